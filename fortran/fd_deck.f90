@@ -1,0 +1,684 @@
+!> The deck reader: one namelist deck is one run. Groups &model, &springs, &damping and
+!> &excitation are required; &friction, &integration and &output are optional. Every value
+!> is validated after reading; messages name the file, the group, the variable and the
+!> value. docs/namelist.md documents every variable.
+module fd_deck
+   use, intrinsic :: ieee_arithmetic, only: ieee_is_finite
+   use fd_kinds, only: dp
+   use fd_error, only: error_type, fatal_error, fmt_int, fmt_real
+   use fd_textio, only: lower
+   use fd_namelist, only: deck_text, group_text, load_deck, find_group, group_item, &
+                          group_read_error, check_groups
+   use fd_model, only: model_type, integration_type, device_type, damping_none, &
+                       damping_stiffness, damping_rayleigh, law_velocity, law_hysteretic
+   use fd_excitation, only: excitation_type, excitation_none, excitation_harmonic, excitation_record
+   use fd_record, only: read_record
+   use fd_output, only: output_type
+   implicit none
+   private
+
+   public :: run_config, read_deck, max_dof, max_springs, max_devices
+
+   integer, parameter :: max_dof = 10000      !! capacity of the DOF arrays of a deck
+   integer, parameter :: max_springs = 40000  !! capacity of the spring arrays
+   integer, parameter :: max_devices = 10000  !! capacity of the device arrays
+   real(dp), parameter :: unset = -huge(1.0_dp)
+   integer, parameter :: unset_int = -huge(1)
+   integer, parameter :: name_len = 32
+
+   !> Everything one deck defines.
+   type :: run_config
+      character(len=:), allocatable :: deck_path  !! the deck read
+      type(model_type) :: model                   !! structure and devices
+      type(excitation_type) :: exc                !! table motion
+      type(integration_type) :: opts              !! integration settings
+      type(output_type) :: out                    !! output settings
+   end type run_config
+
+contains
+
+   !> Read and validate a deck.
+   subroutine read_deck(path, cfg, error)
+      character(len=*), intent(in) :: path                !! deck file
+      type(run_config), intent(out) :: cfg                !! what it defines
+      type(error_type), allocatable, intent(out) :: error !! first problem found
+      type(deck_text) :: deck
+
+      cfg%deck_path = path
+      call load_deck(path, deck, error)
+      if (allocated(error)) return
+      call check_groups(deck, [character(len=12) :: 'model', 'springs', 'damping', 'friction', &
+                               'excitation', 'integration', 'output'], error)
+      if (allocated(error)) return
+      call read_model_group(deck, cfg, error)
+      if (allocated(error)) return
+      call read_springs_group(deck, cfg, error)
+      if (allocated(error)) return
+      call read_damping_group(deck, cfg, error)
+      if (allocated(error)) return
+      call read_friction_group(deck, cfg, error)
+      if (allocated(error)) return
+      call read_excitation_group(deck, cfg, error)
+      if (allocated(error)) return
+      call read_integration_group(deck, cfg, error)
+      if (allocated(error)) return
+      call read_output_group(deck, cfg, error)
+   end subroutine read_deck
+
+   ! ---------------------------------------------------------------- &model
+   subroutine read_model_group(deck, cfg, error)
+      type(deck_text), intent(in) :: deck
+      type(run_config), intent(inout) :: cfg
+      type(error_type), allocatable, intent(out) :: error
+      integer :: n_dof
+      real(dp), allocatable :: mass(:), u0(:), v0(:)
+      namelist /model/ n_dof, mass, u0, v0
+      type(group_text) :: grp
+      character(len=512) :: msg, msg0
+      character(len=:), allocatable :: rec
+      integer :: ios, i, n
+      logical :: found
+
+      n_dof = unset_int
+      allocate (mass(max_dof), u0(max_dof), v0(max_dof))
+      mass = unset; u0 = unset; v0 = unset
+      call find_group(deck, 'model', grp, found, error)
+      if (allocated(error)) return
+      if (.not. found) then
+         call missing_group(deck, 'model', error); return
+      end if
+      msg0 = ''
+      read (grp%lines, nml=model, iostat=ios, iomsg=msg0)
+      if (ios /= 0) then
+         do i = 1, size(grp%items)
+            rec = group_item(grp, i); msg = ''
+            read (rec, nml=model, iostat=ios, iomsg=msg)
+            if (ios /= 0) exit
+         end do
+         if (ios == 0) msg = msg0
+         call group_read_error(deck, grp, i, msg, error); return
+      end if
+      call need_int(deck, 'model', 'n_dof', n_dof, 1, max_dof, error)
+      if (allocated(error)) return
+      n = n_dof
+      call need_reals(deck, 'model', 'mass', mass, n, 'kg', error, positive=.true.)
+      if (allocated(error)) return
+      call optional_reals(deck, 'model', 'u0', u0, n, 0.0_dp, 'm', error)
+      if (allocated(error)) return
+      call optional_reals(deck, 'model', 'v0', v0, n, 0.0_dp, 'm/s', error)
+      if (allocated(error)) return
+      cfg%model%n_dof = n
+      cfg%model%mass = mass(1:n)
+      cfg%model%u0 = u0(1:n)
+      cfg%model%v0 = v0(1:n)
+   end subroutine read_model_group
+
+   ! ---------------------------------------------------------------- &springs
+   subroutine read_springs_group(deck, cfg, error)
+      type(deck_text), intent(in) :: deck
+      type(run_config), intent(inout) :: cfg
+      type(error_type), allocatable, intent(out) :: error
+      integer :: n_springs
+      integer, allocatable :: node_i(:), node_j(:)
+      real(dp), allocatable :: k(:)
+      namelist /springs/ n_springs, node_i, node_j, k
+      type(group_text) :: grp
+      character(len=512) :: msg, msg0
+      character(len=:), allocatable :: rec
+      integer :: ios, i, n
+      logical :: found
+
+      n_springs = unset_int
+      allocate (node_i(max_springs), node_j(max_springs), k(max_springs))
+      node_i = unset_int; node_j = unset_int; k = unset
+      call find_group(deck, 'springs', grp, found, error)
+      if (allocated(error)) return
+      if (.not. found) then
+         call missing_group(deck, 'springs', error); return
+      end if
+      msg0 = ''
+      read (grp%lines, nml=springs, iostat=ios, iomsg=msg0)
+      if (ios /= 0) then
+         do i = 1, size(grp%items)
+            rec = group_item(grp, i); msg = ''
+            read (rec, nml=springs, iostat=ios, iomsg=msg)
+            if (ios /= 0) exit
+         end do
+         if (ios == 0) msg = msg0
+         call group_read_error(deck, grp, i, msg, error); return
+      end if
+      call need_int(deck, 'springs', 'n_springs', n_springs, 0, max_springs, error)
+      if (allocated(error)) return
+      n = n_springs
+      call node_list(deck, 'springs', 'node_i', node_i, n, 1, cfg%model%n_dof, error)
+      if (allocated(error)) return
+      call node_list(deck, 'springs', 'node_j', node_j, n, 0, cfg%model%n_dof, error)
+      if (allocated(error)) return
+      call need_reals(deck, 'springs', 'k', k, n, 'N/m', error, positive=.true.)
+      if (allocated(error)) return
+      do i = 1, n
+         if (node_i(i) == node_j(i)) then
+            call bad(deck, 'springs', 'node_j('//fmt_int(i)//')', fmt_int(node_j(i)), &
+                     'a spring joins two different nodes (node_i('//fmt_int(i)//') = '// &
+                     fmt_int(node_i(i))//')', error)
+            return
+         end if
+      end do
+      cfg%model%n_springs = n
+      cfg%model%spring_i = node_i(1:n)
+      cfg%model%spring_j = node_j(1:n)
+      cfg%model%spring_k = k(1:n)
+   end subroutine read_springs_group
+
+   ! ---------------------------------------------------------------- &damping
+   subroutine read_damping_group(deck, cfg, error)
+      type(deck_text), intent(in) :: deck
+      type(run_config), intent(inout) :: cfg
+      type(error_type), allocatable, intent(out) :: error
+      character(len=name_len) :: damping_type
+      real(dp) :: xi, period, rayleigh_a0, rayleigh_a1
+      namelist /damping/ damping_type, xi, period, rayleigh_a0, rayleigh_a1
+      type(group_text) :: grp
+      character(len=512) :: msg, msg0
+      character(len=:), allocatable :: rec
+      integer :: ios, i
+      logical :: found
+
+      damping_type = ''
+      xi = 0.0_dp; period = 0.0_dp; rayleigh_a0 = 0.0_dp; rayleigh_a1 = 0.0_dp
+      call find_group(deck, 'damping', grp, found, error)
+      if (allocated(error)) return
+      if (.not. found) then
+         call missing_group(deck, 'damping', error); return
+      end if
+      msg0 = ''
+      read (grp%lines, nml=damping, iostat=ios, iomsg=msg0)
+      if (ios /= 0) then
+         do i = 1, size(grp%items)
+            rec = group_item(grp, i); msg = ''
+            read (rec, nml=damping, iostat=ios, iomsg=msg)
+            if (ios /= 0) exit
+         end do
+         if (ios == 0) msg = msg0
+         call group_read_error(deck, grp, i, msg, error); return
+      end if
+      select case (lower(trim(damping_type)))
+      case ('stiffness')
+         cfg%model%damping = damping_stiffness
+         call check_real(deck, 'damping', 'xi', xi, 0.0_dp, 1.0_dp, '', error, open_hi=.true.)
+         if (allocated(error)) return
+         call check_real(deck, 'damping', 'period', period, 0.0_dp, huge(1.0_dp), 's', error)
+         if (allocated(error)) return
+      case ('rayleigh')
+         cfg%model%damping = damping_rayleigh
+         call check_real(deck, 'damping', 'rayleigh_a0', rayleigh_a0, 0.0_dp, huge(1.0_dp), '1/s', error)
+         if (allocated(error)) return
+         call check_real(deck, 'damping', 'rayleigh_a1', rayleigh_a1, 0.0_dp, huge(1.0_dp), 's', error)
+         if (allocated(error)) return
+      case ('none')
+         cfg%model%damping = damping_none
+      case default
+         call bad(deck, 'damping', 'damping_type', "'"//trim(damping_type)//"'", &
+                  "one of 'stiffness' (C = psi K, the paper), 'rayleigh' (C = a0 M + a1 K), 'none'", error)
+         return
+      end select
+      cfg%model%xi = xi
+      cfg%model%period = period
+      cfg%model%rayleigh_a0 = rayleigh_a0
+      cfg%model%rayleigh_a1 = rayleigh_a1
+   end subroutine read_damping_group
+
+   ! ---------------------------------------------------------------- &friction
+   subroutine read_friction_group(deck, cfg, error)
+      type(deck_text), intent(in) :: deck
+      type(run_config), intent(inout) :: cfg
+      type(error_type), allocatable, intent(out) :: error
+      integer :: n_devices
+      integer, allocatable :: node_i(:), node_j(:)
+      character(len=name_len), allocatable :: law(:)
+      real(dp), allocatable :: p(:), mu(:), eps(:), eps1(:), f(:)
+      namelist /friction/ n_devices, node_i, node_j, law, p, mu, eps, eps1, f
+      type(group_text) :: grp
+      character(len=512) :: msg, msg0
+      character(len=:), allocatable :: rec, idx
+      integer :: ios, i, n
+      logical :: found
+
+      n_devices = 0
+      allocate (node_i(max_devices), node_j(max_devices), law(max_devices), p(max_devices), &
+                mu(max_devices), eps(max_devices), eps1(max_devices), f(max_devices))
+      node_i = unset_int; node_j = unset_int; law = ''
+      p = unset; mu = unset; eps = unset; eps1 = unset; f = unset
+      call find_group(deck, 'friction', grp, found, error)
+      if (allocated(error)) return
+      cfg%model%n_devices = 0
+      allocate (cfg%model%dev(0))
+      if (.not. found) return
+      msg0 = ''
+      read (grp%lines, nml=friction, iostat=ios, iomsg=msg0)
+      if (ios /= 0) then
+         do i = 1, size(grp%items)
+            rec = group_item(grp, i); msg = ''
+            read (rec, nml=friction, iostat=ios, iomsg=msg)
+            if (ios /= 0) exit
+         end do
+         if (ios == 0) msg = msg0
+         call group_read_error(deck, grp, i, msg, error); return
+      end if
+      call need_int(deck, 'friction', 'n_devices', n_devices, 0, max_devices, error)
+      if (allocated(error)) return
+      n = n_devices
+      call node_list(deck, 'friction', 'node_i', node_i, n, 1, cfg%model%n_dof, error)
+      if (allocated(error)) return
+      call node_list(deck, 'friction', 'node_j', node_j, n, 0, cfg%model%n_dof, error)
+      if (allocated(error)) return
+      call need_reals(deck, 'friction', 'p', p, n, 'N', error, positive=.false.)
+      if (allocated(error)) return
+      call need_reals(deck, 'friction', 'mu', mu, n, '', error, positive=.false.)
+      if (allocated(error)) return
+      call optional_reals(deck, 'friction', 'eps', eps, n, 1.0e-3_dp, 'm/s', error, positive=.true.)
+      if (allocated(error)) return
+      call optional_reals(deck, 'friction', 'eps1', eps1, n, 1.0e-3_dp, 'm/s', error, positive=.true.)
+      if (allocated(error)) return
+      call optional_reals(deck, 'friction', 'f', f, n, 1.0e-5_dp, 'm', error, positive=.true.)
+      if (allocated(error)) return
+      if (any(law(n + 1:) /= '')) then
+         call bad(deck, 'friction', 'law', 'with '//fmt_int(findloc(law /= '', .true., 1, back=.true.)) &
+                  //' values', 'at most n_devices = '//fmt_int(n)//' values', error)
+         return
+      end if
+      deallocate (cfg%model%dev)
+      allocate (cfg%model%dev(n))
+      do i = 1, n
+         idx = '('//fmt_int(i)//')'
+         if (node_i(i) == node_j(i)) then
+            call bad(deck, 'friction', 'node_j'//idx, fmt_int(node_j(i)), 'a device joins two different '// &
+                     'nodes (node_i'//idx//' = '//fmt_int(node_i(i))//')', error)
+            return
+         end if
+         select case (lower(trim(law(i))))
+         case ('velocity')
+            cfg%model%dev(i)%law = law_velocity
+         case ('hysteretic')
+            cfg%model%dev(i)%law = law_hysteretic
+         case ('')
+            call bad(deck, 'friction', 'law'//idx, '(not given)', &
+                     "one of 'velocity', 'hysteretic'", error)
+            return
+         case default
+            call bad(deck, 'friction', 'law'//idx, "'"//trim(law(i))//"'", &
+                     "one of 'velocity', 'hysteretic'", error)
+            return
+         end select
+         cfg%model%dev(i) = device_type(node_i=node_i(i), node_j=node_j(i), law=cfg%model%dev(i)%law, &
+                                        p=p(i), mu=mu(i), eps=eps(i), eps1=eps1(i), f=f(i))
+      end do
+      cfg%model%n_devices = n
+   end subroutine read_friction_group
+
+   ! ---------------------------------------------------------------- &excitation
+   subroutine read_excitation_group(deck, cfg, error)
+      type(deck_text), intent(in) :: deck
+      type(run_config), intent(inout) :: cfg
+      type(error_type), allocatable, intent(out) :: error
+      character(len=name_len) :: excitation_type, record_kind
+      character(len=1024) :: record_file
+      real(dp) :: amplitude, frequency, duration, dt_record, record_scale
+      integer :: ramp_cycles
+      namelist /excitation/ excitation_type, amplitude, frequency, ramp_cycles, duration, dt_record, &
+         record_file, record_kind, record_scale
+      type(group_text) :: grp
+      character(len=512) :: msg, msg0
+      character(len=:), allocatable :: rec, path
+      integer :: ios, i
+      logical :: found
+
+      excitation_type = ''; record_kind = 'acceleration'; record_file = ''
+      amplitude = unset; frequency = unset; duration = unset; dt_record = unset; record_scale = 1.0_dp
+      ramp_cycles = 0
+      call find_group(deck, 'excitation', grp, found, error)
+      if (allocated(error)) return
+      if (.not. found) then
+         call missing_group(deck, 'excitation', error); return
+      end if
+      msg0 = ''
+      read (grp%lines, nml=excitation, iostat=ios, iomsg=msg0)
+      if (ios /= 0) then
+         do i = 1, size(grp%items)
+            rec = group_item(grp, i); msg = ''
+            read (rec, nml=excitation, iostat=ios, iomsg=msg)
+            if (ios /= 0) exit
+         end do
+         if (ios == 0) msg = msg0
+         call group_read_error(deck, grp, i, msg, error); return
+      end if
+      call need_real(deck, 'excitation', 'dt_record', dt_record, 's', error)
+      if (allocated(error)) return
+      cfg%exc%dt_record = dt_record
+      select case (lower(trim(excitation_type)))
+      case ('harmonic')
+         cfg%exc%kind = excitation_harmonic
+         call need_real(deck, 'excitation', 'amplitude', amplitude, 'm', error, positive=.false.)
+         if (allocated(error)) return
+         call need_real(deck, 'excitation', 'frequency', frequency, 'Hz', error)
+         if (allocated(error)) return
+         if (ramp_cycles < 0) then
+            call bad(deck, 'excitation', 'ramp_cycles', fmt_int(ramp_cycles), '>= 0', error); return
+         end if
+         call need_real(deck, 'excitation', 'duration', duration, 's', error)
+         if (allocated(error)) return
+         cfg%exc%amplitude = amplitude
+         cfg%exc%frequency = frequency
+         cfg%exc%ramp_cycles = ramp_cycles
+      case ('record')
+         cfg%exc%kind = excitation_record
+         if (len_trim(record_file) == 0) then
+            call bad(deck, 'excitation', 'record_file', "''", 'the path of the record file', error); return
+         end if
+         if (.not. ieee_is_finite(record_scale) .or. record_scale == 0.0_dp) then
+            call bad(deck, 'excitation', 'record_scale', fmt_real(record_scale), 'finite and non-zero', error)
+            return
+         end if
+         if (lower(trim(record_kind)) /= 'acceleration' .and. lower(trim(record_kind)) /= 'displacement') then
+            call bad(deck, 'excitation', 'record_kind', "'"//trim(record_kind)//"'", &
+                     "'acceleration' (m/s2 after record_scale) or 'displacement' (m)", error)
+            return
+         end if
+         path = relative_to(deck%path, trim(record_file))
+         call read_record(path, lower(trim(record_kind)) == 'displacement', record_scale, dt_record, &
+                          cfg%exc%acc, error)
+         if (allocated(error)) then
+            error%message = deck%path//", group &excitation, record_file = '"//trim(record_file)//"': "// &
+                            error%message
+            return
+         end if
+         if (duration == unset) duration = (size(cfg%exc%acc) - 1)*dt_record
+         call need_real(deck, 'excitation', 'duration', duration, 's', error)
+         if (allocated(error)) return
+      case ('none')
+         cfg%exc%kind = excitation_none
+         call need_real(deck, 'excitation', 'duration', duration, 's', error)
+         if (allocated(error)) return
+      case default
+         call bad(deck, 'excitation', 'excitation_type', "'"//trim(excitation_type)//"'", &
+                  "one of 'harmonic', 'record', 'none'", error)
+         return
+      end select
+      cfg%exc%duration = duration
+   end subroutine read_excitation_group
+
+   ! ---------------------------------------------------------------- &integration
+   subroutine read_integration_group(deck, cfg, error)
+      type(deck_text), intent(in) :: deck
+      type(run_config), intent(inout) :: cfg
+      type(error_type), allocatable, intent(out) :: error
+      real(dp) :: beta, gamma, n, dt_min
+      integer :: n1, n2
+      logical :: check_correctness
+      namelist /integration/ beta, gamma, n1, n2, n, check_correctness, dt_min
+      type(group_text) :: grp
+      character(len=512) :: msg, msg0
+      character(len=:), allocatable :: rec
+      integer :: ios, i
+      logical :: found
+
+      beta = 0.25_dp; gamma = 0.5_dp; n1 = 20; n2 = 50; n = 10.0_dp
+      check_correctness = .true.; dt_min = 0.0_dp
+      call find_group(deck, 'integration', grp, found, error)
+      if (allocated(error)) return
+      if (found) then
+         msg0 = ''
+         read (grp%lines, nml=integration, iostat=ios, iomsg=msg0)
+         if (ios /= 0) then
+            do i = 1, size(grp%items)
+               rec = group_item(grp, i); msg = ''
+               read (rec, nml=integration, iostat=ios, iomsg=msg)
+               if (ios /= 0) exit
+            end do
+            if (ios == 0) msg = msg0
+            call group_read_error(deck, grp, i, msg, error); return
+         end if
+      end if
+      call check_real(deck, 'integration', 'beta', beta, 0.0_dp, 0.5_dp, '', error, open_lo=.true.)
+      if (allocated(error)) return
+      call check_real(deck, 'integration', 'gamma', gamma, 0.5_dp, 1.0_dp, '', error)
+      if (allocated(error)) return
+      if (n1 < 1) then
+         call bad(deck, 'integration', 'n1', fmt_int(n1), '>= 1 (dt1 = dt_record / n1)', error); return
+      end if
+      if (n2 < 1) then
+         call bad(deck, 'integration', 'n2', fmt_int(n2), '>= 1 (dt2 = dt1 / n2)', error); return
+      end if
+      if (.not. ieee_is_finite(n) .or. n <= 1.0_dp) then
+         call bad(deck, 'integration', 'n', fmt_real(n), '> 1 (correctness condition, eqs. 9 and 12)', error)
+         return
+      end if
+      call check_real(deck, 'integration', 'dt_min', dt_min, 0.0_dp, cfg%exc%dt_record/n1/n2, 's', error)
+      if (allocated(error)) return
+      cfg%opts%beta = beta
+      cfg%opts%gamma = gamma
+      cfg%opts%n1 = n1
+      cfg%opts%n2 = n2
+      cfg%opts%n_corr = n
+      cfg%opts%check = check_correctness
+      cfg%opts%dt_min = dt_min
+   end subroutine read_integration_group
+
+   ! ---------------------------------------------------------------- &output
+   subroutine read_output_group(deck, cfg, error)
+      type(deck_text), intent(in) :: deck
+      type(run_config), intent(inout) :: cfg
+      type(error_type), allocatable, intent(out) :: error
+      character(len=1024) :: dir, name
+      integer :: output_every
+      logical :: write_history
+      namelist /output/ dir, name, output_every, write_history
+      type(group_text) :: grp
+      character(len=512) :: msg, msg0
+      character(len=:), allocatable :: rec
+      integer :: ios, i
+      logical :: found
+
+      dir = 'out'; name = stem(deck%path); output_every = 0; write_history = .true.
+      call find_group(deck, 'output', grp, found, error)
+      if (allocated(error)) return
+      if (found) then
+         msg0 = ''
+         read (grp%lines, nml=output, iostat=ios, iomsg=msg0)
+         if (ios /= 0) then
+            do i = 1, size(grp%items)
+               rec = group_item(grp, i); msg = ''
+               read (rec, nml=output, iostat=ios, iomsg=msg)
+               if (ios /= 0) exit
+            end do
+            if (ios == 0) msg = msg0
+            call group_read_error(deck, grp, i, msg, error); return
+         end if
+      end if
+      if (len_trim(dir) == 0) then
+         call bad(deck, 'output', 'dir', "''", 'a directory path', error); return
+      end if
+      if (len_trim(name) == 0 .or. index(trim(name), '/') > 0) then
+         call bad(deck, 'output', 'name', "'"//trim(name)//"'", 'a file name without directory', error); return
+      end if
+      if (output_every < 0) then
+         call bad(deck, 'output', 'output_every', fmt_int(output_every), '>= 0 (0 = at the record step)', error)
+         return
+      end if
+      cfg%out%dir = trim(dir)
+      cfg%out%name = trim(name)
+      cfg%out%history = write_history
+      cfg%opts%output_every = output_every
+   end subroutine read_output_group
+
+   ! ---------------------------------------------------------------- helpers
+   subroutine missing_group(deck, group, error)
+      type(deck_text), intent(in) :: deck
+      character(len=*), intent(in) :: group
+      type(error_type), allocatable, intent(out) :: error
+      call fatal_error(error, deck%path//": required group &"//group//" is missing")
+   end subroutine missing_group
+
+   subroutine bad(deck, group, var, val, must, error)
+      type(deck_text), intent(in) :: deck
+      character(len=*), intent(in) :: group, var, val, must
+      type(error_type), allocatable, intent(out) :: error
+      call fatal_error(error, deck%path//", group &"//group//": "//var//" = "//val//" is invalid: must be "//must)
+   end subroutine bad
+
+   subroutine need_int(deck, group, var, x, lo, hi, error)
+      type(deck_text), intent(in) :: deck
+      character(len=*), intent(in) :: group, var
+      integer, intent(in) :: x, lo, hi
+      type(error_type), allocatable, intent(out) :: error
+      if (x == unset_int) then
+         call fatal_error(error, deck%path//", group &"//group//": "//var//" is not given"); return
+      end if
+      if (x < lo .or. x > hi) call bad(deck, group, var, fmt_int(x), 'in '//fmt_int(lo)//'..'//fmt_int(hi), error)
+   end subroutine need_int
+
+   subroutine need_real(deck, group, var, x, unit, error, positive)
+      type(deck_text), intent(in) :: deck
+      character(len=*), intent(in) :: group, var, unit
+      real(dp), intent(in) :: x
+      type(error_type), allocatable, intent(out) :: error
+      logical, intent(in), optional :: positive
+      logical :: pos
+      pos = .true.
+      if (present(positive)) pos = positive
+      if (x == unset) then
+         call fatal_error(error, deck%path//", group &"//group//": "//var//" is not given"); return
+      end if
+      if (.not. ieee_is_finite(x)) then
+         call bad(deck, group, var, fmt_real(x), 'a finite number', error); return
+      end if
+      if (pos .and. x <= 0.0_dp) then
+         call bad(deck, group, var, fmt_real(x), '> 0 '//unit, error)
+      else if (.not. pos .and. x < 0.0_dp) then
+         call bad(deck, group, var, fmt_real(x), '>= 0 '//unit, error)
+      end if
+   end subroutine need_real
+
+   subroutine check_real(deck, group, var, x, lo, hi, unit, error, open_lo, open_hi)
+      type(deck_text), intent(in) :: deck
+      character(len=*), intent(in) :: group, var, unit
+      real(dp), intent(in) :: x, lo, hi
+      type(error_type), allocatable, intent(out) :: error
+      logical, intent(in), optional :: open_lo, open_hi
+      logical :: olo, ohi, ok
+      character(len=:), allocatable :: range
+      olo = .false.; ohi = .false.
+      if (present(open_lo)) olo = open_lo
+      if (present(open_hi)) ohi = open_hi
+      ok = ieee_is_finite(x)
+      if (ok) ok = merge(x > lo, x >= lo, olo) .and. merge(x < hi, x <= hi, ohi)
+      if (ok) return
+      range = merge('(', '[', olo)//fmt_real(lo)//', '
+      if (hi >= huge(1.0_dp)) then
+         range = range//'inf)'
+      else
+         range = range//fmt_real(hi)//merge(')', ']', ohi)
+      end if
+      call bad(deck, group, var, fmt_real(x), 'in '//range//' '//unit, error)
+   end subroutine check_real
+
+   !> n values must be given, finite and > 0 (or >= 0); no more than n.
+   subroutine need_reals(deck, group, var, x, n, unit, error, positive)
+      type(deck_text), intent(in) :: deck
+      character(len=*), intent(in) :: group, var, unit
+      real(dp), intent(in) :: x(:)
+      integer, intent(in) :: n
+      type(error_type), allocatable, intent(out) :: error
+      logical, intent(in) :: positive
+      integer :: i
+      do i = 1, n
+         call need_real(deck, group, var//'('//fmt_int(i)//')', x(i), unit, error, positive)
+         if (allocated(error)) return
+      end do
+      call no_extra(deck, group, var, x, n, error)
+   end subroutine need_reals
+
+   !> Values not given take a default; given ones must be finite (and > 0 if positive).
+   subroutine optional_reals(deck, group, var, x, n, default, unit, error, positive)
+      type(deck_text), intent(in) :: deck
+      character(len=*), intent(in) :: group, var, unit
+      real(dp), intent(inout) :: x(:)
+      integer, intent(in) :: n
+      real(dp), intent(in) :: default
+      type(error_type), allocatable, intent(out) :: error
+      logical, intent(in), optional :: positive
+      integer :: i
+      logical :: pos
+      pos = .false.
+      if (present(positive)) pos = positive
+      do i = 1, n
+         if (x(i) == unset) x(i) = default
+         if (.not. ieee_is_finite(x(i))) then
+            call bad(deck, group, var//'('//fmt_int(i)//')', fmt_real(x(i)), 'a finite number', error); return
+         end if
+         if (pos .and. x(i) <= 0.0_dp) then
+            call bad(deck, group, var//'('//fmt_int(i)//')', fmt_real(x(i)), '> 0 '//unit, error); return
+         end if
+      end do
+      call no_extra(deck, group, var, x, n, error)
+   end subroutine optional_reals
+
+   subroutine no_extra(deck, group, var, x, n, error)
+      type(deck_text), intent(in) :: deck
+      character(len=*), intent(in) :: group, var
+      real(dp), intent(in) :: x(:)
+      integer, intent(in) :: n
+      type(error_type), allocatable, intent(out) :: error
+      integer :: last
+      last = findloc(x /= unset, .true., 1, back=.true.)
+      if (last > n) call bad(deck, group, var//'('//fmt_int(last)//')', fmt_real(x(last)), &
+                             'absent: only '//fmt_int(n)//' value(s) are expected', error)
+   end subroutine no_extra
+
+   subroutine node_list(deck, group, var, x, n, lo, hi, error)
+      type(deck_text), intent(in) :: deck
+      character(len=*), intent(in) :: group, var
+      integer, intent(in) :: x(:), n, lo, hi
+      type(error_type), allocatable, intent(out) :: error
+      integer :: i, last
+      do i = 1, n
+         if (x(i) == unset_int) then
+            call fatal_error(error, deck%path//", group &"//group//": "//var//'('//fmt_int(i)//") is not given")
+            return
+         end if
+         if (x(i) < lo .or. x(i) > hi) then
+            call bad(deck, group, var//'('//fmt_int(i)//')', fmt_int(x(i)), 'a node in '//fmt_int(lo)//'..'// &
+                     fmt_int(hi)//merge(' (0 = table)', '            ', lo == 0), error)
+            return
+         end if
+      end do
+      last = findloc(x /= unset_int, .true., 1, back=.true.)
+      if (last > n) call bad(deck, group, var//'('//fmt_int(last)//')', fmt_int(x(last)), &
+                             'absent: only '//fmt_int(n)//' value(s) are expected', error)
+   end subroutine node_list
+
+   !> A path relative to the directory of the deck (absolute paths are kept).
+   pure function relative_to(deck_path, path) result(full)
+      character(len=*), intent(in) :: deck_path, path
+      character(len=:), allocatable :: full
+      integer :: slash
+      if (path(1:1) == '/') then
+         full = path
+         return
+      end if
+      slash = index(deck_path, '/', back=.true.)
+      full = deck_path(1:slash)//path
+   end function relative_to
+
+   !> File name of the deck without its directory and extension.
+   pure function stem(path) result(name)
+      character(len=*), intent(in) :: path
+      character(len=:), allocatable :: name
+      integer :: slash, dot
+      slash = index(path, '/', back=.true.)
+      name = path(slash + 1:)
+      dot = index(name, '.', back=.true.)
+      if (dot > 1) name = name(1:dot - 1)
+   end function stem
+
+end module fd_deck

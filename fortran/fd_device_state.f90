@@ -1,0 +1,38 @@
+!> State of one friction device during a run. Every friction law writes its force in the
+!> current phase as F = ks*s + cs*sdot + f0 (s, sdot: relative displacement and velocity),
+!> so that the time-step loop sees a device as a stiffness ks and a damping cs (both
+!> entering the effective stiffness along the device's direction) and a load f0.
+module fd_device_state
+   use fd_kinds, only: dp
+   implicit none
+   private
+
+   public :: device_state, phase_stick, phase_slip_pos, phase_slip_neg, device_force
+
+   integer, parameter :: phase_stick = 0     !! sticking (adherence)
+   integer, parameter :: phase_slip_pos = 1  !! sliding with positive relative velocity
+   integer, parameter :: phase_slip_neg = -1 !! sliding with negative relative velocity
+
+   !> Phase and force coefficients of one device.
+   type :: device_state
+      integer :: phase = phase_stick   !! stick, slip + or slip -
+      real(dp) :: centre = 0.0_dp      !! hysteretic law: s at which the elastic force is zero [m]
+      logical :: armed = .false.       !! hysteretic law: |sdot| has reached eps1 in this slip
+      real(dp) :: ks = 0.0_dp          !! stiffness in this phase [N/m]
+      real(dp) :: cs = 0.0_dp          !! damping in this phase [N s/m]
+      real(dp) :: f0 = 0.0_dp          !! constant force in this phase [N]
+   end type device_state
+
+contains
+
+   !> Friction force of a device in its current phase [N].
+   elemental function device_force(st, s, sdot) result(force)
+      type(device_state), intent(in) :: st !! device state
+      real(dp), intent(in) :: s            !! relative displacement [m]
+      real(dp), intent(in) :: sdot         !! relative velocity [m/s]
+      real(dp) :: force                    !! F = ks s + cs sdot + f0
+
+      force = st%ks*s + st%cs*sdot + st%f0
+   end function device_force
+
+end module fd_device_state

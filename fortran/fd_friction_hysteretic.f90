@@ -1,0 +1,109 @@
+!> The hysteretic model of friction (Dimova, eqs. 2-5, Fig. 2): elastic-perfectly-plastic
+!> force against relative displacement with stiffness k = P mu / f while sticking, the
+!> constant force P mu sgn(sdot) while sliding. Correctness condition: eq. 12.
+!>
+!> Sliding starts when |F| reaches P mu (eqs. 3-4); the centre of the elastic range moves
+!> with the plastic slip so that F stays continuous. Sliding ends by eq. 2, |sdot| < eps1,
+!> but only once |sdot| has reached eps1 in this sliding phase ("armed"): at the onset of
+!> sliding |sdot| is far below eps1, and eq. 2 read literally would end every sliding phase
+!> at once. Before that, sliding ends when sdot turns against the sliding direction.
+!> An armed slide whose velocity has crossed to the other side of the band reverses.
+module fd_friction_hysteretic
+   use fd_kinds, only: dp
+   use fd_model, only: device_type
+   use fd_device_state, only: device_state, phase_stick, phase_slip_pos, phase_slip_neg
+   implicit none
+   private
+
+   public :: hysteretic_init, hysteretic_update, hysteretic_correct
+
+contains
+
+   !> A run starts sticking with no force.
+   pure subroutine hysteretic_init(dev, s, sdot, st)
+      type(device_type), intent(in) :: dev   !! device parameters
+      real(dp), intent(in) :: s              !! relative displacement [m]
+      real(dp), intent(in) :: sdot           !! relative velocity [m/s]
+      type(device_state), intent(out) :: st  !! initial state
+
+      st%phase = phase_stick
+      st%centre = s
+      st%armed = .false.
+      call set_coefficients(dev, st)
+   end subroutine hysteretic_init
+
+   !> Phase for the next step from the state at the end of this one (eqs. 2-4).
+   pure subroutine hysteretic_update(dev, s, sdot, st, changed)
+      type(device_type), intent(in) :: dev      !! device parameters
+      real(dp), intent(in) :: s                 !! relative displacement [m]
+      real(dp), intent(in) :: sdot              !! relative velocity [m/s]
+      type(device_state), intent(inout) :: st   !! state, updated
+      logical, intent(out) :: changed           !! the phase changed
+      real(dp) :: k, force, slip
+      integer :: old
+
+      old = st%phase
+      k = dev%p*dev%mu/dev%f
+      slip = dev%p*dev%mu
+      if (st%phase == phase_stick) then
+         force = k*(s - st%centre)
+         if (abs(force) >= slip) then
+            st%phase = merge(phase_slip_pos, phase_slip_neg, force > 0.0_dp)
+            st%armed = abs(sdot) >= dev%eps1
+         end if
+      else if (st%armed) then
+         if (abs(sdot) < dev%eps1) then
+            st%phase = phase_stick                                ! eq. 2
+         else if (sdot*st%phase < 0.0_dp) then
+            st%phase = -st%phase                                  ! crossed the band: reverse
+         end if
+      else
+         if (sdot*st%phase <= 0.0_dp) then
+            st%phase = phase_stick                                ! turned before reaching eps1
+         else if (abs(sdot) >= dev%eps1) then
+            st%armed = .true.
+         end if
+      end if
+      changed = st%phase /= old
+      if (st%phase /= phase_stick) then
+         ! plastic slip: the elastic range follows so that |F| = P mu
+         st%centre = s - st%phase*dev%f
+      else if (changed) then
+         ! end of sliding: F stays continuous at P mu sgn
+         st%centre = s - old*dev%f
+         st%armed = .false.
+      end if
+      call set_coefficients(dev, st)
+   end subroutine hysteretic_update
+
+   !> Correctness condition, eq. 12, for a step taken in the phase st: checked in an armed
+   !> slide (the unarmed start of a slide ends by the sign rule instead).
+   pure logical function hysteretic_correct(dev, n, st, sdot_old, sdot_new) result(ok)
+      type(device_type), intent(in) :: dev   !! device parameters
+      real(dp), intent(in) :: n              !! n > 1 of eq. 12
+      type(device_state), intent(in) :: st   !! phase during the step
+      real(dp), intent(in) :: sdot_old       !! relative velocity at t - dt [m/s]
+      real(dp), intent(in) :: sdot_new       !! relative velocity at t [m/s]
+
+      ok = .true.
+      if (st%phase /= phase_stick .and. st%armed) &
+         ok = sdot_new*sdot_old > dev%eps1**2*(1.0_dp - 1.0_dp/n)
+   end function hysteretic_correct
+
+   pure subroutine set_coefficients(dev, st)
+      type(device_type), intent(in) :: dev
+      type(device_state), intent(inout) :: st
+      real(dp) :: k
+
+      st%cs = 0.0_dp
+      if (st%phase == phase_stick) then
+         k = dev%p*dev%mu/dev%f
+         st%ks = k
+         st%f0 = -k*st%centre
+      else
+         st%ks = 0.0_dp
+         st%f0 = st%phase*dev%p*dev%mu
+      end if
+   end subroutine set_coefficients
+
+end module fd_friction_hysteretic

@@ -1,0 +1,126 @@
+!> System matrices: the springs' stiffness K, the viscous damping C (the paper's C = psi K
+!> with psi = T xi / pi, or Rayleigh C = a0 M + a1 K), and the first mode of the stuck
+!> system, in which every friction device is a rigid link.
+module fd_matrices
+   use fd_kinds, only: dp
+   use fd_error, only: error_type, fatal_error, fmt_real
+   use fd_model, only: model_type, damping_none, damping_stiffness, damping_rayleigh
+   use fd_linalg, only: generalized_eigen
+   implicit none
+   private
+
+   public :: stiffness_matrix, damping_matrix, stuck_first_mode
+
+   real(dp), parameter :: pi = acos(-1.0_dp)
+
+contains
+
+   !> Stiffness matrix of the springs (relative coordinates; node 0 is the table).
+   pure subroutine stiffness_matrix(model, k)
+      type(model_type), intent(in) :: model !! the model
+      real(dp), intent(out) :: k(:, :)      !! K [N/m], n_dof x n_dof
+      integer :: s, i, j
+      real(dp) :: ks
+
+      k = 0.0_dp
+      do s = 1, model%n_springs
+         i = model%spring_i(s); j = model%spring_j(s); ks = model%spring_k(s)
+         if (i > 0) k(i, i) = k(i, i) + ks
+         if (j > 0) k(j, j) = k(j, j) + ks
+         if (i > 0 .and. j > 0) then
+            k(i, j) = k(i, j) - ks
+            k(j, i) = k(j, i) - ks
+         end if
+      end do
+   end subroutine stiffness_matrix
+
+   !> First natural period of the stuck system (every device a rigid link between its
+   !> nodes) and its mode shape, from the generalized symmetric eigenproblem.
+   subroutine stuck_first_mode(model, k, period, phi, error)
+      type(model_type), intent(in) :: model          !! the model
+      real(dp), intent(in) :: k(:, :)                !! springs' stiffness
+      real(dp), intent(out) :: period                !! first period T [s]
+      real(dp), intent(out) :: phi(:)                !! first mode, all DOFs
+      type(error_type), allocatable, intent(out) :: error !! no free DOF, or no stiffness
+      integer, allocatable :: root(:), col(:)
+      real(dp), allocatable :: t(:, :), kq(:, :), mq(:, :), lam(:), z(:, :)
+      integer :: n, nq, d, i, a, b
+
+      n = model%n_dof
+      ! union-find over nodes 0..n: each device ties its two nodes together
+      allocate (root(0:n))
+      root = [(i, i=0, n)]
+      do d = 1, model%n_devices
+         a = find(model%dev(d)%node_i); b = find(model%dev(d)%node_j)
+         if (a /= b) root(max(a, b)) = min(a, b)
+      end do
+      allocate (col(0:n))
+      col = 0
+      nq = 0
+      do i = 1, n
+         a = find(i)
+         if (a == 0) cycle
+         if (col(a) == 0) then
+            nq = nq + 1
+            col(a) = nq
+         end if
+      end do
+      if (nq == 0) then
+         call fatal_error(error, "the stuck system has no free DOF: every mass is locked to the table &
+                          &by friction devices, so its first period is undefined (give period in &damping)")
+         return
+      end if
+      allocate (t(n, nq))
+      t = 0.0_dp
+      do i = 1, n
+         a = find(i)
+         if (a /= 0) t(i, col(a)) = 1.0_dp
+      end do
+      kq = matmul(transpose(t), matmul(k, t))
+      allocate (mq(nq, nq))
+      mq = 0.0_dp
+      do i = 1, n
+         if (find(i) /= 0) mq(col(find(i)), col(find(i))) = mq(col(find(i)), col(find(i))) + model%mass(i)
+      end do
+      allocate (lam(nq), z(nq, nq))
+      call generalized_eigen(kq, mq, lam, z, error)
+      if (allocated(error)) return
+      if (lam(1) <= 1.0e-12_dp*maxval(abs(lam))) then
+         call fatal_error(error, "the stuck system has a rigid-body mode (first eigenvalue "// &
+                          fmt_real(lam(1))//"): add springs to the table or give period in &damping")
+         return
+      end if
+      period = 2.0_dp*pi/sqrt(lam(1))
+      phi = matmul(t, z(:, 1))
+   contains
+      integer function find(x)
+         integer, intent(in) :: x
+         find = x
+         do while (root(find) /= find)
+            find = root(find)
+         end do
+      end function find
+   end subroutine stuck_first_mode
+
+   !> Viscous damping matrix of the model.
+   pure subroutine damping_matrix(model, k, period, c)
+      type(model_type), intent(in) :: model !! the model
+      real(dp), intent(in) :: k(:, :)       !! springs' stiffness
+      real(dp), intent(in) :: period        !! stuck first period T [s] (for damping_stiffness)
+      real(dp), intent(out) :: c(:, :)      !! C [N s/m]
+      integer :: i
+
+      select case (model%damping)
+      case (damping_stiffness)
+         c = (period*model%xi/pi)*k
+      case (damping_rayleigh)
+         c = model%rayleigh_a1*k
+         do i = 1, model%n_dof
+            c(i, i) = c(i, i) + model%rayleigh_a0*model%mass(i)
+         end do
+      case default
+         c = 0.0_dp
+      end select
+   end subroutine damping_matrix
+
+end module fd_matrices

@@ -1,0 +1,41 @@
+!> Public API of the frictiondyn library: read a deck, run it, write its outputs.
+module frictiondyn
+   use fd_kinds, only: dp
+   use fd_error, only: error_type, fatal_error
+   use fd_model, only: model_type, integration_type, device_type
+   use fd_excitation, only: excitation_type
+   use fd_result, only: result_type
+   use fd_deck, only: run_config, read_deck
+   use fd_newmark, only: run_newmark
+   use fd_output, only: output_type, write_outputs, history_path, summary_path
+   implicit none
+   private
+
+   public :: dp, error_type, model_type, integration_type, device_type, excitation_type
+   public :: result_type, run_config, output_type
+   public :: read_deck, run_config_solve, run_deck, history_path, summary_path
+
+contains
+
+   !> Run the analysis a configuration defines (no files written).
+   subroutine run_config_solve(cfg, res, error)
+      type(run_config), intent(in) :: cfg                 !! model, excitation, settings
+      type(result_type), intent(out) :: res               !! histories and summary
+      type(error_type), allocatable, intent(out) :: error !! failure of the solver
+      call run_newmark(cfg%model, cfg%exc, cfg%opts, res, error)
+   end subroutine run_config_solve
+
+   !> Read a deck, run it and write its outputs.
+   subroutine run_deck(path, cfg, res, error)
+      character(len=*), intent(in) :: path                !! deck file
+      type(run_config), intent(out) :: cfg                !! what the deck defines
+      type(result_type), intent(out) :: res               !! histories and summary
+      type(error_type), allocatable, intent(out) :: error !! bad deck, solver or output failure
+      call read_deck(path, cfg, error)
+      if (allocated(error)) return
+      call run_config_solve(cfg, res, error)
+      if (allocated(error)) return
+      call write_outputs(cfg%out, cfg%model, res, path, error)
+   end subroutine run_deck
+
+end module frictiondyn

@@ -1,0 +1,52 @@
+!> frictiondyn DECK.nml: run one namelist deck and write its time history and summary.
+program frictiondyn_main
+   use, intrinsic :: iso_fortran_env, only: error_unit, output_unit
+   use frictiondyn, only: error_type, run_config, result_type, run_deck, history_path, summary_path
+   implicit none
+   type(run_config) :: cfg
+   type(result_type) :: res
+   type(error_type), allocatable :: error
+   character(len=:), allocatable :: path
+   integer :: nargs, length, i
+
+   nargs = command_argument_count()
+   if (nargs /= 1) then
+      write (error_unit, '(a)') 'usage: frictiondyn DECK.nml'
+      write (error_unit, '(a)') '  runs one namelist deck; see docs/namelist.md'
+      error stop 2
+   end if
+   call get_command_argument(1, length=length)
+   allocate (character(len=length) :: path)
+   call get_command_argument(1, path)
+   if (path == '-h' .or. path == '--help') then
+      write (output_unit, '(a)') 'usage: frictiondyn DECK.nml'
+      write (output_unit, '(a)') '  runs one namelist deck; see docs/namelist.md'
+      stop
+   end if
+
+   call run_deck(path, cfg, res, error)
+   if (allocated(error)) then
+      write (error_unit, '(a)') 'frictiondyn: error: '//error%message
+      error stop 1
+   end if
+
+   if (res%violations > 0) then
+      write (error_unit, '(a,i0,a)') 'frictiondyn: warning: ', res%violations, &
+         ' step(s) violate the correctness condition (eqs. 9, 12); first at t [s] ='
+      write (error_unit, '(10(1x,f0.6))') res%violation_time(1:res%n_violation_times)
+   end if
+   write (output_unit, '(a)') 'frictiondyn: '//path
+   write (output_unit, '(a,f0.6,a,i0,a,i0,a,i0,a)') '  stuck period ', res%period_stuck, ' s; steps dt1 ', &
+      res%steps_dt1, ', dt2 ', res%steps_dt2, ', finer ', res%steps_finer, ''
+   do i = 1, res%n_devices
+      write (output_unit, '(a,i0,a,i0,a,i0)') '  device ', i, ': stick->slip ', res%stick_to_slip(i), &
+         ', slip->stick ', res%slip_to_stick(i)
+   end do
+   do i = 1, res%n_dof
+      write (output_unit, '(a,i0,a,es12.5,a,es12.5,a)') '  dof ', i, ': peak |u| ', res%peak_u(i), &
+         ' m, peak |a_abs| ', res%peak_aabs(i), ' m/s2'
+   end do
+   write (output_unit, '(a,i0)') '  correctness violations: ', res%violations
+   if (cfg%out%history) write (output_unit, '(a)') '  history: '//history_path(cfg%out)
+   write (output_unit, '(a)') '  summary: '//summary_path(cfg%out)
+end program frictiondyn_main
