@@ -159,8 +159,8 @@ contains
       do i = 1, n
          if (node_i(i) == node_j(i)) then
             call bad(deck, 'springs', 'node_j('//fmt_int(i)//')', fmt_int(node_j(i)), &
-                     'a spring joins two different nodes (node_i('//fmt_int(i)//') = '// &
-                     fmt_int(node_i(i))//')', error)
+                     'different from node_i('//fmt_int(i)//') = '// &
+                     fmt_int(node_i(i))//': a spring joins two different nodes', error)
             return
          end if
       end do
@@ -292,8 +292,8 @@ contains
       do i = 1, n
          idx = '('//fmt_int(i)//')'
          if (node_i(i) == node_j(i)) then
-            call bad(deck, 'friction', 'node_j'//idx, fmt_int(node_j(i)), 'a device joins two different '// &
-                     'nodes (node_i'//idx//' = '//fmt_int(node_i(i))//')', error)
+            call bad(deck, 'friction', 'node_j'//idx, fmt_int(node_j(i)), 'different from node_i'//idx//' = '// &
+                     fmt_int(node_i(i))//': a device joins two different nodes', error)
             return
          end if
          select case (lower(trim(law(i))))

@@ -25,15 +25,58 @@ contains
       if (present(stat)) error%stat = stat
    end subroutine fatal_error
 
-   !> A real number as short text, for messages.
+   !> A real number as short text, for messages: the fewest significant digits that
+   !> read back to the same value, in fixed notation when that is short.
    pure function fmt_real(x) result(str)
+      use, intrinsic :: ieee_arithmetic, only: ieee_is_finite
       use fd_kinds, only: dp
       real(dp), intent(in) :: x               !! value to format
       character(len=:), allocatable :: str    !! the value as text
-      character(len=32) :: buf
+      character(len=40) :: buf, fmt
+      real(dp) :: y
+      integer :: p, e, d, ios
 
-      write (buf, '(g0)') x
-      str = trim(adjustl(buf))
+      if (.not. ieee_is_finite(x)) then
+         write (buf, '(g0)') x
+         str = trim(adjustl(buf))
+         return
+      end if
+      if (x == 0.0_dp) then
+         str = '0'
+         return
+      end if
+      do p = 1, 17
+         write (fmt, '(a,i0,a)') '(es30.', p - 1, 'e3)'
+         write (buf, fmt) x
+         read (buf, *, iostat=ios) y
+         if (ios == 0 .and. y == x) exit
+      end do
+      p = min(p, 17)
+      e = floor(log10(abs(x)))
+      if (e >= -4 .and. e < 15) then
+         d = max(1, p - 1 - e)
+         write (fmt, '(a,i0,a)') '(f0.', d, ')'
+         write (buf, fmt) x
+         str = trim(adjustl(buf))
+         do while (len(str) > 1 .and. str(len(str):len(str)) == '0')
+            str = str(1:len(str) - 1)
+         end do
+         if (str(len(str):len(str)) == '.') str = str//'0'
+         if (str(1:1) == '.') str = '0'//str
+         if (str(1:2) == '-.') str = '-0'//str(2:)
+      else
+         ! mantissa without trailing zeros, exponent without padding: -1.5E-5
+         str = trim(adjustl(buf))
+         e = index(str, 'E')
+         read (str(e + 1:), *) d
+         str = str(1:e - 1)
+         do while (str(len(str):len(str)) == '0')
+            str = str(1:len(str) - 1)
+         end do
+         if (str(len(str):len(str)) == '.') str = str//'0'
+         write (buf, '(i0)') d
+         str = str//'E'//trim(buf)
+      end if
    end function fmt_real
 
    !> An integer as text, for messages.

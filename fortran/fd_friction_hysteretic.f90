@@ -45,7 +45,9 @@ contains
       old = st%phase
       k = dev%p*dev%mu/dev%f
       slip = dev%p*dev%mu
-      if (st%phase == phase_stick) then
+      if (slip == 0.0_dp) then
+         ! no friction capacity: F = 0 (k = 0), never slips
+      else if (st%phase == phase_stick) then
          force = k*(s - st%centre)
          if (abs(force) >= slip) then
             st%phase = merge(phase_slip_pos, phase_slip_neg, force > 0.0_dp)

@@ -35,7 +35,9 @@ contains
       integer :: old
 
       old = st%phase
-      if (abs(sdot) < dev%eps) then
+      if (dev%p*dev%mu == 0.0_dp) then
+         st%phase = phase_stick                 ! no friction capacity: F = 0, never slips
+      else if (abs(sdot) < dev%eps) then
          st%phase = phase_stick
       else if (sdot > 0.0_dp) then
          st%phase = phase_slip_pos

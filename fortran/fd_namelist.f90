@@ -130,6 +130,7 @@ contains
       closed = .false.
       last = first
       do i = first, size(deck%lines)
+         if (i > first .and. len(group_opened(deck%lines(i)%s)) > 0) exit
          last = i
          call append_line(deck%lines(i)%s, i == first, body, line_of, i, closed)
          if (closed) exit

@@ -13,7 +13,7 @@ program frictiondyn_main
    if (nargs /= 1) then
       write (error_unit, '(a)') 'usage: frictiondyn DECK.nml'
       write (error_unit, '(a)') '  runs one namelist deck; see docs/namelist.md'
-      error stop 2
+      stop 2, quiet=.true.
    end if
    call get_command_argument(1, length=length)
    allocate (character(len=length) :: path)
@@ -27,7 +27,7 @@ program frictiondyn_main
    call run_deck(path, cfg, res, error)
    if (allocated(error)) then
       write (error_unit, '(a)') 'frictiondyn: error: '//error%message
-      error stop 1
+      stop 1, quiet=.true.
    end if
 
    if (res%violations > 0) then

@@ -1,0 +1,124 @@
+"""Shared helpers: write decks, run the installed executable, read what it wrote."""
+
+from __future__ import annotations
+
+import subprocess
+from dataclasses import dataclass
+from pathlib import Path
+
+import numpy as np
+import pytest
+
+import frictiondyn
+
+INPUTS = Path(__file__).resolve().parent.parent / "inputs"
+
+# The paper's two-mass model (Dimova, "Experimental Facility")
+M1, M2 = 6.301, 2.530  # kg
+K1, K2 = 1084.0, 2895.0  # N/m
+MU = 0.22
+P = 61.81  # N, = m1 g (the paper does not give P)
+G = 9.81
+TABLE1 = {  # test: (frequency Hz, amplitude m, dt_r s)
+    1: (2.104, 0.003994, 0.01),
+    2: (2.659, 0.004008, 0.008),
+    3: (3.102, 0.004062, 0.00667),
+    4: (4.104, 0.004052, 0.005),
+    5: (5.123, 0.004112, 0.004),
+}
+
+
+def _value(v) -> str:
+    if isinstance(v, bool):
+        return ".true." if v else ".false."
+    if isinstance(v, str):
+        return "'" + v + "'"
+    if isinstance(v, (list, tuple, np.ndarray)):
+        return ", ".join(_value(x) for x in v)
+    if isinstance(v, float):
+        return repr(v)
+    return str(v)
+
+
+def deck_text(groups: dict[str, dict]) -> str:
+    """A namelist deck from {group: {variable: value}}."""
+    out = []
+    for name, variables in groups.items():
+        out.append(f"&{name}")
+        out.extend(f"  {k} = {_value(v)}" for k, v in variables.items())
+        out.append("/")
+    return "\n".join(out) + "\n"
+
+
+def paper_groups(test: int = 4, law: str = "velocity", **friction) -> dict[str, dict]:
+    """Deck groups of the paper's two-mass experiment for one Table 1 test."""
+    freq, amp, dtr = TABLE1[test]
+    fr = {"n_devices": 1, "node_i": 1, "node_j": 2, "law": law, "p": P, "mu": MU}
+    fr.update(friction)
+    return {
+        "model": {"n_dof": 2, "mass": [M1, M2]},
+        "springs": {"n_springs": 2, "node_i": [1, 2], "node_j": [0, 0], "k": [K1, K2]},
+        "damping": {"damping_type": "stiffness", "xi": 0.015},
+        "friction": fr,
+        "excitation": {"excitation_type": "harmonic", "amplitude": amp, "frequency": freq,
+                       "dt_record": dtr, "duration": 40.0},
+        "integration": {"n1": 20, "n2": 50, "n": 10},
+    }
+
+
+@dataclass
+class Run:
+    returncode: int
+    stdout: str
+    stderr: str
+    workdir: Path
+    name: str
+
+    @property
+    def outdir(self) -> Path:
+        return self.workdir / "out"
+
+    def history(self) -> frictiondyn.History:
+        return frictiondyn.read_history(self.outdir / f"{self.name}.csv")
+
+    def summary(self) -> dict:
+        return frictiondyn.read_summary(self.outdir / f"{self.name}.summary.json")
+
+
+def run_deck_file(deck: Path, workdir: Path) -> Run:
+    proc = subprocess.run([frictiondyn.executable(), str(deck)], cwd=workdir,
+                          capture_output=True, text=True)
+    return Run(proc.returncode, proc.stdout, proc.stderr, workdir, deck.stem)
+
+
+@pytest.fixture
+def run(tmp_path):
+    """run(groups or text, name='case', files={}) -> Run, in a fresh directory."""
+    counter = [0]
+
+    def _run(deck, name: str | None = None, files: dict[str, str] | None = None) -> Run:
+        counter[0] += 1
+        work = tmp_path / f"run{counter[0]}"
+        work.mkdir()
+        for fname, text in (files or {}).items():
+            (work / fname).write_text(text)
+        text = deck if isinstance(deck, str) else deck_text(deck)
+        path = work / f"{name or 'case'}.nml"
+        path.write_text(text)
+        return run_deck_file(path, work)
+
+    return _run
+
+
+def ok(r: Run) -> Run:
+    assert r.returncode == 0, r.stderr
+    return r
+
+
+def steady_amplitude(t: np.ndarray, x: np.ndarray, freq: float, cycles: int) -> float:
+    """Amplitude of the component at freq over the last whole cycles (least squares)."""
+    w = 2 * np.pi * freq
+    m = t >= t[-1] - cycles / freq - 1e-12
+    a = np.column_stack([np.sin(w * t[m]), np.cos(w * t[m])])
+    coef, *_ = np.linalg.lstsq(a, x[m], rcond=None)
+    return float(np.hypot(*coef))

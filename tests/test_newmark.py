@@ -1,0 +1,192 @@
+"""Issue 3: the linear Newmark machinery against closed forms."""
+
+from __future__ import annotations
+
+import numpy as np
+import pytest
+from conftest import INPUTS, K1, K2, M1, M2, ok, run_deck_file, steady_amplitude
+
+
+def free_vibration(omega: float, dt_r: float, n1: int, cycles: float = 20.0):
+    period = 2 * np.pi / omega
+    return {
+        "model": {"n_dof": 1, "mass": [2.0], "u0": [0.01], "v0": [0.03]},
+        "springs": {"n_springs": 1, "node_i": [1], "node_j": [0], "k": [2.0 * omega**2]},
+        "damping": {"damping_type": "none"},
+        "excitation": {"excitation_type": "none", "dt_record": dt_r, "duration": cycles * period},
+        "integration": {"n1": n1},
+        "output": {"output_every": 1},
+    }
+
+
+@pytest.mark.parametrize("w_dt", [0.05, 0.2, 0.6, 1.5])
+def test_average_acceleration_period_elongation(run, w_dt):
+    """T_num/T = (w dt/2)/atan(w dt/2) to 1e-6, and no amplitude decay (1e-9)."""
+    omega = 2 * np.pi / 0.7
+    n1 = 4
+    dt = w_dt / omega
+    r = ok(run(free_vibration(omega, dt * n1, n1)))
+    h = r.history()
+    u, v = h["u1"], h["v1"]
+    assert np.allclose(np.diff(h["t"]), dt, rtol=1e-9)
+    # A linear recurrence u[k+1] + u[k-1] = 2 cos(theta) u[k] holds exactly for the
+    # discrete rotation; take cos(theta) where |u[k]| is largest.
+    k = np.argsort(-np.abs(u[1:-1]))[:20] + 1
+    cos_theta = np.median((u[k + 1] + u[k - 1]) / (2 * u[k]))
+    t_ratio = (2 * np.pi / np.arccos(cos_theta) * dt) / (2 * np.pi / omega)
+    expected = (w_dt / 2) / np.arctan(w_dt / 2)
+    assert t_ratio == pytest.approx(expected, rel=1e-6)
+    # the trapezoidal rule conserves the quadratic invariant w^2 u^2 + v^2
+    inv = omega**2 * u**2 + v**2
+    assert np.max(np.abs(inv / inv[0] - 1)) < 1e-9
+
+
+def chain(n: int, masses, stiffnesses):
+    return {
+        "n_dof": n,
+        "mass": list(masses),
+    }, {
+        "n_springs": n,
+        "node_i": list(range(1, n + 1)),
+        "node_j": list(range(0, n)),
+        "k": list(stiffnesses),
+    }
+
+
+def closed_form_aabs(masses, stiffnesses, c, amp, freq):
+    """Steady-state absolute-acceleration amplitudes of a chain under x0 = amp sin(wt)."""
+    n = len(masses)
+    m = np.diag(masses)
+    k = np.zeros((n, n))
+    for i, ks in enumerate(stiffnesses):
+        k[i, i] += ks
+        if i > 0:
+            k[i - 1, i - 1] += ks
+            k[i, i - 1] -= ks
+            k[i - 1, i] -= ks
+    w = 2 * np.pi * freq
+    ag = -amp * w**2  # table acceleration amplitude (complex, sin reference)
+    cmat = c(m, k)
+    u = np.linalg.solve(k - w**2 * m + 1j * w * cmat, -m @ np.ones(n) * ag)
+    return np.abs(-(w**2) * u + ag)
+
+
+@pytest.mark.parametrize(
+    "masses, stiffnesses, damping",
+    [
+        ([6.301, 2.530], [4000.0, 2895.0], {"damping_type": "rayleigh", "rayleigh_a0": 0.4,
+                                            "rayleigh_a1": 0.002}),
+        ([3.0, 2.5, 2.0, 1.5, 1.0], [9000.0, 7000.0, 5000.0, 3000.0, 1500.0],
+         {"damping_type": "rayleigh", "rayleigh_a0": 0.5, "rayleigh_a1": 0.001}),
+        ([3.0, 2.5, 2.0, 1.5, 1.0], [9000.0, 7000.0, 5000.0, 3000.0, 1500.0],
+         {"damping_type": "stiffness", "xi": 0.05}),
+    ],
+)
+def test_chain_steady_state_matches_frequency_response(run, masses, stiffnesses, damping):
+    """2- and 5-DOF damped chains: |aabs| within 1e-3 of (K - w^2 M + i w C)^-1 at dt_r/20."""
+    n = len(masses)
+    freq, amp, dt_r = 3.3, 0.004, 0.005
+    model, springs = chain(n, masses, stiffnesses)
+    r = ok(run({
+        "model": model, "springs": springs, "damping": damping,
+        "excitation": {"excitation_type": "harmonic", "amplitude": amp, "frequency": freq,
+                       "ramp_cycles": 3, "dt_record": dt_r, "duration": 60.0},
+        "integration": {"n1": 20},
+    }))
+    h, s = r.history(), r.summary()
+    if damping["damping_type"] == "rayleigh":
+        def c(m, k):
+            return damping["rayleigh_a0"] * m + damping["rayleigh_a1"] * k
+    else:
+        def c(m, k):
+            return s["period_stuck_s"] * damping["xi"] / np.pi * k
+    expected = closed_form_aabs(masses, stiffnesses, c, amp, freq)
+    for i in range(n):
+        got = steady_amplitude(h["t"], h[f"aabs{i + 1}"], freq, cycles=20)
+        assert got == pytest.approx(expected[i], rel=1e-3)
+    # no phase change, one step size: the effective stiffness is factored once
+    assert s["factorizations"] == 1
+    assert s["steps_dt1"] == round(60.0 / (dt_r / 20))
+
+
+def test_paper_stuck_period_and_damping(tmp_path):
+    """T of m1 + m2 on k1 + k2 is the paper's 0.296 s; the stuck mode's damping ratio is xi."""
+    r = run_deck_file(INPUTS / "test4_velocity.nml", tmp_path)
+    assert r.returncode == 0, r.stderr
+    s = r.summary()
+    t_rigid = 2 * np.pi * np.sqrt((M1 + M2) / (K1 + K2))
+    assert s["period_stuck_s"] == pytest.approx(t_rigid, rel=1e-12)
+    assert s["period_stuck_s"] == pytest.approx(0.296, rel=1e-3)
+    assert s["xi_stuck"] == pytest.approx(0.015, rel=1e-9)
+
+
+def test_stuck_period_with_a_device_to_the_table(run):
+    """A device locking DOF 3 to the table removes it; two devices joining 1-2 merge them."""
+    m = [2.0, 1.0, 1.5, 0.5]
+    k = [800.0, 600.0, 400.0, 300.0]
+    model, springs = chain(4, m, k)
+    r = ok(run({
+        "model": model, "springs": springs,
+        "damping": {"damping_type": "stiffness", "xi": 0.02},
+        "friction": {"n_devices": 2, "node_i": [3, 2], "node_j": [0, 1], "law": ["velocity"] * 2,
+                     "p": [10.0, 10.0], "mu": [0.2, 0.2]},
+        "excitation": {"excitation_type": "none", "dt_record": 0.01, "duration": 0.1},
+    }))
+    # independent: generalized DOFs q = (u1 = u2, u4), u3 = 0
+    t = np.array([[1, 0], [1, 0], [0, 0], [0, 1]], float)
+    kf = np.zeros((4, 4))
+    for i, ks in enumerate(k):
+        kf[i, i] += ks
+        if i > 0:
+            kf[i - 1, i - 1] += ks
+            kf[i, i - 1] -= ks
+            kf[i - 1, i] -= ks
+    kq = t.T @ kf @ t
+    mq = t.T @ np.diag(m) @ t
+    w2 = np.min(np.linalg.eigvals(np.linalg.solve(mq, kq)).real)
+    assert r.summary()["period_stuck_s"] == pytest.approx(2 * np.pi / np.sqrt(w2), rel=1e-12)
+    assert r.summary()["xi_stuck"] == pytest.approx(0.02, rel=1e-9)
+
+
+def harmonic_record_decks(dt_r: float, kind: str, columns: int):
+    freq, amp = 3.102, 0.004062
+    w = 2 * np.pi * freq
+    duration = 6.0
+    tk = np.arange(0.0, duration + 0.5 * dt_r, dt_r)
+    if kind == "acceleration":
+        values = -amp * w**2 * np.sin(w * tk)
+    else:
+        values = amp * np.sin(w * tk)
+    if columns == 1:
+        text = "# harmonic table motion\n" + "\n".join(f"{x:.17e}" for x in values) + "\n"
+    else:
+        text = "\n".join(f"{t:.10f} {x:.17e}" for t, x in zip(tk, values)) + "\n"
+    base = {
+        "model": {"n_dof": 2, "mass": [M1, M2]},
+        "springs": {"n_springs": 2, "node_i": [1, 2], "node_j": [0, 0], "k": [K1, K2]},
+        "damping": {"damping_type": "rayleigh", "rayleigh_a0": 0.3, "rayleigh_a1": 0.001},
+        "integration": {"n1": 20},
+    }
+    harm = dict(base, excitation={"excitation_type": "harmonic", "amplitude": amp,
+                                  "frequency": freq, "dt_record": dt_r, "duration": duration})
+    rec = dict(base, excitation={"excitation_type": "record", "record_file": "table.txt",
+                                 "record_kind": kind, "dt_record": dt_r, "duration": duration})
+    return harm, rec, text
+
+
+@pytest.mark.parametrize("kind, columns", [("acceleration", 1), ("acceleration", 2),
+                                           ("displacement", 1)])
+def test_record_reproduces_harmonic_within_interpolation_error(run, kind, columns):
+    errors = []
+    for dt_r in (0.004, 0.002, 0.001):
+        harm, rec, text = harmonic_record_decks(dt_r, kind, columns)
+        h1 = ok(run(harm)).history()
+        h2 = ok(run(rec, files={"table.txt": text})).history()
+        assert np.allclose(h1["t"], h2["t"])
+        # the relative equations of motion see only the table acceleration
+        scale = np.max(np.abs(h1["aabs1"]))
+        errors.append(np.max(np.abs(h1["aabs1"] - h2["aabs1"])) / scale)
+    assert errors[0] < 2e-3
+    # linear interpolation (and second differences): error ~ dt_r^2
+    assert errors[1] < errors[0] / 3
+    assert errors[2] < errors[1] / 3
