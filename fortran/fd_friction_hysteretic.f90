@@ -19,7 +19,8 @@ module fd_friction_hysteretic
 
 contains
 
-   !> A run starts sticking with no force.
+   !> A run starts sticking with no force, or sliding if the initial relative velocity is
+   !> already outside the band |sdot| < eps1.
    pure subroutine hysteretic_init(dev, s, sdot, st)
       type(device_type), intent(in) :: dev   !! device parameters
       real(dp), intent(in) :: s              !! relative displacement [m]
@@ -29,6 +30,11 @@ contains
       st%phase = phase_stick
       st%centre = s
       st%armed = .false.
+      if (abs(sdot) >= dev%eps1 .and. dev%p*dev%mu > 0.0_dp) then
+         st%phase = merge(phase_slip_pos, phase_slip_neg, sdot > 0.0_dp)
+         st%centre = s - st%phase*dev%f
+         st%armed = .true.
+      end if
       call set_coefficients(dev, st)
    end subroutine hysteretic_init
 

@@ -34,8 +34,8 @@ contains
       end do
    end subroutine stiffness_matrix
 
-   !> First natural period of the stuck system (every device a rigid link between its
-   !> nodes) and its mode shape, from the generalized symmetric eigenproblem.
+   !> First natural period of the stuck system (every device with P mu > 0 a rigid link
+   !> between its nodes) and its mode shape, from the generalized symmetric eigenproblem.
    subroutine stuck_first_mode(model, k, period, phi, error)
       type(model_type), intent(in) :: model          !! the model
       real(dp), intent(in) :: k(:, :)                !! springs' stiffness
@@ -46,11 +46,14 @@ contains
       real(dp), allocatable :: t(:, :), kq(:, :), mq(:, :), lam(:), z(:, :)
       integer :: n, nq, d, i, a, b
 
+      period = 0.0_dp
+      phi = 0.0_dp
       n = model%n_dof
-      ! union-find over nodes 0..n: each device ties its two nodes together
+      ! union-find over nodes 0..n: each device (with a friction capacity) ties its nodes
       allocate (root(0:n))
       root = [(i, i=0, n)]
       do d = 1, model%n_devices
+         if (model%dev(d)%p*model%dev(d)%mu == 0.0_dp) cycle
          a = find(model%dev(d)%node_i); b = find(model%dev(d)%node_j)
          if (a /= b) root(max(a, b)) = min(a, b)
       end do

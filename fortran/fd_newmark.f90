@@ -25,7 +25,8 @@ module fd_newmark
 
    public :: run_newmark
 
-   integer, parameter :: n_slots = 6 !! factorizations kept at once
+   integer, parameter :: max_slots = 32              !! factors kept at most
+   real(dp), parameter :: cache_bytes = 256.0e6_dp    !! memory the factors may take
 
    !> One cached factor of the effective stiffness.
    type :: factor_slot
@@ -45,7 +46,7 @@ module fd_newmark
       logical, allocatable :: changed(:), ok(:), stuck(:)
       real(dp) :: ag = 0.0_dp, ag1 = 0.0_dp
       real(dp) :: w_device = 0.0_dp, e_device0 = 0.0_dp, e_kin0 = 0.0_dp, e_str0 = 0.0_dp
-      type(factor_slot) :: slot(n_slots)
+      type(factor_slot), allocatable :: slot(:)
    end type workspace
 
 contains
@@ -58,25 +59,24 @@ contains
       type(result_type), intent(out) :: res         !! histories and summary
       type(error_type), allocatable, intent(out) :: error !! singular system, divergence
       type(workspace) :: w
-      real(dp) :: dt1, dt2, t0, period
-      real(dp), allocatable :: phi(:)
+      real(dp) :: dt1, dt2, t0
       integer :: nsteps, every, k, j, iout, c0, c1, crate
       logical :: any_changed, any_bad
 
       call system_clock(c0, crate)
-      call setup(model, w, res, period, phi, error)
-      if (allocated(error)) return
-
       dt1 = exc%dt_record/opts%n1
       dt2 = dt1/opts%n2
       res%dt1 = dt1
       res%dt2 = dt2
       res%dt_min = opts%dt_min
       if (res%dt_min <= 0.0_dp) res%dt_min = dt2/2.0_dp**10
+      call setup(model, halving_levels(dt2, res%dt_min), w, res, error)
+      if (allocated(error)) return
       nsteps = max(1, nint(exc%duration/dt1))
       every = opts%output_every
       if (every <= 0) every = opts%n1
-      call allocate_history(model, nsteps/every + 1, res)
+      ! samples at t = 0, every `every` steps, and at the end
+      call allocate_history(model, nsteps/every + 1 + merge(1, 0, mod(nsteps, every) /= 0), res)
 
       ! initial state: devices from the initial conditions, acceleration from equilibrium
       w%u = model%u0
@@ -105,7 +105,7 @@ contains
                if (allocated(error)) return
             end do
          end if
-         if (mod(k, every) == 0) then
+         if (mod(k, every) == 0 .or. k == nsteps) then
             if (.not. all(ieee_is_finite(w%u)) .or. .not. all(ieee_is_finite(w%a))) then
                call fatal_error(error, "the solution is not finite at t = "//fmt_real(k*dt1)// &
                                 " s: the integration diverged (check beta, gamma and the step)")
@@ -120,17 +120,28 @@ contains
       res%run_time = real(c1 - c0, dp)/real(max(crate, 1), dp)
    end subroutine run_newmark
 
-   !> Matrices, workspace, stuck-system period and damping.
-   subroutine setup(model, w, res, period, phi, error)
+   !> Number of halvings from sub down to dt_min.
+   pure integer function halving_levels(sub, dt_min) result(lmax)
+      real(dp), intent(in) :: sub, dt_min
+
+      lmax = 0
+      do while (lmax < 30 .and. sub/2.0_dp**(lmax + 1) >= dt_min*(1.0_dp - 1.0e-12_dp))
+         lmax = lmax + 1
+      end do
+   end function halving_levels
+
+   !> Matrices, workspace, stuck-system period and damping. The factor cache holds the
+   !> step sizes dt1, dt2, dt2/2, ... dt_min with two phase patterns each when memory allows.
+   subroutine setup(model, lmax, w, res, error)
       type(model_type), intent(in) :: model
+      integer, intent(in) :: lmax
       type(workspace), intent(inout) :: w
       type(result_type), intent(inout) :: res
-      real(dp), intent(out) :: period
-      real(dp), allocatable, intent(out) :: phi(:)
       type(error_type), allocatable, intent(out) :: error
       type(error_type), allocatable :: eig_error
-      real(dp), allocatable :: cphi(:)
-      integer :: n, nd, i
+      real(dp), allocatable :: cphi(:), phi(:)
+      real(dp) :: period, t_damp
+      integer :: n, nd, i, n_slots
 
       n = model%n_dof
       nd = model%n_devices
@@ -139,19 +150,21 @@ contains
       w%mass = model%mass
       allocate (w%k(n, n), w%c(n, n), phi(n), cphi(n))
       call stiffness_matrix(model, w%k)
-      period = 0.0_dp
       call stuck_first_mode(model, w%k, period, phi, eig_error)
+      ! the paper's psi = T xi / pi uses the given T, else the computed one
+      t_damp = period
       if (model%damping == damping_stiffness .and. model%period > 0.0_dp) then
-         period = model%period
+         t_damp = model%period
       else if (model%damping == damping_stiffness .and. allocated(eig_error)) then
          call move_alloc(eig_error, error)
          error%message = "&damping: damping_type = 'stiffness' needs the stuck first period, but "// &
                          error%message
          return
       end if
-      call damping_matrix(model, w%k, period, w%c)
-      res%period_stuck = period
+      call damping_matrix(model, w%k, t_damp, w%c)
       if (.not. allocated(eig_error)) then
+         ! damping ratio of the stuck first mode: phi' C phi / (2 w phi' M phi)
+         res%period_stuck = period
          cphi = matmul(w%c, phi)
          res%xi_stuck = dot_product(phi, cphi)/(2.0_dp*(2.0_dp*acos(-1.0_dp)/period)* &
                                                   sum(model%mass*phi**2))
@@ -159,6 +172,9 @@ contains
       allocate (w%u(n), w%v(n), w%a(n), w%u1(n), w%v1(n), w%a1(n), w%rhs(n), w%tmp(n))
       allocate (w%s(nd), w%sd(nd), w%s1(nd), w%sd1(nd), w%st(nd), w%st1(nd))
       allocate (w%changed(nd), w%ok(nd), w%stuck(nd))
+      n_slots = min(max_slots, 2*(lmax + 2), max(4, int(cache_bytes/(8.0_dp*n*n))))
+      if (nd == 0) n_slots = 1
+      allocate (w%slot(n_slots))
       do i = 1, n_slots
          allocate (w%slot(i)%stuck(nd), w%slot(i)%a(n, n))
       end do
@@ -270,17 +286,20 @@ contains
       call factor_for(model, h, c0, c1, w, res, is, error)
       if (allocated(error)) return
       call table_motion(exc, t + h, xg, vg, w%ag1)
-      w%tmp = c1*w%u + c4*w%v + c5*w%a
-      w%rhs = w%mass*(c0*w%u + c2*w%v + c3*w%a - w%ag1)
+      ! incremental form, K^ du = p1 - F0 - K u + M (c2 v + c3 a) + C (c4 v + c5 a), so that
+      ! a1 = c0 du - c2 v - c3 a does not lose digits to c0 u at small steps
+      w%tmp = c4*w%v + c5*w%a
+      w%rhs = w%mass*(c2*w%v + c3*w%a - w%ag1)
       call sym_matvec(w%c, w%tmp, w%rhs, 1.0_dp, 1.0_dp)
+      call sym_matvec(w%k, w%u, w%rhs, -1.0_dp, 1.0_dp)
       do d = 1, w%nd
          proj = w%tmp(model%dev(d)%node_i)
          if (model%dev(d)%node_j > 0) proj = proj - w%tmp(model%dev(d)%node_j)
-         call add_device(model, d, w%st(d)%cs*proj - w%st(d)%f0, w%rhs)
+         call add_device(model, d, w%st(d)%cs*proj - w%st(d)%ks*w%s(d) - w%st(d)%f0, w%rhs)
       end do
       call cholesky_solve(w%slot(is)%a, w%rhs)
-      w%u1 = w%rhs
-      w%a1 = c0*(w%u1 - w%u) - c2*w%v - c3*w%a
+      w%u1 = w%u + w%rhs
+      w%a1 = c0*w%rhs - c2*w%v - c3*w%a
       w%v1 = w%v + h*((1.0_dp - g)*w%a + g*w%a1)
       call device_kinematics(model, w%u1, w%v1, w%s1, w%sd1)
    end subroutine try_step
@@ -298,7 +317,7 @@ contains
 
       w%clock = w%clock + 1
       w%stuck = w%st%ks /= 0.0_dp .or. w%st%cs /= 0.0_dp
-      do is = 1, n_slots
+      do is = 1, size(w%slot)
          if (w%slot(is)%h == h) then
             if (all(w%slot(is)%stuck .eqv. w%stuck)) then
                w%slot(is)%last_use = w%clock
@@ -365,10 +384,7 @@ contains
       real(dp) :: h, tl
       logical :: any_changed, any_bad
 
-      lmax = 0
-      do while (lmax < 30 .and. sub/2.0_dp**(lmax + 1) >= dt_min*(1.0_dp - 1.0e-12_dp))
-         lmax = lmax + 1
-      end do
+      lmax = halving_levels(sub, dt_min)
       units = 2**lmax
       pos = 0
       level = 0

@@ -88,17 +88,23 @@ contains
       end if
    end subroutine write_outputs
 
+   !> Create a directory and its missing parents.
    subroutine make_dir(dir, error)
       character(len=*), intent(in) :: dir
       type(error_type), allocatable, intent(out) :: error
-      integer :: stat
+      integer :: stat, i
       logical :: exists
 
+      do i = 2, len(dir) + 1
+         if (i <= len(dir)) then
+            if (dir(i:i) /= '/') cycle
+         end if
+         inquire (file=dir(1:i - 1)//'/.', exist=exists)
+         if (exists) cycle
+         stat = c_mkdir(dir(1:i - 1)//c_null_char, int(o'755', c_int))
+      end do
       inquire (file=dir//'/.', exist=exists)
-      if (exists) return
-      stat = c_mkdir(dir//c_null_char, int(o'755', c_int))
-      inquire (file=dir//'/.', exist=exists)
-      if (.not. exists) call fatal_error(error, "&output: cannot create the output directory '"//dir//"'")
+      if (.not. exists) call fatal_error(error, "&output: cannot create the output directory dir = '"//dir//"'")
    end subroutine make_dir
 
    subroutine remove(path)

@@ -36,6 +36,7 @@ contains
       call run_config_solve(cfg, res, error)
       if (allocated(error)) return
       call write_outputs(cfg%out, cfg%model, res, path, error)
+      if (allocated(error)) error%message = path//": "//error%message
    end subroutine run_deck
 
 end module frictiondyn
