@@ -7,7 +7,7 @@ module fd_deck
    use fd_kinds, only: dp
    use fd_error, only: error_type, fatal_error, fmt_int, fmt_real
    use fd_textio, only: lower
-   use fd_namelist, only: deck_text, group_text, load_deck, find_group, group_item, &
+   use fd_namelist, only: deck_text, group_text, load_deck, deck_from_string, find_group, group_item, &
                           group_read_error, check_groups
    use fd_model, only: model_type, integration_type, device_type, damping_none, &
                        damping_stiffness, damping_rayleigh, law_velocity, law_hysteretic
@@ -17,7 +17,7 @@ module fd_deck
    implicit none
    private
 
-   public :: run_config, read_deck, max_dof, max_springs, max_devices
+   public :: run_config, read_deck, read_deck_string, max_dof, max_springs, max_devices
 
    integer, parameter :: max_dof = 10000      !! capacity of the DOF arrays of a deck
    integer, parameter :: max_springs = 40000  !! capacity of the spring arrays
@@ -37,16 +37,37 @@ module fd_deck
 
 contains
 
-   !> Read and validate a deck.
+   !> Read and validate a deck file.
    subroutine read_deck(path, cfg, error)
       character(len=*), intent(in) :: path                !! deck file
       type(run_config), intent(out) :: cfg                !! what it defines
       type(error_type), allocatable, intent(out) :: error !! first problem found
       type(deck_text) :: deck
 
-      cfg%deck_path = path
       call load_deck(path, deck, error)
       if (allocated(error)) return
+      call read_groups(deck, cfg, error)
+   end subroutine read_deck
+
+   !> Read and validate a deck given as text. The path names the deck in messages, gives
+   !> the default output name, and is the base of a relative record_file.
+   subroutine read_deck_string(text, path, cfg, error)
+      character(len=*), intent(in) :: text                !! the deck, lines separated by newlines
+      character(len=*), intent(in) :: path                !! name of the deck
+      type(run_config), intent(out) :: cfg                !! what it defines
+      type(error_type), allocatable, intent(out) :: error !! first problem found
+      type(deck_text) :: deck
+
+      call deck_from_string(text, path, deck)
+      call read_groups(deck, cfg, error)
+   end subroutine read_deck_string
+
+   subroutine read_groups(deck, cfg, error)
+      type(deck_text), intent(in) :: deck
+      type(run_config), intent(inout) :: cfg
+      type(error_type), allocatable, intent(out) :: error
+
+      cfg%deck_path = deck%path
       call check_groups(deck, [character(len=12) :: 'model', 'springs', 'damping', 'friction', &
                                'excitation', 'integration', 'output'], error)
       if (allocated(error)) return
@@ -63,7 +84,7 @@ contains
       call read_integration_group(deck, cfg, error)
       if (allocated(error)) return
       call read_output_group(deck, cfg, error)
-   end subroutine read_deck
+   end subroutine read_groups
 
    ! ---------------------------------------------------------------- &model
    subroutine read_model_group(deck, cfg, error)

@@ -9,7 +9,7 @@ module fd_namelist
    implicit none
    private
 
-   public :: deck_text, group_text, load_deck, find_group, group_item, group_read_error
+   public :: deck_text, group_text, load_deck, deck_from_string, find_group, group_item, group_read_error
    public :: check_groups
 
    !> A whole deck in memory.
@@ -39,6 +39,36 @@ contains
       call read_text_file(path, deck%lines, error)
       if (allocated(error)) error%message = "deck: "//error%message
    end subroutine load_deck
+
+   !> A deck given as text (lines separated by newlines); path names it in messages and
+   !> is the base of relative record paths.
+   pure subroutine deck_from_string(text, path, deck)
+      character(len=*), intent(in) :: text   !! the deck
+      character(len=*), intent(in) :: path   !! name used for the deck
+      type(deck_text), intent(out) :: deck   !! its text as lines
+      integer :: i, start, n
+
+      deck%path = path
+      n = 0
+      do i = 1, len(text)
+         if (text(i:i) == achar(10)) n = n + 1
+      end do
+      allocate (deck%lines(n + 1))
+      n = 0
+      start = 1
+      do i = 1, len(text) + 1
+         if (i <= len(text)) then
+            if (text(i:i) /= achar(10)) cycle
+         end if
+         n = n + 1
+         deck%lines(n)%s = text(start:i - 1)
+         if (len(deck%lines(n)%s) > 0) then
+            if (deck%lines(n)%s(len(deck%lines(n)%s):) == achar(13)) &
+               deck%lines(n)%s = deck%lines(n)%s(1:len(deck%lines(n)%s) - 1)
+         end if
+         start = i + 1
+      end do
+   end subroutine deck_from_string
 
    !> The first word of a line, lower case, if it opens a group ('&name').
    pure function group_opened(line) result(name)

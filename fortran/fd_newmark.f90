@@ -23,7 +23,7 @@ module fd_newmark
    implicit none
    private
 
-   public :: run_newmark
+   public :: run_newmark, history_shape
 
    integer, parameter :: max_slots = 32              !! factors kept at most
    real(dp), parameter :: cache_bytes = 256.0e6_dp    !! memory the factors may take
@@ -60,7 +60,7 @@ contains
       type(error_type), allocatable, intent(out) :: error !! singular system, divergence
       type(workspace) :: w
       real(dp) :: dt1, dt2, t0
-      integer :: nsteps, every, k, j, iout, c0, c1, crate
+      integer :: nsteps, every, k, j, iout, nout, c0, c1, crate
       logical :: any_changed, any_bad
 
       call system_clock(c0, crate)
@@ -72,11 +72,8 @@ contains
       if (res%dt_min <= 0.0_dp) res%dt_min = dt2/2.0_dp**10
       call setup(model, halving_levels(dt2, res%dt_min), w, res, error)
       if (allocated(error)) return
-      nsteps = max(1, nint(exc%duration/dt1))
-      every = opts%output_every
-      if (every <= 0) every = opts%n1
-      ! samples at t = 0, every `every` steps, and at the end
-      call allocate_history(model, nsteps/every + 1 + merge(1, 0, mod(nsteps, every) /= 0), res)
+      call history_shape(model, exc, opts, iout, nout, nsteps, every)
+      call allocate_history(model, nout, res)
 
       ! initial state: devices from the initial conditions, acceleration from equilibrium
       w%u = model%u0
@@ -119,6 +116,24 @@ contains
       call system_clock(c1)
       res%run_time = real(c1 - c0, dp)/real(max(crate, 1), dp)
    end subroutine run_newmark
+
+   !> Size of the history a run writes: columns t, ag, (u, v, aabs) per DOF and
+   !> (s, sdot, F, phase) per device; samples at t = 0, every `every` dt1 steps and at the end.
+   pure subroutine history_shape(model, exc, opts, ncol, nout, nsteps, every)
+      type(model_type), intent(in) :: model         !! the model
+      type(excitation_type), intent(in) :: exc      !! the table motion
+      type(integration_type), intent(in) :: opts    !! integration settings
+      integer, intent(out) :: ncol                  !! columns
+      integer, intent(out) :: nout                  !! samples
+      integer, intent(out) :: nsteps                !! dt1 steps of the run
+      integer, intent(out) :: every                 !! dt1 steps between samples
+
+      ncol = 2 + 3*model%n_dof + 4*model%n_devices
+      nsteps = max(1, nint(exc%duration/(exc%dt_record/opts%n1)))
+      every = opts%output_every
+      if (every <= 0) every = opts%n1
+      nout = nsteps/every + 1 + merge(1, 0, mod(nsteps, every) /= 0)
+   end subroutine history_shape
 
    !> Number of halvings from sub down to dt_min.
    pure integer function halving_levels(sub, dt_min) result(lmax)
@@ -190,7 +205,7 @@ contains
       nd = model%n_devices
       res%n_dof = n
       res%n_devices = nd
-      res%ncol = 2 + 3*n + 4*nd
+      res%ncol = 2 + 3*n + 4*nd   ! as in history_shape
       res%nout = nout
       allocate (res%hist(res%ncol, nout), res%names(res%ncol), res%units(res%ncol))
       res%hist = 0.0_dp

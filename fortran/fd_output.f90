@@ -10,7 +10,7 @@ module fd_output
    implicit none
    private
 
-   public :: output_type, write_outputs, history_path, summary_path
+   public :: output_type, write_outputs, history_path, summary_path, summary_json, history_header
 
    !> Where and what to write.
    type :: output_type
@@ -118,7 +118,7 @@ contains
       character(len=*), intent(in) :: path
       type(result_type), intent(in) :: res
       type(error_type), allocatable, intent(out) :: error
-      integer :: unit, ios, i, j
+      integer :: unit, ios, i
       character(len=512) :: msg
       character(len=:), allocatable :: fmt
 
@@ -127,11 +127,7 @@ contains
          call fatal_error(error, "cannot create '"//path//"': "//trim(msg))
          return
       end if
-      do j = 1, res%ncol
-         write (unit, '(a)', advance='no', iostat=ios) trim(res%names(j))//'['//trim(res%units(j))//']'
-         if (j < res%ncol) write (unit, '(a)', advance='no', iostat=ios) ','
-      end do
-      write (unit, '(a)', iostat=ios) ''
+      write (unit, '(a)', iostat=ios) history_header(res)
       fmt = '('//fmt_int(res%ncol)//'(es24.16e3,:,","))'
       do i = 1, res%nout
          write (unit, fmt, iostat=ios, iomsg=msg) res%hist(:, i)
@@ -151,107 +147,116 @@ contains
       type(result_type), intent(in) :: res
       character(len=*), intent(in) :: deck_path
       type(error_type), allocatable, intent(out) :: error
-      integer :: unit, ios, d
+      integer :: unit, ios
       character(len=512) :: msg
-      character(len=:), allocatable :: laws
 
       open (newunit=unit, file=path, status='replace', action='write', iostat=ios, iomsg=msg)
       if (ios /= 0) then
          call fatal_error(error, "cannot create '"//path//"': "//trim(msg))
          return
       end if
-      laws = ''
-      do d = 1, model%n_devices
-         laws = laws//'"'//law_name(model%dev(d)%law)//'"'
-         if (d < model%n_devices) laws = laws//', '
-      end do
-      write (unit, '(a)', iostat=ios) '{'
-      call kv_s('deck', json_escape(deck_path))
-      call kv_i('n_dof', res%n_dof)
-      call kv_i('n_devices', res%n_devices)
-      write (unit, '(a)', iostat=ios) '  "device_law": ['//laws//'],'
-      call kv_r('period_stuck_s', res%period_stuck)
-      call kv_r('xi_stuck', res%xi_stuck)
-      call kv_r('dt1_s', res%dt1)
-      call kv_r('dt2_s', res%dt2)
-      call kv_r('dt_min_s', res%dt_min)
-      call kv_ra('peak_u_m', res%peak_u)
-      call kv_ra('peak_u_time_s', res%peak_u_time)
-      call kv_ra('peak_v_mps', res%peak_v)
-      call kv_ra('peak_aabs_mps2', res%peak_aabs)
-      call kv_ra('peak_aabs_time_s', res%peak_aabs_time)
-      call kv_ra('peak_s_m', res%peak_s)
-      call kv_ra('peak_force_N', res%peak_force)
-      call kv_ia('stick_to_slip', res%stick_to_slip)
-      call kv_ia('slip_to_stick', res%slip_to_stick)
-      call kv_ia('slip_reversals', res%reversals)
-      call kv_i('steps_dt1', res%steps_dt1)
-      call kv_i('steps_dt2', res%steps_dt2)
-      call kv_i('steps_finer', res%steps_finer)
-      call kv_i('factorizations', res%factorizations)
-      call kv_i('correctness_violations', res%violations)
-      call kv_ra('violation_times_s', res%violation_time(1:res%n_violation_times))
-      call kv_ia('violation_devices', res%violation_device(1:res%n_violation_times))
-      call kv_r('energy_input_J', res%e_input)
-      call kv_r('energy_kinetic_J', res%e_kinetic)
-      call kv_r('energy_strain_J', res%e_strain)
-      call kv_r('energy_viscous_J', res%e_viscous)
-      call kv_r('energy_friction_J', res%e_friction)
-      call kv_r('energy_device_elastic_J', res%e_device)
-      call kv_r('energy_residual_J', res%e_residual)
-      call kv_i('samples', res%nout)
-      write (unit, '(a)', iostat=ios) '  "run_time_s": '//fmt_real(res%run_time)
-      write (unit, '(a)', iostat=ios, iomsg=msg) '}'
+      write (unit, '(a)', iostat=ios, iomsg=msg) summary_json(model, res, deck_path)
       if (ios /= 0) then
          close (unit, status='delete')
          call fatal_error(error, "cannot write '"//path//"': "//trim(msg))
          return
       end if
       close (unit)
-   contains
-      subroutine kv_s(key, val)
-         character(len=*), intent(in) :: key, val
-         write (unit, '(a)', iostat=ios) '  "'//key//'": "'//val//'",'
-      end subroutine kv_s
-      subroutine kv_i(key, val)
-         character(len=*), intent(in) :: key
-         integer, intent(in) :: val
-         write (unit, '(a)', iostat=ios) '  "'//key//'": '//fmt_int(val)//','
-      end subroutine kv_i
-      subroutine kv_r(key, val)
-         character(len=*), intent(in) :: key
-         real(dp), intent(in) :: val
-         write (unit, '(a)', iostat=ios) '  "'//key//'": '//json_real(val)//','
-      end subroutine kv_r
-      subroutine kv_ra(key, val)
-         character(len=*), intent(in) :: key
-         real(dp), intent(in) :: val(:)
-         integer :: k
-         write (unit, '(a)', advance='no', iostat=ios) '  "'//key//'": ['
-         do k = 1, size(val)
-            write (unit, '(a)', advance='no', iostat=ios) json_real(val(k))
-            if (k < size(val)) write (unit, '(a)', advance='no', iostat=ios) ', '
-         end do
-         write (unit, '(a)', iostat=ios) '],'
-      end subroutine kv_ra
-      subroutine kv_ia(key, val)
-         character(len=*), intent(in) :: key
-         integer, intent(in) :: val(:)
-         integer :: k
-         write (unit, '(a)', advance='no', iostat=ios) '  "'//key//'": ['
-         do k = 1, size(val)
-            write (unit, '(a)', advance='no', iostat=ios) fmt_int(val(k))
-            if (k < size(val)) write (unit, '(a)', advance='no', iostat=ios) ', '
-         end do
-         write (unit, '(a)', iostat=ios) '],'
-      end subroutine kv_ia
    end subroutine write_summary
+
+   !> The summary of a run as a JSON object (keys documented in docs/namelist.md).
+   pure function summary_json(model, res, deck_path) result(js)
+      type(model_type), intent(in) :: model        !! the model run
+      type(result_type), intent(in) :: res         !! its result
+      character(len=*), intent(in) :: deck_path    !! deck named in the summary
+      character(len=:), allocatable :: js          !! the JSON text
+      character(len=:), allocatable :: laws
+      character(len=1), parameter :: nl = achar(10)
+      integer :: d
+
+      laws = ''
+      do d = 1, model%n_devices
+         laws = laws//'"'//law_name(model%dev(d)%law)//'"'
+         if (d < model%n_devices) laws = laws//', '
+      end do
+      js = '{'//nl
+      js = js//'  "deck": "'//json_escape(deck_path)//'",'//nl
+      js = js//kv('n_dof', fmt_int(res%n_dof))//kv('n_devices', fmt_int(res%n_devices))
+      js = js//'  "device_law": ['//laws//'],'//nl
+      js = js//kv('period_stuck_s', json_real(res%period_stuck))//kv('xi_stuck', json_real(res%xi_stuck))
+      js = js//kv('dt1_s', json_real(res%dt1))//kv('dt2_s', json_real(res%dt2))// &
+           kv('dt_min_s', json_real(res%dt_min))
+      js = js//kv('peak_u_m', reals(res%peak_u))//kv('peak_u_time_s', reals(res%peak_u_time))
+      js = js//kv('peak_v_mps', reals(res%peak_v))//kv('peak_aabs_mps2', reals(res%peak_aabs))
+      js = js//kv('peak_aabs_time_s', reals(res%peak_aabs_time))
+      js = js//kv('peak_s_m', reals(res%peak_s))//kv('peak_force_N', reals(res%peak_force))
+      js = js//kv('stick_to_slip', ints(res%stick_to_slip))//kv('slip_to_stick', ints(res%slip_to_stick))
+      js = js//kv('slip_reversals', ints(res%reversals))
+      js = js//kv('steps_dt1', fmt_int(res%steps_dt1))//kv('steps_dt2', fmt_int(res%steps_dt2))
+      js = js//kv('steps_finer', fmt_int(res%steps_finer))//kv('factorizations', fmt_int(res%factorizations))
+      js = js//kv('correctness_violations', fmt_int(res%violations))
+      js = js//kv('violation_times_s', reals(res%violation_time(1:res%n_violation_times)))
+      js = js//kv('violation_devices', ints(res%violation_device(1:res%n_violation_times)))
+      js = js//kv('energy_input_J', json_real(res%e_input))//kv('energy_kinetic_J', json_real(res%e_kinetic))
+      js = js//kv('energy_strain_J', json_real(res%e_strain))//kv('energy_viscous_J', json_real(res%e_viscous))
+      js = js//kv('energy_friction_J', json_real(res%e_friction))
+      js = js//kv('energy_device_elastic_J', json_real(res%e_device))
+      js = js//kv('energy_residual_J', json_real(res%e_residual))
+      js = js//kv('samples', fmt_int(res%nout))
+      js = js//'  "run_time_s": '//json_real(res%run_time)//nl//'}'
+   contains
+      pure function kv(key, val) result(line)
+         character(len=*), intent(in) :: key, val
+         character(len=:), allocatable :: line
+         line = '  "'//key//'": '//val//','//nl
+      end function kv
+      pure function reals(x) result(str)
+         real(dp), intent(in) :: x(:)
+         character(len=:), allocatable :: str
+         integer :: k
+         str = '['
+         do k = 1, size(x)
+            str = str//json_real(x(k))
+            if (k < size(x)) str = str//', '
+         end do
+         str = str//']'
+      end function reals
+      pure function ints(x) result(str)
+         integer, intent(in) :: x(:)
+         character(len=:), allocatable :: str
+         integer :: k
+         str = '['
+         do k = 1, size(x)
+            str = str//fmt_int(x(k))
+            if (k < size(x)) str = str//', '
+         end do
+         str = str//']'
+      end function ints
+   end function summary_json
+
+   !> The header line of the history: name[unit] of each column, comma separated.
+   pure function history_header(res) result(line)
+      type(result_type), intent(in) :: res     !! the result
+      character(len=:), allocatable :: line    !! the header
+      integer :: j
+
+      line = ''
+      do j = 1, res%ncol
+         line = line//trim(res%names(j))//'['//trim(res%units(j))//']'
+         if (j < res%ncol) line = line//','
+      end do
+   end function history_header
 
    !> A real as JSON: 17 significant digits.
    pure function json_real(x) result(str)
+      use, intrinsic :: ieee_arithmetic, only: ieee_is_finite
       real(dp), intent(in) :: x
       character(len=:), allocatable :: str
       character(len=32) :: buf
+      if (.not. ieee_is_finite(x)) then
+         str = 'null'
+         return
+      end if
       write (buf, '(es24.16e3)') x
       str = trim(adjustl(buf))
    end function json_real

@@ -5,15 +5,16 @@ module frictiondyn
    use fd_model, only: model_type, integration_type, device_type
    use fd_excitation, only: excitation_type
    use fd_result, only: result_type
-   use fd_deck, only: run_config, read_deck
-   use fd_newmark, only: run_newmark
-   use fd_output, only: output_type, write_outputs, history_path, summary_path
+   use fd_deck, only: run_config, read_deck, read_deck_string
+   use fd_newmark, only: run_newmark, history_shape
+   use fd_output, only: output_type, write_outputs, history_path, summary_path, summary_json, history_header
    implicit none
    private
 
    public :: dp, error_type, model_type, integration_type, device_type, excitation_type
    public :: result_type, run_config, output_type
-   public :: read_deck, run_config_solve, run_deck, history_path, summary_path
+   public :: read_deck, read_deck_string, run_config_solve, run_deck, shape_of
+   public :: history_path, summary_path, summary_json, history_header
 
 contains
 
@@ -24,6 +25,15 @@ contains
       type(error_type), allocatable, intent(out) :: error !! failure of the solver
       call run_newmark(cfg%model, cfg%exc, cfg%opts, res, error)
    end subroutine run_config_solve
+
+   !> Columns and samples of the history the configuration's run produces.
+   pure subroutine shape_of(cfg, ncol, nout)
+      type(run_config), intent(in) :: cfg   !! model, excitation, settings
+      integer, intent(out) :: ncol          !! columns
+      integer, intent(out) :: nout          !! samples
+      integer :: nsteps, every
+      call history_shape(cfg%model, cfg%exc, cfg%opts, ncol, nout, nsteps, every)
+   end subroutine shape_of
 
    !> Read a deck, run it and write its outputs.
    subroutine run_deck(path, cfg, res, error)
