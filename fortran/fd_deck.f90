@@ -10,7 +10,7 @@ module fd_deck
    use fd_namelist, only: deck_text, group_text, load_deck, deck_from_string, find_group, group_item, &
                           group_read_error, check_groups
    use fd_model, only: model_type, integration_type, device_type, damping_none, &
-                       damping_stiffness, damping_rayleigh, law_velocity, law_hysteretic
+                       damping_stiffness, damping_rayleigh, law_velocity, law_hysteretic, law_coulomb
    use fd_excitation, only: excitation_type, excitation_none, excitation_harmonic, excitation_record
    use fd_record, only: read_record
    use fd_output, only: output_type
@@ -322,15 +322,24 @@ contains
             cfg%model%dev(i)%law = law_velocity
          case ('hysteretic')
             cfg%model%dev(i)%law = law_hysteretic
+         case ('coulomb')
+            cfg%model%dev(i)%law = law_coulomb
          case ('')
             call bad(deck, 'friction', 'law'//idx, '(not given)', &
-                     "one of 'velocity', 'hysteretic'", error)
+                     "one of 'velocity', 'hysteretic', 'coulomb'", error)
             return
          case default
             call bad(deck, 'friction', 'law'//idx, "'"//trim(law(i))//"'", &
-                     "one of 'velocity', 'hysteretic'", error)
+                     "one of 'velocity', 'hysteretic', 'coulomb'", error)
             return
          end select
+         ! the exact technique integrates the whole model event by event
+         if (i > 1 .and. (cfg%model%dev(i)%law == law_coulomb .neqv. cfg%model%dev(1)%law == law_coulomb)) then
+            call bad(deck, 'friction', 'law'//idx, "'"//trim(law(i))//"'", "'coulomb' for every device or "// &
+                     "for none (law(1) = '"//trim(law(1))//"'): the exact technique cannot be mixed with "// &
+                     "the regularized laws", error)
+            return
+         end if
          cfg%model%dev(i) = device_type(node_i=node_i(i), node_j=node_j(i), law=cfg%model%dev(i)%law, &
                                         p=p(i), mu=mu(i), eps=eps(i), eps1=eps1(i), f=f(i))
       end do

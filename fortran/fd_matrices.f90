@@ -9,7 +9,7 @@ module fd_matrices
    implicit none
    private
 
-   public :: stiffness_matrix, damping_matrix, stuck_first_mode
+   public :: stiffness_matrix, damping_matrix, stuck_first_mode, structure_matrices
 
    real(dp), parameter :: pi = acos(-1.0_dp)
 
@@ -104,6 +104,41 @@ contains
          end do
       end function find
    end subroutine stuck_first_mode
+
+   !> Springs' stiffness K and damping C of the model, with the stuck system's first period
+   !> and that mode's damping ratio phi' C phi / (2 w phi' M phi) (0 when undefined).
+   subroutine structure_matrices(model, k, c, period, xi, error)
+      type(model_type), intent(in) :: model               !! the model
+      real(dp), intent(out) :: k(:, :)                    !! K [N/m]
+      real(dp), intent(out) :: c(:, :)                    !! C [N s/m]
+      real(dp), intent(out) :: period                     !! stuck first period [s], 0 if none
+      real(dp), intent(out) :: xi                         !! its damping ratio
+      type(error_type), allocatable, intent(out) :: error !! 'stiffness' damping without a period
+      type(error_type), allocatable :: eig_error
+      real(dp), allocatable :: phi(:)
+      real(dp) :: t_damp
+
+      allocate (phi(model%n_dof))
+      call stiffness_matrix(model, k)
+      call stuck_first_mode(model, k, period, phi, eig_error)
+      ! the paper's psi = T xi / pi uses the given T, else the computed one
+      t_damp = period
+      if (model%damping == damping_stiffness .and. model%period > 0.0_dp) then
+         t_damp = model%period
+      else if (model%damping == damping_stiffness .and. allocated(eig_error)) then
+         call move_alloc(eig_error, error)
+         error%message = "&damping: damping_type = 'stiffness' needs the stuck first period, but "// &
+                         error%message
+         return
+      end if
+      call damping_matrix(model, k, t_damp, c)
+      xi = 0.0_dp
+      if (allocated(eig_error)) then
+         period = 0.0_dp
+      else
+         xi = dot_product(phi, matmul(c, phi))/(2.0_dp*(2.0_dp*pi/period)*sum(model%mass*phi**2))
+      end if
+   end subroutine structure_matrices
 
    !> Viscous damping matrix of the model.
    pure subroutine damping_matrix(model, k, period, c)

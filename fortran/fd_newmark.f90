@@ -13,17 +13,17 @@ module fd_newmark
    use, intrinsic :: ieee_arithmetic, only: ieee_is_finite
    use fd_kinds, only: dp
    use fd_error, only: error_type, fatal_error, fmt_real, fmt_int
-   use fd_model, only: model_type, integration_type, damping_stiffness
+   use fd_model, only: model_type, integration_type
    use fd_excitation, only: excitation_type, table_motion
-   use fd_matrices, only: stiffness_matrix, damping_matrix, stuck_first_mode
+   use fd_matrices, only: structure_matrices
    use fd_linalg, only: cholesky_factor, cholesky_solve, sym_matvec
    use fd_device_state, only: device_state, phase_stick, device_force
    use fd_friction, only: friction_init, friction_update, friction_correct
-   use fd_result, only: result_type, max_violation_times
+   use fd_result, only: result_type, max_violation_times, init_result, history_shape
    implicit none
    private
 
-   public :: run_newmark, history_shape
+   public :: run_newmark
 
    integer, parameter :: max_slots = 32              !! factors kept at most
    real(dp), parameter :: cache_bytes = 256.0e6_dp    !! memory the factors may take
@@ -73,7 +73,7 @@ contains
       call setup(model, halving_levels(dt2, res%dt_min), w, res, error)
       if (allocated(error)) return
       call history_shape(model, exc, opts, iout, nout, nsteps, every)
-      call allocate_history(model, nout, res)
+      call init_result(model, nout, res)
 
       ! initial state: devices from the initial conditions, acceleration from equilibrium
       w%u = model%u0
@@ -117,24 +117,6 @@ contains
       res%run_time = real(c1 - c0, dp)/real(max(crate, 1), dp)
    end subroutine run_newmark
 
-   !> Size of the history a run writes: columns t, ag, (u, v, aabs) per DOF and
-   !> (s, sdot, F, phase) per device; samples at t = 0, every `every` dt1 steps and at the end.
-   pure subroutine history_shape(model, exc, opts, ncol, nout, nsteps, every)
-      type(model_type), intent(in) :: model         !! the model
-      type(excitation_type), intent(in) :: exc      !! the table motion
-      type(integration_type), intent(in) :: opts    !! integration settings
-      integer, intent(out) :: ncol                  !! columns
-      integer, intent(out) :: nout                  !! samples
-      integer, intent(out) :: nsteps                !! dt1 steps of the run
-      integer, intent(out) :: every                 !! dt1 steps between samples
-
-      ncol = 2 + 3*model%n_dof + 4*model%n_devices
-      nsteps = max(1, nint(exc%duration/(exc%dt_record/opts%n1)))
-      every = opts%output_every
-      if (every <= 0) every = opts%n1
-      nout = nsteps/every + 1 + merge(1, 0, mod(nsteps, every) /= 0)
-   end subroutine history_shape
-
    !> Number of halvings from sub down to dt_min.
    pure integer function halving_levels(sub, dt_min) result(lmax)
       real(dp), intent(in) :: sub, dt_min
@@ -145,7 +127,7 @@ contains
       end do
    end function halving_levels
 
-   !> Matrices, workspace, stuck-system period and damping. The factor cache holds the
+   !> Matrices and workspace. The factor cache holds the
    !> step sizes dt1, dt2, dt2/2, ... dt_min with two phase patterns each when memory allows.
    subroutine setup(model, lmax, w, res, error)
       type(model_type), intent(in) :: model
@@ -153,9 +135,6 @@ contains
       type(workspace), intent(inout) :: w
       type(result_type), intent(inout) :: res
       type(error_type), allocatable, intent(out) :: error
-      type(error_type), allocatable :: eig_error
-      real(dp), allocatable :: cphi(:), phi(:)
-      real(dp) :: period, t_damp
       integer :: n, nd, i, n_slots
 
       n = model%n_dof
@@ -163,27 +142,9 @@ contains
       w%n = n
       w%nd = nd
       w%mass = model%mass
-      allocate (w%k(n, n), w%c(n, n), phi(n), cphi(n))
-      call stiffness_matrix(model, w%k)
-      call stuck_first_mode(model, w%k, period, phi, eig_error)
-      ! the paper's psi = T xi / pi uses the given T, else the computed one
-      t_damp = period
-      if (model%damping == damping_stiffness .and. model%period > 0.0_dp) then
-         t_damp = model%period
-      else if (model%damping == damping_stiffness .and. allocated(eig_error)) then
-         call move_alloc(eig_error, error)
-         error%message = "&damping: damping_type = 'stiffness' needs the stuck first period, but "// &
-                         error%message
-         return
-      end if
-      call damping_matrix(model, w%k, t_damp, w%c)
-      if (.not. allocated(eig_error)) then
-         ! damping ratio of the stuck first mode: phi' C phi / (2 w phi' M phi)
-         res%period_stuck = period
-         cphi = matmul(w%c, phi)
-         res%xi_stuck = dot_product(phi, cphi)/(2.0_dp*(2.0_dp*acos(-1.0_dp)/period)* &
-                                                  sum(model%mass*phi**2))
-      end if
+      allocate (w%k(n, n), w%c(n, n))
+      call structure_matrices(model, w%k, w%c, res%period_stuck, res%xi_stuck, error)
+      if (allocated(error)) return
       allocate (w%u(n), w%v(n), w%a(n), w%u1(n), w%v1(n), w%a1(n), w%rhs(n), w%tmp(n))
       allocate (w%s(nd), w%sd(nd), w%s1(nd), w%sd1(nd), w%st(nd), w%st1(nd))
       allocate (w%changed(nd), w%ok(nd), w%stuck(nd))
@@ -195,45 +156,6 @@ contains
       end do
    end subroutine setup
 
-   subroutine allocate_history(model, nout, res)
-      type(model_type), intent(in) :: model
-      integer, intent(in) :: nout
-      type(result_type), intent(inout) :: res
-      integer :: n, nd, i, c
-
-      n = model%n_dof
-      nd = model%n_devices
-      res%n_dof = n
-      res%n_devices = nd
-      res%ncol = 2 + 3*n + 4*nd   ! as in history_shape
-      res%nout = nout
-      allocate (res%hist(res%ncol, nout), res%names(res%ncol), res%units(res%ncol))
-      res%hist = 0.0_dp
-      res%names(1) = 't'; res%units(1) = 's'
-      res%names(2) = 'ag'; res%units(2) = 'm/s2'
-      c = 2
-      do i = 1, n
-         res%names(c + 1) = 'u'//fmt_int(i); res%units(c + 1) = 'm'
-         res%names(c + 2) = 'v'//fmt_int(i); res%units(c + 2) = 'm/s'
-         res%names(c + 3) = 'aabs'//fmt_int(i); res%units(c + 3) = 'm/s2'
-         c = c + 3
-      end do
-      do i = 1, nd
-         res%names(c + 1) = 's'//fmt_int(i); res%units(c + 1) = 'm'
-         res%names(c + 2) = 'sdot'//fmt_int(i); res%units(c + 2) = 'm/s'
-         res%names(c + 3) = 'F'//fmt_int(i); res%units(c + 3) = 'N'
-         res%names(c + 4) = 'phase'//fmt_int(i); res%units(c + 4) = '-'
-         c = c + 4
-      end do
-      allocate (res%peak_u(n), res%peak_u_time(n), res%peak_v(n), res%peak_aabs(n), &
-                res%peak_aabs_time(n))
-      res%peak_u = 0.0_dp; res%peak_u_time = 0.0_dp; res%peak_v = 0.0_dp
-      res%peak_aabs = 0.0_dp; res%peak_aabs_time = 0.0_dp
-      allocate (res%peak_s(nd), res%peak_force(nd), res%stick_to_slip(nd), &
-                res%slip_to_stick(nd), res%reversals(nd))
-      res%peak_s = 0.0_dp; res%peak_force = 0.0_dp
-      res%stick_to_slip = 0; res%slip_to_stick = 0; res%reversals = 0
-   end subroutine allocate_history
 
    !> Relative displacement and velocity of every device.
    pure subroutine device_kinematics(model, u, v, s, sd)

@@ -194,6 +194,7 @@ contains
       js = js//kv('slip_reversals', ints(res%reversals))
       js = js//kv('steps_dt1', fmt_int(res%steps_dt1))//kv('steps_dt2', fmt_int(res%steps_dt2))
       js = js//kv('steps_finer', fmt_int(res%steps_finer))//kv('factorizations', fmt_int(res%factorizations))
+      js = js//kv('events', fmt_int(res%events))
       js = js//kv('correctness_violations', fmt_int(res%violations))
       js = js//kv('violation_times_s', reals(res%violation_time(1:res%n_violation_times)))
       js = js//kv('violation_devices', ints(res%violation_device(1:res%n_violation_times)))

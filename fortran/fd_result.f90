@@ -2,10 +2,13 @@
 !> phase transitions, correctness violations, energy balance).
 module fd_result
    use fd_kinds, only: dp
+   use fd_error, only: fmt_int
+   use fd_model, only: model_type, integration_type
+   use fd_excitation, only: excitation_type
    implicit none
    private
 
-   public :: result_type, max_violation_times, column_name_len
+   public :: result_type, max_violation_times, column_name_len, init_result, history_shape
 
    integer, parameter :: max_violation_times = 10 !! first violation times kept
    integer, parameter :: column_name_len = 16     !! length of a column name
@@ -42,6 +45,8 @@ module fd_result
       integer :: steps_dt2 = 0         !! steps taken with dt2
       integer :: steps_finer = 0       !! steps taken with dt2/2, dt2/4, ...
       integer :: factorizations = 0    !! factorizations of the effective stiffness
+                                       !! (exact technique: matrix exponentials)
+      integer :: events = 0            !! events located (exact technique)
       ! correctness condition, eqs. 9 and 12
       integer :: violations = 0        !! steps accepted that violate it
       integer :: n_violation_times = 0 !! entries used in violation_time
@@ -57,5 +62,66 @@ module fd_result
       real(dp) :: e_residual = 0.0_dp  !! input - (kinetic + strain + viscous + friction + device)
       real(dp) :: run_time = 0.0_dp    !! wall-clock time of the integration [s]
    end type result_type
+
+contains
+
+   !> Size of the history a run writes: columns t, ag, (u, v, aabs) per DOF and
+   !> (s, sdot, F, phase) per device; samples at t = 0, every `every` dt1 steps and at the end.
+   pure subroutine history_shape(model, exc, opts, ncol, nout, nsteps, every)
+      type(model_type), intent(in) :: model         !! the model
+      type(excitation_type), intent(in) :: exc      !! the table motion
+      type(integration_type), intent(in) :: opts    !! integration settings
+      integer, intent(out) :: ncol                  !! columns
+      integer, intent(out) :: nout                  !! samples
+      integer, intent(out) :: nsteps                !! dt1 steps of the run
+      integer, intent(out) :: every                 !! dt1 steps between samples
+
+      ncol = 2 + 3*model%n_dof + 4*model%n_devices
+      nsteps = max(1, nint(exc%duration/(exc%dt_record/opts%n1)))
+      every = opts%output_every
+      if (every <= 0) every = opts%n1
+      nout = nsteps/every + 1 + merge(1, 0, mod(nsteps, every) /= 0)
+   end subroutine history_shape
+
+   !> Allocate the history and the per-DOF and per-device summary of a run.
+   subroutine init_result(model, nout, res)
+      type(model_type), intent(in) :: model     !! the model run
+      integer, intent(in) :: nout               !! samples of the history
+      type(result_type), intent(inout) :: res   !! the result to set up
+      integer :: n, nd, i, c
+
+      n = model%n_dof
+      nd = model%n_devices
+      res%n_dof = n
+      res%n_devices = nd
+      res%ncol = 2 + 3*n + 4*nd   ! as in history_shape
+      res%nout = nout
+      allocate (res%hist(res%ncol, nout), res%names(res%ncol), res%units(res%ncol))
+      res%hist = 0.0_dp
+      res%names(1) = 't'; res%units(1) = 's'
+      res%names(2) = 'ag'; res%units(2) = 'm/s2'
+      c = 2
+      do i = 1, n
+         res%names(c + 1) = 'u'//fmt_int(i); res%units(c + 1) = 'm'
+         res%names(c + 2) = 'v'//fmt_int(i); res%units(c + 2) = 'm/s'
+         res%names(c + 3) = 'aabs'//fmt_int(i); res%units(c + 3) = 'm/s2'
+         c = c + 3
+      end do
+      do i = 1, nd
+         res%names(c + 1) = 's'//fmt_int(i); res%units(c + 1) = 'm'
+         res%names(c + 2) = 'sdot'//fmt_int(i); res%units(c + 2) = 'm/s'
+         res%names(c + 3) = 'F'//fmt_int(i); res%units(c + 3) = 'N'
+         res%names(c + 4) = 'phase'//fmt_int(i); res%units(c + 4) = '-'
+         c = c + 4
+      end do
+      allocate (res%peak_u(n), res%peak_u_time(n), res%peak_v(n), res%peak_aabs(n), &
+                res%peak_aabs_time(n))
+      res%peak_u = 0.0_dp; res%peak_u_time = 0.0_dp; res%peak_v = 0.0_dp
+      res%peak_aabs = 0.0_dp; res%peak_aabs_time = 0.0_dp
+      allocate (res%peak_s(nd), res%peak_force(nd), res%stick_to_slip(nd), &
+                res%slip_to_stick(nd), res%reversals(nd))
+      res%peak_s = 0.0_dp; res%peak_force = 0.0_dp
+      res%stick_to_slip = 0; res%slip_to_stick = 0; res%reversals = 0
+   end subroutine init_result
 
 end module fd_result
