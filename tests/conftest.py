@@ -6,10 +6,9 @@ import subprocess
 from dataclasses import dataclass
 from pathlib import Path
 
+import frictiondyn
 import numpy as np
 import pytest
-
-import frictiondyn
 
 INPUTS = Path(__file__).resolve().parent.parent / "inputs"
 
@@ -60,8 +59,13 @@ def paper_groups(test: int = 4, law: str = "velocity", **friction) -> dict[str, 
         "springs": {"n_springs": 2, "node_i": [1, 2], "node_j": [0, 0], "k": [K1, K2]},
         "damping": {"damping_type": "stiffness", "xi": 0.015},
         "friction": fr,
-        "excitation": {"excitation_type": "harmonic", "amplitude": amp, "frequency": freq,
-                       "dt_record": dtr, "duration": 40.0},
+        "excitation": {
+            "excitation_type": "harmonic",
+            "amplitude": amp,
+            "frequency": freq,
+            "dt_record": dtr,
+            "duration": 40.0,
+        },
         "integration": {"n1": 20, "n2": 50, "n": 10},
     }
 
@@ -86,8 +90,9 @@ class Run:
 
 
 def run_deck_file(deck: Path, workdir: Path) -> Run:
-    proc = subprocess.run([frictiondyn.executable(), str(deck)], cwd=workdir,
-                          capture_output=True, text=True)
+    proc = subprocess.run(
+        [frictiondyn.executable(), str(deck)], cwd=workdir, capture_output=True, text=True
+    )
     return Run(proc.returncode, proc.stdout, proc.stderr, workdir, deck.stem)
 
 

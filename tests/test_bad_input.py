@@ -17,12 +17,14 @@ def modified(change):
 def _set(group, var, value):
     def change(g):
         g[group][var] = value
+
     return change
 
 
 def _drop(group):
     def change(g):
         del g[group]
+
     return change
 
 
@@ -35,12 +37,20 @@ CASES = [
     ("beta > 1/2", _set("integration", "beta", 0.6), ["&integration", "beta", "0.6"]),
     ("beta = 0", _set("integration", "beta", 0.0), ["&integration", "beta", "= 0 "]),
     ("gamma < 1/2", _set("integration", "gamma", 0.3), ["&integration", "gamma", "0.3"]),
-    ("spring to a missing DOF", _set("springs", "node_j", [0, 3]), ["&springs", "node_j(2)", "= 3 "]),
+    (
+        "spring to a missing DOF",
+        _set("springs", "node_j", [0, 3]),
+        ["&springs", "node_j(2)", "= 3 "],
+    ),
     ("spring to itself", _set("springs", "node_j", [0, 2]), ["&springs", "node_j(2)", "= 2 "]),
     ("negative stiffness", _set("springs", "k", [1084.0, -5.0]), ["&springs", "k(2)", "-5"]),
     ("NaN mass", _set("model", "mass", [float("nan"), 2.53]), ["&model", "mass(1)", "NaN"]),
     ("too many masses", _set("model", "mass", [1.0, 2.0, 3.0]), ["&model", "mass(3)", "3.0"]),
-    ("unknown damping", _set("damping", "damping_type", "modal"), ["&damping", "damping_type", "modal"]),
+    (
+        "unknown damping",
+        _set("damping", "damping_type", "modal"),
+        ["&damping", "damping_type", "modal"],
+    ),
     ("xi >= 1", _set("damping", "xi", 1.5), ["&damping", "xi", "1.5"]),
     ("zero frequency", _set("excitation", "frequency", 0.0), ["&excitation", "frequency", "= 0 "]),
     ("negative duration", _set("excitation", "duration", -1.0), ["&excitation", "duration", "-1"]),
@@ -84,17 +94,35 @@ def test_good_deck_of_the_same_family_runs(run):
 
 
 TEXT_CASES = [
-    ("misspelled variable", ("  n1 = 20", "  nn1 = 20"), ["&integration", "line", "nn1", "20", "unknown"]),
+    (
+        "misspelled variable",
+        ("  n1 = 20", "  nn1 = 20"),
+        ["&integration", "line", "nn1", "20", "unknown"],
+    ),
     ("wrong-typed integer", ("  n1 = 20", "  n1 = 2.5x"), ["&integration", "n1", "2.5x"]),
     ("string for a number", ("  n1 = 20", "  n1 = 'twenty'"), ["&integration", "n1", "twenty"]),
-    ("number for a logical", ("  n = 10", "  check_correctness = 7"), ["&integration", "check_correctness", "7"]),
+    (
+        "number for a logical",
+        ("  n = 10", "  check_correctness = 7"),
+        ["&integration", "check_correctness", "7"],
+    ),
     ("unknown group", ("&springs", "&spring"), ["&spring", "unknown group", "line"]),
-    ("unclosed group", ("  duration = 0.5\n/", "  duration = 0.5\n"), ["&excitation", "not closed"]),
-    ("repeated group", ("&output", "&model\n  n_dof = 2\n/\n&output"), ["&model", "more than once"]),
+    (
+        "unclosed group",
+        ("  duration = 0.5\n/", "  duration = 0.5\n"),
+        ["&excitation", "not closed"],
+    ),
+    (
+        "repeated group",
+        ("&output", "&model\n  n_dof = 2\n/\n&output"),
+        ["&model", "more than once"],
+    ),
 ]
 
 
-@pytest.mark.parametrize("old_new, words", [c[1:] for c in TEXT_CASES], ids=[c[0] for c in TEXT_CASES])
+@pytest.mark.parametrize(
+    "old_new, words", [c[1:] for c in TEXT_CASES], ids=[c[0] for c in TEXT_CASES]
+)
 def test_malformed_deck(run, old_new, words):
     groups = modified(lambda g: None)
     groups["output"] = {"dir": "out"}
@@ -108,7 +136,10 @@ def test_missing_deck_file(tmp_path):
     import subprocess
 
     import frictiondyn
-    r = subprocess.run([frictiondyn.executable(), "nope.nml"], cwd=tmp_path, capture_output=True, text=True)
+
+    r = subprocess.run(
+        [frictiondyn.executable(), "nope.nml"], cwd=tmp_path, capture_output=True, text=True
+    )
     assert r.returncode != 0
     assert "nope.nml" in r.stderr and "does not exist" in r.stderr
     assert list(tmp_path.iterdir()) == []
@@ -120,13 +151,16 @@ def record_deck():
     return g
 
 
-@pytest.mark.parametrize("text, words", [
-    ("0.0\n0.1\nnan\n0.2\n", ["rec.txt", "line 3", "nan", "not finite"]),
-    ("0.0\n0.1\n0.1x\n0.2\n", ["rec.txt", "line 3", "0.1x", "not a number"]),
-    ("0.0\n0.1\n# comment\n0.2 0.3\n", ["rec.txt", "line 4", "column"]),
-    ("0.00 0.0\n0.01 0.1\n0.03 0.2\n", ["rec.txt", "line 3", "0.03", "dt_record"]),
-    ("0.5\n", ["rec.txt", "1 samples"]),
-])
+@pytest.mark.parametrize(
+    "text, words",
+    [
+        ("0.0\n0.1\nnan\n0.2\n", ["rec.txt", "line 3", "nan", "not finite"]),
+        ("0.0\n0.1\n0.1x\n0.2\n", ["rec.txt", "line 3", "0.1x", "not a number"]),
+        ("0.0\n0.1\n# comment\n0.2 0.3\n", ["rec.txt", "line 4", "column"]),
+        ("0.00 0.0\n0.01 0.1\n0.03 0.2\n", ["rec.txt", "line 3", "0.03", "dt_record"]),
+        ("0.5\n", ["rec.txt", "1 samples"]),
+    ],
+)
 def test_bad_record(run, text, words):
     assert_rejected(run(record_deck(), files={"rec.txt": text}), ["&excitation"] + words)
 

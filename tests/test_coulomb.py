@@ -4,7 +4,7 @@ from __future__ import annotations
 
 import numpy as np
 import pytest
-from conftest import G, K1, K2, M1, M2, TABLE1, ok, paper_groups
+from conftest import K1, K2, M1, M2, TABLE1, G, ok, paper_groups
 
 
 def linear_response(m, k, c, amp, freq, t):
@@ -22,7 +22,9 @@ def linear_response(m, k, c, amp, freq, t):
     xp = np.imag(np.outer(np.exp(1j * w * t), big_x))
     lam, vec = np.linalg.eig(a)
     coef = np.linalg.solve(vec, -xp[0].astype(complex))
-    xh = np.real((vec[None, :, :] * (np.exp(np.outer(t, lam))[:, None, :] * coef[None, None, :])).sum(axis=2))
+    xh = np.real(
+        (vec[None, :, :] * (np.exp(np.outer(t, lam))[:, None, :] * coef[None, None, :])).sum(axis=2)
+    )
     return xh + xp
 
 
@@ -93,16 +95,32 @@ def test_den_hartog_non_stop_steady_state_to_1e6(run, r, ratio):
     t0 = np.array([0.0])
     x0, v0, amplitude = den_hartog(t0, m, k, ff, f0, w)
     cycles = 6
-    r_ = ok(run({
-        "model": {"n_dof": 1, "mass": [m], "u0": [float(x0[0])], "v0": [float(v0[0])]},
-        "springs": {"n_springs": 1, "node_i": [1], "node_j": [0], "k": [k]},
-        "damping": {"damping_type": "none"},
-        "friction": {"n_devices": 1, "node_i": 1, "node_j": 0, "law": "coulomb", "p": ff, "mu": 1.0},
-        "excitation": {"excitation_type": "harmonic", "amplitude": amp, "frequency": w / (2 * np.pi),
-                       "dt_record": 0.01, "duration": cycles * 2 * np.pi / w},
-        "integration": {"n1": 10},
-        "output": {"output_every": 1},
-    }))
+    r_ = ok(
+        run(
+            {
+                "model": {"n_dof": 1, "mass": [m], "u0": [float(x0[0])], "v0": [float(v0[0])]},
+                "springs": {"n_springs": 1, "node_i": [1], "node_j": [0], "k": [k]},
+                "damping": {"damping_type": "none"},
+                "friction": {
+                    "n_devices": 1,
+                    "node_i": 1,
+                    "node_j": 0,
+                    "law": "coulomb",
+                    "p": ff,
+                    "mu": 1.0,
+                },
+                "excitation": {
+                    "excitation_type": "harmonic",
+                    "amplitude": amp,
+                    "frequency": w / (2 * np.pi),
+                    "dt_record": 0.01,
+                    "duration": cycles * 2 * np.pi / w,
+                },
+                "integration": {"n1": 10},
+                "output": {"output_every": 1},
+            }
+        )
+    )
     h, s = r_.history(), r_.summary()
     x, v, _ = den_hartog(h["t"], m, k, ff, f0, w)
     assert np.max(np.abs(h["u1"] - x)) < 1e-6 * amplitude
@@ -115,22 +133,35 @@ def test_den_hartog_non_stop_steady_state_to_1e6(run, r, ratio):
 def test_block_stops_exactly(run):
     """A block thrown at v0 on the table stops at v0^2 / (2 mu g) at t = v0 / (mu g)."""
     mu, v0, m = 0.3, 0.5, 2.0
-    r = ok(run({
-        "model": {"n_dof": 1, "mass": [m], "v0": [v0]},
-        "springs": {"n_springs": 0},
-        "damping": {"damping_type": "none"},
-        "friction": {"n_devices": 1, "node_i": 1, "node_j": 0, "law": "coulomb", "p": m * G, "mu": mu},
-        "excitation": {"excitation_type": "none", "dt_record": 0.001, "duration": 0.4},
-        "integration": {"n1": 7},
-        "output": {"output_every": 1},
-    }))
+    r = ok(
+        run(
+            {
+                "model": {"n_dof": 1, "mass": [m], "v0": [v0]},
+                "springs": {"n_springs": 0},
+                "damping": {"damping_type": "none"},
+                "friction": {
+                    "n_devices": 1,
+                    "node_i": 1,
+                    "node_j": 0,
+                    "law": "coulomb",
+                    "p": m * G,
+                    "mu": mu,
+                },
+                "excitation": {"excitation_type": "none", "dt_record": 0.001, "duration": 0.4},
+                "integration": {"n1": 7},
+                "output": {"output_every": 1},
+            }
+        )
+    )
     h, s = r.history(), r.summary()
     d, t_stop = v0**2 / (2 * mu * G), v0 / (mu * G)
     after = h["t"] > t_stop
     assert np.allclose(h["u1"][after], d, rtol=1e-12)
     assert np.all(h["v1"][after] == 0.0)
     before = ~after
-    assert np.allclose(h["u1"][before], v0 * h["t"][before] - 0.5 * mu * G * h["t"][before] ** 2, rtol=1e-12)
+    assert np.allclose(
+        h["u1"][before], v0 * h["t"][before] - 0.5 * mu * G * h["t"][before] ** 2, rtol=1e-12
+    )
     assert s["slip_to_stick"] == [1] and s["stick_to_slip"] == [0]
     # all the kinetic energy went into friction
     assert s["energy_friction_J"] == pytest.approx(0.5 * m * v0**2, rel=1e-12)
@@ -155,7 +186,14 @@ def test_record_input_is_exact_for_piecewise_linear_acceleration(run):
         "model": {"n_dof": 2, "mass": [M1, M2]},
         "springs": {"n_springs": 2, "node_i": [1, 2], "node_j": [0, 0], "k": [K1, K2]},
         "damping": {"damping_type": "rayleigh", "rayleigh_a0": 0.3, "rayleigh_a1": 0.001},
-        "friction": {"n_devices": 1, "node_i": 1, "node_j": 2, "law": "coulomb", "p": 0.0, "mu": 0.2},
+        "friction": {
+            "n_devices": 1,
+            "node_i": 1,
+            "node_j": 2,
+            "law": "coulomb",
+            "p": 0.0,
+            "mu": 0.2,
+        },
         "excitation": {"excitation_type": "record", "record_file": "acc.txt", "dt_record": 0.01},
         "integration": {"n1": 1},
         "output": {"output_every": 1},
@@ -163,8 +201,12 @@ def test_record_input_is_exact_for_piecewise_linear_acceleration(run):
     exact = ok(run(base, files={"acc.txt": text})).history()
     errs = []
     for n1 in (4, 8):
-        g = dict(base, friction={**base["friction"], "law": "velocity"},
-                 integration={"n1": n1}, output={"output_every": n1})
+        g = dict(
+            base,
+            friction={**base["friction"], "law": "velocity"},
+            integration={"n1": n1},
+            output={"output_every": n1},
+        )
         nm = ok(run(g, files={"acc.txt": text})).history()
         errs.append(np.max(np.abs(nm["u1"] - exact["u1"])) / np.max(np.abs(exact["u1"])))
     # Newmark converges to the exact first-order-hold solution at second order
@@ -175,7 +217,13 @@ def test_record_input_is_exact_for_piecewise_linear_acceleration(run):
 
 def test_coulomb_cannot_be_mixed(run):
     g = paper_groups(4, "coulomb")
-    g["friction"] = {"n_devices": 2, "node_i": [1, 2], "node_j": [2, 0], "law": ["coulomb", "velocity"],
-                     "p": [61.81, 10.0], "mu": [0.22, 0.2]}
+    g["friction"] = {
+        "n_devices": 2,
+        "node_i": [1, 2],
+        "node_j": [2, 0],
+        "law": ["coulomb", "velocity"],
+        "p": [61.81, 10.0],
+        "mu": [0.22, 0.2],
+    }
     r = run(g)
     assert r.returncode != 0 and "law(2)" in r.stderr and "coulomb" in r.stderr

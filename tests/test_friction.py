@@ -5,7 +5,19 @@ from __future__ import annotations
 
 import numpy as np
 import pytest
-from conftest import G, INPUTS, K1, K2, M1, M2, TABLE1, ok, paper_groups, run_deck_file, steady_amplitude
+from conftest import (
+    INPUTS,
+    K1,
+    K2,
+    M1,
+    M2,
+    TABLE1,
+    G,
+    ok,
+    paper_groups,
+    run_deck_file,
+    steady_amplitude,
+)
 
 LAWS = ["velocity", "hysteretic"]
 EPS, F_STICK = 1e-3, 1e-5
@@ -17,8 +29,17 @@ def block(law, mu=0.3, m=2.0, excitation=None, v0=0.0, **integration):
         "model": {"n_dof": 1, "mass": [m], "v0": [v0]},
         "springs": {"n_springs": 0},
         "damping": {"damping_type": "none"},
-        "friction": {"n_devices": 1, "node_i": 1, "node_j": 0, "law": law, "p": m * G, "mu": mu,
-                     "eps": EPS, "eps1": EPS, "f": F_STICK},
+        "friction": {
+            "n_devices": 1,
+            "node_i": 1,
+            "node_j": 0,
+            "law": law,
+            "p": m * G,
+            "mu": mu,
+            "eps": EPS,
+            "eps1": EPS,
+            "f": F_STICK,
+        },
         "excitation": excitation,
         "integration": {"n1": 10, "n2": 50, **integration},
         "output": {"output_every": 1},
@@ -30,9 +51,22 @@ def block(law, mu=0.3, m=2.0, excitation=None, v0=0.0, **integration):
 def test_block_sticks_below_mu_g_and_slides_above(run, law, ratio):
     mu, freq = 0.3, 2.0
     amp = ratio * mu * G / (2 * np.pi * freq) ** 2  # peak table acceleration = ratio mu g
-    r = ok(run(block(law, mu, excitation={"excitation_type": "harmonic", "amplitude": amp,
-                                           "frequency": freq, "ramp_cycles": 2,
-                                           "dt_record": 0.002, "duration": 4.0})))
+    r = ok(
+        run(
+            block(
+                law,
+                mu,
+                excitation={
+                    "excitation_type": "harmonic",
+                    "amplitude": amp,
+                    "frequency": freq,
+                    "ramp_cycles": 2,
+                    "dt_record": 0.002,
+                    "duration": 4.0,
+                },
+            )
+        )
+    )
     s, h = r.summary(), r.history()
     if ratio < 1:
         assert s["stick_to_slip"] == [0]
@@ -58,8 +92,16 @@ def test_block_sticks_below_mu_g_and_slides_above(run, law, ratio):
 @pytest.mark.parametrize("law", LAWS)
 def test_block_with_initial_velocity_stops_where_the_closed_form_says(run, law):
     mu, v0 = 0.3, 0.5
-    r = ok(run(block(law, mu, v0=v0,
-                     excitation={"excitation_type": "none", "dt_record": 0.001, "duration": 0.4})))
+    r = ok(
+        run(
+            block(
+                law,
+                mu,
+                v0=v0,
+                excitation={"excitation_type": "none", "dt_record": 0.001, "duration": 0.4},
+            )
+        )
+    )
     h, s = r.history(), r.summary()
     t, x, v, a = h["t"], h["u1"], h["v1"], h["aabs1"]
     d, t_stop = v0**2 / (2 * mu * G), v0 / (mu * G)
@@ -94,11 +136,23 @@ def test_hysteretic_loop_area_is_4_p_mu_d_minus_f(run):
     big, freq, d2 = 1e6, 0.5, 0.01
     groups = {
         "model": {"n_dof": 2, "mass": [1.0, big], "u0": [d2, d2]},
-        "springs": {"n_springs": 2, "node_i": [2, 1], "node_j": [0, 2],
-                    "k": [big * (2 * np.pi * freq) ** 2, 1e5]},
+        "springs": {
+            "n_springs": 2,
+            "node_i": [2, 1],
+            "node_j": [0, 2],
+            "k": [big * (2 * np.pi * freq) ** 2, 1e5],
+        },
         "damping": {"damping_type": "rayleigh", "rayleigh_a1": 2e-4},
-        "friction": {"n_devices": 1, "node_i": 1, "node_j": 0, "law": "hysteretic", "p": pmu,
-                     "mu": 1.0, "f": f, "eps1": 1e-3},
+        "friction": {
+            "n_devices": 1,
+            "node_i": 1,
+            "node_j": 0,
+            "law": "hysteretic",
+            "p": pmu,
+            "mu": 1.0,
+            "f": f,
+            "eps1": 1e-3,
+        },
         "excitation": {"excitation_type": "none", "dt_record": 1e-3, "duration": 2.0 / freq},
         "integration": {"n1": 10, "n2": 20},
         "output": {"output_every": 1},
@@ -208,8 +262,11 @@ def test_fig3_coarse_deck_fails_and_the_corrected_one_agrees_with_the_velocity_l
 
 
 def test_correctness_check_refines_the_coarse_deck(tmp_path):
-    text = (INPUTS / "fig3_coarse.nml").read_text().replace("check_correctness = .false.",
-                                                            "check_correctness = .true.")
+    text = (
+        (INPUTS / "fig3_coarse.nml")
+        .read_text()
+        .replace("check_correctness = .false.", "check_correctness = .true.")
+    )
     deck = tmp_path / "fig3_checked.nml"
     deck.write_text(text)
     r = run_deck_file(deck, tmp_path)
@@ -234,8 +291,13 @@ def test_energy_balance_of_newmark_runs(run, law):
     """Average acceleration: input = kinetic + strain + viscous + friction (+ stored), to round-off."""
     s = ok(run(paper_groups(4, law))).summary()
     total = s["energy_input_J"]
-    parts = (s["energy_kinetic_J"] + s["energy_strain_J"] + s["energy_viscous_J"]
-             + s["energy_friction_J"] + s["energy_device_elastic_J"])
+    parts = (
+        s["energy_kinetic_J"]
+        + s["energy_strain_J"]
+        + s["energy_viscous_J"]
+        + s["energy_friction_J"]
+        + s["energy_device_elastic_J"]
+    )
     assert total > 10
     assert s["energy_friction_J"] > 0.5 * total  # friction dissipates most of it (test 4)
     assert abs(total - parts) < 1e-8 * total
@@ -246,12 +308,29 @@ def chain3(law, p):
     m = [3.0, 2.0, 1.5]
     return {
         "model": {"n_dof": 3, "mass": m},
-        "springs": {"n_springs": 3, "node_i": [1, 2, 3], "node_j": [0, 1, 2], "k": [3000.0, 1200.0, 900.0]},
+        "springs": {
+            "n_springs": 3,
+            "node_i": [1, 2, 3],
+            "node_j": [0, 1, 2],
+            "k": [3000.0, 1200.0, 900.0],
+        },
         "damping": {"damping_type": "rayleigh", "rayleigh_a0": 0.3, "rayleigh_a1": 0.001},
-        "friction": {"n_devices": 2, "node_i": [2, 3], "node_j": [1, 2], "law": [law, law],
-                     "p": p, "mu": [0.2, 0.2]},
-        "excitation": {"excitation_type": "harmonic", "amplitude": 0.01, "frequency": 3.0,
-                       "ramp_cycles": 3, "dt_record": 0.005, "duration": 30.0},
+        "friction": {
+            "n_devices": 2,
+            "node_i": [2, 3],
+            "node_j": [1, 2],
+            "law": [law, law],
+            "p": p,
+            "mu": [0.2, 0.2],
+        },
+        "excitation": {
+            "excitation_type": "harmonic",
+            "amplitude": 0.01,
+            "frequency": 3.0,
+            "ramp_cycles": 3,
+            "dt_record": 0.005,
+            "duration": 30.0,
+        },
         "integration": {"n1": 20, "n2": 50},
         "output": {"output_every": 1},
     }
@@ -278,4 +357,6 @@ def test_two_locked_devices_equal_the_rigid_chain(run, law):
     c = g["damping"]["rayleigh_a0"] * m + g["damping"]["rayleigh_a1"] * k
     expected = rigid_1dof_aabs(m, k, c, 0.01, 3.0)
     for i in (1, 2, 3):
-        assert steady_amplitude(h["t"], h[f"aabs{i}"], 3.0, cycles=20) == pytest.approx(expected, rel=5e-3)
+        assert steady_amplitude(h["t"], h[f"aabs{i}"], 3.0, cycles=20) == pytest.approx(
+            expected, rel=5e-3
+        )

@@ -74,12 +74,21 @@ def closed_form_aabs(masses, stiffnesses, c, amp, freq):
 @pytest.mark.parametrize(
     "masses, stiffnesses, damping",
     [
-        ([6.301, 2.530], [4000.0, 2895.0], {"damping_type": "rayleigh", "rayleigh_a0": 0.4,
-                                            "rayleigh_a1": 0.002}),
-        ([3.0, 2.5, 2.0, 1.5, 1.0], [9000.0, 7000.0, 5000.0, 3000.0, 1500.0],
-         {"damping_type": "rayleigh", "rayleigh_a0": 0.5, "rayleigh_a1": 0.001}),
-        ([3.0, 2.5, 2.0, 1.5, 1.0], [9000.0, 7000.0, 5000.0, 3000.0, 1500.0],
-         {"damping_type": "stiffness", "xi": 0.05}),
+        (
+            [6.301, 2.530],
+            [4000.0, 2895.0],
+            {"damping_type": "rayleigh", "rayleigh_a0": 0.4, "rayleigh_a1": 0.002},
+        ),
+        (
+            [3.0, 2.5, 2.0, 1.5, 1.0],
+            [9000.0, 7000.0, 5000.0, 3000.0, 1500.0],
+            {"damping_type": "rayleigh", "rayleigh_a0": 0.5, "rayleigh_a1": 0.001},
+        ),
+        (
+            [3.0, 2.5, 2.0, 1.5, 1.0],
+            [9000.0, 7000.0, 5000.0, 3000.0, 1500.0],
+            {"damping_type": "stiffness", "xi": 0.05},
+        ),
     ],
 )
 def test_chain_steady_state_matches_frequency_response(run, masses, stiffnesses, damping):
@@ -87,19 +96,34 @@ def test_chain_steady_state_matches_frequency_response(run, masses, stiffnesses,
     n = len(masses)
     freq, amp, dt_r = 3.3, 0.004, 0.005
     model, springs = chain(n, masses, stiffnesses)
-    r = ok(run({
-        "model": model, "springs": springs, "damping": damping,
-        "excitation": {"excitation_type": "harmonic", "amplitude": amp, "frequency": freq,
-                       "ramp_cycles": 3, "dt_record": dt_r, "duration": 60.0},
-        "integration": {"n1": 20},
-    }))
+    r = ok(
+        run(
+            {
+                "model": model,
+                "springs": springs,
+                "damping": damping,
+                "excitation": {
+                    "excitation_type": "harmonic",
+                    "amplitude": amp,
+                    "frequency": freq,
+                    "ramp_cycles": 3,
+                    "dt_record": dt_r,
+                    "duration": 60.0,
+                },
+                "integration": {"n1": 20},
+            }
+        )
+    )
     h, s = r.history(), r.summary()
     if damping["damping_type"] == "rayleigh":
+
         def c(m, k):
             return damping["rayleigh_a0"] * m + damping["rayleigh_a1"] * k
     else:
+
         def c(m, k):
             return s["period_stuck_s"] * damping["xi"] / np.pi * k
+
     expected = closed_form_aabs(masses, stiffnesses, c, amp, freq)
     for i in range(n):
         got = steady_amplitude(h["t"], h[f"aabs{i + 1}"], freq, cycles=20)
@@ -125,13 +149,24 @@ def test_stuck_period_with_a_device_to_the_table(run):
     m = [2.0, 1.0, 1.5, 0.5]
     k = [800.0, 600.0, 400.0, 300.0]
     model, springs = chain(4, m, k)
-    r = ok(run({
-        "model": model, "springs": springs,
-        "damping": {"damping_type": "stiffness", "xi": 0.02},
-        "friction": {"n_devices": 2, "node_i": [3, 2], "node_j": [0, 1], "law": ["velocity"] * 2,
-                     "p": [10.0, 10.0], "mu": [0.2, 0.2]},
-        "excitation": {"excitation_type": "none", "dt_record": 0.01, "duration": 0.1},
-    }))
+    r = ok(
+        run(
+            {
+                "model": model,
+                "springs": springs,
+                "damping": {"damping_type": "stiffness", "xi": 0.02},
+                "friction": {
+                    "n_devices": 2,
+                    "node_i": [3, 2],
+                    "node_j": [0, 1],
+                    "law": ["velocity"] * 2,
+                    "p": [10.0, 10.0],
+                    "mu": [0.2, 0.2],
+                },
+                "excitation": {"excitation_type": "none", "dt_record": 0.01, "duration": 0.1},
+            }
+        )
+    )
     # independent: generalized DOFs q = (u1 = u2, u4), u3 = 0
     t = np.array([[1, 0], [1, 0], [0, 0], [0, 1]], float)
     kf = np.zeros((4, 4))
@@ -167,15 +202,32 @@ def harmonic_record_decks(dt_r: float, kind: str, columns: int):
         "damping": {"damping_type": "rayleigh", "rayleigh_a0": 0.3, "rayleigh_a1": 0.001},
         "integration": {"n1": 20},
     }
-    harm = dict(base, excitation={"excitation_type": "harmonic", "amplitude": amp,
-                                  "frequency": freq, "dt_record": dt_r, "duration": duration})
-    rec = dict(base, excitation={"excitation_type": "record", "record_file": "table.txt",
-                                 "record_kind": kind, "dt_record": dt_r, "duration": duration})
+    harm = dict(
+        base,
+        excitation={
+            "excitation_type": "harmonic",
+            "amplitude": amp,
+            "frequency": freq,
+            "dt_record": dt_r,
+            "duration": duration,
+        },
+    )
+    rec = dict(
+        base,
+        excitation={
+            "excitation_type": "record",
+            "record_file": "table.txt",
+            "record_kind": kind,
+            "dt_record": dt_r,
+            "duration": duration,
+        },
+    )
     return harm, rec, text
 
 
-@pytest.mark.parametrize("kind, columns", [("acceleration", 1), ("acceleration", 2),
-                                           ("displacement", 1)])
+@pytest.mark.parametrize(
+    "kind, columns", [("acceleration", 1), ("acceleration", 2), ("displacement", 1)]
+)
 def test_record_reproduces_harmonic_within_interpolation_error(run, kind, columns):
     errors = []
     for dt_r in (0.004, 0.002, 0.001):

@@ -9,14 +9,41 @@ from __future__ import annotations
 
 from ._api import DeckError, FrictiondynError, Result, SolverError, run, run_text
 from ._exe import ExecutableRun, RunFailed, executable, run_executable
-from .model import (Analysis, Damping, Device, FreeVibration, Harmonic, Integration, Output,
-                    Record, Spring)
+from .model import (
+    Analysis,
+    Damping,
+    Device,
+    FreeVibration,
+    Harmonic,
+    Integration,
+    Output,
+    Record,
+    Spring,
+)
 from .results import History, read_history, read_summary
 
 __all__ = [
-    "Analysis", "Damping", "DeckError", "Device", "ExecutableRun", "FreeVibration",
-    "FrictiondynError", "Harmonic", "History", "Integration", "Output", "Record", "Result",
-    "RunFailed", "SolverError", "Spring", "executable", "read_history", "read_summary", "run",
-    "run_executable", "run_text",
+    "Analysis",
+    "Damping",
+    "DeckError",
+    "Device",
+    "ExecutableRun",
+    "FreeVibration",
+    "FrictiondynError",
+    "Harmonic",
+    "History",
+    "Integration",
+    "Output",
+    "Record",
+    "Result",
+    "RunFailed",
+    "SolverError",
+    "Spring",
+    "executable",
+    "read_history",
+    "read_summary",
+    "run",
+    "run_executable",
+    "run_text",
 ]
 __version__ = "0.1.0"

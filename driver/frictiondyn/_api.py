@@ -8,6 +8,7 @@ status becomes an exception here, in one place.
 from __future__ import annotations
 
 import json
+import math
 import os
 from dataclasses import dataclass, field
 from pathlib import Path
@@ -16,7 +17,17 @@ import numpy as np
 
 from . import _core
 
-__all__ = ["DeckError", "FrictiondynError", "Result", "SolverError", "run", "run_text"]
+__all__ = [
+    "DeckError",
+    "FrictiondynError",
+    "OutputSettings",
+    "Result",
+    "SolverError",
+    "fortran_es",
+    "run",
+    "run_text",
+    "summary_text",
+]
 
 
 class FrictiondynError(RuntimeError):
@@ -44,12 +55,60 @@ def _check(status: int, message: np.ndarray) -> None:
 
 
 def _run(path: str, text: str, from_text: int) -> Result:
-    ncol, nout, lhead, status, message = _core.fd_shape(path, text, from_text)
+    ncol, nout, lhead, outdir, outname, history, status, message = _core.fd_shape(
+        path, text, from_text
+    )
     _check(status, message)
     lsum = 16384 + 512 * ncol
-    hist, header, summary, status, message = _core.fd_run(path, text, from_text, ncol, nout, lhead, lsum)
+    hist, header, summary, status, message = _core.fd_run(
+        path, text, from_text, ncol, nout, lhead, lsum
+    )
     _check(status, message)
-    return Result.from_arrays(_text(header), np.asarray(hist).T.copy(), json.loads(_text(summary)))
+    result = Result.from_arrays(
+        _text(header), np.asarray(hist).T.copy(), json.loads(_text(summary))
+    )
+    result.output = OutputSettings(_text(outdir), _text(outname), bool(history))
+    return result
+
+
+def fortran_es(x: float) -> str:
+    """``x`` as Fortran's ``es24.16e3`` writes it (17 significant digits, 3-digit exponent),
+    without the padding."""
+    if math.isnan(x):
+        return "NaN"
+    if math.isinf(x):
+        return "Infinity" if x > 0 else "-Infinity"
+    mant, _, exp = f"{x:.16E}".partition("E")
+    return f"{mant}E{exp[0]}{abs(int(exp)):03d}"
+
+
+def _json_value(value: object) -> str:
+    if isinstance(value, bool):
+        return "true" if value else "false"
+    if isinstance(value, int):
+        return str(value)
+    if isinstance(value, float):
+        return fortran_es(value)
+    if isinstance(value, str):
+        return json.dumps(value)
+    if isinstance(value, list):
+        return "[" + ", ".join(_json_value(v) for v in value) + "]"
+    return json.dumps(value)
+
+
+def summary_text(summary: dict) -> str:
+    """The summary JSON as the executable writes it (one key a line, reals in es format)."""
+    items = [f"  {json.dumps(k)}: {_json_value(v)}" for k, v in summary.items()]
+    return "{\n" + ",\n".join(items) + "\n}\n"
+
+
+@dataclass
+class OutputSettings:
+    """The deck's &output settings, as the Fortran reader read them."""
+
+    dir: str = "out"
+    name: str = "deck"
+    write_history: bool = True
 
 
 def run(deck: str | os.PathLike) -> Result:
@@ -84,6 +143,7 @@ class Result:
     units: dict[str, str]
     data: np.ndarray  # (samples, columns)
     summary: dict = field(default_factory=dict)
+    output: OutputSettings = field(default_factory=OutputSettings)
 
     @classmethod
     def from_arrays(cls, header: str, data: np.ndarray, summary: dict) -> Result:
@@ -143,8 +203,12 @@ class Result:
 
     def device(self, d: int) -> dict[str, np.ndarray]:
         """Relative displacement s, velocity sdot, force F and phase (0 stick, +-1 slip) of device d."""
-        return {"s": self[f"s{d}"], "sdot": self[f"sdot{d}"], "F": self[f"F{d}"],
-                "phase": self[f"phase{d}"]}
+        return {
+            "s": self[f"s{d}"],
+            "sdot": self[f"sdot{d}"],
+            "F": self[f"F{d}"],
+            "phase": self[f"phase{d}"],
+        }
 
     def label(self, name: str) -> str:
         """Axis label 'name [unit]'."""
@@ -152,18 +216,36 @@ class Result:
         return f"{name} [{_UNITS_LABEL.get(unit, unit)}]" if unit and unit != "-" else name
 
     def to_csv(self, path: str | os.PathLike) -> Path:
-        """Write the history as the executable does: header name[unit], 17 significant digits;
-        the summary goes next to it as <stem>.summary.json."""
+        """Write the history exactly as the executable does (header ``name[unit],...``,
+        ``es24.16e3`` values) and the summary next to it as <stem>.summary.json, each to a
+        temporary name renamed when complete."""
         path = Path(path)
+        tmp = path.with_name(path.name + ".tmp")
         header = ",".join(f"{n}[{self.units[n]}]" for n in self.names)
-        np.savetxt(path, self.data, delimiter=",", header=header, comments="", fmt="%.16E")
-        path.with_name(path.name.removesuffix(".csv") + ".summary.json").write_text(
-            json.dumps(self.summary, indent=2))
+        with tmp.open("w") as fh:
+            fh.write(header + "\n")
+            for row in self.data:
+                fh.write(",".join(fortran_es(float(x)).rjust(24) for x in row) + "\n")
+        tmp.replace(path)
+        self.write_summary(path.with_name(path.name.removesuffix(".csv") + ".summary.json"))
+        return path
+
+    def write_summary(self, path: str | os.PathLike) -> Path:
+        """Write the summary JSON as the executable does."""
+        path = Path(path)
+        tmp = path.with_name(path.name + ".tmp")
+        tmp.write_text(summary_text(self.summary))
+        tmp.replace(path)
         return path
 
     def to_npz(self, path: str | os.PathLike) -> Path:
         """Write names, units, data and the summary (as JSON) to a .npz file."""
         path = Path(path)
-        np.savez(path, names=np.array(self.names), units=np.array([self.units[n] for n in self.names]),
-                 data=self.data, summary=np.array(json.dumps(self.summary)))
+        np.savez(
+            path,
+            names=np.array(self.names),
+            units=np.array([self.units[n] for n in self.names]),
+            data=self.data,
+            summary=np.array(json.dumps(self.summary)),
+        )
         return path

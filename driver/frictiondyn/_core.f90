@@ -7,7 +7,7 @@
 
 !> Read and validate a deck (from the file `path`, or from `text` when from_text /= 0) and
 !> return the size of its history and of its buffers.
-subroutine fd_shape(path, text, from_text, ncol, nout, lhead, status, message)
+subroutine fd_shape(path, text, from_text, ncol, nout, lhead, outdir, outname, history, status, message)
    use, intrinsic :: iso_c_binding, only: c_int, c_char
    use frictiondyn, only: error_type, run_config, shape_of
    implicit none
@@ -17,6 +17,9 @@ subroutine fd_shape(path, text, from_text, ncol, nout, lhead, status, message)
    integer(c_int), intent(out) :: ncol           !! columns of the history
    integer(c_int), intent(out) :: nout           !! samples of the history
    integer(c_int), intent(out) :: lhead          !! length of the header line
+   character(kind=c_char, len=1), intent(out) :: outdir(1024)  !! &output dir
+   character(kind=c_char, len=1), intent(out) :: outname(1024) !! &output name
+   integer(c_int), intent(out) :: history        !! 1: &output write_history
    integer(c_int), intent(out) :: status         !! 0 or an error code
    character(kind=c_char, len=1), intent(out) :: message(4096) !! error message
    !f2py threadsafe
@@ -24,7 +27,8 @@ subroutine fd_shape(path, text, from_text, ncol, nout, lhead, status, message)
    type(error_type), allocatable :: error
    integer :: nc, no
 
-   ncol = 0; nout = 0; lhead = 0
+   ncol = 0; nout = 0; lhead = 0; history = 0
+   outdir = ' '; outname = ' '
    call read_any(path, text, from_text, cfg, error)
    if (allocated(error)) then
       call fail(1, error%message, status, message)
@@ -33,6 +37,13 @@ subroutine fd_shape(path, text, from_text, ncol, nout, lhead, status, message)
    call shape_of(cfg, nc, no)
    ncol = int(nc, c_int); nout = int(no, c_int)
    lhead = int(32*nc, c_int)
+   call put(cfg%out%dir, outdir, status)
+   if (status == 0) call put(cfg%out%name, outname, status)
+   if (status /= 0) then
+      call fail(3, 'output directory or name longer than 1024 characters', status, message)
+      return
+   end if
+   history = merge(1_c_int, 0_c_int, cfg%out%history)
    call fail(0, '', status, message)
 contains
    include 'fd_core_common.inc'

@@ -13,9 +13,6 @@ from pathlib import Path
 from .results import History, read_history, read_summary
 
 
-
-
-
 class RunFailed(RuntimeError):
     """The executable stopped with a non-zero exit status; ``stderr`` holds its message."""
 
@@ -34,7 +31,9 @@ def executable() -> str:
     candidate = Path(sysconfig.get_path("scripts")) / "frictiondyn"
     if candidate.is_file():
         return str(candidate)
-    found = shutil.which("frictiondyn") or shutil.which("frictiondyn", path=os.path.dirname(sys.executable))
+    found = shutil.which("frictiondyn") or shutil.which(
+        "frictiondyn", path=os.path.dirname(sys.executable)
+    )
     if found is None:
         raise FileNotFoundError("the frictiondyn executable is not installed (pip install .)")
     return found
@@ -75,5 +74,7 @@ def run_executable(deck: str | Path, cwd: str | Path | None = None) -> Executabl
         elif key == "summary":
             summ = base / value
     if summ is None:
-        raise RunFailed(proc.returncode, "frictiondyn did not report its summary file:\n" + proc.stdout)
+        raise RunFailed(
+            proc.returncode, "frictiondyn did not report its summary file:\n" + proc.stdout
+        )
     return ExecutableRun(proc.stdout, proc.stderr, hist, summ)

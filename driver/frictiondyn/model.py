@@ -15,8 +15,17 @@ import numpy as np
 
 from ._api import Result, run_text
 
-__all__ = ["Analysis", "Damping", "Device", "FreeVibration", "Harmonic", "Integration", "Output",
-           "Record", "Spring"]
+__all__ = [
+    "Analysis",
+    "Damping",
+    "Device",
+    "FreeVibration",
+    "Harmonic",
+    "Integration",
+    "Output",
+    "Record",
+    "Spring",
+]
 
 
 @dataclass
@@ -82,9 +91,14 @@ class Harmonic:
     ramp_cycles: int = 0
 
     def group(self, directory: Path | None) -> dict:
-        return {"excitation_type": "harmonic", "amplitude": self.amplitude,
-                "frequency": self.frequency, "ramp_cycles": self.ramp_cycles,
-                "dt_record": self.dt_record, "duration": self.duration}
+        return {
+            "excitation_type": "harmonic",
+            "amplitude": self.amplitude,
+            "frequency": self.frequency,
+            "ramp_cycles": self.ramp_cycles,
+            "dt_record": self.dt_record,
+            "duration": self.duration,
+        }
 
 
 @dataclass
@@ -104,8 +118,13 @@ class Record:
             if directory is None:
                 raise ValueError("a Record with values needs a directory to write its file")
             np.savetxt(directory / self.file, np.asarray(self.values, float), fmt="%.17e")
-        g = {"excitation_type": "record", "record_file": self.file, "record_kind": self.kind,
-             "record_scale": self.scale, "dt_record": self.dt_record}
+        g = {
+            "excitation_type": "record",
+            "record_file": self.file,
+            "record_kind": self.kind,
+            "record_scale": self.scale,
+            "dt_record": self.dt_record,
+        }
         if self.duration is not None:
             g["duration"] = self.duration
         return g
@@ -170,25 +189,53 @@ class Analysis:
         groups = [("model", model)]
         springs = {"n_springs": len(self.springs)}
         if self.springs:
-            springs.update(node_i=[s.node_i for s in self.springs], node_j=[s.node_j for s in self.springs],
-                           k=[float(s.k) for s in self.springs])
+            springs.update(
+                node_i=[s.node_i for s in self.springs],
+                node_j=[s.node_j for s in self.springs],
+                k=[float(s.k) for s in self.springs],
+            )
         groups.append(("springs", springs))
         groups.append(("damping", self.damping.group()))
         if self.devices:
             d = self.devices
-            groups.append(("friction", {
-                "n_devices": len(d), "node_i": [x.node_i for x in d], "node_j": [x.node_j for x in d],
-                "law": [x.law for x in d], "p": [float(x.p) for x in d], "mu": [float(x.mu) for x in d],
-                "eps": [float(x.eps) for x in d], "eps1": [float(x.eps1) for x in d],
-                "f": [float(x.f) for x in d]}))
+            groups.append(
+                (
+                    "friction",
+                    {
+                        "n_devices": len(d),
+                        "node_i": [x.node_i for x in d],
+                        "node_j": [x.node_j for x in d],
+                        "law": [x.law for x in d],
+                        "p": [float(x.p) for x in d],
+                        "mu": [float(x.mu) for x in d],
+                        "eps": [float(x.eps) for x in d],
+                        "eps1": [float(x.eps1) for x in d],
+                        "f": [float(x.f) for x in d],
+                    },
+                )
+            )
         groups.append(("excitation", self.excitation.group(directory)))
         i = self.integration
-        groups.append(("integration", {"beta": float(i.beta), "gamma": float(i.gamma), "n1": int(i.n1),
-                                       "n2": int(i.n2), "n": float(i.n),
-                                       "check_correctness": bool(i.check_correctness),
-                                       "dt_min": float(i.dt_min)}))
+        groups.append(
+            (
+                "integration",
+                {
+                    "beta": float(i.beta),
+                    "gamma": float(i.gamma),
+                    "n1": int(i.n1),
+                    "n2": int(i.n2),
+                    "n": float(i.n),
+                    "check_correctness": bool(i.check_correctness),
+                    "dt_min": float(i.dt_min),
+                },
+            )
+        )
         o = self.output
-        out = {"dir": o.dir, "output_every": int(o.output_every), "write_history": bool(o.write_history)}
+        out = {
+            "dir": o.dir,
+            "output_every": int(o.output_every),
+            "write_history": bool(o.write_history),
+        }
         if o.name:
             out["name"] = o.name
         groups.append(("output", out))

@@ -1,0 +1,342 @@
+"""The command line: ``python -m frictiondyn run | plot | compare | paper``.
+
+- ``run DECK [--plot] [--out DIR]``: run a deck through the extension and write its history
+  CSV and summary JSON exactly as the ``frictiondyn`` executable does (same files, same
+  format), into the deck's ``&output`` directory or ``--out``.
+- ``plot RESULT``: PNGs of a result (a CSV written by ``run`` or the executable, or a .npz
+  from ``Result.to_npz``), next to it or in ``--out``.
+- ``compare A B [...]``: overlay two or more results (CSV, .npz, or decks, which are run)
+  and print the differences of their peaks.
+- ``paper OUTDIR``: the paper's Table 1 classification and Figs. 2, 3a, 3b, 4a, 4b.
+- ``validate OUTDIR``: the verification studies of ``frictiondyn.validate``.
+
+Errors print one line ``frictiondyn: error: ...`` on standard error and exit with status 1.
+"""
+
+from __future__ import annotations
+
+import argparse
+import os
+import sys
+from collections.abc import Sequence
+from pathlib import Path
+
+from . import __version__
+from ._api import FrictiondynError, Result, run
+
+__all__ = ["load_result", "main", "write_outputs"]
+
+
+class CliError(Exception):
+    """A problem with the command line's input; printed as one line, exit status 1."""
+
+
+# ---------------------------------------------------------------------------------------
+# Writing outputs the way the executable does
+# ---------------------------------------------------------------------------------------
+
+
+def write_outputs(result: Result, out: str | os.PathLike | None = None) -> tuple[Path | None, Path]:
+    """Write ``<dir>/<name>.csv`` (unless ``write_history = .false.``) and
+    ``<dir>/<name>.summary.json`` as the executable does, with the deck's &output settings
+    (as the Fortran reader read them); ``out`` replaces the directory."""
+    o = result.output
+    directory = Path(out) if out is not None else Path(o.dir)
+    try:
+        directory.mkdir(parents=True, exist_ok=True)
+    except OSError as exc:
+        raise CliError(f"cannot create the output directory {directory}: {exc}") from None
+    summ = directory / f"{o.name}.summary.json"
+    if o.write_history:
+        return result.to_csv(directory / f"{o.name}.csv"), summ
+    return None, result.write_summary(summ)
+
+
+# ---------------------------------------------------------------------------------------
+# Reading results
+# ---------------------------------------------------------------------------------------
+
+
+def load_result(path: str | os.PathLike) -> Result:
+    """A Result from a history CSV (with its summary JSON when present), a .npz written by
+    ``Result.to_npz``, or a deck (.nml, run through the extension)."""
+    p = Path(path)
+    if not p.exists():
+        raise CliError(f"{p}: no such file")
+    suffix = p.suffix.lower()
+    try:
+        if suffix == ".csv":
+            return Result.from_files(p)
+        if suffix == ".npz":
+            return Result.from_npz(p)
+    except (OSError, ValueError, KeyError) as exc:
+        raise CliError(f"{p}: not a frictiondyn result ({exc})") from None
+    if suffix in (".nml", ".namelist", ".in"):
+        return run(p)
+    raise CliError(f"{p}: expected a history .csv, a .npz or a deck .nml")
+
+
+def _stem(path: Path) -> str:
+    return path.name.rsplit(".", 1)[0] if "." in path.name else path.name
+
+
+# ---------------------------------------------------------------------------------------
+# Commands
+# ---------------------------------------------------------------------------------------
+
+
+def _print_summary(result: Result, deck: str) -> None:
+    s = result.summary
+    print(f"frictiondyn: {deck}")
+    print(
+        f"  stuck period {s['period_stuck_s']:.6g} s; steps dt1 {s['steps_dt1']}, "
+        f"dt2 {s['steps_dt2']}, finer {s['steps_finer']}"
+    )
+    laws = s.get("device_law", [])
+    for d in range(result.n_devices):
+        law = f" ({laws[d]})" if d < len(laws) else ""
+        print(
+            f"  device {d + 1}{law}: stick->slip {s['stick_to_slip'][d]}, "
+            f"slip->stick {s['slip_to_stick'][d]}, slip reversals {s['slip_reversals'][d]}, "
+            f"peak |F| {s['peak_force_N'][d]:.6g} N"
+        )
+    for i in range(result.n_dof):
+        print(
+            f"  dof {i + 1}: peak |u| {s['peak_u_m'][i]:.6g} m, "
+            f"peak |a_abs| {s['peak_aabs_mps2'][i]:.6g} m/s2"
+        )
+    print(f"  correctness violations: {s['correctness_violations']}")
+    if s["correctness_violations"]:
+        print(
+            f"frictiondyn: warning: {s['correctness_violations']} step(s) violate the "
+            "correctness condition (eqs. 9, 12)",
+            file=sys.stderr,
+        )
+
+
+def _trange(value: Sequence[float] | None) -> tuple[float, float] | None:
+    if value is None:
+        return None
+    t0, t1 = float(value[0]), float(value[1])
+    if not t1 > t0:
+        raise CliError(f"--t-range {t0:g} {t1:g}: the end must be after the start")
+    return t0, t1
+
+
+def cmd_run(args: argparse.Namespace) -> int:
+    trange = _trange(args.t_range)
+    result = run(args.deck)
+    csv, summ = write_outputs(result, args.out)
+    _print_summary(result, args.deck)
+    if csv is not None:
+        print(f"  history: {csv}")
+    print(f"  summary: {summ}")
+    if args.plot:
+        from . import plots
+
+        for p in plots.plot_all(
+            result, summ.parent, summ.name[: -len(".summary.json")], t_range=trange
+        ):
+            print(f"  plot: {p}")
+    return 0
+
+
+def cmd_plot(args: argparse.Namespace) -> int:
+    from . import plots
+
+    path = Path(args.result)
+    trange = _trange(args.t_range)
+    result = load_result(path)
+    directory = Path(args.out) if args.out else path.parent
+    directory.mkdir(parents=True, exist_ok=True)
+    for p in plots.plot_all(result, directory, _stem(path), t_range=trange):
+        print(f"plot: {p}")
+    return 0
+
+
+def _peak_rows(
+    results: list[Result], t_range: tuple[float, float] | None
+) -> list[tuple[str, str, list[float]]]:
+    """(quantity, unit, peak of each result). Without a time range the summaries' peaks
+    (over every accepted step) are used when all results have them."""
+    from .plots import window
+
+    n_dof = min(r.n_dof for r in results)
+    n_dev = min(r.n_devices for r in results)
+    use_summary = t_range is None and all("peak_aabs_mps2" in r.summary for r in results)
+    rows = []
+    for col, key, count in (
+        ("aabs", "peak_aabs_mps2", n_dof),
+        ("u", "peak_u_m", n_dof),
+        ("F", "peak_force_N", n_dev),
+        ("s", "peak_s_m", n_dev),
+    ):
+        for k in range(1, count + 1):
+            name = f"{col}{k}"
+            if use_summary:
+                vals = [float(r.summary[key][k - 1]) for r in results]
+            else:
+                vals = [float(abs(r[name][window(r, t_range)]).max()) for r in results]
+            unit = results[0].units.get(name, "")
+            rows.append((name, unit, vals))
+    return rows
+
+
+def cmd_compare(args: argparse.Namespace) -> int:
+    from . import plots
+
+    paths = [Path(p) for p in args.results]
+    labels = args.labels if args.labels else [_stem(p) for p in paths]
+    if len(labels) != len(paths):
+        raise CliError(f"--labels gives {len(labels)} names for {len(paths)} results")
+    if len(set(labels)) < len(labels):
+        labels = [f"{i + 1}: {x}" for i, x in enumerate(labels)]
+    trange = _trange(args.t_range)
+    results = [load_result(p) for p in paths]
+    out = Path(args.out)
+    out.mkdir(parents=True, exist_ok=True)
+    if min(r.n_dof for r in results) != max(r.n_dof for r in results):
+        print(
+            "frictiondyn: warning: the results have different numbers of DOFs; comparing "
+            "the common ones",
+            file=sys.stderr,
+        )
+    written = [out / f"{args.name}.png"]
+    plots.plot_compare(results, written[0], t_range=trange, labels=labels)
+    for i in range(1, min(min(r.n_dof for r in results), 10) + 1):
+        written.append(out / f"{args.name}_aabs{i}.png")
+        plots.plot_acceleration(results, i, written[-1], t_range=trange, labels=labels)
+    for d in range(1, min(min(r.n_devices for r in results), 10) + 1):
+        written.append(out / f"{args.name}_hysteresis{d}.png")
+        plots.plot_hysteresis(results, d, written[-1], t_range=trange, labels=labels)
+    where = "whole run" if trange is None else f"t = {trange[0]:g} ... {trange[1]:g} s"
+    print(f"peaks ({where}); difference relative to {labels[0]}:")
+    for i, lab in enumerate(labels):
+        print(f"  [{i + 1}] {lab}")
+    for name, unit, vals in _peak_rows(results, trange):
+        ref = vals[0]
+        cells = [f"{vals[0]:.6g}"]
+        for v in vals[1:]:
+            rel = f" ({100 * (v - ref) / ref:+.2f} %)" if ref != 0 else ""
+            cells.append(f"{v:.6g} [{v - ref:+.3g}{rel}]")
+        print(f"  peak |{name}| [{unit}]: " + "; ".join(cells))
+    for p in written:
+        print(f"plot: {p}")
+    return 0
+
+
+def cmd_paper(args: argparse.Namespace) -> int:
+    from .paper import reproduce
+
+    rep = reproduce(args.outdir, progress=not args.quiet)
+    print("Table 1, steady state (last 10 cycles):")
+    for s in rep.table:
+        mark = "agrees" if s.agrees else "DIFFERS"
+        print(f"  test {s.test} {s.law:<10}: {s.classification:<12} (paper: {s.paper}) {mark}")
+    n = rep.numbers
+    print(
+        f"Fig. 3: coarse deck {int(n['coarse.correctness_violations'])} correctness "
+        f"violations, {int(n['coarse.slip_reversals'])} slip reversals; corrected "
+        f"{int(n['hysteretic.correctness_violations'])} and "
+        f"{int(n['hysteretic.slip_reversals'])}"
+    )
+    print(
+        f"Fig. 4: steady-state peak |a_abs| hysteretic vs velocity: upper "
+        f"{100 * n['fig4.peak_aabs1_rel_diff']:+.2f} %, lower "
+        f"{100 * n['fig4.peak_aabs2_rel_diff']:+.2f} %"
+    )
+    for p in rep.figures.values():
+        print(f"figure: {p}")
+    print(f"report: {rep.report}")
+    return 0
+
+
+def cmd_validate(args: argparse.Namespace) -> int:
+    try:
+        from .validate import main as validate_main
+    except ImportError as exc:
+        raise CliError(f"the validation studies are not installed ({exc})") from None
+
+    def progress(message: str) -> None:
+        if not args.quiet:
+            print(f"validate: {message}", file=sys.stderr, flush=True)
+
+    report = validate_main(args.outdir, progress=progress)
+    print(f"report: {report}")
+    return 0
+
+
+def build_parser() -> argparse.ArgumentParser:
+    parser = argparse.ArgumentParser(
+        prog="python -m frictiondyn",
+        description="Dynamic analysis of structures with friction devices.",
+    )
+    parser.add_argument("--version", action="version", version=f"frictiondyn {__version__}")
+    sub = parser.add_subparsers(dest="command", required=True, metavar="COMMAND")
+
+    trange = {
+        "nargs": 2,
+        "type": float,
+        "metavar": ("T0", "T1"),
+        "help": "plot only t0 <= t <= t1 [s]",
+    }
+    p = sub.add_parser("run", help="run a deck; write its history CSV and summary JSON")
+    p.add_argument("deck", help="namelist deck (.nml)")
+    p.add_argument(
+        "--out", metavar="DIR", help="output directory (default: the deck's &output dir)"
+    )
+    p.add_argument("--plot", action="store_true", help="also write PNGs next to the outputs")
+    p.add_argument("--t-range", **trange)
+    p.set_defaults(func=cmd_run)
+
+    p = sub.add_parser("plot", help="PNGs of a result (.csv or .npz)")
+    p.add_argument("result", help="history CSV (with its .summary.json), or .npz")
+    p.add_argument("--out", metavar="DIR", help="where the PNGs go (default: next to RESULT)")
+    p.add_argument("--t-range", **trange)
+    p.set_defaults(func=cmd_plot)
+
+    p = sub.add_parser("compare", help="overlay two or more results; print peak differences")
+    p.add_argument("results", nargs="+", metavar="RESULT", help=".csv, .npz or deck .nml")
+    p.add_argument("--out", metavar="DIR", default=".", help="where the PNGs go (default: .)")
+    p.add_argument("--name", default="compare", help="base name of the PNGs (default: compare)")
+    p.add_argument("--labels", nargs="+", metavar="LABEL", help="legend names, one per result")
+    p.add_argument("--t-range", **trange)
+    p.set_defaults(func=cmd_compare)
+
+    p = sub.add_parser("paper", help="recompute the paper's Table 1 and Figs. 2, 3, 4")
+    p.add_argument("outdir", help="directory for the PNGs and report.md")
+    p.add_argument("--quiet", action="store_true", help="no progress bar")
+    p.set_defaults(func=cmd_paper)
+
+    p = sub.add_parser(
+        "validate", help="verification studies against exact solutions (frictiondyn.validate)"
+    )
+    p.add_argument("outdir", help="directory for validation.md and its figures")
+    p.add_argument("--quiet", action="store_true", help="no progress messages")
+    p.set_defaults(func=cmd_validate)
+    return parser
+
+
+def _one_line(exc: BaseException) -> str:
+    text = str(exc.args[0]) if isinstance(exc, KeyError) and exc.args else str(exc)
+    text = " ".join(text.split())
+    return text or type(exc).__name__
+
+
+def main(argv: Sequence[str] | None = None) -> int:
+    """Run the command line; return the exit status (0 success, 1 error, 2 usage)."""
+    args = build_parser().parse_args(argv)
+    if args.command == "compare" and len(args.results) < 2:
+        print("frictiondyn: error: compare needs two or more results", file=sys.stderr)
+        return 1
+    try:
+        return int(args.func(args))
+    except BrokenPipeError:  # output piped into e.g. head: stop quietly
+        os.dup2(os.open(os.devnull, os.O_WRONLY), sys.stdout.fileno())
+        return 1
+    except (FrictiondynError, CliError, OSError, ValueError, KeyError) as exc:
+        print(f"frictiondyn: error: {_one_line(exc)}", file=sys.stderr)
+        return 1
+    except KeyboardInterrupt:
+        print("frictiondyn: interrupted", file=sys.stderr)
+        return 130

@@ -1,0 +1,331 @@
+"""The Python API through the f2py extension: the same numbers as the executable, Python-built
+decks, clean exceptions for bad input, no hidden state (repeat, threads), exact round trips
+of the result files, and the accessors."""
+
+from __future__ import annotations
+
+import copy
+import io
+import shutil
+from concurrent.futures import ThreadPoolExecutor
+from pathlib import Path
+
+import frictiondyn
+import numpy as np
+import pytest
+from conftest import INPUTS, K1, K2, M1, M2, MU, TABLE1, P
+from frictiondyn import (
+    Analysis,
+    Damping,
+    DeckError,
+    Device,
+    Harmonic,
+    Integration,
+    Output,
+    Record,
+    Result,
+    Spring,
+)
+from frictiondyn.paper import deck_name, paper_analysis
+
+PMU = P * MU
+
+
+def same_summary(a: dict, b: dict) -> None:
+    """Summaries equal in every key except the wall-clock time and the deck path."""
+    skip = {"run_time_s", "deck"}
+    assert {k: v for k, v in a.items() if k not in skip} == {
+        k: v for k, v in b.items() if k not in skip
+    }
+    assert set(a) == set(b)
+
+
+def short_analysis(law: str = "velocity", duration: float = 3.0, **kw) -> Analysis:
+    """The paper's test 4 model for a few seconds (Table 1 values)."""
+    freq, amp, dtr = TABLE1[4]
+    return Analysis(
+        masses=[M1, M2],
+        springs=[Spring(1, 0, K1), Spring(2, 0, K2)],
+        damping=Damping.stiffness(0.015),
+        devices=[Device(1, 2, p=P, mu=MU, law=law)],
+        excitation=Harmonic(amp, freq, dtr, duration),
+        **kw,
+    )
+
+
+# --- extension vs executable --------------------------------------------------------------
+
+
+@pytest.mark.parametrize("deck", ["test4_velocity", "fig3_coarse"])
+def test_extension_and_executable_give_identical_histories(deck, tmp_path):
+    path = INPUTS / f"{deck}.nml"
+    ext = frictiondyn.run(path)
+    exe_run = frictiondyn.run_executable(path, cwd=tmp_path)
+    exe = Result.from_files(exe_run.history_path)
+    assert exe.names == ext.names and exe.units == ext.units
+    assert ext.data.shape == (8001, 12)  # 40 s written every dt_r = 5 ms
+    assert np.array_equal(ext.data, exe.data)  # 17 digits in the CSV: exact round trip
+    same_summary(ext.summary, exe.summary)
+    assert exe.summary["deck"] == str(path) and ext.summary["deck"] == str(path)
+    # and what they say is the paper's: the coarse deck violates eq. 12, the fine one not
+    if deck == "fig3_coarse":
+        assert ext.summary["correctness_violations"] > 50
+        assert ext.summary["slip_reversals"][0] > 50
+    else:
+        assert ext.summary["correctness_violations"] == 0
+        assert ext.summary["stick_to_slip"][0] > 100
+
+
+@pytest.mark.parametrize(
+    "test,law,coarse",
+    [(t, law, False) for t in TABLE1 for law in ("velocity", "hysteretic")]
+    + [(4, "hysteretic", True)],
+)
+def test_paper_decks_built_in_python_equal_the_bundled_decks(test, law, coarse):
+    """frictiondyn.paper embeds the decks' values: identical runs to inputs/*.nml."""
+    bundled = frictiondyn.run(INPUTS / f"{deck_name(test, law, coarse)}.nml")
+    built = paper_analysis(test, law, coarse=coarse).run()
+    assert np.array_equal(built.data, bundled.data)
+    same_summary(built.summary, bundled.summary)
+
+
+def _record_analysis() -> Analysis:
+    """Test 4's table acceleration given as a record (values), ramped over 2 cycles."""
+    freq, amp, dtr = TABLE1[4]
+    t = np.arange(0, 2.0 + dtr / 2, dtr)
+    w = 2 * np.pi * freq
+    ramp = np.minimum(t * freq / 2, 1.0)
+    acc = -amp * w**2 * np.sin(w * t) * ramp
+    return Analysis(
+        masses=[M1, M2],
+        springs=[Spring(1, 0, K1), Spring(2, 0, K2)],
+        damping=Damping.rayleigh(0.1, 1e-4),
+        devices=[Device(1, 2, p=P, mu=MU, law="hysteretic", f=2e-5, eps1=2e-3)],
+        excitation=Record(dt_record=dtr, file="table.txt", values=acc),
+        integration=Integration(n1=10, n2=20, n=5.0),
+        output=Output(dir="results", name="rec"),
+        u0=[1e-3, 0.0],
+        v0=[0.0, 0.05],
+    )
+
+
+@pytest.mark.parametrize("case", ["harmonic", "record"])
+def test_deck_written_from_python_is_run_identically_by_the_executable(case, tmp_path):
+    a = (
+        short_analysis("hysteretic", output=Output(dir="results", name="harm"))
+        if case == "harmonic"
+        else _record_analysis()
+    )
+    deck = a.write_deck(tmp_path / "deck.nml")
+    exe_run = frictiondyn.run_executable(deck, cwd=tmp_path)
+    assert exe_run.history_path == tmp_path / "results" / f"{a.output.name}.csv"
+    exe = Result.from_files(exe_run.history_path)
+    mine = a.run()
+    assert np.array_equal(mine.data, exe.data)
+    same_summary(mine.summary, exe.summary)
+    if case == "record":
+        # the table acceleration at the record's sample times is the record itself,
+        # and the initial conditions are the deck's
+        values = np.loadtxt(tmp_path / "table.txt")
+        np.testing.assert_allclose(mine["ag"], values[: len(mine["ag"])], rtol=0, atol=1e-12)
+        assert mine["u1"][0] == 1e-3 and mine["v2"][0] == 0.05
+        assert mine.summary["stick_to_slip"][0] > 0
+
+
+# --- bad input ----------------------------------------------------------------------------
+
+
+def _text(a: Analysis, directory: Path | None = None) -> str:
+    return a.deck_text(directory)
+
+
+def _without_group(group: str):
+    def make(tmp: Path) -> str:
+        nml = short_analysis().namelist()
+        del nml[group]
+        buf = io.StringIO()
+        nml.write(buf)
+        return buf.getvalue()
+
+    return make
+
+
+def _modified(change):
+    def make(tmp: Path) -> str:
+        a = copy.deepcopy(short_analysis())
+        change(a)
+        return _text(a, tmp)
+
+    return make
+
+
+def _set_device(**kw):
+    def change(a: Analysis) -> None:
+        for k, v in kw.items():
+            setattr(a.devices[0], k, v)
+
+    return change
+
+
+def _record(file: str, text: str | None):
+    def make(tmp: Path) -> str:
+        if text is not None:
+            (tmp / file).write_text(text)
+        a = short_analysis()
+        a.excitation = Record(dt_record=0.005, file=file)
+        return _text(a, tmp)
+
+    return make
+
+
+BAD = [
+    # (id, deck text maker, words the message must contain)
+    ("missing group", _without_group("damping"), ["&damping", "missing"]),
+    (
+        "misspelled variable",
+        lambda tmp: _text(short_analysis()).replace("n_dof", "n_dofs"),
+        ["&model", "n_dofs"],
+    ),
+    (
+        "negative mass",
+        _modified(lambda a: setattr(a, "masses", [M1, -2.53])),
+        ["&model", "mass(2)", "-2.53", "> 0"],
+    ),
+    ("eps = 0", _modified(_set_device(eps=0.0)), ["&friction", "eps(1)", "= 0", "> 0"]),
+    ("eps < 0", _modified(_set_device(eps=-1e-3)), ["&friction", "eps(1)", "-0.001"]),
+    (
+        "eps1 = 0",
+        _modified(_set_device(eps1=0.0, law="hysteretic")),
+        ["&friction", "eps1(1)", "= 0"],
+    ),
+    (
+        "n = 1",
+        _modified(lambda a: setattr(a.integration, "n", 1.0)),
+        ["&integration", "n = 1", "> 1"],
+    ),
+    ("n < 1", _modified(lambda a: setattr(a.integration, "n", 0.5)), ["&integration", "n = 0.5"]),
+    (
+        "missing record file",
+        _record("nosuch.txt", None),
+        ["&excitation", "record_file", "nosuch.txt", "does not exist"],
+    ),
+    (
+        "record with NaN",
+        _record("nan.txt", "0.0\n0.1\nnan\n0.2\n"),
+        ["&excitation", "nan.txt", "line 3", "nan", "not finite"],
+    ),
+]
+
+
+@pytest.fixture(scope="module")
+def reference() -> Result:
+    return short_analysis().run()
+
+
+@pytest.mark.parametrize("make,words", [b[1:] for b in BAD], ids=[b[0] for b in BAD])
+def test_bad_input_raises_deck_error_and_the_process_still_runs_good_decks(
+    make, words, tmp_path, reference
+):
+    text = make(tmp_path)
+    with pytest.raises(DeckError) as info:
+        frictiondyn.run_text(text, name="bad.nml", base_dir=tmp_path)
+    message = str(info.value)
+    assert "bad.nml" in message
+    for word in words:
+        assert word in message, message
+    assert isinstance(info.value, ValueError)  # DeckError is also a ValueError
+    # the same deck from a file fails the same way
+    (tmp_path / "bad.nml").write_text(text)
+    with pytest.raises(DeckError) as info2:
+        frictiondyn.run(tmp_path / "bad.nml")
+    assert str(info2.value) == message
+    # nothing is left over: a good deck gives the reference result, bit for bit
+    again = short_analysis().run()
+    assert np.array_equal(again.data, reference.data)
+    assert again.summary["stick_to_slip"] == reference.summary["stick_to_slip"]
+
+
+def test_missing_deck_file_is_a_deck_error(tmp_path):
+    with pytest.raises(DeckError, match="nosuch.nml"):
+        frictiondyn.run(tmp_path / "nosuch.nml")
+
+
+# --- no hidden state ----------------------------------------------------------------------
+
+
+def test_same_deck_twice_gives_identical_results():
+    a = frictiondyn.run(INPUTS / "test4_hysteretic.nml")
+    b = frictiondyn.run(INPUTS / "test4_hysteretic.nml")
+    assert np.array_equal(a.data, b.data)
+    same_summary(a.summary, b.summary)
+
+
+def test_runs_in_threads_at_once_equal_serial_runs():
+    decks = [
+        INPUTS / f"{n}.nml"
+        for n in ("test4_velocity", "test4_hysteretic", "fig3_coarse", "test3_velocity")
+    ] * 2
+    serial = [frictiondyn.run(d) for d in decks]
+    with ThreadPoolExecutor(max_workers=len(decks)) as pool:
+        threaded = list(pool.map(frictiondyn.run, decks))
+    for s, t in zip(serial, threaded, strict=True):
+        assert np.array_equal(s.data, t.data)
+        same_summary(s.summary, t.summary)
+    # different decks really gave different answers (no cross-talk to hide)
+    assert serial[0].summary["stick_to_slip"] != serial[1].summary["stick_to_slip"]
+
+
+# --- files --------------------------------------------------------------------------------
+
+
+def test_csv_and_npz_round_trips_are_exact(tmp_path):
+    r = frictiondyn.run(INPUTS / "fig3_coarse.nml")
+    r.to_csv(tmp_path / "a.csv")
+    back = Result.from_files(tmp_path / "a.csv")
+    assert back.names == r.names and back.units == r.units
+    assert np.array_equal(back.data, r.data)
+    assert back.summary == r.summary
+    r.to_npz(tmp_path / "a.npz")
+    z = Result.from_npz(tmp_path / "a.npz")
+    assert z.names == r.names and z.units == r.units
+    assert np.array_equal(z.data, r.data) and z.summary == r.summary
+    assert z.summary["correctness_violations"] > 50  # the Fig. 3 deck's failure, kept
+
+
+def test_the_executables_csv_and_to_csv_read_back_the_same(tmp_path):
+    deck = tmp_path / "test4_velocity.nml"
+    shutil.copy(INPUTS / "test4_velocity.nml", deck)
+    exe = Result.from_files(frictiondyn.run_executable(deck, cwd=tmp_path).history_path)
+    exe.to_csv(tmp_path / "again.csv")
+    assert np.array_equal(Result.from_files(tmp_path / "again.csv").data, exe.data)
+
+
+# --- accessors ----------------------------------------------------------------------------
+
+
+@pytest.mark.parametrize("law", ["velocity", "hysteretic"])
+def test_accessors_satisfy_the_equations_of_motion(law):
+    """dof() and device() return the right columns: eq. (5) holds at every row,
+    m1 a1 + k1 u1 + psi k1 v1 + F = 0 and m2 a2 + k2 u2 + psi k2 v2 - F = 0, s = u1 - u2,
+    s' = v1 - v2, and a sliding device carries P mu."""
+    r = short_analysis(law, output=Output(output_every=1)).run()
+    assert r.n_dof == 2 and r.n_devices == 1
+    d1, d2, dev = r.dof(1), r.dof(2), r.device(1)
+    assert set(d1) == {"u", "v", "aabs"} and set(dev) == {"s", "sdot", "F", "phase"}
+    assert np.array_equal(d1["aabs"], r["aabs1"]) and np.array_equal(d2["u"], r["u2"])
+    psi = r.summary["period_stuck_s"] * 0.015 / np.pi
+    e1 = M1 * d1["aabs"] + K1 * (d1["u"] + psi * d1["v"]) + dev["F"]
+    e2 = M2 * d2["aabs"] + K2 * (d2["u"] + psi * d2["v"]) - dev["F"]
+    assert np.max(np.abs(e1)) < 1e-8 and np.max(np.abs(e2)) < 1e-8  # N, forces ~ 10 N
+    assert np.array_equal(dev["s"], d1["u"] - d2["u"])
+    assert np.array_equal(dev["sdot"], d1["v"] - d2["v"])
+    slide = dev["phase"] != 0
+    assert slide.any() and (~slide).any()
+    np.testing.assert_allclose(np.abs(dev["F"][slide]), PMU, rtol=1e-12)
+    np.testing.assert_allclose(dev["F"][slide], PMU * dev["phase"][slide], rtol=1e-12)
+    assert np.max(np.abs(dev["F"])) <= PMU * (1 + 1e-12)
+    assert r.time is not None and r.time[1] - r.time[0] == pytest.approx(r.summary["dt1_s"])
+    assert r.label("aabs1") == "aabs1 [m/s²]" and r.label("phase1") == "phase1"
+    assert "F1" in r and "F2" not in r
+    with pytest.raises(KeyError, match="no column 'u3'"):
+        r.dof(3)
