@@ -1,0 +1,120 @@
+"""Benchmark of frictiondyn: prints run times, step and event counts, and memory.
+
+    python bench/benchmark.py [--repeat 5] [--quick]
+
+Times are wall-clock medians over --repeat runs through the f2py extension (the
+executable adds its file output on top, timed separately). Nothing here is asserted:
+speed and memory are measured, not tested.
+"""
+
+from __future__ import annotations
+
+import argparse
+import resource
+import statistics
+import subprocess
+import sys
+import tempfile
+import time
+from pathlib import Path
+
+import frictiondyn as fd
+from frictiondyn.model import Analysis, Damping, Device, Harmonic, Integration, Output, Spring
+from frictiondyn.validate import paper_analysis
+
+ROOT = Path(__file__).resolve().parent.parent
+
+
+def timed(an: Analysis, repeat: int) -> tuple[float, fd.Result]:
+    times, res = [], None
+    for _ in range(repeat):
+        t0 = time.perf_counter()
+        res = an.run()
+        times.append(time.perf_counter() - t0)
+    return statistics.median(times), res
+
+
+def chain(n: int, law: str, duration: float) -> Analysis:
+    """n masses in a shear chain, a friction device in every storey but the first."""
+    masses = [1000.0] * n
+    springs = [Spring(i + 1, i, 2.0e6) for i in range(n)]
+    devices = [Device(i + 1, i, 2000.0, 0.3, law=law) for i in range(1, n)]
+    return Analysis(
+        masses=masses,
+        springs=springs,
+        damping=Damping.rayleigh(0.2, 0.002),
+        devices=devices,
+        excitation=Harmonic(0.02, 2.0, 0.005, duration, ramp_cycles=2),
+        integration=Integration(n1=10, n2=20),
+        output=Output(output_every=10),
+    )
+
+
+def main() -> None:
+    ap = argparse.ArgumentParser()
+    ap.add_argument("--repeat", type=int, default=5)
+    ap.add_argument("--quick", action="store_true", help="shorter chain runs")
+    args = ap.parse_args()
+
+    print("frictiondyn benchmark (median of %d runs, extension, no file output)" % args.repeat)
+    print()
+    print("Paper's test 4, 40 s of 4.104 Hz table motion, dt1 = 0.25 ms:")
+    print(
+        f"{'technique':<34}{'time [s]':>10}{'steps':>10}{'events':>8}{'expm/fact':>10}"
+        f"{'transitions':>12}{'violations':>11}"
+    )
+    for label, an in [
+        ("velocity law, eps = 1e-3", paper_analysis(4, "velocity", every=20)),
+        ("hysteretic law, f = 1e-5", paper_analysis(4, "hysteretic", every=20)),
+        (
+            "Fig. 3 coarse (n1 = n2 = 2, off)",
+            paper_analysis(4, "hysteretic", n1=2, n2=2, check=False, every=2),
+        ),
+        ("exact Coulomb (event-driven)", paper_analysis(4, "coulomb", every=20)),
+    ]:
+        t, r = timed(an, args.repeat)
+        s = r.summary
+        steps = s["steps_dt1"] + s["steps_dt2"] + s["steps_finer"]
+        print(
+            f"{label:<34}{t:>10.4f}{steps:>10}{s['events']:>8}{s['factorizations']:>10}"
+            f"{s['stick_to_slip'][0] + s['slip_to_stick'][0]:>12}{s['correctness_violations']:>11}"
+        )
+
+    exe = fd.executable()
+    with tempfile.TemporaryDirectory() as tmp:
+        times = []
+        for _ in range(args.repeat):
+            t0 = time.perf_counter()
+            subprocess.run(
+                [exe, str(ROOT / "inputs" / "test4_velocity.nml")],
+                cwd=tmp,
+                check=True,
+                capture_output=True,
+            )
+            times.append(time.perf_counter() - t0)
+        size = (Path(tmp) / "out" / "test4_velocity.csv").stat().st_size
+    print(
+        f"\nexecutable on inputs/test4_velocity.nml (8001 x 12 CSV, {size / 1e6:.1f} MB): "
+        f"{statistics.median(times):.4f} s"
+    )
+
+    print(
+        "\nShear chain of n masses, a device in every storey above the first, 2 Hz, dt1 = 0.5 ms:"
+    )
+    print(f"{'n':>5}{'law':>12}{'duration [s]':>14}{'time [s]':>10}{'events':>8}{'expm/fact':>10}")
+    sizes = [2, 10, 50] if args.quick else [2, 10, 50, 200]
+    for n in sizes:
+        for law in ("velocity", "coulomb"):
+            if law == "coulomb" and n > 10:
+                continue
+            dur = 5.0 if args.quick else 10.0
+            t, r = timed(chain(n, law, dur), max(1, args.repeat // 2))
+            s = r.summary
+            print(f"{n:>5}{law:>12}{dur:>14.1f}{t:>10.3f}{s['events']:>8}{s['factorizations']:>10}")
+
+    rss = resource.getrusage(resource.RUSAGE_SELF).ru_maxrss / 1024
+    print(f"\npeak resident memory of this process: {rss:.0f} MB")
+
+
+if __name__ == "__main__":
+    sys.exit(main())
