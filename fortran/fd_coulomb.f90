@@ -22,6 +22,7 @@ module fd_coulomb
    use fd_excitation, only: excitation_type, table_motion, excitation_harmonic, excitation_record
    use fd_matrices, only: structure_matrices
    use fd_expm, only: lti_propagators
+   use fd_linalg, only: sym_matvec, gen_matvec
    use fd_result, only: result_type, init_result, history_shape
    use fd_device_state, only: phase_stick
    implicit none
@@ -72,6 +73,10 @@ module fd_coulomb
       real(dp), allocatable :: gphi(:, :, :), gg1(:, :, :), gg2(:, :, :) !! at the Gauss points
       type(forcing_type) :: frc                      !! forcing of the particular solution
       real(dp), allocatable :: xp_s(:, :), xp_c(:, :) !! xp = sum_k xp_s(:,k) sin + xp_c(:,k) cos
+      ! least-squares work, allocated with the pattern so that a step allocates nothing
+      integer :: ns = 0                                       !! sticking active devices
+      integer, allocatable :: ids(:)                          !! their indices
+      real(dp), allocatable :: bm(:, :), rr(:, :), sv(:), lwk(:) !! least-squares work
    end type pattern_type
 
    !> State of the run.
@@ -87,6 +92,12 @@ module fd_coulomb
       real(dp), allocatable :: slip(:)                    !! P mu
       type(pattern_type) :: pat
       integer :: n_expm = 0, n_events = 0
+      real(dp), allocatable :: g_end(:), g_try(:), s0(:)  !! event values, start positions (nd)
+      real(dp), allocatable :: rn(:), vv(:)               !! work (n)
+      ! work sized with each pattern (m = 2 nq), so that a step allocates nothing
+      real(dp), allocatable :: ph(:, :), q1(:, :), q2(:, :)   !! propagators over the trial tau
+      real(dp), allocatable :: pg(:, :), pq1(:, :), pq2(:, :) !! same at a Gauss point
+      real(dp), allocatable :: y(:), y2(:), wk(:), xdot(:)    !! states and work (m)
    end type coulomb_work
 
 contains
@@ -124,7 +135,8 @@ contains
       call decide_phases(model, exc, t, w, res, .true., error)
       if (allocated(error)) return
       e_kin0 = 0.5_dp*sum(w%mass*w%v**2)
-      e_str0 = 0.5_dp*dot_product(w%u, matmul(w%k, w%u))
+      call sym_matvec(w%k, w%u, w%rn, 1.0_dp, 0.0_dp)
+      e_str0 = 0.5_dp*dot_product(w%u, w%rn)
       w_fric = 0.0_dp
       iout = 1
       call sample(model, exc, t, w, res, iout)
@@ -158,7 +170,8 @@ contains
          end if
       end do
       res%e_kinetic = 0.5_dp*sum(w%mass*w%v**2) - e_kin0
-      res%e_strain = 0.5_dp*dot_product(w%u, matmul(w%k, w%u)) - e_str0
+      call sym_matvec(w%k, w%u, w%rn, 1.0_dp, 0.0_dp)
+      res%e_strain = 0.5_dp*dot_product(w%u, w%rn) - e_str0
       res%e_friction = w_fric
       res%e_device = 0.0_dp
       res%e_residual = res%e_input - (res%e_kinetic + res%e_strain + res%e_viscous + res%e_friction)
@@ -180,6 +193,7 @@ contains
       w%mass = model%mass
       allocate (w%k(n, n), w%c(n, n), w%u(n), w%v(n), w%acc(n))
       allocate (w%phase(nd), w%fresh(nd), w%active(nd), w%force(nd), w%slip(nd))
+      allocate (w%g_end(nd), w%g_try(nd), w%s0(nd), w%rn(n), w%vv(n))
       w%fresh = .false.
       w%force = 0.0_dp
       do d = 1, nd
@@ -324,6 +338,7 @@ contains
             w%pat%xp_s(:, kf) = matmul(w%pat%a, rhs(:, 1))/w%pat%frc%w(kf)
          end do
       end if
+      call pattern_work(w)
    contains
       integer function find(x)
          integer, intent(in) :: x
@@ -334,6 +349,32 @@ contains
       end function find
    end subroutine set_pattern
 
+   !> Work arrays of the pattern: sized once here, reused by every step.
+   subroutine pattern_work(w)
+      type(coulomb_work), intent(inout) :: w
+      integer :: m, n, ns, d, rank, info
+      real(dp) :: query(1), rdum(1, 1), bdum(1, 1), sdum(1)
+
+      m = w%pat%m
+      n = w%n
+      if (allocated(w%ph)) deallocate (w%ph, w%q1, w%q2, w%pg, w%pq1, w%pq2, w%y, w%y2, w%wk, w%xdot)
+      allocate (w%ph(m, m), w%q1(m, m), w%q2(m, m), w%pg(m, m), w%pq1(m, m), w%pq2(m, m), &
+                w%y(m), w%y2(m), w%wk(m), w%xdot(m))
+      ns = count(w%active .and. w%phase == phase_stick)
+      w%pat%ns = ns
+      if (allocated(w%pat%ids)) deallocate (w%pat%ids, w%pat%bm, w%pat%rr, w%pat%sv, w%pat%lwk)
+      allocate (w%pat%ids(ns), w%pat%bm(n, ns), w%pat%rr(max(n, ns), 1), w%pat%sv(max(1, min(n, ns))))
+      ns = 0
+      do d = 1, w%nd
+         if (.not. w%active(d) .or. w%phase(d) /= phase_stick) cycle
+         ns = ns + 1
+         w%pat%ids(ns) = d
+      end do
+      query = 0.0_dp
+      if (ns > 0) call dgelss(n, ns, 1, rdum, n, bdum, max(n, ns), sdum, -1.0_dp, rank, query, -1, info)
+      allocate (w%pat%lwk(max(1, int(query(1)), 4*(n + ns) + 64)))
+   end subroutine pattern_work
+
    pure subroutine add_b(model, d, alpha, y)
       type(model_type), intent(in) :: model
       integer, intent(in) :: d
@@ -343,33 +384,41 @@ contains
       if (model%dev(d)%node_j > 0) y(model%dev(d)%node_j) = y(model%dev(d)%node_j) - alpha
    end subroutine add_b
 
-   !> Particular solution (harmonic forcing) at time t.
-   pure function xp(pat, t) result(y)
+   !> Particular solution (harmonic forcing) at time t, into y.
+   pure subroutine xp_into(pat, t, y)
       type(pattern_type), intent(in) :: pat
       real(dp), intent(in) :: t
-      real(dp) :: y(pat%m)
+      real(dp), intent(out) :: y(:)
       integer :: kf
       y = 0.0_dp
       do kf = 1, pat%frc%nf
          y = y + pat%xp_s(:, kf)*sin(pat%frc%w(kf)*t) + pat%xp_c(:, kf)*cos(pat%frc%w(kf)*t)
       end do
-   end function xp
+   end subroutine xp_into
 
-   !> Reduced state at t + tau from the state x at t.
-   subroutine propagate(exc, pat, t, tau, x, phi, g1, g2, y)
+   !> Reduced state at t + tau from the state x at t (wk: work of size m).
+   subroutine propagate(exc, pat, t, tau, x, phi, g1, g2, y, wk)
       type(excitation_type), intent(in) :: exc
       type(pattern_type), intent(in) :: pat
       real(dp), intent(in) :: t, tau, x(:), phi(:, :), g1(:, :), g2(:, :)
       real(dp), intent(out) :: y(:)
+      real(dp), intent(inout) :: wk(:)
       real(dp) :: ag0, ag1, xg, vg
 
       if (pat%m == 0) return
-      y = matmul(phi, x - xp(pat, t)) + xp(pat, t + tau) + matmul(g1, pat%b1)
+      ! y = phi (x - xp(t)) + xp(t + tau) + gam1 b1 [+ first-order hold of a record]
+      call xp_into(pat, t, wk)
+      wk = x - wk
+      call gen_matvec(phi, wk, y, 1.0_dp, 0.0_dp)
+      call xp_into(pat, t + tau, wk)
+      y = y + wk
+      call gen_matvec(g1, pat%b1, y, 1.0_dp, 1.0_dp)
       if (exc%kind == excitation_record) then
-         ! first-order hold: ag linear over the step (steps never straddle a sample)
+         ! steps never straddle a sample, so ag is linear over the step
          call table_motion(exc, t, xg, vg, ag0)
          call table_motion(exc, t + tau, xg, vg, ag1)
-         y = y + matmul(g1, pat%bag)*ag0 + matmul(g2, pat%bag)*((ag1 - ag0)/tau)
+         call gen_matvec(g1, pat%bag, y, ag0, 1.0_dp)
+         call gen_matvec(g2, pat%bag, y, (ag1 - ag0)/tau, 1.0_dp)
       end if
    end subroutine propagate
 
@@ -405,17 +454,20 @@ contains
    end subroutine propagators
 
    !> Full displacement, velocity and acceleration from a reduced state at time t.
-   subroutine expand(exc, pat, t, x, w)
+   subroutine expand(exc, t, x, w)
       type(excitation_type), intent(in) :: exc
-      type(pattern_type), intent(in) :: pat
       real(dp), intent(in) :: t, x(:)
       type(coulomb_work), intent(inout) :: w
-      real(dp) :: xg, vg, ag, xdot(pat%m)
+      real(dp) :: xg, vg, ag
       integer :: i, g, nq
 
+      associate (pat => w%pat, xdot => w%xdot)
       nq = pat%nq
       call table_motion(exc, t, xg, vg, ag)
-      if (pat%m > 0) xdot = matmul(pat%a, x) + pat%b1 + pat%bag*ag
+      if (pat%m > 0) then
+         xdot = pat%b1 + pat%bag*ag
+         call gen_matvec(pat%a, x, xdot, 1.0_dp, 1.0_dp)
+      end if
       do i = 1, w%n
          g = pat%grp(i)
          if (g == 0) then
@@ -424,6 +476,7 @@ contains
             w%u(i) = x(g) + pat%uc(i); w%v(i) = x(nq + g); w%acc(i) = xdot(nq + g)
          end if
       end do
+      end associate
    end subroutine expand
 
    !> Forces needed to keep the sticking devices stuck, at the expanded state (w%u, v, acc):
@@ -433,10 +486,8 @@ contains
       type(excitation_type), intent(in) :: exc
       real(dp), intent(in) :: t
       type(coulomb_work), intent(inout) :: w
-      real(dp), allocatable :: bm(:, :), r(:, :), sv(:), work(:)
-      integer, allocatable :: ids(:)
       real(dp) :: xg, vg, ag
-      integer :: d, ns, rank, info, lwork
+      integer :: d, k, rank, info
 
       do d = 1, w%nd
          if (.not. w%active(d)) then
@@ -445,29 +496,25 @@ contains
             w%force(d) = w%phase(d)*w%slip(d)
          end if
       end do
-      ns = count(w%active .and. w%phase == phase_stick)
-      if (ns == 0) return
+      if (w%pat%ns == 0) return
       call table_motion(exc, t, xg, vg, ag)
-      allocate (r(w%n, 1), bm(w%n, ns), ids(ns))
-      r(:, 1) = -w%mass*(ag + w%acc) - matmul(w%c, w%v) - matmul(w%k, w%u)
-      ns = 0
-      bm = 0.0_dp
-      do d = 1, w%nd
-         if (.not. w%active(d)) cycle
-         if (w%phase(d) /= phase_stick) then
-            call add_b(model, d, -w%force(d), r(:, 1))
-         else
-            ns = ns + 1
-            ids(ns) = d
-            call add_b(model, d, 1.0_dp, bm(:, ns))
-         end if
-      end do
-      lwork = 4*(w%n + ns) + 64
-      allocate (sv(min(w%n, ns)), work(lwork))
-      call dgelss(w%n, ns, 1, bm, w%n, r, w%n, sv, -1.0_dp, rank, work, lwork, info)
-      do d = 1, ns
-         w%force(ids(d)) = r(d, 1)
-      end do
+      associate (r => w%pat%rr, bm => w%pat%bm)
+         r(1:w%n, 1) = -w%mass*(ag + w%acc)
+         call sym_matvec(w%c, w%v, r(1:w%n, 1), -1.0_dp, 1.0_dp)
+         call sym_matvec(w%k, w%u, r(1:w%n, 1), -1.0_dp, 1.0_dp)
+         do d = 1, w%nd
+            if (w%active(d) .and. w%phase(d) /= phase_stick) call add_b(model, d, -w%force(d), r(1:w%n, 1))
+         end do
+         bm = 0.0_dp
+         do k = 1, w%pat%ns
+            call add_b(model, w%pat%ids(k), 1.0_dp, bm(:, k))
+         end do
+         call dgelss(w%n, w%pat%ns, 1, bm, w%n, r, size(r, 1), w%pat%sv, -1.0_dp, rank, w%pat%lwk, &
+                     size(w%pat%lwk), info)
+         do k = 1, w%pat%ns
+            w%force(w%pat%ids(k)) = r(k, 1)
+         end do
+      end associate
    end subroutine stuck_forces
 
    !> Event functions at the expanded state: sliding devices sgn s' (> 0 while sliding on),
@@ -498,36 +545,32 @@ contains
       type(result_type), intent(inout) :: res
       real(dp), intent(inout) :: w_fric
       type(error_type), allocatable, intent(out) :: error
-      real(dp), allocatable :: phi(:, :), g1(:, :), g2(:, :), y(:), g_end(:), g_try(:), s0(:)
       real(dp) :: tc, tau, a, b, fa, fb, c, fc, d_, e, tol, p, q, r_, s, xm, tau_ev
       integer :: m, d, it, first, stalls
       logical :: fired
 
       tc = t
       stalls = 0
-      allocate (g_end(w%nd), g_try(w%nd), s0(w%nd))
       do
          if (tc >= tb) exit
          m = w%pat%m
-         if (allocated(phi)) deallocate (phi, g1, g2, y)
-         allocate (phi(m, m), g1(m, m), g2(m, m), y(m))
          tau = tb - tc
          ! a full step (tb - tc differs from h by the rounding of k h): use the cached propagators
          if (abs(tau - h) <= 1.0e-9_dp*h) tau = h
-         call propagators(w%pat, tau, h, phi, g1, g2, w%n_expm, error)
+         call propagators(w%pat, tau, h, w%ph, w%q1, w%q2, w%n_expm, error)
          if (allocated(error)) return
-         call state_at(tau, g_end)
+         call state_at(tau, w%g_end)
          ! which events fire in (tc, tc + tau]?
          fired = .false.
          first = 0
          tau_ev = tau
          do d = 1, w%nd
-            if (g_end(d) > 0.0_dp) cycle
-            if (w%phase(d) /= phase_stick .and. w%fresh(d) .and. g_end(d) == 0.0_dp) cycle
+            if (w%g_end(d) > 0.0_dp) cycle
+            if (w%phase(d) /= phase_stick .and. w%fresh(d) .and. w%g_end(d) == 0.0_dp) cycle
             fired = .true.
             ! Brent's method on g_d over [0, tau]: g_d(0) >= 0 (holding or sliding on)
             a = 0.0_dp; fa = 1.0_dp
-            b = tau; fb = g_end(d)
+            b = tau; fb = w%g_end(d)
             call brent_root(d, a, fa, b, fb, tau_ev)
             if (tau_ev <= tau) then
                if (first == 0 .or. tau_ev < tau) first = d
@@ -538,18 +581,18 @@ contains
          call energy(tau)
          if (m > 0) then
             if (tau /= tb - tc .and. tau /= h) then
-               call propagators(w%pat, tau, h, phi, g1, g2, w%n_expm, error)
+               call propagators(w%pat, tau, h, w%ph, w%q1, w%q2, w%n_expm, error)
                if (allocated(error)) return
             end if
-            call propagate(exc, w%pat, tc, tau, w%x, phi, g1, g2, y)
-            w%x = y
+            call propagate(exc, w%pat, tc, tau, w%x, w%ph, w%q1, w%q2, w%y, w%wk)
+            w%x = w%y
          end if
          do d = 1, w%nd
-            s0(d) = rel(model, d, w%u)
+            w%s0(d) = rel(model, d, w%u)
          end do
-         call expand(exc, w%pat, tc + tau, w%x, w)
+         call expand(exc, tc + tau, w%x, w)
          do d = 1, w%nd
-            if (w%active(d) .and. w%phase(d) /= phase_stick) w_fric = w_fric + w%slip(d)*abs(rel(model, d, w%u) - s0(d))
+            if (w%active(d) .and. w%phase(d) /= phase_stick) w_fric = w_fric + w%slip(d)*abs(rel(model, d, w%u) - w%s0(d))
          end do
          if (fired) then
             tc = tc + tau
@@ -581,15 +624,15 @@ contains
          real(dp), intent(in) :: tt
          real(dp), intent(out) :: gv(:)
          if (m > 0) then
-            call propagate(exc, w%pat, tc, tt, w%x, phi, g1, g2, y)
-            call expand(exc, w%pat, tc + tt, y, w)
+            call propagate(exc, w%pat, tc, tt, w%x, w%ph, w%q1, w%q2, w%y, w%wk)
+            call expand(exc, tc + tt, w%y, w)
          else
-            call expand(exc, w%pat, tc + tt, w%x, w)
+            call expand(exc, tc + tt, w%x, w)
          end if
          call stuck_forces(model, exc, tc + tt, w)
          call event_values(model, w, gv)
          ! back to the state at tc (expand overwrote u, v, acc)
-         call expand(exc, w%pat, tc, w%x, w)
+         call expand(exc, tc, w%x, w)
       end subroutine state_at
 
       subroutine eval_g(dd, tt, gval)
@@ -597,10 +640,10 @@ contains
          real(dp), intent(in) :: tt
          real(dp), intent(out) :: gval
          if (m > 0) then
-            call propagators(w%pat, tt, h, phi, g1, g2, w%n_expm, error)
+            call propagators(w%pat, tt, h, w%ph, w%q1, w%q2, w%n_expm, error)
          end if
-         call state_at(tt, g_try)
-         gval = g_try(dd)
+         call state_at(tt, w%g_try)
+         gval = w%g_try(dd)
       end subroutine eval_g
 
       !> Brent's zero of g_dd on [a, b], fa > 0 >= fb; result: the smallest root found.
@@ -660,31 +703,33 @@ contains
       !> Input and viscous work over [tc, tc + tt] by 3-point Gauss-Legendre on the exact state.
       subroutine energy(tt)
          real(dp), intent(in) :: tt
-         real(dp) :: pg(m, m), q1(m, m), q2(m, m), yy(m), xg, vg, ag, vv(w%n)
+         real(dp) :: xg, vg, ag
          integer :: ig, i, info
          if (tt <= 0.0_dp) return
          do ig = 1, 3
             if (m > 0) then
                if (tt == h .and. w%pat%h == h) then
-                  pg = w%pat%gphi(:, :, ig); q1 = w%pat%gg1(:, :, ig); q2 = w%pat%gg2(:, :, ig)
+                  call propagate(exc, w%pat, tc, gl_x(ig)*tt, w%x, w%pat%gphi(:, :, ig), w%pat%gg1(:, :, ig), &
+                                 w%pat%gg2(:, :, ig), w%y2, w%wk)
                else
-                  call lti_propagators(w%pat%a, gl_x(ig)*tt, pg, q1, q2, info)
+                  call lti_propagators(w%pat%a, gl_x(ig)*tt, w%pg, w%pq1, w%pq2, info)
                   w%n_expm = w%n_expm + 1
+                  call propagate(exc, w%pat, tc, gl_x(ig)*tt, w%x, w%pg, w%pq1, w%pq2, w%y2, w%wk)
                end if
-               call propagate(exc, w%pat, tc, gl_x(ig)*tt, w%x, pg, q1, q2, yy)
                do i = 1, w%n
                   if (w%pat%grp(i) == 0) then
-                     vv(i) = 0.0_dp
+                     w%vv(i) = 0.0_dp
                   else
-                     vv(i) = yy(w%pat%nq + w%pat%grp(i))
+                     w%vv(i) = w%y2(w%pat%nq + w%pat%grp(i))
                   end if
                end do
             else
-               vv = 0.0_dp
+               w%vv = 0.0_dp
             end if
             call table_motion(exc, tc + gl_x(ig)*tt, xg, vg, ag)
-            res%e_input = res%e_input - gl_w(ig)*tt*ag*sum(w%mass*vv)
-            res%e_viscous = res%e_viscous + gl_w(ig)*tt*dot_product(vv, matmul(w%c, vv))
+            res%e_input = res%e_input - gl_w(ig)*tt*ag*sum(w%mass*w%vv)
+            call sym_matvec(w%c, w%vv, w%rn, 1.0_dp, 0.0_dp)
+            res%e_viscous = res%e_viscous + gl_w(ig)*tt*dot_product(w%vv, w%rn)
          end do
       end subroutine energy
    end subroutine advance
@@ -702,29 +747,45 @@ contains
       logical, intent(in) :: initial
       type(error_type), allocatable, intent(out) :: error
       integer, allocatable :: old(:)
+      logical, allocatable :: held(:)
       real(dp) :: ratio, worst
       integer :: d, dw, iter
       real(dp) :: sd
+      real(dp), parameter :: at_limit = 1.0_dp - 1.0e-9_dp  !! |F| / P mu that counts as the limit
 
       old = w%phase
+      allocate (held(w%nd))
+      held = .false.
       ! the state is expanded at t; candidates: stuck ones, and sliders at a velocity zero
       do d = 1, w%nd
          if (.not. w%active(d) .or. w%phase(d) == phase_stick) cycle
          sd = w%phase(d)*rel(model, d, w%v)
          if (sd <= 0.0_dp .and. .not. w%fresh(d)) w%phase(d) = phase_stick
       end do
-      ! a stuck device whose force reached P mu leaves the candidates first
-      do iter = 1, w%nd + 1
+      ! release, one at a time, the candidate that needs most above P mu (at the limit counts:
+      ! its force got there increasing), in the direction of its force; keep the release only
+      ! if the device then accelerates that way, else it holds
+      dw = 0
+      do iter = 1, 2*w%nd + 2
          call set_pattern(model, exc, t, w, error)
          if (allocated(error)) return
-         call expand(exc, w%pat, t, w%x, w)
+         call expand(exc, t, w%x, w)
          call stuck_forces(model, exc, t, w)
-         worst = 1.0_dp + 64.0_dp*epsilon(1.0_dp)
+         if (dw > 0) then
+            if (w%phase(dw)*rel(model, dw, w%acc) <= 0.0_dp) then
+               w%phase(dw) = phase_stick
+               w%fresh(dw) = .false.
+               held(dw) = .true.
+               dw = 0
+               cycle
+            end if
+         end if
+         worst = at_limit
          dw = 0
          do d = 1, w%nd
-            if (.not. w%active(d) .or. w%phase(d) /= phase_stick) cycle
+            if (.not. w%active(d) .or. w%phase(d) /= phase_stick .or. held(d)) cycle
             ratio = abs(w%force(d))/w%slip(d)
-            if (ratio > worst) then
+            if (ratio >= worst) then
                worst = ratio
                dw = d
             end if

@@ -7,7 +7,7 @@ module fd_linalg
    implicit none
    private
 
-   public :: cholesky_factor, cholesky_solve, sym_matvec, generalized_eigen
+   public :: cholesky_factor, cholesky_solve, sym_matvec, gen_matvec, generalized_eigen
 
    interface
       subroutine dpotrf(uplo, n, a, lda, info)
@@ -33,6 +33,14 @@ module fd_linalg
          real(dp), intent(in) :: a(lda, *), x(*)
          real(dp), intent(inout) :: y(*)
       end subroutine dsymv
+      subroutine dgemv(trans, m, n, alpha, a, lda, x, incx, beta, y, incy)
+         import :: dp
+         character(len=1), intent(in) :: trans
+         integer, intent(in) :: m, n, lda, incx, incy
+         real(dp), intent(in) :: alpha, beta
+         real(dp), intent(in) :: a(lda, *), x(*)
+         real(dp), intent(inout) :: y(*)
+      end subroutine dgemv
       subroutine dsygv(itype, jobz, uplo, n, a, lda, b, ldb, w, work, lwork, info)
          import :: dp
          integer, intent(in) :: itype, n, lda, ldb, lwork
@@ -72,6 +80,18 @@ contains
 
       call dsymv('U', size(a, 1), alpha, a, size(a, 1), x, 1, beta, y, 1)
    end subroutine sym_matvec
+
+   !> y = alpha A x + beta y for a general A.
+   subroutine gen_matvec(a, x, y, alpha, beta)
+      real(dp), intent(in) :: a(:, :)   !! matrix (m x n)
+      real(dp), intent(in) :: x(:)      !! vector (n)
+      real(dp), intent(inout) :: y(:)   !! result (m)
+      real(dp), intent(in) :: alpha     !! factor of A x
+      real(dp), intent(in) :: beta      !! factor of the incoming y
+
+      if (size(a, 1) == 0) return
+      call dgemv('N', size(a, 1), size(a, 2), alpha, a, size(a, 1), x, 1, beta, y, 1)
+   end subroutine gen_matvec
 
    !> Eigenvalues (ascending) and M-normalized eigenvectors of K phi = lambda M phi.
    subroutine generalized_eigen(k, m, lambda, phi, error)
