@@ -20,9 +20,9 @@ module fd_coulomb
    use fd_error, only: error_type, fatal_error, fmt_real
    use fd_model, only: model_type, integration_type, law_coulomb
    use fd_excitation, only: excitation_type, table_motion, excitation_harmonic, excitation_record
-   use fd_matrices, only: structure_matrices
+   use fd_matrices, only: structure_matrices, link_groups
    use fd_expm, only: lti_propagators
-   use fd_linalg, only: sym_matvec, gen_matvec
+   use fd_linalg, only: sym_matvec, gen_matvec, lu_solve, least_squares, least_squares_work
    use fd_result, only: result_type, init_result, history_shape
    use fd_device_state, only: phase_stick
    implicit none
@@ -35,22 +35,6 @@ module fd_coulomb
    real(dp), parameter :: gl_x(3) = [0.5_dp - sqrt(0.15_dp), 0.5_dp, 0.5_dp + sqrt(0.15_dp)]
    real(dp), parameter :: gl_w(3) = [5.0_dp/18.0_dp, 8.0_dp/18.0_dp, 5.0_dp/18.0_dp]
 
-   interface
-      subroutine dgesv(n, nrhs, a, lda, ipiv, b, ldb, info)
-         import :: dp
-         integer, intent(in) :: n, nrhs, lda, ldb
-         real(dp), intent(inout) :: a(lda, *), b(ldb, *)
-         integer, intent(out) :: ipiv(*), info
-      end subroutine dgesv
-      subroutine dgelss(m, n, nrhs, a, lda, b, ldb, s, rcond, rank, work, lwork, info)
-         import :: dp
-         integer, intent(in) :: m, n, nrhs, lda, ldb, lwork
-         real(dp), intent(inout) :: a(lda, *), b(ldb, *)
-         real(dp), intent(out) :: s(*), work(*)
-         real(dp), intent(in) :: rcond
-         integer, intent(out) :: rank, info
-      end subroutine dgelss
-   end interface
 
    !> Table acceleration on one forcing segment: sum_k amp(k) sin(w(k) t) for harmonic
    !> motion; for a record, linear between samples (handled by the caller).
@@ -247,33 +231,18 @@ contains
       real(dp), intent(in) :: t
       type(coulomb_work), intent(inout) :: w
       type(error_type), allocatable, intent(out) :: error
-      integer, allocatable :: root(:), col(:), ipiv(:)
+      integer, allocatable :: ipiv(:)
       real(dp), allocatable :: tq(:, :), mq(:), kq(:, :), cq(:, :), f1(:), fg(:), lhs(:, :), rhs(:, :)
       real(dp), allocatable :: mgrp(:), vq(:)
-      integer :: n, i, d, a, b, nq, m, kf, info, j
+      integer :: n, i, d, nq, m, kf, info, j
 
       n = w%n
-      allocate (root(0:n), col(0:n))
-      root = [(i, i=0, n)]
-      do d = 1, w%nd
-         if (w%phase(d) /= phase_stick .or. .not. w%active(d)) cycle
-         a = find(model%dev(d)%node_i); b = find(model%dev(d)%node_j)
-         if (a /= b) root(max(a, b)) = min(a, b)
-      end do
-      col = 0
-      nq = 0
-      do i = 1, n
-         a = find(i)
-         if (a == 0) cycle
-         if (col(a) == 0) then
-            nq = nq + 1
-            col(a) = nq
-         end if
-      end do
+      if (allocated(w%pat%grp)) deallocate (w%pat%grp)
+      allocate (w%pat%grp(n))
+      call link_groups(model, w%active .and. w%phase == phase_stick, w%pat%grp, nq)
       m = 2*nq
       w%pat%nq = nq
       w%pat%m = m
-      w%pat%grp = [(col(find(i)), i=1, n)]
       allocate (tq(n, nq))
       tq = 0.0_dp
       do i = 1, n
@@ -327,7 +296,7 @@ contains
                lhs(j, j) = lhs(j, j) + w%pat%frc%w(kf)**2
             end do
             rhs(:, 1) = -w%pat%frc%w(kf)*w%pat%frc%amp(kf)*w%pat%bag
-            call dgesv(m, 1, lhs, m, ipiv, rhs, m, info)
+            call lu_solve(lhs, rhs, ipiv, info)
             if (info /= 0) then
                call fatal_error(error, "exact Coulomb technique: the table frequency "// &
                                 fmt_real(w%pat%frc%w(kf)/(2.0_dp*pi))//" Hz is a natural frequency of an "// &
@@ -339,21 +308,12 @@ contains
          end do
       end if
       call pattern_work(w)
-   contains
-      integer function find(x)
-         integer, intent(in) :: x
-         find = x
-         do while (root(find) /= find)
-            find = root(find)
-         end do
-      end function find
    end subroutine set_pattern
 
    !> Work arrays of the pattern: sized once here, reused by every step.
    subroutine pattern_work(w)
       type(coulomb_work), intent(inout) :: w
-      integer :: m, n, ns, d, rank, info
-      real(dp) :: query(1), rdum(1, 1), bdum(1, 1), sdum(1)
+      integer :: m, n, ns, d
 
       m = w%pat%m
       n = w%n
@@ -370,9 +330,7 @@ contains
          ns = ns + 1
          w%pat%ids(ns) = d
       end do
-      query = 0.0_dp
-      if (ns > 0) call dgelss(n, ns, 1, rdum, n, bdum, max(n, ns), sdum, -1.0_dp, rank, query, -1, info)
-      allocate (w%pat%lwk(max(1, int(query(1)), 4*(n + ns) + 64)))
+      allocate (w%pat%lwk(least_squares_work(n, ns)))
    end subroutine pattern_work
 
    pure subroutine add_b(model, d, alpha, y)
@@ -487,7 +445,7 @@ contains
       real(dp), intent(in) :: t
       type(coulomb_work), intent(inout) :: w
       real(dp) :: xg, vg, ag
-      integer :: d, k, rank, info
+      integer :: d, k, info
 
       do d = 1, w%nd
          if (.not. w%active(d)) then
@@ -509,8 +467,7 @@ contains
          do k = 1, w%pat%ns
             call add_b(model, w%pat%ids(k), 1.0_dp, bm(:, k))
          end do
-         call dgelss(w%n, w%pat%ns, 1, bm, w%n, r, size(r, 1), w%pat%sv, -1.0_dp, rank, w%pat%lwk, &
-                     size(w%pat%lwk), info)
+         call least_squares(bm, r, w%pat%sv, w%pat%lwk, info)
          do k = 1, w%pat%ns
             w%force(w%pat%ids(k)) = r(k, 1)
          end do
@@ -753,8 +710,8 @@ contains
       real(dp) :: sd
       real(dp), parameter :: at_limit = 1.0_dp - 1.0e-9_dp  !! |F| / P mu that counts as the limit
 
+      allocate (old(w%nd), held(w%nd))
       old = w%phase
-      allocate (held(w%nd))
       held = .false.
       ! the state is expanded at t; candidates: stuck ones, and sliders at a velocity zero
       do d = 1, w%nd

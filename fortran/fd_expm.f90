@@ -3,6 +3,7 @@
 !> gives the exact propagators of a linear time-invariant system with polynomial input.
 module fd_expm
    use fd_kinds, only: dp
+   use fd_linalg, only: lu_solve
    implicit none
    private
 
@@ -14,14 +15,6 @@ module fd_expm
       670442572800.0_dp, 33522128640.0_dp, 1323241920.0_dp, 40840800.0_dp, 960960.0_dp, &
       16380.0_dp, 182.0_dp, 1.0_dp]
 
-   interface
-      subroutine dgesv(n, nrhs, a, lda, ipiv, b, ldb, info)
-         import :: dp
-         integer, intent(in) :: n, nrhs, lda, ldb
-         real(dp), intent(inout) :: a(lda, *), b(ldb, *)
-         integer, intent(out) :: ipiv(*), info
-      end subroutine dgesv
-   end interface
 
 contains
 
@@ -56,7 +49,7 @@ contains
       e = v + u
       v = v - u
       allocate (ipiv(n))
-      call dgesv(n, n, v, n, ipiv, e, n, info)
+      call lu_solve(v, e, ipiv, info)
       if (info /= 0) return
       do i = 1, s
          e = matmul(e, e)

@@ -8,6 +8,7 @@ module fd_linalg
    private
 
    public :: cholesky_factor, cholesky_solve, sym_matvec, gen_matvec, generalized_eigen
+   public :: lu_solve, least_squares, least_squares_work
 
    interface
       subroutine dpotrf(uplo, n, a, lda, info)
@@ -41,6 +42,20 @@ module fd_linalg
          real(dp), intent(in) :: a(lda, *), x(*)
          real(dp), intent(inout) :: y(*)
       end subroutine dgemv
+      subroutine dgesv(n, nrhs, a, lda, ipiv, b, ldb, info)
+         import :: dp
+         integer, intent(in) :: n, nrhs, lda, ldb
+         real(dp), intent(inout) :: a(lda, *), b(ldb, *)
+         integer, intent(out) :: ipiv(*), info
+      end subroutine dgesv
+      subroutine dgelss(m, n, nrhs, a, lda, b, ldb, s, rcond, rank, work, lwork, info)
+         import :: dp
+         integer, intent(in) :: m, n, nrhs, lda, ldb, lwork
+         real(dp), intent(inout) :: a(lda, *), b(ldb, *)
+         real(dp), intent(out) :: s(*), work(*)
+         real(dp), intent(in) :: rcond
+         integer, intent(out) :: rank, info
+      end subroutine dgelss
       subroutine dsygv(itype, jobz, uplo, n, a, lda, b, ldb, w, work, lwork, info)
          import :: dp
          integer, intent(in) :: itype, n, lda, ldb, lwork
@@ -92,6 +107,38 @@ contains
       if (size(a, 1) == 0) return
       call dgemv('N', size(a, 1), size(a, 2), alpha, a, size(a, 1), x, 1, beta, y, 1)
    end subroutine gen_matvec
+
+   !> Solve A X = B by LU factorization (A and B overwritten; B becomes X).
+   subroutine lu_solve(a, b, ipiv, info)
+      real(dp), intent(inout) :: a(:, :)   !! square matrix, its LU factors on exit
+      real(dp), intent(inout) :: b(:, :)   !! right-hand sides, the solution on exit
+      integer, intent(out) :: ipiv(:)      !! pivots
+      integer, intent(out) :: info         !! 0, or > 0 for a singular A
+
+      call dgesv(size(a, 1), size(b, 2), a, size(a, 1), ipiv, b, size(b, 1), info)
+   end subroutine lu_solve
+
+   !> Work length for least_squares with an m x n matrix.
+   pure integer function least_squares_work(m, n) result(lwork)
+      integer, intent(in) :: m   !! rows
+      integer, intent(in) :: n   !! columns
+
+      lwork = 3*min(m, n) + max(2*min(m, n), max(m, n), 1) + 4*(m + n) + 64
+   end function least_squares_work
+
+   !> Minimum-norm least-squares solution of A x = b by the SVD (LAPACK dgelss): b(1:n)
+   !> holds x on exit; b needs max(m, n) rows. A is overwritten.
+   subroutine least_squares(a, b, sv, work, info)
+      real(dp), intent(inout) :: a(:, :)   !! m x n matrix
+      real(dp), intent(inout) :: b(:, :)   !! right-hand side(s), max(m, n) rows
+      real(dp), intent(out) :: sv(:)       !! singular values, min(m, n)
+      real(dp), intent(inout) :: work(:)   !! work, least_squares_work(m, n)
+      integer, intent(out) :: info         !! 0, or the LAPACK failure
+      integer :: rank
+
+      call dgelss(size(a, 1), size(a, 2), size(b, 2), a, size(a, 1), b, size(b, 1), sv, -1.0_dp, rank, &
+                  work, size(work), info)
+   end subroutine least_squares
 
    !> Eigenvalues (ascending) and M-normalized eigenvectors of K phi = lambda M phi.
    subroutine generalized_eigen(k, m, lambda, phi, error)

@@ -9,7 +9,7 @@ module fd_matrices
    implicit none
    private
 
-   public :: stiffness_matrix, damping_matrix, stuck_first_mode, structure_matrices
+   public :: stiffness_matrix, damping_matrix, stuck_first_mode, structure_matrices, link_groups
 
    real(dp), parameter :: pi = acos(-1.0_dp)
 
@@ -42,32 +42,15 @@ contains
       real(dp), intent(out) :: period                !! first period T [s]
       real(dp), intent(out) :: phi(:)                !! first mode, all DOFs
       type(error_type), allocatable, intent(out) :: error !! no free DOF, or no stiffness
-      integer, allocatable :: root(:), col(:)
+      integer, allocatable :: grp(:)
       real(dp), allocatable :: t(:, :), kq(:, :), mq(:, :), lam(:), z(:, :)
-      integer :: n, nq, d, i, a, b
+      integer :: n, nq, i
 
       period = 0.0_dp
       phi = 0.0_dp
       n = model%n_dof
-      ! union-find over nodes 0..n: each device (with a friction capacity) ties its nodes
-      allocate (root(0:n))
-      root = [(i, i=0, n)]
-      do d = 1, model%n_devices
-         if (model%dev(d)%p*model%dev(d)%mu == 0.0_dp) cycle
-         a = find(model%dev(d)%node_i); b = find(model%dev(d)%node_j)
-         if (a /= b) root(max(a, b)) = min(a, b)
-      end do
-      allocate (col(0:n))
-      col = 0
-      nq = 0
-      do i = 1, n
-         a = find(i)
-         if (a == 0) cycle
-         if (col(a) == 0) then
-            nq = nq + 1
-            col(a) = nq
-         end if
-      end do
+      allocate (grp(n))
+      call link_groups(model, model%dev%p*model%dev%mu > 0.0_dp, grp, nq)
       if (nq == 0) then
          call fatal_error(error, "the stuck system has no free DOF: every mass is locked to the table &
                           &by friction devices, so its first period is undefined (give period in &damping)")
@@ -76,14 +59,13 @@ contains
       allocate (t(n, nq))
       t = 0.0_dp
       do i = 1, n
-         a = find(i)
-         if (a /= 0) t(i, col(a)) = 1.0_dp
+         if (grp(i) /= 0) t(i, grp(i)) = 1.0_dp
       end do
       kq = matmul(transpose(t), matmul(k, t))
       allocate (mq(nq, nq))
       mq = 0.0_dp
       do i = 1, n
-         if (find(i) /= 0) mq(col(find(i)), col(find(i))) = mq(col(find(i)), col(find(i))) + model%mass(i)
+         if (grp(i) /= 0) mq(grp(i), grp(i)) = mq(grp(i), grp(i)) + model%mass(i)
       end do
       allocate (lam(nq), z(nq, nq))
       call generalized_eigen(kq, mq, lam, z, error)
@@ -95,14 +77,6 @@ contains
       end if
       period = 2.0_dp*pi/sqrt(lam(1))
       phi = matmul(t, z(:, 1))
-   contains
-      integer function find(x)
-         integer, intent(in) :: x
-         find = x
-         do while (root(find) /= find)
-            find = root(find)
-         end do
-      end function find
    end subroutine stuck_first_mode
 
    !> Springs' stiffness K and damping C of the model, with the stuck system's first period
@@ -139,6 +113,43 @@ contains
          xi = dot_product(phi, matmul(c, phi))/(2.0_dp*(2.0_dp*pi/period)*sum(model%mass*phi**2))
       end if
    end subroutine structure_matrices
+
+   !> Groups of DOFs joined by rigid links (the devices flagged in `linked`), by union-find
+   !> over the nodes 0..n_dof: grp(i) = 1..nq for a group that moves, 0 for a DOF linked
+   !> (directly or through others) to the table.
+   pure subroutine link_groups(model, linked, grp, nq)
+      type(model_type), intent(in) :: model   !! the model
+      logical, intent(in) :: linked(:)        !! devices acting as rigid links
+      integer, intent(out) :: grp(:)          !! group of each DOF, 0 = with the table
+      integer, intent(out) :: nq              !! number of moving groups
+      integer :: root(0:model%n_dof), col(0:model%n_dof)
+      integer :: d, i, a, b
+
+      root = [(i, i=0, model%n_dof)]
+      do d = 1, model%n_devices
+         if (.not. linked(d)) cycle
+         a = find(model%dev(d)%node_i); b = find(model%dev(d)%node_j)
+         if (a /= b) root(max(a, b)) = min(a, b)
+      end do
+      col = 0
+      nq = 0
+      do i = 1, model%n_dof
+         a = find(i)
+         if (a /= 0 .and. col(a) == 0) then
+            nq = nq + 1
+            col(a) = nq
+         end if
+         grp(i) = col(a)
+      end do
+   contains
+      pure integer function find(x)
+         integer, intent(in) :: x
+         find = x
+         do while (root(find) /= find)
+            find = root(find)
+         end do
+      end function find
+   end subroutine link_groups
 
    !> Viscous damping matrix of the model.
    pure subroutine damping_matrix(model, k, period, c)

@@ -6,26 +6,8 @@ import numpy as np
 import pytest
 from conftest import K1, K2, M1, M2, TABLE1, G, ok, paper_groups
 
-
-def linear_response(m, k, c, amp, freq, t):
-    """Exact response from rest of M u'' + C u' + K u = -M 1 ag, ag = -amp w^2 sin(w t),
-    by eigen-decomposition of the state matrix and the complex frequency response (an
-    independent route from the solver's Pade exponential and real particular solution)."""
-    m, k, c = np.atleast_2d(m), np.atleast_2d(k), np.atleast_2d(c)
-    n = m.shape[0]
-    minv = np.linalg.inv(m)
-    a = np.block([[np.zeros((n, n)), np.eye(n)], [-minv @ k, -minv @ c]])
-    b = np.concatenate([np.zeros(n), -np.ones(n)])  # x' = A x + b ag
-    w = 2 * np.pi * freq
-    # ag = Im(-amp w^2 e^{iwt}): xp(t) = Im(X e^{iwt}), X = (iw - A)^-1 b (-amp w^2)
-    big_x = np.linalg.solve(1j * w * np.eye(2 * n) - a, b * (-amp * w**2))
-    xp = np.imag(np.outer(np.exp(1j * w * t), big_x))
-    lam, vec = np.linalg.eig(a)
-    coef = np.linalg.solve(vec, -xp[0].astype(complex))
-    xh = np.real(
-        (vec[None, :, :] * (np.exp(np.outer(t, lam))[:, None, :] * coef[None, None, :])).sum(axis=2)
-    )
-    return xh + xp
+# independent references (numpy only): eigen-decomposition and Den Hartog's closed form
+from frictiondyn.validate import den_hartog, linear_response
 
 
 def coulomb_paper(p, test=3, duration=5.0):
@@ -59,29 +41,6 @@ def test_zero_p_mu_leaves_free_oscillators_to_1e8(run):
         exact = linear_response(m, k, psi * k, amp, freq, h["t"])
         assert np.max(np.abs(h[f"u{i}"] - exact[:, 0])) < 1e-8 * np.max(np.abs(exact[:, 0]))
     assert np.all(h["F1"] == 0.0)
-
-
-def den_hartog(t, m, k, ff, f0, w):
-    """Den Hartog's steady non-stop solution of m x'' + k x + ff sgn(x') = f0 sin(w t)."""
-    wn = np.sqrt(k / m)
-    r = w / wn
-    xp, a = (f0 / k) / (1 - r**2), ff / k
-    beta = np.pi / r
-    sin_th = (a / (r * xp)) * np.tan(beta / 2)
-    # the half cycle starts at the minimum, x(0) = xp cos(th) < 0
-    th = np.pi - np.arcsin(sin_th) if xp > 0 else np.arcsin(sin_th)
-    c2 = a * np.sin(beta) / (1 + np.cos(beta))
-    half = np.pi / w
-    # forcing f0 cos(w t') with t' = t - T/4; a half cycle with x' > 0 starts at w t0' = th
-    tp = t - 0.5 * np.pi / w
-    t0 = th / w
-    kh = np.floor((tp - t0) / half)
-    tau = tp - t0 - kh * half
-    x = a * np.cos(wn * tau) + c2 * np.sin(wn * tau) + xp * np.cos(w * tau + th) - a
-    v = -a * wn * np.sin(wn * tau) + c2 * wn * np.cos(wn * tau) - xp * w * np.sin(w * tau + th)
-    sgn = np.where(kh % 2 == 0, 1.0, -1.0)
-    amplitude = abs(xp) * np.sqrt(1 - sin_th**2)
-    return sgn * x, sgn * v, amplitude
 
 
 @pytest.mark.parametrize("r, ratio", [(0.7, 0.3), (1.6, 0.2), (0.45, 0.1)])
