@@ -94,6 +94,7 @@ contains
       type(result_type), intent(out) :: res         !! histories and summary
       type(error_type), allocatable, intent(out) :: error !! event chattering, singular phase
       type(coulomb_work) :: w
+      type(forcing_type) :: frc
       real(dp) :: h, t, tn, tb, e_kin0, e_str0, w_fric
       integer :: k, nsteps, every, iout, nout, ncol, c0, c1, crate
 
@@ -136,9 +137,12 @@ contains
             call advance(model, exc, t, tb, h, w, res, w_fric, error)
             if (allocated(error)) return
             t = tb
+            frc = forcing_at(exc, t)
+            if (w%pat%frc%nf /= frc%nf) then
+               call set_pattern(model, exc, t, w, error)   ! the ramp ended: steady forcing
+               if (allocated(error)) return
+            end if
             if (tb >= tn) exit
-            call set_pattern(model, exc, t, w, error)   ! new forcing law after the ramp
-            if (allocated(error)) return
          end do
          t = tn
          res%steps_dt1 = res%steps_dt1 + 1
@@ -706,7 +710,7 @@ contains
       integer, allocatable :: old(:)
       logical, allocatable :: held(:)
       real(dp) :: ratio, worst
-      integer :: d, dw, iter
+      integer :: d, dw, iter, pass
       real(dp) :: sd
       real(dp), parameter :: at_limit = 1.0_dp - 1.0e-9_dp  !! |F| / P mu that counts as the limit
 
@@ -722,35 +726,60 @@ contains
       ! release, one at a time, the candidate that needs most above P mu (at the limit counts:
       ! its force got there increasing), in the direction of its force; keep the release only
       ! if the device then accelerates that way, else it holds
-      dw = 0
-      do iter = 1, 2*w%nd + 2
-         call set_pattern(model, exc, t, w, error)
-         if (allocated(error)) return
-         call expand(exc, t, w%x, w)
-         call stuck_forces(model, exc, t, w)
-         if (dw > 0) then
-            if (w%phase(dw)*rel(model, dw, w%acc) <= 0.0_dp) then
-               w%phase(dw) = phase_stick
-               w%fresh(dw) = .false.
-               held(dw) = .true.
-               dw = 0
-               cycle
-            end if
-         end if
-         worst = at_limit
+      do pass = 1, w%nd + 1
          dw = 0
+         do iter = 1, 2*w%nd + 2
+            call set_pattern(model, exc, t, w, error)
+            if (allocated(error)) return
+            call expand(exc, t, w%x, w)
+            call stuck_forces(model, exc, t, w)
+            if (dw > 0) then
+               if (w%phase(dw)*rel(model, dw, w%acc) <= 0.0_dp) then
+                  w%phase(dw) = phase_stick
+                  w%fresh(dw) = .false.
+                  held(dw) = .true.
+                  dw = 0
+                  cycle
+               end if
+            end if
+            worst = at_limit
+            dw = 0
+            do d = 1, w%nd
+               if (.not. w%active(d) .or. w%phase(d) /= phase_stick .or. held(d)) cycle
+               ratio = abs(w%force(d))/w%slip(d)
+               if (ratio >= worst) then
+                  worst = ratio
+                  dw = d
+               end if
+            end do
+            if (dw == 0) exit
+            w%phase(dw) = int(sign(1.0_dp, w%force(dw)))
+            w%fresh(dw) = .true.
+         end do
+         ! a device released earlier may no longer accelerate in its direction once others
+         ! were released: it holds, and the decision is made again
+         dw = 0
+         worst = 0.0_dp
          do d = 1, w%nd
-            if (.not. w%active(d) .or. w%phase(d) /= phase_stick .or. held(d)) cycle
-            ratio = abs(w%force(d))/w%slip(d)
-            if (ratio >= worst) then
+            if (.not. w%fresh(d) .or. w%phase(d) == phase_stick) cycle
+            ratio = w%phase(d)*rel(model, d, w%acc)
+            if (ratio <= worst) then
                worst = ratio
                dw = d
             end if
          end do
          if (dw == 0) exit
-         w%phase(dw) = int(sign(1.0_dp, w%force(dw)))
-         w%fresh(dw) = .true.
+         w%phase(dw) = phase_stick
+         w%fresh(dw) = .false.
+         held(dw) = .true.
       end do
+      if (dw /= 0) then
+         ! out of passes: leave the state consistent with the phases decided last
+         call set_pattern(model, exc, t, w, error)
+         if (allocated(error)) return
+         call expand(exc, t, w%x, w)
+         call stuck_forces(model, exc, t, w)
+      end if
       do d = 1, w%nd
          if (w%phase(d) /= phase_stick) cycle
          w%fresh(d) = .false.

@@ -186,3 +186,42 @@ def test_coulomb_cannot_be_mixed(run):
     }
     r = run(g)
     assert r.returncode != 0 and "law(2)" in r.stderr and "coulomb" in r.stderr
+
+
+def test_two_devices_exact_against_a_fine_velocity_law(run):
+    """A 3-mass chain with two devices that stick and slip at different times: the exact
+    technique and the velocity law with a narrow band (eps = 1e-5 m/s) agree."""
+    base = {
+        "model": {"n_dof": 3, "mass": [3.0, 2.0, 1.5]},
+        "springs": {"n_springs": 3, "node_i": [1, 2, 3], "node_j": [0, 1, 2],
+                    "k": [3000.0, 1200.0, 900.0]},
+        "damping": {"damping_type": "rayleigh", "rayleigh_a0": 0.3, "rayleigh_a1": 0.001},
+        "excitation": {"excitation_type": "harmonic", "amplitude": 0.01, "frequency": 3.0,
+                       "ramp_cycles": 3, "dt_record": 0.005, "duration": 20.0},
+        "integration": {"n1": 20, "n2": 50},
+        "output": {"output_every": 1},
+    }
+
+    def with_law(law, eps=1e-5):
+        return dict(base, friction={"n_devices": 2, "node_i": [2, 3], "node_j": [1, 2],
+                                    "law": [law, law], "p": [40.0, 40.0], "mu": [0.2, 0.2],
+                                    "eps": [eps, eps]})
+
+    ex = ok(run(with_law("coulomb")))
+    vl = ok(run(with_law("velocity")))
+    se, sv = ex.summary(), vl.summary()
+    assert min(se["stick_to_slip"]) > 100  # both devices stick and slip in every cycle
+    he, hv = ex.history(), vl.history()
+    w = he["t"] > 15.0
+
+    def starts(h, d):  # stick-to-slip changes in the window
+        ph = h[f"phase{d}"][w]
+        return int(np.sum((ph[:-1] == 0) & (ph[1:] != 0)))
+
+    for d in (1, 2):
+        assert starts(he, d) == starts(hv, d) >= 25
+    for i in (1, 2, 3):
+        peak_e = np.max(np.abs(he[f"aabs{i}"][w]))
+        assert np.max(np.abs(hv[f"aabs{i}"][w])) == pytest.approx(peak_e, rel=2e-3)
+        assert np.max(np.abs(hv[f"u{i}"][w] - he[f"u{i}"][w])) < 1e-3 * np.max(np.abs(he[f"u{i}"][w]))
+    assert abs(se["energy_residual_J"]) < 1e-9 * se["energy_input_J"]
