@@ -23,7 +23,7 @@ module fd_coulomb
    use fd_matrices, only: structure_matrices, link_groups
    use fd_expm, only: lti_propagators
    use fd_linalg, only: sym_matvec, gen_matvec, lu_solve, least_squares, least_squares_work
-   use fd_result, only: result_type, init_result, history_shape
+   use fd_result, only: result_type, init_result, history_shape, record_transition
    use fd_device_state, only: phase_stick
    implicit none
    private
@@ -716,6 +716,7 @@ contains
 
       allocate (old(w%nd), held(w%nd))
       old = w%phase
+      dw = 0
       held = .false.
       ! the state is expanded at t; candidates: stuck ones, and sliders at a velocity zero
       do d = 1, w%nd
@@ -786,14 +787,7 @@ contains
       end do
       if (initial) return
       do d = 1, w%nd
-         if (old(d) == w%phase(d)) cycle
-         if (old(d) == phase_stick) then
-            res%stick_to_slip(d) = res%stick_to_slip(d) + 1
-         else if (w%phase(d) == phase_stick) then
-            res%slip_to_stick(d) = res%slip_to_stick(d) + 1
-         else
-            res%reversals(d) = res%reversals(d) + 1
-         end if
+         call record_transition(res, d, old(d), w%phase(d))
       end do
    end subroutine decide_phases
 

@@ -17,9 +17,9 @@ module fd_newmark
    use fd_excitation, only: excitation_type, table_motion
    use fd_matrices, only: structure_matrices
    use fd_linalg, only: cholesky_factor, cholesky_solve, sym_matvec
-   use fd_device_state, only: device_state, phase_stick, device_force
+   use fd_device_state, only: device_state, device_force
    use fd_friction, only: friction_init, friction_update, friction_correct
-   use fd_result, only: result_type, max_violation_times, init_result, history_shape
+   use fd_result, only: result_type, max_violation_times, init_result, history_shape, record_transition
    implicit none
    private
 
@@ -384,14 +384,7 @@ contains
          end do
       end if
       do d = 1, w%nd
-         if (.not. w%changed(d)) cycle
-         if (w%st(d)%phase == phase_stick) then
-            res%stick_to_slip(d) = res%stick_to_slip(d) + 1
-         else if (w%st1(d)%phase == phase_stick) then
-            res%slip_to_stick(d) = res%slip_to_stick(d) + 1
-         else
-            res%reversals(d) = res%reversals(d) + 1
-         end if
+         call record_transition(res, d, w%st(d)%phase, w%st1(d)%phase)
       end do
       w%u = w%u1; w%v = w%v1; w%a = w%a1; w%ag = w%ag1
       w%s = w%s1; w%sd = w%sd1
