@@ -17,7 +17,7 @@
 module fd_coulomb
    use, intrinsic :: ieee_arithmetic, only: ieee_is_finite
    use fd_kinds, only: dp
-   use fd_error, only: error_type, fatal_error, fmt_real
+   use fd_error, only: error_type, fatal_error, fmt_real, fmt_int
    use fd_model, only: model_type, integration_type, law_coulomb
    use fd_excitation, only: excitation_type, table_motion, excitation_harmonic, excitation_record
    use fd_matrices, only: structure_matrices, link_groups
@@ -96,14 +96,23 @@ contains
       type(coulomb_work) :: w
       type(forcing_type) :: frc
       real(dp) :: h, t, tn, tb, e_kin0, e_str0, w_fric
-      integer :: k, nsteps, every, iout, nout, ncol, c0, c1, crate
+      integer :: k, nsteps, every, iout, nout, ncol, c0, c1, crate, stat
 
       call system_clock(c0, crate)
-      call setup(model, w)
+      call setup(model, w, stat)
+      if (stat /= 0) then
+         call fatal_error(error, "not enough memory for the matrices of n_dof = "//fmt_int(model%n_dof)//" DOFs")
+         return
+      end if
       call structure_matrices(model, w%k, w%c, res%period_stuck, res%xi_stuck, error)
       if (allocated(error)) return
       call history_shape(model, exc, opts, ncol, nout, nsteps, every)
-      call init_result(model, nout, res)
+      call init_result(model, nout, res, stat)
+      if (stat /= 0) then
+         call fatal_error(error, "not enough memory for the history: "//fmt_int(nout)//" samples of "// &
+                          fmt_int(ncol)//" columns (raise output_every or shorten duration)")
+         return
+      end if
       h = exc%dt_record/opts%n1
       res%dt1 = h
       res%dt2 = 0.0_dp
@@ -169,9 +178,10 @@ contains
       res%run_time = real(c1 - c0, dp)/real(max(crate, 1), dp)
    end subroutine run_coulomb
 
-   subroutine setup(model, w)
+   subroutine setup(model, w, stat)
       type(model_type), intent(in) :: model
       type(coulomb_work), intent(inout) :: w
+      integer, intent(out) :: stat
       integer :: n, nd, d
 
       n = model%n_dof
@@ -179,7 +189,8 @@ contains
       w%n = n
       w%nd = nd
       w%mass = model%mass
-      allocate (w%k(n, n), w%c(n, n), w%u(n), w%v(n), w%acc(n))
+      allocate (w%k(n, n), w%c(n, n), w%u(n), w%v(n), w%acc(n), stat=stat)
+      if (stat /= 0) return
       allocate (w%phase(nd), w%fresh(nd), w%active(nd), w%force(nd), w%slip(nd))
       allocate (w%g_end(nd), w%g_try(nd), w%s0(nd), w%rn(n), w%vv(n))
       w%fresh = .false.

@@ -485,6 +485,13 @@ contains
       end if
       call check_real(deck, 'integration', 'dt_min', dt_min, 0.0_dp, cfg%exc%dt_record/n1/n2, 's', error)
       if (allocated(error)) return
+      ! the run takes duration / dt1 steps, counted in a default integer
+      if (cfg%exc%duration/(cfg%exc%dt_record/n1) > 2.0e9_dp) then
+         call bad(deck, 'integration', 'n1', fmt_int(n1), 'such that duration / (dt_record / n1) = '// &
+                  fmt_real(cfg%exc%duration/(cfg%exc%dt_record/n1))//' steps stays below 2e9 (duration = '// &
+                  fmt_real(cfg%exc%duration)//' s)', error)
+         return
+      end if
       cfg%opts%beta = beta
       cfg%opts%gamma = gamma
       cfg%opts%n1 = n1

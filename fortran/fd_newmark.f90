@@ -60,7 +60,7 @@ contains
       type(error_type), allocatable, intent(out) :: error !! singular system, divergence
       type(workspace) :: w
       real(dp) :: dt1, dt2, t0
-      integer :: nsteps, every, k, j, iout, nout, c0, c1, crate
+      integer :: nsteps, every, k, j, iout, nout, ncol, c0, c1, crate, stat
       logical :: any_changed, any_bad
 
       call system_clock(c0, crate)
@@ -72,8 +72,13 @@ contains
       if (res%dt_min <= 0.0_dp) res%dt_min = dt2/2.0_dp**10
       call setup(model, halving_levels(dt2, res%dt_min), w, res, error)
       if (allocated(error)) return
-      call history_shape(model, exc, opts, iout, nout, nsteps, every)
-      call init_result(model, nout, res)
+      call history_shape(model, exc, opts, ncol, nout, nsteps, every)
+      call init_result(model, nout, res, stat)
+      if (stat /= 0) then
+         call fatal_error(error, "not enough memory for the history: "//fmt_int(nout)//" samples of "// &
+                          fmt_int(ncol)//" columns (raise output_every or shorten duration)")
+         return
+      end if
 
       ! initial state: devices from the initial conditions, acceleration from equilibrium
       w%u = model%u0
@@ -135,14 +140,18 @@ contains
       type(workspace), intent(inout) :: w
       type(result_type), intent(inout) :: res
       type(error_type), allocatable, intent(out) :: error
-      integer :: n, nd, i, n_slots
+      integer :: n, nd, i, n_slots, stat
 
       n = model%n_dof
       nd = model%n_devices
       w%n = n
       w%nd = nd
       w%mass = model%mass
-      allocate (w%k(n, n), w%c(n, n))
+      allocate (w%k(n, n), w%c(n, n), stat=stat)
+      if (stat /= 0) then
+         call fatal_error(error, "not enough memory for the matrices of n_dof = "//fmt_int(n)//" DOFs")
+         return
+      end if
       call structure_matrices(model, w%k, w%c, res%period_stuck, res%xi_stuck, error)
       if (allocated(error)) return
       allocate (w%u(n), w%v(n), w%a(n), w%u1(n), w%v1(n), w%a1(n), w%rhs(n), w%tmp(n))
@@ -152,7 +161,11 @@ contains
       if (nd == 0) n_slots = 1
       allocate (w%slot(n_slots))
       do i = 1, n_slots
-         allocate (w%slot(i)%stuck(nd), w%slot(i)%a(n, n))
+         allocate (w%slot(i)%stuck(nd), w%slot(i)%a(n, n), stat=stat)
+         if (stat /= 0) then
+            call fatal_error(error, "not enough memory for the factors of n_dof = "//fmt_int(n)//" DOFs")
+            return
+         end if
       end do
    end subroutine setup
 

@@ -85,10 +85,11 @@ contains
    end subroutine history_shape
 
    !> Allocate the history and the per-DOF and per-device summary of a run.
-   subroutine init_result(model, nout, res)
+   subroutine init_result(model, nout, res, stat)
       type(model_type), intent(in) :: model     !! the model run
       integer, intent(in) :: nout               !! samples of the history
       type(result_type), intent(inout) :: res   !! the result to set up
+      integer, intent(out) :: stat              !! 0, or non-zero when memory runs out
       integer :: n, nd, i, c
 
       n = model%n_dof
@@ -97,7 +98,8 @@ contains
       res%n_devices = nd
       res%ncol = 2 + 3*n + 4*nd   ! as in history_shape
       res%nout = nout
-      allocate (res%hist(res%ncol, nout), res%names(res%ncol), res%units(res%ncol))
+      allocate (res%hist(res%ncol, nout), res%names(res%ncol), res%units(res%ncol), stat=stat)
+      if (stat /= 0) return
       res%hist = 0.0_dp
       res%names(1) = 't'; res%units(1) = 's'
       res%names(2) = 'ag'; res%units(2) = 'm/s2'
