@@ -69,6 +69,7 @@ CASES = [
     ("device to itself", _set("friction", "node_j", 1), ["&friction", "node_j(1)", "= 1 "]),
     ("device to a missing DOF", _set("friction", "node_j", 7), ["&friction", "node_j(1)", "= 7 "]),
     ("unknown law", _set("friction", "law", "coloumb"), ["&friction", "law(1)", "coloumb"]),
+    ("more than 2e9 steps", _set("excitation", "duration", 4.0e7), ["&integration", "n1", "2e9"]),
     ("dt_min above dt2", _set("integration", "dt_min", 1.0), ["&integration", "dt_min", "= 1"]),
 ]
 
