@@ -101,7 +101,7 @@ contains
       call system_clock(c0, crate)
       call setup(model, w, stat)
       if (stat /= 0) then
-         call fatal_error(error, "not enough memory for the matrices of n_dof = "//fmt_int(model%n_dof)//" DOFs")
+         call fatal_error(error, "not enough memory for the matrices of n_dof = "//trim(fmt_int(model%n_dof))//" DOFs")
          return
       end if
       call structure_matrices(model, w%k, w%c, res%period_stuck, res%xi_stuck, error)
@@ -109,8 +109,8 @@ contains
       call history_shape(model, exc, opts, ncol, nout, nsteps, every)
       call init_result(model, nout, res, stat)
       if (stat /= 0) then
-         call fatal_error(error, "not enough memory for the history: "//fmt_int(nout)//" samples of "// &
-                          fmt_int(ncol)//" columns (raise output_every or shorten duration)")
+         call fatal_error(error, "not enough memory for the history: "//trim(fmt_int(nout))//" samples of "// &
+                          trim(fmt_int(ncol))//" columns (raise output_every or shorten duration)")
          return
       end if
       h = exc%dt_record/opts%n1
@@ -159,7 +159,7 @@ contains
          if (mod(k, every) == 0 .or. k == nsteps) then
             if (.not. all(ieee_is_finite(w%u))) then
                call fatal_error(error, "exact Coulomb technique: the solution is not finite at t = "// &
-                                fmt_real(t)//" s")
+                                trim(fmt_real(t))//" s")
                return
             end if
             iout = iout + 1
@@ -314,7 +314,7 @@ contains
             call lu_solve(lhs, rhs, ipiv, info)
             if (info /= 0) then
                call fatal_error(error, "exact Coulomb technique: the table frequency "// &
-                                fmt_real(w%pat%frc%w(kf)/(2.0_dp*pi))//" Hz is a natural frequency of an "// &
+                                trim(fmt_real(w%pat%frc%w(kf)/(2.0_dp*pi)))//" Hz is a natural frequency of an "// &
                                 "undamped phase of the structure (no steady state exists)")
                return
             end if
@@ -576,7 +576,7 @@ contains
                stalls = stalls + 1
                if (stalls > 50) then
                   call fatal_error(error, "exact Coulomb technique: events accumulate at t = "// &
-                                   fmt_real(tc)//" s (stick-slip chattering)")
+                                   trim(fmt_real(tc))//" s (stick-slip chattering)")
                   return
                end if
             else

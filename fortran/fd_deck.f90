@@ -112,7 +112,7 @@ contains
       read (grp%lines, nml=model, iostat=ios, iomsg=msg0)
       if (ios /= 0) then
          do i = 1, size(grp%items)
-            rec = group_item(grp, i); msg = ''
+            call group_item(grp, i, rec); msg = ''
             read (rec, nml=model, iostat=ios, iomsg=msg)
             if (ios /= 0) exit
          end do
@@ -161,7 +161,7 @@ contains
       read (grp%lines, nml=springs, iostat=ios, iomsg=msg0)
       if (ios /= 0) then
          do i = 1, size(grp%items)
-            rec = group_item(grp, i); msg = ''
+            call group_item(grp, i, rec); msg = ''
             read (rec, nml=springs, iostat=ios, iomsg=msg)
             if (ios /= 0) exit
          end do
@@ -179,9 +179,9 @@ contains
       if (allocated(error)) return
       do i = 1, n
          if (node_i(i) == node_j(i)) then
-            call bad(deck, 'springs', 'node_j('//fmt_int(i)//')', fmt_int(node_j(i)), &
-                     'different from node_i('//fmt_int(i)//') = '// &
-                     fmt_int(node_i(i))//': a spring joins two different nodes', error)
+            call bad(deck, 'springs', 'node_j('//trim(fmt_int(i))//')', trim(fmt_int(node_j(i))), &
+                     'different from node_i('//trim(fmt_int(i))//') = '// &
+                     trim(fmt_int(node_i(i)))//': a spring joins two different nodes', error)
             return
          end if
       end do
@@ -216,7 +216,7 @@ contains
       read (grp%lines, nml=damping, iostat=ios, iomsg=msg0)
       if (ios /= 0) then
          do i = 1, size(grp%items)
-            rec = group_item(grp, i); msg = ''
+            call group_item(grp, i, rec); msg = ''
             read (rec, nml=damping, iostat=ios, iomsg=msg)
             if (ios /= 0) exit
          end do
@@ -279,7 +279,7 @@ contains
       read (grp%lines, nml=friction, iostat=ios, iomsg=msg0)
       if (ios /= 0) then
          do i = 1, size(grp%items)
-            rec = group_item(grp, i); msg = ''
+            call group_item(grp, i, rec); msg = ''
             read (rec, nml=friction, iostat=ios, iomsg=msg)
             if (ios /= 0) exit
          end do
@@ -304,17 +304,17 @@ contains
       call optional_reals(deck, 'friction', 'f', f, n, 1.0e-5_dp, 'm', error, positive=.true.)
       if (allocated(error)) return
       if (any(law(n + 1:) /= '')) then
-         call bad(deck, 'friction', 'law', 'with '//fmt_int(findloc(law /= '', .true., 1, back=.true.)) &
-                  //' values', 'at most n_devices = '//fmt_int(n)//' values', error)
+         call bad(deck, 'friction', 'law', 'with '//trim(fmt_int(findloc(law /= '', .true., 1, back=.true.))) &
+                  //' values', 'at most n_devices = '//trim(fmt_int(n))//' values', error)
          return
       end if
       deallocate (cfg%model%dev)
       allocate (cfg%model%dev(n))
       do i = 1, n
-         idx = '('//fmt_int(i)//')'
+         idx = '('//trim(fmt_int(i))//')'
          if (node_i(i) == node_j(i)) then
-            call bad(deck, 'friction', 'node_j'//idx, fmt_int(node_j(i)), 'different from node_i'//idx//' = '// &
-                     fmt_int(node_i(i))//': a device joins two different nodes', error)
+            call bad(deck, 'friction', 'node_j'//idx, trim(fmt_int(node_j(i))), 'different from node_i'//idx//' = '// &
+                     trim(fmt_int(node_i(i)))//': a device joins two different nodes', error)
             return
          end if
          select case (lower(trim(law(i))))
@@ -375,7 +375,7 @@ contains
       read (grp%lines, nml=excitation, iostat=ios, iomsg=msg0)
       if (ios /= 0) then
          do i = 1, size(grp%items)
-            rec = group_item(grp, i); msg = ''
+            call group_item(grp, i, rec); msg = ''
             read (rec, nml=excitation, iostat=ios, iomsg=msg)
             if (ios /= 0) exit
          end do
@@ -393,7 +393,7 @@ contains
          call need_real(deck, 'excitation', 'frequency', frequency, 'Hz', error)
          if (allocated(error)) return
          if (ramp_cycles < 0) then
-            call bad(deck, 'excitation', 'ramp_cycles', fmt_int(ramp_cycles), '>= 0', error); return
+            call bad(deck, 'excitation', 'ramp_cycles', trim(fmt_int(ramp_cycles)), '>= 0', error); return
          end if
          call need_real(deck, 'excitation', 'duration', duration, 's', error)
          if (allocated(error)) return
@@ -406,7 +406,7 @@ contains
             call bad(deck, 'excitation', 'record_file', "''", 'the path of the record file', error); return
          end if
          if (.not. ieee_is_finite(record_scale) .or. record_scale == 0.0_dp) then
-            call bad(deck, 'excitation', 'record_scale', fmt_real(record_scale), 'finite and non-zero', error)
+            call bad(deck, 'excitation', 'record_scale', trim(fmt_real(record_scale)), 'finite and non-zero', error)
             return
          end if
          if (lower(trim(record_kind)) /= 'acceleration' .and. lower(trim(record_kind)) /= 'displacement') then
@@ -414,7 +414,7 @@ contains
                      "'acceleration' (m/s2 after record_scale) or 'displacement' (m)", error)
             return
          end if
-         path = relative_to(deck%path, trim(record_file))
+         call relative_to(deck%path, trim(record_file), path)
          call read_record(path, lower(trim(record_kind)) == 'displacement', record_scale, dt_record, &
                           cfg%exc%acc, error)
          if (allocated(error)) then
@@ -461,7 +461,7 @@ contains
          read (grp%lines, nml=integration, iostat=ios, iomsg=msg0)
          if (ios /= 0) then
             do i = 1, size(grp%items)
-               rec = group_item(grp, i); msg = ''
+               call group_item(grp, i, rec); msg = ''
                read (rec, nml=integration, iostat=ios, iomsg=msg)
                if (ios /= 0) exit
             end do
@@ -474,22 +474,22 @@ contains
       call check_real(deck, 'integration', 'gamma', gamma, 0.5_dp, 1.0_dp, '', error)
       if (allocated(error)) return
       if (n1 < 1) then
-         call bad(deck, 'integration', 'n1', fmt_int(n1), '>= 1 (dt1 = dt_record / n1)', error); return
+         call bad(deck, 'integration', 'n1', trim(fmt_int(n1)), '>= 1 (dt1 = dt_record / n1)', error); return
       end if
       if (n2 < 1) then
-         call bad(deck, 'integration', 'n2', fmt_int(n2), '>= 1 (dt2 = dt1 / n2)', error); return
+         call bad(deck, 'integration', 'n2', trim(fmt_int(n2)), '>= 1 (dt2 = dt1 / n2)', error); return
       end if
       if (.not. ieee_is_finite(n) .or. n <= 1.0_dp) then
-         call bad(deck, 'integration', 'n', fmt_real(n), '> 1 (correctness condition, eqs. 9 and 12)', error)
+         call bad(deck, 'integration', 'n', trim(fmt_real(n)), '> 1 (correctness condition, eqs. 9 and 12)', error)
          return
       end if
       call check_real(deck, 'integration', 'dt_min', dt_min, 0.0_dp, cfg%exc%dt_record/n1/n2, 's', error)
       if (allocated(error)) return
       ! the run takes duration / dt1 steps, counted in a default integer
       if (cfg%exc%duration/(cfg%exc%dt_record/n1) > 2.0e9_dp) then
-         call bad(deck, 'integration', 'n1', fmt_int(n1), 'such that duration / (dt_record / n1) = '// &
-                  fmt_real(cfg%exc%duration/(cfg%exc%dt_record/n1))//' steps stays below 2e9 (duration = '// &
-                  fmt_real(cfg%exc%duration)//' s)', error)
+         call bad(deck, 'integration', 'n1', trim(fmt_int(n1)), 'such that duration / (dt_record / n1) = '// &
+                  trim(fmt_real(cfg%exc%duration/(cfg%exc%dt_record/n1)))//' steps stays below 2e9 (duration = '// &
+                  trim(fmt_real(cfg%exc%duration))//' s)', error)
          return
       end if
       cfg%opts%beta = beta
@@ -516,7 +516,8 @@ contains
       integer :: ios, i
       logical :: found
 
-      dir = 'out'; name = stem(deck%path); output_every = 0; write_history = .true.
+      dir = 'out'; output_every = 0; write_history = .true.
+      call stem(deck%path, name)
       call find_group(deck, 'output', grp, found, error)
       if (allocated(error)) return
       if (found) then
@@ -524,7 +525,7 @@ contains
          read (grp%lines, nml=output, iostat=ios, iomsg=msg0)
          if (ios /= 0) then
             do i = 1, size(grp%items)
-               rec = group_item(grp, i); msg = ''
+               call group_item(grp, i, rec); msg = ''
                read (rec, nml=output, iostat=ios, iomsg=msg)
                if (ios /= 0) exit
             end do
@@ -539,7 +540,7 @@ contains
          call bad(deck, 'output', 'name', "'"//trim(name)//"'", 'a file name without directory', error); return
       end if
       if (output_every < 0) then
-         call bad(deck, 'output', 'output_every', fmt_int(output_every), '>= 0 (0 = at the record step)', error)
+         call bad(deck, 'output', 'output_every', trim(fmt_int(output_every)), '>= 0 (0 = at the record step)', error)
          return
       end if
       cfg%out%dir = trim(dir)
@@ -571,7 +572,7 @@ contains
       if (x == unset_int) then
          call fatal_error(error, deck%path//", group &"//group//": "//var//" is not given"); return
       end if
-      if (x < lo .or. x > hi) call bad(deck, group, var, fmt_int(x), 'in '//fmt_int(lo)//'..'//fmt_int(hi), error)
+      if (x < lo .or. x > hi) call bad(deck, group, var, trim(fmt_int(x)), 'in '//trim(fmt_int(lo))//'..'//trim(fmt_int(hi)), error)
    end subroutine need_int
 
    subroutine need_real(deck, group, var, x, unit, error, positive)
@@ -587,12 +588,12 @@ contains
          call fatal_error(error, deck%path//", group &"//group//": "//var//" is not given"); return
       end if
       if (.not. ieee_is_finite(x)) then
-         call bad(deck, group, var, fmt_real(x), 'a finite number', error); return
+         call bad(deck, group, var, trim(fmt_real(x)), 'a finite number', error); return
       end if
       if (pos .and. x <= 0.0_dp) then
-         call bad(deck, group, var, fmt_real(x), '> 0 '//unit, error)
+         call bad(deck, group, var, trim(fmt_real(x)), '> 0 '//unit, error)
       else if (.not. pos .and. x < 0.0_dp) then
-         call bad(deck, group, var, fmt_real(x), '>= 0 '//unit, error)
+         call bad(deck, group, var, trim(fmt_real(x)), '>= 0 '//unit, error)
       end if
    end subroutine need_real
 
@@ -610,13 +611,13 @@ contains
       ok = ieee_is_finite(x)
       if (ok) ok = merge(x > lo, x >= lo, olo) .and. merge(x < hi, x <= hi, ohi)
       if (ok) return
-      range = merge('(', '[', olo)//fmt_real(lo)//', '
+      range = merge('(', '[', olo)//trim(fmt_real(lo))//', '
       if (hi >= huge(1.0_dp)) then
          range = range//'inf)'
       else
-         range = range//fmt_real(hi)//merge(')', ']', ohi)
+         range = range//trim(fmt_real(hi))//merge(')', ']', ohi)
       end if
-      call bad(deck, group, var, fmt_real(x), 'in '//range//' '//unit, error)
+      call bad(deck, group, var, trim(fmt_real(x)), 'in '//range//' '//unit, error)
    end subroutine check_real
 
    !> n values must be given, finite and > 0 (or >= 0); no more than n.
@@ -629,7 +630,7 @@ contains
       logical, intent(in) :: positive
       integer :: i
       do i = 1, n
-         call need_real(deck, group, var//'('//fmt_int(i)//')', x(i), unit, error, positive)
+         call need_real(deck, group, var//'('//trim(fmt_int(i))//')', x(i), unit, error, positive)
          if (allocated(error)) return
       end do
       call no_extra(deck, group, var, x, n, error)
@@ -651,10 +652,10 @@ contains
       do i = 1, n
          if (x(i) == unset) x(i) = default
          if (.not. ieee_is_finite(x(i))) then
-            call bad(deck, group, var//'('//fmt_int(i)//')', fmt_real(x(i)), 'a finite number', error); return
+            call bad(deck, group, var//'('//trim(fmt_int(i))//')', trim(fmt_real(x(i))), 'a finite number', error); return
          end if
          if (pos .and. x(i) <= 0.0_dp) then
-            call bad(deck, group, var//'('//fmt_int(i)//')', fmt_real(x(i)), '> 0 '//unit, error); return
+            call bad(deck, group, var//'('//trim(fmt_int(i))//')', trim(fmt_real(x(i))), '> 0 '//unit, error); return
          end if
       end do
       call no_extra(deck, group, var, x, n, error)
@@ -668,8 +669,8 @@ contains
       type(error_type), allocatable, intent(out) :: error
       integer :: last
       last = findloc(x /= unset, .true., 1, back=.true.)
-      if (last > n) call bad(deck, group, var//'('//fmt_int(last)//')', fmt_real(x(last)), &
-                             'absent: only '//fmt_int(n)//' value(s) are expected', error)
+      if (last > n) call bad(deck, group, var//'('//trim(fmt_int(last))//')', trim(fmt_real(x(last))), &
+                             'absent: only '//trim(fmt_int(n))//' value(s) are expected', error)
    end subroutine no_extra
 
    subroutine node_list(deck, group, var, x, n, lo, hi, error)
@@ -680,24 +681,24 @@ contains
       integer :: i, last
       do i = 1, n
          if (x(i) == unset_int) then
-            call fatal_error(error, deck%path//", group &"//group//": "//var//'('//fmt_int(i)//") is not given")
+            call fatal_error(error, deck%path//", group &"//group//": "//var//'('//trim(fmt_int(i))//") is not given")
             return
          end if
          if (x(i) < lo .or. x(i) > hi) then
-            call bad(deck, group, var//'('//fmt_int(i)//')', fmt_int(x(i)), 'a node in '//fmt_int(lo)//'..'// &
-                     fmt_int(hi)//merge(' (0 = table)', '            ', lo == 0), error)
+            call bad(deck, group, var//'('//trim(fmt_int(i))//')', trim(fmt_int(x(i))), 'a node in '//trim(fmt_int(lo))//'..'// &
+                     trim(fmt_int(hi))//merge(' (0 = table)', '            ', lo == 0), error)
             return
          end if
       end do
       last = findloc(x /= unset_int, .true., 1, back=.true.)
-      if (last > n) call bad(deck, group, var//'('//fmt_int(last)//')', fmt_int(x(last)), &
-                             'absent: only '//fmt_int(n)//' value(s) are expected', error)
+      if (last > n) call bad(deck, group, var//'('//trim(fmt_int(last))//')', trim(fmt_int(x(last))), &
+                             'absent: only '//trim(fmt_int(n))//' value(s) are expected', error)
    end subroutine node_list
 
    !> A path relative to the directory of the deck (absolute paths are kept).
-   pure function relative_to(deck_path, path) result(full)
+   pure subroutine relative_to(deck_path, path, full)
       character(len=*), intent(in) :: deck_path, path
-      character(len=:), allocatable :: full
+      character(len=:), allocatable, intent(out) :: full
       integer :: slash
       if (path(1:1) == '/') then
          full = path
@@ -705,17 +706,17 @@ contains
       end if
       slash = index(deck_path, '/', back=.true.)
       full = deck_path(1:slash)//path
-   end function relative_to
+   end subroutine relative_to
 
    !> File name of the deck without its directory and extension.
-   pure function stem(path) result(name)
+   pure subroutine stem(path, name)
       character(len=*), intent(in) :: path
-      character(len=:), allocatable :: name
+      character(len=*), intent(out) :: name
       integer :: slash, dot
       slash = index(path, '/', back=.true.)
       name = path(slash + 1:)
       dot = index(name, '.', back=.true.)
       if (dot > 1) name = name(1:dot - 1)
-   end function stem
+   end subroutine stem
 
 end module fd_deck

@@ -31,8 +31,9 @@ contains
       use, intrinsic :: ieee_arithmetic, only: ieee_is_finite
       use fd_kinds, only: dp
       real(dp), intent(in) :: x               !! value to format
-      character(len=:), allocatable :: str    !! the value as text
+      character(len=32) :: str                !! the value as text, left-adjusted
       character(len=40) :: buf, fmt
+      character(len=:), allocatable :: w
       real(dp) :: y
       integer :: p, e, d, ios
 
@@ -57,36 +58,34 @@ contains
          d = max(1, p - 1 - e)
          write (fmt, '(a,i0,a)') '(f0.', d, ')'
          write (buf, fmt) x
-         str = trim(adjustl(buf))
-         do while (len(str) > 1 .and. str(len(str):len(str)) == '0')
-            str = str(1:len(str) - 1)
+         w = trim(adjustl(buf))
+         do while (len(w) > 1 .and. w(len(w):len(w)) == '0')
+            w = w(1:len(w) - 1)
          end do
-         if (str(len(str):len(str)) == '.') str = str//'0'
-         if (str(1:1) == '.') str = '0'//str
-         if (str(1:2) == '-.') str = '-0'//str(2:)
+         if (w(len(w):len(w)) == '.') w = w//'0'
+         if (w(1:1) == '.') w = '0'//w
+         if (w(1:2) == '-.') w = '-0'//w(2:)
       else
          ! mantissa without trailing zeros, exponent without padding: -1.5E-5
-         str = trim(adjustl(buf))
-         e = index(str, 'E')
-         read (str(e + 1:), *) d
-         str = str(1:e - 1)
-         do while (str(len(str):len(str)) == '0')
-            str = str(1:len(str) - 1)
+         w = trim(adjustl(buf))
+         e = index(w, 'E')
+         read (w(e + 1:), *) d
+         w = w(1:e - 1)
+         do while (w(len(w):len(w)) == '0')
+            w = w(1:len(w) - 1)
          end do
-         if (str(len(str):len(str)) == '.') str = str//'0'
+         if (w(len(w):len(w)) == '.') w = w//'0'
          write (buf, '(i0)') d
-         str = str//'E'//trim(buf)
+         w = w//'E'//trim(buf)
       end if
+      str = w
    end function fmt_real
 
    !> An integer as text, for messages.
    pure function fmt_int(i) result(str)
       integer, intent(in) :: i                !! value to format
-      character(len=:), allocatable :: str    !! the value as text
-      character(len=16) :: buf
-
-      write (buf, '(i0)') i
-      str = trim(buf)
+      character(len=16) :: str                !! the value as text, left-adjusted
+      write (str, '(i0)') i
    end function fmt_int
 
 end module fd_error

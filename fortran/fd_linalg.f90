@@ -158,7 +158,7 @@ contains
       allocate (work(lwork))
       call dsygv(1, 'V', 'U', n, phi, n, b, n, lambda, work, lwork, info)
       if (info /= 0) then
-         call fatal_error(error, "eigenvalue solver dsygv failed with info = "//fmt_int(info))
+         call fatal_error(error, "eigenvalue solver dsygv failed with info = "//trim(fmt_int(info)))
       end if
    end subroutine generalized_eigen
 

@@ -72,7 +72,7 @@ contains
       if (allocated(error)) return
       if (lam(1) <= 1.0e-12_dp*maxval(abs(lam))) then
          call fatal_error(error, "the stuck system has a rigid-body mode (first eigenvalue "// &
-                          fmt_real(lam(1))//"): add springs to the table or give period in &damping")
+                          trim(fmt_real(lam(1)))//"): add springs to the table or give period in &damping")
          return
       end if
       period = 2.0_dp*pi/sqrt(lam(1))

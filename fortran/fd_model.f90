@@ -68,7 +68,7 @@ contains
    !> Name of a friction law, as written in decks.
    pure function law_name(law) result(name)
       integer, intent(in) :: law              !! law id
-      character(len=:), allocatable :: name   !! its name
+      character(len=16) :: name               !! its name, left-adjusted
       select case (law)
       case (law_velocity)
          name = 'velocity'

@@ -70,22 +70,21 @@ contains
       end do
    end subroutine deck_from_string
 
-   !> The first word of a line, lower case, if it opens a group ('&name').
+   !> The first word of a line, lower case, if it opens a group ('&name'); blank if not.
    pure function group_opened(line) result(name)
       character(len=*), intent(in) :: line
-      character(len=:), allocatable :: name
-      character(len=:), allocatable :: t
-      integer :: e
+      character(len=64) :: name
+      integer :: e, b
 
       name = ''
-      t = adjustl(line)
-      if (len_trim(t) < 2) return
-      if (t(1:1) /= '&') return
-      e = scan(t(2:), ' ,/'//achar(9))
+      b = verify(line, ' '//achar(9))
+      if (b == 0) return
+      if (line(b:b) /= '&' .or. b == len(line)) return
+      e = scan(line(b + 1:), ' ,/'//achar(9))
       if (e == 0) then
-         name = lower(trim(t(2:)))
+         name = lower(line(b + 1:))
       else
-         name = lower(t(2:e))
+         name = lower(line(b + 1:b + e - 1))
       end if
       if (name == 'end') name = ''
    end function group_opened
@@ -95,24 +94,24 @@ contains
       type(deck_text), intent(in) :: deck                 !! the deck
       character(len=*), intent(in) :: known(:)            !! names of the known groups
       type(error_type), allocatable, intent(out) :: error !! unknown or repeated group
-      character(len=:), allocatable :: name
+      character(len=64) :: name
       integer :: i, j, count(size(known))
 
       count = 0
       do i = 1, size(deck%lines)
          name = group_opened(deck%lines(i)%s)
-         if (len(name) == 0) cycle
+         if (len_trim(name) == 0) cycle
          do j = 1, size(known)
             if (name == trim(known(j))) exit
          end do
          if (j > size(known)) then
-            call fatal_error(error, deck%path//", line "//fmt_int(i)//": unknown group &"//name// &
-                             "; the groups are "//join(known))
+            call fatal_error(error, deck%path//", line "//trim(fmt_int(i))//": unknown group &"//trim(name)// &
+                             "; the groups are "//trim(join(known)))
             return
          end if
          count(j) = count(j) + 1
          if (count(j) > 1) then
-            call fatal_error(error, deck%path//", line "//fmt_int(i)//": group &"//name// &
+            call fatal_error(error, deck%path//", line "//trim(fmt_int(i))//": group &"//trim(name)// &
                              " appears more than once")
             return
          end if
@@ -120,13 +119,14 @@ contains
    contains
       function join(words) result(str)
          character(len=*), intent(in) :: words(:)
-         character(len=:), allocatable :: str
+         character(len=512) :: str
          integer :: k
          str = ''
          do k = 1, size(words)
-            str = str//'&'//trim(words(k))
-            if (k < size(words)) str = str//', '
+            str = trim(str)//' &'//trim(words(k))
+            if (k < size(words)) str = trim(str)//','
          end do
+         str = adjustl(str)
       end function join
    end subroutine check_groups
 
@@ -160,13 +160,13 @@ contains
       closed = .false.
       last = first
       do i = first, size(deck%lines)
-         if (i > first .and. len(group_opened(deck%lines(i)%s)) > 0) exit
+         if (i > first .and. len_trim(group_opened(deck%lines(i)%s)) > 0) exit
          last = i
          call append_line(deck%lines(i)%s, i == first, body, line_of, i, closed)
          if (closed) exit
       end do
       if (.not. closed) then
-         call fatal_error(error, deck%path//", group &"//name//" (line "//fmt_int(first)// &
+         call fatal_error(error, deck%path//", group &"//name//" (line "//trim(fmt_int(first))// &
                           "): not closed by '/'")
          return
       end if
@@ -293,13 +293,13 @@ contains
    end subroutine split_items
 
    !> One assignment of a group as a namelist record of its own: '&name item /'.
-   pure function group_item(grp, i) result(record)
-      type(group_text), intent(in) :: grp      !! the group
-      integer, intent(in) :: i                 !! index of the assignment
-      character(len=:), allocatable :: record  !! namelist text to read
+   pure subroutine group_item(grp, i, record)
+      type(group_text), intent(in) :: grp                  !! the group
+      integer, intent(in) :: i                             !! index of the assignment
+      character(len=:), allocatable, intent(out) :: record !! namelist text to read
 
       record = '&'//grp%name//' '//grp%items(i)%s//' /'
-   end function group_item
+   end subroutine group_item
 
    !> Error for a group that could not be read: names the assignment at fault when the
    !> one-by-one re-read found it (bad >= 1), else reports the reader's message.
@@ -313,7 +313,7 @@ contains
       integer :: eq
 
       if (bad < 1 .or. bad > size(grp%items)) then
-         call fatal_error(error, deck%path//", group &"//grp%name//" (line "//fmt_int(grp%first_line)// &
+         call fatal_error(error, deck%path//", group &"//grp%name//" (line "//trim(fmt_int(grp%first_line))// &
                           "): cannot be read: "//trim(msg))
          return
       end if
@@ -323,10 +323,10 @@ contains
       val = trim(adjustl(item(eq + 1:)))
       if (index(msg, 'Cannot match namelist object name '//lower(var)) > 0 .or. &
           index(msg, 'Cannot match namelist object name '//var) > 0) then
-         call fatal_error(error, deck%path//", group &"//grp%name//", line "//fmt_int(grp%item_line(bad))// &
+         call fatal_error(error, deck%path//", group &"//grp%name//", line "//trim(fmt_int(grp%item_line(bad)))// &
                           ": unknown variable '"//var//"' (value "//val//")")
       else
-         call fatal_error(error, deck%path//", group &"//grp%name//", line "//fmt_int(grp%item_line(bad))// &
+         call fatal_error(error, deck%path//", group &"//grp%name//", line "//trim(fmt_int(grp%item_line(bad)))// &
                           ": variable '"//var//"' has a bad value '"//val//"' ("//trim(msg)//")")
       end if
    end subroutine group_read_error

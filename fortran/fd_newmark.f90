@@ -75,8 +75,8 @@ contains
       call history_shape(model, exc, opts, ncol, nout, nsteps, every)
       call init_result(model, nout, res, stat)
       if (stat /= 0) then
-         call fatal_error(error, "not enough memory for the history: "//fmt_int(nout)//" samples of "// &
-                          fmt_int(ncol)//" columns (raise output_every or shorten duration)")
+         call fatal_error(error, "not enough memory for the history: "//trim(fmt_int(nout))//" samples of "// &
+                          trim(fmt_int(ncol))//" columns (raise output_every or shorten duration)")
          return
       end if
 
@@ -109,7 +109,7 @@ contains
          end if
          if (mod(k, every) == 0 .or. k == nsteps) then
             if (.not. all(ieee_is_finite(w%u)) .or. .not. all(ieee_is_finite(w%a))) then
-               call fatal_error(error, "the solution is not finite at t = "//fmt_real(k*dt1)// &
+               call fatal_error(error, "the solution is not finite at t = "//trim(fmt_real(k*dt1))// &
                                 " s: the integration diverged (check beta, gamma and the step)")
                return
             end if
@@ -149,7 +149,7 @@ contains
       w%mass = model%mass
       allocate (w%k(n, n), w%c(n, n), stat=stat)
       if (stat /= 0) then
-         call fatal_error(error, "not enough memory for the matrices of n_dof = "//fmt_int(n)//" DOFs")
+         call fatal_error(error, "not enough memory for the matrices of n_dof = "//trim(fmt_int(n))//" DOFs")
          return
       end if
       call structure_matrices(model, w%k, w%c, res%period_stuck, res%xi_stuck, error)
@@ -163,7 +163,7 @@ contains
       do i = 1, n_slots
          allocate (w%slot(i)%stuck(nd), w%slot(i)%a(n, n), stat=stat)
          if (stat /= 0) then
-            call fatal_error(error, "not enough memory for the factors of n_dof = "//fmt_int(n)//" DOFs")
+            call fatal_error(error, "not enough memory for the factors of n_dof = "//trim(fmt_int(n))//" DOFs")
             return
          end if
       end do
@@ -297,8 +297,8 @@ contains
       res%factorizations = res%factorizations + 1
       if (info /= 0) then
          w%slot(is)%h = -1.0_dp
-         call fatal_error(error, "the effective stiffness for the step "//fmt_real(h)// &
-                          " s is not positive definite (leading minor "//fmt_int(info)//")")
+         call fatal_error(error, "the effective stiffness for the step "//trim(fmt_real(h))// &
+                          " s is not positive definite (leading minor "//trim(fmt_int(info))//")")
          return
       end if
       w%slot(is)%h = h

@@ -10,7 +10,7 @@ module fd_output
    implicit none
    private
 
-   public :: output_type, write_outputs, history_path, summary_path, summary_json, history_header
+   public :: output_type, write_outputs, output_paths, summary_json, history_header
 
    !> Where and what to write.
    type :: output_type
@@ -35,19 +35,14 @@ module fd_output
 
 contains
 
-   !> Path of the time-history CSV.
-   pure function history_path(out) result(path)
-      type(output_type), intent(in) :: out    !! output settings
-      character(len=:), allocatable :: path   !! the CSV file
-      path = out%dir//'/'//out%name//'.csv'
-   end function history_path
-
-   !> Path of the summary file.
-   pure function summary_path(out) result(path)
-      type(output_type), intent(in) :: out    !! output settings
-      character(len=:), allocatable :: path   !! the JSON file
-      path = out%dir//'/'//out%name//'.summary.json'
-   end function summary_path
+   !> Paths of the time-history CSV and of the summary file.
+   pure subroutine output_paths(out, hist, summ)
+      type(output_type), intent(in) :: out                  !! output settings
+      character(len=:), allocatable, intent(out) :: hist    !! the CSV file
+      character(len=:), allocatable, intent(out) :: summ    !! the JSON file
+      hist = out%dir//'/'//out%name//'.csv'
+      summ = out%dir//'/'//out%name//'.summary.json'
+   end subroutine output_paths
 
    !> Write the history and the summary; nothing is left behind on failure.
    subroutine write_outputs(out, model, res, deck_path, error)
@@ -61,8 +56,7 @@ contains
 
       call make_dir(out%dir, error)
       if (allocated(error)) return
-      hist = history_path(out)
-      summ = summary_path(out)
+      call output_paths(out, hist, summ)
       if (out%history) then
          call write_history(hist//'.tmp', res, error)
          if (allocated(error)) return
@@ -120,15 +114,16 @@ contains
       type(error_type), allocatable, intent(out) :: error
       integer :: unit, ios, i
       character(len=512) :: msg
-      character(len=:), allocatable :: fmt
+      character(len=:), allocatable :: fmt, header
 
       open (newunit=unit, file=path, status='replace', action='write', iostat=ios, iomsg=msg)
       if (ios /= 0) then
          call fatal_error(error, "cannot create '"//path//"': "//trim(msg))
          return
       end if
-      write (unit, '(a)', iostat=ios) history_header(res)
-      fmt = '('//fmt_int(res%ncol)//'(es24.16e3,:,","))'
+      call history_header(res, header)
+      write (unit, '(a)', iostat=ios) header
+      fmt = '('//trim(fmt_int(res%ncol))//'(es24.16e3,:,","))'
       do i = 1, res%nout
          write (unit, fmt, iostat=ios, iomsg=msg) res%hist(:, i)
          if (ios /= 0) exit
@@ -149,13 +144,15 @@ contains
       type(error_type), allocatable, intent(out) :: error
       integer :: unit, ios
       character(len=512) :: msg
+      character(len=:), allocatable :: js
 
       open (newunit=unit, file=path, status='replace', action='write', iostat=ios, iomsg=msg)
       if (ios /= 0) then
          call fatal_error(error, "cannot create '"//path//"': "//trim(msg))
          return
       end if
-      write (unit, '(a)', iostat=ios, iomsg=msg) summary_json(model, res, deck_path)
+      call summary_json(model, res, deck_path, js)
+      write (unit, '(a)', iostat=ios, iomsg=msg) js
       if (ios /= 0) then
          close (unit, status='delete')
          call fatal_error(error, "cannot write '"//path//"': "//trim(msg))
@@ -165,80 +162,91 @@ contains
    end subroutine write_summary
 
    !> The summary of a run as a JSON object (keys documented in docs/namelist.md).
-   pure function summary_json(model, res, deck_path) result(js)
-      type(model_type), intent(in) :: model        !! the model run
-      type(result_type), intent(in) :: res         !! its result
-      character(len=*), intent(in) :: deck_path    !! deck named in the summary
-      character(len=:), allocatable :: js          !! the JSON text
-      character(len=:), allocatable :: laws
+   subroutine summary_json(model, res, deck_path, js)
+      type(model_type), intent(in) :: model                !! the model run
+      type(result_type), intent(in) :: res                 !! its result
+      character(len=*), intent(in) :: deck_path            !! deck named in the summary
+      character(len=:), allocatable, intent(out) :: js     !! the JSON text
       character(len=1), parameter :: nl = achar(10)
+      character(len=:), allocatable :: laws, esc
       integer :: d
 
       laws = ''
       do d = 1, model%n_devices
-         laws = laws//'"'//law_name(model%dev(d)%law)//'"'
+         laws = laws//'"'//trim(law_name(model%dev(d)%law))//'"'
          if (d < model%n_devices) laws = laws//', '
       end do
+      call json_escape(deck_path, esc)
       js = '{'//nl
-      js = js//'  "deck": "'//json_escape(deck_path)//'",'//nl
-      js = js//kv('n_dof', fmt_int(res%n_dof))//kv('n_devices', fmt_int(res%n_devices))
+      js = js//'  "deck": "'//esc//'",'//nl
+      call kv('n_dof', trim(fmt_int(res%n_dof)))
+      call kv('n_devices', trim(fmt_int(res%n_devices)))
       js = js//'  "device_law": ['//laws//'],'//nl
-      js = js//kv('period_stuck_s', json_real(res%period_stuck))//kv('xi_stuck', json_real(res%xi_stuck))
-      js = js//kv('dt1_s', json_real(res%dt1))//kv('dt2_s', json_real(res%dt2))// &
-           kv('dt_min_s', json_real(res%dt_min))
-      js = js//kv('peak_u_m', reals(res%peak_u))//kv('peak_u_time_s', reals(res%peak_u_time))
-      js = js//kv('peak_v_mps', reals(res%peak_v))//kv('peak_aabs_mps2', reals(res%peak_aabs))
-      js = js//kv('peak_aabs_time_s', reals(res%peak_aabs_time))
-      js = js//kv('peak_s_m', reals(res%peak_s))//kv('peak_force_N', reals(res%peak_force))
-      js = js//kv('stick_to_slip', ints(res%stick_to_slip))//kv('slip_to_stick', ints(res%slip_to_stick))
-      js = js//kv('slip_reversals', ints(res%reversals))
-      js = js//kv('steps_dt1', fmt_int(res%steps_dt1))//kv('steps_dt2', fmt_int(res%steps_dt2))
-      js = js//kv('steps_finer', fmt_int(res%steps_finer))//kv('factorizations', fmt_int(res%factorizations))
-      js = js//kv('events', fmt_int(res%events))
-      js = js//kv('correctness_violations', fmt_int(res%violations))
-      js = js//kv('violation_times_s', reals(res%violation_time(1:res%n_violation_times)))
-      js = js//kv('violation_devices', ints(res%violation_device(1:res%n_violation_times)))
-      js = js//kv('energy_input_J', json_real(res%e_input))//kv('energy_kinetic_J', json_real(res%e_kinetic))
-      js = js//kv('energy_strain_J', json_real(res%e_strain))//kv('energy_viscous_J', json_real(res%e_viscous))
-      js = js//kv('energy_friction_J', json_real(res%e_friction))
-      js = js//kv('energy_device_elastic_J', json_real(res%e_device))
-      js = js//kv('energy_residual_J', json_real(res%e_residual))
-      js = js//kv('samples', fmt_int(res%nout))
-      js = js//'  "run_time_s": '//json_real(res%run_time)//nl//'}'
+      call kv('period_stuck_s', trim(json_real(res%period_stuck)))
+      call kv('xi_stuck', trim(json_real(res%xi_stuck)))
+      call kv('dt1_s', trim(json_real(res%dt1)))
+      call kv('dt2_s', trim(json_real(res%dt2)))
+      call kv('dt_min_s', trim(json_real(res%dt_min)))
+      call kr('peak_u_m', res%peak_u)
+      call kr('peak_u_time_s', res%peak_u_time)
+      call kr('peak_v_mps', res%peak_v)
+      call kr('peak_aabs_mps2', res%peak_aabs)
+      call kr('peak_aabs_time_s', res%peak_aabs_time)
+      call kr('peak_s_m', res%peak_s)
+      call kr('peak_force_N', res%peak_force)
+      call ki('stick_to_slip', res%stick_to_slip)
+      call ki('slip_to_stick', res%slip_to_stick)
+      call ki('slip_reversals', res%reversals)
+      call kv('steps_dt1', trim(fmt_int(res%steps_dt1)))
+      call kv('steps_dt2', trim(fmt_int(res%steps_dt2)))
+      call kv('steps_finer', trim(fmt_int(res%steps_finer)))
+      call kv('factorizations', trim(fmt_int(res%factorizations)))
+      call kv('events', trim(fmt_int(res%events)))
+      call kv('correctness_violations', trim(fmt_int(res%violations)))
+      call kr('violation_times_s', res%violation_time(1:res%n_violation_times))
+      call ki('violation_devices', res%violation_device(1:res%n_violation_times))
+      call kv('energy_input_J', trim(json_real(res%e_input)))
+      call kv('energy_kinetic_J', trim(json_real(res%e_kinetic)))
+      call kv('energy_strain_J', trim(json_real(res%e_strain)))
+      call kv('energy_viscous_J', trim(json_real(res%e_viscous)))
+      call kv('energy_friction_J', trim(json_real(res%e_friction)))
+      call kv('energy_device_elastic_J', trim(json_real(res%e_device)))
+      call kv('energy_residual_J', trim(json_real(res%e_residual)))
+      call kv('samples', trim(fmt_int(res%nout)))
+      js = js//'  "run_time_s": '//trim(json_real(res%run_time))//nl//'}'
    contains
-      pure function kv(key, val) result(line)
+      subroutine kv(key, val)
          character(len=*), intent(in) :: key, val
-         character(len=:), allocatable :: line
-         line = '  "'//key//'": '//val//','//nl
-      end function kv
-      pure function reals(x) result(str)
+         js = js//'  "'//key//'": '//val//','//nl
+      end subroutine kv
+      subroutine kr(key, x)
+         character(len=*), intent(in) :: key
          real(dp), intent(in) :: x(:)
-         character(len=:), allocatable :: str
          integer :: k
-         str = '['
+         js = js//'  "'//key//'": ['
          do k = 1, size(x)
-            str = str//json_real(x(k))
-            if (k < size(x)) str = str//', '
+            js = js//trim(json_real(x(k)))
+            if (k < size(x)) js = js//', '
          end do
-         str = str//']'
-      end function reals
-      pure function ints(x) result(str)
+         js = js//'],'//nl
+      end subroutine kr
+      subroutine ki(key, x)
+         character(len=*), intent(in) :: key
          integer, intent(in) :: x(:)
-         character(len=:), allocatable :: str
          integer :: k
-         str = '['
+         js = js//'  "'//key//'": ['
          do k = 1, size(x)
-            str = str//fmt_int(x(k))
-            if (k < size(x)) str = str//', '
+            js = js//trim(fmt_int(x(k)))
+            if (k < size(x)) js = js//', '
          end do
-         str = str//']'
-      end function ints
-   end function summary_json
+         js = js//'],'//nl
+      end subroutine ki
+   end subroutine summary_json
 
    !> The header line of the history: name[unit] of each column, comma separated.
-   pure function history_header(res) result(line)
-      type(result_type), intent(in) :: res     !! the result
-      character(len=:), allocatable :: line    !! the header
+   pure subroutine history_header(res, line)
+      type(result_type), intent(in) :: res                 !! the result
+      character(len=:), allocatable, intent(out) :: line   !! the header
       integer :: j
 
       line = ''
@@ -246,31 +254,30 @@ contains
          line = line//trim(res%names(j))//'['//trim(res%units(j))//']'
          if (j < res%ncol) line = line//','
       end do
-   end function history_header
+   end subroutine history_header
 
-   !> A real as JSON: 17 significant digits.
+   !> A real as JSON: 17 significant digits (null when not finite), left-adjusted.
    pure function json_real(x) result(str)
       use, intrinsic :: ieee_arithmetic, only: ieee_is_finite
       real(dp), intent(in) :: x
-      character(len=:), allocatable :: str
-      character(len=32) :: buf
+      character(len=32) :: str
       if (.not. ieee_is_finite(x)) then
          str = 'null'
          return
       end if
-      write (buf, '(es24.16e3)') x
-      str = trim(adjustl(buf))
+      write (str, '(es24.16e3)') x
+      str = adjustl(str)
    end function json_real
 
-   pure function json_escape(s) result(r)
+   pure subroutine json_escape(s, r)
       character(len=*), intent(in) :: s
-      character(len=:), allocatable :: r
+      character(len=:), allocatable, intent(out) :: r
       integer :: i
       r = ''
       do i = 1, len(s)
          if (s(i:i) == '"' .or. s(i:i) == '\') r = r//'\'
          r = r//s(i:i)
       end do
-   end function json_escape
+   end subroutine json_escape
 
 end module fd_output

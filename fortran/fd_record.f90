@@ -36,12 +36,12 @@ contains
          first = adjustl(lines(i)%s)
          if (len_trim(first) == 0) cycle
          if (first(1:1) == '#' .or. first(1:1) == '!') cycle
-         where = "record file '"//path//"', line "//fmt_int(i)
+         where = "record file '"//path//"', line "//trim(fmt_int(i))
          call split_tokens(lines(i)%s, tok)
          if (ncol == 0) ncol = size(tok)
          if (size(tok) /= ncol .or. ncol > 2) then
-            call fatal_error(error, where//": expected "//fmt_int(min(ncol, 2))// &
-                             " column(s) (value, or time and value), found "//fmt_int(size(tok)))
+            call fatal_error(error, where//": expected "//trim(fmt_int(min(ncol, 2)))// &
+                             " column(s) (value, or time and value), found "//trim(fmt_int(size(tok))))
             return
          end if
          n = n + 1
@@ -65,14 +65,14 @@ contains
             if (abs(tim(n) - tim(1) - (n - 1)*dt_record) > 1.0e-6_dp*dt_record + &
                 1.0e-9_dp*abs(tim(n))) then
                call fatal_error(error, where//": time "//tok(1)%s//" is not on the grid of dt_record = " &
-                                //fmt_real(dt_record)//" s starting at "//fmt_real(tim(1))//" s")
+                                //trim(fmt_real(dt_record))//" s starting at "//trim(fmt_real(tim(1)))//" s")
                return
             end if
          end if
       end do
       if (n < 2 .or. (is_displacement .and. n < 4)) then
-         call fatal_error(error, "record file '"//path//"' has "//fmt_int(n)// &
-                          " samples; at least "//fmt_int(merge(4, 2, is_displacement))//" are needed")
+         call fatal_error(error, "record file '"//path//"' has "//trim(fmt_int(n))// &
+                          " samples; at least "//trim(fmt_int(merge(4, 2, is_displacement)))//" are needed")
          return
       end if
       val = scale*val(1:n)

@@ -105,16 +105,16 @@ contains
       res%names(2) = 'ag'; res%units(2) = 'm/s2'
       c = 2
       do i = 1, n
-         res%names(c + 1) = 'u'//fmt_int(i); res%units(c + 1) = 'm'
-         res%names(c + 2) = 'v'//fmt_int(i); res%units(c + 2) = 'm/s'
-         res%names(c + 3) = 'aabs'//fmt_int(i); res%units(c + 3) = 'm/s2'
+         res%names(c + 1) = 'u'//trim(fmt_int(i)); res%units(c + 1) = 'm'
+         res%names(c + 2) = 'v'//trim(fmt_int(i)); res%units(c + 2) = 'm/s'
+         res%names(c + 3) = 'aabs'//trim(fmt_int(i)); res%units(c + 3) = 'm/s2'
          c = c + 3
       end do
       do i = 1, nd
-         res%names(c + 1) = 's'//fmt_int(i); res%units(c + 1) = 'm'
-         res%names(c + 2) = 'sdot'//fmt_int(i); res%units(c + 2) = 'm/s'
-         res%names(c + 3) = 'F'//fmt_int(i); res%units(c + 3) = 'N'
-         res%names(c + 4) = 'phase'//fmt_int(i); res%units(c + 4) = '-'
+         res%names(c + 1) = 's'//trim(fmt_int(i)); res%units(c + 1) = 'm'
+         res%names(c + 2) = 'sdot'//trim(fmt_int(i)); res%units(c + 2) = 'm/s'
+         res%names(c + 3) = 'F'//trim(fmt_int(i)); res%units(c + 3) = 'N'
+         res%names(c + 4) = 'phase'//trim(fmt_int(i)); res%units(c + 4) = '-'
          c = c + 4
       end do
       allocate (res%peak_u(n), res%peak_u_time(n), res%peak_v(n), res%peak_aabs(n), &

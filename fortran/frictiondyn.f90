@@ -9,14 +9,14 @@ module frictiondyn
    use fd_newmark, only: run_newmark
    use fd_coulomb, only: run_coulomb
    use fd_result, only: history_shape
-   use fd_output, only: output_type, write_outputs, history_path, summary_path, summary_json, history_header
+   use fd_output, only: output_type, write_outputs, output_paths, summary_json, history_header
    implicit none
    private
 
    public :: dp, error_type, model_type, integration_type, device_type, excitation_type
    public :: result_type, run_config, output_type
    public :: read_deck, read_deck_string, run_config_solve, run_deck, shape_of
-   public :: history_path, summary_path, summary_json, history_header
+   public :: output_paths, summary_json, history_header
 
 contains
 

@@ -1,12 +1,12 @@
 !> frictiondyn DECK.nml: run one namelist deck and write its time history and summary.
 program frictiondyn_main
    use, intrinsic :: iso_fortran_env, only: error_unit, output_unit
-   use frictiondyn, only: error_type, run_config, result_type, run_deck, history_path, summary_path
+   use frictiondyn, only: error_type, run_config, result_type, run_deck, output_paths
    implicit none
    type(run_config) :: cfg
    type(result_type) :: res
    type(error_type), allocatable :: error
-   character(len=:), allocatable :: path
+   character(len=:), allocatable :: path, hist, summ
    integer :: nargs, length, i
 
    nargs = command_argument_count()
@@ -47,6 +47,7 @@ program frictiondyn_main
          ' m, peak |a_abs| ', res%peak_aabs(i), ' m/s2'
    end do
    write (output_unit, '(a,i0)') '  correctness violations: ', res%violations
-   if (cfg%out%history) write (output_unit, '(a)') '  history: '//history_path(cfg%out)
-   write (output_unit, '(a)') '  summary: '//summary_path(cfg%out)
+   call output_paths(cfg%out, hist, summ)
+   if (cfg%out%history) write (output_unit, '(a)') '  history: '//hist
+   write (output_unit, '(a)') '  summary: '//summ
 end program frictiondyn_main

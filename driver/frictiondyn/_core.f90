@@ -71,6 +71,7 @@ subroutine fd_run(path, text, from_text, ncol, nout, lhead, lsum, hist, header, 
    type(run_config) :: cfg
    type(result_type) :: res
    type(error_type), allocatable :: error
+   character(len=:), allocatable :: text_out
    integer :: nc, no
 
    hist = 0.0_c_double
@@ -92,8 +93,12 @@ subroutine fd_run(path, text, from_text, ncol, nout, lhead, lsum, hist, header, 
       return
    end if
    hist = real(res%hist, c_double)
-   call put(history_header(res), header, status)
-   if (status == 0) call put(summary_json(cfg%model, res, cfg%deck_path), summary, status)
+   call history_header(res, text_out)
+   call put(text_out, header, status)
+   if (status == 0) then
+      call summary_json(cfg%model, res, cfg%deck_path, text_out)
+      call put(text_out, summary, status)
+   end if
    if (status /= 0) then
       call fail(3, 'header or summary buffer too small', status, message)
       return
