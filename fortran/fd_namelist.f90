@@ -5,7 +5,7 @@
 !> time with group_item to find the variable and value at fault.
 module fd_namelist
    use fd_error, only: error_type, fatal_error, fmt_int
-   use fd_textio, only: line_type, read_text_file, lower
+   use fd_textio, only: line_type, read_text_file, split_lines, lower
    implicit none
    private
 
@@ -46,28 +46,9 @@ contains
       character(len=*), intent(in) :: text   !! the deck
       character(len=*), intent(in) :: path   !! name used for the deck
       type(deck_text), intent(out) :: deck   !! its text as lines
-      integer :: i, start, n
 
       deck%path = path
-      n = 0
-      do i = 1, len(text)
-         if (text(i:i) == achar(10)) n = n + 1
-      end do
-      allocate (deck%lines(n + 1))
-      n = 0
-      start = 1
-      do i = 1, len(text) + 1
-         if (i <= len(text)) then
-            if (text(i:i) /= achar(10)) cycle
-         end if
-         n = n + 1
-         deck%lines(n)%s = text(start:i - 1)
-         if (len(deck%lines(n)%s) > 0) then
-            if (deck%lines(n)%s(len(deck%lines(n)%s):) == achar(13)) &
-               deck%lines(n)%s = deck%lines(n)%s(1:len(deck%lines(n)%s) - 1)
-         end if
-         start = i + 1
-      end do
+      call split_lines(text, deck%lines)
    end subroutine deck_from_string
 
    !> The first word of a line, lower case, if it opens a group ('&name'); blank if not.

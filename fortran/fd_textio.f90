@@ -1,11 +1,32 @@
 !> Text-file helpers shared by the deck and record readers: whole files as lines,
 !> and small string utilities. No state; errors name the file.
 module fd_textio
+   use, intrinsic :: iso_c_binding, only: c_char, c_ptr, c_size_t, c_int, c_null_char, c_associated
    use fd_error, only: error_type, fatal_error
    implicit none
    private
 
-   public :: line_type, read_text_file, lower, split_tokens
+   public :: line_type, read_text_file, split_lines, lower, split_tokens
+
+   interface
+      function c_fopen(path, mode) bind(c, name='fopen') result(fp)
+         import :: c_char, c_ptr
+         character(kind=c_char), intent(in) :: path(*), mode(*)
+         type(c_ptr) :: fp
+      end function c_fopen
+      function c_fread(buf, size, count, fp) bind(c, name='fread') result(got)
+         import :: c_char, c_ptr, c_size_t
+         character(kind=c_char), intent(out) :: buf(*)
+         integer(c_size_t), value :: size, count
+         type(c_ptr), value :: fp
+         integer(c_size_t) :: got
+      end function c_fread
+      function c_fclose(fp) bind(c, name='fclose') result(stat)
+         import :: c_ptr, c_int
+         type(c_ptr), value :: fp
+         integer(c_int) :: stat
+      end function c_fclose
+   end interface
 
    !> One line of text.
    type :: line_type
@@ -14,15 +35,18 @@ module fd_textio
 
 contains
 
-   !> Read a whole text file into lines.
+   !> Read a whole text file into lines. The file is read with C stdio, not a Fortran unit:
+   !> gfortran refuses to connect one file to two units at once, which made runs in several
+   !> threads that read the same deck or record fail.
    subroutine read_text_file(path, lines, error)
       character(len=*), intent(in) :: path                   !! file to read
       type(line_type), allocatable, intent(out) :: lines(:)  !! its lines
       type(error_type), allocatable, intent(out) :: error    !! set when it cannot be read
-      type(line_type), allocatable :: tmp(:)
-      character(len=:), allocatable :: line
-      character(len=512) :: msg
-      integer :: unit, ios, n
+      character(len=:), allocatable :: text
+      character(kind=c_char, len=65536) :: chunk
+      type(c_ptr) :: fp
+      integer(c_size_t) :: got
+      integer :: stat
       logical :: exists
 
       inquire (file=path, exist=exists)
@@ -30,61 +54,51 @@ contains
          call fatal_error(error, "file '"//path//"' does not exist")
          return
       end if
-      open (newunit=unit, file=path, status='old', action='read', form='formatted', &
-            access='sequential', iostat=ios, iomsg=msg)
-      if (ios /= 0) then
-         call fatal_error(error, "cannot open file '"//path//"': "//trim(msg))
+      fp = c_fopen(path//c_null_char, 'rb'//c_null_char)
+      if (.not. c_associated(fp)) then
+         call fatal_error(error, "cannot open file '"//path//"'")
          return
       end if
-      allocate (lines(64))
-      n = 0
+      text = ''
       do
-         call get_line(unit, line, ios)
-         if (ios /= 0) exit
-         n = n + 1
-         if (n > size(lines)) then
-            allocate (tmp(2*size(lines)))
-            tmp(1:n - 1) = lines(1:n - 1)
-            call move_alloc(tmp, lines)
-         end if
-         lines(n)%s = line
+         got = c_fread(chunk, 1_c_size_t, int(len(chunk), c_size_t), fp)
+         if (got > 0) text = text//chunk(1:int(got))
+         if (got < len(chunk)) exit
       end do
-      close (unit)
-      if (.not. is_iostat_end(ios)) then
-         call fatal_error(error, "cannot read file '"//path//"'")
-         return
-      end if
-      lines = lines(1:n)
+      stat = c_fclose(fp)
+      call split_lines(text, lines)
    end subroutine read_text_file
 
-   !> Read one line of any length.
-   subroutine get_line(unit, line, iostat)
-      integer, intent(in) :: unit                          !! unit to read from
-      character(len=:), allocatable, intent(out) :: line   !! the line read
-      integer, intent(out) :: iostat                       !! 0, or the end-of-file/error status
-      character(len=1024) :: buf
-      integer :: nread
+   !> Split text at newlines (a final newline ends the last line; carriage returns dropped).
+   pure subroutine split_lines(text, lines)
+      character(len=*), intent(in) :: text                   !! the text
+      type(line_type), allocatable, intent(out) :: lines(:)  !! its lines
+      integer :: i, start, n
 
-      line = ''
-      do
-         read (unit, '(a)', advance='no', iostat=iostat, size=nread) buf
-         if (iostat == 0) then
-            line = line//buf(1:nread)
-            cycle
-         end if
-         if (is_iostat_eor(iostat)) then
-            line = line//buf(1:nread)
-            iostat = 0
-         else if (is_iostat_end(iostat) .and. len(line) > 0) then
-            iostat = 0
-         end if
-         exit
+      n = 0
+      do i = 1, len(text)
+         if (text(i:i) == achar(10)) n = n + 1
       end do
-      ! tolerate files written on Windows
-      if (len(line) > 0) then
-         if (line(len(line):len(line)) == achar(13)) line = line(1:len(line) - 1)
+      if (len(text) > 0) then
+         if (text(len(text):len(text)) /= achar(10)) n = n + 1
       end if
-   end subroutine get_line
+      allocate (lines(n))
+      n = 0
+      start = 1
+      do i = 1, len(text)
+         if (text(i:i) /= achar(10) .and. i < len(text)) cycle
+         n = n + 1
+         if (text(i:i) == achar(10)) then
+            lines(n)%s = text(start:i - 1)
+         else
+            lines(n)%s = text(start:i)
+         end if
+         if (len(lines(n)%s) > 0) then
+            if (lines(n)%s(len(lines(n)%s):) == achar(13)) lines(n)%s = lines(n)%s(1:len(lines(n)%s) - 1)
+         end if
+         start = i + 1
+      end do
+   end subroutine split_lines
 
    !> Lower-case copy of a string.
    pure function lower(str) result(low)
