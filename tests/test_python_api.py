@@ -329,3 +329,32 @@ def test_accessors_satisfy_the_equations_of_motion(law):
     assert "F1" in r and "F2" not in r
     with pytest.raises(KeyError, match="no column 'u3'"):
         r.dof(3)
+
+
+def test_many_concurrent_runs_of_the_same_files_are_identical(tmp_path):
+    """Regression: runs in threads once corrupted each other's text (gfortran kept the
+    length of deferred-length string results in a static variable) and could not open one
+    file twice (Fortran units). 300 concurrent runs of the same decks and record file."""
+    rec = tmp_path / "acc.txt"
+    t = np.arange(0.0, 2.0, 0.005)
+    rec.write_text("\n".join(f"{-2.7 * np.sin(25.8 * x):.17e}" for x in t) + "\n")
+    decks = []
+    for name in ("test4_velocity", "test4_hysteretic", "fig3_coarse"):
+        text = (INPUTS / f"{name}.nml").read_text().replace("duration = 40.0", "duration = 2.0")
+        path = tmp_path / f"{name}.nml"
+        path.write_text(text)
+        decks.append(path)
+    text = (INPUTS / "test4_velocity.nml").read_text()
+    start = text.index("&excitation")
+    end = text.index("/", start)
+    record_deck = tmp_path / "record.nml"
+    record_deck.write_text(text[:start] + "&excitation\n  excitation_type = 'record'\n"
+                           "  record_file = 'acc.txt'\n  dt_record = 0.005\n" + text[end:])
+    decks.append(record_deck)
+    serial = {d: frictiondyn.run(d) for d in decks}
+    work = decks * 75
+    with ThreadPoolExecutor(max_workers=6) as pool:
+        results = list(pool.map(frictiondyn.run, work))
+    for d, r in zip(work, results, strict=True):
+        assert np.array_equal(r.data, serial[d].data)
+        same_summary(r.summary, serial[d].summary)
