@@ -23,7 +23,7 @@ module fd_coulomb
    use fd_matrices, only: structure_matrices, link_groups
    use fd_expm, only: lti_propagators
    use fd_linalg, only: sym_matvec, gen_matvec, lu_solve, least_squares, least_squares_work
-   use fd_result, only: result_type, init_result, history_shape, record_transition
+   use fd_result, only: result_type, init_result, record_transition
    use fd_device_state, only: phase_stick
    implicit none
    private
@@ -96,7 +96,7 @@ contains
       type(coulomb_work) :: w
       type(forcing_type) :: frc
       real(dp) :: h, t, tn, tb, e_kin0, e_str0, w_fric
-      integer :: k, nsteps, every, iout, nout, ncol, c0, c1, crate, stat
+      integer :: k, nsteps, every, iout, c0, c1, crate, stat
 
       call system_clock(c0, crate)
       call setup(model, w, stat)
@@ -106,13 +106,8 @@ contains
       end if
       call structure_matrices(model, w%k, w%c, res%period_stuck, res%xi_stuck, error)
       if (allocated(error)) return
-      call history_shape(model, exc, opts, ncol, nout, nsteps, every)
-      call init_result(model, nout, res, stat)
-      if (stat /= 0) then
-         call fatal_error(error, "not enough memory for the history: "//trim(fmt_int(nout))//" samples of "// &
-                          trim(fmt_int(ncol))//" columns (raise output_every or shorten duration)")
-         return
-      end if
+      call init_result(model, exc, opts, res, nsteps, every, error)
+      if (allocated(error)) return
       h = exc%dt_record/opts%n1
       res%dt1 = h
       res%dt2 = 0.0_dp
@@ -518,7 +513,7 @@ contains
       real(dp), intent(inout) :: w_fric
       type(error_type), allocatable, intent(out) :: error
       real(dp) :: tc, tau, a, b, fa, fb, c, fc, d_, e, tol, p, q, r_, s, xm, tau_ev
-      integer :: m, d, it, first, stalls
+      integer :: m, d, it, stalls
       logical :: fired
 
       tc = t
@@ -534,7 +529,6 @@ contains
          call state_at(tau, w%g_end)
          ! which events fire in (tc, tc + tau]?
          fired = .false.
-         first = 0
          tau_ev = tau
          do d = 1, w%nd
             if (w%g_end(d) > 0.0_dp) cycle
@@ -544,9 +538,6 @@ contains
             a = 0.0_dp; fa = 1.0_dp
             b = tau; fb = w%g_end(d)
             call brent_root(d, a, fa, b, fb, tau_ev)
-            if (tau_ev <= tau) then
-               if (first == 0 .or. tau_ev < tau) first = d
-            end if
             tau = min(tau, tau_ev)
          end do
          ! integrate energy over [tc, tc + tau] and move there

@@ -19,7 +19,7 @@ module fd_newmark
    use fd_linalg, only: cholesky_factor, cholesky_solve, sym_matvec
    use fd_device_state, only: device_state, device_force
    use fd_friction, only: friction_init, friction_update, friction_correct
-   use fd_result, only: result_type, max_violation_times, init_result, history_shape, record_transition
+   use fd_result, only: result_type, max_violation_times, init_result, record_transition
    implicit none
    private
 
@@ -60,7 +60,7 @@ contains
       type(error_type), allocatable, intent(out) :: error !! singular system, divergence
       type(workspace) :: w
       real(dp) :: dt1, dt2, t0
-      integer :: nsteps, every, k, j, iout, nout, ncol, c0, c1, crate, stat
+      integer :: nsteps, every, k, j, iout, c0, c1, crate
       logical :: any_changed, any_bad
 
       call system_clock(c0, crate)
@@ -72,13 +72,8 @@ contains
       if (res%dt_min <= 0.0_dp) res%dt_min = dt2/2.0_dp**10
       call setup(model, halving_levels(dt2, res%dt_min), w, res, error)
       if (allocated(error)) return
-      call history_shape(model, exc, opts, ncol, nout, nsteps, every)
-      call init_result(model, nout, res, stat)
-      if (stat /= 0) then
-         call fatal_error(error, "not enough memory for the history: "//trim(fmt_int(nout))//" samples of "// &
-                          trim(fmt_int(ncol))//" columns (raise output_every or shorten duration)")
-         return
-      end if
+      call init_result(model, exc, opts, res, nsteps, every, error)
+      if (allocated(error)) return
 
       ! initial state: devices from the initial conditions, acceleration from equilibrium
       w%u = model%u0

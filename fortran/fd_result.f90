@@ -2,7 +2,7 @@
 !> phase transitions, correctness violations, energy balance).
 module fd_result
    use fd_kinds, only: dp
-   use fd_error, only: fmt_int
+   use fd_error, only: error_type, fatal_error, fmt_int
    use fd_model, only: model_type, integration_type
    use fd_excitation, only: excitation_type
    implicit none
@@ -84,22 +84,30 @@ contains
       nout = nsteps/every + 1 + merge(1, 0, mod(nsteps, every) /= 0)
    end subroutine history_shape
 
-   !> Allocate the history and the per-DOF and per-device summary of a run.
-   subroutine init_result(model, nout, res, stat)
-      type(model_type), intent(in) :: model     !! the model run
-      integer, intent(in) :: nout               !! samples of the history
-      type(result_type), intent(inout) :: res   !! the result to set up
-      integer, intent(out) :: stat              !! 0, or non-zero when memory runs out
-      integer :: n, nd, i, c
+   !> Allocate the history (its shape from history_shape) and the per-DOF and per-device
+   !> summary of a run; return the run's number of dt1 steps and the sampling interval.
+   subroutine init_result(model, exc, opts, res, nsteps, every, error)
+      type(model_type), intent(in) :: model         !! the model run
+      type(excitation_type), intent(in) :: exc      !! the table motion
+      type(integration_type), intent(in) :: opts    !! integration settings
+      type(result_type), intent(inout) :: res       !! the result to set up
+      integer, intent(out) :: nsteps                !! dt1 steps of the run
+      integer, intent(out) :: every                 !! dt1 steps between samples
+      type(error_type), allocatable, intent(out) :: error !! not enough memory
+      integer :: n, nd, i, c, stat
 
       n = model%n_dof
       nd = model%n_devices
       res%n_dof = n
       res%n_devices = nd
-      res%ncol = 2 + 3*n + 4*nd   ! as in history_shape
-      res%nout = nout
-      allocate (res%hist(res%ncol, nout), res%names(res%ncol), res%units(res%ncol), stat=stat)
-      if (stat /= 0) return
+      call history_shape(model, exc, opts, res%ncol, res%nout, nsteps, every)
+      allocate (res%hist(res%ncol, res%nout), res%names(res%ncol), res%units(res%ncol), stat=stat)
+      if (stat /= 0) then
+         call fatal_error(error, "not enough memory for the history: "//trim(fmt_int(res%nout))// &
+                          " samples of "//trim(fmt_int(res%ncol))//" columns (raise output_every or "// &
+                          "shorten duration)")
+         return
+      end if
       res%hist = 0.0_dp
       res%names(1) = 't'; res%units(1) = 's'
       res%names(2) = 'ag'; res%units(2) = 'm/s2'

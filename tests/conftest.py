@@ -26,6 +26,32 @@ TABLE1 = {  # test: (frequency Hz, amplitude m, dt_r s)
     5: (5.123, 0.004112, 0.004),
 }
 
+EPS, F_STICK = 1e-3, 1e-5  # band eps = eps1 [m/s] and sticking displacement f [m] of block()
+
+
+def block(law, mu=0.3, m=2.0, excitation=None, v0=0.0, **integration):
+    """A rigid block on a friction interface to the table (no spring), any law."""
+    return {
+        "model": {"n_dof": 1, "mass": [m], "v0": [v0]},
+        "springs": {"n_springs": 0},
+        "damping": {"damping_type": "none"},
+        "friction": {
+            "n_devices": 1,
+            "node_i": 1,
+            "node_j": 0,
+            "law": law,
+            "p": m * G,
+            "mu": mu,
+            "eps": EPS,
+            "eps1": EPS,
+            "f": F_STICK,
+        },
+        "excitation": excitation,
+        "integration": {"n1": 10, "n2": 50, **integration},
+        "output": {"output_every": 1},
+    }
+
+
 
 def _value(v) -> str:
     if isinstance(v, bool):

@@ -4,7 +4,7 @@ from __future__ import annotations
 
 import numpy as np
 import pytest
-from conftest import K1, K2, M1, M2, TABLE1, G, ok, paper_groups
+from conftest import K1, K2, M1, M2, TABLE1, G, block, ok, paper_groups
 
 # independent references (numpy only): eigen-decomposition and Den Hartog's closed form
 from frictiondyn.validate import den_hartog, linear_response
@@ -92,26 +92,8 @@ def test_den_hartog_non_stop_steady_state_to_1e6(run, r, ratio):
 def test_block_stops_exactly(run):
     """A block thrown at v0 on the table stops at v0^2 / (2 mu g) at t = v0 / (mu g)."""
     mu, v0, m = 0.3, 0.5, 2.0
-    r = ok(
-        run(
-            {
-                "model": {"n_dof": 1, "mass": [m], "v0": [v0]},
-                "springs": {"n_springs": 0},
-                "damping": {"damping_type": "none"},
-                "friction": {
-                    "n_devices": 1,
-                    "node_i": 1,
-                    "node_j": 0,
-                    "law": "coulomb",
-                    "p": m * G,
-                    "mu": mu,
-                },
-                "excitation": {"excitation_type": "none", "dt_record": 0.001, "duration": 0.4},
-                "integration": {"n1": 7},
-                "output": {"output_every": 1},
-            }
-        )
-    )
+    excitation = {"excitation_type": "none", "dt_record": 0.001, "duration": 0.4}
+    r = ok(run(block("coulomb", mu, m, excitation, v0, n1=7)))
     h, s = r.history(), r.summary()
     d, t_stop = v0**2 / (2 * mu * G), v0 / (mu * G)
     after = h["t"] > t_stop
@@ -211,6 +193,7 @@ def test_two_devices_exact_against_a_fine_velocity_law(run):
     vl = ok(run(with_law("velocity")))
     se, sv = ex.summary(), vl.summary()
     assert min(se["stick_to_slip"]) > 100  # both devices stick and slip in every cycle
+    assert sv["correctness_violations"] == 0
     he, hv = ex.history(), vl.history()
     w = he["t"] > 15.0
 
