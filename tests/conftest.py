@@ -108,7 +108,7 @@ class Run:
     def outdir(self) -> Path:
         return self.workdir / "out"
 
-    def history(self) -> frictiondyn.History:
+    def history(self) -> frictiondyn.Result:
         return frictiondyn.read_history(self.outdir / f"{self.name}.csv")
 
     def summary(self) -> dict:

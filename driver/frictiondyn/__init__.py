@@ -7,7 +7,16 @@ Fortran reader as the ``frictiondyn`` executable and runs it through the f2py ex
 
 from __future__ import annotations
 
-from ._api import DeckError, FrictiondynError, Result, SolverError, run, run_text
+from ._api import (
+    DeckError,
+    FrictiondynError,
+    Result,
+    SolverError,
+    read_history,
+    read_summary,
+    run,
+    run_text,
+)
 from ._exe import ExecutableRun, RunFailed, executable, run_executable
 from .model import (
     Analysis,
@@ -20,7 +29,6 @@ from .model import (
     Record,
     Spring,
 )
-from .results import History, read_history, read_summary
 
 __all__ = [
     "Analysis",
@@ -31,7 +39,6 @@ __all__ = [
     "FreeVibration",
     "FrictiondynError",
     "Harmonic",
-    "History",
     "Integration",
     "Output",
     "Record",

@@ -24,6 +24,8 @@ __all__ = [
     "Result",
     "SolverError",
     "fortran_es",
+    "read_history",
+    "read_summary",
     "run",
     "run_text",
     "summary_text",
@@ -171,6 +173,7 @@ class Result:
 
     @classmethod
     def from_npz(cls, path: str | os.PathLike) -> Result:
+        """A Result from a .npz written by to_npz."""
         with np.load(path, allow_pickle=False) as z:
             names = [str(x) for x in z["names"]]
             units = dict(zip(names, (str(x) for x in z["units"])))
@@ -249,3 +252,13 @@ class Result:
             summary=np.array(json.dumps(self.summary)),
         )
         return path
+
+
+def read_history(path: str | os.PathLike) -> Result:
+    """The executable's history CSV (with its summary JSON next to it, when present)."""
+    return Result.from_files(path)
+
+
+def read_summary(path: str | os.PathLike) -> dict:
+    """The executable's summary JSON."""
+    return json.loads(Path(path).read_text())

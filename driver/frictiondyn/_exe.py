@@ -10,7 +10,7 @@ import sysconfig
 from dataclasses import dataclass
 from pathlib import Path
 
-from .results import History, read_history, read_summary
+from ._api import Result, read_history, read_summary
 
 
 class RunFailed(RuntimeError):
@@ -48,7 +48,7 @@ class ExecutableRun:
     history_path: Path | None
     summary_path: Path
 
-    def history(self) -> History:
+    def history(self) -> Result:
         if self.history_path is None:
             raise ValueError("this run wrote no history (write_history = .false.)")
         return read_history(self.history_path)
