@@ -118,7 +118,7 @@ contains
       type(group_text), intent(out) :: grp                !! the group's text
       logical, intent(out) :: found                       !! the group is present
       type(error_type), allocatable, intent(out) :: error !! group not closed by '/'
-      integer :: i, first, last, width
+      integer :: i, first, last, width, n, cap
       character(len=:), allocatable :: body
       integer, allocatable :: line_of(:)
       logical :: closed
@@ -135,15 +135,21 @@ contains
       if (first == 0) return
       found = .true.
       grp%first_line = first
-      ! body: the text after '&name' up to the closing '/', comments removed
-      body = ''
-      allocate (line_of(0))
+      ! body: the text after '&name' up to the closing '/', comments removed, in buffers
+      ! large enough for the rest of the deck (n characters used)
+      cap = 0
+      do i = first, size(deck%lines)
+         cap = cap + len(deck%lines(i)%s) + 1
+      end do
+      allocate (character(len=cap) :: body)
+      allocate (line_of(cap))
+      n = 0
       closed = .false.
       last = first
       do i = first, size(deck%lines)
          if (i > first .and. len_trim(group_opened(deck%lines(i)%s)) > 0) exit
          last = i
-         call append_line(deck%lines(i)%s, i == first, body, line_of, i, closed)
+         call append_line(deck%lines(i)%s, i == first, body, line_of, n, i, closed)
          if (closed) exit
       end do
       if (.not. closed) then
@@ -159,15 +165,16 @@ contains
       do i = first, last
          grp%lines(i - first + 1) = deck%lines(i)%s
       end do
-      call split_items(body, line_of, grp%items, grp%item_line)
+      call split_items(body(1:n), line_of(1:n), grp%items, grp%item_line)
    end subroutine find_group
 
    !> Append one deck line to the body of a group, without comments, stopping at '/'.
-   pure subroutine append_line(line, is_first, body, line_of, lineno, closed)
+   pure subroutine append_line(line, is_first, body, line_of, n, lineno, closed)
       character(len=*), intent(in) :: line
       logical, intent(in) :: is_first
-      character(len=:), allocatable, intent(inout) :: body
-      integer, allocatable, intent(inout) :: line_of(:)
+      character(len=*), intent(inout) :: body       !! buffer, body(1:n) used
+      integer, intent(inout) :: line_of(:)          !! deck line of each character
+      integer, intent(inout) :: n                   !! characters used
       integer, intent(in) :: lineno
       logical, intent(out) :: closed
       integer :: i, start
@@ -199,11 +206,13 @@ contains
                exit
             end if
          end if
-         body = body//line(i:i)
-         line_of = [line_of, lineno]
+         n = n + 1
+         body(n:n) = line(i:i)
+         line_of(n) = lineno
       end do
-      body = body//' '
-      line_of = [line_of, lineno]
+      n = n + 1
+      body(n:n) = ' '
+      line_of(n) = lineno
    end subroutine append_line
 
    !> Split a group body at the start of each 'name =' or 'name(index) ='.
