@@ -1,0 +1,71 @@
+!> Unit tests of the number formatting used in every message (fd_error): the shortest
+!> text that reads back to the same value.
+module test_fd_format
+   use testdrive, only: new_unittest, unittest_type, error_type, check
+   use fd_kinds, only: dp
+   use fd_error, only: fmt_real, fmt_int
+   implicit none
+   private
+
+   public :: collect_format
+
+contains
+
+   subroutine collect_format(testsuite)
+      type(unittest_type), allocatable, intent(out) :: testsuite(:)
+
+      testsuite = [ &
+                  new_unittest("short values", test_short), &
+                  new_unittest("round trip", test_round_trip), &
+                  new_unittest("exponent form", test_exponent), &
+                  new_unittest("integers", test_int) &
+                  ]
+   end subroutine collect_format
+
+   subroutine test_short(error)
+      type(error_type), allocatable, intent(out) :: error
+
+      call check(error, trim(fmt_real(0.0_dp)), '0')
+      if (allocated(error)) return
+      call check(error, trim(fmt_real(61.81_dp)), '61.81')
+      if (allocated(error)) return
+      call check(error, trim(fmt_real(-0.25_dp)), '-0.25')
+      if (allocated(error)) return
+      call check(error, trim(fmt_real(1.0e-3_dp)), '0.001')
+      if (allocated(error)) return
+      call check(error, trim(fmt_real(3.0_dp)), '3.0')
+   end subroutine test_short
+
+   !> Every value formatted reads back to itself (17 significant digits at most).
+   subroutine test_round_trip(error)
+      type(error_type), allocatable, intent(out) :: error
+      real(dp) :: x, y
+      character(len=32) :: text
+      integer :: i
+
+      do i = -300, 300, 7
+         x = 1.2345678901234567_dp*10.0_dp**i/3.0_dp
+         text = fmt_real(x)
+         read (text, *) y
+         call check(error, y == x, 'fmt_real('//trim(fmt_real(x))//') does not read back exactly')
+         if (allocated(error)) return
+      end do
+   end subroutine test_round_trip
+
+   subroutine test_exponent(error)
+      type(error_type), allocatable, intent(out) :: error
+
+      call check(error, trim(fmt_real(-1.5e-5_dp)), '-1.5E-5')
+      if (allocated(error)) return
+      call check(error, trim(fmt_real(1.0e300_dp)), '1.0E300')
+   end subroutine test_exponent
+
+   subroutine test_int(error)
+      type(error_type), allocatable, intent(out) :: error
+
+      call check(error, trim(fmt_int(-42)), '-42')
+      if (allocated(error)) return
+      call check(error, trim(fmt_int(huge(1))), '2147483647')
+   end subroutine test_int
+
+end module test_fd_format
