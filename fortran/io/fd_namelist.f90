@@ -10,7 +10,7 @@ module fd_namelist
    private
 
    public :: deck_text, group_text, load_deck, deck_from_string, find_group, group_item, group_read_error
-   public :: check_groups
+   public :: check_groups, group_opened
 
    !> A whole deck in memory.
    type :: deck_text
@@ -53,8 +53,8 @@ contains
 
    !> The first word of a line, lower case, if it opens a group ('&name'); blank if not.
    pure function group_opened(line) result(name)
-      character(len=*), intent(in) :: line
-      character(len=64) :: name
+      character(len=*), intent(in) :: line !! a deck line
+      character(len=64) :: name            !! the group it opens, lower case; blank if none
       integer :: e, b
 
       name = ''

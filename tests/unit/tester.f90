@@ -5,6 +5,13 @@ program tester
    use testdrive, only: run_testsuite, new_testsuite, testsuite_type, select_suite, run_selected, &
                         get_argument
    use test_fd_format, only: collect_format
+   use test_fd_expm, only: collect_expm
+   use test_fd_linalg, only: collect_linalg
+   use test_fd_matrices, only: collect_matrices
+   use test_fd_friction, only: collect_friction
+   use test_fd_namelist, only: collect_namelist
+   use test_fd_record, only: collect_record
+   use test_fd_excitation, only: collect_excitation
    implicit none
    integer :: stat, is
    character(len=:), allocatable :: suite_name, test_name
@@ -13,7 +20,14 @@ program tester
 
    stat = 0
    testsuites = [ &
-                new_testsuite("format", collect_format) &
+                new_testsuite("format", collect_format), &
+                new_testsuite("expm", collect_expm), &
+                new_testsuite("linalg", collect_linalg), &
+                new_testsuite("matrices", collect_matrices), &
+                new_testsuite("friction", collect_friction), &
+                new_testsuite("namelist", collect_namelist), &
+                new_testsuite("record", collect_record), &
+                new_testsuite("excitation", collect_excitation) &
                 ]
 
    call get_argument(1, suite_name)

@@ -1,0 +1,243 @@
+!> Unit tests of the system matrices (fd_matrices): groups of DOFs joined by rigid links,
+!> the stiffness and damping matrices, and the stuck system's first mode against closed forms.
+module test_fd_matrices
+   use testdrive, only: new_unittest, unittest_type, error_type, check
+   use fd_kinds, only: dp
+   use fd_error, only: fd_error_type => error_type
+   use fd_model, only: model_type, damping_stiffness, damping_rayleigh, law_velocity
+   use fd_matrices, only: link_groups, stiffness_matrix, damping_matrix, stuck_first_mode, structure_matrices
+   use test_fd_helpers, only: check_close, check_matrix
+   implicit none
+   private
+
+   public :: collect_matrices
+
+   real(dp), parameter :: pi = acos(-1.0_dp)
+   ! the paper's two-mass model (Dimova, "Experimental Facility")
+   real(dp), parameter :: m1 = 6.301_dp, m2 = 2.530_dp, k1 = 1084.0_dp, k2 = 2895.0_dp
+
+contains
+
+   subroutine collect_matrices(testsuite)
+      type(unittest_type), allocatable, intent(out) :: testsuite(:)
+
+      testsuite = [ &
+                  new_unittest("link groups", test_link_groups), &
+                  new_unittest("link groups through the table", test_link_groups_table), &
+                  new_unittest("stiffness matrix", test_stiffness), &
+                  new_unittest("damping matrices", test_damping), &
+                  new_unittest("stuck mode, device between the masses", test_stuck_linked), &
+                  new_unittest("stuck mode, no friction capacity", test_stuck_free), &
+                  new_unittest("stuck mode, everything locked", test_stuck_locked), &
+                  new_unittest("damping ratio of the stuck mode", test_structure_xi) &
+                  ]
+   end subroutine collect_matrices
+
+   !> A model of n masses with the given springs (node_i, node_j, k) and devices (node_i, node_j).
+   subroutine make_model(model, mass, springs, devices)
+      type(model_type), intent(out) :: model
+      real(dp), intent(in) :: mass(:)
+      real(dp), intent(in) :: springs(:, :)   !! (3, n_springs): node_i, node_j, k
+      integer, intent(in) :: devices(:, :)    !! (2, n_devices): node_i, node_j
+      integer :: d
+
+      model%n_dof = size(mass)
+      model%mass = mass
+      model%u0 = 0.0_dp*mass
+      model%v0 = 0.0_dp*mass
+      model%n_springs = size(springs, 2)
+      model%spring_i = nint(springs(1, :))
+      model%spring_j = nint(springs(2, :))
+      model%spring_k = springs(3, :)
+      model%n_devices = size(devices, 2)
+      allocate (model%dev(model%n_devices))
+      do d = 1, model%n_devices
+         model%dev(d)%node_i = devices(1, d)
+         model%dev(d)%node_j = devices(2, d)
+         model%dev(d)%law = law_velocity
+         model%dev(d)%p = 10.0_dp
+         model%dev(d)%mu = 0.2_dp
+      end do
+   end subroutine make_model
+
+   !> The paper's model: m1 on k1 and m2 on k2 to the table, one device between them.
+   subroutine paper_model(model)
+      type(model_type), intent(out) :: model
+      call make_model(model, [m1, m2], reshape([1.0_dp, 0.0_dp, k1, 2.0_dp, 0.0_dp, k2], [3, 2]), &
+                      reshape([1, 2], [2, 1]))
+   end subroutine paper_model
+
+   !> Five DOFs; links 1-2, 4-5 and 5-4 (repeated), 3 unlinked: groups {1, 2}, {3}, {4, 5},
+   !> numbered in the order of their first DOF.
+   subroutine test_link_groups(error)
+      type(error_type), allocatable, intent(out) :: error
+      type(model_type) :: model
+      integer :: grp(5), nq
+      real(dp) :: no_springs(3, 0)
+
+      call make_model(model, [1.0_dp, 1.0_dp, 1.0_dp, 1.0_dp, 1.0_dp], no_springs, &
+                      reshape([2, 1, 3, 2, 4, 5, 5, 4], [2, 4]))
+      call link_groups(model, [.true., .false., .true., .true.], grp, nq)
+      call check(error, nq, 3, 'three moving groups')
+      if (allocated(error)) return
+      call check(error, all(grp == [1, 1, 2, 3, 3]), 'groups {1, 2}, {3}, {4, 5}')
+      if (allocated(error)) return
+      ! the unlinked device 3-2 linked too: {1, 2, 3}, {4, 5}
+      call link_groups(model, [.true., .true., .true., .true.], grp, nq)
+      call check(error, nq, 2, 'two moving groups')
+      if (allocated(error)) return
+      call check(error, all(grp == [1, 1, 1, 2, 2]), 'groups {1, 2, 3}, {4, 5}')
+      if (allocated(error)) return
+      ! nothing linked: every DOF its own group
+      call link_groups(model, [.false., .false., .false., .false.], grp, nq)
+      call check(error, nq == 5 .and. all(grp == [1, 2, 3, 4, 5]), 'no links: five groups')
+   end subroutine test_link_groups
+
+   !> A chain of links that reaches the table (0-3, 3-1, 1-4) puts 1, 3 and 4 with the table.
+   subroutine test_link_groups_table(error)
+      type(error_type), allocatable, intent(out) :: error
+      type(model_type) :: model
+      integer :: grp(4), nq
+      real(dp) :: no_springs(3, 0)
+
+      call make_model(model, [1.0_dp, 1.0_dp, 1.0_dp, 1.0_dp], no_springs, reshape([1, 4, 3, 1, 3, 0], [2, 3]))
+      call link_groups(model, [.true., .true., .true.], grp, nq)
+      call check(error, nq, 1, 'one moving group')
+      if (allocated(error)) return
+      call check(error, all(grp == [0, 1, 0, 0]), 'DOFs 1, 3, 4 with the table')
+      if (allocated(error)) return
+      ! without the link to the table, {1, 3, 4} moves
+      call link_groups(model, [.true., .true., .false.], grp, nq)
+      call check(error, nq == 2 .and. all(grp == [1, 2, 1, 1]), 'groups {1, 3, 4}, {2}')
+   end subroutine test_link_groups_table
+
+   !> A chain table - 1 - 2 - 3 with k = 100, 20, 3, and a spring 3 - 1 of 0.5.
+   subroutine test_stiffness(error)
+      type(error_type), allocatable, intent(out) :: error
+      type(model_type) :: model
+      real(dp) :: k(3, 3), expected(3, 3)
+      integer :: no_devices(2, 0)
+
+      call make_model(model, [1.0_dp, 1.0_dp, 1.0_dp], reshape([1.0_dp, 0.0_dp, 100.0_dp, 2.0_dp, 1.0_dp, 20.0_dp, &
+                      3.0_dp, 2.0_dp, 3.0_dp, 3.0_dp, 1.0_dp, 0.5_dp], [3, 4]), no_devices)
+      call stiffness_matrix(model, k)
+      expected = reshape([120.5_dp, -20.0_dp, -0.5_dp, -20.0_dp, 23.0_dp, -3.0_dp, -0.5_dp, -3.0_dp, 3.5_dp], [3, 3])
+      call check_matrix(error, k, expected, 0.0_dp, 'stiffness of a chain with a cross spring (exact)')
+   end subroutine test_stiffness
+
+   !> C = (T xi / pi) K for 'stiffness'; C = a0 M + a1 K for 'rayleigh'.
+   subroutine test_damping(error)
+      type(error_type), allocatable, intent(out) :: error
+      type(model_type) :: model
+      real(dp) :: k(2, 2), c(2, 2), expected(2, 2)
+
+      call paper_model(model)
+      call stiffness_matrix(model, k)
+      model%damping = damping_stiffness
+      model%xi = 0.015_dp
+      call damping_matrix(model, k, 0.3_dp, c)
+      call check_matrix(error, c, (0.3_dp*0.015_dp/pi)*k, 1.0e-15_dp, 'stiffness-proportional damping')
+      if (allocated(error)) return
+      model%damping = damping_rayleigh
+      model%rayleigh_a0 = 0.4_dp
+      model%rayleigh_a1 = 0.002_dp
+      call damping_matrix(model, k, 0.0_dp, c)
+      expected = 0.002_dp*k
+      expected(1, 1) = expected(1, 1) + 0.4_dp*m1
+      expected(2, 2) = expected(2, 2) + 0.4_dp*m2
+      call check_matrix(error, c, expected, 1.0e-15_dp, 'Rayleigh damping')
+   end subroutine test_damping
+
+   !> The device between the masses is a rigid link: one body m1 + m2 on k1 + k2,
+   !> T = 2 pi sqrt((m1 + m2)/(k1 + k2)) (the paper's 0.296 s), both masses moving alike.
+   subroutine test_stuck_linked(error)
+      type(error_type), allocatable, intent(out) :: error
+      type(model_type) :: model
+      real(dp) :: k(2, 2), period, phi(2)
+      type(fd_error_type), allocatable :: err
+
+      call paper_model(model)
+      call stiffness_matrix(model, k)
+      call stuck_first_mode(model, k, period, phi, err)
+      call check(error, .not. allocated(err), 'stuck_first_mode failed')
+      if (allocated(error)) return
+      call check_close(error, period, 2.0_dp*pi*sqrt((m1 + m2)/(k1 + k2)), 1.0e-14_dp, 'T of the rigid two-mass body')
+      if (allocated(error)) return
+      call check(error, phi(1) == phi(2) .and. phi(1) /= 0.0_dp, 'the linked masses share one mode value')
+      if (allocated(error)) return
+      call check_close(error, (m1 + m2)*phi(1)**2, 1.0_dp, 1.0e-14_dp, 'the mode is mass-normalized')
+   end subroutine test_stuck_linked
+
+   !> With P mu = 0 the device links nothing: two oscillators, the slower one first
+   !> (sqrt(k1/m1) = 13.1 rad/s < sqrt(k2/m2) = 33.8 rad/s); its mode moves m1 only.
+   !> A 2-DOF chain (table - m - m, k, k) with no device: w^2 = (k/m)(3 - sqrt(5))/2.
+   subroutine test_stuck_free(error)
+      type(error_type), allocatable, intent(out) :: error
+      type(model_type) :: model
+      real(dp) :: k(2, 2), period, phi(2)
+      type(fd_error_type), allocatable :: err
+      integer :: no_devices(2, 0)
+
+      call paper_model(model)
+      model%dev(1)%p = 0.0_dp
+      call stiffness_matrix(model, k)
+      call stuck_first_mode(model, k, period, phi, err)
+      call check(error, .not. allocated(err), 'stuck_first_mode failed')
+      if (allocated(error)) return
+      call check_close(error, period, 2.0_dp*pi*sqrt(m1/k1), 1.0e-14_dp, 'T of the slower free oscillator')
+      if (allocated(error)) return
+      call check(error, phi(2) == 0.0_dp, 'the first mode moves m1 only')
+      if (allocated(error)) return
+      call make_model(model, [2.0_dp, 2.0_dp], reshape([1.0_dp, 0.0_dp, 800.0_dp, 2.0_dp, 1.0_dp, 800.0_dp], [3, 2]), &
+                      no_devices)
+      call stiffness_matrix(model, k)
+      call stuck_first_mode(model, k, period, phi, err)
+      call check_close(error, period, 2.0_dp*pi/sqrt(400.0_dp*(3.0_dp - sqrt(5.0_dp))/2.0_dp), 1.0e-14_dp, &
+                       'T of a two-mass chain')
+   end subroutine test_stuck_free
+
+   !> Every mass locked to the table: no free DOF, an error (not a zero period); a free mass
+   !> with no spring: a rigid-body mode, an error.
+   subroutine test_stuck_locked(error)
+      type(error_type), allocatable, intent(out) :: error
+      type(model_type) :: model
+      real(dp) :: k(2, 2), period, phi(2)
+      type(fd_error_type), allocatable :: err
+
+      call make_model(model, [m1, m2], reshape([1.0_dp, 0.0_dp, k1, 2.0_dp, 0.0_dp, k2], [3, 2]), &
+                      reshape([1, 0, 2, 1], [2, 2]))
+      call stiffness_matrix(model, k)
+      call stuck_first_mode(model, k, period, phi, err)
+      call check(error, allocated(err), 'all locked: an error')
+      if (allocated(error)) return
+      call check(error, index(err%message, 'no free DOF') > 0, err%message)
+      if (allocated(error)) return
+      call make_model(model, [m1, m2], reshape([1.0_dp, 0.0_dp, k1], [3, 1]), reshape([1, 2], [2, 1]))
+      model%dev(1)%p = 0.0_dp
+      call stiffness_matrix(model, k)
+      call stuck_first_mode(model, k, period, phi, err)
+      call check(error, allocated(err), 'a mass without a spring: an error')
+      if (allocated(error)) return
+      call check(error, index(err%message, 'rigid-body mode') > 0, err%message)
+   end subroutine test_stuck_locked
+
+   !> With C = (T xi / pi) K the stuck first mode's damping ratio is xi exactly:
+   !> phi' C phi / (2 w phi' M phi) = (T xi / pi) w^2 / (2 w) = xi.
+   subroutine test_structure_xi(error)
+      type(error_type), allocatable, intent(out) :: error
+      type(model_type) :: model
+      real(dp) :: k(2, 2), c(2, 2), period, xi
+      type(fd_error_type), allocatable :: err
+
+      call paper_model(model)
+      model%damping = damping_stiffness
+      model%xi = 0.015_dp
+      call structure_matrices(model, k, c, period, xi, err)
+      call check(error, .not. allocated(err), 'structure_matrices failed')
+      if (allocated(error)) return
+      call check_close(error, xi, 0.015_dp, 1.0e-14_dp, 'damping ratio of the stuck mode')
+      if (allocated(error)) return
+      call check_matrix(error, c, (period*0.015_dp/pi)*k, 1.0e-15_dp, 'C = psi K with psi = T xi / pi')
+   end subroutine test_structure_xi
+
+end module test_fd_matrices

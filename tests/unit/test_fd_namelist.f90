@@ -1,0 +1,279 @@
+!> Unit tests of the namelist lexer (fd_namelist): which lines open a group, a group's
+!> assignments and their deck lines, comments, quoted strings holding '/', '!', '&' or '=',
+!> groups closed by '/' or '&end', unclosed, missing, unknown and repeated groups, and the
+!> messages that name the variable and value at fault.
+module test_fd_namelist
+   use testdrive, only: new_unittest, unittest_type, error_type, check
+   use fd_error, only: fd_error_type => error_type
+   use fd_namelist, only: deck_text, group_text, deck_from_string, load_deck, find_group, group_item, &
+                          group_read_error, check_groups, group_opened
+   implicit none
+   private
+
+   public :: collect_namelist
+
+   character(len=*), parameter :: nl = achar(10)
+   !> A deck using every feature of the lexer (line numbers in the comments).
+   character(len=*), parameter :: sample = &
+      "! frictiondyn deck"//nl// &                                        ! 1
+      "&model"//nl// &                                                    ! 2
+      "  n_dof = 2,  mass = 6.301, 2.530   ! masses [kg]"//nl// &         ! 3
+      "  name = 'a/b!c=d'  title = ""it's / & here"""//nl// &             ! 4
+      "/"//nl// &                                                         ! 5
+      "&Friction n_devices = 1, law(1) = 'velocity', p(1)=61.81 /"//nl// & ! 6
+      "&excitation"//nl// &                                               ! 7
+      "  record_file = 'x.txt'"//nl// &                                   ! 8
+      "  dt_record ="//nl// &                                             ! 9
+      "     0.005"//nl// &                                                ! 10
+      "&END"//nl// &                                                      ! 11
+      "&output"//nl// &                                                   ! 12
+      "  dir = 'out'"//nl// &                                             ! 13
+      achar(9)//"&damping  ! a tab before"//nl// &                        ! 14
+      "/"//nl                                                             ! 15
+
+contains
+
+   subroutine collect_namelist(testsuite)
+      type(unittest_type), allocatable, intent(out) :: testsuite(:)
+
+      testsuite = [ &
+                  new_unittest("group_opened", test_group_opened), &
+                  new_unittest("items and their lines", test_items), &
+                  new_unittest("quotes and comments", test_quotes), &
+                  new_unittest("one-line group", test_one_line), &
+                  new_unittest("closed by &end", test_end), &
+                  new_unittest("not closed", test_not_closed), &
+                  new_unittest("missing group", test_missing), &
+                  new_unittest("unknown and repeated groups", test_check_groups), &
+                  new_unittest("one item as a record", test_group_item), &
+                  new_unittest("messages naming the variable", test_read_error), &
+                  new_unittest("missing deck file", test_load_missing) &
+                  ]
+   end subroutine collect_namelist
+
+   subroutine test_group_opened(error)
+      type(error_type), allocatable, intent(out) :: error
+
+      call check(error, trim(group_opened('&model')), 'model')
+      if (allocated(error)) return
+      call check(error, trim(group_opened('  &MODEL n_dof = 2 /')), 'model', 'lower case, text after the name')
+      if (allocated(error)) return
+      call check(error, trim(group_opened(achar(9)//'&damping')), 'damping', 'a tab before')
+      if (allocated(error)) return
+      call check(error, trim(group_opened('&output,')), 'output', 'a comma after the name')
+      if (allocated(error)) return
+      call check(error, trim(group_opened('&output/')), 'output', "a '/' right after the name")
+      if (allocated(error)) return
+      call check(error, len_trim(group_opened('&end')), 0, "'&end' closes, it does not open")
+      if (allocated(error)) return
+      call check(error, len_trim(group_opened('&END')), 0, "'&END' closes, it does not open")
+      if (allocated(error)) return
+      call check(error, len_trim(group_opened('&')), 0, "a lone '&'")
+      if (allocated(error)) return
+      call check(error, len_trim(group_opened("  name = '&model'")), 0, 'an assignment')
+      if (allocated(error)) return
+      call check(error, len_trim(group_opened('')), 0, 'an empty line')
+      if (allocated(error)) return
+      call check(error, len_trim(group_opened('! &model')), 0, 'a comment')
+   end subroutine test_group_opened
+
+   subroutine test_items(error)
+      type(error_type), allocatable, intent(out) :: error
+      type(deck_text) :: deck
+      type(group_text) :: grp
+      type(fd_error_type), allocatable :: err
+      logical :: found
+
+      call deck_from_string(sample, 'sample.nml', deck)
+      call check(error, size(deck%lines), 15, 'lines of the deck')
+      if (allocated(error)) return
+      call find_group(deck, 'model', grp, found, err)
+      call check(error, found .and. .not. allocated(err), '&model found')
+      if (allocated(error)) return
+      call check(error, grp%first_line, 2)
+      if (allocated(error)) return
+      call check(error, size(grp%lines), 4, 'group lines from &model to /')
+      if (allocated(error)) return
+      call check(error, size(grp%items), 4, 'four assignments')
+      if (allocated(error)) return
+      call check(error, grp%items(1)%s, 'n_dof = 2', 'separator comma dropped')
+      if (allocated(error)) return
+      call check(error, grp%items(2)%s, 'mass = 6.301, 2.530', 'a list value, comment dropped')
+      if (allocated(error)) return
+      call check(error, all(grp%item_line == [3, 3, 4, 4]), 'deck line of each assignment')
+   end subroutine test_items
+
+   !> '/', '!', '&' and '=' inside quotes are text, not syntax.
+   subroutine test_quotes(error)
+      type(error_type), allocatable, intent(out) :: error
+      type(deck_text) :: deck
+      type(group_text) :: grp
+      type(fd_error_type), allocatable :: err
+      logical :: found
+
+      call deck_from_string(sample, 'sample.nml', deck)
+      call find_group(deck, 'model', grp, found, err)
+      call check(error, grp%items(3)%s, "name = 'a/b!c=d'", "'/', '!' and '=' inside single quotes")
+      if (allocated(error)) return
+      call check(error, grp%items(4)%s, 'title = "it''s / & here"', "a quote, '/' and '&' inside double quotes")
+   end subroutine test_quotes
+
+   !> '&Friction ... /' on one line: the name is matched in lower case, an index kept.
+   subroutine test_one_line(error)
+      type(error_type), allocatable, intent(out) :: error
+      type(deck_text) :: deck
+      type(group_text) :: grp
+      type(fd_error_type), allocatable :: err
+      logical :: found
+
+      call deck_from_string(sample, 'sample.nml', deck)
+      call find_group(deck, 'friction', grp, found, err)
+      call check(error, found .and. .not. allocated(err), '&Friction found as friction')
+      if (allocated(error)) return
+      call check(error, size(grp%items), 3, 'three assignments')
+      if (allocated(error)) return
+      call check(error, grp%items(1)%s, 'n_devices = 1')
+      if (allocated(error)) return
+      call check(error, grp%items(2)%s, "law(1) = 'velocity'", 'an indexed variable')
+      if (allocated(error)) return
+      call check(error, grp%items(3)%s, 'p(1)=61.81', 'no blanks around =')
+      if (allocated(error)) return
+      call check(error, all(grp%item_line == 6), 'all on line 6')
+   end subroutine test_one_line
+
+   !> '&END' closes a group; a value may continue on the next line.
+   subroutine test_end(error)
+      type(error_type), allocatable, intent(out) :: error
+      type(deck_text) :: deck
+      type(group_text) :: grp
+      type(fd_error_type), allocatable :: err
+      logical :: found
+
+      call deck_from_string(sample, 'sample.nml', deck)
+      call find_group(deck, 'excitation', grp, found, err)
+      call check(error, found .and. .not. allocated(err), '&excitation closed by &END')
+      if (allocated(error)) return
+      call check(error, size(grp%items), 2, 'two assignments')
+      if (allocated(error)) return
+      call check(error, grp%items(2)%s(1:11), 'dt_record =', 'a value on the next line')
+      if (allocated(error)) return
+      call check(error, trim(adjustl(grp%items(2)%s(12:))), '0.005', 'a value on the next line')
+      if (allocated(error)) return
+      call check(error, all(grp%item_line == [8, 9]), 'lines 8 and 9')
+      if (allocated(error)) return
+      ! the tab-indented group after the unclosed one is found and closed
+      call find_group(deck, 'damping', grp, found, err)
+      call check(error, found .and. .not. allocated(err) .and. grp%first_line == 14, '&damping after a tab')
+      if (allocated(error)) return
+      call check(error, size(grp%items), 0, 'an empty group')
+   end subroutine test_end
+
+   !> A group that runs into the next group without '/' is an error naming it and its line.
+   subroutine test_not_closed(error)
+      type(error_type), allocatable, intent(out) :: error
+      type(deck_text) :: deck
+      type(group_text) :: grp
+      type(fd_error_type), allocatable :: err
+      logical :: found
+
+      call deck_from_string(sample, 'sample.nml', deck)
+      call find_group(deck, 'output', grp, found, err)
+      call check(error, found .and. allocated(err), '&output is not closed')
+      if (allocated(error)) return
+      call check(error, index(err%message, "sample.nml, group &output (line 12): not closed by '/'") > 0, &
+                 err%message)
+      if (allocated(error)) return
+      call deck_from_string('&model'//nl//'  n_dof = 1'//nl, 'end.nml', deck)
+      call find_group(deck, 'model', grp, found, err)
+      call check(error, found .and. allocated(err), 'a group running to the end of the deck')
+   end subroutine test_not_closed
+
+   subroutine test_missing(error)
+      type(error_type), allocatable, intent(out) :: error
+      type(deck_text) :: deck
+      type(group_text) :: grp
+      type(fd_error_type), allocatable :: err
+      logical :: found
+
+      call deck_from_string(sample, 'sample.nml', deck)
+      call find_group(deck, 'springs', grp, found, err)
+      call check(error, .not. found .and. .not. allocated(err), 'a missing group: not found, no error')
+      if (allocated(error)) return
+      call find_group(deck, 'end', grp, found, err)
+      call check(error, .not. found, "'&END' is not a group")
+   end subroutine test_missing
+
+   subroutine test_check_groups(error)
+      type(error_type), allocatable, intent(out) :: error
+      type(deck_text) :: deck
+      type(fd_error_type), allocatable :: err
+
+      call deck_from_string(sample, 'sample.nml', deck)
+      call check_groups(deck, [character(len=10) :: 'model', 'friction', 'excitation', 'output', 'damping'], err)
+      call check(error, .not. allocated(err), 'every group known, once')
+      if (allocated(error)) return
+      call check_groups(deck, [character(len=10) :: 'model', 'friction', 'excitation', 'damping'], err)
+      call check(error, allocated(err), 'an unknown group')
+      if (allocated(error)) return
+      call check(error, index(err%message, 'sample.nml, line 12: unknown group &output') > 0, err%message)
+      if (allocated(error)) return
+      call check(error, index(err%message, '&model, &friction, &excitation, &damping') > 0, err%message)
+      if (allocated(error)) return
+      call deck_from_string('&model /'//nl//'&MODEL'//nl//'/'//nl, 'twice.nml', deck)
+      call check_groups(deck, [character(len=10) :: 'model'], err)
+      call check(error, allocated(err), 'a repeated group')
+      if (allocated(error)) return
+      call check(error, index(err%message, 'twice.nml, line 2: group &model appears more than once') > 0, &
+                 err%message)
+   end subroutine test_check_groups
+
+   subroutine test_group_item(error)
+      type(error_type), allocatable, intent(out) :: error
+      type(deck_text) :: deck
+      type(group_text) :: grp
+      type(fd_error_type), allocatable :: err
+      logical :: found
+      character(len=:), allocatable :: record
+
+      call deck_from_string(sample, 'sample.nml', deck)
+      call find_group(deck, 'friction', grp, found, err)
+      call group_item(grp, 2, record)
+      call check(error, record, "&friction law(1) = 'velocity' /")
+   end subroutine test_group_item
+
+   !> The reader's message becomes one that names file, group, line, variable and value.
+   subroutine test_read_error(error)
+      type(error_type), allocatable, intent(out) :: error
+      type(deck_text) :: deck
+      type(group_text) :: grp
+      type(fd_error_type), allocatable :: err
+      logical :: found
+
+      call deck_from_string('&integration'//nl//'  n1 = 20'//nl//'  nn2 = 50'//nl//'  n = 1.5x'//nl//'/'//nl, &
+                            'bad.nml', deck)
+      call find_group(deck, 'integration', grp, found, err)
+      call group_read_error(deck, grp, 2, 'Cannot match namelist object name nn2', err)
+      call check(error, allocated(err), 'an error')
+      if (allocated(error)) return
+      call check(error, err%message, "bad.nml, group &integration, line 3: unknown variable 'nn2' (value 50)")
+      if (allocated(error)) return
+      call group_read_error(deck, grp, 3, 'Bad real number in item 1 of list input', err)
+      call check(error, err%message, "bad.nml, group &integration, line 4: variable 'n' has a bad value '1.5x' "// &
+                 "(Bad real number in item 1 of list input)")
+      if (allocated(error)) return
+      call group_read_error(deck, grp, 0, 'End of file', err)
+      call check(error, err%message, 'bad.nml, group &integration (line 1): cannot be read: End of file')
+   end subroutine test_read_error
+
+   subroutine test_load_missing(error)
+      type(error_type), allocatable, intent(out) :: error
+      type(deck_text) :: deck
+      type(fd_error_type), allocatable :: err
+
+      call load_deck('no_such_deck_for_the_unit_tests.nml', deck, err)
+      call check(error, allocated(err), 'a missing deck is an error')
+      if (allocated(error)) return
+      call check(error, err%message, "deck: file 'no_such_deck_for_the_unit_tests.nml' does not exist")
+   end subroutine test_load_missing
+
+end module test_fd_namelist
