@@ -7,7 +7,7 @@ import pytest
 from conftest import K1, K2, M1, M2, TABLE1, G, block, ok, paper_groups
 
 # independent references (numpy only): eigen-decomposition and Den Hartog's closed form
-from frictiondyn.validate import den_hartog, linear_response
+from oracles import den_hartog, linear_response
 
 
 def coulomb_paper(p, test=3, duration=5.0):
@@ -17,7 +17,8 @@ def coulomb_paper(p, test=3, duration=5.0):
     return g
 
 
-def test_huge_p_mu_is_one_rigid_body_to_1e8(run):
+def test_huge_p_mu_is_one_rigid_body_to_1e11(run):
+    """Measured: 4.1e-13 of the peak (displacements, velocities, device force)."""
     freq, amp, _ = TABLE1[3]
     r = ok(run(coulomb_paper(1e6)))
     h, s = r.history(), r.summary()
@@ -25,26 +26,31 @@ def test_huge_p_mu_is_one_rigid_body_to_1e8(run):
     psi = s["period_stuck_s"] * 0.015 / np.pi
     exact = linear_response(M1 + M2, K1 + K2, psi * (K1 + K2), amp, freq, h["t"])
     scale = np.max(np.abs(exact[:, 0]))
-    assert np.max(np.abs(h["u1"] - exact[:, 0])) < 1e-8 * scale
-    assert np.max(np.abs(h["u2"] - exact[:, 0])) < 1e-8 * scale
-    assert np.max(np.abs(h["v1"] - exact[:, 1])) < 1e-8 * np.max(np.abs(exact[:, 1]))
-    # the device carries the force that keeps the masses together, within P mu
-    assert np.max(np.abs(h["F1"])) < 1e6 * 0.22
+    assert np.max(np.abs(h["u1"] - exact[:, 0])) < 1e-11 * scale
+    assert np.max(np.abs(h["u2"] - exact[:, 0])) < 1e-11 * scale
+    assert np.max(np.abs(h["v1"] - exact[:, 1])) < 1e-11 * np.max(np.abs(exact[:, 1]))
+    # the device carries the force that keeps the masses together: from m1's equation of
+    # motion, F = -(m1 aabs + k1 u + psi k1 v) with aabs = -(k1 + k2)(u + psi v)/(m1 + m2)
+    u, v = exact[:, 0], exact[:, 1]
+    force = -(M1 * (-(K1 + K2) * (u + psi * v) / (M1 + M2)) + K1 * (u + psi * v))
+    assert np.max(np.abs(h["F1"] - force)) < 1e-11 * np.max(np.abs(force))
 
 
-def test_zero_p_mu_leaves_free_oscillators_to_1e8(run):
+def test_zero_p_mu_leaves_free_oscillators_to_1e11(run):
+    """Measured: 4.5e-13 of the peak."""
     freq, amp, _ = TABLE1[3]
     r = ok(run(coulomb_paper(0.0)))
     h, s = r.history(), r.summary()
     psi = s["period_stuck_s"] * 0.015 / np.pi
     for i, (m, k) in enumerate([(M1, K1), (M2, K2)], start=1):
         exact = linear_response(m, k, psi * k, amp, freq, h["t"])
-        assert np.max(np.abs(h[f"u{i}"] - exact[:, 0])) < 1e-8 * np.max(np.abs(exact[:, 0]))
+        assert np.max(np.abs(h[f"u{i}"] - exact[:, 0])) < 1e-11 * np.max(np.abs(exact[:, 0]))
     assert np.all(h["F1"] == 0.0)
 
 
 @pytest.mark.parametrize("r, ratio", [(0.7, 0.3), (1.6, 0.2), (0.45, 0.1)])
-def test_den_hartog_non_stop_steady_state_to_1e6(run, r, ratio):
+def test_den_hartog_non_stop_steady_state_to_2e11(run, r, ratio):
+    """Measured: 1.2e-12 (displacement) and 1.8e-12 (velocity) of the amplitude."""
     m, fn = 2.0, 1.0
     k = m * (2 * np.pi * fn) ** 2
     w = r * 2 * np.pi * fn
@@ -82,11 +88,11 @@ def test_den_hartog_non_stop_steady_state_to_1e6(run, r, ratio):
     )
     h, s = r_.history(), r_.summary()
     x, v, _ = den_hartog(h["t"], m, k, ff, f0, w)
-    assert np.max(np.abs(h["u1"] - x)) < 1e-6 * amplitude
-    assert np.max(np.abs(h["v1"] - v)) < 1e-6 * amplitude * w
+    assert np.max(np.abs(h["u1"] - x)) < 2e-11 * amplitude
+    assert np.max(np.abs(h["v1"] - v)) < 2e-11 * amplitude * w
     # non-stop: two velocity reversals a cycle, never sticking
-    assert s["slip_to_stick"] == [0]
-    assert s["slip_reversals"][0] == pytest.approx(2 * cycles, abs=1)
+    assert s["slip_to_stick"] == [0] and s["stick_to_slip"] == [0]
+    assert s["slip_reversals"] == [2 * cycles]
 
 
 def test_block_stops_exactly(run):
@@ -110,11 +116,14 @@ def test_block_stops_exactly(run):
 
 @pytest.mark.parametrize("test", [3, 4])
 def test_energy_balance_of_the_exact_technique(run, test):
+    """Input = kinetic + strain + viscous + friction to 1e-11 of the input (measured 0 and
+    1e-13; the residual is round-off, up to 1e-12 on other builds); friction dissipates
+    89 % (test 3) and 87 % (test 4) of it."""
     s = ok(run(coulomb_paper(61.81, test=test, duration=20.0))).summary()
     total = s["energy_input_J"]
     assert total > 1
-    assert s["energy_friction_J"] > 0.5 * total
-    assert abs(s["energy_residual_J"]) < 1e-9 * total
+    assert s["energy_friction_J"] > 0.85 * total
+    assert abs(s["energy_residual_J"]) < 1e-11 * total
 
 
 def test_record_input_is_exact_for_piecewise_linear_acceleration(run):
@@ -151,9 +160,9 @@ def test_record_input_is_exact_for_piecewise_linear_acceleration(run):
         nm = ok(run(g, files={"acc.txt": text})).history()
         errs.append(np.max(np.abs(nm["u1"] - exact["u1"])) / np.max(np.abs(exact["u1"])))
     # Newmark converges to the exact first-order-hold solution at second order
-    # (measured: 1.23e-3 at dt_r/4, 3.06e-4 at dt_r/8 for this white-noise record)
-    assert errs[1] < 1e-3
-    assert errs[1] == pytest.approx(errs[0] / 4, rel=0.05)
+    # (measured: 1.226e-3 at dt_r/4, 3.063e-4 at dt_r/8 for this white-noise record: 4.002)
+    assert errs[1] < 4e-4
+    assert errs[0] / errs[1] == pytest.approx(4.0, rel=0.01)
 
 
 def test_coulomb_cannot_be_mixed(run):
@@ -192,7 +201,8 @@ def test_two_devices_exact_against_a_fine_velocity_law(run):
     ex = ok(run(with_law("coulomb")))
     vl = ok(run(with_law("velocity")))
     se, sv = ex.summary(), vl.summary()
-    assert min(se["stick_to_slip"]) > 100  # both devices stick and slip in every cycle
+    # both devices stick and slip twice in every cycle after the 3-cycle ramp (measured 118, 117)
+    assert min(se["stick_to_slip"]) >= 2 * (20 * 3 - 3)
     assert sv["correctness_violations"] == 0
     he, hv = ex.history(), vl.history()
     w = he["t"] > 15.0
@@ -201,10 +211,12 @@ def test_two_devices_exact_against_a_fine_velocity_law(run):
         ph = h[f"phase{d}"][w]
         return int(np.sum((ph[:-1] == 0) & (ph[1:] != 0)))
 
-    for d in (1, 2):
-        assert starts(he, d) == starts(hv, d) >= 25
+    for d in (1, 2):  # two slides a cycle in the last 5 s (15 cycles), by both techniques
+        assert starts(he, d) == starts(hv, d) == 2 * 15
+    # the band eps = 1e-5 m/s leaves (measured) 7e-5 in the peaks and 7.6e-5 in u
     for i in (1, 2, 3):
         peak_e = np.max(np.abs(he[f"aabs{i}"][w]))
-        assert np.max(np.abs(hv[f"aabs{i}"][w])) == pytest.approx(peak_e, rel=2e-3)
-        assert np.max(np.abs(hv[f"u{i}"][w] - he[f"u{i}"][w])) < 1e-3 * np.max(np.abs(he[f"u{i}"][w]))
-    assert abs(se["energy_residual_J"]) < 1e-9 * se["energy_input_J"]
+        assert np.max(np.abs(hv[f"aabs{i}"][w])) == pytest.approx(peak_e, rel=2e-4)
+        du = np.max(np.abs(hv[f"u{i}"][w] - he[f"u{i}"][w]))
+        assert du < 2e-4 * np.max(np.abs(he[f"u{i}"][w]))
+    assert abs(se["energy_residual_J"]) < 1e-11 * se["energy_input_J"]  # measured 6.5e-14

@@ -21,6 +21,7 @@ from conftest import (
     run_deck_file,
     steady_amplitude,
 )
+from oracles import steady_aabs
 
 LAWS = ["velocity", "hysteretic"]
 
@@ -58,13 +59,14 @@ def test_block_sticks_below_mu_g_and_slides_above(run, law, ratio):
             assert s["peak_s_m"][0] <= load * F_STICK * 1.01
         else:
             assert np.max(np.abs(h["sdot1"])) < load * EPS * (1 + 1e-6)  # viscous: |F|/c1
-        # stuck: the block moves with the table
-        assert np.max(np.abs(h["aabs1"] - h["ag"])) < 1e-2 * mu * G
+        # stuck: the block moves with the table (measured 2.8e-3 and 2.1e-3 of mu g)
+        assert np.max(np.abs(h["aabs1"] - h["ag"])) < 5e-3 * mu * G
     else:
         assert s["stick_to_slip"][0] >= 2 * 4  # slips in every half cycle of the full motion
         assert s["peak_s_m"][0] > 100 * F_STICK
-        # the friction force caps the block's absolute acceleration at mu g
-        assert np.max(np.abs(h["aabs1"])) <= mu * G * (1 + 1e-6)
+        # the friction force caps the block's absolute acceleration at mu g (to round-off:
+        # measured 3.4e-13 above it)
+        assert np.max(np.abs(h["aabs1"])) <= mu * G * (1 + 1e-11)
     assert s["correctness_violations"] == 0
 
 
@@ -86,8 +88,8 @@ def test_block_with_initial_velocity_stops_where_the_closed_form_says(run, law):
     d, t_stop = v0**2 / (2 * mu * G), v0 / (mu * G)
     i = np.argmax(h["phase1"] == 0)  # first sample sticking
     assert i > 0
-    # while sliding the block decelerates at exactly mu g (Newmark is exact for it)
-    assert np.allclose(a[:i], -mu * G, rtol=1e-9)
+    # while sliding the block decelerates at exactly mu g (Newmark is exact for it; 1.7e-12)
+    np.testing.assert_allclose(a[:i], -mu * G, rtol=1e-11, atol=0)
     dt = t[1] - t[0]
     if law == "velocity":
         # sliding ends when |v| drops below the band eps, i.e. eps/(mu g) before t_stop
@@ -141,18 +143,17 @@ def test_hysteretic_loop_area_is_4_p_mu_d_minus_f(run):
     last = t >= t[-1] - 1.0 / freq  # the last whole cycle
     area = abs(np.sum(0.5 * (force[last][1:] + force[last][:-1]) * np.diff(s[last])))
     d = 0.5 * (s[last].max() - s[last].min())
-    assert area == pytest.approx(4 * pmu * (d - f), rel=2e-3)
+    assert area == pytest.approx(4 * pmu * (d - f), rel=2e-3)  # measured 6.0e-4
 
 
 def rigid_1dof_aabs(m, k, c, amp, freq):
-    w = 2 * np.pi * freq
-    ag = -amp * w**2
-    u = -m * ag / (k - w**2 * m + 1j * w * c)
-    return abs(-(w**2) * u + ag)
+    return float(steady_aabs(m, k, c, amp, freq)[0])
 
 
 @pytest.mark.parametrize("law", LAWS)
 def test_huge_p_mu_moves_the_masses_as_one_rigid_body(run, law):
+    """Steady |aabs| of both masses = the rigid body's to 1e-4 (measured 2.2e-5 and 2.3e-5:
+    Newmark's period error at dt1 and the device's finite stiffness)."""
     freq, amp, dtr = TABLE1[4]
     g = paper_groups(4, law, p=1e5)
     g["excitation"].update(ramp_cycles=5)
@@ -163,11 +164,12 @@ def test_huge_p_mu_moves_the_masses_as_one_rigid_body(run, law):
     expected = rigid_1dof_aabs(M1 + M2, K1 + K2, psi * (K1 + K2), amp, freq)
     for i in (1, 2):
         got = steady_amplitude(h["t"], h[f"aabs{i}"], freq, cycles=20)
-        assert got == pytest.approx(expected, rel=5e-3)
+        assert got == pytest.approx(expected, rel=1e-4)
 
 
 @pytest.mark.parametrize("law", LAWS)
 def test_zero_p_mu_leaves_two_independent_oscillators(run, law):
+    """Steady |aabs| of each mass = its own oscillator's to 1e-4 (measured 1.4e-5)."""
     freq, amp, dtr = TABLE1[3]
     g = paper_groups(3, law, p=0.0)
     g["excitation"].update(ramp_cycles=5)
@@ -180,7 +182,7 @@ def test_zero_p_mu_leaves_two_independent_oscillators(run, law):
     assert s["period_stuck_s"] == pytest.approx(t_first, rel=1e-12)
     for i, (m, k) in enumerate([(M1, K1), (M2, K2)], start=1):
         got = steady_amplitude(h["t"], h[f"aabs{i}"], freq, cycles=20)
-        assert got == pytest.approx(rigid_1dof_aabs(m, k, psi * k, amp, freq), rel=5e-3)
+        assert got == pytest.approx(rigid_1dof_aabs(m, k, psi * k, amp, freq), rel=1e-4)
 
 
 def steady_window(h, freq, cycles=10):
@@ -191,7 +193,9 @@ def steady_window(h, freq, cycles=10):
 @pytest.mark.parametrize("test", [1, 2, 3, 4, 5])
 def test_table1_classification(run, test, law):
     """Steady state (last 10 cycles): no sliding in tests 1, 2, 5; stick-slip in every cycle
-    of tests 3 and 4 (the paper's observation), with P = m1 g."""
+    of tests 3 and 4 (the paper's observation), with P = m1 g. Sticking, the hysteretic
+    device stays in its elastic range (|s| spans at most 2 f) and the velocity law creeps
+    (measured span 1.4e-4 m at most); sliding spans 11 to 17 mm."""
     freq = TABLE1[test][0]
     g = paper_groups(test, law)
     g["output"] = {"output_every": 1}
@@ -200,13 +204,14 @@ def test_table1_classification(run, test, law):
     t, phase = h["t"][w], h["phase1"][w]
     if test in (1, 2, 5):
         assert np.all(phase == 0)
-        assert np.ptp(h["s1"][w]) < 1e-3  # no slip: the relative displacement stays tiny
+        span = np.ptp(h["s1"][w])  # no slip: the relative displacement stays tiny
+        assert span <= 2 * 1e-5 if law == "hysteretic" else span < 2e-4
     else:
         cycle = np.floor((t - t[0]) * freq).astype(int)
         for c in range(10):
             in_c = phase[cycle == c]
             assert np.any(in_c == 0) and np.any(in_c != 0), f"cycle {c}: no stick-slip"
-        assert np.ptp(h["s1"][w]) > 5e-3  # sliding of several mm
+        assert np.ptp(h["s1"][w]) > 1e-2  # sliding of a centimetre and more
 
 
 def peaks(h, freq):
@@ -225,18 +230,19 @@ def test_fig3_coarse_deck_fails_and_the_corrected_one_agrees_with_the_velocity_l
         runs[name] = r
     coarse = runs["fig3_coarse"].summary()
     # the paper's Fig. 3b: sign changes of the relative velocity inside sliding phases
-    assert coarse["correctness_violations"] > 50
-    assert coarse["slip_reversals"][0] > 50
+    assert coarse["correctness_violations"] == 388
+    assert coarse["slip_reversals"] == [287]
     assert "violate the correctness condition" in runs["fig3_coarse"].stderr
     h = runs["fig3_coarse"].history()
     slip = h["phase1"] != 0
     same_phase = (h["phase1"][1:] == h["phase1"][:-1]) & slip[1:]
     sign_flips = np.sum(same_phase & (np.sign(h["sdot1"][1:]) != np.sign(h["sdot1"][:-1])))
-    assert sign_flips > 0
+    assert sign_flips == 20  # seen in the rows written (every dt_r)
     corrected = runs["test4_hysteretic"].summary()
     assert corrected["correctness_violations"] == 0
     assert corrected["slip_reversals"] == [0]
     hv, hh = runs["test4_velocity"].history(), runs["test4_hysteretic"].history()
+    # the two laws' steady peaks agree (the paper's Fig. 4): measured +0.34 % and -1.5 %
     np.testing.assert_allclose(peaks(hh, freq), peaks(hv, freq), rtol=0.03)
 
 
@@ -257,17 +263,20 @@ def test_correctness_check_refines_the_coarse_deck(tmp_path):
 
 
 def test_factorizations_follow_step_size_and_phase_pattern(tmp_path):
-    """Velocity law, no halving: (dt1, dt2) x (stick, slip) = 4 factorizations in 40 s."""
+    """Velocity law, no halving: (dt1, dt2) x (stick, slip) = 4 factorizations in 40 s, for
+    two slides in each of the 164 whole cycles of 40 s at 4.104 Hz."""
     r = run_deck_file(INPUTS / "test4_velocity.nml", tmp_path)
     s = r.summary()
     assert s["steps_finer"] == 0
-    assert s["stick_to_slip"][0] > 100
+    assert s["stick_to_slip"] == [2 * int(40.0 * TABLE1[4][0])]
     assert s["factorizations"] == 4
 
 
 @pytest.mark.parametrize("law", LAWS)
 def test_energy_balance_of_newmark_runs(run, law):
-    """Average acceleration: input = kinetic + strain + viscous + friction (+ stored), to round-off."""
+    """Average acceleration: input = kinetic + strain + viscous + friction (+ stored), to
+    round-off: 1e-10 of the input (measured 2.0e-13 and 2.3e-13; up to 4e-12 for other decks
+    and builds)."""
     s = ok(run(paper_groups(4, law))).summary()
     total = s["energy_input_J"]
     parts = (
@@ -278,9 +287,9 @@ def test_energy_balance_of_newmark_runs(run, law):
         + s["energy_device_elastic_J"]
     )
     assert total > 10
-    assert s["energy_friction_J"] > 0.5 * total  # friction dissipates most of it (test 4)
-    assert abs(total - parts) < 1e-8 * total
-    assert abs(s["energy_residual_J"]) < 1e-8 * total
+    assert s["energy_friction_J"] > 0.85 * total  # friction dissipates most of it (87.7 %)
+    assert abs(total - parts) < 1e-10 * total
+    assert abs(s["energy_residual_J"]) < 1e-10 * total
 
 
 def chain3(law, p):
@@ -317,9 +326,10 @@ def chain3(law, p):
 
 @pytest.mark.parametrize("law", LAWS)
 def test_two_devices_change_phase_independently(run, law):
-    h = ok(run(chain3(law, [20.0, 8.0]))).history()
-    s = ok(run(chain3(law, [20.0, 8.0]), name="again")).summary()
-    assert min(s["stick_to_slip"]) > 10
+    r = ok(run(chain3(law, [20.0, 8.0])))
+    h, s = r.history(), r.summary()
+    # at least two slides a cycle after the 3-cycle ramp (measured 179, 179; 363, 358)
+    assert min(s["stick_to_slip"]) >= 2 * (30 * 3 - 3)
     first = [h["t"][np.argmax(h[f"phase{d}"] != 0)] for d in (1, 2)]
     assert first[0] != first[1]
     # at some sample one device slides while the other sticks
@@ -330,6 +340,7 @@ def test_two_devices_change_phase_independently(run, law):
 
 @pytest.mark.parametrize("law", LAWS)
 def test_two_locked_devices_equal_the_rigid_chain(run, law):
+    """Steady |aabs| of the three masses = the rigid body's to 5e-5 (measured 9.8e-6)."""
     g = chain3(law, [1e6, 1e6])
     h = ok(run(g)).history()
     m, k = sum(g["model"]["mass"]), g["springs"]["k"][0]
@@ -337,5 +348,5 @@ def test_two_locked_devices_equal_the_rigid_chain(run, law):
     expected = rigid_1dof_aabs(m, k, c, 0.01, 3.0)
     for i in (1, 2, 3):
         assert steady_amplitude(h["t"], h[f"aabs{i}"], 3.0, cycles=20) == pytest.approx(
-            expected, rel=5e-3
+            expected, rel=5e-5
         )

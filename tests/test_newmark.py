@@ -5,6 +5,7 @@ from __future__ import annotations
 import numpy as np
 import pytest
 from conftest import INPUTS, K1, K2, M1, M2, ok, run_deck_file, steady_amplitude
+from oracles import chain_stiffness, steady_aabs
 
 
 def free_vibration(omega: float, dt_r: float, n1: int, cycles: float = 20.0):
@@ -21,24 +22,25 @@ def free_vibration(omega: float, dt_r: float, n1: int, cycles: float = 20.0):
 
 @pytest.mark.parametrize("w_dt", [0.05, 0.2, 0.6, 1.5])
 def test_average_acceleration_period_elongation(run, w_dt):
-    """T_num/T = (w dt/2)/atan(w dt/2) to 1e-6, and no amplitude decay (1e-9)."""
+    """T_num/T = (w dt/2)/atan(w dt/2) to 1e-12, and no amplitude decay (1e-11): measured
+    3.6e-15 and 6.4e-13 (20 periods, the worst at w dt = 0.05)."""
     omega = 2 * np.pi / 0.7
     n1 = 4
     dt = w_dt / omega
     r = ok(run(free_vibration(omega, dt * n1, n1)))
     h = r.history()
     u, v = h["u1"], h["v1"]
-    assert np.allclose(np.diff(h["t"]), dt, rtol=1e-9)
+    np.testing.assert_allclose(np.diff(h["t"]), dt, rtol=1e-11, atol=0)
     # A linear recurrence u[k+1] + u[k-1] = 2 cos(theta) u[k] holds exactly for the
     # discrete rotation; take cos(theta) where |u[k]| is largest.
     k = np.argsort(-np.abs(u[1:-1]))[:20] + 1
     cos_theta = np.median((u[k + 1] + u[k - 1]) / (2 * u[k]))
     t_ratio = (2 * np.pi / np.arccos(cos_theta) * dt) / (2 * np.pi / omega)
     expected = (w_dt / 2) / np.arctan(w_dt / 2)
-    assert t_ratio == pytest.approx(expected, rel=1e-6)
+    assert t_ratio == pytest.approx(expected, rel=1e-12)
     # the trapezoidal rule conserves the quadratic invariant w^2 u^2 + v^2
     inv = omega**2 * u**2 + v**2
-    assert np.max(np.abs(inv / inv[0] - 1)) < 1e-9
+    assert np.max(np.abs(inv / inv[0] - 1)) < 1e-11
 
 
 def chain(n: int, masses, stiffnesses):
@@ -51,24 +53,6 @@ def chain(n: int, masses, stiffnesses):
         "node_j": list(range(0, n)),
         "k": list(stiffnesses),
     }
-
-
-def closed_form_aabs(masses, stiffnesses, c, amp, freq):
-    """Steady-state absolute-acceleration amplitudes of a chain under x0 = amp sin(wt)."""
-    n = len(masses)
-    m = np.diag(masses)
-    k = np.zeros((n, n))
-    for i, ks in enumerate(stiffnesses):
-        k[i, i] += ks
-        if i > 0:
-            k[i - 1, i - 1] += ks
-            k[i, i - 1] -= ks
-            k[i - 1, i] -= ks
-    w = 2 * np.pi * freq
-    ag = -amp * w**2  # table acceleration amplitude (complex, sin reference)
-    cmat = c(m, k)
-    u = np.linalg.solve(k - w**2 * m + 1j * w * cmat, -m @ np.ones(n) * ag)
-    return np.abs(-(w**2) * u + ag)
 
 
 @pytest.mark.parametrize(
@@ -92,7 +76,11 @@ def closed_form_aabs(masses, stiffnesses, c, amp, freq):
     ],
 )
 def test_chain_steady_state_matches_frequency_response(run, masses, stiffnesses, damping):
-    """2- and 5-DOF damped chains: |aabs| within 1e-3 of (K - w^2 M + i w C)^-1 at dt_r/20."""
+    """2- and 5-DOF damped chains in steady state: |aabs| equals the response of average-
+    acceleration Newmark (the frequency response at the warped frequency (2/dt) tan(w dt/2))
+    to 3e-10, measured 3e-11 (what is left of the transient after 60 s), and the exact
+    frequency response (K - w^2 M + i w C)^-1 to 1e-4 at dt = dt_r/20 (measured 3.8e-5,
+    the period error of the scheme)."""
     n = len(masses)
     freq, amp, dt_r = 3.3, 0.004, 0.005
     model, springs = chain(n, masses, stiffnesses)
@@ -124,10 +112,13 @@ def test_chain_steady_state_matches_frequency_response(run, masses, stiffnesses,
         def c(m, k):
             return s["period_stuck_s"] * damping["xi"] / np.pi * k
 
-    expected = closed_form_aabs(masses, stiffnesses, c, amp, freq)
+    m, k = np.diag(masses), chain_stiffness(stiffnesses)
+    exact = steady_aabs(m, k, c(m, k), amp, freq)
+    newmark = steady_aabs(m, k, c(m, k), amp, freq, dt=s["dt1_s"])
     for i in range(n):
         got = steady_amplitude(h["t"], h[f"aabs{i + 1}"], freq, cycles=20)
-        assert got == pytest.approx(expected[i], rel=1e-3)
+        assert got == pytest.approx(newmark[i], rel=3e-10)
+        assert got == pytest.approx(exact[i], rel=1e-4)
     # no phase change, one step size: the effective stiffness is factored once
     assert s["factorizations"] == 1
     assert s["steps_dt1"] == round(60.0 / (dt_r / 20))
@@ -141,7 +132,7 @@ def test_paper_stuck_period_and_damping(tmp_path):
     t_rigid = 2 * np.pi * np.sqrt((M1 + M2) / (K1 + K2))
     assert s["period_stuck_s"] == pytest.approx(t_rigid, rel=1e-12)
     assert s["period_stuck_s"] == pytest.approx(0.296, rel=1e-3)
-    assert s["xi_stuck"] == pytest.approx(0.015, rel=1e-9)
+    assert s["xi_stuck"] == pytest.approx(0.015, rel=1e-14)
 
 
 def test_stuck_period_with_a_device_to_the_table(run):
@@ -169,18 +160,11 @@ def test_stuck_period_with_a_device_to_the_table(run):
     )
     # independent: generalized DOFs q = (u1 = u2, u4), u3 = 0
     t = np.array([[1, 0], [1, 0], [0, 0], [0, 1]], float)
-    kf = np.zeros((4, 4))
-    for i, ks in enumerate(k):
-        kf[i, i] += ks
-        if i > 0:
-            kf[i - 1, i - 1] += ks
-            kf[i, i - 1] -= ks
-            kf[i - 1, i] -= ks
-    kq = t.T @ kf @ t
+    kq = t.T @ chain_stiffness(k) @ t
     mq = t.T @ np.diag(m) @ t
     w2 = np.min(np.linalg.eigvals(np.linalg.solve(mq, kq)).real)
     assert r.summary()["period_stuck_s"] == pytest.approx(2 * np.pi / np.sqrt(w2), rel=1e-12)
-    assert r.summary()["xi_stuck"] == pytest.approx(0.02, rel=1e-9)
+    assert r.summary()["xi_stuck"] == pytest.approx(0.02, rel=1e-14)
 
 
 def harmonic_record_decks(dt_r: float, kind: str, columns: int):
@@ -229,16 +213,20 @@ def harmonic_record_decks(dt_r: float, kind: str, columns: int):
     "kind, columns", [("acceleration", 1), ("acceleration", 2), ("displacement", 1)]
 )
 def test_record_reproduces_harmonic_within_interpolation_error(run, kind, columns):
+    """A record of the harmonic motion gives the harmonic run's response, with the error of
+    the linear interpolation (or second differences) of the record: second order in dt_r.
+    Measured at dt_r = 4 ms: 5.05e-4 (acceleration), 1.005e-3 (displacement), and error
+    ratios 3.98 to 4.00 per halving of dt_r."""
     errors = []
     for dt_r in (0.004, 0.002, 0.001):
         harm, rec, text = harmonic_record_decks(dt_r, kind, columns)
         h1 = ok(run(harm)).history()
         h2 = ok(run(rec, files={"table.txt": text})).history()
-        assert np.allclose(h1["t"], h2["t"])
+        assert np.array_equal(h1["t"], h2["t"])
         # the relative equations of motion see only the table acceleration
         scale = np.max(np.abs(h1["aabs1"]))
         errors.append(np.max(np.abs(h1["aabs1"] - h2["aabs1"])) / scale)
-    assert errors[0] < 2e-3
+    assert errors[0] < (6e-4 if kind == "acceleration" else 1.2e-3)
     # linear interpolation (and second differences): error ~ dt_r^2
-    assert errors[1] < errors[0] / 3
-    assert errors[2] < errors[1] / 3
+    assert errors[0] / errors[1] == pytest.approx(4.0, rel=0.01)
+    assert errors[1] / errors[2] == pytest.approx(4.0, rel=0.01)

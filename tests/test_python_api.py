@@ -69,11 +69,11 @@ def test_extension_and_executable_give_identical_histories(deck, tmp_path):
     assert exe.summary["deck"] == str(path) and ext.summary["deck"] == str(path)
     # and what they say is the paper's: the coarse deck violates eq. 12, the fine one not
     if deck == "fig3_coarse":
-        assert ext.summary["correctness_violations"] > 50
-        assert ext.summary["slip_reversals"][0] > 50
-    else:
+        assert ext.summary["correctness_violations"] == 388
+        assert ext.summary["slip_reversals"] == [287]
+    else:  # two slides in each of the 164 whole cycles
         assert ext.summary["correctness_violations"] == 0
-        assert ext.summary["stick_to_slip"][0] > 100
+        assert ext.summary["stick_to_slip"] == [2 * 164]
 
 
 @pytest.mark.parametrize(
@@ -289,7 +289,7 @@ def test_csv_and_npz_round_trips_are_exact(tmp_path):
     z = Result.from_npz(tmp_path / "a.npz")
     assert z.names == r.names and z.units == r.units
     assert np.array_equal(z.data, r.data) and z.summary == r.summary
-    assert z.summary["correctness_violations"] > 50  # the Fig. 3 deck's failure, kept
+    assert z.summary["correctness_violations"] == 388  # the Fig. 3 deck's failure, kept
 
 
 def test_the_executables_csv_and_to_csv_read_back_the_same(tmp_path):
@@ -316,7 +316,8 @@ def test_accessors_satisfy_the_equations_of_motion(law):
     psi = r.summary["period_stuck_s"] * 0.015 / np.pi
     e1 = M1 * d1["aabs"] + K1 * (d1["u"] + psi * d1["v"]) + dev["F"]
     e2 = M2 * d2["aabs"] + K2 * (d2["u"] + psi * d2["v"]) - dev["F"]
-    assert np.max(np.abs(e1)) < 1e-8 and np.max(np.abs(e2)) < 1e-8  # N, forces ~ 10 N
+    # N, forces ~ 10 N; measured 5.2e-10 (a = 4 (u - ...)/dt^2 amplifies the round-off of u)
+    assert np.max(np.abs(e1)) < 5e-9 and np.max(np.abs(e2)) < 5e-9
     assert np.array_equal(dev["s"], d1["u"] - d2["u"])
     assert np.array_equal(dev["sdot"], d1["v"] - d2["v"])
     slide = dev["phase"] != 0
@@ -324,7 +325,10 @@ def test_accessors_satisfy_the_equations_of_motion(law):
     np.testing.assert_allclose(np.abs(dev["F"][slide]), PMU, rtol=1e-12)
     np.testing.assert_allclose(dev["F"][slide], PMU * dev["phase"][slide], rtol=1e-12)
     assert np.max(np.abs(dev["F"])) <= PMU * (1 + 1e-12)
-    assert r.time is not None and r.time[1] - r.time[0] == pytest.approx(r.summary["dt1_s"])
+    # the time axis is the t column, a row every dt1 (output_every = 1) from 0 to the end
+    assert np.array_equal(r.time, r["t"]) and r.time[0] == 0.0
+    np.testing.assert_allclose(np.diff(r.time), r.summary["dt1_s"], rtol=1e-11, atol=0)
+    assert r.time[-1] == pytest.approx(3.0, rel=1e-14)
     assert r.label("aabs1") == "aabs1 [m/s²]" and r.label("phase1") == "phase1"
     assert "F1" in r and "F2" not in r
     with pytest.raises(KeyError, match="no column 'u3'"):

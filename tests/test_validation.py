@@ -1,15 +1,24 @@
-"""Issue 6: the verification studies of docs/validation.md, asserted on reduced runs."""
+"""Issue 6: the verification studies of docs/validation.md, asserted on reduced runs, at
+tolerances stated here (measured values in the comments), not taken from the studies."""
 
 from __future__ import annotations
 
 import numpy as np
 import pytest
+from conftest import M1, G, P
 from frictiondyn import validate as v
+
+# largest error / peak of the exact technique against each closed form (measured 4.5e-13
+# for the linear limits, 1.2e-12 for Den Hartog's non-stop motion)
+CLOSED_FORM_TOLERANCE = {"P mu huge": 1e-11, "P mu = 0": 1e-11, "Den Hartog": 2e-11}
 
 
 def test_exact_technique_against_closed_forms():
-    for row in v.closed_forms():
-        assert row["error"] < row["tolerance"], row["case"]
+    rows = v.closed_forms()
+    assert len(rows) == 5
+    for row in rows:
+        tol = next(t for case, t in CLOSED_FORM_TOLERANCE.items() if row["case"].startswith(case))
+        assert row["error"] < tol, row["case"]
 
 
 @pytest.fixture(scope="module")
@@ -26,9 +35,9 @@ def test_velocity_law_converges_at_first_order_in_eps(convergence):
     _, sweeps = convergence
     sv = sweeps[0]
     assert np.all(np.diff(sv.peak_error) < 0) and np.all(np.diff(sv.timing_error) < 0)
-    # measured on 40 s: 0.99 (peaks), 0.92 (timing)
-    assert 0.85 < sv.order("peak") < 1.15
-    assert 0.75 < sv.order("timing") < 1.15
+    # measured on 20 s: 0.988 (peaks), 0.914 (timing)
+    assert sv.order("peak") == pytest.approx(1.0, abs=0.03)
+    assert 0.87 < sv.order("timing") < 0.96
     assert sv.peak_error[-1] < 1e-3  # eps = 1e-4: steady peaks within 0.1 % of exact
     assert all(n == 0 for n in sv.violations)
 
@@ -61,8 +70,9 @@ def test_fig3_coarse_run_is_inconsistent_and_flagged(fig3_rows):
     good = fig3_rows["corrected (n1 = 20, n2 = 50)"]
     vel = fig3_rows["velocity law (eps = 1e-3)"]
     # Fig. 3b: the relative velocity changes sign inside sliding phases, and every such
-    # step is counted as a violation of eq. 12
-    assert off["violations"] > 50 and off["reversals"] > 50
+    # step is counted as a violation of eq. 12 (with the studies' P = m1 g = 61.81281 N; the
+    # bundled deck, P = 61.81 N, gives 388 and 287)
+    assert off["violations"] == 386 and off["reversals"] == 287
     # the check removes them: a correct solution in the paper's sense
     assert on["violations"] == 0 and on["reversals"] == 0
     assert good["violations"] == 0 and good["reversals"] == 0
@@ -78,13 +88,14 @@ def test_fig3_coarse_run_is_inconsistent_and_flagged(fig3_rows):
 
 
 def test_energy_balance_of_all_three_techniques():
+    """Residuals of round-off size: measured 8.5e-14 (exact), 1.9e-13 and 2.2e-13 (Newmark)
+    of the input; friction dissipates 87.2 % of it by every technique, within 3.4e-4."""
     rows = {r["technique"]: r for r in v.energy(duration=20.0)}
-    assert rows["coulomb"]["relative_residual"] < 1e-9
-    assert rows["velocity"]["relative_residual"] < 1e-8
-    assert rows["hysteretic"]["relative_residual"] < 1e-8
-    # friction dissipates most of the input in test 4, by every technique, within 3 %
+    assert rows["coulomb"]["relative_residual"] < 1e-11
+    assert rows["velocity"]["relative_residual"] < 1e-10
+    assert rows["hysteretic"]["relative_residual"] < 1e-10
     fr = [rows[k]["energy_friction_J"] / rows[k]["energy_input_J"] for k in rows]
-    assert min(fr) > 0.8 and max(fr) - min(fr) < 0.03
+    assert min(fr) > 0.85 and max(fr) - min(fr) < 1e-3
 
 
 def test_table1_by_the_three_techniques_matches_the_paper():
@@ -98,6 +109,7 @@ def test_table1_by_the_three_techniques_matches_the_paper():
 
 def test_range_of_normal_force_contains_m1_g():
     lo, hi, pc = v.p_range(duration=40.0, rel=1e-2)
-    assert lo < v.P_PAPER < hi
-    # measured at rel 1e-3: 59.62 N < P < 100.02 N
-    assert 55.0 < lo < 62.0 and 95.0 < hi < 105.0
+    assert lo < P < hi and lo < M1 * G < hi
+    # measured at rel 1e-3: 59.62 N < P < 100.02 N; the bisection to rel 1e-2 finds each
+    # bound within 1 % (measured 59.64 N and 100.36 N)
+    assert lo == pytest.approx(59.62, rel=1e-2) and hi == pytest.approx(100.02, rel=1e-2)
