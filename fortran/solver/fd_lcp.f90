@@ -202,15 +202,9 @@ contains
       integer :: n, i, j, nn, irhs
       real(dp) :: s
 
-      info%method = lcp_method_lemke
-      call check_input(work, m, q, z, w, .true., info%status)
-      if (info%status /= lcp_solved) then
-         call clear(z, w)
-         return
-      end if
+      call enter(work, lcp_method_lemke, m, q, z, w, info)
+      if (info%status /= lcp_solved) return
       n = size(q)
-      work%blo(1:n) = 0.0_dp
-      work%bhi(1:n) = huge(1.0_dp)
       call unit_scaling(work, m, n)
       s = 0.0_dp
       do i = 1, n
@@ -259,31 +253,16 @@ contains
       logical :: inconclusive
       real(dp) :: res
 
-      info%method = lcp_method_enumeration
-      call check_input(work, m, q, z, w, .true., info%status)
-      if (info%status /= lcp_solved) then
-         call clear(z, w)
-         return
-      end if
+      call enter(work, lcp_method_enumeration, m, q, z, w, info)
+      if (info%status /= lcp_solved) return
       n = size(q)
-      if (n > min(work%enum_max, max_enum_bits)) then
-         info%status = lcp_too_large
-         call clear(z, w)
-         return
-      end if
-      work%blo(1:n) = 0.0_dp
-      work%bhi(1:n) = huge(1.0_dp)
       inconclusive = .false.
       do mask = 0, 2**n - 1
          do i = 1, n
             work%state(i) = merge(free, at_lo, btest(mask, i - 1))
          end do
-         call pattern_solve(work, m, q, n, flag)
+         call try_pattern(work, m, q, n, .false., z, w, flag, res)
          if (flag == 2) cycle
-         z = work%zt(1:n)
-         call clip(z, .false., work%blo(1:n), work%bhi(1:n))
-         call affine(m, z, q, w)
-         res = residual_core(m, q, z, w, .false., work%blo(1:n), work%bhi(1:n))
          if (res <= work%tol) then
             info%status = lcp_solved
             info%iterations = mask + 1
@@ -305,18 +284,9 @@ contains
       real(dp), intent(inout) :: z(:)       !! initial guess on entry (0 is fine); the last iterate
       real(dp), intent(out) :: w(:)         !! M z + q
       type(lcp_info), intent(out) :: info   !! status, sweeps, residual
-      integer :: n
 
-      info%method = lcp_method_pgs
-      call check_input(work, m, q, z, w, .false., info%status)
-      if (info%status == lcp_solved) call check_diagonal(m, info%status)
-      if (info%status /= lcp_solved) then
-         call clear(z, w)
-         return
-      end if
-      n = size(q)
-      work%blo(1:n) = 0.0_dp
-      work%bhi(1:n) = huge(1.0_dp)
+      call enter(work, lcp_method_pgs, m, q, z, w, info)
+      if (info%status /= lcp_solved) return
       call pgs_core(work, m, q, .false., z, w, info)
    end subroutine lcp_pgs
 
@@ -357,15 +327,9 @@ contains
       integer :: n, nn, i, j, irhs, r
       real(dp) :: s, acc
 
-      info%method = lcp_method_lemke
-      call check_input(work, m, q, z, w, .true., info%status, lo, hi)
-      if (info%status /= lcp_solved) then
-         call clear(z, w)
-         return
-      end if
+      call enter(work, lcp_method_lemke, m, q, z, w, info, lo, hi)
+      if (info%status /= lcp_solved) return
       n = size(q)
-      work%blo(1:n) = lo
-      work%bhi(1:n) = hi
       call unit_scaling(work, m, n)
       nn = 2*n
       irhs = 2*nn + 2
@@ -432,36 +396,19 @@ contains
       integer :: n, i, flag, count
       real(dp) :: res
 
-      info%method = lcp_method_enumeration
-      call check_input(work, m, q, z, w, .true., info%status, lo, hi)
-      if (info%status /= lcp_solved) then
-         call clear(z, w)
-         return
-      end if
+      call enter(work, lcp_method_enumeration, m, q, z, w, info, lo, hi)
+      if (info%status /= lcp_solved) return
       n = size(q)
-      if (n > min(work%box_enum_max, max_enum_bits)) then
-         info%status = lcp_too_large
-         call clear(z, w)
-         return
-      end if
-      work%blo(1:n) = lo
-      work%bhi(1:n) = hi
       work%state(1:n) = at_lo
       count = 0
       do
          count = count + 1
-         call pattern_solve(work, m, q, n, flag)
-         if (flag /= 2) then
-            z = work%zt(1:n)
-            call clip(z, .true., lo, hi)
-            call affine(m, z, q, w)
-            res = residual_core(m, q, z, w, .true., lo, hi)
-            if (res <= work%tol) then
-               info%status = lcp_solved
-               info%iterations = count
-               info%residual = res
-               return
-            end if
+         call try_pattern(work, m, q, n, .true., z, w, flag, res)
+         if (res <= work%tol) then
+            info%status = lcp_solved
+            info%iterations = count
+            info%residual = res
+            return
          end if
          ! next pattern: a counter in base 3 over the variables that are not fixed
          i = 1
@@ -491,18 +438,9 @@ contains
       real(dp), intent(inout) :: z(:)       !! initial guess on entry (0 is fine); the last iterate
       real(dp), intent(out) :: w(:)         !! M z + q
       type(lcp_info), intent(out) :: info   !! status, sweeps, residual
-      integer :: n
 
-      info%method = lcp_method_pgs
-      call check_input(work, m, q, z, w, .false., info%status, lo, hi)
-      if (info%status == lcp_solved) call check_diagonal(m, info%status)
-      if (info%status /= lcp_solved) then
-         call clear(z, w)
-         return
-      end if
-      n = size(q)
-      work%blo(1:n) = lo
-      work%bhi(1:n) = hi
+      call enter(work, lcp_method_pgs, m, q, z, w, info, lo, hi)
+      if (info%status /= lcp_solved) return
       call pgs_core(work, m, q, .true., z, w, info)
    end subroutine box_lcp_pgs
 
@@ -1074,6 +1012,61 @@ contains
       end do
       if (.not. ieee_is_finite(res)) res = huge(1.0_dp)
    end function residual_core
+
+   !> Entry of every solver: record the method, check the data (PGS: the diagonal too;
+   !> enumeration: its size limit) and put the bounds in the workspace (standard LCP: 0 and
+   !> no upper bound). On return info%status is lcp_solved if the solver may run; if not,
+   !> z = w = 0.
+   pure subroutine enter(work, method, m, q, z, w, info, lo, hi)
+      type(lcp_work), intent(inout) :: work
+      integer, intent(in) :: method
+      real(dp), intent(in) :: m(:, :), q(:)
+      real(dp), intent(inout) :: z(:), w(:)
+      type(lcp_info), intent(inout) :: info
+      real(dp), intent(in), optional :: lo(:), hi(:)
+      integer :: n, limit
+
+      info%method = method
+      call check_input(work, m, q, z, w, method /= lcp_method_pgs, info%status, lo, hi)
+      if (info%status == lcp_solved .and. method == lcp_method_pgs) call check_diagonal(m, info%status)
+      if (info%status == lcp_solved .and. method == lcp_method_enumeration) then
+         limit = work%enum_max
+         if (present(lo)) limit = work%box_enum_max
+         if (size(q) > min(limit, max_enum_bits)) info%status = lcp_too_large
+      end if
+      if (info%status /= lcp_solved) then
+         call clear(z, w)
+         return
+      end if
+      n = size(q)
+      if (present(lo) .and. present(hi)) then
+         work%blo(1:n) = lo
+         work%bhi(1:n) = hi
+      else
+         work%blo(1:n) = 0.0_dp
+         work%bhi(1:n) = huge(1.0_dp)
+      end if
+   end subroutine enter
+
+   !> Try the pattern in work%state: its z clipped into the bounds, w = M z + q and the
+   !> residual res; flag as pattern_solve (2: no z, res = huge).
+   pure subroutine try_pattern(work, m, q, n, box, z, w, flag, res)
+      type(lcp_work), intent(inout) :: work
+      real(dp), intent(in) :: m(:, :), q(:)
+      integer, intent(in) :: n
+      logical, intent(in) :: box
+      real(dp), intent(out) :: z(:), w(:)
+      integer, intent(out) :: flag
+      real(dp), intent(out) :: res
+
+      res = huge(1.0_dp)
+      call pattern_solve(work, m, q, n, flag)
+      if (flag == 2) return
+      z = work%zt(1:n)
+      call clip(z, box, work%blo(1:n), work%bhi(1:n))
+      call affine(m, z, q, w)
+      res = residual_core(m, q, z, w, box, work%blo(1:n), work%bhi(1:n))
+   end subroutine try_pattern
 
    !> Sizes, finiteness and bounds of the data; status lcp_solved when all is well.
    pure subroutine check_input(work, m, q, z, w, pivoting, status, lo, hi)

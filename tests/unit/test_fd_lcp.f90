@@ -19,6 +19,7 @@ module test_fd_lcp
 
    real(dp), parameter :: ctol = 1.0e-12_dp  !! feasibility and complementarity, relative
    real(dp), parameter :: atol = 1.0e-11_dp  !! agreement of two methods on a unique solution, relative
+   character(len=12), parameter :: names(4) = [character(len=12) :: 'lemke', 'enumeration', 'pgs', 'solve']
 
    !> Park-Miller minimal standard generator: reproducible on every platform.
    type :: rng_type
@@ -192,6 +193,60 @@ contains
       if (allocated(err)) call check(error, .false., 'lcp_init: '//err%message)
    end subroutine new_work
 
+   !> Solve by one method (1 Lemke, 2 enumeration, 3 PGS from z = 0, 4 lcp_solve); check
+   !> the status, the solution and the residual reported.
+   subroutine solve_checked(error, work, k, m, q, z, w, what)
+      type(error_type), allocatable, intent(out) :: error
+      type(lcp_work), intent(inout) :: work
+      integer, intent(in) :: k
+      real(dp), intent(in) :: m(:, :), q(:)
+      real(dp), intent(out) :: z(:), w(:)
+      character(len=*), intent(in) :: what
+      type(lcp_info) :: info
+
+      select case (k)
+      case (1)
+         call lcp_lemke(work, m, q, z, w, info)
+      case (2)
+         call lcp_enumerate(work, m, q, z, w, info)
+      case (3)
+         z = 0.0_dp
+         call lcp_pgs(work, m, q, z, w, info)
+      case default
+         call lcp_solve(work, m, q, z, w, info)
+      end select
+      call check_status(error, info, lcp_solved, what//' '//trim(names(k)))
+      if (allocated(error)) return
+      call check_lcp(error, m, q, z, w, what//' '//trim(names(k)))
+      if (allocated(error)) return
+      if (info%residual /= lcp_residual(m, q, z, w)) &
+         call check(error, .false., what//' '//trim(names(k))//': reported residual is not that of z')
+   end subroutine solve_checked
+
+   !> Solve by each method listed, check each, and check that they agree on z (a problem
+   !> with a unique solution).
+   subroutine methods_agree(error, work, methods, m, q, what)
+      type(error_type), allocatable, intent(out) :: error
+      type(lcp_work), intent(inout) :: work
+      integer, intent(in) :: methods(:)
+      real(dp), intent(in) :: m(:, :), q(:)
+      character(len=*), intent(in) :: what
+      real(dp) :: z(size(q)), w(size(q)), zref(size(q))
+      integer :: c
+
+      do c = 1, size(methods)
+         call solve_checked(error, work, methods(c), m, q, z, w, what)
+         if (allocated(error)) return
+         if (c == 1) then
+            zref = z
+         else
+            call check_near(error, z, zref, atol, what//' '//trim(names(methods(c)))//' vs '// &
+                            trim(names(methods(1))))
+            if (allocated(error)) return
+         end if
+      end do
+   end subroutine methods_agree
+
    !> Standard LCP by every method, each checked, with the expected z and w.
    subroutine all_methods(error, work, m, q, zx, wx, what, pgs)
       type(error_type), allocatable, intent(out) :: error
@@ -199,39 +254,19 @@ contains
       real(dp), intent(in) :: m(:, :), q(:), zx(:), wx(:)
       character(len=*), intent(in) :: what
       logical, intent(in) :: pgs
-      real(dp) :: z(size(q)), w(size(q))
-      type(lcp_info) :: info
+      real(dp) :: z(size(q)), w(size(q)), tol
       integer :: k
-      character(len=12), parameter :: names(4) = [character(len=12) :: 'lemke', 'enumeration', 'pgs', 'solve']
 
       do k = 1, 4
-         select case (k)
-         case (1)
-            call lcp_lemke(work, m, q, z, w, info)
-         case (2)
-            call lcp_enumerate(work, m, q, z, w, info)
-         case (3)
-            if (.not. pgs) cycle
-            z = 0.0_dp
-            call lcp_pgs(work, m, q, z, w, info)
-         case (4)
-            call lcp_solve(work, m, q, z, w, info)
-         end select
-         call check_status(error, info, lcp_solved, trim(what)//' '//trim(names(k)))
+         if (k == 3 .and. .not. pgs) cycle
+         call solve_checked(error, work, k, m, q, z, w, what)
          if (allocated(error)) return
-         call check_lcp(error, m, q, z, w, trim(what)//' '//trim(names(k)))
+         ! direct methods to round-off; PGS to its stopping residual
+         tol = merge(1.0e-9_dp, 1.0e-14_dp, k == 3)
+         call check_near(error, z, zx, tol, what//' '//trim(names(k))//' z')
          if (allocated(error)) return
-         call check(error, info%residual == lcp_residual(m, q, z, w), &
-                    trim(what)//' '//trim(names(k))//': reported residual is not that of z')
+         call check_near(error, w, wx, tol, what//' '//trim(names(k))//' w')
          if (allocated(error)) return
-         call check_near(error, z, zx, 1.0e-9_dp, trim(what)//' '//trim(names(k))//' z')
-         if (allocated(error)) return
-         call check_near(error, w, wx, 1.0e-9_dp, trim(what)//' '//trim(names(k))//' w')
-         if (allocated(error)) return
-         if (k /= 3) then
-            call check_near(error, z, zx, 1.0e-14_dp, trim(what)//' '//trim(names(k))//' z (direct)')
-            if (allocated(error)) return
-         end if
       end do
    end subroutine all_methods
 
@@ -343,8 +378,7 @@ contains
       type(error_type), allocatable, intent(out) :: error
       type(lcp_work) :: work
       type(rng_type) :: rng
-      real(dp), allocatable :: m(:, :), q(:), z1(:), w1(:), z2(:), w2(:), z3(:), w3(:)
-      type(lcp_info) :: info
+      real(dp), allocatable :: m(:, :), q(:)
       integer :: n, k, i
       character(len=96) :: what
 
@@ -353,7 +387,7 @@ contains
       work%pgs_tol = 1.0e-14_dp
       work%pgs_max_sweeps = 100000
       do n = 1, 8
-         allocate (m(n, n), q(n), z1(n), w1(n), z2(n), w2(n), z3(n), w3(n))
+         allocate (m(n, n), q(n))
          do k = 1, 150
             call seed(rng, 1000*n + k)
             call random_gram(rng, n, n, 0.5_dp, m)
@@ -361,28 +395,10 @@ contains
                q(i) = uniform(rng, -1.0_dp, 1.0_dp)
             end do
             what = 'n = '//trim(fmt_int(n))//' seed '//trim(fmt_int(k))
-            call lcp_lemke(work, m, q, z1, w1, info)
-            call check_status(error, info, lcp_solved, trim(what)//' lemke')
-            if (allocated(error)) return
-            call check_lcp(error, m, q, z1, w1, trim(what)//' lemke')
-            if (allocated(error)) return
-            call lcp_enumerate(work, m, q, z2, w2, info)
-            call check_status(error, info, lcp_solved, trim(what)//' enumeration')
-            if (allocated(error)) return
-            call check_lcp(error, m, q, z2, w2, trim(what)//' enumeration')
-            if (allocated(error)) return
-            z3 = 0.0_dp
-            call lcp_pgs(work, m, q, z3, w3, info)
-            call check_status(error, info, lcp_solved, trim(what)//' pgs')
-            if (allocated(error)) return
-            call check_lcp(error, m, q, z3, w3, trim(what)//' pgs')
-            if (allocated(error)) return
-            call check_near(error, z1, z2, atol, trim(what)//' lemke vs enumeration')
-            if (allocated(error)) return
-            call check_near(error, z3, z2, atol, trim(what)//' pgs vs enumeration')
+            call methods_agree(error, work, [2, 1, 3], m, q, trim(what))
             if (allocated(error)) return
          end do
-         deallocate (m, q, z1, w1, z2, w2, z3, w3)
+         deallocate (m, q)
       end do
    end subroutine test_random_spd
 
@@ -392,8 +408,7 @@ contains
       type(lcp_work) :: work
       type(rng_type) :: rng
       real(dp) :: m2(2, 2)
-      real(dp), allocatable :: m(:, :), q(:), z1(:), w1(:), z2(:), w2(:)
-      type(lcp_info) :: info
+      real(dp), allocatable :: m(:, :), q(:)
       integer :: n, k, i, j
       character(len=96) :: what
 
@@ -410,7 +425,7 @@ contains
       if (allocated(error)) return
       ! random strictly row diagonally dominant with a positive diagonal: P-matrices
       do n = 1, 8
-         allocate (m(n, n), q(n), z1(n), w1(n), z2(n), w2(n))
+         allocate (m(n, n), q(n))
          do k = 1, 100
             call seed(rng, 5000 + 100*n + k)
             do j = 1, n
@@ -423,18 +438,10 @@ contains
                q(i) = uniform(rng, -1.0_dp, 1.0_dp)
             end do
             what = 'P n = '//trim(fmt_int(n))//' seed '//trim(fmt_int(k))
-            call lcp_lemke(work, m, q, z1, w1, info)
-            call check_status(error, info, lcp_solved, trim(what)//' lemke')
-            if (allocated(error)) return
-            call check_lcp(error, m, q, z1, w1, trim(what)//' lemke')
-            if (allocated(error)) return
-            call lcp_enumerate(work, m, q, z2, w2, info)
-            call check_status(error, info, lcp_solved, trim(what)//' enumeration')
-            if (allocated(error)) return
-            call check_near(error, z1, z2, atol, trim(what)//' lemke vs enumeration')
+            call methods_agree(error, work, [2, 1], m, q, trim(what))
             if (allocated(error)) return
          end do
-         deallocate (m, q, z1, w1, z2, w2)
+         deallocate (m, q)
       end do
    end subroutine test_p_matrix
 
