@@ -22,14 +22,16 @@
 !> **Existence and uniqueness.**
 !> - M a P-matrix (every principal minor > 0: symmetric positive definite, strictly
 !>   diagonally dominant with a positive diagonal, triangular with a positive diagonal):
-!>   the standard and the box LCP have exactly one solution for every q; Lemke's method
-!>   finds it (it never ends on a secondary ray).
+!>   the standard LCP has exactly one solution for every q and Lemke's method finds it (it
+!>   never ends on a secondary ray); the box LCP too has exactly one solution for every q
+!>   and every box (Facchinei and Pang 2003, ch. 3).
 !> - M positive semidefinite (x'Mx >= 0, symmetric or not; copositive-plus): Lemke's
 !>   method with the lexicographic rule ends either with a solution or on a secondary ray,
-!>   and the ray proves that no z >= 0 has M z + q >= 0 (Cottle, Pang, Stone, The Linear
-!>   Complementarity Problem, 1992, Thm 4.4.13). Feasible means solvable.
-!> - M symmetric positive semidefinite: if z1, z2 both solve, then (z1 - z2)'M(z1 - z2) <= 0,
-!>   so M (z1 - z2) = 0 and w1 = w2: w is unique, z in general not.
+!>   and the ray proves that no z >= 0 has M z + q >= 0 (Cottle, Pang and Stone, The Linear
+!>   Complementarity Problem, 1992, sec. 4.4). Feasible means solvable.
+!> - M symmetric positive semidefinite, standard or box LCP: if z1, z2 both solve, then
+!>   w1'(z2 - z1) >= 0 and w2'(z1 - z2) >= 0 give (z1 - z2)'M(z1 - z2) <= 0, so
+!>   M (z1 - z2) = 0 and w1 = w2: w is unique, z in general not.
 !> - Box LCP with finite bounds: a solution exists for every M (a variational inequality on
 !>   a nonempty compact convex set, Hartman-Stampacchia). For friction, M = B' M^-1 B is
 !>   symmetric positive semidefinite (singular when devices are redundant: two devices in
@@ -61,10 +63,11 @@
 !>   LCP only when no pattern was singular-consistent or a near miss. Limits `enum_max`
 !>   (standard, 2^n patterns) and `box_enum_max` (3^n).
 !> - PGS (`lcp_pgs`, `box_lcp_pgs`): z_i <- clamp(z_i - w_i / M_ii, lo_i, hi_i) sweep after
-!>   sweep, from the caller's z (warm start); converges for symmetric positive definite M
-!>   (coordinate descent on a strictly convex quadratic) and, in w, for symmetric positive
-!>   semidefinite M with a positive diagonal; linear rate set by the conditioning. Stops
-!>   when the residual is below `pgs_tol`, else reports lcp_not_converged.
+!>   sweep, from the caller's z (warm start): coordinate descent on 1/2 z'Mz + q'z over the
+!>   box when M is symmetric. It converges for symmetric positive definite M, and for a box
+!>   LCP with symmetric positive semidefinite M and a positive diagonal (Luo and Tseng
+!>   1992), at a linear rate set by the conditioning. It stops when the residual is below
+!>   `pgs_tol`, else reports lcp_not_converged.
 !> - `lcp_solve`, `box_lcp_solve`: Lemke, then enumeration when Lemke fails and n is small.
 !>
 !> **Every returned z is checked.** z is clipped into its bounds (z >= 0, lo <= z <= hi
@@ -72,8 +75,8 @@
 !> `lcp_residual`) must be <= `tol` (PGS: `pgs_tol`) for lcp_solved; otherwise the status
 !> says why. z and w mean nothing unless the status is lcp_solved.
 !>
-!> No procedure stops, prints or allocates: `lcp_init` sizes a workspace once, and every
-!> solver works in it, so a call inside a time-step loop allocates nothing.
+!> No procedure stops or prints. Only `lcp_init` allocates: it sizes a workspace once, and
+!> every solver works in it, so a call inside a time-step loop allocates nothing.
 module fd_lcp
    use, intrinsic :: ieee_arithmetic, only: ieee_is_finite
    use fd_kinds, only: dp
