@@ -12,6 +12,7 @@ program tester
    use test_fd_namelist, only: collect_namelist
    use test_fd_record, only: collect_record
    use test_fd_excitation, only: collect_excitation
+   use test_fd_lcp, only: collect_lcp
    implicit none
    integer :: stat, is
    character(len=:), allocatable :: suite_name, test_name
@@ -19,16 +20,17 @@ program tester
    character(len=*), parameter :: fmt = '("#", *(1x, a))'
 
    stat = 0
-   testsuites = [ &
-                new_testsuite("format", collect_format), &
-                new_testsuite("expm", collect_expm), &
-                new_testsuite("linalg", collect_linalg), &
-                new_testsuite("matrices", collect_matrices), &
-                new_testsuite("friction", collect_friction), &
-                new_testsuite("namelist", collect_namelist), &
-                new_testsuite("record", collect_record), &
-                new_testsuite("excitation", collect_excitation) &
-                ]
+   ! one suite a line (union-merge friendly: see .gitattributes)
+   allocate (testsuites(0))
+   testsuites = [testsuites, new_testsuite("format", collect_format)]
+   testsuites = [testsuites, new_testsuite("expm", collect_expm)]
+   testsuites = [testsuites, new_testsuite("linalg", collect_linalg)]
+   testsuites = [testsuites, new_testsuite("matrices", collect_matrices)]
+   testsuites = [testsuites, new_testsuite("friction", collect_friction)]
+   testsuites = [testsuites, new_testsuite("namelist", collect_namelist)]
+   testsuites = [testsuites, new_testsuite("record", collect_record)]
+   testsuites = [testsuites, new_testsuite("excitation", collect_excitation)]
+   testsuites = [testsuites, new_testsuite("lcp", collect_lcp)]
 
    call get_argument(1, suite_name)
    call get_argument(2, test_name)
