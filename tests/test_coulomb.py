@@ -7,7 +7,7 @@ import pytest
 from conftest import K1, K2, M1, M2, TABLE1, G, block, ok, paper_groups
 
 # independent references (numpy only): eigen-decomposition and Den Hartog's closed form
-from frictiondyn.validate import den_hartog, linear_response
+from oracles import den_hartog, linear_response
 
 
 def coulomb_paper(p, test=3, duration=5.0):

@@ -8,7 +8,6 @@
 - ``compare A B [...]``: overlay two or more results (CSV, .npz, or decks, which are run)
   and print the differences of their peaks.
 - ``paper OUTDIR``: the paper's Table 1 classification and Figs. 2, 3a, 3b, 4a, 4b.
-- ``validate OUTDIR``: the verification studies of ``frictiondyn.validate``.
 
 Errors print one line ``frictiondyn: error: ...`` on standard error and exit with status 1.
 """
@@ -231,21 +230,6 @@ def cmd_paper(args: argparse.Namespace) -> int:
     return 0
 
 
-def cmd_validate(args: argparse.Namespace) -> int:
-    try:
-        from .validate import main as validate_main
-    except ImportError as exc:
-        raise CliError(f"the validation studies are not installed ({exc})") from None
-
-    def progress(message: str) -> None:
-        if not args.quiet:
-            print(f"validate: {message}", file=sys.stderr, flush=True)
-
-    report = validate_main(args.outdir, progress=progress)
-    print(f"report: {report}")
-    return 0
-
-
 def build_parser() -> argparse.ArgumentParser:
     parser = argparse.ArgumentParser(
         prog="python -m frictiondyn",
@@ -288,12 +272,6 @@ def build_parser() -> argparse.ArgumentParser:
     p.add_argument("--quiet", action="store_true", help="no progress bar")
     p.set_defaults(func=cmd_paper)
 
-    p = sub.add_parser(
-        "validate", help="verification studies against exact solutions (frictiondyn.validate)"
-    )
-    p.add_argument("outdir", help="directory for validation.md and its figures")
-    p.add_argument("--quiet", action="store_true", help="no progress messages")
-    p.set_defaults(func=cmd_validate)
     return parser
 
 
