@@ -49,6 +49,8 @@ __all__ = [
     "paper_analysis",
     "reproduce",
     "steady_state",
+    "steady_window",
+    "window_start",
 ]
 
 # The experimental model (paper, "Experimental Facility")
