@@ -12,7 +12,7 @@ import numpy as np
 import pytest
 
 # The paper's two-mass model (Dimova, "Experimental Facility"): the package's one copy
-from frictiondyn.paper import K1, K2, M1, M2, MU, TABLE1, P  # noqa: F401
+from frictiondyn.paper import K1, K2, M1, M2, MU, TABLE1, P
 
 ROOT = Path(__file__).resolve().parent.parent
 INPUTS = ROOT / "inputs"

@@ -65,9 +65,8 @@ def test_misuse_raises_and_the_session_is_closed_on_every_path(tmp_path):
     with pytest.raises(FrictiondynError, match="closed"):
         s.result()
     # an exception inside the with block closes it too
-    with pytest.raises(RuntimeError, match="boom"):
-        with Session(deck) as s2:
-            raise RuntimeError("boom")
+    with pytest.raises(RuntimeError, match="boom"), Session(deck) as s2:
+        raise RuntimeError("boom")
     assert s2.closed
     assert not (tmp_path / "w").exists()
 

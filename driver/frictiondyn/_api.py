@@ -182,9 +182,7 @@ class Session:
         with self._lock:
             _, _, history, status = _core.fd_session_shape(self._live())
             self._check(status)
-            return OutputSettings(
-                self._text(_OUTPUT_DIR), self._text(_OUTPUT_NAME), bool(history)
-            )
+            return OutputSettings(self._text(_OUTPUT_DIR), self._text(_OUTPUT_NAME), bool(history))
 
     @property
     def deck(self) -> str:
