@@ -20,7 +20,7 @@ from pathlib import Path
 
 import frictiondyn as fd
 from frictiondyn.model import Analysis, Damping, Device, Harmonic, Integration, Output, Spring
-from frictiondyn.validate import paper_analysis
+from frictiondyn.paper import paper_analysis
 
 ROOT = Path(__file__).resolve().parent.parent
 
@@ -64,13 +64,13 @@ def main() -> None:
         f"{'transitions':>12}{'violations':>11}"
     )
     for label, an in [
-        ("velocity law, eps = 1e-3", paper_analysis(4, "velocity", every=20)),
-        ("hysteretic law, f = 1e-5", paper_analysis(4, "hysteretic", every=20)),
+        ("velocity law, eps = 1e-3", paper_analysis(4, "velocity", output_every=20)),
+        ("hysteretic law, f = 1e-5", paper_analysis(4, "hysteretic", output_every=20)),
         (
             "Fig. 3 coarse (n1 = n2 = 2, off)",
-            paper_analysis(4, "hysteretic", n1=2, n2=2, check=False, every=2),
+            paper_analysis(4, "hysteretic", coarse=True, output_every=2),
         ),
-        ("exact Coulomb (event-driven)", paper_analysis(4, "coulomb", every=20)),
+        ("exact Coulomb (event-driven)", paper_analysis(4, "coulomb", output_every=20)),
     ]:
         t, r = timed(an, args.repeat)
         s = r.summary

@@ -9,7 +9,8 @@ module frictiondyn
    use fd_newmark, only: run_newmark
    use fd_coulomb, only: run_coulomb
    use fd_result, only: history_shape
-   use fd_output, only: output_type, write_outputs, output_paths, summary_json, history_header
+   use fd_output, only: output_type, write_outputs, output_paths, summary_json, history_header, &
+                        write_output_files
    implicit none
    private
 
@@ -17,6 +18,7 @@ module frictiondyn
    public :: result_type, run_config, output_type
    public :: read_deck, read_deck_string, run_config_solve, run_deck, shape_of
    public :: output_paths, summary_json, history_header
+   public :: write_outputs, write_output_files
 
 contains
 

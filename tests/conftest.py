@@ -3,6 +3,7 @@
 from __future__ import annotations
 
 import subprocess
+import sys
 from dataclasses import dataclass
 from pathlib import Path
 
@@ -10,21 +11,15 @@ import frictiondyn
 import numpy as np
 import pytest
 
-INPUTS = Path(__file__).resolve().parent.parent / "inputs"
+# The paper's two-mass model (Dimova, "Experimental Facility"): the package's one copy
+from frictiondyn.paper import K1, K2, M1, M2, MU, TABLE1, P
 
-# The paper's two-mass model (Dimova, "Experimental Facility")
-M1, M2 = 6.301, 2.530  # kg
-K1, K2 = 1084.0, 2895.0  # N/m
-MU = 0.22
-P = 61.81  # N, = m1 g (the paper does not give P)
-G = 9.81
-TABLE1 = {  # test: (frequency Hz, amplitude m, dt_r s)
-    1: (2.104, 0.003994, 0.01),
-    2: (2.659, 0.004008, 0.008),
-    3: (3.102, 0.004062, 0.00667),
-    4: (4.104, 0.004052, 0.005),
-    5: (5.123, 0.004112, 0.004),
-}
+ROOT = Path(__file__).resolve().parent.parent
+INPUTS = ROOT / "inputs"
+# the validation studies and their closed forms are tools, not installed (tools/validation)
+sys.path.append(str(ROOT / "tools" / "validation"))
+
+G = 9.81  # m/s2, the weight of block()
 
 EPS, F_STICK = 1e-3, 1e-5  # band eps = eps1 [m/s] and sticking displacement f [m] of block()
 

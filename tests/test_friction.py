@@ -21,6 +21,7 @@ from conftest import (
     run_deck_file,
     steady_amplitude,
 )
+from frictiondyn.paper import PAPER_OBSERVATION, steady_state
 from oracles import steady_aabs
 
 LAWS = ["velocity", "hysteretic"]
@@ -193,13 +194,15 @@ def steady_window(h, freq, cycles=10):
 @pytest.mark.parametrize("test", [1, 2, 3, 4, 5])
 def test_table1_classification(run, test, law):
     """Steady state (last 10 cycles): no sliding in tests 1, 2, 5; stick-slip in every cycle
-    of tests 3 and 4 (the paper's observation), with P = m1 g. Sticking, the hysteretic
-    device stays in its elastic range (|s| spans at most 2 f) and the velocity law creeps
-    (measured span 1.4e-4 m at most); sliding spans 11 to 17 mm."""
+    of tests 3 and 4 (the paper's observation), with P = m1 g, by the package's classifier
+    and by the phases themselves. Sticking, the hysteretic device stays in its elastic range
+    (|s| spans at most 2 f) and the velocity law creeps (measured span 1.4e-4 m at most);
+    sliding spans 11 to 17 mm."""
     freq = TABLE1[test][0]
     g = paper_groups(test, law)
     g["output"] = {"output_every": 1}
     h = ok(run(g)).history()
+    assert steady_state(h, test, law).classification == PAPER_OBSERVATION[test]
     w = steady_window(h, freq)
     t, phase = h["t"][w], h["phase1"][w]
     if test in (1, 2, 5):

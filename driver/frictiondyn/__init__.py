@@ -10,7 +10,9 @@ from __future__ import annotations
 from ._api import (
     DeckError,
     FrictiondynError,
+    OutputError,
     Result,
+    Session,
     SolverError,
     read_history,
     read_summary,
@@ -18,6 +20,7 @@ from ._api import (
     run_text,
 )
 from ._exe import ExecutableRun, RunFailed, executable, run_executable
+from ._version import __version__
 from .model import (
     Analysis,
     Damping,
@@ -41,11 +44,14 @@ __all__ = [
     "Harmonic",
     "Integration",
     "Output",
+    "OutputError",
     "Record",
     "Result",
     "RunFailed",
+    "Session",
     "SolverError",
     "Spring",
+    "__version__",
     "executable",
     "read_history",
     "read_summary",
@@ -53,4 +59,3 @@ __all__ = [
     "run_executable",
     "run_text",
 ]
-__version__ = "0.1.0"

@@ -1,15 +1,17 @@
 """Running decks through the f2py extension, and the Result of a run.
 
-The deck is read by the same Fortran namelist reader as the executable's (one parser);
-the extension returns the history, its header and the JSON summary, and every non-zero
-status becomes an exception here, in one place.
+A ``Session`` holds one deck read once by the library's Fortran reader (the same as the
+executable's): it is solved, its history and texts are fetched into buffers of the sizes the
+library reports, and its outputs are written by the library's writer. The session lives in
+the library until it is closed; ``Session`` closes it on every path (use it as a context
+manager). Every non-zero status becomes an exception here, in one place.
 """
 
 from __future__ import annotations
 
 import json
-import math
 import os
+import threading
 from dataclasses import dataclass, field
 from pathlib import Path
 
@@ -20,15 +22,15 @@ from . import _core
 __all__ = [
     "DeckError",
     "FrictiondynError",
+    "OutputError",
     "OutputSettings",
     "Result",
+    "Session",
     "SolverError",
-    "fortran_es",
     "read_history",
     "read_summary",
     "run",
     "run_text",
-    "summary_text",
 ]
 
 
@@ -44,64 +46,16 @@ class SolverError(FrictiondynError):
     """The analysis failed (singular system, divergence)."""
 
 
-_ERRORS = {1: DeckError, 2: SolverError, 3: FrictiondynError}
+class OutputError(FrictiondynError, OSError):
+    """An output file or directory cannot be created or written."""
 
 
-def _text(buf: np.ndarray) -> str:
-    return buf.tobytes().decode("utf-8", errors="replace").rstrip()
-
-
-def _check(status: int, message: np.ndarray) -> None:
-    if status != 0:
-        raise _ERRORS.get(int(status), FrictiondynError)(_text(message))
-
-
-def _run(path: str, text: str, from_text: int) -> Result:
-    ncol, nout, lhead, outdir, outname, history, status, message = _core.fd_shape(
-        path, text, from_text
-    )
-    _check(status, message)
-    lsum = 16384 + 512 * ncol
-    hist, header, summary, status, message = _core.fd_run(
-        path, text, from_text, ncol, nout, lhead, lsum
-    )
-    _check(status, message)
-    result = Result.from_arrays(
-        _text(header), np.asarray(hist).T.copy(), json.loads(_text(summary))
-    )
-    result.output = OutputSettings(_text(outdir), _text(outname), bool(history))
-    return result
-
-
-def fortran_es(x: float) -> str:
-    """``x`` as Fortran's ``es24.16e3`` writes it (17 significant digits, 3-digit exponent),
-    without the padding."""
-    if math.isnan(x):
-        return "NaN"
-    if math.isinf(x):
-        return "Infinity" if x > 0 else "-Infinity"
-    mant, _, exp = f"{x:.16E}".partition("E")
-    return f"{mant}E{exp[0]}{abs(int(exp)):03d}"
-
-
-def _json_value(value: object) -> str:
-    if isinstance(value, bool):
-        return "true" if value else "false"
-    if isinstance(value, int):
-        return str(value)
-    if isinstance(value, float):
-        return fortran_es(value)
-    if isinstance(value, str):
-        return json.dumps(value)
-    if isinstance(value, list):
-        return "[" + ", ".join(_json_value(v) for v in value) + "]"
-    return json.dumps(value)
-
-
-def summary_text(summary: dict) -> str:
-    """The summary JSON as the executable writes it (one key a line, reals in es format)."""
-    items = [f"  {json.dumps(k)}: {_json_value(v)}" for k, v in summary.items()]
-    return "{\n" + ",\n".join(items) + "\n}\n"
+# the status codes of the extension (driver/frictiondyn/_core.f90)
+_ERRORS = {1: DeckError, 2: SolverError, 3: FrictiondynError, 4: OutputError, 5: MemoryError}
+# the texts a session gives (fortran/fd_session.f90)
+_HEADER, _SUMMARY, _OUTPUT_DIR, _OUTPUT_NAME, _HISTORY_PATH, _SUMMARY_PATH, _DECK, _ERROR = range(
+    1, 9
+)
 
 
 @dataclass
@@ -113,19 +67,190 @@ class OutputSettings:
     write_history: bool = True
 
 
+class Session:
+    """One deck, read once by the library, and its run: ``solve()``, then ``result()`` and
+    ``write()``; ``close()`` frees it (a ``with`` block closes it on every path).
+
+    ``Session(deck)`` reads a deck file, ``Session.from_text(text, name, base_dir)`` a deck
+    given as text. A DeckError is raised (and nothing is left open) when the deck is bad.
+    The methods may be called from any thread; ``solve`` releases the GIL, so sessions run
+    side by side in threads.
+    """
+
+    def __init__(self, deck: str | os.PathLike) -> None:
+        self._open(os.fspath(deck), "", 0)
+
+    @classmethod
+    def from_text(
+        cls, text: str, name: str = "deck.nml", base_dir: str | os.PathLike = "."
+    ) -> Session:
+        """A session of a deck given as text; ``name`` names it in messages, a relative
+        record_file is looked up in ``base_dir``."""
+        self = cls.__new__(cls)
+        self._open(os.path.join(os.fspath(base_dir), name), text, 1)
+        return self
+
+    @classmethod
+    def _adopt(cls, data: np.ndarray, header: str, summary: str) -> Session:
+        """A solved session holding a history and texts given here (to write them)."""
+        self = cls.__new__(cls)
+        self._handle, self._lock = 0, threading.Lock()
+        hist = np.asarray(data, dtype=np.float64).T  # (columns, samples), Fortran order
+        handle, status = _core.fd_session_adopt(hist, header, summary)
+        self._started(handle, status)
+        return self
+
+    def _open(self, path: str, text: str, from_text: int) -> None:
+        self._handle, self._lock = 0, threading.Lock()
+        handle, _, _, status = _core.fd_session_open(path, text, from_text)
+        self._started(handle, status)
+
+    def _started(self, handle: int, status: int) -> None:
+        self._handle = int(handle)
+        if status != 0:
+            exc = self._exception(status)
+            self.close()
+            raise exc
+
+    # --- the handle -----------------------------------------------------------------------
+
+    def _exception(self, status: int) -> BaseException:
+        """The exception of a non-zero status, with the message the session keeps."""
+        kind = _ERRORS.get(int(status), FrictiondynError)
+        if self._handle == 0:
+            return kind("not enough memory for a session")
+        n, st = _core.fd_session_text_length(self._handle, _ERROR)
+        message = self._fetch_text(_ERROR, n) if st == 0 else ""
+        return kind(message or f"frictiondyn: status {int(status)}")
+
+    def _check(self, status: int) -> None:
+        if status != 0:
+            raise self._exception(status)
+
+    def _live(self) -> int:
+        if self._handle == 0:
+            raise FrictiondynError("the session is closed")
+        return self._handle
+
+    def _fetch_text(self, which: int, length: int) -> str:
+        if length == 0:
+            return ""
+        buf, status = _core.fd_session_text(self._handle, which, length)
+        self._check(status)
+        return np.asarray(buf).tobytes().decode("utf-8", errors="replace")
+
+    def _text(self, which: int) -> str:
+        n, status = _core.fd_session_text_length(self._live(), which)
+        self._check(status)
+        return self._fetch_text(which, n)
+
+    def close(self) -> None:
+        """Free the session (waits for a solve running in another thread). Idempotent."""
+        with self._lock:
+            if self._handle != 0:
+                handle, self._handle = self._handle, 0
+                _core.fd_session_close(handle)
+
+    @property
+    def closed(self) -> bool:
+        return self._handle == 0
+
+    def __enter__(self) -> Session:
+        return self
+
+    def __exit__(self, *exc: object) -> None:
+        self.close()
+
+    def __del__(self) -> None:  # a safety net; close() or a with block is the rule
+        if getattr(self, "_handle", 0) and _core is not None:
+            _core.fd_session_close(self._handle)
+            self._handle = 0
+
+    # --- what the deck says ---------------------------------------------------------------
+
+    @property
+    def shape(self) -> tuple[int, int]:
+        """(samples, columns) of the history the run gives (``Result.data.shape``)."""
+        with self._lock:
+            ncol, nout, _, status = _core.fd_session_shape(self._live())
+            self._check(status)
+        return int(nout), int(ncol)
+
+    @property
+    def output(self) -> OutputSettings:
+        """The deck's &output settings (the directory as set by ``write(out=...)``)."""
+        with self._lock:
+            _, _, history, status = _core.fd_session_shape(self._live())
+            self._check(status)
+            return OutputSettings(self._text(_OUTPUT_DIR), self._text(_OUTPUT_NAME), bool(history))
+
+    @property
+    def deck(self) -> str:
+        """The deck's path (or name, for a deck given as text)."""
+        with self._lock:
+            return self._text(_DECK)
+
+    # --- running and results --------------------------------------------------------------
+
+    def solve(self) -> Session:
+        """Run the deck (once). Raises SolverError when the analysis fails."""
+        with self._lock:
+            self._check(_core.fd_session_solve(self._live()))
+        return self
+
+    def result(self) -> Result:
+        """The Result of the solved run: history, header and summary (no file written)."""
+        with self._lock:
+            h = self._live()
+            ncol, nout, history, status = _core.fd_session_shape(h)
+            self._check(status)
+            hist, status = _core.fd_session_history(h, ncol, nout)
+            self._check(status)
+            summary = self._text(_SUMMARY)
+            result = Result.from_arrays(self._text(_HEADER), np.asarray(hist).T, summary)
+            result.output = OutputSettings(
+                self._text(_OUTPUT_DIR), self._text(_OUTPUT_NAME), bool(history)
+            )
+        return result
+
+    def write(self, out: str | os.PathLike | None = None) -> tuple[Path | None, Path]:
+        """Write ``<dir>/<name>.csv`` (unless ``write_history = .false.``) and
+        ``<dir>/<name>.summary.json`` exactly as the executable does (the library's writer;
+        the directory is created when missing); ``out`` replaces the deck's directory.
+        Returns the paths written. Raises OutputError when a file cannot be written."""
+        with self._lock:
+            h = self._live()
+            if out is not None:
+                self._check(_core.fd_session_set_output_dir(h, os.fspath(out)))
+            self._check(_core.fd_session_write(h))
+            _, _, history, status = _core.fd_session_shape(h)
+            self._check(status)
+            csv = Path(self._text(_HISTORY_PATH)) if history else None
+            return csv, Path(self._text(_SUMMARY_PATH))
+
+    def _write_files(self, csv: Path | None, summary: Path) -> None:
+        with self._lock:
+            status = _core.fd_session_write_files(
+                self._live(), os.fspath(csv or ""), os.fspath(summary), int(csv is not None)
+            )
+            self._check(status)
+
+
 def run(deck: str | os.PathLike) -> Result:
     """Run a namelist deck file and return its Result (no output file is written).
 
     Raises DeckError for a missing, malformed or invalid deck, SolverError when the
     analysis fails.
     """
-    return _run(os.fspath(deck), "", 0)
+    with Session(deck) as session:
+        return session.solve().result()
 
 
 def run_text(text: str, name: str = "deck.nml", base_dir: str | os.PathLike = ".") -> Result:
     """Run a deck given as text. ``name`` names it in messages; a relative record_file is
     looked up in ``base_dir``."""
-    return _run(os.path.join(os.fspath(base_dir), name), text, 1)
+    with Session.from_text(text, name, base_dir) as session:
+        return session.solve().result()
 
 
 _UNITS_LABEL = {"m/s2": "m/s²"}
@@ -146,9 +271,13 @@ class Result:
     data: np.ndarray  # (samples, columns)
     summary: dict = field(default_factory=dict)
     output: OutputSettings = field(default_factory=OutputSettings)
+    #: the summary as the library wrote it (what to_csv writes while ``summary`` is unchanged)
+    summary_text: str | None = field(default=None, repr=False, compare=False)
 
     @classmethod
-    def from_arrays(cls, header: str, data: np.ndarray, summary: dict) -> Result:
+    def from_arrays(cls, header: str, data: np.ndarray, summary: dict | str) -> Result:
+        """A Result from a header ``name[unit],...``, the data (samples, columns) and the
+        summary (a dict, or the summary JSON text, which is kept)."""
         names, units = [], {}
         for item in header.split(","):
             name, _, unit = item.partition("[")
@@ -156,6 +285,9 @@ class Result:
             units[name] = unit.rstrip("]")
         if data.shape[1] != len(names):
             raise FrictiondynError(f"history has {data.shape[1]} columns but {len(names)} names")
+        if isinstance(summary, str):
+            parsed = json.loads(summary) if summary else {}
+            return cls(names, units, data, parsed, summary_text=summary)
         return cls(names, units, data, summary)
 
     @classmethod
@@ -168,8 +300,8 @@ class Result:
         if summary is None:
             candidate = csv.with_name(csv.name[: -len(".csv")] + ".summary.json")
             summary = candidate if candidate.exists() else None
-        summ = json.loads(Path(summary).read_text()) if summary is not None else {}
-        return cls.from_arrays(header, data, summ)
+        text = Path(summary).read_text().removesuffix("\n") if summary is not None else {}
+        return cls.from_arrays(header, data, text)
 
     @classmethod
     def from_npz(cls, path: str | os.PathLike) -> Result:
@@ -177,7 +309,8 @@ class Result:
         with np.load(path, allow_pickle=False) as z:
             names = [str(x) for x in z["names"]]
             units = dict(zip(names, (str(x) for x in z["units"])))
-            return cls(names, units, z["data"], json.loads(str(z["summary"])))
+            text = str(z["summary"])
+            return cls(names, units, z["data"], json.loads(text), summary_text=text)
 
     def __getitem__(self, name: str) -> np.ndarray:
         try:
@@ -218,27 +351,33 @@ class Result:
         unit = self.units.get(name, "")
         return f"{name} [{_UNITS_LABEL.get(unit, unit)}]" if unit and unit != "-" else name
 
+    def summary_json(self) -> str:
+        """The summary as JSON text: as the library wrote it (reals with 17 significant
+        digits) while ``summary`` is unchanged, else ``json.dumps`` of the dict."""
+        text = self.summary_text
+        if text is not None and json.loads(text or "{}") == self.summary:
+            return text
+        return json.dumps(self.summary, indent=2)
+
+    def _header(self) -> str:
+        return ",".join(f"{n}[{self.units[n]}]" for n in self.names)
+
     def to_csv(self, path: str | os.PathLike) -> Path:
-        """Write the history exactly as the executable does (header ``name[unit],...``,
-        ``es24.16e3`` values) and the summary next to it as <stem>.summary.json, each to a
-        temporary name renamed when complete."""
+        """Write the history (header ``name[unit],...``, ``es24.16e3`` values) and the summary
+        next to it as <stem>.summary.json with the library's writer, exactly as the
+        executable does; each file goes to a temporary name renamed when complete."""
         path = Path(path)
-        tmp = path.with_name(path.name + ".tmp")
-        header = ",".join(f"{n}[{self.units[n]}]" for n in self.names)
-        with tmp.open("w") as fh:
-            fh.write(header + "\n")
-            for row in self.data:
-                fh.write(",".join(fortran_es(float(x)).rjust(24) for x in row) + "\n")
-        tmp.replace(path)
-        self.write_summary(path.with_name(path.name.removesuffix(".csv") + ".summary.json"))
+        summary = path.with_name(path.name.removesuffix(".csv") + ".summary.json")
+        with Session._adopt(self.data, self._header(), self.summary_json()) as session:
+            session._write_files(path, summary)
         return path
 
     def write_summary(self, path: str | os.PathLike) -> Path:
-        """Write the summary JSON as the executable does."""
+        """Write the summary JSON alone with the library's writer, as the executable does."""
         path = Path(path)
-        tmp = path.with_name(path.name + ".tmp")
-        tmp.write_text(summary_text(self.summary))
-        tmp.replace(path)
+        empty = np.zeros((0, len(self.names)))
+        with Session._adopt(empty, self._header(), self.summary_json()) as session:
+            session._write_files(None, path)
         return path
 
     def to_npz(self, path: str | os.PathLike) -> Path:
@@ -249,7 +388,7 @@ class Result:
             names=np.array(self.names),
             units=np.array([self.units[n] for n in self.names]),
             data=self.data,
-            summary=np.array(json.dumps(self.summary)),
+            summary=np.array(self.summary_json()),
         )
         return path
 

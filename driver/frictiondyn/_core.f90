@@ -1,109 +1,316 @@
-!> The f2py layer of frictiondyn: thin, flat entry points over the Fortran library, with
-!> iso_c_binding kinds, explicit-shape arrays, a status and a message. No numerics here.
-!> Errors never stop the process: they come back as status /= 0 and a message, which the
-!> Python side (frictiondyn/_api.py) turns into an exception.
+!> The f2py layer of frictiondyn: thin, flat entry points over the library's session
+!> (fortran/fd_session.f90), with iso_c_binding kinds, explicit-shape arrays and a status.
+!> No numerics here, and no state: a session is allocated by fd_session_open (or
+!> fd_session_adopt) and handed to the caller as an opaque 64-bit handle (the C address of
+!> the session), which the caller passes back to every other entry point and finally to
+!> fd_session_close. The deck is read once, by fd_session_open; every buffer the caller
+!> fills is sized by a number an entry point returned.
 !>
-!> status: 0 success, 1 bad deck or input, 2 solver failure, 3 buffer too small
+!> Errors never stop the process: every entry point returns a status, and the message of a
+!> failure is kept in the session (fetch it with fd_session_text_length and fd_session_text,
+!> which = 8). The Python side (frictiondyn/_api.py) turns it into an exception.
+!>
+!> status: 0 success, 1 bad deck or input, 2 solver failure, 3 misuse (wrong state, wrong
+!> buffer, no session), 4 an output file cannot be written, 5 not enough memory (with the
+!> handle 0 when the session itself could not be allocated: then there is no message).
 
-!> Read and validate a deck (from the file `path`, or from `text` when from_text /= 0) and
-!> return the size of its history and of its buffers.
-subroutine fd_shape(path, text, from_text, ncol, nout, lhead, outdir, outname, history, status, message)
-   use, intrinsic :: iso_c_binding, only: c_int, c_char
-   use frictiondyn, only: error_type, run_config, shape_of
+!> Read and validate a deck (the file `path`, or `text` when from_text /= 0) into a new
+!> session; return its handle and the shape of its history. On status 1 the handle is valid
+!> (it holds the message) and must be closed too.
+subroutine fd_session_open(path, text, from_text, handle, ncol, nout, status)
+   use, intrinsic :: iso_c_binding, only: c_int, c_int64_t
+   use fd_session, only: session_type, session_new, session_open, session_open_text, session_shape
+   use frictiondyn, only: error_type
    implicit none
    character(len=*), intent(in) :: path          !! deck file, or name of a text deck
    character(len=*), intent(in) :: text          !! deck text (when from_text /= 0)
    integer(c_int), intent(in) :: from_text       !! 1: read text, 0: read the file
+   integer(c_int64_t), intent(out) :: handle     !! the new session (0: none, status 5)
    integer(c_int), intent(out) :: ncol           !! columns of the history
    integer(c_int), intent(out) :: nout           !! samples of the history
-   integer(c_int), intent(out) :: lhead          !! length of the header line
-   character(kind=c_char, len=1), intent(out) :: outdir(1024)  !! &output dir
-   character(kind=c_char, len=1), intent(out) :: outname(1024) !! &output name
+   integer(c_int), intent(out) :: status         !! 0 or an error code
+   !f2py threadsafe
+   type(session_type), pointer :: s
+   type(error_type), allocatable :: error
+   integer :: stat, nc, no
+   logical :: history
+
+   ncol = 0; nout = 0
+   call session_new(s, handle, stat)
+   if (stat /= 0) then
+      status = 5
+      return
+   end if
+   if (from_text /= 0) then
+      call session_open_text(s, text, path, error)
+   else
+      call session_open(s, path, error)
+   end if
+   if (.not. allocated(error)) call session_shape(s, nc, no, history, error)
+   call keep_error(s, error, 1, status)
+   if (status /= 0) return
+   ncol = int(nc, c_int); nout = int(no, c_int)
+contains
+   include 'fd_core_common.inc'
+end subroutine fd_session_open
+
+!> A new solved session holding a history and texts given by the caller, to write them with
+!> the library's writer (fd_session_write_files).
+subroutine fd_session_adopt(ncol, nout, hist, header, summary, handle, status)
+   use, intrinsic :: iso_c_binding, only: c_int, c_int64_t, c_double
+   use fd_session, only: session_type, session_new, session_adopt
+   use frictiondyn, only: error_type, dp
+   implicit none
+   integer(c_int), intent(in) :: ncol            !! columns
+   integer(c_int), intent(in) :: nout            !! samples
+   real(c_double), intent(in) :: hist(ncol, nout) !! history
+   character(len=*), intent(in) :: header        !! 'name[unit],...'
+   character(len=*), intent(in) :: summary       !! summary text (JSON)
+   integer(c_int64_t), intent(out) :: handle     !! the new session (0: none, status 5)
+   integer(c_int), intent(out) :: status         !! 0 or an error code
+   !f2py threadsafe
+   type(session_type), pointer :: s
+   type(error_type), allocatable :: error
+   integer :: stat
+
+   call session_new(s, handle, stat)
+   if (stat /= 0) then
+      status = 5
+      return
+   end if
+   call session_adopt(s, real(hist, dp), header, summary, error)
+   call keep_error(s, error, 5, status)
+   if (status /= 0) return
+contains
+   include 'fd_core_common.inc'
+end subroutine fd_session_adopt
+
+!> Free a session. The handle must not be used again.
+subroutine fd_session_close(handle)
+   use, intrinsic :: iso_c_binding, only: c_int64_t
+   use fd_session, only: session_free
+   implicit none
+   integer(c_int64_t), intent(in) :: handle      !! the session
+   !f2py threadsafe
+   call session_free(handle)
+end subroutine fd_session_close
+
+!> Columns and samples of the session's history, and its &output write_history.
+subroutine fd_session_shape(handle, ncol, nout, history, status)
+   use, intrinsic :: iso_c_binding, only: c_int, c_int64_t
+   use fd_session, only: session_type, session_from_handle, session_shape
+   use frictiondyn, only: error_type
+   implicit none
+   integer(c_int64_t), intent(in) :: handle      !! the session
+   integer(c_int), intent(out) :: ncol           !! columns
+   integer(c_int), intent(out) :: nout           !! samples
    integer(c_int), intent(out) :: history        !! 1: &output write_history
    integer(c_int), intent(out) :: status         !! 0 or an error code
-   character(kind=c_char, len=1), intent(out) :: message(4096) !! error message
-   !f2py threadsafe
-   type(run_config) :: cfg
+   type(session_type), pointer :: s
    type(error_type), allocatable :: error
    integer :: nc, no
+   logical :: hist
 
-   ncol = 0; nout = 0; lhead = 0; history = 0
-   outdir = ' '; outname = ' '
-   call read_any(path, text, from_text, cfg, error)
-   if (allocated(error)) then
-      call fail(1, error%message, status, message)
-      return
-   end if
-   call shape_of(cfg, nc, no)
+   ncol = 0; nout = 0; history = 0
+   call session_from_handle(handle, s)
+   status = merge(0_c_int, 3_c_int, associated(s))
+   if (status /= 0) return
+   call session_shape(s, nc, no, hist, error)
+   call keep_error(s, error, 3, status)
+   if (status /= 0) return
    ncol = int(nc, c_int); nout = int(no, c_int)
-   lhead = int(32*nc, c_int)
-   call put(cfg%out%dir, outdir, status)
-   if (status == 0) call put(cfg%out%name, outname, status)
-   if (status /= 0) then
-      call fail(3, 'output directory or name longer than 1024 characters', status, message)
-      return
-   end if
-   history = merge(1_c_int, 0_c_int, cfg%out%history)
-   call fail(0, '', status, message)
+   history = merge(1_c_int, 0_c_int, hist)
 contains
    include 'fd_core_common.inc'
-end subroutine fd_shape
+end subroutine fd_session_shape
 
-!> Run a deck and return its history, header and JSON summary; writes no file.
-subroutine fd_run(path, text, from_text, ncol, nout, lhead, lsum, hist, header, summary, status, message)
-   use, intrinsic :: iso_c_binding, only: c_int, c_char, c_double
-   use frictiondyn, only: error_type, run_config, result_type, run_config_solve, shape_of, &
-                          summary_json, history_header
+!> Run the session's deck. Releases the GIL: sessions may be solved in several threads at once.
+subroutine fd_session_solve(handle, status)
+   use, intrinsic :: iso_c_binding, only: c_int, c_int64_t
+   use fd_session, only: session_type, session_from_handle, session_solve, session_read
+   use frictiondyn, only: error_type
    implicit none
-   character(len=*), intent(in) :: path          !! deck file, or name of a text deck
-   character(len=*), intent(in) :: text          !! deck text (when from_text /= 0)
-   integer(c_int), intent(in) :: from_text       !! 1: read text, 0: read the file
-   integer(c_int), intent(in) :: ncol            !! columns, from fd_shape
-   integer(c_int), intent(in) :: nout            !! samples, from fd_shape
-   integer(c_int), intent(in) :: lhead           !! length of the header buffer
-   integer(c_int), intent(in) :: lsum            !! length of the summary buffer
-   real(c_double), intent(out) :: hist(ncol, nout)               !! history
-   character(kind=c_char, len=1), intent(out) :: header(lhead)   !! 'name[unit],...'
-   character(kind=c_char, len=1), intent(out) :: summary(lsum)   !! summary, JSON
+   integer(c_int64_t), intent(in) :: handle      !! the session
    integer(c_int), intent(out) :: status         !! 0 or an error code
-   character(kind=c_char, len=1), intent(out) :: message(4096) !! error message
    !f2py threadsafe
-   type(run_config) :: cfg
-   type(result_type) :: res
+   type(session_type), pointer :: s
    type(error_type), allocatable :: error
-   character(len=:), allocatable :: text_out
-   integer :: nc, no
+   integer :: code
+
+   call session_from_handle(handle, s)
+   status = merge(0_c_int, 3_c_int, associated(s))
+   if (status /= 0) return
+   code = merge(2, 3, s%state == session_read)  ! a failure of the solver, or misuse
+   call session_solve(s, error)
+   call keep_error(s, error, code, status)
+   if (status /= 0) return
+contains
+   include 'fd_core_common.inc'
+end subroutine fd_session_solve
+
+!> Copy the history of a solved session into `hist` (its shape from fd_session_shape).
+subroutine fd_session_history(handle, ncol, nout, hist, status)
+   use, intrinsic :: iso_c_binding, only: c_int, c_int64_t, c_double
+   use fd_session, only: session_type, session_from_handle, session_solved
+   use frictiondyn, only: error_type
+   use fd_error, only: fatal_error
+   implicit none
+   integer(c_int64_t), intent(in) :: handle      !! the session
+   integer(c_int), intent(in) :: ncol            !! columns
+   integer(c_int), intent(in) :: nout            !! samples
+   real(c_double), intent(out) :: hist(ncol, nout) !! the history
+   integer(c_int), intent(out) :: status         !! 0 or an error code
+   !f2py threadsafe
+   type(session_type), pointer :: s
+   type(error_type), allocatable :: error
 
    hist = 0.0_c_double
-   header = ' '
-   summary = ' '
-   call read_any(path, text, from_text, cfg, error)
-   if (allocated(error)) then
-      call fail(1, error%message, status, message)
-      return
+   call session_from_handle(handle, s)
+   status = merge(0_c_int, 3_c_int, associated(s))
+   if (status /= 0) return
+   if (s%state /= session_solved) then
+      call fatal_error(error, 'cannot give the history: the session is not solved')
+   else if (s%res%ncol /= ncol .or. s%res%nout /= nout) then
+      call fatal_error(error, 'history buffer of the wrong shape')
    end if
-   call shape_of(cfg, nc, no)
-   if (nc /= ncol .or. no /= nout) then
-      call fail(3, 'history buffer of the wrong shape', status, message)
-      return
-   end if
-   call run_config_solve(cfg, res, error)
-   if (allocated(error)) then
-      call fail(2, error%message, status, message)
-      return
-   end if
-   hist = real(res%hist, c_double)
-   call history_header(res, text_out)
-   call put(text_out, header, status)
-   if (status == 0) then
-      call summary_json(cfg%model, res, cfg%deck_path, text_out)
-      call put(text_out, summary, status)
-   end if
-   if (status /= 0) then
-      call fail(3, 'header or summary buffer too small', status, message)
-      return
-   end if
-   call fail(0, '', status, message)
+   call keep_error(s, error, 3, status)
+   if (status /= 0) return
+   hist = real(s%res%hist, c_double)
 contains
    include 'fd_core_common.inc'
-end subroutine fd_run
+end subroutine fd_session_history
+
+!> Length of one of the session's texts: 1 history header, 2 summary JSON, 3 &output dir,
+!> 4 &output name, 5 history CSV path, 6 summary path, 7 deck, 8 message of the last error.
+subroutine fd_session_text_length(handle, which, length, status)
+   use, intrinsic :: iso_c_binding, only: c_int, c_int64_t
+   use fd_session, only: session_type, session_from_handle, session_text
+   use frictiondyn, only: error_type
+   implicit none
+   integer(c_int64_t), intent(in) :: handle      !! the session
+   integer(c_int), intent(in) :: which           !! which text
+   integer(c_int), intent(out) :: length         !! its length in bytes
+   integer(c_int), intent(out) :: status         !! 0 or an error code
+   type(session_type), pointer :: s
+   type(error_type), allocatable :: error
+   character(len=:), allocatable :: str
+
+   length = 0
+   call session_from_handle(handle, s)
+   status = merge(0_c_int, 3_c_int, associated(s))
+   if (status /= 0) return
+   call session_text(s, int(which), str, error)
+   call keep_error(s, error, 3, status)
+   if (status /= 0) return
+   length = int(len(str), c_int)
+contains
+   include 'fd_core_common.inc'
+end subroutine fd_session_text_length
+
+!> One of the session's texts (see fd_session_text_length) into `buf` of exactly its length.
+subroutine fd_session_text(handle, which, length, buf, status)
+   use, intrinsic :: iso_c_binding, only: c_int, c_int64_t, c_char
+   use fd_session, only: session_type, session_from_handle, session_text
+   use frictiondyn, only: error_type
+   use fd_error, only: fatal_error
+   implicit none
+   integer(c_int64_t), intent(in) :: handle      !! the session
+   integer(c_int), intent(in) :: which           !! which text
+   integer(c_int), intent(in) :: length          !! its length, from fd_session_text_length
+   character(kind=c_char, len=1), intent(out) :: buf(length) !! the text
+   integer(c_int), intent(out) :: status         !! 0 or an error code
+   type(session_type), pointer :: s
+   type(error_type), allocatable :: error
+   character(len=:), allocatable :: str
+   integer :: i
+
+   buf = ' '
+   call session_from_handle(handle, s)
+   status = merge(0_c_int, 3_c_int, associated(s))
+   if (status /= 0) return
+   call session_text(s, int(which), str, error)
+   if (.not. allocated(error) .and. len(str) /= length) &
+      call fatal_error(error, 'text buffer of the wrong length')
+   call keep_error(s, error, 3, status)
+   if (status /= 0) return
+   do i = 1, len(str)
+      buf(i) = str(i:i)
+   end do
+contains
+   include 'fd_core_common.inc'
+end subroutine fd_session_text
+
+!> Write the outputs into `dir` instead of the deck's &output dir.
+subroutine fd_session_set_output_dir(handle, dir, status)
+   use, intrinsic :: iso_c_binding, only: c_int, c_int64_t
+   use fd_session, only: session_type, session_from_handle, session_set_output_dir
+   use frictiondyn, only: error_type
+   implicit none
+   integer(c_int64_t), intent(in) :: handle      !! the session
+   character(len=*), intent(in) :: dir           !! output directory
+   integer(c_int), intent(out) :: status         !! 0 or an error code
+   type(session_type), pointer :: s
+   type(error_type), allocatable :: error
+
+   call session_from_handle(handle, s)
+   status = merge(0_c_int, 3_c_int, associated(s))
+   if (status /= 0) return
+   call session_set_output_dir(s, dir, error)
+   call keep_error(s, error, 3, status)
+   if (status /= 0) return
+contains
+   include 'fd_core_common.inc'
+end subroutine fd_session_set_output_dir
+
+!> Write the history CSV and the summary of a solved session as the executable does (the
+!> library's writer, the deck's &output settings).
+subroutine fd_session_write(handle, status)
+   use, intrinsic :: iso_c_binding, only: c_int, c_int64_t
+   use fd_session, only: session_type, session_from_handle, session_write, session_solved
+   use frictiondyn, only: error_type
+   implicit none
+   integer(c_int64_t), intent(in) :: handle      !! the session
+   integer(c_int), intent(out) :: status         !! 0 or an error code
+   !f2py threadsafe
+   type(session_type), pointer :: s
+   type(error_type), allocatable :: error
+   integer :: code
+
+   call session_from_handle(handle, s)
+   status = merge(0_c_int, 3_c_int, associated(s))
+   if (status /= 0) return
+   code = merge(4, 3, s%state == session_solved)
+   call session_write(s, error)
+   call keep_error(s, error, code, status)
+   if (status /= 0) return
+contains
+   include 'fd_core_common.inc'
+end subroutine fd_session_write
+
+!> Write the history (when history /= 0) to `hist_path` and the summary to `summ_path` with
+!> the library's writer.
+subroutine fd_session_write_files(handle, hist_path, summ_path, history, status)
+   use, intrinsic :: iso_c_binding, only: c_int, c_int64_t
+   use fd_session, only: session_type, session_from_handle, session_write_files, session_solved
+   use frictiondyn, only: error_type
+   implicit none
+   integer(c_int64_t), intent(in) :: handle      !! the session
+   character(len=*), intent(in) :: hist_path     !! the history CSV
+   character(len=*), intent(in) :: summ_path     !! the summary file
+   integer(c_int), intent(in) :: history         !! 1: write the history too
+   integer(c_int), intent(out) :: status         !! 0 or an error code
+   !f2py threadsafe
+   type(session_type), pointer :: s
+   type(error_type), allocatable :: error
+   integer :: code
+
+   call session_from_handle(handle, s)
+   status = merge(0_c_int, 3_c_int, associated(s))
+   if (status /= 0) return
+   code = merge(4, 3, s%state == session_solved)
+   call session_write_files(s, hist_path, summ_path, history /= 0, error)
+   call keep_error(s, error, code, status)
+   if (status /= 0) return
+contains
+   include 'fd_core_common.inc'
+end subroutine fd_session_write_files

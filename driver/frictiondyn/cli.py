@@ -1,14 +1,13 @@
 """The command line: ``python -m frictiondyn run | plot | compare | paper``.
 
 - ``run DECK [--plot] [--out DIR]``: run a deck through the extension and write its history
-  CSV and summary JSON exactly as the ``frictiondyn`` executable does (same files, same
-  format), into the deck's ``&output`` directory or ``--out``.
+  CSV and summary JSON with the library's writer, exactly as the ``frictiondyn`` executable
+  does (same files, same format), into the deck's ``&output`` directory or ``--out``.
 - ``plot RESULT``: PNGs of a result (a CSV written by ``run`` or the executable, or a .npz
   from ``Result.to_npz``), next to it or in ``--out``.
 - ``compare A B [...]``: overlay two or more results (CSV, .npz, or decks, which are run)
   and print the differences of their peaks.
 - ``paper OUTDIR``: the paper's Table 1 classification and Figs. 2, 3a, 3b, 4a, 4b.
-- ``validate OUTDIR``: the verification studies of ``frictiondyn.validate``.
 
 Errors print one line ``frictiondyn: error: ...`` on standard error and exit with status 1.
 """
@@ -22,34 +21,13 @@ from collections.abc import Sequence
 from pathlib import Path
 
 from . import __version__
-from ._api import FrictiondynError, Result, run
+from ._api import FrictiondynError, Result, Session, run
 
-__all__ = ["load_result", "main", "write_outputs"]
+__all__ = ["load_result", "main"]
 
 
 class CliError(Exception):
     """A problem with the command line's input; printed as one line, exit status 1."""
-
-
-# ---------------------------------------------------------------------------------------
-# Writing outputs the way the executable does
-# ---------------------------------------------------------------------------------------
-
-
-def write_outputs(result: Result, out: str | os.PathLike | None = None) -> tuple[Path | None, Path]:
-    """Write ``<dir>/<name>.csv`` (unless ``write_history = .false.``) and
-    ``<dir>/<name>.summary.json`` as the executable does, with the deck's &output settings
-    (as the Fortran reader read them); ``out`` replaces the directory."""
-    o = result.output
-    directory = Path(out) if out is not None else Path(o.dir)
-    try:
-        directory.mkdir(parents=True, exist_ok=True)
-    except OSError as exc:
-        raise CliError(f"cannot create the output directory {directory}: {exc}") from None
-    summ = directory / f"{o.name}.summary.json"
-    if o.write_history:
-        return result.to_csv(directory / f"{o.name}.csv"), summ
-    return None, result.write_summary(summ)
 
 
 # ---------------------------------------------------------------------------------------
@@ -125,8 +103,9 @@ def _trange(value: Sequence[float] | None) -> tuple[float, float] | None:
 
 def cmd_run(args: argparse.Namespace) -> int:
     trange = _trange(args.t_range)
-    result = run(args.deck)
-    csv, summ = write_outputs(result, args.out)
+    with Session(args.deck) as session:  # the deck is read once; the library writes
+        result = session.solve().result()
+        csv, summ = session.write(args.out)
     _print_summary(result, args.deck)
     if csv is not None:
         print(f"  history: {csv}")
@@ -251,21 +230,6 @@ def cmd_paper(args: argparse.Namespace) -> int:
     return 0
 
 
-def cmd_validate(args: argparse.Namespace) -> int:
-    try:
-        from .validate import main as validate_main
-    except ImportError as exc:
-        raise CliError(f"the validation studies are not installed ({exc})") from None
-
-    def progress(message: str) -> None:
-        if not args.quiet:
-            print(f"validate: {message}", file=sys.stderr, flush=True)
-
-    report = validate_main(args.outdir, progress=progress)
-    print(f"report: {report}")
-    return 0
-
-
 def build_parser() -> argparse.ArgumentParser:
     parser = argparse.ArgumentParser(
         prog="python -m frictiondyn",
@@ -308,12 +272,6 @@ def build_parser() -> argparse.ArgumentParser:
     p.add_argument("--quiet", action="store_true", help="no progress bar")
     p.set_defaults(func=cmd_paper)
 
-    p = sub.add_parser(
-        "validate", help="verification studies against exact solutions (frictiondyn.validate)"
-    )
-    p.add_argument("outdir", help="directory for validation.md and its figures")
-    p.add_argument("--quiet", action="store_true", help="no progress messages")
-    p.set_defaults(func=cmd_validate)
     return parser
 
 

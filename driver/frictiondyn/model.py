@@ -1,5 +1,8 @@
 """Building an analysis in Python: the same content as a namelist deck, written out with
 f90nml, so that ``Analysis.run()`` and ``frictiondyn DECK`` read the very same deck.
+
+An optional value left at None is left out of the deck: the Fortran reader owns every
+default (docs/namelist.md), and Python restates none of them.
 """
 
 from __future__ import annotations
@@ -40,31 +43,33 @@ class Spring:
 @dataclass
 class Device:
     """Friction device between node_i and node_j (0 = table): normal force p [N], friction
-    coefficient mu, law 'velocity' (band eps [m/s]) or 'hysteretic' (f [m], eps1 [m/s])."""
+    coefficient mu, law 'velocity' (band eps [m/s]), 'hysteretic' (f [m], eps1 [m/s]) or
+    'coulomb' (the exact technique). eps, eps1, f: None takes the reader's default."""
 
     node_i: int
     node_j: int
     p: float
     mu: float
-    law: str = "velocity"
-    eps: float = 1e-3
-    eps1: float = 1e-3
-    f: float = 1e-5
+    law: str
+    eps: float | None = None
+    eps1: float | None = None
+    f: float | None = None
 
 
 @dataclass
 class Damping:
-    """Viscous damping: 'stiffness' (C = psi K, psi = T xi / pi; T computed when 0),
-    'rayleigh' (C = a0 M + a1 K) or 'none'."""
+    """Viscous damping: 'stiffness' (C = psi K, psi = T xi / pi; T computed when the period
+    is not given), 'rayleigh' (C = a0 M + a1 K) or 'none'. Values left at None take the
+    reader's defaults."""
 
     type: str = "none"
-    xi: float = 0.0
-    period: float = 0.0
-    rayleigh_a0: float = 0.0
-    rayleigh_a1: float = 0.0
+    xi: float | None = None
+    period: float | None = None
+    rayleigh_a0: float | None = None
+    rayleigh_a1: float | None = None
 
     @classmethod
-    def stiffness(cls, xi: float, period: float = 0.0) -> Damping:
+    def stiffness(cls, xi: float, period: float | None = None) -> Damping:
         return cls("stiffness", xi=xi, period=period)
 
     @classmethod
@@ -72,45 +77,47 @@ class Damping:
         return cls("rayleigh", rayleigh_a0=a0, rayleigh_a1=a1)
 
     def group(self) -> dict:
-        g = {"damping_type": self.type}
+        g: dict = {"damping_type": self.type}
         if self.type == "stiffness":
-            g.update(xi=self.xi, period=self.period)
+            _put(g, xi=self.xi, period=self.period)
         elif self.type == "rayleigh":
-            g.update(rayleigh_a0=self.rayleigh_a0, rayleigh_a1=self.rayleigh_a1)
+            _put(g, rayleigh_a0=self.rayleigh_a0, rayleigh_a1=self.rayleigh_a1)
         return g
 
 
 @dataclass
 class Harmonic:
-    """Table displacement x0 = amplitude sin(2 pi frequency t), cosine ramp over ramp_cycles."""
+    """Table displacement x0 = amplitude sin(2 pi frequency t), cosine ramp over ramp_cycles
+    (None: the reader's default, no ramp)."""
 
     amplitude: float
     frequency: float
     dt_record: float
     duration: float
-    ramp_cycles: int = 0
+    ramp_cycles: int | None = None
 
     def group(self, directory: Path | None) -> dict:
-        return {
+        g: dict = {
             "excitation_type": "harmonic",
-            "amplitude": self.amplitude,
-            "frequency": self.frequency,
-            "ramp_cycles": self.ramp_cycles,
-            "dt_record": self.dt_record,
-            "duration": self.duration,
+            "amplitude": float(self.amplitude),
+            "frequency": float(self.frequency),
         }
+        _put(g, ramp_cycles=self.ramp_cycles)
+        g.update(dt_record=float(self.dt_record), duration=float(self.duration))
+        return g
 
 
 @dataclass
 class Record:
     """Recorded table acceleration (or displacement) sampled at dt_record: a file, or
-    values that are written to ``file`` next to the deck."""
+    values that are written to ``file`` next to the deck. kind, scale, duration: None takes
+    the reader's default (acceleration, 1, the whole record)."""
 
     dt_record: float
     file: str = "record.txt"
     values: np.ndarray | None = None
-    kind: str = "acceleration"
-    scale: float = 1.0
+    kind: str | None = None
+    scale: float | None = None
     duration: float | None = None
 
     def group(self, directory: Path | None) -> dict:
@@ -118,15 +125,10 @@ class Record:
             if directory is None:
                 raise ValueError("a Record with values needs a directory to write its file")
             np.savetxt(directory / self.file, np.asarray(self.values, float), fmt="%.17e")
-        g = {
-            "excitation_type": "record",
-            "record_file": self.file,
-            "record_kind": self.kind,
-            "record_scale": self.scale,
-            "dt_record": self.dt_record,
-        }
-        if self.duration is not None:
-            g["duration"] = self.duration
+        g: dict = {"excitation_type": "record", "record_file": self.file}
+        _put(g, record_kind=self.kind, record_scale=self.scale)
+        g["dt_record"] = float(self.dt_record)
+        _put(g, duration=self.duration)
         return g
 
 
@@ -138,30 +140,86 @@ class FreeVibration:
     duration: float
 
     def group(self, directory: Path | None) -> dict:
-        return {"excitation_type": "none", "dt_record": self.dt_record, "duration": self.duration}
+        return {
+            "excitation_type": "none",
+            "dt_record": float(self.dt_record),
+            "duration": float(self.duration),
+        }
 
 
 @dataclass
 class Integration:
-    """Newmark and step-control settings (see docs/namelist.md, &integration)."""
+    """Newmark and step-control settings (docs/namelist.md, &integration); None takes the
+    reader's default."""
 
-    beta: float = 0.25
-    gamma: float = 0.5
-    n1: int = 20
-    n2: int = 50
-    n: float = 10.0
-    check_correctness: bool = True
-    dt_min: float = 0.0
+    beta: float | None = None
+    gamma: float | None = None
+    n1: int | None = None
+    n2: int | None = None
+    n: float | None = None
+    check_correctness: bool | None = None
+    dt_min: float | None = None
+
+    def group(self) -> dict:
+        g: dict = {}
+        _put(
+            g,
+            beta=self.beta,
+            gamma=self.gamma,
+            n1=self.n1,
+            n2=self.n2,
+            n=self.n,
+            check_correctness=self.check_correctness,
+            dt_min=self.dt_min,
+        )
+        return g
 
 
 @dataclass
 class Output:
-    """Output settings for the executable (&output)."""
+    """Output settings for the executable (&output); None takes the reader's default (dir
+    'out', name the deck's stem, a row every dt_record, the history written)."""
 
-    dir: str = "out"
+    dir: str | None = None
     name: str | None = None
-    output_every: int = 0
-    write_history: bool = True
+    output_every: int | None = None
+    write_history: bool | None = None
+
+    def group(self) -> dict:
+        g: dict = {}
+        _put(
+            g,
+            dir=self.dir,
+            name=self.name,
+            output_every=self.output_every,
+            write_history=self.write_history,
+        )
+        return g
+
+
+def _value(x: object) -> object:
+    """A value as the deck holds it (numpy scalars to Python's)."""
+    if isinstance(x, (bool, np.bool_)):
+        return bool(x)
+    if isinstance(x, (int, np.integer)):
+        return int(x)
+    if isinstance(x, (float, np.floating)):
+        return float(x)
+    return x
+
+
+def _put(group: dict, **values: object) -> None:
+    """Add the values that are given (not None) to a group."""
+    for key, x in values.items():
+        if x is not None:
+            group[key] = _value(x)
+
+
+def _per_device(group: dict, key: str, values: list) -> None:
+    """An optional per-device value: left out when no device gives it; a device that does
+    not is a null value, which the reader fills with its default."""
+    if any(x is not None for x in values):
+        group[key] = [None if x is None else float(x) for x in values]
 
 
 @dataclass
@@ -198,47 +256,24 @@ class Analysis:
         groups.append(("damping", self.damping.group()))
         if self.devices:
             d = self.devices
-            groups.append(
-                (
-                    "friction",
-                    {
-                        "n_devices": len(d),
-                        "node_i": [x.node_i for x in d],
-                        "node_j": [x.node_j for x in d],
-                        "law": [x.law for x in d],
-                        "p": [float(x.p) for x in d],
-                        "mu": [float(x.mu) for x in d],
-                        "eps": [float(x.eps) for x in d],
-                        "eps1": [float(x.eps1) for x in d],
-                        "f": [float(x.f) for x in d],
-                    },
-                )
-            )
+            friction = {
+                "n_devices": len(d),
+                "node_i": [x.node_i for x in d],
+                "node_j": [x.node_j for x in d],
+                "law": [x.law for x in d],
+                "p": [float(x.p) for x in d],
+                "mu": [float(x.mu) for x in d],
+            }
+            for key in ("eps", "eps1", "f"):
+                _per_device(friction, key, [getattr(x, key) for x in d])
+            groups.append(("friction", friction))
         groups.append(("excitation", self.excitation.group(directory)))
-        i = self.integration
-        groups.append(
-            (
-                "integration",
-                {
-                    "beta": float(i.beta),
-                    "gamma": float(i.gamma),
-                    "n1": int(i.n1),
-                    "n2": int(i.n2),
-                    "n": float(i.n),
-                    "check_correctness": bool(i.check_correctness),
-                    "dt_min": float(i.dt_min),
-                },
-            )
-        )
-        o = self.output
-        out = {
-            "dir": o.dir,
-            "output_every": int(o.output_every),
-            "write_history": bool(o.write_history),
-        }
-        if o.name:
-            out["name"] = o.name
-        groups.append(("output", out))
+        integration = self.integration.group()
+        if integration:
+            groups.append(("integration", integration))
+        out = self.output.group()
+        if out:
+            groups.append(("output", out))
         nml = f90nml.Namelist()
         for name, values in groups:
             nml[name] = f90nml.Namelist(values)

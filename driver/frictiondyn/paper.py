@@ -1,13 +1,15 @@
-"""Recomputing the paper's results: Table 1 classification and Figs. 2, 3a, 3b, 4a, 4b.
+"""The paper's model, in one place, and the recomputation of its results.
 
 S.L. Dimova, *Two techniques for treatment of friction forces: experimental verification
-and analysis*. The decks are built here with ``model.Analysis`` from the paper's values
-(the bundled ``inputs/`` decks are not installed with the package); ``paper_analysis``
-gives exactly the content of ``inputs/test{1..5}_{velocity,hysteretic}.nml`` and
-``inputs/fig3_coarse.nml``, and the tests check that both give identical histories.
+and analysis*. This module holds the experimental model (constants, Table 1), the one
+builder of its analyses (``paper_analysis``: with the defaults, exactly the content of
+``inputs/test{1..5}_{velocity,hysteretic}.nml`` and, with ``coarse``, ``inputs/fig3_coarse.nml``;
+the tests check that both give identical histories) and the one steady-state classifier
+(``steady_state``). The paper command, the validation studies (tools/validation), the
+benchmark and the tests all use them.
 
-``reproduce(outdir)`` runs everything through the extension, writes the figures and a
-``report.md`` with the table and the numbers behind each figure.
+``reproduce(outdir)`` runs Table 1 and the figures through the extension, writes the figures
+and a ``report.md`` with the table and the numbers behind each figure.
 """
 
 from __future__ import annotations
@@ -26,27 +28,44 @@ from ._api import Result
 from .model import Analysis, Damping, Device, Harmonic, Integration, Output, Spring
 
 __all__ = [
+    "DURATION",
+    "EPS",
+    "EPS1",
+    "F_STICK",
+    "K1",
+    "K2",
     "LAWS",
+    "M1",
+    "M2",
+    "MU",
     "PAPER_OBSERVATION",
     "TABLE1",
+    "XI",
+    "P",
     "PaperReport",
     "SteadyState",
     "classify",
+    "deck_name",
     "paper_analysis",
     "reproduce",
     "steady_state",
+    "steady_window",
+    "window_start",
 ]
 
 # The experimental model (paper, "Experimental Facility")
 M1, M2 = 6.301, 2.530  # kg, upper and lower block
 K1, K2 = 1084.0, 2895.0  # N/m, their cantilever bars
 MU = 0.22
-P = 61.81  # N: not given in the paper; P = m1 g = 6.301 * 9.81 (docs/theory.md, section 8)
+#: N: the normal force, not given in the paper: P = m1 g = 6.301 kg * 9.81 m/s2, rounded to
+#: 61.81 N (docs/theory.md, section 8). One value everywhere: decks, studies, tests.
+P = 61.81
 XI = 0.015  # stiffness-proportional damping, C = psi K, psi = T xi / pi
 DURATION = 40.0  # s
 EPS = 1.0e-3  # m/s, velocity law
 EPS1 = 1.0e-3  # m/s, hysteretic law
 F_STICK = 1.0e-5  # m, sticking displacement of the hysteretic law
+N1, N2, N_CORR = 20, 50, 10.0  # the paper's step control: dt1 = dt_r / n1, dt2 = dt1 / n2, n
 
 #: Table 1: test -> (frequency [Hz], amplitude [m], dt_r [s])
 TABLE1: dict[int, tuple[float, float, float]] = {
@@ -56,7 +75,8 @@ TABLE1: dict[int, tuple[float, float, float]] = {
     4: (4.104, 0.004052, 0.005),
     5: (5.123, 0.004112, 0.004),
 }
-#: The paper's observation: adherence in tests 1, 2, 5; stick-slip in every cycle in 3, 4.
+#: The paper's observation: adherence in tests 1, 2, 5; stick-slip in every cycle in 3, 4
+#: (in the vocabulary of SteadyState.classification).
 PAPER_OBSERVATION: dict[int, str] = {
     1: "no sliding",
     2: "no sliding",
@@ -70,33 +90,44 @@ FIGURE_CYCLES = 3  # the window of the time-history figures: the last 3 cycles
 
 
 def paper_analysis(
-    test: int, law: str, *, coarse: bool = False, duration: float = DURATION, output_every: int = 0
+    test: int = 4,
+    law: str = "velocity",
+    *,
+    p: float = P,
+    eps: float = EPS,
+    eps1: float = EPS1,
+    f: float = F_STICK,
+    n1: int = N1,
+    n2: int = N2,
+    n: float = N_CORR,
+    check: bool = True,
+    coarse: bool = False,
+    duration: float = DURATION,
+    output_every: int | None = None,
 ) -> Analysis:
-    """The paper's two-mass model under the table motion of Table 1 test ``test``.
+    """The paper's two-mass model under the table motion of Table 1 test ``test``, with one
+    friction device of ``law`` ('velocity', 'hysteretic' or 'coulomb', the exact technique).
 
-    ``law`` is 'velocity' (eps = 1e-3 m/s) or 'hysteretic' (f = 1e-5 m, eps1 = 1e-3 m/s);
-    n1 = 20, n2 = 50, n = 10 with the correctness check, or with ``coarse`` the paper's
-    Fig. 3 settings n1 = n2 = 2 with the check off. ``output_every`` = 0 writes a row every
-    dt_r, 1 every dt1 step.
+    The defaults are the paper's: P, eps = 1e-3 m/s, f = 1e-5 m, eps1 = 1e-3 m/s, n1 = 20,
+    n2 = 50, n = 10 with the correctness check; ``coarse`` gives the paper's Fig. 3 settings
+    n1 = n2 = 2 with the check off. ``output_every``: a history row every that many dt1
+    steps (1: every step; None: the reader's default, every dt_r).
     """
     if test not in TABLE1:
         raise ValueError(f"Table 1 has tests 1-5, not {test}")
-    if law not in LAWS:
-        raise ValueError(f"law must be 'velocity' or 'hysteretic', not {law!r}")
+    if law not in (*LAWS, "coulomb"):
+        raise ValueError(f"law must be 'velocity', 'hysteretic' or 'coulomb', not {law!r}")
     freq, amp, dtr = TABLE1[test]
-    integration = (
-        Integration(n1=2, n2=2, n=10.0, check_correctness=False)
-        if coarse
-        else Integration(n1=20, n2=50, n=10.0)
-    )
+    if coarse:
+        n1, n2, check = 2, 2, False
     return Analysis(
         masses=[M1, M2],
         springs=[Spring(1, 0, K1), Spring(2, 0, K2)],
         damping=Damping.stiffness(XI),
-        devices=[Device(1, 2, p=P, mu=MU, law=law, eps=EPS, eps1=EPS1, f=F_STICK)],
+        devices=[Device(1, 2, p=p, mu=MU, law=law, eps=eps, eps1=eps1, f=f)],
         excitation=Harmonic(amplitude=amp, frequency=freq, dt_record=dtr, duration=duration),
-        integration=integration,
-        output=Output(dir="out", output_every=output_every),
+        integration=Integration(n1=n1, n2=n2, n=n, check_correctness=check),
+        output=Output(output_every=output_every),
     )
 
 
@@ -115,10 +146,11 @@ class SteadyState:
     cycles: int
     cycles_with_slip: int  #: cycles in which some history row slides
     cycles_with_stick_and_slip: int  #: cycles in which rows both stick and slide
-    stick_to_slip: int  #: stick-to-slip transitions in the window, over every accepted step
+    stick_to_slip: int  #: stick-to-slip transitions in the window (see steady_state)
     slip_to_stick: int
+    slip_fraction: float  #: share of the window's history rows that slide
     ptp_s: float  #: peak-to-peak relative displacement s1 in the window [m]
-    peak_aabs: tuple[float, float]  #: max |absolute acceleration| of m1, m2 in the window
+    peak_aabs: tuple[float, ...]  #: max |absolute acceleration| of each mass in the window
 
     @property
     def classification(self) -> str:
@@ -143,7 +175,7 @@ class SteadyState:
         return self.classification == self.paper
 
 
-def _window_start(result: Result, frequency: float, cycles: int) -> float:
+def window_start(result: Result, frequency: float, cycles: int = STEADY_CYCLES) -> float:
     """t_end - cycles / f, rounded to the dt1 grid (so that a run of that duration is an
     exact prefix of the full run)."""
     dt1 = float(result.summary["dt1_s"])
@@ -151,22 +183,29 @@ def _window_start(result: Result, frequency: float, cycles: int) -> float:
     return round((t_end - cycles / frequency) / dt1) * dt1
 
 
+def steady_window(result: Result, frequency: float, cycles: int = STEADY_CYCLES) -> np.ndarray:
+    """The history rows of the steady state: t >= window_start."""
+    return result.time >= window_start(result, frequency, cycles) - 1e-9
+
+
 def steady_state(
     result: Result,
     test: int,
-    law: str,
+    law: str = "",
     *,
     prefix: Result | None = None,
     cycles: int = STEADY_CYCLES,
 ) -> SteadyState:
-    """Classify the last ``cycles`` cycles of a Table 1 run written every dt1 step.
+    """Classify the last ``cycles`` cycles of a Table 1 run (rows every dt1 step for the
+    cycle counts to see every phase).
 
     ``prefix`` is the same run stopped at the window start (``classify`` makes it): the
     difference of the two summaries' transition counts is exact over every accepted step,
-    including the dt2 sub-steps that the history does not show.
+    including the dt2 sub-steps that the history does not show. Without it the transitions
+    are counted between history rows.
     """
     freq = TABLE1[test][0]
-    t0 = _window_start(result, freq, cycles)
+    t0 = window_start(result, freq, cycles)
     t = result.time
     w = t >= t0 - 1e-9
     phase = result["phase1"][w]
@@ -188,10 +227,10 @@ def steady_state(
         cycles_with_stick_and_slip=int((slip & stick).sum()),
         stick_to_slip=int(s2s),
         slip_to_stick=int(l2s),
+        slip_fraction=float(np.mean(phase != 0)),
         ptp_s=float(np.ptp(result["s1"][w])),
-        peak_aabs=(
-            float(np.max(np.abs(result["aabs1"][w]))),
-            float(np.max(np.abs(result["aabs2"][w]))),
+        peak_aabs=tuple(
+            float(np.max(np.abs(result[f"aabs{i}"][w]))) for i in range(1, result.n_dof + 1)
         ),
     )
 
@@ -200,7 +239,7 @@ def classify(test: int, law: str, cycles: int = STEADY_CYCLES) -> tuple[SteadySt
     """Run Table 1 test ``test`` with ``law`` (every dt1 step written) and its prefix up to
     the steady-state window; return the classification and the full Result."""
     full = paper_analysis(test, law, output_every=1).run(name=f"{deck_name(test, law)}.nml")
-    t0 = _window_start(full, TABLE1[test][0], cycles)
+    t0 = window_start(full, TABLE1[test][0], cycles)
     prefix = paper_analysis(test, law, duration=t0).run(name=f"{deck_name(test, law)}.nml")
     return steady_state(full, test, law, prefix=prefix, cycles=cycles), full
 

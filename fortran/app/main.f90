@@ -1,6 +1,7 @@
 !> frictiondyn DECK.nml: run one namelist deck and write its time history and summary.
 program frictiondyn_main
    use, intrinsic :: iso_fortran_env, only: error_unit, output_unit
+   use, intrinsic :: iso_c_binding, only: c_int
    use frictiondyn, only: error_type, run_config, result_type, run_deck, output_paths
    implicit none
    type(run_config) :: cfg
@@ -8,12 +9,20 @@ program frictiondyn_main
    type(error_type), allocatable :: error
    character(len=:), allocatable :: path, hist, summ
    integer :: nargs, length, i
+   interface
+      !> C's exit: ends the program with a status and no message (Fortran 2008 has no
+      !> silent STOP with a code; STOP's QUIET= is Fortran 2018).
+      subroutine c_exit(status) bind(c, name='exit')
+         import :: c_int
+         integer(c_int), value :: status
+      end subroutine c_exit
+   end interface
 
    nargs = command_argument_count()
    if (nargs /= 1) then
       write (error_unit, '(a)') 'usage: frictiondyn DECK.nml'
       write (error_unit, '(a)') '  runs one namelist deck; see docs/namelist.md'
-      stop 2, quiet=.true.
+      call quit(2)
    end if
    call get_command_argument(1, length=length)
    allocate (character(len=length) :: path)
@@ -27,7 +36,7 @@ program frictiondyn_main
    call run_deck(path, cfg, res, error)
    if (allocated(error)) then
       write (error_unit, '(a)') 'frictiondyn: error: '//error%message
-      stop 1, quiet=.true.
+      call quit(1)
    end if
 
    if (res%violations > 0) then
@@ -50,4 +59,14 @@ program frictiondyn_main
    call output_paths(cfg%out, hist, summ)
    if (cfg%out%history) write (output_unit, '(a)') '  history: '//hist
    write (output_unit, '(a)') '  summary: '//summ
+contains
+
+   !> End the program with a non-zero exit status, silently, after flushing the output.
+   subroutine quit(status)
+      integer, intent(in) :: status  !! exit status
+      flush (output_unit)
+      flush (error_unit)
+      call c_exit(int(status, c_int))
+   end subroutine quit
+
 end program frictiondyn_main

@@ -10,7 +10,7 @@ module fd_output
    implicit none
    private
 
-   public :: output_type, write_outputs, output_paths, summary_json, history_header
+   public :: output_type, write_outputs, write_output_files, output_paths, summary_json, history_header
 
    !> Where and what to write.
    type :: output_type
@@ -44,29 +44,51 @@ contains
       summ = out%dir//'/'//out%name//'.summary.json'
    end subroutine output_paths
 
-   !> Write the history and the summary; nothing is left behind on failure.
+   !> Write the history and the summary into out%dir (created when missing); nothing is left
+   !> behind on failure.
    subroutine write_outputs(out, model, res, deck_path, error)
       type(output_type), intent(in) :: out                !! output settings
       type(model_type), intent(in) :: model               !! the model run
       type(result_type), intent(in) :: res                !! its result
       character(len=*), intent(in) :: deck_path           !! deck, named in the summary
       type(error_type), allocatable, intent(out) :: error !! cannot create or write a file
-      character(len=:), allocatable :: hist, summ
-      integer :: stat
+      character(len=:), allocatable :: hist, summ, header, js
 
       call make_dir(out%dir, error)
       if (allocated(error)) return
       call output_paths(out, hist, summ)
-      if (out%history) then
-         call write_history(hist//'.tmp', res, error)
+      call history_header(res, header)
+      call summary_json(model, res, deck_path, js)
+      call write_output_files(hist, summ, out%history, header, res%hist, js, error)
+   end subroutine write_outputs
+
+   !> Write a history (when `history`: its header line, then one row per sample) to
+   !> `hist_path` and a summary text to `summ_path`, each to a temporary name renamed when
+   !> complete; nothing is left behind on failure. The one writer of output files: the
+   !> executable's outputs and those of the Python package go through it.
+   subroutine write_output_files(hist_path, summ_path, history, header, data, summary, error)
+      character(len=*), intent(in) :: hist_path           !! the history CSV
+      character(len=*), intent(in) :: summ_path           !! the summary file
+      logical, intent(in) :: history                      !! write the history
+      character(len=*), intent(in) :: header              !! 'name[unit],...' of each column
+      real(dp), intent(in) :: data(:, :)                  !! history (columns, samples)
+      character(len=*), intent(in) :: summary             !! summary text (JSON)
+      type(error_type), allocatable, intent(out) :: error !! cannot create or write a file
+      character(len=:), allocatable :: hist, summ
+      integer :: stat
+
+      hist = hist_path
+      summ = summ_path
+      if (history) then
+         call write_history(hist//'.tmp', header, data, error)
          if (allocated(error)) return
       end if
-      call write_summary(summ//'.tmp', model, res, deck_path, error)
+      call write_summary(summ//'.tmp', summary, error)
       if (allocated(error)) then
-         if (out%history) call remove(hist//'.tmp')
+         if (history) call remove(hist//'.tmp')
          return
       end if
-      if (out%history) then
+      if (history) then
          stat = c_rename(hist//'.tmp'//c_null_char, hist//c_null_char)
          if (stat /= 0) then
             call remove(hist//'.tmp'); call remove(summ//'.tmp')
@@ -76,11 +98,11 @@ contains
       end if
       stat = c_rename(summ//'.tmp'//c_null_char, summ//c_null_char)
       if (stat /= 0) then
-         if (out%history) call remove(hist)
+         if (history) call remove(hist)
          call remove(summ//'.tmp')
          call fatal_error(error, "cannot rename '"//summ//".tmp' to '"//summ//"'")
       end if
-   end subroutine write_outputs
+   end subroutine write_output_files
 
    !> Create a directory and its missing parents.
    subroutine make_dir(dir, error)
@@ -108,24 +130,24 @@ contains
       if (ios == 0) close (unit, status='delete')
    end subroutine remove
 
-   subroutine write_history(path, res, error)
+   subroutine write_history(path, header, data, error)
       character(len=*), intent(in) :: path
-      type(result_type), intent(in) :: res
+      character(len=*), intent(in) :: header
+      real(dp), intent(in) :: data(:, :)
       type(error_type), allocatable, intent(out) :: error
       integer :: unit, ios, i
       character(len=512) :: msg
-      character(len=:), allocatable :: fmt, header
+      character(len=:), allocatable :: fmt
 
       open (newunit=unit, file=path, status='replace', action='write', iostat=ios, iomsg=msg)
       if (ios /= 0) then
          call fatal_error(error, "cannot create '"//path//"': "//trim(msg))
          return
       end if
-      call history_header(res, header)
       write (unit, '(a)', iostat=ios) header
-      fmt = '('//trim(fmt_int(res%ncol))//'(es24.16e3,:,","))'
-      do i = 1, res%nout
-         write (unit, fmt, iostat=ios, iomsg=msg) res%hist(:, i)
+      fmt = '('//trim(fmt_int(size(data, 1)))//'(es24.16e3,:,","))'
+      do i = 1, size(data, 2)
+         write (unit, fmt, iostat=ios, iomsg=msg) data(:, i)
          if (ios /= 0) exit
       end do
       if (ios /= 0) then
@@ -136,22 +158,18 @@ contains
       close (unit)
    end subroutine write_history
 
-   subroutine write_summary(path, model, res, deck_path, error)
+   subroutine write_summary(path, js, error)
       character(len=*), intent(in) :: path
-      type(model_type), intent(in) :: model
-      type(result_type), intent(in) :: res
-      character(len=*), intent(in) :: deck_path
+      character(len=*), intent(in) :: js
       type(error_type), allocatable, intent(out) :: error
       integer :: unit, ios
       character(len=512) :: msg
-      character(len=:), allocatable :: js
 
       open (newunit=unit, file=path, status='replace', action='write', iostat=ios, iomsg=msg)
       if (ios /= 0) then
          call fatal_error(error, "cannot create '"//path//"': "//trim(msg))
          return
       end if
-      call summary_json(model, res, deck_path, js)
       write (unit, '(a)', iostat=ios, iomsg=msg) js
       if (ios /= 0) then
          close (unit, status='delete')
