@@ -29,6 +29,12 @@ TABLE1 = {  # test: (frequency Hz, amplitude m, dt_r s)
 EPS, F_STICK = 1e-3, 1e-5  # band eps = eps1 [m/s] and sticking displacement f [m] of block()
 
 
+def technique_for(law: str) -> dict:
+    """The &integration setting a deck of devices of this law needs: 'coulomb' (exact
+    friction) is integrated by the event-driven technique, the other laws by Newmark."""
+    return {"technique": "event_driven"} if law == "coulomb" else {}
+
+
 def block(law, mu=0.3, m=2.0, excitation=None, v0=0.0, **integration):
     """A rigid block on a friction interface to the table (no spring), any law."""
     return {
@@ -47,7 +53,7 @@ def block(law, mu=0.3, m=2.0, excitation=None, v0=0.0, **integration):
             "f": F_STICK,
         },
         "excitation": excitation,
-        "integration": {"n1": 10, "n2": 50, **integration},
+        "integration": {**technique_for(law), "n1": 10, "n2": 50, **integration},
         "output": {"output_every": 1},
     }
 
@@ -92,7 +98,7 @@ def paper_groups(test: int = 4, law: str = "velocity", **friction) -> dict[str, 
             "dt_record": dtr,
             "duration": 40.0,
         },
-        "integration": {"n1": 20, "n2": 50, "n": 10},
+        "integration": {**technique_for(law), "n1": 20, "n2": 50, "n": 10},
     }
 
 

@@ -143,8 +143,12 @@ class FreeVibration:
 
 @dataclass
 class Integration:
-    """Newmark and step-control settings (see docs/namelist.md, &integration)."""
+    """Technique, Newmark and step-control settings (see docs/namelist.md, &integration).
 
+    ``technique`` is 'newmark' or 'event_driven' (exact, for 'coulomb' devices); None
+    leaves it out of the deck, which then uses the library's default ('newmark')."""
+
+    technique: str | None = None
     beta: float = 0.25
     gamma: float = 0.5
     n1: int = 20
@@ -216,10 +220,12 @@ class Analysis:
             )
         groups.append(("excitation", self.excitation.group(directory)))
         i = self.integration
+        integration = {} if i.technique is None else {"technique": i.technique}
         groups.append(
             (
                 "integration",
-                {
+                integration
+                | {
                     "beta": float(i.beta),
                     "gamma": float(i.gamma),
                     "n1": int(i.n1),

@@ -63,7 +63,13 @@ def paper_analysis(
         damping=Damping.stiffness(XI),
         devices=[Device(1, 2, p, MU, law=law, eps=eps, eps1=eps1, f=f)],
         excitation=Harmonic(amp, freq, dtr, duration),
-        integration=Integration(n1=n1, n2=n2, n=n, check_correctness=check),
+        integration=Integration(
+            technique="event_driven" if law == "coulomb" else None,
+            n1=n1,
+            n2=n2,
+            n=n,
+            check_correctness=check,
+        ),
         output=Output(output_every=every),
     )
 
@@ -212,7 +218,7 @@ def closed_forms() -> list[dict]:
             v0=[float(v0[0])],
             devices=[Device(1, 0, ff, 1.0, law="coulomb")],
             excitation=Harmonic(amp_dh, w / (2 * np.pi), 0.01, 6 * 2 * np.pi / w),
-            integration=Integration(n1=10),
+            integration=Integration(technique="event_driven", n1=10),
             output=Output(output_every=1),
         )
         r = an.run()
