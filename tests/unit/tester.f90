@@ -5,6 +5,12 @@ program tester
    use testdrive, only: run_testsuite, new_testsuite, testsuite_type, select_suite, run_selected, &
                         get_argument
    use test_fd_format, only: collect_format
+   use test_fd_textio, only: collect_textio
+   use test_fd_names, only: collect_names
+   use test_fd_technique, only: collect_technique
+   use test_fd_root_finder, only: collect_root_finder
+   use test_fd_phase_pattern, only: collect_phase_pattern
+   use test_fd_observer, only: collect_observer
    implicit none
    integer :: stat, is
    character(len=:), allocatable :: suite_name, test_name
@@ -13,7 +19,13 @@ program tester
 
    stat = 0
    testsuites = [ &
-                new_testsuite("format", collect_format) &
+                new_testsuite("format", collect_format), &
+                new_testsuite("textio", collect_textio), &
+                new_testsuite("names", collect_names), &
+                new_testsuite("technique", collect_technique), &
+                new_testsuite("root_finder", collect_root_finder), &
+                new_testsuite("phase_pattern", collect_phase_pattern), &
+                new_testsuite("observer", collect_observer) &
                 ]
 
    call get_argument(1, suite_name)
