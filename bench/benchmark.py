@@ -45,7 +45,9 @@ def chain(n: int, law: str, duration: float) -> Analysis:
         damping=Damping.rayleigh(0.2, 0.002),
         devices=devices,
         excitation=Harmonic(0.02, 2.0, 0.005, duration, ramp_cycles=2),
-        integration=Integration(n1=10, n2=20),
+        integration=Integration(
+            technique="event_driven" if law == "coulomb" else None, n1=10, n2=20
+        ),
         output=Output(output_every=10),
     )
 

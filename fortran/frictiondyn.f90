@@ -2,12 +2,11 @@
 module frictiondyn
    use fd_kinds, only: dp
    use fd_error, only: error_type, fatal_error
-   use fd_model, only: model_type, integration_type, device_type, law_coulomb
+   use fd_model, only: model_type, integration_type, device_type
    use fd_excitation, only: excitation_type
    use fd_result, only: result_type
    use fd_deck, only: run_config, read_deck, read_deck_string
-   use fd_newmark, only: run_newmark
-   use fd_coulomb, only: run_coulomb
+   use fd_technique, only: run_technique
    use fd_result, only: history_shape
    use fd_output, only: output_type, write_outputs, output_paths, summary_json, history_header, &
                         write_output_files
@@ -22,19 +21,14 @@ module frictiondyn
 
 contains
 
-   !> Run the analysis a configuration defines (no files written): Newmark with the
-   !> velocity and hysteretic laws, or the exact event-driven technique for 'coulomb'.
+   !> Run the analysis a configuration defines (no files written) with the technique of
+   !> its &integration: 'newmark' (the velocity and hysteretic laws) or 'event_driven'
+   !> (exact Coulomb friction); an error for anything that technique cannot integrate.
    subroutine run_config_solve(cfg, res, error)
       type(run_config), intent(in) :: cfg                 !! model, excitation, settings
       type(result_type), intent(out) :: res               !! histories and summary
       type(error_type), allocatable, intent(out) :: error !! failure of the solver
-      ! the exact technique integrates the whole model event by event; the deck reader
-      ! ensures that 'coulomb' devices are not mixed with regularized ones
-      if (any(cfg%model%dev%law == law_coulomb)) then
-         call run_coulomb(cfg%model, cfg%exc, cfg%opts, res, error)
-      else
-         call run_newmark(cfg%model, cfg%exc, cfg%opts, res, error)
-      end if
+      call run_technique(cfg%model, cfg%exc, cfg%opts, res, error)
    end subroutine run_config_solve
 
    !> Columns and samples of the history the configuration's run produces.

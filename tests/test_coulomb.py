@@ -4,7 +4,7 @@ from __future__ import annotations
 
 import numpy as np
 import pytest
-from conftest import K1, K2, M1, M2, TABLE1, G, block, ok, paper_groups
+from conftest import K1, K2, M1, M2, TABLE1, G, block, ok, paper_groups, technique_for
 
 # independent references (numpy only): eigen-decomposition and Den Hartog's closed form
 from oracles import den_hartog, linear_response
@@ -81,7 +81,7 @@ def test_den_hartog_non_stop_steady_state_to_2e11(run, r, ratio):
                     "dt_record": 0.01,
                     "duration": cycles * 2 * np.pi / w,
                 },
-                "integration": {"n1": 10},
+                "integration": {"technique": "event_driven", "n1": 10},
                 "output": {"output_every": 1},
             }
         )
@@ -112,6 +112,22 @@ def test_block_stops_exactly(run):
     assert s["slip_to_stick"] == [1] and s["stick_to_slip"] == [0]
     # all the kinetic energy went into friction
     assert s["energy_friction_J"] == pytest.approx(0.5 * m * v0**2, rel=1e-12)
+
+
+def test_block_stopping_on_the_step_grid_stops_once(run):
+    """A block that comes to rest exactly at a step boundary, t = v0 / (mu g) = 250 dt1:
+    one event, then at rest (v = 0 exactly) at v0^2 / (2 mu g). (The root finder converging
+    to the end of a step used to leave the propagators of its last trial point in use: a
+    residual velocity of 1e-15 m/s and a second, spurious event.)"""
+    mu, m = 0.3, 2.0
+    v0 = mu * G * 0.25
+    excitation = {"excitation_type": "none", "dt_record": 0.01, "duration": 0.5}
+    r = ok(run(block("coulomb", mu, m, excitation, v0, n1=10)))
+    h, s = r.history(), r.summary()
+    assert s["events"] == 1 and s["slip_to_stick"] == [1] and s["stick_to_slip"] == [0]
+    after = h["t"] >= 0.25 - 1e-12
+    assert np.all(h["v1"][after] == 0.0)
+    assert np.allclose(h["u1"][after], v0**2 / (2 * mu * G), rtol=1e-12)
 
 
 @pytest.mark.parametrize("test", [3, 4])
@@ -145,7 +161,7 @@ def test_record_input_is_exact_for_piecewise_linear_acceleration(run):
             "mu": 0.2,
         },
         "excitation": {"excitation_type": "record", "record_file": "acc.txt", "dt_record": 0.01},
-        "integration": {"n1": 1},
+        "integration": {"technique": "event_driven", "n1": 1},
         "output": {"output_every": 1},
     }
     exact = ok(run(base, files={"acc.txt": text})).history()
@@ -177,6 +193,31 @@ def test_coulomb_cannot_be_mixed(run):
     }
     r = run(g)
     assert r.returncode != 0 and "law(2)" in r.stderr and "coulomb" in r.stderr
+    assert "technique = 'event_driven'" in r.stderr and not r.outdir.exists()
+
+
+def test_coulomb_needs_the_event_driven_technique(run):
+    """Law and technique are separate settings: 'coulomb' devices under the default
+    technique (Newmark) are an error naming the group, the variable, the value and what to
+    set, and leave no output."""
+    g = paper_groups(4, "coulomb")
+    del g["integration"]["technique"]
+    r = run(g)
+    assert r.returncode != 0 and r.stdout == ""
+    for w in ("&friction", "law(1) = 'coulomb'", "technique = 'newmark'", "technique = 'event_driven'",
+              "'velocity'", "'hysteretic'"):
+        assert w in r.stderr, f"{w!r} not in {r.stderr!r}"
+    assert not r.outdir.exists()
+
+
+def test_unknown_technique(run):
+    g = paper_groups(4, "velocity")
+    g["integration"]["technique"] = "moreau"
+    r = run(g)
+    assert r.returncode != 0
+    for w in ("&integration", "technique = 'moreau'", "'newmark'", "'event_driven'"):
+        assert w in r.stderr, f"{w!r} not in {r.stderr!r}"
+    assert not r.outdir.exists()
 
 
 def test_two_devices_exact_against_a_fine_velocity_law(run):
@@ -196,7 +237,8 @@ def test_two_devices_exact_against_a_fine_velocity_law(run):
     def with_law(law, eps=1e-5):
         return dict(base, friction={"n_devices": 2, "node_i": [2, 3], "node_j": [1, 2],
                                     "law": [law, law], "p": [40.0, 40.0], "mu": [0.2, 0.2],
-                                    "eps": [eps, eps]})
+                                    "eps": [eps, eps]},
+                    integration={**technique_for(law), **base["integration"]})
 
     ex = ok(run(with_law("coulomb")))
     vl = ok(run(with_law("velocity")))

@@ -149,9 +149,11 @@ class FreeVibration:
 
 @dataclass
 class Integration:
-    """Newmark and step-control settings (docs/namelist.md, &integration); None takes the
-    reader's default."""
+    """Technique, Newmark and step-control settings (docs/namelist.md, &integration); None
+    takes the reader's default. ``technique`` is 'newmark' or 'event_driven' (exact, for
+    'coulomb' devices)."""
 
+    technique: str | None = None
     beta: float | None = None
     gamma: float | None = None
     n1: int | None = None
@@ -164,6 +166,7 @@ class Integration:
         g: dict = {}
         _put(
             g,
+            technique=self.technique,
             beta=self.beta,
             gamma=self.gamma,
             n1=self.n1,

@@ -126,7 +126,13 @@ def paper_analysis(
         damping=Damping.stiffness(XI),
         devices=[Device(1, 2, p=p, mu=MU, law=law, eps=eps, eps1=eps1, f=f)],
         excitation=Harmonic(amplitude=amp, frequency=freq, dt_record=dtr, duration=duration),
-        integration=Integration(n1=n1, n2=n2, n=n, check_correctness=check),
+        integration=Integration(
+            technique="event_driven" if law == "coulomb" else None,
+            n1=n1,
+            n2=n2,
+            n=n,
+            check_correctness=check,
+        ),
         output=Output(output_every=output_every),
     )
 

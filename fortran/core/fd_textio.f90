@@ -42,11 +42,10 @@ contains
       character(len=*), intent(in) :: path                   !! file to read
       type(line_type), allocatable, intent(out) :: lines(:)  !! its lines
       type(error_type), allocatable, intent(out) :: error    !! set when it cannot be read
-      character(len=:), allocatable :: text
-      character(kind=c_char, len=65536) :: chunk
+      character(len=:), allocatable :: text, grown
       type(c_ptr) :: fp
-      integer(c_size_t) :: got
-      integer :: stat
+      integer(c_size_t) :: got, want
+      integer :: stat, n, cap
       logical :: exists
 
       inquire (file=path, exist=exists)
@@ -59,14 +58,25 @@ contains
          call fatal_error(error, "cannot open file '"//path//"'")
          return
       end if
-      text = ''
+      ! read into a buffer that doubles when full: the text is copied O(log size) times,
+      ! not once per chunk
+      cap = 65536
+      allocate (character(len=cap) :: text)
+      n = 0
       do
-         got = c_fread(chunk, 1_c_size_t, int(len(chunk), c_size_t), fp)
-         if (got > 0) text = text//chunk(1:int(got))
-         if (got < len(chunk)) exit
+         if (n == cap) then
+            allocate (character(len=2*cap) :: grown)
+            grown(1:n) = text(1:n)
+            call move_alloc(grown, text)
+            cap = 2*cap
+         end if
+         want = int(cap - n, c_size_t)
+         got = c_fread(text(n + 1:cap), 1_c_size_t, want, fp)
+         n = n + int(got)
+         if (got < want) exit
       end do
       stat = c_fclose(fp)
-      call split_lines(text, lines)
+      call split_lines(text(1:n), lines)
    end subroutine read_text_file
 
    !> Split text at newlines (a final newline ends the last line; carriage returns dropped).

@@ -8,10 +8,16 @@ module fd_device_state
    private
 
    public :: device_state, phase_stick, phase_slip_pos, phase_slip_neg, device_force
+   public :: job_init, job_update, job_correct
 
    integer, parameter :: phase_stick = 0     !! sticking (adherence)
    integer, parameter :: phase_slip_pos = 1  !! sliding with positive relative velocity
    integer, parameter :: phase_slip_neg = -1 !! sliding with negative relative velocity
+
+   ! what the dispatch (fd_friction) asks of a law's entry
+   integer, parameter :: job_init = 1        !! phase and coefficients at t = 0
+   integer, parameter :: job_update = 2      !! phase for the next step
+   integer, parameter :: job_correct = 3     !! correctness condition of a step
 
    !> Phase and force coefficients of one device.
    type :: device_state

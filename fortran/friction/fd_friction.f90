@@ -1,11 +1,15 @@
-!> Dispatch over the friction laws. Adding a law means one new module (init, update,
-!> correct) and one new case in each routine here.
+!> Dispatch over the regularized friction laws (those Newmark integrates). Each law is one
+!> module with one entry, `<law>_law(job, ...)`, that does the job asked (init, update,
+!> correct); adding a law is that module, its row in fd_names' law table and one case in
+!> `dispatch` below. A law with no case here is an error at the start of a run, never a
+!> device without force.
 module fd_friction
    use fd_kinds, only: dp
-   use fd_model, only: device_type, law_velocity, law_hysteretic
-   use fd_device_state, only: device_state
-   use fd_friction_velocity, only: velocity_init, velocity_update, velocity_correct
-   use fd_friction_hysteretic, only: hysteretic_init, hysteretic_update, hysteretic_correct
+   use fd_error, only: error_type, fatal_error, fmt_int
+   use fd_model, only: device_type, law_velocity, law_hysteretic, law_name
+   use fd_device_state, only: device_state, job_init, job_update, job_correct
+   use fd_friction_velocity, only: velocity_law
+   use fd_friction_hysteretic, only: hysteretic_law
    implicit none
    private
 
@@ -13,19 +17,51 @@ module fd_friction
 
 contains
 
-   !> Initial phase and force coefficients of a device.
-   elemental subroutine friction_init(dev, s, sdot, st)
-      type(device_type), intent(in) :: dev   !! device parameters
-      real(dp), intent(in) :: s              !! relative displacement [m]
-      real(dp), intent(in) :: sdot           !! relative velocity [m/s]
-      type(device_state), intent(out) :: st  !! initial state
+   !> The one dispatch over the laws: do `job` for device dev with its law.
+   elemental subroutine dispatch(job, dev, n, s, sdot, sdot_old, st, changed, ok, known)
+      integer, intent(in) :: job                !! job_init, job_update or job_correct
+      type(device_type), intent(in) :: dev      !! device parameters
+      real(dp), intent(in) :: n                 !! n > 1 of the correctness condition
+      real(dp), intent(in) :: s                 !! relative displacement [m]
+      real(dp), intent(in) :: sdot              !! relative velocity (at the end of the step) [m/s]
+      real(dp), intent(in) :: sdot_old          !! relative velocity at the start of the step [m/s]
+      type(device_state), intent(inout) :: st   !! state
+      logical, intent(out) :: changed           !! update: the phase changed
+      logical, intent(out) :: ok                !! correct: the step satisfies the condition
+      logical, intent(out) :: known             !! the law has a case here
 
+      changed = .false.
+      ok = .true.
+      known = .true.
       select case (dev%law)
       case (law_velocity)
-         call velocity_init(dev, s, sdot, st)
+         call velocity_law(job, dev, n, s, sdot, sdot_old, st, changed, ok)
       case (law_hysteretic)
-         call hysteretic_init(dev, s, sdot, st)
+         call hysteretic_law(job, dev, n, s, sdot, sdot_old, st, changed, ok)
+      case default
+         known = .false.
       end select
+   end subroutine dispatch
+
+   !> Initial phase and force coefficients of every device; an error for a device whose
+   !> law is not a regularized law of this dispatch.
+   subroutine friction_init(dev, s, sdot, st, error)
+      type(device_type), intent(in) :: dev(:)   !! devices
+      real(dp), intent(in) :: s(:)              !! relative displacements [m]
+      real(dp), intent(in) :: sdot(:)           !! relative velocities [m/s]
+      type(device_state), intent(out) :: st(:)  !! initial states
+      type(error_type), allocatable, intent(out) :: error !! a law without a case here
+      logical :: changed, ok, known
+      integer :: d
+
+      do d = 1, size(dev)
+         call dispatch(job_init, dev(d), 0.0_dp, s(d), sdot(d), 0.0_dp, st(d), changed, ok, known)
+         if (.not. known) then
+            call fatal_error(error, "device "//trim(fmt_int(d))//": friction law '"//trim(law_name(dev(d)%law))// &
+                             "' (id "//trim(fmt_int(dev(d)%law))//") is not a law the Newmark technique integrates")
+            return
+         end if
+      end do
    end subroutine friction_init
 
    !> Phase of a device for the next step, from the state at the end of this one.
@@ -35,14 +71,9 @@ contains
       real(dp), intent(in) :: sdot              !! relative velocity [m/s]
       type(device_state), intent(inout) :: st   !! state, updated
       logical, intent(out) :: changed           !! the phase changed
+      logical :: ok, known
 
-      changed = .false.
-      select case (dev%law)
-      case (law_velocity)
-         call velocity_update(dev, s, sdot, st, changed)
-      case (law_hysteretic)
-         call hysteretic_update(dev, s, sdot, st, changed)
-      end select
+      call dispatch(job_update, dev, 0.0_dp, s, sdot, 0.0_dp, st, changed, ok, known)
    end subroutine friction_update
 
    !> Correctness condition (eqs. 9 and 12) of a step taken in phase st.
@@ -52,14 +83,11 @@ contains
       type(device_state), intent(in) :: st   !! phase during the step
       real(dp), intent(in) :: sdot_old       !! relative velocity at t - dt [m/s]
       real(dp), intent(in) :: sdot_new       !! relative velocity at t [m/s]
+      type(device_state) :: st_copy
+      logical :: changed, known
 
-      ok = .true.
-      select case (dev%law)
-      case (law_velocity)
-         ok = velocity_correct(dev, n, st, sdot_old, sdot_new)
-      case (law_hysteretic)
-         ok = hysteretic_correct(dev, n, st, sdot_old, sdot_new)
-      end select
+      st_copy = st
+      call dispatch(job_correct, dev, n, 0.0_dp, sdot_new, sdot_old, st_copy, changed, ok, known)
    end function friction_correct
 
 end module fd_friction

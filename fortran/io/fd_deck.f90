@@ -1,19 +1,28 @@
 !> The deck reader: one namelist deck is one run. Groups &model, &springs, &damping and
 !> &excitation are required; &friction, &integration and &output are optional. Every value
-!> is validated after reading; messages name the file, the group, the variable and the
-!> value. docs/namelist.md documents every variable.
+!> is validated after reading, and the model against the technique chosen; messages name
+!> the file, the group, the variable and the value. Keywords, their lists in messages and
+!> every default come from fd_names. docs/namelist.md documents every variable.
 module fd_deck
    use, intrinsic :: ieee_arithmetic, only: ieee_is_finite
    use fd_kinds, only: dp
    use fd_error, only: error_type, fatal_error, fmt_int, fmt_real
-   use fd_textio, only: lower
    use fd_namelist, only: deck_text, group_text, load_deck, deck_from_string, find_group, group_item, &
                           group_read_error, check_groups
-   use fd_model, only: model_type, integration_type, device_type, damping_none, &
-                       damping_stiffness, damping_rayleigh, law_velocity, law_hysteretic, law_coulomb
-   use fd_excitation, only: excitation_type, excitation_none, excitation_harmonic, excitation_record
+   use fd_names, only: keyword_id, keyword_choices, law_id, law_choices, &
+                       damping_types, damping_stiffness, damping_rayleigh, damping_none, &
+                       excitation_types, excitation_harmonic, excitation_record, excitation_none, &
+                       record_kinds, record_displacement, techniques, technique_name, &
+                       default_u0, default_v0, default_xi, default_period, default_rayleigh_a0, &
+                       default_rayleigh_a1, default_n_devices, default_eps, default_eps1, default_f, &
+                       default_ramp_cycles, default_record_kind, default_record_scale, default_technique, &
+                       default_beta, default_gamma, default_n1, default_n2, default_n, &
+                       default_check_correctness, default_dt_min, default_dir, default_output_every, &
+                       default_write_history
+   use fd_model, only: model_type, integration_type, device_type, output_type
+   use fd_excitation, only: excitation_type
    use fd_record, only: read_record
-   use fd_output, only: output_type
+   use fd_technique, only: check_technique
    implicit none
    private
 
@@ -84,6 +93,10 @@ contains
       call read_integration_group(deck, cfg, error)
       if (allocated(error)) return
       call read_output_group(deck, cfg, error)
+      if (allocated(error)) return
+      ! what the technique cannot integrate (a law, a table motion)
+      call check_technique(cfg%model, cfg%exc, cfg%opts, error)
+      if (allocated(error)) error%message = deck%path//", "//error%message
    end subroutine read_groups
 
    ! ---------------------------------------------------------------- &model
@@ -124,9 +137,9 @@ contains
       n = n_dof
       call need_reals(deck, 'model', 'mass', mass, n, 'kg', error, positive=.true.)
       if (allocated(error)) return
-      call optional_reals(deck, 'model', 'u0', u0, n, 0.0_dp, 'm', error)
+      call optional_reals(deck, 'model', 'u0', u0, n, default_u0, 'm', error)
       if (allocated(error)) return
-      call optional_reals(deck, 'model', 'v0', v0, n, 0.0_dp, 'm/s', error)
+      call optional_reals(deck, 'model', 'v0', v0, n, default_v0, 'm/s', error)
       if (allocated(error)) return
       cfg%model%n_dof = n
       cfg%model%mass = mass(1:n)
@@ -201,12 +214,13 @@ contains
       namelist /damping/ damping_type, xi, period, rayleigh_a0, rayleigh_a1
       type(group_text) :: grp
       character(len=512) :: msg, msg0
-      character(len=:), allocatable :: rec
+      character(len=:), allocatable :: rec, choices
       integer :: ios, i
       logical :: found
 
       damping_type = ''
-      xi = 0.0_dp; period = 0.0_dp; rayleigh_a0 = 0.0_dp; rayleigh_a1 = 0.0_dp
+      xi = default_xi; period = default_period
+      rayleigh_a0 = default_rayleigh_a0; rayleigh_a1 = default_rayleigh_a1
       call find_group(deck, 'damping', grp, found, error)
       if (allocated(error)) return
       if (.not. found) then
@@ -223,24 +237,22 @@ contains
          if (ios == 0) msg = msg0
          call group_read_error(deck, grp, i, msg, error); return
       end if
-      select case (lower(trim(damping_type)))
-      case ('stiffness')
-         cfg%model%damping = damping_stiffness
+      cfg%model%damping = keyword_id(damping_types, damping_type)
+      select case (cfg%model%damping)
+      case (damping_stiffness)
          call check_real(deck, 'damping', 'xi', xi, 0.0_dp, 1.0_dp, '', error, open_hi=.true.)
          if (allocated(error)) return
          call check_real(deck, 'damping', 'period', period, 0.0_dp, huge(1.0_dp), 's', error)
          if (allocated(error)) return
-      case ('rayleigh')
-         cfg%model%damping = damping_rayleigh
+      case (damping_rayleigh)
          call check_real(deck, 'damping', 'rayleigh_a0', rayleigh_a0, 0.0_dp, huge(1.0_dp), '1/s', error)
          if (allocated(error)) return
          call check_real(deck, 'damping', 'rayleigh_a1', rayleigh_a1, 0.0_dp, huge(1.0_dp), 's', error)
          if (allocated(error)) return
-      case ('none')
-         cfg%model%damping = damping_none
+      case (damping_none)
       case default
-         call bad(deck, 'damping', 'damping_type', "'"//trim(damping_type)//"'", &
-                  "one of 'stiffness' (C = psi K, the paper), 'rayleigh' (C = a0 M + a1 K), 'none'", error)
+         call keyword_choices(damping_types, choices)
+         call bad(deck, 'damping', 'damping_type', "'"//trim(damping_type)//"'", 'one of '//choices, error)
          return
       end select
       cfg%model%xi = xi
@@ -261,11 +273,11 @@ contains
       namelist /friction/ n_devices, node_i, node_j, law, p, mu, eps, eps1, f
       type(group_text) :: grp
       character(len=512) :: msg, msg0
-      character(len=:), allocatable :: rec, idx
-      integer :: ios, i, n
+      character(len=:), allocatable :: rec, idx, choices
+      integer :: ios, i, n, id
       logical :: found
 
-      n_devices = 0
+      n_devices = default_n_devices
       allocate (node_i(max_devices), node_j(max_devices), law(max_devices), p(max_devices), &
                 mu(max_devices), eps(max_devices), eps1(max_devices), f(max_devices))
       node_i = unset_int; node_j = unset_int; law = ''
@@ -297,11 +309,11 @@ contains
       if (allocated(error)) return
       call need_reals(deck, 'friction', 'mu', mu, n, '', error, positive=.false.)
       if (allocated(error)) return
-      call optional_reals(deck, 'friction', 'eps', eps, n, 1.0e-3_dp, 'm/s', error, positive=.true.)
+      call optional_reals(deck, 'friction', 'eps', eps, n, default_eps, 'm/s', error, positive=.true.)
       if (allocated(error)) return
-      call optional_reals(deck, 'friction', 'eps1', eps1, n, 1.0e-3_dp, 'm/s', error, positive=.true.)
+      call optional_reals(deck, 'friction', 'eps1', eps1, n, default_eps1, 'm/s', error, positive=.true.)
       if (allocated(error)) return
-      call optional_reals(deck, 'friction', 'f', f, n, 1.0e-5_dp, 'm', error, positive=.true.)
+      call optional_reals(deck, 'friction', 'f', f, n, default_f, 'm', error, positive=.true.)
       if (allocated(error)) return
       if (any(law(n + 1:) /= '')) then
          call bad(deck, 'friction', 'law', 'with '//trim(fmt_int(findloc(law /= '', .true., 1, back=.true.))) &
@@ -317,30 +329,17 @@ contains
                      trim(fmt_int(node_i(i)))//': a device joins two different nodes', error)
             return
          end if
-         select case (lower(trim(law(i))))
-         case ('velocity')
-            cfg%model%dev(i)%law = law_velocity
-         case ('hysteretic')
-            cfg%model%dev(i)%law = law_hysteretic
-         case ('coulomb')
-            cfg%model%dev(i)%law = law_coulomb
-         case ('')
-            call bad(deck, 'friction', 'law'//idx, '(not given)', &
-                     "one of 'velocity', 'hysteretic', 'coulomb'", error)
-            return
-         case default
-            call bad(deck, 'friction', 'law'//idx, "'"//trim(law(i))//"'", &
-                     "one of 'velocity', 'hysteretic', 'coulomb'", error)
-            return
-         end select
-         ! the exact technique integrates the whole model event by event
-         if (i > 1 .and. (cfg%model%dev(i)%law == law_coulomb .neqv. cfg%model%dev(1)%law == law_coulomb)) then
-            call bad(deck, 'friction', 'law'//idx, "'"//trim(law(i))//"'", "'coulomb' for every device or "// &
-                     "for none (law(1) = '"//trim(law(1))//"'): the exact technique cannot be mixed with "// &
-                     "the regularized laws", error)
+         id = law_id(law(i))
+         if (id == 0) then
+            call law_choices(choices)
+            if (len_trim(law(i)) == 0) then
+               call bad(deck, 'friction', 'law'//idx, '(not given)', 'one of '//choices, error)
+            else
+               call bad(deck, 'friction', 'law'//idx, "'"//trim(law(i))//"'", 'one of '//choices, error)
+            end if
             return
          end if
-         cfg%model%dev(i) = device_type(node_i=node_i(i), node_j=node_j(i), law=cfg%model%dev(i)%law, &
+         cfg%model%dev(i) = device_type(node_i=node_i(i), node_j=node_j(i), law=id, &
                                         p=p(i), mu=mu(i), eps=eps(i), eps1=eps1(i), f=f(i))
       end do
       cfg%model%n_devices = n
@@ -352,6 +351,7 @@ contains
       type(run_config), intent(inout) :: cfg
       type(error_type), allocatable, intent(out) :: error
       character(len=name_len) :: excitation_type, record_kind
+      integer :: kind_id
       character(len=1024) :: record_file
       real(dp) :: amplitude, frequency, duration, dt_record, record_scale
       integer :: ramp_cycles
@@ -359,13 +359,14 @@ contains
          record_file, record_kind, record_scale
       type(group_text) :: grp
       character(len=512) :: msg, msg0
-      character(len=:), allocatable :: rec, path
+      character(len=:), allocatable :: rec, path, choices
       integer :: ios, i
       logical :: found
 
-      excitation_type = ''; record_kind = 'acceleration'; record_file = ''
-      amplitude = unset; frequency = unset; duration = unset; dt_record = unset; record_scale = 1.0_dp
-      ramp_cycles = 0
+      excitation_type = ''; record_kind = record_kinds(default_record_kind)%name; record_file = ''
+      amplitude = unset; frequency = unset; duration = unset; dt_record = unset
+      record_scale = default_record_scale
+      ramp_cycles = default_ramp_cycles
       call find_group(deck, 'excitation', grp, found, error)
       if (allocated(error)) return
       if (.not. found) then
@@ -385,9 +386,9 @@ contains
       call need_real(deck, 'excitation', 'dt_record', dt_record, 's', error)
       if (allocated(error)) return
       cfg%exc%dt_record = dt_record
-      select case (lower(trim(excitation_type)))
-      case ('harmonic')
-         cfg%exc%kind = excitation_harmonic
+      cfg%exc%kind = keyword_id(excitation_types, excitation_type)
+      select case (cfg%exc%kind)
+      case (excitation_harmonic)
          call need_real(deck, 'excitation', 'amplitude', amplitude, 'm', error, positive=.false.)
          if (allocated(error)) return
          call need_real(deck, 'excitation', 'frequency', frequency, 'Hz', error)
@@ -400,8 +401,7 @@ contains
          cfg%exc%amplitude = amplitude
          cfg%exc%frequency = frequency
          cfg%exc%ramp_cycles = ramp_cycles
-      case ('record')
-         cfg%exc%kind = excitation_record
+      case (excitation_record)
          if (len_trim(record_file) == 0) then
             call bad(deck, 'excitation', 'record_file', "''", 'the path of the record file', error); return
          end if
@@ -409,14 +409,14 @@ contains
             call bad(deck, 'excitation', 'record_scale', trim(fmt_real(record_scale)), 'finite and non-zero', error)
             return
          end if
-         if (lower(trim(record_kind)) /= 'acceleration' .and. lower(trim(record_kind)) /= 'displacement') then
-            call bad(deck, 'excitation', 'record_kind', "'"//trim(record_kind)//"'", &
-                     "'acceleration' (m/s2 after record_scale) or 'displacement' (m)", error)
+         kind_id = keyword_id(record_kinds, record_kind)
+         if (kind_id == 0) then
+            call keyword_choices(record_kinds, choices)
+            call bad(deck, 'excitation', 'record_kind', "'"//trim(record_kind)//"'", 'one of '//choices, error)
             return
          end if
          call relative_to(deck%path, trim(record_file), path)
-         call read_record(path, lower(trim(record_kind)) == 'displacement', record_scale, dt_record, &
-                          cfg%exc%acc, error)
+         call read_record(path, kind_id == record_displacement, record_scale, dt_record, cfg%exc%acc, error)
          if (allocated(error)) then
             error%message = deck%path//", group &excitation, record_file = '"//trim(record_file)//"': "// &
                             error%message
@@ -425,13 +425,12 @@ contains
          if (duration == unset) duration = (size(cfg%exc%acc) - 1)*dt_record
          call need_real(deck, 'excitation', 'duration', duration, 's', error)
          if (allocated(error)) return
-      case ('none')
-         cfg%exc%kind = excitation_none
+      case (excitation_none)
          call need_real(deck, 'excitation', 'duration', duration, 's', error)
          if (allocated(error)) return
       case default
-         call bad(deck, 'excitation', 'excitation_type', "'"//trim(excitation_type)//"'", &
-                  "one of 'harmonic', 'record', 'none'", error)
+         call keyword_choices(excitation_types, choices)
+         call bad(deck, 'excitation', 'excitation_type', "'"//trim(excitation_type)//"'", 'one of '//choices, error)
          return
       end select
       cfg%exc%duration = duration
@@ -442,18 +441,20 @@ contains
       type(deck_text), intent(in) :: deck
       type(run_config), intent(inout) :: cfg
       type(error_type), allocatable, intent(out) :: error
+      character(len=name_len) :: technique
       real(dp) :: beta, gamma, n, dt_min
       integer :: n1, n2
       logical :: check_correctness
-      namelist /integration/ beta, gamma, n1, n2, n, check_correctness, dt_min
+      namelist /integration/ technique, beta, gamma, n1, n2, n, check_correctness, dt_min
       type(group_text) :: grp
       character(len=512) :: msg, msg0
-      character(len=:), allocatable :: rec
-      integer :: ios, i
+      character(len=:), allocatable :: rec, choices
+      integer :: ios, i, technique_id
       logical :: found
 
-      beta = 0.25_dp; gamma = 0.5_dp; n1 = 20; n2 = 50; n = 10.0_dp
-      check_correctness = .true.; dt_min = 0.0_dp
+      technique = technique_name(default_technique)
+      beta = default_beta; gamma = default_gamma; n1 = default_n1; n2 = default_n2; n = default_n
+      check_correctness = default_check_correctness; dt_min = default_dt_min
       call find_group(deck, 'integration', grp, found, error)
       if (allocated(error)) return
       if (found) then
@@ -468,6 +469,12 @@ contains
             if (ios == 0) msg = msg0
             call group_read_error(deck, grp, i, msg, error); return
          end if
+      end if
+      technique_id = keyword_id(techniques, technique)
+      if (technique_id == 0) then
+         call keyword_choices(techniques, choices)
+         call bad(deck, 'integration', 'technique', "'"//trim(technique)//"'", 'one of '//choices, error)
+         return
       end if
       call check_real(deck, 'integration', 'beta', beta, 0.0_dp, 0.5_dp, '', error, open_lo=.true.)
       if (allocated(error)) return
@@ -492,6 +499,7 @@ contains
                   trim(fmt_real(cfg%exc%duration))//' s)', error)
          return
       end if
+      cfg%opts%technique = technique_id
       cfg%opts%beta = beta
       cfg%opts%gamma = gamma
       cfg%opts%n1 = n1
@@ -516,7 +524,7 @@ contains
       integer :: ios, i
       logical :: found
 
-      dir = 'out'; output_every = 0; write_history = .true.
+      dir = default_dir; output_every = default_output_every; write_history = default_write_history
       call stem(deck%path, name)
       call find_group(deck, 'output', grp, found, error)
       if (allocated(error)) return

@@ -5,19 +5,12 @@ module fd_output
    use, intrinsic :: iso_c_binding, only: c_char, c_int, c_null_char
    use fd_kinds, only: dp
    use fd_error, only: error_type, fatal_error, fmt_int, fmt_real
-   use fd_model, only: model_type, law_name
+   use fd_model, only: model_type, output_type, law_name, technique_name
    use fd_result, only: result_type
    implicit none
    private
 
    public :: output_type, write_outputs, write_output_files, output_paths, summary_json, history_header
-
-   !> Where and what to write.
-   type :: output_type
-      character(len=:), allocatable :: dir   !! output directory (created if missing)
-      character(len=:), allocatable :: name  !! base name of the files
-      logical :: history = .true.            !! write the time-history CSV
-   end type output_type
 
    interface
       function c_rename(old, new) bind(c, name='rename') result(stat)
@@ -199,6 +192,7 @@ contains
       js = js//'  "deck": "'//esc//'",'//nl
       call kv('n_dof', trim(fmt_int(res%n_dof)))
       call kv('n_devices', trim(fmt_int(res%n_devices)))
+      call kv('technique', '"'//trim(technique_name(res%technique))//'"')
       js = js//'  "device_law": ['//laws//'],'//nl
       call kv('period_stuck_s', trim(json_real(res%period_stuck)))
       call kv('xi_stuck', trim(json_real(res%xi_stuck)))

@@ -1,18 +1,35 @@
 !> Table motion: harmonic table displacement with an optional cosine ramp, or a recorded
-!> table acceleration sampled at dt_record and linearly interpolated in between.
+!> table acceleration sampled at dt_record and linearly interpolated in between. Every
+!> technique takes the table motion from here: its value at a time (table_motion), and,
+!> for a technique that integrates the forcing exactly, its form on a segment of time:
+!> a sum of sines (harmonic motion, the ramp included), linear between samples (a record),
+!> or zero (forcing_form, table_sines, ramp_end).
 module fd_excitation
    use fd_kinds, only: dp
+   use fd_names, only: excitation_none, excitation_harmonic, excitation_record
    implicit none
    private
 
-   public :: excitation_type, table_motion
+   public :: excitation_type, table_motion, ramp_end
    public :: excitation_none, excitation_harmonic, excitation_record
-
-   integer, parameter :: excitation_none = 0     !! table at rest (free vibration)
-   integer, parameter :: excitation_harmonic = 1 !! x0 = a0 R(t) sin(2 pi f t)
-   integer, parameter :: excitation_record = 2   !! recorded acceleration samples
+   public :: sine_forcing, max_sines, table_sines, segment_end
+   public :: forcing_form, forcing_unknown, forcing_zero, forcing_sines, forcing_linear
 
    real(dp), parameter :: pi = acos(-1.0_dp)
+
+   integer, parameter :: max_sines = 3        !! sines of the table acceleration on a segment
+
+   integer, parameter :: forcing_unknown = -1 !! no exact form known for this excitation
+   integer, parameter :: forcing_zero = 0     !! the table is at rest
+   integer, parameter :: forcing_sines = 1    !! a sum of sines on each segment (table_sines)
+   integer, parameter :: forcing_linear = 2   !! linear between the samples at k dt_record
+
+   !> Table acceleration on one segment of time as a sum of sines, sum_k amp(k) sin(w(k) t).
+   type :: sine_forcing
+      integer :: nf = 0                        !! number of sines (0: none)
+      real(dp) :: w(max_sines) = 0.0_dp        !! circular frequencies [rad/s]
+      real(dp) :: amp(max_sines) = 0.0_dp      !! amplitudes [m/s2]
+   end type sine_forcing
 
    !> The table motion of one run.
    type :: excitation_type
@@ -45,7 +62,7 @@ contains
          s = sin(w*t); c = cos(w*t)
          r = 1.0_dp; r1 = 0.0_dp; r2 = 0.0_dp
          if (exc%ramp_cycles > 0) then
-            tr = exc%ramp_cycles/exc%frequency
+            tr = ramp_end(exc)
             if (t < tr) then
                ! R = (1 - cos(pi t/tr))/2: R, R' vanish at 0 and R' at tr; x0'' stays
                ! continuous at tr because sin(w tr) = 0 after whole cycles.
@@ -71,5 +88,67 @@ contains
          ag = (1.0_dp - x)*exc%acc(k + 1) + x*exc%acc(k + 2)
       end select
    end subroutine table_motion
+
+   !> End of the cosine ramp of harmonic table motion, t_r = ramp_cycles / frequency [s].
+   pure real(dp) function ramp_end(exc)
+      type(excitation_type), intent(in) :: exc !! the table motion (harmonic, ramp_cycles > 0)
+
+      ramp_end = exc%ramp_cycles/exc%frequency
+   end function ramp_end
+
+   !> The form of the table acceleration, for a technique that integrates it exactly.
+   pure integer function forcing_form(exc) result(form)
+      type(excitation_type), intent(in) :: exc !! the table motion
+
+      select case (exc%kind)
+      case (excitation_none)
+         form = forcing_zero
+      case (excitation_harmonic)
+         form = forcing_sines
+      case (excitation_record)
+         form = forcing_linear
+      case default
+         form = forcing_unknown
+      end select
+   end function forcing_form
+
+   !> The table acceleration of harmonic motion on the segment containing t as a sum of
+   !> sines: a0 w^2 sin(w t) after the ramp; during it a0 R sin(w t) with
+   !> R = (1 - cos(nu t))/2, nu = pi / t_r, twice differentiated, is exactly three sines.
+   !> A segment ends at t_r (to 1e-12 relative). nf = 0 for other excitations.
+   pure subroutine table_sines(exc, t, frc)
+      type(excitation_type), intent(in) :: exc !! the table motion
+      real(dp), intent(in) :: t                !! a time in the segment [s]
+      type(sine_forcing), intent(out) :: frc   !! the sines of that segment
+      real(dp) :: om, nu
+
+      frc%nf = 0
+      if (exc%kind /= excitation_harmonic) return
+      om = 2.0_dp*pi*exc%frequency
+      if (exc%ramp_cycles > 0 .and. t < ramp_end(exc)*(1.0_dp - 1.0e-12_dp)) then
+         nu = pi/ramp_end(exc)
+         frc%nf = 3
+         frc%w = [om + nu, om - nu, om]
+         frc%amp = exc%amplitude*[(om + nu)**2/4.0_dp, (om - nu)**2/4.0_dp, -om**2/2.0_dp]
+      else
+         frc%nf = 1
+         frc%w(1) = om
+         frc%amp(1) = -exc%amplitude*om**2
+      end if
+   end subroutine table_sines
+
+   !> Where a step from t towards tn must stop so as not to straddle a change of the form
+   !> of the forcing (the end of the harmonic ramp): that time if it lies in (t, tn) (to
+   !> 1e-12 of tn), else tn. (A record's samples fall on the step grid, dt1 = dt_record/n1.)
+   pure real(dp) function segment_end(exc, t, tn) result(tb)
+      type(excitation_type), intent(in) :: exc !! the table motion
+      real(dp), intent(in) :: t                !! start of the step [s]
+      real(dp), intent(in) :: tn               !! intended end of the step [s]
+
+      tb = tn
+      if (exc%kind == excitation_harmonic .and. exc%ramp_cycles > 0) then
+         if (t < ramp_end(exc) .and. ramp_end(exc) < tn - 1.0e-12_dp*tn) tb = ramp_end(exc)
+      end if
+   end function segment_end
 
 end module fd_excitation

@@ -1,22 +1,23 @@
 !> The structural model: lumped masses with one horizontal DOF each (displacements relative
 !> to the moving table, node 0), linear springs, viscous damping and friction devices,
-!> and the settings of the time integration.
+!> and the settings of the time integration and of the output. The ids and names of laws,
+!> damping types and techniques, and every default, come from fd_names (re-exported here).
 module fd_model
    use fd_kinds, only: dp
+   use fd_names, only: damping_none, damping_stiffness, damping_rayleigh, &
+                       law_velocity, law_hysteretic, law_coulomb, law_name, &
+                       technique_newmark, technique_event_driven, technique_name, &
+                       default_eps, default_eps1, default_f, default_xi, default_period, &
+                       default_rayleigh_a0, default_rayleigh_a1, default_technique, default_beta, &
+                       default_gamma, default_n1, default_n2, default_n, default_check_correctness, &
+                       default_dt_min, default_output_every, default_write_history
    implicit none
    private
 
-   public :: model_type, device_type, integration_type
+   public :: model_type, device_type, integration_type, output_type
    public :: damping_none, damping_stiffness, damping_rayleigh
    public :: law_velocity, law_hysteretic, law_coulomb, law_name
-
-   integer, parameter :: damping_none = 0      !! no viscous damping
-   integer, parameter :: damping_stiffness = 1 !! C = psi K, psi = T xi / pi (the paper)
-   integer, parameter :: damping_rayleigh = 2  !! C = a0 M + a1 K
-
-   integer, parameter :: law_velocity = 1   !! velocity model, eqs. 6-11
-   integer, parameter :: law_hysteretic = 2 !! hysteretic model, eqs. 2-5
-   integer, parameter :: law_coulomb = 3    !! exact event-driven Coulomb friction
+   public :: technique_newmark, technique_event_driven, technique_name
 
    !> One friction device between node_i and node_j (node 0 = the table).
    !> Its relative displacement is s = u(node_i) - u(node_j); its force F acts
@@ -27,9 +28,9 @@ module fd_model
       integer :: law = law_velocity !! friction law id
       real(dp) :: p = 0.0_dp       !! normal force P [N]
       real(dp) :: mu = 0.0_dp      !! friction coefficient [-]
-      real(dp) :: eps = 1.0e-3_dp  !! velocity law band eps [m/s], eqs. 6-7
-      real(dp) :: eps1 = 1.0e-3_dp !! hysteretic end of sliding eps1 [m/s], eq. 2
-      real(dp) :: f = 1.0e-5_dp    !! hysteretic sticking displacement f [m], eq. 3
+      real(dp) :: eps = default_eps   !! velocity law band eps [m/s], eqs. 6-7
+      real(dp) :: eps1 = default_eps1 !! hysteretic end of sliding eps1 [m/s], eq. 2
+      real(dp) :: f = default_f       !! hysteretic sticking displacement f [m], eq. 3
    end type device_type
 
    !> The whole structural model.
@@ -43,42 +44,32 @@ module fd_model
       integer, allocatable :: spring_j(:)     !! second node of each spring (0..n_dof)
       real(dp), allocatable :: spring_k(:)    !! spring stiffness [N/m]
       integer :: damping = damping_none       !! damping model id
-      real(dp) :: xi = 0.0_dp                 !! damping ratio of the stuck first mode [-]
-      real(dp) :: period = 0.0_dp             !! stuck first period T [s]; 0 = computed
-      real(dp) :: rayleigh_a0 = 0.0_dp        !! Rayleigh mass factor [1/s]
-      real(dp) :: rayleigh_a1 = 0.0_dp        !! Rayleigh stiffness factor [s]
+      real(dp) :: xi = default_xi             !! damping ratio of the stuck first mode [-]
+      real(dp) :: period = default_period     !! stuck first period T [s]; 0 = computed
+      real(dp) :: rayleigh_a0 = default_rayleigh_a0 !! Rayleigh mass factor [1/s]
+      real(dp) :: rayleigh_a1 = default_rayleigh_a1 !! Rayleigh stiffness factor [s]
       integer :: n_devices = 0                !! number of friction devices
       type(device_type), allocatable :: dev(:) !! the friction devices
    end type model_type
 
-   !> Settings of the Newmark integration and of the step control.
+   !> Settings of the time integration: the technique, Newmark and the step control.
    type :: integration_type
-      real(dp) :: beta = 0.25_dp     !! Newmark beta
-      real(dp) :: gamma = 0.5_dp     !! Newmark gamma
-      integer :: n1 = 20             !! dt1 = dt_record / n1
-      integer :: n2 = 50             !! dt2 = dt1 / n2 on a phase change
-      real(dp) :: n_corr = 10.0_dp   !! n of the correctness condition, eqs. 9 and 12
-      logical :: check = .true.      !! check the correctness condition
-      real(dp) :: dt_min = 0.0_dp    !! floor of the step halving [s]; 0 = dt2 / 2**10
-      integer :: output_every = 0    !! output every k dt1 steps; 0 = at the record step (n1)
+      integer :: technique = default_technique  !! technique id (fd_names)
+      real(dp) :: beta = default_beta           !! Newmark beta
+      real(dp) :: gamma = default_gamma         !! Newmark gamma
+      integer :: n1 = default_n1                !! dt1 = dt_record / n1
+      integer :: n2 = default_n2                !! dt2 = dt1 / n2 on a phase change
+      real(dp) :: n_corr = default_n            !! n of the correctness condition, eqs. 9 and 12
+      logical :: check = default_check_correctness !! check the correctness condition
+      real(dp) :: dt_min = default_dt_min       !! floor of the step halving [s]; 0 = dt2 / 2**10
+      integer :: output_every = default_output_every !! output every k dt1 steps; 0 = at the record step (n1)
    end type integration_type
 
-contains
-
-   !> Name of a friction law, as written in decks.
-   pure function law_name(law) result(name)
-      integer, intent(in) :: law              !! law id
-      character(len=16) :: name               !! its name, left-adjusted
-      select case (law)
-      case (law_velocity)
-         name = 'velocity'
-      case (law_hysteretic)
-         name = 'hysteretic'
-      case (law_coulomb)
-         name = 'coulomb'
-      case default
-         name = 'unknown'
-      end select
-   end function law_name
+   !> Where and what to write.
+   type :: output_type
+      character(len=:), allocatable :: dir   !! output directory (created if missing)
+      character(len=:), allocatable :: name  !! base name of the files
+      logical :: history = default_write_history !! write the time-history CSV
+   end type output_type
 
 end module fd_model

@@ -9,7 +9,6 @@ module fd_result
    private
 
    public :: result_type, max_violation_times, column_name_len, init_result, history_shape
-   public :: record_transition
 
    integer, parameter :: max_violation_times = 10 !! first violation times kept
    integer, parameter :: column_name_len = 16     !! length of a column name
@@ -29,6 +28,7 @@ module fd_result
       real(dp) :: dt1 = 0.0_dp             !! main step [s]
       real(dp) :: dt2 = 0.0_dp             !! step around phase changes [s]
       real(dp) :: dt_min = 0.0_dp          !! floor of step halving [s]
+      integer :: technique = 0             !! technique id of the run (fd_names)
       ! peaks per DOF (over every step taken)
       real(dp), allocatable :: peak_u(:)        !! max |u| [m]
       real(dp), allocatable :: peak_u_time(:)   !! time of max |u| [s]
@@ -134,22 +134,5 @@ contains
       res%peak_s = 0.0_dp; res%peak_force = 0.0_dp
       res%stick_to_slip = 0; res%slip_to_stick = 0; res%reversals = 0
    end subroutine init_result
-
-   !> Count a phase change of device d (phases: 0 stick, +-1 slip).
-   pure subroutine record_transition(res, d, old, new)
-      type(result_type), intent(inout) :: res   !! the result
-      integer, intent(in) :: d                  !! device
-      integer, intent(in) :: old                !! phase before
-      integer, intent(in) :: new                !! phase after
-
-      if (old == new) return
-      if (old == 0) then
-         res%stick_to_slip(d) = res%stick_to_slip(d) + 1
-      else if (new == 0) then
-         res%slip_to_stick(d) = res%slip_to_stick(d) + 1
-      else
-         res%reversals(d) = res%reversals(d) + 1
-      end if
-   end subroutine record_transition
 
 end module fd_result

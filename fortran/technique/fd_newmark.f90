@@ -13,17 +13,22 @@ module fd_newmark
    use, intrinsic :: ieee_arithmetic, only: ieee_is_finite
    use fd_kinds, only: dp
    use fd_error, only: error_type, fatal_error, fmt_real, fmt_int
+   use fd_names, only: laws, law_name, law_choices, excitation_types, technique_name, technique_newmark, &
+                       technique_event_driven
    use fd_model, only: model_type, integration_type
    use fd_excitation, only: excitation_type, table_motion
    use fd_matrices, only: structure_matrices
+   use fd_kinematics, only: device_kinematics, device_relative, add_device
    use fd_linalg, only: cholesky_factor, cholesky_solve, sym_matvec
    use fd_device_state, only: device_state, device_force
    use fd_friction, only: friction_init, friction_update, friction_correct
-   use fd_result, only: result_type, max_violation_times, init_result, record_transition
+   use fd_result, only: result_type
+   use fd_observer, only: observer_type, observer_init, sample_due, observe_start, observe_peaks, &
+                          observe_sample, observe_transitions, observe_violations, observe_end
    implicit none
    private
 
-   public :: run_newmark
+   public :: run_newmark, newmark_check
 
    integer, parameter :: max_slots = 32              !! factors kept at most
    real(dp), parameter :: cache_bytes = 256.0e6_dp    !! memory the factors may take
@@ -41,15 +46,47 @@ module fd_newmark
       integer :: n = 0, nd = 0, clock = 0
       real(dp), allocatable :: mass(:), k(:, :), c(:, :)
       real(dp), allocatable :: u(:), v(:), a(:), u1(:), v1(:), a1(:), rhs(:), tmp(:)
-      real(dp), allocatable :: s(:), sd(:), s1(:), sd1(:)
+      real(dp), allocatable :: s(:), sd(:), s1(:), sd1(:), f(:)
       type(device_state), allocatable :: st(:), st1(:)
+      integer, allocatable :: phase0(:), phase1(:)    !! phases of st, st1 for the observer
       logical, allocatable :: changed(:), ok(:), stuck(:)
       real(dp) :: ag = 0.0_dp, ag1 = 0.0_dp
-      real(dp) :: w_device = 0.0_dp, e_device0 = 0.0_dp, e_kin0 = 0.0_dp, e_str0 = 0.0_dp
+      real(dp) :: w_device = 0.0_dp                   !! work of the device forces [J]
+      type(observer_type) :: obs                      !! peaks, history, energy balance
       type(factor_slot), allocatable :: slot(:)
    end type workspace
 
 contains
+
+   !> What Newmark cannot integrate: a device whose law is not regularized (exact Coulomb
+   !> friction is set-valued), an excitation type it does not know. Messages name the
+   !> group, the variable, the value and what to set.
+   subroutine newmark_check(model, exc, error)
+      type(model_type), intent(in) :: model         !! the model
+      type(excitation_type), intent(in) :: exc      !! the table motion
+      type(error_type), allocatable, intent(out) :: error !! what cannot be integrated
+      character(len=:), allocatable :: idx, allowed
+      integer :: d, law
+
+      do d = 1, model%n_devices
+         law = model%dev(d)%law
+         if (law >= 1 .and. law <= size(laws)) then
+            if (laws(law)%regularized) cycle
+         end if
+         idx = 'law('//trim(fmt_int(d))//')'
+         call law_choices(allowed, regularized=.true.)
+         call fatal_error(error, "group &friction: "//idx//" = '"//trim(law_name(law))//"' is invalid with "// &
+                          "technique = '"//trim(technique_name(technique_newmark))//"' of &integration: '"// &
+                          trim(law_name(law))//"' is exact (set-valued) friction, which Newmark cannot integrate; "// &
+                          "set technique = '"//trim(technique_name(technique_event_driven))//"' in &integration, "// &
+                          "or "//idx//" to a regularized law: "//allowed)
+         return
+      end do
+      if (exc%kind < 1 .or. exc%kind > size(excitation_types)) then
+         call fatal_error(error, "group &excitation: excitation_type (id "//trim(fmt_int(exc%kind))// &
+                          ") is not a table motion the Newmark technique knows")
+      end if
+   end subroutine newmark_check
 
    !> Integrate a model under a table motion and fill the result.
    subroutine run_newmark(model, exc, opts, res, error)
@@ -60,10 +97,12 @@ contains
       type(error_type), allocatable, intent(out) :: error !! singular system, divergence
       type(workspace) :: w
       real(dp) :: dt1, dt2, t0
-      integer :: nsteps, every, k, j, iout, c0, c1, crate
+      integer :: k, j, c0, c1, crate
       logical :: any_changed, any_bad
 
       call system_clock(c0, crate)
+      call newmark_check(model, exc, error)
+      if (allocated(error)) return
       dt1 = exc%dt_record/opts%n1
       dt2 = dt1/opts%n2
       res%dt1 = dt1
@@ -72,23 +111,23 @@ contains
       if (res%dt_min <= 0.0_dp) res%dt_min = dt2/2.0_dp**10
       call setup(model, halving_levels(dt2, res%dt_min), w, res, error)
       if (allocated(error)) return
-      call init_result(model, exc, opts, res, nsteps, every, error)
+      call observer_init(model, exc, opts, res, w%obs, error)
       if (allocated(error)) return
 
       ! initial state: devices from the initial conditions, acceleration from equilibrium
       w%u = model%u0
       w%v = model%v0
       call device_kinematics(model, w%u, w%v, w%s, w%sd)
-      call friction_init(model%dev, w%s, w%sd, w%st)
+      call friction_init(model%dev, w%s, w%sd, w%st, error)
+      if (allocated(error)) return
       call consistent_acceleration(model, exc, 0.0_dp, w)
-      w%e_device0 = device_energy(w%st, w%s)
-      w%e_kin0 = 0.5_dp*sum(w%mass*w%v**2)
-      w%e_str0 = strain_energy(w%k, w%u, w%rhs)
-      iout = 1
-      call sample(model, 0.0_dp, w, res, iout)
-      call track_peaks(0.0_dp, w, res)
+      call observe_start(w%obs, w%mass, w%k, w%u, w%v, device_energy(w%st, w%s), w%rhs)
+      w%f = device_force(w%st, w%s, w%sd)
+      w%phase0 = w%st%phase
+      call observe_sample(w%obs, res, 0.0_dp, w%ag, w%u, w%v, w%a, w%s, w%sd, w%f, w%phase0)
+      call observe_peaks(res, 0.0_dp, w%u, w%v, w%a, w%ag, w%s, w%f)
 
-      do k = 1, nsteps
+      do k = 1, w%obs%nsteps
          t0 = (k - 1)*dt1
          call try_step(model, exc, opts, t0, dt1, w, res, error)
          if (allocated(error)) return
@@ -102,17 +141,18 @@ contains
                if (allocated(error)) return
             end do
          end if
-         if (mod(k, every) == 0 .or. k == nsteps) then
+         if (sample_due(w%obs, k)) then
             if (.not. all(ieee_is_finite(w%u)) .or. .not. all(ieee_is_finite(w%a))) then
                call fatal_error(error, "the solution is not finite at t = "//trim(fmt_real(k*dt1))// &
                                 " s: the integration diverged (check beta, gamma and the step)")
                return
             end if
-            iout = iout + 1
-            call sample(model, k*dt1, w, res, iout)
+            w%f = device_force(w%st, w%s, w%sd)
+            w%phase0 = w%st%phase
+            call observe_sample(w%obs, res, k*dt1, w%ag, w%u, w%v, w%a, w%s, w%sd, w%f, w%phase0)
          end if
       end do
-      call finish_energy(w, res)
+      call observe_end(w%obs, res, w%mass, w%k, w%u, w%v, device_energy(w%st, w%s), w%w_device, w%rhs)
       call system_clock(c1)
       res%run_time = real(c1 - c0, dp)/real(max(crate, 1), dp)
    end subroutine run_newmark
@@ -150,7 +190,7 @@ contains
       call structure_matrices(model, w%k, w%c, res%period_stuck, res%xi_stuck, error)
       if (allocated(error)) return
       allocate (w%u(n), w%v(n), w%a(n), w%u1(n), w%v1(n), w%a1(n), w%rhs(n), w%tmp(n))
-      allocate (w%s(nd), w%sd(nd), w%s1(nd), w%sd1(nd), w%st(nd), w%st1(nd))
+      allocate (w%s(nd), w%sd(nd), w%s1(nd), w%sd1(nd), w%f(nd), w%st(nd), w%st1(nd), w%phase0(nd), w%phase1(nd))
       allocate (w%changed(nd), w%ok(nd), w%stuck(nd))
       n_slots = min(max_slots, 2*(lmax + 2), max(4, int(cache_bytes/(8.0_dp*n*n))))
       if (nd == 0) n_slots = 1
@@ -164,35 +204,6 @@ contains
       end do
    end subroutine setup
 
-
-   !> Relative displacement and velocity of every device.
-   pure subroutine device_kinematics(model, u, v, s, sd)
-      type(model_type), intent(in) :: model
-      real(dp), intent(in) :: u(:), v(:)
-      real(dp), intent(out) :: s(:), sd(:)
-      integer :: d, i, j
-
-      do d = 1, model%n_devices
-         i = model%dev(d)%node_i; j = model%dev(d)%node_j
-         s(d) = u(i); sd(d) = v(i)
-         if (j > 0) then
-            s(d) = s(d) - u(j); sd(d) = sd(d) - v(j)
-         end if
-      end do
-   end subroutine device_kinematics
-
-   !> Add alpha * b_d to y, b_d = e_i - e_j the direction of device d.
-   pure subroutine add_device(model, d, alpha, y)
-      type(model_type), intent(in) :: model
-      integer, intent(in) :: d
-      real(dp), intent(in) :: alpha
-      real(dp), intent(inout) :: y(:)
-      integer :: i, j
-
-      i = model%dev(d)%node_i; j = model%dev(d)%node_j
-      y(i) = y(i) + alpha
-      if (j > 0) y(j) = y(j) - alpha
-   end subroutine add_device
 
    !> Acceleration in equilibrium with the current phases: M a = p - C v - K u - sum b F.
    subroutine consistent_acceleration(model, exc, t, w)
@@ -238,8 +249,7 @@ contains
       call sym_matvec(w%c, w%tmp, w%rhs, 1.0_dp, 1.0_dp)
       call sym_matvec(w%k, w%u, w%rhs, -1.0_dp, 1.0_dp)
       do d = 1, w%nd
-         proj = w%tmp(model%dev(d)%node_i)
-         if (model%dev(d)%node_j > 0) proj = proj - w%tmp(model%dev(d)%node_j)
+         proj = device_relative(model, d, w%tmp)
          call add_device(model, d, w%st(d)%cs*proj - w%st(d)%ks*w%s(d) - w%st(d)%f0, w%rhs)
       end do
       call cholesky_solve(w%slot(is)%a, w%rhs)
@@ -380,72 +390,17 @@ contains
          w%w_device = w%w_device + 0.5_dp*(f0 + f1)*(w%s1(d) - w%s(d))
       end do
       ! violations of the correctness condition left in an accepted step
-      if (any_bad) then
-         do d = 1, w%nd
-            if (w%ok(d)) cycle
-            res%violations = res%violations + 1
-            if (res%n_violation_times < max_violation_times) then
-               res%n_violation_times = res%n_violation_times + 1
-               res%violation_time(res%n_violation_times) = t1
-               res%violation_device(res%n_violation_times) = d
-            end if
-         end do
-      end if
-      do d = 1, w%nd
-         call record_transition(res, d, w%st(d)%phase, w%st1(d)%phase)
-      end do
+      if (any_bad) call observe_violations(res, t1, w%ok)
+      w%phase0 = w%st%phase
+      w%phase1 = w%st1%phase
+      call observe_transitions(res, w%phase0, w%phase1)
       w%u = w%u1; w%v = w%v1; w%a = w%a1; w%ag = w%ag1
       w%s = w%s1; w%sd = w%sd1
       w%st = w%st1
       if (any(w%changed)) call consistent_acceleration(model, exc, t1, w)
-      call track_peaks(t1, w, res)
+      w%f = device_force(w%st, w%s, w%sd)
+      call observe_peaks(res, t1, w%u, w%v, w%a, w%ag, w%s, w%f)
    end subroutine accept
-
-   subroutine track_peaks(t, w, res)
-      real(dp), intent(in) :: t
-      type(workspace), intent(in) :: w
-      type(result_type), intent(inout) :: res
-      integer :: i
-      real(dp) :: x
-
-      do i = 1, w%n
-         if (abs(w%u(i)) > res%peak_u(i)) then
-            res%peak_u(i) = abs(w%u(i)); res%peak_u_time(i) = t
-         end if
-         res%peak_v(i) = max(res%peak_v(i), abs(w%v(i)))
-         x = abs(w%a(i) + w%ag)
-         if (x > res%peak_aabs(i)) then
-            res%peak_aabs(i) = x; res%peak_aabs_time(i) = t
-         end if
-      end do
-      do i = 1, w%nd
-         res%peak_s(i) = max(res%peak_s(i), abs(w%s(i)))
-         res%peak_force(i) = max(res%peak_force(i), abs(device_force(w%st(i), w%s(i), w%sd(i))))
-      end do
-   end subroutine track_peaks
-
-   subroutine sample(model, t, w, res, iout)
-      type(model_type), intent(in) :: model
-      real(dp), intent(in) :: t
-      type(workspace), intent(in) :: w
-      type(result_type), intent(inout) :: res
-      integer, intent(in) :: iout
-      integer :: i, c
-
-      if (iout > res%nout) return
-      res%hist(1, iout) = t
-      res%hist(2, iout) = w%ag
-      c = 2
-      do i = 1, w%n
-         res%hist(c + 1:c + 3, iout) = [w%u(i), w%v(i), w%a(i) + w%ag]
-         c = c + 3
-      end do
-      do i = 1, model%n_devices
-         res%hist(c + 1:c + 4, iout) = [w%s(i), w%sd(i), device_force(w%st(i), w%s(i), w%sd(i)), &
-                                        real(w%st(i)%phase, dp)]
-         c = c + 4
-      end do
-   end subroutine sample
 
    !> Elastic energy stored in devices whose phase has a stiffness (hysteretic sticking).
    pure real(dp) function device_energy(st, s) result(e)
@@ -458,26 +413,5 @@ contains
          if (st(d)%ks > 0.0_dp) e = e + 0.5_dp*st(d)%ks*(s(d) + st(d)%f0/st(d)%ks)**2
       end do
    end function device_energy
-
-   !> Strain energy of the springs, 1/2 u K u.
-   real(dp) function strain_energy(k, u, tmp) result(e)
-      real(dp), intent(in) :: k(:, :), u(:)
-      real(dp), intent(inout) :: tmp(:)
-
-      call sym_matvec(k, u, tmp, 1.0_dp, 0.0_dp)
-      e = 0.5_dp*dot_product(u, tmp)
-   end function strain_energy
-
-   subroutine finish_energy(w, res)
-      type(workspace), intent(inout) :: w
-      type(result_type), intent(inout) :: res
-
-      res%e_kinetic = 0.5_dp*sum(w%mass*w%v**2) - w%e_kin0
-      res%e_strain = strain_energy(w%k, w%u, w%rhs) - w%e_str0
-      res%e_device = device_energy(w%st, w%s) - w%e_device0
-      res%e_friction = w%w_device - res%e_device
-      res%e_residual = res%e_input - (res%e_kinetic + res%e_strain + res%e_viscous + &
-                                      res%e_friction + res%e_device)
-   end subroutine finish_energy
 
 end module fd_newmark

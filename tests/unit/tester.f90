@@ -13,6 +13,12 @@ program tester
    use test_fd_record, only: collect_record
    use test_fd_excitation, only: collect_excitation
    use test_fd_lcp, only: collect_lcp
+   use test_fd_textio, only: collect_textio
+   use test_fd_names, only: collect_names
+   use test_fd_technique, only: collect_technique
+   use test_fd_root_finder, only: collect_root_finder
+   use test_fd_phase_pattern, only: collect_phase_pattern
+   use test_fd_observer, only: collect_observer
    implicit none
    integer :: stat, is
    character(len=:), allocatable :: suite_name, test_name
@@ -31,6 +37,12 @@ program tester
    testsuites = [testsuites, new_testsuite("record", collect_record)]
    testsuites = [testsuites, new_testsuite("excitation", collect_excitation)]
    testsuites = [testsuites, new_testsuite("lcp", collect_lcp)]
+   testsuites = [testsuites, new_testsuite("textio", collect_textio)]
+   testsuites = [testsuites, new_testsuite("names", collect_names)]
+   testsuites = [testsuites, new_testsuite("technique", collect_technique)]
+   testsuites = [testsuites, new_testsuite("root_finder", collect_root_finder)]
+   testsuites = [testsuites, new_testsuite("phase_pattern", collect_phase_pattern)]
+   testsuites = [testsuites, new_testsuite("observer", collect_observer)]
 
    call get_argument(1, suite_name)
    call get_argument(2, test_name)

@@ -147,7 +147,7 @@ def closed_forms() -> list[dict]:
             v0=[float(v0[0])],
             devices=[Device(1, 0, ff, 1.0, law="coulomb")],
             excitation=Harmonic(amp_dh, w / (2 * np.pi), 0.01, 6 * 2 * np.pi / w),
-            integration=Integration(n1=10),
+            integration=Integration(technique="event_driven", n1=10),
             output=Output(output_every=1),
         )
         r = an.run()

@@ -1,0 +1,184 @@
+!> Names and defaults of the deck's settings, in one place: the keyword tables (friction
+!> laws, techniques, damping types, excitation types, record kinds), from which the deck
+!> reader looks names up and builds its messages, and the default of every optional
+!> namelist variable, which the reader and the model's types start from.
+!> docs/namelist.md documents each of them.
+!>
+!> The id of a keyword is its position in its table. Adding a friction law is one row in
+!> `laws` with its id below it, one module in fortran/friction and one case in
+!> fd_friction's dispatch.
+module fd_names
+   use fd_kinds, only: dp
+   use fd_textio, only: lower
+   implicit none
+   private
+
+   public :: keyword_type, law_type, keyword_len
+   public :: laws, law_velocity, law_hysteretic, law_coulomb
+   public :: techniques, technique_newmark, technique_event_driven
+   public :: damping_types, damping_stiffness, damping_rayleigh, damping_none
+   public :: excitation_types, excitation_harmonic, excitation_record, excitation_none
+   public :: record_kinds, record_acceleration, record_displacement
+   public :: keyword_id, keyword_choices, law_id, law_choices, law_name, technique_name
+   public :: default_u0, default_v0, default_xi, default_period, default_rayleigh_a0, default_rayleigh_a1
+   public :: default_n_devices, default_eps, default_eps1, default_f
+   public :: default_ramp_cycles, default_record_kind, default_record_scale
+   public :: default_technique, default_beta, default_gamma, default_n1, default_n2, default_n
+   public :: default_check_correctness, default_dt_min
+   public :: default_dir, default_output_every, default_write_history
+
+   integer, parameter :: keyword_len = 16   !! length of a keyword in the tables
+
+   !> A keyword of the deck and what it means (shown in messages when not empty).
+   type :: keyword_type
+      character(len=keyword_len) :: name = ''  !! the keyword, lower case
+      character(len=40) :: note = ''           !! its meaning, for messages
+   end type keyword_type
+
+   !> A friction law: its keyword, and whether its force is a function of the device's
+   !> state (regularized: integrated step by step by Newmark) or set-valued (exact Coulomb:
+   !> the force of a sticking device is whatever keeps it stuck, found event by event).
+   type, extends(keyword_type) :: law_type
+      logical :: regularized = .true.          !! a force law Newmark can integrate
+   end type law_type
+
+   ! ------------------------------------------------------------------ friction laws
+   type(law_type), parameter :: laws(*) = [ &
+                                law_type('velocity', '', .true.), &     ! law_velocity, eqs. 6-11
+                                law_type('hysteretic', '', .true.), &   ! law_hysteretic, eqs. 2-5
+                                law_type('coulomb', '', .false.)]       ! law_coulomb, exact
+   integer, parameter :: law_velocity = 1   !! velocity model, eqs. 6-11
+   integer, parameter :: law_hysteretic = 2 !! hysteretic model, eqs. 2-5
+   integer, parameter :: law_coulomb = 3    !! exact (set-valued) Coulomb friction
+
+   ! ------------------------------------------------------------------ techniques
+   type(keyword_type), parameter :: techniques(*) = [ &
+                                    keyword_type('newmark', 'regularized laws'), &
+                                    keyword_type('event_driven', "exact, law 'coulomb'")]
+   integer, parameter :: technique_newmark = 1      !! Newmark with the paper's step control
+   integer, parameter :: technique_event_driven = 2 !! exact event-driven Coulomb technique
+
+   ! ------------------------------------------------------------------ damping types
+   type(keyword_type), parameter :: damping_types(*) = [ &
+                                    keyword_type('stiffness', 'C = psi K, the paper'), &
+                                    keyword_type('rayleigh', 'C = a0 M + a1 K'), &
+                                    keyword_type('none', '')]
+   integer, parameter :: damping_stiffness = 1 !! C = psi K, psi = T xi / pi (the paper)
+   integer, parameter :: damping_rayleigh = 2  !! C = a0 M + a1 K
+   integer, parameter :: damping_none = 3      !! no viscous damping
+
+   ! ------------------------------------------------------------------ excitation types
+   type(keyword_type), parameter :: excitation_types(*) = [ &
+                                    keyword_type('harmonic', ''), &
+                                    keyword_type('record', ''), &
+                                    keyword_type('none', '')]
+   integer, parameter :: excitation_harmonic = 1 !! x0 = a0 R(t) sin(2 pi f t)
+   integer, parameter :: excitation_record = 2   !! recorded acceleration samples
+   integer, parameter :: excitation_none = 3     !! table at rest (free vibration)
+
+   ! ------------------------------------------------------------------ record kinds
+   type(keyword_type), parameter :: record_kinds(*) = [ &
+                                    keyword_type('acceleration', 'm/s2 after record_scale'), &
+                                    keyword_type('displacement', 'm')]
+   integer, parameter :: record_acceleration = 1 !! the record holds table accelerations
+   integer, parameter :: record_displacement = 2 !! the record holds table displacements
+
+   ! ------------------------------------------------------------------ defaults
+   ! &model
+   real(dp), parameter :: default_u0 = 0.0_dp            !! initial displacement [m]
+   real(dp), parameter :: default_v0 = 0.0_dp            !! initial velocity [m/s]
+   ! &damping
+   real(dp), parameter :: default_xi = 0.0_dp            !! damping ratio [-]
+   real(dp), parameter :: default_period = 0.0_dp        !! stuck period, 0 = computed [s]
+   real(dp), parameter :: default_rayleigh_a0 = 0.0_dp   !! [1/s]
+   real(dp), parameter :: default_rayleigh_a1 = 0.0_dp   !! [s]
+   ! &friction
+   integer, parameter :: default_n_devices = 0           !! no devices
+   real(dp), parameter :: default_eps = 1.0e-3_dp        !! velocity band eps [m/s]
+   real(dp), parameter :: default_eps1 = 1.0e-3_dp       !! end of sliding eps1 [m/s]
+   real(dp), parameter :: default_f = 1.0e-5_dp          !! sticking displacement f [m]
+   ! &excitation
+   integer, parameter :: default_ramp_cycles = 0         !! no ramp
+   integer, parameter :: default_record_kind = record_acceleration
+   real(dp), parameter :: default_record_scale = 1.0_dp  !! [-]
+   ! &integration
+   integer, parameter :: default_technique = technique_newmark
+   real(dp), parameter :: default_beta = 0.25_dp         !! Newmark beta
+   real(dp), parameter :: default_gamma = 0.5_dp         !! Newmark gamma
+   integer, parameter :: default_n1 = 20                 !! dt1 = dt_record / n1
+   integer, parameter :: default_n2 = 50                 !! dt2 = dt1 / n2
+   real(dp), parameter :: default_n = 10.0_dp            !! n of eqs. 9 and 12
+   logical, parameter :: default_check_correctness = .true.
+   real(dp), parameter :: default_dt_min = 0.0_dp        !! 0 = dt2 / 2**10 [s]
+   ! &output
+   character(len=*), parameter :: default_dir = 'out'    !! output directory
+   integer, parameter :: default_output_every = 0        !! 0 = every dt_record
+   logical, parameter :: default_write_history = .true.
+
+contains
+
+   !> Id (position in the table) of a keyword, compared without case and trailing blanks;
+   !> 0 when the table does not hold it.
+   pure integer function keyword_id(table, word) result(id)
+      type(keyword_type), intent(in) :: table(:)  !! the keyword table
+      character(len=*), intent(in) :: word        !! the word of the deck
+
+      do id = 1, size(table)
+         if (table(id)%name == lower(trim(word))) return
+      end do
+      id = 0
+   end function keyword_id
+
+   !> Id of a friction law from its name; 0 for an unknown name.
+   pure integer function law_id(word) result(id)
+      character(len=*), intent(in) :: word  !! the word of the deck
+
+      id = keyword_id(laws%keyword_type, word)
+   end function law_id
+
+   !> The keywords of a table for a message: 'a' (note), 'b', 'c'.
+   pure subroutine keyword_choices(table, text)
+      type(keyword_type), intent(in) :: table(:)        !! the keyword table
+      character(len=:), allocatable, intent(out) :: text !! the list
+      integer :: i
+
+      text = ''
+      do i = 1, size(table)
+         if (i > 1) text = text//', '
+         text = text//"'"//trim(table(i)%name)//"'"
+         if (len_trim(table(i)%note) > 0) text = text//' ('//trim(table(i)%note)//')'
+      end do
+   end subroutine keyword_choices
+
+   !> The names of the laws for a message: 'a', 'b', 'c' (with regularized: only the laws
+   !> that are, or are not, regularized).
+   pure subroutine law_choices(text, regularized)
+      character(len=:), allocatable, intent(out) :: text !! the list
+      logical, intent(in), optional :: regularized       !! which laws to list (default all)
+
+      if (present(regularized)) then
+         call keyword_choices(pack(laws%keyword_type, laws%regularized .eqv. regularized), text)
+      else
+         call keyword_choices(laws%keyword_type, text)
+      end if
+   end subroutine law_choices
+
+   !> Name of a friction law, as written in decks ('unknown' for an id not in the table).
+   pure function law_name(law) result(name)
+      integer, intent(in) :: law                !! law id
+      character(len=keyword_len) :: name        !! its name, left-adjusted
+
+      name = 'unknown'
+      if (law >= 1 .and. law <= size(laws)) name = laws(law)%name
+   end function law_name
+
+   !> Name of a technique, as written in decks ('unknown' for an id not in the table).
+   pure function technique_name(technique) result(name)
+      integer, intent(in) :: technique          !! technique id
+      character(len=keyword_len) :: name        !! its name, left-adjusted
+
+      name = 'unknown'
+      if (technique >= 1 .and. technique <= size(techniques)) name = techniques(technique)%name
+   end function technique_name
+
+end module fd_names

@@ -1,0 +1,207 @@
+!> The observer of a run, one for every technique: it sets up the result, keeps the peaks
+!> over every accepted state, samples the history, counts phase transitions and
+!> correctness violations, and closes the energy balance. A technique hands it the state
+!> (time, table acceleration, u, v, relative acceleration, and per device s, s', F and
+!> phase); a new output quantity is a change here (and in the writer), not in the loops.
+module fd_observer
+   use fd_kinds, only: dp
+   use fd_error, only: error_type
+   use fd_model, only: model_type, integration_type
+   use fd_excitation, only: excitation_type
+   use fd_result, only: result_type, init_result, max_violation_times
+   use fd_linalg, only: sym_matvec
+   implicit none
+   private
+
+   public :: observer_type, observer_init, sample_due, observe_start, observe_peaks, observe_sample
+   public :: observe_transitions, observe_violations, observe_end, strain_energy
+
+   !> What the observer keeps between calls.
+   type :: observer_type
+      integer :: nsteps = 0          !! dt1 steps of the run
+      integer :: every = 1           !! dt1 steps between history rows
+      integer :: rows = 0            !! history rows written
+      real(dp) :: e_kin0 = 0.0_dp    !! kinetic energy at the start [J]
+      real(dp) :: e_str0 = 0.0_dp    !! strain energy at the start [J]
+      real(dp) :: e_dev0 = 0.0_dp    !! elastic energy stored in devices at the start [J]
+   end type observer_type
+
+contains
+
+   !> Set up the result of a run (history, per-DOF and per-device summary) and the
+   !> observer: the number of dt1 steps and the sampling interval.
+   subroutine observer_init(model, exc, opts, res, obs, error)
+      type(model_type), intent(in) :: model         !! the model run
+      type(excitation_type), intent(in) :: exc      !! the table motion
+      type(integration_type), intent(in) :: opts    !! integration settings
+      type(result_type), intent(inout) :: res       !! the result to set up
+      type(observer_type), intent(out) :: obs       !! the observer
+      type(error_type), allocatable, intent(out) :: error !! not enough memory
+
+      call init_result(model, exc, opts, res, obs%nsteps, obs%every, error)
+      if (allocated(error)) return
+      res%technique = opts%technique
+   end subroutine observer_init
+
+   !> Whether the history takes a row after dt1 step k (every `every` steps, and the last).
+   pure logical function sample_due(obs, k)
+      type(observer_type), intent(in) :: obs  !! the observer
+      integer, intent(in) :: k                !! dt1 steps done
+
+      sample_due = mod(k, obs%every) == 0 .or. k == obs%nsteps
+   end function sample_due
+
+   !> Strain energy of the springs, 1/2 u' K u.
+   subroutine strain_energy(k, u, tmp, e)
+      real(dp), intent(in) :: k(:, :)      !! springs' stiffness
+      real(dp), intent(in) :: u(:)         !! displacements
+      real(dp), intent(inout) :: tmp(:)    !! work (n)
+      real(dp), intent(out) :: e           !! 1/2 u' K u [J]
+
+      call sym_matvec(k, u, tmp, 1.0_dp, 0.0_dp)
+      e = 0.5_dp*dot_product(u, tmp)
+   end subroutine strain_energy
+
+   !> Energies of the initial state, from which the balance is counted.
+   subroutine observe_start(obs, mass, k, u, v, e_device, tmp)
+      type(observer_type), intent(inout) :: obs !! the observer
+      real(dp), intent(in) :: mass(:)      !! lumped masses
+      real(dp), intent(in) :: k(:, :)      !! springs' stiffness
+      real(dp), intent(in) :: u(:)         !! displacements at t = 0
+      real(dp), intent(in) :: v(:)         !! velocities at t = 0
+      real(dp), intent(in) :: e_device     !! elastic energy stored in devices at t = 0
+      real(dp), intent(inout) :: tmp(:)    !! work (n)
+
+      obs%e_kin0 = 0.5_dp*sum(mass*v**2)
+      call strain_energy(k, u, tmp, obs%e_str0)
+      obs%e_dev0 = e_device
+   end subroutine observe_start
+
+   !> Peaks over the accepted states: |u| (and its time), |v|, |absolute acceleration| (and
+   !> its time) per DOF, |s| and |F| per device.
+   pure subroutine observe_peaks(res, t, u, v, acc, ag, s, force)
+      type(result_type), intent(inout) :: res  !! the result
+      real(dp), intent(in) :: t                !! time [s]
+      real(dp), intent(in) :: u(:)             !! relative displacements [m]
+      real(dp), intent(in) :: v(:)             !! relative velocities [m/s]
+      real(dp), intent(in) :: acc(:)           !! relative accelerations [m/s2]
+      real(dp), intent(in) :: ag               !! table acceleration [m/s2]
+      real(dp), intent(in) :: s(:)             !! device relative displacements [m]
+      real(dp), intent(in) :: force(:)         !! device forces [N]
+      real(dp) :: x
+      integer :: i
+
+      do i = 1, size(u)
+         if (abs(u(i)) > res%peak_u(i)) then
+            res%peak_u(i) = abs(u(i)); res%peak_u_time(i) = t
+         end if
+         res%peak_v(i) = max(res%peak_v(i), abs(v(i)))
+         x = abs(acc(i) + ag)
+         if (x > res%peak_aabs(i)) then
+            res%peak_aabs(i) = x; res%peak_aabs_time(i) = t
+         end if
+      end do
+      do i = 1, size(s)
+         res%peak_s(i) = max(res%peak_s(i), abs(s(i)))
+         res%peak_force(i) = max(res%peak_force(i), abs(force(i)))
+      end do
+   end subroutine observe_peaks
+
+   !> The next row of the history: t, ag, (u, v, aabs) per DOF, (s, s', F, phase) per device.
+   pure subroutine observe_sample(obs, res, t, ag, u, v, acc, s, sd, force, phase)
+      type(observer_type), intent(inout) :: obs !! the observer
+      type(result_type), intent(inout) :: res  !! the result
+      real(dp), intent(in) :: t                !! time [s]
+      real(dp), intent(in) :: ag               !! table acceleration [m/s2]
+      real(dp), intent(in) :: u(:)             !! relative displacements [m]
+      real(dp), intent(in) :: v(:)             !! relative velocities [m/s]
+      real(dp), intent(in) :: acc(:)           !! relative accelerations [m/s2]
+      real(dp), intent(in) :: s(:)             !! device relative displacements [m]
+      real(dp), intent(in) :: sd(:)            !! device relative velocities [m/s]
+      real(dp), intent(in) :: force(:)         !! device forces [N]
+      integer, intent(in) :: phase(:)          !! device phases (0 stick, +-1 slip)
+      integer :: i, c
+
+      obs%rows = obs%rows + 1
+      if (obs%rows > res%nout) return
+      associate (row => obs%rows)
+         res%hist(1, row) = t
+         res%hist(2, row) = ag
+         c = 2
+         do i = 1, size(u)
+            res%hist(c + 1:c + 3, row) = [u(i), v(i), acc(i) + ag]
+            c = c + 3
+         end do
+         do i = 1, size(s)
+            res%hist(c + 1:c + 4, row) = [s(i), sd(i), force(i), real(phase(i), dp)]
+            c = c + 4
+         end do
+      end associate
+   end subroutine observe_sample
+
+   !> Count the phase changes of the devices: stick to slip, slip to stick, and slip
+   !> reversals (slip + to slip - and back without sticking).
+   pure subroutine observe_transitions(res, old, new)
+      type(result_type), intent(inout) :: res  !! the result
+      integer, intent(in) :: old(:)            !! phases before (0 stick, +-1 slip)
+      integer, intent(in) :: new(:)            !! phases after
+
+      integer :: d
+
+      do d = 1, size(old)
+         if (old(d) == new(d)) cycle
+         if (old(d) == 0) then
+            res%stick_to_slip(d) = res%stick_to_slip(d) + 1
+         else if (new(d) == 0) then
+            res%slip_to_stick(d) = res%slip_to_stick(d) + 1
+         else
+            res%reversals(d) = res%reversals(d) + 1
+         end if
+      end do
+   end subroutine observe_transitions
+
+   !> Count the devices that violate the correctness condition (eqs. 9, 12) in a step
+   !> accepted at time t, and keep the first times and devices.
+   pure subroutine observe_violations(res, t, ok)
+      type(result_type), intent(inout) :: res  !! the result
+      real(dp), intent(in) :: t                !! end of the step [s]
+      logical, intent(in) :: ok(:)             !! per device: the step satisfies the condition
+      integer :: d
+
+      do d = 1, size(ok)
+         if (ok(d)) cycle
+         res%violations = res%violations + 1
+         if (res%n_violation_times < max_violation_times) then
+            res%n_violation_times = res%n_violation_times + 1
+            res%violation_time(res%n_violation_times) = t
+            res%violation_device(res%n_violation_times) = d
+         end if
+      end do
+   end subroutine observe_violations
+
+   !> Close the energy balance at the end of the run: kinetic, strain and device elastic
+   !> energy (end minus start), friction dissipation (device work minus stored energy) and
+   !> the residual input - (kinetic + strain + viscous + friction + device elastic). The
+   !> technique has accumulated the input and viscous work in res.
+   subroutine observe_end(obs, res, mass, k, u, v, e_device, w_device, tmp)
+      type(observer_type), intent(in) :: obs   !! the observer
+      type(result_type), intent(inout) :: res  !! the result
+      real(dp), intent(in) :: mass(:)          !! lumped masses
+      real(dp), intent(in) :: k(:, :)          !! springs' stiffness
+      real(dp), intent(in) :: u(:)             !! displacements at the end
+      real(dp), intent(in) :: v(:)             !! velocities at the end
+      real(dp), intent(in) :: e_device         !! elastic energy stored in devices at the end [J]
+      real(dp), intent(in) :: w_device         !! work of the device forces over the run [J]
+      real(dp), intent(inout) :: tmp(:)        !! work (n)
+      real(dp) :: e
+
+      res%e_kinetic = 0.5_dp*sum(mass*v**2) - obs%e_kin0
+      call strain_energy(k, u, tmp, e)
+      res%e_strain = e - obs%e_str0
+      res%e_device = e_device - obs%e_dev0
+      res%e_friction = w_device - res%e_device
+      res%e_residual = res%e_input - (res%e_kinetic + res%e_strain + res%e_viscous + &
+                                      res%e_friction + res%e_device)
+   end subroutine observe_end
+
+end module fd_observer

@@ -1,0 +1,69 @@
+!> The one dispatch over the time-integration techniques (`technique` of &integration):
+!> 'newmark' (regularized friction laws, the paper's step control) and 'event_driven'
+!> (exact Coulomb friction). Each technique says what it cannot integrate (a law, a table
+!> motion) with an error naming the group, the variable, the value and what to set;
+!> adding a technique is its module, its row in fd_names' technique table and one case in
+!> each routine here.
+module fd_technique
+   use fd_error, only: error_type, fatal_error, fmt_int
+   use fd_names, only: technique_newmark, technique_event_driven, techniques, keyword_choices
+   use fd_model, only: model_type, integration_type
+   use fd_excitation, only: excitation_type
+   use fd_result, only: result_type
+   use fd_newmark, only: run_newmark, newmark_check
+   use fd_event_driven, only: run_event_driven, event_driven_check
+   implicit none
+   private
+
+   public :: check_technique, run_technique
+
+contains
+
+   !> An error for anything of the model or the table motion the chosen technique cannot
+   !> integrate (messages start with "group &...": the deck reader prefixes the deck).
+   subroutine check_technique(model, exc, opts, error)
+      type(model_type), intent(in) :: model         !! the model
+      type(excitation_type), intent(in) :: exc      !! the table motion
+      type(integration_type), intent(in) :: opts    !! the technique and its settings
+      type(error_type), allocatable, intent(out) :: error !! what cannot be integrated
+
+      select case (opts%technique)
+      case (technique_newmark)
+         call newmark_check(model, exc, error)
+      case (technique_event_driven)
+         call event_driven_check(model, exc, error)
+      case default
+         call unknown_technique(opts%technique, error)
+      end select
+   end subroutine check_technique
+
+   !> Run the technique the settings choose.
+   subroutine run_technique(model, exc, opts, res, error)
+      type(model_type), intent(in) :: model         !! validated model
+      type(excitation_type), intent(in) :: exc      !! validated table motion
+      type(integration_type), intent(in) :: opts    !! validated settings
+      type(result_type), intent(out) :: res         !! histories and summary
+      type(error_type), allocatable, intent(out) :: error !! what the technique cannot do, or
+                                                          !! its failure
+
+      select case (opts%technique)
+      case (technique_newmark)
+         call run_newmark(model, exc, opts, res, error)
+      case (technique_event_driven)
+         call run_event_driven(model, exc, opts, res, error)
+      case default
+         call unknown_technique(opts%technique, error)
+      end select
+   end subroutine run_technique
+
+   subroutine unknown_technique(technique, error)
+      integer, intent(in) :: technique
+      type(error_type), allocatable, intent(out) :: error
+      character(len=:), allocatable :: choices
+
+      call keyword_choices(techniques, choices)
+      call fatal_error(error, "group &integration: technique (id "//trim(fmt_int(technique))// &
+                       ") is not a technique of this build; one of "//choices)
+   end subroutine unknown_technique
+
+end module fd_technique

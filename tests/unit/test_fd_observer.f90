@@ -1,0 +1,180 @@
+!> Unit tests of the observer (fd_observer) that every technique reports to: the history
+!> rows and their layout, the sampling grid, peaks and their times, transitions,
+!> correctness violations, and the closing of the energy balance.
+module test_fd_observer
+   use testdrive, only: new_unittest, unittest_type, error_type, check, test_failed
+   use fd_kinds, only: dp
+   use fd_error, only: fd_error_type => error_type
+   use fd_model, only: model_type, device_type, integration_type, law_velocity
+   use fd_excitation, only: excitation_type, excitation_none
+   use fd_result, only: result_type, max_violation_times
+   use fd_observer, only: observer_type, observer_init, sample_due, observe_start, observe_peaks, &
+                          observe_sample, observe_transitions, observe_violations, observe_end
+   implicit none
+   private
+
+   public :: collect_observer
+
+contains
+
+   subroutine collect_observer(testsuite)
+      type(unittest_type), allocatable, intent(out) :: testsuite(:)
+
+      testsuite = [ &
+                  new_unittest("sampling grid and history rows", test_history), &
+                  new_unittest("peaks and their times", test_peaks), &
+                  new_unittest("phase transitions", test_transitions), &
+                  new_unittest("correctness violations", test_violations), &
+                  new_unittest("energy balance of a free oscillator", test_energy) &
+                  ]
+   end subroutine collect_observer
+
+   !> Two masses, one device, table at rest for 25 steps of dt1 = 0.5 ms, a row every 20.
+   subroutine setup(model, res, obs, error)
+      type(model_type), intent(out) :: model
+      type(result_type), intent(out) :: res
+      type(observer_type), intent(out) :: obs
+      type(error_type), allocatable, intent(out) :: error
+      type(excitation_type) :: exc
+      type(integration_type) :: opts
+      type(fd_error_type), allocatable :: err
+
+      model%n_dof = 2
+      model%mass = [2.0_dp, 1.0_dp]
+      model%n_devices = 1
+      model%dev = [device_type(node_i=1, node_j=2, law=law_velocity, p=10.0_dp, mu=0.2_dp)]
+      exc%kind = excitation_none
+      exc%dt_record = 0.01_dp
+      exc%duration = 0.0123_dp
+      opts%n1 = 20
+      call observer_init(model, exc, opts, res, obs, err)
+      if (allocated(err)) call test_failed(error, err%message)
+   end subroutine setup
+
+   subroutine test_history(error)
+      type(error_type), allocatable, intent(out) :: error
+      type(model_type) :: model
+      type(result_type) :: res
+      type(observer_type) :: obs
+      integer :: k, due(25), i
+
+      call setup(model, res, obs, error)
+      if (allocated(error)) return
+      ! nint(0.0123 / 5e-4) = 25 steps: rows at t = 0, after step 20 and at the end
+      call check(error, obs%nsteps == 25 .and. res%nout == 3 .and. res%ncol == 2 + 3*2 + 4*1, &
+                 "history shape")
+      if (allocated(error)) return
+      due = 0
+      do k = 1, 25
+         if (sample_due(obs, k)) due(k) = 1
+      end do
+      call check(error, sum(due) == 2 .and. due(20) == 1 .and. due(25) == 1, "rows after steps 20 and 25")
+      if (allocated(error)) return
+      do i = 1, 4   ! the fourth row is beyond the history and is not written
+         call observe_sample(obs, res, 0.01_dp*i, -0.5_dp*i, [1.0_dp, 2.0_dp]*i, [3.0_dp, 4.0_dp]*i, &
+                             [5.0_dp, 6.0_dp]*i, [7.0_dp]*i, [8.0_dp]*i, [9.0_dp]*i, [-1])
+      end do
+      call check(error, obs%rows == 4, "rows counted")
+      if (allocated(error)) return
+      ! t, ag, (u, v, aabs = a + ag) per DOF, (s, s', F, phase) per device
+      call check(error, all(res%hist(:, 2) == [0.02_dp, -1.0_dp, 2.0_dp, 6.0_dp, 9.0_dp, 4.0_dp, 8.0_dp, &
+                                               11.0_dp, 14.0_dp, 16.0_dp, 18.0_dp, -1.0_dp]), &
+                 "layout of a history row")
+   end subroutine test_history
+
+   subroutine test_peaks(error)
+      type(error_type), allocatable, intent(out) :: error
+      type(model_type) :: model
+      type(result_type) :: res
+      type(observer_type) :: obs
+
+      call setup(model, res, obs, error)
+      if (allocated(error)) return
+      call observe_peaks(res, 0.1_dp, [0.01_dp, 0.0_dp], [0.5_dp, -0.1_dp], [1.0_dp, 0.0_dp], 2.0_dp, &
+                         [0.01_dp], [3.0_dp])
+      call observe_peaks(res, 0.2_dp, [-0.03_dp, 0.02_dp], [-0.7_dp, 0.2_dp], [-1.0_dp, 0.0_dp], -4.0_dp, &
+                         [-0.05_dp], [-1.0_dp])
+      call observe_peaks(res, 0.3_dp, [0.02_dp, 0.01_dp], [0.1_dp, 0.3_dp], [0.0_dp, 5.5_dp], 0.0_dp, &
+                         [0.02_dp], [2.0_dp])
+      ! |u| and its time; |v|; |a + ag| (absolute acceleration) and its time
+      call check(error, all(res%peak_u == [0.03_dp, 0.02_dp]) .and. all(res%peak_u_time == [0.2_dp, 0.2_dp]), &
+                 "peak |u| and its time")
+      if (allocated(error)) return
+      call check(error, all(res%peak_v == [0.7_dp, 0.3_dp]), "peak |v|")
+      if (allocated(error)) return
+      call check(error, all(res%peak_aabs == [5.0_dp, 5.5_dp]) .and. &
+                 all(res%peak_aabs_time == [0.2_dp, 0.3_dp]), "peak |aabs| and its time")
+      if (allocated(error)) return
+      call check(error, res%peak_s(1) == 0.05_dp .and. res%peak_force(1) == 3.0_dp, "peak |s| and |F|")
+   end subroutine test_peaks
+
+   subroutine test_transitions(error)
+      type(error_type), allocatable, intent(out) :: error
+      type(model_type) :: model
+      type(result_type) :: res
+      type(observer_type) :: obs
+      integer :: i
+      integer, parameter :: phases(*) = [0, 1, 1, 0, -1, 1, -1, 0, 0]
+
+      call setup(model, res, obs, error)
+      if (allocated(error)) return
+      do i = 2, size(phases)
+         call observe_transitions(res, phases(i - 1:i - 1), phases(i:i))
+      end do
+      ! stick->slip at 0->1 and 0->-1; slip->stick at 1->0 and -1->0; reversals -1->1, 1->-1
+      call check(error, res%stick_to_slip(1) == 2 .and. res%slip_to_stick(1) == 2 .and. res%reversals(1) == 2, &
+                 "transition counts")
+   end subroutine test_transitions
+
+   subroutine test_violations(error)
+      type(error_type), allocatable, intent(out) :: error
+      type(model_type) :: model
+      type(result_type) :: res
+      type(observer_type) :: obs
+      integer :: i
+
+      call setup(model, res, obs, error)
+      if (allocated(error)) return
+      call observe_violations(res, 0.5_dp, [.true.])
+      do i = 1, 12
+         call observe_violations(res, 1.0_dp*i, [.false.])
+      end do
+      call check(error, res%violations == 12 .and. res%n_violation_times == max_violation_times, &
+                 "every violation counted, the first ones kept")
+      if (allocated(error)) return
+      call check(error, res%violation_time(1) == 1.0_dp .and. res%violation_time(10) == 10.0_dp .and. &
+                 all(res%violation_device(1:10) == 1), "times and devices of the first violations")
+   end subroutine test_violations
+
+   !> An undamped oscillator from its extreme (u0, v = 0) to its centre (u = 0, v = w u0):
+   !> the kinetic energy gained is the strain energy lost, and the residual is round-off;
+   !> friction dissipation is device work minus the change of stored device energy.
+   subroutine test_energy(error)
+      type(error_type), allocatable, intent(out) :: error
+      type(model_type) :: model
+      type(result_type) :: res
+      type(observer_type) :: obs
+      real(dp) :: k(2, 2), tmp(2), m(2), u0, w, e
+
+      call setup(model, res, obs, error)
+      if (allocated(error)) return
+      m = [2.0_dp, 1.0_dp]
+      k = reshape([800.0_dp, 0.0_dp, 0.0_dp, 100.0_dp], [2, 2])
+      u0 = 0.01_dp
+      w = sqrt(800.0_dp/2.0_dp)
+      e = 0.5_dp*800.0_dp*u0**2
+      call observe_start(obs, m, k, [u0, 0.0_dp], [0.0_dp, 0.0_dp], 0.3_dp, tmp)
+      call observe_end(obs, res, m, k, [0.0_dp, 0.0_dp], [w*u0, 0.0_dp], 0.2_dp, 1.0_dp, tmp)
+      call check(error, res%e_kinetic, e, rel=.true., thr=1.0e-15_dp)
+      if (allocated(error)) return
+      call check(error, res%e_strain, -e, rel=.true., thr=1.0e-15_dp)
+      if (allocated(error)) return
+      call check(error, res%e_device, -0.1_dp, thr=1.0e-16_dp)
+      if (allocated(error)) return
+      call check(error, res%e_friction, 1.1_dp, thr=1.0e-15_dp)
+      if (allocated(error)) return
+      ! no input, no viscous work: the friction work is the only imbalance
+      call check(error, res%e_residual, -(res%e_friction + res%e_device), thr=1.0e-15_dp)
+   end subroutine test_energy
+
+end module test_fd_observer

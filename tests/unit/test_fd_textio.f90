@@ -1,0 +1,68 @@
+!> Unit tests of the text-file reader (fd_textio): a file of several read buffers (the
+!> buffer grows geometrically), line ends (LF, CRLF, none at the end), a missing file.
+module test_fd_textio
+   use testdrive, only: new_unittest, unittest_type, error_type, check, test_failed
+   use fd_error, only: fd_error_type => error_type, fmt_int
+   use fd_textio, only: line_type, read_text_file
+   implicit none
+   private
+
+   public :: collect_textio
+
+contains
+
+   subroutine collect_textio(testsuite)
+      type(unittest_type), allocatable, intent(out) :: testsuite(:)
+
+      testsuite = [ &
+                  new_unittest("large file, line ends", test_large_file), &
+                  new_unittest("missing file", test_missing) &
+                  ]
+   end subroutine collect_textio
+
+   !> 40000 lines (about 0.6 MB, ten 64 KiB buffers), every seventh ending in CRLF, the last
+   !> without a newline: every line read back exactly.
+   subroutine test_large_file(error)
+      type(error_type), allocatable, intent(out) :: error
+      character(len=*), parameter :: path = 'test_fd_textio.tmp'
+      type(line_type), allocatable :: lines(:)
+      type(fd_error_type), allocatable :: err
+      integer :: unit, i, n
+      character(len=:), allocatable :: eol
+
+      n = 40000
+      open (newunit=unit, file=path, access='stream', form='unformatted', status='replace')
+      do i = 1, n
+         eol = achar(10)
+         if (mod(i, 7) == 0) eol = achar(13)//achar(10)
+         if (i == n) eol = ''
+         write (unit) 'line '//trim(fmt_int(i))//' of the test'//eol
+      end do
+      close (unit)
+      call read_text_file(path, lines, err)
+      open (newunit=unit, file=path, status='old')
+      close (unit, status='delete')
+      if (allocated(err)) then
+         call test_failed(error, err%message); return
+      end if
+      call check(error, size(lines), n)
+      if (allocated(error)) return
+      do i = 1, n
+         if (lines(i)%s /= 'line '//trim(fmt_int(i))//' of the test') then
+            call test_failed(error, "line "//trim(fmt_int(i))//" read as '"//lines(i)%s//"'"); return
+         end if
+      end do
+   end subroutine test_large_file
+
+   subroutine test_missing(error)
+      type(error_type), allocatable, intent(out) :: error
+      type(line_type), allocatable :: lines(:)
+      type(fd_error_type), allocatable :: err
+
+      call read_text_file('no/such/file.txt', lines, err)
+      call check(error, allocated(err), "a missing file must be an error")
+      if (allocated(error)) return
+      call check(error, index(err%message, 'no/such/file.txt') > 0, "message names the file: "//err%message)
+   end subroutine test_missing
+
+end module test_fd_textio
