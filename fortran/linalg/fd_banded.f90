@@ -6,12 +6,14 @@
 !> K (springs) and C (a0 M + a1 K + dashpots) are stored once, in a reverse Cuthill-McKee
 !> ordering of the graph of springs, dashpots and devices, as symmetric band matrices
 !> (memory n (bandwidth + 1) each); K^ is factored by LAPACK's banded Cholesky (dpbtrf). A
-!> small system (n <= spd_dense_max_n, or a band nearly as wide as the matrix) is stored
-!> dense and factored by dpotrf instead, where that is faster.
+!> small system (n <= spd_dense_max_n) is stored dense and factored by dpotrf instead, where
+!> that is faster.
 !>
 !> A change of one device's kd is a rank-one change of K^: its factor is updated (kd grew)
 !> or downdated (kd shrank) in O((n - first column) * bandwidth) operations, with the
-!> mixed hyperbolic rotations of Chambers / Bojanczyk et al. When several devices change
+!> mixed hyperbolic rotations of Chambers / Bojanczyk et al., stopped once the rest of the
+!> change is below rounding (in a K^ dominated by inertia, after a few columns: the cost of
+!> an update then does not grow with n). When several devices change
 !> together, the factor is recomputed from the first changed column instead if that costs
 !> fewer operations. A per-column estimate of the backward error that updates add (with
 !> respect to a fresh factor) is kept; a downdate whose pivot collapses (positive
@@ -19,6 +21,7 @@
 !> refactored, counted in the statistics. After spd_setup nothing allocates.
 module fd_banded
    use, intrinsic :: ieee_arithmetic, only: ieee_is_finite
+   use, intrinsic :: iso_fortran_env, only: int64
    use fd_kinds, only: dp
    use fd_error, only: error_type, fatal_error, fmt_int, fmt_real
    use fd_rcm, only: rcm_order, graph_bandwidth
@@ -38,18 +41,25 @@ module fd_banded
    integer, parameter :: spd_rank_one = 1  !! device changes: always rank-one modifications
    integer, parameter :: spd_refactor = 2  !! device changes: always refactor from the first column
 
-   !> Largest n stored dense by spd_auto (measured crossover, bench/banded.sh).
-   integer, parameter :: spd_dense_max_n = 4
+   !> Largest n stored dense by spd_auto: the measured crossover of a step's solve and two
+   !> products (bash bench/banded.sh small; banded is faster from n = 9 on).
+   integer, parameter :: spd_dense_max_n = 8
 
    !> Backward error a single rank-one modification adds, relative to the pivot it touches.
    real(dp), parameter :: unit_error = 2.0_dp*epsilon(1.0_dp)
+   !> Update entries below this times their pivot are dropped (tau^2 = eps/4).
+   real(dp), parameter :: truncate_tol = 0.5_dp*sqrt(epsilon(1.0_dp))
+   !> Order (dense) or band up to which the unblocked LAPACK factorizations are called.
+   integer, parameter :: unblocked_max = 64
    !> A pivot^2 below this times (band + 1) times its diagonal is rounding noise.
    real(dp), parameter :: singular_tol = 4.0_dp*epsilon(1.0_dp)
    !> Default budget of that estimated error before a refactorization.
    real(dp), parameter :: default_budget = 1.0e-12_dp
-   !> Operation-count weights (flop equivalents of the per-column overhead: square root,
-   !> divisions, loop and call overhead), measured by bench/banded.sh.
-   real(dp), parameter :: w_update = 20.0_dp, w_factor = 30.0_dp
+   !> Cost model, in flop equivalents, measured by `bash bench/banded.sh calibrate` (about
+   !> 0.37 ns each): a rank-one modification costs w_update + band per column touched (it is
+   !> bound by the latency of a square root and two divisions, not by its 4 band flops), a
+   !> refactorization w_factor + band^2 + 2 band per column (dpbtf2's two BLAS calls).
+   real(dp), parameter :: w_update = 64.0_dp, w_factor = 90.0_dp
 
    !> What the factor has cost so far; the caller may report it.
    type :: spd_stats
@@ -59,6 +69,7 @@ module fd_banded
       integer :: downdates = 0      !! rank-one downdates made (a device stiffness shrank)
       integer :: fallbacks = 0      !! downdates abandoned (pivot lost to round-off): refactored
       integer :: refreshes = 0      !! modifications that would exceed the error budget: refactored
+      integer(int64) :: update_columns = 0 !! columns touched by the rank-one modifications
    end type spd_stats
 
    !> The system: structure, storage, factor and work space. Set up by spd_setup.
@@ -74,6 +85,7 @@ module fd_banded
       logical, private :: factored = .false.          !! fac holds the factor of K^
       real(dp), private :: c0 = 0.0_dp, c1 = 0.0_dp  !! coefficients of M and C in K^
       real(dp), private :: budget = default_budget    !! allowed estimated update error
+      real(dp), private :: span = huge(1.0_dp)        !! running mean of columns per update
       integer, allocatable, private :: perm(:)        !! new -> old DOF
       integer, allocatable, private :: inv(:)         !! old -> new DOF
       integer, allocatable, private :: dlo(:), dhi(:) !! device columns (new), dlo < dhi or dhi = 0
@@ -96,14 +108,27 @@ module fd_banded
          real(dp), intent(inout) :: a(lda, *)
          integer, intent(out) :: info
       end subroutine dpotrf
-      subroutine dpotrs(uplo, n, nrhs, a, lda, b, ldb, info)
+      subroutine dpotf2(uplo, n, a, lda, info)
          import :: dp
          character(len=1), intent(in) :: uplo
-         integer, intent(in) :: n, nrhs, lda, ldb
-         real(dp), intent(in) :: a(lda, *)
-         real(dp), intent(inout) :: b(ldb, *)
+         integer, intent(in) :: n, lda
+         real(dp), intent(inout) :: a(lda, *)
          integer, intent(out) :: info
-      end subroutine dpotrs
+      end subroutine dpotf2
+      subroutine dpbtf2(uplo, n, kd, ab, ldab, info)
+         import :: dp
+         character(len=1), intent(in) :: uplo
+         integer, intent(in) :: n, kd, ldab
+         real(dp), intent(inout) :: ab(ldab, *)
+         integer, intent(out) :: info
+      end subroutine dpbtf2
+      subroutine dtrsv(uplo, trans, diag, n, a, lda, x, incx)
+         import :: dp
+         character(len=1), intent(in) :: uplo, trans, diag
+         integer, intent(in) :: n, lda, incx
+         real(dp), intent(in) :: a(lda, *)
+         real(dp), intent(inout) :: x(*)
+      end subroutine dtrsv
       subroutine dpbtrf(uplo, n, kd, ab, ldab, info)
          import :: dp
          character(len=1), intent(in) :: uplo
@@ -263,9 +288,10 @@ contains
       end do
       kbw = graph_bandwidth(ei, ej, sys%inv)
       if (mode == spd_auto) then
-         ! dense where it is faster: a few DOFs, or a band nearly as wide as the matrix
+         ! dense where it is faster: a few DOFs (a band nearly as wide as the matrix is no
+         ! slower than dense storage: bench/banded.sh wide)
          mode = spd_banded
-         if (n <= spd_dense_max_n .or. 2*(kbw + 1) > n) mode = spd_dense
+         if (n <= spd_dense_max_n) mode = spd_dense
       end if
       sys%n = n
       sys%nd = nd
@@ -441,6 +467,7 @@ contains
       sys%c0 = c0
       sys%c1 = c1
       sys%kd(:) = kd
+      sys%span = huge(1.0_dp)
       call full_factor(sys, error)
    end subroutine spd_factor
 
@@ -519,8 +546,14 @@ contains
                end do
             end if
          end if
-         if (sys%dense) then
+         ! the unblocked kernels where the blocked drivers would choose them anyway (dpbtrf
+         ! for a band <= 64) or lose to them (dpotrf below 64): no ilaenv query per call
+         if (sys%dense .and. n - p + 1 <= unblocked_max) then
+            call dpotf2('U', n - p + 1, fac(idx(sys, p, p)), n, info)
+         else if (sys%dense) then
             call dpotrf('U', n - p + 1, fac(idx(sys, p, p)), n, info)
+         else if (kb <= unblocked_max) then
+            call dpbtf2('U', n - p + 1, kb, fac(idx(sys, p, p) - kb), sys%ld, info)
          else
             call dpbtrf('U', n - p + 1, kb, fac(idx(sys, p, p) - kb), sys%ld, info)
          end if
@@ -661,10 +694,15 @@ contains
 
    !> U' U + delta v v' -> U' U, v = e_a - e_b (e_a when b = 0), a < b: hyperbolic
    !> (delta < 0) or circular (delta > 0) rotations in the mixed form, column a to n,
-   !> touching the band only. status: 0 done; 1 abandoned, a pivot collapsed (the
-   !> downdate alone loses more than the budget); 2 abandoned, the accumulated error
-   !> estimate would exceed the budget. An abandoned modification leaves the factor
-   !> partly modified and marked not factored.
+   !> touching the band only. The rotations stop early once the rest of the update vector
+   !> is negligible: when every remaining entry x_j satisfies |x_j| <= tau U_jj, the
+   !> neglected x x' is at most tau^2 = eps/4 relative to the diagonal (below rounding). In a
+   !> diagonally dominant K^ (inertia c0 M against springs, as at Newmark's small steps) the
+   !> change of the factor decays geometrically along the band, so an update costs a few
+   !> decay lengths, not n. status: 0 done; 1 abandoned, a pivot collapsed (the downdate
+   !> alone loses more than the budget); 2 abandoned, the accumulated error estimate would
+   !> exceed the budget. An abandoned modification leaves the factor partly modified and
+   !> marked not factored.
    subroutine rank_one(sys, a, b, delta, status)
       type(spd_system), intent(inout) :: sys
       integer, intent(in) :: a, b
@@ -687,51 +725,79 @@ contains
          k = a
          do while (k <= last)
             xk = xv(k)
-            if (xk /= 0.0_dp) then
-               xv(k) = 0.0_dp
-               kk = idx(sys, k, k)
-               ukk = fac(kk)
-               s = xk/ukk
-               if (up) then
-                  ratio = 1.0_dp + s*s
-               else
-                  ratio = (1.0_dp - s)*(1.0_dp + s)
-               end if
-               e = (errcol(k) + unit_error)/ratio
-               if (.not. (ratio > 0.0_dp .and. e <= sys%budget)) then
-                  status = 2
-                  if (.not. (ratio > 0.0_dp .and. unit_error <= sys%budget*ratio)) status = 1
-                  xv(k:min(n, k + kb)) = 0.0_dp
-                  sys%factored = .false.
-                  return
-               end if
-               errcol(k) = e
-               c = sqrt(ratio)
-               ci = 1.0_dp/c
-               fac(kk) = ukk*c
-               jmax = min(n, k + kb)
-               ij = kk
-               if (up) then
-                  do j = k + 1, jmax
-                     ij = ij + sj
-                     u = (fac(ij) + s*xv(j))*ci
-                     fac(ij) = u
-                     xv(j) = c*xv(j) - s*u
-                  end do
-               else
-                  do j = k + 1, jmax
-                     ij = ij + sj
-                     u = (fac(ij) - s*xv(j))*ci
-                     fac(ij) = u
-                     xv(j) = c*xv(j) - s*u
-                  end do
-               end if
-               last = max(last, jmax)
+            if (xk == 0.0_dp) then
+               k = k + 1
+               cycle
             end if
+            kk = idx(sys, k, k)
+            ukk = fac(kk)
+            if (abs(xk) <= truncate_tol*ukk) then
+               if (negligible(sys, k + 1, min(last, k + kb))) then
+                  do j = k, min(last, k + kb)
+                     errcol(j) = errcol(j) + truncate_tol**2
+                     xv(j) = 0.0_dp
+                  end do
+                  exit
+               end if
+            end if
+            xv(k) = 0.0_dp
+            s = xk/ukk
+            if (up) then
+               ratio = 1.0_dp + s*s
+            else
+               ratio = (1.0_dp - s)*(1.0_dp + s)
+            end if
+            e = (errcol(k) + unit_error)/ratio
+            if (.not. (ratio > 0.0_dp .and. e <= sys%budget)) then
+               status = 2
+               if (.not. (ratio > 0.0_dp .and. unit_error <= sys%budget*ratio)) status = 1
+               xv(k:min(n, k + kb)) = 0.0_dp
+               sys%factored = .false.
+               return
+            end if
+            errcol(k) = e
+            c = sqrt(ratio)
+            ci = 1.0_dp/c
+            fac(kk) = ukk*c
+            jmax = min(n, k + kb)
+            ij = kk
+            if (up) then
+               do j = k + 1, jmax
+                  ij = ij + sj
+                  u = (fac(ij) + s*xv(j))*ci
+                  fac(ij) = u
+                  xv(j) = c*xv(j) - s*u
+               end do
+            else
+               do j = k + 1, jmax
+                  ij = ij + sj
+                  u = (fac(ij) - s*xv(j))*ci
+                  fac(ij) = u
+                  xv(j) = c*xv(j) - s*u
+               end do
+            end if
+            last = max(last, jmax)
             k = k + 1
          end do
       end associate
+      ! columns touched, and their running average (the cost model's length of an update)
+      k = min(k, n + 1) - a
+      sys%stats%update_columns = sys%stats%update_columns + k
+      sys%span = 0.875_dp*sys%span + 0.125_dp*real(k, dp)
    end subroutine rank_one
+
+   !> Whether every entry of the update vector in columns j1..j2 is negligible.
+   pure logical function negligible(sys, j1, j2)
+      type(spd_system), intent(in) :: sys
+      integer, intent(in) :: j1, j2
+      integer :: j
+
+      negligible = .false.
+      do j = j1, j2
+         if (abs(sys%xv(j)) > truncate_tol*sys%fac(idx(sys, j, j))) return
+      end do
+      negligible = .true.
+   end function negligible
 
    !> Whether to refactor rather than modify, by the method or the operation counts.
    pure logical function prefer_refactor(sys, refactor, modify)
@@ -765,14 +831,15 @@ contains
       end if
    end subroutine band_sums
 
-   !> Operations of one rank-one modification from column p.
+   !> Operations of one rank-one modification from column p: n - p + 1 columns, or as many
+   !> as the recent updates touched before their change decayed below rounding.
    pure real(dp) function cost_update(sys, p)
       type(spd_system), intent(in) :: sys
       integer, intent(in) :: p
-      real(dp) :: s1, s2
+      real(dp) :: cols
 
-      call band_sums(sys%n, sys%kb, p, s1, s2)
-      cost_update = w_update*real(sys%n - p + 1, dp) + 4.0_dp*s1
+      cols = min(real(sys%n - p + 1, dp), sys%span)
+      cost_update = cols*(w_update + real(min(sys%kb, sys%n - p), dp))
    end function cost_update
 
    !> Operations of a refactorization from column p (the rows above p included).
@@ -804,7 +871,9 @@ contains
          return
       end if
       if (sys%dense) then
-         call dpotrs('U', sys%n, 1, sys%fac, sys%ld, b, sys%n, info)
+         ! U' U x = b: two triangular solves (dpotrs's work without its level-3 call overhead)
+         call dtrsv('U', 'T', 'N', sys%n, sys%fac, sys%ld, b, 1)
+         call dtrsv('U', 'N', 'N', sys%n, sys%fac, sys%ld, b, 1)
       else
          do i = 1, sys%n
             sys%w1(i) = b(sys%perm(i))
