@@ -19,6 +19,7 @@ program tester
    use test_fd_root_finder, only: collect_root_finder
    use test_fd_phase_pattern, only: collect_phase_pattern
    use test_fd_observer, only: collect_observer
+   use test_fd_banded, only: collect_banded
    implicit none
    integer :: stat, is
    character(len=:), allocatable :: suite_name, test_name
@@ -43,6 +44,10 @@ program tester
    testsuites = [testsuites, new_testsuite("root_finder", collect_root_finder)]
    testsuites = [testsuites, new_testsuite("phase_pattern", collect_phase_pattern)]
    testsuites = [testsuites, new_testsuite("observer", collect_observer)]
+   testsuites = [ &
+                new_testsuite("format", collect_format), &
+                new_testsuite("banded", collect_banded) &
+                ]
 
    call get_argument(1, suite_name)
    call get_argument(2, test_name)
