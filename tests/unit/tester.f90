@@ -44,10 +44,7 @@ program tester
    testsuites = [testsuites, new_testsuite("root_finder", collect_root_finder)]
    testsuites = [testsuites, new_testsuite("phase_pattern", collect_phase_pattern)]
    testsuites = [testsuites, new_testsuite("observer", collect_observer)]
-   testsuites = [ &
-                new_testsuite("format", collect_format), &
-                new_testsuite("banded", collect_banded) &
-                ]
+   testsuites = [testsuites, new_testsuite("banded", collect_banded)]
 
    call get_argument(1, suite_name)
    call get_argument(2, test_name)
