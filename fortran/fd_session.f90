@@ -8,22 +8,31 @@
 !> session_write writes the outputs with the library's writer. session_adopt makes a solved
 !> session from a history and texts given by the caller, to write them with the same writer.
 !>
-!> Room to grow: a cancel flag and the current time of a running solve belong here (the solver
-!> polls and updates them through its observer), as does a choice of the DOFs and devices to keep
-!> (set between open and solve; session_shape then reports the reduced history).
+!> The run's control (fd_run_control) lives here too: between open and solve the caller may
+!> choose the DOFs and devices the history keeps (session_select; session_shape then reports
+!> the reduced history), ask for the history to be written to its output file as the run goes
+!> (session_stream: memory then does not grow with the duration; session_write commits the
+!> file), give a buffer of its own that the rows go to (session_solve's `buffer`: the history is
+!> then held once, by the caller) and a progress callback. While a solve runs in one thread,
+!> another may call session_cancel (the solver stops within a poll, ~10 ms, with an error of
+!> stat_cancelled; a streamed file is removed) and session_progress (the time reached).
 module fd_session
    use, intrinsic :: iso_c_binding, only: c_int64_t, c_intptr_t, c_ptr, c_loc, c_f_pointer
    use fd_kinds, only: dp
    use fd_error, only: error_type, fatal_error, fmt_int
    use frictiondyn, only: run_config, result_type, read_deck, read_deck_string, run_config_solve, &
                           shape_of, summary_json, history_header, output_paths, write_outputs, &
-                          write_output_files
+                          write_output_files, run_control, select_history
+   use fd_run_control, only: progress_callback, control_reset
+   use fd_history_stream, only: stream_close, stream_discard
+   use fd_output, only: commit_streamed_outputs, make_dir
    implicit none
    private
 
    public :: session_type, session_open, session_open_text, session_adopt, session_solve
    public :: session_shape, session_text, session_set_output_dir, session_write, session_write_files
    public :: session_new, session_from_handle, session_free
+   public :: session_select, session_stream, session_cancel, session_progress, session_set_progress
    public :: text_header, text_summary, text_output_dir, text_output_name, text_history_path, &
              text_summary_path, text_deck, text_error
 
@@ -54,6 +63,10 @@ module fd_session
       type(error_type), allocatable :: error          !! last error, for a caller that keeps it
                                                       !! here (the C layer); the procedures below
                                                       !! return theirs as an argument
+      type(run_control) :: ctl                        !! history selection, destinations, stop
+      logical :: stream = .false.                     !! write the history file as the run goes
+      character(len=:), allocatable :: stream_tmp     !! its temporary name, once complete
+      logical :: have_history = .false.               !! res%hist holds the history
    end type session_type
 
 contains
@@ -88,7 +101,10 @@ contains
       integer(c_int64_t), intent(in) :: handle        !! the handle (0: nothing to free)
       type(session_type), pointer :: s
       call session_from_handle(handle, s)
-      if (associated(s)) deallocate (s)
+      if (associated(s)) then
+         call stream_discard(s%ctl%stream)   ! a streamed history never committed is removed
+         deallocate (s)
+      end if
    end subroutine session_free
 
    !> Read and validate a deck file into a fresh session.
@@ -141,21 +157,110 @@ contains
       s%state = session_solved
    end subroutine session_adopt
 
-   !> Run the session's deck; its history, header and summary are then available.
-   subroutine session_solve(s, error)
-      type(session_type), intent(inout) :: s              !! a session with a deck read
+   !> Run the session's deck; its header and summary are then available, and its history:
+   !> in `buffer` when given (the caller's (ncol, nout) array, filled row by row; the session
+   !> keeps none), else in the session (unless the session streams its history and `keep` is
+   !> false). A streamed history is complete under its temporary name (session_write renames
+   !> it); on failure or cancel it is removed.
+   subroutine session_solve(s, error, buffer, keep)
+      type(session_type), intent(inout), target :: s      !! a session with a deck read
       type(error_type), allocatable, intent(out) :: error !! wrong state, or the solver failed
+      real(dp), intent(inout), target, optional :: buffer(:, :) !! where the rows go
+      logical, intent(in), optional :: keep               !! hold the history in the session
+                                                          !! (default: unless streamed)
+      type(error_type), allocatable :: close_error
+      character(len=:), allocatable :: hist, summ, tag
+      character(len=24) :: addr
+
       call need(s, session_read, 'solve', error)
       if (allocated(error)) return
-      call run_config_solve(s%cfg, s%res, error)
+      call control_reset(s%ctl)
+      s%ctl%keep = .not. s%stream
+      if (present(keep)) s%ctl%keep = keep
+      if (present(buffer)) then
+         s%ctl%buffer => buffer
+         s%ctl%keep = .false.
+      end if
+      if (allocated(s%ctl%stream_path)) deallocate (s%ctl%stream_path)
+      if (s%stream) then
+         call make_dir(s%cfg%out%dir, error)
+         if (allocated(error)) then
+            s%state = state_failed
+            return
+         end if
+         call output_paths(s%cfg%out, hist, summ)
+         ! a name unique to this session while it lives (its address), created exclusively
+         write (addr, '(z0)') transfer(c_loc(s), 0_c_intptr_t)
+         tag = trim(addr)
+         s%ctl%stream_path = hist//'.'//tag//'.tmp'
+      end if
+      call run_config_solve(s%cfg, s%res, error, s%ctl)
+      nullify (s%ctl%buffer)
       if (allocated(error)) then
+         if (s%stream) call stream_discard(s%ctl%stream)
          s%state = state_failed
          return
       end if
+      if (s%stream) then
+         call stream_close(s%ctl%stream, close_error)
+         if (allocated(close_error)) then
+            call move_alloc(close_error, error)
+            s%state = state_failed
+            return
+         end if
+         s%stream_tmp = s%ctl%stream_path
+      end if
+      s%have_history = s%ctl%keep
       call history_header(s%res, s%header)
       call summary_json(s%cfg%model, s%res, s%cfg%deck_path, s%summary)
       s%state = session_solved
    end subroutine session_solve
+
+   !> Keep only these DOFs and devices in the history (ascending, 1-based); before solve.
+   subroutine session_select(s, dofs, devices, error)
+      type(session_type), intent(inout) :: s              !! a session with a deck read
+      integer, intent(in) :: dofs(:)                      !! DOFs kept
+      integer, intent(in) :: devices(:)                   !! devices kept
+      type(error_type), allocatable, intent(out) :: error !! wrong state, a number out of range
+      call need(s, session_read, 'select the history', error)
+      if (allocated(error)) return
+      call select_history(s%ctl, dofs, devices, s%cfg%model%n_dof, s%cfg%model%n_devices, error)
+   end subroutine session_select
+
+   !> Write the history to its output file (the &output dir and name, or the directory set
+   !> by session_set_output_dir) as the run goes; before solve.
+   subroutine session_stream(s, error)
+      type(session_type), intent(inout) :: s              !! a session with a deck read
+      type(error_type), allocatable, intent(out) :: error !! wrong state
+      call need(s, session_read, 'stream its history', error)
+      if (allocated(error)) return
+      s%stream = .true.
+   end subroutine session_stream
+
+   !> Ask a running solve to stop (from another thread; harmless at any other time: the next
+   !> solve clears the request).
+   subroutine session_cancel(s)
+      type(session_type), intent(inout) :: s   !! the session
+      s%ctl%cancel = 1
+   end subroutine session_cancel
+
+   !> The time a running solve has reached, and the duration of the run [s].
+   subroutine session_progress(s, t, duration)
+      type(session_type), intent(in) :: s      !! the session
+      real(dp), intent(out) :: t               !! time reached [s]
+      real(dp), intent(out) :: duration        !! duration [s]
+      t = s%ctl%time
+      duration = s%ctl%duration
+   end subroutine session_progress
+
+   !> A procedure the solve calls every `interval` seconds of wall clock with the time reached.
+   subroutine session_set_progress(s, callback, interval)
+      type(session_type), intent(inout) :: s   !! the session
+      procedure(progress_callback) :: callback !! the callback
+      real(dp), intent(in) :: interval         !! seconds between calls
+      s%ctl%on_progress => callback
+      s%ctl%progress_interval = interval
+   end subroutine session_set_progress
 
    !> Columns and samples of the history (that the run will produce, or has produced).
    subroutine session_shape(s, ncol, nout, history, error)
@@ -168,6 +273,7 @@ contains
       select case (s%state)
       case (session_read, state_failed)
          call shape_of(s%cfg, ncol, nout)
+         if (.not. s%ctl%select_all) ncol = 2 + 3*size(s%ctl%dofs) + 4*size(s%ctl%devices)
       case (session_solved)
          ncol = s%res%ncol
          nout = s%res%nout
@@ -236,37 +342,71 @@ contains
    end subroutine session_set_output_dir
 
    !> Write the history CSV (unless &output write_history = .false.) and the summary, as the
-   !> executable does: the library's writer, into the &output dir (created when missing).
-   subroutine session_write(s, error)
-      type(session_type), intent(in) :: s                 !! a solved session read from a deck
+   !> executable does: the library's writer, into the &output dir (created when missing). A
+   !> streamed history is renamed into place; else the history is the session's, or `data`
+   !> (the caller's buffer of session_solve).
+   subroutine session_write(s, error, data)
+      type(session_type), intent(inout) :: s              !! a solved session read from a deck
       type(error_type), allocatable, intent(out) :: error !! not solved, or cannot write
+      real(dp), intent(in), optional :: data(:, :)        !! the history, when the caller holds it
+      character(len=:), allocatable :: hist, summ
+      real(dp) :: none(s%res%ncol, 0)
+
       call need(s, session_solved, 'write its outputs', error)
       if (allocated(error)) return
       if (.not. s%from_deck) then
          call fatal_error(error, 'the session holds no deck: no output settings')
          return
       end if
-      call write_outputs(s%cfg%out, s%cfg%model, s%res, s%cfg%deck_path, error)
+      call output_paths(s%cfg%out, hist, summ)
+      if (allocated(s%stream_tmp)) then
+         if (s%cfg%out%history) then
+            call commit_streamed_outputs(s%stream_tmp, hist, summ, s%summary, error)
+            if (allocated(s%ctl%stream%path)) deallocate (s%ctl%stream%path)
+         else
+            call stream_discard(s%ctl%stream)
+            call write_output_files(hist, summ, .false., s%header, none, s%summary, error)
+         end if
+         deallocate (s%stream_tmp)
+         if (allocated(error)) error%message = s%cfg%deck_path//': '//error%message
+         return
+      end if
+      call make_dir(s%cfg%out%dir, error)
+      if (allocated(error)) return
+      if (present(data)) then
+         call write_output_files(hist, summ, s%cfg%out%history, s%header, data, s%summary, error)
+      else if (s%have_history .or. .not. s%cfg%out%history) then
+         call write_output_files(hist, summ, s%cfg%out%history, s%header, s%res%hist, s%summary, error)
+      else
+         call fatal_error(error, 'cannot write the history: the session does not hold it (give the buffer)')
+      end if
       if (allocated(error)) error%message = s%cfg%deck_path//': '//error%message
    end subroutine session_write
 
    !> Write the history (when `history`) to `hist_path` and the summary to `summ_path` with the
    !> library's writer (each to a temporary name renamed when complete; nothing left on failure).
-   subroutine session_write_files(s, hist_path, summ_path, history, error)
+   !> The history is the session's, or `data` when given.
+   subroutine session_write_files(s, hist_path, summ_path, history, error, data)
       type(session_type), intent(in) :: s                 !! a solved session
       character(len=*), intent(in) :: hist_path           !! the history CSV
       character(len=*), intent(in) :: summ_path           !! the summary file
       logical, intent(in) :: history                      !! write the history
       type(error_type), allocatable, intent(out) :: error !! not solved, or cannot write
+      real(dp), intent(in), optional :: data(:, :)        !! the history, when the caller holds it
       call need(s, session_solved, 'write its outputs', error)
       if (allocated(error)) return
-      call write_output_files(hist_path, summ_path, history, s%header, s%res%hist, s%summary, error)
+      if (present(data)) then
+         call write_output_files(hist_path, summ_path, history, s%header, data, s%summary, error)
+      else
+         call write_output_files(hist_path, summ_path, history, s%header, s%res%hist, s%summary, error)
+      end if
    end subroutine session_write_files
 
    ! ---------------------------------------------------------------- helpers
    subroutine reset(s)
       type(session_type), intent(inout) :: s
       type(session_type) :: fresh
+      call stream_discard(s%ctl%stream)
       s = fresh
    end subroutine reset
 

@@ -10,11 +10,12 @@ module frictiondyn
    use fd_result, only: history_shape
    use fd_output, only: output_type, write_outputs, output_paths, summary_json, history_header, &
                         write_output_files
+   use fd_run_control, only: run_control, select_history, stat_cancelled
    implicit none
    private
 
    public :: dp, error_type, model_type, integration_type, device_type, excitation_type
-   public :: result_type, run_config, output_type
+   public :: result_type, run_config, output_type, run_control, select_history, stat_cancelled
    public :: read_deck, read_deck_string, run_config_solve, run_deck, shape_of
    public :: output_paths, summary_json, history_header
    public :: write_outputs, write_output_files
@@ -24,11 +25,13 @@ contains
    !> Run the analysis a configuration defines (no files written) with the technique of
    !> its &integration: 'newmark' (the velocity and hysteretic laws) or 'event_driven'
    !> (exact Coulomb friction); an error for anything that technique cannot integrate.
-   subroutine run_config_solve(cfg, res, error)
+   subroutine run_config_solve(cfg, res, error, ctl)
       type(run_config), intent(in) :: cfg                 !! model, excitation, settings
       type(result_type), intent(out) :: res               !! histories and summary
       type(error_type), allocatable, intent(out) :: error !! failure of the solver
-      call run_technique(cfg%model, cfg%exc, cfg%opts, res, error)
+      type(run_control), intent(inout), target, optional :: ctl !! history selection and
+                                                          !! destinations, stop, progress
+      call run_technique(cfg%model, cfg%exc, cfg%opts, res, error, ctl)
    end subroutine run_config_solve
 
    !> Columns and samples of the history the configuration's run produces.

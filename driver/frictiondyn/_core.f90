@@ -12,7 +12,11 @@
 !>
 !> status: 0 success, 1 bad deck or input, 2 solver failure, 3 misuse (wrong state, wrong
 !> buffer, no session), 4 an output file cannot be written, 5 not enough memory (with the
-!> handle 0 when the session itself could not be allocated: then there is no message).
+!> handle 0 when the session itself could not be allocated: then there is no message),
+!> 6 the solve was cancelled (fd_session_cancel).
+!>
+!> Threads: fd_session_solve releases the GIL; while it runs, another thread may call
+!> fd_session_cancel and fd_session_progress on the same handle (and nothing else).
 
 !> Read and validate a deck (the file `path`, or `text` when from_text /= 0) into a new
 !> session; return its handle and the shape of its history. On status 1 the handle is valid
@@ -125,12 +129,19 @@ contains
 end subroutine fd_session_shape
 
 !> Run the session's deck. Releases the GIL: sessions may be solved in several threads at once.
-subroutine fd_session_solve(handle, status)
-   use, intrinsic :: iso_c_binding, only: c_int, c_int64_t
+!> mode 1: the history goes into `hist` (the caller's (ncol, nout) buffer, Fortran order: the
+!> library keeps no copy); 2: the session keeps it (fd_session_history copies it out); 0: no
+!> history in memory (the session streams it to its file, or only the summary is wanted).
+subroutine fd_session_solve(handle, mode, ncol, nout, hist, status)
+   use, intrinsic :: iso_c_binding, only: c_int, c_int64_t, c_double
    use fd_session, only: session_type, session_from_handle, session_solve, session_read
-   use frictiondyn, only: error_type
+   use frictiondyn, only: error_type, stat_cancelled
    implicit none
    integer(c_int64_t), intent(in) :: handle      !! the session
+   integer(c_int), intent(in) :: mode            !! 0 none, 1 into hist, 2 kept in the session
+   integer(c_int), intent(in) :: ncol            !! columns of hist
+   integer(c_int), intent(in) :: nout            !! samples of hist
+   real(c_double), intent(inout), target :: hist(ncol, nout) !! the caller's history buffer
    integer(c_int), intent(out) :: status         !! 0 or an error code
    !f2py threadsafe
    type(session_type), pointer :: s
@@ -141,12 +152,107 @@ subroutine fd_session_solve(handle, status)
    status = merge(0_c_int, 3_c_int, associated(s))
    if (status /= 0) return
    code = merge(2, 3, s%state == session_read)  ! a failure of the solver, or misuse
-   call session_solve(s, error)
+   select case (mode)
+   case (1)
+      call session_solve(s, error, buffer=hist)
+   case (2)
+      call session_solve(s, error, keep=.true.)
+   case default
+      call session_solve(s, error, keep=.false.)
+   end select
+   if (allocated(error)) then
+      if (error%stat == stat_cancelled) code = 6
+   end if
    call keep_error(s, error, code, status)
    if (status /= 0) return
 contains
    include 'fd_core_common.inc'
 end subroutine fd_session_solve
+
+!> Keep only some DOFs and devices (1-based, ascending) in the history; before solving.
+subroutine fd_session_select(handle, ndof, dofs, ndev, devices, ncol, status)
+   use, intrinsic :: iso_c_binding, only: c_int, c_int64_t
+   use fd_session, only: session_type, session_from_handle, session_select, session_shape
+   use frictiondyn, only: error_type
+   implicit none
+   integer(c_int64_t), intent(in) :: handle      !! the session
+   integer(c_int), intent(in) :: ndof            !! number of DOFs kept
+   integer(c_int), intent(in) :: dofs(ndof)      !! the DOFs kept
+   integer(c_int), intent(in) :: ndev            !! number of devices kept
+   integer(c_int), intent(in) :: devices(ndev)   !! the devices kept
+   integer(c_int), intent(out) :: ncol           !! columns of the history now
+   integer(c_int), intent(out) :: status         !! 0 or an error code
+   type(session_type), pointer :: s
+   type(error_type), allocatable :: error
+   integer :: nc, no
+   logical :: hist
+
+   ncol = 0
+   call session_from_handle(handle, s)
+   status = merge(0_c_int, 3_c_int, associated(s))
+   if (status /= 0) return
+   call session_select(s, int(dofs), int(devices), error)
+   if (.not. allocated(error)) call session_shape(s, nc, no, hist, error)
+   call keep_error(s, error, 1, status)
+   if (status /= 0) return
+   ncol = int(nc, c_int)
+contains
+   include 'fd_core_common.inc'
+end subroutine fd_session_select
+
+!> Write the history to the deck's output file as the run goes (fd_session_write commits it).
+subroutine fd_session_stream(handle, status)
+   use, intrinsic :: iso_c_binding, only: c_int, c_int64_t
+   use fd_session, only: session_type, session_from_handle, session_stream
+   use frictiondyn, only: error_type
+   implicit none
+   integer(c_int64_t), intent(in) :: handle      !! the session
+   integer(c_int), intent(out) :: status         !! 0 or an error code
+   type(session_type), pointer :: s
+   type(error_type), allocatable :: error
+
+   call session_from_handle(handle, s)
+   status = merge(0_c_int, 3_c_int, associated(s))
+   if (status /= 0) return
+   call session_stream(s, error)
+   call keep_error(s, error, 3, status)
+   if (status /= 0) return
+contains
+   include 'fd_core_common.inc'
+end subroutine fd_session_stream
+
+!> Ask a solve running in another thread to stop (it returns status 6 within a poll).
+subroutine fd_session_cancel(handle)
+   use, intrinsic :: iso_c_binding, only: c_int64_t
+   use fd_session, only: session_type, session_from_handle, session_cancel
+   implicit none
+   integer(c_int64_t), intent(in) :: handle      !! the session
+   !f2py threadsafe
+   type(session_type), pointer :: s
+
+   call session_from_handle(handle, s)
+   if (associated(s)) call session_cancel(s)
+end subroutine fd_session_cancel
+
+!> The time a solve running in another thread has reached, and the run's duration [s].
+subroutine fd_session_progress(handle, t, duration)
+   use, intrinsic :: iso_c_binding, only: c_int64_t, c_double
+   use fd_session, only: session_type, session_from_handle, session_progress
+   use frictiondyn, only: dp
+   implicit none
+   integer(c_int64_t), intent(in) :: handle      !! the session
+   real(c_double), intent(out) :: t              !! time reached [s]
+   real(c_double), intent(out) :: duration       !! duration [s]
+   !f2py threadsafe
+   type(session_type), pointer :: s
+   real(dp) :: tt, dd
+
+   t = 0.0_c_double; duration = 0.0_c_double
+   call session_from_handle(handle, s)
+   if (.not. associated(s)) return
+   call session_progress(s, tt, dd)
+   t = real(tt, c_double); duration = real(dd, c_double)
+end subroutine fd_session_progress
 
 !> Copy the history of a solved session into `hist` (its shape from fd_session_shape).
 subroutine fd_session_history(handle, ncol, nout, hist, status)
@@ -263,13 +369,18 @@ contains
 end subroutine fd_session_set_output_dir
 
 !> Write the history CSV and the summary of a solved session as the executable does (the
-!> library's writer, the deck's &output settings).
-subroutine fd_session_write(handle, status)
-   use, intrinsic :: iso_c_binding, only: c_int, c_int64_t
+!> library's writer, the deck's &output settings). The history is `hist` when use_hist /= 0
+!> (the caller's buffer of fd_session_solve), else the session's (or its streamed file).
+subroutine fd_session_write(handle, use_hist, ncol, nout, hist, status)
+   use, intrinsic :: iso_c_binding, only: c_int, c_int64_t, c_double
    use fd_session, only: session_type, session_from_handle, session_write, session_solved
    use frictiondyn, only: error_type
    implicit none
    integer(c_int64_t), intent(in) :: handle      !! the session
+   integer(c_int), intent(in) :: use_hist        !! 1: the history is hist
+   integer(c_int), intent(in) :: ncol            !! columns of hist
+   integer(c_int), intent(in) :: nout            !! samples of hist
+   real(c_double), intent(in) :: hist(ncol, nout) !! the history (when use_hist = 1)
    integer(c_int), intent(out) :: status         !! 0 or an error code
    !f2py threadsafe
    type(session_type), pointer :: s
@@ -280,17 +391,21 @@ subroutine fd_session_write(handle, status)
    status = merge(0_c_int, 3_c_int, associated(s))
    if (status /= 0) return
    code = merge(4, 3, s%state == session_solved)
-   call session_write(s, error)
+   if (use_hist /= 0) then
+      call session_write(s, error, hist)
+   else
+      call session_write(s, error)
+   end if
    call keep_error(s, error, code, status)
    if (status /= 0) return
 contains
    include 'fd_core_common.inc'
 end subroutine fd_session_write
 
-!> Write the history (when history /= 0) to `hist_path` and the summary to `summ_path` with
-!> the library's writer.
-subroutine fd_session_write_files(handle, hist_path, summ_path, history, status)
-   use, intrinsic :: iso_c_binding, only: c_int, c_int64_t
+!> Write the history (when history /= 0: `hist` when use_hist /= 0, else the session's) to
+!> `hist_path` and the summary to `summ_path` with the library's writer.
+subroutine fd_session_write_files(handle, hist_path, summ_path, history, use_hist, ncol, nout, hist, status)
+   use, intrinsic :: iso_c_binding, only: c_int, c_int64_t, c_double
    use fd_session, only: session_type, session_from_handle, session_write_files, session_solved
    use frictiondyn, only: error_type
    implicit none
@@ -298,6 +413,10 @@ subroutine fd_session_write_files(handle, hist_path, summ_path, history, status)
    character(len=*), intent(in) :: hist_path     !! the history CSV
    character(len=*), intent(in) :: summ_path     !! the summary file
    integer(c_int), intent(in) :: history         !! 1: write the history too
+   integer(c_int), intent(in) :: use_hist        !! 1: the history is hist
+   integer(c_int), intent(in) :: ncol            !! columns of hist
+   integer(c_int), intent(in) :: nout            !! samples of hist
+   real(c_double), intent(in) :: hist(ncol, nout) !! the history (when use_hist = 1)
    integer(c_int), intent(out) :: status         !! 0 or an error code
    !f2py threadsafe
    type(session_type), pointer :: s
@@ -308,7 +427,11 @@ subroutine fd_session_write_files(handle, hist_path, summ_path, history, status)
    status = merge(0_c_int, 3_c_int, associated(s))
    if (status /= 0) return
    code = merge(4, 3, s%state == session_solved)
-   call session_write_files(s, hist_path, summ_path, history /= 0, error)
+   if (use_hist /= 0) then
+      call session_write_files(s, hist_path, summ_path, history /= 0, error, hist)
+   else
+      call session_write_files(s, hist_path, summ_path, history /= 0, error)
+   end if
    call keep_error(s, error, code, status)
    if (status /= 0) return
 contains

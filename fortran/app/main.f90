@@ -1,11 +1,16 @@
 !> frictiondyn DECK.nml: run one namelist deck and write its time history and summary.
+!> The history is written as the run goes (to a temporary name, renamed when the run is
+!> complete: memory does not grow with the duration); on a terminal a progress line is shown.
 program frictiondyn_main
    use, intrinsic :: iso_fortran_env, only: error_unit, output_unit
    use, intrinsic :: iso_c_binding, only: c_int
-   use frictiondyn, only: error_type, run_config, result_type, run_deck, output_paths
+   use fd_kinds, only: dp
+   use frictiondyn, only: error_type, output_paths
+   use fd_session, only: session_type, session_open, session_stream, session_solve, session_write, &
+                         session_set_progress
+   use fd_progress_line, only: progress_wanted, progress_show, progress_clear
    implicit none
-   type(run_config) :: cfg
-   type(result_type) :: res
+   type(session_type), target :: ses
    type(error_type), allocatable :: error
    character(len=:), allocatable :: path, hist, summ
    integer :: nargs, length, i
@@ -33,12 +38,23 @@ program frictiondyn_main
       stop
    end if
 
-   call run_deck(path, cfg, res, error)
+   call session_open(ses, path, error)
+   if (.not. allocated(error)) then
+      if (progress_wanted()) call session_set_progress(ses, progress_show, 0.2_dp)
+      call session_stream(ses, error)
+   end if
+   if (.not. allocated(error)) then
+      call session_solve(ses, error)
+      call progress_clear()
+      if (allocated(error)) error%message = path//": "//error%message
+   end if
+   if (.not. allocated(error)) call session_write(ses, error)
    if (allocated(error)) then
       write (error_unit, '(a)') 'frictiondyn: error: '//error%message
       call quit(1)
    end if
 
+   associate (res => ses%res, cfg => ses%cfg)
    if (res%violations > 0) then
       write (error_unit, '(a,i0,a)') 'frictiondyn: warning: ', res%violations, &
          ' step(s) violate the correctness condition (eqs. 9, 12); first at t [s] ='
@@ -59,6 +75,7 @@ program frictiondyn_main
    call output_paths(cfg%out, hist, summ)
    if (cfg%out%history) write (output_unit, '(a)') '  history: '//hist
    write (output_unit, '(a)') '  summary: '//summ
+   end associate
 contains
 
    !> End the program with a non-zero exit status, silently, after flushing the output.

@@ -18,7 +18,7 @@ module fd_deck
                        default_ramp_cycles, default_record_kind, default_record_scale, default_technique, &
                        default_beta, default_gamma, default_n1, default_n2, default_n, &
                        default_check_correctness, default_dt_min, default_dir, default_output_every, &
-                       default_write_history
+                       default_write_history, linear_systems, default_linear_system
    use fd_model, only: model_type, integration_type, device_type, output_type
    use fd_excitation, only: excitation_type
    use fd_record, only: read_record
@@ -441,18 +441,19 @@ contains
       type(deck_text), intent(in) :: deck
       type(run_config), intent(inout) :: cfg
       type(error_type), allocatable, intent(out) :: error
-      character(len=name_len) :: technique
+      character(len=name_len) :: technique, linear_system
       real(dp) :: beta, gamma, n, dt_min
       integer :: n1, n2
       logical :: check_correctness
-      namelist /integration/ technique, beta, gamma, n1, n2, n, check_correctness, dt_min
+      namelist /integration/ technique, beta, gamma, n1, n2, n, check_correctness, dt_min, linear_system
       type(group_text) :: grp
       character(len=512) :: msg, msg0
       character(len=:), allocatable :: rec, choices
-      integer :: ios, i, technique_id
+      integer :: ios, i, technique_id, system_id
       logical :: found
 
       technique = technique_name(default_technique)
+      linear_system = linear_systems(default_linear_system)%name
       beta = default_beta; gamma = default_gamma; n1 = default_n1; n2 = default_n2; n = default_n
       check_correctness = default_check_correctness; dt_min = default_dt_min
       call find_group(deck, 'integration', grp, found, error)
@@ -474,6 +475,12 @@ contains
       if (technique_id == 0) then
          call keyword_choices(techniques, choices)
          call bad(deck, 'integration', 'technique', "'"//trim(technique)//"'", 'one of '//choices, error)
+         return
+      end if
+      system_id = keyword_id(linear_systems, linear_system)
+      if (system_id == 0) then
+         call keyword_choices(linear_systems, choices)
+         call bad(deck, 'integration', 'linear_system', "'"//trim(linear_system)//"'", 'one of '//choices, error)
          return
       end if
       call check_real(deck, 'integration', 'beta', beta, 0.0_dp, 0.5_dp, '', error, open_lo=.true.)
@@ -507,6 +514,7 @@ contains
       cfg%opts%n_corr = n
       cfg%opts%check = check_correctness
       cfg%opts%dt_min = dt_min
+      cfg%opts%linear_system = system_id
    end subroutine read_integration_group
 
    ! ---------------------------------------------------------------- &output

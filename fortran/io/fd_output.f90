@@ -11,6 +11,7 @@ module fd_output
    private
 
    public :: output_type, write_outputs, write_output_files, output_paths, summary_json, history_header
+   public :: commit_streamed_outputs, make_dir
 
    interface
       function c_rename(old, new) bind(c, name='rename') result(stat)
@@ -96,6 +97,37 @@ contains
          call fatal_error(error, "cannot rename '"//summ//".tmp' to '"//summ//"'")
       end if
    end subroutine write_output_files
+
+   !> The outputs of a run whose history was written as it went (fd_history_stream): the
+   !> complete history file `hist_tmp` is renamed to `hist_path` and the summary text written
+   !> to `summ_path`, the summary to a temporary name first, renamed last; on failure nothing is
+   !> left under either final name (and the temporary files are removed).
+   subroutine commit_streamed_outputs(hist_tmp, hist_path, summ_path, summary, error)
+      character(len=*), intent(in) :: hist_tmp            !! the complete history, closed
+      character(len=*), intent(in) :: hist_path           !! its final name
+      character(len=*), intent(in) :: summ_path           !! the summary file
+      character(len=*), intent(in) :: summary             !! summary text (JSON)
+      type(error_type), allocatable, intent(out) :: error !! cannot write or rename
+      integer :: stat
+
+      call write_summary(summ_path//'.tmp', summary, error)
+      if (allocated(error)) then
+         call remove(hist_tmp)
+         return
+      end if
+      stat = c_rename(hist_tmp//c_null_char, hist_path//c_null_char)
+      if (stat /= 0) then
+         call remove(hist_tmp); call remove(summ_path//'.tmp')
+         call fatal_error(error, "cannot rename '"//hist_tmp//"' to '"//hist_path//"'")
+         return
+      end if
+      stat = c_rename(summ_path//'.tmp'//c_null_char, summ_path//c_null_char)
+      if (stat /= 0) then
+         call remove(hist_path)
+         call remove(summ_path//'.tmp')
+         call fatal_error(error, "cannot rename '"//summ_path//".tmp' to '"//summ_path//"'")
+      end if
+   end subroutine commit_streamed_outputs
 
    !> Create a directory and its missing parents.
    subroutine make_dir(dir, error)
@@ -213,6 +245,17 @@ contains
       call kv('steps_dt2', trim(fmt_int(res%steps_dt2)))
       call kv('steps_finer', trim(fmt_int(res%steps_finer)))
       call kv('factorizations', trim(fmt_int(res%factorizations)))
+      call kv('factor_updates', trim(fmt_int(res%factor_updates)))
+      call kv('partial_factorizations', trim(fmt_int(res%partial_factorizations)))
+      select case (res%storage)
+      case (1)
+         call kv('linear_system', '"dense"')
+      case (2)
+         call kv('linear_system', '"banded"')
+      case default
+         call kv('linear_system', 'null')
+      end select
+      call kv('half_bandwidth', trim(fmt_int(res%bandwidth)))
       call kv('events', trim(fmt_int(res%events)))
       call kv('correctness_violations', trim(fmt_int(res%violations)))
       call kr('violation_times_s', res%violation_time(1:res%n_violation_times))

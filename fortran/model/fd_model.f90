@@ -10,7 +10,8 @@ module fd_model
                        default_eps, default_eps1, default_f, default_xi, default_period, &
                        default_rayleigh_a0, default_rayleigh_a1, default_technique, default_beta, &
                        default_gamma, default_n1, default_n2, default_n, default_check_correctness, &
-                       default_dt_min, default_output_every, default_write_history
+                       default_dt_min, default_output_every, default_write_history, &
+                       default_linear_system
    implicit none
    private
 
@@ -63,6 +64,7 @@ module fd_model
       logical :: check = default_check_correctness !! check the correctness condition
       real(dp) :: dt_min = default_dt_min       !! floor of the step halving [s]; 0 = dt2 / 2**10
       integer :: output_every = default_output_every !! output every k dt1 steps; 0 = at the record step (n1)
+      integer :: linear_system = default_linear_system !! storage of the effective stiffness (fd_names)
    end type integration_type
 
    !> Where and what to write.

@@ -19,12 +19,13 @@ module fd_names
    public :: damping_types, damping_stiffness, damping_rayleigh, damping_none
    public :: excitation_types, excitation_harmonic, excitation_record, excitation_none
    public :: record_kinds, record_acceleration, record_displacement
+   public :: linear_systems, linear_system_auto, linear_system_dense, linear_system_banded
    public :: keyword_id, keyword_choices, law_id, law_choices, law_name, technique_name
    public :: default_u0, default_v0, default_xi, default_period, default_rayleigh_a0, default_rayleigh_a1
    public :: default_n_devices, default_eps, default_eps1, default_f
    public :: default_ramp_cycles, default_record_kind, default_record_scale
    public :: default_technique, default_beta, default_gamma, default_n1, default_n2, default_n
-   public :: default_check_correctness, default_dt_min
+   public :: default_check_correctness, default_dt_min, default_linear_system
    public :: default_dir, default_output_every, default_write_history
 
    integer, parameter :: keyword_len = 16   !! length of a keyword in the tables
@@ -83,6 +84,15 @@ module fd_names
    integer, parameter :: record_acceleration = 1 !! the record holds table accelerations
    integer, parameter :: record_displacement = 2 !! the record holds table displacements
 
+   ! ------------------------------------------------------------------ linear systems
+   type(keyword_type), parameter :: linear_systems(*) = [ &
+                                    keyword_type('auto', 'dense up to 8 DOFs, else banded'), &
+                                    keyword_type('dense', ''), &
+                                    keyword_type('banded', '')]
+   integer, parameter :: linear_system_auto = 1   !! storage chosen by the kernel (fd_banded)
+   integer, parameter :: linear_system_dense = 2  !! dense effective stiffness
+   integer, parameter :: linear_system_banded = 3 !! banded, reverse Cuthill-McKee ordering
+
    ! ------------------------------------------------------------------ defaults
    ! &model
    real(dp), parameter :: default_u0 = 0.0_dp            !! initial displacement [m]
@@ -110,6 +120,7 @@ module fd_names
    real(dp), parameter :: default_n = 10.0_dp            !! n of eqs. 9 and 12
    logical, parameter :: default_check_correctness = .true.
    real(dp), parameter :: default_dt_min = 0.0_dp        !! 0 = dt2 / 2**10 [s]
+   integer, parameter :: default_linear_system = linear_system_auto
    ! &output
    character(len=*), parameter :: default_dir = 'out'    !! output directory
    integer, parameter :: default_output_every = 0        !! 0 = every dt_record

@@ -3,18 +3,33 @@
 !> correctness violations, and closes the energy balance. A technique hands it the state
 !> (time, table acceleration, u, v, relative acceleration, and per device s, s', F and
 !> phase); a new output quantity is a change here (and in the writer), not in the loops.
+!>
+!> A run's control (fd_run_control), when the technique is given one, says which history
+!> columns are kept and where their rows go (the result, the caller's buffer, a file written
+!> as the run goes), and asks to stop: the technique calls observe_poll after every accepted
+!> step, and returns the error of observe_stop_error when it says stop. Polls cost a counter
+!> decrement; every few milliseconds of wall clock a poll reads the stop request, publishes
+!> the time reached and calls the progress callback when its interval has passed.
 module fd_observer
+   use, intrinsic :: iso_fortran_env, only: int64
    use fd_kinds, only: dp
-   use fd_error, only: error_type
+   use fd_error, only: error_type, fatal_error, fmt_real
    use fd_model, only: model_type, integration_type
    use fd_excitation, only: excitation_type
    use fd_result, only: result_type, init_result, max_violation_times
    use fd_linalg, only: sym_matvec
+   use fd_run_control, only: run_control, cancel_requested, stat_cancelled
+   use fd_history_stream, only: stream_open, stream_row, stream_failed, stream_close
+   use fd_output, only: history_header
    implicit none
    private
 
    public :: observer_type, observer_init, sample_due, observe_start, observe_peaks, observe_sample
    public :: observe_transitions, observe_violations, observe_end, strain_energy
+   public :: observe_start_energy, observe_end_energy, observe_poll, observe_stop_error
+
+   !> Wall-clock time aimed at between two polls that look at the clock [s].
+   real(dp), parameter :: poll_target = 0.01_dp
 
    !> What the observer keeps between calls.
    type :: observer_type
@@ -24,23 +39,72 @@ module fd_observer
       real(dp) :: e_kin0 = 0.0_dp    !! kinetic energy at the start [J]
       real(dp) :: e_str0 = 0.0_dp    !! strain energy at the start [J]
       real(dp) :: e_dev0 = 0.0_dp    !! elastic energy stored in devices at the start [J]
+      type(run_control), pointer :: ctl => null() !! the run's control, if any
+      integer, allocatable :: dofs(:)     !! DOFs in the history
+      integer, allocatable :: devices(:)  !! devices in the history
+      logical :: all_columns = .true.     !! every DOF and device in the history
+      real(dp), allocatable :: row(:)     !! the row being formed
+      logical :: to_result = .true.       !! rows into res%hist
+      integer :: countdown = 1            !! polls until the next look at the clock
+      integer :: poll_every = 1           !! polls between looks at the clock
+      integer(int64) :: last_poll = 0     !! clock count of the last look
+      integer(int64) :: last_report = 0   !! clock count of the last progress report
+      integer(int64) :: rate = 1          !! clock counts a second
+      logical :: stopped = .false.        !! a poll said stop
+      real(dp) :: stop_time = 0.0_dp      !! time reached when it did [s]
    end type observer_type
 
 contains
 
    !> Set up the result of a run (history, per-DOF and per-device summary) and the
-   !> observer: the number of dt1 steps and the sampling interval.
-   subroutine observer_init(model, exc, opts, res, obs, error)
+   !> observer: the number of dt1 steps and the sampling interval. With a control: the
+   !> history's columns and destinations it selects, and its history file opened (created
+   !> under its temporary name, the header written).
+   subroutine observer_init(model, exc, opts, res, obs, error, ctl)
       type(model_type), intent(in) :: model         !! the model run
       type(excitation_type), intent(in) :: exc      !! the table motion
       type(integration_type), intent(in) :: opts    !! integration settings
       type(result_type), intent(inout) :: res       !! the result to set up
       type(observer_type), intent(out) :: obs       !! the observer
-      type(error_type), allocatable, intent(out) :: error !! not enough memory
+      type(error_type), allocatable, intent(out) :: error !! not enough memory, history file
+      type(run_control), intent(inout), target, optional :: ctl !! the run's control
+      character(len=:), allocatable :: header
+      integer :: i, rows
 
-      call init_result(model, exc, opts, res, obs%nsteps, obs%every, error)
+      if (present(ctl)) then
+         obs%ctl => ctl
+         obs%all_columns = ctl%select_all
+         obs%to_result = ctl%keep .and. .not. associated(ctl%buffer)
+      end if
+      if (obs%all_columns) then
+         obs%dofs = [(i, i=1, model%n_dof)]
+         obs%devices = [(i, i=1, model%n_devices)]
+      else
+         obs%dofs = ctl%dofs
+         obs%devices = ctl%devices
+      end if
+      call init_result(model, exc, opts, res, obs%nsteps, obs%every, error, obs%dofs, obs%devices, obs%to_result)
       if (allocated(error)) return
       res%technique = opts%technique
+      allocate (obs%row(res%ncol))
+      obs%row = 0.0_dp
+      if (.not. associated(obs%ctl)) return
+      ctl%duration = obs%nsteps*(exc%dt_record/opts%n1)
+      ctl%time = 0.0_dp
+      if (associated(ctl%buffer)) then
+         rows = size(ctl%buffer, 2)
+         if (size(ctl%buffer, 1) /= res%ncol .or. rows /= res%nout) then
+            call fatal_error(error, "the history buffer has the wrong shape")
+            return
+         end if
+      end if
+      if (allocated(ctl%stream_path)) then
+         call history_header(res, header)
+         call stream_open(ctl%stream, ctl%stream_path, header, res%ncol, error)
+         if (allocated(error)) return
+      end if
+      call system_clock(obs%last_poll, obs%rate)
+      obs%last_report = obs%last_poll
    end subroutine observer_init
 
    !> Whether the history takes a row after dt1 step k (every `every` steps, and the last).
@@ -71,11 +135,25 @@ contains
       real(dp), intent(in) :: v(:)         !! velocities at t = 0
       real(dp), intent(in) :: e_device     !! elastic energy stored in devices at t = 0
       real(dp), intent(inout) :: tmp(:)    !! work (n)
+      real(dp) :: e_strain
+
+      call strain_energy(k, u, tmp, e_strain)
+      call observe_start_energy(obs, mass, v, e_strain, e_device)
+   end subroutine observe_start
+
+   !> Energies of the initial state, the strain energy given (a technique that stores K in
+   !> its own form computes it).
+   pure subroutine observe_start_energy(obs, mass, v, e_strain, e_device)
+      type(observer_type), intent(inout) :: obs !! the observer
+      real(dp), intent(in) :: mass(:)      !! lumped masses
+      real(dp), intent(in) :: v(:)         !! velocities at t = 0
+      real(dp), intent(in) :: e_strain     !! strain energy of the springs at t = 0 [J]
+      real(dp), intent(in) :: e_device     !! elastic energy stored in devices at t = 0
 
       obs%e_kin0 = 0.5_dp*sum(mass*v**2)
-      call strain_energy(k, u, tmp, obs%e_str0)
+      obs%e_str0 = e_strain
       obs%e_dev0 = e_device
-   end subroutine observe_start
+   end subroutine observe_start_energy
 
    !> Peaks over the accepted states: |u| (and its time), |v|, |absolute acceleration| (and
    !> its time) per DOF, |s| and |F| per device.
@@ -107,8 +185,10 @@ contains
       end do
    end subroutine observe_peaks
 
-   !> The next row of the history: t, ag, (u, v, aabs) per DOF, (s, s', F, phase) per device.
-   pure subroutine observe_sample(obs, res, t, ag, u, v, acc, s, sd, force, phase)
+   !> The next row of the history: t, ag, (u, v, aabs) per kept DOF, (s, s', F, phase) per
+   !> kept device; into the result, the control's buffer and its history file as selected.
+   !> Allocates nothing.
+   subroutine observe_sample(obs, res, t, ag, u, v, acc, s, sd, force, phase)
       type(observer_type), intent(inout) :: obs !! the observer
       type(result_type), intent(inout) :: res  !! the result
       real(dp), intent(in) :: t                !! time [s]
@@ -120,24 +200,108 @@ contains
       real(dp), intent(in) :: sd(:)            !! device relative velocities [m/s]
       real(dp), intent(in) :: force(:)         !! device forces [N]
       integer, intent(in) :: phase(:)          !! device phases (0 stick, +-1 slip)
-      integer :: i, c
+      integer :: i, j, c
 
       obs%rows = obs%rows + 1
       if (obs%rows > res%nout) return
-      associate (row => obs%rows)
-         res%hist(1, row) = t
-         res%hist(2, row) = ag
+      associate (row => obs%row)
+         row(1) = t
+         row(2) = ag
          c = 2
-         do i = 1, size(u)
-            res%hist(c + 1:c + 3, row) = [u(i), v(i), acc(i) + ag]
-            c = c + 3
-         end do
-         do i = 1, size(s)
-            res%hist(c + 1:c + 4, row) = [s(i), sd(i), force(i), real(phase(i), dp)]
-            c = c + 4
-         end do
+         if (obs%all_columns) then
+            do i = 1, size(u)
+               row(c + 1) = u(i); row(c + 2) = v(i); row(c + 3) = acc(i) + ag
+               c = c + 3
+            end do
+            do i = 1, size(s)
+               row(c + 1) = s(i); row(c + 2) = sd(i); row(c + 3) = force(i); row(c + 4) = real(phase(i), dp)
+               c = c + 4
+            end do
+         else
+            do j = 1, size(obs%dofs)
+               i = obs%dofs(j)
+               row(c + 1) = u(i); row(c + 2) = v(i); row(c + 3) = acc(i) + ag
+               c = c + 3
+            end do
+            do j = 1, size(obs%devices)
+               i = obs%devices(j)
+               row(c + 1) = s(i); row(c + 2) = sd(i); row(c + 3) = force(i); row(c + 4) = real(phase(i), dp)
+               c = c + 4
+            end do
+         end if
+         if (obs%to_result) res%hist(:, obs%rows) = row
+         if (associated(obs%ctl)) then
+            if (associated(obs%ctl%buffer)) obs%ctl%buffer(:, obs%rows) = row
+            if (allocated(obs%ctl%stream_path)) call stream_row(obs%ctl%stream, row)
+         end if
       end associate
    end subroutine observe_sample
+
+   !> Called by a technique after every accepted step. Mostly a counter; every ~10 ms of
+   !> wall clock (the interval adapts to the cost of a step) it publishes the time reached,
+   !> calls the progress callback when its interval has passed, and says whether the run must
+   !> stop: a stop was requested, or the history file could not be written.
+   subroutine observe_poll(obs, t, stop)
+      type(observer_type), intent(inout) :: obs !! the observer
+      real(dp), intent(in) :: t                !! time reached [s]
+      logical, intent(out) :: stop             !! the technique must return observe_stop_error's error
+      integer(int64) :: now
+      real(dp) :: elapsed
+
+      stop = .false.
+      obs%countdown = obs%countdown - 1
+      if (obs%countdown > 0) return
+      if (.not. associated(obs%ctl)) then
+         obs%countdown = huge(1)
+         return
+      end if
+      call system_clock(now)
+      elapsed = real(now - obs%last_poll, dp)/real(obs%rate, dp)
+      obs%last_poll = now
+      ! aim at a look every poll_target seconds
+      if (elapsed < 0.5_dp*poll_target .and. obs%poll_every < 1048576) then
+         obs%poll_every = 2*obs%poll_every
+      else if (elapsed > 2.0_dp*poll_target .and. obs%poll_every > 1) then
+         obs%poll_every = obs%poll_every/2
+      end if
+      obs%countdown = obs%poll_every
+      obs%ctl%time = t
+      if (cancel_requested(obs%ctl%cancel)) stop = .true.
+      if (allocated(obs%ctl%stream_path)) then
+         if (stream_failed(obs%ctl%stream)) stop = .true.
+      end if
+      if (stop) then
+         obs%stopped = .true.
+         obs%stop_time = t
+         return
+      end if
+      if (associated(obs%ctl%on_progress)) then
+         if (real(now - obs%last_report, dp) >= obs%ctl%progress_interval*real(obs%rate, dp)) then
+            obs%last_report = now
+            call obs%ctl%on_progress(t, obs%ctl%duration)
+         end if
+      end if
+   end subroutine observe_poll
+
+   !> The error a technique returns when observe_poll said stop: the run was cancelled
+   !> (error%stat = stat_cancelled), or the history file could not be written.
+   subroutine observe_stop_error(obs, error)
+      type(observer_type), intent(inout) :: obs          !! the observer
+      type(error_type), allocatable, intent(out) :: error !! why the run stopped
+      type(error_type), allocatable :: write_error
+
+      if (associated(obs%ctl)) then
+         if (allocated(obs%ctl%stream_path)) then
+            if (stream_failed(obs%ctl%stream)) then
+               call stream_close(obs%ctl%stream, write_error)
+               call move_alloc(write_error, error)
+               return
+            end if
+         end if
+      end if
+      call fatal_error(error, "the run was cancelled at t = "//trim(fmt_real(obs%stop_time))//" s", &
+                       stat=stat_cancelled)
+   end subroutine observe_stop_error
 
    !> Count the phase changes of the devices: stick to slip, slip to stick, and slip
    !> reversals (slip + to slip - and back without sticking).
@@ -184,7 +348,7 @@ contains
    !> the residual input - (kinetic + strain + viscous + friction + device elastic). The
    !> technique has accumulated the input and viscous work in res.
    subroutine observe_end(obs, res, mass, k, u, v, e_device, w_device, tmp)
-      type(observer_type), intent(in) :: obs   !! the observer
+      type(observer_type), intent(inout) :: obs !! the observer
       type(result_type), intent(inout) :: res  !! the result
       real(dp), intent(in) :: mass(:)          !! lumped masses
       real(dp), intent(in) :: k(:, :)          !! springs' stiffness
@@ -195,13 +359,27 @@ contains
       real(dp), intent(inout) :: tmp(:)        !! work (n)
       real(dp) :: e
 
-      res%e_kinetic = 0.5_dp*sum(mass*v**2) - obs%e_kin0
       call strain_energy(k, u, tmp, e)
-      res%e_strain = e - obs%e_str0
+      call observe_end_energy(obs, res, mass, v, e, e_device, w_device)
+   end subroutine observe_end
+
+   !> Close the energy balance, the final strain energy given.
+   subroutine observe_end_energy(obs, res, mass, v, e_strain, e_device, w_device)
+      type(observer_type), intent(inout) :: obs !! the observer
+      type(result_type), intent(inout) :: res  !! the result
+      real(dp), intent(in) :: mass(:)          !! lumped masses
+      real(dp), intent(in) :: v(:)             !! velocities at the end
+      real(dp), intent(in) :: e_strain         !! strain energy of the springs at the end [J]
+      real(dp), intent(in) :: e_device         !! elastic energy stored in devices at the end [J]
+      real(dp), intent(in) :: w_device         !! work of the device forces over the run [J]
+
+      res%e_kinetic = 0.5_dp*sum(mass*v**2) - obs%e_kin0
+      res%e_strain = e_strain - obs%e_str0
       res%e_device = e_device - obs%e_dev0
       res%e_friction = w_device - res%e_device
       res%e_residual = res%e_input - (res%e_kinetic + res%e_strain + res%e_viscous + &
                                       res%e_friction + res%e_device)
-   end subroutine observe_end
+      if (associated(obs%ctl)) obs%ctl%time = obs%ctl%duration
+   end subroutine observe_end_energy
 
 end module fd_observer

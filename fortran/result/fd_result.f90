@@ -47,6 +47,10 @@ module fd_result
       integer :: steps_finer = 0       !! steps taken with dt2/2, dt2/4, ...
       integer :: factorizations = 0    !! factorizations of the effective stiffness
                                        !! (exact technique: matrix exponentials)
+      integer :: factor_updates = 0    !! rank-one updates and downdates of the factor (phase changes)
+      integer :: partial_factorizations = 0 !! refactorizations from the first changed column on
+      integer :: storage = 0           !! effective stiffness stored 1 dense, 2 banded (0: none)
+      integer :: bandwidth = 0         !! its half-bandwidth in the solver's ordering
       integer :: events = 0            !! events located (exact technique)
       ! correctness condition, eqs. 9 and 12
       integer :: violations = 0        !! steps accepted that violate it
@@ -67,8 +71,9 @@ module fd_result
 contains
 
    !> Size of the history a run writes: columns t, ag, (u, v, aabs) per DOF and
-   !> (s, sdot, F, phase) per device; samples at t = 0, every `every` dt1 steps and at the end.
-   pure subroutine history_shape(model, exc, opts, ncol, nout, nsteps, every)
+   !> (s, sdot, F, phase) per device (of those kept, when given); samples at t = 0, every
+   !> `every` dt1 steps and at the end.
+   pure subroutine history_shape(model, exc, opts, ncol, nout, nsteps, every, n_dof_kept, n_devices_kept)
       type(model_type), intent(in) :: model         !! the model
       type(excitation_type), intent(in) :: exc      !! the table motion
       type(integration_type), intent(in) :: opts    !! integration settings
@@ -76,17 +81,26 @@ contains
       integer, intent(out) :: nout                  !! samples
       integer, intent(out) :: nsteps                !! dt1 steps of the run
       integer, intent(out) :: every                 !! dt1 steps between samples
+      integer, intent(in), optional :: n_dof_kept   !! DOFs in the history (default all)
+      integer, intent(in), optional :: n_devices_kept !! devices in the history (default all)
+      integer :: nk, ndk
 
-      ncol = 2 + 3*model%n_dof + 4*model%n_devices
+      nk = model%n_dof
+      ndk = model%n_devices
+      if (present(n_dof_kept)) nk = n_dof_kept
+      if (present(n_devices_kept)) ndk = n_devices_kept
+      ncol = 2 + 3*nk + 4*ndk
       nsteps = max(1, nint(exc%duration/(exc%dt_record/opts%n1)))
       every = opts%output_every
       if (every <= 0) every = opts%n1
       nout = nsteps/every + 1 + merge(1, 0, mod(nsteps, every) /= 0)
    end subroutine history_shape
 
-   !> Allocate the history (its shape from history_shape) and the per-DOF and per-device
-   !> summary of a run; return the run's number of dt1 steps and the sampling interval.
-   subroutine init_result(model, exc, opts, res, nsteps, every, error)
+   !> Allocate the history (its shape from history_shape; no rows when `keep` is false:
+   !> they go elsewhere) and the per-DOF and per-device summary of a run; return the run's
+   !> number of dt1 steps and the sampling interval. `dofs` and `devices` name the DOFs and
+   !> devices whose columns the history has (default: all).
+   subroutine init_result(model, exc, opts, res, nsteps, every, error, dofs, devices, keep)
       type(model_type), intent(in) :: model         !! the model run
       type(excitation_type), intent(in) :: exc      !! the table motion
       type(integration_type), intent(in) :: opts    !! integration settings
@@ -94,35 +108,53 @@ contains
       integer, intent(out) :: nsteps                !! dt1 steps of the run
       integer, intent(out) :: every                 !! dt1 steps between samples
       type(error_type), allocatable, intent(out) :: error !! not enough memory
-      integer :: n, nd, i, c, stat
+      integer, intent(in), optional :: dofs(:)      !! DOFs in the history (ascending)
+      integer, intent(in), optional :: devices(:)   !! devices in the history (ascending)
+      logical, intent(in), optional :: keep         !! hold the rows here (default true)
+      integer, allocatable :: kd(:), kv(:)
+      integer :: n, nd, i, c, stat, rows
 
       n = model%n_dof
       nd = model%n_devices
       res%n_dof = n
       res%n_devices = nd
-      call history_shape(model, exc, opts, res%ncol, res%nout, nsteps, every)
-      allocate (res%hist(res%ncol, res%nout), res%names(res%ncol), res%units(res%ncol), stat=stat)
+      if (present(dofs)) then
+         kd = dofs
+      else
+         kd = [(i, i=1, n)]
+      end if
+      if (present(devices)) then
+         kv = devices
+      else
+         kv = [(i, i=1, nd)]
+      end if
+      call history_shape(model, exc, opts, res%ncol, res%nout, nsteps, every, size(kd), size(kv))
+      rows = res%nout
+      if (present(keep)) then
+         if (.not. keep) rows = 0
+      end if
+      allocate (res%hist(res%ncol, rows), res%names(res%ncol), res%units(res%ncol), stat=stat)
       if (stat /= 0) then
          call fatal_error(error, "not enough memory for the history: "//trim(fmt_int(res%nout))// &
-                          " samples of "//trim(fmt_int(res%ncol))//" columns (raise output_every or "// &
-                          "shorten duration)")
+                          " samples of "//trim(fmt_int(res%ncol))//" columns (raise output_every, "// &
+                          "keep fewer DOFs and devices, or stream the history to its file)")
          return
       end if
       res%hist = 0.0_dp
       res%names(1) = 't'; res%units(1) = 's'
       res%names(2) = 'ag'; res%units(2) = 'm/s2'
       c = 2
-      do i = 1, n
-         res%names(c + 1) = 'u'//trim(fmt_int(i)); res%units(c + 1) = 'm'
-         res%names(c + 2) = 'v'//trim(fmt_int(i)); res%units(c + 2) = 'm/s'
-         res%names(c + 3) = 'aabs'//trim(fmt_int(i)); res%units(c + 3) = 'm/s2'
+      do i = 1, size(kd)
+         res%names(c + 1) = 'u'//trim(fmt_int(kd(i))); res%units(c + 1) = 'm'
+         res%names(c + 2) = 'v'//trim(fmt_int(kd(i))); res%units(c + 2) = 'm/s'
+         res%names(c + 3) = 'aabs'//trim(fmt_int(kd(i))); res%units(c + 3) = 'm/s2'
          c = c + 3
       end do
-      do i = 1, nd
-         res%names(c + 1) = 's'//trim(fmt_int(i)); res%units(c + 1) = 'm'
-         res%names(c + 2) = 'sdot'//trim(fmt_int(i)); res%units(c + 2) = 'm/s'
-         res%names(c + 3) = 'F'//trim(fmt_int(i)); res%units(c + 3) = 'N'
-         res%names(c + 4) = 'phase'//trim(fmt_int(i)); res%units(c + 4) = '-'
+      do i = 1, size(kv)
+         res%names(c + 1) = 's'//trim(fmt_int(kv(i))); res%units(c + 1) = 'm'
+         res%names(c + 2) = 'sdot'//trim(fmt_int(kv(i))); res%units(c + 2) = 'm/s'
+         res%names(c + 3) = 'F'//trim(fmt_int(kv(i))); res%units(c + 3) = 'N'
+         res%names(c + 4) = 'phase'//trim(fmt_int(kv(i))); res%units(c + 4) = '-'
          c = c + 4
       end do
       allocate (res%peak_u(n), res%peak_u_time(n), res%peak_v(n), res%peak_aabs(n), &

@@ -6,54 +6,64 @@
 !> down to dt_min; a violation left at the floor is counted and reported, never hidden.
 !>
 !> In each phase a device is linear, F = ks s + cs s' + f0, so a step solves one linear
-!> system with the effective stiffness K + ks.. + (gamma/(beta h)) (C + cs..) + M/(beta h^2).
-!> Its Cholesky factor is kept in a small cache keyed by the step size and the pattern of
-!> sticking devices: it is factored again only when one of them changes.
+!> system with the effective stiffness K^ = K + (gamma/(beta h)) C + M/(beta h^2) +
+!> sum_d kd_d b_d b_d', kd_d = ks + (gamma/(beta h)) cs. K^ is held by the structure-aware
+!> kernel fd_banded (dense for a few DOFs, else banded in a reverse Cuthill-McKee ordering;
+!> memory linear in the number of DOFs): one system per step size (dt1, dt2, dt2/2, ...,
+!> dt_min), all copies of one set-up system, each factored the first time its step size is
+!> used. When the pattern of sticking devices has changed since a system was last used, its
+!> factor is updated (rank-one updates and downdates, or a refactorization from the first
+!> changed column when that is cheaper: spd_update_devices), never refactored from scratch.
+!> K and C (C = a0 M + a1 K, the damping of fd_matrices' structure_damping) are never formed
+!> densely; nothing in this module holds an n x n array, and nothing allocates once the loop
+!> has started.
 module fd_newmark
    use, intrinsic :: ieee_arithmetic, only: ieee_is_finite
    use fd_kinds, only: dp
    use fd_error, only: error_type, fatal_error, fmt_real, fmt_int
    use fd_names, only: laws, law_name, law_choices, excitation_types, technique_name, technique_newmark, &
-                       technique_event_driven
+                       technique_event_driven, linear_system_dense, linear_system_banded
    use fd_model, only: model_type, integration_type
    use fd_excitation, only: excitation_type, table_motion
-   use fd_matrices, only: structure_matrices
+   use fd_matrices, only: structure_damping
    use fd_kinematics, only: device_kinematics, device_relative, add_device
-   use fd_linalg, only: cholesky_factor, cholesky_solve, sym_matvec
+   use fd_banded, only: spd_system, spd_setup, spd_factor, spd_update_devices, spd_solve, spd_k_matvec, &
+                        spd_c_matvec, spd_auto, spd_dense, spd_banded, spd_is_dense, spd_bandwidth
    use fd_device_state, only: device_state, device_force
    use fd_friction, only: friction_init, friction_update, friction_correct
    use fd_result, only: result_type
-   use fd_observer, only: observer_type, observer_init, sample_due, observe_start, observe_peaks, &
-                          observe_sample, observe_transitions, observe_violations, observe_end
+   use fd_run_control, only: run_control
+   use fd_observer, only: observer_type, observer_init, sample_due, observe_start_energy, observe_peaks, &
+                          observe_sample, observe_transitions, observe_violations, observe_end_energy, &
+                          observe_poll, observe_stop_error
    implicit none
    private
 
    public :: run_newmark, newmark_check
 
-   integer, parameter :: max_slots = 32              !! factors kept at most
-   real(dp), parameter :: cache_bytes = 256.0e6_dp    !! memory the factors may take
-
-   !> One cached factor of the effective stiffness.
-   type :: factor_slot
-      real(dp) :: h = -1.0_dp              !! step size it was made for
-      logical, allocatable :: stuck(:)     !! devices with ks or cs in the matrix
-      real(dp), allocatable :: a(:, :)     !! Cholesky factor
-      integer :: last_use = 0              !! for least-recently-used replacement
-   end type factor_slot
+   !> The effective stiffness of one step size.
+   type :: level_type
+      real(dp) :: h = 0.0_dp               !! step size [s]
+      real(dp) :: c0 = 0.0_dp, c1 = 0.0_dp, c2 = 0.0_dp, c3 = 0.0_dp, c4 = 0.0_dp, c5 = 0.0_dp !! Newmark
+      type(spd_system) :: sys              !! its factored K^
+      logical :: factored = .false.        !! factored once (then only updated)
+      integer :: version = -1              !! the pattern of device stiffnesses it holds
+   end type level_type
 
    !> Everything the loop works on, allocated once before it starts.
    type :: workspace
-      integer :: n = 0, nd = 0, clock = 0
-      real(dp), allocatable :: mass(:), k(:, :), c(:, :)
+      integer :: n = 0, nd = 0
+      real(dp), allocatable :: mass(:)
+      type(level_type), allocatable :: lev(:)         !! 1: dt1, 2: dt2, 2 + l: dt2 / 2**l
+      integer :: version = 0                          !! counts the accepted phase changes
       real(dp), allocatable :: u(:), v(:), a(:), u1(:), v1(:), a1(:), rhs(:), tmp(:)
-      real(dp), allocatable :: s(:), sd(:), s1(:), sd1(:), f(:)
+      real(dp), allocatable :: s(:), sd(:), s1(:), sd1(:), f(:), kd(:)
       type(device_state), allocatable :: st(:), st1(:)
       integer, allocatable :: phase0(:), phase1(:)    !! phases of st, st1 for the observer
-      logical, allocatable :: changed(:), ok(:), stuck(:)
+      logical, allocatable :: changed(:), ok(:)
       real(dp) :: ag = 0.0_dp, ag1 = 0.0_dp
       real(dp) :: w_device = 0.0_dp                   !! work of the device forces [J]
       type(observer_type) :: obs                      !! peaks, history, energy balance
-      type(factor_slot), allocatable :: slot(:)
    end type workspace
 
 contains
@@ -88,17 +98,19 @@ contains
       end if
    end subroutine newmark_check
 
-   !> Integrate a model under a table motion and fill the result.
-   subroutine run_newmark(model, exc, opts, res, error)
+   !> Integrate a model under a table motion and fill the result. With a control: the
+   !> history columns and destinations it selects, stop requests and progress reports.
+   subroutine run_newmark(model, exc, opts, res, error, ctl)
       type(model_type), intent(in) :: model         !! validated model
       type(excitation_type), intent(in) :: exc      !! validated table motion
       type(integration_type), intent(in) :: opts    !! validated settings
       type(result_type), intent(out) :: res         !! histories and summary
-      type(error_type), allocatable, intent(out) :: error !! singular system, divergence
+      type(error_type), allocatable, intent(out) :: error !! singular system, divergence, stop
+      type(run_control), intent(inout), target, optional :: ctl !! the run's control
       type(workspace) :: w
       real(dp) :: dt1, dt2, t0
-      integer :: k, j, c0, c1, crate
-      logical :: any_changed, any_bad
+      integer :: k, j, c0, c1, crate, l
+      logical :: any_changed, any_bad, stop
 
       call system_clock(c0, crate)
       call newmark_check(model, exc, error)
@@ -109,9 +121,9 @@ contains
       res%dt2 = dt2
       res%dt_min = opts%dt_min
       if (res%dt_min <= 0.0_dp) res%dt_min = dt2/2.0_dp**10
-      call setup(model, halving_levels(dt2, res%dt_min), w, res, error)
+      call setup(model, opts, dt1, dt2, halving_levels(dt2, res%dt_min), w, res, error)
       if (allocated(error)) return
-      call observer_init(model, exc, opts, res, w%obs, error)
+      call observer_init(model, exc, opts, res, w%obs, error, ctl)
       if (allocated(error)) return
 
       ! initial state: devices from the initial conditions, acceleration from equilibrium
@@ -121,7 +133,7 @@ contains
       call friction_init(model%dev, w%s, w%sd, w%st, error)
       if (allocated(error)) return
       call consistent_acceleration(model, exc, 0.0_dp, w)
-      call observe_start(w%obs, w%mass, w%k, w%u, w%v, device_energy(w%st, w%s), w%rhs)
+      call observe_start_energy(w%obs, w%mass, w%v, strain_energy(model, w%u), device_energy(w%st, w%s))
       w%f = device_force(w%st, w%s, w%sd)
       w%phase0 = w%st%phase
       call observe_sample(w%obs, res, 0.0_dp, w%ag, w%u, w%v, w%a, w%s, w%sd, w%f, w%phase0)
@@ -129,7 +141,7 @@ contains
 
       do k = 1, w%obs%nsteps
          t0 = (k - 1)*dt1
-         call try_step(model, exc, opts, t0, dt1, w, res, error)
+         call try_step(model, exc, opts, t0, 1, w, error)
          if (allocated(error)) return
          call judge(model, opts, w, any_changed, any_bad)
          if (w%nd == 0 .or. .not. (any_changed .or. (any_bad .and. opts%check))) then
@@ -151,8 +163,21 @@ contains
             w%phase0 = w%st%phase
             call observe_sample(w%obs, res, k*dt1, w%ag, w%u, w%v, w%a, w%s, w%sd, w%f, w%phase0)
          end if
+         call observe_poll(w%obs, k*dt1, stop)
+         if (stop) then
+            call observe_stop_error(w%obs, error)
+            return
+         end if
       end do
-      call observe_end(w%obs, res, w%mass, w%k, w%u, w%v, device_energy(w%st, w%s), w%w_device, w%rhs)
+      call observe_end_energy(w%obs, res, w%mass, w%v, strain_energy(model, w%u), device_energy(w%st, w%s), &
+                              w%w_device)
+      do l = 1, size(w%lev)
+         associate (stats => w%lev(l)%sys%stats)
+            res%factorizations = res%factorizations + stats%factorizations
+            res%partial_factorizations = res%partial_factorizations + stats%partial
+            res%factor_updates = res%factor_updates + stats%updates + stats%downdates
+         end associate
+      end do
       call system_clock(c1)
       res%run_time = real(c1 - c0, dp)/real(max(crate, 1), dp)
    end subroutine run_newmark
@@ -167,43 +192,63 @@ contains
       end do
    end function halving_levels
 
-   !> Matrices and workspace. The factor cache holds the
-   !> step sizes dt1, dt2, dt2/2, ... dt_min with two phase patterns each when memory allows.
-   subroutine setup(model, lmax, w, res, error)
+   !> The effective stiffness systems (one set up, copied for every step size; factored when
+   !> first used) and the workspace. Memory linear in the number of DOFs and devices.
+   subroutine setup(model, opts, dt1, dt2, lmax, w, res, error)
       type(model_type), intent(in) :: model
+      type(integration_type), intent(in) :: opts
+      real(dp), intent(in) :: dt1, dt2
       integer, intent(in) :: lmax
       type(workspace), intent(inout) :: w
       type(result_type), intent(inout) :: res
       type(error_type), allocatable, intent(out) :: error
-      integer :: n, nd, i, n_slots, stat
+      type(spd_system) :: base
+      real(dp) :: a0, a1, b, g, h
+      integer :: n, nd, l, path, stat
 
       n = model%n_dof
       nd = model%n_devices
       w%n = n
       w%nd = nd
       w%mass = model%mass
-      allocate (w%k(n, n), w%c(n, n), stat=stat)
+      call structure_damping(model, a0, a1, res%period_stuck, res%xi_stuck, error)
+      if (allocated(error)) return
+      select case (opts%linear_system)
+      case (linear_system_dense)
+         path = spd_dense
+      case (linear_system_banded)
+         path = spd_banded
+      case default
+         path = spd_auto
+      end select
+      call spd_setup(base, model%mass, model%spring_i, model%spring_j, model%spring_k, model%dev%node_i, &
+                     model%dev%node_j, error, a0=a0, a1=a1, path=path)
+      if (allocated(error)) return
+      res%storage = merge(1, 2, spd_is_dense(base))
+      res%bandwidth = spd_bandwidth(base)
+      allocate (w%lev(lmax + 2), stat=stat)
       if (stat /= 0) then
-         call fatal_error(error, "not enough memory for the matrices of n_dof = "//trim(fmt_int(n))//" DOFs")
+         call fatal_error(error, "not enough memory for the effective stiffness of n_dof = "//trim(fmt_int(n))//" DOFs")
          return
       end if
-      call structure_matrices(model, w%k, w%c, res%period_stuck, res%xi_stuck, error)
-      if (allocated(error)) return
-      allocate (w%u(n), w%v(n), w%a(n), w%u1(n), w%v1(n), w%a1(n), w%rhs(n), w%tmp(n))
-      allocate (w%s(nd), w%sd(nd), w%s1(nd), w%sd1(nd), w%f(nd), w%st(nd), w%st1(nd), w%phase0(nd), w%phase1(nd))
-      allocate (w%changed(nd), w%ok(nd), w%stuck(nd))
-      n_slots = min(max_slots, 2*(lmax + 2), max(4, int(cache_bytes/(8.0_dp*n*n))))
-      if (nd == 0) n_slots = 1
-      allocate (w%slot(n_slots))
-      do i = 1, n_slots
-         allocate (w%slot(i)%stuck(nd), w%slot(i)%a(n, n), stat=stat)
-         if (stat /= 0) then
-            call fatal_error(error, "not enough memory for the factors of n_dof = "//trim(fmt_int(n))//" DOFs")
-            return
+      b = opts%beta
+      g = opts%gamma
+      do l = 1, lmax + 2
+         if (l == 1) then
+            h = dt1
+         else
+            h = dt2/2.0_dp**(l - 2)
          end if
+         w%lev(l)%h = h
+         w%lev(l)%c0 = 1.0_dp/(b*h*h); w%lev(l)%c1 = g/(b*h); w%lev(l)%c2 = 1.0_dp/(b*h)
+         w%lev(l)%c3 = 0.5_dp/b - 1.0_dp; w%lev(l)%c4 = g/b - 1.0_dp; w%lev(l)%c5 = h*(0.5_dp*g/b - 1.0_dp)
+         w%lev(l)%sys = base
       end do
+      allocate (w%u(n), w%v(n), w%a(n), w%u1(n), w%v1(n), w%a1(n), w%rhs(n), w%tmp(n))
+      allocate (w%s(nd), w%sd(nd), w%s1(nd), w%sd1(nd), w%f(nd), w%kd(nd), w%st(nd), w%st1(nd), &
+                w%phase0(nd), w%phase1(nd))
+      allocate (w%changed(nd), w%ok(nd))
    end subroutine setup
-
 
    !> Acceleration in equilibrium with the current phases: M a = p - C v - K u - sum b F.
    subroutine consistent_acceleration(model, exc, t, w)
@@ -216,99 +261,78 @@ contains
 
       call table_motion(exc, t, xg, vg, w%ag)
       w%rhs = -w%mass*w%ag
-      call sym_matvec(w%c, w%v, w%rhs, -1.0_dp, 1.0_dp)
-      call sym_matvec(w%k, w%u, w%rhs, -1.0_dp, 1.0_dp)
+      call spd_c_matvec(w%lev(1)%sys, w%v, w%rhs, -1.0_dp, 1.0_dp)
+      call spd_k_matvec(w%lev(1)%sys, w%u, w%rhs, -1.0_dp, 1.0_dp)
       do d = 1, w%nd
          call add_device(model, d, -device_force(w%st(d), w%s(d), w%sd(d)), w%rhs)
       end do
       w%a = w%rhs/w%mass
    end subroutine consistent_acceleration
 
-   !> One Newmark step of size h from t with the current phases, into the trial state.
-   subroutine try_step(model, exc, opts, t, h, w, res, error)
+   !> One Newmark step of the size of level lv from t with the current phases, into the
+   !> trial state.
+   subroutine try_step(model, exc, opts, t, lv, w, error)
       type(model_type), intent(in) :: model
       type(excitation_type), intent(in) :: exc
       type(integration_type), intent(in) :: opts
-      real(dp), intent(in) :: t, h
-      type(workspace), intent(inout) :: w
-      type(result_type), intent(inout) :: res
+      real(dp), intent(in) :: t
+      integer, intent(in) :: lv
+      type(workspace), intent(inout), target :: w
       type(error_type), allocatable, intent(out) :: error
-      real(dp) :: b, g, c0, c1, c2, c3, c4, c5, xg, vg, proj
-      integer :: is, d
+      real(dp) :: g, h, xg, vg, proj
+      integer :: d
 
-      b = opts%beta; g = opts%gamma
-      c0 = 1.0_dp/(b*h*h); c1 = g/(b*h); c2 = 1.0_dp/(b*h); c3 = 0.5_dp/b - 1.0_dp
-      c4 = g/b - 1.0_dp; c5 = h*(0.5_dp*g/b - 1.0_dp)
-      call factor_for(model, h, c0, c1, w, res, is, error)
+      call factor_for(lv, w, error)
       if (allocated(error)) return
-      call table_motion(exc, t + h, xg, vg, w%ag1)
-      ! incremental form, K^ du = p1 - F0 - K u + M (c2 v + c3 a) + C (c4 v + c5 a), so that
-      ! a1 = c0 du - c2 v - c3 a does not lose digits to c0 u at small steps
-      w%tmp = c4*w%v + c5*w%a
-      w%rhs = w%mass*(c2*w%v + c3*w%a - w%ag1)
-      call sym_matvec(w%c, w%tmp, w%rhs, 1.0_dp, 1.0_dp)
-      call sym_matvec(w%k, w%u, w%rhs, -1.0_dp, 1.0_dp)
-      do d = 1, w%nd
-         proj = device_relative(model, d, w%tmp)
-         call add_device(model, d, w%st(d)%cs*proj - w%st(d)%ks*w%s(d) - w%st(d)%f0, w%rhs)
-      end do
-      call cholesky_solve(w%slot(is)%a, w%rhs)
-      w%u1 = w%u + w%rhs
-      w%a1 = c0*w%rhs - c2*w%v - c3*w%a
-      w%v1 = w%v + h*((1.0_dp - g)*w%a + g*w%a1)
+      associate (lev => w%lev(lv))
+         h = lev%h
+         g = opts%gamma
+         call table_motion(exc, t + h, xg, vg, w%ag1)
+         ! incremental form, K^ du = p1 - F0 - K u + M (c2 v + c3 a) + C (c4 v + c5 a), so that
+         ! a1 = c0 du - c2 v - c3 a does not lose digits to c0 u at small steps
+         w%tmp = lev%c4*w%v + lev%c5*w%a
+         w%rhs = w%mass*(lev%c2*w%v + lev%c3*w%a - w%ag1)
+         call spd_c_matvec(lev%sys, w%tmp, w%rhs, 1.0_dp, 1.0_dp)
+         call spd_k_matvec(lev%sys, w%u, w%rhs, -1.0_dp, 1.0_dp)
+         do d = 1, w%nd
+            proj = device_relative(model, d, w%tmp)
+            call add_device(model, d, w%st(d)%cs*proj - w%st(d)%ks*w%s(d) - w%st(d)%f0, w%rhs)
+         end do
+         call spd_solve(lev%sys, w%rhs, error)
+         if (allocated(error)) return
+         w%u1 = w%u + w%rhs
+         w%a1 = lev%c0*w%rhs - lev%c2*w%v - lev%c3*w%a
+         w%v1 = w%v + h*((1.0_dp - g)*w%a + g*w%a1)
+      end associate
       call device_kinematics(model, w%u1, w%v1, w%s1, w%sd1)
    end subroutine try_step
 
-   !> The cached factor for step h and the current phase pattern, made if missing.
-   subroutine factor_for(model, h, c0, c1, w, res, is, error)
-      type(model_type), intent(in) :: model
-      real(dp), intent(in) :: h, c0, c1
-      type(workspace), intent(inout) :: w
-      type(result_type), intent(inout) :: res
-      integer, intent(out) :: is
+   !> The factored effective stiffness of level lv for the current phases: factored the
+   !> first time the level is used, updated (never refactored from scratch) when the
+   !> devices' stiffnesses have changed since it was last used.
+   subroutine factor_for(lv, w, error)
+      integer, intent(in) :: lv
+      type(workspace), intent(inout), target :: w
       type(error_type), allocatable, intent(out) :: error
-      integer :: i, d, info, ni, nj
-      real(dp) :: kd
+      integer :: d
 
-      w%clock = w%clock + 1
-      w%stuck = w%st%ks /= 0.0_dp .or. w%st%cs /= 0.0_dp
-      do is = 1, size(w%slot)
-         if (w%slot(is)%h == h) then
-            if (all(w%slot(is)%stuck .eqv. w%stuck)) then
-               w%slot(is)%last_use = w%clock
-               return
-            end if
-         end if
-      end do
-      is = minloc(w%slot%last_use, 1)
-      associate (a => w%slot(is)%a)
-         a = w%k + c1*w%c
-         do i = 1, w%n
-            a(i, i) = a(i, i) + c0*w%mass(i)
-         end do
+      associate (lev => w%lev(lv))
+         if (lev%factored .and. lev%version == w%version) return
          do d = 1, w%nd
-            kd = w%st(d)%ks + c1*w%st(d)%cs
-            if (kd == 0.0_dp) cycle
-            ni = model%dev(d)%node_i; nj = model%dev(d)%node_j
-            a(ni, ni) = a(ni, ni) + kd
-            if (nj > 0) then
-               a(nj, nj) = a(nj, nj) + kd
-               a(ni, nj) = a(ni, nj) - kd
-               a(nj, ni) = a(nj, ni) - kd
-            end if
+            w%kd(d) = w%st(d)%ks + lev%c1*w%st(d)%cs
          end do
-         call cholesky_factor(a, info)
+         if (.not. lev%factored) then
+            call spd_factor(lev%sys, lev%c0, lev%c1, w%kd, error)
+            lev%factored = .not. allocated(error)
+         else
+            call spd_update_devices(lev%sys, w%kd, error)
+         end if
+         if (allocated(error)) then
+            error%message = "the step "//trim(fmt_real(lev%h))//" s: "//error%message
+            return
+         end if
+         lev%version = w%version
       end associate
-      res%factorizations = res%factorizations + 1
-      if (info /= 0) then
-         w%slot(is)%h = -1.0_dp
-         call fatal_error(error, "the effective stiffness for the step "//trim(fmt_real(h))// &
-                          " s is not positive definite (leading minor "//trim(fmt_int(info))//")")
-         return
-      end if
-      w%slot(is)%h = h
-      w%slot(is)%stuck = w%stuck
-      w%slot(is)%last_use = w%clock
    end subroutine factor_for
 
    !> Phases after the trial step, and the correctness condition of the step.
@@ -337,7 +361,7 @@ contains
       type(error_type), allocatable, intent(out) :: error
       integer :: lmax, level, pos, units
       real(dp) :: h, tl
-      logical :: any_changed, any_bad
+      logical :: any_changed, any_bad, stop
 
       lmax = halving_levels(sub, dt_min)
       units = 2**lmax
@@ -346,7 +370,7 @@ contains
       do while (pos < units)
          h = sub/2.0_dp**level
          tl = t + sub*real(pos, dp)/real(units, dp)
-         call try_step(model, exc, opts, tl, h, w, res, error)
+         call try_step(model, exc, opts, tl, 2 + level, w, error)
          if (allocated(error)) return
          call judge(model, opts, w, any_changed, any_bad)
          if (any_bad .and. opts%check .and. level < lmax) then
@@ -358,6 +382,11 @@ contains
             res%steps_dt2 = res%steps_dt2 + 1
          else
             res%steps_finer = res%steps_finer + 1
+         end if
+         call observe_poll(w%obs, tl + h, stop)
+         if (stop) then
+            call observe_stop_error(w%obs, error)
+            return
          end if
          pos = pos + 2**(lmax - level)
          do while (level > 0)
@@ -381,8 +410,7 @@ contains
       ! energy of the step, forces at both ends in the step's phases
       w%tmp = w%u1 - w%u
       res%e_input = res%e_input - 0.5_dp*(w%ag + w%ag1)*sum(w%mass*w%tmp)
-      w%rhs = 0.0_dp
-      call sym_matvec(w%c, w%tmp, w%rhs, 1.0_dp, 0.0_dp)
+      call spd_c_matvec(w%lev(1)%sys, w%tmp, w%rhs, 1.0_dp, 0.0_dp)
       res%e_viscous = res%e_viscous + 0.5_dp*sum((w%v + w%v1)*w%rhs)
       do d = 1, w%nd
          f0 = device_force(w%st(d), w%s(d), w%sd(d))
@@ -397,10 +425,30 @@ contains
       w%u = w%u1; w%v = w%v1; w%a = w%a1; w%ag = w%ag1
       w%s = w%s1; w%sd = w%sd1
       w%st = w%st1
-      if (any(w%changed)) call consistent_acceleration(model, exc, t1, w)
+      if (any(w%changed)) then
+         w%version = w%version + 1
+         call consistent_acceleration(model, exc, t1, w)
+      end if
       w%f = device_force(w%st, w%s, w%sd)
       call observe_peaks(res, t1, w%u, w%v, w%a, w%ag, w%s, w%f)
    end subroutine accept
+
+   !> Strain energy of the springs, 1/2 u' K u = sum_s k_s (u_i - u_j)^2 / 2 (no cancellation).
+   pure real(dp) function strain_energy(model, u) result(e)
+      type(model_type), intent(in) :: model
+      real(dp), intent(in) :: u(:)
+      real(dp) :: x
+      integer :: s
+
+      e = 0.0_dp
+      do s = 1, model%n_springs
+         x = 0.0_dp
+         if (model%spring_i(s) > 0) x = u(model%spring_i(s))
+         if (model%spring_j(s) > 0) x = x - u(model%spring_j(s))
+         e = e + model%spring_k(s)*x*x
+      end do
+      e = 0.5_dp*e
+   end function strain_energy
 
    !> Elastic energy stored in devices whose phase has a stiffness (hysteretic sticking).
    pure real(dp) function device_energy(st, s) result(e)

@@ -10,6 +10,7 @@ module fd_technique
    use fd_model, only: model_type, integration_type
    use fd_excitation, only: excitation_type
    use fd_result, only: result_type
+   use fd_run_control, only: run_control
    use fd_newmark, only: run_newmark, newmark_check
    use fd_event_driven, only: run_event_driven, event_driven_check
    implicit none
@@ -37,20 +38,22 @@ contains
       end select
    end subroutine check_technique
 
-   !> Run the technique the settings choose.
-   subroutine run_technique(model, exc, opts, res, error)
+   !> Run the technique the settings choose (with the caller's control of the run, if any:
+   !> history columns and destinations, stop requests, progress).
+   subroutine run_technique(model, exc, opts, res, error, ctl)
       type(model_type), intent(in) :: model         !! validated model
       type(excitation_type), intent(in) :: exc      !! validated table motion
       type(integration_type), intent(in) :: opts    !! validated settings
       type(result_type), intent(out) :: res         !! histories and summary
       type(error_type), allocatable, intent(out) :: error !! what the technique cannot do, or
                                                           !! its failure
+      type(run_control), intent(inout), target, optional :: ctl !! the run's control
 
       select case (opts%technique)
       case (technique_newmark)
-         call run_newmark(model, exc, opts, res, error)
+         call run_newmark(model, exc, opts, res, error, ctl)
       case (technique_event_driven)
-         call run_event_driven(model, exc, opts, res, error)
+         call run_event_driven(model, exc, opts, res, error, ctl)
       case default
          call unknown_technique(opts%technique, error)
       end select

@@ -23,7 +23,8 @@ module fd_event_driven
    use fd_device_state, only: phase_stick
    use fd_result, only: result_type
    use fd_observer, only: observer_type, observer_init, sample_due, observe_start, observe_peaks, &
-                          observe_sample, observe_transitions, observe_end
+                          observe_sample, observe_transitions, observe_end, observe_poll, observe_stop_error
+   use fd_run_control, only: run_control
    use fd_root_finder, only: root_function, brent_root
    use fd_phase_pattern, only: forcing_changed, propagate, pattern_exp, quad_x, quad_w
    use fd_ed_state, only: ed_state, ed_setup, set_pattern, expand_state, step_propagators
@@ -91,15 +92,17 @@ contains
    end subroutine event_driven_check
 
    !> Integrate a model whose devices all follow the exact Coulomb law.
-   subroutine run_event_driven(model, exc, opts, res, error)
+   subroutine run_event_driven(model, exc, opts, res, error, ctl)
       type(model_type), intent(in), target :: model        !! validated model (all devices coulomb)
       type(excitation_type), intent(in), target :: exc     !! table motion
       type(integration_type), intent(in) :: opts           !! n1 and output_every are used
       type(result_type), intent(out) :: res                !! histories and summary
-      type(error_type), allocatable, intent(out) :: error  !! event chattering, singular phase
+      type(error_type), allocatable, intent(out) :: error  !! event chattering, singular phase, stop
+      type(run_control), intent(inout), target, optional :: ctl !! the run's control (fd_run_control)
       type(ed_work), target :: w
       real(dp) :: h, t, tn, tb, xg, vg, ag
       integer :: k, c0, c1, crate, stat
+      logical :: stop
 
       call system_clock(c0, crate)
       call event_driven_check(model, exc, error)
@@ -114,7 +117,7 @@ contains
          allocate (w%rn(st%n), w%vv(st%n))
          call structure_matrices(model, st%k, st%c, res%period_stuck, res%xi_stuck, error)
          if (allocated(error)) return
-         call observer_init(model, exc, opts, res, w%obs, error)
+         call observer_init(model, exc, opts, res, w%obs, error, ctl)
          if (allocated(error)) return
          h = exc%dt_record/opts%n1
          res%dt1 = h
@@ -163,6 +166,11 @@ contains
                   return
                end if
                call observe_sample(w%obs, res, t, ag, st%u, st%v, st%acc, w%s, w%sd, st%force, st%phase)
+            end if
+            call observe_poll(w%obs, t, stop)
+            if (stop) then
+               call observe_stop_error(w%obs, error)
+               return
             end if
          end do
          call observe_end(w%obs, res, st%mass, st%k, st%u, st%v, 0.0_dp, w%w_fric, w%rn)
