@@ -5,6 +5,15 @@ executable's): it is solved, its history and texts are fetched into buffers of t
 library reports, and its outputs are written by the library's writer. The session lives in
 the library until it is closed; ``Session`` closes it on every path (use it as a context
 manager). Every non-zero status becomes an exception here, in one place.
+
+The history is held once: the library writes its rows straight into a numpy array this module
+allocates (``Result.data`` is a view of it), and only the DOFs and devices selected are kept
+(``Session.select``, ``run(dofs=..., devices=...)``); ``Session.stream`` writes it to its file
+as the run goes instead. A solve runs in a worker thread when called from the main thread:
+Ctrl-C (in a terminal or a notebook) asks the library to stop, which it does within a poll
+(about 10 ms), and KeyboardInterrupt is raised; a ``progress(t, duration)`` callback is called
+about ten times a second meanwhile. The Fortran work runs without the GIL: runs in several
+threads overlap.
 """
 
 from __future__ import annotations
@@ -12,6 +21,7 @@ from __future__ import annotations
 import json
 import os
 import threading
+from collections.abc import Callable, Sequence
 from dataclasses import dataclass, field
 from pathlib import Path
 
@@ -25,6 +35,7 @@ __all__ = [
     "OutputError",
     "OutputSettings",
     "Result",
+    "RunCancelled",
     "Session",
     "SolverError",
     "read_history",
@@ -50,8 +61,27 @@ class OutputError(FrictiondynError, OSError):
     """An output file or directory cannot be created or written."""
 
 
+class RunCancelled(FrictiondynError):
+    """The solve was cancelled (``Session.cancel`` from another thread)."""
+
+
 # the status codes of the extension (driver/frictiondyn/_core.f90)
-_ERRORS = {1: DeckError, 2: SolverError, 3: FrictiondynError, 4: OutputError, 5: MemoryError}
+_ERRORS = {
+    1: DeckError,
+    2: SolverError,
+    3: FrictiondynError,
+    4: OutputError,
+    5: MemoryError,
+    6: RunCancelled,
+}
+#: seconds between looks at a solve running in the worker thread (Ctrl-C, progress)
+_POLL = 0.05
+#: the progress callback: (time reached [s], duration [s])
+ProgressCallback = Callable[[float, float], object]
+
+
+def _no_history() -> np.ndarray:
+    return np.zeros((1, 1), dtype=np.float64, order="F")
 # the texts a session gives (fortran/fd_session.f90)
 _HEADER, _SUMMARY, _OUTPUT_DIR, _OUTPUT_NAME, _HISTORY_PATH, _SUMMARY_PATH, _DECK, _ERROR = range(
     1, 9
@@ -73,8 +103,10 @@ class Session:
 
     ``Session(deck)`` reads a deck file, ``Session.from_text(text, name, base_dir)`` a deck
     given as text. A DeckError is raised (and nothing is left open) when the deck is bad.
-    The methods may be called from any thread; ``solve`` releases the GIL, so sessions run
-    side by side in threads.
+    Before ``solve``: ``select`` the DOFs and devices the history keeps, ``stream`` the
+    history to its file as the run goes. The methods may be called from any thread; ``solve``
+    releases the GIL, so sessions run side by side in threads, and ``cancel`` stops a solve
+    running in another thread.
     """
 
     def __init__(self, deck: str | os.PathLike) -> None:
@@ -94,14 +126,19 @@ class Session:
     def _adopt(cls, data: np.ndarray, header: str, summary: str) -> Session:
         """A solved session holding a history and texts given here (to write them)."""
         self = cls.__new__(cls)
-        self._handle, self._lock = 0, threading.Lock()
-        hist = np.asarray(data, dtype=np.float64).T  # (columns, samples), Fortran order
-        handle, status = _core.fd_session_adopt(hist, header, summary)
+        self._init_state()
+        empty = np.zeros((np.shape(data)[1], 0), dtype=np.float64, order="F")
+        handle, status = _core.fd_session_adopt(empty, header, summary)
         self._started(handle, status)
         return self
 
-    def _open(self, path: str, text: str, from_text: int) -> None:
+    def _init_state(self) -> None:
         self._handle, self._lock = 0, threading.Lock()
+        self._hist: np.ndarray | None = None  # the history, (columns, samples), Fortran order
+        self._streamed = False
+
+    def _open(self, path: str, text: str, from_text: int) -> None:
+        self._init_state()
         handle, _, _, status = _core.fd_session_open(path, text, from_text)
         self._started(handle, status)
 
@@ -145,11 +182,13 @@ class Session:
         return self._fetch_text(which, n)
 
     def close(self) -> None:
-        """Free the session (waits for a solve running in another thread). Idempotent."""
+        """Free the session (waits for a solve running in another thread). Idempotent. A
+        streamed history that was not written (``write``) is removed."""
         with self._lock:
             if self._handle != 0:
                 handle, self._handle = self._handle, 0
                 _core.fd_session_close(handle)
+            self._hist = None
 
     @property
     def closed(self) -> bool:
@@ -192,22 +231,120 @@ class Session:
 
     # --- running and results --------------------------------------------------------------
 
-    def solve(self) -> Session:
-        """Run the deck (once). Raises SolverError when the analysis fails."""
+    def select(
+        self, dofs: Sequence[int] | None = None, devices: Sequence[int] | None = None
+    ) -> Session:
+        """Keep only these DOFs and devices (1-based) in the history; None keeps all of them,
+        an empty list none. Before ``solve``; the summary still covers every DOF and device."""
         with self._lock:
-            self._check(_core.fd_session_solve(self._live()))
+            h = self._live()
+            n_dof, n_dev = self._sizes()
+            d = np.arange(1, n_dof + 1) if dofs is None else np.asarray(dofs, dtype=np.int32)
+            v = np.arange(1, n_dev + 1) if devices is None else np.asarray(devices, dtype=np.int32)
+            d, v = np.sort(d).astype(np.int32), np.sort(v).astype(np.int32)
+            _, status = _core.fd_session_select(h, d, v)
+            self._check(status)
         return self
 
+    def _sizes(self) -> tuple[int, int]:
+        """(DOFs, devices) of the deck."""
+        n_dof, n_dev, status = _core.fd_session_sizes(self._handle)
+        self._check(status)
+        return int(n_dof), int(n_dev)
+
+    def stream(self, out: str | os.PathLike | None = None) -> Session:
+        """Write the history CSV to ``<dir>/<name>.csv`` as the run goes (a temporary name,
+        renamed by ``write``; removed when the run fails, is cancelled or the session is
+        closed unwritten), so that memory does not grow with the duration. ``out`` replaces
+        the deck's directory. Before ``solve``."""
+        with self._lock:
+            h = self._live()
+            if out is not None:
+                self._check(_core.fd_session_set_output_dir(h, os.fspath(out)))
+            self._check(_core.fd_session_stream(h))
+            self._streamed = True
+        return self
+
+    def cancel(self) -> None:
+        """Ask a solve running in another thread to stop: it raises RunCancelled there
+        (KeyboardInterrupt when the stop came from Ctrl-C). Harmless when nothing runs."""
+        h = self._handle
+        if h != 0:
+            _core.fd_session_cancel(h)
+
+    def progress(self) -> tuple[float, float]:
+        """(time reached, duration) of a solve running in another thread [s]."""
+        h = self._handle
+        if h == 0:
+            return 0.0, 0.0
+        t, duration = _core.fd_session_progress(h)
+        return float(t), float(duration)
+
+    def solve(self, progress: ProgressCallback | None = None, history: bool = True) -> Session:
+        """Run the deck (once). ``history``: keep the history (the columns selected) in
+        memory, in one numpy array that ``result`` wraps; False keeps only the summary (and
+        the streamed file). ``progress(t, duration)`` is called about ten times a second.
+        Ctrl-C stops the run within about 10 ms of the solver and raises KeyboardInterrupt.
+        Raises SolverError when the analysis fails."""
+        with self._lock:
+            h = self._live()
+            ncol, nout, _, status = _core.fd_session_shape(h)
+            self._check(status)
+            if history:
+                buf = np.empty((int(ncol), int(nout)), dtype=np.float64, order="F")
+            else:
+                buf = _no_history()
+            status = self._run(h, 1 if history else 0, buf, progress)
+            self._check(status)
+            self._hist = buf if history else None
+        return self
+
+    @staticmethod
+    def _run(h: int, mode: int, buf: np.ndarray, progress: ProgressCallback | None) -> int:
+        """fd_session_solve, in a worker thread when this is the main thread (where Ctrl-C
+        arrives) or a progress callback is given; else here (the GIL is released either way)."""
+        if threading.current_thread() is not threading.main_thread() and progress is None:
+            return int(_core.fd_session_solve(h, mode, buf))
+        out: list[int] = []
+        worker = threading.Thread(
+            target=lambda: out.append(int(_core.fd_session_solve(h, mode, buf))),
+            name="frictiondyn-solve",
+            daemon=True,
+        )
+        worker.start()
+        try:
+            while worker.is_alive():
+                worker.join(_POLL)
+                if progress is not None and worker.is_alive():
+                    t, duration = _core.fd_session_progress(h)
+                    progress(float(t), float(duration))
+        except KeyboardInterrupt:
+            _core.fd_session_cancel(h)
+            while worker.is_alive():  # the solver stops within a poll: wait for it, so that
+                try:  # the session is never freed under a running solve
+                    worker.join()
+                except KeyboardInterrupt:
+                    continue
+            raise
+        if progress is not None:
+            t, duration = _core.fd_session_progress(h)
+            progress(float(t), float(duration))
+        return out[0] if out else 3
+
     def result(self) -> Result:
-        """The Result of the solved run: history, header and summary (no file written)."""
+        """The Result of the solved run: history (the columns kept; none when ``solve`` was
+        told not to keep it), header and summary (no file written). The Result's data is a
+        view of the one history array, not a copy."""
         with self._lock:
             h = self._live()
             ncol, nout, history, status = _core.fd_session_shape(h)
             self._check(status)
-            hist, status = _core.fd_session_history(h, ncol, nout)
-            self._check(status)
             summary = self._text(_SUMMARY)
-            result = Result.from_arrays(self._text(_HEADER), np.asarray(hist).T, summary)
+            if self._hist is not None:
+                data = self._hist.T
+            else:
+                data = np.zeros((0, int(ncol)))
+            result = Result.from_arrays(self._text(_HEADER), data, summary)
             result.output = OutputSettings(
                 self._text(_OUTPUT_DIR), self._text(_OUTPUT_NAME), bool(history)
             )
@@ -216,41 +353,72 @@ class Session:
     def write(self, out: str | os.PathLike | None = None) -> tuple[Path | None, Path]:
         """Write ``<dir>/<name>.csv`` (unless ``write_history = .false.``) and
         ``<dir>/<name>.summary.json`` exactly as the executable does (the library's writer;
-        the directory is created when missing); ``out`` replaces the deck's directory.
-        Returns the paths written. Raises OutputError when a file cannot be written."""
+        the directory is created when missing); ``out`` replaces the deck's directory (not
+        for a streamed history, whose directory was set by ``stream``). Returns the paths
+        written. Raises OutputError when a file cannot be written."""
         with self._lock:
             h = self._live()
             if out is not None:
+                if self._streamed:
+                    raise FrictiondynError(
+                        "the history was streamed to the directory given to stream(); "
+                        "write() takes no other directory"
+                    )
                 self._check(_core.fd_session_set_output_dir(h, os.fspath(out)))
-            self._check(_core.fd_session_write(h))
+            use = self._hist is not None and not self._streamed
+            self._check(_core.fd_session_write(h, int(use), self._hist if use else _no_history()))
             _, _, history, status = _core.fd_session_shape(h)
             self._check(status)
             csv = Path(self._text(_HISTORY_PATH)) if history else None
             return csv, Path(self._text(_SUMMARY_PATH))
 
-    def _write_files(self, csv: Path | None, summary: Path) -> None:
+    def _write_files(self, csv: Path | None, summary: Path, data: np.ndarray | None) -> None:
         with self._lock:
+            hist = _no_history() if data is None else np.asfortranarray(data.T, dtype=np.float64)
             status = _core.fd_session_write_files(
-                self._live(), os.fspath(csv or ""), os.fspath(summary), int(csv is not None)
+                self._live(),
+                os.fspath(csv or ""),
+                os.fspath(summary),
+                int(csv is not None),
+                int(data is not None),
+                hist,
             )
             self._check(status)
 
 
-def run(deck: str | os.PathLike) -> Result:
+def run(
+    deck: str | os.PathLike,
+    dofs: Sequence[int] | None = None,
+    devices: Sequence[int] | None = None,
+    progress: ProgressCallback | None = None,
+) -> Result:
     """Run a namelist deck file and return its Result (no output file is written).
 
-    Raises DeckError for a missing, malformed or invalid deck, SolverError when the
-    analysis fails.
+    ``dofs``, ``devices``: keep only these (1-based) in the history (None: all; the summary
+    covers all). ``progress(t, duration)``: called about ten times a second. Ctrl-C stops
+    the run and raises KeyboardInterrupt. Raises DeckError for a missing, malformed or
+    invalid deck, SolverError when the analysis fails.
     """
     with Session(deck) as session:
-        return session.solve().result()
+        if dofs is not None or devices is not None:
+            session.select(dofs, devices)
+        return session.solve(progress).result()
 
 
-def run_text(text: str, name: str = "deck.nml", base_dir: str | os.PathLike = ".") -> Result:
+def run_text(
+    text: str,
+    name: str = "deck.nml",
+    base_dir: str | os.PathLike = ".",
+    dofs: Sequence[int] | None = None,
+    devices: Sequence[int] | None = None,
+    progress: ProgressCallback | None = None,
+) -> Result:
     """Run a deck given as text. ``name`` names it in messages; a relative record_file is
-    looked up in ``base_dir``."""
+    looked up in ``base_dir``; ``dofs``, ``devices``, ``progress`` as for ``run``."""
     with Session.from_text(text, name, base_dir) as session:
-        return session.solve().result()
+        if dofs is not None or devices is not None:
+            session.select(dofs, devices)
+        return session.solve(progress).result()
 
 
 _UNITS_LABEL = {"m/s2": "m/s²"}
@@ -369,7 +537,7 @@ class Result:
         path = Path(path)
         summary = path.with_name(path.name.removesuffix(".csv") + ".summary.json")
         with Session._adopt(self.data, self._header(), self.summary_json()) as session:
-            session._write_files(path, summary)
+            session._write_files(path, summary, self.data)
         return path
 
     def write_summary(self, path: str | os.PathLike) -> Path:
@@ -377,7 +545,7 @@ class Result:
         path = Path(path)
         empty = np.zeros((0, len(self.names)))
         with Session._adopt(empty, self._header(), self.summary_json()) as session:
-            session._write_files(None, path)
+            session._write_files(None, path, None)
         return path
 
     def to_npz(self, path: str | os.PathLike) -> Path:

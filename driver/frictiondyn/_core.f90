@@ -200,6 +200,33 @@ contains
    include 'fd_core_common.inc'
 end subroutine fd_session_select
 
+!> Numbers of DOFs and devices of the session's deck.
+subroutine fd_session_sizes(handle, n_dof, n_devices, status)
+   use, intrinsic :: iso_c_binding, only: c_int, c_int64_t
+   use fd_session, only: session_type, session_from_handle, session_read
+   use frictiondyn, only: error_type
+   use fd_error, only: fatal_error
+   implicit none
+   integer(c_int64_t), intent(in) :: handle      !! the session
+   integer(c_int), intent(out) :: n_dof          !! DOFs
+   integer(c_int), intent(out) :: n_devices      !! devices
+   integer(c_int), intent(out) :: status         !! 0 or an error code
+   type(session_type), pointer :: s
+   type(error_type), allocatable :: error
+
+   n_dof = 0; n_devices = 0
+   call session_from_handle(handle, s)
+   status = merge(0_c_int, 3_c_int, associated(s))
+   if (status /= 0) return
+   if (.not. s%from_deck .or. s%state < session_read) call fatal_error(error, 'the session holds no deck')
+   call keep_error(s, error, 3, status)
+   if (status /= 0) return
+   n_dof = int(s%cfg%model%n_dof, c_int)
+   n_devices = int(s%cfg%model%n_devices, c_int)
+contains
+   include 'fd_core_common.inc'
+end subroutine fd_session_sizes
+
 !> Write the history to the deck's output file as the run goes (fd_session_write commits it).
 subroutine fd_session_stream(handle, status)
    use, intrinsic :: iso_c_binding, only: c_int, c_int64_t

@@ -493,6 +493,31 @@ contains
       call refactor_from(sys, 1, error)
    end subroutine full_factor
 
+   !> Refactor after an abandoned modification (a lost pivot, or the error budget reached):
+   !> from its first column p, or from the first column whose estimated error has used a
+   !> quarter of the budget if that comes earlier, so that every column has room for updates
+   !> again. Columns before that are kept: a refresh costs O((n - q) band^2), not a factorization
+   !> from scratch (unless q = 1).
+   subroutine refresh(sys, p, error)
+      type(spd_system), intent(inout) :: sys
+      integer, intent(in) :: p
+      type(error_type), allocatable, intent(out) :: error
+      integer :: q, j
+
+      q = p
+      do j = 1, p - 1
+         if (sys%errcol(j) > 0.25_dp*sys%budget) then
+            q = j
+            exit
+         end if
+      end do
+      if (q <= 1) then
+         call full_factor(sys, error)
+      else
+         call refactor_from(sys, q, error)
+      end if
+   end subroutine refresh
+
    !> Recompute the factor from column p on (columns before p are kept): assemble columns
    !> p..n of K^, subtract the rows of U above p (U22' U22 = A22 - U12' U12), factor.
    subroutine refactor_from(sys, p, error)
@@ -609,7 +634,7 @@ contains
          call refactor_from(sys, p, error)
       else
          call modify(sys, d, kd, ok)
-         if (.not. ok) call full_factor(sys, error)
+         if (.not. ok) call refresh(sys, p, error)
       end if
    end subroutine spd_update_device
 
@@ -656,7 +681,7 @@ contains
             call modify(sys, d, kd(d), ok)
             if (.not. ok) then
                sys%kd(:) = kd
-               call full_factor(sys, error)
+               call refresh(sys, p, error)
                return
             end if
          end do

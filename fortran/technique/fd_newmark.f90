@@ -279,30 +279,36 @@ contains
       integer, intent(in) :: lv
       type(workspace), intent(inout), target :: w
       type(error_type), allocatable, intent(out) :: error
-      real(dp) :: g, h, xg, vg, proj
+      real(dp) :: b, g, h, xg, vg, f
       integer :: d
 
       call factor_for(lv, w, error)
       if (allocated(error)) return
       associate (lev => w%lev(lv))
          h = lev%h
+         b = opts%beta
          g = opts%gamma
          call table_motion(exc, t + h, xg, vg, w%ag1)
-         ! incremental form, K^ du = p1 - F0 - K u + M (c2 v + c3 a) + C (c4 v + c5 a), so that
-         ! a1 = c0 du - c2 v - c3 a does not lose digits to c0 u at small steps
-         w%tmp = lev%c4*w%v + lev%c5*w%a
-         w%rhs = w%mass*(lev%c2*w%v + lev%c3*w%a - w%ag1)
-         call spd_c_matvec(lev%sys, w%tmp, w%rhs, 1.0_dp, 1.0_dp)
-         call spd_k_matvec(lev%sys, w%u, w%rhs, -1.0_dp, 1.0_dp)
+         ! acceleration form: with the predictors u~ = u + h v + (1/2 - beta) h^2 a and
+         ! v~ = v + (1 - gamma) h a, (M + gamma h C_t + beta h^2 K_t) a1 = p1 - F0 - C_t v~ - K_t u~,
+         ! solved as K^ a1 = c0 (...) (K^ = c0 (M + ...)); u1 = u~ + beta h^2 a1, v1 = v~ + gamma h a1.
+         ! The solve's error is relative to a1 itself (the incremental form's, to c0 du ~ v / h)
+         w%tmp = w%v + ((1.0_dp - g)*h)*w%a
+         w%u1 = w%u + (h*w%v + ((0.5_dp - b)*h*h)*w%a)
+         w%rhs = -w%mass*w%ag1
+         call spd_c_matvec(lev%sys, w%tmp, w%rhs, -1.0_dp, 1.0_dp)
+         call spd_k_matvec(lev%sys, w%u1, w%rhs, -1.0_dp, 1.0_dp)
          do d = 1, w%nd
-            proj = device_relative(model, d, w%tmp)
-            call add_device(model, d, w%st(d)%cs*proj - w%st(d)%ks*w%s(d) - w%st(d)%f0, w%rhs)
+            f = w%st(d)%ks*device_relative(model, d, w%u1) + w%st(d)%cs*device_relative(model, d, w%tmp) + &
+                w%st(d)%f0
+            call add_device(model, d, -f, w%rhs)
          end do
+         w%rhs = lev%c0*w%rhs
          call spd_solve(lev%sys, w%rhs, error)
          if (allocated(error)) return
-         w%u1 = w%u + w%rhs
-         w%a1 = lev%c0*w%rhs - lev%c2*w%v - lev%c3*w%a
-         w%v1 = w%v + h*((1.0_dp - g)*w%a + g*w%a1)
+         w%a1 = w%rhs
+         w%u1 = w%u1 + (b*h*h)*w%a1
+         w%v1 = w%tmp + (g*h)*w%a1
       end associate
       call device_kinematics(model, w%u1, w%v1, w%s1, w%sd1)
    end subroutine try_step
