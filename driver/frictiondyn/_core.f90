@@ -96,7 +96,7 @@ subroutine fd_run(path, text, from_text, ncol, nout, lhead, lsum, hist, header, 
    call history_header(res, text_out)
    call put(text_out, header, status)
    if (status == 0) then
-      call summary_json(cfg%model, res, cfg%deck_path, text_out)
+      call summary_json(cfg%model, res, cfg%deck_path, text_out, cfg%record)
       call put(text_out, summary, status)
    end if
    if (status /= 0) then

@@ -1,12 +1,12 @@
 !> Text-file helpers shared by the deck and record readers: whole files as lines,
 !> and small string utilities. No state; errors name the file.
 module fd_textio
-   use, intrinsic :: iso_c_binding, only: c_char, c_ptr, c_size_t, c_int, c_null_char, c_associated
+   use, intrinsic :: iso_c_binding, only: c_char, c_ptr, c_size_t, c_int, c_long, c_null_char, c_associated
    use fd_error, only: error_type, fatal_error
    implicit none
    private
 
-   public :: line_type, read_text_file, split_lines, lower, split_tokens
+   public :: line_type, read_text_file, read_file_text, split_lines, lower, split_tokens
 
    interface
       function c_fopen(path, mode) bind(c, name='fopen') result(fp)
@@ -21,6 +21,18 @@ module fd_textio
          type(c_ptr), value :: fp
          integer(c_size_t) :: got
       end function c_fread
+      function c_fseek(fp, offset, whence) bind(c, name='fseek') result(stat)
+         import :: c_ptr, c_long, c_int
+         type(c_ptr), value :: fp
+         integer(c_long), value :: offset
+         integer(c_int), value :: whence
+         integer(c_int) :: stat
+      end function c_fseek
+      function c_ftell(fp) bind(c, name='ftell') result(pos)
+         import :: c_ptr, c_long
+         type(c_ptr), value :: fp
+         integer(c_long) :: pos
+      end function c_ftell
       function c_fclose(fp) bind(c, name='fclose') result(stat)
          import :: c_ptr, c_int
          type(c_ptr), value :: fp
@@ -43,11 +55,25 @@ contains
       type(line_type), allocatable, intent(out) :: lines(:)  !! its lines
       type(error_type), allocatable, intent(out) :: error    !! set when it cannot be read
       character(len=:), allocatable :: text
+
+      call read_file_text(path, text, error)
+      if (allocated(error)) return
+      call split_lines(text, lines)
+   end subroutine read_text_file
+
+   !> Read a whole file into one string, in one read of its size (a file of 100 MB takes
+   !> a fraction of a second; growing the string chunk by chunk took quadratic time).
+   subroutine read_file_text(path, text, error)
+      character(len=*), intent(in) :: path                   !! file to read
+      character(len=:), allocatable, intent(out) :: text     !! its bytes
+      type(error_type), allocatable, intent(out) :: error    !! set when it cannot be read
       character(kind=c_char, len=65536) :: chunk
       type(c_ptr) :: fp
       integer(c_size_t) :: got
-      integer :: stat
+      integer(c_long) :: size
+      integer :: stat, n
       logical :: exists
+      integer(c_int), parameter :: seek_set = 0, seek_end = 2
 
       inquire (file=path, exist=exists)
       if (.not. exists) then
@@ -59,15 +85,29 @@ contains
          call fatal_error(error, "cannot open file '"//path//"'")
          return
       end if
-      text = ''
-      do
-         got = c_fread(chunk, 1_c_size_t, int(len(chunk), c_size_t), fp)
-         if (got > 0) text = text//chunk(1:int(got))
-         if (got < len(chunk)) exit
-      end do
+      size = -1
+      if (c_fseek(fp, 0_c_long, seek_end) == 0) size = c_ftell(fp)
+      if (size >= 0 .and. size < huge(n)) then
+         stat = c_fseek(fp, 0_c_long, seek_set)
+         allocate (character(len=int(size)) :: text)
+         n = 0
+         if (size > 0) n = int(c_fread(text, 1_c_size_t, int(size, c_size_t), fp))
+         if (n /= size) then
+            stat = c_fclose(fp)
+            call fatal_error(error, "cannot read file '"//path//"'")
+            return
+         end if
+      else
+         ! not seekable (a pipe): read chunk by chunk
+         text = ''
+         do
+            got = c_fread(chunk, 1_c_size_t, int(len(chunk), c_size_t), fp)
+            if (got > 0) text = text//chunk(1:int(got))
+            if (got < len(chunk)) exit
+         end do
+      end if
       stat = c_fclose(fp)
-      call split_lines(text, lines)
-   end subroutine read_text_file
+   end subroutine read_file_text
 
    !> Split text at newlines (a final newline ends the last line; carriage returns dropped).
    pure subroutine split_lines(text, lines)

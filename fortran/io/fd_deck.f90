@@ -12,7 +12,7 @@ module fd_deck
    use fd_model, only: model_type, integration_type, device_type, damping_none, &
                        damping_stiffness, damping_rayleigh, law_velocity, law_hysteretic, law_coulomb
    use fd_excitation, only: excitation_type, excitation_none, excitation_harmonic, excitation_record
-   use fd_record, only: read_record
+   use fd_record, only: read_record, record_info, record_formats, record_units_list, units_factor
    use fd_output, only: output_type
    implicit none
    private
@@ -33,6 +33,7 @@ module fd_deck
       type(excitation_type) :: exc                !! table motion
       type(integration_type) :: opts              !! integration settings
       type(output_type) :: out                    !! output settings
+      type(record_info) :: record                 !! the record read (excitation_type = 'record')
    end type run_config
 
 contains
@@ -351,19 +352,21 @@ contains
       type(deck_text), intent(in) :: deck
       type(run_config), intent(inout) :: cfg
       type(error_type), allocatable, intent(out) :: error
-      character(len=name_len) :: excitation_type, record_kind
+      character(len=name_len) :: excitation_type, record_kind, record_format, record_units
       character(len=1024) :: record_file
-      real(dp) :: amplitude, frequency, duration, dt_record, record_scale
+      real(dp) :: amplitude, frequency, duration, dt_record, record_scale, factor
       integer :: ramp_cycles
+      logical :: known
       namelist /excitation/ excitation_type, amplitude, frequency, ramp_cycles, duration, dt_record, &
-         record_file, record_kind, record_scale
+         record_file, record_kind, record_scale, record_format, record_units
       type(group_text) :: grp
       character(len=512) :: msg, msg0
       character(len=:), allocatable :: rec, path
       integer :: ios, i
       logical :: found
 
-      excitation_type = ''; record_kind = 'acceleration'; record_file = ''
+      excitation_type = ''; record_kind = 'acceleration'; record_file = ''; record_format = 'auto'
+      record_units = ''
       amplitude = unset; frequency = unset; duration = unset; dt_record = unset; record_scale = 1.0_dp
       ramp_cycles = 0
       call find_group(deck, 'excitation', grp, found, error)
@@ -382,8 +385,11 @@ contains
          if (ios == 0) msg = msg0
          call group_read_error(deck, grp, i, msg, error); return
       end if
-      call need_real(deck, 'excitation', 'dt_record', dt_record, 's', error)
-      if (allocated(error)) return
+      ! a record whose file gives DT (AT2) may leave dt_record out
+      if (.not. (lower(trim(excitation_type)) == 'record' .and. dt_record == unset)) then
+         call need_real(deck, 'excitation', 'dt_record', dt_record, 's', error)
+         if (allocated(error)) return
+      end if
       cfg%exc%dt_record = dt_record
       select case (lower(trim(excitation_type)))
       case ('harmonic')
@@ -411,17 +417,34 @@ contains
          end if
          if (lower(trim(record_kind)) /= 'acceleration' .and. lower(trim(record_kind)) /= 'displacement') then
             call bad(deck, 'excitation', 'record_kind', "'"//trim(record_kind)//"'", &
-                     "'acceleration' (m/s2 after record_scale) or 'displacement' (m)", error)
+                     "'acceleration' or 'displacement'", error)
             return
          end if
+         select case (lower(trim(record_format)))
+         case ('auto', 'at2', 'values', 'time_value')
+         case default
+            call bad(deck, 'excitation', 'record_format', "'"//trim(record_format)//"'", 'one of '//record_formats, error)
+            return
+         end select
+         if (len_trim(record_units) > 0) then
+            call units_factor(lower(trim(record_units)), lower(trim(record_kind)) == 'displacement', factor, known)
+            if (.not. known) then
+               call bad(deck, 'excitation', 'record_units', "'"//trim(record_units)//"'", 'one of '// &
+                        record_units_list//", matching record_kind = '"//trim(record_kind)//"'", error)
+               return
+            end if
+         end if
          call relative_to(deck%path, trim(record_file), path)
-         call read_record(path, lower(trim(record_kind)) == 'displacement', record_scale, dt_record, &
-                          cfg%exc%acc, error)
+         call read_record(path, trim(record_format), lower(trim(record_kind)) == 'displacement', &
+                          trim(record_units), record_scale, merge(dt_record, 0.0_dp, dt_record /= unset), &
+                          cfg%exc%acc, cfg%record, error)
          if (allocated(error)) then
             error%message = deck%path//", group &excitation, record_file = '"//trim(record_file)//"': "// &
                             error%message
             return
          end if
+         dt_record = cfg%record%dt
+         cfg%exc%dt_record = dt_record
          if (duration == unset) duration = (size(cfg%exc%acc) - 1)*dt_record
          call need_real(deck, 'excitation', 'duration', duration, 's', error)
          if (allocated(error)) return

@@ -1,16 +1,19 @@
 !> Output files of a run: the time-history CSV (a header naming every column with its
 !> unit, 17 significant digits) and the summary (JSON). Each is written to a temporary
-!> name and renamed when complete; on any error no output file is left behind.
+!> name unique to the writer and the pair is committed under a lock (write_outputs); on
+!> any error no output file is left behind and earlier outputs of the name stay.
 module fd_output
    use, intrinsic :: iso_c_binding, only: c_char, c_int, c_null_char
    use fd_kinds, only: dp
    use fd_error, only: error_type, fatal_error, fmt_int, fmt_real
    use fd_model, only: model_type, law_name
    use fd_result, only: result_type
+   use fd_record, only: record_info
+   use fd_version, only: frictiondyn_version
    implicit none
    private
 
-   public :: output_type, write_outputs, output_paths, summary_json, history_header
+   public :: output_type, write_outputs, output_paths, temp_output_paths, summary_json, history_header
 
    !> Where and what to write.
    type :: output_type
@@ -20,18 +23,47 @@ module fd_output
    end type output_type
 
    interface
-      function c_rename(old, new) bind(c, name='rename') result(stat)
-         import :: c_char, c_int
-         character(kind=c_char), intent(in) :: old(*), new(*)
-         integer(c_int) :: stat
-      end function c_rename
       function c_mkdir(path, mode) bind(c, name='mkdir') result(stat)
          import :: c_char, c_int
          character(kind=c_char), intent(in) :: path(*)
          integer(c_int), value :: mode
          integer(c_int) :: stat
       end function c_mkdir
+      function c_lock_acquire(path, fd) bind(c, name='fd_lock_acquire') result(err)
+         import :: c_char, c_int
+         character(kind=c_char), intent(in) :: path(*)
+         integer(c_int), intent(out) :: fd
+         integer(c_int) :: err
+      end function c_lock_acquire
+      function c_lock_release(path, fd) bind(c, name='fd_lock_release') result(err)
+         import :: c_char, c_int
+         character(kind=c_char), intent(in) :: path(*)
+         integer(c_int), value :: fd
+         integer(c_int) :: err
+      end function c_lock_release
+      function c_unlink(path) bind(c, name='fd_unlink') result(err)
+         import :: c_char, c_int
+         character(kind=c_char), intent(in) :: path(*)
+         integer(c_int) :: err
+      end function c_unlink
+      function c_rename(old, new) bind(c, name='fd_rename') result(err)
+         import :: c_char, c_int
+         character(kind=c_char), intent(in) :: old(*), new(*)
+         integer(c_int) :: err
+      end function c_rename
+      subroutine c_errno_text(err, buf, length) bind(c, name='fd_errno_text')
+         import :: c_char, c_int
+         integer(c_int), value :: err
+         character(kind=c_char), intent(out) :: buf(*)
+         integer(c_int), value :: length
+      end subroutine c_errno_text
+      function c_getpid() bind(c, name='fd_getpid') result(pid)
+         import :: c_int
+         integer(c_int) :: pid
+      end function c_getpid
    end interface
+
+   integer(c_int), parameter :: enoent = 2
 
 contains
 
@@ -44,43 +76,122 @@ contains
       summ = out%dir//'/'//out%name//'.summary.json'
    end subroutine output_paths
 
-   !> Write the history and the summary; nothing is left behind on failure.
-   subroutine write_outputs(out, model, res, deck_path, error)
+   !> Temporary names of the two outputs for a tag unique to the writing process:
+   !> `<dir>/.<name>.csv.<tag>.tmp` and `<dir>/.<name>.summary.json.<tag>.tmp`.
+   pure subroutine temp_output_paths(out, tag, hist_tmp, summ_tmp)
+      type(output_type), intent(in) :: out                    !! output settings
+      character(len=*), intent(in) :: tag                     !! unique per writer
+      character(len=:), allocatable, intent(out) :: hist_tmp  !! temporary CSV
+      character(len=:), allocatable, intent(out) :: summ_tmp  !! temporary summary
+      hist_tmp = out%dir//'/.'//out%name//'.csv.'//tag//'.tmp'
+      summ_tmp = out%dir//'/.'//out%name//'.summary.json.'//tag//'.tmp'
+   end subroutine temp_output_paths
+
+   !> A tag for temporary names: the process id and a random number (the names are also
+   !> created exclusively, so two writers never share one).
+   subroutine default_tag(tag)
+      character(len=:), allocatable, intent(out) :: tag  !! e.g. '12345-3f9a0c1d'
+      character(len=32) :: buf
+      real(dp) :: r
+      call random_number(r)
+      write (buf, '(i0,"-",z8.8)') c_getpid(), int(r*2147483647.0_dp)
+      tag = trim(buf)
+   end subroutine default_tag
+
+   !> Write the history and the summary as one consistent pair. Each goes to a temporary
+   !> name unique to the writer (`tag`, default: process id and a random number); when both
+   !> are complete they are committed under an exclusive lock on `<dir>/.<name>.lock`:
+   !> remove the old summary, rename the CSV, rename the summary. Two writers of one name
+   !> thus commit one after the other, and a writer killed in the middle leaves a CSV
+   !> without summary (an incomplete run), never one run's CSV beside another's summary.
+   !> A failed write (full disk, quota) removes the temporary files and leaves the earlier
+   !> outputs untouched; the error names the file.
+   subroutine write_outputs(out, model, res, deck_path, record, tag, error)
       type(output_type), intent(in) :: out                !! output settings
       type(model_type), intent(in) :: model               !! the model run
       type(result_type), intent(in) :: res                !! its result
       character(len=*), intent(in) :: deck_path           !! deck, named in the summary
-      type(error_type), allocatable, intent(out) :: error !! cannot create or write a file
-      character(len=:), allocatable :: hist, summ
-      integer :: stat
+      type(record_info), intent(in), optional :: record   !! the record read, named in the summary
+      character(len=*), intent(in), optional :: tag       !! unique suffix of the temporary names
+      type(error_type), allocatable, intent(out) :: error !! cannot create, write or rename a file
+      character(len=:), allocatable :: hist, summ, htmp, stmp, mytag, lock
+      integer(c_int) :: err, fd
+      integer :: attempt
 
       call make_dir(out%dir, error)
       if (allocated(error)) return
       call output_paths(out, hist, summ)
+      do attempt = 1, 10
+         if (present(tag)) then
+            mytag = tag
+         else
+            call default_tag(mytag)
+         end if
+         call temp_output_paths(out, mytag, htmp, stmp)
+         call write_summary(stmp, model, res, deck_path, record, error)
+         if (.not. allocated(error)) exit
+         if (present(tag) .or. error%stat /= 17) return  ! 17: the name exists (random clash)
+      end do
+      if (allocated(error)) return
       if (out%history) then
-         call write_history(hist//'.tmp', res, error)
-         if (allocated(error)) return
-      end if
-      call write_summary(summ//'.tmp', model, res, deck_path, error)
-      if (allocated(error)) then
-         if (out%history) call remove(hist//'.tmp')
-         return
-      end if
-      if (out%history) then
-         stat = c_rename(hist//'.tmp'//c_null_char, hist//c_null_char)
-         if (stat /= 0) then
-            call remove(hist//'.tmp'); call remove(summ//'.tmp')
-            call fatal_error(error, "cannot rename '"//hist//".tmp' to '"//hist//"'")
+         call write_history(htmp, res, error)
+         if (allocated(error)) then
+            err = c_unlink(stmp//c_null_char)
             return
          end if
       end if
-      stat = c_rename(summ//'.tmp'//c_null_char, summ//c_null_char)
-      if (stat /= 0) then
-         if (out%history) call remove(hist)
-         call remove(summ//'.tmp')
-         call fatal_error(error, "cannot rename '"//summ//".tmp' to '"//summ//"'")
+
+      lock = out%dir//'/.'//out%name//'.lock'
+      err = c_lock_acquire(lock//c_null_char, fd)
+      if (err /= 0) then
+         call discard()
+         call os_error(error, "cannot lock '"//lock//"'", err)
+         return
       end if
+      ! the commit: the summary marks a complete pair, so it goes first and comes back last
+      err = c_unlink(summ//c_null_char)
+      if (err /= 0 .and. err /= enoent) then
+         call discard()
+         call os_error(error, "cannot replace '"//summ//"'", err)
+      else if (out%history) then
+         err = c_rename(htmp//c_null_char, hist//c_null_char)
+         if (err /= 0) then
+            call discard()
+            call os_error(error, "cannot rename '"//htmp//"' to '"//hist//"'", err)
+         end if
+      else
+         ! no history this time: an older CSV of the name would not match the new summary
+         err = c_unlink(hist//c_null_char)
+         if (err /= 0 .and. err /= enoent) then
+            call discard()
+            call os_error(error, "cannot remove the earlier '"//hist//"'", err)
+         end if
+      end if
+      if (.not. allocated(error)) then
+         err = c_rename(stmp//c_null_char, summ//c_null_char)
+         if (err /= 0) then
+            call discard()
+            call os_error(error, "cannot rename '"//stmp//"' to '"//summ//"'", err)
+         end if
+      end if
+      err = c_lock_release(lock//c_null_char, fd)
+   contains
+      subroutine discard()
+         integer(c_int) :: e
+         e = c_unlink(stmp//c_null_char)
+         if (out%history) e = c_unlink(htmp//c_null_char)
+      end subroutine discard
    end subroutine write_outputs
+
+   !> An error naming what failed and the system's reason (errno text).
+   subroutine os_error(error, what, err)
+      type(error_type), allocatable, intent(out) :: error
+      character(len=*), intent(in) :: what
+      integer(c_int), intent(in) :: err
+      character(kind=c_char, len=256) :: buf
+      call c_errno_text(err, buf, int(len(buf), c_int))
+      call fatal_error(error, what//": "//buf(1:max(0, index(buf, c_null_char) - 1)))
+   end subroutine os_error
 
    !> Create a directory and its missing parents.
    subroutine make_dir(dir, error)
@@ -101,12 +212,43 @@ contains
       if (.not. exists) call fatal_error(error, "&output: cannot create the output directory dir = '"//dir//"'")
    end subroutine make_dir
 
-   subroutine remove(path)
+   !> Create a new file (exclusively: stat 17 when it exists) for writing.
+   subroutine create_new(path, unit, error)
       character(len=*), intent(in) :: path
-      integer :: unit, ios
-      open (newunit=unit, file=path, status='old', iostat=ios)
-      if (ios == 0) close (unit, status='delete')
-   end subroutine remove
+      integer, intent(out) :: unit
+      type(error_type), allocatable, intent(out) :: error
+      integer :: ios
+      logical :: exists
+      character(len=512) :: msg
+      open (newunit=unit, file=path, status='new', action='write', iostat=ios, iomsg=msg)
+      if (ios /= 0) then
+         inquire (file=path, exist=exists)
+         call fatal_error(error, "cannot create '"//path//"': "//trim(msg), stat=merge(17, 1, exists))
+      end if
+   end subroutine create_new
+
+   !> Close a written file; on any error (a full disk shows here, when the buffer is
+   !> flushed) the file is removed and the error names it.
+   subroutine finish(unit, path, ios_write, msg_write, error)
+      integer, intent(in) :: unit, ios_write
+      character(len=*), intent(in) :: path, msg_write
+      type(error_type), allocatable, intent(out) :: error
+      integer :: ios
+      integer(c_int) :: err
+      character(len=512) :: msg
+      if (ios_write /= 0) then
+         close (unit, status='delete', iostat=ios)
+         err = c_unlink(path//c_null_char)
+         call fatal_error(error, "cannot write '"//path//"': "//trim(msg_write))
+         return
+      end if
+      msg = ''
+      close (unit, iostat=ios, iomsg=msg)
+      if (ios /= 0) then
+         err = c_unlink(path//c_null_char)
+         call fatal_error(error, "cannot write '"//path//"': "//trim(msg))
+      end if
+   end subroutine finish
 
    subroutine write_history(path, res, error)
       character(len=*), intent(in) :: path
@@ -116,57 +258,47 @@ contains
       character(len=512) :: msg
       character(len=:), allocatable :: fmt, header
 
-      open (newunit=unit, file=path, status='replace', action='write', iostat=ios, iomsg=msg)
-      if (ios /= 0) then
-         call fatal_error(error, "cannot create '"//path//"': "//trim(msg))
-         return
-      end if
+      call create_new(path, unit, error)
+      if (allocated(error)) return
       call history_header(res, header)
-      write (unit, '(a)', iostat=ios) header
+      msg = ''
+      write (unit, '(a)', iostat=ios, iomsg=msg) header
       fmt = '('//trim(fmt_int(res%ncol))//'(es24.16e3,:,","))'
-      do i = 1, res%nout
-         write (unit, fmt, iostat=ios, iomsg=msg) res%hist(:, i)
-         if (ios /= 0) exit
-      end do
-      if (ios /= 0) then
-         close (unit, status='delete')
-         call fatal_error(error, "cannot write '"//path//"': "//trim(msg))
-         return
+      if (ios == 0) then
+         do i = 1, res%nout
+            write (unit, fmt, iostat=ios, iomsg=msg) res%hist(:, i)
+            if (ios /= 0) exit
+         end do
       end if
-      close (unit)
+      call finish(unit, path, ios, msg, error)
    end subroutine write_history
 
-   subroutine write_summary(path, model, res, deck_path, error)
+   subroutine write_summary(path, model, res, deck_path, record, error)
       character(len=*), intent(in) :: path
       type(model_type), intent(in) :: model
       type(result_type), intent(in) :: res
       character(len=*), intent(in) :: deck_path
+      type(record_info), intent(in), optional :: record
       type(error_type), allocatable, intent(out) :: error
       integer :: unit, ios
       character(len=512) :: msg
       character(len=:), allocatable :: js
 
-      open (newunit=unit, file=path, status='replace', action='write', iostat=ios, iomsg=msg)
-      if (ios /= 0) then
-         call fatal_error(error, "cannot create '"//path//"': "//trim(msg))
-         return
-      end if
-      call summary_json(model, res, deck_path, js)
+      call create_new(path, unit, error)
+      if (allocated(error)) return
+      call summary_json(model, res, deck_path, js, record)
+      msg = ''
       write (unit, '(a)', iostat=ios, iomsg=msg) js
-      if (ios /= 0) then
-         close (unit, status='delete')
-         call fatal_error(error, "cannot write '"//path//"': "//trim(msg))
-         return
-      end if
-      close (unit)
+      call finish(unit, path, ios, msg, error)
    end subroutine write_summary
 
    !> The summary of a run as a JSON object (keys documented in docs/namelist.md).
-   subroutine summary_json(model, res, deck_path, js)
+   subroutine summary_json(model, res, deck_path, js, record)
       type(model_type), intent(in) :: model                !! the model run
       type(result_type), intent(in) :: res                 !! its result
       character(len=*), intent(in) :: deck_path            !! deck named in the summary
       character(len=:), allocatable, intent(out) :: js     !! the JSON text
+      type(record_info), intent(in), optional :: record    !! the record read, if any
       character(len=1), parameter :: nl = achar(10)
       character(len=:), allocatable :: laws, esc
       integer :: d
@@ -179,6 +311,23 @@ contains
       call json_escape(deck_path, esc)
       js = '{'//nl
       js = js//'  "deck": "'//esc//'",'//nl
+      js = js//'  "frictiondyn_version": "'//frictiondyn_version//'",'//nl
+      if (present(record)) then
+         if (allocated(record%path)) then
+            js = js//'  "record": {'
+            call json_escape(record%path, esc)
+            js = js//'"file": "'//esc//'", "format": "'//trim(record%format)//'", "format_detected": '// &
+                 trim(merge('true ', 'false', record%detected))//', "units": "'//trim(record%units)// &
+                 '", "samples": '//trim(fmt_int(record%npts))//', "dt_s": '//trim(json_real(record%dt))// &
+                 ', "scale": '//trim(json_real(record%scale))//', "peak_acc_mps2": '// &
+                 trim(json_real(record%peak_acc))
+            if (allocated(record%title)) then
+               call json_escape(record%title, esc)
+               js = js//', "title": "'//esc//'"'
+            end if
+            js = js//'},'//nl
+         end if
+      end if
       call kv('n_dof', trim(fmt_int(res%n_dof)))
       call kv('n_devices', trim(fmt_int(res%n_devices)))
       js = js//'  "device_law": ['//laws//'],'//nl
@@ -275,8 +424,13 @@ contains
       integer :: i
       r = ''
       do i = 1, len(s)
-         if (s(i:i) == '"' .or. s(i:i) == '\') r = r//'\'
-         r = r//s(i:i)
+         if (s(i:i) == '"' .or. s(i:i) == '\') then
+            r = r//'\'//s(i:i)
+         else if (iachar(s(i:i)) < 32) then
+            r = r//' '
+         else
+            r = r//s(i:i)
+         end if
       end do
    end subroutine json_escape
 

@@ -5,6 +5,7 @@ program tester
    use testdrive, only: run_testsuite, new_testsuite, testsuite_type, select_suite, run_selected, &
                         get_argument
    use test_fd_format, only: collect_format
+   use test_fd_record, only: collect_record
    implicit none
    integer :: stat, is
    character(len=:), allocatable :: suite_name, test_name
@@ -13,7 +14,8 @@ program tester
 
    stat = 0
    testsuites = [ &
-                new_testsuite("format", collect_format) &
+                new_testsuite("format", collect_format), &
+                new_testsuite("record", collect_record) &
                 ]
 
    call get_argument(1, suite_name)
