@@ -443,6 +443,7 @@ contains
                             error%message
             return
          end if
+         cfg%record%path = trim(record_file)   ! as the deck gives it (like the summary's "deck")
          dt_record = cfg%record%dt
          cfg%exc%dt_record = dt_record
          if (duration == unset) duration = (size(cfg%exc%acc) - 1)*dt_record

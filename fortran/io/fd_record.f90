@@ -491,7 +491,7 @@ contains
       integer, intent(in) :: ncol
       character(len=40) :: s
       if (ncol == 1) then
-         s = 'one value a line'
+         s = 'one column (one value a line)'
       else
          s = 'two columns (time and value)'
       end if
@@ -567,7 +567,7 @@ contains
       tok = s(lo:hi)
       select case (stat)
       case (num_nan)
-         call fatal_error(error, where//": '"//tok//"' is NaN; expected a finite number")
+         call fatal_error(error, where//": '"//tok//"' is NaN: not finite; expected a finite number")
       case (num_infinite)
          call fatal_error(error, where//": value '"//tok//"' is not finite")
       case (4)
