@@ -23,7 +23,7 @@ A key is "group.variable", "group.variable(i)" (one element), a label without a 
 exists; complete runs are skipped, so an interrupted sweep resumes where it stopped. A run
 that fails leaves ``runs/<id>.error.txt`` with the executable's message and does not stop
 the others. ``results.csv`` collects every run's parameters, status, the frictiondyn version,
-the deck's SHA-256 and its summary (arrays as ``key[i]``, i from 1).
+the run's deck (``run_deck``) and its SHA-256, and its summary (arrays as ``key[i]``, i from 1).
 """
 
 from __future__ import annotations
@@ -534,7 +534,7 @@ def collect(sweep: Sweep, write: bool = True) -> Collected:
         for k in sweep.parameters:
             v = run.params.get(k)
             row[k] = json.dumps(v) if isinstance(v, list) else v
-        row["deck"] = run.deck
+        row["run_deck"] = run.deck
         row["deck_sha256"] = run.deck_sha256
         row["frictiondyn_version"] = (summ or {}).get("frictiondyn_version", "")
         if summ is not None:

@@ -70,3 +70,42 @@ int fd_getpid(void)
 {
     return (int)getpid();
 }
+
+/* Create a new file for writing (O_EXCL: EEXIST when the name exists); *fd on success. */
+int fd_file_create(const char *path, int *fd)
+{
+    int f = open(path, O_WRONLY | O_CREAT | O_EXCL | O_CLOEXEC, 0644);
+    if (f < 0)
+        return errno;
+    *fd = f;
+    return 0;
+}
+
+/* Write len bytes; 0 or errno (ENOSPC, EDQUOT, EIO, ...). gfortran's formatted writes
+ * lose these errors (a full disk gave a truncated file and iostat = 0), hence this. */
+int fd_file_write(int fd, const char *buf, long len)
+{
+    while (len > 0) {
+        ssize_t n = write(fd, buf, (size_t)len);
+        if (n < 0) {
+            if (errno == EINTR)
+                continue;
+            return errno;
+        }
+        buf += n;
+        len -= n;
+    }
+    return 0;
+}
+
+/* fsync (the data is on disk before the file is renamed into place; NFS reports a full
+ * disk or quota here at the latest) and close; 0 or the first errno. */
+int fd_file_close(int fd)
+{
+    int e = 0;
+    if (fsync(fd) != 0 && errno != EINVAL && errno != EROFS)
+        e = errno;
+    if (close(fd) != 0 && e == 0)
+        e = errno;
+    return e;
+}

@@ -3,7 +3,7 @@
 !> name unique to the writer and the pair is committed under a lock (write_outputs); on
 !> any error no output file is left behind and earlier outputs of the name stay.
 module fd_output
-   use, intrinsic :: iso_c_binding, only: c_char, c_int, c_null_char
+   use, intrinsic :: iso_c_binding, only: c_char, c_int, c_long, c_null_char
    use fd_kinds, only: dp
    use fd_error, only: error_type, fatal_error, fmt_int, fmt_real
    use fd_model, only: model_type, law_name
@@ -57,13 +57,31 @@ module fd_output
          character(kind=c_char), intent(out) :: buf(*)
          integer(c_int), value :: length
       end subroutine c_errno_text
+      function c_file_create(path, fd) bind(c, name='fd_file_create') result(err)
+         import :: c_char, c_int
+         character(kind=c_char), intent(in) :: path(*)
+         integer(c_int), intent(out) :: fd
+         integer(c_int) :: err
+      end function c_file_create
+      function c_file_write(fd, buf, length) bind(c, name='fd_file_write') result(err)
+         import :: c_char, c_int, c_long
+         integer(c_int), value :: fd
+         character(kind=c_char), intent(in) :: buf(*)
+         integer(c_long), value :: length
+         integer(c_int) :: err
+      end function c_file_write
+      function c_file_close(fd) bind(c, name='fd_file_close') result(err)
+         import :: c_int
+         integer(c_int), value :: fd
+         integer(c_int) :: err
+      end function c_file_close
       function c_getpid() bind(c, name='fd_getpid') result(pid)
          import :: c_int
          integer(c_int) :: pid
       end function c_getpid
    end interface
 
-   integer(c_int), parameter :: enoent = 2
+   integer(c_int), parameter :: enoent = 2, eexist = 17
 
 contains
 
@@ -212,65 +230,80 @@ contains
       if (.not. exists) call fatal_error(error, "&output: cannot create the output directory dir = '"//dir//"'")
    end subroutine make_dir
 
-   !> Create a new file (exclusively: stat 17 when it exists) for writing.
-   subroutine create_new(path, unit, error)
+   !> Create a new file (exclusively: error stat 17 when the name exists) for writing.
+   subroutine create_new(path, fd, error)
       character(len=*), intent(in) :: path
-      integer, intent(out) :: unit
+      integer(c_int), intent(out) :: fd
       type(error_type), allocatable, intent(out) :: error
-      integer :: ios
-      logical :: exists
-      character(len=512) :: msg
-      open (newunit=unit, file=path, status='new', action='write', iostat=ios, iomsg=msg)
-      if (ios /= 0) then
-         inquire (file=path, exist=exists)
-         call fatal_error(error, "cannot create '"//path//"': "//trim(msg), stat=merge(17, 1, exists))
+      integer(c_int) :: err
+      err = c_file_create(path//c_null_char, fd)
+      if (err /= 0) then
+         call os_error(error, "cannot create '"//path//"'", err)
+         if (err == eexist) error%stat = 17
       end if
    end subroutine create_new
 
-   !> Close a written file; on any error (a full disk shows here, when the buffer is
-   !> flushed) the file is removed and the error names it.
-   subroutine finish(unit, path, ios_write, msg_write, error)
-      integer, intent(in) :: unit, ios_write
-      character(len=*), intent(in) :: path, msg_write
+   !> Write bytes; on failure the file is closed and removed, and the error names it.
+   subroutine put_bytes(fd, path, text, error)
+      integer(c_int), intent(in) :: fd
+      character(len=*), intent(in) :: path, text
       type(error_type), allocatable, intent(out) :: error
-      integer :: ios
-      integer(c_int) :: err
-      character(len=512) :: msg
-      if (ios_write /= 0) then
-         close (unit, status='delete', iostat=ios)
-         err = c_unlink(path//c_null_char)
-         call fatal_error(error, "cannot write '"//path//"': "//trim(msg_write))
-         return
+      integer(c_int) :: err, e
+      if (len(text) == 0) return
+      err = c_file_write(fd, text, int(len(text), c_long))
+      if (err /= 0) then
+         e = c_file_close(fd)
+         e = c_unlink(path//c_null_char)
+         call os_error(error, "cannot write '"//path//"'", err)
       end if
-      msg = ''
-      close (unit, iostat=ios, iomsg=msg)
-      if (ios /= 0) then
-         err = c_unlink(path//c_null_char)
-         call fatal_error(error, "cannot write '"//path//"': "//trim(msg))
+   end subroutine put_bytes
+
+   !> Flush to disk and close; on failure (a full disk or quota may show only here) the
+   !> file is removed and the error names it.
+   subroutine finish(fd, path, error)
+      integer(c_int), intent(in) :: fd
+      character(len=*), intent(in) :: path
+      type(error_type), allocatable, intent(out) :: error
+      integer(c_int) :: err, e
+      err = c_file_close(fd)
+      if (err /= 0) then
+         e = c_unlink(path//c_null_char)
+         call os_error(error, "cannot write '"//path//"'", err)
       end if
    end subroutine finish
 
+   !> The history CSV: rows formatted into a buffer of about 1 MB, written with POSIX
+   !> write (every error is seen: gfortran's own writes lose a full disk).
    subroutine write_history(path, res, error)
       character(len=*), intent(in) :: path
       type(result_type), intent(in) :: res
       type(error_type), allocatable, intent(out) :: error
-      integer :: unit, ios, i
-      character(len=512) :: msg
-      character(len=:), allocatable :: fmt, header
+      integer(c_int) :: fd
+      integer :: i, pos, width, rows_per_chunk
+      character(len=:), allocatable :: fmt, header, buf
+      character(len=1), parameter :: nl = achar(10)
 
-      call create_new(path, unit, error)
+      call create_new(path, fd, error)
       if (allocated(error)) return
       call history_header(res, header)
-      msg = ''
-      write (unit, '(a)', iostat=ios, iomsg=msg) header
+      call put_bytes(fd, path, header//nl, error)
+      if (allocated(error)) return
       fmt = '('//trim(fmt_int(res%ncol))//'(es24.16e3,:,","))'
-      if (ios == 0) then
-         do i = 1, res%nout
-            write (unit, fmt, iostat=ios, iomsg=msg) res%hist(:, i)
-            if (ios /= 0) exit
-         end do
-      end if
-      call finish(unit, path, ios, msg, error)
+      width = 25*res%ncol               ! 24 characters a value, a comma or the newline
+      rows_per_chunk = max(1, 1048576/width)
+      allocate (character(len=width*rows_per_chunk) :: buf)
+      pos = 0
+      do i = 1, res%nout
+         write (buf(pos + 1:pos + width - 1), fmt) res%hist(:, i)
+         buf(pos + width:pos + width) = nl
+         pos = pos + width
+         if (pos == len(buf) .or. i == res%nout) then
+            call put_bytes(fd, path, buf(1:pos), error)
+            if (allocated(error)) return
+            pos = 0
+         end if
+      end do
+      call finish(fd, path, error)
    end subroutine write_history
 
    subroutine write_summary(path, model, res, deck_path, record, error)
@@ -280,16 +313,15 @@ contains
       character(len=*), intent(in) :: deck_path
       type(record_info), intent(in), optional :: record
       type(error_type), allocatable, intent(out) :: error
-      integer :: unit, ios
-      character(len=512) :: msg
+      integer(c_int) :: fd
       character(len=:), allocatable :: js
 
-      call create_new(path, unit, error)
+      call create_new(path, fd, error)
       if (allocated(error)) return
       call summary_json(model, res, deck_path, js, record)
-      msg = ''
-      write (unit, '(a)', iostat=ios, iomsg=msg) js
-      call finish(unit, path, ios, msg, error)
+      call put_bytes(fd, path, js//achar(10), error)
+      if (allocated(error)) return
+      call finish(fd, path, error)
    end subroutine write_summary
 
    !> The summary of a run as a JSON object (keys documented in docs/namelist.md).
