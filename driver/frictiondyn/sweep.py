@@ -108,6 +108,7 @@ class Sweep:
     directory: Path
     parameters: list[str]
     runs: list[Run] = field(default_factory=list)
+    zipped: list[str] = field(default_factory=list)  #: the parameters of [zip]
 
     def complete(self, run: Run) -> bool:
         """The run's summary exists and is a complete JSON object."""
@@ -227,7 +228,7 @@ def expand(spec_path: str | os.PathLike, directory: str | os.PathLike | None = N
     (sdir / "logs").mkdir(exist_ok=True)
     keys, rows = _combinations(spec)
     width = max(4, len(str(len(rows) - 1)))
-    sweep = Sweep(name=name, directory=sdir, parameters=keys)
+    sweep = Sweep(name=name, directory=sdir, parameters=keys, zipped=list(spec.get("zip", {})))
     bases: dict[str, f90nml.Namelist] = {}
     for index, params in enumerate(rows):
         base = params.get("deck", spec.get("base"))
@@ -288,6 +289,7 @@ def expand(spec_path: str | os.PathLike, directory: str | os.PathLike | None = N
         "spec": str(spec_path),
         "frictiondyn_version": __version__,
         "parameters": keys,
+        "zip": sweep.zipped,
         "runs": [
             {"index": r.index, "id": r.id, "deck": r.deck, "deck_sha256": r.deck_sha256,
              "params": r.params}
@@ -321,7 +323,8 @@ def load(directory: str | os.PathLike) -> Sweep:
     except FileNotFoundError:
         raise SweepError(f"{sdir}: no manifest.json (not a sweep directory)") from None
     runs = [Run(r["index"], r["id"], r["params"], r["deck"], r["deck_sha256"]) for r in m["runs"]]
-    return Sweep(name=m["name"], directory=sdir, parameters=m["parameters"], runs=runs)
+    return Sweep(name=m["name"], directory=sdir, parameters=m["parameters"], runs=runs,
+                 zipped=m.get("zip", []))
 
 
 # ------------------------------------------------------------------------------- running
@@ -601,7 +604,8 @@ def plot(
 ) -> Path:
     """One summary quantity (``y``, a results.csv column such as ``peak_u_m[5]``) against
     one parameter (``x``), one line per value of ``by`` (default: the other varied
-    parameters, together). Writes a PNG (default ``<dir>/<y>_vs_<x>.png``)."""
+    parameters, together, less those zipped with ``x``, which vary with it). Writes a PNG
+    (default ``<dir>/<y>_vs_<x>.png``)."""
     from matplotlib.backends.backend_agg import FigureCanvasAgg
     from matplotlib.figure import Figure
 
@@ -613,7 +617,8 @@ def plot(
         if col not in rows[0]:
             raise SweepError(f"{col!r} is not a column of results.csv; columns: "
                              + ", ".join(rows[0].keys()))
-    others = [by] if by else [p for p in sweep.parameters if p != x]
+    along = sweep.zipped if x in sweep.zipped else [x]
+    others = [by] if by else [p for p in sweep.parameters if p not in along]
     groups: dict[str, list[tuple[float, float]]] = {}
     for r in rows:
         xv, yv = _number(r[x]), _number(r[y])
