@@ -189,7 +189,7 @@ contains
       call read_record(file, 'auto', .false., '', 1.0_dp, 0.01_dp, acc, info, err)
       call check(error, allocated(err), 'NaN')
       if (allocated(error)) return
-      call check(error, index(err%message, "line 3: value 'nan' is not finite") > 0, err%message)
+      call check(error, index(err%message, "line 3: 'nan' is NaN: not finite") > 0, err%message)
       if (allocated(error)) return
       call write_file([character(len=20) :: '0.0', '0.1x', '0.2'])
       call read_record(file, 'auto', .false., '', 1.0_dp, 0.01_dp, acc, info, err)
@@ -201,14 +201,15 @@ contains
       call read_record(file, 'auto', .false., '', 1.0_dp, 0.01_dp, acc, info, err)
       call check(error, allocated(err), 'a change of the number of columns')
       if (allocated(error)) return
-      call check(error, index(err%message, "line 3: expected 1 column(s)") > 0, err%message)
+      call check(error, index(err%message, "line 3: expected one column (one value a line), found 2 values") > 0, &
+                 err%message)
       if (allocated(error)) return
       call write_file([character(len=20) :: '0.0 1 2', '0.1 1 2'])
       call read_record(file, 'auto', .false., '', 1.0_dp, 0.01_dp, acc, info, err)
       call remove_file()
       call check(error, allocated(err), 'three columns')
       if (allocated(error)) return
-      call check(error, index(err%message, "line 1: expected 2 column(s) (value, or time and value), found 3") > 0, &
+      call check(error, index(err%message, "line 1: expected one column (one value a line), found 3 values") > 0, &
                  err%message)
    end subroutine test_bad_values
 
