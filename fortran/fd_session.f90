@@ -17,7 +17,7 @@
 !> another may call session_cancel (the solver stops within a poll, ~10 ms, with an error of
 !> stat_cancelled; a streamed file is removed) and session_progress (the time reached).
 module fd_session
-   use, intrinsic :: iso_c_binding, only: c_int64_t, c_intptr_t, c_ptr, c_loc, c_f_pointer
+   use, intrinsic :: iso_c_binding, only: c_int, c_int64_t, c_intptr_t, c_ptr, c_loc, c_f_pointer
    use fd_kinds, only: dp
    use fd_error, only: error_type, fatal_error, fmt_int
    use frictiondyn, only: run_config, result_type, read_deck, read_deck_string, run_config_solve, &
@@ -25,9 +25,16 @@ module fd_session
                           write_output_files, run_control, select_history
    use fd_run_control, only: progress_callback, control_reset
    use fd_history_stream, only: stream_close, stream_discard
-   use fd_output, only: commit_streamed_outputs, make_dir
+   use fd_output, only: make_dir, temp_output_paths
    implicit none
    private
+
+   interface
+      function c_getpid() bind(c, name='fd_getpid') result(pid)
+         import :: c_int
+         integer(c_int) :: pid
+      end function c_getpid
+   end interface
 
    public :: session_type, session_open, session_open_text, session_adopt, session_solve
    public :: session_shape, session_text, session_set_output_dir, session_write, session_write_files
@@ -65,6 +72,7 @@ module fd_session
                                                       !! return theirs as an argument
       type(run_control) :: ctl                        !! history selection, destinations, stop
       logical :: stream = .false.                     !! write the history file as the run goes
+      character(len=:), allocatable :: tag            !! suffix of its temporary name
       character(len=:), allocatable :: stream_tmp     !! its temporary name, once complete
       logical :: have_history = .false.               !! res%hist holds the history
    end type session_type
@@ -169,39 +177,41 @@ contains
       logical, intent(in), optional :: keep               !! hold the history in the session
                                                           !! (default: unless streamed)
       type(error_type), allocatable :: close_error
-      character(len=:), allocatable :: hist, summ, tag
-      character(len=24) :: addr
+      character(len=:), allocatable :: htmp, stmp
+      character(len=40) :: addr
 
       call need(s, session_read, 'solve', error)
       if (allocated(error)) return
       call control_reset(s%ctl)
-      s%ctl%keep = .not. s%stream
+      s%ctl%keep = .not. (s%stream .and. s%cfg%out%history)
       if (present(keep)) s%ctl%keep = keep
       if (present(buffer)) then
          s%ctl%buffer => buffer
          s%ctl%keep = .false.
       end if
       if (allocated(s%ctl%stream_path)) deallocate (s%ctl%stream_path)
-      if (s%stream) then
+      if (s%stream .and. s%cfg%out%history) then
          call make_dir(s%cfg%out%dir, error)
          if (allocated(error)) then
             s%state = state_failed
             return
          end if
-         call output_paths(s%cfg%out, hist, summ)
-         ! a name unique to this session while it lives (its address), created exclusively
-         write (addr, '(z0)') transfer(c_loc(s), 0_c_intptr_t)
-         tag = trim(addr)
-         s%ctl%stream_path = hist//'.'//tag//'.tmp'
+         if (.not. allocated(s%tag)) then
+            ! unique while the session lives: the process and the session's address
+            write (addr, '(i0,"-",z0)') c_getpid(), transfer(c_loc(s), 0_c_intptr_t)
+            s%tag = trim(addr)
+         end if
+         call temp_output_paths(s%cfg%out, s%tag, htmp, stmp)
+         s%ctl%stream_path = htmp
       end if
       call run_config_solve(s%cfg, s%res, error, s%ctl)
       nullify (s%ctl%buffer)
       if (allocated(error)) then
-         if (s%stream) call stream_discard(s%ctl%stream)
+         call stream_discard(s%ctl%stream)
          s%state = state_failed
          return
       end if
-      if (s%stream) then
+      if (allocated(s%ctl%stream_path)) then
          call stream_close(s%ctl%stream, close_error)
          if (allocated(close_error)) then
             call move_alloc(close_error, error)
@@ -212,7 +222,7 @@ contains
       end if
       s%have_history = s%ctl%keep
       call history_header(s%res, s%header)
-      call summary_json(s%cfg%model, s%res, s%cfg%deck_path, s%summary)
+      call summary_json(s%cfg%model, s%res, s%cfg%deck_path, s%summary, s%cfg%record)
       s%state = session_solved
    end subroutine session_solve
 
@@ -228,13 +238,18 @@ contains
    end subroutine session_select
 
    !> Write the history to its output file (the &output dir and name, or the directory set
-   !> by session_set_output_dir) as the run goes; before solve.
-   subroutine session_stream(s, error)
+   !> by session_set_output_dir) as the run goes, under the temporary name of
+   !> temp_output_paths for `tag`; session_write commits it. Before solve.
+   subroutine session_stream(s, error, tag)
       type(session_type), intent(inout) :: s              !! a session with a deck read
       type(error_type), allocatable, intent(out) :: error !! wrong state
+      character(len=*), intent(in), optional :: tag       !! suffix of the temporary names
+                                                          !! (temp_output_paths; default: the
+                                                          !! process id and the session's address)
       call need(s, session_read, 'stream its history', error)
       if (allocated(error)) return
       s%stream = .true.
+      if (present(tag)) s%tag = tag
    end subroutine session_stream
 
    !> Ask a running solve to stop (from another thread; harmless at any other time: the next
@@ -360,25 +375,21 @@ contains
       end if
       call output_paths(s%cfg%out, hist, summ)
       if (allocated(s%stream_tmp)) then
-         if (s%cfg%out%history) then
-            call commit_streamed_outputs(s%stream_tmp, hist, summ, s%summary, error)
-            if (allocated(s%ctl%stream%path)) deallocate (s%ctl%stream%path)
-         else
-            call stream_discard(s%ctl%stream)
-            call write_output_files(hist, summ, .false., s%header, none, s%summary, error)
-         end if
+         ! the history is complete under its temporary name: commit it with the summary
+         call write_output_files(hist, summ, s%cfg%out%history, s%header, none, s%summary, error, &
+                                 tag=s%tag, streamed=.true.)
+         if (allocated(s%ctl%stream%path)) deallocate (s%ctl%stream%path)
          deallocate (s%stream_tmp)
-         if (allocated(error)) error%message = s%cfg%deck_path//': '//error%message
-         return
-      end if
-      call make_dir(s%cfg%out%dir, error)
-      if (allocated(error)) return
-      if (present(data)) then
-         call write_output_files(hist, summ, s%cfg%out%history, s%header, data, s%summary, error)
-      else if (s%have_history .or. .not. s%cfg%out%history) then
-         call write_output_files(hist, summ, s%cfg%out%history, s%header, s%res%hist, s%summary, error)
       else
-         call fatal_error(error, 'cannot write the history: the session does not hold it (give the buffer)')
+         call make_dir(s%cfg%out%dir, error)
+         if (allocated(error)) return
+         if (present(data)) then
+            call write_output_files(hist, summ, s%cfg%out%history, s%header, data, s%summary, error)
+         else if (s%have_history .or. .not. s%cfg%out%history) then
+            call write_output_files(hist, summ, s%cfg%out%history, s%header, s%res%hist, s%summary, error)
+         else
+            call fatal_error(error, 'cannot write the history: the session does not hold it (give the buffer)')
+         end if
       end if
       if (allocated(error)) error%message = s%cfg%deck_path//': '//error%message
    end subroutine session_write

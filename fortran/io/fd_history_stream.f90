@@ -5,7 +5,8 @@
 !> time-step loop allocates nothing). The file is created exclusively under a temporary name
 !> the caller chooses; stream_close flushes and closes it, and the caller renames it into place
 !> (stream_commit) or removes it (stream_discard). A failed write is kept in the stream (its
-!> errno) and reported by stream_failed / stream_close: the loop polls it, never prints.
+!> errno) and reported by stream_failed / stream_close: the loop polls it, never prints. The
+!> file calls are fd_fileops.c's (the writer's), the row formatting fd_stream_c.c's.
 module fd_history_stream
    use, intrinsic :: iso_c_binding, only: c_char, c_int, c_long, c_double, c_null_char
    use fd_kinds, only: dp
@@ -39,35 +40,35 @@ module fd_history_stream
          character(kind=c_char), intent(inout) :: buf(*)
          integer(c_long) :: nbytes
       end function c_format_row
-      function c_create(path, fd) bind(c, name='fd_stream_create') result(err)
+      function c_create(path, fd) bind(c, name='fd_file_create') result(err)
          import :: c_char, c_int
          character(kind=c_char), intent(in) :: path(*)
          integer(c_int), intent(out) :: fd
          integer(c_int) :: err
       end function c_create
-      function c_write(fd, buf, length) bind(c, name='fd_stream_write') result(err)
+      function c_write(fd, buf, length) bind(c, name='fd_file_write') result(err)
          import :: c_char, c_int, c_long
          integer(c_int), value :: fd
          character(kind=c_char), intent(in) :: buf(*)
          integer(c_long), value :: length
          integer(c_int) :: err
       end function c_write
-      function c_close(fd) bind(c, name='fd_stream_close') result(err)
+      function c_close(fd) bind(c, name='fd_file_close') result(err)
          import :: c_int
          integer(c_int), value :: fd
          integer(c_int) :: err
       end function c_close
-      function c_unlink(path) bind(c, name='fd_stream_unlink') result(err)
+      function c_unlink(path) bind(c, name='fd_unlink') result(err)
          import :: c_char, c_int
          character(kind=c_char), intent(in) :: path(*)
          integer(c_int) :: err
       end function c_unlink
-      function c_rename(old, new) bind(c, name='fd_stream_rename') result(err)
+      function c_rename(old, new) bind(c, name='fd_rename') result(err)
          import :: c_char, c_int
          character(kind=c_char), intent(in) :: old(*), new(*)
          integer(c_int) :: err
       end function c_rename
-      subroutine c_errno_text(err, buf, length) bind(c, name='fd_stream_errno_text')
+      subroutine c_errno_text(err, buf, length) bind(c, name='fd_errno_text')
          import :: c_char, c_int
          integer(c_int), value :: err
          character(kind=c_char), intent(out) :: buf(*)
