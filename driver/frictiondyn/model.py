@@ -1,5 +1,7 @@
-"""Building an analysis in Python: the same content as a namelist deck, written out with
-f90nml, so that ``Analysis.run()`` and ``frictiondyn DECK`` read the very same deck.
+"""Building an analysis in Python: the same content as a namelist deck, so that
+``Analysis.run()`` and ``frictiondyn DECK`` read the very same deck (``namelist()`` gives it
+as an f90nml Namelist; ``deck_text()`` writes the same namelist text directly, with the values
+as f90nml writes them: a run of a small model should not wait on the writer).
 
 An optional value left at None is left out of the deck: the Fortran reader owns every
 default (docs/namelist.md), and Python restates none of them.
@@ -7,9 +9,9 @@ default (docs/namelist.md), and Python restates none of them.
 
 from __future__ import annotations
 
-import io
 import os
 import tempfile
+from collections.abc import Callable, Sequence
 from dataclasses import dataclass, field
 from pathlib import Path
 
@@ -218,6 +220,39 @@ def _put(group: dict, **values: object) -> None:
             group[key] = _value(x)
 
 
+def _fortran(x: object) -> str:
+    """A value as f90nml writes it: repr of a float or int, a quoted string, .true./.false.,
+    nothing for None (a null value: the reader keeps its default)."""
+    if x is None:
+        return ""
+    if isinstance(x, bool):
+        return ".true." if x else ".false."
+    if isinstance(x, str):
+        return "'" + x.replace("'", "''") + "'"
+    return repr(x)
+
+
+def _group_text(name: str, values: dict) -> str:
+    """One namelist group, lists wrapped at about 72 columns."""
+    lines = [f"&{name}"]
+    for key, value in values.items():
+        head = f"    {key} = "
+        if not isinstance(value, list):
+            lines.append(head + _fortran(value))
+            continue
+        items = [_fortran(x) for x in value]
+        line, indent = head, " " * len(head)
+        for k, item in enumerate(items):
+            piece = item + (", " if k < len(items) - 1 else "")
+            if len(line) + len(piece) > 76 and line.strip() and line != head:
+                lines.append(line.rstrip())
+                line = indent
+            line += piece
+        lines.append(line.rstrip())
+    lines.append("/")
+    return "\n".join(lines) + "\n"
+
+
 def _per_device(group: dict, key: str, values: list) -> None:
     """An optional per-device value: left out when no device gives it; a device that does
     not is a null value, which the reader fills with its default."""
@@ -241,6 +276,14 @@ class Analysis:
 
     def namelist(self, directory: Path | None = None) -> f90nml.Namelist:
         """The deck as an f90nml Namelist (writes a Record's values into directory)."""
+        nml = f90nml.Namelist()
+        for name, values in self.groups(directory):
+            nml[name] = f90nml.Namelist(values)
+        return nml
+
+    def groups(self, directory: Path | None = None) -> list[tuple[str, dict]]:
+        """The deck's groups and their values, in order (writes a Record's values into
+        directory)."""
         n = len(self.masses)
         model = {"n_dof": n, "mass": [float(m) for m in self.masses]}
         if self.u0 is not None:
@@ -277,15 +320,11 @@ class Analysis:
         out = self.output.group()
         if out:
             groups.append(("output", out))
-        nml = f90nml.Namelist()
-        for name, values in groups:
-            nml[name] = f90nml.Namelist(values)
-        return nml
+        return groups
 
     def deck_text(self, directory: Path | None = None) -> str:
-        buf = io.StringIO()
-        self.namelist(directory).write(buf)
-        return buf.getvalue()
+        """The deck as namelist text (writes a Record's values into directory)."""
+        return "\n".join(_group_text(name, values) for name, values in self.groups(directory))
 
     def write_deck(self, path: str | os.PathLike) -> Path:
         """Write the deck (and a Record's values next to it) for the executable."""
@@ -293,9 +332,19 @@ class Analysis:
         path.write_text(self.deck_text(path.parent))
         return path
 
-    def run(self, name: str = "analysis.nml") -> Result:
+    def run(
+        self,
+        name: str = "analysis.nml",
+        dofs: Sequence[int] | None = None,
+        devices: Sequence[int] | None = None,
+        progress: Callable[[float, float], object] | None = None,
+    ) -> Result:
         """Run through the extension (no deck file needed; a Record's values go to a
-        temporary directory for the duration of the run)."""
+        temporary directory for the duration of the run). ``dofs``, ``devices``,
+        ``progress``: as for ``frictiondyn.run``."""
+        kw = {"dofs": dofs, "devices": devices, "progress": progress}
+        if not isinstance(self.excitation, Record) or self.excitation.values is None:
+            return run_text(self.deck_text(None), name=name, base_dir=".", **kw)
         with tempfile.TemporaryDirectory() as tmp:
             directory = Path(tmp)
-            return run_text(self.deck_text(directory), name=name, base_dir=directory)
+            return run_text(self.deck_text(directory), name=name, base_dir=directory, **kw)

@@ -29,9 +29,12 @@ module fd_deck
 
    public :: run_config, read_deck, read_deck_string, max_dof, max_springs, max_devices
 
-   integer, parameter :: max_dof = 10000      !! capacity of the DOF arrays of a deck
-   integer, parameter :: max_springs = 40000  !! capacity of the spring arrays
-   integer, parameter :: max_devices = 10000  !! capacity of the device arrays
+   ! Largest counts a deck may declare. The arrays read are sized from the deck's own counts
+   ! (array_capacity), so these only bound what a deck may ask: about 1.3 kB of memory a DOF
+   ! (the effective stiffness of every step size, docs/namelist.md), 1.3 GB at the limit.
+   integer, parameter :: max_dof = 1000000      !! DOFs (n_dof)
+   integer, parameter :: max_springs = 4000000  !! springs (n_springs)
+   integer, parameter :: max_devices = 1000000  !! friction devices (n_devices)
    real(dp), parameter :: unset = -huge(1.0_dp)
    integer, parameter :: unset_int = -huge(1)
    integer, parameter :: name_len = 32
@@ -116,13 +119,14 @@ contains
       logical :: found
 
       n_dof = unset_int
-      allocate (mass(max_dof), u0(max_dof), v0(max_dof))
-      mass = unset; u0 = unset; v0 = unset
       call find_group(deck, 'model', grp, found, error)
       if (allocated(error)) return
       if (.not. found) then
          call missing_group(deck, 'model', error); return
       end if
+      i = array_capacity(grp, 'n_dof', max_dof)
+      allocate (mass(i), u0(i), v0(i))
+      mass = unset; u0 = unset; v0 = unset
       msg0 = ''
       read (grp%lines, nml=model, iostat=ios, iomsg=msg0)
       if (ios /= 0) then
@@ -165,13 +169,14 @@ contains
       logical :: found
 
       n_springs = unset_int
-      allocate (node_i(max_springs), node_j(max_springs), k(max_springs))
-      node_i = unset_int; node_j = unset_int; k = unset
       call find_group(deck, 'springs', grp, found, error)
       if (allocated(error)) return
       if (.not. found) then
          call missing_group(deck, 'springs', error); return
       end if
+      i = array_capacity(grp, 'n_springs', max_springs)
+      allocate (node_i(i), node_j(i), k(i))
+      node_i = unset_int; node_j = unset_int; k = unset
       msg0 = ''
       read (grp%lines, nml=springs, iostat=ios, iomsg=msg0)
       if (ios /= 0) then
@@ -280,15 +285,15 @@ contains
       logical :: found
 
       n_devices = default_n_devices
-      allocate (node_i(max_devices), node_j(max_devices), law(max_devices), p(max_devices), &
-                mu(max_devices), eps(max_devices), eps1(max_devices), f(max_devices))
-      node_i = unset_int; node_j = unset_int; law = ''
-      p = unset; mu = unset; eps = unset; eps1 = unset; f = unset
       call find_group(deck, 'friction', grp, found, error)
       if (allocated(error)) return
       cfg%model%n_devices = 0
       allocate (cfg%model%dev(0))
       if (.not. found) return
+      i = array_capacity(grp, 'n_devices', max_devices)
+      allocate (node_i(i), node_j(i), law(i), p(i), mu(i), eps(i), eps1(i), f(i))
+      node_i = unset_int; node_j = unset_int; law = ''
+      p = unset; mu = unset; eps = unset; eps1 = unset; f = unset
       msg0 = ''
       read (grp%lines, nml=friction, iostat=ios, iomsg=msg0)
       if (ios /= 0) then
@@ -592,6 +597,30 @@ contains
    end subroutine read_output_group
 
    ! ---------------------------------------------------------------- helpers
+   !> Size of a group's arrays, from the count the group declares (`count_var`, read from its
+   !> assignment before the namelist read): twice the count and a few more, so that a list of
+   !> extra values is reported by no_extra, and memory follows the deck, not the capacity
+   !> limit; 16 when the count is absent, unreadable or outside 0..limit (the checks after
+   !> the read report it).
+   pure integer function array_capacity(grp, count_var, limit) result(cap)
+      type(group_text), intent(in) :: grp     !! the group
+      character(len=*), intent(in) :: count_var !! its count variable (lower case)
+      integer, intent(in) :: limit            !! largest count allowed
+      character(len=:), allocatable :: item
+      integer :: i, eq, n, ios
+
+      cap = 16
+      do i = size(grp%items), 1, -1         ! the last assignment counts, as in a namelist read
+         item = grp%items(i)%s
+         eq = index(item, '=')
+         if (eq < 2) cycle
+         if (lower(trim(adjustl(item(1:eq - 1)))) /= count_var) cycle
+         read (item(eq + 1:), *, iostat=ios) n
+         if (ios == 0 .and. n >= 0 .and. n <= limit) cap = 2*n + 16
+         return
+      end do
+   end function array_capacity
+
    subroutine missing_group(deck, group, error)
       type(deck_text), intent(in) :: deck
       character(len=*), intent(in) :: group

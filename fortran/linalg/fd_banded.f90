@@ -29,7 +29,7 @@ module fd_banded
    private
 
    public :: spd_system, spd_stats, spd_setup, spd_factor, spd_update_device, spd_update_devices
-   public :: spd_solve, spd_k_matvec, spd_c_matvec
+   public :: spd_solve, spd_k_matvec, spd_c_matvec, spd_kc_matvec
    public :: spd_size, spd_bandwidth, spd_is_dense, spd_device_kd, spd_error_estimate
    public :: spd_auto, spd_dense, spd_banded, spd_dense_max_n, spd_choose, spd_rank_one, spd_refactor
 
@@ -84,6 +84,8 @@ module fd_banded
       integer, private :: method = spd_choose         !! how device changes are made
       logical, private :: factored = .false.          !! fac holds the factor of K^
       real(dp), private :: c0 = 0.0_dp, c1 = 0.0_dp  !! coefficients of M and C in K^
+      real(dp), private :: a0 = 0.0_dp, a1 = 0.0_dp  !! C = a0 M + a1 K (+ dashpots)
+      logical, private :: rayleigh_c = .true.         !! C = a0 M + a1 K exactly (no dashpots)
       real(dp), private :: budget = default_budget    !! allowed estimated update error
       real(dp), private :: span = huge(1.0_dp)        !! running mean of columns per update
       integer, allocatable, private :: perm(:)        !! new -> old DOF
@@ -98,6 +100,7 @@ module fd_banded
       real(dp), allocatable, private :: errcol(:)     !! estimated update error per column
       real(dp), allocatable, private :: w1(:), w2(:)  !! work vectors (permutations)
       real(dp), allocatable, private :: xv(:)         !! update vector, zero between calls
+      real(dp), allocatable, private :: rdiag(:)      !! 1 / U(j, j) (the small dense solve)
    end type spd_system
 
    interface
@@ -311,7 +314,8 @@ contains
       end if
 
       allocate (sys%mass(n), sys%kmat(sys%ld*n), sys%cmat(sys%ld*n), sys%fac(sys%ld*n))
-      allocate (sys%kd(nd), sys%errcol(n), sys%w1(n), sys%w2(n), sys%xv(n))
+      allocate (sys%kd(nd), sys%errcol(n), sys%w1(n), sys%w2(n), sys%xv(n), sys%rdiag(n))
+      sys%rdiag = 0.0_dp
       allocate (sys%dlo(nd), sys%dhi(nd), sys%dorder(nd))
       sys%mass = mass(sys%perm)
       sys%kmat = 0.0_dp
@@ -326,6 +330,9 @@ contains
          call add_link(sys, sys%kmat, spring_i(i), spring_j(i), spring_k(i))
       end do
       ! C = a0 M + a1 K + dashpots
+      sys%a0 = ca0
+      sys%a1 = ca1
+      sys%rayleigh_c = nc == 0
       sys%cmat = ca1*sys%kmat
       do i = 1, n
          a = idx(sys, i, i)
@@ -603,6 +610,9 @@ contains
       e = 0.0_dp
       if (p > 1) e = maxval(sys%errcol(max(1, p - kb):p - 1))
       sys%errcol(p:n) = e
+      do j = p, n
+         sys%rdiag(j) = 1.0_dp/sys%fac(idx(sys, j, j))
+      end do
       sys%factored = .true.
    end subroutine refactor_from
 
@@ -784,6 +794,7 @@ contains
             c = sqrt(ratio)
             ci = 1.0_dp/c
             fac(kk) = ukk*c
+            sys%rdiag(k) = 1.0_dp/fac(kk)
             jmax = min(n, k + kb)
             ij = kk
             if (up) then
@@ -882,7 +893,7 @@ contains
    !> Solve K^ x = b with the current factor; b is overwritten by x (original DOF order).
    subroutine spd_solve(sys, b, error)
       type(spd_system), intent(inout) :: sys     !! the system (factored)
-      real(dp), intent(inout) :: b(:)            !! right-hand side on entry, solution on exit
+      real(dp), intent(inout), contiguous :: b(:) !! right-hand side on entry, solution on exit
       type(error_type), allocatable, intent(out) :: error !! not factored, wrong size
       integer :: i, info
 
@@ -896,9 +907,15 @@ contains
          return
       end if
       if (sys%dense) then
-         ! U' U x = b: two triangular solves (dpotrs's work without its level-3 call overhead)
-         call dtrsv('U', 'T', 'N', sys%n, sys%fac, sys%ld, b, 1)
-         call dtrsv('U', 'N', 'N', sys%n, sys%fac, sys%ld, b, 1)
+         ! U' U x = b: two triangular solves (dpotrs's work without its level-3 call overhead);
+         ! for a few DOFs the loops of the reference dtrsv, without the call (a step of a
+         ! two-mass model costs tens of nanoseconds: the calls were a third of it)
+         if (sys%n <= spd_dense_max_n) then
+            call small_solve(sys%n, sys%fac, sys%rdiag, b)
+         else
+            call dtrsv('U', 'T', 'N', sys%n, sys%fac, sys%ld, b, 1)
+            call dtrsv('U', 'N', 'N', sys%n, sys%fac, sys%ld, b, 1)
+         end if
       else
          do i = 1, sys%n
             sys%w1(i) = b(sys%perm(i))
@@ -913,8 +930,8 @@ contains
    !> y = alpha K x + beta y (original DOF order; y is not read when beta = 0).
    subroutine spd_k_matvec(sys, x, y, alpha, beta)
       type(spd_system), intent(inout) :: sys     !! the system (set up)
-      real(dp), intent(in) :: x(:)               !! vector, size n
-      real(dp), intent(inout) :: y(:)            !! result, size n
+      real(dp), intent(in), contiguous :: x(:)   !! vector, size n
+      real(dp), intent(inout), contiguous :: y(:) !! result, size n
       real(dp), intent(in) :: alpha              !! factor of K x
       real(dp), intent(in) :: beta               !! factor of the incoming y
 
@@ -924,23 +941,77 @@ contains
    !> y = alpha C x + beta y (original DOF order; y is not read when beta = 0).
    subroutine spd_c_matvec(sys, x, y, alpha, beta)
       type(spd_system), intent(inout) :: sys     !! the system (set up)
-      real(dp), intent(in) :: x(:)               !! vector, size n
-      real(dp), intent(inout) :: y(:)            !! result, size n
+      real(dp), intent(in), contiguous :: x(:)   !! vector, size n
+      real(dp), intent(inout), contiguous :: y(:) !! result, size n
       real(dp), intent(in) :: alpha              !! factor of C x
       real(dp), intent(in) :: beta               !! factor of the incoming y
 
       call band_matvec(sys, sys%cmat, x, y, alpha, beta)
    end subroutine spd_c_matvec
 
+   !> y = y + alpha (K x + C z) (original DOF order). When C = a0 M + a1 K (no dashpots) one
+   !> product, K (x + a1 z) + a0 M z, instead of two: what a Newmark step needs.
+   subroutine spd_kc_matvec(sys, x, z, y, alpha)
+      type(spd_system), intent(inout) :: sys     !! the system (set up)
+      real(dp), intent(in), contiguous :: x(:)   !! vector multiplied by K, size n
+      real(dp), intent(in), contiguous :: z(:)   !! vector multiplied by C, size n
+      real(dp), intent(inout), contiguous :: y(:) !! result, size n (added to)
+      real(dp), intent(in) :: alpha              !! factor of K x + C z
+      integer :: i, p
+
+      if (.not. sys%rayleigh_c) then
+         call band_matvec(sys, sys%kmat, x, y, alpha, 1.0_dp)
+         call band_matvec(sys, sys%cmat, z, y, alpha, 1.0_dp)
+         return
+      end if
+      associate (n => sys%n, w1 => sys%w1, w2 => sys%w2, perm => sys%perm, mass => sys%mass)
+         if (sys%dense .and. n <= spd_dense_max_n) then
+            ! scalar loops: a vector load of what scalar stores just wrote stalls the store
+            ! forwarding, and n is a few DOFs
+            !GCC$ novector
+            do i = 1, n
+               w1(i) = x(i) + sys%a1*z(i)
+            end do
+            call small_symv(n, sys%kmat, w1, w2, 1.0_dp, 0.0_dp)
+            !GCC$ novector
+            do i = 1, n
+               y(i) = y(i) + alpha*(w2(i) + sys%a0*mass(i)*z(i))
+            end do
+         else if (sys%dense) then
+            do i = 1, n
+               w1(i) = x(i) + sys%a1*z(i)
+            end do
+            call dsymv('U', n, 1.0_dp, sys%kmat, sys%ld, w1, 1, 0.0_dp, w2, 1)
+            do i = 1, n
+               y(i) = y(i) + alpha*(w2(i) + sys%a0*mass(i)*z(i))
+            end do
+         else
+            do i = 1, n
+               p = perm(i)
+               w1(i) = x(p) + sys%a1*z(p)
+            end do
+            call dsbmv('U', n, sys%kb, 1.0_dp, sys%kmat, sys%ld, w1, 1, 0.0_dp, w2, 1)
+            do i = 1, n
+               p = perm(i)
+               y(p) = y(p) + alpha*(w2(i) + sys%a0*mass(i)*z(p))
+            end do
+         end if
+      end associate
+   end subroutine spd_kc_matvec
+
    subroutine band_matvec(sys, mat, x, y, alpha, beta)
       type(spd_system), intent(inout) :: sys
-      real(dp), intent(in) :: mat(:)
-      real(dp), intent(in) :: x(:)
-      real(dp), intent(inout) :: y(:)
+      real(dp), intent(in), contiguous :: mat(:)
+      real(dp), intent(in), contiguous :: x(:)
+      real(dp), intent(inout), contiguous :: y(:)
       real(dp), intent(in) :: alpha, beta
       integer :: i
 
       if (sys%dense) then
+         if (sys%n <= spd_dense_max_n) then
+            call small_symv(sys%n, mat, x, y, alpha, beta)
+            return
+         end if
          if (beta == 0.0_dp) y = 0.0_dp
          call dsymv('U', sys%n, alpha, mat, sys%ld, x, 1, beta, y, 1)
          return
@@ -959,6 +1030,69 @@ contains
          end do
       end if
    end subroutine band_matvec
+
+   !> U' U x = b for a small dense upper factor (n x n, column-major), b overwritten: the
+   !> loops of the reference BLAS dtrsv ('U', 'T') then dtrsv ('U', 'N'), with the divisions by
+   !> the pivots made multiplications by their reciprocals (kept with the factor): the solve
+   !> of a two-mass model waited on four divisions.
+   pure subroutine small_solve(n, u, rdiag, b)
+      integer, intent(in) :: n
+      real(dp), intent(in) :: u(n, n), rdiag(n)
+      real(dp), intent(inout) :: b(n)
+      real(dp) :: temp
+      integer :: i, j
+
+      do j = 1, n
+         temp = b(j)
+         !GCC$ novector
+         do i = 1, j - 1
+            temp = temp - u(i, j)*b(i)
+         end do
+         b(j) = temp*rdiag(j)
+      end do
+      do j = n, 1, -1
+         b(j) = b(j)*rdiag(j)
+         temp = b(j)
+         !GCC$ novector
+         do i = j - 1, 1, -1
+            b(i) = b(i) - temp*u(i, j)
+         end do
+      end do
+   end subroutine small_solve
+
+   !> y = alpha A x + beta y for a small symmetric A (upper triangle, n x n column-major): the
+   !> operations of the reference BLAS dsymv ('U'), in its order (y not read when beta = 0).
+   pure subroutine small_symv(n, a, x, y, alpha, beta)
+      integer, intent(in) :: n
+      real(dp), intent(in) :: a(n, n), x(n)
+      real(dp), intent(inout) :: y(n)
+      real(dp), intent(in) :: alpha, beta
+      real(dp) :: temp1, temp2
+      integer :: i, j
+
+      if (beta == 0.0_dp) then
+         !GCC$ novector
+         do i = 1, n
+            y(i) = 0.0_dp
+         end do
+      else if (beta /= 1.0_dp) then
+         !GCC$ novector
+         do i = 1, n
+            y(i) = beta*y(i)
+         end do
+      end if
+      if (alpha == 0.0_dp) return
+      do j = 1, n
+         temp1 = alpha*x(j)
+         temp2 = 0.0_dp
+         !GCC$ novector
+         do i = 1, j - 1
+            y(i) = y(i) + temp1*a(i, j)
+            temp2 = temp2 + a(i, j)*x(i)
+         end do
+         y(j) = y(j) + temp1*a(j, j) + alpha*temp2
+      end do
+   end subroutine small_symv
 
    !> Number of DOFs.
    pure integer function spd_size(sys)

@@ -10,7 +10,7 @@ module fd_excitation
    implicit none
    private
 
-   public :: excitation_type, table_motion, ramp_end
+   public :: excitation_type, table_motion, table_acceleration, ramp_end
    public :: excitation_none, excitation_harmonic, excitation_record
    public :: sine_forcing, max_sines, table_sines, segment_end
    public :: forcing_form, forcing_unknown, forcing_zero, forcing_sines, forcing_linear
@@ -88,6 +88,22 @@ contains
          ag = (1.0_dp - x)*exc%acc(k + 1) + x*exc%acc(k + 2)
       end select
    end subroutine table_motion
+
+   !> Table acceleration at time t: the ag of table_motion, to the last bit, without the
+   !> displacement and velocity a time step does not need (harmonic motion after its ramp:
+   !> one sine, not a sine and a cosine).
+   pure real(dp) function table_acceleration(exc, t) result(ag)
+      type(excitation_type), intent(in) :: exc !! the table motion
+      real(dp), intent(in) :: t                !! time [s]
+      real(dp) :: w, xg, vg
+
+      if (exc%kind == excitation_harmonic .and. exc%ramp_cycles == 0) then
+         w = 2.0_dp*pi*exc%frequency
+         ag = -(exc%amplitude*(w*w*sin(w*t)))
+      else
+         call table_motion(exc, t, xg, vg, ag)
+      end if
+   end function table_acceleration
 
    !> End of the cosine ramp of harmonic table motion, t_r = ramp_cycles / frequency [s].
    pure real(dp) function ramp_end(exc)

@@ -160,12 +160,12 @@ contains
    pure subroutine observe_peaks(res, t, u, v, acc, ag, s, force)
       type(result_type), intent(inout) :: res  !! the result
       real(dp), intent(in) :: t                !! time [s]
-      real(dp), intent(in) :: u(:)             !! relative displacements [m]
-      real(dp), intent(in) :: v(:)             !! relative velocities [m/s]
-      real(dp), intent(in) :: acc(:)           !! relative accelerations [m/s2]
+      real(dp), intent(in), contiguous :: u(:)   !! relative displacements [m]
+      real(dp), intent(in), contiguous :: v(:)   !! relative velocities [m/s]
+      real(dp), intent(in), contiguous :: acc(:) !! relative accelerations [m/s2]
       real(dp), intent(in) :: ag               !! table acceleration [m/s2]
-      real(dp), intent(in) :: s(:)             !! device relative displacements [m]
-      real(dp), intent(in) :: force(:)         !! device forces [N]
+      real(dp), intent(in), contiguous :: s(:)   !! device relative displacements [m]
+      real(dp), intent(in), contiguous :: force(:) !! device forces [N]
       real(dp) :: x
       integer :: i
 

@@ -24,11 +24,11 @@ module fd_newmark
    use fd_names, only: laws, law_name, law_choices, excitation_types, technique_name, technique_newmark, &
                        technique_event_driven, linear_system_dense, linear_system_banded
    use fd_model, only: model_type, integration_type
-   use fd_excitation, only: excitation_type, table_motion
+   use fd_excitation, only: excitation_type, table_motion, table_acceleration
    use fd_matrices, only: structure_damping
-   use fd_kinematics, only: device_kinematics, device_relative, add_device
+   use fd_kinematics, only: device_kinematics, add_device
    use fd_banded, only: spd_system, spd_setup, spd_factor, spd_update_devices, spd_solve, spd_k_matvec, &
-                        spd_c_matvec, spd_auto, spd_dense, spd_banded, spd_is_dense, spd_bandwidth
+                        spd_c_matvec, spd_kc_matvec, spd_auto, spd_dense, spd_banded, spd_is_dense, spd_bandwidth
    use fd_device_state, only: device_state, device_force
    use fd_friction, only: friction_init, friction_update, friction_correct
    use fd_result, only: result_type
@@ -44,7 +44,9 @@ module fd_newmark
    !> The effective stiffness of one step size.
    type :: level_type
       real(dp) :: h = 0.0_dp               !! step size [s]
-      real(dp) :: c0 = 0.0_dp, c1 = 0.0_dp, c2 = 0.0_dp, c3 = 0.0_dp, c4 = 0.0_dp, c5 = 0.0_dp !! Newmark
+      real(dp) :: c0 = 0.0_dp, c1 = 0.0_dp             !! K^ = K + c1 C + c0 M + ...
+      real(dp) :: gh = 0.0_dp, g1h = 0.0_dp            !! gamma h, (1 - gamma) h
+      real(dp) :: bh2 = 0.0_dp, b2h2 = 0.0_dp          !! beta h^2, (1/2 - beta) h^2
       type(spd_system) :: sys              !! its factored K^
       logical :: factored = .false.        !! factored once (then only updated)
       integer :: version = -1              !! the pattern of device stiffnesses it holds
@@ -53,11 +55,14 @@ module fd_newmark
    !> Everything the loop works on, allocated once before it starts.
    type :: workspace
       integer :: n = 0, nd = 0
+      integer :: lmax = 0                             !! halvings below dt2
+      real(dp) :: a0 = 0.0_dp, a1c = 0.0_dp           !! C = a0 M + a1c K
       real(dp), allocatable :: mass(:)
       type(level_type), allocatable :: lev(:)         !! 1: dt1, 2: dt2, 2 + l: dt2 / 2**l
       integer :: version = 0                          !! counts the accepted phase changes
       real(dp), allocatable :: u(:), v(:), a(:), u1(:), v1(:), a1(:), rhs(:), tmp(:)
       real(dp), allocatable :: s(:), sd(:), s1(:), sd1(:), f(:), kd(:)
+      integer, allocatable :: di(:), dj(:)            !! device nodes (dj = 0: the table)
       type(device_state), allocatable :: st(:), st1(:)
       integer, allocatable :: phase0(:), phase1(:)    !! phases of st, st1 for the observer
       logical, allocatable :: changed(:), ok(:)
@@ -141,15 +146,15 @@ contains
 
       do k = 1, w%obs%nsteps
          t0 = (k - 1)*dt1
-         call try_step(model, exc, opts, t0, 1, w, error)
+         call try_step(exc, t0, 1, w, error)
          if (allocated(error)) return
          call judge(model, opts, w, any_changed, any_bad)
          if (w%nd == 0 .or. .not. (any_changed .or. (any_bad .and. opts%check))) then
-            call accept(model, exc, t0 + dt1, w, res, .false.)
+            call accept(model, exc, t0 + dt1, w, res, any_changed, .false.)
             res%steps_dt1 = res%steps_dt1 + 1
          else
             do j = 1, opts%n2
-               call advance_refined(model, exc, opts, t0 + (j - 1)*dt2, dt2, res%dt_min, w, res, error)
+               call advance_refined(model, exc, opts, t0 + (j - 1)*dt2, dt2, w, res, error)
                if (allocated(error)) return
             end do
          end if
@@ -213,6 +218,8 @@ contains
       w%mass = model%mass
       call structure_damping(model, a0, a1, res%period_stuck, res%xi_stuck, error)
       if (allocated(error)) return
+      w%a0 = a0
+      w%a1c = a1
       select case (opts%linear_system)
       case (linear_system_dense)
          path = spd_dense
@@ -226,6 +233,7 @@ contains
       if (allocated(error)) return
       res%storage = merge(1, 2, spd_is_dense(base))
       res%bandwidth = spd_bandwidth(base)
+      w%lmax = lmax
       allocate (w%lev(lmax + 2), stat=stat)
       if (stat /= 0) then
          call fatal_error(error, "not enough memory for the effective stiffness of n_dof = "//trim(fmt_int(n))//" DOFs")
@@ -240,14 +248,17 @@ contains
             h = dt2/2.0_dp**(l - 2)
          end if
          w%lev(l)%h = h
-         w%lev(l)%c0 = 1.0_dp/(b*h*h); w%lev(l)%c1 = g/(b*h); w%lev(l)%c2 = 1.0_dp/(b*h)
-         w%lev(l)%c3 = 0.5_dp/b - 1.0_dp; w%lev(l)%c4 = g/b - 1.0_dp; w%lev(l)%c5 = h*(0.5_dp*g/b - 1.0_dp)
+         w%lev(l)%c0 = 1.0_dp/(b*h*h); w%lev(l)%c1 = g/(b*h)
+         w%lev(l)%gh = g*h; w%lev(l)%g1h = (1.0_dp - g)*h
+         w%lev(l)%bh2 = b*h*h; w%lev(l)%b2h2 = (0.5_dp - b)*h*h
          w%lev(l)%sys = base
       end do
       allocate (w%u(n), w%v(n), w%a(n), w%u1(n), w%v1(n), w%a1(n), w%rhs(n), w%tmp(n))
       allocate (w%s(nd), w%sd(nd), w%s1(nd), w%sd1(nd), w%f(nd), w%kd(nd), w%st(nd), w%st1(nd), &
                 w%phase0(nd), w%phase1(nd))
       allocate (w%changed(nd), w%ok(nd))
+      w%di = model%dev%node_i
+      w%dj = model%dev%node_j
    end subroutine setup
 
    !> Acceleration in equilibrium with the current phases: M a = p - C v - K u - sum b F.
@@ -270,48 +281,108 @@ contains
    end subroutine consistent_acceleration
 
    !> One Newmark step of the size of level lv from t with the current phases, into the
-   !> trial state.
-   subroutine try_step(model, exc, opts, t, lv, w, error)
-      type(model_type), intent(in) :: model
+   !> trial state. Acceleration form: with the predictors u~ = u + h v + (1/2 - beta) h^2 a
+   !> and v~ = v + (1 - gamma) h a,
+   !>   (M + gamma h C_t + beta h^2 K_t) a1 = p1 - F0 - C_t v~ - K_t u~,
+   !> solved as K^ a1 = c0 (...) (K^ = c0 (M + ...)); u1 = u~ + beta h^2 a1, v1 = v~ + gamma h a1.
+   !> The solve's error is relative to a1 itself (the incremental form's is relative to
+   !> c0 du ~ v / (beta h), large at small steps): rank-one updates of the factor keep the
+   !> equilibrium at round-off.
+   subroutine try_step(exc, t, lv, w, error)
       type(excitation_type), intent(in) :: exc
-      type(integration_type), intent(in) :: opts
       real(dp), intent(in) :: t
       integer, intent(in) :: lv
       type(workspace), intent(inout), target :: w
       type(error_type), allocatable, intent(out) :: error
-      real(dp) :: b, g, h, xg, vg, f
-      integer :: d
+      real(dp) :: h, ag1
 
-      call factor_for(lv, w, error)
-      if (allocated(error)) return
-      associate (lev => w%lev(lv))
-         h = lev%h
-         b = opts%beta
-         g = opts%gamma
-         call table_motion(exc, t + h, xg, vg, w%ag1)
-         ! acceleration form: with the predictors u~ = u + h v + (1/2 - beta) h^2 a and
-         ! v~ = v + (1 - gamma) h a, (M + gamma h C_t + beta h^2 K_t) a1 = p1 - F0 - C_t v~ - K_t u~,
-         ! solved as K^ a1 = c0 (...) (K^ = c0 (M + ...)); u1 = u~ + beta h^2 a1, v1 = v~ + gamma h a1.
-         ! The solve's error is relative to a1 itself (the incremental form's, to c0 du ~ v / h)
-         w%tmp = w%v + ((1.0_dp - g)*h)*w%a
-         w%u1 = w%u + (h*w%v + ((0.5_dp - b)*h*h)*w%a)
-         w%rhs = -w%mass*w%ag1
-         call spd_c_matvec(lev%sys, w%tmp, w%rhs, -1.0_dp, 1.0_dp)
-         call spd_k_matvec(lev%sys, w%u1, w%rhs, -1.0_dp, 1.0_dp)
-         do d = 1, w%nd
-            f = w%st(d)%ks*device_relative(model, d, w%u1) + w%st(d)%cs*device_relative(model, d, w%tmp) + &
-                w%st(d)%f0
-            call add_device(model, d, -f, w%rhs)
-         end do
-         w%rhs = lev%c0*w%rhs
-         call spd_solve(lev%sys, w%rhs, error)
+      if (.not. (w%lev(lv)%factored .and. w%lev(lv)%version == w%version)) then
+         call factor_for(lv, w, error)
          if (allocated(error)) return
-         w%a1 = w%rhs
-         w%u1 = w%u1 + (b*h*h)*w%a1
-         w%v1 = w%tmp + (g*h)*w%a1
-      end associate
-      call device_kinematics(model, w%u1, w%v1, w%s1, w%sd1)
+      end if
+      h = w%lev(lv)%h
+      ag1 = table_acceleration(exc, t + h)
+      w%ag1 = ag1
+      call predict(w%n, h, w%lev(lv)%g1h, w%lev(lv)%b2h2, ag1, w%mass, w%u, w%v, w%a, w%tmp, w%u1, w%rhs)
+      call spd_kc_matvec(w%lev(lv)%sys, w%u1, w%tmp, w%rhs, -1.0_dp)
+      call device_loads(w%n, w%nd, w%di, w%dj, w%st, w%u1, w%tmp, w%lev(lv)%c0, w%rhs)
+      call spd_solve(w%lev(lv)%sys, w%rhs, error)
+      if (allocated(error)) return
+      call correct(w%n, w%nd, w%lev(lv)%bh2, w%lev(lv)%gh, w%di, w%dj, w%rhs, w%tmp, w%a1, w%u1, w%v1, &
+                   w%s1, w%sd1)
    end subroutine try_step
+
+   !> Predictors v~ = v + (1 - gamma) h a (in vt), u~ = u + h v + (1/2 - beta) h^2 a (in ut),
+   !> and the table's inertia load -M ag1 (in rhs).
+   pure subroutine predict(n, h, g1h, b2h2, ag1, mass, u, v, a, vt, ut, rhs)
+      integer, intent(in) :: n
+      real(dp), intent(in) :: h, g1h, b2h2, ag1
+      real(dp), intent(in) :: mass(n), u(n), v(n), a(n)
+      real(dp), intent(out) :: vt(n), ut(n), rhs(n)
+      integer :: i
+
+      do i = 1, n
+         vt(i) = v(i) + g1h*a(i)
+         ut(i) = u(i) + (h*v(i) + b2h2*a(i))
+         rhs(i) = -mass(i)*ag1
+      end do
+   end subroutine predict
+
+   !> The devices' forces at the predictors, F = ks s~ + cs s'~ + f0, subtracted from rhs
+   !> along b_d; then rhs scaled by c0 (K^ = c0 (M + gamma h C_t + beta h^2 K_t)).
+   pure subroutine device_loads(n, nd, di, dj, st, ut, vt, c0, rhs)
+      integer, intent(in) :: n, nd
+      integer, intent(in) :: di(nd), dj(nd)
+      type(device_state), intent(in) :: st(nd)
+      real(dp), intent(in) :: ut(n), vt(n), c0
+      real(dp), intent(inout) :: rhs(n)
+      real(dp) :: f
+      integer :: d, i, j
+
+      do d = 1, nd
+         i = di(d)
+         j = dj(d)
+         if (j > 0) then
+            f = st(d)%ks*(ut(i) - ut(j)) + st(d)%cs*(vt(i) - vt(j)) + st(d)%f0
+            rhs(j) = rhs(j) + f
+         else
+            f = st(d)%ks*ut(i) + st(d)%cs*vt(i) + st(d)%f0
+         end if
+         rhs(i) = rhs(i) - f
+      end do
+      do i = 1, n
+         rhs(i) = c0*rhs(i)
+      end do
+   end subroutine device_loads
+
+   !> The trial state from a1 (in rhs): u1 = u~ + beta h^2 a1, v1 = v~ + gamma h a1, and the
+   !> devices' relative displacement and velocity.
+   pure subroutine correct(n, nd, bh2, gh, di, dj, a1s, vt, a1, u1, v1, s1, sd1)
+      integer, intent(in) :: n, nd
+      real(dp), intent(in) :: bh2, gh
+      integer, intent(in) :: di(nd), dj(nd)
+      real(dp), intent(in) :: a1s(n), vt(n)
+      real(dp), intent(out) :: a1(n), v1(n), s1(nd), sd1(nd)
+      real(dp), intent(inout) :: u1(n)
+      integer :: d, i, j
+
+      do i = 1, n
+         a1(i) = a1s(i)
+         u1(i) = u1(i) + bh2*a1s(i)
+         v1(i) = vt(i) + gh*a1s(i)
+      end do
+      do d = 1, nd
+         i = di(d)
+         j = dj(d)
+         if (j > 0) then
+            s1(d) = u1(i) - u1(j)
+            sd1(d) = v1(i) - v1(j)
+         else
+            s1(d) = u1(i)
+            sd1(d) = v1(i)
+         end if
+      end do
+   end subroutine correct
 
    !> The factored effective stiffness of level lv for the current phases: factored the
    !> first time the level is used, updated (never refactored from scratch) when the
@@ -347,21 +418,26 @@ contains
       type(integration_type), intent(in) :: opts
       type(workspace), intent(inout) :: w
       logical, intent(out) :: any_changed, any_bad
+      integer :: d
 
-      w%st1 = w%st
-      call friction_update(model%dev, w%s1, w%sd1, w%st1, w%changed)
-      w%ok = friction_correct(model%dev, opts%n_corr, w%st, w%sd, w%sd1)
-      any_changed = any(w%changed)
-      any_bad = .not. all(w%ok)
+      any_changed = .false.
+      any_bad = .false.
+      do d = 1, w%nd
+         w%st1(d) = w%st(d)
+         call friction_update(model%dev(d), w%s1(d), w%sd1(d), w%st1(d), w%changed(d))
+         w%ok(d) = friction_correct(model%dev(d), opts%n_corr, w%st(d), w%sd(d), w%sd1(d))
+         any_changed = any_changed .or. w%changed(d)
+         any_bad = any_bad .or. .not. w%ok(d)
+      end do
    end subroutine judge
 
    !> Cover [t, t + sub] with steps sub, sub/2, ... down to dt_min, halving while the
    !> correctness condition fails (when the check is on).
-   subroutine advance_refined(model, exc, opts, t, sub, dt_min, w, res, error)
+   subroutine advance_refined(model, exc, opts, t, sub, w, res, error)
       type(model_type), intent(in) :: model
       type(excitation_type), intent(in) :: exc
       type(integration_type), intent(in) :: opts
-      real(dp), intent(in) :: t, sub, dt_min
+      real(dp), intent(in) :: t, sub
       type(workspace), intent(inout) :: w
       type(result_type), intent(inout) :: res
       type(error_type), allocatable, intent(out) :: error
@@ -369,21 +445,21 @@ contains
       real(dp) :: h, tl
       logical :: any_changed, any_bad, stop
 
-      lmax = halving_levels(sub, dt_min)
+      lmax = w%lmax
       units = 2**lmax
       pos = 0
       level = 0
       do while (pos < units)
-         h = sub/2.0_dp**level
+         h = w%lev(2 + level)%h
          tl = t + sub*real(pos, dp)/real(units, dp)
-         call try_step(model, exc, opts, tl, 2 + level, w, error)
+         call try_step(exc, tl, 2 + level, w, error)
          if (allocated(error)) return
          call judge(model, opts, w, any_changed, any_bad)
          if (any_bad .and. opts%check .and. level < lmax) then
             level = level + 1
             cycle
          end if
-         call accept(model, exc, tl + h, w, res, any_bad)
+         call accept(model, exc, tl + h, w, res, any_changed, any_bad)
          if (level == 0) then
             res%steps_dt2 = res%steps_dt2 + 1
          else
@@ -403,41 +479,117 @@ contains
    end subroutine advance_refined
 
    !> Make the trial state the current one: phases, counters, energy, peaks.
-   subroutine accept(model, exc, t1, w, res, any_bad)
+   subroutine accept(model, exc, t1, w, res, any_changed, any_bad)
       type(model_type), intent(in) :: model
       type(excitation_type), intent(in) :: exc
       real(dp), intent(in) :: t1
       type(workspace), intent(inout) :: w
       type(result_type), intent(inout) :: res
-      logical, intent(in) :: any_bad
+      logical, intent(in) :: any_changed         !! a device changed phase
+      logical, intent(in) :: any_bad             !! a device violates the correctness condition
       integer :: d
-      real(dp) :: f0, f1
+      real(dp) :: ein
+      logical :: changed_k
 
-      ! energy of the step, forces at both ends in the step's phases
-      w%tmp = w%u1 - w%u
-      res%e_input = res%e_input - 0.5_dp*(w%ag + w%ag1)*sum(w%mass*w%tmp)
-      call spd_c_matvec(w%lev(1)%sys, w%tmp, w%rhs, 1.0_dp, 0.0_dp)
-      res%e_viscous = res%e_viscous + 0.5_dp*sum((w%v + w%v1)*w%rhs)
-      do d = 1, w%nd
-         f0 = device_force(w%st(d), w%s(d), w%sd(d))
-         f1 = device_force(w%st(d), w%s1(d), w%sd1(d))
-         w%w_device = w%w_device + 0.5_dp*(f0 + f1)*(w%s1(d) - w%s(d))
-      end do
+      ! energy of the step, forces at both ends in the step's phases; the state moves on
+      call step_energy(w%n, w%mass, w%u, w%v, w%a, w%u1, w%v1, w%a1, w%tmp, w%rhs, ein)
+      res%e_input = res%e_input - 0.5_dp*(w%ag + w%ag1)*ein
+      res%e_viscous = res%e_viscous + 0.5_dp*viscous_work(model, w%a0, w%a1c, w%mass, w%tmp, w%rhs)
+      w%ag = w%ag1
+      call device_work(w%nd, w%st, w%s, w%sd, w%s1, w%sd1, w%w_device)
       ! violations of the correctness condition left in an accepted step
       if (any_bad) call observe_violations(res, t1, w%ok)
-      w%phase0 = w%st%phase
-      w%phase1 = w%st1%phase
-      call observe_transitions(res, w%phase0, w%phase1)
-      w%u = w%u1; w%v = w%v1; w%a = w%a1; w%ag = w%ag1
-      w%s = w%s1; w%sd = w%sd1
-      w%st = w%st1
-      if (any(w%changed)) then
-         w%version = w%version + 1
-         call consistent_acceleration(model, exc, t1, w)
+      if (any_changed) then
+         w%phase0 = w%st%phase
+         w%phase1 = w%st1%phase
+         call observe_transitions(res, w%phase0, w%phase1)
       end if
-      w%f = device_force(w%st, w%s, w%sd)
+      ! the factors follow the devices' stiffness and damping (whatever changed them)
+      changed_k = .false.
+      do d = 1, w%nd
+         changed_k = changed_k .or. w%st1(d)%ks /= w%st(d)%ks .or. w%st1(d)%cs /= w%st(d)%cs
+         w%st(d) = w%st1(d)
+      end do
+      if (changed_k) w%version = w%version + 1
+      if (any_changed) call consistent_acceleration(model, exc, t1, w)
+      do d = 1, w%nd
+         w%f(d) = w%st(d)%ks*w%s(d) + w%st(d)%cs*w%sd(d) + w%st(d)%f0
+      end do
       call observe_peaks(res, t1, w%u, w%v, w%a, w%ag, w%s, w%f)
    end subroutine accept
+
+   !> The state moves to the trial state; du = u1 - u (in du), v + v1 (in vsum) and
+   !> sum_i m_i du_i (the input work's factor) of the step.
+   pure subroutine step_energy(n, mass, u, v, a, u1, v1, a1, du, vsum, ein)
+      integer, intent(in) :: n
+      real(dp), intent(in) :: mass(n), u1(n), v1(n), a1(n)
+      real(dp), intent(inout) :: u(n), v(n), a(n)
+      real(dp), intent(out) :: du(n), vsum(n), ein
+      integer :: i
+
+      ein = 0.0_dp
+      do i = 1, n
+         du(i) = u1(i) - u(i)
+         vsum(i) = v(i) + v1(i)
+         ein = ein + mass(i)*du(i)
+         u(i) = u1(i)
+         v(i) = v1(i)
+         a(i) = a1(i)
+      end do
+   end subroutine step_energy
+
+   !> (v + v1)' C du of a step, C = a0 M + a1 K, K from the springs (no matrix product).
+   pure real(dp) function viscous_work(model, a0, a1, mass, du, vsum) result(e)
+      type(model_type), intent(in) :: model
+      real(dp), intent(in) :: a0, a1
+      real(dp), intent(in) :: mass(:), du(:), vsum(:)
+      real(dp) :: ek, x, y
+      integer :: i, s
+
+      e = 0.0_dp
+      if (a0 /= 0.0_dp) then
+         do i = 1, size(du)
+            e = e + mass(i)*vsum(i)*du(i)
+         end do
+         e = a0*e
+      end if
+      if (a1 /= 0.0_dp) then
+         ek = 0.0_dp
+         do s = 1, model%n_springs
+            x = 0.0_dp
+            y = 0.0_dp
+            if (model%spring_i(s) > 0) then
+               x = du(model%spring_i(s))
+               y = vsum(model%spring_i(s))
+            end if
+            if (model%spring_j(s) > 0) then
+               x = x - du(model%spring_j(s))
+               y = y - vsum(model%spring_j(s))
+            end if
+            ek = ek + model%spring_k(s)*x*y
+         end do
+         e = e + a1*ek
+      end if
+   end function viscous_work
+
+   !> Work of the device forces over the step (trapezoid, the step's phases); s, s' move on.
+   pure subroutine device_work(nd, st, s, sd, s1, sd1, w)
+      integer, intent(in) :: nd
+      type(device_state), intent(in) :: st(nd)
+      real(dp), intent(inout) :: s(nd), sd(nd)
+      real(dp), intent(in) :: s1(nd), sd1(nd)
+      real(dp), intent(inout) :: w
+      real(dp) :: f0, f1
+      integer :: d
+
+      do d = 1, nd
+         f0 = st(d)%ks*s(d) + st(d)%cs*sd(d) + st(d)%f0
+         f1 = st(d)%ks*s1(d) + st(d)%cs*sd1(d) + st(d)%f0
+         w = w + 0.5_dp*(f0 + f1)*(s1(d) - s(d))
+         s(d) = s1(d)
+         sd(d) = sd1(d)
+      end do
+   end subroutine device_work
 
    !> Strain energy of the springs, 1/2 u' K u = sum_s k_s (u_i - u_j)^2 / 2 (no cancellation).
    pure real(dp) function strain_energy(model, u) result(e)
