@@ -123,6 +123,8 @@ contains
       call reset(s)
       call read_deck(path, s%cfg, error)
       if (allocated(error)) return
+      call deck_selection(s, error)
+      if (allocated(error)) return
       s%state = session_read
       s%from_deck = .true.
    end subroutine session_open
@@ -136,6 +138,8 @@ contains
       type(error_type), allocatable, intent(out) :: error !! bad deck or record
       call reset(s)
       call read_deck_string(text, path, s%cfg, error)
+      if (allocated(error)) return
+      call deck_selection(s, error)
       if (allocated(error)) return
       s%state = session_read
       s%from_deck = .true.
@@ -414,6 +418,27 @@ contains
    end subroutine session_write_files
 
    ! ---------------------------------------------------------------- helpers
+   !> The history columns the deck's &output selects (history_dofs, history_devices).
+   subroutine deck_selection(s, error)
+      type(session_type), intent(inout) :: s
+      type(error_type), allocatable, intent(out) :: error
+      integer, allocatable :: dofs(:), devices(:)
+      integer :: i
+
+      if (.not. (allocated(s%cfg%out%history_dofs) .or. allocated(s%cfg%out%history_devices))) return
+      if (allocated(s%cfg%out%history_dofs)) then
+         dofs = s%cfg%out%history_dofs
+      else
+         dofs = [(i, i=1, s%cfg%model%n_dof)]
+      end if
+      if (allocated(s%cfg%out%history_devices)) then
+         devices = s%cfg%out%history_devices
+      else
+         devices = [(i, i=1, s%cfg%model%n_devices)]
+      end if
+      call select_history(s%ctl, dofs, devices, s%cfg%model%n_dof, s%cfg%model%n_devices, error)
+   end subroutine deck_selection
+
    subroutine reset(s)
       type(session_type), intent(inout) :: s
       type(session_type) :: fresh

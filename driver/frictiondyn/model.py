@@ -183,12 +183,16 @@ class Integration:
 @dataclass
 class Output:
     """Output settings for the executable (&output); None takes the reader's default (dir
-    'out', name the deck's stem, a row every dt_record, the history written)."""
+    'out', name the deck's stem, a row every dt_record, the history written, of every DOF
+    and device)."""
 
     dir: str | None = None
     name: str | None = None
     output_every: int | None = None
     write_history: bool | None = None
+    #: DOFs and devices (1-based) whose columns the history has; None: all, []: none
+    history_dofs: list[int] | None = None
+    history_devices: list[int] | None = None
 
     def group(self) -> dict:
         g: dict = {}
@@ -199,6 +203,10 @@ class Output:
             output_every=self.output_every,
             write_history=self.write_history,
         )
+        for key in ("history_dofs", "history_devices"):
+            value = getattr(self, key)
+            if value is not None:
+                g[key] = [int(x) for x in value] if len(value) else 0
         return g
 
 

@@ -556,7 +556,8 @@ contains
       character(len=1024) :: dir, name
       integer :: output_every
       logical :: write_history
-      namelist /output/ dir, name, output_every, write_history
+      integer, allocatable :: history_dofs(:), history_devices(:)
+      namelist /output/ dir, name, output_every, write_history, history_dofs, history_devices
       type(group_text) :: grp
       character(len=512) :: msg, msg0
       character(len=:), allocatable :: rec
@@ -564,6 +565,8 @@ contains
       logical :: found
 
       dir = default_dir; output_every = default_output_every; write_history = default_write_history
+      allocate (history_dofs(cfg%model%n_dof + 2), history_devices(cfg%model%n_devices + 2))
+      history_dofs = unset_int; history_devices = unset_int
       call stem(deck%path, name)
       call find_group(deck, 'output', grp, found, error)
       if (allocated(error)) return
@@ -590,11 +593,51 @@ contains
          call bad(deck, 'output', 'output_every', trim(fmt_int(output_every)), '>= 0 (0 = at the record step)', error)
          return
       end if
+      call history_list(deck, 'history_dofs', history_dofs, cfg%model%n_dof, cfg%out%history_dofs, error)
+      if (allocated(error)) return
+      call history_list(deck, 'history_devices', history_devices, cfg%model%n_devices, cfg%out%history_devices, &
+                        error)
+      if (allocated(error)) return
       cfg%out%dir = trim(dir)
       cfg%out%name = trim(name)
       cfg%out%history = write_history
       cfg%opts%output_every = output_every
    end subroutine read_output_group
+
+   !> A list of DOFs or devices for the history: not given, all (list not allocated); a single
+   !> 0, none; else numbers in 1..n, increasing, without repeats.
+   subroutine history_list(deck, var, x, n, list, error)
+      type(deck_text), intent(in) :: deck
+      character(len=*), intent(in) :: var
+      integer, intent(in) :: x(:), n
+      integer, allocatable, intent(inout) :: list(:)
+      type(error_type), allocatable, intent(out) :: error
+      integer :: m, i
+
+      m = count(x /= unset_int)
+      if (m == 0) return
+      if (any(x(m + 1:) /= unset_int)) then
+         call bad(deck, 'output', var, 'with a gap', 'a list of consecutive values', error); return
+      end if
+      if (m == 1 .and. x(1) == 0) then
+         allocate (list(0))
+         return
+      end if
+      do i = 1, m
+         if (x(i) < 1 .or. x(i) > n) then
+            call bad(deck, 'output', var//'('//trim(fmt_int(i))//')', trim(fmt_int(x(i))), &
+                     'in 1..'//trim(fmt_int(n))//' (or a single 0: none)', error); return
+         end if
+         if (i > 1) then
+            if (x(i) <= x(i - 1)) then
+               call bad(deck, 'output', var//'('//trim(fmt_int(i))//')', trim(fmt_int(x(i))), &
+                        'greater than '//var//'('//trim(fmt_int(i - 1))//') = '//trim(fmt_int(x(i - 1)))// &
+                        ' (increasing, without repeats)', error); return
+            end if
+         end if
+      end do
+      list = x(1:m)
+   end subroutine history_list
 
    ! ---------------------------------------------------------------- helpers
    !> Size of a group's arrays, from the count the group declares (`count_var`, read from its

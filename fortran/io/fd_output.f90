@@ -375,38 +375,42 @@ contains
       character(len=:), allocatable, intent(out) :: js     !! the JSON text
       type(record_info), intent(in), optional :: record    !! the record read, if any
       character(len=1), parameter :: nl = achar(10)
-      character(len=:), allocatable :: laws, esc
+      character(len=:), allocatable :: laws, esc, buf
+      integer :: pos, nlaw
       integer :: d
 
-      laws = ''
+      nlaw = 0
+      allocate (character(len=64) :: laws)
       do d = 1, model%n_devices
-         laws = laws//'"'//trim(law_name(model%dev(d)%law))//'"'
-         if (d < model%n_devices) laws = laws//', '
+         call put_law('"'//trim(law_name(model%dev(d)%law))//'"')
+         if (d < model%n_devices) call put_law(', ')
       end do
       call json_escape(deck_path, esc)
-      js = '{'//nl
-      js = js//'  "deck": "'//esc//'",'//nl
-      js = js//'  "frictiondyn_version": "'//frictiondyn_version//'",'//nl
+      pos = 0
+      allocate (character(len=4096 + 64*(res%n_dof + res%n_devices)*8) :: buf)
+      call put('{'//nl)
+      call put('  "deck": "'//esc//'",'//nl)
+      call put('  "frictiondyn_version": "'//frictiondyn_version//'",'//nl)
       if (present(record)) then
          if (allocated(record%path)) then
-            js = js//'  "record": {'
+            call put('  "record": {')
             call json_escape(record%path, esc)
-            js = js//'"file": "'//esc//'", "format": "'//trim(record%format)//'", "format_detected": '// &
+            call put('"file": "'//esc//'", "format": "'//trim(record%format)//'", "format_detected": '// &
                  trim(merge('true ', 'false', record%detected))//', "units": "'//trim(record%units)// &
                  '", "samples": '//trim(fmt_int(record%npts))//', "dt_s": '//trim(json_real(record%dt))// &
                  ', "scale": '//trim(json_real(record%scale))//', "peak_acc_mps2": '// &
-                 trim(json_real(record%peak_acc))
+                 trim(json_real(record%peak_acc)))
             if (allocated(record%title)) then
                call json_escape(record%title, esc)
-               js = js//', "title": "'//esc//'"'
+               call put(', "title": "'//esc//'"')
             end if
-            js = js//'},'//nl
+            call put('},'//nl)
          end if
       end if
       call kv('n_dof', trim(fmt_int(res%n_dof)))
       call kv('n_devices', trim(fmt_int(res%n_devices)))
       call kv('technique', '"'//trim(technique_name(res%technique))//'"')
-      js = js//'  "device_law": ['//laws//'],'//nl
+      call put('  "device_law": ['//laws(1:nlaw)//'],'//nl)
       call kv('period_stuck_s', trim(json_real(res%period_stuck)))
       call kv('xi_stuck', trim(json_real(res%xi_stuck)))
       call kv('dt1_s', trim(json_real(res%dt1)))
@@ -449,33 +453,57 @@ contains
       call kv('energy_device_elastic_J', trim(json_real(res%e_device)))
       call kv('energy_residual_J', trim(json_real(res%e_residual)))
       call kv('samples', trim(fmt_int(res%nout)))
-      js = js//'  "run_time_s": '//trim(json_real(res%run_time))//nl//'}'
+      call put('  "run_time_s": '//trim(json_real(res%run_time))//nl//'}')
+      js = buf(1:pos)
    contains
+      !> Append to the text (capacity doubled when full: linear in the length, not quadratic).
+      subroutine put(text)
+         character(len=*), intent(in) :: text
+         character(len=:), allocatable :: bigger
+         if (pos + len(text) > len(buf)) then
+            allocate (character(len=2*(pos + len(text))) :: bigger)
+            bigger(1:pos) = buf(1:pos)
+            call move_alloc(bigger, buf)
+         end if
+         buf(pos + 1:pos + len(text)) = text
+         pos = pos + len(text)
+      end subroutine put
+      subroutine put_law(text)
+         character(len=*), intent(in) :: text
+         character(len=:), allocatable :: bigger
+         if (nlaw + len(text) > len(laws)) then
+            allocate (character(len=2*(nlaw + len(text))) :: bigger)
+            bigger(1:nlaw) = laws(1:nlaw)
+            call move_alloc(bigger, laws)
+         end if
+         laws(nlaw + 1:nlaw + len(text)) = text
+         nlaw = nlaw + len(text)
+      end subroutine put_law
       subroutine kv(key, val)
          character(len=*), intent(in) :: key, val
-         js = js//'  "'//key//'": '//val//','//nl
+         call put('  "'//key//'": '//val//','//nl)
       end subroutine kv
       subroutine kr(key, x)
          character(len=*), intent(in) :: key
          real(dp), intent(in) :: x(:)
          integer :: k
-         js = js//'  "'//key//'": ['
+         call put('  "'//key//'": [')
          do k = 1, size(x)
-            js = js//trim(json_real(x(k)))
-            if (k < size(x)) js = js//', '
+            call put(trim(json_real(x(k))))
+            if (k < size(x)) call put(', ')
          end do
-         js = js//'],'//nl
+         call put('],'//nl)
       end subroutine kr
       subroutine ki(key, x)
          character(len=*), intent(in) :: key
          integer, intent(in) :: x(:)
          integer :: k
-         js = js//'  "'//key//'": ['
+         call put('  "'//key//'": [')
          do k = 1, size(x)
-            js = js//trim(fmt_int(x(k)))
-            if (k < size(x)) js = js//', '
+            call put(trim(fmt_int(x(k))))
+            if (k < size(x)) call put(', ')
          end do
-         js = js//'],'//nl
+         call put('],'//nl)
       end subroutine ki
    end subroutine summary_json
 
@@ -483,12 +511,22 @@ contains
    pure subroutine history_header(res, line)
       type(result_type), intent(in) :: res                 !! the result
       character(len=:), allocatable, intent(out) :: line   !! the header
-      integer :: j
+      integer :: j, pos, n
 
-      line = ''
+      n = 0
       do j = 1, res%ncol
-         line = line//trim(res%names(j))//'['//trim(res%units(j))//']'
-         if (j < res%ncol) line = line//','
+         n = n + len_trim(res%names(j)) + len_trim(res%units(j)) + 3
+      end do
+      allocate (character(len=max(n - 1, 0)) :: line)
+      pos = 0
+      do j = 1, res%ncol
+         n = len_trim(res%names(j)) + len_trim(res%units(j)) + 2
+         line(pos + 1:pos + n) = trim(res%names(j))//'['//trim(res%units(j))//']'
+         pos = pos + n
+         if (j < res%ncol) then
+            line(pos + 1:pos + 1) = ','
+            pos = pos + 1
+         end if
       end do
    end subroutine history_header
 

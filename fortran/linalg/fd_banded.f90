@@ -49,6 +49,8 @@ module fd_banded
    real(dp), parameter :: unit_error = 2.0_dp*epsilon(1.0_dp)
    !> Update entries below this times their pivot are dropped (tau^2 = eps/4).
    real(dp), parameter :: truncate_tol = 0.5_dp*sqrt(epsilon(1.0_dp))
+   !> Band up to which the solve is this module's loops (band_solve), not dpbtrs.
+   integer, parameter :: narrow_band = 8
    !> Order (dense) or band up to which the unblocked LAPACK factorizations are called.
    integer, parameter :: unblocked_max = 64
    !> A pivot^2 below this times (band + 1) times its diagonal is rounding noise.
@@ -920,7 +922,11 @@ contains
          do i = 1, sys%n
             sys%w1(i) = b(sys%perm(i))
          end do
-         call dpbtrs('U', sys%n, sys%kb, 1, sys%fac, sys%ld, sys%w1, sys%n, info)
+         if (sys%kb <= narrow_band) then
+            call band_solve(sys%n, sys%kb, sys%fac, sys%rdiag, sys%w1)
+         else
+            call dpbtrs('U', sys%n, sys%kb, 1, sys%fac, sys%ld, sys%w1, sys%n, info)
+         end if
          do i = 1, sys%n
             b(sys%perm(i)) = sys%w1(i)
          end do
@@ -1059,6 +1065,34 @@ contains
          end do
       end do
    end subroutine small_solve
+
+   !> U' U x = b for an upper band factor of half-bandwidth kb (LAPACK's band layout, U(i, j)
+   !> at i + j kb), b overwritten: dpbtrs's two dtbsv, in their order, with the divisions by
+   !> the pivots made multiplications by their reciprocals and the band loops written for a
+   !> narrow band (a shear building's is 1: the reference dtbsv spent most of a step's solve in
+   !> its index arithmetic).
+   pure subroutine band_solve(n, kb, u, rdiag, b)
+      integer, intent(in) :: n, kb
+      real(dp), intent(in) :: u(*), rdiag(n)
+      real(dp), intent(inout) :: b(n)
+      real(dp) :: temp
+      integer :: i, j
+
+      do j = 1, n
+         temp = b(j)
+         do i = max(1, j - kb), j - 1
+            temp = temp - u(i + j*kb)*b(i)
+         end do
+         b(j) = temp*rdiag(j)
+      end do
+      do j = n, 1, -1
+         b(j) = b(j)*rdiag(j)
+         temp = b(j)
+         do i = j - 1, max(1, j - kb), -1
+            b(i) = b(i) - temp*u(i + j*kb)
+         end do
+      end do
+   end subroutine band_solve
 
    !> y = alpha A x + beta y for a small symmetric A (upper triangle, n x n column-major): the
    !> operations of the reference BLAS dsymv ('U'), in its order (y not read when beta = 0).

@@ -72,6 +72,8 @@ module fd_model
       character(len=:), allocatable :: dir   !! output directory (created if missing)
       character(len=:), allocatable :: name  !! base name of the files
       logical :: history = default_write_history !! write the time-history CSV
+      integer, allocatable :: history_dofs(:)    !! DOFs in the history (not allocated: all)
+      integer, allocatable :: history_devices(:) !! devices in the history (not allocated: all)
    end type output_type
 
 end module fd_model

@@ -152,6 +152,10 @@ contains
          if (w%nd == 0 .or. .not. (any_changed .or. (any_bad .and. opts%check))) then
             call accept(model, exc, t0 + dt1, w, res, any_changed, .false.)
             res%steps_dt1 = res%steps_dt1 + 1
+         else if (opts%n2 == 1 .and. .not. (any_bad .and. opts%check)) then
+            ! redone as one step of dt2 = dt1 from the same state and phases: the trial itself
+            call accept(model, exc, t0 + dt1, w, res, any_changed, any_bad)
+            res%steps_dt2 = res%steps_dt2 + 1
          else
             do j = 1, opts%n2
                call advance_refined(model, exc, opts, t0 + (j - 1)*dt2, dt2, w, res, error)
