@@ -49,6 +49,7 @@ VENV = ROOT / ".venv"
 SIZES = [2, 10, 30, 100, 300, 1000]
 QUICK_SIZES = [2, 10, 30]
 CHILD_TAG = "@@child-result@@ "
+CHILD_OVERHEAD_S = 30.0  # allowed beyond the budget to a single-run process (start, imports, build)
 
 
 # ----------------------------------------------------------------------------- environment
@@ -208,7 +209,10 @@ def run_child(code: str, spec: str, args, deck: Path | None, timeout: float) -> 
     try:
         p = subprocess.run(cmd, check=False, capture_output=True, text=True, timeout=timeout)
     except subprocess.TimeoutExpired:
-        return {"error": f"a single run exceeded the budget of {timeout:.0f} s (stopped)"}
+        return {
+            "error": f"a single run did not end within {timeout:.0f} s (stopped)",
+            "timed_out": True,
+        }
     for line in p.stdout.splitlines():
         if line.startswith(CHILD_TAG):
             return json.loads(line[len(CHILD_TAG) :])
@@ -226,11 +230,11 @@ def _worst(diff: dict) -> tuple[float, str]:
 
 def _predict(history: list[tuple[int, float]], n: int) -> float | None:
     """A single run's time at size n from the last two measured sizes (power law, exponent
-    clamped to [1, 3]; 2 when only one size is known)."""
+    clamped to [1, 3]; 1 when only one size is known: optimistic, the run's time limit guards)."""
     if not history:
         return None
     (n1, t1) = history[-1]
-    p = 2.0
+    p = 1.0
     if len(history) >= 2:
         (n0, t0) = history[-2]
         if t0 > 0 and n1 != n0:
@@ -275,15 +279,19 @@ def run_case(spec: str, args, history: dict, om, fd) -> dict:
         pred = _predict(history[code], n_size) if n_size else None
         if pred is not None and pred > args.budget:
             note = (
-                f"{label} not run: a single run is predicted to take {pred:.0f} s "
-                f"(from the smaller buildings) > budget {args.budget:.0f} s"
+                f"{label} not run: a single run is predicted to take {pred:.3g} s "
+                f"(from the smaller buildings) > budget {args.budget:g} s"
             )
             rec["notes"].append(note)
             print("   " + note, flush=True)
             child[code] = {"error": "skipped (predicted beyond budget)", "predicted_s": pred}
             continue
-        child[code] = run_child(code, spec, args, deck if code == "fd" else None, args.budget)
+        # the budget is for the run; the process also starts Python and builds the model
+        limit = args.budget + CHILD_OVERHEAD_S
+        child[code] = run_child(code, spec, args, deck if code == "fd" else None, limit)
         c = child[code]
+        if c.get("timed_out") and n_size:
+            history[code].append((n_size, limit))  # a lower bound: larger N are not tried
         if "error" in c:
             note = f"{label}: {c['error']}"
             rec["notes"].append(note)
@@ -334,7 +342,7 @@ def run_case(spec: str, args, history: dict, om, fd) -> dict:
         if code not in timed and "error" not in child[code]:
             note = (
                 f"{label}: {args.repeats + 1} runs would exceed the budget of "
-                f"{args.budget:.0f} s; its figure is the single run"
+                f"{args.budget:g} s; its figure is the single run"
             )
             rec["notes"].append(note)
             print("   " + note, flush=True)
@@ -585,7 +593,8 @@ def plot(results: list[dict], path: Path, meta: dict) -> None:
         title=title,
     )
     ax1.grid(True, which="both", alpha=0.3)
-    ax1.legend(fontsize=8, loc="upper left")
+    if ax1.get_legend_handles_labels()[0]:
+        ax1.legend(fontsize=8, loc="upper left")
     ax1.text(
         0.98,
         0.02,
@@ -613,7 +622,8 @@ def plot(results: list[dict], path: Path, meta: dict) -> None:
     ax2.yaxis.set_major_formatter(ScalarFormatter())
     ax2.yaxis.set_minor_formatter(NullFormatter())
     ax2.grid(True, which="both", alpha=0.3)
-    ax2.legend(fontsize=7, loc="best")
+    if ax2.get_legend_handles_labels()[0]:
+        ax2.legend(fontsize=7, loc="best")
     m = meta["machine"]
     fig.suptitle(
         f"frictiondyn {meta['frictiondyn']} ({m.get('git_commit', '?')}) vs OpenSeesPy "
@@ -624,6 +634,62 @@ def plot(results: list[dict], path: Path, meta: dict) -> None:
     )
     fig.tight_layout()
     fig.savefig(path, dpi=110)
+
+
+# ----------------------------------------------------------------------------- solver study
+
+STUDY_ALGORITHMS = ("Newton", "KrylovNewton", "ModifiedNewton")
+STUDY_SYSTEMS = ("BandGeneral", "BandSPD", "ProfileSPD", "UmfPack")
+
+
+def ops_study(args, om) -> int:
+    """OpenSees's solver settings against each other (median of --repeats interleaved runs):
+    the evidence for the settings the comparison uses."""
+    specs = [] if args.no_test4 else ["test4:hysteretic", "test4:velocity"]
+    specs += [f"building:{n}" for n in args.sizes]
+    configs = [(a, s) for a in STUDY_ALGORITHMS for s in STUDY_SYSTEMS]
+    base = json.loads(args.ops_settings)
+    out = {"repeats": args.repeats, "configs": [f"{a} + {s}" for a, s in configs], "cases": {}}
+    print(
+        f"OpenSees solver settings, us/step, median of {args.repeats} interleaved runs "
+        f"(numberer {base['numberer']}, NormDispIncr {base['tol']:g})",
+        flush=True,
+    )
+    status = 0
+    for spec in specs:
+        case = om.make_case(spec, args.quick)
+        ref = om.frictiondyn_peaks(case.analysis().run())
+        times = {c: [] for c in configs}
+        worst = 0.0
+        for rep in range(args.repeats):
+            for a, s in configs if rep % 2 == 0 else configs[::-1]:
+                settings = om.OpenSeesSettings(**{**base, "algorithm": a, "system": s})
+                try:
+                    r = om.run_opensees(case, settings)
+                except RuntimeError:
+                    times[(a, s)].append(float("nan"))
+                    continue
+                w, _ = _worst(om.compare_peaks(ref, r.peaks))
+                worst = max(worst, w)
+                times[(a, s)].append(1e6 * r.seconds / case.n_steps)
+        med = {f"{a} + {s}": statistics.median(v) for (a, s), v in times.items()}
+        out["cases"][case.name] = {"us_per_step": med, "peak_difference_max": worst}
+        print(
+            f"   {case.name}: done, peaks within {100 * worst:.2f} % of frictiondyn's", flush=True
+        )
+        if worst > args.peak_tol:
+            status = 1
+    names = list(out["cases"])
+    print("\n| algorithm + system | " + " | ".join(names) + " |")
+    print("|---|" + "---|" * len(names))
+    for c in out["configs"]:
+        cells = " | ".join(f"{out['cases'][n]['us_per_step'][c]:.1f}" for n in names)
+        print(f"| {c} | {cells} |")
+    args.out.mkdir(parents=True, exist_ok=True)
+    path = args.out / "compare_opensees_study.json"
+    path.write_text(json.dumps(out, indent=1))
+    print(f"json: {path}")
+    return status
 
 
 # ----------------------------------------------------------------------------- main
@@ -663,6 +729,12 @@ def parse_args(argv=None):
         help="directory for the JSON and the plot (default out/bench, quick: out/bench/quick)",
     )
     ap.add_argument("--no-install", action="store_true", help="do not pip install openseespy")
+    ap.add_argument(
+        "--ops-study",
+        action="store_true",
+        help="instead: time OpenSees's solver settings against each other on the cases "
+        "(each checked against frictiondyn's peaks) and write compare_opensees_study.json",
+    )
     ap.add_argument("--ops-algorithm", default="KrylovNewton")
     ap.add_argument("--ops-system", default="BandGeneral")
     ap.add_argument("--ops-numberer", default="RCM")
@@ -704,6 +776,8 @@ def main(argv=None) -> int:
     import frictiondyn as fd
     import opensees_models as om
 
+    if args.ops_study:
+        return ops_study(args, om)
     settings = om.OpenSeesSettings(**json.loads(args.ops_settings))
     meta = {
         "frictiondyn": getattr(fd, "__version__", "?"),
