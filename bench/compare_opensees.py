@@ -68,12 +68,18 @@ def ensure_frictiondyn() -> None:
     if in_venv or not venv_python.exists():
         if os.environ.get("FD_BENCH_REEXEC") == "setup":
             sys.exit("compare_opensees: frictiondyn is still not importable after tools/setup.sh")
-        print("compare_opensees: frictiondyn is not installed; running tools/setup.sh", flush=True)
+        print(
+            "compare_opensees: frictiondyn is not installed; running tools/setup.sh",
+            flush=True,
+        )
         subprocess.run(["bash", str(ROOT / "tools" / "setup.sh")], check=True)
         os.environ["FD_BENCH_REEXEC"] = "setup"
     else:
         os.environ["FD_BENCH_REEXEC"] = "venv"
-    os.execv(str(venv_python), [str(venv_python), str(Path(__file__).resolve()), *sys.argv[1:]])
+    os.execv(
+        str(venv_python),
+        [str(venv_python), str(Path(__file__).resolve()), *sys.argv[1:]],
+    )
 
 
 def ensure_openseespy(install: bool) -> str:
@@ -83,7 +89,10 @@ def ensure_openseespy(install: bool) -> str:
     except ImportError:
         if not install:
             sys.exit("compare_opensees: openseespy is not installed (and --no-install was given)")
-        print(f"compare_opensees: installing openseespy from PyPI into {sys.prefix}", flush=True)
+        print(
+            f"compare_opensees: installing openseespy from PyPI into {sys.prefix}",
+            flush=True,
+        )
         subprocess.run([sys.executable, "-m", "pip", "install", "-q", "openseespy"], check=True)
         import openseespy.opensees  # noqa: F401
     from importlib.metadata import version
@@ -161,14 +170,21 @@ def child_main(args) -> int:
         import frictiondyn as fd
 
         rss0 = _proc_status("VmRSS")
-        t0 = time.perf_counter()
+        t0, c0 = time.perf_counter(), time.process_time()
         res = fd.run(args.deck)
         out["seconds"] = time.perf_counter() - t0
+        out["cpu_seconds"] = time.process_time() - c0
         out["peaks"] = {q: v.tolist() for q, v in om.frictiondyn_peaks(res).items()}
         s = res.summary
         out["stats"] = {
             k: s[k]
-            for k in ("steps_dt1", "steps_dt2", "steps_finer", "factorizations", "period_stuck_s")
+            for k in (
+                "steps_dt1",
+                "steps_dt2",
+                "steps_finer",
+                "factorizations",
+                "period_stuck_s",
+            )
             if k in s
         }
         if "stick_to_slip" in s:
@@ -183,6 +199,7 @@ def child_main(args) -> int:
         rss0 = _proc_status("VmRSS")
         run = om.run_opensees(case, settings)
         out["seconds"] = run.seconds
+        out["cpu_seconds"] = run.cpu_seconds
         out["build_seconds"] = run.build_seconds
         out["peaks"] = {q: v.tolist() for q, v in run.peaks.items()}
     out["rss_before_mb"] = rss0
@@ -284,7 +301,10 @@ def run_case(spec: str, args, history: dict, om, fd) -> dict:
             )
             rec["notes"].append(note)
             print("   " + note, flush=True)
-            child[code] = {"error": "skipped (predicted beyond budget)", "predicted_s": pred}
+            child[code] = {
+                "error": "skipped (predicted beyond budget)",
+                "predicted_s": pred,
+            }
             continue
         # the budget is for the run; the process also starts Python and builds the model
         limit = args.budget + CHILD_OVERHEAD_S
@@ -352,30 +372,26 @@ def run_case(spec: str, args, history: dict, om, fd) -> dict:
     if "ops" in timed:
         variants.append("ops")
     times: dict[str, list[float]] = {v: [] for v in variants}
+    cpu_times: dict[str, list[float]] = {v: [] for v in variants}
     ops_build: list[float] = []
     settings = om.OpenSeesSettings(**json.loads(args.ops_settings))
     worst_timed = 0.0
 
     def one(v: str, keep: bool) -> None:
         nonlocal worst_timed
-        if v == "fd":
-            t0 = time.perf_counter()
-            res = fd.run(deck)
-            dt = time.perf_counter() - t0
-            peaks = om.frictiondyn_peaks(res)
-        elif v == "fd_short":
-            t0 = time.perf_counter()
-            fd.run(deck_short)
-            dt = time.perf_counter() - t0
-            peaks = None
-        elif v == "fd_e2e":
-            t0 = time.perf_counter()
-            res = full_an.run()
-            dt = time.perf_counter() - t0
-            peaks = om.frictiondyn_peaks(res)
+        peaks = None
+        if v.startswith("fd"):
+            w0, c0 = time.perf_counter(), time.process_time()
+            if v == "fd":
+                peaks = om.frictiondyn_peaks(fd.run(deck))
+            elif v == "fd_short":
+                fd.run(deck_short)
+            else:
+                peaks = om.frictiondyn_peaks(full_an.run())
+            wall, cpu = time.perf_counter() - w0, time.process_time() - c0
         else:
             r = om.run_opensees(case, settings)
-            dt, peaks = r.seconds, r.peaks
+            wall, cpu, peaks = r.seconds, r.cpu_seconds, r.peaks
             if keep:
                 ops_build.append(r.build_seconds)
         if peaks is not None and ref:
@@ -388,7 +404,8 @@ def run_case(spec: str, args, history: dict, om, fd) -> dict:
                     f"{100 * w:.2f} % from the other code's"
                 )
         if keep:
-            times[v].append(dt)
+            times[v].append(wall)
+            cpu_times[v].append(cpu)
 
     for v in variants:  # warm-up
         one(v, keep=False)
@@ -397,42 +414,49 @@ def run_case(spec: str, args, history: dict, om, fd) -> dict:
             one(v, keep=True)
     tmp.cleanup()
 
-    # 4. figures
+    # 4. figures: wall-clock medians (what a user waits), and CPU-time medians (this process's
+    # CPU seconds: on a machine shared with other work, the better estimate of an idle one)
     n = case.n_steps
     res: dict = {
         "repeats": args.repeats if timed else 0,
         "timed_codes": timed,
         "timed_peak_difference_max": worst_timed if timed else None,
     }
+    med = {v: statistics.median(t) for v, t in times.items()}
+    cmed = {v: statistics.median(t) for v, t in cpu_times.items()}
     if "fd" in timed:
-        med, med_s = statistics.median(times["fd"]), statistics.median(times["fd_short"])
-        res["fd_run_s"] = med
+        res["fd_run_s"] = med["fd"]
         res["fd_run_s_range"] = [min(times["fd"]), max(times["fd"])]
-        res["fd_setup_s"] = med_s
-        res["fd_us_per_step"] = 1e6 * (med - med_s) / (n - short_steps)
-        res["fd_end_to_end_us_per_step"] = 1e6 * med / n
+        res["fd_setup_s"] = med["fd_short"]
+        res["fd_us_per_step"] = 1e6 * (med["fd"] - med["fd_short"]) / (n - short_steps)
+        res["fd_cpu_us_per_step"] = 1e6 * (cmed["fd"] - cmed["fd_short"]) / (n - short_steps)
+        res["fd_end_to_end_us_per_step"] = 1e6 * med["fd"] / n
         if "fd_e2e" in times:
-            res["fd_analysis_run_s"] = statistics.median(times["fd_e2e"])
+            res["fd_analysis_run_s"] = med["fd_e2e"]
+            res["fd_analysis_run_cpu_s"] = cmed["fd_e2e"]
         res["fd_runs"] = len(times["fd"])
     elif ok_fd:
         res["fd_run_s"] = child["fd"]["seconds"]
         res["fd_us_per_step"] = 1e6 * child["fd"]["seconds"] / n
+        res["fd_cpu_us_per_step"] = 1e6 * child["fd"]["cpu_seconds"] / n
         res["fd_end_to_end_us_per_step"] = res["fd_us_per_step"]
         res["fd_runs"] = 1
     if "ops" in timed:
-        med = statistics.median(times["ops"])
-        res["ops_analyze_s"] = med
+        res["ops_analyze_s"] = med["ops"]
         res["ops_analyze_s_range"] = [min(times["ops"]), max(times["ops"])]
         res["ops_build_s"] = statistics.median(ops_build)
-        res["ops_us_per_step"] = 1e6 * med / n
+        res["ops_us_per_step"] = 1e6 * med["ops"] / n
+        res["ops_cpu_us_per_step"] = 1e6 * cmed["ops"] / n
         res["ops_runs"] = len(times["ops"])
     elif ok_ops:
         res["ops_analyze_s"] = child["ops"]["seconds"]
         res["ops_build_s"] = child["ops"]["build_seconds"]
         res["ops_us_per_step"] = 1e6 * child["ops"]["seconds"] / n
+        res["ops_cpu_us_per_step"] = 1e6 * child["ops"]["cpu_seconds"] / n
         res["ops_runs"] = 1
     if "fd_us_per_step" in res and "ops_us_per_step" in res and rec["peaks_agree"]:
         res["ratio"] = res["ops_us_per_step"] / res["fd_us_per_step"]
+        res["ratio_cpu"] = res["ops_cpu_us_per_step"] / res["fd_cpu_us_per_step"]
         if "fd_analysis_run_s" in res:
             res["ratio_end_to_end"] = (res["ops_analyze_s"] + res["ops_build_s"]) / res[
                 "fd_analysis_run_s"
@@ -460,11 +484,19 @@ def _fmt(x, spec=".2f", none="n/a") -> str:
     return none if x is None else format(x, spec)
 
 
-def _ratio_text(r: dict) -> str:
-    x = r.get("ratio")
+def _ratio_text(r: dict, key: str = "ratio") -> str:
+    x = r.get(key)
     if x is None:
         return "n/a"
     return f"{x:.1f}x faster" if x >= 1 else f"{1 / x:.1f}x slower"
+
+
+def _us(r: dict, code: str, spec: str) -> str:
+    """'wall (CPU)' microseconds per step of one code, marked when a single run."""
+    return (
+        f"{_fmt(r.get(f'{code}_us_per_step'), spec)} ({_fmt(r.get(f'{code}_cpu_us_per_step'), spec)})"
+        f"{_mark(r, code)}"
+    )
 
 
 def _mark(r: dict, code: str) -> str:
@@ -477,9 +509,10 @@ def tables(results: list[dict], peak_tol: float) -> str:
     if t4:
         out.append("Paper's test 4 (2 DOFs, 1 device), frictiondyn against OpenSeesPy:\n")
         out.append(
-            "| frictiondyn law | OpenSees material | steps | frictiondyn us/step | "
-            "OpenSees us/step | frictiondyn is | frictiondyn Analysis.run() s | "
-            "OpenSees build + analyze s | end to end | peaks differ by |"
+            "| frictiondyn law | OpenSees material | steps | frictiondyn us/step wall (CPU) | "
+            "OpenSees us/step wall (CPU) | frictiondyn is, wall (CPU) | "
+            "frictiondyn Analysis.run() s | OpenSees build + analyze s | end to end | "
+            "peaks differ by |"
         )
         out.append("|---|---|---|---|---|---|---|---|---|---|")
         for r in t4:
@@ -487,8 +520,8 @@ def tables(results: list[dict], peak_tol: float) -> str:
             ops_e2e = (r["ops_analyze_s"] + r["ops_build_s"]) if "ops_analyze_s" in r else None
             out.append(
                 f"| {r['law']} | {r['opensees_material']} | {r['steps']} | "
-                f"{_fmt(r.get('fd_us_per_step'))}{_mark(r, 'fd')} | "
-                f"{_fmt(r.get('ops_us_per_step'))}{_mark(r, 'ops')} | {_ratio_text(r)} | "
+                f"{_us(r, 'fd', '.2f')} | {_us(r, 'ops', '.2f')} | "
+                f"{_ratio_text(r)} ({_ratio_text(r, 'ratio_cpu')}) | "
                 f"{_fmt(r.get('fd_analysis_run_s'), '.4f')} | {_fmt(ops_e2e, '.4f')} | "
                 f"{_fmt(e2e, '.1f')}x | {_peak_text(r)} |"
             )
@@ -499,7 +532,8 @@ def tables(results: list[dict], peak_tol: float) -> str:
             "storey:\n"
         )
         out.append(
-            "| storeys N | steps | frictiondyn us/step | OpenSees us/step | frictiondyn is | "
+            "| storeys N | steps | frictiondyn us/step wall (CPU) | OpenSees us/step wall (CPU) | "
+            "frictiondyn is, wall (CPU) | "
             "peaks differ by | frictiondyn peak RSS MB | OpenSees peak RSS MB | "
             "frictiondyn steps dt1 + dt2, transitions |"
         )
@@ -512,9 +546,8 @@ def tables(results: list[dict], peak_tol: float) -> str:
                 else "n/a"
             )
             out.append(
-                f"| {r['n_dof']} | {r['steps']} | {_fmt(r.get('fd_us_per_step'), '.1f')}"
-                f"{_mark(r, 'fd')} | {_fmt(r.get('ops_us_per_step'), '.1f')}{_mark(r, 'ops')} | "
-                f"{_ratio_text(r)} | {_peak_text(r)} | {_fmt(r.get('fd_rss_peak_mb'), '.0f')} | "
+                f"| {r['n_dof']} | {r['steps']} | {_us(r, 'fd', '.1f')} | {_us(r, 'ops', '.1f')} | "
+                f"{_ratio_text(r)} ({_ratio_text(r, 'ratio_cpu')}) | {_peak_text(r)} | {_fmt(r.get('fd_rss_peak_mb'), '.0f')} | "
                 f"{_fmt(r.get('ops_rss_peak_mb'), '.0f')} | {steps} |"
             )
     notes = [f"- {r['name']}: {n}" for r in results for n in r["notes"]]
@@ -548,9 +581,25 @@ def plot(results: list[dict], path: Path, meta: dict) -> None:
             for r in b
             if f"{code}_us_per_step" in r
         ]
+        cpts = [
+            (r["n_dof"], r[f"{code}_cpu_us_per_step"])
+            for r in b
+            if r.get(f"{code}_cpu_us_per_step") is not None
+        ]
+        if cpts:
+            xs, ys = zip(*cpts)
+            ax1.plot(
+                xs,
+                ys,
+                "--",
+                color=color,
+                lw=0.9,
+                alpha=0.7,
+                label=label.split(" (")[0] + ", CPU time",
+            )
         if pts:
             xs, ys, _ = zip(*pts)
-            ax1.plot(xs, ys, "-", color=color, lw=1.2, label=label)
+            ax1.plot(xs, ys, "-", color=color, lw=1.2, label=label + ", wall")
             for x, y, n in pts:
                 ax1.plot(x, y, marker, color=color, ms=7, mfc=color if n > 1 else "white")
         mem = [
@@ -560,7 +609,14 @@ def plot(results: list[dict], path: Path, meta: dict) -> None:
         ]
         if mem:
             xs, ys, y0 = zip(*mem)
-            ax2.plot(xs, ys, "-" + marker, color=color, ms=6, label=label.split(" (")[0] + ": peak")
+            ax2.plot(
+                xs,
+                ys,
+                "-" + marker,
+                color=color,
+                ms=6,
+                label=label.split(" (")[0] + ": peak",
+            )
             ax2.plot(
                 xs,
                 y0,
@@ -579,7 +635,12 @@ def plot(results: list[dict], path: Path, meta: dict) -> None:
         y0, x = lows[0] / 2, [ns[0], ns[-1]]
         ax1.plot(x, [y0 * v / ns[0] for v in x], ":", color="grey", lw=1, label="∝ N (guide)")
         ax1.plot(
-            x, [y0 * (v / ns[0]) ** 2 for v in x], "--", color="grey", lw=1, label="∝ N² (guide)"
+            x,
+            [y0 * (v / ns[0]) ** 2 for v in x],
+            "--",
+            color="grey",
+            lw=1,
+            label="∝ N² (guide)",
         )
     skipped = [r["n_dof"] for r in b if "fd_us_per_step" not in r]
     title = f"cost per step (median of {meta['repeats']} interleaved runs)"
@@ -649,7 +710,11 @@ def ops_study(args, om) -> int:
     specs += [f"building:{n}" for n in args.sizes]
     configs = [(a, s) for a in STUDY_ALGORITHMS for s in STUDY_SYSTEMS]
     base = json.loads(args.ops_settings)
-    out = {"repeats": args.repeats, "configs": [f"{a} + {s}" for a, s in configs], "cases": {}}
+    out = {
+        "repeats": args.repeats,
+        "configs": [f"{a} + {s}" for a, s in configs],
+        "cases": {},
+    }
     print(
         f"OpenSees solver settings, us/step, median of {args.repeats} interleaved runs "
         f"(numberer {base['numberer']}, NormDispIncr {base['tol']:g})",
@@ -675,7 +740,8 @@ def ops_study(args, om) -> int:
         med = {f"{a} + {s}": statistics.median(v) for (a, s), v in times.items()}
         out["cases"][case.name] = {"us_per_step": med, "peak_difference_max": worst}
         print(
-            f"   {case.name}: done, peaks within {100 * worst:.2f} % of frictiondyn's", flush=True
+            f"   {case.name}: done, peaks within {100 * worst:.2f} % of frictiondyn's",
+            flush=True,
         )
         if worst > args.peak_tol:
             status = 1

@@ -36,8 +36,18 @@ ROOT = Path(__file__).resolve().parent.parent
 INPUTS = ROOT / "inputs"
 G = 9.81  # m/s2
 
-QUANTITIES = ("u", "aabs", "s", "F")  # peak |relative displacement|, |abs. acceleration|, |s|, |F|
-SUMMARY_KEYS = {"u": "peak_u_m", "aabs": "peak_aabs_mps2", "s": "peak_s_m", "F": "peak_force_N"}
+QUANTITIES = (
+    "u",
+    "aabs",
+    "s",
+    "F",
+)  # peak |relative displacement|, |abs. acceleration|, |s|, |F|
+SUMMARY_KEYS = {
+    "u": "peak_u_m",
+    "aabs": "peak_aabs_mps2",
+    "s": "peak_s_m",
+    "F": "peak_force_N",
+}
 
 
 @dataclass
@@ -78,7 +88,11 @@ class Test4Case:
         model, springs, damp = nml["model"], nml["springs"], nml["damping"]
         fric, exc, integ = nml["friction"], nml["excitation"], nml["integration"]
         self.masses = [float(m) for m in _list(model["mass"])]
-        ni, nj, k = _list(springs["node_i"]), _list(springs["node_j"]), _list(springs["k"])
+        ni, nj, k = (
+            _list(springs["node_i"]),
+            _list(springs["node_j"]),
+            _list(springs["k"]),
+        )
         self.springs = [(int(a), int(b), float(c)) for a, b, c in zip(ni, nj, k)]
         law = str(_list(fric["law"])[0]).strip().lower()
         ok = (
@@ -101,7 +115,10 @@ class Test4Case:
         self.eps1 = float(fric.get("eps1", 1e-3))
         self.f = float(fric.get("f", 1e-5))
         self.xi, self.period = float(damp["xi"]), float(damp.get("period", 0.0))
-        self.amplitude, self.frequency = float(exc["amplitude"]), float(exc["frequency"])
+        self.amplitude, self.frequency = (
+            float(exc["amplitude"]),
+            float(exc["frequency"]),
+        )
         self.dt_record = float(exc["dt_record"])
         self.n1, self.n2, self.n = int(integ["n1"]), int(integ["n2"]), float(integ["n"])
         self.dt = self.dt_record / self.n1
@@ -136,11 +153,21 @@ class Test4Case:
             damping=fd.Damping.stiffness(self.xi, self.period),
             devices=[
                 fd.Device(
-                    i, j, self.p, self.mu, law=self.law, eps=self.eps, eps1=self.eps1, f=self.f
+                    i,
+                    j,
+                    self.p,
+                    self.mu,
+                    law=self.law,
+                    eps=self.eps,
+                    eps1=self.eps1,
+                    f=self.f,
                 )
             ],
             excitation=fd.Harmonic(
-                self.amplitude, self.frequency, self.dt_record, duration or self.duration
+                self.amplitude,
+                self.frequency,
+                self.dt_record,
+                duration or self.duration,
             ),
             integration=fd.Integration(n1=self.n1, n2=self.n2, n=self.n),
         )
@@ -336,7 +363,15 @@ def _recorders(ops, workdir: Path, nodes: list[int], devices: list[int]) -> None
     deformation and force."""
     prec = ("-precision", 12)
     ops.recorder(
-        "EnvelopeNode", "-file", str(workdir / "u.env"), *prec, "-node", *nodes, "-dof", 1, "disp"
+        "EnvelopeNode",
+        "-file",
+        str(workdir / "u.env"),
+        *prec,
+        "-node",
+        *nodes,
+        "-dof",
+        1,
+        "disp",
     )
     ops.recorder(
         "EnvelopeNode",
@@ -352,10 +387,22 @@ def _recorders(ops, workdir: Path, nodes: list[int], devices: list[int]) -> None
         "accel",
     )
     ops.recorder(
-        "EnvelopeElement", "-file", str(workdir / "s.env"), *prec, "-ele", *devices, "deformation"
+        "EnvelopeElement",
+        "-file",
+        str(workdir / "s.env"),
+        *prec,
+        "-ele",
+        *devices,
+        "deformation",
     )
     ops.recorder(
-        "EnvelopeElement", "-file", str(workdir / "F.env"), *prec, "-ele", *devices, "basicForce"
+        "EnvelopeElement",
+        "-file",
+        str(workdir / "F.env"),
+        *prec,
+        "-ele",
+        *devices,
+        "basicForce",
     )
 
 
@@ -377,7 +424,8 @@ def import_opensees():
 
 @dataclass
 class OpenSeesRun:
-    seconds: float  # analyze() only
+    seconds: float  # analyze() only, wall clock
+    cpu_seconds: float  # analyze() only, CPU time of this process
     build_seconds: float
     peaks: dict[str, np.ndarray]
 
@@ -390,9 +438,9 @@ def run_opensees(case, settings: OpenSeesSettings | None = None) -> OpenSeesRun:
         work = Path(tmp)
         t0 = time.perf_counter()
         case.build_opensees(ops, settings, work)
-        t1 = time.perf_counter()
+        t1, c1 = time.perf_counter(), time.process_time()
         status = ops.analyze(case.n_steps, case.dt)
-        t2 = time.perf_counter()
+        t2, c2 = time.perf_counter(), time.process_time()
         t_now = ops.getTime()
         ops.wipe()  # closes the recorders: the envelopes are written
         if status != 0:
@@ -400,7 +448,7 @@ def run_opensees(case, settings: OpenSeesSettings | None = None) -> OpenSeesRun:
                 f"{case.name}: OpenSees analyze failed (status {status}) at t = {t_now} s"
             )
         peaks = {q: np.loadtxt(work / f"{q}.env", ndmin=2)[2].copy() for q in QUANTITIES}
-    return OpenSeesRun(t2 - t1, t1 - t0, peaks)
+    return OpenSeesRun(t2 - t1, c2 - c1, t1 - t0, peaks)
 
 
 # ----------------------------------------------------------------------------- frictiondyn
