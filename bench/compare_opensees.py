@@ -466,15 +466,19 @@ def run_case(spec: str, args, history: dict, om, fd) -> dict:
             res[f"{code}_rss_peak_mb"] = child[code]["rss_peak_mb"]
             res[f"{code}_rss_before_mb"] = child[code]["rss_before_mb"]
     rec.update(res)
-    line = f"   {case.name}:"
+    parts = []
     if "fd_us_per_step" in res:
-        line += f" frictiondyn {res['fd_us_per_step']:.2f} us/step ({res['fd_runs']} runs)"
+        parts.append(f"frictiondyn {res['fd_us_per_step']:.2f} us/step ({_runs(res['fd_runs'])})")
     if "ops_us_per_step" in res:
-        line += f", OpenSees {res['ops_us_per_step']:.2f} us/step ({res['ops_runs']} runs)"
+        parts.append(f"OpenSees {res['ops_us_per_step']:.2f} us/step ({_runs(res['ops_runs'])})")
     if "ratio" in res:
-        line += f", ratio {res['ratio']:.2f}"
-    print(line, flush=True)
+        parts.append(f"ratio {res['ratio']:.2f}")
+    print(f"   {case.name}: " + ", ".join(parts), flush=True)
     return rec
+
+
+def _runs(n: int) -> str:
+    return "1 run" if n == 1 else f"{n} runs"
 
 
 # ----------------------------------------------------------------------------- report
@@ -668,20 +672,17 @@ def plot(results: list[dict], path: Path, meta: dict) -> None:
     )
     ax2.set(
         xscale="log",
-        yscale="log",
         xlabel="storeys N (DOFs)",
         ylabel="resident memory [MB]",
         title="peak RSS (VmHWM) of a process running one case",
     )
-    from matplotlib.ticker import LogLocator, NullFormatter, ScalarFormatter
+    from matplotlib.ticker import NullFormatter, ScalarFormatter
 
     for ax in (ax1, ax2):
         ax.set_xticks(ns)
         ax.xaxis.set_major_formatter(ScalarFormatter())
         ax.xaxis.set_minor_formatter(NullFormatter())
-    ax2.yaxis.set_major_locator(LogLocator(base=10, subs=(1.0, 2.0, 5.0)))
-    ax2.yaxis.set_major_formatter(ScalarFormatter())
-    ax2.yaxis.set_minor_formatter(NullFormatter())
+    ax2.set_ylim(bottom=0)
     ax2.grid(True, which="both", alpha=0.3)
     if ax2.get_legend_handles_labels()[0]:
         ax2.legend(fontsize=7, loc="best")
@@ -796,6 +797,11 @@ def parse_args(argv=None):
     )
     ap.add_argument("--no-install", action="store_true", help="do not pip install openseespy")
     ap.add_argument(
+        "--replot",
+        action="store_true",
+        help="only print the tables and redraw the plot from <out>/compare_opensees.json",
+    )
+    ap.add_argument(
         "--ops-study",
         action="store_true",
         help="instead: time OpenSees's solver settings against each other on the cases "
@@ -834,6 +840,11 @@ def parse_args(argv=None):
 
 def main(argv=None) -> int:
     args = parse_args(argv)
+    if args.replot:
+        data = json.loads((args.out / "compare_opensees.json").read_text())
+        print(tables(data["results"], data["meta"]["peak_tol"]))
+        plot(data["results"], args.out / "compare_opensees.png", data["meta"])
+        return 0
     ensure_frictiondyn()
     if args.child:  # the frictiondyn child does not load OpenSees (its memory is measured)
         return child_main(args)
