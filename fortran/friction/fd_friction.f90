@@ -8,12 +8,12 @@ module fd_friction
    use fd_error, only: error_type, fatal_error, fmt_int
    use fd_model, only: device_type, law_velocity, law_hysteretic, law_name
    use fd_device_state, only: device_state, job_init, job_update, job_correct
-   use fd_friction_velocity, only: velocity_law
-   use fd_friction_hysteretic, only: hysteretic_law
+   use fd_friction_velocity, only: velocity_law, velocity_update, velocity_correct
+   use fd_friction_hysteretic, only: hysteretic_law, hysteretic_update, hysteretic_correct
    implicit none
    private
 
-   public :: friction_init, friction_update, friction_correct
+   public :: friction_init, friction_update, friction_correct, friction_step
 
 contains
 
@@ -42,6 +42,46 @@ contains
          known = .false.
       end select
    end subroutine dispatch
+
+   !> After a trial step, for every device: the phase for the next step (st1, from st at
+   !> the trial state s1, sd1) and the correctness condition of the step (eqs. 9, 12), with
+   !> whether any phase changed and any device violates the condition. What friction_update
+   !> and friction_correct do device by device, in one loop that calls each law's routines
+   !> directly (the time step's per-device cost in a large structure). A device whose law has
+   !> no case here keeps its state (friction_init rejected it before the first step).
+   subroutine friction_step(dev, n, s1, sd1, sd, st, st1, changed, ok, any_changed, any_bad)
+      type(device_type), intent(in) :: dev(:)   !! devices
+      real(dp), intent(in) :: n                 !! n > 1 of the correctness condition
+      real(dp), intent(in) :: s1(:)             !! relative displacements at the step's end [m]
+      real(dp), intent(in) :: sd1(:)            !! relative velocities at the step's end [m/s]
+      real(dp), intent(in) :: sd(:)             !! relative velocities at its start [m/s]
+      type(device_state), intent(in) :: st(:)   !! states during the step
+      type(device_state), intent(inout) :: st1(:) !! states for the next step
+      logical, intent(out) :: changed(:)        !! the phase changed
+      logical, intent(out) :: ok(:)             !! the step satisfies the condition
+      logical, intent(out) :: any_changed       !! some phase changed
+      logical, intent(out) :: any_bad           !! some device violates the condition
+      integer :: d
+
+      any_changed = .false.
+      any_bad = .false.
+      do d = 1, size(dev)
+         st1(d) = st(d)
+         select case (dev(d)%law)
+         case (law_hysteretic)
+            call hysteretic_update(dev(d), s1(d), sd1(d), st1(d), changed(d))
+            ok(d) = hysteretic_correct(dev(d), n, st(d), sd(d), sd1(d))
+         case (law_velocity)
+            call velocity_update(dev(d), s1(d), sd1(d), st1(d), changed(d))
+            ok(d) = velocity_correct(dev(d), n, st(d), sd(d), sd1(d))
+         case default
+            changed(d) = .false.
+            ok(d) = .true.
+         end select
+         any_changed = any_changed .or. changed(d)
+         any_bad = any_bad .or. .not. ok(d)
+      end do
+   end subroutine friction_step
 
    !> Initial phase and force coefficients of every device; an error for a device whose
    !> law is not a regularized law of this dispatch.

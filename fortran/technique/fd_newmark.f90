@@ -30,7 +30,7 @@ module fd_newmark
    use fd_banded, only: spd_system, spd_setup, spd_factor, spd_update_devices, spd_solve, spd_k_matvec, &
                         spd_c_matvec, spd_kc_matvec, spd_auto, spd_dense, spd_banded, spd_is_dense, spd_bandwidth
    use fd_device_state, only: device_state, device_force
-   use fd_friction, only: friction_init, friction_update, friction_correct
+   use fd_friction, only: friction_init, friction_step
    use fd_result, only: result_type
    use fd_run_control, only: run_control
    use fd_observer, only: observer_type, observer_init, sample_due, observe_start_energy, observe_peaks, &
@@ -422,17 +422,9 @@ contains
       type(integration_type), intent(in) :: opts
       type(workspace), intent(inout) :: w
       logical, intent(out) :: any_changed, any_bad
-      integer :: d
 
-      any_changed = .false.
-      any_bad = .false.
-      do d = 1, w%nd
-         w%st1(d) = w%st(d)
-         call friction_update(model%dev(d), w%s1(d), w%sd1(d), w%st1(d), w%changed(d))
-         w%ok(d) = friction_correct(model%dev(d), opts%n_corr, w%st(d), w%sd(d), w%sd1(d))
-         any_changed = any_changed .or. w%changed(d)
-         any_bad = any_bad .or. .not. w%ok(d)
-      end do
+      call friction_step(model%dev, opts%n_corr, w%s1, w%sd1, w%sd, w%st, w%st1, w%changed, w%ok, &
+                         any_changed, any_bad)
    end subroutine judge
 
    !> Cover [t, t + sub] with steps sub, sub/2, ... down to dt_min, halving while the
@@ -491,7 +483,6 @@ contains
       type(result_type), intent(inout) :: res
       logical, intent(in) :: any_changed         !! a device changed phase
       logical, intent(in) :: any_bad             !! a device violates the correctness condition
-      integer :: d
       real(dp) :: ein
       logical :: changed_k
 
@@ -500,7 +491,6 @@ contains
       res%e_input = res%e_input - 0.5_dp*(w%ag + w%ag1)*ein
       res%e_viscous = res%e_viscous + 0.5_dp*viscous_work(model, w%a0, w%a1c, w%mass, w%tmp, w%rhs)
       w%ag = w%ag1
-      call device_work(w%nd, w%st, w%s, w%sd, w%s1, w%sd1, w%w_device)
       ! violations of the correctness condition left in an accepted step
       if (any_bad) call observe_violations(res, t1, w%ok)
       if (any_changed) then
@@ -508,17 +498,11 @@ contains
          w%phase1 = w%st1%phase
          call observe_transitions(res, w%phase0, w%phase1)
       end if
-      ! the factors follow the devices' stiffness and damping (whatever changed them)
-      changed_k = .false.
-      do d = 1, w%nd
-         changed_k = changed_k .or. w%st1(d)%ks /= w%st(d)%ks .or. w%st1(d)%cs /= w%st(d)%cs
-         w%st(d) = w%st1(d)
-      end do
+      ! device work over the step; the devices move on; the factors follow their stiffness
+      ! and damping (whatever changed them)
+      call device_step(w%nd, w%st, w%st1, w%s, w%sd, w%s1, w%sd1, w%f, w%w_device, changed_k)
       if (changed_k) w%version = w%version + 1
       if (any_changed) call consistent_acceleration(model, exc, t1, w)
-      do d = 1, w%nd
-         w%f(d) = w%st(d)%ks*w%s(d) + w%st(d)%cs*w%sd(d) + w%st(d)%f0
-      end do
       call observe_peaks(res, t1, w%u, w%v, w%a, w%ag, w%s, w%f)
    end subroutine accept
 
@@ -576,24 +560,33 @@ contains
       end if
    end function viscous_work
 
-   !> Work of the device forces over the step (trapezoid, the step's phases); s, s' move on.
-   pure subroutine device_work(nd, st, s, sd, s1, sd1, w)
+   !> Work of the device forces over the step (trapezoid, the step's phases); the devices move
+   !> on to the trial state (s, s', state) and their force in it; whether a stiffness or
+   !> damping changed.
+   pure subroutine device_step(nd, st, st1, s, sd, s1, sd1, f, w, changed_k)
       integer, intent(in) :: nd
-      type(device_state), intent(in) :: st(nd)
+      type(device_state), intent(inout) :: st(nd)
+      type(device_state), intent(in) :: st1(nd)
       real(dp), intent(inout) :: s(nd), sd(nd)
       real(dp), intent(in) :: s1(nd), sd1(nd)
+      real(dp), intent(out) :: f(nd)
       real(dp), intent(inout) :: w
+      logical, intent(out) :: changed_k
       real(dp) :: f0, f1
       integer :: d
 
+      changed_k = .false.
       do d = 1, nd
          f0 = st(d)%ks*s(d) + st(d)%cs*sd(d) + st(d)%f0
          f1 = st(d)%ks*s1(d) + st(d)%cs*sd1(d) + st(d)%f0
          w = w + 0.5_dp*(f0 + f1)*(s1(d) - s(d))
          s(d) = s1(d)
          sd(d) = sd1(d)
+         changed_k = changed_k .or. st1(d)%ks /= st(d)%ks .or. st1(d)%cs /= st(d)%cs
+         st(d) = st1(d)
+         f(d) = st(d)%ks*s(d) + st(d)%cs*sd(d) + st(d)%f0
       end do
-   end subroutine device_work
+   end subroutine device_step
 
    !> Strain energy of the springs, 1/2 u' K u = sum_s k_s (u_i - u_j)^2 / 2 (no cancellation).
    pure real(dp) function strain_energy(model, u) result(e)
