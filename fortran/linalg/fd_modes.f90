@@ -125,8 +125,8 @@ contains
       type(error_type), allocatable, intent(out) :: error
       type(spd_system) :: sys
       real(dp), allocatable :: x(:, :), y(:, :), kr(:, :), mr(:, :), lam(:), lam_old(:), q(:, :), row(:)
-      real(dp) :: delta, change
-      integer :: n, nq, it, i, j, e, a, b
+      real(dp) :: delta, change, norm
+      integer :: n, nq, it, i, j, e, a, b, pass
       integer :: none(0)
       real(dp) :: nokd(0)
       logical :: done
@@ -167,6 +167,27 @@ contains
             call spd_solve(sys, y(:, j), error)
             if (allocated(error)) return
          end do
+         ! M-orthonormal columns (modified Gram-Schmidt, twice): the operator scales them by up
+         ! to lambda_q / lambda_1 (1e10 and more with a rigid-body mode), which would leave
+         ! Y' M Y numerically singular; a column that collapses is replaced by a fresh one
+         do j = 1, nq
+            do pass = 1, 2
+               do i = 1, j - 1
+                  y(:, j) = y(:, j) - sum(mass*y(:, i)*y(:, j))*y(:, i)
+               end do
+            end do
+            norm = sqrt(sum(mass*y(:, j)**2))
+            if (.not. (norm > 1.0e-12_dp*maxval(abs(y(:, j))) .and. norm > 0.0_dp)) then
+               do i = 1, n
+                  y(i, j) = start_value(i, j + nq*it)
+               end do
+               do i = 1, j - 1
+                  y(:, j) = y(:, j) - sum(mass*y(:, i)*y(:, j))*y(:, i)
+               end do
+               norm = sqrt(sum(mass*y(:, j)**2))
+            end if
+            y(:, j) = y(:, j)/norm
+         end do
          ! Ritz projection: kr = Y' K Y from the elements, mr = Y' M Y
          kr = 0.0_dp
          do e = 1, size(ei)
@@ -191,7 +212,8 @@ contains
          ! converged: every wanted eigenvalue, and every wanted simple mode's shape
          done = it > 1
          do i = 1, nev
-            if (abs(lam(i) - lam_old(i)) > lambda_tol*abs(lam(i))) done = .false.
+            ! relative to the eigenvalue, or to the shift for one at round-off (a rigid-body mode)
+            if (abs(lam(i) - lam_old(i)) > lambda_tol*max(abs(lam(i)), delta)) done = .false.
          end do
          if (done) then
             do i = 1, nev

@@ -21,6 +21,8 @@ program tester
    use test_fd_phase_pattern, only: collect_phase_pattern
    use test_fd_observer, only: collect_observer
    use test_fd_banded, only: collect_banded
+   use test_fd_modes, only: collect_modes
+   use test_fd_stream, only: collect_stream
    implicit none
    integer :: stat, is
    character(len=:), allocatable :: suite_name, test_name
@@ -47,6 +49,8 @@ program tester
    testsuites = [testsuites, new_testsuite("phase_pattern", collect_phase_pattern)]
    testsuites = [testsuites, new_testsuite("observer", collect_observer)]
    testsuites = [testsuites, new_testsuite("banded", collect_banded)]
+   testsuites = [testsuites, new_testsuite("modes", collect_modes)]
+   testsuites = [testsuites, new_testsuite("stream", collect_stream)]
 
    call get_argument(1, suite_name)
    call get_argument(2, test_name)

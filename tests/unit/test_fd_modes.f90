@@ -1,0 +1,200 @@
+!> Unit tests of the lowest natural modes (fd_modes): the subspace iteration with the banded
+!> factor against the closed form of a uniform chain and against LAPACK's dense dsygv on
+!> randomly numbered chains and a plane frame; the mode shapes M-normalized, K-orthogonal,
+!> and the residual of K phi = lambda M phi at round-off; a structure with a rigid-body mode
+!> recognised (lambda ~ 0 against the scale of the spectrum).
+module test_fd_modes
+   use testdrive, only: new_unittest, unittest_type, error_type, check
+   use fd_kinds, only: dp
+   use fd_error, only: lib_error => error_type
+   use fd_modes, only: lowest_modes, modes_dense, modes_iterative
+   use test_fd_helpers, only: check_close
+   implicit none
+   private
+
+   public :: collect_modes
+
+   real(dp), parameter :: pi = acos(-1.0_dp)
+
+contains
+
+   subroutine collect_modes(testsuite)
+      type(unittest_type), allocatable, intent(out) :: testsuite(:)
+
+      testsuite = [ &
+                  new_unittest("uniform chain closed form", test_chain_closed_form), &
+                  new_unittest("iterative equals dense", test_against_dense), &
+                  new_unittest("frame modes and residuals", test_frame), &
+                  new_unittest("rigid-body mode has lambda ~ 0", test_rigid) &
+                  ]
+   end subroutine collect_modes
+
+   !> A fixed-base chain of n equal masses m and springs k: w_j^2 = (4 k / m) sin^2((2j - 1) pi
+   !> / (2 (2 n + 1))). n = 2000 by subspace iteration, the five lowest to 1e-12.
+   subroutine test_chain_closed_form(error)
+      type(error_type), allocatable, intent(out) :: error
+      integer, parameter :: n = 2000, nev = 5
+      real(dp), parameter :: m = 3.0_dp, k = 1.0e6_dp
+      real(dp) :: mass(n), ek(n), lam(nev), phi(n, nev), scale, exact
+      integer :: ei(n), ej(n), i, j
+      type(lib_error), allocatable :: err
+
+      mass = m
+      do i = 1, n
+         ei(i) = i; ej(i) = i - 1; ek(i) = k
+      end do
+      call lowest_modes(mass, ei, ej, ek, nev, lam, phi, scale, err, path=modes_iterative)
+      call check(error, .not. allocated(err), 'lowest_modes failed: '//text(err))
+      if (allocated(error)) return
+      do j = 1, nev
+         exact = 4.0_dp*k/m*sin((2*j - 1)*pi/(2.0_dp*(2*n + 1)))**2
+         call check_close(error, lam(j), exact, 1.0e-12_dp, 'chain eigenvalue')
+         if (allocated(error)) return
+         call check_close(error, sum(mass*phi(:, j)**2), 1.0_dp, 1.0e-12_dp, 'M-normalized')
+         if (allocated(error)) return
+      end do
+      call check(error, scale >= 4.0_dp*k/m, 'the scale bounds the spectrum')
+   end subroutine test_chain_closed_form
+
+   !> Randomly numbered chains of random masses and springs, n = 60: the iterative path gives
+   !> dsygv's lowest eigenvalues to dsygv's own accuracy (64 eps of the largest eigenvalue)
+   !> and its mode shapes (up to sign) to 1e-8.
+   subroutine test_against_dense(error)
+      type(error_type), allocatable, intent(out) :: error
+      integer, parameter :: n = 60, nev = 4
+      real(dp) :: mass(n), ek(n), l1(nev), l2(nev), p1(n, nev), p2(n, nev), s1, s2, r
+      integer :: ei(n), ej(n), q(n), i, j, trial
+      type(lib_error), allocatable :: err
+
+      do trial = 1, 3
+         call permutation(n, 17*trial, q)
+         do i = 1, n
+            mass(q(i)) = 1.0_dp + hashed(i, trial)
+            ei(i) = q(i)
+            ej(i) = 0
+            if (i > 1) ej(i) = q(i - 1)
+            ek(i) = 1.0e3_dp*(1.0_dp + hashed(i + n, trial))
+         end do
+         call lowest_modes(mass, ei, ej, ek, nev, l1, p1, s1, err, path=modes_dense)
+         call check(error, .not. allocated(err), 'dense modes failed: '//text(err))
+         if (allocated(error)) return
+         call lowest_modes(mass, ei, ej, ek, nev, l2, p2, s2, err, path=modes_iterative)
+         call check(error, .not. allocated(err), 'iterative modes failed: '//text(err))
+         if (allocated(error)) return
+         do j = 1, nev
+            ! dsygv's error is backward, relative to the spectrum's largest eigenvalue s1
+            call check_close(error, l2(j), l1(j), 64.0_dp*epsilon(1.0_dp)*s1, 'eigenvalue against dsygv', &
+                             absolute=.true.)
+            if (allocated(error)) return
+            r = sign(1.0_dp, sum(p1(:, j)*p2(:, j)))
+            call check_close(error, maxval(abs(p2(:, j) - r*p1(:, j))), 0.0_dp, 1.0e-8_dp*maxval(abs(p1(:, j))), &
+                             'mode shape against dsygv', absolute=.true.)
+            if (allocated(error)) return
+         end do
+      end do
+   end subroutine test_against_dense
+
+   !> A plane frame of 4 columns and 50 floors (band 4 after RCM): the three lowest modes
+   !> satisfy K phi = lambda M phi to 1e-9 of lambda M phi and are K- and M-orthogonal.
+   subroutine test_frame(error)
+      type(error_type), allocatable, intent(out) :: error
+      integer, parameter :: nx = 4, ny = 50, n = nx*ny, nev = 3
+      real(dp), allocatable :: ek(:), kphi(:)
+      integer, allocatable :: ei(:), ej(:)
+      real(dp) :: mass(n), lam(nev), phi(n, nev), scale, res, kab
+      integer :: c, f, e, a, b, i
+      type(lib_error), allocatable :: err
+
+      allocate (ei(0), ej(0), ek(0))
+      do f = 1, ny
+         do c = 1, nx
+            mass(node(c, f)) = 2.0_dp + 0.1_dp*c
+            ei = [ei, node(c, f)]; ej = [ej, merge(node(c, f - 1), 0, f > 1)]; ek = [ek, 5.0e3_dp]
+            if (c < nx) then
+               ei = [ei, node(c, f)]; ej = [ej, node(c + 1, f)]; ek = [ek, 2.0e3_dp]
+            end if
+         end do
+      end do
+      call lowest_modes(mass, ei, ej, ek, nev, lam, phi, scale, err, path=modes_iterative)
+      call check(error, .not. allocated(err), 'lowest_modes failed: '//text(err))
+      if (allocated(error)) return
+      allocate (kphi(n))
+      do i = 1, nev
+         kphi = 0.0_dp
+         do e = 1, size(ei)
+            a = ei(e); b = ej(e)
+            kphi(a) = kphi(a) + ek(e)*(phi(a, i) - value(b, i))
+            if (b > 0) kphi(b) = kphi(b) - ek(e)*(phi(a, i) - phi(b, i))
+         end do
+         res = maxval(abs(kphi - lam(i)*mass*phi(:, i)))/maxval(abs(lam(i)*mass*phi(:, i)))
+         call check_close(error, res, 0.0_dp, 1.0e-9_dp, 'residual of K phi = lambda M phi', absolute=.true.)
+         if (allocated(error)) return
+         if (i > 1) then
+            call check_close(error, sum(mass*phi(:, i)*phi(:, 1)), 0.0_dp, 1.0e-10_dp, 'M-orthogonal', &
+                             absolute=.true.)
+            if (allocated(error)) return
+            kab = 0.0_dp
+            do e = 1, size(ei)
+               a = ei(e); b = ej(e)
+               kab = kab + ek(e)*(phi(a, i) - value(b, i))*(phi(a, 1) - value(b, 1))
+            end do
+            call check_close(error, kab/lam(i), 0.0_dp, 1.0e-10_dp, 'K-orthogonal', absolute=.true.)
+            if (allocated(error)) return
+         end if
+      end do
+   contains
+      pure integer function node(c, f)
+         integer, intent(in) :: c, f
+         node = (f - 1)*nx + c
+      end function node
+      pure real(dp) function value(b, i)
+         integer, intent(in) :: b, i
+         value = 0.0_dp
+         if (b > 0) value = phi(b, i)
+      end function value
+   end subroutine test_frame
+
+   !> Two masses joined by a spring, nothing to the table: a rigid-body mode (lambda below
+   !> 1e-12 of the spectrum's scale) and the spring's mode, 2 k / m for equal masses; both paths.
+   subroutine test_rigid(error)
+      type(error_type), allocatable, intent(out) :: error
+      real(dp) :: lam(2), phi(2, 2), scale
+      integer :: path
+      type(lib_error), allocatable :: err
+
+      do path = modes_dense, modes_iterative
+         call lowest_modes([2.0_dp, 2.0_dp], [1], [2], [800.0_dp], 2, lam, phi, scale, err, path=path)
+         call check(error, .not. allocated(err), 'lowest_modes failed: '//text(err))
+         if (allocated(error)) return
+         call check(error, abs(lam(1)) <= 1.0e-12_dp*scale, 'rigid-body mode not recognised')
+         if (allocated(error)) return
+         call check_close(error, lam(2), 800.0_dp, 1.0e-12_dp, 'the spring mode 2 k / m')
+         if (allocated(error)) return
+      end do
+   end subroutine test_rigid
+
+   ! ---------------------------------------------------------------- helpers
+   function text(err) result(msg)
+      type(lib_error), allocatable, intent(in) :: err
+      character(len=300) :: msg
+      msg = ''
+      if (allocated(err)) msg = err%message
+   end function text
+
+   pure subroutine permutation(n, s, q)
+      integer, intent(in) :: n, s
+      integer, intent(out) :: q(n)
+      integer :: i, j, t
+      q = [(i, i=1, n)]
+      do i = n, 2, -1
+         j = 1 + mod(i*s + 7*i*i, i)
+         t = q(i); q(i) = q(j); q(j) = t
+      end do
+   end subroutine permutation
+
+   pure real(dp) function hashed(i, s)
+      integer, intent(in) :: i, s
+      hashed = modulo(sin(real(i*37 + s*101, dp))*43758.5453_dp, 1.0_dp)
+   end function hashed
+
+end module test_fd_modes
