@@ -1,8 +1,10 @@
 """The command line: ``python -m frictiondyn run | plot | compare | paper``.
 
-- ``run DECK [--plot] [--out DIR]``: run a deck through the extension and write its history
-  CSV and summary JSON with the library's writer, exactly as the ``frictiondyn`` executable
-  does (same files, same format), into the deck's ``&output`` directory or ``--out``.
+- ``run DECK [--plot] [--out DIR] [--quiet]``: run a deck through the extension and write its
+  history CSV and summary JSON with the library's writer, exactly as the ``frictiondyn``
+  executable does (same files, same format, the history written as the run goes), into the
+  deck's ``&output`` directory or ``--out``; a progress bar on a terminal (not with
+  ``--quiet``); Ctrl-C stops the run and leaves no output.
 - ``plot RESULT``: PNGs of a result (a CSV written by ``run`` or the executable, or a .npz
   from ``Result.to_npz``), next to it or in ``--out``.
 - ``compare A B [...]``: overlay two or more results (CSV, .npz, or decks, which are run)
@@ -103,11 +105,50 @@ def _trange(value: Sequence[float] | None) -> tuple[float, float] | None:
     return t0, t1
 
 
+class _ProgressBar:
+    """A progress bar in seconds of simulated time on standard error, when it is a terminal
+    (nothing in a pipe or a batch log); the solve's progress callback."""
+
+    def __init__(self, enabled: bool) -> None:
+        self.bar = None
+        self.enabled = enabled
+
+    def __call__(self, t: float, duration: float) -> None:
+        if not self.enabled:
+            return
+        if self.bar is None:
+            import shutil
+
+            from tqdm import tqdm
+
+            width = shutil.get_terminal_size((80, 24)).columns or 80  # 0 on a bare pty
+            self.bar = tqdm(
+                total=duration, unit="s", unit_scale=False, leave=False, file=sys.stderr,
+                ncols=width,
+                bar_format="{desc}{percentage:3.0f}%|{bar}| t = {n:.2f} of {total:.2f} s "
+                "[{elapsed}<{remaining}]", desc="frictiondyn: ",
+            )
+        self.bar.n = min(t, duration)
+        self.bar.refresh()
+
+    def close(self) -> None:
+        if self.bar is not None:
+            self.bar.close()
+
+
 def cmd_run(args: argparse.Namespace) -> int:
     trange = _trange(args.t_range)
+    bar = _ProgressBar(sys.stderr.isatty() and not args.quiet)
     with Session(args.deck) as session:  # the deck is read once; the library writes
-        result = session.solve().result()
-        csv, summ = session.write(args.out)
+        # the history goes to its file as the run goes (memory does not grow with the
+        # duration); it is also kept in memory only for the plots
+        session.stream(args.out)
+        try:
+            session.solve(progress=bar, history=args.plot)
+        finally:
+            bar.close()
+        result = session.result()
+        csv, summ = session.write()
     _print_summary(result, args.deck)
     if csv is not None:
         print(f"  history: {csv}")
@@ -253,6 +294,7 @@ def build_parser() -> argparse.ArgumentParser:
     )
     p.add_argument("--plot", action="store_true", help="also write PNGs next to the outputs")
     p.add_argument("--t-range", **trange)
+    p.add_argument("--quiet", action="store_true", help="no progress bar")
     p.set_defaults(func=cmd_run)
 
     p = sub.add_parser("plot", help="PNGs of a result (.csv or .npz)")
