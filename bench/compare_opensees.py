@@ -11,7 +11,15 @@ Installs what it needs beyond the tests: openseespy from PyPI into the running e
   law against an OpenSees ElasticPP zeroLength link, its velocity law against OpenSees's
   CoulombDamper material;
 - a shear building of N storeys with a friction damper in every storey (hysteretic law =
-  ElasticPP link) under 20 s of a synthetic ground acceleration, N = 2 ... 1000.
+  ElasticPP link) under 20 s of a synthetic ground acceleration, N = 2 ... 10000 (--sizes).
+  (The velocity law's building is measured by bench/scale.py, frictiondyn alone: against
+  OpenSees's CoulombDamper links its absolute accelerations differ by up to 40 %, the two
+  codes resolving the stiff damping of the sticking band differently.)
+
+frictiondyn keeps in its history the roof's DOF and the first device only (its summary has
+every DOF's and device's peaks), as OpenSees keeps envelopes only. Its cost is given per
+dt1 step (what OpenSees takes) and per Newmark step taken (dt1, dt2 and finer steps: the
+paper's step control redoes a dt1 step in which a device changes phase as n2 dt2 steps).
 
 For each case, first each code runs once in a subprocess of its own (its peak resident memory
 is measured there, VmHWM); both codes' peaks (|u| and |absolute acceleration| of every DOF,
@@ -43,10 +51,16 @@ import tempfile
 import time
 from pathlib import Path
 
+# numpy's bundled OpenBLAS starts one busy-waiting thread per core after its first call (the
+# building case's record is made with numpy): on a 2-core machine they took a core from
+# whichever code was timed next. Neither code uses that BLAS; one thread is enough.
+os.environ.setdefault("OPENBLAS_NUM_THREADS", "1")
+os.environ.setdefault("OMP_NUM_THREADS", "1")
+
 HERE = Path(__file__).resolve().parent
 ROOT = HERE.parent
 VENV = ROOT / ".venv"
-SIZES = [2, 10, 30, 100, 300, 1000]
+SIZES = [2, 10, 30, 100, 300, 1000, 3000, 10000]
 QUICK_SIZES = [2, 10, 30]
 CHILD_TAG = "@@child-result@@ "
 CHILD_OVERHEAD_S = 30.0  # allowed beyond the budget to a single-run process (start, imports, build)
@@ -169,9 +183,10 @@ def child_main(args) -> int:
     if args.child == "fd":
         import frictiondyn as fd
 
+        case = om.make_case(args.case, args.quick)
         rss0 = _proc_status("VmRSS")
         t0, c0 = time.perf_counter(), time.process_time()
-        res = fd.run(args.deck)
+        res = fd.run(args.deck, **fd_keep(case))
         out["seconds"] = time.perf_counter() - t0
         out["cpu_seconds"] = time.process_time() - c0
         out["peaks"] = {q: v.tolist() for q, v in om.frictiondyn_peaks(res).items()}
@@ -183,6 +198,10 @@ def child_main(args) -> int:
                 "steps_dt2",
                 "steps_finer",
                 "factorizations",
+                "factor_updates",
+                "partial_factorizations",
+                "linear_system",
+                "half_bandwidth",
                 "period_stuck_s",
             )
             if k in s
@@ -206,6 +225,21 @@ def child_main(args) -> int:
     out["rss_peak_mb"] = _proc_status("VmHWM")
     print(CHILD_TAG + json.dumps(out), flush=True)
     return 0
+
+
+def fd_keep(case) -> dict:
+    """What frictiondyn keeps in its history: every column for test 4, the roof DOF and the
+    first device for a building (its summary has every peak; OpenSees keeps envelopes)."""
+    if getattr(case, "n_storeys", None) is None:
+        return {}
+    return {"dofs": [case.n_dof], "devices": [1]}
+
+
+def newmark_steps(stats: dict) -> int | None:
+    """Newmark steps a frictiondyn run took (dt1, dt2 and finer)."""
+    if "steps_dt1" not in stats:
+        return None
+    return int(stats["steps_dt1"] + stats["steps_dt2"] + stats["steps_finer"])
 
 
 def run_child(code: str, spec: str, args, deck: Path | None, timeout: float) -> dict:
@@ -262,7 +296,8 @@ def _predict(history: list[tuple[int, float]], n: int) -> float | None:
 def run_case(spec: str, args, history: dict, om, fd) -> dict:
     case = om.make_case(spec, args.quick)
     kind = spec.split(":")[0]
-    n_size = case.n_dof if kind == "building" else None
+    n_size = case.n_dof if kind.startswith("building") else None
+    history = history.setdefault(kind, {"fd": [], "ops": []})  # predictions per kind of case
     rec: dict = {
         "case": spec,
         "name": case.name,
@@ -276,8 +311,8 @@ def run_case(spec: str, args, history: dict, om, fd) -> dict:
         rec["opensees_material"] = case.opensees_material
         rec["law"] = case.law
     else:
-        rec["law"] = "hysteretic"
-        rec["opensees_material"] = "ElasticPP"
+        rec["law"] = case.law
+        rec["opensees_material"] = case.opensees_material
     print(
         f"\n== {case.name}: {case.n_dof} DOFs, {case.n_steps} steps of {case.dt * 1e3:g} ms",
         flush=True,
@@ -383,9 +418,9 @@ def run_case(spec: str, args, history: dict, om, fd) -> dict:
         if v.startswith("fd"):
             w0, c0 = time.perf_counter(), time.process_time()
             if v == "fd":
-                peaks = om.frictiondyn_peaks(fd.run(deck))
+                peaks = om.frictiondyn_peaks(fd.run(deck, **fd_keep(case)))
             elif v == "fd_short":
-                fd.run(deck_short)
+                fd.run(deck_short, **fd_keep(case))
             else:
                 peaks = om.frictiondyn_peaks(full_an.run())
             wall, cpu = time.perf_counter() - w0, time.process_time() - c0
@@ -461,6 +496,13 @@ def run_case(spec: str, args, history: dict, om, fd) -> dict:
             res["ratio_end_to_end"] = (res["ops_analyze_s"] + res["ops_build_s"]) / res[
                 "fd_analysis_run_s"
             ]
+    # frictiondyn per Newmark step taken (its dt2 re-integrations included): the unit of work
+    # that is O(N) in the structure, against OpenSees's per dt1 step
+    nm = newmark_steps(child["fd"].get("stats", {})) if ok_fd else None
+    if nm and "fd_us_per_step" in res:
+        res["fd_newmark_steps"] = nm
+        res["fd_us_per_newmark_step"] = res["fd_us_per_step"] * n / nm
+        res["fd_cpu_us_per_newmark_step"] = res["fd_cpu_us_per_step"] * n / nm
     for code in ("fd", "ops"):
         if ok_fd if code == "fd" else ok_ops:
             res[f"{code}_rss_peak_mb"] = child[code]["rss_peak_mb"]
@@ -529,19 +571,25 @@ def tables(results: list[dict], peak_tol: float) -> str:
                 f"{_fmt(r.get('fd_analysis_run_s'), '.4f')} | {_fmt(ops_e2e, '.4f')} | "
                 f"{_fmt(e2e, '.1f')}x | {_peak_text(r)} |"
             )
-    b = [r for r in results if r["case"].startswith("building")]
-    if b:
+    for law, material in (("hysteretic", "ElasticPP"), ("velocity", "CoulombDamper")):
+        b = [
+            r
+            for r in results
+            if r["case"].startswith("building") and r.get("law", "hysteretic") == law
+        ]
+        if not b:
+            continue
         out.append(
-            "\nShear building, a friction damper (hysteretic law = ElasticPP link) in every "
+            f"\nShear building, a friction damper ({law} law = {material} link) in every "
             "storey:\n"
         )
         out.append(
             "| storeys N | steps | frictiondyn us/step wall (CPU) | OpenSees us/step wall (CPU) | "
-            "frictiondyn is, wall (CPU) | "
+            "frictiondyn is, wall (CPU) | frictiondyn Newmark steps, us each (CPU) | "
             "peaks differ by | frictiondyn peak RSS MB | OpenSees peak RSS MB | "
             "frictiondyn steps dt1 + dt2, transitions |"
         )
-        out.append("|---|---|---|---|---|---|---|---|---|")
+        out.append("|---|---|---|---|---|---|---|---|---|---|")
         for r in b:
             st = r["single_run"]["fd"].get("stats", {})
             steps = (
@@ -549,15 +597,46 @@ def tables(results: list[dict], peak_tol: float) -> str:
                 if "steps_dt1" in st
                 else "n/a"
             )
+            nm = (
+                f"{r['fd_newmark_steps']}, {r['fd_us_per_newmark_step']:.2f} "
+                f"({r['fd_cpu_us_per_newmark_step']:.2f})"
+                if "fd_newmark_steps" in r
+                else "n/a"
+            )
             out.append(
                 f"| {r['n_dof']} | {r['steps']} | {_us(r, 'fd', '.1f')} | {_us(r, 'ops', '.1f')} | "
-                f"{_ratio_text(r)} ({_ratio_text(r, 'ratio_cpu')}) | {_peak_text(r)} | {_fmt(r.get('fd_rss_peak_mb'), '.0f')} | "
+                f"{_ratio_text(r)} ({_ratio_text(r, 'ratio_cpu')}) | {nm} | {_peak_text(r)} | "
+                f"{_fmt(r.get('fd_rss_peak_mb'), '.0f')} | "
                 f"{_fmt(r.get('ops_rss_peak_mb'), '.0f')} | {steps} |"
             )
+        out.append("\n" + growth_text(b))
     notes = [f"- {r['name']}: {n}" for r in results for n in r["notes"]]
     if notes:
         out.append("\nNotes:\n" + "\n".join(notes))
     return "\n".join(out)
+
+
+def growth_text(b: list[dict]) -> str:
+    """Exponents p of cost ~ N^p between successive sizes and over the whole range, per dt1
+    step and per Newmark step (CPU time: the better figure on a shared machine)."""
+    lines = []
+    for key, label in (
+        ("fd_cpu_us_per_step", "frictiondyn per dt1 step"),
+        ("fd_cpu_us_per_newmark_step", "frictiondyn per Newmark step"),
+        ("ops_cpu_us_per_step", "OpenSees per step"),
+    ):
+        pts = [(r["n_dof"], r[key]) for r in b if r.get(key)]
+        pts = [(n, y) for n, y in pts if n >= 10]
+        if len(pts) < 2:
+            continue
+        parts = [
+            f"{n0}-{n1}: {math.log(y1 / y0) / math.log(n1 / n0):.2f}"
+            for (n0, y0), (n1, y1) in zip(pts, pts[1:])
+        ]
+        (n0, y0), (n1, y1) = pts[0], pts[-1]
+        whole = math.log(y1 / y0) / math.log(n1 / n0)
+        lines.append(f"- {label}: N^p with p = {', '.join(parts)}; {n0}-{n1}: {whole:.2f}")
+    return "Growth of the cost (CPU) with N:\n" + "\n".join(lines) if lines else ""
 
 
 def _peak_text(r: dict) -> str:
@@ -570,7 +649,11 @@ def _peak_text(r: dict) -> str:
 def plot(results: list[dict], path: Path, meta: dict) -> None:
     from matplotlib.figure import Figure
 
-    b = [r for r in results if r["case"].startswith("building")]
+    b = [
+        r
+        for r in results
+        if r["case"].startswith("building") and r.get("law", "hysteretic") == "hysteretic"
+    ]
     if not b:
         return
     fig = Figure(figsize=(11, 4.6))
@@ -579,6 +662,19 @@ def plot(results: list[dict], path: Path, meta: dict) -> None:
         "fd": ("frictiondyn (hysteretic law)", "C0", "o"),
         "ops": ("OpenSeesPy (ElasticPP links)", "C3", "s"),
     }
+    nm = [(r["n_dof"], r["fd_cpu_us_per_newmark_step"]) for r in b if "fd_cpu_us_per_newmark_step" in r]
+    if nm:
+        xs, ys = zip(*nm)
+        ax1.plot(xs, ys, "-.", color="C2", marker="^", ms=6, lw=1.1,
+                 label="frictiondyn per Newmark step (dt1, dt2 or finer), CPU")
+    bv = [r for r in results if r["case"].startswith("building_velocity")]
+    for code, color in (("fd", "C0"), ("ops", "C3")):
+        pts = [(r["n_dof"], r[f"{code}_cpu_us_per_step"]) for r in bv if r.get(f"{code}_cpu_us_per_step")]
+        if pts:
+            xs, ys = zip(*pts)
+            ax1.plot(xs, ys, ":", color=color, marker="v", ms=5, lw=1,
+                     label=("frictiondyn velocity law" if code == "fd" else "OpenSeesPy CoulombDamper")
+                     + ", CPU")
     for code, (label, color, marker) in styles.items():
         pts = [
             (r["n_dof"], r[f"{code}_us_per_step"], r.get(f"{code}_runs", 0))
@@ -774,9 +870,14 @@ def parse_args(argv=None):
         "--sizes",
         type=str,
         default=None,
-        help="comma-separated storey counts (default 2,10,30,100,300,1000)",
+        help="comma-separated storey counts (default 2,10,30,100,300,1000,3000,10000)",
     )
     ap.add_argument("--no-test4", action="store_true", help="skip the paper's test 4")
+    ap.add_argument(
+        "--no-buildings",
+        action="store_true",
+        help="only the paper's test 4",
+    )
     ap.add_argument(
         "--budget",
         type=float,
@@ -833,6 +934,8 @@ def parse_args(argv=None):
         args.sizes = QUICK_SIZES if args.quick else SIZES
     else:
         args.sizes = [int(s) for s in args.sizes.split(",") if s]
+    if args.no_buildings:
+        args.sizes = []
     if args.out is None:
         args.out = ROOT / "out" / "bench" / ("quick" if args.quick else "")
     return args
@@ -884,7 +987,7 @@ def main(argv=None) -> int:
     args.out.mkdir(parents=True, exist_ok=True)
     json_path = args.out / "compare_opensees.json"
     results: list[dict] = []
-    history: dict[str, list] = {"fd": [], "ops": []}
+    history: dict[str, dict] = {}
     t_start = time.perf_counter()
     status = 0
     for spec in specs:

@@ -1,0 +1,289 @@
+"""frictiondyn alone at scale (issue 13): cost and memory against the number of storeys, for
+both regularized laws; memory against the duration; reading a large deck; runs in threads;
+how fast Ctrl-C stops a run.
+
+    .venv/bin/python bench/scale.py                        # all of it (about 30 min)
+    .venv/bin/python bench/scale.py --sizes 10,100 --no-extras   # a quick look
+    .venv/bin/python bench/scale.py --out docs/performance       # what docs/performance.md shows
+
+The building is bench/opensees_models.py's BuildingCase (a friction damper in every storey,
+20 s of synthetic ground motion at dt_r = 10 ms, dt1 = 1 ms), with the hysteretic law and
+with the velocity law (band eps = 1 mm/s). Each size runs in a process of its own (its peak
+resident memory, VmHWM, is measured there), keeping the roof's DOF and the first device in
+its history (the summary has every peak). Cost is CPU time of the run (the machine may be
+shared), per dt1 step and per Newmark step taken (dt1, dt2 and finer: the paper's step
+control redoes a dt1 step in which a device changes phase as n2 = 50 dt2 steps, so the
+number of Newmark steps per dt1 step grows with the number of devices until it saturates at
+51). Writes <out>/scale.json and prints the tables. Nothing here asserts a speed.
+"""
+
+from __future__ import annotations
+
+import argparse
+import json
+import math
+import os
+import signal
+import statistics
+import subprocess
+import sys
+import tempfile
+import threading
+import time
+from pathlib import Path
+
+os.environ.setdefault("OPENBLAS_NUM_THREADS", "1")  # numpy's BLAS threads spin otherwise
+HERE = Path(__file__).resolve().parent
+ROOT = HERE.parent
+TAG = "@@scale-result@@ "
+
+
+def _status(key: str) -> float:
+    with open("/proc/self/status") as fh:
+        for line in fh:
+            if line.startswith(key + ":"):
+                return int(line.split()[1]) / 1024.0
+    return float("nan")
+
+
+def child(args) -> int:
+    """One run in this process: CPU and wall time, steps, peak memory."""
+    import frictiondyn as fd
+
+    rss0 = _status("VmRSS")
+    t0, c0 = time.perf_counter(), time.process_time()
+    with fd.Session(args.deck) as s:
+        t_open = time.perf_counter() - t0
+        s.select([args.n], [1])
+        t1, c1 = time.perf_counter(), time.process_time()
+        s.solve()
+        wall, cpu = time.perf_counter() - t1, time.process_time() - c1
+        r = s.result()
+    st = r.summary
+    out = {
+        "wall_s": wall,
+        "cpu_s": cpu,
+        "open_s": t_open,
+        "run_time_s": st["run_time_s"],
+        "steps_dt1": st["steps_dt1"],
+        "steps_dt2": st["steps_dt2"],
+        "steps_finer": st["steps_finer"],
+        "factorizations": st["factorizations"],
+        "factor_updates": st["factor_updates"],
+        "partial_factorizations": st["partial_factorizations"],
+        "linear_system": st["linear_system"],
+        "half_bandwidth": st["half_bandwidth"],
+        "transitions": int(sum(st["stick_to_slip"])),
+        "rss_before_mb": rss0,
+        "rss_peak_mb": _status("VmHWM"),
+        "history_mb": r.data.nbytes / 1e6,
+    }
+    print(TAG + json.dumps(out), flush=True)
+    return 0
+
+
+def run_child(deck: Path, n: int) -> dict:
+    p = subprocess.run(
+        [sys.executable, __file__, "--child", "--deck", str(deck), "--n", str(n)],
+        capture_output=True,
+        text=True,
+        check=False,
+    )
+    for line in p.stdout.splitlines():
+        if line.startswith(TAG):
+            return json.loads(line[len(TAG):])
+    raise RuntimeError(f"child failed: {p.stderr.strip()[-500:]}")
+
+
+def make_deck(work: Path, n: int, law: str, duration: float) -> Path:
+    sys.path.insert(0, str(HERE))
+    import opensees_models as om
+
+    case = om.BuildingCase(n, duration=duration, law=law)
+    d = work / f"{law}_{n}_{duration:g}"
+    d.mkdir(parents=True, exist_ok=True)
+    return case.analysis().write_deck(d / "building.nml")
+
+
+def exponents(pts: list[tuple[int, float]]) -> dict:
+    out = {}
+    for (n0, y0), (n1, y1) in zip(pts, pts[1:]):
+        out[f"{n0}-{n1}"] = math.log(y1 / y0) / math.log(n1 / n0)
+    if len(pts) > 2:
+        (n0, y0), (n1, y1) = pts[0], pts[-1]
+        out[f"{n0}-{n1}"] = math.log(y1 / y0) / math.log(n1 / n0)
+    return out
+
+
+def scaling(args, work: Path) -> dict:
+    res: dict = {}
+    for law in args.laws:
+        rows = []
+        for n in args.sizes:
+            deck = make_deck(work, n, law, args.duration)
+            r = run_child(deck, n)
+            nm = r["steps_dt1"] + r["steps_dt2"] + r["steps_finer"]
+            steps = round(args.duration / 1e-3)
+            r.update(
+                n=n,
+                newmark_steps=nm,
+                cpu_us_per_step=1e6 * r["cpu_s"] / steps,
+                run_us_per_step=1e6 * r["wall_s"] / steps,
+                run_us_per_newmark_step=1e6 * r["wall_s"] / nm,
+                cpu_us_per_newmark_step=1e6 * r["cpu_s"] / nm,
+            )
+            rows.append(r)
+            print(
+                f"{law:10s} N = {n:6d}: {r['cpu_us_per_step']:10.1f} us/dt1 step, "
+                f"{r['cpu_us_per_newmark_step']:8.2f} us/Newmark step (CPU; wall "
+                f"{r['run_us_per_step']:.1f}, {r['run_us_per_newmark_step']:.2f}), steps {r['steps_dt1']} + {r['steps_dt2']} + "
+                f"{r['steps_finer']}, {r['transitions']} transitions, factor: "
+                f"{r['factorizations']} full, {r['partial_factorizations']} partial, "
+                f"{r['factor_updates']} updates; deck read {r['open_s']:.3f} s; peak RSS "
+                f"{r['rss_peak_mb']:.0f} MB",
+                flush=True,
+            )
+        res[law] = {
+            "rows": rows,
+            "exponent_per_dt1_step": exponents([(r["n"], r["cpu_us_per_step"]) for r in rows]),
+            "exponent_per_newmark_step": exponents(
+                [(r["n"], r["cpu_us_per_newmark_step"]) for r in rows]
+            ),
+            "exponent_memory_above_start": exponents(
+                [(r["n"], max(r["rss_peak_mb"] - r["rss_before_mb"], 1e-3)) for r in rows]
+            ),
+        }
+    return res
+
+
+def memory_vs_duration(args, work: Path) -> dict:
+    n = args.memory_size
+    out = {}
+    for duration in (args.duration / 2, args.duration):
+        r = run_child(make_deck(work, n, "hysteretic", duration), n)
+        out[f"{duration:g}"] = {"rss_peak_mb": r["rss_peak_mb"], "rss_before_mb": r["rss_before_mb"]}
+        print(f"memory, N = {n}, {duration:g} s: peak RSS {r['rss_peak_mb']:.1f} MB "
+              f"(before the run {r['rss_before_mb']:.1f} MB)", flush=True)
+    return out
+
+
+def deck_reading(work: Path, n: int) -> dict:
+    import frictiondyn as fd
+
+    deck = make_deck(work, n, "hysteretic", 1.0)
+    size = deck.stat().st_size + (deck.parent / "record.txt").stat().st_size
+    ts = []
+    for _ in range(5):
+        t0 = time.perf_counter()
+        with fd.Session(deck):
+            pass
+        ts.append(time.perf_counter() - t0)
+    print(f"reading the {n}-storey deck ({size / 1e6:.2f} MB with its record): "
+          f"median {statistics.median(ts) * 1e3:.1f} ms of 5", flush=True)
+    return {"n": n, "bytes": size, "median_s": statistics.median(ts), "runs_s": ts}
+
+
+def threads(work: Path, n: int) -> dict:
+    """Two runs one after the other, then two at once in two threads: wall times."""
+    import frictiondyn as fd
+
+    deck = make_deck(work, n, "hysteretic", 5.0)
+
+    def one():
+        fd.run(deck, dofs=[n], devices=[1])
+
+    one()  # warm-up
+    t0 = time.perf_counter()
+    one()
+    one()
+    seq = time.perf_counter() - t0
+    t0 = time.perf_counter()
+    th = [threading.Thread(target=one) for _ in range(2)]
+    for t in th:
+        t.start()
+    for t in th:
+        t.join()
+    par = time.perf_counter() - t0
+    print(f"threads, N = {n}: two runs in sequence {seq:.2f} s, in two threads {par:.2f} s "
+          f"(overlap: {seq / par:.2f}x; {os.cpu_count()} cores, load {os.getloadavg()[0]:.1f})",
+          flush=True)
+    return {"n": n, "sequential_s": seq, "threads_s": par, "speedup": seq / par,
+            "cores": os.cpu_count(), "load": os.getloadavg()[0]}
+
+
+INTERRUPT = """
+import os, signal, sys, threading, time, frictiondyn as fd
+deck = sys.argv[1]
+def fire():
+    global t_sig
+    t_sig = time.perf_counter()
+    os.kill(os.getpid(), signal.SIGINT)
+threading.Timer(float(sys.argv[2]), fire).start()
+try:
+    with fd.Session(deck) as s:
+        s.select([int(sys.argv[3])], [1])
+        s.solve()
+    print("finished")
+except KeyboardInterrupt:
+    print("latency", time.perf_counter() - t_sig)
+"""
+
+
+def interrupt(work: Path, n: int, repeats: int) -> dict:
+    deck = make_deck(work, n, "hysteretic", 20.0)
+    lat = []
+    for k in range(repeats):
+        p = subprocess.run([sys.executable, "-c", INTERRUPT, str(deck), str(0.3 + 0.07 * k), str(n)],
+                           capture_output=True, text=True, check=False)
+        words = p.stdout.split()
+        if "latency" in words:
+            lat.append(float(words[-1]))
+    print(f"Ctrl-C during fd.run (N = {n}): KeyboardInterrupt after {statistics.median(lat) * 1e3:.1f} ms "
+          f"(median of {len(lat)}), at most {max(lat) * 1e3:.1f} ms", flush=True)
+    return {"n": n, "latency_s": lat, "median_s": statistics.median(lat), "max_s": max(lat)}
+
+
+def main(argv=None) -> int:
+    ap = argparse.ArgumentParser(description=__doc__.split("\n\n")[0])
+    ap.add_argument("--sizes", default="10,100,1000,10000")
+    ap.add_argument("--laws", default="hysteretic,velocity")
+    ap.add_argument("--duration", type=float, default=20.0)
+    ap.add_argument("--memory-size", type=int, default=1000)
+    ap.add_argument("--no-extras", action="store_true", help="only the scaling")
+    ap.add_argument("--out", type=Path, default=ROOT / "out" / "bench")
+    ap.add_argument("--child", action="store_true", help=argparse.SUPPRESS)
+    ap.add_argument("--deck", help=argparse.SUPPRESS)
+    ap.add_argument("--n", type=int, help=argparse.SUPPRESS)
+    args = ap.parse_args(argv)
+    if args.child:
+        return child(args)
+    args.sizes = [int(x) for x in args.sizes.split(",") if x]
+    args.laws = [x for x in args.laws.split(",") if x]
+    meta = {"command": " ".join([Path(sys.executable).name, *sys.argv]), "cores": os.cpu_count(),
+            "load_start": os.getloadavg()}
+    result: dict = {"meta": meta}
+    with tempfile.TemporaryDirectory(prefix="fd_scale_") as tmp:
+        work = Path(tmp)
+        result["scaling"] = scaling(args, work)
+        if not args.no_extras:
+            result["memory_vs_duration"] = memory_vs_duration(args, work)
+            result["deck_reading"] = deck_reading(work, max(args.sizes))
+            result["threads"] = threads(work, 100)
+            result["interrupt"] = interrupt(work, 1000, 10)
+    meta["load_end"] = os.getloadavg()
+    for law, r in result["scaling"].items():
+        print(f"{law}: cost (CPU) per dt1 step ~ N^p, p = "
+              + ", ".join(f"{k}: {v:.2f}" for k, v in r["exponent_per_dt1_step"].items()))
+        print(f"{law}: cost (CPU) per Newmark step ~ N^p, p = "
+              + ", ".join(f"{k}: {v:.2f}" for k, v in r["exponent_per_newmark_step"].items()))
+        print(f"{law}: memory above the interpreter's ~ N^p, p = "
+              + ", ".join(f"{k}: {v:.2f}" for k, v in r["exponent_memory_above_start"].items()))
+    args.out.mkdir(parents=True, exist_ok=True)
+    path = args.out / "scale.json"
+    path.write_text(json.dumps(result, indent=1))
+    print(f"json: {path}")
+    return 0
+
+
+if __name__ == "__main__":
+    sys.exit(main())
