@@ -996,7 +996,11 @@ contains
                p = perm(i)
                w1(i) = x(p) + sys%a1*z(p)
             end do
-            call dsbmv('U', n, sys%kb, 1.0_dp, sys%kmat, sys%ld, w1, 1, 0.0_dp, w2, 1)
+            if (sys%kb <= narrow_band) then
+               call band_symv(n, sys%kb, sys%kmat, w1, w2)
+            else
+               call dsbmv('U', n, sys%kb, 1.0_dp, sys%kmat, sys%ld, w1, 1, 0.0_dp, w2, 1)
+            end if
             do i = 1, n
                p = perm(i)
                y(p) = y(p) + alpha*(w2(i) + sys%a0*mass(i)*z(p))
@@ -1025,7 +1029,11 @@ contains
       do i = 1, sys%n
          sys%w1(i) = x(sys%perm(i))
       end do
-      call dsbmv('U', sys%n, sys%kb, 1.0_dp, mat, sys%ld, sys%w1, 1, 0.0_dp, sys%w2, 1)
+      if (sys%kb <= narrow_band) then
+         call band_symv(sys%n, sys%kb, mat, sys%w1, sys%w2)
+      else
+         call dsbmv('U', sys%n, sys%kb, 1.0_dp, mat, sys%ld, sys%w1, 1, 0.0_dp, sys%w2, 1)
+      end if
       if (beta == 0.0_dp) then
          do i = 1, sys%n
             y(sys%perm(i)) = alpha*sys%w2(i)
@@ -1078,6 +1086,18 @@ contains
       real(dp) :: temp
       integer :: i, j
 
+      if (kb == 1) then
+         b(1) = b(1)*rdiag(1)
+         do j = 2, n
+            b(j) = (b(j) - u(2*j - 1)*b(j - 1))*rdiag(j)
+         end do
+         do j = n, 2, -1
+            b(j) = b(j)*rdiag(j)
+            b(j - 1) = b(j - 1) - b(j)*u(2*j - 1)
+         end do
+         b(1) = b(1)*rdiag(1)
+         return
+      end if
       do j = 1, n
          temp = b(j)
          do i = max(1, j - kb), j - 1
@@ -1093,6 +1113,35 @@ contains
          end do
       end do
    end subroutine band_solve
+
+   !> y = A x for a symmetric band A (upper band layout, A(i, j) at i + j kb): the loops of
+   !> the reference dsbmv, written for a narrow band (a chain's is 1: a tridiagonal product).
+   pure subroutine band_symv(n, kb, a, x, y)
+      integer, intent(in) :: n, kb
+      real(dp), intent(in) :: a(*), x(n)
+      real(dp), intent(out) :: y(n)
+      real(dp) :: temp1, temp2
+      integer :: i, j
+
+      if (kb == 1) then
+         y(1) = a(2)*x(1)
+         do j = 2, n
+            y(j - 1) = y(j - 1) + x(j)*a(2*j - 1)
+            y(j) = x(j)*a(2*j) + a(2*j - 1)*x(j - 1)
+         end do
+         return
+      end if
+      do j = 1, n
+         temp1 = x(j)
+         temp2 = 0.0_dp
+         y(j) = 0.0_dp
+         do i = max(1, j - kb), j - 1
+            y(i) = y(i) + temp1*a(i + j*kb)
+            temp2 = temp2 + a(i + j*kb)*x(i)
+         end do
+         y(j) = temp1*a(j + j*kb) + temp2
+      end do
+   end subroutine band_symv
 
    !> y = alpha A x + beta y for a small symmetric A (upper triangle, n x n column-major): the
    !> operations of the reference BLAS dsymv ('U'), in its order (y not read when beta = 0).
