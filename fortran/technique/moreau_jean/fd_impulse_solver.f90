@@ -47,7 +47,7 @@ module fd_impulse_solver
    implicit none
    private
 
-   public :: impulse_solver, solver_setup, solve_impulses, solver_max_lcp
+   public :: impulse_solver, solver_setup, solve_impulses, predict_pattern, solver_max_lcp
 
    !> Largest number of edges in doubt the Lemke fallback takes (its tableau holds
    !> 2 p x (4 p + 2) reals: 4.2 MB at 256).
@@ -66,6 +66,8 @@ module fd_impulse_solver
       integer, allocatable :: sigma(:)            !! (ne) pattern: 0 stick, +1/-1 slide that way
       real(dp), allocatable :: lam(:)             !! (ne) impulses of the solution
       real(dp), allocatable :: w(:)               !! (ne) end-of-step relative velocities b_e'v1
+      real(dp), allocatable :: lam_prev(:), w_prev(:) !! (ne) the solution before (predict_pattern)
+      logical :: have_prev = .false.              !! lam_prev, w_prev hold a solution
       logical, allocatable :: locked(:)           !! (ne) sliding edges whose sign is given (never change)
       ! the pattern of the current factor
       logical, allocatable :: fstuck(:)
@@ -73,7 +75,7 @@ module fd_impulse_solver
       logical :: fvalid = .false.
       ! work
       logical, allocatable :: stuck(:), changed(:), viol(:), doubt(:)
-      real(dp), allocatable :: f(:), q(:), rho(:), sc(:), lsc(:), col(:)
+      real(dp), allocatable :: f(:), q(:), rho(:), sc(:), lsc(:), col(:), rabs(:)
       type(lcp_work) :: lcp
       integer :: pmax = 0
       integer, allocatable :: dlist(:)
@@ -84,6 +86,7 @@ module fd_impulse_solver
       integer :: fallbacks = 0      !! calls that needed the Lemke fallback
       integer :: lcp_largest = 0    !! most edges in doubt in a fallback
       real(dp) :: mismatch = 0.0_dp !! largest relative inconsistency of a group's residual met
+      real(dp) :: tolw = 0.0_dp     !! velocity tolerance of the last check
    end type impulse_solver
 
 contains
@@ -118,7 +121,8 @@ contains
       call gs_setup(p%gs, mass, si, sj, sk, max(2*kbw, 8))
       allocate (p%sigma(ne), p%lam(ne), p%w(ne), p%locked(ne), p%fstuck(ne))
       allocate (p%stuck(ne), p%changed(ne), p%viol(ne), p%doubt(ne), p%dlist(ne))
-      allocate (p%f(n), p%q(n), p%rho(0:n), p%sc(0:n), p%lsc(ne), p%col(n))
+      allocate (p%f(n), p%q(n), p%rho(0:n), p%sc(0:n), p%lsc(ne), p%col(n), p%rabs(n))
+      allocate (p%lam_prev(ne), p%w_prev(ne))
       p%sigma = 0
       p%lam = 0.0_dp
       p%w = 0.0_dp
@@ -139,27 +143,49 @@ contains
    !> Solve the one-step problem W v1 = r - B lambda with the complementarity conditions
    !> (module header), from the pattern in p%sigma (the previous solution: warm start). On
    !> exit p%sigma, p%lam and p%w hold the solution's pattern, impulses and end velocities.
-   subroutine solve_impulses(p, r, alpha, beta, g, v1, error)
+   subroutine solve_impulses(p, r, rabs, alpha, beta, g, v1, error)
       type(impulse_solver), intent(inout) :: p      !! the solver
       real(dp), intent(in) :: r(:)                  !! free right-hand side (n)
+      real(dp), intent(in) :: rabs(:)               !! size of the terms r was summed from (n, >= |r|),
+                                                    !! for the tolerances of the checks
       real(dp), intent(in) :: alpha                 !! W = alpha M + beta K: alpha > 0
       real(dp), intent(in) :: beta                  !! and beta >= 0
-      real(dp), intent(in) :: g(:)                  !! (ne) bounds of the impulses, >= 0
+      real(dp), intent(in) :: g(:)                  !! (ne) bounds of the impulses, > 0
       real(dp), intent(out) :: v1(:)                !! end-of-step velocities (n)
       type(error_type), allocatable, intent(out) :: error !! singular system, LCP failure
-      integer :: it, nviol, last, best, backups, e
+      logical :: done
 
       p%calls = p%calls + 1
       p%changed = .false.
       p%viol = .false.
+      p%rabs = rabs
+      call active_set(p, r, alpha, beta, g, v1, max(p%max_iter, 2*p%ne), done, error)
+      if (allocated(error) .or. done) return
+      call fallback(p, r, alpha, beta, g, v1, error)
+   end subroutine solve_impulses
+
+   !> The active-set (block principal pivoting) iteration from the pattern p%sigma, at most
+   !> max_it patterns: all violating edges change while their number falls (or for
+   !> max_backups tries more), then the last one alone.
+   subroutine active_set(p, r, alpha, beta, g, v1, max_it, done, error)
+      type(impulse_solver), intent(inout) :: p
+      real(dp), intent(in) :: r(:), alpha, beta, g(:)
+      real(dp), intent(out) :: v1(:)
+      integer, intent(in) :: max_it
+      logical, intent(out) :: done
+      type(error_type), allocatable, intent(out) :: error
+      integer :: it, nviol, last, best, backups, e
+
+      done = .false.
       best = huge(1)
       backups = max_backups
-      do it = 1, p%max_iter
+      do it = 1, max_it
          call solve_pattern(p, r, alpha, beta, g, v1, error)
          if (allocated(error)) return
          call check_pattern(p, alpha, beta, g, v1, nviol, last)
          if (nviol == 0) then
             call finish(p, g)
+            done = .true.
             return
          end if
          if (nviol < best .or. backups > 0) then
@@ -176,8 +202,37 @@ contains
             call flip(p, last)
          end if
       end do
-      call fallback(p, r, alpha, beta, g, v1, error)
-   end subroutine solve_impulses
+   end subroutine active_set
+
+   !> The first guess of the next step's pattern: the last solution's, except where the trend
+   !> of the last two solutions (same step size) crosses a limit within the step: a sliding
+   !> edge whose relative velocity, extrapolated linearly, changes sign is guessed sticking, a
+   !> sticking edge whose impulse, extrapolated, leaves its bound is guessed sliding that way.
+   !> Devices that stop together (proportional slip loads) are then guessed together, where
+   !> the active-set iteration would find them one after the other (a sliding device cannot
+   !> see that its neighbours stop).
+   pure subroutine predict_pattern(p, g)
+      type(impulse_solver), intent(inout) :: p      !! the solver, after a solve_impulses
+      real(dp), intent(in) :: g(:)                  !! (ne) bounds of the next step's impulses
+      real(dp) :: x
+      integer :: e
+
+      if (p%have_prev) then
+         do e = 1, p%ne
+            if (p%locked(e)) cycle
+            if (p%sigma(e) == 0) then
+               x = 2.0_dp*p%lam(e) - p%lam_prev(e)
+               if (abs(x) > g(e)) p%sigma(e) = merge(1, -1, x > 0.0_dp)
+            else
+               x = 2.0_dp*p%w(e) - p%w_prev(e)
+               if (p%sigma(e)*x < 0.0_dp) p%sigma(e) = 0
+            end if
+         end do
+      end if
+      p%lam_prev = p%lam
+      p%w_prev = p%w
+      p%have_prev = .true.
+   end subroutine predict_pattern
 
    !> Change the status of edge e: sticking to sliding in the direction of its impulse,
    !> sliding to sticking.
@@ -237,7 +292,9 @@ contains
       if (allocated(error)) return
       p%f = r
       do e = 1, p%ne
-         if (.not. p%stuck(e)) call add_edge(p%es, e, -p%sigma(e)*g(e), p%f)
+         if (p%stuck(e)) cycle
+         p%lam(e) = p%sigma(e)*g(e)
+         call add_edge(p%es, e, -p%lam(e), p%f)
       end do
       call reduced_solve(p, p%f, v1)
    end subroutine solve_pattern
@@ -253,20 +310,28 @@ contains
       integer :: e, n
 
       n = p%n
-      tolw = tol_rel*maxval(abs(v1)) + tiny(1.0_dp)
+      ! the size of the terms of rho = f - W v1 (f: r and the sliding impulses), for the
+      ! tolerances: of the impulses below, of the velocities (that size over alpha M)
+      p%rho(0) = 0.0_dp
+      p%sc(0) = 0.0_dp
+      p%rho(1:n) = p%f - alpha*p%gs%mass*v1
+      call gs_k_matvec(p%gs, v1, p%rho(1:n), -beta, 1.0_dp)
+      p%sc(1:n) = p%rabs + alpha*p%gs%mass*abs(v1)
+      call gs_k_absmatvec(p%gs, v1, p%sc(1:n), beta)
+      do e = 1, p%ne
+         if (p%stuck(e)) cycle
+         p%sc(p%es%ei(e)) = p%sc(p%es%ei(e)) + abs(p%lam(e))
+         p%sc(p%es%ej(e)) = p%sc(p%es%ej(e)) + abs(p%lam(e))
+      end do
+      tolw = tol_rel*maxval(p%sc(1:n)/(alpha*p%gs%mass)) + tiny(1.0_dp)
       p%viol = .false.
       do e = 1, p%ne
          p%w(e) = edge_relative(p%es, e, v1)
          if (p%stuck(e) .or. p%locked(e) .or. p%doubt(e)) cycle
          if (p%sigma(e)*p%w(e) < -tolw) p%viol(e) = .true.
       end do
+      p%tolw = tolw
       ! impulses of the sticking edges: B_S lambda_S = f - W v1
-      p%rho(0) = 0.0_dp
-      p%sc(0) = 0.0_dp
-      p%rho(1:n) = p%f - alpha*p%gs%mass*v1
-      call gs_k_matvec(p%gs, v1, p%rho(1:n), -beta, 1.0_dp)
-      p%sc(1:n) = abs(p%f) + alpha*p%gs%mass*abs(v1)
-      call gs_k_absmatvec(p%gs, v1, p%sc(1:n), beta)
       call recover_impulses(p%es, p%stuck, p%rho, p%sc, p%lam, p%lsc, mm)
       p%mismatch = max(p%mismatch, mm)
       do e = 1, p%ne
@@ -328,7 +393,9 @@ contains
          if (allocated(error)) return
          p%f = r
          do e = 1, p%ne
-            if (.not. p%stuck(e) .and. .not. p%doubt(e)) call add_edge(p%es, e, -p%sigma(e)*g(e), p%f)
+            if (p%stuck(e) .or. p%doubt(e)) cycle
+            p%lam(e) = p%sigma(e)*g(e)
+            call add_edge(p%es, e, -p%lam(e), p%f)
          end do
          call reduced_solve(p, p%f, v1)
          ! Delassus operator of the edges in doubt and their free velocities
@@ -377,7 +444,7 @@ contains
          end do
       end do
       ! the edges in doubt: sticking when their end velocity is zero, else sliding their way
-      tolw = tol_rel*maxval(abs(v1)) + tiny(1.0_dp)
+      tolw = p%tolw
       do e = 1, p%ne
          if (p%doubt(e)) then
             if (abs(p%w(e)) <= tolw) then

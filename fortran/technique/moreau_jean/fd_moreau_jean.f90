@@ -30,8 +30,8 @@ module fd_moreau_jean
    use fd_observer, only: observer_type, observer_init, sample_due, observe_peaks, observe_sample, &
                           observe_transitions, observe_start_energies, observe_end_energies
    use fd_stick_groups, only: groups_build, add_edge, edge_relative
-   use fd_group_system, only: gs_k_matvec, gs_lowest_eigenvalue
-   use fd_impulse_solver, only: impulse_solver, solver_setup, solve_impulses
+   use fd_group_system, only: gs_k_matvec, gs_k_absmatvec, gs_lowest_eigenvalue
+   use fd_impulse_solver, only: impulse_solver, solver_setup, solve_impulses, predict_pattern
    implicit none
    private
 
@@ -45,9 +45,12 @@ module fd_moreau_jean
       type(observer_type) :: obs                          !! peaks, history, energy balance
       integer :: n = 0, nd = 0, ne = 0
       real(dp) :: a0 = 0.0_dp, a1 = 0.0_dp                !! C = a0 M + a1 K
-      real(dp), allocatable :: u(:), v(:), u1(:), v1(:), acc(:), r(:), du(:), kx(:)  !! (n)
+      real(dp), allocatable :: u(:), v(:), u1(:), v1(:), acc(:), r(:), du(:), kx(:), rabs(:)  !! (n)
       real(dp), allocatable :: s(:), sd(:), force(:)      !! (nd)
-      integer, allocatable :: phase0(:), phase1(:)        !! (nd)
+      integer, allocatable :: phase0(:), phase1(:)        !! (nd) phases before and after a step
+      integer, allocatable :: counted(:)                  !! (nd) phase last counted as a transition
+      logical, allocatable :: pending(:)                  !! (nd) stopped from a slide at the last step
+      integer, allocatable :: ta(:), tb(:)                !! (nd) transitions handed to the observer
       real(dp), allocatable :: g_step(:), g_force(:)      !! (ne) bounds: P mu h, P mu
       real(dp) :: w_fric = 0.0_dp                         !! friction work [J]
    end type mj_work
@@ -162,10 +165,14 @@ contains
       w%kx = w%a1*w%v + w%u
       call gs_k_matvec(w%p%gs, w%kx, w%r, -1.0_dp, 0.0_dp)
       w%r = w%r - model%mass*(ag0 + w%a0*w%v)
-      call solve_impulses(w%p, w%r, 1.0_dp, 0.0_dp, w%g_force, w%acc, error)
+      w%rabs = model%mass*(abs(ag0) + w%a0*abs(w%v))
+      call gs_k_absmatvec(w%p%gs, w%kx, w%rabs, 1.0_dp)
+      call solve_impulses(w%p, w%r, w%rabs, 1.0_dp, 0.0_dp, w%g_force, w%acc, error)
       if (allocated(error)) return
       w%p%locked = .false.
       call device_state(model, w, 1.0_dp, w%phase0)
+      w%counted = w%phase0
+      w%pending = .false.
       call energies(w, e_kin, e_str)
       call observe_start_energies(w%obs, e_kin, e_str, 0.0_dp)
       call observe_sample(w%obs, res, 0.0_dp, ag0, w%u, w%v, w%acc, w%s, w%sd, w%force, w%phase0)
@@ -178,7 +185,10 @@ contains
          w%kx = ck*w%v + h*w%u
          call gs_k_matvec(w%p%gs, w%kx, w%r, -1.0_dp, 0.0_dp)
          w%r = w%r + model%mass*(cm*w%v - h*agt)
-         call solve_impulses(w%p, w%r, alpha, beta, w%g_step, w%v1, error)
+         w%rabs = model%mass*(abs(cm*w%v) + h*abs(agt))
+         call gs_k_absmatvec(w%p%gs, w%kx, w%rabs, 1.0_dp)
+         if (k > 1) call predict_pattern(w%p, w%g_step)
+         call solve_impulses(w%p, w%r, w%rabs, alpha, beta, w%g_step, w%v1, error)
          if (allocated(error)) return
          w%u1 = w%u + h*((1.0_dp - th)*w%v + th*w%v1)
          ! energy of the step: input, viscous and friction work over du = h v_theta
@@ -201,7 +211,7 @@ contains
          w%v = w%v1
          ag0 = ag1
          call device_state(model, w, 1.0_dp/h, w%phase1)
-         call observe_transitions(res, w%phase0, w%phase1)
+         call count_transitions(w, res, .false.)
          w%phase0 = w%phase1
          call observe_peaks(res, t1, w%u, w%v, w%acc, ag1, w%s, w%force)
          res%steps_dt1 = res%steps_dt1 + 1
@@ -213,6 +223,7 @@ contains
             call observe_sample(w%obs, res, t1, ag1, w%u, w%v, w%acc, w%s, w%sd, w%force, w%phase1)
          end if
       end do
+      call count_transitions(w, res, .true.)
       call energies(w, e_kin, e_str)
       call observe_end_energies(w%obs, res, e_kin, e_str, 0.0_dp, w%w_fric)
       res%factorizations = w%p%gs%factorizations
@@ -267,8 +278,9 @@ contains
          om = 2.0_dp*pi/period
          res%xi_stuck = (w%a0 + w%a1*om**2)/(2.0_dp*om)
       end if
-      allocate (w%u(n), w%v(n), w%u1(n), w%v1(n), w%acc(n), w%r(n), w%du(n), w%kx(n))
-      allocate (w%s(nd), w%sd(nd), w%force(nd), w%phase0(nd), w%phase1(nd))
+      allocate (w%u(n), w%v(n), w%u1(n), w%v1(n), w%acc(n), w%r(n), w%du(n), w%kx(n), w%rabs(n))
+      allocate (w%s(nd), w%sd(nd), w%force(nd), w%phase0(nd), w%phase1(nd), w%counted(nd), w%pending(nd))
+      allocate (w%ta(nd), w%tb(nd))
       allocate (w%g_step(w%ne), w%g_force(w%ne))
    end subroutine setup
 
@@ -292,6 +304,49 @@ contains
          end if
       end do
    end subroutine device_state
+
+   !> Count the phase transitions of the step (phase0 -> phase1) with the observer. A device
+   !> that stops from a slide is counted one step later: if it then slides the other way, it
+   !> passed through zero velocity within the step (the one-step problem lands on w = 0 for a
+   !> fraction 2 P mu / (|D| + P mu) of such reversals, D the driving force, whatever h) and
+   !> the pair counts as one slip reversal, as the exact technique counts it; otherwise as
+   !> slip-to-stick (and stick-to-slip). At the end of the run (`last`) a pending stop counts.
+   subroutine count_transitions(w, res, last)
+      type(mj_work), intent(inout) :: w
+      type(result_type), intent(inout) :: res
+      logical, intent(in) :: last
+      integer :: d, p, c
+
+      do d = 1, w%nd
+         p = w%phase1(d)
+         c = w%counted(d)
+         w%ta(d) = c          ! after the first transition of the step
+         w%tb(d) = c          ! after the second (a stop and a start in one count)
+         if (w%pending(d)) then
+            w%pending(d) = .false.
+            if (last .or. p == 0) then
+               w%ta(d) = 0
+               w%tb(d) = 0
+            else if (p == -c) then
+               w%ta(d) = p
+               w%tb(d) = p
+            else
+               w%ta(d) = 0
+               w%tb(d) = p
+            end if
+         else if (p /= c .and. .not. last) then
+            if (c /= 0 .and. p == 0) then
+               w%pending(d) = .true.
+            else
+               w%ta(d) = p
+               w%tb(d) = p
+            end if
+         end if
+      end do
+      call observe_transitions(res, w%counted, w%ta)
+      call observe_transitions(res, w%ta, w%tb)
+      w%counted = w%tb
+   end subroutine count_transitions
 
    !> Kinetic and strain energy of the current state.
    subroutine energies(w, e_kin, e_str)
