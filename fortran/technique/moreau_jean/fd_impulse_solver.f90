@@ -61,7 +61,7 @@ module fd_impulse_solver
       type(group_system) :: gs                    !! springs, masses and the reduced factor
       integer :: n = 0                            !! DOFs
       integer :: ne = 0                           !! edges
-      integer :: max_iter = 50                    !! patterns tried before the fallback
+      integer :: max_iter = 0                     !! patterns tried before the fallback; 0: 2 ne + 50
       integer, allocatable :: node_order(:)       !! RCM order of the nodes (groups numbered in it)
       integer, allocatable :: sigma(:)            !! (ne) pattern: 0 stick, +1/-1 slide that way
       real(dp), allocatable :: lam(:)             !! (ne) impulses of the solution
@@ -159,7 +159,7 @@ contains
       p%changed = .false.
       p%viol = .false.
       p%rabs = rabs
-      call active_set(p, r, alpha, beta, g, v1, max(p%max_iter, 2*p%ne), done, error)
+      call active_set(p, r, alpha, beta, g, v1, merge(p%max_iter, 2*p%ne + 50, p%max_iter > 0), done, error)
       if (allocated(error) .or. done) return
       call fallback(p, r, alpha, beta, g, v1, error)
    end subroutine solve_impulses
