@@ -47,7 +47,7 @@ module fd_impulse_solver
    implicit none
    private
 
-   public :: impulse_solver, solver_setup, solve_impulses, predict_pattern, solver_max_lcp
+   public :: impulse_solver, solver_setup, solve_impulses, predict_pattern, pattern_acceleration, solver_max_lcp
 
    !> Largest number of edges in doubt the Lemke fallback takes (its tableau holds
    !> 2 p x (4 p + 2) reals: 4.2 MB at 256).
@@ -203,6 +203,35 @@ contains
          end if
       end do
    end subroutine active_set
+
+   !> The acceleration of the structure under nodal forces f (all but friction) with the
+   !> pattern of the last solution held: sticking devices rigid, sliding ones carrying
+   !> sigma P mu. The groups' masses are diagonal, so a = T (T'M T)^-1 T'(f - B_L sigma P mu)
+   !> costs two passes over the nodes, and no factorization.
+   subroutine pattern_acceleration(p, f, pmu, acc)
+      type(impulse_solver), intent(inout) :: p      !! the solver, after a solve_impulses
+      real(dp), intent(in) :: f(:)                  !! nodal forces but friction [N] (n)
+      real(dp), intent(in) :: pmu(:)                !! (ne) P mu of each edge [N]
+      real(dp), intent(out) :: acc(:)               !! accelerations [m/s2] (n)
+      integer :: e, i
+
+      p%stuck = p%sigma == 0
+      if (.not. all(p%stuck .eqv. p%fstuck)) then
+         ! the groups of the pattern (a fallback may leave other groups factored)
+         call groups_build(p%es, p%stuck, p%node_order)
+         p%fvalid = .false.
+      end if
+      p%col = f
+      do e = 1, p%ne
+         if (.not. p%stuck(e)) call add_edge(p%es, e, -p%sigma(e)*pmu(e), p%col)
+      end do
+      call restrict(p%es, p%col, p%q)
+      call restrict(p%es, p%gs%mass, p%f)
+      do i = 1, p%es%nr
+         p%q(i) = p%q(i)/p%f(i)
+      end do
+      call expand(p%es, p%q, acc)
+   end subroutine pattern_acceleration
 
    !> The first guess of the next step's pattern: the last solution's, except where the trend
    !> of the last two solutions (same step size) crosses a limit within the step: a sliding

@@ -29,9 +29,9 @@ module fd_moreau_jean
    use fd_result, only: result_type
    use fd_observer, only: observer_type, observer_init, sample_due, observe_peaks, observe_sample, &
                           observe_transitions, observe_start_energies, observe_end_energies
-   use fd_stick_groups, only: groups_build, add_edge, edge_relative
+   use fd_stick_groups, only: groups_build, edge_relative
    use fd_group_system, only: gs_k_matvec, gs_k_absmatvec, gs_lowest_eigenvalue
-   use fd_impulse_solver, only: impulse_solver, solver_setup, solve_impulses, predict_pattern
+   use fd_impulse_solver, only: impulse_solver, solver_setup, solve_impulses, predict_pattern, pattern_acceleration
    implicit none
    private
 
@@ -199,14 +199,11 @@ contains
          do e = 1, w%ne
             w%w_fric = w%w_fric + w%p%lam(e)*edge_relative(w%p%es, e, w%du)/h
          end do
-         ! acceleration at t1 from equilibrium with the step's friction forces lambda / h
+         ! acceleration at t1 from equilibrium with the end-of-step pattern held
          w%kx = w%a1*w%v1 + w%u1
-         call gs_k_matvec(w%p%gs, w%kx, w%acc, -1.0_dp, 0.0_dp)
-         w%acc = w%acc - model%mass*(ag1 + w%a0*w%v1)
-         do e = 1, w%ne
-            call add_edge(w%p%es, e, -w%p%lam(e)/h, w%acc)
-         end do
-         w%acc = w%acc/model%mass
+         call gs_k_matvec(w%p%gs, w%kx, w%r, -1.0_dp, 0.0_dp)
+         w%r = w%r - model%mass*(ag1 + w%a0*w%v1)
+         call pattern_acceleration(w%p, w%r, w%g_force, w%acc)
          w%u = w%u1
          w%v = w%v1
          ag0 = ag1
