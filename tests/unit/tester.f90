@@ -11,6 +11,7 @@ program tester
    use test_fd_friction, only: collect_friction
    use test_fd_namelist, only: collect_namelist
    use test_fd_record, only: collect_record
+   use test_fd_record_parse, only: collect_record_parse
    use test_fd_excitation, only: collect_excitation
    use test_fd_lcp, only: collect_lcp
    use test_fd_textio, only: collect_textio
@@ -39,6 +40,7 @@ program tester
    testsuites = [testsuites, new_testsuite("friction", collect_friction)]
    testsuites = [testsuites, new_testsuite("namelist", collect_namelist)]
    testsuites = [testsuites, new_testsuite("record", collect_record)]
+   testsuites = [testsuites, new_testsuite("record_parse", collect_record_parse)]
    testsuites = [testsuites, new_testsuite("excitation", collect_excitation)]
    testsuites = [testsuites, new_testsuite("lcp", collect_lcp)]
    testsuites = [testsuites, new_testsuite("textio", collect_textio)]
