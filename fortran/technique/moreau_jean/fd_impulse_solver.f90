@@ -247,14 +247,16 @@ contains
       integer :: e
 
       if (p%have_prev) then
+         ! a change only where the trend crosses the limit by more than the tolerances of the
+         ! checks: a device at rest at its limit (both statuses hold) keeps its status
          do e = 1, p%ne
             if (p%locked(e)) cycle
             if (p%sigma(e) == 0) then
                x = 2.0_dp*p%lam(e) - p%lam_prev(e)
-               if (abs(x) > g(e)) p%sigma(e) = merge(1, -1, x > 0.0_dp)
+               if (abs(x) > g(e) + tol_rel*p%lsc(e)) p%sigma(e) = merge(1, -1, x > 0.0_dp)
             else
                x = 2.0_dp*p%w(e) - p%w_prev(e)
-               if (p%sigma(e)*x < 0.0_dp) p%sigma(e) = 0
+               if (p%sigma(e)*x < -p%tolw) p%sigma(e) = 0
             end if
          end do
       end if
