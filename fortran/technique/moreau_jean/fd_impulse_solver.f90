@@ -64,6 +64,8 @@ module fd_impulse_solver
       integer :: max_iter = 0                     !! patterns tried before the fallback; 0: 2 ne + 50
       integer, allocatable :: node_order(:)       !! RCM order of the nodes (groups numbered in it)
       integer, allocatable :: sigma(:)            !! (ne) pattern: 0 stick, +1/-1 slide that way
+      integer, allocatable :: sa(:)               !! (ne) pattern of the accelerations at a step's end
+      real(dp), allocatable :: fa(:)              !! (ne) forces of the devices at rest there [N]
       real(dp), allocatable :: lam(:)             !! (ne) impulses of the solution
       real(dp), allocatable :: w(:)               !! (ne) end-of-step relative velocities b_e'v1
       real(dp), allocatable :: lam_prev(:), w_prev(:) !! (ne) the solution before (predict_pattern)
@@ -122,7 +124,7 @@ contains
       allocate (p%sigma(ne), p%lam(ne), p%w(ne), p%locked(ne), p%fstuck(ne))
       allocate (p%stuck(ne), p%changed(ne), p%viol(ne), p%doubt(ne), p%dlist(ne))
       allocate (p%f(n), p%q(n), p%rho(0:n), p%sc(0:n), p%lsc(ne), p%col(n), p%rabs(n))
-      allocate (p%lam_prev(ne), p%w_prev(ne))
+      allocate (p%lam_prev(ne), p%w_prev(ne), p%sa(ne), p%fa(ne))
       p%sigma = 0
       p%lam = 0.0_dp
       p%w = 0.0_dp
@@ -204,33 +206,68 @@ contains
       end do
    end subroutine active_set
 
-   !> The acceleration of the structure under nodal forces f (all but friction) with the
-   !> pattern of the last solution held: sticking devices rigid, sliding ones carrying
-   !> sigma P mu. The groups' masses are diagonal, so a = T (T'M T)^-1 T'(f - B_L sigma P mu)
-   !> costs two passes over the nodes, and no factorization.
+   !> The acceleration of the structure at the end of a step: nodal forces f (all but
+   !> friction) and Coulomb's law at the level of accelerations, given the end velocities:
+   !> a device that slides keeps sigma P mu; one at rest (sticking at the end of the step)
+   !> holds if the force that keeps it at rest is within P mu, else it starts to slide in
+   !> the direction of that force (as the exact technique decides at an event). The groups'
+   !> masses are diagonal, so a pattern's acceleration a = T (T'M T)^-1 T'(f - B_L F_L) and
+   !> its sticking forces (elimination over the groups' trees) cost a few passes over the
+   !> nodes and no factorization; the pattern of the step is the first guess, and in most
+   !> steps the answer.
    subroutine pattern_acceleration(p, f, pmu, acc)
       type(impulse_solver), intent(inout) :: p      !! the solver, after a solve_impulses
       real(dp), intent(in) :: f(:)                  !! nodal forces but friction [N] (n)
       real(dp), intent(in) :: pmu(:)                !! (ne) P mu of each edge [N]
       real(dp), intent(out) :: acc(:)               !! accelerations [m/s2] (n)
-      integer :: e, i
+      real(dp) :: mm, tola
+      integer :: e, i, it, nviol
 
-      p%stuck = p%sigma == 0
-      if (.not. all(p%stuck .eqv. p%fstuck)) then
-         ! the groups of the pattern (a fallback may leave other groups factored)
-         call groups_build(p%es, p%stuck, p%node_order)
-         p%fvalid = .false.
-      end if
-      p%col = f
-      do e = 1, p%ne
-         if (.not. p%stuck(e)) call add_edge(p%es, e, -p%sigma(e)*pmu(e), p%col)
+      p%sa = p%sigma
+      do it = 1, p%ne + 2
+         p%stuck = p%sa == 0
+         if (.not. all(p%stuck .eqv. p%fstuck)) then
+            ! the groups of this pattern (the factor's are then rebuilt at the next step)
+            call groups_build(p%es, p%stuck, p%node_order)
+            p%fvalid = .false.
+         end if
+         p%col = f
+         p%sc(1:p%n) = abs(f)
+         do e = 1, p%ne
+            if (p%stuck(e)) cycle
+            call add_edge(p%es, e, -p%sa(e)*pmu(e), p%col)
+            p%sc(p%es%ei(e)) = p%sc(p%es%ei(e)) + pmu(e)
+            p%sc(p%es%ej(e)) = p%sc(p%es%ej(e)) + pmu(e)
+         end do
+         call restrict(p%es, p%col, p%q)
+         call restrict(p%es, p%gs%mass, p%f)
+         do i = 1, p%es%nr
+            p%q(i) = p%q(i)/p%f(i)
+         end do
+         call expand(p%es, p%q, acc)
+         ! the forces that keep the sticking devices at rest: B_S F_S = f - B_L F_L - M a
+         p%rho(0) = 0.0_dp
+         p%sc(0) = 0.0_dp
+         p%rho(1:p%n) = p%col - p%gs%mass*acc
+         tola = tol_rel*maxval(p%sc(1:p%n)/p%gs%mass) + tiny(1.0_dp)
+         call recover_impulses(p%es, p%stuck, p%rho, p%sc, p%fa, p%lsc, mm)
+         nviol = 0
+         do e = 1, p%ne
+            if (p%stuck(e)) then
+               if (abs(p%fa(e)) > pmu(e) + tol_rel*p%lsc(e)) then
+                  p%sa(e) = merge(1, -1, p%fa(e) > 0.0_dp)
+                  nviol = nviol + 1
+               end if
+            else if (p%sigma(e) == 0) then
+               ! started at the end of the step: it must accelerate its way
+               if (p%sa(e)*edge_relative(p%es, e, acc) < -tola) then
+                  p%sa(e) = 0
+                  nviol = nviol + 1
+               end if
+            end if
+         end do
+         if (nviol == 0) return
       end do
-      call restrict(p%es, p%col, p%q)
-      call restrict(p%es, p%gs%mass, p%f)
-      do i = 1, p%es%nr
-         p%q(i) = p%q(i)/p%f(i)
-      end do
-      call expand(p%es, p%q, acc)
    end subroutine pattern_acceleration
 
    !> The first guess of the next step's pattern: the last solution's, except where the trend
