@@ -69,6 +69,9 @@ module fd_impulse_solver
       real(dp), allocatable :: lam(:)             !! (ne) impulses of the solution
       real(dp), allocatable :: w(:)               !! (ne) end-of-step relative velocities b_e'v1
       real(dp), allocatable :: lam_prev(:), w_prev(:) !! (ne) the solution before (predict_pattern)
+      real(dp), allocatable :: amax(:)            !! (ne) b_e'M^-1 b_e >= alpha b_e'W^-1 b_e
+      integer, allocatable :: queue(:)            !! (ne) work of the stop expansion
+      real(dp), allocatable :: wt(:)              !! (ne) its estimated relative velocities
       logical :: have_prev = .false.              !! lam_prev, w_prev hold a solution
       logical, allocatable :: locked(:)           !! (ne) sliding edges whose sign is given (never change)
       ! the pattern of the current factor
@@ -124,7 +127,11 @@ contains
       allocate (p%sigma(ne), p%lam(ne), p%w(ne), p%locked(ne), p%fstuck(ne))
       allocate (p%stuck(ne), p%changed(ne), p%viol(ne), p%doubt(ne), p%dlist(ne))
       allocate (p%f(n), p%q(n), p%rho(0:n), p%sc(0:n), p%lsc(ne), p%col(n), p%rabs(n))
-      allocate (p%lam_prev(ne), p%w_prev(ne), p%sa(ne), p%fa(ne))
+      allocate (p%lam_prev(ne), p%w_prev(ne), p%sa(ne), p%fa(ne), p%amax(ne), p%queue(ne), p%wt(ne))
+      do i = 1, ne
+         p%amax(i) = 1.0_dp/mass(p%es%ei(i))
+         if (p%es%ej(i) > 0) p%amax(i) = p%amax(i) + 1.0_dp/mass(p%es%ej(i))
+      end do
       p%sigma = 0
       p%lam = 0.0_dp
       p%w = 0.0_dp
@@ -197,6 +204,7 @@ contains
             else
                backups = backups - 1
             end if
+            call expand_stops(p)
             do e = 1, p%ne
                if (p%viol(e)) call flip(p, e)
             end do
@@ -205,6 +213,57 @@ contains
          end if
       end do
    end subroutine active_set
+
+   !> Devices that stop together. A sliding edge found moving the wrong way is to stop: the
+   !> impulse that stops it, d_e = w_e / (b_e'W^-1 b_e), changes the relative velocity of
+   !> every edge sharing a node x with it by -(b_f(x) b_e(x) / m_x) d_e / (b_e'M^-1 b_e)
+   !> (W taken as its mass part alpha M, which dominates it at a step's scale). A sliding
+   !> neighbour thereby turned the wrong way (beyond the tolerance) is to stop too, and so on
+   !> along the structure. A sliding edge cannot see that its neighbour stops before the
+   !> neighbour has stopped: without this estimate, a run of k devices stopping at once
+   !> (under proportional slip loads) takes k patterns. The estimate only proposes: the next
+   !> pattern is checked exactly.
+   subroutine expand_stops(p)
+      type(impulse_solver), intent(inout) :: p
+      integer :: head, tail, e, x, q, f, k
+      real(dp) :: d
+
+      tail = 0
+      do e = 1, p%ne
+         p%wt(e) = p%w(e)
+         if (p%viol(e) .and. .not. p%stuck(e) .and. .not. p%locked(e)) then
+            tail = tail + 1
+            p%queue(tail) = e
+         end if
+      end do
+      head = 1
+      do while (head <= tail)
+         e = p%queue(head)
+         head = head + 1
+         d = p%wt(e)/p%amax(e)
+         p%wt(e) = 0.0_dp
+         do k = 1, 2
+            x = merge(p%es%ei(e), p%es%ej(e), k == 1)
+            if (x == 0) cycle
+            do q = p%es%start(x), p%es%start(x + 1) - 1
+               f = p%es%inc(q)
+               if (f == e .or. p%stuck(f) .or. p%locked(f) .or. p%doubt(f)) cycle
+               ! b_f(x) b_e(x) = +1 when x is the same end of both edges, -1 otherwise
+               if ((p%es%ei(f) == x) .eqv. (p%es%ei(e) == x)) then
+                  p%wt(f) = p%wt(f) - d/p%gs%mass(x)
+               else
+                  p%wt(f) = p%wt(f) + d/p%gs%mass(x)
+               end if
+               if (p%viol(f)) cycle
+               if (p%sigma(f)*p%wt(f) < -p%tolw) then
+                  p%viol(f) = .true.
+                  tail = tail + 1
+                  p%queue(tail) = f
+               end if
+            end do
+         end do
+      end do
+   end subroutine expand_stops
 
    !> The acceleration of the structure at the end of a step: nodal forces f (all but
    !> friction) and Coulomb's law at the level of accelerations, given the end velocities:
