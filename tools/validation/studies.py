@@ -153,24 +153,9 @@ def closed_forms() -> list[dict]:
         err = max(np.max(np.abs(a - b)) / np.max(np.abs(b)) for a, b in refs)
         rows.append({"case": label, "error": err, "tolerance": 1e-8})
     for rr, ratio in ((0.7, 0.3), (1.6, 0.2), (0.45, 0.1)):
-        m, fn, amp_dh = 2.0, 1.0, 0.01
-        k = m * (2 * np.pi * fn) ** 2
-        w = rr * 2 * np.pi * fn
-        f0 = m * amp_dh * w**2
-        ff = ratio * f0
-        x0, v0, amplitude = den_hartog(np.array([0.0]), m, k, ff, f0, w)
-        an = Analysis(
-            masses=[m],
-            springs=[Spring(1, 0, k)],
-            u0=[float(x0[0])],
-            v0=[float(v0[0])],
-            devices=[Device(1, 0, ff, 1.0, law="coulomb")],
-            excitation=Harmonic(amp_dh, w / (2 * np.pi), 0.01, 6 * 2 * np.pi / w),
-            integration=Integration(technique="event_driven", n1=10),
-            output=Output(output_every=1),
-        )
+        an, exact = den_hartog_case(rr, ratio, Integration(technique="event_driven", n1=10))
         r = an.run()
-        x, _, _ = den_hartog(r.time, m, k, ff, f0, w)
+        x, _, amplitude = exact(r.time)
         rows.append(
             {
                 "case": f"Den Hartog non-stop, w/wn = {rr}, F_f/F_0 = {ratio}",
@@ -179,6 +164,29 @@ def closed_forms() -> list[dict]:
             }
         )
     return rows
+
+
+def den_hartog_case(rr: float, ratio: float, integration: Integration):
+    """A 2 kg block on a 1 Hz spring on the table moving 10 mm at w = rr wn, with Coulomb
+    friction F_f = ratio F_0, started on Den Hartog's steady non-stop orbit, 6 cycles: the
+    analysis, and exact(t) -> (x, v, amplitude) of the closed form (oracles.den_hartog)."""
+    m, fn, amp = 2.0, 1.0, 0.01
+    k = m * (2 * np.pi * fn) ** 2
+    w = rr * 2 * np.pi * fn
+    f0 = m * amp * w**2  # -m ag = m amp w^2 sin(w t)
+    ff = ratio * f0
+    x0, v0, _ = den_hartog(np.array([0.0]), m, k, ff, f0, w)
+    an = Analysis(
+        masses=[m],
+        springs=[Spring(1, 0, k)],
+        u0=[float(x0[0])],
+        v0=[float(v0[0])],
+        devices=[Device(1, 0, ff, 1.0, law="coulomb")],
+        excitation=Harmonic(amp, w / (2 * np.pi), 0.01, 6 * 2 * np.pi / w),
+        integration=integration,
+        output=Output(output_every=1),
+    )
+    return an, lambda t: den_hartog(t, m, k, ff, f0, w)
 
 
 # ----------------------------------------------------------------------------- 2. convergence
@@ -431,27 +439,13 @@ def mj_den_hartog(
     started on the steady orbit): largest errors of u and v over 6 cycles, relative to the
     amplitude (and to amplitude * w). The step counts avoid powers of two, which land the
     velocity reversals on the same fractions of a step."""
-    m, fn, amp = 2.0, 1.0, 0.01
-    k = m * (2 * np.pi * fn) ** 2
-    w = rr * 2 * np.pi * fn
-    f0 = m * amp * w**2
-    ff = ratio * f0
-    x0, v0, amplitude = den_hartog(np.array([0.0]), m, k, ff, f0, w)
     rows = []
     for theta in thetas:
         for n1 in n1_values:
-            an = Analysis(
-                masses=[m],
-                springs=[Spring(1, 0, k)],
-                u0=[float(x0[0])],
-                v0=[float(v0[0])],
-                devices=[Device(1, 0, ff, 1.0, law="coulomb")],
-                excitation=Harmonic(amp, w / (2 * np.pi), 0.01, 6 * 2 * np.pi / w),
-                integration=Integration(technique=MJ, n1=n1, theta=theta),
-                output=Output(output_every=1),
-            )
+            an, exact = den_hartog_case(rr, ratio, Integration(technique=MJ, n1=n1, theta=theta))
             r = an.run()
-            x, v, _ = den_hartog(r.time, m, k, ff, f0, w)
+            x, v, amplitude = exact(r.time)
+            w = 2 * np.pi * an.excitation.frequency
             rows.append(
                 {
                     "theta": theta,

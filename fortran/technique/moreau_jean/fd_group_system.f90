@@ -118,12 +118,7 @@ contains
          gs%factored = .true.
          return
       end if
-      kb = 0
-      do s = 1, gs%ns
-         a = grp(gs%si(s))
-         b = grp(gs%sj(s))
-         if (a > 0 .and. b > 0 .and. a /= b) kb = max(kb, abs(a - b))
-      end do
+      kb = reduced_bandwidth(gs, grp)
       gs%kb = kb
       gs%factorizations = gs%factorizations + 1
       if (kb <= 1) then
@@ -257,12 +252,7 @@ contains
       integer, allocatable :: iwork(:), ifail(:)
       integer :: s, a, b, kb, i, m, info
 
-      kb = 0
-      do s = 1, gs%ns
-         a = grp(gs%si(s))
-         b = grp(gs%sj(s))
-         if (a > 0 .and. b > 0 .and. a /= b) kb = max(kb, abs(a - b))
-      end do
+      kb = reduced_bandwidth(gs, grp)
       allocate (ab(kb + 1, nr), bb(1, nr), w(nr), work(7*nr), iwork(5*nr), ifail(nr), q(1, 1), z(1, 1))
       ab = 0.0_dp
       bb = 0.0_dp
@@ -289,6 +279,21 @@ contains
       end if
       lam = w(1)
    end subroutine gs_lowest_eigenvalue
+
+   !> Half-bandwidth of T'K T for the groups grp: the largest |grp(i) - grp(j)| over the
+   !> springs joining two moving groups.
+   pure integer function reduced_bandwidth(gs, grp) result(kb)
+      type(group_system), intent(in) :: gs       !! the system
+      integer, intent(in) :: grp(0:)             !! group of each node (0:n)
+      integer :: s, a, b
+
+      kb = 0
+      do s = 1, gs%ns
+         a = grp(gs%si(s))
+         b = grp(gs%sj(s))
+         if (a > 0 .and. b > 0 .and. a /= b) kb = max(kb, abs(a - b))
+      end do
+   end function reduced_bandwidth
 
    !> Half-bandwidth of the factored reduced system.
    pure integer function gs_bandwidth(gs)
