@@ -42,9 +42,8 @@ import numpy as np
 
 HERE = Path(__file__).resolve().parent
 sys.path.insert(0, str(HERE))
-from opensees_models import BuildingCase  # noqa: E402
-
-import frictiondyn as fd  # noqa: E402
+import frictiondyn as fd
+from opensees_models import BuildingCase
 
 SIZES = [10, 30, 100, 300, 1000]
 
@@ -115,8 +114,10 @@ def slope(x, y) -> float:
 
 def report(rows: list[dict]) -> str:
     lines = [
-        "| storeys N | steps | us/step CPU | us/step wall | patterns/step | factorizations/step | "
-        "Lemke fallbacks | transitions | residual / input | friction / input |",
+        (
+            "| storeys N | steps | us/step CPU | us/step wall | patterns/step | factorizations/step | "
+            "Lemke fallbacks | transitions | residual / input | friction / input |"
+        ),
         "|---|---|---|---|---|---|---|---|---|---|",
     ]
     for r in rows:
@@ -130,7 +131,9 @@ def report(rows: list[dict]) -> str:
     lines.append("")
     lines.append(f"cost per step (CPU) ~ N^{slope(n, c):.2f} over N = {n[0]} ... {n[-1]}")
     for i in range(1, len(rows)):
-        lines.append(f"  N = {n[i - 1]} -> {n[i]}: exponent {math.log(c[i] / c[i - 1]) / math.log(n[i] / n[i - 1]):.2f}")
+        lines.append(
+            f"  N = {n[i - 1]} -> {n[i]}: exponent {math.log(c[i] / c[i - 1]) / math.log(n[i] / n[i - 1]):.2f}"
+        )
     return "\n".join(lines)
 
 
@@ -155,7 +158,9 @@ def alloc(n: int, durations: tuple[float, float]) -> int:
             steps = round(dur / (case.dt_record / case.n1))
             counts.append(allocs)
             steps_run.append(steps)
-            print(f"N = {n}, {dur:g} s ({steps} steps): {allocs} allocs, {frees} frees, {nbytes} bytes")
+            print(
+                f"N = {n}, {dur:g} s ({steps} steps): {allocs} allocs, {frees} frees, {nbytes} bytes"
+            )
     per_step = (counts[1] - counts[0]) / (steps_run[1] - steps_run[0])
     # set-up and output (the deck's duration, the record's samples kept) may differ by a
     # few allocations; one in the loop would add one per step at least
@@ -170,7 +175,9 @@ def alloc(n: int, durations: tuple[float, float]) -> int:
 def main(argv=None) -> int:
     ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     ap.add_argument("mode", nargs="?", default="cost", choices=["cost", "alloc"])
-    ap.add_argument("--sizes", default=",".join(map(str, SIZES)), help="storey counts, comma-separated")
+    ap.add_argument(
+        "--sizes", default=",".join(map(str, SIZES)), help="storey counts, comma-separated"
+    )
     ap.add_argument("--repeats", type=int, default=5)
     ap.add_argument("--duration", type=float, default=20.0, help="seconds of record (<= 20)")
     ap.add_argument("--out", default="out/bench", help="directory of moreau_jean.json")

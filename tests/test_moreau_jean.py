@@ -79,7 +79,9 @@ def test_block_stops_without_chattering():
     t_stop, d = v0 / (mu * G), v0**2 / (2 * mu * G)
     slide = r.time < t_stop - h
     assert np.allclose(r["v1"][slide], v0 - mu * G * r.time[slide], rtol=0, atol=1e-14)
-    assert np.allclose(r["u1"][slide], v0 * r.time[slide] - 0.5 * mu * G * r.time[slide] ** 2, rtol=1e-12)
+    assert np.allclose(
+        r["u1"][slide], v0 * r.time[slide] - 0.5 * mu * G * r.time[slide] ** 2, rtol=1e-12
+    )
     after = r.time > t_stop + h
     assert np.all(r["v1"][after] == 0.0) and np.all(r["phase1"][after] == 0)
     assert abs(r["u1"][-1] - d) < mu * G * h**2  # the last, partial step (measured 1.3e-7 m)
@@ -89,7 +91,9 @@ def test_block_stops_without_chattering():
 
 def _split_device(an: Analysis, parts: int) -> Analysis:
     d = an.devices[0]
-    an.devices = [Device(d.node_i, d.node_j, d.p / parts, d.mu, law="coulomb") for _ in range(parts)]
+    an.devices = [
+        Device(d.node_i, d.node_j, d.p / parts, d.mu, law="coulomb") for _ in range(parts)
+    ]
     return an
 
 
@@ -103,7 +107,9 @@ def test_identical_devices_in_parallel(parts):
     for q in ("u1", "u2", "v1", "aabs1", "aabs2"):
         assert np.max(np.abs(many[q] - one[q])) <= 1e-12 * np.max(np.abs(one[q])), q
     for k in range(1, parts + 1):
-        assert np.allclose(many[f"F{k}"], one["F1"] / parts, rtol=1e-12, atol=1e-12 * np.max(np.abs(one["F1"])))
+        assert np.allclose(
+            many[f"F{k}"], one["F1"] / parts, rtol=1e-12, atol=1e-12 * np.max(np.abs(one["F1"]))
+        )
         assert np.array_equal(many[f"phase{k}"], one["phase1"])
     s1, sn = one.summary, many.summary
     assert sn["stick_to_slip"] == s1["stick_to_slip"] * parts
@@ -115,9 +121,12 @@ def _twin_towers(n: int, duration: float) -> tuple[Analysis, Analysis]:
     one = v.building(n, duration=duration, output_every=10)
     two = v.building(n, duration=duration, output_every=10)
     two.masses = one.masses * 2
-    two.springs = one.springs + [Spring(s.node_i + n, s.node_j + n if s.node_j else 0, s.k) for s in one.springs]
+    two.springs = one.springs + [
+        Spring(s.node_i + n, s.node_j + n if s.node_j else 0, s.k) for s in one.springs
+    ]
     two.devices = one.devices + [
-        Device(d.node_i + n, d.node_j + n if d.node_j else 0, d.p, d.mu, law="coulomb") for d in one.devices
+        Device(d.node_i + n, d.node_j + n if d.node_j else 0, d.p, d.mu, law="coulomb")
+        for d in one.devices
     ]
     return one, two
 

@@ -54,7 +54,7 @@ from frictiondyn.paper import (
 from oracles import den_hartog, linear_response
 
 sys.path.insert(0, str(Path(__file__).resolve().parents[2] / "bench"))
-from opensees_models import BuildingCase  # noqa: E402  (the benchmark's building, one definition)
+from opensees_models import BuildingCase  # the benchmark's building, one definition
 
 DELTA = 0.05  # m/s: level of |s'| whose crossings time the slides (above the sticking noise)
 
@@ -371,7 +371,9 @@ def history_errors(approx: Result, exact: Result, test: int) -> dict[str, float]
             / float(np.max(np.abs(exact[f"{q}{i}"][w])))
             for i in (1, 2)
         )
-    out["s"] = float(np.max(np.abs(approx["s1"][w] - exact["s1"][w])) / np.max(np.abs(exact["s1"][w])))
+    out["s"] = float(
+        np.max(np.abs(approx["s1"][w] - exact["s1"][w])) / np.max(np.abs(exact["s1"][w]))
+    )
     out["a_rms"] = history_error(approx, exact, test)[0]
     return out
 
@@ -526,7 +528,12 @@ def mj_buildings_exact(
             t0 = time.perf_counter()
             try:
                 ex = building(
-                    n, technique="event_driven", n1=n1, duration=duration, output_every=n1, harmonic=harmonic
+                    n,
+                    technique="event_driven",
+                    n1=n1,
+                    duration=duration,
+                    output_every=n1,
+                    harmonic=harmonic,
                 ).run()
                 failure = ""
             except SolverError as exc:
@@ -567,7 +574,9 @@ def mj_buildings_velocity(
     for n in storeys:
         ref = building(n, n1=40, duration=duration, output_every=40).run()
         for eps in eps_values:
-            r = building(n, technique="newmark", law="velocity", eps=eps, duration=duration, n1=10).run()
+            r = building(
+                n, technique="newmark", law="velocity", eps=eps, duration=duration, n1=10
+            ).run()
             rows.append(
                 {
                     "storeys": n,
@@ -608,18 +617,11 @@ __all__ = [
     "DELTA",
     "MJ",
     "MJSweep",
-    "building",
-    "mj_analysis",
-    "mj_buildings_exact",
-    "mj_buildings_velocity",
-    "mj_convergence",
-    "mj_den_hartog",
-    "mj_scaling",
-    "mj_table1",
     "P",
     "Steady",
     "Sweep",
     "analysis",
+    "building",
     "classify_p",
     "closed_forms",
     "convergence",
@@ -629,6 +631,13 @@ __all__ = [
     "errors",
     "fig3",
     "history_error",
+    "mj_analysis",
+    "mj_buildings_exact",
+    "mj_buildings_velocity",
+    "mj_convergence",
+    "mj_den_hartog",
+    "mj_scaling",
+    "mj_table1",
     "observed_order",
     "p_range",
     "steady",

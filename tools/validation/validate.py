@@ -358,7 +358,9 @@ def mj_section(lines: list[str], figs: Path, subplots, step) -> None:
     add("")
 
     step("Moreau-Jean: buildings against the exact technique")
-    bex = mj_buildings_exact(storeys=(5, 10, 20), harmonic=True) + mj_buildings_exact(storeys=(5, 10))
+    bex = mj_buildings_exact(storeys=(5, 10, 20), harmonic=True) + mj_buildings_exact(
+        storeys=(5, 10)
+    )
     add("### 6.4 Shear buildings with proportional slip loads, against the exact technique")
     add("")
     add("The benchmark's building (bench/opensees_models.py: 1000 t, first period 1 s, storey")
@@ -392,7 +394,11 @@ def mj_section(lines: list[str], figs: Path, subplots, step) -> None:
     add("")
     fails = sorted({r["exact_failure"] for r in bex if r["exact_failure"]})
     if fails:
-        add("Where the exact technique does not run, it says why: " + "; ".join(f"'{m}'" for m in fails) + ".")
+        add(
+            "Where the exact technique does not run, it says why: "
+            + "; ".join(f"'{m}'" for m in fails)
+            + "."
+        )
         add("")
 
     step("Moreau-Jean: buildings against the velocity law")
@@ -442,7 +448,9 @@ def mj_section(lines: list[str], figs: Path, subplots, step) -> None:
         )
     add("")
     slope = observed_order([r["storeys"] for r in sc], [r["us_per_step"] for r in sc])
-    add(f"Cost per step grows like N^{slope:.2f} from {sc[0]['storeys']} to {sc[-1]['storeys']} storeys.")
+    add(
+        f"Cost per step grows like N^{slope:.2f} from {sc[0]['storeys']} to {sc[-1]['storeys']} storeys."
+    )
     add("")
 
     # findings of the section, at its head
@@ -452,21 +460,30 @@ def mj_section(lines: list[str], figs: Path, subplots, step) -> None:
     head = [
         "Findings:",
         "",
-        f"- Den Hartog's closed form: observed order {dh_orders[0.5][0]:.2f} (theta = 1/2) and "
-        f"{dh_orders[1.0][0]:.2f} (theta = 1) in the displacement, first order as the theory says.",
-        f"- Test 4 against the exact technique: theta = 1 converges at first order (peaks "
-        f"{one.order('peak_error'):.2f}, timing {one.order('timing_error'):.2f}); theta = 1/2 at "
-        f"{half.order('peak_error'):.2f} (peaks), {half.order('timing_error'):.2f} (timing), "
-        f"{half.order('u_error'):.2f} (u): the stick-slip events of this test are velocity zeros, "
-        "where the velocity is continuous and the step's error is of second order. At the decks' "
-        f"n1 = 20 the steady peaks are {half.peak_error[2]:.1e} off.",
+        (
+            f"- Den Hartog's closed form: observed order {dh_orders[0.5][0]:.2f} (theta = 1/2) and "
+            f"{dh_orders[1.0][0]:.2f} (theta = 1) in the displacement, first order as the theory says."
+        ),
+        (
+            f"- Test 4 against the exact technique: theta = 1 converges at first order (peaks "
+            f"{one.order('peak_error'):.2f}, timing {one.order('timing_error'):.2f}); theta = 1/2 at "
+            f"{half.order('peak_error'):.2f} (peaks), {half.order('timing_error'):.2f} (timing), "
+            f"{half.order('u_error'):.2f} (u): the stick-slip events of this test are velocity "
+            "zeros, where the velocity is continuous and the step's error is of second order. At "
+            f"the decks' n1 = 20 the steady peaks are {half.peak_error[2]:.1e} off."
+        ),
         f"- Table 1 is reproduced: {sum(st.agrees for st in t1)} of 5 tests classified as observed.",
-        f"- Buildings with proportional slip loads: at n1 = 40 the peaks agree with the exact "
-        f"technique to {max(r['peak_difference'] for r in agree if r['n1'] == 40):.1e} where it runs; "
-        f"under the record it stops ({len([r for r in bex if r['exact_failure']])} runs) while Moreau-Jean runs.",
-        f"- Tall buildings: the energy balance closes to {max(abs(r['residual']) for r in sc):.0e} "
-        f"of the input; {sum(r['fallbacks'] for r in sc)} Lemke fallbacks in "
-        f"{sum(r['steps'] for r in sc)} steps; cost per step ~ N^{slope:.2f}.",
+        (
+            f"- Buildings with proportional slip loads: at n1 = 40 the peaks agree with the exact "
+            f"technique to {max(r['peak_difference'] for r in agree if r['n1'] == 40):.1e} where it "
+            f"runs; under the record it stops ({len([r for r in bex if r['exact_failure']])} runs) "
+            "while Moreau-Jean runs."
+        ),
+        (
+            f"- Tall buildings: the energy balance closes to {max(abs(r['residual']) for r in sc):.0e} "
+            f"of the input; {sum(r['fallbacks'] for r in sc)} Lemke fallbacks in "
+            f"{sum(r['steps'] for r in sc)} steps; cost per step ~ N^{slope:.2f}."
+        ),
         "",
     ]
     at = lines.index("## 6. The Moreau-Jean technique (`technique = 'moreau_jean'`)") + 5
