@@ -22,17 +22,24 @@
 !> Kunisch, SIAM J. Optim. 13, 2002), and block principal pivoting for the dual box LCP in
 !> lambda (Judice and Pires, Comput. Oper. Res. 21, 1994), with their safeguard: all the
 !> violating edges change while the number of violations falls (or for max_backups tries
-!> more), then one at a time (the last violating edge, Murty's rule). The previous step's
-!> pattern is the first guess: in most steps it is right, or one exchange away.
+!> more), then one at a time (the last violating edge, Murty's rule). The first guess is
+!> the previous step's pattern corrected by the trend of the last two solutions
+!> (predict_pattern); a stop found proposes the stops it causes in its neighbours
+!> (expand_stops): devices that stop together are then found together, not one per pattern.
+!> The checks' tolerances are 1e-10 of the size of the terms each quantity is summed from
+!> (rounding, not an approximation).
 !>
 !> **Fallback: Lemke on the edges in doubt.** If the iteration has not ended after max_iter
-!> patterns, the edges whose status changed in this call, or is violated, are put in doubt
+!> patterns (default 2 ne + 50), the edges whose status changed in this call, or is violated, are put in doubt
 !> (D); every other edge keeps its status, the reduced system of the others is factored,
 !> and the box LCP of the edges in D, with the Delassus operator A = B_D' T (T'W T)^-1 T' B_D
 !> (|D| solves) and the free velocities, is solved by Lemke's method (fd_lcp: exact, and
 !> always successful for this symmetric positive semidefinite operator). The edges outside D
 !> are then checked against the result; those violated join D and the LCP is solved again.
 !> D only grows, so this ends, at worst with every edge in D: the whole problem by Lemke.
+!>
+!> pattern_acceleration gives the acceleration at the end of a step from Coulomb's law at the
+!> level of accelerations (no factorization: the groups' masses are diagonal).
 !>
 !> Only solver_setup allocates (the band storage may grow once a pattern needs a wider
 !> band, see fd_group_system; never for a chain).
@@ -74,10 +81,10 @@ module fd_impulse_solver
       real(dp), allocatable :: wt(:)              !! (ne) its estimated relative velocities
       logical :: have_prev = .false.              !! lam_prev, w_prev hold a solution
       logical, allocatable :: locked(:)           !! (ne) sliding edges whose sign is given (never change)
-      ! the pattern of the current factor
-      logical, allocatable :: fstuck(:)
-      real(dp) :: falpha = -1.0_dp, fbeta = -1.0_dp
-      logical :: fvalid = .false.
+      logical, allocatable :: fstuck(:)           !! (ne) the sticking edges of the current factor
+      real(dp) :: falpha = -1.0_dp                !! its alpha
+      real(dp) :: fbeta = -1.0_dp                 !! its beta
+      logical :: fvalid = .false.                 !! the factor and the groups are those of fstuck
       ! work
       logical, allocatable :: stuck(:), changed(:), viol(:), doubt(:)
       real(dp), allocatable :: f(:), q(:), rho(:), sc(:), lsc(:), col(:), rabs(:)
@@ -87,7 +94,7 @@ module fd_impulse_solver
       real(dp), allocatable :: amat(:, :), qv(:), lo(:), hi(:), z(:), wz(:)
       ! counts
       integer :: calls = 0          !! one-step problems solved
-      integer :: patterns = 0       !! patterns solved (linear solves with the reduced factor)
+      integer :: patterns = 0       !! patterns solved (each a solve with a reduced factor and a check)
       integer :: fallbacks = 0      !! calls that needed the Lemke fallback
       integer :: lcp_largest = 0    !! most edges in doubt in a fallback
       real(dp) :: mismatch = 0.0_dp !! largest relative inconsistency of a group's residual met
@@ -400,7 +407,6 @@ contains
       real(dp), intent(in) :: f(:)
       real(dp), intent(out) :: v1(:)
 
-      p%patterns = p%patterns + 1
       call restrict(p%es, f, p%q)
       call gs_solve(p%gs, p%q)
       call expand(p%es, p%q, v1)
@@ -424,6 +430,7 @@ contains
          call add_edge(p%es, e, -p%lam(e), p%f)
       end do
       call reduced_solve(p, p%f, v1)
+      p%patterns = p%patterns + 1
    end subroutine solve_pattern
 
    !> Check a pattern's solution: the sliding edges (not in doubt, not locked) must move their
@@ -552,6 +559,7 @@ contains
             call add_edge(p%es, e, -p%z(k), p%f)
          end do
          call reduced_solve(p, p%f, v1)
+         p%patterns = p%patterns + 1
          call check_pattern(p, alpha, beta, g, v1, nviol, last)
          if (nviol == 0) exit
          ! the violated edges join D; a violated sticking edge in a group with a loop brings
