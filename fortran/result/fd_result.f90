@@ -52,6 +52,8 @@ module fd_result
       integer :: storage = 0           !! effective stiffness stored 1 dense, 2 banded (0: none)
       integer :: bandwidth = 0         !! its half-bandwidth in the solver's ordering
       integer :: events = 0            !! events located (exact technique)
+      integer :: patterns = 0          !! stick-slip patterns solved in one-step problems (Moreau-Jean)
+      integer :: lcp_fallbacks = 0     !! one-step problems that needed Lemke's fallback (Moreau-Jean)
       ! correctness condition, eqs. 9 and 12
       integer :: violations = 0        !! steps accepted that violate it
       integer :: n_violation_times = 0 !! entries used in violation_time

@@ -33,8 +33,8 @@ module fd_newmark
    use fd_friction, only: friction_init, friction_step
    use fd_result, only: result_type
    use fd_run_control, only: run_control
-   use fd_observer, only: observer_type, observer_init, sample_due, observe_start_energy, observe_peaks, &
-                          observe_sample, observe_transitions, observe_violations, observe_end_energy, &
+   use fd_observer, only: observer_type, observer_init, sample_due, observe_start_energies, observe_peaks, &
+                          observe_sample, observe_transitions, observe_violations, observe_end_energies, &
                           observe_poll, observe_stop_error
    implicit none
    private
@@ -138,7 +138,8 @@ contains
       call friction_init(model%dev, w%s, w%sd, w%st, error)
       if (allocated(error)) return
       call consistent_acceleration(model, exc, 0.0_dp, w)
-      call observe_start_energy(w%obs, w%mass, w%v, strain_energy(model, w%u), device_energy(w%st, w%s))
+      call observe_start_energies(w%obs, 0.5_dp*sum(w%mass*w%v**2), strain_energy(model, w%u), &
+                                  device_energy(w%st, w%s))
       w%f = device_force(w%st, w%s, w%sd)
       w%phase0 = w%st%phase
       call observe_sample(w%obs, res, 0.0_dp, w%ag, w%u, w%v, w%a, w%s, w%sd, w%f, w%phase0)
@@ -178,7 +179,8 @@ contains
             return
          end if
       end do
-      call observe_end_energy(w%obs, res, w%mass, w%v, strain_energy(model, w%u), device_energy(w%st, w%s), &
+      call observe_end_energies(w%obs, res, 0.5_dp*sum(w%mass*w%v**2), strain_energy(model, w%u), &
+                                device_energy(w%st, w%s), &
                               w%w_device)
       do l = 1, size(w%lev)
          associate (stats => w%lev(l)%sys%stats)
