@@ -353,6 +353,53 @@ def test_runs_in_threads_overlap_without_the_gil(tmp_path):
     assert both, "the two runs never advanced together"
 
 
+# ----------------------------------------------------------------- one observer, every technique
+
+
+@pytest.mark.parametrize("technique", ["event_driven", "moreau_jean"])
+def test_run_control_is_the_same_for_the_coulomb_techniques(tmp_path, technique):
+    """The exact and Moreau-Jean techniques report through the same observer as Newmark:
+    selected columns equal those of the full history, the executable's streamed CSV equals
+    the Result bit for bit, progress reaches the end, a cancelled run raises RunCancelled
+    promptly and leaves no output."""
+    n = 4
+
+    def coulomb(duration, output):
+        g = building(n=n, law="coulomb", duration=duration, output=output)
+        g["integration"] = {"technique": technique, "n1": 5}
+        return g
+
+    g = coulomb(1.0, {"output_every": 1, "dir": "out", "name": "c"})
+    full = run(g)
+    assert full.summary["technique"] == technique
+    part = run(g, dofs=[2, 4], devices=[3])
+    assert part.names == ["t", "ag", "u2", "v2", "aabs2", "u4", "v4", "aabs4", "s3", "sdot3", "F3", "phase3"]
+    for name in part.names:
+        assert np.array_equal(part[name], full[name]), name
+    assert part.summary == {**full.summary, "run_time_s": part.summary["run_time_s"]}
+    deck = tmp_path / "c.nml"
+    deck.write_text(deck_text(g))
+    proc = subprocess.run([fd.executable(), str(deck)], cwd=tmp_path, capture_output=True, text=True)
+    assert proc.returncode == 0, proc.stderr
+    exe = fd.Result.from_files(tmp_path / "out" / "c.csv")
+    assert exe.names == full.names and np.array_equal(exe.data, full.data)
+    seen: list[tuple[float, float]] = []
+    fd.run(deck, progress=lambda t, d: seen.append((t, d)))
+    assert seen and seen[-1] == (1.0, 1.0)
+    # a run of hours of motion, cancelled from another thread
+    long = tmp_path / "long.nml"
+    long.write_text(deck_text(coulomb(1.0e5, {"output_every": 1000, "dir": "out2", "name": "long"})))
+    with fd.Session(long) as s:
+        s.stream(tmp_path / "out2")
+        threading.Timer(0.3, s.cancel).start()
+        t0 = time.perf_counter()
+        with pytest.raises(fd.RunCancelled, match="cancelled at t = "):
+            s.solve(history=False)
+        assert time.perf_counter() - t0 < 5.0
+        assert 0.0 < s.progress()[0] < 1.0e5
+    assert not (tmp_path / "out2").exists() or list((tmp_path / "out2").iterdir()) == []
+
+
 # ----------------------------------------------------------------- capacity, modes
 
 
