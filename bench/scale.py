@@ -236,8 +236,10 @@ def interrupt(work: Path, n: int, repeats: int) -> dict:
         p = subprocess.run([sys.executable, "-c", INTERRUPT, str(deck), str(0.3 + 0.07 * k), str(n)],
                            capture_output=True, text=True, check=False)
         words = p.stdout.split()
-        if "latency" in words:
-            lat.append(float(words[-1]))
+        if "latency" in words:  # the number follows the word (other output may come after it)
+            lat.append(float(words[words.index("latency") + 1]))
+        else:
+            print(f"interrupt run {k}: no latency reported: {(p.stdout + p.stderr).strip()[-300:]!r}", flush=True)
     print(f"Ctrl-C during fd.run (N = {n}): KeyboardInterrupt after {statistics.median(lat) * 1e3:.1f} ms "
           f"(median of {len(lat)}), at most {max(lat) * 1e3:.1f} ms", flush=True)
     return {"n": n, "latency_s": lat, "median_s": statistics.median(lat), "max_s": max(lat)}
