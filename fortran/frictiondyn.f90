@@ -24,11 +24,15 @@ contains
    !> Run the analysis a configuration defines (no files written) with the technique of
    !> its &integration: 'newmark' (the velocity and hysteretic laws) or 'event_driven'
    !> (exact Coulomb friction); an error for anything that technique cannot integrate.
+   !> A solver's error names the deck.
    subroutine run_config_solve(cfg, res, error)
       type(run_config), intent(in) :: cfg                 !! model, excitation, settings
       type(result_type), intent(out) :: res               !! histories and summary
       type(error_type), allocatable, intent(out) :: error !! failure of the solver
       call run_technique(cfg%model, cfg%exc, cfg%opts, res, error)
+      if (allocated(error) .and. allocated(cfg%deck_path)) then
+         if (len(cfg%deck_path) > 0) error%message = cfg%deck_path//": "//error%message
+      end if
    end subroutine run_config_solve
 
    !> Columns and samples of the history the configuration's run produces.

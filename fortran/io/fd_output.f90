@@ -214,6 +214,13 @@ contains
       call kv('steps_finer', trim(fmt_int(res%steps_finer)))
       call kv('factorizations', trim(fmt_int(res%factorizations)))
       call kv('events', trim(fmt_int(res%events)))
+      if (res%exact_peaks) then
+         ! the exact technique: peaks are the exact extrema; its event times, accumulations
+         call kv('peaks_exact', 'true')
+         call kr('event_times_s', res%event_time(1:res%n_event_times))
+         call kv('accumulation_points', trim(fmt_int(res%accumulations)))
+         call kr('accumulation_times_s', res%accumulation_time(1:res%n_accumulation_times))
+      end if
       call kv('correctness_violations', trim(fmt_int(res%violations)))
       call kr('violation_times_s', res%violation_time(1:res%n_violation_times))
       call ki('violation_devices', res%violation_device(1:res%n_violation_times))

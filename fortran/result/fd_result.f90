@@ -3,14 +3,16 @@
 module fd_result
    use fd_kinds, only: dp
    use fd_error, only: error_type, fatal_error, fmt_int
-   use fd_model, only: model_type, integration_type
+   use fd_model, only: model_type, integration_type, technique_event_driven
    use fd_excitation, only: excitation_type
    implicit none
    private
 
    public :: result_type, max_violation_times, column_name_len, init_result, history_shape
+   public :: max_event_times, has_envelope
 
    integer, parameter :: max_violation_times = 10 !! first violation times kept
+   integer, parameter :: max_event_times = 1000   !! first event times kept (exact technique)
    integer, parameter :: column_name_len = 16     !! length of a column name
 
    !> Everything a run produces.
@@ -47,7 +49,15 @@ module fd_result
       integer :: steps_finer = 0       !! steps taken with dt2/2, dt2/4, ...
       integer :: factorizations = 0    !! factorizations of the effective stiffness
                                        !! (exact technique: matrix exponentials)
-      integer :: events = 0            !! events located (exact technique)
+      integer :: events = 0            !! events located (exact technique): instants at which
+                                       !! phases changed
+      integer :: n_event_times = 0     !! entries used in event_time
+      real(dp) :: event_time(max_event_times) = 0.0_dp !! times of the first events [s]
+      integer :: accumulations = 0     !! accumulation points of events (Zeno), handled
+      integer :: n_accumulation_times = 0 !! entries used in accumulation_time
+      real(dp) :: accumulation_time(max_violation_times) = 0.0_dp !! their first times [s]
+      logical :: exact_peaks = .false. !! peaks are the exact extrema (exact technique)
+      integer :: env_col = 0           !! first column of the maxima between rows (0: none)
       ! correctness condition, eqs. 9 and 12
       integer :: violations = 0        !! steps accepted that violate it
       integer :: n_violation_times = 0 !! entries used in violation_time
@@ -66,8 +76,19 @@ module fd_result
 
 contains
 
+   !> Whether a run of these settings writes, after the state columns, the maxima of |u|,
+   !> |v|, |aabs| per DOF and |s|, |F| per device since the previous row (the exact
+   !> technique, whose solution between rows is known).
+   pure logical function has_envelope(opts)
+      type(integration_type), intent(in) :: opts    !! integration settings
+
+      has_envelope = opts%technique == technique_event_driven
+   end function has_envelope
+
    !> Size of the history a run writes: columns t, ag, (u, v, aabs) per DOF and
-   !> (s, sdot, F, phase) per device; samples at t = 0, every `every` dt1 steps and at the end.
+   !> (s, sdot, F, phase) per device, then (exact technique) the maxima since the previous
+   !> row (peak_u, peak_v, peak_aabs) per DOF and (peak_s, peak_F) per device; samples at
+   !> t = 0, every `every` dt1 steps and at the end.
    pure subroutine history_shape(model, exc, opts, ncol, nout, nsteps, every)
       type(model_type), intent(in) :: model         !! the model
       type(excitation_type), intent(in) :: exc      !! the table motion
@@ -78,6 +99,7 @@ contains
       integer, intent(out) :: every                 !! dt1 steps between samples
 
       ncol = 2 + 3*model%n_dof + 4*model%n_devices
+      if (has_envelope(opts)) ncol = ncol + 3*model%n_dof + 2*model%n_devices
       nsteps = max(1, nint(exc%duration/(exc%dt_record/opts%n1)))
       every = opts%output_every
       if (every <= 0) every = opts%n1
@@ -125,6 +147,21 @@ contains
          res%names(c + 4) = 'phase'//trim(fmt_int(i)); res%units(c + 4) = '-'
          c = c + 4
       end do
+      if (has_envelope(opts)) then
+         res%env_col = c + 1
+         res%exact_peaks = .true.
+         do i = 1, n
+            res%names(c + 1) = 'peak_u'//trim(fmt_int(i)); res%units(c + 1) = 'm'
+            res%names(c + 2) = 'peak_v'//trim(fmt_int(i)); res%units(c + 2) = 'm/s'
+            res%names(c + 3) = 'peak_aabs'//trim(fmt_int(i)); res%units(c + 3) = 'm/s2'
+            c = c + 3
+         end do
+         do i = 1, nd
+            res%names(c + 1) = 'peak_s'//trim(fmt_int(i)); res%units(c + 1) = 'm'
+            res%names(c + 2) = 'peak_F'//trim(fmt_int(i)); res%units(c + 2) = 'N'
+            c = c + 2
+         end do
+      end if
       allocate (res%peak_u(n), res%peak_u_time(n), res%peak_v(n), res%peak_aabs(n), &
                 res%peak_aabs_time(n))
       res%peak_u = 0.0_dp; res%peak_u_time = 0.0_dp; res%peak_v = 0.0_dp
