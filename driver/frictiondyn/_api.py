@@ -263,7 +263,9 @@ class Result:
     ``result["u1"]`` is a column by name (see ``names``, ``units``); ``time`` is ``t``;
     ``dof(i)`` and ``device(d)`` group the series of one DOF or device (1-based);
     ``summary`` is the run's summary (peaks, transitions, steps, correctness violations,
-    energy) as a dict.
+    energy) as a dict; ``peak(name, t_range)`` the peak of a series (exact for the exact
+    technique, whose peaks include the extrema between rows and the one-sided values at
+    events).
     """
 
     names: list[str]
@@ -345,6 +347,27 @@ class Result:
             "F": self[f"F{d}"],
             "phase": self[f"phase{d}"],
         }
+
+    def peak(self, name: str, t_range: tuple[float, float] | None = None) -> float:
+        """Largest |name| (``'aabs2'``, ``'u1'``, ``'F1'``, ...) over the run, or over the rows
+        with ``t_range[0] <= t <= t_range[1]``.
+
+        For the exact technique it is exact: its history holds, in ``peak_<name>``, the
+        maxima since the previous row (extrema between rows and one-sided values at events
+        included), so this is the true peak over the time from the range's first row to its
+        last. Otherwise it is the largest sampled value of the rows in the range."""
+        t = self.time
+        if t_range is None:
+            rows = np.arange(len(t))
+        else:
+            rows = np.nonzero((t >= t_range[0] - 1e-12) & (t <= t_range[1] + 1e-12))[0]
+        if rows.size == 0:
+            raise ValueError(f"no history row in the time range {t_range}")
+        values = np.abs(self[name][rows])
+        if f"peak_{name}" not in self:
+            return float(values.max())
+        envelope = self[f"peak_{name}"][rows[1:]]
+        return float(max(values[0], envelope.max(initial=0.0)))
 
     def label(self, name: str) -> str:
         """Axis label 'name [unit]'."""

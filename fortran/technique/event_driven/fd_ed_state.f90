@@ -39,6 +39,7 @@ module fd_ed_state
       real(dp), allocatable :: qc(:, :), pc(:, :), cp(:, :) !! Taylor coefficients (n, 0:kmax+1)
       real(dp), allocatable :: g(:), gn(:)                 !! table acceleration, remainder factors (0:kmax)
       real(dp) :: rem = 0.0_dp                             !! remainder bound of the state's norm
+      real(dp) :: size = 0.0_dp                            !! the state polynomial's size
       integer :: order = 2                                 !! Taylor degree K of the sub-interval
       real(dp) :: span = 0.0_dp                            !! sub-interval length S
       real(dp), allocatable :: yc(:, :)                    !! quantities (0:kmax, nquant)
@@ -56,6 +57,7 @@ module fd_ed_state
       logical, allocatable :: crossed(:), near(:)
       ! vectors over the DOFs and over the devices
       real(dp), allocatable :: fn(:), pe(:), pa(:), qa(:, :), pq(:, :)
+      real(dp), allocatable :: aab(:)                      !! magnitude of the terms of each group's acceleration
    end type ed_state
 
 contains
@@ -109,7 +111,7 @@ contains
                 st%offs(2*nd), st%eon(2*nd), st%pw(0:kmax, 0:max_depth), st%pw2(0:kmax), st%pc1(0:kmax), &
                 st%roots(kmax), st%wm(nd, nd), st%lq(nd), st%lqa(nd), st%lo(nd), st%hi(nd), st%z(nd), st%w(nd), &
                 st%zs(nd), st%cand(nd), st%sig(nd), st%newph(nd), st%oldph(nd), st%crossed(nd), st%near(nd), &
-                st%fn(n), st%pe(n), st%pa(n), st%qa(n, 0:kmax + 1), st%pq(n, 0:kmax + 1), stat=stat)
+                st%fn(n), st%pe(n), st%pa(n), st%aab(n), st%qa(n, 0:kmax + 1), st%pq(n, 0:kmax + 1), stat=stat)
       if (stat /= 0) then
          call fatal_error(error, "not enough memory for the exact technique's state of n_dof = "// &
                           trim(fmt_int(n))//" DOFs and n_devices = "//trim(fmt_int(nd))//" devices")
@@ -150,9 +152,18 @@ contains
          kk = min(kmax, pat%order + 4)
          call table_taylor(exc, t, st%g(0:kk), st%gn(0:kk))
          call pattern_series(pat, st%q, st%p, st%b1, st%g(0:kk), st%gn(0:kk), span, st%qc, st%pc, st%cp, &
-                             st%order, st%rem)
+                             st%order, st%rem, st%size)
          kk = st%order
          rg = st%gn(kk)*span**(kk + 1)          ! remainder of ag
+         ! the magnitude of the terms that make up each group's acceleration: the rounding
+         ! level of the velocities' and forces' variation over the sub-interval
+         do i = 1, pat%nq
+            a0 = abs(st%b1(i)) + abs(st%g(0))
+            do j = 1, pat%nq
+               a0 = a0 + abs(pat%kt(i, j)*st%q(j)) + abs(pat%ct(i, j)*st%p(j))
+            end do
+            st%aab(i) = a0
+         end do
          ! per DOF: u, v, aabs
          do i = 1, st%n
             gi = pat%grp(i)
@@ -214,11 +225,11 @@ contains
                   st%ec(j, e) = st%phase(d)*x
                end do
                if (gi > 0) then
-                  a0 = a0 + abs(st%pc(gi, 0))
+                  a0 = a0 + abs(st%pc(gi, 0)) + span*st%aab(gi)
                   st%erem(e) = st%erem(e) + pat%wp(gi)*st%rem
                end if
                if (gj > 0) then
-                  a0 = a0 + abs(st%pc(gj, 0))
+                  a0 = a0 + abs(st%pc(gj, 0)) + span*st%aab(gj)
                   st%erem(e) = st%erem(e) + pat%wp(gj)*st%rem
                end if
                st%eta(e) = 256.0_dp*epsilon(1.0_dp)*(a0 + poly_abs_bound(st%ec(0:kk, e), span))
@@ -234,8 +245,10 @@ contains
                      f(j + 1) = sk
                   end do
                   f(1) = f(1) + st%f0(r)
+                  a0 = a0 + span*abs(pat%fag(r)*st%g(1))
                   do i = 1, pat%nq
-                     a0 = a0 + abs(pat%fq(r, i)*st%qc(i, 0)) + abs(pat%fp(r, i)*st%pc(i, 0))
+                     a0 = a0 + abs(pat%fq(r, i)*st%qc(i, 0)) + abs(pat%fp(r, i)*st%pc(i, 0)) + &
+                          span*(abs(pat%fq(r, i)*st%pc(i, 0)) + abs(pat%fp(r, i))*st%aab(i))
                   end do
                   st%yrem(iq_f(st%n, d)) = pat%wf(r)*st%rem + abs(pat%fag(r))*rg
                   st%ec(0:kk, e) = -f

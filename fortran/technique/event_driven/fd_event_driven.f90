@@ -191,8 +191,8 @@ contains
       !> The loop over sub-intervals from t = 0 to t_end.
       subroutine advance_run(err)
          type(error_type), allocatable, intent(out) :: err
-         real(dp) :: span, tb, s_use, s_ev, thr, smin, tol, t_new, worst
-         integer :: e, kk, halvings, iq
+         real(dp) :: span, tb, s_use, s_ev, thr, smin, tol, t_new
+         integer :: e, kk, halvings
          logical :: fired, found, fresh
 
          associate (st => w%st)
@@ -200,14 +200,10 @@ contains
             do while (t < t_end)
                tb = segment_end(exc, t, t_end)
                span = min(st%cache%slot(st%cur)%delta, tb - t)
-               ! the polynomials, with a remainder below the rounding level
+               ! the polynomials, with a remainder below the rounding level of the state
                do halvings = 0, 40
                   call ed_polynomials(model, exc, t, span, st)
-                  worst = 0.0_dp
-                  do iq = 1, st%nquant
-                     worst = max(worst, st%yrem(iq)/max(poly_abs_bound(st%yc(0:st%order, iq), span), tiny(1.0_dp)))
-                  end do
-                  if (worst <= 1.0e-13_dp) exit
+                  if (st%rem <= 2.0_dp**(-50)*st%size) exit
                   span = 0.5_dp*span
                end do
                kk = st%order

@@ -471,7 +471,7 @@ contains
    !> header; q'Kq q bounded by w2 q'Mq q) falls below 2^-52 of the polynomial's size,
    !> sum_k ||x_k|| span^k, or to ubound(g). g, gn: the table acceleration's coefficients
    !> and remainder factors (0:kcap). Returns K and the bound.
-   pure subroutine pattern_series(pat, q, p, b1, g, gn, span, qc, pc, cp, order, rem)
+   pure subroutine pattern_series(pat, q, p, b1, g, gn, span, qc, pc, cp, order, rem, size)
       type(pattern_type), intent(in) :: pat         !! the pattern
       real(dp), intent(in) :: q(:), p(:)            !! reduced state (nq)
       real(dp), intent(in) :: b1(:)                 !! constant load (nq)
@@ -481,12 +481,14 @@ contains
       real(dp), intent(out) :: cp(:, 0:)            !! Cq pc (n, 0:kmax)
       integer, intent(out) :: order                 !! the degree K
       real(dp), intent(out) :: rem                  !! bound of the remainder's norm over [0, S]
+      real(dp), intent(out) :: size                 !! sum_k ||x_k|| S^k
       integer :: kk, nq, i, j
-      real(dp) :: f, e, sk, size, grow, nrm
+      real(dp) :: f, e, sk, grow, nrm
 
       nq = pat%nq
       order = 5
       rem = 0.0_dp
+      size = 0.0_dp
       if (nq == 0) return
       qc(1:nq, 0) = q(1:nq)
       pc(1:nq, 0) = p(1:nq)
