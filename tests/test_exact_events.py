@@ -354,3 +354,20 @@ def test_exact_steady_state_peak_of_test4(run):
     assert peaks[0] == pytest.approx(peaks[1], rel=1e-13)
     assert peaks[0] == pytest.approx(9.93062, abs=5e-6)
     assert sampled[0] == pytest.approx(9.92559, abs=5e-6) and sampled[1] < sampled[0] < peaks[0]
+
+
+def test_an_error_names_the_deck_the_time_and_what_to_try(run):
+    """A state that overflows (u0 = 1e307 m on a 1e4 N/m spring): the exact technique
+    stops with an error naming the deck, the time and what to check, and leaves no output."""
+    g = {
+        "model": {"n_dof": 1, "mass": [1.0], "u0": [1.0e307]},
+        "springs": {"n_springs": 1, "node_i": [1], "node_j": [0], "k": [1.0e4]},
+        "damping": {"damping_type": "none"},
+        "friction": {"n_devices": 1, "node_i": 1, "node_j": 0, "law": "coulomb", "p": 10.0, "mu": 0.5},
+        "excitation": {"excitation_type": "none", "dt_record": 0.01, "duration": 1.0},
+        "integration": {"technique": "event_driven"},
+    }
+    r = run(g, name="overflow")
+    assert r.returncode != 0 and not r.outdir.exists()
+    for w in ("overflow.nml", "event-driven technique at t = 0 s", "not finite", "u0"):
+        assert w in r.stderr, f"{w!r} not in {r.stderr!r}"

@@ -362,8 +362,9 @@ contains
                call absorb_until(sr)
                call values_at(sr, w%yv)
                if (.not. all(ieee_is_finite(w%yv))) then
-                  call fatal_error(err, "the solution is not finite at t = "//trim(fmt_real(s_row))// &
-                                   " s; check the masses, springs and table motion")
+                  call fatal_error(err, "event-driven technique at t = "//trim(fmt_real(s_row))// &
+                                   " s: the solution is not finite (an overflow); check the masses, the "// &
+                                   "stiffnesses, the initial displacements u0 and velocities v0, and the table motion")
                   return
                end if
                do iq = 1, st%nquant
@@ -564,7 +565,7 @@ contains
                call fatal_error(err, "event-driven technique at t = "//trim(fmt_real(t))//" s: "// &
                                 trim(fmt_int(ring_size))//" phase changes within "// &
                                 trim(fmt_real(accumulation_span*max(1.0_dp, abs(t))))//" s, and sticking at their "// &
-                                "limit would need forces above P mu in devices "//list//"; try technique = "// &
+                                "limit would need forces above P mu in "//list//"; try technique = "// &
                                 "'newmark' with law = 'velocity', or report the deck")
                return
             end if

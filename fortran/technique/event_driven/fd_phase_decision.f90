@@ -37,6 +37,7 @@
 !> limit while the LCP's forces do not, the LCP's share is kept (a constant in the null
 !> space of the incidence) until the next event.
 module fd_phase_decision
+   use, intrinsic :: ieee_arithmetic, only: ieee_is_finite
    use fd_kinds, only: dp
    use fd_error, only: error_type, fatal_error, fmt_int, fmt_real
    use fd_model, only: model_type
@@ -110,6 +111,12 @@ contains
             st%pa(model%dev(d)%node_i) = st%pa(model%dev(d)%node_i) + st%slip(d)
             if (model%dev(d)%node_j > 0) st%pa(model%dev(d)%node_j) = st%pa(model%dev(d)%node_j) + st%slip(d)
          end do
+         if (.not. all(ieee_is_finite(st%pe))) then
+            call fatal_error(error, "event-driven technique at t = "//trim(fmt_real(t))//" s: the forces on "// &
+                             "the structure are not finite (an overflow); check the masses, the stiffnesses, "// &
+                             "the initial displacements u0 and velocities v0, and the table motion")
+            return
+         end if
          do a = 1, nc
             st%lq(a) = -rel_over_mass(model, st%cand(a), st%pe, st%mass)
             st%lqa(a) = abs_over_mass(model, st%cand(a), st%pa, st%mass)
@@ -374,13 +381,14 @@ contains
       end do
    end function group_delassus
 
-   !> "d1, d2, ..." of the devices idx(1:m) (at most 20 named).
+   !> "device d" or "devices d1, d2, ..." of the devices idx(1:m) (at most 20 named).
    subroutine device_list(idx, m, text)
       integer, intent(in) :: idx(:)
       integer, intent(in) :: m
       character(len=:), allocatable, intent(out) :: text
       integer :: a
-      text = ''
+      text = 'devices '
+      if (m == 1) text = 'device '
       do a = 1, min(m, 20)
          text = text//trim(fmt_int(idx(a)))
          if (a < min(m, 20)) text = text//', '
@@ -398,7 +406,7 @@ contains
       character(len=:), allocatable :: list
       call device_list(idx, m, list)
       call fatal_error(error, "event-driven technique at t = "//trim(fmt_real(t))//" s: "//what// &
-                       " of devices "//list//" was not solved ("//trim(lcp_status_text(info%status))//", residual "// &
+                       " of "//list//" was not solved ("//trim(lcp_status_text(info%status))//", residual "// &
                        trim(fmt_real(info%residual))//"); try a small change of the slip loads P mu of "// &
                        "these devices, or technique = 'newmark' with law = 'velocity'")
    end subroutine lcp_failed
