@@ -63,6 +63,7 @@ module fd_event_driven
       integer :: n_events = 0                             !! event instants at which phases changed
       real(dp) :: ring(ring_size) = -huge(1.0_dp)         !! times of the last events
       integer :: ring_pos = 0
+      real(dp) :: last_accumulation = -huge(1.0_dp)       !! time of the last accumulation point
    end type ed_work
 
 contains
@@ -518,6 +519,13 @@ contains
             w%ring(w%ring_pos) = t
             oldest = mod(w%ring_pos, ring_size) + 1
             if (t - w%ring(oldest) <= accumulation_span*max(1.0_dp, abs(t))) then
+               if (t - w%last_accumulation <= accumulation_span*max(1.0_dp, abs(t))) then
+                  call fatal_error(err, "event-driven technique at t = "//trim(fmt_real(t))//" s: events "// &
+                                   "accumulate again where sticking at the limit of the sequence should have "// &
+                                   "ended them; try technique = 'newmark' with law = 'velocity', or report the deck")
+                  return
+               end if
+               w%last_accumulation = t
                call accumulation(err)
                if (allocated(err)) return
                w%ring = -huge(1.0_dp)

@@ -78,6 +78,8 @@ contains
       n = st%n
       nd = st%nd
       changed = .false.
+      slot0 = 0
+      slot1 = 0
       st%oldph = st%phase
       st%newph = st%phase
       call table_motion(exc, t, xg, vg, ag)
