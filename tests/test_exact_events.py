@@ -14,6 +14,7 @@ and reports exact peaks.
 
 from __future__ import annotations
 
+import itertools
 import math
 
 import numpy as np
@@ -73,7 +74,7 @@ def synthetic_record(seed: int = 7, dt: float = 0.01, duration: float = 10.0, pg
     zeta_g = 0.6) of unit white noise, integrated with 20 sub-steps a sample; envelope t^2
     rising to 1.5 s, flat to 5 s, exp(-0.5 (t - 5)) after; scaled to the PGA; starts at 0."""
     rng = np.random.default_rng(seed)
-    n = int(round(duration / dt)) + 1
+    n = round(duration / dt) + 1
     noise = rng.normal(0.0, 1.0, n)
     wg, zg = 5.0 * np.pi, 0.6
     x = v = 0.0
@@ -156,7 +157,12 @@ def symmetric_structure() -> dict:
     identical device: both devices stick and slip at the same instants."""
     return {
         "model": {"n_dof": 3, "mass": [2.0, 2.0, 3.0]},
-        "springs": {"n_springs": 3, "node_i": [1, 2, 3], "node_j": [0, 0, 0], "k": [2000.0, 2000.0, 500.0]},
+        "springs": {
+            "n_springs": 3,
+            "node_i": [1, 2, 3],
+            "node_j": [0, 0, 0],
+            "k": [2000.0, 2000.0, 500.0],
+        },
         "damping": {"damping_type": "rayleigh", "rayleigh_a0": 0.2, "rayleigh_a1": 0.0005},
         "friction": {
             "n_devices": 2,
@@ -221,10 +227,25 @@ CASES = {
     # name: (groups, files, eps sequence, DOFs); the eps are where the velocity law's error
     # is first order (at smaller eps Newmark's own step error, ~1e-5, sets a floor)
     "parallel devices": (parallel_devices, False, (1e-3, 5e-4, 2.5e-4), 2),
-    "5-storey, slip loads 9 % of the weight above": (lambda: shear_building(5, 0.09), True, (5e-5, 2.5e-5, 1.25e-5), 5),
-    "20-storey, slip loads 10 % of the weight above": (lambda: shear_building(20, 0.10), True, (2e-4, 1e-4, 5e-5), 20),
+    "5-storey, slip loads 9 % of the weight above": (
+        lambda: shear_building(5, 0.09),
+        True,
+        (5e-5, 2.5e-5, 1.25e-5),
+        5,
+    ),
+    "20-storey, slip loads 10 % of the weight above": (
+        lambda: shear_building(20, 0.10),
+        True,
+        (2e-4, 1e-4, 5e-5),
+        20,
+    ),
     "symmetric structure": (symmetric_structure, False, (1e-3, 5e-4, 2.5e-4), 3),
-    "a limit reached as another device stops": (limit_when_another_stops, False, (1e-3, 5e-4, 2.5e-4), 2),
+    "a limit reached as another device stops": (
+        limit_when_another_stops,
+        False,
+        (1e-3, 5e-4, 2.5e-4),
+        2,
+    ),
 }
 
 
@@ -244,7 +265,9 @@ def test_simultaneous_events(run, case):
     assert s["accumulation_points"] == 0
     assert s["events"] > 0 and sum(s["stick_to_slip"]) > 0
     # some events change several devices at once
-    assert sum(s["stick_to_slip"]) + sum(s["slip_to_stick"]) + sum(s["slip_reversals"]) > s["events"]
+    assert (
+        sum(s["stick_to_slip"]) + sum(s["slip_to_stick"]) + sum(s["slip_reversals"]) > s["events"]
+    )
     scale = max(s["energy_input_J"], s["energy_friction_J"])
     assert abs(s["energy_residual_J"]) < 1e-12 * scale
     ex = exact.history()
@@ -252,7 +275,7 @@ def test_simultaneous_events(run, case):
     for eps in eps_list:
         vel = ok(run(velocity_groups(groups, eps), files=files))
         errs.append(errors(vel.history(), ex, n_dof))
-    for (h0, p0), (h1, p1) in zip(errs, errs[1:]):
+    for (h0, p0), (h1, p1) in itertools.pairwise(errs):
         assert 0.85 < math.log2(h0 / h1) < 1.15, f"history errors {errs}"
         assert 0.85 < math.log2(p0 / p1) < 1.15, f"peak errors {errs}"
 
@@ -325,14 +348,23 @@ def test_maxima_between_rows_do_not_depend_on_the_rows(run):
         assert np.all(c[1:] >= vals[1:]) and np.all(c[1:] >= vals[:-1]), q
 
 
+SUMMARY_PEAK = {
+    "aabs": "peak_aabs_mps2",
+    "u": "peak_u_m",
+    "v": "peak_v_mps",
+    "s": "peak_s_m",
+    "F": "peak_force_N",
+}
+
+
 def _summary_key(q: str) -> str:
-    return {"aabs": "peak_aabs_mps2", "u": "peak_u_m", "v": "peak_v_mps", "s": "peak_s_m", "F": "peak_force_N"}[
-        q.rstrip("0123456789")
-    ]
+    """The summary's peak key of a series name (aabs2 -> peak_aabs_mps2)."""
+    return SUMMARY_PEAK[q[:-1]]
 
 
 def _index(q: str) -> int:
-    return int(q.lstrip("aabsuvF")) - 1
+    """The 0-based index of a series name's DOF or device (aabs2 -> 1)."""
+    return int(q[-1]) - 1
 
 
 def test_exact_steady_state_peak_of_test4(run):
@@ -363,7 +395,14 @@ def test_an_error_names_the_deck_the_time_and_what_to_try(run):
         "model": {"n_dof": 1, "mass": [1.0], "u0": [1.0e307]},
         "springs": {"n_springs": 1, "node_i": [1], "node_j": [0], "k": [1.0e4]},
         "damping": {"damping_type": "none"},
-        "friction": {"n_devices": 1, "node_i": 1, "node_j": 0, "law": "coulomb", "p": 10.0, "mu": 0.5},
+        "friction": {
+            "n_devices": 1,
+            "node_i": 1,
+            "node_j": 0,
+            "law": "coulomb",
+            "p": 10.0,
+            "mu": 0.5,
+        },
         "excitation": {"excitation_type": "none", "dt_record": 0.01, "duration": 1.0},
         "integration": {"technique": "event_driven"},
     }

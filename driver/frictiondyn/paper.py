@@ -15,7 +15,6 @@ and a ``report.md`` with the table and the numbers behind each figure.
 from __future__ import annotations
 
 import math
-
 import os
 import sys
 from collections.abc import Callable

@@ -70,7 +70,9 @@ class Steady:
         r = self.result
         w = steady_window(r, TABLE1[self.state.test][0])
         t = r.time[w]
-        pick = np.ones(t.size, bool) if times is None else np.isin(np.round(t, 9), np.round(times, 9))
+        pick = (
+            np.ones(t.size, bool) if times is None else np.isin(np.round(t, 9), np.round(times, 9))
+        )
         return np.array([np.max(np.abs(r[f"aabs{i}"][w][pick])) for i in (1, 2)])
 
     @property
@@ -375,12 +377,12 @@ __all__ = [
     "critical_p",
     "energy",
     "errors",
-    "residual",
-    "true_peak_error",
     "fig3",
     "history_error",
     "observed_order",
     "p_range",
+    "residual",
     "steady",
     "table1",
+    "true_peak_error",
 ]

@@ -179,9 +179,18 @@ def main(outdir: str | Path, progress=None) -> Path:
         )
     add("")
     # every run of the studies above: each n1 of the dt1 sweep, each eps and f
-    n1s = [int(round(TABLE1[4][2] / x)) for x in sweeps[2].values]
-    ex_res = max(sweeps[2].exact_residual + sweeps[0].exact_residual + [r["residual"] for r in rows3 if r["run"] == "exact"])
-    nm_res = max(sweeps[0].residual + sweeps[1].residual + sweeps[2].residual + [r["residual"] for r in rows3 if r["run"] != "exact"])
+    n1s = [round(TABLE1[4][2] / x) for x in sweeps[2].values]
+    ex_res = max(
+        sweeps[2].exact_residual
+        + sweeps[0].exact_residual
+        + [r["residual"] for r in rows3 if r["run"] == "exact"]
+    )
+    nm_res = max(
+        sweeps[0].residual
+        + sweeps[1].residual
+        + sweeps[2].residual
+        + [r["residual"] for r in rows3 if r["run"] != "exact"]
+    )
     add(
         f"Over every run of sections 2 and 3 (n1 = {', '.join(str(n) for n in n1s)}; every eps and f "
         f"at n1 = 20; the Fig. 3 decks) the largest residual / input is {ex_res:.1e} for the exact "
