@@ -438,31 +438,14 @@ contains
       real(dp), intent(in) :: g(0:)                 !! table acceleration's coefficients (0:K)
       real(dp), intent(out) :: qc(:, 0:), pc(:, 0:) !! coefficients (n, 0:K+1), rows 1..nq used
       real(dp), intent(out) :: cp(:, 0:)            !! Cq pc (n, 0:K)
-      integer :: kk, nq, i, j
-      real(dp) :: f
+      integer :: kk, nq
 
       nq = pat%nq
       if (nq == 0) return
       qc(1:nq, 0) = q(1:nq)
       pc(1:nq, 0) = p(1:nq)
       do kk = 0, ubound(g, 1)
-         f = 1.0_dp/(kk + 1)
-         do i = 1, nq
-            qc(i, kk + 1) = pc(i, kk)*f
-            pc(i, kk + 1) = -g(kk)
-            cp(i, kk) = 0.0_dp
-         end do
-         if (kk == 0) pc(1:nq, 1) = pc(1:nq, 1) + b1(1:nq)
-         do j = 1, nq
-            do i = 1, nq
-               pc(i, kk + 1) = pc(i, kk + 1) - pat%kt(i, j)*qc(j, kk)
-               cp(i, kk) = cp(i, kk) + pat%ct(i, j)*pc(j, kk)
-            end do
-         end do
-         do i = 1, nq
-            pc(i, kk + 1) = (pc(i, kk + 1) - cp(i, kk))*f
-            cp(i, kk) = cp(i, kk)*pat%mq(i)
-         end do
+         call taylor_step(pat, kk, g(kk), b1, qc, pc, cp)
       end do
    end subroutine pattern_taylor
 
@@ -482,8 +465,8 @@ contains
       integer, intent(out) :: order                 !! the degree K
       real(dp), intent(out) :: rem                  !! bound of the remainder's norm over [0, S]
       real(dp), intent(out) :: size                 !! sum_k ||x_k|| S^k
-      integer :: kk, nq, i, j
-      real(dp) :: f, e, sk, grow, nrm
+      integer :: kk, nq, i
+      real(dp) :: e, sk, grow, nrm
 
       nq = pat%nq
       order = 5
@@ -496,24 +479,10 @@ contains
       size = 0.0_dp
       sk = 1.0_dp
       do kk = 0, ubound(g, 1)
-         f = 1.0_dp/(kk + 1)
-         do i = 1, nq
-            qc(i, kk + 1) = pc(i, kk)*f
-            pc(i, kk + 1) = -g(kk)
-            cp(i, kk) = 0.0_dp
-         end do
-         if (kk == 0) pc(1:nq, 1) = pc(1:nq, 1) + b1(1:nq)
-         do j = 1, nq
-            do i = 1, nq
-               pc(i, kk + 1) = pc(i, kk + 1) - pat%kt(i, j)*qc(j, kk)
-               cp(i, kk) = cp(i, kk) + pat%ct(i, j)*pc(j, kk)
-            end do
-         end do
+         call taylor_step(pat, kk, g(kk), b1, qc, pc, cp)
          e = 0.0_dp
          nrm = 0.0_dp
          do i = 1, nq
-            pc(i, kk + 1) = (pc(i, kk + 1) - cp(i, kk))*f
-            cp(i, kk) = cp(i, kk)*pat%mq(i)
             nrm = nrm + pat%mq(i)*(pc(i, kk)**2 + (pat%w2 + pat%alpha**2)*qc(i, kk)**2)
             e = e + pat%mq(i)*(pc(i, kk + 1)**2 + (pat%w2 + pat%alpha**2)*qc(i, kk + 1)**2)
          end do
@@ -524,6 +493,39 @@ contains
          if (kk >= 5 .and. rem <= 2.0_dp**(-52)*size) exit
       end do
    end subroutine pattern_series
+
+   !> One step of the Taylor recursion: the coefficients of degree kk + 1 of q and p, and
+   !> cp(:, kk) = Cq pc(:, kk), from those of degree kk (gk: the table acceleration's
+   !> coefficient of degree kk; b1 enters at kk = 0).
+   pure subroutine taylor_step(pat, kk, gk, b1, qc, pc, cp)
+      type(pattern_type), intent(in) :: pat             !! the pattern
+      integer, intent(in) :: kk                         !! degree done
+      real(dp), intent(in) :: gk                        !! table acceleration, degree kk
+      real(dp), intent(in) :: b1(:)                     !! constant load (nq)
+      real(dp), intent(inout) :: qc(:, 0:), pc(:, 0:)   !! coefficients
+      real(dp), intent(inout) :: cp(:, 0:)              !! Cq pc
+      integer :: i, j, nq
+      real(dp) :: f
+
+      nq = pat%nq
+      f = 1.0_dp/(kk + 1)
+      do i = 1, nq
+         qc(i, kk + 1) = pc(i, kk)*f
+         pc(i, kk + 1) = -gk
+         cp(i, kk) = 0.0_dp
+      end do
+      if (kk == 0) pc(1:nq, 1) = pc(1:nq, 1) + b1(1:nq)
+      do j = 1, nq
+         do i = 1, nq
+            pc(i, kk + 1) = pc(i, kk + 1) - pat%kt(i, j)*qc(j, kk)
+            cp(i, kk) = cp(i, kk) + pat%ct(i, j)*pc(j, kk)
+         end do
+      end do
+      do i = 1, nq
+         pc(i, kk + 1) = (pc(i, kk + 1) - cp(i, kk))*f
+         cp(i, kk) = cp(i, kk)*pat%mq(i)
+      end do
+   end subroutine taylor_step
 
    !> The bound on the norm of the remainder of the degree-K Taylor polynomial of the state
    !> over [0, s] (module header), from x_{K+1} = (qc(:, K+1), pc(:, K+1)).

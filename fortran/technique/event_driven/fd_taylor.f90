@@ -299,24 +299,8 @@ contains
             end if
             side(lev) = 0
          end if
-         if (side(lev) == 0) then
-            side(lev) = 1
-            work(0:n, lev + 1) = work(0:n, lev)
-            a(lev + 1) = a(lev)
-            w(lev + 1) = 0.5_dp*w(lev)
-            lev = lev + 1
-            side(lev) = -1
-         else if (side(lev) == 1) then
-            side(lev) = 2
-            call poly_shift(work(0:n, lev), 0.5_dp*w(lev), work(0:n, lev + 1))
-            a(lev + 1) = a(lev) + 0.5_dp*w(lev)
-            w(lev + 1) = w(lev) - 0.5_dp*w(lev)
-            lev = lev + 1
-            side(lev) = -1
-         else
-            lev = lev - 1
-            if (lev < 0) return
-         end if
+         call next_piece(work, n, a, w, side, lev)
+         if (lev < 0) return
       end do
    end subroutine first_crossing
 
@@ -392,25 +376,38 @@ contains
             end if
             side(lev) = 0
          end if
-         if (side(lev) == 0) then
-            side(lev) = 1
-            work(0:n, lev + 1) = work(0:n, lev)
-            a(lev + 1) = a(lev)
-            w(lev + 1) = 0.5_dp*w(lev)
-            lev = lev + 1
-            side(lev) = -1
-         else if (side(lev) == 1) then
-            side(lev) = 2
-            call poly_shift(work(0:n, lev), 0.5_dp*w(lev), work(0:n, lev + 1))
-            a(lev + 1) = a(lev) + 0.5_dp*w(lev)
-            w(lev + 1) = w(lev) - 0.5_dp*w(lev)
-            lev = lev + 1
-            side(lev) = -1
-         else
-            lev = lev - 1
-            if (lev < 0) return
-         end if
+         call next_piece(work, n, a, w, side, lev)
+         if (lev < 0) return
       end do
    end subroutine stationary_points
+
+   !> One move of the left-first traversal of the bisection of [0, L] after the piece at
+   !> level lev was split: into its left half (same coefficients), then into its right half
+   !> (coefficients shifted to its start), then back up (lev < 0: the traversal is over).
+   pure subroutine next_piece(work, n, a, w, side, lev)
+      real(dp), intent(inout) :: work(0:, 0:)  !! coefficients of each level's piece
+      integer, intent(in) :: n                 !! degree
+      real(dp), intent(inout) :: a(0:), w(0:)  !! start and length of each level's piece
+      integer, intent(inout) :: side(0:)       !! -1 new, 0 split, 1 left done, 2 both done
+      integer, intent(inout) :: lev            !! current level
+
+      if (side(lev) == 0) then
+         side(lev) = 1
+         work(0:n, lev + 1) = work(0:n, lev)
+         a(lev + 1) = a(lev)
+         w(lev + 1) = 0.5_dp*w(lev)
+         lev = lev + 1
+         side(lev) = -1
+      else if (side(lev) == 1) then
+         side(lev) = 2
+         call poly_shift(work(0:n, lev), 0.5_dp*w(lev), work(0:n, lev + 1))
+         a(lev + 1) = a(lev) + 0.5_dp*w(lev)
+         w(lev + 1) = w(lev) - 0.5_dp*w(lev)
+         lev = lev + 1
+         side(lev) = -1
+      else
+         lev = lev - 1
+      end if
+   end subroutine next_piece
 
 end module fd_taylor
