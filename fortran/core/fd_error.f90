@@ -15,7 +15,7 @@ module fd_error
 contains
 
    !> Create an error with a message (and an optional status code).
-   subroutine fatal_error(error, message, stat)
+   pure subroutine fatal_error(error, message, stat)
       type(error_type), allocatable, intent(out) :: error !! the error to create
       character(len=*), intent(in) :: message            !! message naming the offending input
       integer, intent(in), optional :: stat              !! status code (default 1)

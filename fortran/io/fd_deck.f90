@@ -69,7 +69,8 @@ contains
       type(error_type), allocatable, intent(out) :: error !! first problem found
       type(deck_text) :: deck
 
-      call deck_from_string(text, path, deck)
+      call deck_from_string(text, path, deck, error)
+      if (allocated(error)) return
       call read_groups(deck, cfg, error)
    end subroutine read_deck_string
 
