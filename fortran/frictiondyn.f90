@@ -7,7 +7,7 @@ module frictiondyn
    use fd_result, only: result_type
    use fd_deck, only: run_config, read_deck, read_deck_string
    use fd_technique, only: run_technique
-   use fd_result, only: history_shape
+   use fd_result, only: history_shape, check_finite
    use fd_output, only: output_type, write_outputs, output_paths, temp_output_paths, summary_json, &
                         history_header, write_output_files
    implicit none
@@ -29,6 +29,9 @@ contains
       type(result_type), intent(out) :: res               !! histories and summary
       type(error_type), allocatable, intent(out) :: error !! failure of the solver
       call run_technique(cfg%model, cfg%exc, cfg%opts, res, error)
+      if (allocated(error)) return
+      ! no null in a summary, no NaN in a history: a quantity that overflowed is an error
+      call check_finite(res, error)
    end subroutine run_config_solve
 
    !> Columns and samples of the history the configuration's run produces.

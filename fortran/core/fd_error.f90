@@ -4,7 +4,11 @@ module fd_error
    implicit none
    private
 
-   public :: error_type, fatal_error, fmt_real, fmt_int
+   public :: error_type, fatal_error, fmt_real, fmt_int, stat_no_memory
+
+   !> The stat of an error raised because memory could not be had (an allocation the size
+   !> of the input failed): the caller may tell it from a bad input.
+   integer, parameter :: stat_no_memory = 5
 
    !> An error raised by the library, handed back to the caller.
    type :: error_type

@@ -6,7 +6,7 @@
 module fd_deck
    use, intrinsic :: ieee_arithmetic, only: ieee_is_finite
    use fd_kinds, only: dp
-   use fd_error, only: error_type, fatal_error, fmt_int, fmt_real
+   use fd_error, only: error_type, fatal_error, fmt_int, fmt_real, stat_no_memory
    use fd_textio, only: lower
    use fd_namelist, only: deck_text, group_text, load_deck, deck_from_string, find_group, group_item, &
                           group_read_error, check_groups
@@ -24,6 +24,8 @@ module fd_deck
    use fd_excitation, only: excitation_type
    use fd_record, only: read_record, record_info, record_formats, record_units_list, units_factor
    use fd_technique, only: check_technique
+   use fd_newmark, only: halving_levels
+   use fd_names, only: law_velocity, law_hysteretic, technique_newmark
    implicit none
    private
 
@@ -33,8 +35,22 @@ module fd_deck
    integer, parameter :: max_springs = 40000  !! capacity of the spring arrays
    integer, parameter :: max_devices = 10000  !! capacity of the device arrays
    real(dp), parameter :: unset = -huge(1.0_dp)
+   !> Largest magnitude of a real value, and smallest of a value that must be > 0 (a mass,
+   !> stiffness, band, step, frequency...): within them the products a run forms (forces,
+   !> energies, effective stiffness) stay far from the limits of double precision.
+   real(dp), parameter, public :: max_magnitude = 1.0e30_dp, min_scale = 1.0e-30_dp
+   !> Most Newmark steps one dt1 step may be refined into: n2 steps dt2, each halved L times.
+   integer, parameter, public :: max_refinement = 2**20
+   !> Largest ratio of a stiffness joining two DOFs (a spring, a sticking device) to the
+   !> inertia of its masses in the effective stiffness, k beta dt1**2 / (m_i + m_j): beyond,
+   !> the factorization loses more than 12 of the 16 digits of double precision.
+   real(dp), parameter, public :: max_stiffness_ratio = 1.0e12_dp
    integer, parameter :: unset_int = -huge(1)
-   integer, parameter :: name_len = 32
+   integer, parameter :: name_len = 32        !! capacity of a keyword value
+   integer, parameter :: path_len = 1024      !! capacity of record_file, dir, name
+   ! strings are read one character longer than their capacity: a longer value is an error,
+   ! not cut
+   integer, parameter :: name_read = name_len + 1, path_read = path_len + 1
 
    !> Everything one deck defines.
    type :: run_config
@@ -99,8 +115,106 @@ contains
       if (allocated(error)) return
       ! what the technique cannot integrate (a law, a table motion)
       call check_technique(cfg%model, cfg%exc, cfg%opts, error)
-      if (allocated(error)) error%message = deck%path//", "//error%message
+      if (allocated(error)) then
+         error%message = deck%path//", "//error%message
+         return
+      end if
+      if (cfg%opts%technique == technique_newmark) call check_newmark_steps(deck, cfg, error)
    end subroutine read_groups
+
+   !> What makes Newmark's steps meaningless or its work unbounded (docs/namelist.md,
+   !> "&integration", "Limits of the step control"): a refinement of more than
+   !> max_refinement steps per dt1 step; with the correctness check on, a device's band (eps,
+   !> eps1) narrower than the velocity change its friction force makes in the finest step
+   !> (every step would be halved down to dt_min, at up to max_refinement times the cost);
+   !> a stiffness joining two DOFs more than max_stiffness_ratio times their inertia at dt1.
+   subroutine check_newmark_steps(deck, cfg, error)
+      type(deck_text), intent(in) :: deck
+      type(run_config), intent(in) :: cfg
+      type(error_type), allocatable, intent(out) :: error
+      real(dp) :: dt1, dt2, dt_min, m_red, m_sum, band, floor, pmu, kd, ratio
+      integer :: levels, d, s, i, j
+      character(len=:), allocatable :: var, idx
+
+      associate (model => cfg%model, opts => cfg%opts)
+         dt1 = cfg%exc%dt_record/opts%n1
+         dt2 = dt1/opts%n2
+         dt_min = opts%dt_min
+         if (dt_min <= 0.0_dp) dt_min = dt2/2.0_dp**10
+         levels = 0
+         if (opts%check) levels = halving_levels(dt2, dt_min)
+         if (opts%n2 > max_refinement) then
+            call bad(deck, 'integration', 'n2', trim(fmt_int(opts%n2)), 'at most '//trim(fmt_int(max_refinement))// &
+                     ': a dt1 step is refined into at most that many steps', error)
+            return
+         end if
+         if (real(opts%n2, dp)*2.0_dp**levels > max_refinement) then
+            call bad(deck, 'integration', 'dt_min', trim(fmt_real(opts%dt_min)), 'such that n2 * 2**L <= '// &
+                     trim(fmt_int(max_refinement))//', L the halvings from dt2 = '//trim(fmt_real(dt2))// &
+                     ' s down to dt_min (here n2 = '//trim(fmt_int(opts%n2))//', L = '//trim(fmt_int(levels))// &
+                     '): a dt1 step is refined into at most that many steps; raise dt_min or lower n2', error)
+            return
+         end if
+         do d = 1, model%n_devices
+            associate (dev => model%dev(d))
+               i = dev%node_i; j = dev%node_j
+               pmu = dev%p*dev%mu
+               if (pmu == 0.0_dp) cycle
+               m_sum = model%mass(i)
+               m_red = model%mass(i)
+               if (j > 0) then
+                  m_sum = m_sum + model%mass(j)
+                  m_red = model%mass(i)*model%mass(j)/m_sum
+               end if
+               idx = '('//trim(fmt_int(d))//')'
+               select case (dev%law)
+               case (law_velocity)
+                  var = 'eps'//idx; band = dev%eps
+                  kd = opts%gamma/(opts%beta*dt1)*(pmu/dev%eps)
+               case (law_hysteretic)
+                  var = 'eps1'//idx; band = dev%eps1
+                  kd = pmu/dev%f
+               case default
+                  cycle
+               end select
+               floor = pmu*dt_min/m_red
+               if (opts%check .and. band < floor) then
+                  call bad(deck, 'friction', var, trim(fmt_real(band)), 'at least '//trim(fmt_real(floor))// &
+                           ' m/s, the velocity change P mu dt_min / m = '//trim(fmt_real(pmu))//' N * '// &
+                           trim(fmt_real(dt_min))//' s / '//trim(fmt_real(m_red))//' kg that the friction force of '// &
+                           'device '//trim(fmt_int(d))//' makes in the finest step (m: the mass it moves): no step '// &
+                           'can resolve a narrower band, and the correctness check would halve every step down to '// &
+                           'dt_min; widen the band, or lower dt_min in &integration', error)
+                  return
+               end if
+               ratio = kd*opts%beta*dt1**2/m_sum
+               if (j > 0 .and. ratio > max_stiffness_ratio) then
+                  if (dev%law == law_hysteretic) var = 'f'//idx
+                  call bad(deck, 'friction', var, trim(fmt_real(merge(dev%f, dev%eps, dev%law == law_hysteretic))), &
+                           'such that the sticking stiffness of device '//trim(fmt_int(d))//', '// &
+                           trim(fmt_real(kd))//' N/m in the effective stiffness at dt1 = '//trim(fmt_real(dt1))// &
+                           ' s, stays within '//trim(fmt_real(max_stiffness_ratio))//' times the inertia of its '// &
+                           'masses, (m_i + m_j) / (beta dt1**2) (here '//trim(fmt_real(ratio))//' times): beyond, '// &
+                           'the factorization loses all its digits; raise it, or raise n1', error)
+                  return
+               end if
+            end associate
+         end do
+         do s = 1, model%n_springs
+            i = model%spring_i(s); j = model%spring_j(s)
+            if (j <= 0) cycle
+            ratio = model%spring_k(s)*opts%beta*dt1**2/(model%mass(i) + model%mass(j))
+            if (ratio > max_stiffness_ratio) then
+               call bad(deck, 'springs', 'k('//trim(fmt_int(s))//')', trim(fmt_real(model%spring_k(s))), &
+                        'within '//trim(fmt_real(max_stiffness_ratio))//' times the inertia of its masses at the '// &
+                        'step dt1 = '//trim(fmt_real(dt1))//' s, (m_i + m_j) / (beta dt1**2) (here '// &
+                        trim(fmt_real(ratio))//' times): beyond, the factorization loses all its digits; '// &
+                        'lower it, or raise n1', error)
+               return
+            end if
+         end do
+      end associate
+   end subroutine check_newmark_steps
 
    ! ---------------------------------------------------------------- &model
    subroutine read_model_group(deck, cfg, error)
@@ -212,7 +326,7 @@ contains
       type(deck_text), intent(in) :: deck
       type(run_config), intent(inout) :: cfg
       type(error_type), allocatable, intent(out) :: error
-      character(len=name_len) :: damping_type
+      character(len=name_read) :: damping_type
       real(dp) :: xi, period, rayleigh_a0, rayleigh_a1
       namelist /damping/ damping_type, xi, period, rayleigh_a0, rayleigh_a1
       type(group_text) :: grp
@@ -240,17 +354,19 @@ contains
          if (ios == 0) msg = msg0
          call group_read_error(deck, grp, i, msg, error); return
       end if
+      call check_length(deck, 'damping', 'damping_type', damping_type, name_len, error)
+      if (allocated(error)) return
       cfg%model%damping = keyword_id(damping_types, damping_type)
       select case (cfg%model%damping)
       case (damping_stiffness)
          call check_real(deck, 'damping', 'xi', xi, 0.0_dp, 1.0_dp, '', error, open_hi=.true.)
          if (allocated(error)) return
-         call check_real(deck, 'damping', 'period', period, 0.0_dp, huge(1.0_dp), 's', error)
+         call check_real(deck, 'damping', 'period', period, 0.0_dp, max_magnitude, 's', error)
          if (allocated(error)) return
       case (damping_rayleigh)
-         call check_real(deck, 'damping', 'rayleigh_a0', rayleigh_a0, 0.0_dp, huge(1.0_dp), '1/s', error)
+         call check_real(deck, 'damping', 'rayleigh_a0', rayleigh_a0, 0.0_dp, max_magnitude, '1/s', error)
          if (allocated(error)) return
-         call check_real(deck, 'damping', 'rayleigh_a1', rayleigh_a1, 0.0_dp, huge(1.0_dp), 's', error)
+         call check_real(deck, 'damping', 'rayleigh_a1', rayleigh_a1, 0.0_dp, max_magnitude, 's', error)
          if (allocated(error)) return
       case (damping_none)
       case default
@@ -271,7 +387,7 @@ contains
       type(error_type), allocatable, intent(out) :: error
       integer :: n_devices
       integer, allocatable :: node_i(:), node_j(:)
-      character(len=name_len), allocatable :: law(:)
+      character(len=name_read), allocatable :: law(:)
       real(dp), allocatable :: p(:), mu(:), eps(:), eps1(:), f(:)
       namelist /friction/ n_devices, node_i, node_j, law, p, mu, eps, eps1, f
       type(group_text) :: grp
@@ -301,6 +417,10 @@ contains
          if (ios == 0) msg = msg0
          call group_read_error(deck, grp, i, msg, error); return
       end if
+      do i = 1, size(law)
+         call check_length(deck, 'friction', 'law('//trim(fmt_int(i))//')', law(i), name_len, error)
+         if (allocated(error)) return
+      end do
       call need_int(deck, 'friction', 'n_devices', n_devices, 0, max_devices, error)
       if (allocated(error)) return
       n = n_devices
@@ -324,7 +444,12 @@ contains
          return
       end if
       deallocate (cfg%model%dev)
-      allocate (cfg%model%dev(n))
+      allocate (cfg%model%dev(n), stat=ios)
+      if (ios /= 0) then
+         call fatal_error(error, deck%path//", group &friction: not enough memory for "//trim(fmt_int(n))//" devices", &
+                          stat_no_memory)
+         return
+      end if
       do i = 1, n
          idx = '('//trim(fmt_int(i))//')'
          if (node_i(i) == node_j(i)) then
@@ -353,9 +478,9 @@ contains
       type(deck_text), intent(in) :: deck
       type(run_config), intent(inout) :: cfg
       type(error_type), allocatable, intent(out) :: error
-      character(len=name_len) :: excitation_type, record_kind, record_format, record_units
+      character(len=name_read) :: excitation_type, record_kind, record_format, record_units
       integer :: kind_id
-      character(len=1024) :: record_file
+      character(len=path_read) :: record_file
       real(dp) :: amplitude, frequency, duration, dt_record, record_scale, factor
       integer :: ramp_cycles
       logical :: known
@@ -388,6 +513,12 @@ contains
          if (ios == 0) msg = msg0
          call group_read_error(deck, grp, i, msg, error); return
       end if
+      call check_length(deck, 'excitation', 'excitation_type', excitation_type, name_len, error)
+      if (.not. allocated(error)) call check_length(deck, 'excitation', 'record_kind', record_kind, name_len, error)
+      if (.not. allocated(error)) call check_length(deck, 'excitation', 'record_format', record_format, name_len, error)
+      if (.not. allocated(error)) call check_length(deck, 'excitation', 'record_units', record_units, name_len, error)
+      if (.not. allocated(error)) call check_length(deck, 'excitation', 'record_file', record_file, path_len, error)
+      if (allocated(error)) return
       ! a record whose file gives DT (AT2) may leave dt_record out
       if (.not. (keyword_id(excitation_types, excitation_type) == excitation_record .and. dt_record == unset)) then
          call need_real(deck, 'excitation', 'dt_record', dt_record, 's', error)
@@ -417,6 +548,8 @@ contains
             call bad(deck, 'excitation', 'record_scale', trim(fmt_real(record_scale)), 'finite and non-zero', error)
             return
          end if
+         call check_magnitude(deck, 'excitation', 'record_scale', record_scale, '', .true., error)
+         if (allocated(error)) return
          kind_id = keyword_id(record_kinds, record_kind)
          if (kind_id == 0) then
             call keyword_choices(record_kinds, choices)
@@ -449,6 +582,15 @@ contains
          cfg%record%path = trim(record_file)   ! as the deck gives it (like the summary's "deck")
          dt_record = cfg%record%dt
          cfg%exc%dt_record = dt_record
+         call check_magnitude(deck, 'excitation', "dt_record (the record file's DT)", dt_record, 's', .true., error)
+         if (allocated(error)) return
+         if (.not. (cfg%record%peak_acc <= max_magnitude)) then
+            call bad(deck, 'excitation', 'record_file', "'"//trim(record_file)//"'", 'a record whose table '// &
+                     'acceleration (after record_units and record_scale = '//trim(fmt_real(record_scale))// &
+                     ') stays within '//trim(fmt_real(max_magnitude))//' m/s2 in magnitude; it reaches '// &
+                     trim(fmt_real(cfg%record%peak_acc))//' m/s2', error)
+            return
+         end if
          if (duration == unset) duration = (size(cfg%exc%acc) - 1)*dt_record
          call need_real(deck, 'excitation', 'duration', duration, 's', error)
          if (allocated(error)) return
@@ -468,7 +610,7 @@ contains
       type(deck_text), intent(in) :: deck
       type(run_config), intent(inout) :: cfg
       type(error_type), allocatable, intent(out) :: error
-      character(len=name_len) :: technique
+      character(len=name_read) :: technique
       real(dp) :: beta, gamma, n, dt_min
       integer :: n1, n2
       logical :: check_correctness
@@ -497,6 +639,8 @@ contains
             call group_read_error(deck, grp, i, msg, error); return
          end if
       end if
+      call check_length(deck, 'integration', 'technique', technique, name_len, error)
+      if (allocated(error)) return
       technique_id = keyword_id(techniques, technique)
       if (technique_id == 0) then
          call keyword_choices(techniques, choices)
@@ -517,6 +661,8 @@ contains
          call bad(deck, 'integration', 'n', trim(fmt_real(n)), '> 1 (correctness condition, eqs. 9 and 12)', error)
          return
       end if
+      call check_magnitude(deck, 'integration', 'n', n, '', .false., error)
+      if (allocated(error)) return
       call check_real(deck, 'integration', 'dt_min', dt_min, 0.0_dp, cfg%exc%dt_record/n1/n2, 's', error)
       if (allocated(error)) return
       ! the run takes duration / dt1 steps, counted in a default integer
@@ -541,7 +687,7 @@ contains
       type(deck_text), intent(in) :: deck
       type(run_config), intent(inout) :: cfg
       type(error_type), allocatable, intent(out) :: error
-      character(len=1024) :: dir, name
+      character(len=path_read) :: dir, name
       integer :: output_every
       logical :: write_history
       namelist /output/ dir, name, output_every, write_history
@@ -568,6 +714,9 @@ contains
             call group_read_error(deck, grp, i, msg, error); return
          end if
       end if
+      call check_length(deck, 'output', 'dir', dir, path_len, error)
+      if (.not. allocated(error)) call check_length(deck, 'output', 'name', name, path_len, error)
+      if (allocated(error)) return
       if (len_trim(dir) == 0) then
          call bad(deck, 'output', 'dir', "''", 'a directory path', error); return
       end if
@@ -599,6 +748,17 @@ contains
       call fatal_error(error, deck%path//", group &"//group//": "//var//" = "//val//" is invalid: must be "//must)
    end subroutine bad
 
+   !> A string value longer than its capacity is an error (the namelist reader would cut it).
+   subroutine check_length(deck, group, var, x, cap, error)
+      type(deck_text), intent(in) :: deck
+      character(len=*), intent(in) :: group, var, x
+      integer, intent(in) :: cap
+      type(error_type), allocatable, intent(out) :: error
+      if (len_trim(x) <= cap) return
+      call bad(deck, group, var, "'"//x(1:min(cap, 40))//"...'", 'at most '//trim(fmt_int(cap))//' characters long', &
+               error)
+   end subroutine check_length
+
    subroutine need_int(deck, group, var, x, lo, hi, error)
       type(deck_text), intent(in) :: deck
       character(len=*), intent(in) :: group, var
@@ -629,8 +789,26 @@ contains
          call bad(deck, group, var, trim(fmt_real(x)), '> 0 '//unit, error)
       else if (.not. pos .and. x < 0.0_dp) then
          call bad(deck, group, var, trim(fmt_real(x)), '>= 0 '//unit, error)
+      else
+         call check_magnitude(deck, group, var, x, unit, pos, error)
       end if
    end subroutine need_real
+
+   !> |x| at most max_magnitude; and at least min_scale when x must be > 0 (or is not 0).
+   subroutine check_magnitude(deck, group, var, x, unit, scale, error)
+      type(deck_text), intent(in) :: deck
+      character(len=*), intent(in) :: group, var, unit
+      real(dp), intent(in) :: x
+      logical, intent(in) :: scale                 !! x is a scale: small values are checked too
+      type(error_type), allocatable, intent(out) :: error
+      if (abs(x) > max_magnitude) then
+         call bad(deck, group, var, trim(fmt_real(x)), 'at most '//trim(fmt_real(max_magnitude))//' '//trim(unit)// &
+                  ' in magnitude (larger values overflow the products a run forms)', error)
+      else if (scale .and. abs(x) < min_scale) then
+         call bad(deck, group, var, trim(fmt_real(x)), 'at least '//trim(fmt_real(min_scale))//' '//trim(unit)// &
+                  ' in magnitude (smaller values make the steps and products of a run meaningless)', error)
+      end if
+   end subroutine check_magnitude
 
    subroutine check_real(deck, group, var, x, lo, hi, unit, error, open_lo, open_hi)
       type(deck_text), intent(in) :: deck
@@ -645,10 +823,13 @@ contains
       if (present(open_hi)) ohi = open_hi
       ok = ieee_is_finite(x)
       if (ok) ok = merge(x > lo, x >= lo, olo) .and. merge(x < hi, x <= hi, ohi)
-      if (ok) return
+      if (ok) then
+         call check_magnitude(deck, group, var, x, unit, .false., error)
+         return
+      end if
       range = merge('(', '[', olo)//trim(fmt_real(lo))//', '
-      if (hi >= huge(1.0_dp)) then
-         range = range//'inf)'
+      if (hi >= max_magnitude) then
+         range = range//trim(fmt_real(max_magnitude))//']'
       else
          range = range//trim(fmt_real(hi))//merge(')', ']', ohi)
       end if
@@ -692,6 +873,8 @@ contains
          if (pos .and. x(i) <= 0.0_dp) then
             call bad(deck, group, var//'('//trim(fmt_int(i))//')', trim(fmt_real(x(i))), '> 0 '//unit, error); return
          end if
+         call check_magnitude(deck, group, var//'('//trim(fmt_int(i))//')', x(i), unit, pos, error)
+         if (allocated(error)) return
       end do
       call no_extra(deck, group, var, x, n, error)
    end subroutine optional_reals

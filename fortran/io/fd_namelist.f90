@@ -5,7 +5,7 @@
 !> read where it is declared); on failure they re-read the group one assignment at a
 !> time with group_item to find the variable and value at fault.
 module fd_namelist
-   use fd_error, only: error_type, fatal_error, fmt_int
+   use fd_error, only: error_type, fatal_error, fmt_int, stat_no_memory
    use fd_textio, only: line_type, read_text_file, split_lines, lower
    implicit none
    private
@@ -341,8 +341,8 @@ contains
                                                           !! assigned twice
       type(group_span), allocatable :: spans(:)
       type(group_span) :: sp
-      integer :: i, first, last, width, n, cap, c1, c2, j
-      character(len=:), allocatable :: body, line, vi, vj
+      integer :: i, first, last, width, n, cap, c1, c2, j, stat
+      character(len=:), allocatable :: body, line, var
       integer, allocatable :: line_of(:)
 
       grp%name = name
@@ -364,7 +364,10 @@ contains
       do i = first, last
          width = max(width, len(deck%lines(i)%s) + 2)
       end do
-      allocate (character(len=width) :: grp%lines(last - first + 1))
+      allocate (character(len=width) :: grp%lines(last - first + 1), stat=stat)
+      if (stat /= 0) then
+         call no_memory(); return
+      end if
       cap = 0
       do i = first, last
          line = deck%lines(i)%s
@@ -374,8 +377,11 @@ contains
          cap = cap + len(line) + 1
       end do
       ! body: the text after '&name' up to the end, comments removed (n characters used)
-      allocate (character(len=cap) :: body)
-      allocate (line_of(cap))
+      allocate (character(len=cap) :: body, stat=stat)
+      if (stat == 0) allocate (line_of(cap), stat=stat)
+      if (stat /= 0) then
+         call no_memory(); return
+      end if
       n = 0
       do i = first, last
          c1 = 1
@@ -384,21 +390,83 @@ contains
          if (i == last) c2 = sp%last_col - 1
          call append_line(deck%lines(i)%s(1:c2), c1, body, line_of, n, i)
       end do
-      call split_items(body(1:n), line_of(1:n), grp%items, grp%item_line)
+      call split_items(body(1:n), line_of(1:n), grp%items, grp%item_line, stat)
+      if (stat /= 0) then
+         call no_memory(); return
+      end if
       ! a variable (or array element) given twice: the namelist reader would keep the last
-      do i = 2, size(grp%items)
-         call item_variable(grp%items(i)%s, vi)
-         do j = 1, i - 1
-            call item_variable(grp%items(j)%s, vj)
-            if (vi == vj .and. len(vi) > 0) then
-               call fatal_error(error, deck%path//", group &"//name//", line "//trim(fmt_int(grp%item_line(i)))// &
-                                ": '"//vi//"' is assigned again (first at line "//trim(fmt_int(grp%item_line(j)))// &
-                                "); give each variable once")
-               return
-            end if
-         end do
-      end do
+      call repeated_item(grp%items, i, j, stat)
+      if (stat /= 0) then
+         call no_memory(); return
+      end if
+      if (i > 0) then
+         call item_variable(grp%items(i)%s, var)
+         call fatal_error(error, deck%path//", group &"//name//", line "//trim(fmt_int(grp%item_line(i)))// &
+                          ": '"//var//"' is assigned again (first at line "//trim(fmt_int(grp%item_line(j)))// &
+                          "); give each variable once")
+      end if
+   contains
+      subroutine no_memory()
+         call fatal_error(error, deck%path//", group &"//name//" (line "//trim(fmt_int(first))// &
+                          "): not enough memory to read it", stat_no_memory)
+      end subroutine no_memory
    end subroutine find_group
+
+   !> The first assignment (i) that sets the same variable or element as an earlier one (j);
+   !> i = 0 if none. Names are sorted (merge sort): linear-logarithmic in the assignments.
+   pure subroutine repeated_item(items, i, j, stat)
+      type(line_type), intent(in) :: items(:)   !! the assignments of a group
+      integer, intent(out) :: i                  !! the repeated one, 0 if none
+      integer, intent(out) :: j                  !! the earlier one it repeats
+      integer, intent(out) :: stat               !! 0, or not enough memory
+      character(len=64), allocatable :: names(:)
+      character(len=:), allocatable :: var
+      integer, allocatable :: order(:), tmp(:)
+      integer :: k, n, width, lo, mid, hi, a, b, c
+
+      i = 0; j = 0
+      n = size(items)
+      allocate (names(n), order(n), tmp(n), stat=stat)
+      if (stat /= 0 .or. n < 2) return
+      do k = 1, n
+         call item_variable(items(k)%s, var)
+         names(k) = var
+         if (len(var) > len(names)) names(k) = ''   ! not a variable of any group: the reader rejects it
+         order(k) = k
+      end do
+      ! bottom-up merge sort of order by (name, position): stable
+      width = 1
+      do while (width < n)
+         lo = 1
+         do while (lo <= n)
+            mid = min(lo + width, n + 1)
+            hi = min(lo + 2*width, n + 1)
+            a = lo; b = mid; c = lo
+            do while (c < hi)
+               if (b >= hi) then
+                  tmp(c) = order(a); a = a + 1
+               else if (a >= mid) then
+                  tmp(c) = order(b); b = b + 1
+               else if (llt(names(order(b)), names(order(a)))) then
+                  tmp(c) = order(b); b = b + 1
+               else
+                  tmp(c) = order(a); a = a + 1
+               end if
+               c = c + 1
+            end do
+            lo = hi
+         end do
+         order = tmp
+         width = 2*width
+      end do
+      ! equal names are adjacent, in deck order: report the repeat that comes first in the deck
+      do k = 2, n
+         if (names(order(k)) /= names(order(k - 1)) .or. len_trim(names(order(k))) == 0) cycle
+         if (i == 0 .or. order(k) < i) then
+            i = order(k); j = order(k - 1)
+         end if
+      end do
+   end subroutine repeated_item
 
    !> The variable an assignment sets, lower case, blanks removed: 'mass', 'mass(2)'.
    pure subroutine item_variable(item, var)
@@ -444,16 +512,20 @@ contains
    end subroutine append_line
 
    !> Split a group body at the start of each 'name =' or 'name(index) ='.
-   pure subroutine split_items(body, line_of, items, item_line)
+   pure subroutine split_items(body, line_of, items, item_line, stat)
       character(len=*), intent(in) :: body
       integer, intent(in) :: line_of(:)
       type(line_type), allocatable, intent(out) :: items(:)
       integer, allocatable, intent(out) :: item_line(:)
+      integer, intent(out) :: stat                  !! 0, or not enough memory
       integer, allocatable :: starts(:)
-      integer :: i, j, depth
+      integer :: i, j, depth, ns
       character(len=1) :: quote
 
-      allocate (starts(0))
+      ! at most one assignment per '=' of the body
+      allocate (starts(max(1, count_char(body, '='))), stat=stat)
+      if (stat /= 0) return
+      ns = 0
       quote = ' '
       do i = 1, len(body)
          if (quote /= ' ') then
@@ -486,11 +558,13 @@ contains
             if (.not. is_name_char(body(j:j)) .and. body(j:j) /= '%') exit
             j = j - 1
          end do
-         starts = [starts, j + 1]
+         ns = ns + 1
+         starts(ns) = j + 1
       end do
-      allocate (items(size(starts)), item_line(size(starts)))
-      do i = 1, size(starts)
-         if (i < size(starts)) then
+      allocate (items(ns), item_line(ns), stat=stat)
+      if (stat /= 0) return
+      do i = 1, ns
+         if (i < ns) then
             items(i)%s = trim(adjustl(body(starts(i):starts(i + 1) - 1)))
          else
             items(i)%s = trim(adjustl(body(starts(i):)))
@@ -503,6 +577,17 @@ contains
          item_line(i) = line_of(min(starts(i), size(line_of)))
       end do
    end subroutine split_items
+
+   !> Occurrences of a character in a string.
+   pure integer function count_char(str, c) result(n)
+      character(len=*), intent(in) :: str
+      character(len=1), intent(in) :: c
+      integer :: i
+      n = 0
+      do i = 1, len(str)
+         if (str(i:i) == c) n = n + 1
+      end do
+   end function count_char
 
    !> One assignment of a group as a namelist record of its own: '&name item /'.
    pure subroutine group_item(grp, i, record)

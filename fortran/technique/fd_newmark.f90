@@ -12,7 +12,7 @@
 module fd_newmark
    use, intrinsic :: ieee_arithmetic, only: ieee_is_finite
    use fd_kinds, only: dp
-   use fd_error, only: error_type, fatal_error, fmt_real, fmt_int
+   use fd_error, only: error_type, fatal_error, fmt_real, fmt_int, stat_no_memory
    use fd_names, only: laws, law_name, law_choices, excitation_types, technique_name, technique_newmark, &
                        technique_event_driven
    use fd_model, only: model_type, integration_type
@@ -28,7 +28,7 @@ module fd_newmark
    implicit none
    private
 
-   public :: run_newmark, newmark_check
+   public :: run_newmark, newmark_check, halving_levels
 
    integer, parameter :: max_slots = 32              !! factors kept at most
    real(dp), parameter :: cache_bytes = 256.0e6_dp    !! memory the factors may take
@@ -157,7 +157,7 @@ contains
       res%run_time = real(c1 - c0, dp)/real(max(crate, 1), dp)
    end subroutine run_newmark
 
-   !> Number of halvings from sub down to dt_min.
+   !> Number of halvings from sub down to dt_min (at most 30).
    pure integer function halving_levels(sub, dt_min) result(lmax)
       real(dp), intent(in) :: sub, dt_min
 
@@ -181,24 +181,31 @@ contains
       nd = model%n_devices
       w%n = n
       w%nd = nd
-      w%mass = model%mass
-      allocate (w%k(n, n), w%c(n, n), stat=stat)
+      allocate (w%mass(n), w%k(n, n), w%c(n, n), stat=stat)
       if (stat /= 0) then
-         call fatal_error(error, "not enough memory for the matrices of n_dof = "//trim(fmt_int(n))//" DOFs")
+         call fatal_error(error, "not enough memory for the matrices of n_dof = "//trim(fmt_int(n))//" DOFs", &
+                          stat_no_memory)
          return
       end if
+      w%mass = model%mass
       call structure_matrices(model, w%k, w%c, res%period_stuck, res%xi_stuck, error)
       if (allocated(error)) return
-      allocate (w%u(n), w%v(n), w%a(n), w%u1(n), w%v1(n), w%a1(n), w%rhs(n), w%tmp(n))
-      allocate (w%s(nd), w%sd(nd), w%s1(nd), w%sd1(nd), w%f(nd), w%st(nd), w%st1(nd), w%phase0(nd), w%phase1(nd))
-      allocate (w%changed(nd), w%ok(nd), w%stuck(nd))
+      allocate (w%u(n), w%v(n), w%a(n), w%u1(n), w%v1(n), w%a1(n), w%rhs(n), w%tmp(n), &
+                w%s(nd), w%sd(nd), w%s1(nd), w%sd1(nd), w%f(nd), w%st(nd), w%st1(nd), w%phase0(nd), w%phase1(nd), &
+                w%changed(nd), w%ok(nd), w%stuck(nd), stat=stat)
+      if (stat /= 0) then
+         call fatal_error(error, "not enough memory for the state of n_dof = "//trim(fmt_int(n))//" DOFs", &
+                          stat_no_memory)
+         return
+      end if
       n_slots = min(max_slots, 2*(lmax + 2), max(4, int(cache_bytes/(8.0_dp*n*n))))
       if (nd == 0) n_slots = 1
-      allocate (w%slot(n_slots))
+      allocate (w%slot(n_slots), stat=stat)
       do i = 1, n_slots
-         allocate (w%slot(i)%stuck(nd), w%slot(i)%a(n, n), stat=stat)
+         if (stat == 0) allocate (w%slot(i)%stuck(nd), w%slot(i)%a(n, n), stat=stat)
          if (stat /= 0) then
-            call fatal_error(error, "not enough memory for the factors of n_dof = "//trim(fmt_int(n))//" DOFs")
+            call fatal_error(error, "not enough memory for the factors of n_dof = "//trim(fmt_int(n))//" DOFs", &
+                             stat_no_memory)
             return
          end if
       end do
