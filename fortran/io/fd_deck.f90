@@ -24,8 +24,8 @@ module fd_deck
    use fd_excitation, only: excitation_type
    use fd_record, only: read_record, record_info, record_formats, record_units_list, units_factor
    use fd_technique, only: check_technique
-   use fd_newmark, only: halving_levels
-   use fd_names, only: law_velocity, law_hysteretic, technique_newmark
+   use fd_step_limits, only: check_step_limits
+   use fd_names, only: technique_newmark
    implicit none
    private
 
@@ -39,12 +39,6 @@ module fd_deck
    !> stiffness, band, step, frequency...): within them the products a run forms (forces,
    !> energies, effective stiffness) stay far from the limits of double precision.
    real(dp), parameter, public :: max_magnitude = 1.0e30_dp, min_scale = 1.0e-30_dp
-   !> Most Newmark steps one dt1 step may be refined into: n2 steps dt2, each halved L times.
-   integer, parameter, public :: max_refinement = 2**20
-   !> Largest ratio of a stiffness joining two DOFs (a spring, a sticking device) to the
-   !> inertia of its masses in the effective stiffness, k beta dt1**2 / (m_i + m_j): beyond,
-   !> the factorization loses more than 12 of the 16 digits of double precision.
-   real(dp), parameter, public :: max_stiffness_ratio = 1.0e12_dp
    integer, parameter :: unset_int = -huge(1)
    integer, parameter :: name_len = 32        !! capacity of a keyword value
    integer, parameter :: path_len = 1024      !! capacity of record_file, dir, name
@@ -119,102 +113,10 @@ contains
          error%message = deck%path//", "//error%message
          return
       end if
-      if (cfg%opts%technique == technique_newmark) call check_newmark_steps(deck, cfg, error)
+      ! Newmark's steps: bounded work, digits left in the effective stiffness
+      if (cfg%opts%technique == technique_newmark) call check_step_limits(cfg%model, cfg%exc, cfg%opts, error)
+      if (allocated(error)) error%message = deck%path//", "//error%message
    end subroutine read_groups
-
-   !> What makes Newmark's steps meaningless or its work unbounded (docs/namelist.md,
-   !> "&integration", "Limits of the step control"): a refinement of more than
-   !> max_refinement steps per dt1 step; with the correctness check on, a device's band (eps,
-   !> eps1) narrower than the velocity change its friction force makes in the finest step
-   !> (every step would be halved down to dt_min, at up to max_refinement times the cost);
-   !> a stiffness joining two DOFs more than max_stiffness_ratio times their inertia at dt1.
-   subroutine check_newmark_steps(deck, cfg, error)
-      type(deck_text), intent(in) :: deck
-      type(run_config), intent(in) :: cfg
-      type(error_type), allocatable, intent(out) :: error
-      real(dp) :: dt1, dt2, dt_min, m_red, m_sum, band, floor, pmu, kd, ratio
-      integer :: levels, d, s, i, j
-      character(len=:), allocatable :: var, idx
-
-      associate (model => cfg%model, opts => cfg%opts)
-         dt1 = cfg%exc%dt_record/opts%n1
-         dt2 = dt1/opts%n2
-         dt_min = opts%dt_min
-         if (dt_min <= 0.0_dp) dt_min = dt2/2.0_dp**10
-         levels = 0
-         if (opts%check) levels = halving_levels(dt2, dt_min)
-         if (opts%n2 > max_refinement) then
-            call bad(deck, 'integration', 'n2', trim(fmt_int(opts%n2)), 'at most '//trim(fmt_int(max_refinement))// &
-                     ': a dt1 step is refined into at most that many steps', error)
-            return
-         end if
-         if (real(opts%n2, dp)*2.0_dp**levels > max_refinement) then
-            call bad(deck, 'integration', 'dt_min', trim(fmt_real(opts%dt_min)), 'such that n2 * 2**L <= '// &
-                     trim(fmt_int(max_refinement))//', L the halvings from dt2 = '//trim(fmt_real(dt2))// &
-                     ' s down to dt_min (here n2 = '//trim(fmt_int(opts%n2))//', L = '//trim(fmt_int(levels))// &
-                     '): a dt1 step is refined into at most that many steps; raise dt_min or lower n2', error)
-            return
-         end if
-         do d = 1, model%n_devices
-            associate (dev => model%dev(d))
-               i = dev%node_i; j = dev%node_j
-               pmu = dev%p*dev%mu
-               if (pmu == 0.0_dp) cycle
-               m_sum = model%mass(i)
-               m_red = model%mass(i)
-               if (j > 0) then
-                  m_sum = m_sum + model%mass(j)
-                  m_red = model%mass(i)*model%mass(j)/m_sum
-               end if
-               idx = '('//trim(fmt_int(d))//')'
-               select case (dev%law)
-               case (law_velocity)
-                  var = 'eps'//idx; band = dev%eps
-                  kd = opts%gamma/(opts%beta*dt1)*(pmu/dev%eps)
-               case (law_hysteretic)
-                  var = 'eps1'//idx; band = dev%eps1
-                  kd = pmu/dev%f
-               case default
-                  cycle
-               end select
-               floor = pmu*dt_min/m_red
-               if (opts%check .and. band < floor) then
-                  call bad(deck, 'friction', var, trim(fmt_real(band)), 'at least '//trim(fmt_real(floor))// &
-                           ' m/s, the velocity change P mu dt_min / m = '//trim(fmt_real(pmu))//' N * '// &
-                           trim(fmt_real(dt_min))//' s / '//trim(fmt_real(m_red))//' kg that the friction force of '// &
-                           'device '//trim(fmt_int(d))//' makes in the finest step (m: the mass it moves): no step '// &
-                           'can resolve a narrower band, and the correctness check would halve every step down to '// &
-                           'dt_min; widen the band, or lower dt_min in &integration', error)
-                  return
-               end if
-               ratio = kd*opts%beta*dt1**2/m_sum
-               if (j > 0 .and. ratio > max_stiffness_ratio) then
-                  if (dev%law == law_hysteretic) var = 'f'//idx
-                  call bad(deck, 'friction', var, trim(fmt_real(merge(dev%f, dev%eps, dev%law == law_hysteretic))), &
-                           'such that the sticking stiffness of device '//trim(fmt_int(d))//', '// &
-                           trim(fmt_real(kd))//' N/m in the effective stiffness at dt1 = '//trim(fmt_real(dt1))// &
-                           ' s, stays within '//trim(fmt_real(max_stiffness_ratio))//' times the inertia of its '// &
-                           'masses, (m_i + m_j) / (beta dt1**2) (here '//trim(fmt_real(ratio))//' times): beyond, '// &
-                           'the factorization loses all its digits; raise it, or raise n1', error)
-                  return
-               end if
-            end associate
-         end do
-         do s = 1, model%n_springs
-            i = model%spring_i(s); j = model%spring_j(s)
-            if (j <= 0) cycle
-            ratio = model%spring_k(s)*opts%beta*dt1**2/(model%mass(i) + model%mass(j))
-            if (ratio > max_stiffness_ratio) then
-               call bad(deck, 'springs', 'k('//trim(fmt_int(s))//')', trim(fmt_real(model%spring_k(s))), &
-                        'within '//trim(fmt_real(max_stiffness_ratio))//' times the inertia of its masses at the '// &
-                        'step dt1 = '//trim(fmt_real(dt1))//' s, (m_i + m_j) / (beta dt1**2) (here '// &
-                        trim(fmt_real(ratio))//' times): beyond, the factorization loses all its digits; '// &
-                        'lower it, or raise n1', error)
-               return
-            end if
-         end do
-      end associate
-   end subroutine check_newmark_steps
 
    ! ---------------------------------------------------------------- &model
    subroutine read_model_group(deck, cfg, error)

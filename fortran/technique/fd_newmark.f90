@@ -25,10 +25,11 @@ module fd_newmark
    use fd_result, only: result_type
    use fd_observer, only: observer_type, observer_init, sample_due, observe_start, observe_peaks, &
                           observe_sample, observe_transitions, observe_violations, observe_end
+   use fd_step_limits, only: halving_levels, unresolved_band
    implicit none
    private
 
-   public :: run_newmark, newmark_check, halving_levels
+   public :: run_newmark, newmark_check
 
    integer, parameter :: max_slots = 32              !! factors kept at most
    real(dp), parameter :: cache_bytes = 256.0e6_dp    !! memory the factors may take
@@ -156,16 +157,6 @@ contains
       call system_clock(c1)
       res%run_time = real(c1 - c0, dp)/real(max(crate, 1), dp)
    end subroutine run_newmark
-
-   !> Number of halvings from sub down to dt_min (at most 30).
-   pure integer function halving_levels(sub, dt_min) result(lmax)
-      real(dp), intent(in) :: sub, dt_min
-
-      lmax = 0
-      do while (lmax < 30 .and. sub/2.0_dp**(lmax + 1) >= dt_min*(1.0_dp - 1.0e-12_dp))
-         lmax = lmax + 1
-      end do
-   end function halving_levels
 
    !> Matrices and workspace. The factor cache holds the
    !> step sizes dt1, dt2, dt2/2, ... dt_min with two phase patterns each when memory allows.
@@ -342,7 +333,7 @@ contains
       type(workspace), intent(inout) :: w
       type(result_type), intent(inout) :: res
       type(error_type), allocatable, intent(out) :: error
-      integer :: lmax, level, pos, units
+      integer :: lmax, level, pos, units, d
       real(dp) :: h, tl
       logical :: any_changed, any_bad
 
@@ -359,6 +350,15 @@ contains
          if (any_bad .and. opts%check .and. level < lmax) then
             level = level + 1
             cycle
+         end if
+         if (any_bad .and. opts%check) then
+            ! a violation left at dt_min: an error when the band is below what dt_min resolves
+            ! (fd_step_limits), else counted
+            do d = 1, w%nd
+               if (w%ok(d)) cycle
+               call unresolved_band(model, d, tl + h, dt_min, error)
+               if (allocated(error)) return
+            end do
          end if
          call accept(model, exc, tl + h, w, res, any_bad)
          if (level == 0) then
