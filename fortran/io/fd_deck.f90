@@ -9,7 +9,7 @@ module fd_deck
    use fd_error, only: error_type, fatal_error, fmt_int, fmt_real, stat_no_memory
    use fd_textio, only: lower
    use fd_namelist, only: deck_text, group_text, load_deck, deck_from_string, find_group, group_item, &
-                          group_read_error, check_groups
+                          group_read_error, check_groups, longest_string
    use fd_names, only: keyword_id, keyword_choices, law_id, law_choices, &
                        damping_types, damping_stiffness, damping_rayleigh, damping_none, &
                        excitation_types, excitation_harmonic, excitation_record, excitation_none, &
@@ -42,9 +42,6 @@ module fd_deck
    integer, parameter :: unset_int = -huge(1)
    integer, parameter :: name_len = 32        !! capacity of a keyword value
    integer, parameter :: path_len = 1024      !! capacity of record_file, dir, name
-   ! strings are read one character longer than their capacity: a longer value is an error,
-   ! not cut
-   integer, parameter :: name_read = name_len + 1, path_read = path_len + 1
 
    !> Everything one deck defines.
    type :: run_config
@@ -228,7 +225,7 @@ contains
       type(deck_text), intent(in) :: deck
       type(run_config), intent(inout) :: cfg
       type(error_type), allocatable, intent(out) :: error
-      character(len=name_read) :: damping_type
+      character(len=name_len) :: damping_type
       real(dp) :: xi, period, rayleigh_a0, rayleigh_a1
       namelist /damping/ damping_type, xi, period, rayleigh_a0, rayleigh_a1
       type(group_text) :: grp
@@ -256,7 +253,7 @@ contains
          if (ios == 0) msg = msg0
          call group_read_error(deck, grp, i, msg, error); return
       end if
-      call check_length(deck, 'damping', 'damping_type', damping_type, name_len, error)
+      call check_length(deck, grp, 'damping_type', name_len, error)
       if (allocated(error)) return
       cfg%model%damping = keyword_id(damping_types, damping_type)
       select case (cfg%model%damping)
@@ -289,7 +286,7 @@ contains
       type(error_type), allocatable, intent(out) :: error
       integer :: n_devices
       integer, allocatable :: node_i(:), node_j(:)
-      character(len=name_read), allocatable :: law(:)
+      character(len=name_len), allocatable :: law(:)
       real(dp), allocatable :: p(:), mu(:), eps(:), eps1(:), f(:)
       namelist /friction/ n_devices, node_i, node_j, law, p, mu, eps, eps1, f
       type(group_text) :: grp
@@ -319,10 +316,8 @@ contains
          if (ios == 0) msg = msg0
          call group_read_error(deck, grp, i, msg, error); return
       end if
-      do i = 1, size(law)
-         call check_length(deck, 'friction', 'law('//trim(fmt_int(i))//')', law(i), name_len, error)
-         if (allocated(error)) return
-      end do
+      call check_length(deck, grp, 'law', name_len, error)
+      if (allocated(error)) return
       call need_int(deck, 'friction', 'n_devices', n_devices, 0, max_devices, error)
       if (allocated(error)) return
       n = n_devices
@@ -380,9 +375,9 @@ contains
       type(deck_text), intent(in) :: deck
       type(run_config), intent(inout) :: cfg
       type(error_type), allocatable, intent(out) :: error
-      character(len=name_read) :: excitation_type, record_kind, record_format, record_units
+      character(len=name_len) :: excitation_type, record_kind, record_format, record_units
       integer :: kind_id
-      character(len=path_read) :: record_file
+      character(len=path_len) :: record_file
       real(dp) :: amplitude, frequency, duration, dt_record, record_scale, factor
       integer :: ramp_cycles
       logical :: known
@@ -415,11 +410,11 @@ contains
          if (ios == 0) msg = msg0
          call group_read_error(deck, grp, i, msg, error); return
       end if
-      call check_length(deck, 'excitation', 'excitation_type', excitation_type, name_len, error)
-      if (.not. allocated(error)) call check_length(deck, 'excitation', 'record_kind', record_kind, name_len, error)
-      if (.not. allocated(error)) call check_length(deck, 'excitation', 'record_format', record_format, name_len, error)
-      if (.not. allocated(error)) call check_length(deck, 'excitation', 'record_units', record_units, name_len, error)
-      if (.not. allocated(error)) call check_length(deck, 'excitation', 'record_file', record_file, path_len, error)
+      call check_length(deck, grp, 'excitation_type', name_len, error)
+      if (.not. allocated(error)) call check_length(deck, grp, 'record_kind', name_len, error)
+      if (.not. allocated(error)) call check_length(deck, grp, 'record_format', name_len, error)
+      if (.not. allocated(error)) call check_length(deck, grp, 'record_units', name_len, error)
+      if (.not. allocated(error)) call check_length(deck, grp, 'record_file', path_len, error)
       if (allocated(error)) return
       ! a record whose file gives DT (AT2) may leave dt_record out
       if (.not. (keyword_id(excitation_types, excitation_type) == excitation_record .and. dt_record == unset)) then
@@ -512,7 +507,7 @@ contains
       type(deck_text), intent(in) :: deck
       type(run_config), intent(inout) :: cfg
       type(error_type), allocatable, intent(out) :: error
-      character(len=name_read) :: technique
+      character(len=name_len) :: technique
       real(dp) :: beta, gamma, n, dt_min
       integer :: n1, n2
       logical :: check_correctness
@@ -541,7 +536,7 @@ contains
             call group_read_error(deck, grp, i, msg, error); return
          end if
       end if
-      call check_length(deck, 'integration', 'technique', technique, name_len, error)
+      call check_length(deck, grp, 'technique', name_len, error)
       if (allocated(error)) return
       technique_id = keyword_id(techniques, technique)
       if (technique_id == 0) then
@@ -589,7 +584,7 @@ contains
       type(deck_text), intent(in) :: deck
       type(run_config), intent(inout) :: cfg
       type(error_type), allocatable, intent(out) :: error
-      character(len=path_read) :: dir, name
+      character(len=path_len) :: dir, name
       integer :: output_every
       logical :: write_history
       namelist /output/ dir, name, output_every, write_history
@@ -616,8 +611,8 @@ contains
             call group_read_error(deck, grp, i, msg, error); return
          end if
       end if
-      call check_length(deck, 'output', 'dir', dir, path_len, error)
-      if (.not. allocated(error)) call check_length(deck, 'output', 'name', name, path_len, error)
+      call check_length(deck, grp, 'dir', path_len, error)
+      if (.not. allocated(error)) call check_length(deck, grp, 'name', path_len, error)
       if (allocated(error)) return
       if (len_trim(dir) == 0) then
          call bad(deck, 'output', 'dir', "''", 'a directory path', error); return
@@ -650,15 +645,20 @@ contains
       call fatal_error(error, deck%path//", group &"//group//": "//var//" = "//val//" is invalid: must be "//must)
    end subroutine bad
 
-   !> A string value longer than its capacity is an error (the namelist reader would cut it).
-   subroutine check_length(deck, group, var, x, cap, error)
+   !> A string longer than its variable's capacity is an error (the namelist reader would cut
+   !> it), found in the group's text.
+   subroutine check_length(deck, grp, var, cap, error)
       type(deck_text), intent(in) :: deck
-      character(len=*), intent(in) :: group, var, x
+      type(group_text), intent(in) :: grp
+      character(len=*), intent(in) :: var
       integer, intent(in) :: cap
       type(error_type), allocatable, intent(out) :: error
-      if (len_trim(x) <= cap) return
-      call bad(deck, group, var, "'"//x(1:min(cap, 40))//"...'", 'at most '//trim(fmt_int(cap))//' characters long', &
-               error)
+      integer :: length, line
+      call longest_string(grp, var, length, line)
+      if (length <= cap) return
+      call fatal_error(error, deck%path//", group &"//grp%name//", line "//trim(fmt_int(line))//": "//var// &
+                       " is a string of "//trim(fmt_int(length))//" characters: must be at most "// &
+                       trim(fmt_int(cap))//" characters long")
    end subroutine check_length
 
    subroutine need_int(deck, group, var, x, lo, hi, error)

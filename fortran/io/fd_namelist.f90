@@ -11,7 +11,7 @@ module fd_namelist
    private
 
    public :: deck_text, group_text, load_deck, deck_from_string, find_group, group_item, group_read_error
-   public :: check_groups, group_opened, scan_deck, group_span
+   public :: check_groups, group_opened, scan_deck, group_span, longest_string
 
    character(len=*), parameter :: blanks = ' '//achar(9)  !! what separates words on a line
 
@@ -467,6 +467,60 @@ contains
          end if
       end do
    end subroutine repeated_item
+
+   !> The longest string an assignment of variable `var` (or of its elements, 'var(i)') gives
+   !> in the group, in characters (a doubled quote counts once), and the deck line of that
+   !> assignment; 0 and 0 when none. The namelist reader cuts a longer string to its variable.
+   pure subroutine longest_string(grp, var, length, line)
+      type(group_text), intent(in) :: grp       !! the group
+      character(len=*), intent(in) :: var       !! variable name, lower case
+      integer, intent(out) :: length            !! characters of its longest string
+      integer, intent(out) :: line              !! deck line of that assignment
+      character(len=:), allocatable :: name
+      integer :: i, k, n, paren
+      character(len=1) :: quote
+
+      length = 0
+      line = 0
+      if (.not. allocated(grp%items)) return
+      do i = 1, size(grp%items)
+         call item_variable(grp%items(i)%s, name)
+         paren = index(name, '(')
+         if (paren > 0) name = name(1:paren - 1)
+         if (name /= var) cycle
+         associate (item => grp%items(i)%s)
+            quote = ' '
+            n = 0
+            k = index(item, '=') + 1
+            do while (k <= len(item))
+               if (quote == ' ') then
+                  if (item(k:k) == '"' .or. item(k:k) == "'") then
+                     quote = item(k:k)
+                     n = 0
+                  end if
+               else if (item(k:k) == quote) then
+                  if (k < len(item)) then
+                     if (item(k + 1:k + 1) == quote) then   ! a doubled quote: one character
+                        n = n + 1
+                        k = k + 2
+                        cycle
+                     end if
+                  end if
+                  quote = ' '
+                  if (n > length) then
+                     length = n; line = grp%item_line(i)
+                  end if
+               else
+                  n = n + 1
+               end if
+               k = k + 1
+            end do
+            if (quote /= ' ' .and. n > length) then   ! not closed: as long as it goes
+               length = n; line = grp%item_line(i)
+            end if
+         end associate
+      end do
+   end subroutine longest_string
 
    !> The variable an assignment sets, lower case, blanks removed: 'mass', 'mass(2)'.
    pure subroutine item_variable(item, var)

@@ -6,7 +6,7 @@ module test_fd_namelist
    use testdrive, only: new_unittest, unittest_type, error_type, check
    use fd_error, only: fd_error_type => error_type
    use fd_namelist, only: deck_text, group_text, deck_from_string, load_deck, find_group, group_item, &
-                          group_read_error, check_groups, group_opened
+                          group_read_error, check_groups, group_opened, longest_string
    implicit none
    private
 
@@ -53,7 +53,8 @@ contains
                   new_unittest("nothing outside groups but comments", test_outside), &
                   new_unittest("'&' and '$' only where they open or close", test_ampersand), &
                   new_unittest("a NUL character", test_nul), &
-                  new_unittest("a variable given twice", test_twice) &
+                  new_unittest("a variable given twice", test_twice), &
+                  new_unittest("the longest string of a variable", test_longest) &
                   ]
    end subroutine collect_namelist
 
@@ -382,6 +383,36 @@ contains
       call find_group(deck, 'model', grp, found, err)
       call check(error, .not. allocated(err), 'two elements of an array')
    end subroutine test_twice
+
+   !> longest_string: quoted strings of a variable and its elements, a doubled quote counted
+   !> once, other variables ignored; the line of the longest.
+   subroutine test_longest(error)
+      type(error_type), allocatable, intent(out) :: error
+      type(deck_text) :: deck
+      type(group_text) :: grp
+      type(fd_error_type), allocatable :: err
+      logical :: found
+      integer :: length, line
+
+      call deck_from_string("&friction"//nl//"  law = 'velocity', ""hysteretic"""//nl// &
+                            "  law(3) = 'it''s   x', name = '"//repeat('n', 50)//"'"//nl//"/"//nl, 't.nml', deck)
+      call find_group(deck, 'friction', grp, found, err)
+      call check(error, found .and. .not. allocated(err), 'found')
+      if (allocated(error)) return
+      call longest_string(grp, 'law', length, line)
+      call check(error, length == 10 .and. line == 2, "law: 'hysteretic', line 2")
+      if (allocated(error)) return
+      call longest_string(grp, 'name', length, line)
+      call check(error, length == 50 .and. line == 3, 'name: 50 characters, line 3')
+      if (allocated(error)) return
+      call longest_string(grp, 'dir', length, line)
+      call check(error, length == 0 .and. line == 0, 'dir: not given')
+      if (allocated(error)) return
+      call deck_from_string("&friction law(3) = 'it''s    x' /"//nl, 't.nml', deck)
+      call find_group(deck, 'friction', grp, found, err)
+      call longest_string(grp, 'law', length, line)
+      call check(error, length, 9, "it's    x: a doubled quote is one character")
+   end subroutine test_longest
 
    !> check_groups on a deck gives an error containing `text`.
    subroutine expect_error(deck_string, text, error)
