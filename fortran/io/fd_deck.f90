@@ -354,6 +354,12 @@ contains
                      trim(fmt_int(node_i(i)))//': a device joins two different nodes', error)
             return
          end if
+         if (p(i)*mu(i) /= 0.0_dp .and. p(i)*mu(i) < min_scale) then
+            call bad(deck, 'friction', 'p'//idx//' * mu'//idx, trim(fmt_real(p(i)*mu(i))), '0 (no friction) or at '// &
+                     'least '//trim(fmt_real(min_scale))//' N: the friction force P mu of a device (here P = '// &
+                     trim(fmt_real(p(i)))//' N, mu = '//trim(fmt_real(mu(i)))//')', error)
+            return
+         end if
          id = law_id(law(i))
          if (id == 0) then
             call law_choices(choices)
