@@ -378,8 +378,9 @@ def make_case(seed: int, index: int, all_bases=None) -> Case:
     deck = text
     for _ in range(n):
         r = rng.random()
-        if files and r < 0.25:
-            fname = rng.choice(sorted(files))
+        records = sorted(k for k, v in files.items() if v is not None)
+        if records and r < 0.25:
+            fname = rng.choice(records)
             files[fname], what = r_mutate(rng, files[fname])
             case.mutations.append(what)
             case.touched.add("record")
