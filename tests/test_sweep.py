@@ -38,6 +38,7 @@ base = "{inputs}/test4_coulomb.nml"
 [cross]
 deck = ["{inputs}/test4_velocity.nml", "{inputs}/test5_velocity.nml"]
 "friction.law" = ["coulomb"]
+"integration.technique" = ["event_driven"]
 "friction.p" = [59.0, 60.5, 99.5]
 "excitation.duration" = [30.0, 40.0]
 """

@@ -19,7 +19,7 @@ module fd_deck
                        default_u0, default_v0, default_xi, default_period, default_rayleigh_a0, &
                        default_rayleigh_a1, default_n_devices, default_eps, default_eps1, default_f, &
                        default_ramp_cycles, default_record_kind, default_record_scale, default_technique, &
-                       default_beta, default_gamma, default_n1, default_n2, default_n, &
+                       default_beta, default_gamma, default_n1, default_n2, default_n, default_theta, &
                        default_check_correctness, default_dt_min, default_dir, default_output_every, &
                        default_write_history
    use fd_model, only: model_type, integration_type, device_type, output_type
@@ -526,10 +526,10 @@ contains
       type(run_config), intent(inout) :: cfg
       type(error_type), allocatable, intent(out) :: error
       character(len=name_len) :: technique
-      real(dp) :: beta, gamma, n, dt_min
+      real(dp) :: beta, gamma, n, dt_min, theta
       integer :: n1, n2
       logical :: check_correctness
-      namelist /integration/ technique, beta, gamma, n1, n2, n, check_correctness, dt_min
+      namelist /integration/ technique, beta, gamma, n1, n2, n, check_correctness, dt_min, theta
       type(group_text) :: grp
       character(len=512) :: msg, msg0
       character(len=:), allocatable :: rec, choices
@@ -538,7 +538,7 @@ contains
 
       technique = technique_name(default_technique)
       beta = default_beta; gamma = default_gamma; n1 = default_n1; n2 = default_n2; n = default_n
-      check_correctness = default_check_correctness; dt_min = default_dt_min
+      check_correctness = default_check_correctness; dt_min = default_dt_min; theta = default_theta
       call find_group(deck, 'integration', grp, found, error)
       if (allocated(error)) return
       if (found) then
@@ -580,6 +580,8 @@ contains
       if (allocated(error)) return
       call check_real(deck, 'integration', 'dt_min', dt_min, 0.0_dp, cfg%exc%dt_record/n1/n2, 's', error)
       if (allocated(error)) return
+      call check_real(deck, 'integration', 'theta', theta, 0.5_dp, 1.0_dp, '', error)
+      if (allocated(error)) return
       ! the run takes duration / dt1 steps, counted in a default integer
       if (cfg%exc%duration/(cfg%exc%dt_record/n1) > 2.0e9_dp) then
          call bad(deck, 'integration', 'n1', trim(fmt_int(n1)), 'such that duration / (dt_record / n1) = '// &
@@ -595,6 +597,7 @@ contains
       cfg%opts%n_corr = n
       cfg%opts%check = check_correctness
       cfg%opts%dt_min = dt_min
+      cfg%opts%theta = theta
    end subroutine read_integration_group
 
    ! ---------------------------------------------------------------- &output
