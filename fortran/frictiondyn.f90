@@ -7,16 +7,16 @@ module frictiondyn
    use fd_result, only: result_type
    use fd_deck, only: run_config, read_deck, read_deck_string
    use fd_technique, only: run_technique
-   use fd_result, only: history_shape
-   use fd_output, only: output_type, write_outputs, output_paths, summary_json, history_header, &
-                        write_output_files
+   use fd_result, only: history_shape, check_finite
+   use fd_output, only: output_type, write_outputs, output_paths, temp_output_paths, summary_json, &
+                        history_header, write_output_files
    implicit none
    private
 
    public :: dp, error_type, model_type, integration_type, device_type, excitation_type
    public :: result_type, run_config, output_type
    public :: read_deck, read_deck_string, run_config_solve, run_deck, shape_of
-   public :: output_paths, summary_json, history_header
+   public :: output_paths, temp_output_paths, summary_json, history_header
    public :: write_outputs, write_output_files
 
 contains
@@ -30,9 +30,9 @@ contains
       type(result_type), intent(out) :: res               !! histories and summary
       type(error_type), allocatable, intent(out) :: error !! failure of the solver
       call run_technique(cfg%model, cfg%exc, cfg%opts, res, error)
-      if (allocated(error) .and. allocated(cfg%deck_path)) then
-         if (len(cfg%deck_path) > 0) error%message = cfg%deck_path//": "//error%message
-      end if
+      if (allocated(error)) return
+      ! no null in a summary, no NaN in a history: a quantity that overflowed is an error
+      call check_finite(res, error)
    end subroutine run_config_solve
 
    !> Columns and samples of the history the configuration's run produces.
@@ -54,7 +54,7 @@ contains
       if (allocated(error)) return
       call run_config_solve(cfg, res, error)
       if (allocated(error)) return
-      call write_outputs(cfg%out, cfg%model, res, path, error)
+      call write_outputs(cfg%out, cfg%model, res, path, record=cfg%record, error=error)
       if (allocated(error)) error%message = path//": "//error%message
    end subroutine run_deck
 

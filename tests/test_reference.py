@@ -66,16 +66,28 @@ def _is_int(x) -> bool:
     return isinstance(x, int) and not isinstance(x, bool)
 
 
+def _flatten(summary: dict) -> dict:
+    """Nested objects (the record block) as dotted keys, compared by the same rules."""
+    flat = {}
+    for key, value in summary.items():
+        if isinstance(value, dict):
+            flat.update({f"{key}.{k}": v for k, v in value.items()})
+        else:
+            flat[key] = value
+    return flat
+
+
 def compare_summary(got: dict, ref: dict) -> list[str]:
     """Mismatches of a run's summary against a reference summary (empty list: equal)."""
     bad = []
     scale = abs(ref.get("energy_input_J", 0.0))
+    got, ref = _flatten(got), _flatten(ref)
     for key, want in ref.items():
         if key not in got:
             bad.append(f"{key}: missing from the run")
             continue
         have = got[key]
-        if key == "deck":
+        if key in ("deck", "record.file"):
             if Path(have).name != Path(want).name:
                 bad.append(f"deck: {have!r} != {want!r}")
             continue

@@ -22,6 +22,7 @@ from . import _core
 __all__ = [
     "DeckError",
     "FrictiondynError",
+    "OutOfMemoryError",
     "OutputError",
     "OutputSettings",
     "Result",
@@ -50,12 +51,37 @@ class OutputError(FrictiondynError, OSError):
     """An output file or directory cannot be created or written."""
 
 
+class OutOfMemoryError(FrictiondynError, MemoryError):
+    """Memory for what the deck asks (its matrices, its history) cannot be had; the message
+    says what and how large. Also a MemoryError."""
+
+
 # the status codes of the extension (driver/frictiondyn/_core.f90)
-_ERRORS = {1: DeckError, 2: SolverError, 3: FrictiondynError, 4: OutputError, 5: MemoryError}
+_ERRORS = {1: DeckError, 2: SolverError, 3: FrictiondynError, 4: OutputError, 5: OutOfMemoryError}
+
+
+def _text_bytes(text: str, what: str) -> np.ndarray:
+    """Text for the extension: its UTF-8 bytes (lone surrogates, as os.fsdecode makes them,
+    back to their bytes), as the int16 array (one byte an element) the extension takes."""
+    try:
+        data = text.encode("utf-8", "surrogateescape")
+    except UnicodeEncodeError as exc:
+        raise DeckError(f"{what}: character {exc.start + 1} cannot be encoded as UTF-8") from None
+    return np.frombuffer(data, dtype=np.uint8).astype(np.int16)
+
+
+def _path_bytes(path: str | os.PathLike) -> np.ndarray:
+    """A path for the extension: its bytes in the file system's encoding (as above)."""
+    try:
+        data = os.fsencode(path)
+    except UnicodeEncodeError as exc:
+        raise DeckError(f"{os.fspath(path)!r}: cannot be encoded as a file name ({exc.reason})") from None
+    return np.frombuffer(data, dtype=np.uint8).astype(np.int16)
 # the texts a session gives (fortran/fd_session.f90)
 _HEADER, _SUMMARY, _OUTPUT_DIR, _OUTPUT_NAME, _HISTORY_PATH, _SUMMARY_PATH, _DECK, _ERROR = range(
     1, 9
 )
+_PATHS = (_OUTPUT_DIR, _OUTPUT_NAME, _HISTORY_PATH, _SUMMARY_PATH, _DECK)
 
 
 @dataclass
@@ -78,7 +104,7 @@ class Session:
     """
 
     def __init__(self, deck: str | os.PathLike) -> None:
-        self._open(os.fspath(deck), "", 0)
+        self._open(_path_bytes(deck), _text_bytes("", "deck"), 0)
 
     @classmethod
     def from_text(
@@ -87,7 +113,10 @@ class Session:
         """A session of a deck given as text; ``name`` names it in messages, a relative
         record_file is looked up in ``base_dir``."""
         self = cls.__new__(cls)
-        self._open(os.path.join(os.fspath(base_dir), name), text, 1)
+        if not isinstance(text, str):
+            raise TypeError(f"the deck text must be a str, not {type(text).__name__}")
+        path = os.path.join(os.fspath(base_dir), os.fspath(name))
+        self._open(_path_bytes(path), _text_bytes(text, path), 1)
         return self
 
     @classmethod
@@ -96,11 +125,13 @@ class Session:
         self = cls.__new__(cls)
         self._handle, self._lock = 0, threading.Lock()
         hist = np.asarray(data, dtype=np.float64).T  # (columns, samples), Fortran order
-        handle, status = _core.fd_session_adopt(hist, header, summary)
+        handle, status = _core.fd_session_adopt(
+            hist, _text_bytes(header, "header"), _text_bytes(summary, "summary")
+        )
         self._started(handle, status)
         return self
 
-    def _open(self, path: str, text: str, from_text: int) -> None:
+    def _open(self, path: np.ndarray, text: np.ndarray, from_text: int) -> None:
         self._handle, self._lock = 0, threading.Lock()
         handle, _, _, status = _core.fd_session_open(path, text, from_text)
         self._started(handle, status)
@@ -137,7 +168,10 @@ class Session:
             return ""
         buf, status = _core.fd_session_text(self._handle, which, length)
         self._check(status)
-        return np.asarray(buf).tobytes().decode("utf-8", errors="replace")
+        data = np.asarray(buf).tobytes()
+        if which in _PATHS:  # paths as the file system names them (any bytes round-trip)
+            return os.fsdecode(data)
+        return data.decode("utf-8", errors="replace")
 
     def _text(self, which: int) -> str:
         n, status = _core.fd_session_text_length(self._live(), which)
@@ -204,7 +238,15 @@ class Session:
             h = self._live()
             ncol, nout, history, status = _core.fd_session_shape(h)
             self._check(status)
-            hist, status = _core.fd_session_history(h, ncol, nout)
+            try:
+                hist, status = _core.fd_session_history(h, ncol, nout)
+            except MemoryError:
+                raise OutOfMemoryError(
+                    f"{self._text(_DECK)}: not enough memory for the history in Python: "
+                    f"{nout} samples of {ncol} columns ({8 * nout * ncol / 2**20:.0f} MiB); "
+                    "raise output_every in &output, or set write_history = .false. and use "
+                    "Session.write()"
+                ) from None
             self._check(status)
             summary = self._text(_SUMMARY)
             result = Result.from_arrays(self._text(_HEADER), np.asarray(hist).T, summary)
@@ -221,7 +263,7 @@ class Session:
         with self._lock:
             h = self._live()
             if out is not None:
-                self._check(_core.fd_session_set_output_dir(h, os.fspath(out)))
+                self._check(_core.fd_session_set_output_dir(h, _path_bytes(out)))
             self._check(_core.fd_session_write(h))
             _, _, history, status = _core.fd_session_shape(h)
             self._check(status)
@@ -231,7 +273,7 @@ class Session:
     def _write_files(self, csv: Path | None, summary: Path) -> None:
         with self._lock:
             status = _core.fd_session_write_files(
-                self._live(), os.fspath(csv or ""), os.fspath(summary), int(csv is not None)
+                self._live(), _path_bytes(csv or ""), _path_bytes(summary), int(csv is not None)
             )
             self._check(status)
 

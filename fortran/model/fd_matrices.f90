@@ -3,7 +3,7 @@
 !> system, in which every friction device is a rigid link.
 module fd_matrices
    use fd_kinds, only: dp
-   use fd_error, only: error_type, fatal_error, fmt_real
+   use fd_error, only: error_type, fatal_error, fmt_real, fmt_int, stat_no_memory
    use fd_model, only: model_type, damping_none, damping_stiffness, damping_rayleigh
    use fd_linalg, only: generalized_eigen
    implicit none
@@ -43,31 +43,37 @@ contains
       real(dp), intent(out) :: phi(:)                !! first mode, all DOFs
       type(error_type), allocatable, intent(out) :: error !! no free DOF, or no stiffness
       integer, allocatable :: grp(:)
-      real(dp), allocatable :: t(:, :), kq(:, :), mq(:, :), lam(:), z(:, :)
-      integer :: n, nq, i
+      real(dp), allocatable :: kq(:, :), mq(:, :), lam(:), z(:, :)
+      integer :: n, nq, i, j, stat
 
       period = 0.0_dp
       phi = 0.0_dp
       n = model%n_dof
-      allocate (grp(n))
+      allocate (grp(n), stat=stat)
+      if (stat /= 0) then
+         call no_memory(n); return
+      end if
       call link_groups(model, model%dev%p*model%dev%mu > 0.0_dp, grp, nq)
       if (nq == 0) then
          call fatal_error(error, "the stuck system has no free DOF: every mass is locked to the table &
                           &by friction devices, so its first period is undefined (give period in &damping)")
          return
       end if
-      allocate (t(n, nq))
-      t = 0.0_dp
-      do i = 1, n
-         if (grp(i) /= 0) t(i, grp(i)) = 1.0_dp
-      end do
-      kq = matmul(transpose(t), matmul(k, t))
-      allocate (mq(nq, nq))
+      allocate (kq(nq, nq), mq(nq, nq), lam(nq), z(nq, nq), stat=stat)
+      if (stat /= 0) then
+         call no_memory(nq); return
+      end if
+      ! K and M of the groups, T' K T and T' M T with T(i, grp(i)) = 1, summed entry by entry
+      ! (no n x nq matrix T)
+      kq = 0.0_dp
       mq = 0.0_dp
-      do i = 1, n
-         if (grp(i) /= 0) mq(grp(i), grp(i)) = mq(grp(i), grp(i)) + model%mass(i)
+      do j = 1, n
+         if (grp(j) == 0) cycle
+         mq(grp(j), grp(j)) = mq(grp(j), grp(j)) + model%mass(j)
+         do i = 1, n
+            if (grp(i) /= 0) kq(grp(i), grp(j)) = kq(grp(i), grp(j)) + k(i, j)
+         end do
       end do
-      allocate (lam(nq), z(nq, nq))
       call generalized_eigen(kq, mq, lam, z, error)
       if (allocated(error)) return
       if (lam(1) <= 1.0e-12_dp*maxval(abs(lam))) then
@@ -76,7 +82,15 @@ contains
          return
       end if
       period = 2.0_dp*pi/sqrt(lam(1))
-      phi = matmul(t, z(:, 1))
+      do i = 1, n
+         if (grp(i) /= 0) phi(i) = z(grp(i), 1)
+      end do
+   contains
+      subroutine no_memory(size)
+         integer, intent(in) :: size
+         call fatal_error(error, "not enough memory for the stuck system's eigenproblem of "// &
+                          trim(fmt_int(size))//" DOFs", stat_no_memory)
+      end subroutine no_memory
    end subroutine stuck_first_mode
 
    !> Springs' stiffness K and damping C of the model, with the stuck system's first period
@@ -89,10 +103,16 @@ contains
       real(dp), intent(out) :: xi                         !! its damping ratio
       type(error_type), allocatable, intent(out) :: error !! 'stiffness' damping without a period
       type(error_type), allocatable :: eig_error
-      real(dp), allocatable :: phi(:)
+      real(dp), allocatable :: phi(:), cphi(:)
       real(dp) :: t_damp
+      integer :: stat
 
-      allocate (phi(model%n_dof))
+      allocate (phi(model%n_dof), cphi(model%n_dof), stat=stat)
+      if (stat /= 0) then
+         call fatal_error(error, "not enough memory for the matrices of "//trim(fmt_int(model%n_dof))//" DOFs", &
+                          stat_no_memory)
+         return
+      end if
       call stiffness_matrix(model, k)
       call stuck_first_mode(model, k, period, phi, eig_error)
       ! the paper's psi = T xi / pi uses the given T, else the computed one
@@ -110,7 +130,8 @@ contains
       if (allocated(eig_error)) then
          period = 0.0_dp
       else
-         xi = dot_product(phi, matmul(c, phi))/(2.0_dp*(2.0_dp*pi/period)*sum(model%mass*phi**2))
+         cphi = matmul(c, phi)
+         xi = dot_product(phi, cphi)/(2.0_dp*(2.0_dp*pi/period)*sum(model%mass*phi**2))
       end if
    end subroutine structure_matrices
 

@@ -15,7 +15,7 @@ module fd_names
 
    public :: keyword_type, law_type, keyword_len
    public :: laws, law_velocity, law_hysteretic, law_coulomb
-   public :: techniques, technique_newmark, technique_event_driven
+   public :: techniques, technique_newmark, technique_event_driven, technique_moreau_jean
    public :: damping_types, damping_stiffness, damping_rayleigh, damping_none
    public :: excitation_types, excitation_harmonic, excitation_record, excitation_none
    public :: record_kinds, record_acceleration, record_displacement
@@ -24,7 +24,7 @@ module fd_names
    public :: default_n_devices, default_eps, default_eps1, default_f
    public :: default_ramp_cycles, default_record_kind, default_record_scale
    public :: default_technique, default_beta, default_gamma, default_n1, default_n2, default_n
-   public :: default_check_correctness, default_dt_min
+   public :: default_check_correctness, default_dt_min, default_theta
    public :: default_dir, default_output_every, default_write_history
 
    integer, parameter :: keyword_len = 16   !! length of a keyword in the tables
@@ -54,9 +54,11 @@ module fd_names
    ! ------------------------------------------------------------------ techniques
    type(keyword_type), parameter :: techniques(*) = [ &
                                     keyword_type('newmark', 'regularized laws'), &
-                                    keyword_type('event_driven', "exact, law 'coulomb'")]
+                                    keyword_type('event_driven', "exact, law 'coulomb'"), &
+                                    keyword_type('moreau_jean', "time stepping, law 'coulomb'")]
    integer, parameter :: technique_newmark = 1      !! Newmark with the paper's step control
    integer, parameter :: technique_event_driven = 2 !! exact event-driven Coulomb technique
+   integer, parameter :: technique_moreau_jean = 3  !! Moreau-Jean time stepping, exact Coulomb impulses
 
    ! ------------------------------------------------------------------ damping types
    type(keyword_type), parameter :: damping_types(*) = [ &
@@ -110,6 +112,7 @@ module fd_names
    real(dp), parameter :: default_n = 10.0_dp            !! n of eqs. 9 and 12
    logical, parameter :: default_check_correctness = .true.
    real(dp), parameter :: default_dt_min = 0.0_dp        !! 0 = dt2 / 2**10 [s]
+   real(dp), parameter :: default_theta = 0.5_dp         !! theta of the Moreau-Jean technique
    ! &output
    character(len=*), parameter :: default_dir = 'out'    !! output directory
    integer, parameter :: default_output_every = 0        !! 0 = every dt_record
@@ -133,7 +136,12 @@ contains
    pure integer function law_id(word) result(id)
       character(len=*), intent(in) :: word  !! the word of the deck
 
-      id = keyword_id(laws%keyword_type, word)
+      ! over the table itself: laws%keyword_type, a section of a constant, is copied to a
+      ! temporary at every call
+      do id = 1, size(laws)
+         if (laws(id)%keyword_type%name == lower(trim(word))) return
+      end do
+      id = 0
    end function law_id
 
    !> The keywords of a table for a message: 'a' (note), 'b', 'c'.
@@ -155,12 +163,18 @@ contains
    pure subroutine law_choices(text, regularized)
       character(len=:), allocatable, intent(out) :: text !! the list
       logical, intent(in), optional :: regularized       !! which laws to list (default all)
+      type(keyword_type) :: table(size(laws))
+      integer :: i, n
 
-      if (present(regularized)) then
-         call keyword_choices(pack(laws%keyword_type, laws%regularized .eqv. regularized), text)
-      else
-         call keyword_choices(laws%keyword_type, text)
-      end if
+      n = 0
+      do i = 1, size(laws)
+         if (present(regularized)) then
+            if (laws(i)%regularized .neqv. regularized) cycle
+         end if
+         n = n + 1
+         table(n) = laws(i)%keyword_type
+      end do
+      call keyword_choices(table(1:n), text)
    end subroutine law_choices
 
    !> Name of a friction law, as written in decks ('unknown' for an id not in the table).

@@ -2,13 +2,14 @@
 !> phase transitions, correctness violations, energy balance).
 module fd_result
    use fd_kinds, only: dp
-   use fd_error, only: error_type, fatal_error, fmt_int
+   use, intrinsic :: ieee_arithmetic, only: ieee_is_finite
+   use fd_error, only: error_type, fatal_error, fmt_int, fmt_real, stat_no_memory
    use fd_model, only: model_type, integration_type, technique_event_driven
    use fd_excitation, only: excitation_type
    implicit none
    private
 
-   public :: result_type, max_violation_times, column_name_len, init_result, history_shape
+   public :: result_type, max_violation_times, column_name_len, init_result, history_shape, check_finite
    public :: max_event_times, has_envelope
 
    integer, parameter :: max_violation_times = 10 !! first violation times kept
@@ -58,6 +59,8 @@ module fd_result
       real(dp) :: accumulation_time(max_violation_times) = 0.0_dp !! their first times [s]
       logical :: exact_peaks = .false. !! peaks are the exact extrema (exact technique)
       integer :: env_col = 0           !! first column of the maxima between rows (0: none)
+      integer :: patterns = 0          !! stick-slip patterns solved in one-step problems (Moreau-Jean)
+      integer :: lcp_fallbacks = 0     !! one-step problems that needed Lemke's fallback (Moreau-Jean)
       ! correctness condition, eqs. 9 and 12
       integer :: violations = 0        !! steps accepted that violate it
       integer :: n_violation_times = 0 !! entries used in violation_time
@@ -127,7 +130,7 @@ contains
       if (stat /= 0) then
          call fatal_error(error, "not enough memory for the history: "//trim(fmt_int(res%nout))// &
                           " samples of "//trim(fmt_int(res%ncol))//" columns (raise output_every or "// &
-                          "shorten duration)")
+                          "shorten duration)", stat_no_memory)
          return
       end if
       res%hist = 0.0_dp
@@ -163,13 +166,72 @@ contains
          end do
       end if
       allocate (res%peak_u(n), res%peak_u_time(n), res%peak_v(n), res%peak_aabs(n), &
-                res%peak_aabs_time(n))
+                res%peak_aabs_time(n), res%peak_s(nd), res%peak_force(nd), res%stick_to_slip(nd), &
+                res%slip_to_stick(nd), res%reversals(nd), stat=stat)
+      if (stat /= 0) then
+         call fatal_error(error, "not enough memory for the summary of "//trim(fmt_int(n))//" DOFs and "// &
+                          trim(fmt_int(nd))//" devices", stat_no_memory)
+         return
+      end if
       res%peak_u = 0.0_dp; res%peak_u_time = 0.0_dp; res%peak_v = 0.0_dp
       res%peak_aabs = 0.0_dp; res%peak_aabs_time = 0.0_dp
-      allocate (res%peak_s(nd), res%peak_force(nd), res%stick_to_slip(nd), &
-                res%slip_to_stick(nd), res%reversals(nd))
       res%peak_s = 0.0_dp; res%peak_force = 0.0_dp
       res%stick_to_slip = 0; res%slip_to_stick = 0; res%reversals = 0
    end subroutine init_result
+
+   !> Every number of a result must be finite: an error names the first quantity that is not
+   !> (its summary key, or its history column and time), never a null in a summary.
+   subroutine check_finite(res, error)
+      type(result_type), intent(in) :: res                !! the result of a run
+      type(error_type), allocatable, intent(out) :: error !! the first quantity not finite
+      integer :: i, j
+
+      call scalar('period_stuck_s', res%period_stuck)
+      call scalar('xi_stuck', res%xi_stuck)
+      call scalar('energy_input_J', res%e_input)
+      call scalar('energy_kinetic_J', res%e_kinetic)
+      call scalar('energy_strain_J', res%e_strain)
+      call scalar('energy_viscous_J', res%e_viscous)
+      call scalar('energy_friction_J', res%e_friction)
+      call scalar('energy_device_elastic_J', res%e_device)
+      call scalar('energy_residual_J', res%e_residual)
+      if (allocated(error)) return
+      if (allocated(res%peak_u)) call vector('peak_u_m', res%peak_u)
+      if (allocated(res%peak_v)) call vector('peak_v_mps', res%peak_v)
+      if (allocated(res%peak_aabs)) call vector('peak_aabs_mps2', res%peak_aabs)
+      if (allocated(res%peak_s)) call vector('peak_s_m', res%peak_s)
+      if (allocated(res%peak_force)) call vector('peak_force_N', res%peak_force)
+      if (allocated(error) .or. .not. allocated(res%hist)) return
+      do j = 1, min(res%nout, size(res%hist, 2))
+         do i = 1, size(res%hist, 1)
+            if (ieee_is_finite(res%hist(i, j))) cycle
+            call fatal_error(error, "the run produced a value that is not finite (overflow): history column "// &
+                             trim(res%names(i))//" at t = "//trim(fmt_real(res%hist(1, j)))//" s is "// &
+                             trim(fmt_real(res%hist(i, j)))//"; the deck's values are too large (or too small) for "// &
+                             "double precision")
+            return
+         end do
+      end do
+   contains
+      subroutine scalar(key, x)
+         character(len=*), intent(in) :: key
+         real(dp), intent(in) :: x
+         if (allocated(error)) return
+         if (ieee_is_finite(x)) return
+         call fatal_error(error, "the run produced a value that is not finite (overflow): "//key//" = "// &
+                          trim(fmt_real(x))//"; the deck's values are too large (or too small) for double precision")
+      end subroutine scalar
+      subroutine vector(key, x)
+         character(len=*), intent(in) :: key
+         real(dp), intent(in) :: x(:)
+         integer :: k
+         if (allocated(error)) return
+         do k = 1, size(x)
+            if (ieee_is_finite(x(k))) cycle
+            call scalar(key//'('//trim(fmt_int(k))//')', x(k))
+            return
+         end do
+      end subroutine vector
+   end subroutine check_finite
 
 end module fd_result

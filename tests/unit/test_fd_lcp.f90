@@ -6,6 +6,7 @@
 module test_fd_lcp
    use testdrive, only: new_unittest, unittest_type, error_type, check
    use fd_kinds, only: dp
+   use, intrinsic :: ieee_arithmetic, only: ieee_value, ieee_quiet_nan
    use fd_error, only: fmt_real, fmt_int, fd_error_type => error_type
    use fd_linalg, only: lu_solve
    use fd_lcp, only: lcp_work, lcp_info, lcp_init, lcp_solve, lcp_lemke, lcp_enumerate, lcp_pgs, &
@@ -613,7 +614,7 @@ contains
       call check_status(error, info, lcp_bad_input, 'size(z) /= n')
       if (allocated(error)) return
       zero = 0.0_dp
-      nan = zero/zero
+      nan = ieee_value(zero, ieee_quiet_nan)   ! not 0/0: a build that traps invalid stops there
       q3(2) = nan
       call lcp_solve(work, m3, q3, z3, w3, info)
       call check_status(error, info, lcp_bad_input, 'NaN in q')

@@ -11,6 +11,7 @@ program tester
    use test_fd_friction, only: collect_friction
    use test_fd_namelist, only: collect_namelist
    use test_fd_record, only: collect_record
+   use test_fd_record_parse, only: collect_record_parse
    use test_fd_excitation, only: collect_excitation
    use test_fd_lcp, only: collect_lcp
    use test_fd_textio, only: collect_textio
@@ -20,6 +21,10 @@ program tester
    use test_fd_phase_pattern, only: collect_phase_pattern
    use test_fd_observer, only: collect_observer
    use test_fd_taylor, only: collect_taylor
+   use test_fd_banded, only: collect_banded
+   use test_fd_stick_groups, only: collect_stick_groups
+   use test_fd_group_system, only: collect_group_system
+   use test_fd_impulse_solver, only: collect_impulse_solver
    implicit none
    integer :: stat, is
    character(len=:), allocatable :: suite_name, test_name
@@ -36,6 +41,7 @@ program tester
    testsuites = [testsuites, new_testsuite("friction", collect_friction)]
    testsuites = [testsuites, new_testsuite("namelist", collect_namelist)]
    testsuites = [testsuites, new_testsuite("record", collect_record)]
+   testsuites = [testsuites, new_testsuite("record_parse", collect_record_parse)]
    testsuites = [testsuites, new_testsuite("excitation", collect_excitation)]
    testsuites = [testsuites, new_testsuite("lcp", collect_lcp)]
    testsuites = [testsuites, new_testsuite("textio", collect_textio)]
@@ -45,6 +51,10 @@ program tester
    testsuites = [testsuites, new_testsuite("phase_pattern", collect_phase_pattern)]
    testsuites = [testsuites, new_testsuite("observer", collect_observer)]
    testsuites = [testsuites, new_testsuite("taylor", collect_taylor)]
+   testsuites = [testsuites, new_testsuite("banded", collect_banded)]
+   testsuites = [testsuites, new_testsuite("stick_groups", collect_stick_groups)]
+   testsuites = [testsuites, new_testsuite("group_system", collect_group_system)]
+   testsuites = [testsuites, new_testsuite("impulse_solver", collect_impulse_solver)]
 
    call get_argument(1, suite_name)
    call get_argument(2, test_name)
