@@ -45,6 +45,9 @@ module fd_event_driven
    public :: run_event_driven, event_driven_check
 
    integer, parameter :: ring_size = 64          !! events in the accumulation window
+   !> Most sub-intervals a run may need (about an hour of integration): a pattern whose
+   !> frequencies need more for the rest of the run is an error, not a run without end.
+   real(dp), parameter :: max_subintervals = 1.0e9_dp
    real(dp), parameter :: accumulation_span = 1.0e-9_dp !! [s], times max(1, t): the window
 
    !> Everything the loop works on.
@@ -200,6 +203,14 @@ contains
             fresh = .true.
             do while (t < t_end)
                tb = segment_end(exc, t, t_end)
+               if (t_end - t > max_subintervals*st%cache%slot(st%cur)%delta) then
+                  call fatal_error(err, "the structure's highest frequency with the current phases "// &
+                                   "needs sub-intervals of "//trim(fmt_real(st%cache%slot(st%cur)%delta))// &
+                                   " s: more than "//trim(fmt_real(max_subintervals))//" for the "// &
+                                   trim(fmt_real(t_end - t))//" s left; check for a stiff spring on a "// &
+                                   "small mass (the frequencies sqrt(k/m)), or use the velocity law")
+                  return
+               end if
                span = min(st%cache%slot(st%cur)%delta, tb - t)
                ! the polynomials, with a remainder below the rounding level of the state
                do halvings = 0, 40
