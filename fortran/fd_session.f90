@@ -25,7 +25,7 @@ module fd_session
                           write_output_files, run_control, select_history
    use fd_run_control, only: progress_callback, control_reset
    use fd_history_stream, only: stream_close, stream_discard
-   use fd_output, only: make_dir, temp_output_paths
+   use fd_output, only: make_dir, temp_output_paths, remove_made_dirs
    implicit none
    private
 
@@ -74,6 +74,7 @@ module fd_session
       logical :: stream = .false.                     !! write the history file as the run goes
       character(len=:), allocatable :: tag            !! suffix of its temporary name
       character(len=:), allocatable :: stream_tmp     !! its temporary name, once complete
+      character(len=:), allocatable :: made_dir       !! outermost directory created for it
       logical :: have_history = .false.               !! res%hist holds the history
    end type session_type
 
@@ -110,7 +111,7 @@ contains
       type(session_type), pointer :: s
       call session_from_handle(handle, s)
       if (associated(s)) then
-         call stream_discard(s%ctl%stream)   ! a streamed history never committed is removed
+         call discard_stream(s)   ! a streamed history never committed is removed
          deallocate (s)
       end if
    end subroutine session_free
@@ -195,7 +196,7 @@ contains
       end if
       if (allocated(s%ctl%stream_path)) deallocate (s%ctl%stream_path)
       if (s%stream .and. s%cfg%out%history) then
-         call make_dir(s%cfg%out%dir, error)
+         call make_dir(s%cfg%out%dir, error, s%made_dir)
          if (allocated(error)) then
             s%state = state_failed
             return
@@ -211,13 +212,15 @@ contains
       call run_config_solve(s%cfg, s%res, error, s%ctl)
       nullify (s%ctl%buffer)
       if (allocated(error)) then
-         call stream_discard(s%ctl%stream)
+         call discard_stream(s)
          s%state = state_failed
+         error%message = s%cfg%deck_path//": "//error%message   ! as the executable says it
          return
       end if
       if (allocated(s%ctl%stream_path)) then
          call stream_close(s%ctl%stream, close_error)
          if (allocated(close_error)) then
+            call discard_stream(s)
             call move_alloc(close_error, error)
             s%state = state_failed
             return
@@ -291,8 +294,11 @@ contains
       ncol = 0; nout = 0; history = .false.
       select case (s%state)
       case (session_read, state_failed)
-         call shape_of(s%cfg, ncol, nout)
-         if (.not. s%ctl%select_all) ncol = 2 + 3*size(s%ctl%dofs) + 4*size(s%ctl%devices)
+         if (s%ctl%select_all) then
+            call shape_of(s%cfg, ncol, nout)
+         else
+            call shape_of(s%cfg, ncol, nout, size(s%ctl%dofs), size(s%ctl%devices))
+         end if
       case (session_solved)
          ncol = s%res%ncol
          nout = s%res%nout
@@ -384,6 +390,8 @@ contains
                                  tag=s%tag, streamed=.true.)
          if (allocated(s%ctl%stream%path)) deallocate (s%ctl%stream%path)
          deallocate (s%stream_tmp)
+         if (allocated(error) .and. allocated(s%made_dir)) call remove_made_dirs(s%cfg%out%dir, s%made_dir)
+         if (allocated(s%made_dir)) deallocate (s%made_dir)
       else
          call make_dir(s%cfg%out%dir, error)
          if (allocated(error)) return
@@ -442,9 +450,20 @@ contains
    subroutine reset(s)
       type(session_type), intent(inout) :: s
       type(session_type) :: fresh
-      call stream_discard(s%ctl%stream)
+      call discard_stream(s)
       s = fresh
    end subroutine reset
+
+   !> Remove a streamed history not committed, and the directories created for it when
+   !> they are left empty: a run that failed or was cancelled leaves nothing behind.
+   subroutine discard_stream(s)
+      type(session_type), intent(inout) :: s
+      call stream_discard(s%ctl%stream)
+      if (allocated(s%made_dir)) then
+         call remove_made_dirs(s%cfg%out%dir, s%made_dir)
+         deallocate (s%made_dir)
+      end if
+   end subroutine discard_stream
 
    subroutine need(s, state, what, error)
       type(session_type), intent(in) :: s

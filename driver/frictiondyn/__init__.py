@@ -10,6 +10,7 @@ from __future__ import annotations
 from ._api import (
     DeckError,
     FrictiondynError,
+    OutOfMemoryError,
     OutputError,
     Result,
     RunCancelled,
@@ -44,6 +45,7 @@ __all__ = [
     "FrictiondynError",
     "Harmonic",
     "Integration",
+    "OutOfMemoryError",
     "Output",
     "OutputError",
     "Record",

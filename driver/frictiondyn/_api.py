@@ -32,6 +32,7 @@ from . import _core
 __all__ = [
     "DeckError",
     "FrictiondynError",
+    "OutOfMemoryError",
     "OutputError",
     "OutputSettings",
     "Result",
@@ -65,13 +66,18 @@ class RunCancelled(FrictiondynError):
     """The solve was cancelled (``Session.cancel`` from another thread)."""
 
 
+class OutOfMemoryError(FrictiondynError, MemoryError):
+    """Memory for what the deck asks (its matrices, its history) cannot be had; the message
+    says what and how large. Also a MemoryError."""
+
+
 # the status codes of the extension (driver/frictiondyn/_core.f90)
 _ERRORS = {
     1: DeckError,
     2: SolverError,
     3: FrictiondynError,
     4: OutputError,
-    5: MemoryError,
+    5: OutOfMemoryError,
     6: RunCancelled,
 }
 #: seconds between looks at a solve running in the worker thread (Ctrl-C, progress)
@@ -82,10 +88,37 @@ ProgressCallback = Callable[[float, float], object]
 
 def _no_history() -> np.ndarray:
     return np.zeros((1, 1), dtype=np.float64, order="F")
+
+
+def _text_bytes(text: str, what: str) -> np.ndarray:
+    """Text for the extension: its UTF-8 bytes (lone surrogates, as os.fsdecode makes them,
+    back to their bytes), as the int16 array (one byte an element) the extension takes."""
+    try:
+        data = text.encode("utf-8", "surrogateescape")
+    except UnicodeEncodeError as exc:
+        raise DeckError(f"{what}: character {exc.start + 1} cannot be encoded as UTF-8") from None
+    return np.frombuffer(data, dtype=np.uint8).astype(np.int16)
+
+
+def _path_bytes(path: str | os.PathLike) -> np.ndarray:
+    """A path for the extension: its bytes in the file system's encoding (as above)."""
+    try:
+        data = os.fsencode(path)
+    except UnicodeEncodeError as exc:
+        raise DeckError(f"{os.fspath(path)!r}: cannot be encoded as a file name ({exc.reason})") from None
+    return np.frombuffer(data, dtype=np.uint8).astype(np.int16)
+
+
+def _history_array(ncol: int, nout: int) -> np.ndarray:
+    """The history buffer the library writes its rows into, (columns, samples), Fortran order."""
+    return np.empty((ncol, nout), dtype=np.float64, order="F")
+
+
 # the texts a session gives (fortran/fd_session.f90)
 _HEADER, _SUMMARY, _OUTPUT_DIR, _OUTPUT_NAME, _HISTORY_PATH, _SUMMARY_PATH, _DECK, _ERROR = range(
     1, 9
 )
+_PATHS = (_OUTPUT_DIR, _OUTPUT_NAME, _HISTORY_PATH, _SUMMARY_PATH, _DECK)
 
 
 @dataclass
@@ -110,7 +143,7 @@ class Session:
     """
 
     def __init__(self, deck: str | os.PathLike) -> None:
-        self._open(os.fspath(deck), "", 0)
+        self._open(_path_bytes(deck), _text_bytes("", "deck"), 0)
 
     @classmethod
     def from_text(
@@ -119,7 +152,10 @@ class Session:
         """A session of a deck given as text; ``name`` names it in messages, a relative
         record_file is looked up in ``base_dir``."""
         self = cls.__new__(cls)
-        self._open(os.path.join(os.fspath(base_dir), name), text, 1)
+        if not isinstance(text, str):
+            raise TypeError(f"the deck text must be a str, not {type(text).__name__}")
+        path = os.path.join(os.fspath(base_dir), os.fspath(name))
+        self._open(_path_bytes(path), _text_bytes(text, path), 1)
         return self
 
     @classmethod
@@ -128,7 +164,9 @@ class Session:
         self = cls.__new__(cls)
         self._init_state()
         empty = np.zeros((np.shape(data)[1], 0), dtype=np.float64, order="F")
-        handle, status = _core.fd_session_adopt(empty, header, summary)
+        handle, status = _core.fd_session_adopt(
+            empty, _text_bytes(header, "header"), _text_bytes(summary, "summary")
+        )
         self._started(handle, status)
         return self
 
@@ -137,7 +175,7 @@ class Session:
         self._hist: np.ndarray | None = None  # the history, (columns, samples), Fortran order
         self._streamed = False
 
-    def _open(self, path: str, text: str, from_text: int) -> None:
+    def _open(self, path: np.ndarray, text: np.ndarray, from_text: int) -> None:
         self._init_state()
         handle, _, _, status = _core.fd_session_open(path, text, from_text)
         self._started(handle, status)
@@ -174,7 +212,10 @@ class Session:
             return ""
         buf, status = _core.fd_session_text(self._handle, which, length)
         self._check(status)
-        return np.asarray(buf).tobytes().decode("utf-8", errors="replace")
+        data = np.asarray(buf).tobytes()
+        if which in _PATHS:  # paths as the file system names them (any bytes round-trip)
+            return os.fsdecode(data)
+        return data.decode("utf-8", errors="replace")
 
     def _text(self, which: int) -> str:
         n, status = _core.fd_session_text_length(self._live(), which)
@@ -260,7 +301,7 @@ class Session:
         with self._lock:
             h = self._live()
             if out is not None:
-                self._check(_core.fd_session_set_output_dir(h, os.fspath(out)))
+                self._check(_core.fd_session_set_output_dir(h, _path_bytes(out)))
             self._check(_core.fd_session_stream(h))
             self._streamed = True
         return self
@@ -291,7 +332,16 @@ class Session:
             ncol, nout, _, status = _core.fd_session_shape(h)
             self._check(status)
             if history:
-                buf = np.empty((int(ncol), int(nout)), dtype=np.float64, order="F")
+                try:
+                    buf = _history_array(int(ncol), int(nout))
+                except MemoryError:
+                    raise OutOfMemoryError(
+                        f"{self._text(_DECK)}: not enough memory for the history in Python: "
+                        f"{nout} samples of {ncol} columns ({8 * nout * ncol / 2**20:.0f} MiB); "
+                        "raise output_every in &output, keep fewer DOFs and devices "
+                        "(Session.select), or stream the history to its file (Session.stream) "
+                        "and solve(history=False)"
+                    ) from None
             else:
                 buf = _no_history()
             status = self._run(h, 1 if history else 0, buf, progress)
@@ -364,7 +414,7 @@ class Session:
                         "the history was streamed to the directory given to stream(); "
                         "write() takes no other directory"
                     )
-                self._check(_core.fd_session_set_output_dir(h, os.fspath(out)))
+                self._check(_core.fd_session_set_output_dir(h, _path_bytes(out)))
             use = self._hist is not None and not self._streamed
             self._check(_core.fd_session_write(h, int(use), self._hist if use else _no_history()))
             _, _, history, status = _core.fd_session_shape(h)
@@ -377,8 +427,8 @@ class Session:
             hist = _no_history() if data is None else np.asfortranarray(data.T, dtype=np.float64)
             status = _core.fd_session_write_files(
                 self._live(),
-                os.fspath(csv or ""),
-                os.fspath(summary),
+                _path_bytes(csv or ""),
+                _path_bytes(summary),
                 int(csv is not None),
                 int(data is not None),
                 hist,
@@ -431,7 +481,9 @@ class Result:
     ``result["u1"]`` is a column by name (see ``names``, ``units``); ``time`` is ``t``;
     ``dof(i)`` and ``device(d)`` group the series of one DOF or device (1-based);
     ``summary`` is the run's summary (peaks, transitions, steps, correctness violations,
-    energy) as a dict.
+    energy) as a dict; ``peak(name, t_range)`` the peak of a series (exact for the exact
+    technique, whose peaks include the extrema between rows and the one-sided values at
+    events).
     """
 
     names: list[str]
@@ -513,6 +565,27 @@ class Result:
             "F": self[f"F{d}"],
             "phase": self[f"phase{d}"],
         }
+
+    def peak(self, name: str, t_range: tuple[float, float] | None = None) -> float:
+        """Largest |name| (``'aabs2'``, ``'u1'``, ``'F1'``, ...) over the run, or over the rows
+        with ``t_range[0] <= t <= t_range[1]``.
+
+        For the exact technique it is exact: its history holds, in ``peak_<name>``, the
+        maxima since the previous row (extrema between rows and one-sided values at events
+        included), so this is the true peak over the time from the range's first row to its
+        last. Otherwise it is the largest sampled value of the rows in the range."""
+        t = self.time
+        if t_range is None:
+            rows = np.arange(len(t))
+        else:
+            rows = np.nonzero((t >= t_range[0] - 1e-12) & (t <= t_range[1] + 1e-12))[0]
+        if rows.size == 0:
+            raise ValueError(f"no history row in the time range {t_range}")
+        values = np.abs(self[name][rows])
+        if f"peak_{name}" not in self:
+            return float(values.max())
+        envelope = self[f"peak_{name}"][rows[1:]]
+        return float(max(values[0], envelope.max(initial=0.0)))
 
     def label(self, name: str) -> str:
         """Axis label 'name [unit]'."""

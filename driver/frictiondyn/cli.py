@@ -345,7 +345,7 @@ def main(argv: Sequence[str] | None = None) -> int:
     except BrokenPipeError:  # output piped into e.g. head: stop quietly
         os.dup2(os.open(os.devnull, os.O_WRONLY), sys.stdout.fileno())
         return 1
-    except (FrictiondynError, CliError, OSError, ValueError, KeyError) as exc:
+    except (FrictiondynError, CliError, OSError, ValueError, KeyError, MemoryError) as exc:
         print(f"frictiondyn: error: {_one_line(exc)}", file=sys.stderr)
         return 1
     except KeyboardInterrupt:

@@ -108,7 +108,7 @@ program frictiondyn_main
    call progress_clear()
    if (allocated(error)) then
       call clear_temps()
-      call fail(deck//": "//error%message)
+      call fail(error%message)   ! the session names the deck
    end if
    call session_write(ses, error)
    call clear_temps()

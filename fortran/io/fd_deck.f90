@@ -5,11 +5,13 @@
 !> every default come from fd_names. docs/namelist.md documents every variable.
 module fd_deck
    use, intrinsic :: ieee_arithmetic, only: ieee_is_finite
+   use, intrinsic :: ieee_exceptions, only: ieee_set_halting_mode, ieee_support_halting, ieee_overflow, &
+                                            ieee_set_flag
    use fd_kinds, only: dp
-   use fd_error, only: error_type, fatal_error, fmt_int, fmt_real
+   use fd_error, only: error_type, fatal_error, fmt_int, fmt_real, stat_no_memory
    use fd_textio, only: lower
    use fd_namelist, only: deck_text, group_text, load_deck, deck_from_string, find_group, group_item, &
-                          group_read_error, check_groups
+                          group_read_error, check_groups, longest_string
    use fd_names, only: keyword_id, keyword_choices, law_id, law_choices, &
                        damping_types, damping_stiffness, damping_rayleigh, damping_none, &
                        excitation_types, excitation_harmonic, excitation_record, excitation_none, &
@@ -24,6 +26,8 @@ module fd_deck
    use fd_excitation, only: excitation_type
    use fd_record, only: read_record, record_info, record_formats, record_units_list, units_factor
    use fd_technique, only: check_technique
+   use fd_step_limits, only: check_step_limits
+   use fd_names, only: technique_newmark
    implicit none
    private
 
@@ -36,8 +40,13 @@ module fd_deck
    integer, parameter :: max_springs = 4000000  !! springs (n_springs)
    integer, parameter :: max_devices = 1000000  !! friction devices (n_devices)
    real(dp), parameter :: unset = -huge(1.0_dp)
+   !> Largest magnitude of a real value, and smallest of a value that must be > 0 (a mass,
+   !> stiffness, band, step, frequency...): within them the products a run forms (forces,
+   !> energies, effective stiffness) stay far from the limits of double precision.
+   real(dp), parameter, public :: max_magnitude = 1.0e30_dp, min_scale = 1.0e-30_dp
    integer, parameter :: unset_int = -huge(1)
-   integer, parameter :: name_len = 32
+   integer, parameter :: name_len = 32        !! capacity of a keyword value
+   integer, parameter :: path_len = 1024      !! capacity of record_file, dir, name
 
    !> Everything one deck defines.
    type :: run_config
@@ -58,9 +67,14 @@ contains
       type(error_type), allocatable, intent(out) :: error !! first problem found
       type(deck_text) :: deck
 
+      ! a value too large for a double ('1e400' in a deck or a record) overflows to infinity
+      ! when it is converted, and is then rejected with a message: a build that traps
+      ! overflow (-ffpe-trap, tools/test_checked.sh) must not stop there. The halting mode is
+      ! restored when this reader returns (Fortran 2008, 14.3), the overflow handled.
+      if (ieee_support_halting(ieee_overflow)) call ieee_set_halting_mode(ieee_overflow, .false.)
       call load_deck(path, deck, error)
-      if (allocated(error)) return
-      call read_groups(deck, cfg, error)
+      if (.not. allocated(error)) call read_groups(deck, cfg, error)
+      call ieee_set_flag(ieee_overflow, .false.)
    end subroutine read_deck
 
    !> Read and validate a deck given as text. The path names the deck in messages, gives
@@ -72,8 +86,14 @@ contains
       type(error_type), allocatable, intent(out) :: error !! first problem found
       type(deck_text) :: deck
 
-      call deck_from_string(text, path, deck)
-      call read_groups(deck, cfg, error)
+      ! a value too large for a double ('1e400' in a deck or a record) overflows to infinity
+      ! when it is converted, and is then rejected with a message: a build that traps
+      ! overflow (-ffpe-trap, tools/test_checked.sh) must not stop there. The halting mode is
+      ! restored when this reader returns (Fortran 2008, 14.3), the overflow handled.
+      if (ieee_support_halting(ieee_overflow)) call ieee_set_halting_mode(ieee_overflow, .false.)
+      call deck_from_string(text, path, deck, error)
+      if (.not. allocated(error)) call read_groups(deck, cfg, error)
+      call ieee_set_flag(ieee_overflow, .false.)
    end subroutine read_deck_string
 
    subroutine read_groups(deck, cfg, error)
@@ -101,6 +121,12 @@ contains
       if (allocated(error)) return
       ! what the technique cannot integrate (a law, a table motion)
       call check_technique(cfg%model, cfg%exc, cfg%opts, error)
+      if (allocated(error)) then
+         error%message = deck%path//", "//error%message
+         return
+      end if
+      ! Newmark's steps: bounded work, digits left in the effective stiffness
+      if (cfg%opts%technique == technique_newmark) call check_step_limits(cfg%model, cfg%exc, cfg%opts, error)
       if (allocated(error)) error%message = deck%path//", "//error%message
    end subroutine read_groups
 
@@ -125,7 +151,10 @@ contains
          call missing_group(deck, 'model', error); return
       end if
       i = array_capacity(grp, 'n_dof', max_dof)
-      allocate (mass(i), u0(i), v0(i))
+      allocate (mass(i), u0(i), v0(i), stat=ios)
+      if (ios /= 0) then
+         call no_memory(deck, 'model', i, 'DOFs', error); return
+      end if
       mass = unset; u0 = unset; v0 = unset
       msg0 = ''
       read (grp%lines, nml=model, iostat=ios, iomsg=msg0)
@@ -175,7 +204,10 @@ contains
          call missing_group(deck, 'springs', error); return
       end if
       i = array_capacity(grp, 'n_springs', max_springs)
-      allocate (node_i(i), node_j(i), k(i))
+      allocate (node_i(i), node_j(i), k(i), stat=ios)
+      if (ios /= 0) then
+         call no_memory(deck, 'springs', i, 'springs', error); return
+      end if
       node_i = unset_int; node_j = unset_int; k = unset
       msg0 = ''
       read (grp%lines, nml=springs, iostat=ios, iomsg=msg0)
@@ -244,17 +276,19 @@ contains
          if (ios == 0) msg = msg0
          call group_read_error(deck, grp, i, msg, error); return
       end if
+      call check_length(deck, grp, 'damping_type', name_len, error)
+      if (allocated(error)) return
       cfg%model%damping = keyword_id(damping_types, damping_type)
       select case (cfg%model%damping)
       case (damping_stiffness)
          call check_real(deck, 'damping', 'xi', xi, 0.0_dp, 1.0_dp, '', error, open_hi=.true.)
          if (allocated(error)) return
-         call check_real(deck, 'damping', 'period', period, 0.0_dp, huge(1.0_dp), 's', error)
+         call check_real(deck, 'damping', 'period', period, 0.0_dp, max_magnitude, 's', error)
          if (allocated(error)) return
       case (damping_rayleigh)
-         call check_real(deck, 'damping', 'rayleigh_a0', rayleigh_a0, 0.0_dp, huge(1.0_dp), '1/s', error)
+         call check_real(deck, 'damping', 'rayleigh_a0', rayleigh_a0, 0.0_dp, max_magnitude, '1/s', error)
          if (allocated(error)) return
-         call check_real(deck, 'damping', 'rayleigh_a1', rayleigh_a1, 0.0_dp, huge(1.0_dp), 's', error)
+         call check_real(deck, 'damping', 'rayleigh_a1', rayleigh_a1, 0.0_dp, max_magnitude, 's', error)
          if (allocated(error)) return
       case (damping_none)
       case default
@@ -291,7 +325,10 @@ contains
       allocate (cfg%model%dev(0))
       if (.not. found) return
       i = array_capacity(grp, 'n_devices', max_devices)
-      allocate (node_i(i), node_j(i), law(i), p(i), mu(i), eps(i), eps1(i), f(i))
+      allocate (node_i(i), node_j(i), law(i), p(i), mu(i), eps(i), eps1(i), f(i), stat=ios)
+      if (ios /= 0) then
+         call no_memory(deck, 'friction', i, 'devices', error); return
+      end if
       node_i = unset_int; node_j = unset_int; law = ''
       p = unset; mu = unset; eps = unset; eps1 = unset; f = unset
       msg0 = ''
@@ -305,6 +342,8 @@ contains
          if (ios == 0) msg = msg0
          call group_read_error(deck, grp, i, msg, error); return
       end if
+      call check_length(deck, grp, 'law', name_len, error)
+      if (allocated(error)) return
       call need_int(deck, 'friction', 'n_devices', n_devices, 0, max_devices, error)
       if (allocated(error)) return
       n = n_devices
@@ -328,12 +367,23 @@ contains
          return
       end if
       deallocate (cfg%model%dev)
-      allocate (cfg%model%dev(n))
+      allocate (cfg%model%dev(n), stat=ios)
+      if (ios /= 0) then
+         call fatal_error(error, deck%path//", group &friction: not enough memory for "//trim(fmt_int(n))//" devices", &
+                          stat_no_memory)
+         return
+      end if
       do i = 1, n
          idx = '('//trim(fmt_int(i))//')'
          if (node_i(i) == node_j(i)) then
             call bad(deck, 'friction', 'node_j'//idx, trim(fmt_int(node_j(i))), 'different from node_i'//idx//' = '// &
                      trim(fmt_int(node_i(i)))//': a device joins two different nodes', error)
+            return
+         end if
+         if (p(i)*mu(i) /= 0.0_dp .and. p(i)*mu(i) < min_scale) then
+            call bad(deck, 'friction', 'p'//idx//' * mu'//idx, trim(fmt_real(p(i)*mu(i))), '0 (no friction) or at '// &
+                     'least '//trim(fmt_real(min_scale))//' N: the friction force P mu of a device (here P = '// &
+                     trim(fmt_real(p(i)))//' N, mu = '//trim(fmt_real(mu(i)))//')', error)
             return
          end if
          id = law_id(law(i))
@@ -359,7 +409,7 @@ contains
       type(error_type), allocatable, intent(out) :: error
       character(len=name_len) :: excitation_type, record_kind, record_format, record_units
       integer :: kind_id
-      character(len=1024) :: record_file
+      character(len=path_len) :: record_file
       real(dp) :: amplitude, frequency, duration, dt_record, record_scale, factor
       integer :: ramp_cycles
       logical :: known
@@ -392,6 +442,12 @@ contains
          if (ios == 0) msg = msg0
          call group_read_error(deck, grp, i, msg, error); return
       end if
+      call check_length(deck, grp, 'excitation_type', name_len, error)
+      if (.not. allocated(error)) call check_length(deck, grp, 'record_kind', name_len, error)
+      if (.not. allocated(error)) call check_length(deck, grp, 'record_format', name_len, error)
+      if (.not. allocated(error)) call check_length(deck, grp, 'record_units', name_len, error)
+      if (.not. allocated(error)) call check_length(deck, grp, 'record_file', path_len, error)
+      if (allocated(error)) return
       ! a record whose file gives DT (AT2) may leave dt_record out
       if (.not. (keyword_id(excitation_types, excitation_type) == excitation_record .and. dt_record == unset)) then
          call need_real(deck, 'excitation', 'dt_record', dt_record, 's', error)
@@ -421,6 +477,8 @@ contains
             call bad(deck, 'excitation', 'record_scale', trim(fmt_real(record_scale)), 'finite and non-zero', error)
             return
          end if
+         call check_magnitude(deck, 'excitation', 'record_scale', record_scale, '', .true., error)
+         if (allocated(error)) return
          kind_id = keyword_id(record_kinds, record_kind)
          if (kind_id == 0) then
             call keyword_choices(record_kinds, choices)
@@ -453,6 +511,15 @@ contains
          cfg%record%path = trim(record_file)   ! as the deck gives it (like the summary's "deck")
          dt_record = cfg%record%dt
          cfg%exc%dt_record = dt_record
+         call check_magnitude(deck, 'excitation', "dt_record (the record file's DT)", dt_record, 's', .true., error)
+         if (allocated(error)) return
+         if (.not. (cfg%record%peak_acc <= max_magnitude)) then
+            call bad(deck, 'excitation', 'record_file', "'"//trim(record_file)//"'", 'a record whose table '// &
+                     'acceleration (after record_units and record_scale = '//trim(fmt_real(record_scale))// &
+                     ') stays within '//trim(fmt_real(max_magnitude))//' m/s2 in magnitude; it reaches '// &
+                     trim(fmt_real(cfg%record%peak_acc))//' m/s2', error)
+            return
+         end if
          if (duration == unset) duration = (size(cfg%exc%acc) - 1)*dt_record
          call need_real(deck, 'excitation', 'duration', duration, 's', error)
          if (allocated(error)) return
@@ -502,6 +569,9 @@ contains
             call group_read_error(deck, grp, i, msg, error); return
          end if
       end if
+      call check_length(deck, grp, 'technique', name_len, error)
+      if (.not. allocated(error)) call check_length(deck, grp, 'linear_system', name_len, error)
+      if (allocated(error)) return
       technique_id = keyword_id(techniques, technique)
       if (technique_id == 0) then
          call keyword_choices(techniques, choices)
@@ -528,6 +598,8 @@ contains
          call bad(deck, 'integration', 'n', trim(fmt_real(n)), '> 1 (correctness condition, eqs. 9 and 12)', error)
          return
       end if
+      call check_magnitude(deck, 'integration', 'n', n, '', .false., error)
+      if (allocated(error)) return
       call check_real(deck, 'integration', 'dt_min', dt_min, 0.0_dp, cfg%exc%dt_record/n1/n2, 's', error)
       if (allocated(error)) return
       call check_real(deck, 'integration', 'theta', theta, 0.5_dp, 1.0_dp, '', error)
@@ -556,7 +628,7 @@ contains
       type(deck_text), intent(in) :: deck
       type(run_config), intent(inout) :: cfg
       type(error_type), allocatable, intent(out) :: error
-      character(len=1024) :: dir, name
+      character(len=path_len) :: dir, name
       integer :: output_every
       logical :: write_history
       integer, allocatable :: history_dofs(:), history_devices(:)
@@ -568,7 +640,11 @@ contains
       logical :: found
 
       dir = default_dir; output_every = default_output_every; write_history = default_write_history
-      allocate (history_dofs(cfg%model%n_dof + 2), history_devices(cfg%model%n_devices + 2))
+      allocate (history_dofs(cfg%model%n_dof + 2), history_devices(cfg%model%n_devices + 2), stat=ios)
+      if (ios /= 0) then
+         call no_memory(deck, 'output', cfg%model%n_dof + cfg%model%n_devices, 'history_dofs and history_devices', &
+                        error); return
+      end if
       history_dofs = unset_int; history_devices = unset_int
       call stem(deck%path, name)
       call find_group(deck, 'output', grp, found, error)
@@ -586,6 +662,9 @@ contains
             call group_read_error(deck, grp, i, msg, error); return
          end if
       end if
+      call check_length(deck, grp, 'dir', path_len, error)
+      if (.not. allocated(error)) call check_length(deck, grp, 'name', path_len, error)
+      if (allocated(error)) return
       if (len_trim(dir) == 0) then
          call bad(deck, 'output', 'dir', "''", 'a directory path', error); return
       end if
@@ -681,6 +760,32 @@ contains
       call fatal_error(error, deck%path//", group &"//group//": "//var//" = "//val//" is invalid: must be "//must)
    end subroutine bad
 
+   !> Memory for a group's arrays of n entries cannot be had.
+   subroutine no_memory(deck, group, n, what, error)
+      type(deck_text), intent(in) :: deck
+      character(len=*), intent(in) :: group, what
+      integer, intent(in) :: n
+      type(error_type), allocatable, intent(out) :: error
+      call fatal_error(error, deck%path//", group &"//group//": not enough memory to read "//trim(fmt_int(n))// &
+                       " entries of "//what, stat_no_memory)
+   end subroutine no_memory
+
+   !> A string longer than its variable's capacity is an error (the namelist reader would cut
+   !> it), found in the group's text.
+   subroutine check_length(deck, grp, var, cap, error)
+      type(deck_text), intent(in) :: deck
+      type(group_text), intent(in) :: grp
+      character(len=*), intent(in) :: var
+      integer, intent(in) :: cap
+      type(error_type), allocatable, intent(out) :: error
+      integer :: length, line
+      call longest_string(grp, var, length, line)
+      if (length <= cap) return
+      call fatal_error(error, deck%path//", group &"//grp%name//", line "//trim(fmt_int(line))//": "//var// &
+                       " is a string of "//trim(fmt_int(length))//" characters: must be at most "// &
+                       trim(fmt_int(cap))//" characters long")
+   end subroutine check_length
+
    subroutine need_int(deck, group, var, x, lo, hi, error)
       type(deck_text), intent(in) :: deck
       character(len=*), intent(in) :: group, var
@@ -711,8 +816,26 @@ contains
          call bad(deck, group, var, trim(fmt_real(x)), '> 0 '//unit, error)
       else if (.not. pos .and. x < 0.0_dp) then
          call bad(deck, group, var, trim(fmt_real(x)), '>= 0 '//unit, error)
+      else
+         call check_magnitude(deck, group, var, x, unit, pos, error)
       end if
    end subroutine need_real
+
+   !> |x| at most max_magnitude; and at least min_scale when x must be > 0 (or is not 0).
+   subroutine check_magnitude(deck, group, var, x, unit, scale, error)
+      type(deck_text), intent(in) :: deck
+      character(len=*), intent(in) :: group, var, unit
+      real(dp), intent(in) :: x
+      logical, intent(in) :: scale                 !! x is a scale: small values are checked too
+      type(error_type), allocatable, intent(out) :: error
+      if (abs(x) > max_magnitude) then
+         call bad(deck, group, var, trim(fmt_real(x)), 'at most '//trim(fmt_real(max_magnitude))//' '//trim(unit)// &
+                  ' in magnitude (larger values overflow the products a run forms)', error)
+      else if (scale .and. abs(x) < min_scale) then
+         call bad(deck, group, var, trim(fmt_real(x)), 'at least '//trim(fmt_real(min_scale))//' '//trim(unit)// &
+                  ' in magnitude (smaller values make the steps and products of a run meaningless)', error)
+      end if
+   end subroutine check_magnitude
 
    subroutine check_real(deck, group, var, x, lo, hi, unit, error, open_lo, open_hi)
       type(deck_text), intent(in) :: deck
@@ -727,10 +850,13 @@ contains
       if (present(open_hi)) ohi = open_hi
       ok = ieee_is_finite(x)
       if (ok) ok = merge(x > lo, x >= lo, olo) .and. merge(x < hi, x <= hi, ohi)
-      if (ok) return
+      if (ok) then
+         call check_magnitude(deck, group, var, x, unit, .false., error)
+         return
+      end if
       range = merge('(', '[', olo)//trim(fmt_real(lo))//', '
-      if (hi >= huge(1.0_dp)) then
-         range = range//'inf)'
+      if (hi >= max_magnitude) then
+         range = range//trim(fmt_real(max_magnitude))//']'
       else
          range = range//trim(fmt_real(hi))//merge(')', ']', ohi)
       end if
@@ -774,6 +900,8 @@ contains
          if (pos .and. x(i) <= 0.0_dp) then
             call bad(deck, group, var//'('//trim(fmt_int(i))//')', trim(fmt_real(x(i))), '> 0 '//unit, error); return
          end if
+         call check_magnitude(deck, group, var//'('//trim(fmt_int(i))//')', x(i), unit, pos, error)
+         if (allocated(error)) return
       end do
       call no_extra(deck, group, var, x, n, error)
    end subroutine optional_reals

@@ -14,9 +14,14 @@ module fd_output
    private
 
    public :: output_type, write_outputs, write_output_files, output_paths, temp_output_paths, summary_json, &
-             history_header, make_dir
+             history_header, make_dir, remove_made_dirs
 
    interface
+      function c_rmdir(path) bind(c, name='rmdir') result(stat)
+         import :: c_char, c_int
+         character(kind=c_char), intent(in) :: path(*)
+         integer(c_int) :: stat
+      end function c_rmdir
       function c_mkdir(path, mode) bind(c, name='mkdir') result(stat)
          import :: c_char, c_int
          character(kind=c_char), intent(in) :: path(*)
@@ -259,10 +264,12 @@ contains
       call fatal_error(error, what//": "//buf(1:max(0, index(buf, c_null_char) - 1)))
    end subroutine os_error
 
-   !> Create a directory and its missing parents.
-   subroutine make_dir(dir, error)
+   !> Create a directory and its missing parents; `made`, when given, is the first (outermost)
+   !> directory this call created (not allocated: none), for remove_made_dirs.
+   subroutine make_dir(dir, error, made)
       character(len=*), intent(in) :: dir
       type(error_type), allocatable, intent(out) :: error
+      character(len=:), allocatable, intent(out), optional :: made
       integer :: stat, i
       logical :: exists
 
@@ -273,10 +280,32 @@ contains
          inquire (file=dir(1:i - 1)//'/.', exist=exists)
          if (exists) cycle
          stat = c_mkdir(dir(1:i - 1)//c_null_char, int(o'755', c_int))
+         if (stat == 0 .and. present(made)) then
+            if (.not. allocated(made)) made = dir(1:i - 1)
+         end if
       end do
       inquire (file=dir//'/.', exist=exists)
       if (.not. exists) call fatal_error(error, "&output: cannot create the output directory dir = '"//dir//"'")
    end subroutine make_dir
+
+   !> Remove the directories make_dir created for `dir` (`made` the outermost), innermost
+   !> first, each only when empty (rmdir): a run that failed leaves no directory behind.
+   subroutine remove_made_dirs(dir, made)
+      character(len=*), intent(in) :: dir   !! the directory asked for
+      character(len=*), intent(in) :: made  !! the outermost one created
+      integer :: i, stat
+
+      if (len(made) == 0 .or. len(made) > len(dir)) return
+      if (dir(1:len(made)) /= made) return
+      i = len(dir)
+      do while (i >= len(made))
+         if (i == len(dir) .or. dir(i + 1:i + 1) == '/') then
+            stat = c_rmdir(dir(1:i)//c_null_char)
+            if (stat /= 0) return
+         end if
+         i = i - 1
+      end do
+   end subroutine remove_made_dirs
 
    !> Create a new file (exclusively: error stat 17 when the name exists) for writing.
    subroutine create_new(path, fd, error)
@@ -438,10 +467,17 @@ contains
       case (2)
          call kv('linear_system', '"banded"')
       case default
-         call kv('linear_system', 'null')
+         call kv('linear_system', '"none"')
       end select
       call kv('half_bandwidth', trim(fmt_int(res%bandwidth)))
       call kv('events', trim(fmt_int(res%events)))
+      if (res%exact_peaks) then
+         ! the exact technique: peaks are the exact extrema; its event times, accumulations
+         call kv('peaks_exact', 'true')
+         call kr('event_times_s', res%event_time(1:res%n_event_times))
+         call kv('accumulation_points', trim(fmt_int(res%accumulations)))
+         call kr('accumulation_times_s', res%accumulation_time(1:res%n_accumulation_times))
+      end if
       call kv('patterns_solved', trim(fmt_int(res%patterns)))
       call kv('lcp_fallbacks', trim(fmt_int(res%lcp_fallbacks)))
       call kv('correctness_violations', trim(fmt_int(res%violations)))

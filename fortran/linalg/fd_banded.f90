@@ -23,12 +23,12 @@ module fd_banded
    use, intrinsic :: ieee_arithmetic, only: ieee_is_finite
    use, intrinsic :: iso_fortran_env, only: int64
    use fd_kinds, only: dp
-   use fd_error, only: error_type, fatal_error, fmt_int, fmt_real
+   use fd_error, only: error_type, fatal_error, fmt_int, fmt_real, stat_no_memory
    use fd_rcm, only: rcm_order, graph_bandwidth
    implicit none
    private
 
-   public :: spd_system, spd_stats, spd_setup, spd_factor, spd_update_device, spd_update_devices
+   public :: spd_system, spd_stats, spd_setup, spd_copy, spd_factor, spd_update_device, spd_update_devices
    public :: spd_solve, spd_k_matvec, spd_c_matvec, spd_kc_matvec
    public :: spd_size, spd_bandwidth, spd_is_dense, spd_device_kd, spd_error_estimate
    public :: spd_auto, spd_dense, spd_banded, spd_dense_max_n, spd_choose, spd_rank_one, spd_refactor
@@ -200,7 +200,7 @@ contains
       integer, allocatable :: ei(:), ej(:), di(:), dj(:)
       real(dp), allocatable :: dc(:)
       real(dp) :: ca0, ca1
-      integer :: n, ns, nd, nc, ne, i, d, a, b, kbw, mode
+      integer :: n, ns, nd, nc, ne, i, d, a, b, kbw, mode, stat
 
       n = size(mass)
       ns = size(spring_i)
@@ -315,10 +315,23 @@ contains
          sys%off = 0
       end if
 
-      allocate (sys%mass(n), sys%kmat(sys%ld*n), sys%cmat(sys%ld*n), sys%fac(sys%ld*n))
-      allocate (sys%kd(nd), sys%errcol(n), sys%w1(n), sys%w2(n), sys%xv(n), sys%rdiag(n))
+      if (int(sys%ld, int64)*n > int(huge(n), int64)) then
+         call fatal_error(error, "not enough memory for the effective stiffness of "//trim(fmt_int(n))// &
+                          " DOFs of half-bandwidth "//trim(fmt_int(sys%kb))//": "// &
+                          trim(fmt_real(real(sys%ld, dp)*n))//" values each, more than one array may hold", &
+                          stat_no_memory)
+         return
+      end if
+      allocate (sys%mass(n), sys%kmat(sys%ld*n), sys%cmat(sys%ld*n), sys%fac(sys%ld*n), sys%kd(nd), &
+                sys%errcol(n), sys%w1(n), sys%w2(n), sys%xv(n), sys%rdiag(n), sys%dlo(nd), sys%dhi(nd), &
+                sys%dorder(nd), stat=stat)
+      if (stat /= 0) then
+         call fatal_error(error, "not enough memory for the effective stiffness of "//trim(fmt_int(n))// &
+                          " DOFs of half-bandwidth "//trim(fmt_int(sys%kb))//" (3 x "// &
+                          trim(fmt_real(8.0_dp*real(sys%ld, dp)*n/2.0_dp**20))//" MiB)", stat_no_memory)
+         return
+      end if
       sys%rdiag = 0.0_dp
-      allocate (sys%dlo(nd), sys%dhi(nd), sys%dorder(nd))
       sys%mass = mass(sys%perm)
       sys%kmat = 0.0_dp
       sys%cmat = 0.0_dp
@@ -360,6 +373,28 @@ contains
       end do
       call sort_devices(sys)
    end subroutine spd_setup
+
+   !> A copy of a system set up by spd_setup (another step size starts from it): memory that
+   !> cannot be had is an error, not a stop of the runtime in an assignment.
+   subroutine spd_copy(src, dst, error)
+      type(spd_system), intent(in) :: src                 !! a system set up
+      type(spd_system), intent(out) :: dst                !! its copy
+      type(error_type), allocatable, intent(out) :: error !! not enough memory
+      integer :: stat
+
+      allocate (dst%perm(size(src%perm)), dst%inv(size(src%inv)), dst%dlo(size(src%dlo)), &
+                dst%dhi(size(src%dhi)), dst%dorder(size(src%dorder)), dst%mass(size(src%mass)), &
+                dst%kmat(size(src%kmat)), dst%cmat(size(src%cmat)), dst%fac(size(src%fac)), &
+                dst%kd(size(src%kd)), dst%errcol(size(src%errcol)), dst%w1(size(src%w1)), &
+                dst%w2(size(src%w2)), dst%xv(size(src%xv)), dst%rdiag(size(src%rdiag)), stat=stat)
+      if (stat /= 0) then
+         call fatal_error(error, "not enough memory for another copy of the effective stiffness of "// &
+                          trim(fmt_int(src%n))//" DOFs of half-bandwidth "//trim(fmt_int(src%kb))// &
+                          " (one per step size)", stat_no_memory)
+         return
+      end if
+      dst = src   ! every array already has its shape: nothing is allocated here
+   end subroutine spd_copy
 
    !> Check the nodes and coefficients of a list of two-node elements.
    subroutine check_links(what, ni, nj, coef, n, error)

@@ -3,7 +3,7 @@
 !> and the generalized symmetric eigenproblem K phi = w^2 M phi.
 module fd_linalg
    use fd_kinds, only: dp
-   use fd_error, only: error_type, fatal_error, fmt_int
+   use fd_error, only: error_type, fatal_error, fmt_int, stat_no_memory
    implicit none
    private
 
@@ -148,14 +148,17 @@ contains
       real(dp), intent(out) :: phi(:, :)               !! eigenvectors in columns
       type(error_type), allocatable, intent(out) :: error !! LAPACK failure
       real(dp), allocatable :: b(:, :), work(:)
-      integer :: n, info, lwork
+      integer :: n, info, lwork, stat
 
       n = size(k, 1)
-      allocate (b(n, n))
+      lwork = max(1, 3*n - 1)
+      allocate (b(n, n), work(lwork), stat=stat)
+      if (stat /= 0) then
+         call fatal_error(error, "not enough memory for an eigenproblem of order "//trim(fmt_int(n)), stat_no_memory)
+         return
+      end if
       phi = k
       b = m
-      lwork = max(1, 3*n - 1)
-      allocate (work(lwork))
       call dsygv(1, 'V', 'U', n, phi, n, b, n, lambda, work, lwork, info)
       if (info /= 0) then
          call fatal_error(error, "eigenvalue solver dsygv failed with info = "//trim(fmt_int(info)))

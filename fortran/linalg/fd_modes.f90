@@ -19,7 +19,7 @@
 !> has no cancellation: the eigenvalues come out to a few ulps of the projected problem.
 module fd_modes
    use fd_kinds, only: dp
-   use fd_error, only: error_type, fatal_error, fmt_int, fmt_real
+   use fd_error, only: error_type, fatal_error, fmt_int, fmt_real, stat_no_memory
    use fd_linalg, only: generalized_eigen
    use fd_banded, only: spd_system, spd_setup, spd_factor, spd_solve
    implicit none
@@ -126,7 +126,7 @@ contains
       type(spd_system) :: sys
       real(dp), allocatable :: x(:, :), y(:, :), kr(:, :), mr(:, :), lam(:), lam_old(:), q(:, :), row(:)
       real(dp) :: delta, change, norm
-      integer :: n, nq, it, i, j, e, a, b, pass
+      integer :: n, nq, it, i, j, e, a, b, pass, stat
       integer :: none(0)
       real(dp) :: nokd(0)
       logical :: done
@@ -152,7 +152,12 @@ contains
       call spd_factor(sys, delta, 0.0_dp, nokd, error)
       if (allocated(error)) return
 
-      allocate (x(n, nq), y(n, nq), kr(nq, nq), mr(nq, nq), lam(nq), lam_old(nq), q(nq, nq))
+      allocate (x(n, nq), y(n, nq), kr(nq, nq), mr(nq, nq), lam(nq), lam_old(nq), q(nq, nq), stat=stat)
+      if (stat /= 0) then
+         call fatal_error(error, "not enough memory for the subspace iteration of the modes of "// &
+                          trim(fmt_int(n))//" DOFs ("//trim(fmt_int(nq))//" vectors)", stat_no_memory)
+         return
+      end if
       ! start: the mass vector (it excites every DOF), then reproducible pseudo-random vectors
       x(:, 1) = mass
       do j = 2, nq

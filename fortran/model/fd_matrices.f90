@@ -3,7 +3,7 @@
 !> system, in which every friction device is a rigid link.
 module fd_matrices
    use fd_kinds, only: dp
-   use fd_error, only: error_type, fatal_error, fmt_real
+   use fd_error, only: error_type, fatal_error, fmt_real, fmt_int, stat_no_memory
    use fd_model, only: model_type, damping_none, damping_stiffness, damping_rayleigh
    use fd_modes, only: lowest_modes
    implicit none
@@ -54,18 +54,25 @@ contains
       integer, allocatable :: grp(:), ea(:), eb(:)
       real(dp), allocatable :: mq(:), ek(:), lam(:), z(:, :)
       real(dp) :: scale
-      integer :: n, i, s, a, b, ne, m
+      integer :: n, i, s, a, b, ne, m, stat
 
       omega2 = 0.0_dp
       phi = 0.0_dp
       n = model%n_dof
-      allocate (grp(n))
+      allocate (grp(n), stat=stat)
+      if (stat /= 0) then
+         nq = -1
+         call no_memory(n); return
+      end if
       call link_groups(model, linked, grp, nq)
       if (nq == 0) then
          call fatal_error(error, "the system has no free DOF: every mass is locked to the table by rigid links")
          return
       end if
-      allocate (mq(nq), ea(model%n_springs), eb(model%n_springs), ek(model%n_springs))
+      allocate (mq(nq), ea(model%n_springs), eb(model%n_springs), ek(model%n_springs), stat=stat)
+      if (stat /= 0) then
+         call no_memory(nq); return
+      end if
       mq = 0.0_dp
       do i = 1, n
          if (grp(i) /= 0) mq(grp(i)) = mq(grp(i)) + model%mass(i)
@@ -79,7 +86,10 @@ contains
          ek(ne) = model%spring_k(s)
       end do
       m = min(nev, nq)
-      allocate (lam(m), z(nq, m))
+      allocate (lam(m), z(nq, m), stat=stat)
+      if (stat /= 0) then
+         call no_memory(nq); return
+      end if
       call lowest_modes(mq, ea(1:ne), eb(1:ne), ek(1:ne), m, lam, z, scale, error, path)
       if (allocated(error)) return
       if (lam(1) <= 1.0e-12_dp*scale) then
@@ -92,6 +102,11 @@ contains
          if (grp(i) /= 0) phi(i, 1:m) = z(grp(i), :)
       end do
    contains
+      subroutine no_memory(size)
+         integer, intent(in) :: size
+         call fatal_error(error, "not enough memory for the eigenproblem of "//trim(fmt_int(size))// &
+                          " DOFs", stat_no_memory)
+      end subroutine no_memory
       pure integer function group_of(node)
          integer, intent(in) :: node
          group_of = 0
@@ -196,10 +211,16 @@ contains
       real(dp), intent(out) :: xi                         !! its damping ratio
       type(error_type), allocatable, intent(out) :: error !! 'stiffness' damping without a period
       type(error_type), allocatable :: eig_error
-      real(dp), allocatable :: phi(:)
+      real(dp), allocatable :: phi(:), cphi(:)
       real(dp) :: t_damp
+      integer :: stat
 
-      allocate (phi(model%n_dof))
+      allocate (phi(model%n_dof), cphi(model%n_dof), stat=stat)
+      if (stat /= 0) then
+         call fatal_error(error, "not enough memory for the matrices of "//trim(fmt_int(model%n_dof))//" DOFs", &
+                          stat_no_memory)
+         return
+      end if
       call stiffness_matrix(model, k)
       call stuck_first_mode(model, period, phi, eig_error)
       ! the paper's psi = T xi / pi uses the given T, else the computed one
@@ -217,7 +238,8 @@ contains
       if (allocated(eig_error)) then
          period = 0.0_dp
       else
-         xi = dot_product(phi, matmul(c, phi))/(2.0_dp*(2.0_dp*pi/period)*sum(model%mass*phi**2))
+         cphi = matmul(c, phi)
+         xi = dot_product(phi, cphi)/(2.0_dp*(2.0_dp*pi/period)*sum(model%mass*phi**2))
       end if
    end subroutine structure_matrices
 

@@ -12,11 +12,12 @@
 !> the time reached and calls the progress callback when its interval has passed.
 module fd_observer
    use, intrinsic :: iso_fortran_env, only: int64
+   use, intrinsic :: ieee_arithmetic, only: ieee_is_finite
    use fd_kinds, only: dp
    use fd_error, only: error_type, fatal_error, fmt_real
    use fd_model, only: model_type, integration_type
    use fd_excitation, only: excitation_type
-   use fd_result, only: result_type, init_result, max_violation_times
+   use fd_result, only: result_type, init_result, max_violation_times, max_event_times
    use fd_linalg, only: sym_matvec
    use fd_run_control, only: run_control, cancel_requested, stat_cancelled
    use fd_history_stream, only: stream_open, stream_row, stream_failed, stream_close
@@ -27,6 +28,14 @@ module fd_observer
    public :: observer_type, observer_init, sample_due, observe_start, observe_peaks, observe_sample
    public :: observe_transitions, observe_violations, observe_end, strain_energy
    public :: observe_start_energies, observe_end_energies, observe_poll, observe_stop_error
+   public :: observe_peak_value, observe_event, observe_accumulation
+   public :: peak_of_u, peak_of_v, peak_of_aabs, peak_of_s, peak_of_force
+
+   integer, parameter :: peak_of_u = 1      !! |u| of a DOF
+   integer, parameter :: peak_of_v = 2      !! |v| of a DOF
+   integer, parameter :: peak_of_aabs = 3   !! |absolute acceleration| of a DOF
+   integer, parameter :: peak_of_s = 4      !! |s| of a device
+   integer, parameter :: peak_of_force = 5  !! |F| of a device
 
    !> Wall-clock time aimed at between two polls that look at the clock [s].
    real(dp), parameter :: poll_target = 0.01_dp
@@ -184,10 +193,61 @@ contains
       end do
    end subroutine observe_peaks
 
+   !> One value into a peak of the summary (a technique that knows its solution between
+   !> steps passes the exact extrema, with their times): quantity peak_of_*, DOF or device i.
+   pure subroutine observe_peak_value(res, quantity, i, value, t)
+      type(result_type), intent(inout) :: res  !! the result
+      integer, intent(in) :: quantity          !! peak_of_u, _v, _aabs, _s, _force
+      integer, intent(in) :: i                 !! DOF or device
+      real(dp), intent(in) :: value            !! |value|
+      real(dp), intent(in) :: t                !! its time [s]
+
+      select case (quantity)
+      case (peak_of_u)
+         if (value > res%peak_u(i)) then
+            res%peak_u(i) = value; res%peak_u_time(i) = t
+         end if
+      case (peak_of_v)
+         res%peak_v(i) = max(res%peak_v(i), value)
+      case (peak_of_aabs)
+         if (value > res%peak_aabs(i)) then
+            res%peak_aabs(i) = value; res%peak_aabs_time(i) = t
+         end if
+      case (peak_of_s)
+         res%peak_s(i) = max(res%peak_s(i), value)
+      case (peak_of_force)
+         res%peak_force(i) = max(res%peak_force(i), value)
+      end select
+   end subroutine observe_peak_value
+
+   !> An event at time t (phases changed): its time is kept (the first max_event_times).
+   pure subroutine observe_event(res, t)
+      type(result_type), intent(inout) :: res  !! the result
+      real(dp), intent(in) :: t                !! time of the event [s]
+
+      if (res%n_event_times >= max_event_times) return
+      res%n_event_times = res%n_event_times + 1
+      res%event_time(res%n_event_times) = t
+   end subroutine observe_event
+
+   !> An accumulation point of events (a Zeno sequence) at time t, ended by sticking.
+   pure subroutine observe_accumulation(res, t)
+      type(result_type), intent(inout) :: res  !! the result
+      real(dp), intent(in) :: t                !! its time [s]
+
+      res%accumulations = res%accumulations + 1
+      if (res%n_accumulation_times >= max_violation_times) return
+      res%n_accumulation_times = res%n_accumulation_times + 1
+      res%accumulation_time(res%n_accumulation_times) = t
+   end subroutine observe_accumulation
+
    !> The next row of the history: t, ag, (u, v, aabs) per kept DOF, (s, s', F, phase) per
-   !> kept device; into the result, the control's buffer and its history file as selected.
-   !> Allocates nothing.
-   subroutine observe_sample(obs, res, t, ag, u, v, acc, s, sd, force, phase)
+   !> kept device, then (a history with those columns, has_envelope) the maxima since the
+   !> previous row `env` of the kept DOFs and devices; into the result, the control's buffer
+   !> and its history file as selected. The first value not finite of a row that goes only to
+   !> the buffer or the file is noted in the control (run_config_solve makes it an error; the
+   !> result's rows are checked at the end). Allocates nothing.
+   subroutine observe_sample(obs, res, t, ag, u, v, acc, s, sd, force, phase, env)
       type(observer_type), intent(inout) :: obs !! the observer
       type(result_type), intent(inout) :: res  !! the result
       real(dp), intent(in) :: t                !! time [s]
@@ -199,7 +259,9 @@ contains
       real(dp), intent(in) :: sd(:)            !! device relative velocities [m/s]
       real(dp), intent(in) :: force(:)         !! device forces [N]
       integer, intent(in) :: phase(:)          !! device phases (0 stick, +-1 slip)
-      integer :: i, j, c
+      real(dp), intent(in), optional :: env(:) !! maxima since the previous row: (|u|, |v|, |aabs|)
+                                               !! per DOF, then (|s|, |F|) per device (all of them)
+      integer :: i, j, c, nq
 
       obs%rows = obs%rows + 1
       if (obs%rows > res%nout) return
@@ -228,7 +290,36 @@ contains
                c = c + 4
             end do
          end if
-         if (obs%to_result) res%hist(:, obs%rows) = row
+         if (present(env) .and. res%env_col > 0) then
+            nq = 3*size(u)
+            if (obs%all_columns) then
+               row(c + 1:c + size(env)) = env
+            else
+               do j = 1, size(obs%dofs)
+                  i = obs%dofs(j)
+                  row(c + 1:c + 3) = env(3*i - 2:3*i)
+                  c = c + 3
+               end do
+               do j = 1, size(obs%devices)
+                  i = obs%devices(j)
+                  row(c + 1:c + 2) = env(nq + 2*i - 1:nq + 2*i)
+                  c = c + 2
+               end do
+            end if
+         end if
+         if (obs%to_result) then
+            res%hist(:, obs%rows) = row
+         else if (associated(obs%ctl)) then
+            if (obs%ctl%bad_column == 0) then
+               do i = 1, size(row)
+                  if (ieee_is_finite(row(i))) cycle
+                  obs%ctl%bad_column = i
+                  obs%ctl%bad_time = t
+                  obs%ctl%bad_value = row(i)
+                  exit
+               end do
+            end if
+         end if
          if (associated(obs%ctl)) then
             if (associated(obs%ctl%buffer)) obs%ctl%buffer(:, obs%rows) = row
             if (allocated(obs%ctl%stream_path)) call stream_row(obs%ctl%stream, row)

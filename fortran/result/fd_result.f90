@@ -2,15 +2,19 @@
 !> phase transitions, correctness violations, energy balance).
 module fd_result
    use fd_kinds, only: dp
-   use fd_error, only: error_type, fatal_error, fmt_int
-   use fd_model, only: model_type, integration_type
+   use, intrinsic :: ieee_arithmetic, only: ieee_is_finite
+   use fd_error, only: error_type, fatal_error, fmt_int, fmt_real, stat_no_memory
+   use fd_model, only: model_type, integration_type, technique_event_driven
    use fd_excitation, only: excitation_type
    implicit none
    private
 
-   public :: result_type, max_violation_times, column_name_len, init_result, history_shape
+   public :: result_type, max_violation_times, column_name_len, init_result, history_shape, check_finite
+   public :: nonfinite_history_error
+   public :: max_event_times, has_envelope
 
    integer, parameter :: max_violation_times = 10 !! first violation times kept
+   integer, parameter :: max_event_times = 1000   !! first event times kept (exact technique)
    integer, parameter :: column_name_len = 16     !! length of a column name
 
    !> Everything a run produces.
@@ -51,7 +55,15 @@ module fd_result
       integer :: partial_factorizations = 0 !! refactorizations from the first changed column on
       integer :: storage = 0           !! effective stiffness stored 1 dense, 2 banded (0: none)
       integer :: bandwidth = 0         !! its half-bandwidth in the solver's ordering
-      integer :: events = 0            !! events located (exact technique)
+      integer :: events = 0            !! events located (exact technique): instants at which
+                                       !! phases changed
+      integer :: n_event_times = 0     !! entries used in event_time
+      real(dp) :: event_time(max_event_times) = 0.0_dp !! times of the first events [s]
+      integer :: accumulations = 0     !! accumulation points of events (Zeno), handled
+      integer :: n_accumulation_times = 0 !! entries used in accumulation_time
+      real(dp) :: accumulation_time(max_violation_times) = 0.0_dp !! their first times [s]
+      logical :: exact_peaks = .false. !! peaks are the exact extrema (exact technique)
+      integer :: env_col = 0           !! first column of the maxima between rows (0: none)
       integer :: patterns = 0          !! stick-slip patterns solved in one-step problems (Moreau-Jean)
       integer :: lcp_fallbacks = 0     !! one-step problems that needed Lemke's fallback (Moreau-Jean)
       ! correctness condition, eqs. 9 and 12
@@ -72,9 +84,19 @@ module fd_result
 
 contains
 
+   !> Whether a run of these settings writes, after the state columns, the maxima of |u|,
+   !> |v|, |aabs| per DOF and |s|, |F| per device since the previous row (the exact
+   !> technique, whose solution between rows is known).
+   pure logical function has_envelope(opts)
+      type(integration_type), intent(in) :: opts    !! integration settings
+
+      has_envelope = opts%technique == technique_event_driven
+   end function has_envelope
+
    !> Size of the history a run writes: columns t, ag, (u, v, aabs) per DOF and
-   !> (s, sdot, F, phase) per device (of those kept, when given); samples at t = 0, every
-   !> `every` dt1 steps and at the end.
+   !> (s, sdot, F, phase) per device, then (exact technique) the maxima since the previous
+   !> row (peak_u, peak_v, peak_aabs) per DOF and (peak_s, peak_F) per device, all of the
+   !> DOFs and devices kept when given; samples at t = 0, every `every` dt1 steps and at the end.
    pure subroutine history_shape(model, exc, opts, ncol, nout, nsteps, every, n_dof_kept, n_devices_kept)
       type(model_type), intent(in) :: model         !! the model
       type(excitation_type), intent(in) :: exc      !! the table motion
@@ -92,6 +114,7 @@ contains
       if (present(n_dof_kept)) nk = n_dof_kept
       if (present(n_devices_kept)) ndk = n_devices_kept
       ncol = 2 + 3*nk + 4*ndk
+      if (has_envelope(opts)) ncol = ncol + 3*nk + 2*ndk
       nsteps = max(1, nint(exc%duration/(exc%dt_record/opts%n1)))
       every = opts%output_every
       if (every <= 0) every = opts%n1
@@ -139,7 +162,7 @@ contains
       if (stat /= 0) then
          call fatal_error(error, "not enough memory for the history: "//trim(fmt_int(res%nout))// &
                           " samples of "//trim(fmt_int(res%ncol))//" columns (raise output_every, "// &
-                          "keep fewer DOFs and devices, or stream the history to its file)")
+                          "keep fewer DOFs and devices, or stream the history to its file)", stat_no_memory)
          return
       end if
       res%hist = 0.0_dp
@@ -159,14 +182,97 @@ contains
          res%names(c + 4) = 'phase'//trim(fmt_int(kv(i))); res%units(c + 4) = '-'
          c = c + 4
       end do
+      if (has_envelope(opts)) then
+         res%env_col = c + 1
+         res%exact_peaks = .true.
+         do i = 1, size(kd)
+            res%names(c + 1) = 'peak_u'//trim(fmt_int(kd(i))); res%units(c + 1) = 'm'
+            res%names(c + 2) = 'peak_v'//trim(fmt_int(kd(i))); res%units(c + 2) = 'm/s'
+            res%names(c + 3) = 'peak_aabs'//trim(fmt_int(kd(i))); res%units(c + 3) = 'm/s2'
+            c = c + 3
+         end do
+         do i = 1, size(kv)
+            res%names(c + 1) = 'peak_s'//trim(fmt_int(kv(i))); res%units(c + 1) = 'm'
+            res%names(c + 2) = 'peak_F'//trim(fmt_int(kv(i))); res%units(c + 2) = 'N'
+            c = c + 2
+         end do
+      end if
       allocate (res%peak_u(n), res%peak_u_time(n), res%peak_v(n), res%peak_aabs(n), &
-                res%peak_aabs_time(n))
+                res%peak_aabs_time(n), res%peak_s(nd), res%peak_force(nd), res%stick_to_slip(nd), &
+                res%slip_to_stick(nd), res%reversals(nd), stat=stat)
+      if (stat /= 0) then
+         call fatal_error(error, "not enough memory for the summary of "//trim(fmt_int(n))//" DOFs and "// &
+                          trim(fmt_int(nd))//" devices", stat_no_memory)
+         return
+      end if
       res%peak_u = 0.0_dp; res%peak_u_time = 0.0_dp; res%peak_v = 0.0_dp
       res%peak_aabs = 0.0_dp; res%peak_aabs_time = 0.0_dp
-      allocate (res%peak_s(nd), res%peak_force(nd), res%stick_to_slip(nd), &
-                res%slip_to_stick(nd), res%reversals(nd))
       res%peak_s = 0.0_dp; res%peak_force = 0.0_dp
       res%stick_to_slip = 0; res%slip_to_stick = 0; res%reversals = 0
    end subroutine init_result
+
+   !> Every number of a result must be finite: an error names the first quantity that is not
+   !> (its summary key, or its history column and time), never a null in a summary.
+   subroutine check_finite(res, error)
+      type(result_type), intent(in) :: res                !! the result of a run
+      type(error_type), allocatable, intent(out) :: error !! the first quantity not finite
+      integer :: i, j
+
+      call scalar('period_stuck_s', res%period_stuck)
+      call scalar('xi_stuck', res%xi_stuck)
+      call scalar('energy_input_J', res%e_input)
+      call scalar('energy_kinetic_J', res%e_kinetic)
+      call scalar('energy_strain_J', res%e_strain)
+      call scalar('energy_viscous_J', res%e_viscous)
+      call scalar('energy_friction_J', res%e_friction)
+      call scalar('energy_device_elastic_J', res%e_device)
+      call scalar('energy_residual_J', res%e_residual)
+      if (allocated(error)) return
+      if (allocated(res%peak_u)) call vector('peak_u_m', res%peak_u)
+      if (allocated(res%peak_v)) call vector('peak_v_mps', res%peak_v)
+      if (allocated(res%peak_aabs)) call vector('peak_aabs_mps2', res%peak_aabs)
+      if (allocated(res%peak_s)) call vector('peak_s_m', res%peak_s)
+      if (allocated(res%peak_force)) call vector('peak_force_N', res%peak_force)
+      if (allocated(error) .or. .not. allocated(res%hist)) return
+      do j = 1, min(res%nout, size(res%hist, 2))
+         do i = 1, size(res%hist, 1)
+            if (ieee_is_finite(res%hist(i, j))) cycle
+            call nonfinite_history_error(res%names(i), res%hist(1, j), res%hist(i, j), error)
+            return
+         end do
+      end do
+   contains
+      subroutine scalar(key, x)
+         character(len=*), intent(in) :: key
+         real(dp), intent(in) :: x
+         if (allocated(error)) return
+         if (ieee_is_finite(x)) return
+         call fatal_error(error, "the run produced a value that is not finite (overflow): "//key//" = "// &
+                          trim(fmt_real(x))//"; the deck's values are too large (or too small) for double precision")
+      end subroutine scalar
+      subroutine vector(key, x)
+         character(len=*), intent(in) :: key
+         real(dp), intent(in) :: x(:)
+         integer :: k
+         if (allocated(error)) return
+         do k = 1, size(x)
+            if (ieee_is_finite(x(k))) cycle
+            call scalar(key//'('//trim(fmt_int(k))//')', x(k))
+            return
+         end do
+      end subroutine vector
+   end subroutine check_finite
+
+   !> The error of a history value that is not finite: column `name` at time t.
+   subroutine nonfinite_history_error(name, t, x, error)
+      character(len=*), intent(in) :: name               !! the column
+      real(dp), intent(in) :: t                           !! the row's time [s]
+      real(dp), intent(in) :: x                           !! the value
+      type(error_type), allocatable, intent(out) :: error !! the error
+
+      call fatal_error(error, "the run produced a value that is not finite (overflow): history column "// &
+                       trim(name)//" at t = "//trim(fmt_real(t))//" s is "//trim(fmt_real(x))// &
+                       "; the deck's values are too large (or too small) for double precision")
+   end subroutine nonfinite_history_error
 
 end module fd_result

@@ -49,6 +49,11 @@ module fd_run_control
       real(dp) :: duration = 0.0_dp                   !! duration of the run [s]
       procedure(progress_callback), pointer, nopass :: on_progress => null() !! progress report
       real(dp) :: progress_interval = 0.1_dp          !! wall-clock seconds between reports
+      ! the first value not finite in a row that went only to the buffer or the file (the
+      ! result's rows are checked at the end): run_config_solve makes it an error
+      integer :: bad_column = 0                       !! its column (0: none)
+      real(dp) :: bad_time = 0.0_dp                   !! its row's time [s]
+      real(dp) :: bad_value = 0.0_dp                  !! the value
    end type run_control
 
 contains
@@ -101,13 +106,14 @@ contains
       end subroutine check_list
    end subroutine select_history
 
-   !> Clear what a run left in the control (the stop request, the time, the buffer), keeping
-   !> the selection and the settings.
+   !> Clear what a run left in the control (the stop request, the time, the buffer, a value
+   !> not finite), keeping the selection and the settings.
    subroutine control_reset(ctl)
       type(run_control), intent(inout) :: ctl   !! the control
 
       ctl%cancel = 0
       ctl%time = 0.0_dp
+      ctl%bad_column = 0
       nullify (ctl%buffer)
    end subroutine control_reset
 

@@ -20,7 +20,7 @@
 module fd_newmark
    use, intrinsic :: ieee_arithmetic, only: ieee_is_finite
    use fd_kinds, only: dp
-   use fd_error, only: error_type, fatal_error, fmt_real, fmt_int
+   use fd_error, only: error_type, fatal_error, fmt_real, fmt_int, stat_no_memory
    use fd_names, only: laws, law_name, law_choices, excitation_types, technique_name, technique_newmark, &
                        technique_event_driven, linear_system_dense, linear_system_banded
    use fd_model, only: model_type, integration_type
@@ -28,7 +28,8 @@ module fd_newmark
    use fd_matrices, only: structure_damping
    use fd_kinematics, only: device_kinematics, add_device
    use fd_banded, only: spd_system, spd_setup, spd_factor, spd_update_devices, spd_solve, spd_k_matvec, &
-                        spd_c_matvec, spd_kc_matvec, spd_auto, spd_dense, spd_banded, spd_is_dense, spd_bandwidth
+                        spd_c_matvec, spd_kc_matvec, spd_auto, spd_dense, spd_banded, spd_is_dense, spd_bandwidth, &
+                        spd_copy
    use fd_device_state, only: device_state, device_force
    use fd_friction, only: friction_init, friction_step
    use fd_result, only: result_type
@@ -36,6 +37,7 @@ module fd_newmark
    use fd_observer, only: observer_type, observer_init, sample_due, observe_start_energies, observe_peaks, &
                           observe_sample, observe_transitions, observe_violations, observe_end_energies, &
                           observe_poll, observe_stop_error
+   use fd_step_limits, only: halving_levels, unresolved_band
    implicit none
    private
 
@@ -193,16 +195,6 @@ contains
       res%run_time = real(c1 - c0, dp)/real(max(crate, 1), dp)
    end subroutine run_newmark
 
-   !> Number of halvings from sub down to dt_min.
-   pure integer function halving_levels(sub, dt_min) result(lmax)
-      real(dp), intent(in) :: sub, dt_min
-
-      lmax = 0
-      do while (lmax < 30 .and. sub/2.0_dp**(lmax + 1) >= dt_min*(1.0_dp - 1.0e-12_dp))
-         lmax = lmax + 1
-      end do
-   end function halving_levels
-
    !> The effective stiffness systems (one set up, copied for every step size; factored when
    !> first used) and the workspace. Memory linear in the number of DOFs and devices.
    subroutine setup(model, opts, dt1, dt2, lmax, w, res, error)
@@ -221,6 +213,12 @@ contains
       nd = model%n_devices
       w%n = n
       w%nd = nd
+      allocate (w%mass(n), stat=stat)
+      if (stat /= 0) then
+         call fatal_error(error, "not enough memory for the masses of n_dof = "//trim(fmt_int(n))//" DOFs", &
+                          stat_no_memory)
+         return
+      end if
       w%mass = model%mass
       call structure_damping(model, a0, a1, res%period_stuck, res%xi_stuck, error)
       if (allocated(error)) return
@@ -242,7 +240,8 @@ contains
       w%lmax = lmax
       allocate (w%lev(lmax + 2), stat=stat)
       if (stat /= 0) then
-         call fatal_error(error, "not enough memory for the effective stiffness of n_dof = "//trim(fmt_int(n))//" DOFs")
+         call fatal_error(error, "not enough memory for the effective stiffness of n_dof = "//trim(fmt_int(n))// &
+                          " DOFs", stat_no_memory)
          return
       end if
       b = opts%beta
@@ -257,12 +256,17 @@ contains
          w%lev(l)%c0 = 1.0_dp/(b*h*h); w%lev(l)%c1 = g/(b*h)
          w%lev(l)%gh = g*h; w%lev(l)%g1h = (1.0_dp - g)*h
          w%lev(l)%bh2 = b*h*h; w%lev(l)%b2h2 = (0.5_dp - b)*h*h
-         w%lev(l)%sys = base
+         call spd_copy(base, w%lev(l)%sys, error)
+         if (allocated(error)) return
       end do
-      allocate (w%u(n), w%v(n), w%a(n), w%u1(n), w%v1(n), w%a1(n), w%rhs(n), w%tmp(n))
-      allocate (w%s(nd), w%sd(nd), w%s1(nd), w%sd1(nd), w%f(nd), w%kd(nd), w%st(nd), w%st1(nd), &
-                w%phase0(nd), w%phase1(nd))
-      allocate (w%changed(nd), w%ok(nd))
+      allocate (w%u(n), w%v(n), w%a(n), w%u1(n), w%v1(n), w%a1(n), w%rhs(n), w%tmp(n), &
+                w%s(nd), w%sd(nd), w%s1(nd), w%sd1(nd), w%f(nd), w%kd(nd), w%st(nd), w%st1(nd), &
+                w%phase0(nd), w%phase1(nd), w%changed(nd), w%ok(nd), stat=stat)
+      if (stat /= 0) then
+         call fatal_error(error, "not enough memory for the state of n_dof = "//trim(fmt_int(n))//" DOFs", &
+                          stat_no_memory)
+         return
+      end if
       w%di = model%dev%node_i
       w%dj = model%dev%node_j
    end subroutine setup
@@ -439,7 +443,7 @@ contains
       type(workspace), intent(inout) :: w
       type(result_type), intent(inout) :: res
       type(error_type), allocatable, intent(out) :: error
-      integer :: lmax, level, pos, units
+      integer :: lmax, level, pos, units, d
       real(dp) :: h, tl
       logical :: any_changed, any_bad, stop
 
@@ -456,6 +460,15 @@ contains
          if (any_bad .and. opts%check .and. level < lmax) then
             level = level + 1
             cycle
+         end if
+         if (any_bad .and. opts%check) then
+            ! a violation left at dt_min: an error when the band is below what dt_min resolves
+            ! (fd_step_limits), else counted
+            do d = 1, w%nd
+               if (w%ok(d)) cycle
+               call unresolved_band(model, d, tl + h, res%dt_min, error)
+               if (allocated(error)) return
+            end do
          end if
          call accept(model, exc, tl + h, w, res, any_changed, any_bad)
          if (level == 0) then

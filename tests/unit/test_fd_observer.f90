@@ -7,7 +7,10 @@ module test_fd_observer
    use fd_error, only: fd_error_type => error_type
    use fd_model, only: model_type, device_type, integration_type, law_velocity
    use fd_excitation, only: excitation_type, excitation_none
-   use fd_result, only: result_type, max_violation_times
+   use fd_result, only: result_type, max_violation_times, check_finite, nonfinite_history_error
+   use fd_run_control, only: run_control, select_history
+   use fd_names, only: technique_event_driven
+   use, intrinsic :: ieee_arithmetic, only: ieee_value, ieee_quiet_nan, ieee_positive_inf
    use fd_observer, only: observer_type, observer_init, sample_due, observe_start, observe_peaks, &
                           observe_sample, observe_transitions, observe_violations, observe_end
    implicit none
@@ -25,7 +28,10 @@ contains
                   new_unittest("peaks and their times", test_peaks), &
                   new_unittest("phase transitions", test_transitions), &
                   new_unittest("correctness violations", test_violations), &
-                  new_unittest("energy balance of a free oscillator", test_energy) &
+                  new_unittest("energy balance of a free oscillator", test_energy), &
+                  new_unittest("a non-finite result named", test_non_finite), &
+                  new_unittest("a non-finite row outside the result noted", test_non_finite_buffer), &
+                  new_unittest("maxima between rows of the kept DOFs and devices", test_selected_envelope) &
                   ]
    end subroutine collect_observer
 
@@ -176,5 +182,133 @@ contains
       ! no input, no viscous work: the friction work is the only imbalance
       call check(error, res%e_residual, -(res%e_friction + res%e_device), thr=1.0e-15_dp)
    end subroutine test_energy
+
+   !> check_finite: a finite result passes; an overflowed energy, peak or history value is an
+   !> error naming its summary key (or column and time), never a null in a summary.
+   subroutine test_non_finite(error)
+      type(error_type), allocatable, intent(out) :: error
+      type(model_type) :: model
+      type(result_type) :: res, bad
+      type(observer_type) :: obs
+      type(fd_error_type), allocatable :: err
+
+      call setup(model, res, obs, error)
+      if (allocated(error)) return
+      call check_finite(res, err)
+      call check(error, .not. allocated(err), 'a finite result')
+      if (allocated(error)) return
+      bad = res
+      bad%e_input = ieee_value(1.0_dp, ieee_positive_inf)
+      call check_finite(bad, err)
+      call check(error, allocated(err), 'an infinite energy')
+      if (allocated(error)) return
+      call check(error, index(err%message, 'energy_input_J = Inf') > 0, err%message)
+      if (allocated(error)) return
+      bad = res
+      bad%peak_force(1) = ieee_value(1.0_dp, ieee_quiet_nan)
+      call check_finite(bad, err)
+      call check(error, allocated(err), 'a NaN peak')
+      if (allocated(error)) return
+      call check(error, index(err%message, 'peak_force_N(1) = NaN') > 0, err%message)
+      if (allocated(error)) return
+      bad = res
+      bad%hist(1, 2) = 0.01_dp
+      bad%hist(4, 2) = -ieee_value(1.0_dp, ieee_positive_inf)
+      call check_finite(bad, err)
+      call check(error, allocated(err), 'an infinite history value')
+      if (allocated(error)) return
+      call check(error, index(err%message, 'history column v1 at t = 0.01 s is -Inf') > 0, err%message)
+   end subroutine test_non_finite
+
+   !> A row that goes only to the caller's buffer (the history file alike) is not in the
+   !> result that check_finite sees: the observer notes its first value not finite in the
+   !> control, for run_config_solve's error (the same message as check_finite's).
+   subroutine test_non_finite_buffer(error)
+      type(error_type), allocatable, intent(out) :: error
+      type(model_type) :: model
+      type(result_type) :: res
+      type(observer_type) :: obs
+      type(excitation_type) :: exc
+      type(integration_type) :: opts
+      type(run_control), target :: ctl
+      type(fd_error_type), allocatable :: err
+      real(dp), target :: buf(12, 3)
+      real(dp) :: nan
+
+      nan = ieee_value(1.0_dp, ieee_quiet_nan)
+      model%n_dof = 2
+      model%mass = [2.0_dp, 1.0_dp]
+      model%n_devices = 1
+      model%dev = [device_type(node_i=1, node_j=2, law=law_velocity, p=10.0_dp, mu=0.2_dp)]
+      exc%kind = excitation_none
+      exc%dt_record = 0.01_dp
+      exc%duration = 0.0123_dp
+      opts%n1 = 20
+      ctl%buffer => buf
+      ctl%keep = .false.
+      call observer_init(model, exc, opts, res, obs, err, ctl)
+      if (allocated(err)) call test_failed(error, err%message)
+      if (allocated(error)) return
+      call check(error, size(res%hist, 2) == 0 .and. res%nout == 3, 'no rows in the result')
+      if (allocated(error)) return
+      call observe_sample(obs, res, 0.0_dp, 0.0_dp, [1.0_dp, 2.0_dp], [0.0_dp, 0.0_dp], [0.0_dp, 0.0_dp], &
+                          [1.0_dp], [0.0_dp], [0.0_dp], [0])
+      call check(error, ctl%bad_column == 0, 'a finite row')
+      if (allocated(error)) return
+      call observe_sample(obs, res, 0.01_dp, 0.0_dp, [1.0_dp, 2.0_dp], [0.0_dp, nan], [0.0_dp, 0.0_dp], &
+                          [1.0_dp], [0.0_dp], [nan], [0])
+      call check(error, ctl%bad_column == 7 .and. ctl%bad_time == 0.01_dp, 'the first NaN: v2 at t = 0.01 s')
+      if (allocated(error)) return
+      call check(error, buf(7, 2) /= buf(7, 2), 'the row is in the buffer as computed')
+      if (allocated(error)) return
+      call check_finite(res, err)
+      call check(error, .not. allocated(err), 'the result itself holds no row')
+      if (allocated(error)) return
+      call nonfinite_history_error(res%names(ctl%bad_column), ctl%bad_time, ctl%bad_value, err)
+      call check(error, index(err%message, 'history column v2 at t = 0.01 s is NaN') > 0, err%message)
+   end subroutine test_non_finite_buffer
+
+   !> The exact technique's maxima between rows (peak_*) follow the history selection: the
+   !> columns of the DOFs and devices kept, in their order, their values from the full list.
+   subroutine test_selected_envelope(error)
+      type(error_type), allocatable, intent(out) :: error
+      type(model_type) :: model
+      type(result_type) :: res
+      type(observer_type) :: obs
+      type(excitation_type) :: exc
+      type(integration_type) :: opts
+      type(run_control), target :: ctl
+      type(fd_error_type), allocatable :: err
+      real(dp) :: env(3*3 + 2*2)
+      integer :: i
+
+      model%n_dof = 3
+      model%mass = [1.0_dp, 1.0_dp, 1.0_dp]
+      model%n_devices = 2
+      model%dev = [device_type(node_i=1, node_j=0, law=law_velocity, p=1.0_dp, mu=0.1_dp), &
+                   device_type(node_i=3, node_j=2, law=law_velocity, p=1.0_dp, mu=0.1_dp)]
+      exc%kind = excitation_none
+      exc%dt_record = 0.01_dp
+      exc%duration = 0.01_dp
+      opts%n1 = 1
+      opts%technique = technique_event_driven
+      call select_history(ctl, [3], [2], 3, 2, err)
+      if (allocated(err)) call test_failed(error, err%message)
+      if (allocated(error)) return
+      call observer_init(model, exc, opts, res, obs, err, ctl)
+      if (allocated(err)) call test_failed(error, err%message)
+      if (allocated(error)) return
+      call check(error, res%ncol == 2 + 3 + 4 + 3 + 2, 'columns: t, ag, 3 of DOF 3, 4 of device 2, 3 + 2 maxima')
+      if (allocated(error)) return
+      call check(error, res%names(10) == 'peak_u3' .and. res%names(12) == 'peak_aabs3' .and. &
+                 res%names(13) == 'peak_s2' .and. res%names(14) == 'peak_F2', 'names of the kept maxima')
+      if (allocated(error)) return
+      env = [(real(i, dp), i=1, size(env))]
+      call observe_sample(obs, res, 0.0_dp, 0.0_dp, [0.0_dp, 0.0_dp, 0.0_dp], [0.0_dp, 0.0_dp, 0.0_dp], &
+                          [0.0_dp, 0.0_dp, 0.0_dp], [0.0_dp, 0.0_dp], [0.0_dp, 0.0_dp], [0.0_dp, 0.0_dp], [0, 0], env)
+      ! DOF 3: entries 7, 8, 9; device 2: entries 9 + 3, 9 + 4
+      call check(error, all(res%hist(10:14, 1) == [7.0_dp, 8.0_dp, 9.0_dp, 12.0_dp, 13.0_dp]), &
+                 'the maxima of DOF 3 and device 2')
+   end subroutine test_selected_envelope
 
 end module test_fd_observer
