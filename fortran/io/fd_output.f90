@@ -7,6 +7,9 @@ module fd_output
    use fd_error, only: error_type, fatal_error, fmt_int, fmt_real
    use fd_model, only: model_type, output_type, law_name, technique_name
    use fd_result, only: result_type
+   use fd_version, only: frictiondyn_version
+   use fd_names, only: excitation_types, mode_systems
+   use fd_matrices, only: modes_type, modes_none, modes_flexible, modes_rigid, modes_unrestrained
    implicit none
    private
 
@@ -190,12 +193,13 @@ contains
       call json_escape(deck_path, esc)
       js = '{'//nl
       js = js//'  "deck": "'//esc//'",'//nl
+      js = js//'  "frictiondyn_version": "'//frictiondyn_version//'",'//nl
       call kv('n_dof', trim(fmt_int(res%n_dof)))
       call kv('n_devices', trim(fmt_int(res%n_devices)))
       call kv('technique', '"'//trim(technique_name(res%technique))//'"')
       js = js//'  "device_law": ['//laws//'],'//nl
-      call kv('period_stuck_s', trim(json_real(res%period_stuck)))
-      call kv('xi_stuck', trim(json_real(res%xi_stuck)))
+      call kv('period_stuck_s', trim(json_defined(res%period_stuck, res%period_stuck > 0.0_dp)))
+      call kv('xi_stuck', trim(json_defined(res%xi_stuck, res%period_stuck > 0.0_dp)))
       call kv('dt1_s', trim(json_real(res%dt1)))
       call kv('dt2_s', trim(json_real(res%dt2)))
       call kv('dt_min_s', trim(json_real(res%dt_min)))
@@ -224,9 +228,126 @@ contains
       call kv('energy_friction_J', trim(json_real(res%e_friction)))
       call kv('energy_device_elastic_J', trim(json_real(res%e_device)))
       call kv('energy_residual_J', trim(json_real(res%e_residual)))
+      call engineering_keys()
       call kv('samples', trim(fmt_int(res%nout)))
       js = js//'  "run_time_s": '//trim(json_real(res%run_time))//nl//'}'
    contains
+      !> What produced the run, the names, the modes, the storeys (fd_engineering).
+      subroutine engineering_keys()
+         integer :: i
+         real(dp), allocatable :: ratio(:)
+         call kv('deck_sha256', '"'//trim(model%deck_sha256)//'"')
+         if (allocated(model%record_file)) then
+            call json_escape(model%record_file, esc)
+            call kv('record_file', '"'//esc//'"')
+            call kv('record_sha256', '"'//trim(model%record_sha256)//'"')
+         else
+            call kv('record_file', 'null')
+            call kv('record_sha256', 'null')
+         end if
+         associate (eng => res%eng)
+            if (eng%excitation >= 1 .and. eng%excitation <= size(excitation_types)) then
+               call kv('excitation_type', '"'//trim(excitation_types(eng%excitation)%name)//'"')
+            else
+               call kv('excitation_type', 'null')
+            end if
+            call kv('excitation_frequency_Hz', trim(json_defined(eng%frequency, eng%frequency > 0.0_dp)))
+            call kv('duration_s', trim(json_real(eng%duration)))
+            call ks('dof_labels', eng%dof_label)
+            call ks('device_labels', eng%device_label)
+            call kv('damping_a0_per_s', trim(json_real(eng%a0)))
+            call kv('damping_a1_s', trim(json_real(eng%a1)))
+            call modes_keys('stuck', eng%stuck)
+            call modes_keys('free', eng%free)
+            call kr('residual_s_m', eng%residual_s)
+            call kv('peak_base_shear_N', trim(json_real(eng%peak_shear(0))))
+            call kv('peak_base_shear_time_s', trim(json_real(eng%peak_shear_time(0))))
+            call kv('residual_base_shear_N', trim(json_real(eng%shear(0))))
+            call kv('n_storeys', trim(fmt_int(eng%n_storeys)))
+            call ks('storey_labels', eng%storey_label)
+            js = js//'  "storey_nodes": ['
+            do i = 1, eng%n_storeys
+               js = js//'['//trim(fmt_int(eng%storey_i(i)))//', '//trim(fmt_int(eng%storey_j(i)))//']'
+               if (i < eng%n_storeys) js = js//', '
+            end do
+            js = js//'],'//nl
+            call kd('storey_height_m', eng%height, eng%height > 0.0_dp)
+            call kr('peak_drift_m', eng%peak_drift)
+            call kr('peak_drift_time_s', eng%peak_drift_time)
+            call kr('residual_drift_m', eng%drift)
+            allocate (ratio(eng%n_storeys))
+            ratio = 0.0_dp
+            where (eng%height > 0.0_dp) ratio = eng%peak_drift/eng%height
+            call kd('peak_drift_ratio', ratio, eng%height > 0.0_dp)
+            where (eng%height > 0.0_dp) ratio = eng%drift/eng%height
+            call kd('residual_drift_ratio', ratio, eng%height > 0.0_dp)
+            call kr('peak_storey_shear_N', eng%peak_shear(1:))
+            call kr('peak_storey_shear_time_s', eng%peak_shear_time(1:))
+            call kr('residual_storey_shear_N', eng%shear(1:))
+         end associate
+      end subroutine engineering_keys
+      !> The modes of one system: status, periods (null: infinite), shapes, mass ratios, damping.
+      subroutine modes_keys(name, m)
+         character(len=*), intent(in) :: name
+         type(modes_type), intent(in) :: m
+         integer :: j, i
+         select case (m%status)
+         case (modes_flexible)
+            call kv('modes_'//name//'_status', '"flexible"')
+         case (modes_rigid)
+            call kv('modes_'//name//'_status', '"rigid"')
+         case (modes_unrestrained)
+            call kv('modes_'//name//'_status', '"unrestrained"')
+         case default
+            call kv('modes_'//name//'_status', '"not computed"')
+            call kr('periods_'//name//'_s', [real(dp) ::])
+            js = js//'  "mode_shapes_'//name//'": [],'//nl
+            call kr('modal_mass_ratio_'//name, [real(dp) ::])
+            call kr('modal_xi_'//name, [real(dp) ::])
+            return
+         end select
+         call kr('periods_'//name//'_s', m%period)
+         js = js//'  "mode_shapes_'//name//'": ['
+         do j = 1, m%n
+            js = js//'['
+            do i = 1, size(m%shape, 1)
+               js = js//trim(json_real(m%shape(i, j)))
+               if (i < size(m%shape, 1)) js = js//', '
+            end do
+            js = js//']'
+            if (j < m%n) js = js//', '
+         end do
+         js = js//'],'//nl
+         call kr('modal_mass_ratio_'//name, m%mass_ratio)
+         call kr('modal_xi_'//name, m%xi)
+      end subroutine modes_keys
+      !> Reals, null where not defined.
+      subroutine kd(key, x, defined)
+         character(len=*), intent(in) :: key
+         real(dp), intent(in) :: x(:)
+         logical, intent(in) :: defined(:)
+         integer :: k
+         js = js//'  "'//key//'": ['
+         do k = 1, size(x)
+            js = js//trim(json_defined(x(k), defined(k)))
+            if (k < size(x)) js = js//', '
+         end do
+         js = js//'],'//nl
+      end subroutine kd
+      !> Strings.
+      subroutine ks(key, x)
+         character(len=*), intent(in) :: key
+         character(len=*), intent(in) :: x(:)
+         integer :: k
+         character(len=:), allocatable :: e
+         js = js//'  "'//key//'": ['
+         do k = 1, size(x)
+            call json_escape(trim(x(k)), e)
+            js = js//'"'//e//'"'
+            if (k < size(x)) js = js//', '
+         end do
+         js = js//'],'//nl
+      end subroutine ks
       subroutine kv(key, val)
          character(len=*), intent(in) :: key, val
          js = js//'  "'//key//'": '//val//','//nl
@@ -267,6 +388,15 @@ contains
          if (j < res%ncol) line = line//','
       end do
    end subroutine history_header
+
+   !> A real as JSON when it is defined, else null.
+   pure function json_defined(x, defined) result(str)
+      real(dp), intent(in) :: x
+      logical, intent(in) :: defined
+      character(len=32) :: str
+      str = 'null'
+      if (defined) str = json_real(x)
+   end function json_defined
 
    !> A real as JSON: 17 significant digits (null when not finite), left-adjusted.
    pure function json_real(x) result(str)

@@ -10,6 +10,7 @@ module fd_observer
    use fd_excitation, only: excitation_type
    use fd_result, only: result_type, init_result, max_violation_times
    use fd_linalg, only: sym_matvec
+   use fd_engineering, only: engineering_init, observe_engineering, storey_values
    implicit none
    private
 
@@ -41,6 +42,8 @@ contains
       call init_result(model, exc, opts, res, obs%nsteps, obs%every, error)
       if (allocated(error)) return
       res%technique = opts%technique
+      ! names, modes and storeys (res%period_stuck: set by the technique before)
+      call engineering_init(model, exc, opts, res%period_stuck, res%eng, error)
    end subroutine observer_init
 
    !> Whether the history takes a row after dt1 step k (every `every` steps, and the last).
@@ -105,6 +108,7 @@ contains
          res%peak_s(i) = max(res%peak_s(i), abs(s(i)))
          res%peak_force(i) = max(res%peak_force(i), abs(force(i)))
       end do
+      call observe_engineering(res%eng, t, u, v, s, force)
    end subroutine observe_peaks
 
    !> The next row of the history: t, ag, (u, v, aabs) per DOF, (s, s', F, phase) per device.
@@ -136,6 +140,12 @@ contains
             res%hist(c + 1:c + 4, row) = [s(i), sd(i), force(i), real(phase(i), dp)]
             c = c + 4
          end do
+         ! storeys: (drift, V) each, then the base shear
+         if (res%eng%n_storeys > 0) then
+            i = res%eng%n_storeys
+            call storey_values(res%eng, u, v, force, res%hist(c + 1:c + 2*i - 1:2, row), &
+                               res%hist(c + 2:c + 2*i:2, row), res%hist(c + 2*i + 1, row))
+         end if
       end associate
    end subroutine observe_sample
 

@@ -5,6 +5,7 @@ module fd_result
    use fd_error, only: error_type, fatal_error, fmt_int
    use fd_model, only: model_type, integration_type
    use fd_excitation, only: excitation_type
+   use fd_engineering, only: engineering_type, engineering_columns
    implicit none
    private
 
@@ -62,12 +63,15 @@ module fd_result
       real(dp) :: e_device = 0.0_dp    !! elastic energy stored in sticking devices at the end
       real(dp) :: e_residual = 0.0_dp  !! input - (kinetic + strain + viscous + friction + device)
       real(dp) :: run_time = 0.0_dp    !! wall-clock time of the integration [s]
+      ! names, modes, storey drifts and shears, residual values (fd_engineering)
+      type(engineering_type) :: eng    !! the engineering outputs
    end type result_type
 
 contains
 
    !> Size of the history a run writes: columns t, ag, (u, v, aabs) per DOF and
-   !> (s, sdot, F, phase) per device; samples at t = 0, every `every` dt1 steps and at the end.
+   !> (s, sdot, F, phase) per device, then (drift, V) per storey and Vb when the model names
+   !> storeys; samples at t = 0, every `every` dt1 steps and at the end.
    pure subroutine history_shape(model, exc, opts, ncol, nout, nsteps, every)
       type(model_type), intent(in) :: model         !! the model
       type(excitation_type), intent(in) :: exc      !! the table motion
@@ -77,7 +81,7 @@ contains
       integer, intent(out) :: nsteps                !! dt1 steps of the run
       integer, intent(out) :: every                 !! dt1 steps between samples
 
-      ncol = 2 + 3*model%n_dof + 4*model%n_devices
+      ncol = 2 + 3*model%n_dof + 4*model%n_devices + engineering_columns(model)
       nsteps = max(1, nint(exc%duration/(exc%dt_record/opts%n1)))
       every = opts%output_every
       if (every <= 0) every = opts%n1
@@ -125,6 +129,14 @@ contains
          res%names(c + 4) = 'phase'//trim(fmt_int(i)); res%units(c + 4) = '-'
          c = c + 4
       end do
+      if (engineering_columns(model) > 0) then
+         do i = 1, model%n_storeys
+            res%names(c + 1) = 'drift'//trim(fmt_int(i)); res%units(c + 1) = 'm'
+            res%names(c + 2) = 'V'//trim(fmt_int(i)); res%units(c + 2) = 'N'
+            c = c + 2
+         end do
+         res%names(c + 1) = 'Vb'; res%units(c + 1) = 'N'
+      end if
       allocate (res%peak_u(n), res%peak_u_time(n), res%peak_v(n), res%peak_aabs(n), &
                 res%peak_aabs_time(n))
       res%peak_u = 0.0_dp; res%peak_u_time = 0.0_dp; res%peak_v = 0.0_dp
