@@ -115,7 +115,7 @@ contains
                if (speed <= dev%mu_v(k)) exit
             end do
             w = (speed - dev%mu_v(k - 1))/(dev%mu_v(k) - dev%mu_v(k - 1))
-            mu = (1.0_dp - w)*dev%mu_at(k - 1) + w*dev%mu_at(k)
+            mu = dev%mu_at(k - 1) + w*(dev%mu_at(k) - dev%mu_at(k - 1))
          end if
       case default
          mu = dev%mu
