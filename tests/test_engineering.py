@@ -95,7 +95,8 @@ def test_drifts_and_shears_follow_from_the_histories(law):
         shear = k[st - 1] * (drift + a1 * rate) + r[f"F{st}"]
         np.testing.assert_allclose(r[f"V{st}"], shear, rtol=0, atol=1e-9 * np.abs(shear).max())
         inertia = -(m[st - 1 :] * acc[:, st - 1 :]).sum(axis=1)
-        np.testing.assert_allclose(r[f"V{st}"], inertia, rtol=0, atol=1e-7 * np.abs(inertia).max())
+        # measured: 3.6e-13 (velocity), 8.1e-13 (hysteretic), 5.4e-14 (coulomb) of the peak
+        np.testing.assert_allclose(r[f"V{st}"], inertia, rtol=0, atol=1e-11 * np.abs(inertia).max())
     assert np.array_equal(r["Vb"], r["V1"])  # one storey on the table
     # peaks over every accepted step: at least the rows' (every dt1 here), at most a little more
     for st in range(1, 5):
