@@ -21,7 +21,7 @@ G = 9.81
 MASS = [250e3, 200e3, 200e3, 200e3]  # kg: base slab, floors 1-3
 K_FRAME = 150e6  # N/m, each storey of the frame
 LABELS = ["base slab", "floor 1", "floor 2", "roof"]
-RECORD = fd.Record(dt_record=0.01, file=str(INPUTS / "synthetic_kt.txt"), duration=30.0)
+RECORD = fd.Record(dt_record=0.01, file=str(INPUTS / "synthetic_pga035.AT2"), duration=30.0)
 
 
 def isolated() -> fd.Analysis:

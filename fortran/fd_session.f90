@@ -153,7 +153,7 @@ contains
          return
       end if
       call history_header(s%res, s%header)
-      call summary_json(s%cfg%model, s%res, s%cfg%deck_path, s%summary)
+      call summary_json(s%cfg%model, s%res, s%cfg%deck_path, s%summary, s%cfg%record)
       s%state = session_solved
    end subroutine session_solve
 
@@ -246,7 +246,7 @@ contains
          call fatal_error(error, 'the session holds no deck: no output settings')
          return
       end if
-      call write_outputs(s%cfg%out, s%cfg%model, s%res, s%cfg%deck_path, error)
+      call write_outputs(s%cfg%out, s%cfg%model, s%res, s%cfg%deck_path, record=s%cfg%record, error=error)
       if (allocated(error)) error%message = s%cfg%deck_path//': '//error%message
    end subroutine session_write
 

@@ -8,15 +8,15 @@ module frictiondyn
    use fd_deck, only: run_config, read_deck, read_deck_string
    use fd_technique, only: run_technique
    use fd_result, only: history_shape
-   use fd_output, only: output_type, write_outputs, output_paths, summary_json, history_header, &
-                        write_output_files
+   use fd_output, only: output_type, write_outputs, output_paths, temp_output_paths, summary_json, &
+                        history_header, write_output_files
    implicit none
    private
 
    public :: dp, error_type, model_type, integration_type, device_type, excitation_type
    public :: result_type, run_config, output_type
    public :: read_deck, read_deck_string, run_config_solve, run_deck, shape_of
-   public :: output_paths, summary_json, history_header
+   public :: output_paths, temp_output_paths, summary_json, history_header
    public :: write_outputs, write_output_files
 
 contains
@@ -50,7 +50,7 @@ contains
       if (allocated(error)) return
       call run_config_solve(cfg, res, error)
       if (allocated(error)) return
-      call write_outputs(cfg%out, cfg%model, res, path, error)
+      call write_outputs(cfg%out, cfg%model, res, path, record=cfg%record, error=error)
       if (allocated(error)) error%message = path//": "//error%message
    end subroutine run_deck
 

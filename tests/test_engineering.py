@@ -59,7 +59,7 @@ def building(law: str = "velocity", duration: float = 6.0, **kw) -> fd.Analysis:
         ],
         "storeys": [fd.Storey.of_spring(i + 1, height=3.5) for i in range(n)],
         "excitation": fd.Record(
-            dt_record=0.01, file=str(INPUTS / "synthetic_kt.txt"), duration=duration
+            dt_record=0.01, file=str(INPUTS / "synthetic_pga035.AT2"), duration=duration
         ),
         "integration": fd.Integration(n1=10, **integ),
         "output": fd.Output(output_every=1),
@@ -344,7 +344,7 @@ def test_friction_braces_equal_the_spelled_out_hysteretic_devices():
         )
         for i in range(2)
     ]
-    rec = fd.Record(dt_record=0.01, file=str(INPUTS / "synthetic_kt.txt"), duration=5.0)
+    rec = fd.Record(dt_record=0.01, file=str(INPUTS / "synthetic_pga035.AT2"), duration=5.0)
     common = {
         "excitation": rec,
         "storeys": [fd.Storey(1, 0), fd.Storey(2, 1)],
@@ -354,7 +354,7 @@ def test_friction_braces_equal_the_spelled_out_hysteretic_devices():
     b = chain(2, devices=spelled, **common).run()
     assert a.summary["stick_to_slip"][0] > 0  # the dampers slip
     assert np.array_equal(a.data, b.data)
-    skip = {"deck", "deck_sha256", "run_time_s", "record_file"}
+    skip = {"deck", "deck_sha256", "run_time_s"}
     assert {k: v for k, v in a.summary.items() if k not in skip} == {
         k: v for k, v in b.summary.items() if k not in skip
     }
@@ -379,7 +379,7 @@ def test_sliding_isolators_equal_the_spelled_out_device_and_spring(radius):
     dev = fd.Device.exponential(1, 0, w, 0.08, 0.04, 20.0, eps=1e-3, label="isolator 1")
     frame = [fd.Spring(2, 1, K_STOREY), fd.Spring(3, 2, K_STOREY)]
     spring = [fd.Spring(1, 0, w / radius)] if radius > 0 else []
-    rec = fd.Record(dt_record=0.01, file=str(INPUTS / "synthetic_kt.txt"), duration=6.0)
+    rec = fd.Record(dt_record=0.01, file=str(INPUTS / "synthetic_pga035.AT2"), duration=6.0)
     a = chain(3, springs=frame, isolators=[iso], excitation=rec, u0=None).run()
     b = chain(3, springs=frame + spring, devices=[dev], excitation=rec, u0=None).run()
     assert a.summary["stick_to_slip"][0] > 0
@@ -396,13 +396,10 @@ def test_sliding_isolators_equal_the_spelled_out_device_and_spring(radius):
 def test_the_summary_names_the_version_the_deck_and_the_record_with_their_hashes(tmp_path):
     s = fd.run(INPUTS / "building5_bare.nml").summary
     assert s["frictiondyn_version"] == fd.__version__
-    assert (
-        s["deck_sha256"] == hashlib.sha256((INPUTS / "building5_bare.nml").read_bytes()).hexdigest()
-    )
-    assert Path(s["record_file"]).resolve() == (INPUTS / "synthetic_kt.txt").resolve()
-    assert (
-        s["record_sha256"] == hashlib.sha256((INPUTS / "synthetic_kt.txt").read_bytes()).hexdigest()
-    )
+    deck, record = INPUTS / "building5_bare.nml", INPUTS / "synthetic_pga035.AT2"
+    assert s["deck_sha256"] == hashlib.sha256(deck.read_bytes()).hexdigest()
+    assert s["record"]["file"] == "synthetic_pga035.AT2"  # as the deck gives it
+    assert s["record"]["sha256"] == hashlib.sha256(record.read_bytes()).hexdigest()
     assert s["excitation_type"] == "record" and s["excitation_frequency_Hz"] is None
     # a deck given as text: the hash of the text; the same text written to a file: the same
     a = chain(2)
@@ -411,7 +408,7 @@ def test_the_summary_names_the_version_the_deck_and_the_record_with_their_hashes
     assert a.run().summary["deck_sha256"] == hashlib.sha256(text.encode()).hexdigest()
     exe = fd.run_executable(deck, cwd=tmp_path).summary()
     assert exe["deck_sha256"] == hashlib.sha256(deck.read_bytes()).hexdigest()
-    assert exe["record_file"] is None and exe["record_sha256"] is None
+    assert "record" not in exe
 
 
 # --- Python conveniences -----------------------------------------------------------------
@@ -419,15 +416,15 @@ def test_the_summary_names_the_version_the_deck_and_the_record_with_their_hashes
 
 def test_a_relative_record_file_is_the_callers(tmp_path, monkeypatch):
     (tmp_path / "motions").mkdir()
-    (tmp_path / "motions" / "rec.txt").write_bytes((INPUTS / "synthetic_kt.txt").read_bytes())
+    (tmp_path / "motions" / "rec.AT2").write_bytes((INPUTS / "synthetic_pga035.AT2").read_bytes())
     monkeypatch.chdir(tmp_path)
-    rel = chain(2, excitation=fd.Record(dt_record=0.01, file="motions/rec.txt", duration=2.0))
+    rel = chain(2, excitation=fd.Record(dt_record=0.01, file="motions/rec.AT2", duration=2.0))
     absolute = chain(
-        2, excitation=fd.Record(dt_record=0.01, file=str(INPUTS / "synthetic_kt.txt"), duration=2.0)
+        2, excitation=fd.Record(dt_record=0.01, file=str(INPUTS / "synthetic_pga035.AT2"), duration=2.0)
     )
     assert np.array_equal(rel.run().data, absolute.run().data)
     # the deck written for the executable keeps the path as given (relative to the deck)
-    assert "record_file = 'motions/rec.txt'" in rel.deck_text()
+    assert "record_file = 'motions/rec.AT2'" in rel.deck_text()
 
 
 def test_to_dataframe():

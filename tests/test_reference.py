@@ -89,17 +89,29 @@ def _leaves(key: str, have, want):
         yield from _leaves(f"{key}[{i}]", h, w)
 
 
+def _flatten(summary: dict) -> dict:
+    """Nested objects (the record block) as dotted keys, compared by the same rules."""
+    flat = {}
+    for key, value in summary.items():
+        if isinstance(value, dict):
+            flat.update({f"{key}.{k}": v for k, v in value.items()})
+        else:
+            flat[key] = value
+    return flat
+
+
 def compare_summary(got: dict, ref: dict) -> list[str]:
     """Mismatches of a run's summary against a reference summary (empty list: equal)."""
     bad = []
     scale = abs(ref.get("energy_input_J", 0.0))
+    got, ref = _flatten(got), _flatten(ref)
     for key, want in ref.items():
         if key not in got:
             bad.append(f"{key}: missing from the run")
             continue
         have = got[key]
-        if key in ("deck", "record_file") and want is not None:
-            if have is None or Path(have).name != Path(want).name:
+        if key in ("deck", "record.file"):
+            if Path(have).name != Path(want).name:
                 bad.append(f"{key}: {have!r} != {want!r}")
             continue
         if _shape(want) != _shape(have):

@@ -8,6 +8,8 @@
 - ``compare A B [...]``: overlay two or more results (CSV, .npz, or decks, which are run)
   and print the differences of their peaks.
 - ``paper OUTDIR``: the paper's Table 1 classification and Figs. 2, 3a, 3b, 4a, 4b.
+- ``sweep SPEC.toml`` / ``sweep collect DIR`` / ``sweep plot DIR X Y``: parameter sweeps,
+  locally or as a Slurm job array (``frictiondyn.sweep``, docs/batch.md).
 
 Errors print one line ``frictiondyn: error: ...`` on standard error and exit with status 1.
 """
@@ -309,6 +311,9 @@ def build_parser() -> argparse.ArgumentParser:
     p.add_argument("--quiet", action="store_true", help="no progress bar")
     p.set_defaults(func=cmd_paper)
 
+    from .sweep import add_parser as add_sweep_parser
+
+    add_sweep_parser(sub)
     return parser
 
 
@@ -320,7 +325,13 @@ def _one_line(exc: BaseException) -> str:
 
 def main(argv: Sequence[str] | None = None) -> int:
     """Run the command line; return the exit status (0 success, 1 error, 2 usage)."""
-    args = build_parser().parse_args(argv)
+    argv = list(sys.argv[1:] if argv is None else argv)
+    if argv[:1] == ["sweep"]:  # its own command line (frictiondyn.sweep.main)
+        from .sweep import main as sweep_main
+
+        args = argparse.Namespace(command="sweep", func=lambda a: sweep_main(argv[1:]))
+    else:
+        args = build_parser().parse_args(argv)
     if args.command == "compare" and len(args.results) < 2:
         print("frictiondyn: error: compare needs two or more results", file=sys.stderr)
         return 1

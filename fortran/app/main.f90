@@ -1,14 +1,42 @@
-!> frictiondyn DECK.nml: run one namelist deck and write its time history and summary.
+!> frictiondyn: run one namelist deck and write its time history and summary.
+!>
+!>   frictiondyn DECK.nml
+!>   frictiondyn --list DECKS.txt --index I    (deck I, 0-based, of a list: a job-array task)
+!>   frictiondyn --version | --help
+!>
+!> Exit status: 0 success (also with correctness warnings), 1 error, 2 wrong command line;
+!> killed by SIGINT/SIGTERM/SIGHUP/SIGXCPU: the temporary outputs are removed first.
 program frictiondyn_main
    use, intrinsic :: iso_fortran_env, only: error_unit, output_unit
-   use, intrinsic :: iso_c_binding, only: c_int
-   use frictiondyn, only: error_type, run_config, result_type, run_deck, output_paths
+   use, intrinsic :: iso_c_binding, only: c_char, c_int, c_null_char
+   use frictiondyn, only: error_type, run_config, result_type, read_deck, run_config_solve, &
+                          write_outputs, output_paths, temp_output_paths
+   use fd_version, only: frictiondyn_version
    implicit none
+
+   interface
+      subroutine install_signal_handlers() bind(c, name='fd_app_install_signal_handlers')
+      end subroutine install_signal_handlers
+      function register_temps(a, b) bind(c, name='fd_app_register_temps') result(stat)
+         import :: c_char, c_int
+         character(kind=c_char), intent(in) :: a(*), b(*)
+         integer(c_int) :: stat
+      end function register_temps
+      subroutine clear_temps() bind(c, name='fd_app_clear_temps')
+      end subroutine clear_temps
+      subroutine app_tag(buf, length) bind(c, name='fd_app_tag')
+         import :: c_char, c_int
+         character(kind=c_char), intent(out) :: buf(*)
+         integer(c_int), value :: length
+      end subroutine app_tag
+   end interface
+
    type(run_config) :: cfg
    type(result_type) :: res
    type(error_type), allocatable :: error
-   character(len=:), allocatable :: path, hist, summ
-   integer :: nargs, length, i
+   character(len=:), allocatable :: deck, list, index_text, arg, hist, summ, htmp, stmp, tag
+   character(kind=c_char, len=300) :: tagbuf
+   integer :: nargs, i, idx, ios
    interface
       !> C's exit: ends the program with a status and no message (Fortran 2008 has no
       !> silent STOP with a code; STOP's QUIET= is Fortran 2018).
@@ -18,35 +46,73 @@ program frictiondyn_main
       end subroutine c_exit
    end interface
 
+   call install_signal_handlers()
    nargs = command_argument_count()
-   if (nargs /= 1) then
-      write (error_unit, '(a)') 'usage: frictiondyn DECK.nml'
-      write (error_unit, '(a)') '  runs one namelist deck; see docs/namelist.md'
-      call quit(2)
+   if (nargs == 0) call usage_error('no deck given')
+   i = 1
+   do while (i <= nargs)
+      call argument(i, arg)
+      select case (arg)
+      case ('-h', '--help')
+         call help()
+         stop
+      case ('-V', '--version')
+         write (output_unit, '(a)') 'frictiondyn '//frictiondyn_version
+         stop
+      case ('--list')
+         if (i == nargs) call usage_error('--list needs a file of decks')
+         i = i + 1
+         call argument(i, list)
+      case ('--index')
+         if (i == nargs) call usage_error('--index needs a number')
+         i = i + 1
+         call argument(i, index_text)
+      case default
+         if (arg(1:min(1, len(arg))) == '-' .and. len(arg) > 1) call usage_error("unknown option '"//arg//"'")
+         if (allocated(deck)) call usage_error('one deck at a time (use --list for many)')
+         deck = arg
+      end select
+      i = i + 1
+   end do
+   if (allocated(list) .neqv. allocated(index_text)) call usage_error('--list and --index go together')
+   if (allocated(list) .and. allocated(deck)) call usage_error('give a deck or --list/--index, not both')
+   if (allocated(list)) then
+      if (verify(index_text, '0123456789') /= 0 .or. len(index_text) == 0 .or. len(index_text) > 9) &
+         call usage_error("--index '"//index_text//"' is not a whole number >= 0")
+      read (index_text, *, iostat=ios) idx
+      call deck_of_list(list, idx, deck, error)
+      if (allocated(error)) call fail(error%message)
    end if
-   call get_command_argument(1, length=length)
-   allocate (character(len=length) :: path)
-   call get_command_argument(1, path)
-   if (path == '-h' .or. path == '--help') then
-      write (output_unit, '(a)') 'usage: frictiondyn DECK.nml'
-      write (output_unit, '(a)') '  runs one namelist deck; see docs/namelist.md'
-      stop
-   end if
+   if (.not. allocated(deck)) call usage_error('no deck given')
 
-   call run_deck(path, cfg, res, error)
-   if (allocated(error)) then
-      write (error_unit, '(a)') 'frictiondyn: error: '//error%message
-      call quit(1)
-   end if
+   call read_deck(deck, cfg, error)
+   if (allocated(error)) call fail(error%message)
+   call run_config_solve(cfg, res, error)
+   if (allocated(error)) call fail(deck//": "//error%message)
+
+   ! the temporary outputs, registered for the signal handler before they exist
+   call app_tag(tagbuf, int(len(tagbuf), c_int))
+   tag = tagbuf(1:index(tagbuf, c_null_char) - 1)
+   call temp_output_paths(cfg%out, tag, htmp, stmp)
+   if (register_temps(htmp//c_null_char, stmp//c_null_char) /= 0) &
+      call fail(deck//": output path too long: '"//htmp//"'")
+   call write_outputs(cfg%out, cfg%model, res, deck, record=cfg%record, tag=tag, error=error)
+   call clear_temps()
+   if (allocated(error)) call fail(deck//": "//error%message)
 
    if (res%violations > 0) then
       write (error_unit, '(a,i0,a)') 'frictiondyn: warning: ', res%violations, &
          ' step(s) violate the correctness condition (eqs. 9, 12); first at t [s] ='
       write (error_unit, '(10(1x,f0.6))') res%violation_time(1:res%n_violation_times)
    end if
-   write (output_unit, '(a)') 'frictiondyn: '//path
+   write (output_unit, '(a)') 'frictiondyn: '//deck
    write (output_unit, '(a,f0.6,a,i0,a,i0,a,i0,a)') '  stuck period ', res%period_stuck, ' s; steps dt1 ', &
       res%steps_dt1, ', dt2 ', res%steps_dt2, ', finer ', res%steps_finer, ''
+   if (allocated(cfg%record%path)) then
+      write (output_unit, '(a,i0,a,es12.5,a)') '  record '//cfg%record%path//' ('//trim(cfg%record%format)// &
+         trim(merge(', detected', '          ', cfg%record%detected))//', '//trim(cfg%record%units)//'): ', &
+         cfg%record%npts, ' samples, dt ', cfg%record%dt, ' s'
+   end if
    do i = 1, res%n_devices
       write (output_unit, '(a,i0,a,i0,a,i0)') '  device ', i, ': stick->slip ', res%stick_to_slip(i), &
          ', slip->stick ', res%slip_to_stick(i)
@@ -59,7 +125,82 @@ program frictiondyn_main
    call output_paths(cfg%out, hist, summ)
    if (cfg%out%history) write (output_unit, '(a)') '  history: '//hist
    write (output_unit, '(a)') '  summary: '//summ
+
 contains
+
+   subroutine argument(k, val)
+      integer, intent(in) :: k
+      character(len=:), allocatable, intent(out) :: val
+      integer :: length
+      call get_command_argument(k, length=length)
+      allocate (character(len=length) :: val)
+      if (length > 0) call get_command_argument(k, val)
+   end subroutine argument
+
+   !> Line idx+1 of the list file: a deck path, relative to the list's directory unless
+   !> it starts with '/'.
+   subroutine deck_of_list(path, idx, deck_path, error)
+      character(len=*), intent(in) :: path
+      integer, intent(in) :: idx
+      character(len=:), allocatable, intent(out) :: deck_path
+      type(error_type), allocatable, intent(out) :: error
+      character(len=4096) :: line
+      integer :: unit, ios, k, slash
+      character(len=256) :: msg
+
+      open (newunit=unit, file=path, status='old', action='read', iostat=ios, iomsg=msg)
+      if (ios /= 0) then
+         allocate (error)
+         error%message = "--list '"//path//"': "//trim(msg)
+         return
+      end if
+      do k = 0, idx
+         read (unit, '(a)', iostat=ios) line
+         if (ios /= 0) exit
+      end do
+      close (unit)
+      if (ios /= 0) then
+         allocate (error)
+         error%message = "--list '"//path//"' has only "//trim(itoa(k))//" line(s); --index "// &
+                         trim(itoa(idx))//" asks for line "//trim(itoa(idx + 1))
+         return
+      end if
+      if (len_trim(line) == 0) then
+         allocate (error)
+         error%message = "--list '"//path//"', line "//trim(itoa(idx + 1))//" (--index "//trim(itoa(idx))// &
+                         ") is empty: expected the path of a deck"
+         return
+      end if
+      deck_path = trim(adjustl(line))
+      if (deck_path(1:1) /= '/') then
+         slash = index(path, '/', back=.true.)
+         deck_path = path(1:slash)//deck_path
+      end if
+   end subroutine deck_of_list
+
+   pure function itoa(k) result(s)
+      integer, intent(in) :: k
+      character(len=16) :: s
+      write (s, '(i0)') k
+   end function itoa
+
+   subroutine help()
+      write (output_unit, '(a)') 'usage: frictiondyn DECK.nml', &
+         '       frictiondyn --list DECKS.txt --index I', &
+         '       frictiondyn --version | --help', '', &
+         'Runs one namelist deck (docs/namelist.md) and writes <dir>/<name>.csv (time history)', &
+         'and <dir>/<name>.summary.json (peaks, steps, transitions, energy) as one consistent pair.', &
+         '', &
+         '  DECK.nml             the deck to run', &
+         '  --list DECKS.txt     a file with one deck path a line (relative to its directory)', &
+         '  --index I            run the deck on line I+1 of the list (0-based, as', &
+         '                       $SLURM_ARRAY_TASK_ID in a job array)', &
+         '  -V, --version        print the version', &
+         '  -h, --help           print this help', '', &
+         'Exit status: 0 success (also with correctness warnings), 1 error (the message on', &
+         'standard error names the file, group, variable and value), 2 wrong command line.', &
+         'Batch runs: python -m frictiondyn sweep (docs/batch.md).'
+   end subroutine help
 
    !> End the program with a non-zero exit status, silently, after flushing the output.
    subroutine quit(status)
@@ -68,5 +209,18 @@ contains
       flush (error_unit)
       call c_exit(int(status, c_int))
    end subroutine quit
+
+   subroutine usage_error(msg)
+      character(len=*), intent(in) :: msg
+      write (error_unit, '(a)') 'frictiondyn: '//msg
+      write (error_unit, '(a)') 'usage: frictiondyn DECK.nml | --list DECKS.txt --index I | --version | --help'
+      call quit(2)
+   end subroutine usage_error
+
+   subroutine fail(msg)
+      character(len=*), intent(in) :: msg
+      write (error_unit, '(a)') 'frictiondyn: error: '//msg
+      call quit(1)
+   end subroutine fail
 
 end program frictiondyn_main

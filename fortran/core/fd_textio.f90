@@ -6,7 +6,7 @@ module fd_textio
    implicit none
    private
 
-   public :: line_type, read_text_file, split_lines, lower, split_tokens
+   public :: line_type, read_text_file, read_file_text, split_lines, lower, split_tokens
 
    interface
       function c_fopen(path, mode) bind(c, name='fopen') result(fp)
@@ -42,7 +42,20 @@ contains
       character(len=*), intent(in) :: path                   !! file to read
       type(line_type), allocatable, intent(out) :: lines(:)  !! its lines
       type(error_type), allocatable, intent(out) :: error    !! set when it cannot be read
-      character(len=:), allocatable :: text, grown
+      character(len=:), allocatable :: text
+
+      call read_file_text(path, text, error)
+      if (allocated(error)) return
+      call split_lines(text, lines)
+   end subroutine read_text_file
+
+   !> Read a whole file into one string (a buffer that doubles: linear time; growing the
+   !> string chunk by chunk took quadratic time).
+   subroutine read_file_text(path, text, error)
+      character(len=*), intent(in) :: path                   !! file to read
+      character(len=:), allocatable, intent(out) :: text     !! its bytes
+      type(error_type), allocatable, intent(out) :: error    !! set when it cannot be read
+      character(len=:), allocatable :: buf, grown
       type(c_ptr) :: fp
       integer(c_size_t) :: got, want
       integer :: stat, n, cap
@@ -58,26 +71,26 @@ contains
          call fatal_error(error, "cannot open file '"//path//"'")
          return
       end if
-      ! read into a buffer that doubles when full: the text is copied O(log size) times,
-      ! not once per chunk
+      ! read into a buffer that doubles when full (works for pipes too): the text is
+      ! copied O(log size) times, not once per chunk
       cap = 65536
-      allocate (character(len=cap) :: text)
+      allocate (character(len=cap) :: buf)
       n = 0
       do
          if (n == cap) then
             allocate (character(len=2*cap) :: grown)
-            grown(1:n) = text(1:n)
-            call move_alloc(grown, text)
+            grown(1:n) = buf(1:n)
+            call move_alloc(grown, buf)
             cap = 2*cap
          end if
          want = int(cap - n, c_size_t)
-         got = c_fread(text(n + 1:cap), 1_c_size_t, want, fp)
+         got = c_fread(buf(n + 1:cap), 1_c_size_t, want, fp)
          n = n + int(got)
          if (got < want) exit
       end do
+      text = buf(1:n)
       stat = c_fclose(fp)
-      call split_lines(text(1:n), lines)
-   end subroutine read_text_file
+   end subroutine read_file_text
 
    !> Split text at newlines (a final newline ends the last line; carriage returns dropped).
    pure subroutine split_lines(text, lines)

@@ -7,7 +7,8 @@ module fd_deck
    use, intrinsic :: ieee_arithmetic, only: ieee_is_finite
    use fd_kinds, only: dp
    use fd_error, only: error_type, fatal_error, fmt_int, fmt_real
-   use fd_namelist, only: deck_text, group_text, load_deck, deck_from_string, find_group, group_item, &
+   use fd_textio, only: lower
+   use fd_namelist, only: deck_text, group_text, deck_from_string, find_group, group_item, &
                           group_read_error, check_groups
    use fd_names, only: keyword_id, keyword_choices, law_id, law_choices, &
                        damping_types, damping_stiffness, damping_rayleigh, damping_none, &
@@ -21,7 +22,7 @@ module fd_deck
                        default_write_history
    use fd_model, only: model_type, integration_type, device_type, output_type
    use fd_excitation, only: excitation_type
-   use fd_record, only: read_record
+   use fd_record, only: read_record, record_info, record_formats, record_units_list, units_factor
    use fd_technique, only: check_technique
    use fd_names, only: label_len, max_mu_points, mu_laws, mu_constant, mu_exponential, mu_table, mode_systems, &
                        system_stuck, law_velocity, law_hysteretic, technique_event_driven, technique_newmark, &
@@ -29,7 +30,8 @@ module fd_deck
                        default_storey_height, law_name
    use fd_model, only: source_friction, source_brace, source_isolator
    use fd_matrices, only: modes_type, natural_modes, stiffness_matrix
-   use fd_sha256, only: sha256_file, sha256_text
+   use fd_sha256, only: sha256_text
+   use fd_textio, only: read_file_text
    implicit none
    private
 
@@ -49,22 +51,29 @@ module fd_deck
       type(excitation_type) :: exc                !! table motion
       type(integration_type) :: opts              !! integration settings
       type(output_type) :: out                    !! output settings
+      type(record_info) :: record                 !! the record read (excitation_type = 'record')
    end type run_config
 
 contains
 
-   !> Read and validate a deck file.
+   !> Read and validate a deck file. Its bytes are read once: split into lines as load_deck
+   !> does, and hashed for the summary (deck_sha256, what `sha256sum` prints).
    subroutine read_deck(path, cfg, error)
       character(len=*), intent(in) :: path                !! deck file
       type(run_config), intent(out) :: cfg                !! what it defines
       type(error_type), allocatable, intent(out) :: error !! first problem found
       type(deck_text) :: deck
+      character(len=:), allocatable :: text
 
-      call load_deck(path, deck, error)
-      if (allocated(error)) return
+      call read_file_text(path, text, error)
+      if (allocated(error)) then
+         error%message = "deck: "//error%message
+         return
+      end if
+      call deck_from_string(text, path, deck)
       call read_groups(deck, cfg, error)
       if (allocated(error)) return
-      call sha256_file(path, cfg%model%deck_sha256, error)
+      call sha256_text(text, cfg%model%deck_sha256)
    end subroutine read_deck
 
    !> Read and validate a deck given as text. The path names the deck in messages, gives
@@ -403,13 +412,14 @@ contains
       type(deck_text), intent(in) :: deck
       type(run_config), intent(inout) :: cfg
       type(error_type), allocatable, intent(out) :: error
-      character(len=name_len) :: excitation_type, record_kind
+      character(len=name_len) :: excitation_type, record_kind, record_format, record_units
       integer :: kind_id
       character(len=1024) :: record_file
-      real(dp) :: amplitude, frequency, duration, dt_record, record_scale
+      real(dp) :: amplitude, frequency, duration, dt_record, record_scale, factor
       integer :: ramp_cycles
+      logical :: known
       namelist /excitation/ excitation_type, amplitude, frequency, ramp_cycles, duration, dt_record, &
-         record_file, record_kind, record_scale
+         record_file, record_kind, record_scale, record_format, record_units
       type(group_text) :: grp
       character(len=512) :: msg, msg0
       character(len=:), allocatable :: rec, path, choices
@@ -420,6 +430,7 @@ contains
       amplitude = unset; frequency = unset; duration = unset; dt_record = unset
       record_scale = default_record_scale
       ramp_cycles = default_ramp_cycles
+      record_format = 'auto'; record_units = ''
       call find_group(deck, 'excitation', grp, found, error)
       if (allocated(error)) return
       if (.not. found) then
@@ -436,8 +447,11 @@ contains
          if (ios == 0) msg = msg0
          call group_read_error(deck, grp, i, msg, error); return
       end if
-      call need_real(deck, 'excitation', 'dt_record', dt_record, 's', error)
-      if (allocated(error)) return
+      ! a record whose file gives DT (AT2) may leave dt_record out
+      if (.not. (keyword_id(excitation_types, excitation_type) == excitation_record .and. dt_record == unset)) then
+         call need_real(deck, 'excitation', 'dt_record', dt_record, 's', error)
+         if (allocated(error)) return
+      end if
       cfg%exc%dt_record = dt_record
       cfg%exc%kind = keyword_id(excitation_types, excitation_type)
       select case (cfg%exc%kind)
@@ -468,16 +482,32 @@ contains
             call bad(deck, 'excitation', 'record_kind', "'"//trim(record_kind)//"'", 'one of '//choices, error)
             return
          end if
+         select case (lower(trim(record_format)))
+         case ('auto', 'at2', 'values', 'time_value')
+         case default
+            call bad(deck, 'excitation', 'record_format', "'"//trim(record_format)//"'", 'one of '//record_formats, error)
+            return
+         end select
+         if (len_trim(record_units) > 0) then
+            call units_factor(lower(trim(record_units)), kind_id == record_displacement, factor, known)
+            if (.not. known) then
+               call bad(deck, 'excitation', 'record_units', "'"//trim(record_units)//"'", 'one of '// &
+                        record_units_list//", matching record_kind = '"//trim(record_kind)//"'", error)
+               return
+            end if
+         end if
          call relative_to(deck%path, trim(record_file), path)
-         call read_record(path, kind_id == record_displacement, record_scale, dt_record, cfg%exc%acc, error)
+         call read_record(path, trim(record_format), kind_id == record_displacement, &
+                          trim(record_units), record_scale, merge(dt_record, 0.0_dp, dt_record /= unset), &
+                          cfg%exc%acc, cfg%record, error)
          if (allocated(error)) then
             error%message = deck%path//", group &excitation, record_file = '"//trim(record_file)//"': "// &
                             error%message
             return
          end if
-         cfg%model%record_file = path
-         call sha256_file(path, cfg%model%record_sha256, error)
-         if (allocated(error)) return
+         cfg%record%path = trim(record_file)   ! as the deck gives it (like the summary's "deck")
+         dt_record = cfg%record%dt
+         cfg%exc%dt_record = dt_record
          if (duration == unset) duration = (size(cfg%exc%acc) - 1)*dt_record
          call need_real(deck, 'excitation', 'duration', duration, 's', error)
          if (allocated(error)) return

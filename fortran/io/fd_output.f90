@@ -1,33 +1,83 @@
 !> Output files of a run: the time-history CSV (a header naming every column with its
 !> unit, 17 significant digits) and the summary (JSON). Each is written to a temporary
-!> name and renamed when complete; on any error no output file is left behind.
+!> name unique to the writer and the pair is committed under a lock (write_outputs); on
+!> any error no output file is left behind and earlier outputs of the name stay.
 module fd_output
-   use, intrinsic :: iso_c_binding, only: c_char, c_int, c_null_char
+   use, intrinsic :: iso_c_binding, only: c_char, c_int, c_long, c_null_char
    use fd_kinds, only: dp
    use fd_error, only: error_type, fatal_error, fmt_int, fmt_real
    use fd_model, only: model_type, output_type, law_name, technique_name
    use fd_result, only: result_type
+   use fd_record, only: record_info
    use fd_version, only: frictiondyn_version
-   use fd_names, only: excitation_types, mode_systems
-   use fd_matrices, only: modes_type, modes_none, modes_flexible, modes_rigid, modes_unrestrained
+   use fd_names, only: excitation_types
+   use fd_matrices, only: modes_type, modes_flexible, modes_rigid, modes_unrestrained
    implicit none
    private
 
-   public :: output_type, write_outputs, write_output_files, output_paths, summary_json, history_header
+   public :: output_type, write_outputs, write_output_files, output_paths, temp_output_paths, summary_json, &
+             history_header
 
    interface
-      function c_rename(old, new) bind(c, name='rename') result(stat)
-         import :: c_char, c_int
-         character(kind=c_char), intent(in) :: old(*), new(*)
-         integer(c_int) :: stat
-      end function c_rename
       function c_mkdir(path, mode) bind(c, name='mkdir') result(stat)
          import :: c_char, c_int
          character(kind=c_char), intent(in) :: path(*)
          integer(c_int), value :: mode
          integer(c_int) :: stat
       end function c_mkdir
+      function c_lock_acquire(path, fd) bind(c, name='fd_lock_acquire') result(err)
+         import :: c_char, c_int
+         character(kind=c_char), intent(in) :: path(*)
+         integer(c_int), intent(out) :: fd
+         integer(c_int) :: err
+      end function c_lock_acquire
+      function c_lock_release(path, fd) bind(c, name='fd_lock_release') result(err)
+         import :: c_char, c_int
+         character(kind=c_char), intent(in) :: path(*)
+         integer(c_int), value :: fd
+         integer(c_int) :: err
+      end function c_lock_release
+      function c_unlink(path) bind(c, name='fd_unlink') result(err)
+         import :: c_char, c_int
+         character(kind=c_char), intent(in) :: path(*)
+         integer(c_int) :: err
+      end function c_unlink
+      function c_rename(old, new) bind(c, name='fd_rename') result(err)
+         import :: c_char, c_int
+         character(kind=c_char), intent(in) :: old(*), new(*)
+         integer(c_int) :: err
+      end function c_rename
+      subroutine c_errno_text(err, buf, length) bind(c, name='fd_errno_text')
+         import :: c_char, c_int
+         integer(c_int), value :: err
+         character(kind=c_char), intent(out) :: buf(*)
+         integer(c_int), value :: length
+      end subroutine c_errno_text
+      function c_file_create(path, fd) bind(c, name='fd_file_create') result(err)
+         import :: c_char, c_int
+         character(kind=c_char), intent(in) :: path(*)
+         integer(c_int), intent(out) :: fd
+         integer(c_int) :: err
+      end function c_file_create
+      function c_file_write(fd, buf, length) bind(c, name='fd_file_write') result(err)
+         import :: c_char, c_int, c_long
+         integer(c_int), value :: fd
+         character(kind=c_char), intent(in) :: buf(*)
+         integer(c_long), value :: length
+         integer(c_int) :: err
+      end function c_file_write
+      function c_file_close(fd) bind(c, name='fd_file_close') result(err)
+         import :: c_int
+         integer(c_int), value :: fd
+         integer(c_int) :: err
+      end function c_file_close
+      function c_getpid() bind(c, name='fd_getpid') result(pid)
+         import :: c_int
+         integer(c_int) :: pid
+      end function c_getpid
    end interface
+
+   integer(c_int), parameter :: enoent = 2, eexist = 17
 
 contains
 
@@ -40,65 +90,162 @@ contains
       summ = out%dir//'/'//out%name//'.summary.json'
    end subroutine output_paths
 
-   !> Write the history and the summary into out%dir (created when missing); nothing is left
-   !> behind on failure.
-   subroutine write_outputs(out, model, res, deck_path, error)
+   !> Temporary names of the two outputs for a tag unique to the writing process:
+   !> `<dir>/.<name>.csv.<tag>.tmp` and `<dir>/.<name>.summary.json.<tag>.tmp`.
+   pure subroutine temp_output_paths(out, tag, hist_tmp, summ_tmp)
+      type(output_type), intent(in) :: out                    !! output settings
+      character(len=*), intent(in) :: tag                     !! unique per writer
+      character(len=:), allocatable, intent(out) :: hist_tmp  !! temporary CSV
+      character(len=:), allocatable, intent(out) :: summ_tmp  !! temporary summary
+      character(len=:), allocatable :: hist, summ
+      call output_paths(out, hist, summ)
+      call hidden_name(hist, '.'//tag//'.tmp', hist_tmp)
+      call hidden_name(summ, '.'//tag//'.tmp', summ_tmp)
+   end subroutine temp_output_paths
+
+   !> `dir/.file<suffix>` for a path `dir/file` (hidden, in the same directory, so that a
+   !> rename onto the path never crosses file systems).
+   pure subroutine hidden_name(path, suffix, hidden)
+      character(len=*), intent(in) :: path                  !! a file path
+      character(len=*), intent(in) :: suffix                !! appended to the name
+      character(len=:), allocatable, intent(out) :: hidden  !! the hidden name
+      integer :: slash
+      slash = index(path, '/', back=.true.)
+      hidden = path(1:slash)//'.'//path(slash + 1:)//suffix
+   end subroutine hidden_name
+
+   !> A tag for temporary names: the process id and a random number (the names are also
+   !> created exclusively, so two writers never share one).
+   subroutine default_tag(tag)
+      character(len=:), allocatable, intent(out) :: tag  !! e.g. '12345-3f9a0c1d'
+      character(len=32) :: buf
+      real(dp) :: r
+      call random_number(r)
+      write (buf, '(i0,"-",z8.8)') c_getpid(), int(r*2147483647.0_dp)
+      tag = trim(buf)
+   end subroutine default_tag
+
+   !> Write the history (when out%history) and the summary of a run into out%dir (created
+   !> when missing) as one consistent pair: see write_output_files.
+   subroutine write_outputs(out, model, res, deck_path, record, tag, error)
       type(output_type), intent(in) :: out                !! output settings
       type(model_type), intent(in) :: model               !! the model run
       type(result_type), intent(in) :: res                !! its result
       character(len=*), intent(in) :: deck_path           !! deck, named in the summary
-      type(error_type), allocatable, intent(out) :: error !! cannot create or write a file
+      type(record_info), intent(in), optional :: record   !! the record read, named in the summary
+      character(len=*), intent(in), optional :: tag       !! unique suffix of the temporary names
+      type(error_type), allocatable, intent(out) :: error !! cannot create, write or rename a file
       character(len=:), allocatable :: hist, summ, header, js
 
       call make_dir(out%dir, error)
       if (allocated(error)) return
       call output_paths(out, hist, summ)
       call history_header(res, header)
-      call summary_json(model, res, deck_path, js)
-      call write_output_files(hist, summ, out%history, header, res%hist, js, error)
+      call summary_json(model, res, deck_path, js, record)
+      call write_output_files(hist, summ, out%history, header, res%hist, js, error, tag)
    end subroutine write_outputs
 
-   !> Write a history (when `history`: its header line, then one row per sample) to
-   !> `hist_path` and a summary text to `summ_path`, each to a temporary name renamed when
-   !> complete; nothing is left behind on failure. The one writer of output files: the
-   !> executable's outputs and those of the Python package go through it.
-   subroutine write_output_files(hist_path, summ_path, history, header, data, summary, error)
+   !> The one writer of output files (the executable's and the Python package's): a history
+   !> (when `history`: its header line, then one row per sample) at `hist_path` and a
+   !> summary text at `summ_path`, as one consistent pair. Each goes to a hidden temporary
+   !> name in its directory, unique to the writer (`tag`, default: process id and a random
+   !> number); when both are complete they are committed under an exclusive lock on
+   !> `<dir>/.<name>.lock` (name: the summary's without `.summary.json`): remove the old
+   !> summary, rename the CSV, rename the summary. Two writers of one name thus commit one
+   !> after the other, and a writer killed in the middle leaves a CSV without summary (an
+   !> incomplete run), never one run's CSV beside another's summary. A failed write (full
+   !> disk, quota) removes the temporary files and leaves the earlier outputs untouched; the
+   !> error names the file.
+   subroutine write_output_files(hist_path, summ_path, history, header, data, summary, error, tag)
       character(len=*), intent(in) :: hist_path           !! the history CSV
       character(len=*), intent(in) :: summ_path           !! the summary file
       logical, intent(in) :: history                      !! write the history
       character(len=*), intent(in) :: header              !! 'name[unit],...' of each column
       real(dp), intent(in) :: data(:, :)                  !! history (columns, samples)
       character(len=*), intent(in) :: summary             !! summary text (JSON)
-      type(error_type), allocatable, intent(out) :: error !! cannot create or write a file
-      character(len=:), allocatable :: hist, summ
-      integer :: stat
+      type(error_type), allocatable, intent(out) :: error !! cannot create, write or rename a file
+      character(len=*), intent(in), optional :: tag       !! unique suffix of the temporary names
+      character(len=:), allocatable :: htmp, stmp, mytag, lock, stem
+      integer(c_int) :: err, fd
+      integer :: attempt, ls
 
-      hist = hist_path
-      summ = summ_path
+      do attempt = 1, 10
+         if (present(tag)) then
+            mytag = tag
+         else
+            call default_tag(mytag)
+         end if
+         call hidden_name(hist_path, '.'//mytag//'.tmp', htmp)
+         call hidden_name(summ_path, '.'//mytag//'.tmp', stmp)
+         call write_summary(stmp, summary, error)
+         if (.not. allocated(error)) exit
+         if (present(tag) .or. error%stat /= eexist) return  ! the name exists (random clash)
+      end do
+      if (allocated(error)) return
       if (history) then
-         call write_history(hist//'.tmp', header, data, error)
-         if (allocated(error)) return
-      end if
-      call write_summary(summ//'.tmp', summary, error)
-      if (allocated(error)) then
-         if (history) call remove(hist//'.tmp')
-         return
-      end if
-      if (history) then
-         stat = c_rename(hist//'.tmp'//c_null_char, hist//c_null_char)
-         if (stat /= 0) then
-            call remove(hist//'.tmp'); call remove(summ//'.tmp')
-            call fatal_error(error, "cannot rename '"//hist//".tmp' to '"//hist//"'")
+         call write_history(htmp, header, data, error)
+         if (allocated(error)) then
+            err = c_unlink(stmp//c_null_char)
             return
          end if
       end if
-      stat = c_rename(summ//'.tmp'//c_null_char, summ//c_null_char)
-      if (stat /= 0) then
-         if (history) call remove(hist)
-         call remove(summ//'.tmp')
-         call fatal_error(error, "cannot rename '"//summ//".tmp' to '"//summ//"'")
+
+      stem = summ_path
+      ls = len(stem) - len('.summary.json')
+      if (ls > 0) then
+         if (stem(ls + 1:) == '.summary.json') stem = stem(1:ls)
       end if
+      call hidden_name(stem, '.lock', lock)
+      err = c_lock_acquire(lock//c_null_char, fd)
+      if (err /= 0) then
+         call discard()
+         call os_error(error, "cannot lock '"//lock//"'", err)
+         return
+      end if
+      ! the commit: the summary marks a complete pair, so it goes first and comes back last
+      err = c_unlink(summ_path//c_null_char)
+      if (err /= 0 .and. err /= enoent) then
+         call discard()
+         call os_error(error, "cannot replace '"//summ_path//"'", err)
+      else if (history) then
+         err = c_rename(htmp//c_null_char, hist_path//c_null_char)
+         if (err /= 0) then
+            call discard()
+            call os_error(error, "cannot rename '"//htmp//"' to '"//hist_path//"'", err)
+         end if
+      else
+         ! no history this time: an older CSV of the name would not match the new summary
+         err = c_unlink(hist_path//c_null_char)
+         if (err /= 0 .and. err /= enoent) then
+            call discard()
+            call os_error(error, "cannot remove the earlier '"//hist_path//"'", err)
+         end if
+      end if
+      if (.not. allocated(error)) then
+         err = c_rename(stmp//c_null_char, summ_path//c_null_char)
+         if (err /= 0) then
+            call discard()
+            call os_error(error, "cannot rename '"//stmp//"' to '"//summ_path//"'", err)
+         end if
+      end if
+      err = c_lock_release(lock//c_null_char, fd)
+   contains
+      subroutine discard()
+         integer(c_int) :: e
+         e = c_unlink(stmp//c_null_char)
+         if (history) e = c_unlink(htmp//c_null_char)
+      end subroutine discard
    end subroutine write_output_files
+
+   !> An error naming what failed and the system's reason (errno text).
+   subroutine os_error(error, what, err)
+      type(error_type), allocatable, intent(out) :: error
+      character(len=*), intent(in) :: what
+      integer(c_int), intent(in) :: err
+      character(kind=c_char, len=256) :: buf
+      call c_errno_text(err, buf, int(len(buf), c_int))
+      call fatal_error(error, what//": "//buf(1:max(0, index(buf, c_null_char) - 1)))
+   end subroutine os_error
 
    !> Create a directory and its missing parents.
    subroutine make_dir(dir, error)
@@ -119,68 +266,102 @@ contains
       if (.not. exists) call fatal_error(error, "&output: cannot create the output directory dir = '"//dir//"'")
    end subroutine make_dir
 
-   subroutine remove(path)
+   !> Create a new file (exclusively: error stat 17 when the name exists) for writing.
+   subroutine create_new(path, fd, error)
       character(len=*), intent(in) :: path
-      integer :: unit, ios
-      open (newunit=unit, file=path, status='old', iostat=ios)
-      if (ios == 0) close (unit, status='delete')
-   end subroutine remove
+      integer(c_int), intent(out) :: fd
+      type(error_type), allocatable, intent(out) :: error
+      integer(c_int) :: err
+      err = c_file_create(path//c_null_char, fd)
+      if (err /= 0) then
+         call os_error(error, "cannot create '"//path//"'", err)
+         if (err == eexist) error%stat = 17
+      end if
+   end subroutine create_new
 
+   !> Write bytes; on failure the file is closed and removed, and the error names it.
+   subroutine put_bytes(fd, path, text, error)
+      integer(c_int), intent(in) :: fd
+      character(len=*), intent(in) :: path, text
+      type(error_type), allocatable, intent(out) :: error
+      integer(c_int) :: err, e
+      if (len(text) == 0) return
+      err = c_file_write(fd, text, int(len(text), c_long))
+      if (err /= 0) then
+         e = c_file_close(fd)
+         e = c_unlink(path//c_null_char)
+         call os_error(error, "cannot write '"//path//"'", err)
+      end if
+   end subroutine put_bytes
+
+   !> Flush to disk and close; on failure (a full disk or quota may show only here) the
+   !> file is removed and the error names it.
+   subroutine finish(fd, path, error)
+      integer(c_int), intent(in) :: fd
+      character(len=*), intent(in) :: path
+      type(error_type), allocatable, intent(out) :: error
+      integer(c_int) :: err, e
+      err = c_file_close(fd)
+      if (err /= 0) then
+         e = c_unlink(path//c_null_char)
+         call os_error(error, "cannot write '"//path//"'", err)
+      end if
+   end subroutine finish
+
+   !> The history CSV: rows formatted into a buffer of about 1 MB, written with POSIX
+   !> write (every error is seen: gfortran's own writes lose a full disk).
    subroutine write_history(path, header, data, error)
       character(len=*), intent(in) :: path
       character(len=*), intent(in) :: header
       real(dp), intent(in) :: data(:, :)
       type(error_type), allocatable, intent(out) :: error
-      integer :: unit, ios, i
-      character(len=512) :: msg
-      character(len=:), allocatable :: fmt
+      integer(c_int) :: fd
+      integer :: i, pos, width, rows_per_chunk
+      character(len=:), allocatable :: fmt, buf
+      character(len=1), parameter :: nl = achar(10)
 
-      open (newunit=unit, file=path, status='replace', action='write', iostat=ios, iomsg=msg)
-      if (ios /= 0) then
-         call fatal_error(error, "cannot create '"//path//"': "//trim(msg))
-         return
-      end if
-      write (unit, '(a)', iostat=ios) header
+      call create_new(path, fd, error)
+      if (allocated(error)) return
+      call put_bytes(fd, path, header//nl, error)
+      if (allocated(error)) return
       fmt = '('//trim(fmt_int(size(data, 1)))//'(es24.16e3,:,","))'
+      width = 25*size(data, 1)               ! 24 characters a value, a comma or the newline
+      rows_per_chunk = max(1, 1048576/width)
+      allocate (character(len=width*rows_per_chunk) :: buf)
+      pos = 0
       do i = 1, size(data, 2)
-         write (unit, fmt, iostat=ios, iomsg=msg) data(:, i)
-         if (ios /= 0) exit
+         write (buf(pos + 1:pos + width - 1), fmt) data(:, i)
+         buf(pos + width:pos + width) = nl
+         pos = pos + width
+         if (pos == len(buf) .or. i == size(data, 2)) then
+            call put_bytes(fd, path, buf(1:pos), error)
+            if (allocated(error)) return
+            pos = 0
+         end if
       end do
-      if (ios /= 0) then
-         close (unit, status='delete')
-         call fatal_error(error, "cannot write '"//path//"': "//trim(msg))
-         return
-      end if
-      close (unit)
+      call finish(fd, path, error)
    end subroutine write_history
 
    subroutine write_summary(path, js, error)
       character(len=*), intent(in) :: path
       character(len=*), intent(in) :: js
       type(error_type), allocatable, intent(out) :: error
-      integer :: unit, ios
-      character(len=512) :: msg
+      integer(c_int) :: fd
 
-      open (newunit=unit, file=path, status='replace', action='write', iostat=ios, iomsg=msg)
-      if (ios /= 0) then
-         call fatal_error(error, "cannot create '"//path//"': "//trim(msg))
-         return
-      end if
-      write (unit, '(a)', iostat=ios, iomsg=msg) js
-      if (ios /= 0) then
-         close (unit, status='delete')
-         call fatal_error(error, "cannot write '"//path//"': "//trim(msg))
-         return
-      end if
-      close (unit)
+      call create_new(path, fd, error)
+      if (allocated(error)) return
+      call put_bytes(fd, path, js//achar(10), error)
+      if (allocated(error)) return
+      call finish(fd, path, error)
    end subroutine write_summary
 
    !> The summary of a run as a JSON object (keys documented in docs/namelist.md).
-   subroutine summary_json(model, res, deck_path, js)
+   subroutine summary_json(model, res, deck_path, js, record)
       type(model_type), intent(in) :: model                !! the model run
       type(result_type), intent(in) :: res                 !! its result
       character(len=*), intent(in) :: deck_path            !! deck named in the summary
       character(len=:), allocatable, intent(out) :: js     !! the JSON text
+      type(record_info), intent(in), optional :: record    !! the record read, if any
       character(len=1), parameter :: nl = achar(10)
       character(len=:), allocatable :: laws, esc
       integer :: d
@@ -194,6 +375,22 @@ contains
       js = '{'//nl
       js = js//'  "deck": "'//esc//'",'//nl
       js = js//'  "frictiondyn_version": "'//frictiondyn_version//'",'//nl
+      if (present(record)) then
+         if (allocated(record%path)) then
+            js = js//'  "record": {'
+            call json_escape(record%path, esc)
+            js = js//'"file": "'//esc//'", "format": "'//trim(record%format)//'", "format_detected": '// &
+                 trim(merge('true ', 'false', record%detected))//', "units": "'//trim(record%units)// &
+                 '", "samples": '//trim(fmt_int(record%npts))//', "dt_s": '//trim(json_real(record%dt))// &
+                 ', "scale": '//trim(json_real(record%scale))//', "peak_acc_mps2": '// &
+                 trim(json_real(record%peak_acc))//', "sha256": "'//trim(record%sha256)//'"'
+            if (allocated(record%title)) then
+               call json_escape(record%title, esc)
+               js = js//', "title": "'//esc//'"'
+            end if
+            js = js//'},'//nl
+         end if
+      end if
       call kv('n_dof', trim(fmt_int(res%n_dof)))
       call kv('n_devices', trim(fmt_int(res%n_devices)))
       call kv('technique', '"'//trim(technique_name(res%technique))//'"')
@@ -237,14 +434,6 @@ contains
          integer :: i
          real(dp), allocatable :: ratio(:)
          call kv('deck_sha256', '"'//trim(model%deck_sha256)//'"')
-         if (allocated(model%record_file)) then
-            call json_escape(model%record_file, esc)
-            call kv('record_file', '"'//esc//'"')
-            call kv('record_sha256', '"'//trim(model%record_sha256)//'"')
-         else
-            call kv('record_file', 'null')
-            call kv('record_sha256', 'null')
-         end if
          associate (eng => res%eng)
             if (eng%excitation >= 1 .and. eng%excitation <= size(excitation_types)) then
                call kv('excitation_type', '"'//trim(excitation_types(eng%excitation)%name)//'"')
@@ -417,8 +606,13 @@ contains
       integer :: i
       r = ''
       do i = 1, len(s)
-         if (s(i:i) == '"' .or. s(i:i) == '\') r = r//'\'
-         r = r//s(i:i)
+         if (s(i:i) == '"' .or. s(i:i) == '\') then
+            r = r//'\'//s(i:i)
+         else if (iachar(s(i:i)) < 32) then
+            r = r//' '
+         else
+            r = r//s(i:i)
+         end if
       end do
    end subroutine json_escape
 

@@ -1,89 +1,763 @@
-!> Reader of recorded table motion: one value a line, or time-value columns, sampled at
-!> dt_record. Displacement records are turned into accelerations by second differences.
+!> Reader of recorded table motion. Three formats: PEER NGA `.AT2` (four header lines, NPTS
+!> and DT on the fourth, several values a line), one value a line, or time-value columns.
+!> Parsing is strict: every value is a plain decimal number (no Fortran list-directed
+!> tokens such as '/', 'r*' or '*'), a line with no value is an error, the count of values
+!> must match NPTS; every message names the file, the line and what was expected. Values
+!> are converted with C strtod (correctly rounded), one pass over the file read at once.
+!> Displacement records are turned into accelerations by second differences.
 module fd_record
-   use, intrinsic :: ieee_arithmetic, only: ieee_is_finite
+   use, intrinsic :: ieee_arithmetic, only: ieee_is_finite, ieee_is_nan
+   use, intrinsic :: iso_c_binding, only: c_char, c_double, c_ptr, c_null_ptr, c_null_char
    use fd_kinds, only: dp
    use fd_error, only: error_type, fatal_error, fmt_int, fmt_real
-   use fd_textio, only: line_type, read_text_file, split_tokens
+   use fd_textio, only: read_file_text, lower
+   use fd_sha256, only: sha256_text
    implicit none
    private
 
-   public :: read_record
+   public :: record_info, read_record, parse_real, units_factor, standard_gravity
+   public :: record_formats, record_units_list
+
+   real(dp), parameter :: standard_gravity = 9.80665_dp  !! g [m/s2] (CGPM 1901)
+   !> The valid values of record_format.
+   character(len=*), parameter :: record_formats = "'auto', 'at2', 'values', 'time_value'"
+   !> The valid values of record_units.
+   character(len=*), parameter :: record_units_list = &
+      "'g', 'm/s2', 'cm/s2' (= 'gal'), 'mm/s2' (acceleration); 'm', 'cm', 'mm' (displacement)"
+
+   integer, parameter :: num_ok = 0, num_syntax = 1, num_nan = 2, num_infinite = 3
+
+   !> What was read from a record file (named in the summary).
+   type :: record_info
+      character(len=:), allocatable :: path    !! the file read
+      character(len=16) :: format = ''         !! 'at2', 'values' or 'time_value'
+      logical :: detected = .false.            !! format chosen by record_format = 'auto'
+      character(len=16) :: units = ''          !! units of the file's values
+      integer :: npts = 0                      !! samples read
+      real(dp) :: dt = 0.0_dp                  !! sampling step [s]
+      real(dp) :: scale = 1.0_dp               !! record_scale applied
+      real(dp) :: peak_acc = 0.0_dp            !! max |table acceleration| fed to the run [m/s2]
+      character(len=:), allocatable :: title   !! AT2: header lines 1 and 2
+      character(len=64) :: sha256 = ''         !! SHA-256 of the file's bytes (as read)
+   end type record_info
+
+   interface
+      function c_strtod(str, endptr) bind(c, name='strtod') result(x)
+         import :: c_char, c_double, c_ptr
+         character(kind=c_char), intent(in) :: str(*)
+         type(c_ptr), value :: endptr
+         real(c_double) :: x
+      end function c_strtod
+   end interface
 
 contains
 
-   !> Read a record file and return the table acceleration at k*dt_record, k = 0, 1, ...
-   !> Blank lines and lines starting with '#' or '!' are skipped.
-   subroutine read_record(path, is_displacement, scale, dt_record, acc, error)
+   !> Read a record file and return the table acceleration at k*dt, k = 0, 1, ... [m/s2].
+   subroutine read_record(path, format, is_displacement, units, scale, dt_record, acc, info, error)
       character(len=*), intent(in) :: path            !! record file
-      logical, intent(in) :: is_displacement          !! the record holds displacements [m]
+      character(len=*), intent(in) :: format          !! 'auto', 'at2', 'values', 'time_value'
+      logical, intent(in) :: is_displacement          !! the record holds displacements
+      character(len=*), intent(in) :: units           !! units of the values; '' = the default
       real(dp), intent(in) :: scale                   !! factor applied to every value
-      real(dp), intent(in) :: dt_record               !! sampling step of the record [s]
+      real(dp), intent(in) :: dt_record               !! sampling step [s]; <= 0: not given (AT2 only)
       real(dp), allocatable, intent(out) :: acc(:)    !! table acceleration samples [m/s2]
+      type(record_info), intent(out) :: info          !! what was read
       type(error_type), allocatable, intent(out) :: error !! bad file, line or value
-      type(line_type), allocatable :: lines(:), tok(:)
-      real(dp), allocatable :: val(:), tim(:)
-      real(dp) :: x
-      integer :: i, k, n, ncol, ios
-      character(len=:), allocatable :: where, first
+      character(len=:), allocatable :: text, used_units
+      real(dp), allocatable :: val(:)
+      real(dp) :: factor
+      character(len=16) :: fmt_used
+      logical :: ok
+      integer :: n
 
-      call read_text_file(path, lines, error)
+      info%path = path
+      info%scale = scale
+      call read_file_text(path, text, error)
       if (allocated(error)) return
-      allocate (val(size(lines)), tim(size(lines)))
-      n = 0
-      ncol = 0
-      do i = 1, size(lines)
-         first = adjustl(lines(i)%s)
-         if (len_trim(first) == 0) cycle
-         if (first(1:1) == '#' .or. first(1:1) == '!') cycle
-         where = "record file '"//path//"', line "//trim(fmt_int(i))
-         call split_tokens(lines(i)%s, tok)
-         if (ncol == 0) ncol = size(tok)
-         if (size(tok) /= ncol .or. ncol > 2) then
-            call fatal_error(error, where//": expected "//trim(fmt_int(min(ncol, 2)))// &
-                             " column(s) (value, or time and value), found "//trim(fmt_int(size(tok))))
+      call sha256_text(text, info%sha256)
+      fmt_used = lower(format)
+      info%detected = fmt_used == 'auto'
+      if (fmt_used == 'auto') call detect_format(path, text, fmt_used)
+      info%format = fmt_used
+      used_units = trim(lower(units))
+      select case (trim(fmt_used))
+      case ('at2')
+         call read_at2(path, text, is_displacement, used_units, dt_record, val, info, error)
+      case ('values', 'time_value')
+         if (.not. dt_record > 0.0_dp) then
+            call fatal_error(error, "record file '"//path//"' ("//trim(fmt_used)//" format) has no DT: "// &
+                             "dt_record must be given")
             return
          end if
-         n = n + 1
-         do k = 1, ncol
-            read (tok(k)%s, *, iostat=ios) x
-            if (ios /= 0) then
-               call fatal_error(error, where//": '"//tok(k)%s//"' is not a number")
-               return
-            end if
-            if (.not. ieee_is_finite(x)) then
-               call fatal_error(error, where//": value '"//tok(k)%s//"' is not finite")
-               return
-            end if
-            if (k == ncol) then
-               val(n) = x
-            else
-               tim(n) = x
-            end if
-         end do
-         if (ncol == 2 .and. n > 1) then
-            if (abs(tim(n) - tim(1) - (n - 1)*dt_record) > 1.0e-6_dp*dt_record + &
-                1.0e-9_dp*abs(tim(n))) then
-               call fatal_error(error, where//": time "//tok(1)%s//" is not on the grid of dt_record = " &
-                                //trim(fmt_real(dt_record))//" s starting at "//trim(fmt_real(tim(1)))//" s")
-               return
-            end if
-         end if
-      end do
+         call read_plain(path, text, fmt_used == 'time_value', dt_record, val, error)
+         info%dt = dt_record
+         if (len(used_units) == 0) used_units = merge('m   ', 'm/s2', is_displacement)
+      case default
+         call fatal_error(error, "record_format = '"//trim(format)//"' is not one of "//record_formats)
+      end select
+      if (allocated(error)) return
+      call units_factor(used_units, is_displacement, factor, ok)
+      if (.not. ok) then
+         call fatal_error(error, "record file '"//path//"': record_units = '"//used_units//"' is invalid for a "// &
+                          merge('displacement', 'acceleration', is_displacement)//" record: must be one of "// &
+                          record_units_list)
+         return
+      end if
+      info%units = used_units
+      n = size(val)
+      info%npts = n
       if (n < 2 .or. (is_displacement .and. n < 4)) then
          call fatal_error(error, "record file '"//path//"' has "//trim(fmt_int(n))// &
                           " samples; at least "//trim(fmt_int(merge(4, 2, is_displacement)))//" are needed")
          return
       end if
-      val = scale*val(1:n)
+      val = (factor*scale)*val
       if (is_displacement) then
          allocate (acc(n))
-         acc(2:n - 1) = (val(3:n) - 2.0_dp*val(2:n - 1) + val(1:n - 2))/dt_record**2
-         acc(1) = (2.0_dp*val(1) - 5.0_dp*val(2) + 4.0_dp*val(3) - val(4))/dt_record**2
-         acc(n) = (2.0_dp*val(n) - 5.0_dp*val(n - 1) + 4.0_dp*val(n - 2) - val(n - 3))/dt_record**2
+         acc(2:n - 1) = (val(3:n) - 2.0_dp*val(2:n - 1) + val(1:n - 2))/info%dt**2
+         acc(1) = (2.0_dp*val(1) - 5.0_dp*val(2) + 4.0_dp*val(3) - val(4))/info%dt**2
+         acc(n) = (2.0_dp*val(n) - 5.0_dp*val(n - 1) + 4.0_dp*val(n - 2) - val(n - 3))/info%dt**2
       else
-         acc = val
+         call move_alloc(val, acc)
       end if
+      info%peak_acc = maxval(abs(acc))
    end subroutine read_record
+
+   !> Factor from the given units to SI (m/s2 or m); ok = .false. for unknown units or
+   !> units of the other kind.
+   pure subroutine units_factor(units, is_displacement, factor, ok)
+      character(len=*), intent(in) :: units      !! lower-case units
+      logical, intent(in) :: is_displacement     !! displacement (else acceleration) units
+      real(dp), intent(out) :: factor            !! multiply a value to get SI
+      logical, intent(out) :: ok                 !! the units are known for this kind
+      ok = .true.
+      factor = 1.0_dp
+      if (is_displacement) then
+         select case (units)
+         case ('m')
+            factor = 1.0_dp
+         case ('cm')
+            factor = 1.0e-2_dp
+         case ('mm')
+            factor = 1.0e-3_dp
+         case default
+            ok = .false.
+         end select
+      else
+         select case (units)
+         case ('g')
+            factor = standard_gravity
+         case ('m/s2')
+            factor = 1.0_dp
+         case ('cm/s2', 'gal')
+            factor = 1.0e-2_dp
+         case ('mm/s2')
+            factor = 1.0e-3_dp
+         case default
+            ok = .false.
+         end select
+      end if
+   end subroutine units_factor
+
+   !> 'auto': an AT2 file has NPTS and DT on its fourth line (or the extension .at2, .dt2);
+   !> otherwise the number of columns of the first data line: 1 'values', 2 'time_value'.
+   subroutine detect_format(path, text, format)
+      character(len=*), intent(in) :: path, text
+      character(len=*), intent(out) :: format
+      integer :: lo, hi, next, line, dot, ncol
+      character(len=:), allocatable :: ext
+      logical :: has_tab
+
+      dot = index(path, '.', back=.true.)
+      ext = ''
+      if (dot > index(path, '/', back=.true.)) ext = lower(path(dot + 1:))
+      if (ext == 'at2' .or. ext == 'dt2') then
+         format = 'at2'
+         return
+      end if
+      next = 1
+      line = 0
+      format = 'values'
+      do while (next <= len(text))
+         call next_line(text, next, lo, hi)
+         line = line + 1
+         if (line == 4) then
+            if (index(upper(text(lo:hi)), 'NPTS') > 0 .and. index(upper(text(lo:hi)), 'DT') > 0) then
+               format = 'at2'
+               return
+            end if
+         end if
+         if (line >= 4) exit
+      end do
+      ! plain: the first line with a value that is not a comment
+      next = 1
+      do while (next <= len(text))
+         call next_line(text, next, lo, hi)
+         if (is_blank(text(lo:hi), has_tab)) cycle
+         if (is_comment(text(lo:hi))) cycle
+         ncol = count_fields(text(lo:hi))
+         if (ncol == 2) format = 'time_value'
+         exit
+      end do
+   end subroutine detect_format
+
+   !> PEER NGA format: line 1 the database, line 2 event and station, line 3 the kind and
+   !> units ("ACCELERATION TIME SERIES IN UNITS OF G"), line 4 NPTS and DT in either
+   !> spelling ("NPTS=  5590, DT=   .0050 SEC" or "5590   0.0050   NPTS, DT"), then the
+   !> values, several a line.
+   subroutine read_at2(path, text, is_displacement, units, dt_record, val, info, error)
+      character(len=*), intent(in) :: path, text
+      logical, intent(in) :: is_displacement
+      character(len=:), allocatable, intent(inout) :: units
+      real(dp), intent(in) :: dt_record
+      real(dp), allocatable, intent(out) :: val(:)
+      type(record_info), intent(inout) :: info
+      type(error_type), allocatable, intent(out) :: error
+      integer :: next, lo, hi, line, npts, n, stat, bad_lo, bad_hi, k
+      integer :: hlo(4), hhi(4)
+      real(dp) :: dt
+      character(len=:), allocatable :: h3, declared, where
+      logical :: has_tab
+
+      next = 1
+      do line = 1, 4
+         if (next > len(text)) then
+            call fatal_error(error, "record file '"//path//"' (AT2 format) ends at line "//trim(fmt_int(line - 1))// &
+                             ": expected four header lines, NPTS and DT on the fourth")
+            return
+         end if
+         call next_line(text, next, hlo(line), hhi(line))
+      end do
+      info%title = trim(adjustl(text(hlo(1):hhi(1))))//' | '//trim(adjustl(text(hlo(2):hhi(2))))
+      do k = 1, len(info%title)   ! printable ASCII only: the title goes into the JSON summary
+         if (iachar(info%title(k:k)) < 32 .or. iachar(info%title(k:k)) > 126) info%title(k:k) = '?'
+      end do
+      ! line 3: kind and units
+      h3 = upper(text(hlo(3):hhi(3)))
+      where = "record file '"//path//"', line 3"
+      if (index(h3, 'VELOCITY') > 0) then
+         call fatal_error(error, where//": the header declares a velocity time series ('"//trim(text(hlo(3):hhi(3)))// &
+                          "'); expected an acceleration or displacement record")
+         return
+      end if
+      if (index(h3, 'DISPLACEMENT') > 0 .and. .not. is_displacement) then
+         call fatal_error(error, where//": the header declares a displacement time series; set record_kind = "// &
+                          "'displacement' or give an acceleration record")
+         return
+      end if
+      if (index(h3, 'ACCELERATION') > 0 .and. is_displacement) then
+         call fatal_error(error, where//": the header declares an acceleration time series, but record_kind = "// &
+                          "'displacement'")
+         return
+      end if
+      call header_units(h3, declared)
+      if (len(declared) > 0 .and. len(units) > 0 .and. declared /= units) then
+         call fatal_error(error, where//": the header declares units of '"//declared//"' but record_units = '"// &
+                          units//"'")
+         return
+      end if
+      if (len(units) == 0) then
+         units = declared
+         if (len(units) == 0) units = merge('cm', 'g ', is_displacement)
+      end if
+      ! line 4: NPTS and DT
+      call npts_dt(path, text(hlo(4):hhi(4)), npts, dt, error)
+      if (allocated(error)) return
+      if (dt_record > 0.0_dp) then
+         if (abs(dt_record - dt) > 1.0e-6_dp*dt) then
+            call fatal_error(error, "record file '"//path//"', line 4: DT = "//trim(fmt_real(dt))// &
+                             " s differs from dt_record = "//trim(fmt_real(dt_record))// &
+                             " s (leave dt_record out to take the file's DT)")
+            return
+         end if
+      end if
+      info%dt = dt
+      ! values
+      allocate (val(npts))
+      n = 0
+      line = 4
+      do while (next <= len(text))
+         call next_line(text, next, lo, hi)
+         line = line + 1
+         if (is_blank(text(lo:hi), has_tab)) then
+            if (has_tab) then
+               call fatal_error(error, "record file '"//path//"', line "//trim(fmt_int(line))// &
+                                ": no value (only blanks, tabs or commas); expected numbers")
+               return
+            end if
+            cycle
+         end if
+         call line_values(text(lo:hi), val, n, stat, bad_lo, bad_hi)
+         if (stat /= num_ok) then
+            call value_error(path, line, text(lo:hi), stat, bad_lo, bad_hi, npts, error)
+            return
+         end if
+      end do
+      if (n < npts) then
+         call fatal_error(error, "record file '"//path//"' has "//trim(fmt_int(n))// &
+                          " values after the header, but line 4 declares NPTS = "//trim(fmt_int(npts)))
+         return
+      end if
+   end subroutine read_at2
+
+   !> Units declared on AT2 line 3 ("... IN UNITS OF G"), lower case; '' when absent.
+   pure subroutine header_units(h3, units)
+      character(len=*), intent(in) :: h3
+      character(len=:), allocatable, intent(out) :: units
+      integer :: k, e
+      character(len=:), allocatable :: w
+
+      units = ''
+      k = index(h3, 'UNITS OF')
+      if (k == 0) return
+      w = adjustl(h3(k + 8:))
+      e = scan(w, ' ,'//achar(9)//achar(13))
+      if (e > 0) w = w(1:e - 1)
+      select case (w)
+      case ('G')
+         units = 'g'
+      case ('CM/S/S', 'CM/SEC/SEC', 'CM/S2', 'CM/SEC2', 'CM/S^2', 'CM/SEC^2', 'GAL')
+         units = 'cm/s2'
+      case ('M/S/S', 'M/SEC/SEC', 'M/S2', 'M/SEC2', 'M/S^2')
+         units = 'm/s2'
+      case ('CM')
+         units = 'cm'
+      case ('M')
+         units = 'm'
+      case ('MM')
+         units = 'mm'
+      case default
+         units = lower(w)
+      end select
+   end subroutine header_units
+
+   !> NPTS and DT of AT2 line 4, in the spellings of the PEER files:
+   !> "NPTS=  5590, DT=   .0050 SEC", "5590   0.0050   NPTS, DT", "NPTS, DT: 5590 0.0050 SEC".
+   subroutine npts_dt(path, line, npts, dt, error)
+      character(len=*), intent(in) :: path, line
+      integer, intent(out) :: npts
+      real(dp), intent(out) :: dt
+      type(error_type), allocatable, intent(out) :: error
+      character(len=:), allocatable :: up, where, expect, tok(:)
+      character(len=64) :: num(2)
+      integer :: k, nnum, stat, ios
+      logical :: keyed
+
+      npts = 0; dt = 0.0_dp
+      up = upper(line)
+      where = "record file '"//path//"', line 4"
+      expect = "expected NPTS and DT, e.g. 'NPTS=  5590, DT=   .0050 SEC' or '5590   .0050   NPTS, DT'"
+      if (index(up, 'NPTS') == 0) then
+         call fatal_error(error, where//": NPTS is missing; "//expect//", found '"//trim(line)//"'")
+         return
+      end if
+      if (index(up, 'DT') == 0) then
+         call fatal_error(error, where//": DT is missing; "//expect//", found '"//trim(line)//"'")
+         return
+      end if
+      keyed = index(up, '=') > 0
+      num = ''
+      if (keyed) then
+         call keyed_value(up, 'NPTS', num(1))
+         call keyed_value(up, 'DT', num(2))
+         nnum = count(num /= '')
+      else
+         call words(up, tok)
+         nnum = 0
+         do k = 1, size(tok)
+            select case (trim(tok(k)))
+            case ('NPTS', 'DT', 'SEC', 'SECS', 'S')
+               cycle
+            end select
+            nnum = nnum + 1
+            if (nnum <= 2) num(nnum) = tok(k)
+         end do
+      end if
+      if (num(1) == '' .or. nnum > 2) then
+         call fatal_error(error, where//": cannot find the value of NPTS; "//expect//", found '"//trim(line)//"'")
+         return
+      end if
+      if (num(2) == '') then
+         call fatal_error(error, where//": DT has no value; "//expect//", found '"//trim(line)//"'")
+         return
+      end if
+      if (verify(trim(num(1)), '0123456789') /= 0) then
+         call fatal_error(error, where//": NPTS = '"//trim(num(1))//"' is not a whole number")
+         return
+      end if
+      read (num(1), '(i64)', iostat=ios) npts
+      if (ios /= 0 .or. npts < 1) then
+         call fatal_error(error, where//": NPTS = '"//trim(num(1))//"' must be a whole number >= 1")
+         return
+      end if
+      call parse_real(trim(num(2)), dt, stat)
+      if (stat /= num_ok) then
+         call fatal_error(error, where//": DT = '"//trim(num(2))//"' is not a finite number")
+         return
+      end if
+      if (dt <= 0.0_dp) then
+         call fatal_error(error, where//": DT = "//trim(num(2))//" s must be > 0")
+      end if
+   contains
+      !> The word after "KEY=" (KEY as a whole word), '' when absent.
+      pure subroutine keyed_value(s, key, v)
+         character(len=*), intent(in) :: s, key
+         character(len=*), intent(out) :: v
+         integer :: p, q, e
+         v = ''
+         p = 0
+         do
+            q = index(s(p + 1:), key)
+            if (q == 0) return
+            p = p + q
+            if (p > 1) then
+               if (index('ABCDEFGHIJKLMNOPQRSTUVWXYZ', s(p - 1:p - 1)) > 0) cycle
+            end if
+            e = verify(s(p + len(key):), ' ')
+            if (e == 0) return
+            e = p + len(key) - 1 + e
+            if (s(e:e) /= '=') cycle
+            v = adjustl(s(e + 1:))
+            e = scan(v, ' ,;'//achar(9)//achar(13))
+            if (e > 0) v = v(1:e - 1)
+            if (v == 'SEC' .or. v == 'NPTS' .or. v == 'DT') v = ''
+            return
+         end do
+      end subroutine keyed_value
+   end subroutine npts_dt
+
+   !> One value a line ('values') or time and value ('time_value'); blank lines and lines
+   !> starting with '#' or '!' are skipped.
+   subroutine read_plain(path, text, two, dt_record, val, error)
+      character(len=*), intent(in) :: path, text
+      logical, intent(in) :: two
+      real(dp), intent(in) :: dt_record
+      real(dp), allocatable, intent(out) :: val(:)
+      type(error_type), allocatable, intent(out) :: error
+      real(dp), allocatable :: buf(:)
+      real(dp) :: pair(2), t1
+      integer :: next, lo, hi, line, n, nl, k, stat, bad_lo, bad_hi, ncol, m
+      logical :: has_tab
+      character(len=:), allocatable :: where
+
+      ncol = merge(2, 1, two)
+      nl = 1
+      do k = 1, len(text)
+         if (text(k:k) == achar(10)) nl = nl + 1
+      end do
+      allocate (buf(nl))
+      n = 0
+      line = 0
+      next = 1
+      t1 = 0.0_dp
+      do while (next <= len(text))
+         call next_line(text, next, lo, hi)
+         line = line + 1
+         if (is_blank(text(lo:hi), has_tab)) then
+            if (has_tab) then
+               call fatal_error(error, "record file '"//path//"', line "//trim(fmt_int(line))// &
+                                ": no value (only blanks, tabs or commas); expected "//trim(columns_text(ncol)))
+               return
+            end if
+            cycle
+         end if
+         if (is_comment(text(lo:hi))) cycle
+         m = 0
+         call line_values(text(lo:hi), pair, m, stat, bad_lo, bad_hi)
+         if (stat == 4 .or. (stat == num_ok .and. m /= ncol)) then
+            call fatal_error(error, "record file '"//path//"', line "//trim(fmt_int(line))//": expected "// &
+                             trim(columns_text(ncol))//", found "//trim(fmt_int(count_fields(text(lo:hi))))//" values")
+            return
+         end if
+         if (stat /= num_ok) then
+            call value_error(path, line, text(lo:hi), stat, bad_lo, bad_hi, 0, error)
+            return
+         end if
+         n = n + 1
+         buf(n) = pair(ncol)
+         if (two) then
+            if (n == 1) t1 = pair(1)
+            if (abs(pair(1) - t1 - (n - 1)*dt_record) > 1.0e-6_dp*dt_record + 1.0e-9_dp*abs(pair(1))) then
+               where = "record file '"//path//"', line "//trim(fmt_int(line))
+               call fatal_error(error, where//": time "//trim(adjustl(text(lo + bad_lo - 1:lo + bad_hi - 1)))// &
+                                " is not on the grid of dt_record = "//trim(fmt_real(dt_record))// &
+                                " s starting at "//trim(fmt_real(t1))//" s (expected "// &
+                                trim(fmt_real(t1 + (n - 1)*dt_record))//" s)")
+               return
+            end if
+         end if
+      end do
+      val = buf(1:n)
+   end subroutine read_plain
+
+   pure function columns_text(ncol) result(s)
+      integer, intent(in) :: ncol
+      character(len=40) :: s
+      if (ncol == 1) then
+         s = 'one column (one value a line)'
+      else
+         s = 'two columns (time and value)'
+      end if
+   end function columns_text
+
+   !> Parse the values of one line into v(n+1:); stat 0 or the num_* code of the first bad
+   !> token (bad_lo:bad_hi its position in the line), 4 when v is full, 5 for an empty field
+   !> between commas. On success bad_lo:bad_hi is the first token.
+   subroutine line_values(s, v, n, stat, bad_lo, bad_hi)
+      character(len=*), intent(in) :: s
+      real(dp), intent(inout) :: v(:)
+      integer, intent(inout) :: n
+      integer, intent(out) :: stat, bad_lo, bad_hi
+      integer :: i, j, ls
+      logical :: comma, any_field
+      real(dp) :: x
+
+      stat = num_ok
+      bad_lo = 1; bad_hi = 0
+      ls = len(s)
+      i = 1
+      comma = .false.
+      any_field = .false.
+      do
+         do while (i <= ls)
+            if (.not. is_space(s(i:i))) exit
+            i = i + 1
+         end do
+         if (i > ls) exit
+         if (s(i:i) == ',') then
+            if (comma .or. .not. any_field) then
+               stat = 5; bad_lo = i; bad_hi = i
+               return
+            end if
+            comma = .true.
+            i = i + 1
+            cycle
+         end if
+         j = i
+         do while (j <= ls)
+            if (is_space(s(j:j)) .or. s(j:j) == ',') exit
+            j = j + 1
+         end do
+         if (.not. any_field) then
+            bad_lo = i; bad_hi = j - 1
+         end if
+         call parse_real(s(i:j - 1), x, stat)
+         if (stat /= num_ok) then
+            bad_lo = i; bad_hi = j - 1
+            return
+         end if
+         if (n >= size(v)) then
+            stat = 4; bad_lo = i; bad_hi = j - 1
+            return
+         end if
+         n = n + 1
+         v(n) = x
+         any_field = .true.
+         comma = .false.
+         i = j
+      end do
+      if (comma) then
+         stat = 5; bad_lo = ls; bad_hi = ls
+      end if
+   end subroutine line_values
+
+   subroutine value_error(path, line, s, stat, lo, hi, npts, error)
+      character(len=*), intent(in) :: path, s
+      integer, intent(in) :: line, stat, lo, hi, npts
+      type(error_type), allocatable, intent(out) :: error
+      character(len=:), allocatable :: where, tok
+      where = "record file '"//path//"', line "//trim(fmt_int(line))
+      tok = s(lo:hi)
+      select case (stat)
+      case (num_nan)
+         call fatal_error(error, where//": '"//tok//"' is NaN: not finite; expected a finite number")
+      case (num_infinite)
+         call fatal_error(error, where//": value '"//tok//"' is not finite")
+      case (4)
+         call fatal_error(error, where//": value '"//tok//"' is beyond the NPTS = "//trim(fmt_int(npts))// &
+                          " values that line 4 declares")
+      case (5)
+         call fatal_error(error, where//": empty field (a comma with no value before or after it); "// &
+                          "expected a number")
+      case default
+         if (scan(tok, '*/') > 0) then
+            call fatal_error(error, where//": '"//tok//"' is not a number (Fortran list-directed repeat "// &
+                             "counts 'r*', '*' and '/' are not accepted in records)")
+         else
+            call fatal_error(error, where//": '"//tok//"' is not a number")
+         end if
+      end select
+   end subroutine value_error
+
+   !> A decimal number: [sign] digits [. digits] [e|E|d|D [sign] digits], at least one
+   !> digit in the mantissa. stat: 0, 1 not a number, 2 NaN, 3 infinite (or overflow).
+   subroutine parse_real(tok, x, stat)
+      character(len=*), intent(in) :: tok   !! the token, without blanks
+      real(dp), intent(out) :: x            !! its value
+      integer, intent(out) :: stat          !! 0 ok, 1 syntax, 2 NaN, 3 not finite
+      character(kind=c_char, len=80) :: buf
+      integer :: i, n, nd
+      character :: c
+      character(len=:), allocatable :: low
+
+      x = 0.0_dp
+      stat = num_syntax
+      n = len(tok)
+      if (n == 0 .or. n >= len(buf)) return
+      i = 1
+      if (tok(1:1) == '+' .or. tok(1:1) == '-') i = 2
+      nd = 0
+      do while (i <= n)
+         c = tok(i:i)
+         if (c < '0' .or. c > '9') exit
+         nd = nd + 1; i = i + 1
+      end do
+      if (i <= n) then
+         if (tok(i:i) == '.') then
+            i = i + 1
+            do while (i <= n)
+               c = tok(i:i)
+               if (c < '0' .or. c > '9') exit
+               nd = nd + 1; i = i + 1
+            end do
+         end if
+      end if
+      if (nd == 0) then
+         low = lower(tok)
+         if (low(merge(2, 1, scan(low(1:1), '+-') > 0):) == 'nan' .or. index(low, 'nan(') > 0) then
+            stat = num_nan
+         else if (any(low == ['inf      ', '+inf     ', '-inf     ', 'infinity ', '+infinity', '-infinity'])) then
+            stat = num_infinite
+         end if
+         return
+      end if
+      buf(1:i - 1) = tok(1:i - 1)
+      if (i <= n) then
+         if (index('eEdD', tok(i:i)) == 0) return
+         buf(i:i) = 'e'
+         i = i + 1
+         if (i <= n) then
+            if (tok(i:i) == '+' .or. tok(i:i) == '-') then
+               buf(i:i) = tok(i:i)
+               i = i + 1
+            end if
+         end if
+         nd = 0
+         do while (i <= n)
+            c = tok(i:i)
+            if (c < '0' .or. c > '9') exit
+            buf(i:i) = c
+            nd = nd + 1; i = i + 1
+         end do
+         if (nd == 0 .or. i <= n) return
+      end if
+      buf(n + 1:n + 1) = c_null_char
+      x = c_strtod(buf, c_null_ptr)
+      if (ieee_is_nan(x)) then
+         stat = num_nan
+      else if (.not. ieee_is_finite(x)) then
+         stat = num_infinite
+      else
+         stat = num_ok
+      end if
+   end subroutine parse_real
+
+   ! ------------------------------------------------------------------ text helpers
+   !> The line starting at next: text(lo:hi), without its newline or carriage return;
+   !> next moves past the newline.
+   pure subroutine next_line(text, next, lo, hi)
+      character(len=*), intent(in) :: text
+      integer, intent(inout) :: next
+      integer, intent(out) :: lo, hi
+      integer :: k
+      lo = next
+      k = index(text(next:), achar(10))
+      if (k == 0) then
+         hi = len(text)
+         next = len(text) + 1
+      else
+         hi = next + k - 2
+         next = next + k
+      end if
+      if (hi >= lo) then
+         if (text(hi:hi) == achar(13)) hi = hi - 1
+      end if
+   end subroutine next_line
+
+   pure logical function is_space(c)
+      character, intent(in) :: c
+      is_space = c == ' ' .or. c == achar(9) .or. c == achar(13)
+   end function is_space
+
+   !> Only blanks, tabs and commas; has_tab tells whether a tab or a comma is among them
+   !> (a line of blanks is skipped; one with a tab or comma but no value is an error).
+   logical function is_blank(s, has_tab)
+      character(len=*), intent(in) :: s
+      logical, intent(out) :: has_tab
+      is_blank = verify(s, ' '//achar(9)//achar(13)//',') == 0
+      has_tab = is_blank .and. scan(s, achar(9)//',') > 0
+   end function is_blank
+
+   pure logical function is_comment(s)
+      character(len=*), intent(in) :: s
+      integer :: k
+      k = verify(s, ' '//achar(9))
+      is_comment = .false.
+      if (k > 0) is_comment = s(k:k) == '#' .or. s(k:k) == '!'
+   end function is_comment
+
+   !> Number of fields of a line (blanks, tabs or commas between them).
+   pure integer function count_fields(s)
+      character(len=*), intent(in) :: s
+      integer :: i
+      logical :: in_tok
+      count_fields = 0
+      in_tok = .false.
+      do i = 1, len(s)
+         if (is_space(s(i:i)) .or. s(i:i) == ',') then
+            in_tok = .false.
+         else if (.not. in_tok) then
+            in_tok = .true.
+            count_fields = count_fields + 1
+         end if
+      end do
+   end function count_fields
+
+   !> Words of a line split at blanks, tabs, commas, colons and '='.
+   pure subroutine words(s, w)
+      character(len=*), intent(in) :: s
+      character(len=:), allocatable, intent(out) :: w(:)
+      integer :: i, j, n
+      character(len=*), parameter :: seps = ' ,:='//achar(9)//achar(13)
+      n = 0
+      i = 1
+      allocate (character(len=64) :: w(len(s)/2 + 1))
+      do while (i <= len(s))
+         if (index(seps, s(i:i)) > 0) then
+            i = i + 1
+            cycle
+         end if
+         j = i
+         do while (j <= len(s))
+            if (index(seps, s(j:j)) > 0) exit
+            j = j + 1
+         end do
+         n = n + 1
+         w(n) = s(i:j - 1)
+         i = j
+      end do
+      w = w(1:n)
+   end subroutine words
+
+   pure function upper(s) result(u)
+      character(len=*), intent(in) :: s
+      character(len=len(s)) :: u
+      integer :: i, c
+      u = s
+      do i = 1, len(s)
+         c = iachar(s(i:i))
+         if (c >= iachar('a') .and. c <= iachar('z')) u(i:i) = achar(c - 32)
+      end do
+   end function upper
 
 end module fd_record

@@ -83,10 +83,8 @@ module fd_model
       real(dp), allocatable :: storey_height(:) !! height [m]; 0 = not given
       character(len=label_len), allocatable :: storey_label(:) !! name of each storey
       integer, allocatable :: spring_source(:) !! the deck group of each spring (source_*)
-      ! what produced the model (echoed in the summary)
+      ! what produced the model (echoed in the summary; the record's hash is in record_info)
       character(len=64) :: deck_sha256 = ''   !! SHA-256 of the deck
-      character(len=:), allocatable :: record_file  !! record file read (path as resolved)
-      character(len=64) :: record_sha256 = '' !! SHA-256 of the record file
    end type model_type
 
    !> Settings of the time integration: the technique, Newmark and the step control.

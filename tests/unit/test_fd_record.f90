@@ -6,7 +6,7 @@ module test_fd_record
    use testdrive, only: new_unittest, unittest_type, error_type, check
    use fd_kinds, only: dp
    use fd_error, only: fd_error_type => error_type
-   use fd_record, only: read_record
+   use fd_record, only: read_record, record_info
    use test_fd_helpers, only: check_close
    implicit none
    private
@@ -72,10 +72,11 @@ contains
    subroutine test_one_column(error)
       type(error_type), allocatable, intent(out) :: error
       real(dp), allocatable :: acc(:)
+      type(record_info) :: info
       type(fd_error_type), allocatable :: err
 
       call write_file([character(len=20) :: '# table acceleration', '0.0', '', '  0.25', '! a note', '-1.5e-2', '3'])
-      call read_record(file, .false., 2.0_dp, 0.01_dp, acc, err)
+      call read_record(file, 'auto', .false., '', 2.0_dp, 0.01_dp, acc, info, err)
       call remove_file()
       call check(error, .not. allocated(err), 'a good record')
       if (allocated(error)) return
@@ -88,11 +89,12 @@ contains
    subroutine test_two_columns(error)
       type(error_type), allocatable, intent(out) :: error
       real(dp), allocatable :: acc(:)
+      type(record_info) :: info
       type(fd_error_type), allocatable :: err
 
       call write_file([character(len=30) :: '0.50 1.0', '0.51, -2.0', '0.52'//achar(9)//'4.0', &
                        '0.5300000001 8.0'])
-      call read_record(file, .false., 1.0_dp, 0.01_dp, acc, err)
+      call read_record(file, 'auto', .false., '', 1.0_dp, 0.01_dp, acc, info, err)
       call remove_file()
       call check(error, .not. allocated(err), 'a good two-column record (times within 1e-6 dt of the grid)')
       if (allocated(error)) return
@@ -103,10 +105,11 @@ contains
    subroutine test_grid(error)
       type(error_type), allocatable, intent(out) :: error
       real(dp), allocatable :: acc(:)
+      type(record_info) :: info
       type(fd_error_type), allocatable :: err
 
       call write_file([character(len=20) :: '# t a', '0.00 0.0', '0.01 0.1', '0.03 0.2'])
-      call read_record(file, .false., 1.0_dp, 0.01_dp, acc, err)
+      call read_record(file, 'auto', .false., '', 1.0_dp, 0.01_dp, acc, info, err)
       call remove_file()
       call check(error, allocated(err), 'a time off the grid')
       if (allocated(error)) return
@@ -115,7 +118,7 @@ contains
       if (allocated(error)) return
       ! the same times with dt_record = 0.015 fail at line 3
       call write_file([character(len=20) :: '0.00 0.0', '0.01 0.1', '0.03 0.2'])
-      call read_record(file, .false., 1.0_dp, 0.015_dp, acc, err)
+      call read_record(file, 'auto', .false., '', 1.0_dp, 0.015_dp, acc, info, err)
       call remove_file()
       call check(error, allocated(err), 'a time off the grid')
       if (allocated(error)) return
@@ -123,7 +126,7 @@ contains
       if (allocated(error)) return
       ! 1e-4 dt off the grid is too much (the reader allows 1e-6 dt for rounded times)
       call write_file([character(len=20) :: '0.00 0.0', '0.01 0.1', '0.020001 0.2'])
-      call read_record(file, .false., 1.0_dp, 0.01_dp, acc, err)
+      call read_record(file, 'auto', .false., '', 1.0_dp, 0.01_dp, acc, info, err)
       call remove_file()
       call check(error, allocated(err), 'a time 1e-4 dt off the grid')
       if (allocated(error)) return
@@ -135,6 +138,7 @@ contains
    subroutine test_quadratic(error)
       type(error_type), allocatable, intent(out) :: error
       real(dp), allocatable :: acc(:)
+      type(record_info) :: info
       real(dp) :: x(51)
       type(fd_error_type), allocatable :: err
       real(dp), parameter :: dt = 0.01_dp, c = 0.75_dp
@@ -142,7 +146,7 @@ contains
 
       x = [(3.0e-3_dp - 0.02_dp*(k*dt) + c*(k*dt)**2, k=0, 50)]
       call write_values(x, .false., 0.0_dp, dt)
-      call read_record(file, .true., 1.0_dp, dt, acc, err)
+      call read_record(file, 'auto', .true., '', 1.0_dp, dt, acc, info, err)
       call remove_file()
       call check(error, .not. allocated(err) .and. size(acc) == size(x), 'a displacement record')
       if (allocated(error)) return
@@ -156,6 +160,7 @@ contains
    subroutine test_cubic(error)
       type(error_type), allocatable, intent(out) :: error
       real(dp), allocatable :: acc(:)
+      type(record_info) :: info
       real(dp) :: x(31)
       type(fd_error_type), allocatable :: err
       real(dp), parameter :: dt = 0.02_dp, d = 0.4_dp
@@ -163,7 +168,7 @@ contains
 
       x = [(d*(k*dt)**3, k=0, 30)]
       call write_values(x, .true., 0.0_dp, dt)
-      call read_record(file, .true., 0.5_dp, dt, acc, err)
+      call read_record(file, 'auto', .true., '', 0.5_dp, dt, acc, info, err)
       call remove_file()
       call check(error, .not. allocated(err) .and. size(acc) == size(x), 'a displacement record')
       if (allocated(error)) return
@@ -177,32 +182,34 @@ contains
    subroutine test_bad_values(error)
       type(error_type), allocatable, intent(out) :: error
       real(dp), allocatable :: acc(:)
+      type(record_info) :: info
       type(fd_error_type), allocatable :: err
 
       call write_file([character(len=20) :: '0.0', '0.1', 'nan', '0.2'])
-      call read_record(file, .false., 1.0_dp, 0.01_dp, acc, err)
+      call read_record(file, 'auto', .false., '', 1.0_dp, 0.01_dp, acc, info, err)
       call check(error, allocated(err), 'NaN')
       if (allocated(error)) return
-      call check(error, index(err%message, "line 3: value 'nan' is not finite") > 0, err%message)
+      call check(error, index(err%message, "line 3: 'nan' is NaN: not finite") > 0, err%message)
       if (allocated(error)) return
       call write_file([character(len=20) :: '0.0', '0.1x', '0.2'])
-      call read_record(file, .false., 1.0_dp, 0.01_dp, acc, err)
+      call read_record(file, 'auto', .false., '', 1.0_dp, 0.01_dp, acc, info, err)
       call check(error, allocated(err), 'not a number')
       if (allocated(error)) return
       call check(error, index(err%message, "line 2: '0.1x' is not a number") > 0, err%message)
       if (allocated(error)) return
       call write_file([character(len=20) :: '0.0', '0.1', '0.2 0.3'])
-      call read_record(file, .false., 1.0_dp, 0.01_dp, acc, err)
+      call read_record(file, 'auto', .false., '', 1.0_dp, 0.01_dp, acc, info, err)
       call check(error, allocated(err), 'a change of the number of columns')
       if (allocated(error)) return
-      call check(error, index(err%message, "line 3: expected 1 column(s)") > 0, err%message)
+      call check(error, index(err%message, "line 3: expected one column (one value a line), found 2 values") > 0, &
+                 err%message)
       if (allocated(error)) return
       call write_file([character(len=20) :: '0.0 1 2', '0.1 1 2'])
-      call read_record(file, .false., 1.0_dp, 0.01_dp, acc, err)
+      call read_record(file, 'auto', .false., '', 1.0_dp, 0.01_dp, acc, info, err)
       call remove_file()
       call check(error, allocated(err), 'three columns')
       if (allocated(error)) return
-      call check(error, index(err%message, "line 1: expected 2 column(s) (value, or time and value), found 3") > 0, &
+      call check(error, index(err%message, "line 1: expected one column (one value a line), found 3 values") > 0, &
                  err%message)
    end subroutine test_bad_values
 
@@ -210,21 +217,22 @@ contains
    subroutine test_too_few(error)
       type(error_type), allocatable, intent(out) :: error
       real(dp), allocatable :: acc(:)
+      type(record_info) :: info
       type(fd_error_type), allocatable :: err
 
       call write_file([character(len=20) :: '# one', '0.5'])
-      call read_record(file, .false., 1.0_dp, 0.01_dp, acc, err)
+      call read_record(file, 'auto', .false., '', 1.0_dp, 0.01_dp, acc, info, err)
       call check(error, allocated(err), 'one sample')
       if (allocated(error)) return
       call check(error, index(err%message, 'has 1 samples; at least 2 are needed') > 0, err%message)
       if (allocated(error)) return
       call write_file([character(len=20) :: '0.0', '0.1', '0.2'])
-      call read_record(file, .true., 1.0_dp, 0.01_dp, acc, err)
+      call read_record(file, 'auto', .true., '', 1.0_dp, 0.01_dp, acc, info, err)
       call check(error, allocated(err), 'a displacement record of 3 samples')
       if (allocated(error)) return
       call check(error, index(err%message, 'has 3 samples; at least 4 are needed') > 0, err%message)
       if (allocated(error)) return
-      call read_record(file, .false., 1.0_dp, 0.01_dp, acc, err)
+      call read_record(file, 'auto', .false., '', 1.0_dp, 0.01_dp, acc, info, err)
       call remove_file()
       call check(error, .not. allocated(err) .and. size(acc) == 3, 'the same 3 samples as accelerations')
    end subroutine test_too_few
@@ -232,9 +240,10 @@ contains
    subroutine test_missing(error)
       type(error_type), allocatable, intent(out) :: error
       real(dp), allocatable :: acc(:)
+      type(record_info) :: info
       type(fd_error_type), allocatable :: err
 
-      call read_record('no_such_record_for_the_unit_tests.txt', .false., 1.0_dp, 0.01_dp, acc, err)
+      call read_record('no_such_record_for_the_unit_tests.txt', 'auto', .false., '', 1.0_dp, 0.01_dp, acc, info, err)
       call check(error, allocated(err), 'a missing file')
       if (allocated(error)) return
       call check(error, err%message, "file 'no_such_record_for_the_unit_tests.txt' does not exist")

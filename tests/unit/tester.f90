@@ -11,6 +11,7 @@ program tester
    use test_fd_friction, only: collect_friction
    use test_fd_namelist, only: collect_namelist
    use test_fd_record, only: collect_record
+   use test_fd_record_parse, only: collect_record_parse
    use test_fd_excitation, only: collect_excitation
    use test_fd_lcp, only: collect_lcp
    use test_fd_textio, only: collect_textio
@@ -22,6 +23,7 @@ program tester
    use test_fd_sha256, only: collect_sha256
    use test_fd_engineering, only: collect_engineering
    use test_fd_friction_mu, only: collect_friction_mu
+   use test_fd_banded, only: collect_banded
    implicit none
    integer :: stat, is
    character(len=:), allocatable :: suite_name, test_name
@@ -38,6 +40,7 @@ program tester
    testsuites = [testsuites, new_testsuite("friction", collect_friction)]
    testsuites = [testsuites, new_testsuite("namelist", collect_namelist)]
    testsuites = [testsuites, new_testsuite("record", collect_record)]
+   testsuites = [testsuites, new_testsuite("record_parse", collect_record_parse)]
    testsuites = [testsuites, new_testsuite("excitation", collect_excitation)]
    testsuites = [testsuites, new_testsuite("lcp", collect_lcp)]
    testsuites = [testsuites, new_testsuite("textio", collect_textio)]
@@ -49,6 +52,7 @@ program tester
    testsuites = [testsuites, new_testsuite("sha256", collect_sha256)]
    testsuites = [testsuites, new_testsuite("engineering", collect_engineering)]
    testsuites = [testsuites, new_testsuite("friction_mu", collect_friction_mu)]
+   testsuites = [testsuites, new_testsuite("banded", collect_banded)]
 
    call get_argument(1, suite_name)
    call get_argument(2, test_name)

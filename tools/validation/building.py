@@ -7,7 +7,7 @@ the worked examples with rigid-plastic friction dampers (docs/theory.md, section
 The building (inputs/building5_dampers.nml without its braces): floors 300 t (roof 250 t),
 storeys 400 ... 200 MN/m, Rayleigh 2 % at the bare frame's modes 1 and 3, a friction device
 in every storey slipping at 5 % of the weight above it, the synthetic record
-inputs/synthetic_kt.txt (20 s, PGA 0.35 g), then 10 s at rest; rows every dt1 = 1 ms.
+inputs/synthetic_pga035.AT2 (20 s, PGA 0.35 g), then 10 s at rest; rows every dt1 = 1 ms.
 Errors are against the exact technique (devices rigid while stuck): peak drift and peak
 floor acceleration (largest relative error over the storeys / floors), the RMS of the roof
 acceleration error over the record, the roof acceleration's content above 30 Hz (RMS of
@@ -45,7 +45,7 @@ def building(law: str, **device) -> fd.Analysis:
         damping=fd.Damping.rayleigh_modes(0.02, 1, 3, "free"),
         devices=[fd.Device(i + 1, i, p=SLIP[i], mu=1.0, law=law, **device) for i in range(5)],
         storeys=[fd.Storey.of_spring(i + 1, height=HEIGHT[i]) for i in range(5)],
-        excitation=fd.Record(0.01, file=str(ROOT / "inputs" / "synthetic_kt.txt"), duration=30.0),
+        excitation=fd.Record(0.01, file=str(ROOT / "inputs" / "synthetic_pga035.AT2"), duration=30.0),
         integration=integ,
         output=fd.Output(output_every=1),
     )

@@ -1,0 +1,472 @@
+"""The models of the OpenSeesPy comparison, built once for frictiondyn and once for OpenSees.
+
+Two families of cases (bench/compare_opensees.py runs them; tests/test_bench_opensees.py
+cross-checks the 2-storey building):
+
+- ``Test4Case``: the paper's test 4 (inputs/test4_<law>.nml, read with f90nml), shortened to
+  10 s. frictiondyn's hysteretic law is OpenSees's ElasticPP material (E = P mu / f, yield
+  strain f); its velocity law is OpenSees's CoulombDamper material (tangent 0, friction force
+  P mu, velocity band ``-tol`` eps): both are the same force law, not an approximation of it.
+- ``BuildingCase``: a shear building of N storeys with a friction damper (slip load Fs in a
+  brace of stiffness kb: frictiondyn's hysteretic law with P mu = Fs, f = Fs / kb; an
+  ElasticPP zeroLength link in OpenSees) in every storey, under a synthetic ground
+  acceleration made by ``synthetic_record``.
+
+Both codes integrate with Newmark's average acceleration method at the same step dt1. The
+damping is the same matrix in both: C = a0 M + a1 K (K the springs, not the devices), in
+OpenSees as ``rayleigh(a0, 0, 0, 0)`` on the masses and an Elastic material's damping tangent
+eta = a1 k in each spring (a global ``rayleigh`` beta would also damp the friction links).
+
+Neither code is imported at module level: a process that runs one code loads only that code
+(its memory is measured alone), and the frictiondyn half works without openseespy.
+"""
+
+from __future__ import annotations
+
+import math
+import tempfile
+import time
+from dataclasses import dataclass, field
+from pathlib import Path
+
+import f90nml
+import numpy as np
+
+ROOT = Path(__file__).resolve().parent.parent
+INPUTS = ROOT / "inputs"
+G = 9.81  # m/s2
+
+QUANTITIES = (
+    "u",
+    "aabs",
+    "s",
+    "F",
+)  # peak |relative displacement|, |abs. acceleration|, |s|, |F|
+SUMMARY_KEYS = {
+    "u": "peak_u_m",
+    "aabs": "peak_aabs_mps2",
+    "s": "peak_s_m",
+    "F": "peak_force_N",
+}
+
+
+@dataclass
+class OpenSeesSettings:
+    """How OpenSees solves each step: what a careful OpenSees user would choose for a chain of
+    zeroLength links (see docs/performance.md for the measured alternatives)."""
+
+    algorithm: str = "KrylovNewton"
+    system: str = "BandGeneral"
+    numberer: str = "RCM"
+    test: str = "NormDispIncr"
+    tol: float = 1e-8  # m
+    max_iter: int = 50
+
+    def describe(self) -> str:
+        return (
+            f"Newmark(0.5, 0.25), {self.algorithm}, {self.system}, numberer {self.numberer}, "
+            f"test {self.test} {self.tol:g} (max {self.max_iter} iterations), constraints Plain"
+        )
+
+
+# ----------------------------------------------------------------------------- cases
+
+
+def _list(x) -> list:
+    return list(x) if isinstance(x, (list, tuple)) else [x]
+
+
+@dataclass
+class Test4Case:
+    """The paper's test 4 from its deck, ``duration`` seconds, with the deck's law."""
+
+    law: str  # 'hysteretic' or 'velocity'
+    duration: float = 10.0
+
+    def __post_init__(self) -> None:
+        nml = f90nml.read(INPUTS / f"test4_{self.law}.nml")
+        model, springs, damp = nml["model"], nml["springs"], nml["damping"]
+        fric, exc, integ = nml["friction"], nml["excitation"], nml["integration"]
+        self.masses = [float(m) for m in _list(model["mass"])]
+        ni, nj, k = (
+            _list(springs["node_i"]),
+            _list(springs["node_j"]),
+            _list(springs["k"]),
+        )
+        self.springs = [(int(a), int(b), float(c)) for a, b, c in zip(ni, nj, k)]
+        law = str(_list(fric["law"])[0]).strip().lower()
+        ok = (
+            len(self.masses) == 2
+            and int(fric["n_devices"]) == 1
+            and law == self.law
+            and sorted((int(fric["node_i"]), int(fric["node_j"]))) == [1, 2]
+            and all(j == 0 for _, j, _ in self.springs)
+            and str(damp["damping_type"]).lower() == "stiffness"
+            and str(exc["excitation_type"]).lower() == "harmonic"
+            and int(exc.get("ramp_cycles", 0)) == 0
+        )
+        if not ok:
+            raise ValueError(
+                f"inputs/test4_{self.law}.nml is not the two-mass model this bench knows"
+            )
+        self.device = (int(fric["node_i"]), int(fric["node_j"]))
+        self.p, self.mu = float(fric["p"]), float(fric["mu"])
+        self.eps = float(fric.get("eps", 1e-3))
+        self.eps1 = float(fric.get("eps1", 1e-3))
+        self.f = float(fric.get("f", 1e-5))
+        self.xi, self.period = float(damp["xi"]), float(damp.get("period", 0.0))
+        self.amplitude, self.frequency = (
+            float(exc["amplitude"]),
+            float(exc["frequency"]),
+        )
+        self.dt_record = float(exc["dt_record"])
+        self.n1, self.n2, self.n = int(integ["n1"]), int(integ["n2"]), float(integ["n"])
+        self.dt = self.dt_record / self.n1
+        self.n_steps = round(self.duration / self.dt)
+
+    @property
+    def name(self) -> str:
+        return f"test4_{self.law}"
+
+    @property
+    def opensees_material(self) -> str:
+        return "ElasticPP" if self.law == "hysteretic" else "CoulombDamper"
+
+    @property
+    def n_dof(self) -> int:
+        return 2
+
+    def stuck_period(self) -> float:
+        """First period of the stuck system (the device a rigid link: m1 + m2 on k1 + k2), the
+        T of the deck's C = psi K, psi = T xi / pi, when the deck does not give it."""
+        if self.period > 0:
+            return self.period
+        return 2 * math.pi * math.sqrt(sum(self.masses) / sum(k for _, _, k in self.springs))
+
+    def analysis(self, duration: float | None = None):
+        import frictiondyn as fd
+
+        i, j = self.device
+        return fd.Analysis(
+            masses=self.masses,
+            springs=[fd.Spring(a, b, k) for a, b, k in self.springs],
+            damping=fd.Damping.stiffness(self.xi, self.period),
+            devices=[
+                fd.Device(
+                    i,
+                    j,
+                    self.p,
+                    self.mu,
+                    law=self.law,
+                    eps=self.eps,
+                    eps1=self.eps1,
+                    f=self.f,
+                )
+            ],
+            excitation=fd.Harmonic(
+                self.amplitude,
+                self.frequency,
+                self.dt_record,
+                duration or self.duration,
+            ),
+            integration=fd.Integration(n1=self.n1, n2=self.n2, n=self.n),
+        )
+
+    def short_analysis(self):
+        """The same deck for one record interval: what a run costs besides its steps."""
+        return self.analysis(self.dt_record)
+
+    def build_opensees(self, ops, settings: OpenSeesSettings, workdir: Path) -> None:
+        psi = self.stuck_period() * self.xi / math.pi
+        ops.wipe()
+        ops.model("basic", "-ndm", 1, "-ndf", 1)
+        for n in range(3):
+            ops.node(n, 0.0)
+        ops.fix(0, 1)
+        for n, m in enumerate(self.masses, start=1):
+            ops.mass(n, m)
+        for e, (a, b, k) in enumerate(self.springs, start=1):
+            ops.uniaxialMaterial("Elastic", e, k, psi * k)  # spring and its dashpot psi k
+            ops.element("zeroLength", e, b, a, "-mat", e, "-dir", 1)
+        pmu = self.p * self.mu
+        if self.law == "hysteretic":
+            ops.uniaxialMaterial("ElasticPP", 10, pmu / self.f, self.f)
+        else:
+            ops.uniaxialMaterial("CoulombDamper", 10, 0.0, pmu, "-tol", self.eps)
+        i, j = self.device
+        ops.element("zeroLength", 10, j, i, "-mat", 10, "-dir", 1)  # deformation u_i - u_j = s
+        w = 2 * math.pi * self.frequency
+        # table displacement a0 sin(w t): acceleration -a0 w^2 sin(w t), exact at every step
+        ops.timeSeries(
+            "Trig",
+            1,
+            0.0,
+            self.duration + 1.0,
+            1.0 / self.frequency,
+            "-factor",
+            -self.amplitude * w * w,
+        )
+        ops.pattern("UniformExcitation", 1, 1, "-accel", 1)
+        _recorders(ops, workdir, [1, 2], [10])
+        _analysis(ops, settings)
+
+
+def synthetic_record(
+    dt: float = 0.01, duration: float = 20.0, pga: float = 0.3 * G, seed: int = 20240613
+) -> np.ndarray:
+    """A reproducible synthetic ground acceleration [m/s2] sampled at dt, ``duration`` long:
+    white noise through a Kanai-Tajimi filter (2.5 Hz, 0.6) and a Clough-Penzien high-pass
+    (0.25 Hz, 0.6), under a Jennings envelope (quadratic rise to 2 s, strong phase to 10 s,
+    exponential decay), scaled to the peak ground acceleration ``pga``; starts at rest."""
+    n = round(duration / dt) + 1
+    rng = np.random.default_rng(seed)
+    spectrum = np.fft.rfft(rng.standard_normal(n))
+    om = 2 * np.pi * np.fft.rfftfreq(n, dt)
+    wg, zg, wf, zf = 2 * np.pi * 2.5, 0.6, 2 * np.pi * 0.25, 0.6
+    kanai = (wg**2 + 2j * zg * wg * om) / (wg**2 - om**2 + 2j * zg * wg * om)
+    clough = om**2 / (wf**2 - om**2 + 2j * zf * wf * om)
+    a = np.fft.irfft(spectrum * kanai * clough, n)
+    t = np.arange(n) * dt
+    a *= np.where(t < 2.0, (t / 2.0) ** 2, np.where(t < 10.0, 1.0, np.exp(-0.25 * (t - 10.0))))
+    a *= pga / np.abs(a).max()
+    a[0] = 0.0
+    return a
+
+
+@dataclass
+class BuildingCase:
+    """Shear building, N storeys, a friction damper in a brace in every storey.
+
+    One building discretized with N storeys: total mass ``total_mass`` shared equally by the
+    floors; storey stiffness proportional to the weight it carries, scaled so that the bare
+    frame's first period is ``period`` for every N; in every storey a brace of the storey's
+    stiffness with a friction damper slipping at ``slip_ratio`` times the weight above it;
+    Rayleigh damping ``xi`` on the frame's modes 1 and 3. Ground: ``synthetic_record``,
+    ``duration`` s sampled at ``dt_record``; step dt1 = dt_record / n1 in both codes.
+    """
+
+    n_storeys: int
+    duration: float = 20.0
+    dt_record: float = 0.01
+    n1: int = 10
+    period: float = 1.0
+    total_mass: float = 1.0e6
+    slip_ratio: float = 0.05
+    xi: float = 0.02
+    record: np.ndarray = field(default=None, repr=False)
+
+    def __post_init__(self) -> None:
+        n = self.n_storeys
+        if self.record is None:
+            self.record = synthetic_record(self.dt_record, 20.0)
+        self.m = self.total_mass / n
+        above = np.arange(n, 0, -1, dtype=float)  # floors carried by storey i (bottom first)
+        lam = _chain_eigenvalues(above, self.m)
+        scale = (2 * math.pi / self.period) ** 2 / lam[0]
+        self.k = above * scale
+        w1 = 2 * math.pi / self.period
+        w3 = math.sqrt(lam[min(2, n - 1)] * scale)
+        self.a0 = 2 * self.xi * w1 * w3 / (w1 + w3)
+        self.a1 = 2 * self.xi / (w1 + w3)
+        self.slip = self.slip_ratio * G * self.m * above
+        self.kb = self.k.copy()
+        self.dt = self.dt_record / self.n1
+        self.n_steps = round(self.duration / self.dt)
+
+    @property
+    def name(self) -> str:
+        return f"building_{self.n_storeys}"
+
+    @property
+    def n_dof(self) -> int:
+        return self.n_storeys
+
+    def analysis(self, duration: float | None = None):
+        import frictiondyn as fd
+
+        n = self.n_storeys
+        return fd.Analysis(
+            masses=[self.m] * n,
+            springs=[fd.Spring(i + 1, i, float(self.k[i])) for i in range(n)],
+            damping=fd.Damping.rayleigh(self.a0, self.a1),
+            devices=[
+                fd.Device(
+                    i + 1,
+                    i,
+                    float(self.slip[i]),
+                    1.0,
+                    law="hysteretic",
+                    f=float(self.slip[i] / self.kb[i]),
+                )
+                for i in range(n)
+            ],
+            excitation=fd.Record(
+                self.dt_record, values=self.record, duration=duration or self.duration
+            ),
+            integration=fd.Integration(n1=self.n1),
+        )
+
+    def short_analysis(self):
+        return self.analysis(self.dt_record)
+
+    def build_opensees(self, ops, settings: OpenSeesSettings, workdir: Path) -> None:
+        n = self.n_storeys
+        ops.wipe()
+        ops.model("basic", "-ndm", 1, "-ndf", 1)
+        for i in range(n + 1):
+            ops.node(i, 0.0)
+        ops.fix(0, 1)
+        for i in range(1, n + 1):
+            ops.mass(i, self.m)
+        for i in range(n):
+            k, fs, kb = float(self.k[i]), float(self.slip[i]), float(self.kb[i])
+            ops.uniaxialMaterial("Elastic", i + 1, k, self.a1 * k)
+            ops.element("zeroLength", i + 1, i, i + 1, "-mat", i + 1, "-dir", 1)
+            ops.uniaxialMaterial("ElasticPP", n + i + 1, kb, fs / kb)
+            ops.element("zeroLength", n + i + 1, i, i + 1, "-mat", n + i + 1, "-dir", 1)
+        ops.rayleigh(self.a0, 0.0, 0.0, 0.0)
+        ops.timeSeries("Path", 1, "-dt", self.dt_record, "-values", *map(float, self.record))
+        ops.pattern("UniformExcitation", 1, 1, "-accel", 1)
+        _recorders(ops, workdir, list(range(1, n + 1)), list(range(n + 1, 2 * n + 1)))
+        _analysis(ops, settings)
+
+
+def _chain_eigenvalues(k: np.ndarray, m: float) -> np.ndarray:
+    """Eigenvalues w^2 (ascending) of a fixed-base shear chain, storey stiffness k, floor mass m."""
+    n = len(k)
+    kk = np.zeros((n, n))
+    for i in range(n):
+        kk[i, i] += k[i]
+        if i > 0:
+            kk[i - 1, i - 1] += k[i]
+            kk[i, i - 1] -= k[i]
+            kk[i - 1, i] -= k[i]
+    return np.linalg.eigvalsh(kk / m)
+
+
+def make_case(spec: str, quick: bool = False):
+    """'test4:hysteretic', 'test4:velocity' or 'building:N' (quick: the short smoke versions)."""
+    kind, _, arg = spec.partition(":")
+    if kind == "test4":
+        return Test4Case(arg, duration=2.0 if quick else 10.0)
+    if kind == "building":
+        return BuildingCase(int(arg), duration=5.0 if quick else 20.0)
+    raise ValueError(f"unknown case {spec!r}")
+
+
+# ----------------------------------------------------------------------------- OpenSees
+
+
+def _recorders(ops, workdir: Path, nodes: list[int], devices: list[int]) -> None:
+    """Envelopes (min, max, max |.|) of what frictiondyn's summary gives: nodal relative
+    displacement, absolute acceleration (-timeSeries adds the ground's), the devices'
+    deformation and force."""
+    prec = ("-precision", 12)
+    ops.recorder(
+        "EnvelopeNode",
+        "-file",
+        str(workdir / "u.env"),
+        *prec,
+        "-node",
+        *nodes,
+        "-dof",
+        1,
+        "disp",
+    )
+    ops.recorder(
+        "EnvelopeNode",
+        "-file",
+        str(workdir / "aabs.env"),
+        *prec,
+        "-timeSeries",
+        1,
+        "-node",
+        *nodes,
+        "-dof",
+        1,
+        "accel",
+    )
+    ops.recorder(
+        "EnvelopeElement",
+        "-file",
+        str(workdir / "s.env"),
+        *prec,
+        "-ele",
+        *devices,
+        "deformation",
+    )
+    ops.recorder(
+        "EnvelopeElement",
+        "-file",
+        str(workdir / "F.env"),
+        *prec,
+        "-ele",
+        *devices,
+        "basicForce",
+    )
+
+
+def _analysis(ops, s: OpenSeesSettings) -> None:
+    ops.constraints("Plain")
+    ops.numberer(s.numberer)
+    ops.system(s.system)
+    ops.test(s.test, s.tol, s.max_iter)
+    ops.algorithm(s.algorithm)
+    ops.integrator("Newmark", 0.5, 0.25)
+    ops.analysis("Transient")
+
+
+def import_opensees():
+    import openseespy.opensees as ops
+
+    return ops
+
+
+@dataclass
+class OpenSeesRun:
+    seconds: float  # analyze() only, wall clock
+    cpu_seconds: float  # analyze() only, CPU time of this process
+    build_seconds: float
+    peaks: dict[str, np.ndarray]
+
+
+def run_opensees(case, settings: OpenSeesSettings | None = None) -> OpenSeesRun:
+    """Build the case in OpenSees (timed apart), analyze it (timed), read its envelopes."""
+    ops = import_opensees()
+    settings = settings or OpenSeesSettings()
+    with tempfile.TemporaryDirectory(prefix="fd_ops_") as tmp:
+        work = Path(tmp)
+        t0 = time.perf_counter()
+        case.build_opensees(ops, settings, work)
+        t1, c1 = time.perf_counter(), time.process_time()
+        status = ops.analyze(case.n_steps, case.dt)
+        t2, c2 = time.perf_counter(), time.process_time()
+        t_now = ops.getTime()
+        ops.wipe()  # closes the recorders: the envelopes are written
+        if status != 0:
+            raise RuntimeError(
+                f"{case.name}: OpenSees analyze failed (status {status}) at t = {t_now} s"
+            )
+        peaks = {q: np.loadtxt(work / f"{q}.env", ndmin=2)[2].copy() for q in QUANTITIES}
+    return OpenSeesRun(t2 - t1, c2 - c1, t1 - t0, peaks)
+
+
+# ----------------------------------------------------------------------------- frictiondyn
+
+
+def frictiondyn_peaks(result) -> dict[str, np.ndarray]:
+    """The peaks of a frictiondyn Result's summary, as arrays."""
+    return {q: np.asarray(result.summary[SUMMARY_KEYS[q]], dtype=float) for q in QUANTITIES}
+
+
+def compare_peaks(a: dict, b: dict) -> dict[str, tuple[float, int]]:
+    """For each quantity, the largest relative difference |a - b| / |b| over DOFs (devices)
+    and where it is (0-based)."""
+    out = {}
+    for q in QUANTITIES:
+        x, y = np.abs(np.asarray(a[q], float)), np.abs(np.asarray(b[q], float))
+        if x.shape != y.shape:
+            raise ValueError(f"peak {q}: {x.shape} values against {y.shape}")
+        rel = np.abs(x - y) / np.maximum(y, 1e-300)
+        out[q] = (float(rel.max()), int(rel.argmax()))
+    return out

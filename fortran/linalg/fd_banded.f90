@@ -1,0 +1,976 @@
+!> The effective stiffness of a structure with friction devices, stored and factored the way
+!> its graph allows, and kept factored as devices change phase:
+!>
+!>   K^ = K + c1 C + c0 M + sum_d kd_d b_d b_d',   b_d = e_i - e_j (e_i for a device on the table)
+!>
+!> K (springs) and C (a0 M + a1 K + dashpots) are stored once, in a reverse Cuthill-McKee
+!> ordering of the graph of springs, dashpots and devices, as symmetric band matrices
+!> (memory n (bandwidth + 1) each); K^ is factored by LAPACK's banded Cholesky (dpbtrf). A
+!> small system (n <= spd_dense_max_n) is stored dense and factored by dpotrf instead, where
+!> that is faster.
+!>
+!> A change of one device's kd is a rank-one change of K^: its factor is updated (kd grew)
+!> or downdated (kd shrank) in O((n - first column) * bandwidth) operations, with the
+!> mixed hyperbolic rotations of Chambers / Bojanczyk et al., stopped once the rest of the
+!> change is below rounding (in a K^ dominated by inertia, after a few columns: the cost of
+!> an update then does not grow with n). When several devices change
+!> together, the factor is recomputed from the first changed column instead if that costs
+!> fewer operations. A per-column estimate of the backward error that updates add (with
+!> respect to a fresh factor) is kept; a downdate whose pivot collapses (positive
+!> definiteness lost to round-off, or the error budget exceeded) is abandoned and the matrix
+!> refactored, counted in the statistics. After spd_setup nothing allocates.
+module fd_banded
+   use, intrinsic :: ieee_arithmetic, only: ieee_is_finite
+   use, intrinsic :: iso_fortran_env, only: int64
+   use fd_kinds, only: dp
+   use fd_error, only: error_type, fatal_error, fmt_int, fmt_real
+   use fd_rcm, only: rcm_order, graph_bandwidth
+   implicit none
+   private
+
+   public :: spd_system, spd_stats, spd_setup, spd_factor, spd_update_device, spd_update_devices
+   public :: spd_solve, spd_k_matvec, spd_c_matvec
+   public :: spd_size, spd_bandwidth, spd_is_dense, spd_device_kd, spd_error_estimate
+   public :: spd_auto, spd_dense, spd_banded, spd_dense_max_n, spd_choose, spd_rank_one, spd_refactor
+
+   integer, parameter :: spd_auto = 0    !! storage chosen by size and bandwidth
+   integer, parameter :: spd_dense = 1   !! dense storage, dpotrf
+   integer, parameter :: spd_banded = 2  !! RCM ordering, band storage, dpbtrf
+
+   integer, parameter :: spd_choose = 0    !! device changes: by operation count
+   integer, parameter :: spd_rank_one = 1  !! device changes: always rank-one modifications
+   integer, parameter :: spd_refactor = 2  !! device changes: always refactor from the first column
+
+   !> Largest n stored dense by spd_auto: the measured crossover of a step's solve and two
+   !> products (bash bench/banded.sh small; banded is faster from n = 9 on).
+   integer, parameter :: spd_dense_max_n = 8
+
+   !> Backward error a single rank-one modification adds, relative to the pivot it touches.
+   real(dp), parameter :: unit_error = 2.0_dp*epsilon(1.0_dp)
+   !> Update entries below this times their pivot are dropped (tau^2 = eps/4).
+   real(dp), parameter :: truncate_tol = 0.5_dp*sqrt(epsilon(1.0_dp))
+   !> Order (dense) or band up to which the unblocked LAPACK factorizations are called.
+   integer, parameter :: unblocked_max = 64
+   !> A pivot^2 below this times (band + 1) times its diagonal is rounding noise.
+   real(dp), parameter :: singular_tol = 4.0_dp*epsilon(1.0_dp)
+   !> Default budget of that estimated error before a refactorization.
+   real(dp), parameter :: default_budget = 1.0e-12_dp
+   !> Cost model, in flop equivalents, measured by `bash bench/banded.sh calibrate` (about
+   !> 0.37 ns each): a rank-one modification costs w_update + band per column touched (it is
+   !> bound by the latency of a square root and two divisions, not by its 4 band flops), a
+   !> refactorization w_factor + band^2 + 2 band per column (dpbtf2's two BLAS calls).
+   real(dp), parameter :: w_update = 64.0_dp, w_factor = 90.0_dp
+
+   !> What the factor has cost so far; the caller may report it.
+   type :: spd_stats
+      integer :: factorizations = 0 !! full factorizations (spd_factor, fallbacks, refreshes)
+      integer :: partial = 0        !! refactorizations from the first changed column
+      integer :: updates = 0        !! rank-one updates made (a device stiffness grew)
+      integer :: downdates = 0      !! rank-one downdates made (a device stiffness shrank)
+      integer :: fallbacks = 0      !! downdates abandoned (pivot lost to round-off): refactored
+      integer :: refreshes = 0      !! modifications that would exceed the error budget: refactored
+      integer(int64) :: update_columns = 0 !! columns touched by the rank-one modifications
+   end type spd_stats
+
+   !> The system: structure, storage, factor and work space. Set up by spd_setup.
+   type :: spd_system
+      type(spd_stats) :: stats                        !! counts of the work done
+      integer, private :: n = 0                       !! number of DOFs
+      integer, private :: nd = 0                      !! number of devices
+      integer, private :: kb = 0                      !! half-bandwidth (n - 1 when dense)
+      integer, private :: ld = 0                      !! leading dimension of the storage
+      integer, private :: sj = 0, off = 0             !! U(i, j) is stored at i + j sj + off
+      logical, private :: dense = .false.             !! dense storage (else band)
+      integer, private :: method = spd_choose         !! how device changes are made
+      logical, private :: factored = .false.          !! fac holds the factor of K^
+      real(dp), private :: c0 = 0.0_dp, c1 = 0.0_dp  !! coefficients of M and C in K^
+      real(dp), private :: budget = default_budget    !! allowed estimated update error
+      real(dp), private :: span = huge(1.0_dp)        !! running mean of columns per update
+      integer, allocatable, private :: perm(:)        !! new -> old DOF
+      integer, allocatable, private :: inv(:)         !! old -> new DOF
+      integer, allocatable, private :: dlo(:), dhi(:) !! device columns (new), dlo < dhi or dhi = 0
+      integer, allocatable, private :: dorder(:)      !! devices by decreasing last column
+      real(dp), allocatable, private :: mass(:)       !! masses (new order)
+      real(dp), allocatable, private :: kmat(:)       !! K, upper triangle, storage layout
+      real(dp), allocatable, private :: cmat(:)       !! C, upper triangle, storage layout
+      real(dp), allocatable, private :: fac(:)        !! Cholesky factor U of K^ = U' U
+      real(dp), allocatable, private :: kd(:)         !! device stiffness in the factor
+      real(dp), allocatable, private :: errcol(:)     !! estimated update error per column
+      real(dp), allocatable, private :: w1(:), w2(:)  !! work vectors (permutations)
+      real(dp), allocatable, private :: xv(:)         !! update vector, zero between calls
+   end type spd_system
+
+   interface
+      subroutine dpotrf(uplo, n, a, lda, info)
+         import :: dp
+         character(len=1), intent(in) :: uplo
+         integer, intent(in) :: n, lda
+         real(dp), intent(inout) :: a(lda, *)
+         integer, intent(out) :: info
+      end subroutine dpotrf
+      subroutine dpotf2(uplo, n, a, lda, info)
+         import :: dp
+         character(len=1), intent(in) :: uplo
+         integer, intent(in) :: n, lda
+         real(dp), intent(inout) :: a(lda, *)
+         integer, intent(out) :: info
+      end subroutine dpotf2
+      subroutine dpbtf2(uplo, n, kd, ab, ldab, info)
+         import :: dp
+         character(len=1), intent(in) :: uplo
+         integer, intent(in) :: n, kd, ldab
+         real(dp), intent(inout) :: ab(ldab, *)
+         integer, intent(out) :: info
+      end subroutine dpbtf2
+      subroutine dtrsv(uplo, trans, diag, n, a, lda, x, incx)
+         import :: dp
+         character(len=1), intent(in) :: uplo, trans, diag
+         integer, intent(in) :: n, lda, incx
+         real(dp), intent(in) :: a(lda, *)
+         real(dp), intent(inout) :: x(*)
+      end subroutine dtrsv
+      subroutine dpbtrf(uplo, n, kd, ab, ldab, info)
+         import :: dp
+         character(len=1), intent(in) :: uplo
+         integer, intent(in) :: n, kd, ldab
+         real(dp), intent(inout) :: ab(ldab, *)
+         integer, intent(out) :: info
+      end subroutine dpbtrf
+      subroutine dpbtrs(uplo, n, kd, nrhs, ab, ldab, b, ldb, info)
+         import :: dp
+         character(len=1), intent(in) :: uplo
+         integer, intent(in) :: n, kd, nrhs, ldab, ldb
+         real(dp), intent(in) :: ab(ldab, *)
+         real(dp), intent(inout) :: b(ldb, *)
+         integer, intent(out) :: info
+      end subroutine dpbtrs
+      subroutine dsyrk(uplo, trans, n, k, alpha, a, lda, beta, c, ldc)
+         import :: dp
+         character(len=1), intent(in) :: uplo, trans
+         integer, intent(in) :: n, k, lda, ldc
+         real(dp), intent(in) :: alpha, beta
+         real(dp), intent(in) :: a(lda, *)
+         real(dp), intent(inout) :: c(ldc, *)
+      end subroutine dsyrk
+      subroutine dsymv(uplo, n, alpha, a, lda, x, incx, beta, y, incy)
+         import :: dp
+         character(len=1), intent(in) :: uplo
+         integer, intent(in) :: n, lda, incx, incy
+         real(dp), intent(in) :: alpha, beta
+         real(dp), intent(in) :: a(lda, *), x(*)
+         real(dp), intent(inout) :: y(*)
+      end subroutine dsymv
+      subroutine dsbmv(uplo, n, k, alpha, a, lda, x, incx, beta, y, incy)
+         import :: dp
+         character(len=1), intent(in) :: uplo
+         integer, intent(in) :: n, k, lda, incx, incy
+         real(dp), intent(in) :: alpha, beta
+         real(dp), intent(in) :: a(lda, *), x(*)
+         real(dp), intent(inout) :: y(*)
+      end subroutine dsbmv
+   end interface
+
+contains
+
+   !> Set up the system: graph, ordering, storage, K and C. Allocates everything the
+   !> other procedures use; the factor is made by spd_factor.
+   subroutine spd_setup(sys, mass, spring_i, spring_j, spring_k, dev_i, dev_j, error, &
+                        a0, a1, dashpot_i, dashpot_j, dashpot_c, path, budget, method)
+      type(spd_system), intent(out) :: sys       !! the system
+      real(dp), intent(in) :: mass(:)            !! masses [kg], one per DOF (n = size)
+      integer, intent(in) :: spring_i(:)         !! first node of each spring (0..n, 0 = table)
+      integer, intent(in) :: spring_j(:)         !! second node of each spring (0..n)
+      real(dp), intent(in) :: spring_k(:)        !! spring stiffness [N/m], >= 0
+      integer, intent(in) :: dev_i(:)            !! first node of each device (0..n)
+      integer, intent(in) :: dev_j(:)            !! second node of each device (0..n)
+      type(error_type), allocatable, intent(out) :: error !! invalid input
+      real(dp), intent(in), optional :: a0       !! C = a0 M + ... [1/s], default 0
+      real(dp), intent(in), optional :: a1       !! C = ... + a1 K + ... [s], default 0
+      integer, intent(in), optional :: dashpot_i(:)  !! first node of each dashpot (0..n)
+      integer, intent(in), optional :: dashpot_j(:)  !! second node of each dashpot (0..n)
+      real(dp), intent(in), optional :: dashpot_c(:) !! dashpot coefficient [N s/m], >= 0
+      integer, intent(in), optional :: path      !! spd_auto (default), spd_dense or spd_banded
+      real(dp), intent(in), optional :: budget   !! allowed estimated update error, default 1e-12
+      integer, intent(in), optional :: method    !! spd_choose (default), spd_rank_one, spd_refactor
+      integer, allocatable :: ei(:), ej(:), di(:), dj(:)
+      real(dp), allocatable :: dc(:)
+      real(dp) :: ca0, ca1
+      integer :: n, ns, nd, nc, ne, i, d, a, b, kbw, mode
+
+      n = size(mass)
+      ns = size(spring_i)
+      nd = size(dev_i)
+      ca0 = 0.0_dp
+      ca1 = 0.0_dp
+      if (present(a0)) ca0 = a0
+      if (present(a1)) ca1 = a1
+      mode = spd_auto
+      if (present(path)) mode = path
+      if (present(dashpot_i) .and. present(dashpot_j) .and. present(dashpot_c)) then
+         di = dashpot_i
+         dj = dashpot_j
+         dc = dashpot_c
+      else if (present(dashpot_i) .or. present(dashpot_j) .or. present(dashpot_c)) then
+         call fatal_error(error, "spd_setup: dashpot_i, dashpot_j and dashpot_c go together")
+         return
+      else
+         allocate (di(0), dj(0), dc(0))
+      end if
+      nc = size(di)
+
+      if (n < 1) then
+         call fatal_error(error, "spd_setup: the structure has no DOF (size(mass) = 0)")
+         return
+      end if
+      do i = 1, n
+         if (.not. (mass(i) > 0.0_dp .and. ieee_is_finite(mass(i)))) then
+            call fatal_error(error, "spd_setup: mass("//trim(fmt_int(i))//") = "//trim(fmt_real(mass(i)))// &
+                             " must be finite and > 0")
+            return
+         end if
+      end do
+      if (size(spring_j) /= ns .or. size(spring_k) /= ns) then
+         call fatal_error(error, "spd_setup: spring_i, spring_j and spring_k differ in size")
+         return
+      end if
+      if (size(dev_j) /= nd) then
+         call fatal_error(error, "spd_setup: dev_i and dev_j differ in size")
+         return
+      end if
+      if (size(dj) /= nc .or. size(dc) /= nc) then
+         call fatal_error(error, "spd_setup: dashpot_i, dashpot_j and dashpot_c differ in size")
+         return
+      end if
+      call check_links("spring", spring_i, spring_j, spring_k, n, error)
+      if (allocated(error)) return
+      call check_links("device", dev_i, dev_j, [(0.0_dp, i=1, nd)], n, error)
+      if (allocated(error)) return
+      call check_links("dashpot", di, dj, dc, n, error)
+      if (allocated(error)) return
+      if (.not. (ca0 >= 0.0_dp .and. ieee_is_finite(ca0))) then
+         call fatal_error(error, "spd_setup: a0 = "//trim(fmt_real(ca0))//" must be finite and >= 0")
+         return
+      end if
+      if (.not. (ca1 >= 0.0_dp .and. ieee_is_finite(ca1))) then
+         call fatal_error(error, "spd_setup: a1 = "//trim(fmt_real(ca1))//" must be finite and >= 0")
+         return
+      end if
+      if (mode /= spd_auto .and. mode /= spd_dense .and. mode /= spd_banded) then
+         call fatal_error(error, "spd_setup: path = "//trim(fmt_int(mode))//" is not spd_auto, spd_dense &
+                          &or spd_banded")
+         return
+      end if
+      if (present(method)) then
+         if (method /= spd_choose .and. method /= spd_rank_one .and. method /= spd_refactor) then
+            call fatal_error(error, "spd_setup: method = "//trim(fmt_int(method))//" is not spd_choose, &
+                             &spd_rank_one or spd_refactor")
+            return
+         end if
+         sys%method = method
+      end if
+      if (present(budget)) then
+         if (.not. (budget > 0.0_dp)) then
+            call fatal_error(error, "spd_setup: budget = "//trim(fmt_real(budget))//" must be > 0")
+            return
+         end if
+         sys%budget = budget
+      end if
+
+      ! the graph: springs, devices and dashpots between two DOFs
+      ne = ns + nd + nc
+      allocate (ei(ne), ej(ne))
+      ei = [spring_i, dev_i, di]
+      ej = [spring_j, dev_j, dj]
+      allocate (sys%perm(n), sys%inv(n))
+      call rcm_order(n, ei, ej, sys%perm)
+      do i = 1, n
+         sys%inv(sys%perm(i)) = i
+      end do
+      kbw = graph_bandwidth(ei, ej, sys%inv)
+      if (mode == spd_auto) then
+         ! dense where it is faster: a few DOFs (a band nearly as wide as the matrix is no
+         ! slower than dense storage: bench/banded.sh wide)
+         mode = spd_banded
+         if (n <= spd_dense_max_n) mode = spd_dense
+      end if
+      sys%n = n
+      sys%nd = nd
+      sys%dense = mode == spd_dense
+      if (sys%dense) then
+         sys%perm = [(i, i=1, n)]
+         sys%inv = sys%perm
+         sys%kb = n - 1
+         sys%ld = n
+         sys%sj = n
+         sys%off = -n
+      else
+         sys%kb = kbw
+         sys%ld = kbw + 1
+         sys%sj = kbw
+         sys%off = 0
+      end if
+
+      allocate (sys%mass(n), sys%kmat(sys%ld*n), sys%cmat(sys%ld*n), sys%fac(sys%ld*n))
+      allocate (sys%kd(nd), sys%errcol(n), sys%w1(n), sys%w2(n), sys%xv(n))
+      allocate (sys%dlo(nd), sys%dhi(nd), sys%dorder(nd))
+      sys%mass = mass(sys%perm)
+      sys%kmat = 0.0_dp
+      sys%cmat = 0.0_dp
+      sys%fac = 0.0_dp
+      sys%kd = 0.0_dp
+      sys%errcol = 0.0_dp
+      sys%w1 = 0.0_dp
+      sys%w2 = 0.0_dp
+      sys%xv = 0.0_dp
+      do i = 1, ns
+         call add_link(sys, sys%kmat, spring_i(i), spring_j(i), spring_k(i))
+      end do
+      ! C = a0 M + a1 K + dashpots
+      sys%cmat = ca1*sys%kmat
+      do i = 1, n
+         a = idx(sys, i, i)
+         sys%cmat(a) = sys%cmat(a) + ca0*sys%mass(i)
+      end do
+      do i = 1, nc
+         call add_link(sys, sys%cmat, di(i), dj(i), dc(i))
+      end do
+      do d = 1, nd
+         a = 0
+         b = 0
+         if (dev_i(d) > 0) a = sys%inv(dev_i(d))
+         if (dev_j(d) > 0) b = sys%inv(dev_j(d))
+         if (a == 0) then
+            a = b
+            b = 0
+         end if
+         if (b > 0 .and. b < a) then
+            i = a; a = b; b = i
+         end if
+         sys%dlo(d) = a
+         sys%dhi(d) = b
+      end do
+      call sort_devices(sys)
+   end subroutine spd_setup
+
+   !> Check the nodes and coefficients of a list of two-node elements.
+   subroutine check_links(what, ni, nj, coef, n, error)
+      character(len=*), intent(in) :: what
+      integer, intent(in) :: ni(:), nj(:)
+      real(dp), intent(in) :: coef(:)
+      integer, intent(in) :: n
+      type(error_type), allocatable, intent(out) :: error
+      integer :: e
+
+      do e = 1, size(ni)
+         if (ni(e) < 0 .or. ni(e) > n .or. nj(e) < 0 .or. nj(e) > n) then
+            call fatal_error(error, "spd_setup: "//what//" "//trim(fmt_int(e))//" joins nodes "// &
+                             trim(fmt_int(ni(e)))//" and "//trim(fmt_int(nj(e)))//", outside 0.."// &
+                             trim(fmt_int(n)))
+            return
+         end if
+         if (ni(e) == nj(e)) then
+            call fatal_error(error, "spd_setup: "//what//" "//trim(fmt_int(e))//" joins node "// &
+                             trim(fmt_int(ni(e)))//" to itself")
+            return
+         end if
+         if (.not. (coef(e) >= 0.0_dp .and. ieee_is_finite(coef(e)))) then
+            call fatal_error(error, "spd_setup: "//what//" "//trim(fmt_int(e))//" has the coefficient "// &
+                             trim(fmt_real(coef(e)))//", which must be finite and >= 0")
+            return
+         end if
+      end do
+   end subroutine check_links
+
+   !> Add a two-node element of coefficient k between old nodes i and j (0 = table).
+   subroutine add_link(sys, mat, i, j, k)
+      type(spd_system), intent(in) :: sys
+      real(dp), intent(inout) :: mat(:)
+      integer, intent(in) :: i, j
+      real(dp), intent(in) :: k
+      integer :: a, b, t
+
+      a = 0
+      b = 0
+      if (i > 0) a = sys%inv(i)
+      if (j > 0) b = sys%inv(j)
+      if (a > 0) mat(idx(sys, a, a)) = mat(idx(sys, a, a)) + k
+      if (b > 0) mat(idx(sys, b, b)) = mat(idx(sys, b, b)) + k
+      if (a > 0 .and. b > 0) then
+         if (a > b) then
+            t = a; a = b; b = t
+         end if
+         mat(idx(sys, a, b)) = mat(idx(sys, a, b)) - k
+      end if
+   end subroutine add_link
+
+   !> Devices by decreasing last column (insertion into buckets by column).
+   subroutine sort_devices(sys)
+      type(spd_system), intent(inout) :: sys
+      integer, allocatable :: cnt(:)
+      integer :: d, c, pos
+
+      allocate (cnt(0:sys%n + 1))
+      cnt = 0
+      do d = 1, sys%nd
+         c = max(sys%dlo(d), sys%dhi(d))
+         cnt(c) = cnt(c) + 1
+      end do
+      ! start of each column's bucket, columns n..1
+      pos = 1
+      do c = sys%n, 1, -1
+         d = cnt(c)
+         cnt(c) = pos
+         pos = pos + d
+      end do
+      do d = 1, sys%nd
+         c = max(sys%dlo(d), sys%dhi(d))
+         sys%dorder(cnt(c)) = d
+         cnt(c) = cnt(c) + 1
+      end do
+   end subroutine sort_devices
+
+   !> Position of U(i, j), i <= j, in the storage.
+   pure integer function idx(sys, i, j)
+      type(spd_system), intent(in) :: sys
+      integer, intent(in) :: i, j
+
+      idx = i + j*sys%sj + sys%off
+   end function idx
+
+   !> Factor K^ = K + c1 C + c0 M + sum_d kd_d b_d b_d' from scratch.
+   subroutine spd_factor(sys, c0, c1, kd, error)
+      type(spd_system), intent(inout) :: sys     !! the system (set up)
+      real(dp), intent(in) :: c0                 !! coefficient of M, >= 0
+      real(dp), intent(in) :: c1                 !! coefficient of C, >= 0
+      real(dp), intent(in) :: kd(:)              !! device stiffness, one per device, >= 0
+      type(error_type), allocatable, intent(out) :: error !! bad input, K^ not positive definite
+      integer :: d
+
+      if (.not. allocated(sys%fac)) then
+         call fatal_error(error, "spd_factor: the system is not set up (call spd_setup)")
+         return
+      end if
+      if (.not. (c0 >= 0.0_dp .and. c1 >= 0.0_dp .and. ieee_is_finite(c0) .and. ieee_is_finite(c1))) then
+         call fatal_error(error, "spd_factor: c0 = "//trim(fmt_real(c0))//" and c1 = "//trim(fmt_real(c1))// &
+                          " must be finite and >= 0")
+         return
+      end if
+      if (size(kd) /= sys%nd) then
+         call fatal_error(error, "spd_factor: "//trim(fmt_int(size(kd)))//" device stiffnesses given for "// &
+                          trim(fmt_int(sys%nd))//" devices")
+         return
+      end if
+      do d = 1, sys%nd
+         call check_kd("spd_factor", d, kd(d), error)
+         if (allocated(error)) return
+      end do
+      sys%c0 = c0
+      sys%c1 = c1
+      sys%kd(:) = kd
+      sys%span = huge(1.0_dp)
+      call full_factor(sys, error)
+   end subroutine spd_factor
+
+   subroutine check_kd(where, d, kd, error)
+      character(len=*), intent(in) :: where
+      integer, intent(in) :: d
+      real(dp), intent(in) :: kd
+      type(error_type), allocatable, intent(out) :: error
+
+      if (.not. (kd >= 0.0_dp .and. ieee_is_finite(kd))) then
+         call fatal_error(error, where//": device "//trim(fmt_int(d))//" stiffness "//trim(fmt_real(kd))// &
+                          " must be finite and >= 0")
+      end if
+   end subroutine check_kd
+
+   !> Factor from column 1; resets the error estimate.
+   subroutine full_factor(sys, error)
+      type(spd_system), intent(inout) :: sys
+      type(error_type), allocatable, intent(out) :: error
+
+      sys%stats%factorizations = sys%stats%factorizations + 1
+      sys%errcol = 0.0_dp
+      call refactor_from(sys, 1, error)
+   end subroutine full_factor
+
+   !> Recompute the factor from column p on (columns before p are kept): assemble columns
+   !> p..n of K^, subtract the rows of U above p (U22' U22 = A22 - U12' U12), factor.
+   subroutine refactor_from(sys, p, error)
+      type(spd_system), intent(inout) :: sys
+      integer, intent(in) :: p
+      type(error_type), allocatable, intent(out) :: error
+      integer :: i, j, l, k, m, d, a, b, n, kb, info
+      real(dp) :: s, e
+
+      n = sys%n
+      kb = sys%kb
+      sys%factored = .false.
+      associate (fac => sys%fac, kmat => sys%kmat, cmat => sys%cmat)
+         do j = p, n
+            do i = max(p, j - kb), j
+               k = idx(sys, i, j)
+               fac(k) = kmat(k) + sys%c1*cmat(k)
+            end do
+            k = idx(sys, j, j)
+            fac(k) = fac(k) + sys%c0*sys%mass(j)
+         end do
+         do m = 1, sys%nd
+            d = sys%dorder(m)
+            a = sys%dlo(d)
+            b = sys%dhi(d)
+            if (max(a, b) < p) exit
+            if (sys%kd(d) == 0.0_dp) cycle
+            if (a >= p) fac(idx(sys, a, a)) = fac(idx(sys, a, a)) + sys%kd(d)
+            if (b > 0) then
+               fac(idx(sys, b, b)) = fac(idx(sys, b, b)) + sys%kd(d)
+               if (a >= p) fac(idx(sys, a, b)) = fac(idx(sys, a, b)) - sys%kd(d)
+            end if
+         end do
+         do j = p, n
+            sys%w2(j) = fac(idx(sys, j, j))
+         end do
+         if (p > 1) then
+            if (sys%dense) then
+               call dsyrk('U', 'T', n - p + 1, p - 1, -1.0_dp, fac(idx(sys, 1, p)), n, 1.0_dp, &
+                          fac(idx(sys, p, p)), n)
+            else
+               do j = p, min(n, p + kb - 1)
+                  do i = p, j
+                     s = 0.0_dp
+                     do l = max(1, j - kb), p - 1
+                        s = s + fac(idx(sys, l, i))*fac(idx(sys, l, j))
+                     end do
+                     k = idx(sys, i, j)
+                     fac(k) = fac(k) - s
+                  end do
+               end do
+            end if
+         end if
+         ! the unblocked kernels where the blocked drivers would choose them anyway (dpbtrf
+         ! for a band <= 64) or lose to them (dpotrf below 64): no ilaenv query per call
+         if (sys%dense .and. n - p + 1 <= unblocked_max) then
+            call dpotf2('U', n - p + 1, fac(idx(sys, p, p)), n, info)
+         else if (sys%dense) then
+            call dpotrf('U', n - p + 1, fac(idx(sys, p, p)), n, info)
+         else if (kb <= unblocked_max) then
+            call dpbtf2('U', n - p + 1, kb, fac(idx(sys, p, p) - kb), sys%ld, info)
+         else
+            call dpbtrf('U', n - p + 1, kb, fac(idx(sys, p, p) - kb), sys%ld, info)
+         end if
+      end associate
+      if (info /= 0) then
+         k = info + p - 1
+         call fatal_error(error, "the effective stiffness is not positive definite (pivot of DOF "// &
+                          trim(fmt_int(sys%perm(min(max(k, 1), n))))//")")
+         return
+      end if
+      ! a pivot at the level of the rounding error of the factorization: numerically singular
+      do j = p, n
+         s = sys%fac(idx(sys, j, j))
+         if (s*s <= singular_tol*(min(kb, j - 1) + 1)*sys%w2(j)) then
+            call fatal_error(error, "the effective stiffness is numerically singular: the pivot of DOF "// &
+                             trim(fmt_int(sys%perm(j)))//" is "//trim(fmt_real(s*s))//" for a diagonal of "// &
+                             trim(fmt_real(sys%w2(j)))//" (not positive definite to working precision)")
+            return
+         end if
+      end do
+      ! the recomputed columns inherit the error of the rows of U above them
+      e = 0.0_dp
+      if (p > 1) e = maxval(sys%errcol(max(1, p - kb):p - 1))
+      sys%errcol(p:n) = e
+      sys%factored = .true.
+   end subroutine refactor_from
+
+   !> Change the stiffness of one device to kd and update the factor accordingly.
+   subroutine spd_update_device(sys, d, kd, error)
+      type(spd_system), intent(inout) :: sys     !! the system (factored)
+      integer, intent(in) :: d                   !! device, 1..number of devices
+      real(dp), intent(in) :: kd                 !! its new stiffness, >= 0
+      type(error_type), allocatable, intent(out) :: error !! bad input, not factored, K^ not SPD
+      integer :: p
+      logical :: ok
+
+      if (.not. sys%factored) then
+         call fatal_error(error, "spd_update_device: the system is not factored (call spd_factor)")
+         return
+      end if
+      if (d < 1 .or. d > sys%nd) then
+         call fatal_error(error, "spd_update_device: device "//trim(fmt_int(d))//" is not in 1.."// &
+                          trim(fmt_int(sys%nd)))
+         return
+      end if
+      call check_kd("spd_update_device", d, kd, error)
+      if (allocated(error)) return
+      if (kd == sys%kd(d)) return
+      p = sys%dlo(d)
+      if (prefer_refactor(sys, cost_refactor(sys, p), cost_update(sys, p))) then
+         sys%kd(d) = kd
+         sys%stats%partial = sys%stats%partial + 1
+         call refactor_from(sys, p, error)
+      else
+         call modify(sys, d, kd, ok)
+         if (.not. ok) call full_factor(sys, error)
+      end if
+   end subroutine spd_update_device
+
+   !> Change the stiffness of every device to kd(:) and update the factor: rank-one updates
+   !> (the stiffnesses that grew first, then downdates), or a refactorization from the first
+   !> changed column when that costs fewer operations.
+   subroutine spd_update_devices(sys, kd, error)
+      type(spd_system), intent(inout) :: sys     !! the system (factored)
+      real(dp), intent(in) :: kd(:)              !! new device stiffness, one per device, >= 0
+      type(error_type), allocatable, intent(out) :: error !! bad input, not factored, K^ not SPD
+      integer :: d, p, pass
+      real(dp) :: cost
+      logical :: ok
+
+      if (.not. sys%factored) then
+         call fatal_error(error, "spd_update_devices: the system is not factored (call spd_factor)")
+         return
+      end if
+      if (size(kd) /= sys%nd) then
+         call fatal_error(error, "spd_update_devices: "//trim(fmt_int(size(kd)))// &
+                          " device stiffnesses given for "//trim(fmt_int(sys%nd))//" devices")
+         return
+      end if
+      p = sys%n + 1
+      cost = 0.0_dp
+      do d = 1, sys%nd
+         call check_kd("spd_update_devices", d, kd(d), error)
+         if (allocated(error)) return
+         if (kd(d) == sys%kd(d)) cycle
+         p = min(p, sys%dlo(d))
+         cost = cost + cost_update(sys, sys%dlo(d))
+      end do
+      if (p > sys%n) return
+      if (prefer_refactor(sys, cost_refactor(sys, p), cost)) then
+         sys%kd(:) = kd
+         sys%stats%partial = sys%stats%partial + 1
+         call refactor_from(sys, p, error)
+         return
+      end if
+      do pass = 1, 2
+         do d = 1, sys%nd
+            if (kd(d) == sys%kd(d)) cycle
+            if ((pass == 1) .neqv. (kd(d) > sys%kd(d))) cycle
+            call modify(sys, d, kd(d), ok)
+            if (.not. ok) then
+               sys%kd(:) = kd
+               call full_factor(sys, error)
+               return
+            end if
+         end do
+      end do
+   end subroutine spd_update_devices
+
+   !> Rank-one update or downdate of the factor for device d's stiffness becoming kd. A
+   !> downdate that loses its pivot, or any modification that would exceed the error budget,
+   !> is abandoned (ok false, counted): the caller refactors.
+   subroutine modify(sys, d, kd, ok)
+      type(spd_system), intent(inout) :: sys
+      integer, intent(in) :: d
+      real(dp), intent(in) :: kd
+      logical, intent(out) :: ok
+      real(dp) :: delta
+      integer :: status
+
+      delta = kd - sys%kd(d)
+      sys%kd(d) = kd
+      call rank_one(sys, sys%dlo(d), sys%dhi(d), delta, status)
+      ok = status == 0
+      select case (status)
+      case (0)
+         if (delta > 0.0_dp) then
+            sys%stats%updates = sys%stats%updates + 1
+         else
+            sys%stats%downdates = sys%stats%downdates + 1
+         end if
+      case (1)
+         sys%stats%fallbacks = sys%stats%fallbacks + 1
+      case default
+         sys%stats%refreshes = sys%stats%refreshes + 1
+      end select
+   end subroutine modify
+
+   !> U' U + delta v v' -> U' U, v = e_a - e_b (e_a when b = 0), a < b: hyperbolic
+   !> (delta < 0) or circular (delta > 0) rotations in the mixed form, column a to n,
+   !> touching the band only. The rotations stop early once the rest of the update vector
+   !> is negligible: when every remaining entry x_j satisfies |x_j| <= tau U_jj, the
+   !> neglected x x' is at most tau^2 = eps/4 relative to the diagonal (below rounding). In a
+   !> diagonally dominant K^ (inertia c0 M against springs, as at Newmark's small steps) the
+   !> change of the factor decays geometrically along the band, so an update costs a few
+   !> decay lengths, not n. status: 0 done; 1 abandoned, a pivot collapsed (the downdate
+   !> alone loses more than the budget); 2 abandoned, the accumulated error estimate would
+   !> exceed the budget. An abandoned modification leaves the factor partly modified and
+   !> marked not factored.
+   subroutine rank_one(sys, a, b, delta, status)
+      type(spd_system), intent(inout) :: sys
+      integer, intent(in) :: a, b
+      real(dp), intent(in) :: delta
+      integer, intent(out) :: status
+      real(dp) :: x, xk, ukk, s, ratio, c, ci, e, u
+      integer :: k, j, jmax, last, kk, ij, n, kb, sj
+      logical :: up
+
+      status = 0
+      n = sys%n
+      kb = sys%kb
+      sj = sys%sj
+      up = delta > 0.0_dp
+      x = sqrt(abs(delta))
+      associate (fac => sys%fac, xv => sys%xv, errcol => sys%errcol)
+         xv(a) = x
+         if (b > 0) xv(b) = -x
+         last = max(a, b)
+         k = a
+         do while (k <= last)
+            xk = xv(k)
+            if (xk == 0.0_dp) then
+               k = k + 1
+               cycle
+            end if
+            kk = idx(sys, k, k)
+            ukk = fac(kk)
+            if (abs(xk) <= truncate_tol*ukk) then
+               if (negligible(sys, k + 1, min(last, k + kb))) then
+                  do j = k, min(last, k + kb)
+                     errcol(j) = errcol(j) + truncate_tol**2
+                     xv(j) = 0.0_dp
+                  end do
+                  exit
+               end if
+            end if
+            xv(k) = 0.0_dp
+            s = xk/ukk
+            if (up) then
+               ratio = 1.0_dp + s*s
+            else
+               ratio = (1.0_dp - s)*(1.0_dp + s)
+            end if
+            e = (errcol(k) + unit_error)/ratio
+            if (.not. (ratio > 0.0_dp .and. e <= sys%budget)) then
+               status = 2
+               if (.not. (ratio > 0.0_dp .and. unit_error <= sys%budget*ratio)) status = 1
+               xv(k:min(n, k + kb)) = 0.0_dp
+               sys%factored = .false.
+               return
+            end if
+            errcol(k) = e
+            c = sqrt(ratio)
+            ci = 1.0_dp/c
+            fac(kk) = ukk*c
+            jmax = min(n, k + kb)
+            ij = kk
+            if (up) then
+               do j = k + 1, jmax
+                  ij = ij + sj
+                  u = (fac(ij) + s*xv(j))*ci
+                  fac(ij) = u
+                  xv(j) = c*xv(j) - s*u
+               end do
+            else
+               do j = k + 1, jmax
+                  ij = ij + sj
+                  u = (fac(ij) - s*xv(j))*ci
+                  fac(ij) = u
+                  xv(j) = c*xv(j) - s*u
+               end do
+            end if
+            last = max(last, jmax)
+            k = k + 1
+         end do
+      end associate
+      ! columns touched, and their running average (the cost model's length of an update)
+      k = min(k, n + 1) - a
+      sys%stats%update_columns = sys%stats%update_columns + k
+      sys%span = 0.875_dp*sys%span + 0.125_dp*real(k, dp)
+   end subroutine rank_one
+
+   !> Whether every entry of the update vector in columns j1..j2 is negligible.
+   pure logical function negligible(sys, j1, j2)
+      type(spd_system), intent(in) :: sys
+      integer, intent(in) :: j1, j2
+      integer :: j
+
+      negligible = .false.
+      do j = j1, j2
+         if (abs(sys%xv(j)) > truncate_tol*sys%fac(idx(sys, j, j))) return
+      end do
+      negligible = .true.
+   end function negligible
+
+   !> Whether to refactor rather than modify, by the method or the operation counts.
+   pure logical function prefer_refactor(sys, refactor, modify)
+      type(spd_system), intent(in) :: sys
+      real(dp), intent(in) :: refactor, modify
+
+      select case (sys%method)
+      case (spd_rank_one)
+         prefer_refactor = .false.
+      case (spd_refactor)
+         prefer_refactor = .true.
+      case default
+         prefer_refactor = refactor < modify
+      end select
+   end function prefer_refactor
+
+   !> Sums over the columns k = p..n of min(kb, n - k) and of its square.
+   pure subroutine band_sums(n, kb, p, s1, s2)
+      integer, intent(in) :: n, kb, p
+      real(dp), intent(out) :: s1, s2
+      real(dp) :: m, b
+
+      m = real(n - p, dp)
+      b = real(kb, dp)
+      if (m <= b) then
+         s1 = m*(m + 1.0_dp)/2.0_dp
+         s2 = m*(m + 1.0_dp)*(2.0_dp*m + 1.0_dp)/6.0_dp
+      else
+         s1 = b*(b + 1.0_dp)/2.0_dp + (m - b)*b
+         s2 = b*(b + 1.0_dp)*(2.0_dp*b + 1.0_dp)/6.0_dp + (m - b)*b*b
+      end if
+   end subroutine band_sums
+
+   !> Operations of one rank-one modification from column p: n - p + 1 columns, or as many
+   !> as the recent updates touched before their change decayed below rounding.
+   pure real(dp) function cost_update(sys, p)
+      type(spd_system), intent(in) :: sys
+      integer, intent(in) :: p
+      real(dp) :: cols
+
+      cols = min(real(sys%n - p + 1, dp), sys%span)
+      cost_update = cols*(w_update + real(min(sys%kb, sys%n - p), dp))
+   end function cost_update
+
+   !> Operations of a refactorization from column p (the rows above p included).
+   pure real(dp) function cost_refactor(sys, p)
+      type(spd_system), intent(in) :: sys
+      integer, intent(in) :: p
+      real(dp) :: s1, s2, r, c
+
+      call band_sums(sys%n, sys%kb, p, s1, s2)
+      r = real(min(sys%kb, p - 1), dp)
+      c = real(min(sys%kb, sys%n - p + 1), dp)
+      cost_refactor = w_factor*real(sys%n - p + 1, dp) + 2.0_dp*s1 + s2 + r*c*c
+   end function cost_refactor
+
+   !> Solve K^ x = b with the current factor; b is overwritten by x (original DOF order).
+   subroutine spd_solve(sys, b, error)
+      type(spd_system), intent(inout) :: sys     !! the system (factored)
+      real(dp), intent(inout) :: b(:)            !! right-hand side on entry, solution on exit
+      type(error_type), allocatable, intent(out) :: error !! not factored, wrong size
+      integer :: i, info
+
+      if (.not. sys%factored) then
+         call fatal_error(error, "spd_solve: the system is not factored (call spd_factor)")
+         return
+      end if
+      if (size(b) /= sys%n) then
+         call fatal_error(error, "spd_solve: right-hand side of size "//trim(fmt_int(size(b)))// &
+                          " for "//trim(fmt_int(sys%n))//" DOFs")
+         return
+      end if
+      if (sys%dense) then
+         ! U' U x = b: two triangular solves (dpotrs's work without its level-3 call overhead)
+         call dtrsv('U', 'T', 'N', sys%n, sys%fac, sys%ld, b, 1)
+         call dtrsv('U', 'N', 'N', sys%n, sys%fac, sys%ld, b, 1)
+      else
+         do i = 1, sys%n
+            sys%w1(i) = b(sys%perm(i))
+         end do
+         call dpbtrs('U', sys%n, sys%kb, 1, sys%fac, sys%ld, sys%w1, sys%n, info)
+         do i = 1, sys%n
+            b(sys%perm(i)) = sys%w1(i)
+         end do
+      end if
+   end subroutine spd_solve
+
+   !> y = alpha K x + beta y (original DOF order; y is not read when beta = 0).
+   subroutine spd_k_matvec(sys, x, y, alpha, beta)
+      type(spd_system), intent(inout) :: sys     !! the system (set up)
+      real(dp), intent(in) :: x(:)               !! vector, size n
+      real(dp), intent(inout) :: y(:)            !! result, size n
+      real(dp), intent(in) :: alpha              !! factor of K x
+      real(dp), intent(in) :: beta               !! factor of the incoming y
+
+      call band_matvec(sys, sys%kmat, x, y, alpha, beta)
+   end subroutine spd_k_matvec
+
+   !> y = alpha C x + beta y (original DOF order; y is not read when beta = 0).
+   subroutine spd_c_matvec(sys, x, y, alpha, beta)
+      type(spd_system), intent(inout) :: sys     !! the system (set up)
+      real(dp), intent(in) :: x(:)               !! vector, size n
+      real(dp), intent(inout) :: y(:)            !! result, size n
+      real(dp), intent(in) :: alpha              !! factor of C x
+      real(dp), intent(in) :: beta               !! factor of the incoming y
+
+      call band_matvec(sys, sys%cmat, x, y, alpha, beta)
+   end subroutine spd_c_matvec
+
+   subroutine band_matvec(sys, mat, x, y, alpha, beta)
+      type(spd_system), intent(inout) :: sys
+      real(dp), intent(in) :: mat(:)
+      real(dp), intent(in) :: x(:)
+      real(dp), intent(inout) :: y(:)
+      real(dp), intent(in) :: alpha, beta
+      integer :: i
+
+      if (sys%dense) then
+         if (beta == 0.0_dp) y = 0.0_dp
+         call dsymv('U', sys%n, alpha, mat, sys%ld, x, 1, beta, y, 1)
+         return
+      end if
+      do i = 1, sys%n
+         sys%w1(i) = x(sys%perm(i))
+      end do
+      call dsbmv('U', sys%n, sys%kb, 1.0_dp, mat, sys%ld, sys%w1, 1, 0.0_dp, sys%w2, 1)
+      if (beta == 0.0_dp) then
+         do i = 1, sys%n
+            y(sys%perm(i)) = alpha*sys%w2(i)
+         end do
+      else
+         do i = 1, sys%n
+            y(sys%perm(i)) = alpha*sys%w2(i) + beta*y(sys%perm(i))
+         end do
+      end if
+   end subroutine band_matvec
+
+   !> Number of DOFs.
+   pure integer function spd_size(sys)
+      type(spd_system), intent(in) :: sys !! the system
+
+      spd_size = sys%n
+   end function spd_size
+
+   !> Half-bandwidth of the stored matrices in the RCM ordering (n - 1 when dense).
+   pure integer function spd_bandwidth(sys)
+      type(spd_system), intent(in) :: sys !! the system
+
+      spd_bandwidth = sys%kb
+   end function spd_bandwidth
+
+   !> Whether the system is stored dense.
+   pure logical function spd_is_dense(sys)
+      type(spd_system), intent(in) :: sys !! the system
+
+      spd_is_dense = sys%dense
+   end function spd_is_dense
+
+   !> Stiffness of device d in the current factor.
+   pure real(dp) function spd_device_kd(sys, d)
+      type(spd_system), intent(in) :: sys !! the system
+      integer, intent(in) :: d            !! device
+
+      spd_device_kd = sys%kd(d)
+   end function spd_device_kd
+
+   !> Largest estimated backward error that updates have added to the factor, relative to
+   !> the pivots (0 after a fresh factorization; kept below the budget).
+   pure real(dp) function spd_error_estimate(sys)
+      type(spd_system), intent(in) :: sys !! the system
+
+      spd_error_estimate = 0.0_dp
+      if (sys%n > 0) spd_error_estimate = maxval(sys%errcol)
+   end function spd_error_estimate
+
+end module fd_banded

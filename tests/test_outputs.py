@@ -1,0 +1,200 @@
+"""Outputs that batch runs can trust: the CSV and the summary of one run land as a pair
+(never one run's CSV beside another run's summary), a failed write is an error naming the
+file with earlier outputs untouched, no temporary file is left behind (also on SIGTERM and
+SIGINT); the executable's command line (--list/--index, --version, --help)."""
+
+from __future__ import annotations
+
+import json
+import os
+import signal
+import subprocess
+import time
+from pathlib import Path
+
+import frictiondyn
+import numpy as np
+import pytest
+from conftest import deck_text
+
+EXE = frictiondyn.executable()
+
+
+def oscillator(n_dof: int, duration: float, name: str = "same", every: int = 1) -> dict:
+    """n_dof masses in a chain under a harmonic table motion; output every dt1 step."""
+    return {
+        "model": {"n_dof": n_dof, "mass": [100.0] * n_dof},
+        "springs": {"n_springs": n_dof, "node_i": list(range(1, n_dof + 1)),
+                    "node_j": list(range(n_dof)), "k": [4.0e4] * n_dof},
+        "damping": {"damping_type": "rayleigh", "rayleigh_a0": 0.2},
+        "excitation": {"excitation_type": "harmonic", "amplitude": 0.01, "frequency": 2.0,
+                       "dt_record": 0.01, "duration": duration},
+        "integration": {"n1": 2},
+        "output": {"name": name, "output_every": every},
+    }
+
+
+def pair_is_consistent(outdir: Path, name: str = "same") -> tuple[int, int]:
+    """The CSV and the summary of `name` come from one run: the CSV's columns and rows are
+    those the summary announces (n_dof, samples). Returns (n_dof, samples)."""
+    summ = json.loads((outdir / f"{name}.summary.json").read_text())
+    lines = (outdir / f"{name}.csv").read_text().splitlines()
+    ncol = len(lines[0].split(","))
+    assert ncol == 2 + 3 * summ["n_dof"], (ncol, summ["n_dof"])
+    assert len(lines) - 1 == summ["samples"], (len(lines) - 1, summ["samples"])
+    return summ["n_dof"], summ["samples"]
+
+
+def leftovers(outdir: Path) -> list[str]:
+    return sorted(p.name for p in outdir.iterdir() if p.name.startswith("."))
+
+
+def test_two_executables_writing_one_name_never_leave_a_mixed_pair(tmp_path):
+    """Two different runs (1 DOF, 2 s; 3 DOF, 1.5 s) write the same output name at the same
+    time, 60 times: every time the pair on disk is one run's CSV with that run's summary,
+    and no temporary or lock file is left."""
+    a, b = tmp_path / "a.nml", tmp_path / "b.nml"
+    a.write_text(deck_text(oscillator(1, 2.0)))
+    b.write_text(deck_text(oscillator(3, 1.5)))
+    out = tmp_path / "out"
+    seen = set()
+    for _ in range(60):
+        procs = [subprocess.Popen([EXE, str(d)], cwd=tmp_path, stdout=subprocess.DEVNULL,
+                                  stderr=subprocess.PIPE) for d in (a, b)]
+        for p in procs:
+            assert p.wait() == 0, p.stderr.read()
+            p.stderr.close()
+        seen.add(pair_is_consistent(out))
+        assert leftovers(out) == []
+    assert seen <= {(1, 401), (3, 301)}
+
+
+def test_threads_writing_one_name_through_the_library(tmp_path):
+    """The same from one process: the library's writer in threads (through the executable
+    is covered above; here many writers share a process, as the extension's users do)."""
+    from concurrent.futures import ThreadPoolExecutor
+
+    a, b = tmp_path / "a.nml", tmp_path / "b.nml"
+    a.write_text(deck_text(oscillator(1, 0.5)))
+    b.write_text(deck_text(oscillator(2, 0.4)))
+
+    def one(d):
+        return subprocess.run([EXE, str(d)], cwd=tmp_path, capture_output=True).returncode
+
+    with ThreadPoolExecutor(8) as pool:
+        assert set(pool.map(one, [a, b] * 40)) == {0}
+    pair_is_consistent(tmp_path / "out")
+    assert leftovers(tmp_path / "out") == []
+
+
+@pytest.fixture
+def small_fs(tmp_path):
+    """A 160 KiB tmpfs (mounted as root); unmounted afterwards."""
+    if os.geteuid() != 0:
+        pytest.skip("mounting a tmpfs needs root (CI runs as root)")
+    mnt = tmp_path / "fs"
+    mnt.mkdir()
+    r = subprocess.run(["mount", "-t", "tmpfs", "-o", "size=160k", "tmpfs", str(mnt)],
+                       capture_output=True, text=True)
+    if r.returncode != 0:
+        pytest.skip(f"cannot mount a tmpfs here: {r.stderr.strip()}")
+    try:
+        yield mnt
+    finally:
+        subprocess.run(["umount", "-l", str(mnt)], check=False)
+
+
+def test_full_file_system_fails_with_a_message_and_keeps_earlier_outputs(tmp_path, small_fs):
+    """A first run fits; a second run of the same name does not: exit status 1, the message
+    names the file and says the disk is full, the first run's pair is untouched, no
+    temporary file is left."""
+    deck = tmp_path / "run.nml"
+    g = oscillator(1, 1.0, name="run")
+    g["output"]["dir"] = str(small_fs)
+    deck.write_text(deck_text(g))
+    first = subprocess.run([EXE, str(deck)], cwd=tmp_path, capture_output=True, text=True)
+    assert first.returncode == 0, first.stderr
+    before = {p.name: p.read_bytes() for p in small_fs.iterdir()}
+    assert set(before) == {"run.csv", "run.summary.json"}
+    g["excitation"]["duration"] = 20.0  # 2001 rows of 5 columns: about 250 KB
+    deck.write_text(deck_text(g))
+    second = subprocess.run([EXE, str(deck)], cwd=tmp_path, capture_output=True, text=True)
+    assert second.returncode == 1
+    assert "frictiondyn: error:" in second.stderr
+    assert "No space left on device" in second.stderr
+    assert f"cannot write '{small_fs}/.run.csv." in second.stderr
+    after = {p.name: p.read_bytes() for p in small_fs.iterdir()}
+    assert after == before
+
+
+@pytest.mark.parametrize("sig", [signal.SIGTERM, signal.SIGINT])
+def test_signal_while_writing_leaves_no_temporary_file(tmp_path, sig):
+    """A run with a large history (60 DOF, every dt1 step: about 180 MB) is stopped by the
+    signal while it writes its CSV: the process dies of that signal, the temporary files
+    are gone, the earlier outputs of the name are untouched."""
+    g = oscillator(60, 0.05, name="big")
+    (tmp_path / "big.nml").write_text(deck_text(g))
+    assert subprocess.run([EXE, "big.nml"], cwd=tmp_path, capture_output=True).returncode == 0
+    out = tmp_path / "out"
+    before = {p.name: p.read_bytes() for p in out.iterdir()}
+    g["excitation"]["duration"] = 40.0
+    g["integration"]["n1"] = 10
+    (tmp_path / "big.nml").write_text(deck_text(g))
+    p = subprocess.Popen([EXE, "big.nml"], cwd=tmp_path, stdout=subprocess.DEVNULL,
+                         stderr=subprocess.DEVNULL)
+    deadline = time.monotonic() + 60
+    while time.monotonic() < deadline and p.poll() is None:
+        tmp = [f for f in out.iterdir() if f.name.startswith(".big.csv.")]
+        if tmp and tmp[0].stat().st_size > 1_000_000:
+            break
+        time.sleep(0.01)
+    assert p.poll() is None, "the run ended before it was stopped"
+    p.send_signal(sig)
+    assert p.wait(30) == -sig
+    assert leftovers(out) == []
+    assert {f.name: f.read_bytes() for f in out.iterdir()} == before
+
+
+def test_list_and_index(tmp_path):
+    """--list/--index run line index+1 of the list (paths relative to the list's folder);
+    an index past the end and an empty line are errors naming the list and the line."""
+    (tmp_path / "decks").mkdir()
+    for i, n in enumerate((1, 2, 3)):
+        g = oscillator(n, 0.3, name=f"run{i}")
+        (tmp_path / "decks" / f"d{i}.nml").write_text(deck_text(g))
+    (tmp_path / "list.txt").write_text("decks/d0.nml\ndecks/d1.nml\n\ndecks/d2.nml\n")
+    work = tmp_path / "w"
+    work.mkdir()
+    r = subprocess.run([EXE, "--list", str(tmp_path / "list.txt"), "--index", "1"], cwd=work,
+                       capture_output=True, text=True)
+    assert r.returncode == 0, r.stderr
+    assert pair_is_consistent(work / "out", "run1")[0] == 2
+    alone = subprocess.run([EXE, str(tmp_path / "decks" / "d1.nml")], cwd=tmp_path,
+                           capture_output=True, text=True)
+    assert alone.returncode == 0
+    assert (work / "out" / "run1.csv").read_bytes() == (tmp_path / "out" / "run1.csv").read_bytes()
+    r = subprocess.run([EXE, "--list", "list.txt", "--index", "2"], cwd=tmp_path,
+                       capture_output=True, text=True)
+    assert r.returncode == 1 and "line 3 (--index 2) is empty" in r.stderr
+    r = subprocess.run([EXE, "--list", "list.txt", "--index", "9"], cwd=tmp_path,
+                       capture_output=True, text=True)
+    assert r.returncode == 1 and "has only 4 line(s)" in r.stderr and "line 10" in r.stderr
+    for bad in (["--list", "list.txt"], ["--index", "1"], ["--list", "list.txt", "--index", "-1"],
+                ["a.nml", "b.nml"], ["--frobnicate"]):
+        r = subprocess.run([EXE, *bad], cwd=tmp_path, capture_output=True, text=True)
+        assert r.returncode == 2 and "usage:" in r.stderr, bad
+
+
+def test_version_and_help():
+    r = subprocess.run([EXE, "--version"], capture_output=True, text=True)
+    assert r.returncode == 0 and r.stdout.strip() == f"frictiondyn {frictiondyn.__version__}"
+    r = subprocess.run([EXE, "--help"], capture_output=True, text=True)
+    assert r.returncode == 0 and "--list DECKS.txt --index I" in r.stdout
+
+
+def test_summary_names_the_version(run):
+    r = run(oscillator(1, 0.1), name="v")
+    assert r.returncode == 0
+    summ = json.loads((r.workdir / "out" / "same.summary.json").read_text())
+    assert summ["frictiondyn_version"] == frictiondyn.__version__
+    assert np.isfinite(summ["energy_residual_J"])

@@ -1,0 +1,876 @@
+!> Unit tests of the structure-aware effective stiffness (fd_banded, fd_rcm): the banded and
+!> dense paths against an independent dense assembly factored by LAPACK's dpotrf, every
+!> pattern of sticking devices reached by rank-one updates, long random sequences of
+!> updates and downdates, the fallback when a downdate loses its pivot, the partial
+!> refactorization, the RCM ordering and the matrix-vector products.
+module test_fd_banded
+   use, intrinsic :: iso_fortran_env, only: int64
+   use testdrive, only: new_unittest, unittest_type, error_type, check, test_failed
+   use fd_kinds, only: dp
+   use fd_error, only: lib_error => error_type
+   use fd_linalg, only: cholesky_factor, cholesky_solve, sym_matvec
+   use fd_rcm, only: rcm_order, graph_bandwidth
+   use fd_banded, only: spd_system, spd_setup, spd_factor, spd_update_device, spd_update_devices, &
+                        spd_solve, spd_k_matvec, spd_c_matvec, spd_bandwidth, spd_is_dense, &
+                        spd_error_estimate, spd_auto, spd_dense, spd_banded, spd_dense_max_n, &
+                        spd_choose, spd_rank_one, spd_refactor
+   implicit none
+   private
+
+   public :: collect_banded
+
+   !> A structure as lists: masses, springs, devices, dashpots, Rayleigh coefficients.
+   type :: problem
+      integer :: n = 0
+      real(dp), allocatable :: mass(:), sk(:), pc(:)
+      integer, allocatable :: si(:), sj(:), di(:), dj(:), pi(:), pj(:)
+      real(dp) :: a0 = 0.0_dp, a1 = 0.0_dp
+   end type problem
+
+   real(dp), parameter :: h = 0.01_dp                   !! step of the Newmark coefficients
+   real(dp), parameter :: c0 = 4.0_dp/h**2, c1 = 2.0_dp/h !! average acceleration
+
+contains
+
+   subroutine collect_banded(testsuite)
+      type(unittest_type), allocatable, intent(out) :: testsuite(:)
+
+      testsuite = [ &
+                  new_unittest("rcm chain bandwidth 1", test_rcm_chain), &
+                  new_unittest("rcm frame band", test_rcm_frame), &
+                  new_unittest("banded solve equals dense", test_solve), &
+                  new_unittest("matvecs equal dense", test_matvec), &
+                  new_unittest("every device pattern n=10", test_patterns), &
+                  new_unittest("long random update sequence", test_long_sequence), &
+                  new_unittest("fallback on lost pivot", test_fallback), &
+                  new_unittest("partial refactorization", test_partial), &
+                  new_unittest("update local when inertia dominates", test_local_update), &
+                  new_unittest("storage chosen by size", test_auto_path), &
+                  new_unittest("bad input named", test_errors) &
+                  ]
+   end subroutine collect_banded
+
+   ! ---------------------------------------------------------------- structures
+
+   subroutine seed(k)
+      integer, intent(in) :: k
+      integer :: m, i
+      integer, allocatable :: s(:)
+
+      call random_seed(size=m)
+      allocate (s(m))
+      s = 7919*k + [(104729*i, i=1, size(s))]
+      call random_seed(put=s)
+   end subroutine seed
+
+   real(dp) function urand(lo, hi)
+      real(dp), intent(in) :: lo, hi
+      real(dp) :: r
+
+      call random_number(r)
+      urand = lo + (hi - lo)*r
+   end function urand
+
+   !> A random permutation of 1..n (identity when not shuffled).
+   subroutine shuffle(n, q, mix)
+      integer, intent(in) :: n
+      integer, allocatable, intent(out) :: q(:)
+      logical, intent(in) :: mix
+      integer :: i, j, t
+
+      q = [(i, i=1, n)]
+      if (.not. mix) return
+      do i = n, 2, -1
+         j = 1 + int(urand(0.0_dp, real(i, dp)))
+         j = min(j, i)
+         t = q(i); q(i) = q(j); q(j) = t
+      end do
+   end subroutine shuffle
+
+   !> Shear building of n storeys, randomly numbered: a spring and a friction device in every
+   !> storey (the first to the table), dashpots in every third storey, Rayleigh damping.
+   subroutine chain(n, pb, mix)
+      integer, intent(in) :: n
+      type(problem), intent(out) :: pb
+      logical, intent(in) :: mix
+      integer, allocatable :: q(:)
+      integer :: k, below
+
+      call shuffle(n, q, mix)
+      pb%n = n
+      allocate (pb%mass(n), pb%sk(n), pb%si(n), pb%sj(n), pb%di(n), pb%dj(n))
+      allocate (pb%pi(0), pb%pj(0), pb%pc(0))
+      do k = 1, n
+         below = 0
+         if (k > 1) below = q(k - 1)
+         pb%mass(q(k)) = urand(1.0_dp, 2.0_dp)
+         pb%si(k) = q(k); pb%sj(k) = below; pb%sk(k) = urand(1.0e3_dp, 2.0e3_dp)
+         pb%di(k) = below; pb%dj(k) = q(k)
+         if (mod(k, 3) == 0) then
+            pb%pi = [pb%pi, q(k)]
+            pb%pj = [pb%pj, below]
+            pb%pc = [pb%pc, urand(1.0_dp, 5.0_dp)]
+         end if
+      end do
+      pb%a0 = 0.3_dp
+      pb%a1 = 2.0e-3_dp
+   end subroutine chain
+
+   !> Plane frame of nx columns and ny floors, randomly numbered: column springs (the first
+   !> floor to the table), beam springs, a friction brace along the diagonal of every bay and
+   !> a friction device in the first column of every storey.
+   subroutine frame(nx, ny, pb, mix)
+      integer, intent(in) :: nx, ny
+      type(problem), intent(out) :: pb
+      logical, intent(in) :: mix
+      integer, allocatable :: q(:)
+      integer :: c, f, below
+
+      pb%n = nx*ny
+      call shuffle(pb%n, q, mix)
+      allocate (pb%mass(pb%n), pb%sk(0), pb%si(0), pb%sj(0), pb%di(0), pb%dj(0))
+      allocate (pb%pi(0), pb%pj(0), pb%pc(0))
+      do f = 1, ny
+         do c = 1, nx
+            pb%mass(node(c, f)) = urand(1.0_dp, 2.0_dp)
+            below = 0
+            if (f > 1) below = node(c, f - 1)
+            pb%si = [pb%si, node(c, f)]; pb%sj = [pb%sj, below]; pb%sk = [pb%sk, urand(1.0e3_dp, 2.0e3_dp)]
+            if (c == 1) then
+               pb%di = [pb%di, node(c, f)]; pb%dj = [pb%dj, below]
+            end if
+            if (c < nx) then
+               pb%si = [pb%si, node(c, f)]; pb%sj = [pb%sj, node(c + 1, f)]
+               pb%sk = [pb%sk, urand(1.0e3_dp, 2.0e3_dp)]
+               below = 0
+               if (f > 1) below = node(c + 1, f - 1)
+               pb%di = [pb%di, node(c, f)]; pb%dj = [pb%dj, below]
+               if (mod(c + f, 2) == 0) then
+                  pb%pi = [pb%pi, node(c, f)]; pb%pj = [pb%pj, node(c + 1, f)]; pb%pc = [pb%pc, 3.0_dp]
+               end if
+            end if
+         end do
+      end do
+      pb%a0 = 0.2_dp
+      pb%a1 = 1.0e-3_dp
+   contains
+      integer function node(cc, ff)
+         integer, intent(in) :: cc, ff
+         node = q((ff - 1)*nx + cc)
+      end function node
+   end subroutine frame
+
+   !> Two chains side by side, not connected: two components of the graph.
+   subroutine two_chains(n1, n2, pb)
+      integer, intent(in) :: n1, n2
+      type(problem), intent(out) :: pb
+      type(problem) :: a, b
+
+      call chain(n1, a, .true.)
+      call chain(n2, b, .true.)
+      pb%n = n1 + n2
+      pb%mass = [a%mass, b%mass]
+      pb%si = [a%si, shift(b%si)]; pb%sj = [a%sj, shift(b%sj)]; pb%sk = [a%sk, b%sk]
+      pb%di = [a%di, shift(b%di)]; pb%dj = [a%dj, shift(b%dj)]
+      pb%pi = [a%pi, shift(b%pi)]; pb%pj = [a%pj, shift(b%pj)]; pb%pc = [a%pc, b%pc]
+      pb%a0 = a%a0
+      pb%a1 = a%a1
+   contains
+      function shift(v) result(w)
+         integer, intent(in) :: v(:)
+         integer :: w(size(v))
+         w = merge(v + n1, 0, v > 0)
+      end function shift
+   end subroutine two_chains
+
+   subroutine setup(pb, sys, path, method, budget, error)
+      type(problem), intent(in) :: pb
+      type(spd_system), intent(out) :: sys
+      integer, intent(in) :: path, method
+      real(dp), intent(in), optional :: budget
+      type(error_type), allocatable, intent(out) :: error
+      type(lib_error), allocatable :: err
+
+      call spd_setup(sys, pb%mass, pb%si, pb%sj, pb%sk, pb%di, pb%dj, err, a0=pb%a0, a1=pb%a1, &
+                     dashpot_i=pb%pi, dashpot_j=pb%pj, dashpot_c=pb%pc, path=path, method=method, &
+                     budget=budget)
+      call pass(err, error)
+   end subroutine setup
+
+   subroutine pass(err, error)
+      type(lib_error), allocatable, intent(in) :: err
+      type(error_type), allocatable, intent(out) :: error
+
+      if (allocated(err)) call test_failed(error, "library error: "//err%message)
+   end subroutine pass
+
+   ! ------------------------------------------------------- dense reference
+
+   subroutine add_link(a, i, j, k)
+      real(dp), intent(inout) :: a(:, :)
+      integer, intent(in) :: i, j
+      real(dp), intent(in) :: k
+
+      if (i > 0) a(i, i) = a(i, i) + k
+      if (j > 0) a(j, j) = a(j, j) + k
+      if (i > 0 .and. j > 0) then
+         a(i, j) = a(i, j) - k
+         a(j, i) = a(j, i) - k
+      end if
+   end subroutine add_link
+
+   subroutine dense_k(pb, a)
+      type(problem), intent(in) :: pb
+      real(dp), allocatable, intent(out) :: a(:, :)
+      integer :: e
+
+      allocate (a(pb%n, pb%n))
+      a = 0.0_dp
+      do e = 1, size(pb%si)
+         call add_link(a, pb%si(e), pb%sj(e), pb%sk(e))
+      end do
+   end subroutine dense_k
+
+   subroutine dense_c(pb, a)
+      type(problem), intent(in) :: pb
+      real(dp), allocatable, intent(out) :: a(:, :)
+      integer :: e, i
+
+      call dense_k(pb, a)
+      a = pb%a1*a
+      do i = 1, pb%n
+         a(i, i) = a(i, i) + pb%a0*pb%mass(i)
+      end do
+      do e = 1, size(pb%pi)
+         call add_link(a, pb%pi(e), pb%pj(e), pb%pc(e))
+      end do
+   end subroutine dense_c
+
+   !> x = (K + c1 C + c0 M + sum kd b b')^-1 b by an independent dense assembly and dpotrf.
+   subroutine dense_solve(pb, kd, b, x)
+      type(problem), intent(in) :: pb
+      real(dp), intent(in) :: kd(:), b(:)
+      real(dp), allocatable, intent(out) :: x(:)
+      real(dp), allocatable :: a(:, :), c(:, :)
+      integer :: i, d, info
+
+      call dense_k(pb, a)
+      call dense_c(pb, c)
+      a = a + c1*c
+      do i = 1, pb%n
+         a(i, i) = a(i, i) + c0*pb%mass(i)
+      end do
+      do d = 1, size(pb%di)
+         call add_link(a, pb%di(d), pb%dj(d), kd(d))
+      end do
+      call cholesky_factor(a, info)
+      x = b
+      call cholesky_solve(a, x)
+   end subroutine dense_solve
+
+   real(dp) function rel_diff(x, y)
+      real(dp), intent(in) :: x(:), y(:)
+
+      rel_diff = norm2(x - y)/norm2(y)
+   end function rel_diff
+
+   !> Solve with sys and with a fresh dense factor; their relative difference.
+   subroutine compare(pb, sys, kd, b, diff, error)
+      type(problem), intent(in) :: pb
+      type(spd_system), intent(inout) :: sys
+      real(dp), intent(in) :: kd(:), b(:)
+      real(dp), intent(out) :: diff
+      type(error_type), allocatable, intent(out) :: error
+      type(lib_error), allocatable :: err
+      real(dp), allocatable :: x(:), xref(:)
+
+      allocate (x(size(b)))
+      x(:) = b
+      call spd_solve(sys, x, err)
+      call pass(err, error)
+      if (allocated(error)) return
+      call dense_solve(pb, kd, b, xref)
+      diff = rel_diff(x, xref)
+   end subroutine compare
+
+   subroutine random_vector(n, b)
+      integer, intent(in) :: n
+      real(dp), allocatable, intent(out) :: b(:)
+      integer :: i
+
+      allocate (b(n))
+      do i = 1, n
+         b(i) = urand(-1.0_dp, 1.0_dp)
+      end do
+   end subroutine random_vector
+
+   !> A device stiffness of a sticking device: up to 25 times the inertia term c0 m.
+   real(dp) function stick_kd()
+      stick_kd = urand(1.0e4_dp, 1.0e6_dp)
+   end function stick_kd
+
+   ! ------------------------------------------------------------------ tests
+
+   !> A chain numbered at random comes back as a path; a two-component graph too.
+   subroutine test_rcm_chain(error)
+      type(error_type), allocatable, intent(out) :: error
+      type(problem) :: pb
+      type(spd_system) :: sys
+      integer, allocatable :: perm(:), inv(:), ei(:), ej(:)
+      integer :: i, trial, n
+
+      call seed(1)
+      do trial = 1, 5
+         n = 10*trial**2
+         call chain(n, pb, .true.)
+         ei = [pb%si, pb%di]
+         ej = [pb%sj, pb%dj]
+         allocate (perm(n), inv(n))
+         call rcm_order(n, ei, ej, perm)
+         inv = 0
+         inv(perm) = [(i, i=1, n)]
+         call check(error, all(inv > 0), "rcm_order does not return a permutation")
+         if (allocated(error)) return
+         call check(error, graph_bandwidth(ei, ej, [(i, i=1, n)]) > n/4, &
+                    "the random numbering should have a wide band")
+         if (allocated(error)) return
+         call check(error, graph_bandwidth(ei, ej, inv), 1)
+         if (allocated(error)) return
+         deallocate (perm, inv)
+      end do
+      call setup(pb, sys, spd_banded, spd_choose, error=error)
+      if (allocated(error)) return
+      call check(error, spd_bandwidth(sys), 1)
+      if (allocated(error)) return
+      call two_chains(30, 45, pb)
+      call setup(pb, sys, spd_banded, spd_choose, error=error)
+      if (allocated(error)) return
+      call check(error, spd_bandwidth(sys), 1)
+   end subroutine test_rcm_chain
+
+   !> A randomly numbered frame of nx columns gets a band of the order of nx: at most the
+   !> two widest consecutive level sets of the breadth-first search from a corner.
+   subroutine test_rcm_frame(error)
+      type(error_type), allocatable, intent(out) :: error
+      type(problem) :: pb
+      type(spd_system) :: sys
+      integer :: nx
+
+      call seed(2)
+      do nx = 2, 6
+         call frame(nx, 40, pb, .true.)
+         call setup(pb, sys, spd_banded, spd_choose, error=error)
+         if (allocated(error)) return
+         call check(error, spd_bandwidth(sys) >= nx .and. spd_bandwidth(sys) <= 2*nx, &
+                    "frame with columns and braces: band outside nx..2 nx")
+         if (allocated(error)) return
+      end do
+   end subroutine test_rcm_frame
+
+   !> Banded (RCM) and dense factors solve like an independent dense assembly, to 1e-12.
+   subroutine test_solve(error)
+      type(error_type), allocatable, intent(out) :: error
+      type(problem) :: pb
+      type(spd_system) :: sys
+      type(lib_error), allocatable :: err
+      real(dp), allocatable :: kd(:), b(:)
+      real(dp) :: diff, worst
+      integer :: trial, d, path
+
+      call seed(3)
+      worst = 0.0_dp
+      do trial = 1, 12
+         select case (mod(trial, 4))
+         case (0)
+            call chain(1 + 7*trial**2, pb, .true.)
+         case (1)
+            call frame(1 + mod(trial, 5), 3*trial, pb, .true.)
+         case (2)
+            call two_chains(trial, 3*trial, pb)
+         case default
+            call chain(trial, pb, .true.)
+         end select
+         allocate (kd(size(pb%di)))
+         do d = 1, size(kd)
+            kd(d) = merge(stick_kd(), 0.0_dp, urand(0.0_dp, 1.0_dp) < 0.5_dp)
+         end do
+         call random_vector(pb%n, b)
+         do path = spd_dense, spd_banded
+            call setup(pb, sys, path, spd_choose, error=error)
+            if (allocated(error)) return
+            call spd_factor(sys, c0, c1, kd, err)
+            call pass(err, error)
+            if (allocated(error)) return
+            call compare(pb, sys, kd, b, diff, error)
+            if (allocated(error)) return
+            worst = max(worst, diff)
+            call check(error, diff <= 1.0e-12_dp, "n = "//trim(itoa(pb%n))//": solve differs from dense by "// &
+                       trim(rtoa(diff)))
+            if (allocated(error)) return
+         end do
+         deallocate (kd)
+      end do
+   end subroutine test_solve
+
+   !> K x and C x (alpha, beta) equal the dense products, banded and dense storage.
+   subroutine test_matvec(error)
+      type(error_type), allocatable, intent(out) :: error
+      type(problem) :: pb
+      type(spd_system) :: sys
+      real(dp), allocatable :: kk(:, :), cc(:, :), x(:), y(:), y0(:), yref(:)
+      integer :: path, trial
+
+      call seed(4)
+      do trial = 1, 3
+         if (trial == 1) call chain(40, pb, .true.)
+         if (trial == 2) call frame(4, 9, pb, .true.)
+         if (trial == 3) call two_chains(5, 9, pb)
+         call dense_k(pb, kk)
+         call dense_c(pb, cc)
+         call random_vector(pb%n, x)
+         call random_vector(pb%n, y0)
+         do path = spd_dense, spd_banded
+            call setup(pb, sys, path, spd_choose, error=error)
+            if (allocated(error)) return
+            y = y0
+            call spd_k_matvec(sys, x, y, -0.7_dp, 2.0_dp)
+            yref = -0.7_dp*matmul(kk, x) + 2.0_dp*y0
+            call check(error, rel_diff(y, yref) <= 1.0e-14_dp, "K x differs: "//trim(rtoa(rel_diff(y, yref))))
+            if (allocated(error)) return
+            y = huge(1.0_dp)
+            call spd_c_matvec(sys, x, y, 1.5_dp, 0.0_dp)
+            yref = 1.5_dp*matmul(cc, x)
+            call check(error, rel_diff(y, yref) <= 1.0e-14_dp, "C x differs: "//trim(rtoa(rel_diff(y, yref))))
+            if (allocated(error)) return
+            ! the library's dense product agrees too (same upper triangle convention)
+            y = 0.0_dp
+            call sym_matvec(kk, x, y, 1.0_dp, 0.0_dp)
+            yref = y
+            call spd_k_matvec(sys, x, y, 1.0_dp, 0.0_dp)
+            call check(error, rel_diff(y, yref) <= 1.0e-14_dp, "K x differs from dsymv")
+            if (allocated(error)) return
+         end do
+      end do
+   end subroutine test_matvec
+
+   !> A 10-storey building with a device in every storey (the first to the table): all 2^10
+   !> patterns of sticking devices, reached one device at a time in Gray-code order by
+   !> rank-one updates and downdates, solve like a fresh dense factor to 1e-10.
+   subroutine test_patterns(error)
+      type(error_type), allocatable, intent(out) :: error
+      type(problem) :: pb
+      type(spd_system) :: sys
+      type(lib_error), allocatable :: err
+      real(dp), allocatable :: kon(:), kd(:), b(:)
+      real(dp) :: diff, worst
+      integer :: variant, t, d, path, method, ndev
+
+      call seed(5)
+      do variant = 1, 5
+         if (variant <= 4) then
+            call chain(10, pb, .true.)
+         else
+            call frame(2, 5, pb, .true.)  ! 10 DOFs, 10 devices: 2^10 patterns on a band of 2..4
+         end if
+         ndev = size(pb%di)
+         path = merge(spd_dense, spd_banded, variant == 3)
+         method = spd_rank_one
+         if (variant == 2) method = spd_choose
+         if (variant == 4) method = spd_refactor
+         allocate (kon(ndev))
+         do d = 1, ndev
+            kon(d) = stick_kd()
+         end do
+         allocate (kd(ndev))
+         kd = 0.0_dp
+         call random_vector(pb%n, b)
+         call setup(pb, sys, path, method, error=error)
+         if (allocated(error)) return
+         call spd_factor(sys, c0, c1, kd, err)
+         call pass(err, error)
+         if (allocated(error)) return
+         worst = 0.0_dp
+         do t = 1, 2**ndev - 1
+            d = 1 + trailz(t)
+            kd(d) = merge(0.0_dp, kon(d), kd(d) > 0.0_dp)
+            call spd_update_device(sys, d, kd(d), err)
+            call pass(err, error)
+            if (allocated(error)) return
+            call compare(pb, sys, kd, b, diff, error)
+            if (allocated(error)) return
+            worst = max(worst, diff)
+         end do
+         call check(error, worst <= 1.0e-10_dp, "variant "//trim(itoa(variant))//": a pattern differs from "// &
+                    "the dense factor by "//trim(rtoa(worst)))
+         if (allocated(error)) return
+         associate (s => sys%stats)
+            call check(error, s%updates + s%downdates + s%partial + s%fallbacks + s%refreshes, 2**ndev - 1)
+            if (allocated(error)) return
+            if (method == spd_rank_one) then
+               ! the rank-one path did the work (refactorizations only when the budget says so)
+               call check(error, s%updates >= 400 .and. s%downdates >= 400, "variant "//trim(itoa(variant))// &
+                          ": too few rank-one modifications: "//trim(itoa(s%updates))//" updates, "// &
+                          trim(itoa(s%downdates))//" downdates")
+               if (allocated(error)) return
+            end if
+            if (method == spd_refactor) then
+               call check(error, s%partial, 2**ndev - 1)
+               if (allocated(error)) return
+            end if
+         end associate
+         deallocate (kon, kd)
+      end do
+   end subroutine test_patterns
+
+   !> 20000 random changes of 1 to 3 devices of a braced frame (stiffness up or down, or a
+   !> device released): every 100 changes the factor still solves like a fresh one (1e-10),
+   !> and its error estimate stays within the budget.
+   subroutine test_long_sequence(error)
+      type(error_type), allocatable, intent(out) :: error
+      type(problem) :: pb
+      type(spd_system) :: sys
+      type(lib_error), allocatable :: err
+      real(dp), allocatable :: kd(:), b(:)
+      real(dp) :: diff, worst
+      integer :: t, j, d, ndev
+
+      call seed(6)
+      call frame(4, 15, pb, .true.)
+      ndev = size(pb%di)
+      allocate (kd(ndev))
+      do d = 1, ndev
+         kd(d) = stick_kd()
+      end do
+      call random_vector(pb%n, b)
+      call setup(pb, sys, spd_banded, spd_rank_one, error=error)
+      if (allocated(error)) return
+      call spd_factor(sys, c0, c1, kd, err)
+      call pass(err, error)
+      if (allocated(error)) return
+      worst = 0.0_dp
+      do t = 1, 20000
+         do j = 1, 1 + int(urand(0.0_dp, 2.999_dp))
+            d = 1 + min(ndev - 1, int(urand(0.0_dp, real(ndev, dp))))
+            if (urand(0.0_dp, 1.0_dp) < 0.3_dp) then
+               kd(d) = 0.0_dp
+            else
+               kd(d) = stick_kd()
+            end if
+         end do
+         call spd_update_devices(sys, kd, err)
+         call pass(err, error)
+         if (allocated(error)) return
+         if (mod(t, 100) == 0) then
+            call compare(pb, sys, kd, b, diff, error)
+            if (allocated(error)) return
+            worst = max(worst, diff)
+            call check(error, spd_error_estimate(sys) <= 1.0e-12_dp, "error estimate over the budget")
+            if (allocated(error)) return
+         end if
+      end do
+      call check(error, worst <= 1.0e-10_dp, "after a long sequence the factor differs from a fresh one by "// &
+                 trim(rtoa(worst)))
+      if (allocated(error)) return
+      call check(error, sys%stats%updates > 10000 .and. sys%stats%downdates > 10000, &
+                 "the sequence should be made of rank-one modifications")
+   end subroutine test_long_sequence
+
+   !> A device far stiffer than the rest of its row, then released: the downdate loses the
+   !> pivot (1e17: the diagonal was absorbed, positive definiteness is lost to round-off;
+   !> 1e14: ten digits cancel). Both fall back to a refactorization and solve to 1e-12. With
+   !> the check off (an unlimited budget) the 1e14 downdate goes through and is visibly
+   !> wrong (1e-8 and worse): the fallback is what keeps the answer right.
+   subroutine test_fallback(error)
+      type(error_type), allocatable, intent(out) :: error
+      type(problem) :: pb
+      type(spd_system) :: sys
+      type(lib_error), allocatable :: err
+      real(dp), allocatable :: kd(:), b(:)
+      real(dp) :: diff, big(2)
+      integer :: i, path
+
+      call seed(7)
+      call chain(10, pb, .true.)
+      allocate (kd(10))
+      call random_vector(pb%n, b)
+      big = [1.0e17_dp, 1.0e14_dp]
+      do path = spd_dense, spd_banded
+         do i = 1, 2
+            call setup(pb, sys, path, spd_rank_one, error=error)
+            if (allocated(error)) return
+            kd = 0.0_dp
+            call spd_factor(sys, c0, c1, kd, err)
+            call pass(err, error)
+            if (allocated(error)) return
+            call spd_update_device(sys, 4, big(i), err)
+            call pass(err, error)
+            if (allocated(error)) return
+            call spd_update_device(sys, 4, 0.0_dp, err)
+            call pass(err, error)
+            if (allocated(error)) return
+            call check(error, sys%stats%fallbacks, 1)
+            if (allocated(error)) return
+            call check(error, sys%stats%downdates, 0)
+            if (allocated(error)) return
+            call compare(pb, sys, kd, b, diff, error)
+            if (allocated(error)) return
+            call check(error, diff <= 1.0e-12_dp, "after the fallback: "//trim(rtoa(diff)))
+            if (allocated(error)) return
+            call check(error, spd_error_estimate(sys) == 0.0_dp, "a fresh factor has no update error")
+            if (allocated(error)) return
+         end do
+         ! the same 1e14 downdate without the accuracy check
+         call setup(pb, sys, path, spd_rank_one, budget=1.0_dp, error=error)
+         if (allocated(error)) return
+         call spd_factor(sys, c0, c1, kd, err)
+         call pass(err, error)
+         if (allocated(error)) return
+         call spd_update_device(sys, 4, big(2), err)
+         call pass(err, error)
+         if (allocated(error)) return
+         call spd_update_device(sys, 4, 0.0_dp, err)
+         call pass(err, error)
+         if (allocated(error)) return
+         call check(error, sys%stats%fallbacks == 0 .and. sys%stats%downdates == 1, &
+                    "with an unlimited budget the downdate should go through")
+         if (allocated(error)) return
+         call compare(pb, sys, kd, b, diff, error)
+         if (allocated(error)) return
+         call check(error, diff > 1.0e-8_dp, "an unchecked 1e14 downdate should be inaccurate, differs by "// &
+                    trim(rtoa(diff)))
+         if (allocated(error)) return
+      end do
+   end subroutine test_fallback
+
+   !> Several devices changed at once: the refactorization from the first changed column
+   !> (rows above it kept) solves like a fresh factor, on band and dense storage; on a long
+   !> chain, changes near the end of the ordering are made by refactoring the last columns.
+   subroutine test_partial(error)
+      type(error_type), allocatable, intent(out) :: error
+      type(problem) :: pb
+      type(spd_system) :: sys
+      type(lib_error), allocatable :: err
+      real(dp), allocatable :: kd(:), b(:)
+      real(dp) :: diff
+      integer :: path, t, d, ndev, trial
+
+      call seed(8)
+      do trial = 1, 2
+         if (trial == 1) call chain(200, pb, .true.)
+         if (trial == 2) call frame(5, 30, pb, .true.)
+         ndev = size(pb%di)
+         allocate (kd(ndev))
+         kd = 0.0_dp
+         call random_vector(pb%n, b)
+         do path = spd_dense, spd_banded
+            call setup(pb, sys, path, spd_refactor, error=error)
+            if (allocated(error)) return
+            call spd_factor(sys, c0, c1, kd, err)
+            call pass(err, error)
+            if (allocated(error)) return
+            do t = 1, 30
+               do d = 1, 4
+                  kd(1 + mod(7*t + 13*d, ndev)) = merge(0.0_dp, stick_kd(), mod(t + d, 3) == 0)
+               end do
+               call spd_update_devices(sys, kd, err)
+               call pass(err, error)
+               if (allocated(error)) return
+               call compare(pb, sys, kd, b, diff, error)
+               if (allocated(error)) return
+               call check(error, diff <= 1.0e-12_dp, "partial refactorization differs by "//trim(rtoa(diff)))
+               if (allocated(error)) return
+            end do
+            call check(error, sys%stats%partial, 30)
+            if (allocated(error)) return
+            call check(error, sys%stats%factorizations, 1)
+            if (allocated(error)) return
+         end do
+         deallocate (kd)
+      end do
+   end subroutine test_partial
+
+   !> In a 600-storey building at a Newmark step of 10 ms (c0 m is 30 times the storey
+   !> stiffness) the change of the factor from a device in the middle storey decays by about
+   !> that factor per storey: the update stops after a few storeys, and still solves like a
+   !> fresh factor. Without inertia (a static solve of a chain tied to the table at both
+   !> ends, so that no part of it floats) the change does not decay and the update runs to
+   !> the end of the chain.
+   subroutine test_local_update(error)
+      type(error_type), allocatable, intent(out) :: error
+      type(problem) :: pb
+      type(spd_system) :: sys
+      type(lib_error), allocatable :: err
+      real(dp), allocatable :: kd(:), b(:), x(:), xref(:), a(:, :)
+      real(dp) :: diff
+      integer :: trial, d, info
+      integer(int64) :: cols
+      integer, parameter :: n = 600, mid = 300
+
+      call seed(11)
+      call chain(n, pb, .false.)
+      pb%si = [pb%si, n]
+      pb%sj = [pb%sj, 0]
+      pb%sk = [pb%sk, 1.0e3_dp]
+      pb%a0 = 0.0_dp
+      pb%a1 = 0.0_dp
+      allocate (kd(n))
+      kd = 0.0_dp
+      call random_vector(n, b)
+      call setup(pb, sys, spd_banded, spd_rank_one, error=error)
+      if (allocated(error)) return
+      call spd_factor(sys, c0, c1, kd, err)
+      call pass(err, error)
+      if (allocated(error)) return
+      do trial = 1, 2
+         kd(mid) = merge(stick_kd(), 0.0_dp, trial == 1)
+         call spd_update_device(sys, mid, kd(mid), err)
+         call pass(err, error)
+         if (allocated(error)) return
+         call compare(pb, sys, kd, b, diff, error)
+         if (allocated(error)) return
+         call check(error, diff <= 1.0e-12_dp, "local update differs from dense by "//trim(rtoa(diff)))
+         if (allocated(error)) return
+      end do
+      call check(error, sys%stats%update_columns <= 2*10, "an update at the middle storey touched "// &
+                 trim(itoa(int(sys%stats%update_columns)))//" columns in two updates")
+      if (allocated(error)) return
+      ! static: K + kd b b' only
+      cols = sys%stats%update_columns
+      call spd_factor(sys, 0.0_dp, 0.0_dp, kd, err)
+      call pass(err, error)
+      if (allocated(error)) return
+      kd(mid) = stick_kd()
+      call spd_update_device(sys, mid, kd(mid), err)
+      call pass(err, error)
+      if (allocated(error)) return
+      call check(error, sys%stats%update_columns - cols >= n/2 - 1, "a static update touched only "// &
+                 trim(itoa(int(sys%stats%update_columns - cols)))//" columns")
+      if (allocated(error)) return
+      x = b
+      call spd_solve(sys, x, err)
+      call pass(err, error)
+      if (allocated(error)) return
+      call dense_k(pb, a)
+      do d = 1, n
+         call add_link(a, pb%di(d), pb%dj(d), kd(d))
+      end do
+      call cholesky_factor(a, info)
+      xref = b
+      call cholesky_solve(a, xref)
+      diff = rel_diff(x, xref)
+      call check(error, diff <= 1.0e-10_dp, "static update differs from dense by "//trim(rtoa(diff)))
+   end subroutine test_local_update
+
+   !> The automatic choice: dense for a few DOFs, band for a long chain.
+   subroutine test_auto_path(error)
+      type(error_type), allocatable, intent(out) :: error
+      type(problem) :: pb
+      type(spd_system) :: sys
+
+      call seed(9)
+      call chain(spd_dense_max_n, pb, .true.)
+      call setup(pb, sys, spd_auto, spd_choose, error=error)
+      if (allocated(error)) return
+      call check(error, spd_is_dense(sys), "a system of spd_dense_max_n DOFs should be dense")
+      if (allocated(error)) return
+      call chain(1000, pb, .true.)
+      call setup(pb, sys, spd_auto, spd_choose, error=error)
+      if (allocated(error)) return
+      call check(error, .not. spd_is_dense(sys), "a 1000-storey chain should be banded")
+      if (allocated(error)) return
+      call check(error, spd_bandwidth(sys), 1)
+   end subroutine test_auto_path
+
+   !> Bad input and misuse come back as errors naming what is wrong.
+   subroutine test_errors(error)
+      type(error_type), allocatable, intent(out) :: error
+      type(problem) :: pb
+      type(spd_system) :: sys
+      type(lib_error), allocatable :: err
+      real(dp), allocatable :: x(:)
+      integer :: path
+
+      call seed(10)
+      call chain(6, pb, .false.)
+      pb%mass(3) = 0.0_dp
+      call spd_setup(sys, pb%mass, pb%si, pb%sj, pb%sk, pb%di, pb%dj, err)
+      call expect(err, "mass(3)", error)
+      if (allocated(error)) return
+      pb%mass(3) = 1.0_dp
+      pb%sj(2) = 7
+      call spd_setup(sys, pb%mass, pb%si, pb%sj, pb%sk, pb%di, pb%dj, err)
+      call expect(err, "spring 2 joins nodes 2 and 7, outside 0..6", error)
+      if (allocated(error)) return
+      pb%sj(2) = 1
+      pb%sk(4) = -1.0_dp
+      call spd_setup(sys, pb%mass, pb%si, pb%sj, pb%sk, pb%di, pb%dj, err)
+      call expect(err, "spring 4 has the coefficient -1.0", error)
+      if (allocated(error)) return
+      pb%sk(4) = 1.0e3_dp
+      call spd_setup(sys, pb%mass, pb%si, pb%sj, pb%sk, pb%di, pb%dj, err, path=5)
+      call expect(err, "path = 5", error)
+      if (allocated(error)) return
+      do path = spd_dense, spd_banded
+         call spd_setup(sys, pb%mass, pb%si, pb%sj, pb%sk, pb%di, pb%dj, err, path=path)
+         call pass(err, error)
+         if (allocated(error)) return
+         x = [1.0_dp, 2.0_dp, 3.0_dp, 4.0_dp, 5.0_dp, 6.0_dp]
+         call spd_solve(sys, x, err)
+         call expect(err, "not factored", error)
+         if (allocated(error)) return
+         call spd_update_device(sys, 1, 1.0_dp, err)
+         call expect(err, "not factored", error)
+         if (allocated(error)) return
+         call spd_factor(sys, c0, c1, [1.0_dp], err)
+         call expect(err, "1 device stiffnesses given for 6 devices", error)
+         if (allocated(error)) return
+         call spd_factor(sys, c0, c1, [0.0_dp, 0.0_dp, -2.0_dp, 0.0_dp, 0.0_dp, 0.0_dp], err)
+         call expect(err, "device 3 stiffness -2.0", error)
+         if (allocated(error)) return
+         call spd_factor(sys, c0, c1, [(0.0_dp, path=1, 6)], err)
+         call pass(err, error)
+         if (allocated(error)) return
+         call spd_update_device(sys, 7, 1.0_dp, err)
+         call expect(err, "device 7 is not in 1..6", error)
+         if (allocated(error)) return
+      end do
+      ! a free-floating structure without inertia is singular: said so, not solved
+      pb%sj(1) = 2
+      pb%si(1) = 1
+      pb%sj(2) = 3
+      call spd_setup(sys, pb%mass, pb%si, pb%sj, pb%sk, pb%di(2:), pb%dj(2:), err, path=spd_banded)
+      call pass(err, error)
+      if (allocated(error)) return
+      call spd_factor(sys, 0.0_dp, 0.0_dp, [(0.0_dp, path=1, 5)], err)
+      call expect(err, "not positive definite", error)
+      if (allocated(error)) return
+      x = [1.0_dp, 2.0_dp, 3.0_dp, 4.0_dp, 5.0_dp, 6.0_dp]
+      call spd_solve(sys, x, err)
+      call expect(err, "not factored", error)
+   end subroutine test_errors
+
+   subroutine expect(err, text, error)
+      type(lib_error), allocatable, intent(in) :: err
+      character(len=*), intent(in) :: text
+      type(error_type), allocatable, intent(out) :: error
+
+      if (.not. allocated(err)) then
+         call test_failed(error, "expected an error containing '"//text//"'")
+      else if (index(err%message, text) == 0) then
+         call test_failed(error, "error '"//err%message//"' does not contain '"//text//"'")
+      end if
+   end subroutine expect
+
+   pure function itoa(i) result(s)
+      integer, intent(in) :: i
+      character(len=12) :: s
+      write (s, '(i0)') i
+   end function itoa
+
+   pure function rtoa(x) result(s)
+      real(dp), intent(in) :: x
+      character(len=12) :: s
+      write (s, '(es10.3)') x
+   end function rtoa
+
+end module test_fd_banded
