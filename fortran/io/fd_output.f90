@@ -479,7 +479,8 @@ contains
       subroutine modes_keys(name, m)
          character(len=*), intent(in) :: name
          type(modes_type), intent(in) :: m
-         integer :: j, i
+         character(len=:), allocatable :: list
+         integer :: j
          select case (m%status)
          case (modes_flexible)
             call kv('modes_'//name//'_status', '"flexible"')
@@ -498,12 +499,8 @@ contains
          call kr('periods_'//name//'_s', m%period)
          js = js//'  "mode_shapes_'//name//'": ['
          do j = 1, m%n
-            js = js//'['
-            do i = 1, size(m%shape, 1)
-               js = js//trim(json_real(m%shape(i, j)))
-               if (i < size(m%shape, 1)) js = js//', '
-            end do
-            js = js//']'
+            call json_list(m%shape(:, j), list)
+            js = js//list
             if (j < m%n) js = js//', '
          end do
          js = js//'],'//nl
@@ -544,13 +541,9 @@ contains
       subroutine kr(key, x)
          character(len=*), intent(in) :: key
          real(dp), intent(in) :: x(:)
-         integer :: k
-         js = js//'  "'//key//'": ['
-         do k = 1, size(x)
-            js = js//trim(json_real(x(k)))
-            if (k < size(x)) js = js//', '
-         end do
-         js = js//'],'//nl
+         character(len=:), allocatable :: list
+         call json_list(x, list)
+         js = js//'  "'//key//'": '//list//','//nl
       end subroutine kr
       subroutine ki(key, x)
          character(len=*), intent(in) :: key
@@ -577,6 +570,31 @@ contains
          if (j < res%ncol) line = line//','
       end do
    end subroutine history_header
+
+   !> A list of reals as JSON, '[x1, x2, ...]', built in one buffer (appending number by
+   !> number to a growing string copies it each time: quadratic for long lists).
+   pure subroutine json_list(x, text)
+      real(dp), intent(in) :: x(:)
+      character(len=:), allocatable, intent(out) :: text
+      character(len=:), allocatable :: buf
+      character(len=32) :: item
+      integer :: k, n, l
+
+      allocate (character(len=2 + 34*size(x)) :: buf)
+      buf(1:1) = '['
+      n = 1
+      do k = 1, size(x)
+         item = json_real(x(k))
+         l = len_trim(item)
+         buf(n + 1:n + l) = item(1:l)
+         n = n + l
+         if (k < size(x)) then
+            buf(n + 1:n + 2) = ', '
+            n = n + 2
+         end if
+      end do
+      text = buf(1:n)//']'
+   end subroutine json_list
 
    !> A real as JSON when it is defined, else null.
    pure function json_defined(x, defined) result(str)

@@ -8,7 +8,8 @@ module fd_matrices
    use fd_error, only: error_type, fatal_error, fmt_real
    use fd_model, only: model_type, damping_none, damping_stiffness, damping_rayleigh, law_hysteretic, &
                        system_stuck, system_free
-   use fd_linalg, only: generalized_eigen
+   use fd_linalg, only: generalized_eigen, lowest_eigen, lowest_eigen_band
+   use fd_rcm, only: rcm_order
    implicit none
    private
 
@@ -182,7 +183,8 @@ contains
    !> system_free: every device removed. A system with no free DOF is rigid (no mode); an
    !> eigenvalue below 1e-12 of the largest is a rigid-body mode (w = 0, infinite period).
    !> Shapes are expanded to every DOF and scaled so that the component of largest
-   !> magnitude is +1; the damping ratio of each mode is taken with the given C.
+   !> magnitude is +1; the damping ratio of each mode is taken with the given C. Only the
+   !> lowest nmax pairs are computed (LAPACK dsyevr on Mq^-1/2 Kq Mq^-1/2, Mq diagonal).
    subroutine natural_modes(model, k, c, system, nmax, modes, error)
       type(model_type), intent(in) :: model          !! the model
       real(dp), intent(in) :: k(:, :)                !! springs' stiffness
@@ -193,9 +195,9 @@ contains
       type(error_type), allocatable, intent(out) :: error !! LAPACK failure
       integer, allocatable :: grp(:)
       logical, allocatable :: linked(:)
-      real(dp), allocatable :: t(:, :), ks(:, :), kq(:, :), mq(:, :), cq(:, :), lam(:), z(:, :), phi(:)
+      real(dp), allocatable :: ks(:, :), kq(:, :), mq(:, :), cq(:, :), lam(:), z(:, :), phi(:), sq(:)
       real(dp) :: kd, big, w, pm, l, mtot
-      integer :: n, nq, i, j, d, ni, nj, imax
+      integer :: n, nq, i, j, d, ni, nj, imax, kfirst
 
       n = model%n_dof
       modes%system = system
@@ -222,32 +224,50 @@ contains
          allocate (modes%omega2(0), modes%period(0), modes%shape(n, 0), modes%mass_ratio(0), modes%xi(0))
          return
       end if
-      allocate (t(n, nq))
-      t = 0.0_dp
-      do i = 1, n
-         if (grp(i) /= 0) t(i, grp(i)) = 1.0_dp
+      ! Kq = T' K T, Cq = T' C T, Mq = T' M T by summing over the groups (T is 0/1: O(n^2))
+      allocate (kq(nq, nq), cq(nq, nq), mq(nq, nq))
+      kq = 0.0_dp; cq = 0.0_dp; mq = 0.0_dp
+      do j = 1, n
+         if (grp(j) == 0) cycle
+         do i = 1, n
+            if (grp(i) == 0) cycle
+            kq(grp(i), grp(j)) = kq(grp(i), grp(j)) + ks(i, j)
+            cq(grp(i), grp(j)) = cq(grp(i), grp(j)) + c(i, j)
+         end do
+         mq(grp(j), grp(j)) = mq(grp(j), grp(j)) + model%mass(j)
       end do
-      kq = matmul(transpose(t), matmul(ks, t))
-      cq = matmul(transpose(t), matmul(c, t))
-      allocate (mq(nq, nq))
-      mq = 0.0_dp
-      do i = 1, n
-         if (grp(i) /= 0) mq(grp(i), grp(i)) = mq(grp(i), grp(i)) + model%mass(i)
-      end do
-      allocate (lam(nq), z(nq, nq))
-      call generalized_eigen(kq, mq, lam, z, error)
-      if (allocated(error)) return
-      big = maxval(abs(lam))
-      modes%status = modes_flexible
+      ! M is diagonal in the reduced coordinates: the standard problem of Mq^-1/2 Kq Mq^-1/2,
+      ! whose lowest pairs alone are computed; z = Mq^-1/2 y is M-normalized
       modes%n = min(max(nmax, 0), nq)
+      allocate (sq(nq))
+      do i = 1, nq
+         sq(i) = 1.0_dp/sqrt(mq(i, i))
+      end do
+      do j = 1, nq
+         kq(:, j) = sq*kq(:, j)*sq(j)
+      end do
+      ! a rigid-body mode: an eigenvalue below 1e-12 of the largest (bounded by the norm)
+      big = 0.0_dp
+      do j = 1, nq
+         big = max(big, sum(abs(kq(:, j))))
+      end do
+      kfirst = max(modes%n, 1)
+      allocate (lam(kfirst), z(nq, kfirst))
+      call lowest_pairs(kq, kfirst, lam, z, error)
+      if (allocated(error)) return
+      do j = 1, kfirst
+         z(:, j) = sq*z(:, j)
+      end do
+      modes%status = modes_flexible
+      if (lam(1) <= 1.0e-12_dp*big) modes%status = modes_unrestrained
       allocate (modes%omega2(modes%n), modes%period(modes%n), modes%shape(n, modes%n), &
                 modes%mass_ratio(modes%n), modes%xi(modes%n), phi(n))
       mtot = sum(model%mass)
-      do j = 1, nq
-         if (lam(j) <= 1.0e-12_dp*big) modes%status = modes_unrestrained
-      end do
       do j = 1, modes%n
-         phi = matmul(t, z(:, j))
+         do i = 1, n
+            phi(i) = 0.0_dp
+            if (grp(i) /= 0) phi(i) = z(grp(i), j)
+         end do
          imax = maxloc(abs(phi), 1)
          phi = phi/phi(imax)
          modes%shape(:, j) = phi
@@ -266,6 +286,56 @@ contains
          end if
       end do
    end subroutine natural_modes
+
+   !> The k lowest eigenpairs of a symmetric matrix: in band storage after a reverse
+   !> Cuthill-McKee ordering when its bandwidth is small (a building: 1 to a few), O(n b^2);
+   !> as a dense matrix otherwise.
+   subroutine lowest_pairs(a, k, lambda, vec, error)
+      real(dp), intent(in) :: a(:, :)
+      integer, intent(in) :: k
+      real(dp), intent(out) :: lambda(:), vec(:, :)
+      type(error_type), allocatable, intent(out) :: error
+      integer, allocatable :: ei(:), ej(:), perm(:), inv(:)
+      real(dp), allocatable :: ab(:, :), vp(:, :)
+      integer :: n, i, j, ne, bw
+
+      n = size(a, 1)
+      ne = 0
+      do j = 1, n
+         do i = 1, j - 1
+            if (a(i, j) /= 0.0_dp) ne = ne + 1
+         end do
+      end do
+      allocate (ei(ne), ej(ne), perm(n), inv(n))
+      ne = 0
+      do j = 1, n
+         do i = 1, j - 1
+            if (a(i, j) == 0.0_dp) cycle
+            ne = ne + 1
+            ei(ne) = i; ej(ne) = j
+         end do
+      end do
+      call rcm_order(n, ei, ej, perm)
+      inv(perm) = [(i, i=1, n)]
+      bw = 0
+      do i = 1, ne
+         bw = max(bw, abs(inv(ei(i)) - inv(ej(i))))
+      end do
+      if (n < 32 .or. 4*bw > n) then
+         call lowest_eigen(a, k, lambda, vec, error)
+         return
+      end if
+      allocate (ab(bw + 1, n), vp(n, k))
+      ab = 0.0_dp
+      do j = 1, n
+         do i = max(1, j - bw), j
+            ab(bw + 1 + i - j, j) = a(perm(i), perm(j))
+         end do
+      end do
+      call lowest_eigen_band(ab, k, lambda, vp, error)
+      if (allocated(error)) return
+      vec(perm, :) = vp
+   end subroutine lowest_pairs
 
    !> The factor b of the stiffness-proportional part of C = a0 M + b K: psi = T xi / pi
    !> ('stiffness': T the given period, else the stuck first period), a1 ('rayleigh'), 0

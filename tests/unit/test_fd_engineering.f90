@@ -30,6 +30,7 @@ contains
       testsuite = [ &
                   new_unittest("uniform chain, free: closed-form periods and shapes", test_chain_free), &
                   new_unittest("uniform chain, stuck: a rigid link and hysteretic springs", test_chain_stuck), &
+                  new_unittest("long chain: the band eigensolver", test_chain_long), &
                   new_unittest("rigid and unrestrained systems", test_rigid), &
                   new_unittest("modal damping ratios of Rayleigh damping", test_rayleigh_xi), &
                   new_unittest("storey drifts and shears of a hand-computed state", test_storeys) &
@@ -122,6 +123,39 @@ contains
       if (allocated(error)) return
       call check_chain_modes(error, modes, 5, 1.0_dp, 'free chain')
    end subroutine test_chain_free
+
+   !> 80 floors, numbered from the roof down (the band path reorders them): every period,
+   !> and every shape up to its sign (two components of equal magnitude and opposite sign
+   !> make the sign of the "largest is +1" scaling depend on the numbering).
+   subroutine test_chain_long(error)
+      type(error_type), allocatable, intent(out) :: error
+      type(model_type) :: model
+      type(modes_type) :: modes
+      real(dp) :: w, phi(80), got(80)
+      integer :: i, j, r, n
+
+      n = 80
+      call chain(model, n, reshape([1, 0], [2, 1]), [law_velocity])
+      do i = 1, n   ! DOF i is floor n + 1 - i; spring i joins floor i to floor i - 1
+         model%spring_i(i) = n + 1 - i
+         model%spring_j(i) = merge(0, n + 2 - i, i == 1)
+      end do
+      call modes_of(model, system_free, modes, error)
+      if (allocated(error)) return
+      call check(error, modes%nq == n .and. modes%n == n, 'every mode')
+      if (allocated(error)) return
+      do r = 1, n
+         w = 2.0_dp*sqrt(k/m)*sin((2*r - 1)*pi/(2.0_dp*(2*n + 1)))
+         call check_close(error, modes%period(r), 2.0_dp*pi/w, 1.0e-11_dp, 'period, band path')
+         if (allocated(error)) return
+         phi = [(sin(j*(2*r - 1)*pi/(2*n + 1)), j=1, n)]
+         phi = phi/maxval(abs(phi))
+         got = modes%shape(n:1:-1, r)
+         got = got*sign(1.0_dp, dot_product(got, phi))
+         call check_close(error, maxval(abs(got - phi)), 0.0_dp, 1.0e-9_dp, 'shape, band path', absolute=.true.)
+         if (allocated(error)) return
+      end do
+   end subroutine test_chain_long
 
    subroutine test_chain_stuck(error)
       type(error_type), allocatable, intent(out) :: error
