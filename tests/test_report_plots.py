@@ -76,6 +76,8 @@ def test_units_and_names_from_the_deck(damped):
     assert fig.axes[0].get_title() == "" and fig.axes[0].get_ylabel() == "storey shear [kN]"
     with pytest.raises(ValueError, match="furlong"):
         plots.plot_acceleration(damped, 1, units="furlong")
+    with pytest.raises(TypeError, match="t_rang"):  # a misspelt option is not ignored
+        plots.plot_drift(damped, 1, t_rang=(0.0, 1.0))
 
 
 def test_profiles_over_the_height_are_the_summary_peaks(damped, bare):

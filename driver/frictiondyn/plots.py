@@ -15,7 +15,11 @@ returns the Figure; keyword options are common to all:
   N/kN/MN, acceleration m/s2/cm/s2/g, velocity m/s/cm/s/mm/s); SI by default;
 - ``labels``: legend names of the results (default: the deck's name); the deck's ``label``
   of each DOF, device and storey names panels and axes ("roof", "damper 2");
-- ``title``: the panel's title (``""`` for none; a descriptive one by default).
+- ``title``: the panel's title (``""`` for none; a descriptive one by default);
+- ``cycles`` (5) and ``max_points`` (5000; 0: no thinning), as above.
+
+The profiles take ``ax``, ``labels``, ``title``, ``units`` and ``dpi``. An unknown option is a
+TypeError naming it.
 
 Time histories: ``plot_acceleration``, ``plot_relative_velocity``, ``plot_phase``,
 ``plot_drift``, ``plot_storey_shear``, ``plot_base_shear``, ``plot_columns``; loops:
@@ -301,32 +305,50 @@ def _axis_label(result: Result, name: str, units: Units, describe: bool) -> str:
     return f"{text} [{units.name(unit)}]"
 
 
+@dataclass
+class _Options:
+    """The keyword options every time-history and loop plot takes (module docstring)."""
+
+    ax: Axes | None = None
+    t_range: TRange = None
+    labels: Sequence[str] | None = None
+    title: str | None = None
+    units: Units | str | None = None
+    dpi: int | None = None
+    cycles: int = _CYCLES
+    max_points: int = _MAX_POINTS
+
+    @classmethod
+    def of(cls, function: str, options: dict) -> _Options:
+        unknown = set(options) - set(cls.__dataclass_fields__)
+        if unknown:
+            known = ", ".join(cls.__dataclass_fields__)
+            raise TypeError(f"{function}() got unknown options {sorted(unknown)}; options: {known}")
+        return cls(**options)
+
+
 def _overlay(
     ax: Axes,
     results: list[Result],
-    names: list[str],
     x: str,
     y: str,
-    t_range: TRange,
-    units: Units,
+    opt: _Options,
     *,
     describe: bool = True,
     drawstyle: str = "default",
-    cycles: int = _CYCLES,
-    max_points: int = _MAX_POINTS,
     loop: bool = False,
 ) -> None:
     _check_column(results, x)
     _check_column(results, y)
-    for r, name in zip(results, names, strict=True):
-        m = window(r, _resolve(r, t_range, cycles))
-        fx = units.factor(r.units.get(x, ""))
-        fy = units.factor(r.units.get(y, ""))
-        xs, ys = r[x][m] * fx, r[y][m] * fy
+    units = Units.parse(opt.units)
+    for r, name in zip(results, _labels(results, opt.labels), strict=True):
+        m = window(r, _resolve(r, opt.t_range, opt.cycles))
+        xs = r[x][m] * units.factor(r.units.get(x, ""))
+        ys = r[y][m] * units.factor(r.units.get(y, ""))
         if not loop and drawstyle == "default":
-            xs, ys = thin(xs, ys, max_points)
-        elif loop and len(xs) > 4 * max_points > 0:
-            step = int(np.ceil(len(xs) / (4 * max_points)))
+            xs, ys = thin(xs, ys, opt.max_points)
+        elif loop and len(xs) > 4 * opt.max_points > 0:
+            step = int(np.ceil(len(xs) / (4 * opt.max_points)))
             xs, ys = xs[::step], ys[::step]
         ax.plot(xs, ys, label=name, linewidth=0.9, drawstyle=drawstyle)
     ax.set_xlabel(_axis_label(results[0], x, units, describe))
@@ -341,360 +363,160 @@ def _item_label(results: list[Result], kind: str, k: int) -> str:
     return names[k - 1] if 0 < k <= len(names) else f"{kind} {k}"
 
 
+def _plot(
+    function: str,
+    results: Results,
+    x: str,
+    y: str,
+    default_title: str,
+    path: PathLike,
+    options: dict,
+    *,
+    size: tuple[float, float] = _SIZE,
+    **overlay,
+) -> tuple[Figure, Axes, _Options]:
+    """One panel of y against x for each result, with the common options; saved when path."""
+    opt = _Options.of(function, options)
+    rs = _as_list(results)
+    _check_column(rs, y)
+    fig, ax = _axes(opt.ax, size)
+    _overlay(ax, rs, x, y, opt, **overlay)
+    _title(ax, opt.title, default_title)
+    return fig, ax, opt
+
+
 # --------------------------------------------------------------------------- time histories
 
 
 def plot_columns(
-    results: Results,
-    y: str,
-    path: PathLike = None,
-    *,
-    x: str = "t",
-    ax: Axes | None = None,
-    t_range: TRange = None,
-    labels: Sequence[str] | None = None,
-    title: str | None = None,
-    units: Units | str | None = None,
-    dpi: int | None = None,
-    cycles: int = _CYCLES,
-    max_points: int = _MAX_POINTS,
+    results: Results, y: str, path: PathLike = None, *, x: str = "t", **options
 ) -> Figure:
     """Column ``y`` against column ``x`` (default time) of each result, overlaid; the axes
     are named by the columns ("u1 [m]")."""
-    rs = _as_list(results)
-    fig, ax = _axes(ax)
-    u = Units.parse(units)
-    _overlay(
-        ax,
-        rs,
-        _labels(rs, labels),
-        x,
-        y,
-        t_range,
-        u,
-        describe=False,
-        cycles=cycles,
-        max_points=max_points,
-        loop=x != "t",
+    fig, _, opt = _plot(
+        "plot_columns", results, x, y, f"{y} vs {x}", path, options, describe=False, loop=x != "t"
     )
-    _title(ax, title, f"{y} vs {x}")
-    return _finish(fig, path, dpi)
+    return _finish(fig, path, opt.dpi)
 
 
-def _history(
-    results: Results,
-    column: str,
-    default_title: str,
-    path: PathLike,
-    ax: Axes | None,
-    t_range: TRange,
-    labels: Sequence[str] | None,
-    title: str | None,
-    units: Units | str | None,
-    dpi: int | None,
-    cycles: int,
-    max_points: int,
-    size: tuple[float, float] = _SIZE,
-    drawstyle: str = "default",
-) -> tuple[Figure, Axes, list[Result]]:
-    rs = _as_list(results)
-    fig, ax = _axes(ax, size)
-    _overlay(
-        ax,
-        rs,
-        _labels(rs, labels),
-        "t",
-        column,
-        t_range,
-        Units.parse(units),
-        drawstyle=drawstyle,
-        cycles=cycles,
-        max_points=max_points,
-    )
-    _title(ax, title, default_title)
-    return fig, ax, rs
-
-
-def plot_acceleration(
-    results: Results,
-    dof: int,
-    path: PathLike = None,
-    *,
-    ax: Axes | None = None,
-    t_range: TRange = None,
-    labels: Sequence[str] | None = None,
-    title: str | None = None,
-    units: Units | str | None = None,
-    dpi: int | None = None,
-    cycles: int = _CYCLES,
-    max_points: int = _MAX_POINTS,
-) -> Figure:
+def plot_acceleration(results: Results, dof: int, path: PathLike = None, **options) -> Figure:
     """Absolute acceleration of DOF ``dof`` (1-based) vs time, one line per result (the
     paper's Figs. 3a, 4a, 4b)."""
-    rs = _as_list(results)
-    _check_column(rs, f"aabs{dof}")
-    name = _item_label(rs, "dof", dof)
-    fig, _, _ = _history(
-        rs,
+    name = _item_label(_as_list(results), "dof", dof)
+    fig, _, opt = _plot(
+        "plot_acceleration",
+        results,
+        "t",
         f"aabs{dof}",
         f"{name}: absolute acceleration",
         path,
-        ax,
-        t_range,
-        labels,
-        title,
-        units,
-        dpi,
-        cycles,
-        max_points,
+        options,
     )
-    return _finish(fig, path, dpi)
+    return _finish(fig, path, opt.dpi)
 
 
 def plot_relative_velocity(
-    results: Results,
-    device: int,
-    path: PathLike = None,
-    *,
-    ax: Axes | None = None,
-    t_range: TRange = None,
-    labels: Sequence[str] | None = None,
-    band: float | None = None,
-    title: str | None = None,
-    units: Units | str | None = None,
-    dpi: int | None = None,
-    cycles: int = _CYCLES,
-    max_points: int = _MAX_POINTS,
+    results: Results, device: int, path: PathLike = None, *, band: float | None = None, **options
 ) -> Figure:
     """Relative velocity difference s' of device ``device`` vs time (the paper's Fig. 3b).
     ``band`` (eps or eps1 [m/s]) adds two dashed lines at +-band."""
-    rs = _as_list(results)
-    _check_column(rs, f"sdot{device}")
-    name = _item_label(rs, "device", device)
-    fig, ax, _ = _history(
-        rs,
+    name = _item_label(_as_list(results), "device", device)
+    fig, ax, opt = _plot(
+        "plot_relative_velocity",
+        results,
+        "t",
         f"sdot{device}",
         f"{name}: relative velocity",
         path,
-        ax,
-        t_range,
-        labels,
-        title,
-        units,
-        dpi,
-        cycles,
-        max_points,
+        options,
     )
     if band is not None:
-        f = Units.parse(units).factor("m/s")
+        f = Units.parse(opt.units).factor("m/s")
         for sign in (1.0, -1.0):
             ax.axhline(sign * band * f, color="0.4", linestyle="--", linewidth=0.7)
-    return _finish(fig, path, dpi)
+    return _finish(fig, path, opt.dpi)
 
 
-def plot_phase(
-    results: Results,
-    device: int,
-    path: PathLike = None,
-    *,
-    ax: Axes | None = None,
-    t_range: TRange = None,
-    labels: Sequence[str] | None = None,
-    title: str | None = None,
-    dpi: int | None = None,
-    cycles: int = _CYCLES,
-) -> Figure:
+def plot_phase(results: Results, device: int, path: PathLike = None, **options) -> Figure:
     """Phase of device ``device`` vs time: -1 slip -, 0 stick, +1 slip + (steps; every row)."""
-    rs = _as_list(results)
-    _check_column(rs, f"phase{device}")
-    name = _item_label(rs, "device", device)
-    fig, ax, _ = _history(
-        rs,
+    name = _item_label(_as_list(results), "device", device)
+    fig, ax, opt = _plot(
+        "plot_phase",
+        results,
+        "t",
         f"phase{device}",
         f"{name}: stick/slip phase",
         path,
-        ax,
-        t_range,
-        labels,
-        title,
-        None,
-        dpi,
-        cycles,
-        0,
-        (8.0, 3.0),
-        "steps-post",
+        options,
+        size=(8.0, 3.0),
+        drawstyle="steps-post",
     )
     ax.set_yticks([-1, 0, 1], ["slip \u2212", "stick", "slip +"])
     ax.set_ylim(-1.3, 1.3)
-    return _finish(fig, path, dpi)
+    return _finish(fig, path, opt.dpi)
 
 
-def plot_drift(
-    results: Results,
-    storey: int,
-    path: PathLike = None,
-    *,
-    ax: Axes | None = None,
-    t_range: TRange = None,
-    labels: Sequence[str] | None = None,
-    title: str | None = None,
-    units: Units | str | None = None,
-    dpi: int | None = None,
-    cycles: int = _CYCLES,
-    max_points: int = _MAX_POINTS,
-) -> Figure:
+def plot_drift(results: Results, storey: int, path: PathLike = None, **options) -> Figure:
     """Drift of storey ``storey`` (1-based; decks with &storeys) vs time."""
-    rs = _as_list(results)
-    _check_column(rs, f"drift{storey}")
-    name = _item_label(rs, "storey", storey)
-    fig, _, _ = _history(
-        rs,
-        f"drift{storey}",
-        f"{name}: drift",
-        path,
-        ax,
-        t_range,
-        labels,
-        title,
-        units,
-        dpi,
-        cycles,
-        max_points,
+    name = _item_label(_as_list(results), "storey", storey)
+    fig, _, opt = _plot(
+        "plot_drift", results, "t", f"drift{storey}", f"{name}: drift", path, options
     )
-    return _finish(fig, path, dpi)
+    return _finish(fig, path, opt.dpi)
 
 
-def plot_storey_shear(
-    results: Results,
-    storey: int,
-    path: PathLike = None,
-    *,
-    ax: Axes | None = None,
-    t_range: TRange = None,
-    labels: Sequence[str] | None = None,
-    title: str | None = None,
-    units: Units | str | None = None,
-    dpi: int | None = None,
-    cycles: int = _CYCLES,
-    max_points: int = _MAX_POINTS,
-) -> Figure:
+def plot_storey_shear(results: Results, storey: int, path: PathLike = None, **options) -> Figure:
     """Storey shear of storey ``storey`` (1-based; decks with &storeys) vs time."""
-    rs = _as_list(results)
-    _check_column(rs, f"V{storey}")
-    name = _item_label(rs, "storey", storey)
-    fig, _, _ = _history(
-        rs,
-        f"V{storey}",
-        f"{name}: storey shear",
-        path,
-        ax,
-        t_range,
-        labels,
-        title,
-        units,
-        dpi,
-        cycles,
-        max_points,
+    name = _item_label(_as_list(results), "storey", storey)
+    fig, _, opt = _plot(
+        "plot_storey_shear", results, "t", f"V{storey}", f"{name}: storey shear", path, options
     )
-    return _finish(fig, path, dpi)
+    return _finish(fig, path, opt.dpi)
 
 
-def plot_base_shear(
-    results: Results,
-    path: PathLike = None,
-    *,
-    ax: Axes | None = None,
-    t_range: TRange = None,
-    labels: Sequence[str] | None = None,
-    title: str | None = None,
-    units: Units | str | None = None,
-    dpi: int | None = None,
-    cycles: int = _CYCLES,
-    max_points: int = _MAX_POINTS,
-) -> Figure:
+def plot_base_shear(results: Results, path: PathLike = None, **options) -> Figure:
     """Base shear vs time (decks with &storeys)."""
-    fig, _, _ = _history(
-        results,
-        "Vb",
-        "base shear",
-        path,
-        ax,
-        t_range,
-        labels,
-        title,
-        units,
-        dpi,
-        cycles,
-        max_points,
-    )
-    return _finish(fig, path, dpi)
+    fig, _, opt = _plot("plot_base_shear", results, "t", "Vb", "base shear", path, options)
+    return _finish(fig, path, opt.dpi)
 
 
 # --------------------------------------------------------------------------- loops
 
 
-def plot_hysteresis(
-    results: Results,
-    device: int,
-    path: PathLike = None,
-    *,
-    ax: Axes | None = None,
-    t_range: TRange = None,
-    labels: Sequence[str] | None = None,
-    title: str | None = None,
-    units: Units | str | None = None,
-    dpi: int | None = None,
-    cycles: int = _CYCLES,
-) -> Figure:
+def plot_hysteresis(results: Results, device: int, path: PathLike = None, **options) -> Figure:
     """Friction force F vs relative displacement s of device ``device``: its loops (the
     paper's Fig. 2)."""
-    rs = _as_list(results)
-    fig, ax = _axes(ax, (6.0, 4.5))
-    _overlay(
-        ax,
-        rs,
-        _labels(rs, labels),
+    name = _item_label(_as_list(results), "device", device)
+    fig, _, opt = _plot(
+        "plot_hysteresis",
+        results,
         f"s{device}",
         f"F{device}",
-        t_range,
-        Units.parse(units),
-        cycles=cycles,
+        f"{name}: force-displacement loop",
+        path,
+        options,
+        size=(6.0, 4.5),
         loop=True,
     )
-    _title(ax, title, f"{_item_label(rs, 'device', device)}: force-displacement loop")
-    return _finish(fig, path, dpi)
+    return _finish(fig, path, opt.dpi)
 
 
-def plot_storey_loop(
-    results: Results,
-    storey: int,
-    path: PathLike = None,
-    *,
-    ax: Axes | None = None,
-    t_range: TRange = None,
-    labels: Sequence[str] | None = None,
-    title: str | None = None,
-    units: Units | str | None = None,
-    dpi: int | None = None,
-    cycles: int = _CYCLES,
-) -> Figure:
+def plot_storey_loop(results: Results, storey: int, path: PathLike = None, **options) -> Figure:
     """Storey shear vs drift of storey ``storey``: the loops of the whole storey (frame,
     damping and devices)."""
-    rs = _as_list(results)
-    fig, ax = _axes(ax, (6.0, 4.5))
-    _overlay(
-        ax,
-        rs,
-        _labels(rs, labels),
+    name = _item_label(_as_list(results), "storey", storey)
+    fig, _, opt = _plot(
+        "plot_storey_loop",
+        results,
         f"drift{storey}",
         f"V{storey}",
-        t_range,
-        Units.parse(units),
-        cycles=cycles,
+        f"{name}: shear vs drift",
+        path,
+        options,
+        size=(6.0, 4.5),
         loop=True,
     )
-    _title(ax, title, f"{_item_label(rs, 'storey', storey)}: shear vs drift")
-    return _finish(fig, path, dpi)
+    return _finish(fig, path, opt.dpi)
 
 
 # --------------------------------------------------------------------------- profiles

@@ -1,18 +1,16 @@
-!> SHA-256 (FIPS 180-4) of text and of files, for the summary's provenance: the hash of the
-!> deck and of the record a run read, the same hex digest `sha256sum FILE` prints.
+!> SHA-256 (FIPS 180-4) of bytes, for the summary's provenance: the hash of the deck and of
+!> the record a run read (the bytes the readers read), the hex digest `sha256sum FILE` prints.
 !>
 !> The words are held in default 32-bit integers and added modulo 2**32 through 64-bit
 !> integers (Fortran has no unsigned type and signed overflow is not defined); rotations and
 !> shifts act on the bit pattern. A digest is built incrementally (sha256_init, sha256_update
-!> any number of times, sha256_final), so a file is hashed in chunks without holding it whole.
+!> any number of times, sha256_final) or at once (sha256_text).
 module fd_sha256
    use, intrinsic :: iso_fortran_env, only: int32, int64
-   use, intrinsic :: iso_c_binding, only: c_char, c_ptr, c_size_t, c_int, c_null_char, c_associated
-   use fd_error, only: error_type, fatal_error
    implicit none
    private
 
-   public :: sha256_state, sha256_init, sha256_update, sha256_final, sha256_text, sha256_file
+   public :: sha256_state, sha256_init, sha256_update, sha256_final, sha256_text
 
    integer(int64), parameter :: k64(64) = [ &
       int(z'428a2f98', int64), int(z'71374491', int64), int(z'b5c0fbcf', int64), int(z'e9b5dba5', int64), &
@@ -48,26 +46,6 @@ module fd_sha256
       integer :: fill = 0                   !! bytes in block
       integer(int64) :: length = 0          !! bytes hashed so far
    end type sha256_state
-
-   interface
-      function c_fopen(path, mode) bind(c, name='fopen') result(fp)
-         import :: c_char, c_ptr
-         character(kind=c_char), intent(in) :: path(*), mode(*)
-         type(c_ptr) :: fp
-      end function c_fopen
-      function c_fread(buf, size, count, fp) bind(c, name='fread') result(got)
-         import :: c_char, c_ptr, c_size_t
-         character(kind=c_char), intent(out) :: buf(*)
-         integer(c_size_t), value :: size, count
-         type(c_ptr), value :: fp
-         integer(c_size_t) :: got
-      end function c_fread
-      function c_fclose(fp) bind(c, name='fclose') result(stat)
-         import :: c_ptr, c_int
-         type(c_ptr), value :: fp
-         integer(c_int) :: stat
-      end function c_fclose
-   end interface
 
 contains
 
@@ -139,34 +117,6 @@ contains
       call sha256_update(st, text)
       call sha256_final(st, hex)
    end subroutine sha256_text
-
-   !> SHA-256 of a file's bytes (what `sha256sum FILE` prints), read in chunks with C stdio.
-   subroutine sha256_file(path, hex, error)
-      character(len=*), intent(in) :: path                !! the file
-      character(len=64), intent(out) :: hex               !! the hash in hex
-      type(error_type), allocatable, intent(out) :: error !! the file cannot be read
-      integer(c_size_t), parameter :: chunk = 65536
-      character(kind=c_char, len=chunk) :: buf
-      type(sha256_state) :: st
-      type(c_ptr) :: fp
-      integer(c_size_t) :: got
-      integer :: stat
-
-      hex = ''
-      fp = c_fopen(path//c_null_char, 'rb'//c_null_char)
-      if (.not. c_associated(fp)) then
-         call fatal_error(error, "cannot open file '"//path//"' to hash it")
-         return
-      end if
-      call sha256_init(st)
-      do
-         got = c_fread(buf, 1_c_size_t, chunk, fp)
-         if (got > 0) call sha256_update(st, buf(1:int(got)))
-         if (got < chunk) exit
-      end do
-      stat = c_fclose(fp)
-      call sha256_final(st, hex)
-   end subroutine sha256_file
 
    !> One 64-byte block into the hash words.
    pure subroutine compress(h, block)
