@@ -604,7 +604,7 @@ def plot_drift_profile(
         ax.set_yticks(levels.mean(axis=1), r0.storey_labels)
         ax.set_ylabel("storey")
     ax.set_ylim(bottom=0.0)
-    ax.set_xlim(left=0.0)
+    ax.set_xlim(0.0, 1.08 * max(ln.get_xdata().max() for ln in ax.get_lines()))
     use_ratio = (
         ratio if ratio is not None else all(h is not None for h in r0.summary["storey_height_m"])
     )
@@ -648,7 +648,7 @@ def plot_acceleration_profile(
     else:
         ax.set_yticks(np.concatenate([[0.0], levels]), ["table", *r0.dof_labels])
         ax.set_ylabel("level")
-    ax.set_xlim(left=0.0)
+    ax.set_xlim(0.0, 1.08 * max(ln.get_xdata().max() for ln in ax.get_lines()))
     ax.set_xlabel(f"peak absolute acceleration [{u.name('m/s2')}]")
     ax.grid(True, linewidth=0.3)
     if len(rs) > 1:
