@@ -39,7 +39,9 @@ def building(dampers: bool) -> fd.Analysis:
         if dampers
         else [],
         storeys=[fd.Storey.of_spring(i + 1, height=HEIGHT[i]) for i in range(5)],
-        excitation=fd.Record(dt_record=0.01, file=str(INPUTS / "synthetic_pga035.AT2"), duration=30.0),
+        excitation=fd.Record(
+            dt_record=0.01, file=str(INPUTS / "synthetic_pga035.AT2"), duration=30.0
+        ),
         integration=fd.Integration(n1=10, n2=50 if dampers else None),
     )
 

@@ -420,7 +420,10 @@ def test_a_relative_record_file_is_the_callers(tmp_path, monkeypatch):
     monkeypatch.chdir(tmp_path)
     rel = chain(2, excitation=fd.Record(dt_record=0.01, file="motions/rec.AT2", duration=2.0))
     absolute = chain(
-        2, excitation=fd.Record(dt_record=0.01, file=str(INPUTS / "synthetic_pga035.AT2"), duration=2.0)
+        2,
+        excitation=fd.Record(
+            dt_record=0.01, file=str(INPUTS / "synthetic_pga035.AT2"), duration=2.0
+        ),
     )
     assert np.array_equal(rel.run().data, absolute.run().data)
     # the deck written for the executable keeps the path as given (relative to the deck)

@@ -45,7 +45,9 @@ def building(law: str, **device) -> fd.Analysis:
         damping=fd.Damping.rayleigh_modes(0.02, 1, 3, "free"),
         devices=[fd.Device(i + 1, i, p=SLIP[i], mu=1.0, law=law, **device) for i in range(5)],
         storeys=[fd.Storey.of_spring(i + 1, height=HEIGHT[i]) for i in range(5)],
-        excitation=fd.Record(0.01, file=str(ROOT / "inputs" / "synthetic_pga035.AT2"), duration=30.0),
+        excitation=fd.Record(
+            0.01, file=str(ROOT / "inputs" / "synthetic_pga035.AT2"), duration=30.0
+        ),
         integration=integ,
         output=fd.Output(output_every=1),
     )
