@@ -10,7 +10,6 @@ import hashlib
 import os
 import subprocess
 import sys
-from pathlib import Path
 
 import frictiondyn as fd
 import numpy as np
