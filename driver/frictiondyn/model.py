@@ -292,8 +292,8 @@ class FreeVibration:
 @dataclass
 class Integration:
     """Technique, Newmark and step-control settings (docs/namelist.md, &integration); None
-    takes the reader's default. ``technique`` is 'newmark' or 'event_driven' (exact, for
-    'coulomb' devices)."""
+    takes the reader's default. ``technique`` is 'newmark', 'event_driven' (exact, for
+    'coulomb' devices) or 'moreau_jean' (time stepping for 'coulomb' devices; ``theta``)."""
 
     technique: str | None = None
     beta: float | None = None
@@ -303,6 +303,7 @@ class Integration:
     n: float | None = None
     check_correctness: bool | None = None
     dt_min: float | None = None
+    theta: float | None = None
 
     def group(self) -> dict:
         g: dict = {}
@@ -316,6 +317,7 @@ class Integration:
             n=self.n,
             check_correctness=self.check_correctness,
             dt_min=self.dt_min,
+            theta=self.theta,
         )
         return g
 

@@ -104,6 +104,8 @@ def paper_analysis(
     coarse: bool = False,
     duration: float = DURATION,
     output_every: int | None = None,
+    technique: str | None = None,
+    theta: float | None = None,
 ) -> Analysis:
     """The paper's two-mass model under the table motion of Table 1 test ``test``, with one
     friction device of ``law`` ('velocity', 'hysteretic' or 'coulomb', the exact technique).
@@ -111,7 +113,9 @@ def paper_analysis(
     The defaults are the paper's: P, eps = 1e-3 m/s, f = 1e-5 m, eps1 = 1e-3 m/s, n1 = 20,
     n2 = 50, n = 10 with the correctness check; ``coarse`` gives the paper's Fig. 3 settings
     n1 = n2 = 2 with the check off. ``output_every``: a history row every that many dt1
-    steps (1: every step; None: the reader's default, every dt_r).
+    steps (1: every step; None: the reader's default, every dt_r). ``technique``: None
+    chooses 'event_driven' for 'coulomb' and Newmark for the others; 'moreau_jean' (with
+    its ``theta``) is the other technique of 'coulomb' devices.
     """
     if test not in TABLE1:
         raise ValueError(f"Table 1 has tests 1-5, not {test}")
@@ -127,7 +131,8 @@ def paper_analysis(
         devices=[Device(1, 2, p=p, mu=MU, law=law, eps=eps, eps1=eps1, f=f)],
         excitation=Harmonic(amplitude=amp, frequency=freq, dt_record=dtr, duration=duration),
         integration=Integration(
-            technique="event_driven" if law == "coulomb" else None,
+            technique=technique or ("event_driven" if law == "coulomb" else None),
+            theta=theta,
             n1=n1,
             n2=n2,
             n=n,

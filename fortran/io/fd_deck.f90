@@ -17,7 +17,7 @@ module fd_deck
                        default_u0, default_v0, default_xi, default_period, default_rayleigh_a0, &
                        default_rayleigh_a1, default_n_devices, default_eps, default_eps1, default_f, &
                        default_ramp_cycles, default_record_kind, default_record_scale, default_technique, &
-                       default_beta, default_gamma, default_n1, default_n2, default_n, &
+                       default_beta, default_gamma, default_n1, default_n2, default_n, default_theta, &
                        default_check_correctness, default_dt_min, default_dir, default_output_every, &
                        default_write_history
    use fd_model, only: model_type, integration_type, device_type, output_type
@@ -528,10 +528,10 @@ contains
       type(run_config), intent(inout) :: cfg
       type(error_type), allocatable, intent(out) :: error
       character(len=name_len) :: technique
-      real(dp) :: beta, gamma, n, dt_min
+      real(dp) :: beta, gamma, n, dt_min, theta
       integer :: n1, n2
       logical :: check_correctness
-      namelist /integration/ technique, beta, gamma, n1, n2, n, check_correctness, dt_min
+      namelist /integration/ technique, beta, gamma, n1, n2, n, check_correctness, dt_min, theta
       type(group_text) :: grp
       character(len=512) :: msg, msg0
       character(len=:), allocatable :: rec, choices
@@ -540,7 +540,7 @@ contains
 
       technique = technique_name(default_technique)
       beta = default_beta; gamma = default_gamma; n1 = default_n1; n2 = default_n2; n = default_n
-      check_correctness = default_check_correctness; dt_min = default_dt_min
+      check_correctness = default_check_correctness; dt_min = default_dt_min; theta = default_theta
       call find_group(deck, 'integration', grp, found, error)
       if (allocated(error)) return
       if (found) then
@@ -578,6 +578,8 @@ contains
       end if
       call check_real(deck, 'integration', 'dt_min', dt_min, 0.0_dp, cfg%exc%dt_record/n1/n2, 's', error)
       if (allocated(error)) return
+      call check_real(deck, 'integration', 'theta', theta, 0.5_dp, 1.0_dp, '', error)
+      if (allocated(error)) return
       ! the run takes duration / dt1 steps, counted in a default integer
       if (cfg%exc%duration/(cfg%exc%dt_record/n1) > 2.0e9_dp) then
          call bad(deck, 'integration', 'n1', trim(fmt_int(n1)), 'such that duration / (dt_record / n1) = '// &
@@ -593,6 +595,7 @@ contains
       cfg%opts%n_corr = n
       cfg%opts%check = check_correctness
       cfg%opts%dt_min = dt_min
+      cfg%opts%theta = theta
    end subroutine read_integration_group
 
    ! ---------------------------------------------------------------- &output
@@ -1230,21 +1233,21 @@ contains
    end subroutine resolve_rayleigh
 
    !> What the technique cannot do with the shorthands: braces are hysteretic devices, which
-   !> the exact technique does not integrate (its devices are rigid while stuck).
+   !> only Newmark integrates (the exact Coulomb techniques' devices are rigid while stuck).
    subroutine check_shorthands(deck, cfg, error)
       type(deck_text), intent(in) :: deck
       type(run_config), intent(inout) :: cfg
       type(error_type), allocatable, intent(out) :: error
       integer :: d
 
-      if (cfg%opts%technique /= technique_event_driven) return
+      if (cfg%opts%technique == technique_newmark) return
       do d = 1, cfg%model%n_devices
          if (cfg%model%dev(d)%source /= source_brace) cycle
          call fatal_error(error, deck%path//", group &braces: brace "//trim(fmt_int(cfg%model%dev(d)%source_index))// &
-                          " cannot be integrated with technique = 'event_driven' of &integration: a brace's "// &
-                          "elastic stiffness in series with the damper is the sticking stiffness of the hysteretic "// &
-                          "law, which only technique = 'newmark' integrates (the exact technique's devices are "// &
-                          "rigid while stuck); set technique = 'newmark'")
+                          " cannot be integrated with technique = '"//trim(technique_name(cfg%opts%technique))// &
+                          "' of &integration: a brace's elastic stiffness in series with the damper is the "// &
+                          "sticking stiffness of the hysteretic law, which only technique = 'newmark' integrates "// &
+                          "(the exact Coulomb techniques' devices are rigid while stuck); set technique = 'newmark'")
          return
       end do
    end subroutine check_shorthands

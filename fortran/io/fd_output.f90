@@ -415,6 +415,8 @@ contains
       call kv('steps_finer', trim(fmt_int(res%steps_finer)))
       call kv('factorizations', trim(fmt_int(res%factorizations)))
       call kv('events', trim(fmt_int(res%events)))
+      call kv('patterns_solved', trim(fmt_int(res%patterns)))
+      call kv('lcp_fallbacks', trim(fmt_int(res%lcp_fallbacks)))
       call kv('correctness_violations', trim(fmt_int(res%violations)))
       call kr('violation_times_s', res%violation_time(1:res%n_violation_times))
       call ki('violation_devices', res%violation_device(1:res%n_violation_times))

@@ -6,11 +6,11 @@ module fd_model
    use fd_kinds, only: dp
    use fd_names, only: damping_none, damping_stiffness, damping_rayleigh, &
                        law_velocity, law_hysteretic, law_coulomb, law_name, &
-                       technique_newmark, technique_event_driven, technique_name, &
+                       technique_newmark, technique_event_driven, technique_moreau_jean, technique_name, &
                        default_eps, default_eps1, default_f, default_xi, default_period, &
                        default_rayleigh_a0, default_rayleigh_a1, default_technique, default_beta, &
                        default_gamma, default_n1, default_n2, default_n, default_check_correctness, &
-                       default_dt_min, default_output_every, default_write_history, &
+                       default_dt_min, default_output_every, default_write_history, default_theta, &
                        mu_constant, mu_exponential, mu_table, label_len, max_mu_points, &
                        system_stuck, system_free, default_mu_law, default_mode_system, default_n_modes
    implicit none
@@ -19,7 +19,7 @@ module fd_model
    public :: model_type, device_type, integration_type, output_type
    public :: damping_none, damping_stiffness, damping_rayleigh
    public :: law_velocity, law_hysteretic, law_coulomb, law_name
-   public :: technique_newmark, technique_event_driven, technique_name
+   public :: technique_newmark, technique_event_driven, technique_moreau_jean, technique_name
    public :: mu_constant, mu_exponential, mu_table, label_len, max_mu_points
    public :: system_stuck, system_free
    public :: source_friction, source_brace, source_isolator
@@ -97,6 +97,7 @@ module fd_model
       real(dp) :: n_corr = default_n            !! n of the correctness condition, eqs. 9 and 12
       logical :: check = default_check_correctness !! check the correctness condition
       real(dp) :: dt_min = default_dt_min       !! floor of the step halving [s]; 0 = dt2 / 2**10
+      real(dp) :: theta = default_theta         !! theta of the Moreau-Jean technique, 0.5..1
       integer :: output_every = default_output_every !! output every k dt1 steps; 0 = at the record step (n1)
       integer :: n_modes = default_n_modes      !! natural modes reported per system (&output)
    end type integration_type

@@ -15,7 +15,7 @@ module fd_names
 
    public :: keyword_type, law_type, keyword_len
    public :: laws, law_velocity, law_hysteretic, law_coulomb
-   public :: techniques, technique_newmark, technique_event_driven
+   public :: techniques, technique_newmark, technique_event_driven, technique_moreau_jean
    public :: damping_types, damping_stiffness, damping_rayleigh, damping_none
    public :: excitation_types, excitation_harmonic, excitation_record, excitation_none
    public :: record_kinds, record_acceleration, record_displacement
@@ -26,7 +26,7 @@ module fd_names
    public :: default_n_devices, default_eps, default_eps1, default_f
    public :: default_ramp_cycles, default_record_kind, default_record_scale
    public :: default_technique, default_beta, default_gamma, default_n1, default_n2, default_n
-   public :: default_check_correctness, default_dt_min
+   public :: default_check_correctness, default_dt_min, default_theta
    public :: default_dir, default_output_every, default_write_history
    public :: default_mu_law, default_mode_system, default_n_modes, default_radius, default_storey_height
    public :: label_len, max_mu_points
@@ -60,9 +60,11 @@ module fd_names
    ! ------------------------------------------------------------------ techniques
    type(keyword_type), parameter :: techniques(*) = [ &
                                     keyword_type('newmark', 'regularized laws'), &
-                                    keyword_type('event_driven', "exact, law 'coulomb'")]
+                                    keyword_type('event_driven', "exact, law 'coulomb'"), &
+                                    keyword_type('moreau_jean', "time stepping, law 'coulomb'")]
    integer, parameter :: technique_newmark = 1      !! Newmark with the paper's step control
    integer, parameter :: technique_event_driven = 2 !! exact event-driven Coulomb technique
+   integer, parameter :: technique_moreau_jean = 3  !! Moreau-Jean time stepping, exact Coulomb impulses
 
    ! ------------------------------------------------------------------ damping types
    type(keyword_type), parameter :: damping_types(*) = [ &
@@ -138,6 +140,7 @@ module fd_names
    real(dp), parameter :: default_n = 10.0_dp            !! n of eqs. 9 and 12
    logical, parameter :: default_check_correctness = .true.
    real(dp), parameter :: default_dt_min = 0.0_dp        !! 0 = dt2 / 2**10 [s]
+   real(dp), parameter :: default_theta = 0.5_dp         !! theta of the Moreau-Jean technique
    ! &output
    character(len=*), parameter :: default_dir = 'out'    !! output directory
    integer, parameter :: default_output_every = 0        !! 0 = every dt_record

@@ -16,6 +16,7 @@ module fd_observer
 
    public :: observer_type, observer_init, sample_due, observe_start, observe_peaks, observe_sample
    public :: observe_transitions, observe_violations, observe_end, strain_energy
+   public :: observe_start_energies, observe_end_energies
 
    !> What the observer keeps between calls.
    type :: observer_type
@@ -75,10 +76,24 @@ contains
       real(dp), intent(in) :: e_device     !! elastic energy stored in devices at t = 0
       real(dp), intent(inout) :: tmp(:)    !! work (n)
 
-      obs%e_kin0 = 0.5_dp*sum(mass*v**2)
-      call strain_energy(k, u, tmp, obs%e_str0)
-      obs%e_dev0 = e_device
+      real(dp) :: e
+
+      call strain_energy(k, u, tmp, e)
+      call observe_start_energies(obs, 0.5_dp*sum(mass*v**2), e, e_device)
    end subroutine observe_start
+
+   !> Energies of the initial state, given by a technique that computes them itself (without
+   !> a dense stiffness matrix).
+   pure subroutine observe_start_energies(obs, e_kin, e_str, e_device)
+      type(observer_type), intent(inout) :: obs !! the observer
+      real(dp), intent(in) :: e_kin        !! kinetic energy at t = 0 [J]
+      real(dp), intent(in) :: e_str        !! springs' strain energy at t = 0 [J]
+      real(dp), intent(in) :: e_device     !! elastic energy stored in devices at t = 0 [J]
+
+      obs%e_kin0 = e_kin
+      obs%e_str0 = e_str
+      obs%e_dev0 = e_device
+   end subroutine observe_start_energies
 
    !> Peaks over the accepted states: |u| (and its time), |v|, |absolute acceleration| (and
    !> its time) per DOF, |s| and |F| per device.
@@ -205,13 +220,26 @@ contains
       real(dp), intent(inout) :: tmp(:)        !! work (n)
       real(dp) :: e
 
-      res%e_kinetic = 0.5_dp*sum(mass*v**2) - obs%e_kin0
       call strain_energy(k, u, tmp, e)
-      res%e_strain = e - obs%e_str0
+      call observe_end_energies(obs, res, 0.5_dp*sum(mass*v**2), e, e_device, w_device)
+   end subroutine observe_end
+
+   !> Close the energy balance from the end energies a technique computed itself (see
+   !> observe_end).
+   pure subroutine observe_end_energies(obs, res, e_kin, e_str, e_device, w_device)
+      type(observer_type), intent(in) :: obs   !! the observer
+      type(result_type), intent(inout) :: res  !! the result
+      real(dp), intent(in) :: e_kin            !! kinetic energy at the end [J]
+      real(dp), intent(in) :: e_str            !! springs' strain energy at the end [J]
+      real(dp), intent(in) :: e_device         !! elastic energy stored in devices at the end [J]
+      real(dp), intent(in) :: w_device         !! work of the device forces over the run [J]
+
+      res%e_kinetic = e_kin - obs%e_kin0
+      res%e_strain = e_str - obs%e_str0
       res%e_device = e_device - obs%e_dev0
       res%e_friction = w_device - res%e_device
       res%e_residual = res%e_input - (res%e_kinetic + res%e_strain + res%e_viscous + &
                                       res%e_friction + res%e_device)
-   end subroutine observe_end
+   end subroutine observe_end_energies
 
 end module fd_observer

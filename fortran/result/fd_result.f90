@@ -49,6 +49,8 @@ module fd_result
       integer :: factorizations = 0    !! factorizations of the effective stiffness
                                        !! (exact technique: matrix exponentials)
       integer :: events = 0            !! events located (exact technique)
+      integer :: patterns = 0          !! stick-slip patterns solved in one-step problems (Moreau-Jean)
+      integer :: lcp_fallbacks = 0     !! one-step problems that needed Lemke's fallback (Moreau-Jean)
       ! correctness condition, eqs. 9 and 12
       integer :: violations = 0        !! steps accepted that violate it
       integer :: n_violation_times = 0 !! entries used in violation_time

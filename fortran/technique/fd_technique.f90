@@ -1,17 +1,20 @@
 !> The one dispatch over the time-integration techniques (`technique` of &integration):
-!> 'newmark' (regularized friction laws, the paper's step control) and 'event_driven'
-!> (exact Coulomb friction). Each technique says what it cannot integrate (a law, a table
+!> 'newmark' (regularized friction laws, the paper's step control), 'event_driven'
+!> (exact Coulomb friction, event by event) and 'moreau_jean' (Coulomb friction by
+!> nonsmooth time stepping, at building scale). Each technique says what it cannot integrate (a law, a table
 !> motion) with an error naming the group, the variable, the value and what to set;
 !> adding a technique is its module, its row in fd_names' technique table and one case in
 !> each routine here.
 module fd_technique
    use fd_error, only: error_type, fatal_error, fmt_int
-   use fd_names, only: technique_newmark, technique_event_driven, techniques, keyword_choices
+   use fd_names, only: technique_newmark, technique_event_driven, technique_moreau_jean, techniques, &
+                       keyword_choices
    use fd_model, only: model_type, integration_type
    use fd_excitation, only: excitation_type
    use fd_result, only: result_type
    use fd_newmark, only: run_newmark, newmark_check
    use fd_event_driven, only: run_event_driven, event_driven_check
+   use fd_moreau_jean, only: run_moreau_jean, moreau_jean_check
    implicit none
    private
 
@@ -32,6 +35,8 @@ contains
          call newmark_check(model, exc, error)
       case (technique_event_driven)
          call event_driven_check(model, exc, error)
+      case (technique_moreau_jean)
+         call moreau_jean_check(model, exc, opts, error)
       case default
          call unknown_technique(opts%technique, error)
       end select
@@ -51,6 +56,8 @@ contains
          call run_newmark(model, exc, opts, res, error)
       case (technique_event_driven)
          call run_event_driven(model, exc, opts, res, error)
+      case (technique_moreau_jean)
+         call run_moreau_jean(model, exc, opts, res, error)
       case default
          call unknown_technique(opts%technique, error)
       end select

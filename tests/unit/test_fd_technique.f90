@@ -7,7 +7,7 @@ module test_fd_technique
    use fd_kinds, only: dp
    use fd_error, only: fd_error_type => error_type
    use fd_model, only: model_type, device_type, integration_type, law_velocity, law_hysteretic, law_coulomb, &
-                       technique_newmark, technique_event_driven
+                       technique_newmark, technique_event_driven, technique_moreau_jean
    use fd_excitation, only: excitation_type, excitation_harmonic
    use fd_result, only: result_type
    use fd_device_state, only: device_state, phase_stick
@@ -27,6 +27,7 @@ contains
                   new_unittest("valid combinations", test_valid), &
                   new_unittest("coulomb under newmark", test_coulomb_newmark), &
                   new_unittest("regularized law under event_driven", test_velocity_event_driven), &
+                  new_unittest("moreau_jean: coulomb only, theta in range", test_moreau_jean), &
                   new_unittest("unknown technique", test_unknown_technique), &
                   new_unittest("unknown excitation", test_unknown_excitation), &
                   new_unittest("friction dispatch: a law it lacks", test_friction_dispatch) &
@@ -135,6 +136,34 @@ contains
       call expect(err, [character(len=40) :: "law(2) = 'velocity'"], error)
    end subroutine test_velocity_event_driven
 
+   !> Moreau-Jean integrates 'coulomb' devices (the two-mass set-up runs, its technique
+   !> recorded), refuses a regularized law naming what to set, and theta outside [1/2, 1].
+   subroutine test_moreau_jean(error)
+      type(error_type), allocatable, intent(out) :: error
+      type(model_type) :: model
+      type(excitation_type) :: exc
+      type(integration_type) :: opts
+      type(result_type) :: res
+      type(fd_error_type), allocatable :: err
+
+      call setup(law_coulomb, law_coulomb, model, exc)
+      opts%technique = technique_moreau_jean
+      call run_technique(model, exc, opts, res, err)
+      call check(error, .not. allocated(err), "coulomb under moreau_jean runs")
+      if (allocated(error)) return
+      call check(error, res%technique == technique_moreau_jean .and. res%steps_dt1 == 100, "its steps")
+      if (allocated(error)) return
+      call setup(law_coulomb, law_hysteretic, model, exc)
+      call check_technique(model, exc, opts, err)
+      call expect(err, [character(len=40) :: "group &friction", "law(2) = 'hysteretic'", &
+                        "technique = 'moreau_jean'", "law(2) = 'coulomb'", "technique = 'newmark'"], error)
+      if (allocated(error)) return
+      call setup(law_coulomb, law_coulomb, model, exc)
+      opts%theta = 0.45_dp
+      call check_technique(model, exc, opts, err)
+      call expect(err, [character(len=40) :: "&integration", "theta = 0.45", "between 0.5 and 1"], error)
+   end subroutine test_moreau_jean
+
    subroutine test_unknown_technique(error)
       type(error_type), allocatable, intent(out) :: error
       type(model_type) :: model
@@ -146,8 +175,8 @@ contains
       call setup(law_velocity, law_velocity, model, exc)
       opts%technique = 99
       call check_technique(model, exc, opts, err)
-      call expect(err, [character(len=40) :: "&integration", "technique (id 99)", "'newmark'", "'event_driven'"], &
-                  error)
+      call expect(err, [character(len=40) :: "&integration", "technique (id 99)", "'newmark'", "'event_driven'", &
+                        "'moreau_jean'"], error)
       if (allocated(error)) return
       call run_technique(model, exc, opts, res, err)
       call expect(err, [character(len=40) :: "technique (id 99)"], error)

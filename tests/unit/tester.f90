@@ -24,6 +24,9 @@ program tester
    use test_fd_engineering, only: collect_engineering
    use test_fd_friction_mu, only: collect_friction_mu
    use test_fd_banded, only: collect_banded
+   use test_fd_stick_groups, only: collect_stick_groups
+   use test_fd_group_system, only: collect_group_system
+   use test_fd_impulse_solver, only: collect_impulse_solver
    implicit none
    integer :: stat, is
    character(len=:), allocatable :: suite_name, test_name
@@ -53,6 +56,9 @@ program tester
    testsuites = [testsuites, new_testsuite("engineering", collect_engineering)]
    testsuites = [testsuites, new_testsuite("friction_mu", collect_friction_mu)]
    testsuites = [testsuites, new_testsuite("banded", collect_banded)]
+   testsuites = [testsuites, new_testsuite("stick_groups", collect_stick_groups)]
+   testsuites = [testsuites, new_testsuite("group_system", collect_group_system)]
+   testsuites = [testsuites, new_testsuite("impulse_solver", collect_impulse_solver)]
 
    call get_argument(1, suite_name)
    call get_argument(2, test_name)

@@ -1,6 +1,6 @@
 """How the regularized laws' parameters act on a building: eps (velocity law) and f
 (hysteretic law) measured against the exact Coulomb technique on the 5-storey building of
-the worked examples with rigid-plastic friction dampers (docs/theory.md, section 14).
+the worked examples with rigid-plastic friction dampers (docs/theory.md, section 15).
 
     .venv/bin/python tools/validation/building.py          # prints the markdown tables
 

@@ -10,17 +10,33 @@ Studies:
 3. the paper's Fig. 3 story, correctness condition off and on, against the exact solution;
 4. the energy balance of the three techniques;
 5. Table 1 by the three techniques, and the range of the normal force P for which the
-   paper's classification holds.
+   paper's classification holds;
+6. the Moreau-Jean technique: its convergence to the exact technique on the paper's tests
+   and to Den Hartog's closed form as the step shrinks, Table 1, shear buildings of 5 to 30
+   storeys with proportional slip loads against the exact technique and the velocity law,
+   and 100 to 1000 storeys (energy balance, cost per step).
 """
 
 from __future__ import annotations
 
 import math
+import sys
+import time
 from dataclasses import dataclass, field
+from pathlib import Path
 
 import numpy as np
-from frictiondyn import Result
-from frictiondyn.model import Analysis, Device, Harmonic, Integration, Output, Spring
+from frictiondyn import Result, SolverError
+from frictiondyn.model import (
+    Analysis,
+    Damping,
+    Device,
+    Harmonic,
+    Integration,
+    Output,
+    Record,
+    Spring,
+)
 from frictiondyn.paper import (
     K1,
     K2,
@@ -36,6 +52,9 @@ from frictiondyn.paper import (
     steady_window,
 )
 from oracles import den_hartog, linear_response
+
+sys.path.insert(0, str(Path(__file__).resolve().parents[2] / "bench"))
+from opensees_models import BuildingCase  # the benchmark's building, one definition
 
 DELTA = 0.05  # m/s: level of |s'| whose crossings time the slides (above the sticking noise)
 
@@ -134,24 +153,9 @@ def closed_forms() -> list[dict]:
         err = max(np.max(np.abs(a - b)) / np.max(np.abs(b)) for a, b in refs)
         rows.append({"case": label, "error": err, "tolerance": 1e-8})
     for rr, ratio in ((0.7, 0.3), (1.6, 0.2), (0.45, 0.1)):
-        m, fn, amp_dh = 2.0, 1.0, 0.01
-        k = m * (2 * np.pi * fn) ** 2
-        w = rr * 2 * np.pi * fn
-        f0 = m * amp_dh * w**2
-        ff = ratio * f0
-        x0, v0, amplitude = den_hartog(np.array([0.0]), m, k, ff, f0, w)
-        an = Analysis(
-            masses=[m],
-            springs=[Spring(1, 0, k)],
-            u0=[float(x0[0])],
-            v0=[float(v0[0])],
-            devices=[Device(1, 0, ff, 1.0, law="coulomb")],
-            excitation=Harmonic(amp_dh, w / (2 * np.pi), 0.01, 6 * 2 * np.pi / w),
-            integration=Integration(technique="event_driven", n1=10),
-            output=Output(output_every=1),
-        )
+        an, exact = den_hartog_case(rr, ratio, Integration(technique="event_driven", n1=10))
         r = an.run()
-        x, _, _ = den_hartog(r.time, m, k, ff, f0, w)
+        x, _, amplitude = exact(r.time)
         rows.append(
             {
                 "case": f"Den Hartog non-stop, w/wn = {rr}, F_f/F_0 = {ratio}",
@@ -160,6 +164,29 @@ def closed_forms() -> list[dict]:
             }
         )
     return rows
+
+
+def den_hartog_case(rr: float, ratio: float, integration: Integration):
+    """A 2 kg block on a 1 Hz spring on the table moving 10 mm at w = rr wn, with Coulomb
+    friction F_f = ratio F_0, started on Den Hartog's steady non-stop orbit, 6 cycles: the
+    analysis, and exact(t) -> (x, v, amplitude) of the closed form (oracles.den_hartog)."""
+    m, fn, amp = 2.0, 1.0, 0.01
+    k = m * (2 * np.pi * fn) ** 2
+    w = rr * 2 * np.pi * fn
+    f0 = m * amp * w**2  # -m ag = m amp w^2 sin(w t)
+    ff = ratio * f0
+    x0, v0, _ = den_hartog(np.array([0.0]), m, k, ff, f0, w)
+    an = Analysis(
+        masses=[m],
+        springs=[Spring(1, 0, k)],
+        u0=[float(x0[0])],
+        v0=[float(v0[0])],
+        devices=[Device(1, 0, ff, 1.0, law="coulomb")],
+        excitation=Harmonic(amp, w / (2 * np.pi), 0.01, 6 * 2 * np.pi / w),
+        integration=integration,
+        output=Output(output_every=1),
+    )
+    return an, lambda t: den_hartog(t, m, k, ff, f0, w)
 
 
 # ----------------------------------------------------------------------------- 2. convergence
@@ -323,12 +350,284 @@ def p_range(duration: float = 40.0, rel: float = 1e-3) -> tuple[float, float, di
     return lo, hi, pc
 
 
+# ----------------------------------------------------------------------------- 6. Moreau-Jean
+MJ = "moreau_jean"
+
+
+def mj_analysis(test: int = 4, *, n1: int = 20, theta: float | None = None, **kw) -> Analysis:
+    """The paper's analysis with its 'coulomb' device integrated by Moreau-Jean."""
+    return analysis(test, "coulomb", n1=n1, technique=MJ, theta=theta, **kw)
+
+
+def history_errors(approx: Result, exact: Result, test: int) -> dict[str, float]:
+    """Largest error of the u, v, s histories over the steady state, relative to the exact
+    peak (worst mass), and the RMS error of the absolute accelerations (as history_error);
+    the two runs share their sampling grid."""
+    w = steady_window(approx, TABLE1[test][0])
+    out = {}
+    for q in ("u", "v"):
+        out[q] = max(
+            float(np.max(np.abs(approx[f"{q}{i}"][w] - exact[f"{q}{i}"][w])))
+            / float(np.max(np.abs(exact[f"{q}{i}"][w])))
+            for i in (1, 2)
+        )
+    out["s"] = float(
+        np.max(np.abs(approx["s1"][w] - exact["s1"][w])) / np.max(np.abs(exact["s1"][w]))
+    )
+    out["a_rms"] = history_error(approx, exact, test)[0]
+    return out
+
+
+@dataclass
+class MJSweep:
+    """Errors of the Moreau-Jean technique against the exact one as dt1 shrinks."""
+
+    theta: float
+    test: int
+    dt: list[float] = field(default_factory=list)
+    peak_error: list[float] = field(default_factory=list)
+    timing_error: list[float] = field(default_factory=list)
+    u_error: list[float] = field(default_factory=list)
+    v_error: list[float] = field(default_factory=list)
+    a_rms: list[float] = field(default_factory=list)
+    friction_error: list[float] = field(default_factory=list)
+    transitions: list[int] = field(default_factory=list)
+    exact_transitions: list[int] = field(default_factory=list)
+    patterns: list[float] = field(default_factory=list)
+
+    def order(self, which: str) -> float:
+        y = getattr(self, which)
+        ok = [(x, e) for x, e in zip(self.dt, y) if np.isfinite(e) and e > 0]
+        return observed_order([x for x, _ in ok], [e for _, e in ok])
+
+
+def mj_convergence(
+    test: int = 4,
+    n1_values=(5, 10, 20, 40, 80, 160),
+    thetas=(0.5, 1.0),
+    duration: float = 40.0,
+) -> list[MJSweep]:
+    """Moreau-Jean against the exact technique on one Table 1 test, both sampled every dt1."""
+    exact = {n1: analysis(test, "coulomb", n1=n1, duration=duration).run() for n1 in n1_values}
+    sweeps = []
+    for theta in thetas:
+        sw = MJSweep(theta, test)
+        for n1 in n1_values:
+            ex = exact[n1]
+            r = mj_analysis(test, n1=n1, theta=theta, duration=duration).run()
+            pe, te = errors(steady(r, test), steady(ex, test))
+            he = history_errors(r, ex, test)
+            s, se = r.summary, ex.summary
+            sw.dt.append(TABLE1[test][2] / n1)
+            sw.peak_error.append(pe)
+            sw.timing_error.append(te)
+            sw.u_error.append(he["u"])
+            sw.v_error.append(he["v"])
+            sw.a_rms.append(he["a_rms"])
+            sw.friction_error.append(
+                abs(s["energy_friction_J"] - se["energy_friction_J"]) / se["energy_friction_J"]
+            )
+            sw.transitions.append(int(s["stick_to_slip"][0] + s["slip_to_stick"][0]))
+            sw.exact_transitions.append(int(se["stick_to_slip"][0] + se["slip_to_stick"][0]))
+            sw.patterns.append(s["patterns_solved"] / s["steps_dt1"])
+        sweeps.append(sw)
+    return sweeps
+
+
+def mj_den_hartog(
+    n1_values=(10, 21, 43, 87, 175, 351), thetas=(0.5, 1.0), rr: float = 0.7, ratio: float = 0.3
+) -> list[dict]:
+    """Moreau-Jean on Den Hartog's non-stop motion (a block on a spring, on a moving table,
+    started on the steady orbit): largest errors of u and v over 6 cycles, relative to the
+    amplitude (and to amplitude * w). The step counts avoid powers of two, which land the
+    velocity reversals on the same fractions of a step."""
+    rows = []
+    for theta in thetas:
+        for n1 in n1_values:
+            an, exact = den_hartog_case(rr, ratio, Integration(technique=MJ, n1=n1, theta=theta))
+            r = an.run()
+            x, v, amplitude = exact(r.time)
+            w = 2 * np.pi * an.excitation.frequency
+            rows.append(
+                {
+                    "theta": theta,
+                    "n1": n1,
+                    "dt": 0.01 / n1,
+                    "u_error": float(np.max(np.abs(r["u1"] - x)) / amplitude),
+                    "v_error": float(np.max(np.abs(r["v1"] - v)) / (amplitude * w)),
+                    "reversals": int(r.summary["slip_reversals"][0]),
+                    "stops": int(r.summary["slip_to_stick"][0]),
+                }
+            )
+    return rows
+
+
+def mj_table1(duration: float = 40.0) -> list[SteadyState]:
+    """Table 1 by the Moreau-Jean technique (n1 = 20, as the decks)."""
+    return [steady_state(mj_analysis(t, duration=duration).run(), t, MJ) for t in TABLE1]
+
+
+def building(
+    n: int,
+    *,
+    technique: str = MJ,
+    law: str = "coulomb",
+    eps: float | None = None,
+    n1: int = 10,
+    duration: float = 10.0,
+    theta: float | None = None,
+    output_every: int = 10,
+    harmonic: bool = False,
+) -> Analysis:
+    """The benchmark's shear building (bench/opensees_models.BuildingCase: 1000 t, first
+    period 1 s, storey stiffness and slip load proportional to the weight carried, slip at
+    5 % of it, Rayleigh 2 % on modes 1 and 3, synthetic ground motion of PGA 0.3 g) with a
+    rigid friction damper per storey: Coulomb devices (or a regularized law) between floors.
+    ``harmonic``: the table moves 20 mm at 1.5 Hz (one cycle of ramp) instead."""
+    c = BuildingCase(n, duration=duration, n1=n1)
+    if harmonic:
+        excitation = Harmonic(0.02, 1.5, c.dt_record, duration, ramp_cycles=1)
+    else:
+        excitation = Record(c.dt_record, values=c.record, duration=duration)
+    return Analysis(
+        masses=[c.m] * n,
+        springs=[Spring(i + 1, i, float(c.k[i])) for i in range(n)],
+        damping=Damping.rayleigh(c.a0, c.a1),
+        devices=[Device(i + 1, i, float(c.slip[i]), 1.0, law=law, eps=eps) for i in range(n)],
+        excitation=excitation,
+        integration=Integration(technique=technique, n1=n1, theta=theta),
+        output=Output(output_every=output_every),
+    )
+
+
+def building_peaks(r: Result) -> dict[str, np.ndarray]:
+    s = r.summary
+    return {
+        "aabs": np.array(s["peak_aabs_mps2"]),
+        "u": np.array(s["peak_u_m"]),
+        "s": np.array(s["peak_s_m"]),
+    }
+
+
+def peak_difference(a: Result, b: Result) -> float:
+    """Largest difference of the peaks (floor accelerations, displacements, storey slips),
+    relative to the largest peak of each kind in b."""
+    pa, pb = building_peaks(a), building_peaks(b)
+    return max(float(np.max(np.abs(pa[k] - pb[k])) / np.max(np.abs(pb[k]))) for k in pa)
+
+
+def mj_buildings_exact(
+    storeys=(5, 10), n1_values=(10, 40), duration: float = 10.0, harmonic: bool = False
+) -> list[dict]:
+    """Moreau-Jean against the exact technique on buildings with proportional slip loads
+    (where the exact technique runs: its message when it does not)."""
+    rows = []
+    for n in storeys:
+        for n1 in n1_values:
+            # the exact run on the same step grid: peaks are taken over the same instants
+            t0 = time.perf_counter()
+            try:
+                ex = building(
+                    n,
+                    technique="event_driven",
+                    n1=n1,
+                    duration=duration,
+                    output_every=n1,
+                    harmonic=harmonic,
+                ).run()
+                failure = ""
+            except SolverError as exc:
+                ex, failure = None, str(exc)
+            t_ex = time.perf_counter() - t0
+            r = building(n, n1=n1, duration=duration, output_every=n1, harmonic=harmonic).run()
+            s = r.summary
+            row = {
+                "excitation": "harmonic" if harmonic else "record",
+                "storeys": n,
+                "n1": n1,
+                "transitions": int(sum(s["stick_to_slip"]) + sum(s["slip_to_stick"])),
+                "friction": s["energy_friction_J"],
+                "time_s": s["run_time_s"],
+                "exact_failure": failure,
+                "exact_time_s": t_ex,
+            }
+            if ex is not None:
+                se = ex.summary
+                ex_u = np.vstack([ex[f"u{i}"] for i in range(1, n + 1)])
+                r_u = np.vstack([r[f"u{i}"] for i in range(1, n + 1)])
+                row.update(
+                    peak_difference=peak_difference(r, ex),
+                    u_history=float(np.max(np.abs(r_u - ex_u)) / np.max(np.abs(ex_u))),
+                    exact_transitions=int(sum(se["stick_to_slip"]) + sum(se["slip_to_stick"])),
+                    exact_friction=se["energy_friction_J"],
+                    exact_events=int(se["events"]),
+                )
+            rows.append(row)
+    return rows
+
+
+def mj_buildings_velocity(
+    storeys=(5, 10, 20, 30), eps_values=(1e-2, 1e-3, 1e-4), duration: float = 10.0
+) -> list[dict]:
+    """The velocity law as eps -> 0 against Moreau-Jean (n1 = 40) on the same buildings."""
+    rows = []
+    for n in storeys:
+        ref = building(n, n1=40, duration=duration, output_every=40).run()
+        for eps in eps_values:
+            r = building(
+                n, technique="newmark", law="velocity", eps=eps, duration=duration, n1=10
+            ).run()
+            rows.append(
+                {
+                    "storeys": n,
+                    "eps": eps,
+                    "peak_difference": peak_difference(r, ref),
+                    "violations": int(r.summary["correctness_violations"]),
+                    "time_s": r.summary["run_time_s"],
+                    "mj_time_s": ref.summary["run_time_s"],
+                }
+            )
+    return rows
+
+
+def mj_scaling(storeys=(100, 300, 1000), duration: float = 20.0) -> list[dict]:
+    """Energy balance and cost of the Moreau-Jean technique on tall buildings (20 s record);
+    cost: processor time of the run (set-up included) per step."""
+    rows = []
+    for n in storeys:
+        an = building(n, duration=duration, output_every=100000)
+        c0 = time.process_time()
+        s = an.run().summary
+        cpu = (
+            time.process_time() - c0
+        )  # processor time: steadier than the clock on a shared machine
+        steps = s["steps_dt1"]
+        rows.append(
+            {
+                "storeys": n,
+                "steps": steps,
+                "us_per_step": 1e6 * cpu / steps,
+                "patterns_per_step": s["patterns_solved"] / steps,
+                "factorizations_per_step": s["factorizations"] / steps,
+                "fallbacks": int(s["lcp_fallbacks"]),
+                "input": s["energy_input_J"],
+                "friction": s["energy_friction_J"],
+                "residual": s["energy_residual_J"] / s["energy_input_J"],
+                "transitions": int(sum(s["stick_to_slip"]) + sum(s["slip_to_stick"])),
+            }
+        )
+    return rows
+
+
 __all__ = [
     "DELTA",
+    "MJ",
+    "MJSweep",
     "P",
     "Steady",
     "Sweep",
     "analysis",
+    "building",
     "classify_p",
     "closed_forms",
     "convergence",
@@ -338,6 +637,13 @@ __all__ = [
     "errors",
     "fig3",
     "history_error",
+    "mj_analysis",
+    "mj_buildings_exact",
+    "mj_buildings_velocity",
+    "mj_convergence",
+    "mj_den_hartog",
+    "mj_scaling",
+    "mj_table1",
     "observed_order",
     "p_range",
     "steady",

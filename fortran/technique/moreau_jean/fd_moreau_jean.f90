@@ -1,0 +1,358 @@
+!> The Moreau-Jean technique (`technique = 'moreau_jean'`): nonsmooth time stepping of
+!>   M u'' + C u' + K u + sum_d b_d F_d = -M r x0''(t)
+!> with unregularized Coulomb friction, at building scale.
+!>
+!> The theta-method on velocities, with the friction of the step as impulses: over a step h
+!>   M (v1 - v) = h (f_theta - C v_theta - K u_theta) - B lambda,   u1 = u + h v_theta,
+!>   v_theta = (1 - theta) v + theta v1,  u_theta = u + theta h v_theta,
+!> i.e. (M + h theta C + h^2 theta^2 K) v1 = r - B lambda, where every device's impulse
+!> lambda_d satisfies Coulomb's law at the end-of-step velocity (fd_impulse_solver): it
+!> sticks (b_d'v1 = 0, |lambda_d| <= P mu h) or slides with lambda_d = P mu h sgn(b_d'v1).
+!> The one-step problem is solved exactly by an active-set iteration on the structure's
+!> reduced band system (O(n) per pattern for a shear building), with Lemke's method as
+!> the fallback. No eps, no f; first order in time (docs/theory.md, section 12).
+!>
+!> Reported to the observer at the end of every step: u1, v1, the absolute acceleration
+!> from equilibrium at t + h with the step's mean friction forces F_d = lambda_d / h, the
+!> devices' phases (sticking, sliding which way) and transitions. Energy: input and viscous
+!> work and the friction work sum lambda_d Delta s_d / h over each step; the balance closes
+!> to round-off for theta = 1/2 and leaves the method's numerical dissipation for theta > 1/2.
+module fd_moreau_jean
+   use, intrinsic :: ieee_arithmetic, only: ieee_is_finite
+   use fd_kinds, only: dp
+   use fd_error, only: error_type, fatal_error, fmt_real, fmt_int
+   use fd_names, only: law_coulomb, law_name, excitation_types, technique_name, technique_moreau_jean, &
+                       technique_newmark, damping_stiffness, damping_rayleigh
+   use fd_model, only: model_type, integration_type
+   use fd_excitation, only: excitation_type, table_motion
+   use fd_kinematics, only: device_kinematics
+   use fd_result, only: result_type
+   use fd_observer, only: observer_type, observer_init, sample_due, observe_peaks, observe_sample, &
+                          observe_transitions, observe_start_energies, observe_end_energies
+   use fd_stick_groups, only: groups_build, edge_relative
+   use fd_group_system, only: gs_k_matvec, gs_k_absmatvec, gs_lowest_eigenvalue
+   use fd_impulse_solver, only: impulse_solver, solver_setup, solve_impulses, predict_pattern, pattern_acceleration
+   implicit none
+   private
+
+   public :: run_moreau_jean, moreau_jean_check, stuck_period
+
+   real(dp), parameter :: pi = acos(-1.0_dp)
+
+   !> Everything the loop works on, allocated before it starts.
+   type :: mj_work
+      type(impulse_solver) :: p                           !! the one-step solver
+      type(observer_type) :: obs                          !! peaks, history, energy balance
+      integer :: n = 0, nd = 0, ne = 0
+      real(dp) :: a0 = 0.0_dp, a1 = 0.0_dp                !! C = a0 M + a1 K
+      real(dp), allocatable :: u(:), v(:), u1(:), v1(:), acc(:), r(:), du(:), kx(:), rabs(:)  !! (n)
+      real(dp), allocatable :: s(:), sd(:), force(:)      !! (nd)
+      integer, allocatable :: phase0(:), phase1(:)        !! (nd) phases before and after a step
+      integer, allocatable :: counted(:)                  !! (nd) phase last counted as a transition
+      logical, allocatable :: pending(:)                  !! (nd) stopped from a slide at the last step
+      integer, allocatable :: ta(:), tb(:)                !! (nd) transitions handed to the observer
+      real(dp), allocatable :: g_step(:), g_force(:)      !! (ne) bounds: P mu h, P mu
+      real(dp) :: w_fric = 0.0_dp                         !! friction work [J]
+   end type mj_work
+
+contains
+
+   !> What the Moreau-Jean technique cannot integrate: a device whose law is not 'coulomb',
+   !> a table motion it does not know, theta outside [1/2, 1]. Messages name the group, the
+   !> variable, the value and what to set.
+   subroutine moreau_jean_check(model, exc, opts, error)
+      type(model_type), intent(in) :: model         !! the model
+      type(excitation_type), intent(in) :: exc      !! the table motion
+      type(integration_type), intent(in) :: opts    !! the settings (theta)
+      type(error_type), allocatable, intent(out) :: error !! what cannot be integrated
+      character(len=:), allocatable :: idx, tech
+      integer :: d
+
+      tech = "technique = '"//trim(technique_name(technique_moreau_jean))//"'"
+      do d = 1, model%n_devices
+         if (model%dev(d)%law == law_coulomb) cycle
+         idx = 'law('//trim(fmt_int(d))//')'
+         call fatal_error(error, "group &friction: "//idx//" = '"//trim(law_name(model%dev(d)%law))// &
+                          "' is invalid with "//tech//" of &integration: the Moreau-Jean technique "// &
+                          "integrates unregularized Coulomb friction, 'coulomb' devices only; set "//idx// &
+                          " = '"//trim(law_name(law_coulomb))//"', or technique = '"// &
+                          trim(technique_name(technique_newmark))//"' with a regularized law for every device")
+         return
+      end do
+      if (exc%kind < 1 .or. exc%kind > size(excitation_types)) then
+         call fatal_error(error, "group &excitation: excitation_type (id "//trim(fmt_int(exc%kind))// &
+                          ") is not a table motion the Moreau-Jean technique knows")
+         return
+      end if
+      if (.not. (opts%theta >= 0.5_dp .and. opts%theta <= 1.0_dp)) then
+         call fatal_error(error, "group &integration: theta = "//trim(fmt_real(opts%theta))// &
+                          " is invalid with "//tech//": it must be between 0.5 and 1")
+      end if
+   end subroutine moreau_jean_check
+
+   !> First period of the stuck system (every device with P mu > 0 a rigid link) from the
+   !> lowest eigenvalue of its reduced band system. Errors as fd_matrices' stuck_first_mode.
+   subroutine stuck_period(p, period, error)
+      type(impulse_solver), intent(inout) :: p      !! the solver (its edges and springs)
+      real(dp), intent(out) :: period               !! first period T [s]
+      type(error_type), allocatable, intent(out) :: error !! no free DOF, rigid-body mode
+      real(dp) :: lam, scale
+      logical, allocatable :: all_stuck(:)
+
+      period = 0.0_dp
+      allocate (all_stuck(p%ne))
+      all_stuck = .true.
+      call groups_build(p%es, all_stuck, p%node_order)
+      p%fvalid = .false.
+      if (p%es%nr == 0) then
+         call fatal_error(error, "the stuck system has no free DOF: every mass is locked to the table &
+                          &by friction devices, so its first period is undefined (give period in &damping)")
+         return
+      end if
+      call gs_lowest_eigenvalue(p%gs, p%es%grp, p%es%nr, lam, scale, error)
+      if (allocated(error)) return
+      if (lam <= 1.0e-12_dp*scale) then
+         call fatal_error(error, "the stuck system has a rigid-body mode (first eigenvalue "// &
+                          trim(fmt_real(lam))//"): add springs to the table or give period in &damping")
+         return
+      end if
+      period = 2.0_dp*pi/sqrt(lam)
+   end subroutine stuck_period
+
+   !> Integrate a model whose devices all follow Coulomb's law by Moreau-Jean time stepping.
+   subroutine run_moreau_jean(model, exc, opts, res, error)
+      type(model_type), intent(in) :: model         !! validated model (all devices coulomb)
+      type(excitation_type), intent(in) :: exc      !! table motion
+      type(integration_type), intent(in) :: opts    !! n1, theta and output_every are used
+      type(result_type), intent(out) :: res         !! histories and summary
+      type(error_type), allocatable, intent(out) :: error !! singular system, LCP failure
+      type(mj_work) :: w
+      real(dp) :: h, th, alpha, beta, cm, ck, t1, ag0, ag1, agt, xg, vg, e_kin, e_str
+      integer :: k, e, c0, c1, crate
+
+      call system_clock(c0, crate)
+      call moreau_jean_check(model, exc, opts, error)
+      if (allocated(error)) return
+      call setup(model, w, res, error)
+      if (allocated(error)) return
+      call observer_init(model, exc, opts, res, w%obs, error)
+      if (allocated(error)) return
+      th = opts%theta
+      h = exc%dt_record/opts%n1
+      res%dt1 = h
+      res%dt2 = 0.0_dp
+      res%dt_min = 0.0_dp
+      ! W = M + h theta C + (h theta)^2 K = alpha M + beta K
+      alpha = 1.0_dp + h*th*w%a0
+      beta = h*th*w%a1 + (h*th)**2
+      ! r = W v + h (f_theta - C v - K (u + theta h v)) = cm M v - K (ck v + h u) + h f_theta
+      cm = 1.0_dp - h*(1.0_dp - th)*w%a0
+      ck = h*(1.0_dp - th)*(w%a1 + h*th)
+      w%g_step = h*w%p%es%pmu
+      w%g_force = w%p%es%pmu
+
+      ! initial state; devices moving at t = 0 slide that way, the others are decided by the
+      ! acceleration problem (W = M, bounds P mu): its solution is the initial acceleration
+      w%u = model%u0
+      w%v = model%v0
+      call table_motion(exc, 0.0_dp, xg, vg, ag0)
+      do e = 1, w%ne
+         w%p%sigma(e) = 0
+         if (edge_relative(w%p%es, e, w%v) > 0.0_dp) w%p%sigma(e) = 1
+         if (edge_relative(w%p%es, e, w%v) < 0.0_dp) w%p%sigma(e) = -1
+      end do
+      w%p%locked = w%p%sigma /= 0
+      w%kx = w%a1*w%v + w%u
+      call gs_k_matvec(w%p%gs, w%kx, w%r, -1.0_dp, 0.0_dp)
+      w%r = w%r - model%mass*(ag0 + w%a0*w%v)
+      w%rabs = model%mass*(abs(ag0) + w%a0*abs(w%v))
+      call gs_k_absmatvec(w%p%gs, w%kx, w%rabs, 1.0_dp)
+      call solve_impulses(w%p, w%r, w%rabs, 1.0_dp, 0.0_dp, w%g_force, w%acc, error)
+      if (allocated(error)) return
+      w%p%locked = .false.
+      call device_state(model, w, 1.0_dp, w%phase0)
+      w%counted = w%phase0
+      w%pending = .false.
+      call energies(w, e_kin, e_str)
+      call observe_start_energies(w%obs, e_kin, e_str, 0.0_dp)
+      call observe_sample(w%obs, res, 0.0_dp, ag0, w%u, w%v, w%acc, w%s, w%sd, w%force, w%phase0)
+      call observe_peaks(res, 0.0_dp, w%u, w%v, w%acc, ag0, w%s, w%force)
+
+      do k = 1, w%obs%nsteps
+         t1 = k*h
+         call table_motion(exc, t1, xg, vg, ag1)
+         agt = (1.0_dp - th)*ag0 + th*ag1
+         w%kx = ck*w%v + h*w%u
+         call gs_k_matvec(w%p%gs, w%kx, w%r, -1.0_dp, 0.0_dp)
+         w%r = w%r + model%mass*(cm*w%v - h*agt)
+         w%rabs = model%mass*(abs(cm*w%v) + h*abs(agt))
+         call gs_k_absmatvec(w%p%gs, w%kx, w%rabs, 1.0_dp)
+         if (k > 1) call predict_pattern(w%p, w%g_step)
+         call solve_impulses(w%p, w%r, w%rabs, alpha, beta, w%g_step, w%v1, error)
+         if (allocated(error)) return
+         w%u1 = w%u + h*((1.0_dp - th)*w%v + th*w%v1)
+         ! energy of the step: input, viscous and friction work over du = h v_theta
+         w%du = w%u1 - w%u
+         res%e_input = res%e_input - agt*sum(model%mass*w%du)
+         call gs_k_matvec(w%p%gs, w%du, w%kx, 1.0_dp, 0.0_dp)
+         res%e_viscous = res%e_viscous + (w%a0*sum(model%mass*w%du**2) + w%a1*dot_product(w%du, w%kx))/h
+         do e = 1, w%ne
+            w%w_fric = w%w_fric + w%p%lam(e)*edge_relative(w%p%es, e, w%du)/h
+         end do
+         ! acceleration at t1 from equilibrium with the end-of-step pattern held
+         w%kx = w%a1*w%v1 + w%u1
+         call gs_k_matvec(w%p%gs, w%kx, w%r, -1.0_dp, 0.0_dp)
+         w%r = w%r - model%mass*(ag1 + w%a0*w%v1)
+         call pattern_acceleration(w%p, w%r, w%g_force, w%acc)
+         w%u = w%u1
+         w%v = w%v1
+         ag0 = ag1
+         call device_state(model, w, 1.0_dp/h, w%phase1)
+         call count_transitions(w, res, .false.)
+         w%phase0 = w%phase1
+         call observe_peaks(res, t1, w%u, w%v, w%acc, ag1, w%s, w%force)
+         res%steps_dt1 = res%steps_dt1 + 1
+         if (sample_due(w%obs, k)) then
+            if (.not. all(ieee_is_finite(w%u)) .or. .not. all(ieee_is_finite(w%acc))) then
+               call fatal_error(error, "moreau_jean: the solution is not finite at t = "//trim(fmt_real(t1))//" s")
+               return
+            end if
+            call observe_sample(w%obs, res, t1, ag1, w%u, w%v, w%acc, w%s, w%sd, w%force, w%phase1)
+         end if
+      end do
+      call count_transitions(w, res, .true.)
+      call energies(w, e_kin, e_str)
+      call observe_end_energies(w%obs, res, e_kin, e_str, 0.0_dp, w%w_fric)
+      res%factorizations = w%p%gs%factorizations
+      res%patterns = w%p%patterns
+      res%lcp_fallbacks = w%p%fallbacks
+      call system_clock(c1)
+      res%run_time = real(c1 - c0, dp)/real(max(crate, 1), dp)
+   end subroutine run_moreau_jean
+
+   !> Solver, damping coefficients, stuck period and work space.
+   subroutine setup(model, w, res, error)
+      type(model_type), intent(in) :: model
+      type(mj_work), intent(inout) :: w
+      type(result_type), intent(inout) :: res
+      type(error_type), allocatable, intent(out) :: error
+      type(error_type), allocatable :: eig_error
+      real(dp) :: period, t_damp, om
+      integer :: n, nd
+
+      n = model%n_dof
+      nd = model%n_devices
+      w%n = n
+      w%nd = nd
+      call solver_setup(w%p, model%mass, model%spring_i, model%spring_j, model%spring_k, model%dev%node_i, &
+                        model%dev%node_j, model%dev%p*model%dev%mu, error)
+      if (allocated(error)) return
+      w%ne = w%p%ne
+      ! C = a0 M + a1 K: the paper's psi K with the given or the stuck period, or Rayleigh
+      call stuck_period(w%p, period, eig_error)
+      t_damp = period
+      w%a0 = 0.0_dp
+      w%a1 = 0.0_dp
+      select case (model%damping)
+      case (damping_stiffness)
+         if (model%period > 0.0_dp) then
+            t_damp = model%period
+         else if (allocated(eig_error)) then
+            call move_alloc(eig_error, error)
+            error%message = "&damping: damping_type = 'stiffness' needs the stuck first period, but "// &
+                            error%message
+            return
+         end if
+         w%a1 = t_damp*model%xi/pi
+      case (damping_rayleigh)
+         w%a0 = model%rayleigh_a0
+         w%a1 = model%rayleigh_a1
+      end select
+      res%period_stuck = 0.0_dp
+      res%xi_stuck = 0.0_dp
+      if (.not. allocated(eig_error)) then
+         res%period_stuck = period
+         om = 2.0_dp*pi/period
+         res%xi_stuck = (w%a0 + w%a1*om**2)/(2.0_dp*om)
+      end if
+      allocate (w%u(n), w%v(n), w%u1(n), w%v1(n), w%acc(n), w%r(n), w%du(n), w%kx(n), w%rabs(n))
+      allocate (w%s(nd), w%sd(nd), w%force(nd), w%phase0(nd), w%phase1(nd), w%counted(nd), w%pending(nd))
+      allocate (w%ta(nd), w%tb(nd))
+      allocate (w%g_step(w%ne), w%g_force(w%ne))
+   end subroutine setup
+
+   !> Device kinematics, forces (impulses times `per`) and phases from the solver's edges.
+   pure subroutine device_state(model, w, per, phase)
+      type(model_type), intent(in) :: model
+      type(mj_work), intent(inout) :: w
+      real(dp), intent(in) :: per
+      integer, intent(out) :: phase(:)
+      integer :: d, e
+
+      call device_kinematics(model, w%u, w%v, w%s, w%sd)
+      do d = 1, w%nd
+         e = w%p%es%dev_edge(d)
+         if (e == 0) then
+            w%force(d) = 0.0_dp
+            phase(d) = 0
+         else
+            w%force(d) = w%p%es%dev_sign(d)*w%p%es%dev_share(d)*w%p%lam(e)*per
+            phase(d) = w%p%es%dev_sign(d)*w%p%sigma(e)
+         end if
+      end do
+   end subroutine device_state
+
+   !> Count the phase transitions of the step (phase0 -> phase1) with the observer. A device
+   !> that stops from a slide is counted one step later: if it then slides the other way, it
+   !> passed through zero velocity within the step (the one-step problem lands on w = 0 for a
+   !> fraction 2 P mu / (|D| + P mu) of such reversals, D the driving force, whatever h) and
+   !> the pair counts as one slip reversal, as the exact technique counts it; otherwise as
+   !> slip-to-stick (and stick-to-slip). At the end of the run (`last`) a pending stop counts.
+   subroutine count_transitions(w, res, last)
+      type(mj_work), intent(inout) :: w
+      type(result_type), intent(inout) :: res
+      logical, intent(in) :: last
+      integer :: d, p, c
+
+      do d = 1, w%nd
+         p = w%phase1(d)
+         c = w%counted(d)
+         w%ta(d) = c          ! after the first transition of the step
+         w%tb(d) = c          ! after the second (a stop and a start in one count)
+         if (w%pending(d)) then
+            w%pending(d) = .false.
+            if (last .or. p == 0) then
+               w%ta(d) = 0
+               w%tb(d) = 0
+            else if (p == -c) then
+               w%ta(d) = p
+               w%tb(d) = p
+            else
+               w%ta(d) = 0
+               w%tb(d) = p
+            end if
+         else if (p /= c .and. .not. last) then
+            if (c /= 0 .and. p == 0) then
+               w%pending(d) = .true.
+            else
+               w%ta(d) = p
+               w%tb(d) = p
+            end if
+         end if
+      end do
+      call observe_transitions(res, w%counted, w%ta)
+      call observe_transitions(res, w%ta, w%tb)
+      w%counted = w%tb
+   end subroutine count_transitions
+
+   !> Kinetic and strain energy of the current state.
+   subroutine energies(w, e_kin, e_str)
+      type(mj_work), intent(inout) :: w
+      real(dp), intent(out) :: e_kin, e_str
+
+      e_kin = 0.5_dp*sum(w%p%gs%mass*w%v**2)
+      call gs_k_matvec(w%p%gs, w%u, w%kx, 1.0_dp, 0.0_dp)
+      e_str = 0.5_dp*dot_product(w%u, w%kx)
+   end subroutine energies
+
+end module fd_moreau_jean
