@@ -44,7 +44,11 @@ def building(law: str = "velocity", duration: float = 6.0, **kw) -> fd.Analysis:
     rows every dt1."""
     n = 4
     mass, k = [3e5, 3e5, 3e5, 2.5e5], [4e8, 3.6e8, 3.2e8, 2.6e8]
-    integ = {"technique": "event_driven"} if law == "coulomb" else {"n2": 20}
+    if law in ("coulomb", "moreau_jean"):  # exact Coulomb friction, two techniques
+        integ = {"technique": "event_driven" if law == "coulomb" else "moreau_jean"}
+        law = "coulomb"
+    else:
+        integ = {"n2": 20}
     defaults = {
         "masses": mass,
         "labels": ["floor 1", "floor 2", "floor 3", "roof"],
@@ -70,7 +74,7 @@ def building(law: str = "velocity", duration: float = 6.0, **kw) -> fd.Analysis:
 # --- drifts and shears ------------------------------------------------------------------
 
 
-@pytest.mark.parametrize("law", ["velocity", "hysteretic", "coulomb"])
+@pytest.mark.parametrize("law", ["velocity", "hysteretic", "coulomb", "moreau_jean"])
 def test_drifts_and_shears_follow_from_the_histories(law):
     """drift = u_i - u_j, V = springs (with a1 K damping) + devices, row by row; and by
     equilibrium the storey shears are the inertia forces above the storey (a0 = 0): an
@@ -94,7 +98,8 @@ def test_drifts_and_shears_follow_from_the_histories(law):
         shear = k[st - 1] * (drift + a1 * rate) + r[f"F{st}"]
         np.testing.assert_allclose(r[f"V{st}"], shear, rtol=0, atol=1e-9 * np.abs(shear).max())
         inertia = -(m[st - 1 :] * acc[:, st - 1 :]).sum(axis=1)
-        # measured: 3.6e-13 (velocity), 8.1e-13 (hysteretic), 5.4e-14 (coulomb) of the peak
+        # measured: 3.6e-13 (velocity), 8.1e-13 (hysteretic), 5.4e-14 (coulomb), 7.7e-16
+        # (moreau_jean: its end-of-step forces and acceleration are one equilibrium) of the peak
         np.testing.assert_allclose(r[f"V{st}"], inertia, rtol=0, atol=1e-11 * np.abs(inertia).max())
     assert np.array_equal(r["Vb"], r["V1"])  # one storey on the table
     # peaks over every accepted step: at least the rows' (every dt1 here), at most a little more
@@ -109,6 +114,20 @@ def test_drifts_and_shears_follow_from_the_histories(law):
     assert s["residual_s_m"] == [r[f"s{d}"][-1] for d in range(1, 5)]
     assert s["residual_storey_shear_N"] == [r[f"V{st}"][-1] for st in range(1, 5)]
     assert s["residual_drift_ratio"] == [x / 3.5 for x in s["residual_drift_m"]]
+
+
+def test_moreau_jean_and_event_driven_report_the_same_drifts_and_shears():
+    """Two independent techniques for exact Coulomb friction, one observer: the building's
+    peak drifts and storey shears agree to the Moreau-Jean step's first-order error
+    (measured at n1 = 20: 6.1e-4 relative in peak drift, 5.1e-4 in peak shear, both at the
+    roof; 2.8e-3 in residual drift, storey 3)."""
+    ed = building("coulomb").run().summary
+    mj = building("moreau_jean").run().summary
+    assert mj["technique"] == "moreau_jean" and ed["technique"] == "event_driven"
+    np.testing.assert_allclose(mj["residual_drift_m"], ed["residual_drift_m"], rtol=5e-3)
+    np.testing.assert_allclose(mj["peak_drift_m"], ed["peak_drift_m"], rtol=1e-3)
+    np.testing.assert_allclose(mj["peak_storey_shear_N"], ed["peak_storey_shear_N"], rtol=1e-3)
+    assert mj["peak_base_shear_N"] == pytest.approx(ed["peak_base_shear_N"], rel=1e-3)
 
 
 def test_peaks_of_a_linear_run_are_the_rows_peaks():
@@ -497,6 +516,42 @@ def test_labels_reach_the_result():
         ),
         (
             lambda: chain(
+                2,
+                braces=[fd.FrictionBrace(1, 0, 1e3, 1e6)],
+                integration=fd.Integration(technique="moreau_jean"),
+            ),
+            ["&braces", "brace 1", "technique = 'moreau_jean'", "technique = 'newmark'"],
+        ),
+        (
+            lambda: chain(
+                2,
+                devices=[fd.Device.exponential(1, 0, 1e3, 0.1, 0.05, 5.0)],
+                integration=fd.Integration(technique="moreau_jean"),
+            ),
+            ["&friction", "law(1)", "moreau_jean"],
+        ),
+        (
+            lambda: chain(
+                2,
+                devices=[
+                    fd.Device(
+                        1,
+                        0,
+                        p=1e3,
+                        mu=None,
+                        law="coulomb",
+                        mu_law="exponential",
+                        mu_max=0.1,
+                        mu_min=0.05,
+                        mu_rate=5.0,
+                    )
+                ],
+                integration=fd.Integration(technique="moreau_jean"),
+            ),
+            ["&friction", "mu_law(1)", "velocity law only"],
+        ),
+        (
+            lambda: chain(
                 2, isolators=[fd.SlidingIsolator(1, 0, 1e3, 0.1, "velocity", radius=-2.0)]
             ),
             ["&isolators", "radius(1)", "-2"],
@@ -510,6 +565,9 @@ def test_labels_reach_the_result():
         "forgotten mu_law",
         "table order",
         "brace exact technique",
+        "brace moreau_jean",
+        "mu(v) velocity law under moreau_jean",
+        "mu(v) coulomb under moreau_jean",
         "negative radius",
         "storey on one node",
         "too many labels",
