@@ -150,6 +150,7 @@ contains
       call run_config_solve(s%cfg, s%res, error)
       if (allocated(error)) then
          s%state = state_failed
+         error%message = s%cfg%deck_path//": "//error%message   ! as the executable says it
          return
       end if
       call history_header(s%res, s%header)

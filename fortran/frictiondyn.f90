@@ -7,7 +7,7 @@ module frictiondyn
    use fd_result, only: result_type
    use fd_deck, only: run_config, read_deck, read_deck_string
    use fd_technique, only: run_technique
-   use fd_result, only: history_shape
+   use fd_result, only: history_shape, check_finite
    use fd_output, only: output_type, write_outputs, output_paths, temp_output_paths, summary_json, &
                         history_header, write_output_files
    implicit none
@@ -24,11 +24,15 @@ contains
    !> Run the analysis a configuration defines (no files written) with the technique of
    !> its &integration: 'newmark' (the velocity and hysteretic laws) or 'event_driven'
    !> (exact Coulomb friction); an error for anything that technique cannot integrate.
+   !> A solver's error names the deck.
    subroutine run_config_solve(cfg, res, error)
       type(run_config), intent(in) :: cfg                 !! model, excitation, settings
       type(result_type), intent(out) :: res               !! histories and summary
       type(error_type), allocatable, intent(out) :: error !! failure of the solver
       call run_technique(cfg%model, cfg%exc, cfg%opts, res, error)
+      if (allocated(error)) return
+      ! no null in a summary, no NaN in a history: a quantity that overflowed is an error
+      call check_finite(res, error)
    end subroutine run_config_solve
 
    !> Columns and samples of the history the configuration's run produces.

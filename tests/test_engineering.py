@@ -130,6 +130,33 @@ def test_moreau_jean_and_event_driven_report_the_same_drifts_and_shears():
     assert mj["peak_base_shear_N"] == pytest.approx(ed["peak_base_shear_N"], rel=1e-3)
 
 
+def test_the_exact_technique_gives_exact_storey_peaks_whatever_the_sampling():
+    """Under the exact technique a storey's drift and shear are polynomials between events
+    (linear in u, u' and F): the summary's peaks are their exact extrema, the same to
+    round-off whether the history keeps every dt1 or every 50th (the events do not depend on
+    the sampling); the rows' maxima never exceed them, and the envelope columns give them."""
+    fine = building("coulomb").run()
+    coarse = building("coulomb", output=fd.Output(output_every=50)).run()
+    sf, sc = fine.summary, coarse.summary
+    assert sf["peaks_exact"] is True and sc["peaks_exact"] is True
+    for key in ("peak_drift_m", "peak_storey_shear_N"):
+        np.testing.assert_allclose(sc[key], sf[key], rtol=1e-12)
+    assert sc["peak_base_shear_N"] == pytest.approx(sf["peak_base_shear_N"], rel=1e-12)
+    below = []
+    for r in (fine, coarse):
+        s = r.summary
+        for st in range(1, 5):
+            for col, key in ((f"drift{st}", "peak_drift_m"), (f"V{st}", "peak_storey_shear_N")):
+                # the envelope holds the maxima between rows: their largest is the peak
+                assert r[f"peak_{col}"].max() == s[key][st - 1]
+                assert r.peak(col) == s[key][st - 1]
+                assert np.abs(r[col]).max() <= s[key][st - 1]
+            below.append(np.abs(r[f"drift{st}"]).max() < s["peak_drift_m"][st - 1] * (1 - 1e-6))
+        assert r["peak_Vb"].max() == s["peak_base_shear_N"] == r.peak("Vb")
+    # every 50th dt1 (0.05 s) the rows miss the peaks the exact technique finds
+    assert any(below)
+
+
 def test_peaks_of_a_linear_run_are_the_rows_peaks():
     """Without devices every accepted step is a row (output_every = 1): the summary's peaks
     and their times are exactly the history's."""
@@ -144,7 +171,8 @@ def test_peaks_of_a_linear_run_are_the_rows_peaks():
         k = int(np.argmax(np.abs(r[f"drift{st}"])))
         assert s["peak_drift_m"][st - 1] == abs(r[f"drift{st}"][k])
         assert s["peak_drift_time_s"][st - 1] == pytest.approx(r.time[k], rel=1e-12)
-    assert s["peak_drift_ratio"] == [None] * 3 and s["storey_height_m"] == [None] * 3
+    # no height given: 0 (the summary holds no null), and so the drift ratio
+    assert s["peak_drift_ratio"] == [0.0] * 3 and s["storey_height_m"] == [0.0] * 3
     assert s["peak_base_shear_N"] == np.abs(r["Vb"]).max()
     # with a0 M damping the base shear is the inertia forces less the a0 M v forces
     m = np.full(3, M_FLOOR)
@@ -195,7 +223,7 @@ def test_a_rigid_stuck_system_is_reported_rigid_not_as_zero_seconds():
     a = chain(2, devices=[fd.Device(i, 0, p=1e6, mu=0.5, law="velocity") for i in (1, 2)])
     s = a.run().summary
     assert s["modes_stuck_status"] == "rigid" and s["periods_stuck_s"] == []
-    assert s["period_stuck_s"] is None and s["xi_stuck"] is None
+    assert s["period_stuck_s"] == 0.0 and s["xi_stuck"] == 0.0  # 0: none (no null)
     assert s["modes_free_status"] == "flexible" and len(s["periods_free_s"]) == 2
     # a flat slider with nothing to the table: the free system has a rigid-body mode
     b = fd.Analysis(
@@ -204,7 +232,10 @@ def test_a_rigid_stuck_system_is_reported_rigid_not_as_zero_seconds():
         isolators=[fd.SlidingIsolator(1, 0, weight=2 * M_FLOOR * G, mu=0.05, law="velocity")],
         excitation=fd.FreeVibration(0.01, 0.1),
     )
-    modes = b.run().modes("free")
+    rb = b.run()
+    # the summary: 0 for the rigid-body mode's period and damping ratio (no null)
+    assert rb.summary["periods_free_s"][0] == 0.0 and rb.summary["modal_xi_free"][0] == 0.0
+    modes = rb.modes("free")
     assert modes.status == "unrestrained" and modes.periods[0] == np.inf
     assert modes.mass_ratios[0] == pytest.approx(1.0, rel=1e-12) and np.isnan(modes.xi[0])
 
@@ -218,7 +249,7 @@ def test_hysteretic_devices_are_their_sticking_springs_in_the_stuck_modes():
     for j in range(n):
         w, _ = chain_mode(n, j + 1)
         assert s["periods_stuck_s"][j] == pytest.approx(2 * np.pi / w / np.sqrt(2), rel=1e-12)
-    assert s["period_stuck_s"] is None  # every device a rigid link to the table: rigid
+    assert s["period_stuck_s"] == 0.0  # every device a rigid link to the table: rigid, none
 
 
 # --- Rayleigh damping from modes -------------------------------------------------------
@@ -418,7 +449,7 @@ def test_the_summary_names_the_version_the_deck_and_the_record_with_their_hashes
     assert s["deck_sha256"] == hashlib.sha256(deck.read_bytes()).hexdigest()
     assert s["record"]["file"] == "synthetic_pga035.AT2"  # as the deck gives it
     assert s["record"]["sha256"] == hashlib.sha256(record.read_bytes()).hexdigest()
-    assert s["excitation_type"] == "record" and s["excitation_frequency_Hz"] is None
+    assert s["excitation_type"] == "record" and s["excitation_frequency_Hz"] == 0.0
     # a deck given as text: the hash of the text; the same text written to a file: the same
     a = chain(2)
     text = a.deck_text()
@@ -578,6 +609,119 @@ def test_bad_engineering_input_is_named(analysis, words):
         analysis().run()
     for w in words:
         assert w in str(exc.value), str(exc.value)
+
+
+def _deck_with(extra: str, *, devices: bool = False) -> str:
+    """The deck of a 2-floor chain with groups added (a velocity-law device at the roof)."""
+    text = chain(2).deck_text()
+    if devices:
+        text += (
+            "\n&friction\n  n_devices = 1, node_i = 2, node_j = 1, law = 'velocity',"
+            " p = 1e3, mu = 0.1\n/\n"
+        )
+    return text + "\n" + extra + "\n"
+
+
+@pytest.mark.parametrize(
+    "extra,devices,words",
+    [
+        (
+            "&storeys\n  n_storeys = 1, node_i = 1, node_j = 0, height = 1e-31\n/",
+            False,
+            ["&storeys", "height(1)", "at least"],
+        ),
+        (
+            (
+                "&isolators\n  n_isolators = 1, node_i = 1, node_j = 0, law = 'velocity',"
+                " weight = 1e3, mu = 0.1, radius = 1e-29\n/"
+            ),
+            False,
+            ["&isolators", "weight(1) / radius(1)", "at most"],
+        ),
+        (
+            (
+                "&isolators\n  n_isolators = 1, node_i = 1, node_j = 0, law = 'velocity',"
+                " weight = 1e-20, mu = 1e-20\n/"
+            ),
+            False,
+            ["&isolators", "weight(1) * mu(1)", "at least"],
+        ),
+        (
+            (
+                "&braces\n  n_braces = 1, node_i = 1, node_j = 0, slip_load = 1e-20,"
+                " stiffness = 1e20\n/"
+            ),
+            False,
+            ["&braces", "slip_load(1) / stiffness(1)", "at least"],
+        ),
+        (
+            "&braces\n  n_braces = 1, node_i = 1, node_j = 0, slip_load = 1e31, stiffness = 1e6\n/",
+            False,
+            ["&braces", "slip_load(1)", "at most"],
+        ),
+        (
+            "&storeys\n  n_storeys = 1, node_i = 1, node_j = 0, label = '" + "x" * 32 + "'\n/",
+            False,
+            ["&storeys", "label", "32 characters", "at most 31"],
+        ),
+        (
+            "&storeys\n  n_storeys = 1, node_i = 1, node_j = 0\n  label = 'a'\n  label = 'b'\n/",
+            False,
+            ["&storeys", "'label'", "assigned again"],
+        ),
+        (
+            "&output\n  n_modes = -1\n/",
+            False,
+            ["&output", "n_modes", "-1"],
+        ),
+    ],
+    ids=[
+        "tiny storey height",
+        "isolator stiffness W/R too large",
+        "isolator W mu too small",
+        "brace f too small",
+        "brace slip load too large",
+        "label too long",
+        "label given twice",
+        "negative n_modes",
+    ],
+)
+def test_limits_of_the_engineering_groups_are_checked_up_front(extra, devices, words):
+    """The deck's magnitude limits, string capacities and single assignment hold for the
+    variables of &storeys, &braces, &isolators and the labels too, and for what they derive
+    (a brace's f, an isolator's W / R and W mu): a message naming the group, the variable
+    and the value, before any run."""
+    with pytest.raises(fd.DeckError) as exc:
+        fd.run_text(_deck_with(extra, devices=devices), "limits.nml")
+    for w in words:
+        assert w in str(exc.value), str(exc.value)
+
+
+def test_mu_of_v_and_rayleigh_from_modes_are_held_to_the_limits():
+    """mu(v) parameters and the a0, a1 found from xi at two modes obey the magnitude limits."""
+    text = chain(2).deck_text() + (
+        "\n&friction\n  n_devices = 1, node_i = 2, node_j = 1, law = 'velocity', p = 1e3,"
+        " mu_law = 'exponential', mu_max = 1e31, mu_min = 0.05, mu_rate = 5.0\n/\n"
+    )
+    with pytest.raises(fd.DeckError, match=r"&friction: mu_max\(1\) = .* at most"):
+        fd.run_text(text, "mu.nml")
+    text = chain(2).deck_text() + (
+        "\n&friction\n  n_devices = 1, node_i = 2, node_j = 1, law = 'velocity', p = 1e3,"
+        " mu_law = '" + "e" * 33 + "'\n/\n"
+    )
+    with pytest.raises(fd.DeckError, match=r"&friction, line \d+: mu_law is a string of 33"):
+        fd.run_text(text, "mu.nml")
+    # a stiff, light chain: w ~ 1e17 rad/s, a0 = xi w ~ 1e16 is within the limits and runs
+    light = fd.Analysis(
+        masses=[1e-20, 1e-20],
+        springs=[fd.Spring(1, 0, 1e14), fd.Spring(2, 1, 1e14)],
+        damping=fd.Damping.rayleigh_modes(0.05, 1, 2),
+        excitation=fd.FreeVibration(dt_record=1e-18, duration=1e-17),
+        u0=[1e-3, 2e-3],
+    )
+    s = light.run().summary
+    w = 2 * np.pi / np.array(s["periods_stuck_s"])
+    assert s["damping_a0_per_s"] == pytest.approx(2 * 0.05 * w[0] * w[1] / (w[0] + w[1]), rel=1e-9)
 
 
 # --- worked examples --------------------------------------------------------------------

@@ -23,6 +23,7 @@ __all__ = [
     "DeckError",
     "FrictiondynError",
     "Modes",
+    "OutOfMemoryError",
     "OutputError",
     "OutputSettings",
     "Result",
@@ -51,12 +52,37 @@ class OutputError(FrictiondynError, OSError):
     """An output file or directory cannot be created or written."""
 
 
+class OutOfMemoryError(FrictiondynError, MemoryError):
+    """Memory for what the deck asks (its matrices, its history) cannot be had; the message
+    says what and how large. Also a MemoryError."""
+
+
 # the status codes of the extension (driver/frictiondyn/_core.f90)
-_ERRORS = {1: DeckError, 2: SolverError, 3: FrictiondynError, 4: OutputError, 5: MemoryError}
+_ERRORS = {1: DeckError, 2: SolverError, 3: FrictiondynError, 4: OutputError, 5: OutOfMemoryError}
+
+
+def _text_bytes(text: str, what: str) -> np.ndarray:
+    """Text for the extension: its UTF-8 bytes (lone surrogates, as os.fsdecode makes them,
+    back to their bytes), as the int16 array (one byte an element) the extension takes."""
+    try:
+        data = text.encode("utf-8", "surrogateescape")
+    except UnicodeEncodeError as exc:
+        raise DeckError(f"{what}: character {exc.start + 1} cannot be encoded as UTF-8") from None
+    return np.frombuffer(data, dtype=np.uint8).astype(np.int16)
+
+
+def _path_bytes(path: str | os.PathLike) -> np.ndarray:
+    """A path for the extension: its bytes in the file system's encoding (as above)."""
+    try:
+        data = os.fsencode(path)
+    except UnicodeEncodeError as exc:
+        raise DeckError(f"{os.fspath(path)!r}: cannot be encoded as a file name ({exc.reason})") from None
+    return np.frombuffer(data, dtype=np.uint8).astype(np.int16)
 # the texts a session gives (fortran/fd_session.f90)
 _HEADER, _SUMMARY, _OUTPUT_DIR, _OUTPUT_NAME, _HISTORY_PATH, _SUMMARY_PATH, _DECK, _ERROR = range(
     1, 9
 )
+_PATHS = (_OUTPUT_DIR, _OUTPUT_NAME, _HISTORY_PATH, _SUMMARY_PATH, _DECK)
 
 
 @dataclass
@@ -79,7 +105,7 @@ class Session:
     """
 
     def __init__(self, deck: str | os.PathLike) -> None:
-        self._open(os.fspath(deck), "", 0)
+        self._open(_path_bytes(deck), _text_bytes("", "deck"), 0)
 
     @classmethod
     def from_text(
@@ -88,7 +114,10 @@ class Session:
         """A session of a deck given as text; ``name`` names it in messages, a relative
         record_file is looked up in ``base_dir``."""
         self = cls.__new__(cls)
-        self._open(os.path.join(os.fspath(base_dir), name), text, 1)
+        if not isinstance(text, str):
+            raise TypeError(f"the deck text must be a str, not {type(text).__name__}")
+        path = os.path.join(os.fspath(base_dir), os.fspath(name))
+        self._open(_path_bytes(path), _text_bytes(text, path), 1)
         return self
 
     @classmethod
@@ -97,11 +126,13 @@ class Session:
         self = cls.__new__(cls)
         self._handle, self._lock = 0, threading.Lock()
         hist = np.asarray(data, dtype=np.float64).T  # (columns, samples), Fortran order
-        handle, status = _core.fd_session_adopt(hist, header, summary)
+        handle, status = _core.fd_session_adopt(
+            hist, _text_bytes(header, "header"), _text_bytes(summary, "summary")
+        )
         self._started(handle, status)
         return self
 
-    def _open(self, path: str, text: str, from_text: int) -> None:
+    def _open(self, path: np.ndarray, text: np.ndarray, from_text: int) -> None:
         self._handle, self._lock = 0, threading.Lock()
         handle, _, _, status = _core.fd_session_open(path, text, from_text)
         self._started(handle, status)
@@ -138,7 +169,10 @@ class Session:
             return ""
         buf, status = _core.fd_session_text(self._handle, which, length)
         self._check(status)
-        return np.asarray(buf).tobytes().decode("utf-8", errors="replace")
+        data = np.asarray(buf).tobytes()
+        if which in _PATHS:  # paths as the file system names them (any bytes round-trip)
+            return os.fsdecode(data)
+        return data.decode("utf-8", errors="replace")
 
     def _text(self, which: int) -> str:
         n, status = _core.fd_session_text_length(self._live(), which)
@@ -205,7 +239,15 @@ class Session:
             h = self._live()
             ncol, nout, history, status = _core.fd_session_shape(h)
             self._check(status)
-            hist, status = _core.fd_session_history(h, ncol, nout)
+            try:
+                hist, status = _core.fd_session_history(h, ncol, nout)
+            except MemoryError:
+                raise OutOfMemoryError(
+                    f"{self._text(_DECK)}: not enough memory for the history in Python: "
+                    f"{nout} samples of {ncol} columns ({8 * nout * ncol / 2**20:.0f} MiB); "
+                    "raise output_every in &output, or set write_history = .false. and use "
+                    "Session.write()"
+                ) from None
             self._check(status)
             summary = self._text(_SUMMARY)
             result = Result.from_arrays(self._text(_HEADER), np.asarray(hist).T, summary)
@@ -222,7 +264,7 @@ class Session:
         with self._lock:
             h = self._live()
             if out is not None:
-                self._check(_core.fd_session_set_output_dir(h, os.fspath(out)))
+                self._check(_core.fd_session_set_output_dir(h, _path_bytes(out)))
             self._check(_core.fd_session_write(h))
             _, _, history, status = _core.fd_session_shape(h)
             self._check(status)
@@ -232,7 +274,7 @@ class Session:
     def _write_files(self, csv: Path | None, summary: Path) -> None:
         with self._lock:
             status = _core.fd_session_write_files(
-                self._live(), os.fspath(csv or ""), os.fspath(summary), int(csv is not None)
+                self._live(), _path_bytes(csv or ""), _path_bytes(summary), int(csv is not None)
             )
             self._check(status)
 
@@ -284,8 +326,8 @@ class Modes:
 
 
 def _floats(values) -> np.ndarray:
-    """A JSON list with nulls as a float array with nan (inf for periods, given as nan)."""
-    return np.array([np.nan if v is None else float(v) for v in values], dtype=float)
+    """A JSON list as a float array."""
+    return np.array([float(v) for v in values], dtype=float)
 
 
 @dataclass
@@ -295,7 +337,9 @@ class Result:
     ``result["u1"]`` is a column by name (see ``names``, ``units``); ``time`` is ``t``;
     ``dof(i)`` and ``device(d)`` group the series of one DOF or device (1-based);
     ``summary`` is the run's summary (peaks, transitions, steps, correctness violations,
-    energy) as a dict.
+    energy) as a dict; ``peak(name, t_range)`` the peak of a series (exact for the exact
+    technique, whose peaks include the extrema between rows and the one-sided values at
+    events).
     """
 
     names: list[str]
@@ -378,6 +422,27 @@ class Result:
             "phase": self[f"phase{d}"],
         }
 
+    def peak(self, name: str, t_range: tuple[float, float] | None = None) -> float:
+        """Largest |name| (``'aabs2'``, ``'u1'``, ``'F1'``, ...) over the run, or over the rows
+        with ``t_range[0] <= t <= t_range[1]``.
+
+        For the exact technique it is exact: its history holds, in ``peak_<name>``, the
+        maxima since the previous row (extrema between rows and one-sided values at events
+        included), so this is the true peak over the time from the range's first row to its
+        last. Otherwise it is the largest sampled value of the rows in the range."""
+        t = self.time
+        if t_range is None:
+            rows = np.arange(len(t))
+        else:
+            rows = np.nonzero((t >= t_range[0] - 1e-12) & (t <= t_range[1] + 1e-12))[0]
+        if rows.size == 0:
+            raise ValueError(f"no history row in the time range {t_range}")
+        values = np.abs(self[name][rows])
+        if f"peak_{name}" not in self:
+            return float(values.max())
+        envelope = self[f"peak_{name}"][rows[1:]]
+        return float(max(values[0], envelope.max(initial=0.0)))
+
     def label(self, name: str) -> str:
         """Axis label 'name [unit]'."""
         unit = self.units.get(name, "")
@@ -425,7 +490,8 @@ class Result:
         if f"modes_{system}_status" not in s:
             raise KeyError("the summary has no modes (written by an older frictiondyn)")
         periods = _floats(s[f"periods_{system}_s"])
-        periods[np.isnan(periods)] = np.inf  # null: a rigid-body mode
+        rigid = periods == 0.0  # a rigid-body mode: the summary gives period and xi 0
+        periods[rigid] = np.inf
         shapes = np.array(s[f"mode_shapes_{system}"], dtype=float).reshape(len(periods), self.n_dof)
         return Modes(
             system,
@@ -433,7 +499,7 @@ class Result:
             periods,
             shapes,
             _floats(s[f"modal_mass_ratio_{system}"]),
-            _floats(s[f"modal_xi_{system}"]),
+            np.where(rigid, np.nan, _floats(s[f"modal_xi_{system}"])),
         )
 
     def to_dataframe(self, index: str | None = "t"):

@@ -10,6 +10,13 @@
 !> failure is kept in the session (fetch it with fd_session_text_length and fd_session_text,
 !> which = 8). The Python side (frictiondyn/_api.py) turns it into an exception.
 !>
+!> Text in (a path, a deck, a header) comes as bytes, one byte (0..255) in each element of a
+!> c_short array, encoded by the caller (UTF-8 for text, the file system's encoding for
+!> paths): f2py's character arguments accept only ASCII str and end a string at a NUL, so
+!> text passed as characters could hold no non-ASCII character (a micro sign in a comment,
+!> an accented path) and lost what follows a NUL. (f2py's c_int8_t arrays do not compile:
+!> it declares them as an undefined C type, signed_char.)
+!>
 !> status: 0 success, 1 bad deck or input, 2 solver failure, 3 misuse (wrong state, wrong
 !> buffer, no session), 4 an output file cannot be written, 5 not enough memory (with the
 !> handle 0 when the session itself could not be allocated: then there is no message).
@@ -17,13 +24,15 @@
 !> Read and validate a deck (the file `path`, or `text` when from_text /= 0) into a new
 !> session; return its handle and the shape of its history. On status 1 the handle is valid
 !> (it holds the message) and must be closed too.
-subroutine fd_session_open(path, text, from_text, handle, ncol, nout, status)
-   use, intrinsic :: iso_c_binding, only: c_int, c_int64_t
+subroutine fd_session_open(npath, path, ntext, text, from_text, handle, ncol, nout, status)
+   use, intrinsic :: iso_c_binding, only: c_int, c_int64_t, c_short
    use fd_session, only: session_type, session_new, session_open, session_open_text, session_shape
    use frictiondyn, only: error_type
    implicit none
-   character(len=*), intent(in) :: path          !! deck file, or name of a text deck
-   character(len=*), intent(in) :: text          !! deck text (when from_text /= 0)
+   integer(c_int), intent(in) :: npath           !! bytes of the path
+   integer(c_short), intent(in) :: path(npath)  !! deck file, or name of a text deck
+   integer(c_int), intent(in) :: ntext           !! bytes of the text
+   integer(c_short), intent(in) :: text(ntext)  !! deck text (when from_text /= 0)
    integer(c_int), intent(in) :: from_text       !! 1: read text, 0: read the file
    integer(c_int64_t), intent(out) :: handle     !! the new session (0: none, status 5)
    integer(c_int), intent(out) :: ncol           !! columns of the history
@@ -34,6 +43,7 @@ subroutine fd_session_open(path, text, from_text, handle, ncol, nout, status)
    type(error_type), allocatable :: error
    integer :: stat, nc, no
    logical :: history
+   character(len=:), allocatable :: path_s, text_s
 
    ncol = 0; nout = 0
    call session_new(s, handle, stat)
@@ -41,10 +51,14 @@ subroutine fd_session_open(path, text, from_text, handle, ncol, nout, status)
       status = 5
       return
    end if
-   if (from_text /= 0) then
-      call session_open_text(s, text, path, error)
+   call bytes_text(path, path_s, error)
+   if (.not. allocated(error) .and. from_text /= 0) call bytes_text(text, text_s, error)
+   if (allocated(error)) then
+      ! not enough memory for the text
+   else if (from_text /= 0) then
+      call session_open_text(s, text_s, path_s, error)
    else
-      call session_open(s, path, error)
+      call session_open(s, path_s, error)
    end if
    if (.not. allocated(error)) call session_shape(s, nc, no, history, error)
    call keep_error(s, error, 1, status)
@@ -56,29 +70,34 @@ end subroutine fd_session_open
 
 !> A new solved session holding a history and texts given by the caller, to write them with
 !> the library's writer (fd_session_write_files).
-subroutine fd_session_adopt(ncol, nout, hist, header, summary, handle, status)
-   use, intrinsic :: iso_c_binding, only: c_int, c_int64_t, c_double
+subroutine fd_session_adopt(ncol, nout, hist, nheader, header, nsummary, summary, handle, status)
+   use, intrinsic :: iso_c_binding, only: c_int, c_int64_t, c_double, c_short
    use fd_session, only: session_type, session_new, session_adopt
-   use frictiondyn, only: error_type, dp
+   use frictiondyn, only: error_type
    implicit none
    integer(c_int), intent(in) :: ncol            !! columns
    integer(c_int), intent(in) :: nout            !! samples
    real(c_double), intent(in) :: hist(ncol, nout) !! history
-   character(len=*), intent(in) :: header        !! 'name[unit],...'
-   character(len=*), intent(in) :: summary       !! summary text (JSON)
+   integer(c_int), intent(in) :: nheader         !! bytes of the header
+   integer(c_short), intent(in) :: header(nheader) !! 'name[unit],...'
+   integer(c_int), intent(in) :: nsummary        !! bytes of the summary
+   integer(c_short), intent(in) :: summary(nsummary) !! summary text (JSON)
    integer(c_int64_t), intent(out) :: handle     !! the new session (0: none, status 5)
    integer(c_int), intent(out) :: status         !! 0 or an error code
    !f2py threadsafe
    type(session_type), pointer :: s
    type(error_type), allocatable :: error
    integer :: stat
+   character(len=:), allocatable :: header_s, summary_s
 
    call session_new(s, handle, stat)
    if (stat /= 0) then
       status = 5
       return
    end if
-   call session_adopt(s, real(hist, dp), header, summary, error)
+   call bytes_text(header, header_s, error)
+   if (.not. allocated(error)) call bytes_text(summary, summary_s, error)
+   if (.not. allocated(error)) call session_adopt(s, hist, header_s, summary_s, error)
    call keep_error(s, error, 5, status)
    if (status /= 0) return
 contains
@@ -241,21 +260,24 @@ contains
 end subroutine fd_session_text
 
 !> Write the outputs into `dir` instead of the deck's &output dir.
-subroutine fd_session_set_output_dir(handle, dir, status)
-   use, intrinsic :: iso_c_binding, only: c_int, c_int64_t
+subroutine fd_session_set_output_dir(handle, ndir, dir, status)
+   use, intrinsic :: iso_c_binding, only: c_int, c_int64_t, c_short
    use fd_session, only: session_type, session_from_handle, session_set_output_dir
    use frictiondyn, only: error_type
    implicit none
    integer(c_int64_t), intent(in) :: handle      !! the session
-   character(len=*), intent(in) :: dir           !! output directory
+   integer(c_int), intent(in) :: ndir            !! bytes of the directory
+   integer(c_short), intent(in) :: dir(ndir)    !! output directory
    integer(c_int), intent(out) :: status         !! 0 or an error code
    type(session_type), pointer :: s
    type(error_type), allocatable :: error
+   character(len=:), allocatable :: dir_s
 
    call session_from_handle(handle, s)
    status = merge(0_c_int, 3_c_int, associated(s))
    if (status /= 0) return
-   call session_set_output_dir(s, dir, error)
+   call bytes_text(dir, dir_s, error)
+   if (.not. allocated(error)) call session_set_output_dir(s, dir_s, error)
    call keep_error(s, error, 3, status)
    if (status /= 0) return
 contains
@@ -289,26 +311,31 @@ end subroutine fd_session_write
 
 !> Write the history (when history /= 0) to `hist_path` and the summary to `summ_path` with
 !> the library's writer.
-subroutine fd_session_write_files(handle, hist_path, summ_path, history, status)
-   use, intrinsic :: iso_c_binding, only: c_int, c_int64_t
+subroutine fd_session_write_files(handle, nhist, hist_path, nsumm, summ_path, history, status)
+   use, intrinsic :: iso_c_binding, only: c_int, c_int64_t, c_short
    use fd_session, only: session_type, session_from_handle, session_write_files, session_solved
    use frictiondyn, only: error_type
    implicit none
    integer(c_int64_t), intent(in) :: handle      !! the session
-   character(len=*), intent(in) :: hist_path     !! the history CSV
-   character(len=*), intent(in) :: summ_path     !! the summary file
+   integer(c_int), intent(in) :: nhist           !! bytes of hist_path
+   integer(c_short), intent(in) :: hist_path(nhist) !! the history CSV
+   integer(c_int), intent(in) :: nsumm           !! bytes of summ_path
+   integer(c_short), intent(in) :: summ_path(nsumm) !! the summary file
    integer(c_int), intent(in) :: history         !! 1: write the history too
    integer(c_int), intent(out) :: status         !! 0 or an error code
    !f2py threadsafe
    type(session_type), pointer :: s
    type(error_type), allocatable :: error
    integer :: code
+   character(len=:), allocatable :: hist_s, summ_s
 
    call session_from_handle(handle, s)
    status = merge(0_c_int, 3_c_int, associated(s))
    if (status /= 0) return
    code = merge(4, 3, s%state == session_solved)
-   call session_write_files(s, hist_path, summ_path, history /= 0, error)
+   call bytes_text(hist_path, hist_s, error)
+   if (.not. allocated(error)) call bytes_text(summ_path, summ_s, error)
+   if (.not. allocated(error)) call session_write_files(s, hist_s, summ_s, history /= 0, error)
    call keep_error(s, error, code, status)
    if (status /= 0) return
 contains

@@ -69,7 +69,7 @@ def _print_summary(result: Result, deck: str) -> None:
     s = result.summary
     print(f"frictiondyn: {deck}")
     period = s.get("period_stuck_s")
-    stuck = f"stuck period {period:.6g} s" if period is not None else "stuck system has no period"
+    stuck = f"stuck period {period:.6g} s" if period else "stuck system has no period"
     print(f"  {stuck}; steps dt1 {s['steps_dt1']}, dt2 {s['steps_dt2']}, finer {s['steps_finer']}")
     laws = s.get("device_law", [])
     for d in range(result.n_devices):
@@ -86,8 +86,9 @@ def _print_summary(result: Result, deck: str) -> None:
         )
     storeys = result.storey_labels
     for k in range(result.n_storeys):
-        ratio = (s.get("peak_drift_ratio") or [None] * result.n_storeys)[k]
-        extra = f" ({100 * ratio:.3g} %)" if ratio is not None else ""
+        height = (s.get("storey_height_m") or [0.0] * result.n_storeys)[k]
+        ratio = (s.get("peak_drift_ratio") or [0.0] * result.n_storeys)[k]
+        extra = f" ({100 * ratio:.3g} %)" if height > 0 else ""
         print(
             f"  {storeys[k]}: peak drift {s['peak_drift_m'][k]:.6g} m{extra}, residual "
             f"{s['residual_drift_m'][k]:.3g} m, peak shear {s['peak_storey_shear_N'][k]:.6g} N"
@@ -340,7 +341,7 @@ def main(argv: Sequence[str] | None = None) -> int:
     except BrokenPipeError:  # output piped into e.g. head: stop quietly
         os.dup2(os.open(os.devnull, os.O_WRONLY), sys.stdout.fileno())
         return 1
-    except (FrictiondynError, CliError, OSError, ValueError, KeyError) as exc:
+    except (FrictiondynError, CliError, OSError, ValueError, KeyError, MemoryError) as exc:
         print(f"frictiondyn: error: {_one_line(exc)}", file=sys.stderr)
         return 1
     except KeyboardInterrupt:

@@ -528,7 +528,7 @@ def _storey_levels(r: Result) -> tuple[np.ndarray, bool]:
     counts as 0 m), else storey numbers; (levels (ns, 2), in metres)."""
     s = r.summary
     nodes = s.get("storey_nodes") or []
-    heights = [0.0 if h is None else h for h in (s.get("storey_height_m") or [])]
+    heights = list(s.get("storey_height_m") or [])  # 0: not given
     z = {0: 0.0}
     if nodes and any(h > 0 for h in heights):
         pending = list(range(len(nodes)))
@@ -580,9 +580,9 @@ def plot_drift_profile(
         s = r.summary
         if not r.n_storeys:
             raise ValueError(f"{name}: no storeys (give &storeys in the deck)")
-        use_ratio = ratio if ratio is not None else all(h is not None for h in s["storey_height_m"])
+        use_ratio = ratio if ratio is not None else all(h > 0 for h in s["storey_height_m"])
         key = "drift_ratio" if use_ratio else "drift_m"
-        if use_ratio and any(h is None for h in s["storey_height_m"]):
+        if use_ratio and not all(h > 0 for h in s["storey_height_m"]):
             raise ValueError(f"{name}: drift ratios need every storey's height")
         scale = 100.0 if use_ratio else u.factor("m")
         levels, metres = _storey_levels(r)
@@ -605,9 +605,7 @@ def plot_drift_profile(
         ax.set_ylabel("storey")
     ax.set_ylim(bottom=0.0)
     ax.set_xlim(0.0, 1.08 * max(ln.get_xdata().max() for ln in ax.get_lines()))
-    use_ratio = (
-        ratio if ratio is not None else all(h is not None for h in r0.summary["storey_height_m"])
-    )
+    use_ratio = ratio if ratio is not None else all(h > 0 for h in r0.summary["storey_height_m"])
     ax.set_xlabel("drift ratio [%]" if use_ratio else f"drift [{u.name('m')}]")
     ax.grid(True, linewidth=0.3)
     if len(rs) > 1 or residual:

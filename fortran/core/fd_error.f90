@@ -4,7 +4,11 @@ module fd_error
    implicit none
    private
 
-   public :: error_type, fatal_error, fmt_real, fmt_int
+   public :: error_type, fatal_error, fmt_real, fmt_int, stat_no_memory
+
+   !> The stat of an error raised because memory could not be had (an allocation the size
+   !> of the input failed): the caller may tell it from a bad input.
+   integer, parameter :: stat_no_memory = 5
 
    !> An error raised by the library, handed back to the caller.
    type :: error_type
@@ -15,7 +19,7 @@ module fd_error
 contains
 
    !> Create an error with a message (and an optional status code).
-   subroutine fatal_error(error, message, stat)
+   pure subroutine fatal_error(error, message, stat)
       type(error_type), allocatable, intent(out) :: error !! the error to create
       character(len=*), intent(in) :: message            !! message naming the offending input
       integer, intent(in), optional :: stat              !! status code (default 1)

@@ -2,11 +2,14 @@
 !> and small string utilities. No state; errors name the file.
 module fd_textio
    use, intrinsic :: iso_c_binding, only: c_char, c_ptr, c_size_t, c_int, c_null_char, c_associated
-   use fd_error, only: error_type, fatal_error
+   use fd_error, only: error_type, fatal_error, fmt_int
    implicit none
    private
 
-   public :: line_type, read_text_file, read_file_text, split_lines, lower, split_tokens
+   public :: line_type, read_text_file, read_file_text, split_lines, lower, split_tokens, max_file_bytes
+
+   !> Largest text file read (a deck or a record): 1 GiB. Lengths stay in default integers.
+   integer, parameter :: max_file_bytes = 2**30
 
    interface
       function c_fopen(path, mode) bind(c, name='fopen') result(fp)
@@ -26,6 +29,27 @@ module fd_textio
          type(c_ptr), value :: fp
          integer(c_int) :: stat
       end function c_fclose
+      function c_ferror(fp) bind(c, name='ferror') result(stat)
+         import :: c_ptr, c_int
+         type(c_ptr), value :: fp
+         integer(c_int) :: stat
+      end function c_ferror
+      function c_access(path, mode) bind(c, name='access') result(stat)
+         import :: c_char, c_int
+         character(kind=c_char), intent(in) :: path(*)
+         integer(c_int), value :: mode
+         integer(c_int) :: stat
+      end function c_access
+      function c_opendir(path) bind(c, name='opendir') result(dir)
+         import :: c_char, c_ptr
+         character(kind=c_char), intent(in) :: path(*)
+         type(c_ptr) :: dir
+      end function c_opendir
+      function c_closedir(dir) bind(c, name='closedir') result(stat)
+         import :: c_ptr, c_int
+         type(c_ptr), value :: dir
+         integer(c_int) :: stat
+      end function c_closedir
    end interface
 
    !> One line of text.
@@ -43,27 +67,45 @@ contains
       type(line_type), allocatable, intent(out) :: lines(:)  !! its lines
       type(error_type), allocatable, intent(out) :: error    !! set when it cannot be read
       character(len=:), allocatable :: text
+      integer :: stat
 
       call read_file_text(path, text, error)
       if (allocated(error)) return
-      call split_lines(text, lines)
+      call split_lines(text, lines, stat)
+      if (stat /= 0) call fatal_error(error, "not enough memory for the lines of file '"//path//"' ("// &
+                                      trim(fmt_int(len(text)))//" bytes)")
    end subroutine read_text_file
 
-   !> Read a whole file into one string (a buffer that doubles: linear time; growing the
-   !> string chunk by chunk took quadratic time).
+   !> Read a whole text file into one string (a buffer that doubles: linear time; growing
+   !> the string chunk by chunk took quadratic time). Errors name the file and say what it
+   !> is: missing, a directory, unreadable, larger than max_file_bytes, or not text (a NUL
+   !> character); memory that cannot be had is an error too.
    subroutine read_file_text(path, text, error)
       character(len=*), intent(in) :: path                   !! file to read
       character(len=:), allocatable, intent(out) :: text     !! its bytes
       type(error_type), allocatable, intent(out) :: error    !! set when it cannot be read
       character(len=:), allocatable :: buf, grown
-      type(c_ptr) :: fp
+      type(c_ptr) :: fp, dir
       integer(c_size_t) :: got, want
-      integer :: stat, n, cap
-      logical :: exists
+      integer :: stat, n, cap, nul
+      logical :: failed
 
-      inquire (file=path, exist=exists)
-      if (.not. exists) then
+      if (index(path, achar(0)) > 0) then
+         call fatal_error(error, "the file name '"//path(1:index(path, achar(0)) - 1)//"...' contains a NUL character")
+         return
+      end if
+      if (c_access(path//c_null_char, 0_c_int) /= 0) then      ! F_OK
          call fatal_error(error, "file '"//path//"' does not exist")
+         return
+      end if
+      dir = c_opendir(path//c_null_char)
+      if (c_associated(dir)) then
+         stat = c_closedir(dir)
+         call fatal_error(error, "'"//path//"' is a directory, not a file")
+         return
+      end if
+      if (c_access(path//c_null_char, 4_c_int) /= 0) then      ! R_OK
+         call fatal_error(error, "file '"//path//"' is not readable (permission denied)")
          return
       end if
       fp = c_fopen(path//c_null_char, 'rb'//c_null_char)
@@ -74,11 +116,19 @@ contains
       ! read into a buffer that doubles when full (works for pipes too): the text is
       ! copied O(log size) times, not once per chunk
       cap = 65536
-      allocate (character(len=cap) :: buf)
+      allocate (character(len=cap) :: buf, stat=stat)
       n = 0
-      do
+      failed = .false.
+      do while (stat == 0)
          if (n == cap) then
-            allocate (character(len=2*cap) :: grown)
+            if (cap >= max_file_bytes) then
+               stat = c_fclose(fp)
+               call fatal_error(error, "file '"//path//"' is larger than "//trim(fmt_int(max_file_bytes/2**20))// &
+                                " MiB: not a deck or a record")
+               return
+            end if
+            allocate (character(len=2*cap) :: grown, stat=stat)
+            if (stat /= 0) exit
             grown(1:n) = buf(1:n)
             call move_alloc(grown, buf)
             cap = 2*cap
@@ -86,17 +136,48 @@ contains
          want = int(cap - n, c_size_t)
          got = c_fread(buf(n + 1:cap), 1_c_size_t, want, fp)
          n = n + int(got)
-         if (got < want) exit
+         if (got < want) then
+            failed = c_ferror(fp) /= 0
+            exit
+         end if
       end do
-      text = buf(1:n)
+      if (stat == 0) allocate (character(len=n) :: text, stat=stat)
+      if (stat /= 0) then
+         stat = c_fclose(fp)
+         call fatal_error(error, "not enough memory to read file '"//path//"' ("//trim(fmt_int(n))//" bytes read)")
+         return
+      end if
       stat = c_fclose(fp)
+      if (failed) then
+         call fatal_error(error, "cannot read file '"//path//"' (an input/output error after "// &
+                          trim(fmt_int(n))//" bytes)")
+         return
+      end if
+      text = buf(1:n)
+      nul = index(text, achar(0))
+      if (nul > 0) then
+         call fatal_error(error, "file '"//path//"', line "//trim(fmt_int(count_lines(text(1:nul))))// &
+                          ": a NUL character (byte 0): not a text file")
+         return
+      end if
    end subroutine read_file_text
 
+   !> Number of the line holding the last character of text (1 + newlines before it).
+   pure integer function count_lines(text) result(n)
+      character(len=*), intent(in) :: text
+      integer :: i
+      n = 1
+      do i = 1, len(text) - 1
+         if (text(i:i) == achar(10)) n = n + 1
+      end do
+   end function count_lines
+
    !> Split text at newlines (a final newline ends the last line; carriage returns dropped).
-   pure subroutine split_lines(text, lines)
+   pure subroutine split_lines(text, lines, stat)
       character(len=*), intent(in) :: text                   !! the text
-      type(line_type), allocatable, intent(out) :: lines(:)  !! its lines
-      integer :: i, start, n
+      type(line_type), allocatable, intent(out) :: lines(:)  !! its lines (none if stat /= 0)
+      integer, intent(out), optional :: stat                 !! 0, or not enough memory
+      integer :: i, start, n, last, st
 
       n = 0
       do i = 1, len(text)
@@ -105,20 +186,30 @@ contains
       if (len(text) > 0) then
          if (text(len(text):len(text)) /= achar(10)) n = n + 1
       end if
-      allocate (lines(n))
+      if (present(stat)) stat = 0
+      allocate (lines(n), stat=st)
+      if (st /= 0) then
+         if (present(stat)) stat = st
+         return
+      end if
       n = 0
       start = 1
       do i = 1, len(text)
          if (text(i:i) /= achar(10) .and. i < len(text)) cycle
          n = n + 1
-         if (text(i:i) == achar(10)) then
-            lines(n)%s = text(start:i - 1)
-         else
-            lines(n)%s = text(start:i)
+         last = i
+         if (text(i:i) == achar(10)) last = i - 1
+         if (last >= start) then
+            if (text(last:last) == achar(13)) last = last - 1
          end if
-         if (len(lines(n)%s) > 0) then
-            if (lines(n)%s(len(lines(n)%s):) == achar(13)) lines(n)%s = lines(n)%s(1:len(lines(n)%s) - 1)
+         allocate (character(len=max(0, last - start + 1)) :: lines(n)%s, stat=st)
+         if (st /= 0) then
+            deallocate (lines)
+            allocate (lines(0))
+            if (present(stat)) stat = st
+            return
          end if
+         lines(n)%s = text(start:last)
          start = i + 1
       end do
    end subroutine split_lines

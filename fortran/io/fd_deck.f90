@@ -5,11 +5,13 @@
 !> every default come from fd_names. docs/namelist.md documents every variable.
 module fd_deck
    use, intrinsic :: ieee_arithmetic, only: ieee_is_finite
+   use, intrinsic :: ieee_exceptions, only: ieee_set_halting_mode, ieee_support_halting, ieee_overflow, &
+                                            ieee_set_flag
    use fd_kinds, only: dp
-   use fd_error, only: error_type, fatal_error, fmt_int, fmt_real
+   use fd_error, only: error_type, fatal_error, fmt_int, fmt_real, stat_no_memory
    use fd_textio, only: lower
    use fd_namelist, only: deck_text, group_text, deck_from_string, find_group, group_item, &
-                          group_read_error, check_groups
+                          group_read_error, check_groups, longest_string
    use fd_names, only: keyword_id, keyword_choices, law_id, law_choices, &
                        damping_types, damping_stiffness, damping_rayleigh, damping_none, &
                        excitation_types, excitation_harmonic, excitation_record, excitation_none, &
@@ -32,6 +34,7 @@ module fd_deck
    use fd_matrices, only: modes_type, natural_modes, stiffness_matrix
    use fd_sha256, only: sha256_text
    use fd_textio, only: read_file_text
+   use fd_step_limits, only: check_step_limits
    implicit none
    private
 
@@ -41,8 +44,13 @@ module fd_deck
    integer, parameter :: max_springs = 40000  !! capacity of the spring arrays
    integer, parameter :: max_devices = 10000  !! capacity of the device arrays
    real(dp), parameter :: unset = -huge(1.0_dp)
+   !> Largest magnitude of a real value, and smallest of a value that must be > 0 (a mass,
+   !> stiffness, band, step, frequency...): within them the products a run forms (forces,
+   !> energies, effective stiffness) stay far from the limits of double precision.
+   real(dp), parameter, public :: max_magnitude = 1.0e30_dp, min_scale = 1.0e-30_dp
    integer, parameter :: unset_int = -huge(1)
-   integer, parameter :: name_len = 32
+   integer, parameter :: name_len = 32        !! capacity of a keyword value
+   integer, parameter :: path_len = 1024      !! capacity of record_file, dir, name
 
    !> Everything one deck defines.
    type :: run_config
@@ -70,8 +78,14 @@ contains
          error%message = "deck: "//error%message
          return
       end if
-      call deck_from_string(text, path, deck)
-      call read_groups(deck, cfg, error)
+      ! a value too large for a double ('1e400' in a deck or a record) overflows to infinity
+      ! when it is converted, and is then rejected with a message: a build that traps
+      ! overflow (-ffpe-trap, tools/test_checked.sh) must not stop there. The halting mode is
+      ! restored when this reader returns (Fortran 2008, 14.3), the overflow handled.
+      if (ieee_support_halting(ieee_overflow)) call ieee_set_halting_mode(ieee_overflow, .false.)
+      call deck_from_string(text, path, deck, error)
+      if (.not. allocated(error)) call read_groups(deck, cfg, error)
+      call ieee_set_flag(ieee_overflow, .false.)
       if (allocated(error)) return
       call sha256_text(text, cfg%model%deck_sha256)
    end subroutine read_deck
@@ -85,8 +99,14 @@ contains
       type(error_type), allocatable, intent(out) :: error !! first problem found
       type(deck_text) :: deck
 
-      call deck_from_string(text, path, deck)
-      call read_groups(deck, cfg, error)
+      ! a value too large for a double ('1e400' in a deck or a record) overflows to infinity
+      ! when it is converted, and is then rejected with a message: a build that traps
+      ! overflow (-ffpe-trap, tools/test_checked.sh) must not stop there. The halting mode is
+      ! restored when this reader returns (Fortran 2008, 14.3), the overflow handled.
+      if (ieee_support_halting(ieee_overflow)) call ieee_set_halting_mode(ieee_overflow, .false.)
+      call deck_from_string(text, path, deck, error)
+      if (.not. allocated(error)) call read_groups(deck, cfg, error)
+      call ieee_set_flag(ieee_overflow, .false.)
       if (allocated(error)) return
       call sha256_text(text, cfg%model%deck_sha256)
    end subroutine read_deck_string
@@ -129,6 +149,12 @@ contains
       if (allocated(error)) return
       ! what the technique cannot integrate (a law, a table motion)
       call check_technique(cfg%model, cfg%exc, cfg%opts, error)
+      if (allocated(error)) then
+         error%message = deck%path//", "//error%message
+         return
+      end if
+      ! Newmark's steps: bounded work, digits left in the effective stiffness
+      if (cfg%opts%technique == technique_newmark) call check_step_limits(cfg%model, cfg%exc, cfg%opts, error)
       if (allocated(error)) error%message = deck%path//", "//error%message
    end subroutine read_groups
 
@@ -177,7 +203,7 @@ contains
       if (allocated(error)) return
       call optional_reals(deck, 'model', 'v0', v0, n, default_v0, 'm/s', error)
       if (allocated(error)) return
-      call check_labels(deck, 'model', label, n, error)
+      call check_labels(deck, grp, 'model', label, n, error)
       if (allocated(error)) return
       cfg%model%dof_label = label(1:n)
       cfg%model%n_dof = n
@@ -281,17 +307,20 @@ contains
          if (ios == 0) msg = msg0
          call group_read_error(deck, grp, i, msg, error); return
       end if
+      call check_length(deck, grp, 'damping_type', name_len, error)
+      if (.not. allocated(error)) call check_length(deck, grp, 'mode_system', name_len, error)
+      if (allocated(error)) return
       cfg%model%damping = keyword_id(damping_types, damping_type)
       select case (cfg%model%damping)
       case (damping_stiffness)
          call check_real(deck, 'damping', 'xi', xi, 0.0_dp, 1.0_dp, '', error, open_hi=.true.)
          if (allocated(error)) return
-         call check_real(deck, 'damping', 'period', period, 0.0_dp, huge(1.0_dp), 's', error)
+         call check_real(deck, 'damping', 'period', period, 0.0_dp, max_magnitude, 's', error)
          if (allocated(error)) return
       case (damping_rayleigh)
-         call check_real(deck, 'damping', 'rayleigh_a0', rayleigh_a0, 0.0_dp, huge(1.0_dp), '1/s', error)
+         call check_real(deck, 'damping', 'rayleigh_a0', rayleigh_a0, 0.0_dp, max_magnitude, '1/s', error)
          if (allocated(error)) return
-         call check_real(deck, 'damping', 'rayleigh_a1', rayleigh_a1, 0.0_dp, huge(1.0_dp), 's', error)
+         call check_real(deck, 'damping', 'rayleigh_a1', rayleigh_a1, 0.0_dp, max_magnitude, 's', error)
          if (allocated(error)) return
          call rayleigh_modes(deck, xi, rayleigh_a0, rayleigh_a1, mode_i, mode_j, mode_system, cfg, error)
          if (allocated(error)) return
@@ -350,6 +379,9 @@ contains
          if (ios == 0) msg = msg0
          call group_read_error(deck, grp, i, msg, error); return
       end if
+      call check_length(deck, grp, 'law', name_len, error)
+      if (.not. allocated(error)) call check_length(deck, grp, 'mu_law', name_len, error)
+      if (allocated(error)) return
       call need_int(deck, 'friction', 'n_devices', n_devices, 0, max_devices, error)
       if (allocated(error)) return
       n = n_devices
@@ -362,7 +394,7 @@ contains
       call read_mu_laws(deck, 'friction', n, mu_law, mu, mu_max, mu_min, mu_rate, mu_table_v, mu_table_mu, &
                         mu_ids, error)
       if (allocated(error)) return
-      call check_labels(deck, 'friction', label, n, error)
+      call check_labels(deck, grp, 'friction', label, n, error)
       if (allocated(error)) return
       call need_reals(deck, 'friction', 'mu', mu, n, '', error, positive=.false.)
       if (allocated(error)) return
@@ -378,12 +410,23 @@ contains
          return
       end if
       deallocate (cfg%model%dev)
-      allocate (cfg%model%dev(n))
+      allocate (cfg%model%dev(n), stat=ios)
+      if (ios /= 0) then
+         call fatal_error(error, deck%path//", group &friction: not enough memory for "//trim(fmt_int(n))//" devices", &
+                          stat_no_memory)
+         return
+      end if
       do i = 1, n
          idx = '('//trim(fmt_int(i))//')'
          if (node_i(i) == node_j(i)) then
             call bad(deck, 'friction', 'node_j'//idx, trim(fmt_int(node_j(i))), 'different from node_i'//idx//' = '// &
                      trim(fmt_int(node_i(i)))//': a device joins two different nodes', error)
+            return
+         end if
+         if (p(i)*mu(i) /= 0.0_dp .and. p(i)*mu(i) < min_scale) then
+            call bad(deck, 'friction', 'p'//idx//' * mu'//idx, trim(fmt_real(p(i)*mu(i))), '0 (no friction) or at '// &
+                     'least '//trim(fmt_real(min_scale))//' N: the friction force P mu of a device (here P = '// &
+                     trim(fmt_real(p(i)))//' N, mu = '//trim(fmt_real(mu(i)))//')', error)
             return
          end if
          id = law_id(law(i))
@@ -414,7 +457,7 @@ contains
       type(error_type), allocatable, intent(out) :: error
       character(len=name_len) :: excitation_type, record_kind, record_format, record_units
       integer :: kind_id
-      character(len=1024) :: record_file
+      character(len=path_len) :: record_file
       real(dp) :: amplitude, frequency, duration, dt_record, record_scale, factor
       integer :: ramp_cycles
       logical :: known
@@ -447,6 +490,12 @@ contains
          if (ios == 0) msg = msg0
          call group_read_error(deck, grp, i, msg, error); return
       end if
+      call check_length(deck, grp, 'excitation_type', name_len, error)
+      if (.not. allocated(error)) call check_length(deck, grp, 'record_kind', name_len, error)
+      if (.not. allocated(error)) call check_length(deck, grp, 'record_format', name_len, error)
+      if (.not. allocated(error)) call check_length(deck, grp, 'record_units', name_len, error)
+      if (.not. allocated(error)) call check_length(deck, grp, 'record_file', path_len, error)
+      if (allocated(error)) return
       ! a record whose file gives DT (AT2) may leave dt_record out
       if (.not. (keyword_id(excitation_types, excitation_type) == excitation_record .and. dt_record == unset)) then
          call need_real(deck, 'excitation', 'dt_record', dt_record, 's', error)
@@ -476,6 +525,8 @@ contains
             call bad(deck, 'excitation', 'record_scale', trim(fmt_real(record_scale)), 'finite and non-zero', error)
             return
          end if
+         call check_magnitude(deck, 'excitation', 'record_scale', record_scale, '', .true., error)
+         if (allocated(error)) return
          kind_id = keyword_id(record_kinds, record_kind)
          if (kind_id == 0) then
             call keyword_choices(record_kinds, choices)
@@ -508,6 +559,15 @@ contains
          cfg%record%path = trim(record_file)   ! as the deck gives it (like the summary's "deck")
          dt_record = cfg%record%dt
          cfg%exc%dt_record = dt_record
+         call check_magnitude(deck, 'excitation', "dt_record (the record file's DT)", dt_record, 's', .true., error)
+         if (allocated(error)) return
+         if (.not. (cfg%record%peak_acc <= max_magnitude)) then
+            call bad(deck, 'excitation', 'record_file', "'"//trim(record_file)//"'", 'a record whose table '// &
+                     'acceleration (after record_units and record_scale = '//trim(fmt_real(record_scale))// &
+                     ') stays within '//trim(fmt_real(max_magnitude))//' m/s2 in magnitude; it reaches '// &
+                     trim(fmt_real(cfg%record%peak_acc))//' m/s2', error)
+            return
+         end if
          if (duration == unset) duration = (size(cfg%exc%acc) - 1)*dt_record
          call need_real(deck, 'excitation', 'duration', duration, 's', error)
          if (allocated(error)) return
@@ -556,6 +616,8 @@ contains
             call group_read_error(deck, grp, i, msg, error); return
          end if
       end if
+      call check_length(deck, grp, 'technique', name_len, error)
+      if (allocated(error)) return
       technique_id = keyword_id(techniques, technique)
       if (technique_id == 0) then
          call keyword_choices(techniques, choices)
@@ -576,6 +638,8 @@ contains
          call bad(deck, 'integration', 'n', trim(fmt_real(n)), '> 1 (correctness condition, eqs. 9 and 12)', error)
          return
       end if
+      call check_magnitude(deck, 'integration', 'n', n, '', .false., error)
+      if (allocated(error)) return
       call check_real(deck, 'integration', 'dt_min', dt_min, 0.0_dp, cfg%exc%dt_record/n1/n2, 's', error)
       if (allocated(error)) return
       call check_real(deck, 'integration', 'theta', theta, 0.5_dp, 1.0_dp, '', error)
@@ -603,7 +667,7 @@ contains
       type(deck_text), intent(in) :: deck
       type(run_config), intent(inout) :: cfg
       type(error_type), allocatable, intent(out) :: error
-      character(len=1024) :: dir, name
+      character(len=path_len) :: dir, name
       integer :: output_every, n_modes
       logical :: write_history
       namelist /output/ dir, name, output_every, write_history, n_modes
@@ -631,6 +695,9 @@ contains
             call group_read_error(deck, grp, i, msg, error); return
          end if
       end if
+      call check_length(deck, grp, 'dir', path_len, error)
+      if (.not. allocated(error)) call check_length(deck, grp, 'name', path_len, error)
+      if (allocated(error)) return
       if (len_trim(dir) == 0) then
          call bad(deck, 'output', 'dir', "''", 'a directory path', error); return
       end if
@@ -702,7 +769,7 @@ contains
       if (allocated(error)) return
       call optional_reals(deck, 'braces', 'eps1', eps1, n, default_eps1, 'm/s', error, positive=.true.)
       if (allocated(error)) return
-      call check_labels(deck, 'braces', label, n, error)
+      call check_labels(deck, grp, 'braces', label, n, error)
       if (allocated(error)) return
       allocate (dev(n))
       do i = 1, n
@@ -712,6 +779,10 @@ contains
                      trim(fmt_int(node_i(i)))//': a brace joins two different nodes', error)
             return
          end if
+         ! the sticking displacement f = slip_load / stiffness, a length: within the limits
+         call check_magnitude(deck, 'braces', 'slip_load'//idx//' / stiffness'//idx, slip_load(i)/stiffness(i), &
+                              'm', .true., error)
+         if (allocated(error)) return
          dev(i) = device_type(node_i=node_i(i), node_j=node_j(i), law=law_hysteretic, p=slip_load(i), &
                               mu=1.0_dp, eps1=eps1(i), f=slip_load(i)/stiffness(i))
          dev(i)%label = label(i)
@@ -768,6 +839,9 @@ contains
          if (ios == 0) msg = msg0
          call group_read_error(deck, grp, i, msg, error); return
       end if
+      call check_length(deck, grp, 'law', name_len, error)
+      if (.not. allocated(error)) call check_length(deck, grp, 'mu_law', name_len, error)
+      if (allocated(error)) return
       call need_int(deck, 'isolators', 'n_isolators', n_isolators, 0, max_devices - cfg%model%n_devices, error)
       if (allocated(error)) return
       n = n_isolators
@@ -790,7 +864,7 @@ contains
       if (allocated(error)) return
       call optional_reals(deck, 'isolators', 'f', f, n, default_f, 'm', error, positive=.true.)
       if (allocated(error)) return
-      call check_labels(deck, 'isolators', label, n, error)
+      call check_labels(deck, grp, 'isolators', label, n, error)
       if (allocated(error)) return
       if (any(law(n + 1:) /= '')) then
          call bad(deck, 'isolators', 'law', 'with '//trim(fmt_int(findloc(law /= '', .true., 1, back=.true.))) &
@@ -807,6 +881,20 @@ contains
          end if
          if (radius(i) < 0.0_dp) then
             call bad(deck, 'isolators', 'radius'//idx, trim(fmt_real(radius(i))), '>= 0 m (0 = flat)', error)
+            return
+         end if
+         if (radius(i) > 0.0_dp) then
+            call check_magnitude(deck, 'isolators', 'radius'//idx, radius(i), 'm', .true., error)
+            if (allocated(error)) return
+            ! the pendulum's stiffness W / R is a spring: within the magnitude limits
+            call check_magnitude(deck, 'isolators', 'weight'//idx//' / radius'//idx, weight(i)/radius(i), 'N/m', &
+                                 .true., error)
+            if (allocated(error)) return
+         end if
+         if (weight(i)*mu(i) /= 0.0_dp .and. weight(i)*mu(i) < min_scale) then
+            call bad(deck, 'isolators', 'weight'//idx//' * mu'//idx, trim(fmt_real(weight(i)*mu(i))), &
+                     '0 (no friction) or at least '//trim(fmt_real(min_scale))//' N: the friction force W mu of '// &
+                     'an isolator (here W = '//trim(fmt_real(weight(i)))//' N, mu = '//trim(fmt_real(mu(i)))//')', error)
             return
          end if
          id = law_id(law(i))
@@ -917,7 +1005,7 @@ contains
       if (allocated(error)) return
       call optional_reals(deck, 'storeys', 'height', height, n, default_storey_height, 'm', error)
       if (allocated(error)) return
-      call check_labels(deck, 'storeys', label, n, error)
+      call check_labels(deck, grp, 'storeys', label, n, error)
       if (allocated(error)) return
       do i = 1, n
          idx = '('//trim(fmt_int(i))//')'
@@ -929,6 +1017,10 @@ contains
          if (height(i) < 0.0_dp) then
             call bad(deck, 'storeys', 'height'//idx, trim(fmt_real(height(i))), '>= 0 m (0 = not given)', error)
             return
+         end if
+         if (height(i) > 0.0_dp) then
+            call check_magnitude(deck, 'storeys', 'height'//idx, height(i), 'm', .true., error)
+            if (allocated(error)) return
          end if
       end do
       cfg%model%n_storeys = n
@@ -1111,14 +1203,18 @@ contains
 
    !> Labels: at most n given; each at most label_len characters (longer ones are cut by the
    !> reader: refused here when the last character is used, as a likely cut).
-   subroutine check_labels(deck, group, label, n, error)
+   subroutine check_labels(deck, grp, group, label, n, error)
       type(deck_text), intent(in) :: deck
+      type(group_text), intent(in) :: grp
       character(len=*), intent(in) :: group
       character(len=label_len), intent(in) :: label(:)
       integer, intent(in) :: n
       type(error_type), allocatable, intent(out) :: error
       integer :: last, i
 
+      ! a longer string would be cut by the namelist reader: refused from the group's text
+      call check_length(deck, grp, 'label', label_len - 1, error)
+      if (allocated(error)) return
       last = findloc(label /= '', .true., 1, back=.true.)
       if (last > n) then
          call bad(deck, group, 'label('//trim(fmt_int(last))//')', "'"//trim(label(last))//"'", &
@@ -1196,13 +1292,18 @@ contains
       real(dp), allocatable :: k(:, :), c(:, :)
       real(dp) :: wi, wj
       character(len=:), allocatable :: sys
-      integer :: n, mi, mj, bad_mode
+      integer :: n, mi, mj, bad_mode, stat
 
       if (cfg%model%damping /= damping_rayleigh .or. cfg%model%mode_i == 0) return
       n = cfg%model%n_dof
       mi = cfg%model%mode_i
       mj = cfg%model%mode_j
-      allocate (k(n, n), c(n, n))
+      allocate (k(n, n), c(n, n), stat=stat)
+      if (stat /= 0) then
+         call fatal_error(error, deck%path//", group &damping: not enough memory for the modes of "// &
+                          trim(fmt_int(n))//" DOFs (mode_i, mode_j)", stat_no_memory)
+         return
+      end if
       c = 0.0_dp
       call stiffness_matrix(cfg%model, k)
       call natural_modes(cfg%model, k, c, cfg%model%mode_system, max(mi, mj), modes, error)
@@ -1230,6 +1331,11 @@ contains
       wj = sqrt(modes%omega2(mj))
       cfg%model%rayleigh_a0 = 2.0_dp*cfg%model%xi*wi*wj/(wi + wj)
       cfg%model%rayleigh_a1 = 2.0_dp*cfg%model%xi/(wi + wj)
+      ! the factors found are held to the limits of given ones
+      call check_magnitude(deck, 'damping', 'rayleigh_a0 (from xi, mode_i, mode_j)', cfg%model%rayleigh_a0, '1/s', &
+                           .false., error)
+      if (.not. allocated(error)) call check_magnitude(deck, 'damping', 'rayleigh_a1 (from xi, mode_i, mode_j)', &
+                                                       cfg%model%rayleigh_a1, 's', .false., error)
    end subroutine resolve_rayleigh
 
    !> What the technique cannot do with the shorthands: braces are hysteretic devices, which
@@ -1267,6 +1373,22 @@ contains
       call fatal_error(error, deck%path//", group &"//group//": "//var//" = "//val//" is invalid: must be "//must)
    end subroutine bad
 
+   !> A string longer than its variable's capacity is an error (the namelist reader would cut
+   !> it), found in the group's text.
+   subroutine check_length(deck, grp, var, cap, error)
+      type(deck_text), intent(in) :: deck
+      type(group_text), intent(in) :: grp
+      character(len=*), intent(in) :: var
+      integer, intent(in) :: cap
+      type(error_type), allocatable, intent(out) :: error
+      integer :: length, line
+      call longest_string(grp, var, length, line)
+      if (length <= cap) return
+      call fatal_error(error, deck%path//", group &"//grp%name//", line "//trim(fmt_int(line))//": "//var// &
+                       " is a string of "//trim(fmt_int(length))//" characters: must be at most "// &
+                       trim(fmt_int(cap))//" characters long")
+   end subroutine check_length
+
    subroutine need_int(deck, group, var, x, lo, hi, error)
       type(deck_text), intent(in) :: deck
       character(len=*), intent(in) :: group, var
@@ -1297,8 +1419,26 @@ contains
          call bad(deck, group, var, trim(fmt_real(x)), '> 0 '//unit, error)
       else if (.not. pos .and. x < 0.0_dp) then
          call bad(deck, group, var, trim(fmt_real(x)), '>= 0 '//unit, error)
+      else
+         call check_magnitude(deck, group, var, x, unit, pos, error)
       end if
    end subroutine need_real
+
+   !> |x| at most max_magnitude; and at least min_scale when x must be > 0 (or is not 0).
+   subroutine check_magnitude(deck, group, var, x, unit, scale, error)
+      type(deck_text), intent(in) :: deck
+      character(len=*), intent(in) :: group, var, unit
+      real(dp), intent(in) :: x
+      logical, intent(in) :: scale                 !! x is a scale: small values are checked too
+      type(error_type), allocatable, intent(out) :: error
+      if (abs(x) > max_magnitude) then
+         call bad(deck, group, var, trim(fmt_real(x)), 'at most '//trim(fmt_real(max_magnitude))//' '//trim(unit)// &
+                  ' in magnitude (larger values overflow the products a run forms)', error)
+      else if (scale .and. abs(x) < min_scale) then
+         call bad(deck, group, var, trim(fmt_real(x)), 'at least '//trim(fmt_real(min_scale))//' '//trim(unit)// &
+                  ' in magnitude (smaller values make the steps and products of a run meaningless)', error)
+      end if
+   end subroutine check_magnitude
 
    subroutine check_real(deck, group, var, x, lo, hi, unit, error, open_lo, open_hi)
       type(deck_text), intent(in) :: deck
@@ -1313,10 +1453,13 @@ contains
       if (present(open_hi)) ohi = open_hi
       ok = ieee_is_finite(x)
       if (ok) ok = merge(x > lo, x >= lo, olo) .and. merge(x < hi, x <= hi, ohi)
-      if (ok) return
+      if (ok) then
+         call check_magnitude(deck, group, var, x, unit, .false., error)
+         return
+      end if
       range = merge('(', '[', olo)//trim(fmt_real(lo))//', '
-      if (hi >= huge(1.0_dp)) then
-         range = range//'inf)'
+      if (hi >= max_magnitude) then
+         range = range//trim(fmt_real(max_magnitude))//']'
       else
          range = range//trim(fmt_real(hi))//merge(')', ']', ohi)
       end if
@@ -1360,6 +1503,8 @@ contains
          if (pos .and. x(i) <= 0.0_dp) then
             call bad(deck, group, var//'('//trim(fmt_int(i))//')', trim(fmt_real(x(i))), '> 0 '//unit, error); return
          end if
+         call check_magnitude(deck, group, var//'('//trim(fmt_int(i))//')', x(i), unit, pos, error)
+         if (allocated(error)) return
       end do
       call no_extra(deck, group, var, x, n, error)
    end subroutine optional_reals

@@ -1,22 +1,36 @@
-!> Generic support for namelist decks: a deck held in memory as lines, the text of one
-!> group found in it, and messages that name the file, group, line, variable and value.
+!> Generic support for namelist decks: a deck held in memory as lines, checked to be well
+!> formed (every character either in a group, in a comment or blank: scan_deck), the text
+!> of one group found in it, and messages that name the file, group, line, variable and value.
 !> The group readers in fd_deck do the namelist reads themselves (a namelist can only be
 !> read where it is declared); on failure they re-read the group one assignment at a
 !> time with group_item to find the variable and value at fault.
 module fd_namelist
-   use fd_error, only: error_type, fatal_error, fmt_int
+   use fd_error, only: error_type, fatal_error, fmt_int, stat_no_memory
    use fd_textio, only: line_type, read_text_file, split_lines, lower
    implicit none
    private
 
    public :: deck_text, group_text, load_deck, deck_from_string, find_group, group_item, group_read_error
-   public :: check_groups, group_opened
+   public :: check_groups, group_opened, scan_deck, group_span, longest_string
+
+   character(len=*), parameter :: blanks = ' '//achar(9)  !! what separates words on a line
 
    !> A whole deck in memory.
    type :: deck_text
       character(len=:), allocatable :: path          !! the deck file
       type(line_type), allocatable :: lines(:)       !! its lines
    end type deck_text
+
+   !> Where one group lies in a deck.
+   type :: group_span
+      character(len=64) :: name = ''   !! group name, lower case
+      integer :: first_line = 0        !! deck line of '&name'
+      integer :: first_col = 0         !! its column of '&' (or '$')
+      integer :: name_end = 0          !! column of the name's last character
+      integer :: last_line = 0         !! deck line of the end ('/', '&end' or '$end')
+      integer :: last_col = 0          !! its column
+      integer :: close_len = 1         !! its length: 1 for '/', 4 for '&end', '$end'
+   end type group_span
 
    !> One group of a deck, ready for an internal namelist read.
    type :: group_text
@@ -42,58 +56,65 @@ contains
 
    !> A deck given as text (lines separated by newlines); path names it in messages and
    !> is the base of relative record paths.
-   pure subroutine deck_from_string(text, path, deck)
+   pure subroutine deck_from_string(text, path, deck, error)
       character(len=*), intent(in) :: text   !! the deck
       character(len=*), intent(in) :: path   !! name used for the deck
       type(deck_text), intent(out) :: deck   !! its text as lines
+      type(error_type), allocatable, intent(out), optional :: error !! not enough memory
+      integer :: stat
 
       deck%path = path
-      call split_lines(text, deck%lines)
+      call split_lines(text, deck%lines, stat)
+      if (stat /= 0 .and. present(error)) call fatal_error(error, path//": not enough memory for the lines "// &
+                                                           "of the deck ("//trim(fmt_int(len(text)))//" bytes)")
    end subroutine deck_from_string
 
-   !> The first word of a line, lower case, if it opens a group ('&name'); blank if not.
+   !> The group a line opens ('&name' or the legacy '$name' as its first word, after blanks
+   !> or tabs), lower case; blank if none ('&end' closes, it does not open).
    pure function group_opened(line) result(name)
       character(len=*), intent(in) :: line !! a deck line
       character(len=64) :: name            !! the group it opens, lower case; blank if none
       integer :: e, b
 
       name = ''
-      b = verify(line, ' '//achar(9))
+      b = verify(line, blanks)
       if (b == 0) return
-      if (line(b:b) /= '&' .or. b == len(line)) return
-      e = scan(line(b + 1:), ' ,/'//achar(9))
-      if (e == 0) then
-         name = lower(line(b + 1:))
-      else
-         name = lower(line(b + 1:b + e - 1))
-      end if
+      if (line(b:b) /= '&' .and. line(b:b) /= '$') return
+      e = b + 1
+      do while (e <= len(line))
+         if (.not. is_name_char(line(e:e))) exit
+         e = e + 1
+      end do
+      if (e == b + 1) return
+      name = lower(line(b + 1:e - 1))
       if (name == 'end') name = ''
    end function group_opened
 
-   !> Every group of the deck must be one of the known names, and appear once.
+   !> Every group of the deck must be one of the known names, and appear once; the deck
+   !> must be well formed (see scan_deck).
    subroutine check_groups(deck, known, error)
       type(deck_text), intent(in) :: deck                 !! the deck
       character(len=*), intent(in) :: known(:)            !! names of the known groups
-      type(error_type), allocatable, intent(out) :: error !! unknown or repeated group
-      character(len=64) :: name
+      type(error_type), allocatable, intent(out) :: error !! unknown or repeated group, or bad text
+      type(group_span), allocatable :: spans(:)
       integer :: i, j, count(size(known))
 
+      call scan_deck(deck, spans, error)
+      if (allocated(error)) return
       count = 0
-      do i = 1, size(deck%lines)
-         name = group_opened(deck%lines(i)%s)
-         if (len_trim(name) == 0) cycle
+      do i = 1, size(spans)
          do j = 1, size(known)
-            if (name == trim(known(j))) exit
+            if (spans(i)%name == trim(known(j))) exit
          end do
          if (j > size(known)) then
-            call fatal_error(error, deck%path//", line "//trim(fmt_int(i))//": unknown group &"//trim(name)// &
-                             "; the groups are "//trim(join(known)))
+            call fatal_error(error, deck%path//", line "//trim(fmt_int(spans(i)%first_line))//": unknown group &"// &
+                             trim(spans(i)%name)//"; the groups are "//trim(join(known)))
             return
          end if
          count(j) = count(j) + 1
          if (count(j) > 1) then
-            call fatal_error(error, deck%path//", line "//trim(fmt_int(i))//": group &"//trim(name)// &
-                             " appears more than once")
+            call fatal_error(error, deck%path//", line "//trim(fmt_int(spans(i)%first_line))//": group &"// &
+                             trim(spans(i)%name)//" appears more than once")
             return
          end if
       end do
@@ -111,100 +132,429 @@ contains
       end function join
    end subroutine check_groups
 
+   !> Where the groups of a deck lie. The deck must be well formed: a group opens with
+   !> '&name' (or the legacy '$name') as the first word of its line and closes with '/'
+   !> (or '&end', '$end') outside quotes and comments; outside groups only blank lines and
+   !> comments ('!') are allowed; inside a group '&' and '$' appear only in quoted strings;
+   !> no NUL character anywhere. Anything else is an error naming the deck and the line:
+   !> nothing in a deck is skipped unread.
+   pure subroutine scan_deck(deck, spans, error)
+      type(deck_text), intent(in) :: deck                 !! the deck
+      type(group_span), allocatable, intent(out) :: spans(:) !! its groups, in order
+      type(error_type), allocatable, intent(out) :: error !! the first thing not well formed
+      type(group_span), allocatable :: grown(:)
+      type(group_span) :: cur
+      integer :: i, k, b, e, n, nl
+      logical :: inside
+      character(len=1) :: quote, ch
+      character(len=:), allocatable :: where
+
+      allocate (spans(8))
+      n = 0
+      inside = .false.
+      do i = 1, size(deck%lines)
+         associate (line => deck%lines(i)%s)
+            nl = len(line)
+            where = deck%path//", line "//trim(fmt_int(i))
+            if (index(line, achar(0)) > 0) then
+               call fatal_error(error, where//": a NUL character (byte 0) in the deck: not a text file")
+               return
+            end if
+            k = 1
+            if (.not. inside) then
+               b = verify(line, blanks)
+               if (b == 0) cycle
+               if (line(b:b) == '!') cycle
+               if (line(b:b) /= '&' .and. line(b:b) /= '$') then
+                  call outside_text(where, line, b, error)
+                  return
+               end if
+               e = b + 1
+               do while (e <= nl)
+                  if (.not. is_name_char(line(e:e))) exit
+                  e = e + 1
+               end do
+               if (e == b + 1) then
+                  call fatal_error(error, where//": '"//trim(shown(line(b:)))//"': '"//line(b:b)// &
+                                   "' must be followed by the group name, with no blank ('"//line(b:b)//"name')")
+                  return
+               end if
+               if (lower(line(b + 1:e - 1)) == 'end') then
+                  call fatal_error(error, where//": '"//line(b:e - 1)//"' outside any group (a group closed twice?)")
+                  return
+               end if
+               if (e <= nl) then
+                  if (scan(line(e:e), blanks//',/!') == 0) then
+                     call fatal_error(error, where//": '"//trim(shown(line(b:)))//"' does not open a group: "// &
+                                      "a group name is letters, digits and '_', followed by a blank")
+                     return
+                  end if
+               end if
+               cur = group_span()
+               cur%name = lower(line(b + 1:min(e - 1, b + len(cur%name))))
+               cur%first_line = i
+               cur%first_col = b
+               cur%name_end = e - 1
+               inside = .true.
+               k = e
+            else
+               ! a line of an open group that opens another group: the open one is not closed
+               if (len_trim(group_opened(line)) > 0) then
+                  call fatal_error(error, deck%path//", group &"//trim(cur%name)//" (line "// &
+                                   trim(fmt_int(cur%first_line))//"): not closed by '/' before line "// &
+                                   trim(fmt_int(i))//" ('"//trim(shown(adjustl(line)))//"')")
+                  return
+               end if
+            end if
+            ! inside the group: look for its end
+            quote = ' '
+            do while (k <= nl)
+               ch = line(k:k)
+               if (quote /= ' ') then
+                  if (ch == quote) quote = ' '
+               else if (ch == '"' .or. ch == "'") then
+                  quote = ch
+               else if (ch == '!') then
+                  exit
+               else if (ch == '/') then
+                  cur%last_line = i; cur%last_col = k; cur%close_len = 1
+                  exit
+               else if (ch == '&' .or. ch == '$') then
+                  if (closes(line, k)) then
+                     cur%last_line = i; cur%last_col = k; cur%close_len = 4
+                     exit
+                  end if
+                  call fatal_error(error, where//", group &"//trim(cur%name)//": '"//trim(shown(line(k:)))//"': '"//ch// &
+                                   "' inside a group, outside quotes (a group ends with '/'; a group opens on a line "// &
+                                   "of its own)")
+                  return
+               end if
+               k = k + 1
+            end do
+            if (cur%last_line == i) then
+               inside = .false.
+               if (n == size(spans)) then
+                  allocate (grown(2*n))
+                  grown(1:n) = spans
+                  call move_alloc(grown, spans)
+               end if
+               n = n + 1
+               spans(n) = cur
+               ! after the end of a group: nothing but a comment
+               k = k + cur%close_len
+               if (k <= nl) then
+                  b = verify(line(k:), blanks)
+                  if (b > 0) then
+                     if (line(k + b - 1:k + b - 1) /= '!') then
+                        call fatal_error(error, where//": '"//trim(shown(line(k + b - 1:)))//"' after the end of group &"// &
+                                         trim(cur%name)//": a group ends its line (only a comment may follow)")
+                        return
+                     end if
+                  end if
+               end if
+            end if
+         end associate
+      end do
+      if (inside) then
+         call fatal_error(error, deck%path//", group &"//trim(cur%name)//" (line "//trim(fmt_int(cur%first_line))// &
+                          "): not closed by '/'")
+         return
+      end if
+      spans = spans(1:n)
+   end subroutine scan_deck
+
+   !> Whether '&end' or '$end' (any case) starts at k and ends there (no name character follows).
+   pure logical function closes(line, k)
+      character(len=*), intent(in) :: line
+      integer, intent(in) :: k
+
+      closes = .false.
+      if (k + 3 > len(line)) return
+      if (lower(line(k + 1:k + 3)) /= 'end') return
+      closes = .true.
+      if (k + 4 <= len(line)) closes = .not. is_name_char(line(k + 4:k + 4))
+   end function closes
+
+   !> The error for text outside any group, saying what it looks like.
+   pure subroutine outside_text(where, line, b, error)
+      character(len=*), intent(in) :: where, line
+      integer, intent(in) :: b                            !! first non-blank character
+      type(error_type), allocatable, intent(out) :: error
+      character(len=:), allocatable :: what
+      integer :: amp, i
+
+      amp = scan(line, '&$')
+      if (line(b:b) == '/') then
+         what = "a '/' outside any group (a group closed twice?)"
+      else if (amp > 0) then
+         what = "'"//line(amp:amp)//"' not read as the start of a group: a group opens with '"//line(amp:amp)// &
+                "name' as the first word of its line, with only blanks or tabs before it"
+         do i = b, amp - 1
+            if (iachar(line(i:i)) > 126) then
+               what = what//" (here a non-ASCII character, byte "//trim(fmt_int(iachar(line(i:i))))//", comes before it)"
+               exit
+            end if
+         end do
+      else if (index(line, '=') > 0) then
+         what = "an assignment outside any group"
+      else
+         what = "text outside any group"
+      end if
+      call fatal_error(error, where//": '"//trim(shown(line(b:)))//"': "//what// &
+                       "; between groups only blank lines and comments ('!') are allowed")
+   end subroutine outside_text
+
+   !> Deck text as shown in a message: at most 60 characters (cut on a UTF-8 character
+   !> boundary), control characters shown as '?', trailing blanks dropped.
+   pure function shown(text) result(out)
+      character(len=*), intent(in) :: text
+      character(len=64) :: out
+      integer :: n, i
+
+      n = min(len_trim(text), 60)
+      if (n < len_trim(text)) then
+         ! do not cut a multi-byte character: back off over continuation bytes (10xxxxxx)
+         do while (n > 1 .and. iand(iachar(text(n + 1:n + 1)), 192) == 128)
+            n = n - 1
+         end do
+      end if
+      out = text(1:n)
+      do i = 1, n
+         if (iachar(out(i:i)) < 32 .or. iachar(out(i:i)) == 127) out(i:i) = '?'
+      end do
+      if (n < len_trim(text)) out(n + 1:) = '...'
+   end function shown
+
+   pure logical function is_name_char(c)
+      character(len=1), intent(in) :: c
+      is_name_char = (c >= 'a' .and. c <= 'z') .or. (c >= 'A' .and. c <= 'Z') .or. &
+                     (c >= '0' .and. c <= '9') .or. c == '_'
+   end function is_name_char
+
    !> Find a group in the deck and split it into assignments.
    subroutine find_group(deck, name, grp, found, error)
       type(deck_text), intent(in) :: deck                 !! the deck
       character(len=*), intent(in) :: name                !! group name, lower case
       type(group_text), intent(out) :: grp                !! the group's text
       logical, intent(out) :: found                       !! the group is present
-      type(error_type), allocatable, intent(out) :: error !! group not closed by '/'
-      integer :: i, first, last, width, n, cap
-      character(len=:), allocatable :: body
+      type(error_type), allocatable, intent(out) :: error !! deck not well formed, or a variable
+                                                          !! assigned twice
+      type(group_span), allocatable :: spans(:)
+      type(group_span) :: sp
+      integer :: i, first, last, width, n, cap, c1, c2, j, stat
+      character(len=:), allocatable :: body, line, var
       integer, allocatable :: line_of(:)
-      logical :: closed
 
       grp%name = name
       found = .false.
-      first = 0
-      do i = 1, size(deck%lines)
-         if (group_opened(deck%lines(i)%s) == name) then
-            first = i
-            exit
-         end if
+      call scan_deck(deck, spans, error)
+      if (allocated(error)) return
+      do i = 1, size(spans)
+         if (spans(i)%name == name) exit
       end do
-      if (first == 0) return
+      if (i > size(spans)) return
+      sp = spans(i)
       found = .true.
+      first = sp%first_line
+      last = sp%last_line
       grp%first_line = first
-      ! body: the text after '&name' up to the closing '/', comments removed, in buffers
-      ! large enough for the rest of the deck (n characters used)
-      cap = 0
-      do i = first, size(deck%lines)
-         cap = cap + len(deck%lines(i)%s) + 1
-      end do
-      allocate (character(len=cap) :: body)
-      allocate (line_of(cap))
-      n = 0
-      closed = .false.
-      last = first
-      do i = first, size(deck%lines)
-         if (i > first .and. len_trim(group_opened(deck%lines(i)%s)) > 0) exit
-         last = i
-         call append_line(deck%lines(i)%s, i == first, body, line_of, n, i, closed)
-         if (closed) exit
-      end do
-      if (.not. closed) then
-         call fatal_error(error, deck%path//", group &"//name//" (line "//trim(fmt_int(first))// &
-                          "): not closed by '/'")
-         return
-      end if
+      ! the group's lines as the namelist reader gets them: '&name' (for '$name' too) up to
+      ! its end, which becomes '/'
       width = 1
       do i = first, last
-         width = max(width, len(deck%lines(i)%s))
+         width = max(width, len(deck%lines(i)%s) + 2)
       end do
-      allocate (character(len=width) :: grp%lines(last - first + 1))
+      allocate (character(len=width) :: grp%lines(last - first + 1), stat=stat)
+      if (stat /= 0) then
+         call no_memory(); return
+      end if
+      cap = 0
       do i = first, last
-         grp%lines(i - first + 1) = deck%lines(i)%s
+         line = deck%lines(i)%s
+         if (i == last) line = line(1:sp%last_col - 1)//' /'
+         if (i == first) line(sp%first_col:sp%first_col) = '&'
+         grp%lines(i - first + 1) = line
+         cap = cap + len(line) + 1
       end do
-      call split_items(body(1:n), line_of(1:n), grp%items, grp%item_line)
+      ! body: the text after '&name' up to the end, comments removed (n characters used)
+      allocate (character(len=cap) :: body, stat=stat)
+      if (stat == 0) allocate (line_of(cap), stat=stat)
+      if (stat /= 0) then
+         call no_memory(); return
+      end if
+      n = 0
+      do i = first, last
+         c1 = 1
+         c2 = len(deck%lines(i)%s)
+         if (i == first) c1 = sp%name_end + 1
+         if (i == last) c2 = sp%last_col - 1
+         call append_line(deck%lines(i)%s(1:c2), c1, body, line_of, n, i)
+      end do
+      call split_items(body(1:n), line_of(1:n), grp%items, grp%item_line, stat)
+      if (stat /= 0) then
+         call no_memory(); return
+      end if
+      ! a variable (or array element) given twice: the namelist reader would keep the last
+      call repeated_item(grp%items, i, j, stat)
+      if (stat /= 0) then
+         call no_memory(); return
+      end if
+      if (i > 0) then
+         call item_variable(grp%items(i)%s, var)
+         call fatal_error(error, deck%path//", group &"//name//", line "//trim(fmt_int(grp%item_line(i)))// &
+                          ": '"//var//"' is assigned again (first at line "//trim(fmt_int(grp%item_line(j)))// &
+                          "); give each variable once")
+      end if
+   contains
+      subroutine no_memory()
+         call fatal_error(error, deck%path//", group &"//name//" (line "//trim(fmt_int(first))// &
+                          "): not enough memory to read it", stat_no_memory)
+      end subroutine no_memory
    end subroutine find_group
 
-   !> Append one deck line to the body of a group, without comments, stopping at '/'.
-   pure subroutine append_line(line, is_first, body, line_of, n, lineno, closed)
+   !> The first assignment (i) that sets the same variable or element as an earlier one (j);
+   !> i = 0 if none. Names are sorted (merge sort): linear-logarithmic in the assignments.
+   pure subroutine repeated_item(items, i, j, stat)
+      type(line_type), intent(in) :: items(:)   !! the assignments of a group
+      integer, intent(out) :: i                  !! the repeated one, 0 if none
+      integer, intent(out) :: j                  !! the earlier one it repeats
+      integer, intent(out) :: stat               !! 0, or not enough memory
+      character(len=64), allocatable :: names(:)
+      character(len=:), allocatable :: var
+      integer, allocatable :: order(:), tmp(:)
+      integer :: k, n, width, lo, mid, hi, a, b, c
+
+      i = 0; j = 0
+      n = size(items)
+      allocate (names(n), order(n), tmp(n), stat=stat)
+      if (stat /= 0 .or. n < 2) return
+      do k = 1, n
+         call item_variable(items(k)%s, var)
+         names(k) = var
+         if (len(var) > len(names)) names(k) = ''   ! not a variable of any group: the reader rejects it
+         order(k) = k
+      end do
+      ! bottom-up merge sort of order by (name, position): stable
+      width = 1
+      do while (width < n)
+         lo = 1
+         do while (lo <= n)
+            mid = min(lo + width, n + 1)
+            hi = min(lo + 2*width, n + 1)
+            a = lo; b = mid; c = lo
+            do while (c < hi)
+               if (b >= hi) then
+                  tmp(c) = order(a); a = a + 1
+               else if (a >= mid) then
+                  tmp(c) = order(b); b = b + 1
+               else if (llt(names(order(b)), names(order(a)))) then
+                  tmp(c) = order(b); b = b + 1
+               else
+                  tmp(c) = order(a); a = a + 1
+               end if
+               c = c + 1
+            end do
+            lo = hi
+         end do
+         order = tmp
+         width = 2*width
+      end do
+      ! equal names are adjacent, in deck order: report the repeat that comes first in the deck
+      do k = 2, n
+         if (names(order(k)) /= names(order(k - 1)) .or. len_trim(names(order(k))) == 0) cycle
+         if (i == 0 .or. order(k) < i) then
+            i = order(k); j = order(k - 1)
+         end if
+      end do
+   end subroutine repeated_item
+
+   !> The longest string an assignment of variable `var` (or of its elements, 'var(i)') gives
+   !> in the group, in characters (a doubled quote counts once), and the deck line of that
+   !> assignment; 0 and 0 when none. The namelist reader cuts a longer string to its variable.
+   pure subroutine longest_string(grp, var, length, line)
+      type(group_text), intent(in) :: grp       !! the group
+      character(len=*), intent(in) :: var       !! variable name, lower case
+      integer, intent(out) :: length            !! characters of its longest string
+      integer, intent(out) :: line              !! deck line of that assignment
+      character(len=:), allocatable :: name
+      integer :: i, k, n, paren
+      character(len=1) :: quote
+
+      length = 0
+      line = 0
+      if (.not. allocated(grp%items)) return
+      do i = 1, size(grp%items)
+         call item_variable(grp%items(i)%s, name)
+         paren = index(name, '(')
+         if (paren > 0) name = name(1:paren - 1)
+         if (name /= var) cycle
+         associate (item => grp%items(i)%s)
+            quote = ' '
+            n = 0
+            k = index(item, '=') + 1
+            do while (k <= len(item))
+               if (quote == ' ') then
+                  if (item(k:k) == '"' .or. item(k:k) == "'") then
+                     quote = item(k:k)
+                     n = 0
+                  end if
+               else if (item(k:k) == quote) then
+                  if (k < len(item)) then
+                     if (item(k + 1:k + 1) == quote) then   ! a doubled quote: one character
+                        n = n + 1
+                        k = k + 2
+                        cycle
+                     end if
+                  end if
+                  quote = ' '
+                  if (n > length) then
+                     length = n; line = grp%item_line(i)
+                  end if
+               else
+                  n = n + 1
+               end if
+               k = k + 1
+            end do
+            if (quote /= ' ' .and. n > length) then   ! not closed: as long as it goes
+               length = n; line = grp%item_line(i)
+            end if
+         end associate
+      end do
+   end subroutine longest_string
+
+   !> The variable an assignment sets, lower case, blanks removed: 'mass', 'mass(2)'.
+   pure subroutine item_variable(item, var)
+      character(len=*), intent(in) :: item
+      character(len=:), allocatable, intent(out) :: var
+      integer :: i, eq
+
+      var = ''
+      eq = index(item, '=')
+      if (eq == 0) return
+      do i = 1, eq - 1
+         if (item(i:i) /= ' ' .and. item(i:i) /= achar(9)) var = var//lower(item(i:i))
+      end do
+   end subroutine item_variable
+
+   !> Append a deck line, from column c1, to the body of a group without its comment.
+   pure subroutine append_line(line, c1, body, line_of, n, lineno)
       character(len=*), intent(in) :: line
-      logical, intent(in) :: is_first
+      integer, intent(in) :: c1
       character(len=*), intent(inout) :: body       !! buffer, body(1:n) used
       integer, intent(inout) :: line_of(:)          !! deck line of each character
       integer, intent(inout) :: n                   !! characters used
       integer, intent(in) :: lineno
-      logical, intent(out) :: closed
-      integer :: i, start
+      integer :: i
       character(len=1) :: quote
 
-      closed = .false.
-      start = 1
-      if (is_first) then
-         start = index(line, '&') + 1
-         do while (start <= len(line))
-            if (scan(line(start:start), ' ,'//achar(9)) > 0) exit
-            start = start + 1
-         end do
-      end if
       quote = ' '
-      do i = start, len(line)
+      do i = c1, len(line)
          if (quote /= ' ') then
             if (line(i:i) == quote) quote = ' '
          else if (line(i:i) == '"' .or. line(i:i) == "'") then
             quote = line(i:i)
          else if (line(i:i) == '!') then
             exit
-         else if (line(i:i) == '/') then
-            closed = .true.
-            exit
-         else if (line(i:i) == '&') then
-            if (lower(line(i:min(i + 3, len(line)))) == '&end') then
-               closed = .true.
-               exit
-            end if
          end if
          n = n + 1
          body(n:n) = line(i:i)
@@ -216,16 +566,20 @@ contains
    end subroutine append_line
 
    !> Split a group body at the start of each 'name =' or 'name(index) ='.
-   pure subroutine split_items(body, line_of, items, item_line)
+   pure subroutine split_items(body, line_of, items, item_line, stat)
       character(len=*), intent(in) :: body
       integer, intent(in) :: line_of(:)
       type(line_type), allocatable, intent(out) :: items(:)
       integer, allocatable, intent(out) :: item_line(:)
+      integer, intent(out) :: stat                  !! 0, or not enough memory
       integer, allocatable :: starts(:)
-      integer :: i, j, depth
+      integer :: i, j, depth, ns
       character(len=1) :: quote
 
-      allocate (starts(0))
+      ! at most one assignment per '=' of the body
+      allocate (starts(max(1, count_char(body, '='))), stat=stat)
+      if (stat /= 0) return
+      ns = 0
       quote = ' '
       do i = 1, len(body)
          if (quote /= ' ') then
@@ -255,14 +609,16 @@ contains
             end if
          end if
          do while (j >= 1)
-            if (.not. is_name_char(body(j:j))) exit
+            if (.not. is_name_char(body(j:j)) .and. body(j:j) /= '%') exit
             j = j - 1
          end do
-         starts = [starts, j + 1]
+         ns = ns + 1
+         starts(ns) = j + 1
       end do
-      allocate (items(size(starts)), item_line(size(starts)))
-      do i = 1, size(starts)
-         if (i < size(starts)) then
+      allocate (items(ns), item_line(ns), stat=stat)
+      if (stat /= 0) return
+      do i = 1, ns
+         if (i < ns) then
             items(i)%s = trim(adjustl(body(starts(i):starts(i + 1) - 1)))
          else
             items(i)%s = trim(adjustl(body(starts(i):)))
@@ -274,13 +630,18 @@ contains
          end if
          item_line(i) = line_of(min(starts(i), size(line_of)))
       end do
-   contains
-      pure logical function is_name_char(c)
-         character(len=1), intent(in) :: c
-         is_name_char = (c >= 'a' .and. c <= 'z') .or. (c >= 'A' .and. c <= 'Z') .or. &
-                        (c >= '0' .and. c <= '9') .or. c == '_' .or. c == '%'
-      end function is_name_char
    end subroutine split_items
+
+   !> Occurrences of a character in a string.
+   pure integer function count_char(str, c) result(n)
+      character(len=*), intent(in) :: str
+      character(len=1), intent(in) :: c
+      integer :: i
+      n = 0
+      do i = 1, len(str)
+         if (str(i:i) == c) n = n + 1
+      end do
+   end function count_char
 
    !> One assignment of a group as a namelist record of its own: '&name item /'.
    pure subroutine group_item(grp, i, record)

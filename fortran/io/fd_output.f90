@@ -395,8 +395,8 @@ contains
       call kv('n_devices', trim(fmt_int(res%n_devices)))
       call kv('technique', '"'//trim(technique_name(res%technique))//'"')
       js = js//'  "device_law": ['//laws//'],'//nl
-      call kv('period_stuck_s', trim(json_defined(res%period_stuck, res%period_stuck > 0.0_dp)))
-      call kv('xi_stuck', trim(json_defined(res%xi_stuck, res%period_stuck > 0.0_dp)))
+      call kv('period_stuck_s', trim(json_real(res%period_stuck)))
+      call kv('xi_stuck', trim(json_real(res%xi_stuck)))
       call kv('dt1_s', trim(json_real(res%dt1)))
       call kv('dt2_s', trim(json_real(res%dt2)))
       call kv('dt_min_s', trim(json_real(res%dt_min)))
@@ -415,6 +415,13 @@ contains
       call kv('steps_finer', trim(fmt_int(res%steps_finer)))
       call kv('factorizations', trim(fmt_int(res%factorizations)))
       call kv('events', trim(fmt_int(res%events)))
+      if (res%exact_peaks) then
+         ! the exact technique: peaks are the exact extrema; its event times, accumulations
+         call kv('peaks_exact', 'true')
+         call kr('event_times_s', res%event_time(1:res%n_event_times))
+         call kv('accumulation_points', trim(fmt_int(res%accumulations)))
+         call kr('accumulation_times_s', res%accumulation_time(1:res%n_accumulation_times))
+      end if
       call kv('patterns_solved', trim(fmt_int(res%patterns)))
       call kv('lcp_fallbacks', trim(fmt_int(res%lcp_fallbacks)))
       call kv('correctness_violations', trim(fmt_int(res%violations)))
@@ -440,9 +447,9 @@ contains
             if (eng%excitation >= 1 .and. eng%excitation <= size(excitation_types)) then
                call kv('excitation_type', '"'//trim(excitation_types(eng%excitation)%name)//'"')
             else
-               call kv('excitation_type', 'null')
+               call kv('excitation_type', '"unknown"')
             end if
-            call kv('excitation_frequency_Hz', trim(json_defined(eng%frequency, eng%frequency > 0.0_dp)))
+            call kv('excitation_frequency_Hz', trim(json_real(eng%frequency)))
             call kv('duration_s', trim(json_real(eng%duration)))
             call ks('dof_labels', eng%dof_label)
             call ks('device_labels', eng%device_label)
@@ -462,22 +469,22 @@ contains
                if (i < eng%n_storeys) js = js//', '
             end do
             js = js//'],'//nl
-            call kd('storey_height_m', eng%height, eng%height > 0.0_dp)
+            call kr('storey_height_m', eng%height)
             call kr('peak_drift_m', eng%peak_drift)
             call kr('peak_drift_time_s', eng%peak_drift_time)
             call kr('residual_drift_m', eng%drift)
             allocate (ratio(eng%n_storeys))
             ratio = 0.0_dp
             where (eng%height > 0.0_dp) ratio = eng%peak_drift/eng%height
-            call kd('peak_drift_ratio', ratio, eng%height > 0.0_dp)
+            call kr('peak_drift_ratio', ratio)
             where (eng%height > 0.0_dp) ratio = eng%drift/eng%height
-            call kd('residual_drift_ratio', ratio, eng%height > 0.0_dp)
+            call kr('residual_drift_ratio', ratio)
             call kr('peak_storey_shear_N', eng%peak_shear(1:))
             call kr('peak_storey_shear_time_s', eng%peak_shear_time(1:))
             call kr('residual_storey_shear_N', eng%shear(1:))
          end associate
       end subroutine engineering_keys
-      !> The modes of one system: status, periods (null: infinite), shapes, mass ratios, damping.
+      !> The modes of one system: status, periods (0: a rigid-body mode), shapes, mass ratios, damping.
       subroutine modes_keys(name, m)
          character(len=*), intent(in) :: name
          type(modes_type), intent(in) :: m
@@ -498,7 +505,8 @@ contains
             call kr('modal_xi_'//name, [real(dp) ::])
             return
          end select
-         call kr('periods_'//name//'_s', m%period)
+         ! a rigid-body mode (w = 0): period and damping ratio 0 (its period is infinite)
+         call kr('periods_'//name//'_s', merge(m%period, 0.0_dp, m%omega2 > 0.0_dp))
          js = js//'  "mode_shapes_'//name//'": ['
          do j = 1, m%n
             call json_list(m%shape(:, j), list)
@@ -507,21 +515,8 @@ contains
          end do
          js = js//'],'//nl
          call kr('modal_mass_ratio_'//name, m%mass_ratio)
-         call kr('modal_xi_'//name, m%xi)
+         call kr('modal_xi_'//name, merge(m%xi, 0.0_dp, m%omega2 > 0.0_dp))
       end subroutine modes_keys
-      !> Reals, null where not defined.
-      subroutine kd(key, x, defined)
-         character(len=*), intent(in) :: key
-         real(dp), intent(in) :: x(:)
-         logical, intent(in) :: defined(:)
-         integer :: k
-         js = js//'  "'//key//'": ['
-         do k = 1, size(x)
-            js = js//trim(json_defined(x(k), defined(k)))
-            if (k < size(x)) js = js//', '
-         end do
-         js = js//'],'//nl
-      end subroutine kd
       !> Strings.
       subroutine ks(key, x)
          character(len=*), intent(in) :: key
@@ -597,15 +592,6 @@ contains
       end do
       text = buf(1:n)//']'
    end subroutine json_list
-
-   !> A real as JSON when it is defined, else null.
-   pure function json_defined(x, defined) result(str)
-      real(dp), intent(in) :: x
-      logical, intent(in) :: defined
-      character(len=32) :: str
-      str = 'null'
-      if (defined) str = json_real(x)
-   end function json_defined
 
    !> A real as JSON: 17 significant digits (null when not finite), left-adjusted.
    pure function json_real(x) result(str)

@@ -3,7 +3,7 @@
 !> and the generalized symmetric eigenproblem K phi = w^2 M phi.
 module fd_linalg
    use fd_kinds, only: dp
-   use fd_error, only: error_type, fatal_error, fmt_int
+   use fd_error, only: error_type, fatal_error, fmt_int, stat_no_memory
    implicit none
    private
 
@@ -171,14 +171,20 @@ contains
       real(dp), allocatable :: b(:, :), w(:), work(:)
       integer, allocatable :: iwork(:), isuppz(:)
       real(dp) :: query(1)
-      integer :: n, m, info, iquery(1)
+      integer :: n, m, info, iquery(1), stat
 
       n = size(a, 1)
-      allocate (b(n, n), w(n), isuppz(2*max(1, k)))
+      allocate (b(n, n), w(n), isuppz(2*max(1, k)), stat=stat)
+      if (stat /= 0) then
+         call no_memory(); return
+      end if
       b = a
       call dsyevr('V', 'I', 'U', n, b, n, 0.0_dp, 0.0_dp, 1, k, 0.0_dp, m, w, vec, n, isuppz, &
                   query, -1, iquery, -1, info)
-      allocate (work(max(1, int(query(1)))), iwork(max(1, iquery(1))))
+      allocate (work(max(1, int(query(1)))), iwork(max(1, iquery(1))), stat=stat)
+      if (stat /= 0) then
+         call no_memory(); return
+      end if
       call dsyevr('V', 'I', 'U', n, b, n, 0.0_dp, 0.0_dp, 1, k, 0.0_dp, m, w, vec, n, isuppz, &
                   work, size(work), iwork, size(iwork), info)
       if (info /= 0 .or. m /= k) then
@@ -186,6 +192,11 @@ contains
          return
       end if
       lambda = w(1:k)
+   contains
+      subroutine no_memory()
+         call fatal_error(error, "not enough memory for the eigenproblem of "//trim(fmt_int(n))//" unknowns", &
+                          stat_no_memory)
+      end subroutine no_memory
    end subroutine lowest_eigen
 
    !> The k lowest eigenvalues (ascending) and orthonormal eigenvectors of a symmetric band
@@ -199,11 +210,16 @@ contains
       type(error_type), allocatable, intent(out) :: error !! LAPACK failure
       real(dp), allocatable :: b(:, :), q(:, :), w(:), work(:)
       integer, allocatable :: iwork(:), ifail(:)
-      integer :: n, kd, m, info
+      integer :: n, kd, m, info, stat
 
       kd = size(ab, 1) - 1
       n = size(ab, 2)
-      allocate (b(kd + 1, n), q(n, n), w(n), work(7*n), iwork(5*n), ifail(n))
+      allocate (b(kd + 1, n), q(n, n), w(n), work(7*n), iwork(5*n), ifail(n), stat=stat)
+      if (stat /= 0) then
+         call fatal_error(error, "not enough memory for the band eigenproblem of "//trim(fmt_int(n))//" unknowns", &
+                          stat_no_memory)
+         return
+      end if
       b = ab
       call dsbevx('V', 'I', 'U', n, kd, b, kd + 1, q, n, 0.0_dp, 0.0_dp, 1, k, 0.0_dp, m, w, vec, n, &
                   work, iwork, ifail, info)
@@ -222,14 +238,17 @@ contains
       real(dp), intent(out) :: phi(:, :)               !! eigenvectors in columns
       type(error_type), allocatable, intent(out) :: error !! LAPACK failure
       real(dp), allocatable :: b(:, :), work(:)
-      integer :: n, info, lwork
+      integer :: n, info, lwork, stat
 
       n = size(k, 1)
-      allocate (b(n, n))
+      lwork = max(1, 3*n - 1)
+      allocate (b(n, n), work(lwork), stat=stat)
+      if (stat /= 0) then
+         call fatal_error(error, "not enough memory for an eigenproblem of order "//trim(fmt_int(n)), stat_no_memory)
+         return
+      end if
       phi = k
       b = m
-      lwork = max(1, 3*n - 1)
-      allocate (work(lwork))
       call dsygv(1, 'V', 'U', n, phi, n, b, n, lambda, work, lwork, info)
       if (info /= 0) then
          call fatal_error(error, "eigenvalue solver dsygv failed with info = "//trim(fmt_int(info)))

@@ -5,7 +5,7 @@
 module fd_matrices
    use, intrinsic :: ieee_arithmetic, only: ieee_value, ieee_positive_inf, ieee_quiet_nan
    use fd_kinds, only: dp
-   use fd_error, only: error_type, fatal_error, fmt_real
+   use fd_error, only: error_type, fatal_error, fmt_real, fmt_int, stat_no_memory
    use fd_model, only: model_type, damping_none, damping_stiffness, damping_rayleigh, law_hysteretic, &
                        system_stuck, system_free
    use fd_linalg, only: generalized_eigen, lowest_eigen, lowest_eigen_band
@@ -68,31 +68,37 @@ contains
       real(dp), intent(out) :: phi(:)                !! first mode, all DOFs
       type(error_type), allocatable, intent(out) :: error !! no free DOF, or no stiffness
       integer, allocatable :: grp(:)
-      real(dp), allocatable :: t(:, :), kq(:, :), mq(:, :), lam(:), z(:, :)
-      integer :: n, nq, i
+      real(dp), allocatable :: kq(:, :), mq(:, :), lam(:), z(:, :)
+      integer :: n, nq, i, j, stat
 
       period = 0.0_dp
       phi = 0.0_dp
       n = model%n_dof
-      allocate (grp(n))
+      allocate (grp(n), stat=stat)
+      if (stat /= 0) then
+         call no_memory(n); return
+      end if
       call link_groups(model, model%dev%p*model%dev%mu > 0.0_dp, grp, nq)
       if (nq == 0) then
          call fatal_error(error, "the stuck system has no free DOF: every mass is locked to the table &
                           &by friction devices, so its first period is undefined (give period in &damping)")
          return
       end if
-      allocate (t(n, nq))
-      t = 0.0_dp
-      do i = 1, n
-         if (grp(i) /= 0) t(i, grp(i)) = 1.0_dp
-      end do
-      kq = matmul(transpose(t), matmul(k, t))
-      allocate (mq(nq, nq))
+      allocate (kq(nq, nq), mq(nq, nq), lam(nq), z(nq, nq), stat=stat)
+      if (stat /= 0) then
+         call no_memory(nq); return
+      end if
+      ! K and M of the groups, T' K T and T' M T with T(i, grp(i)) = 1, summed entry by entry
+      ! (no n x nq matrix T)
+      kq = 0.0_dp
       mq = 0.0_dp
-      do i = 1, n
-         if (grp(i) /= 0) mq(grp(i), grp(i)) = mq(grp(i), grp(i)) + model%mass(i)
+      do j = 1, n
+         if (grp(j) == 0) cycle
+         mq(grp(j), grp(j)) = mq(grp(j), grp(j)) + model%mass(j)
+         do i = 1, n
+            if (grp(i) /= 0) kq(grp(i), grp(j)) = kq(grp(i), grp(j)) + k(i, j)
+         end do
       end do
-      allocate (lam(nq), z(nq, nq))
       call generalized_eigen(kq, mq, lam, z, error)
       if (allocated(error)) return
       if (lam(1) <= 1.0e-12_dp*maxval(abs(lam))) then
@@ -101,7 +107,15 @@ contains
          return
       end if
       period = 2.0_dp*pi/sqrt(lam(1))
-      phi = matmul(t, z(:, 1))
+      do i = 1, n
+         if (grp(i) /= 0) phi(i) = z(grp(i), 1)
+      end do
+   contains
+      subroutine no_memory(size)
+         integer, intent(in) :: size
+         call fatal_error(error, "not enough memory for the stuck system's eigenproblem of "// &
+                          trim(fmt_int(size))//" DOFs", stat_no_memory)
+      end subroutine no_memory
    end subroutine stuck_first_mode
 
    !> Springs' stiffness K and damping C of the model, with the stuck system's first period
@@ -114,10 +128,16 @@ contains
       real(dp), intent(out) :: xi                         !! its damping ratio
       type(error_type), allocatable, intent(out) :: error !! 'stiffness' damping without a period
       type(error_type), allocatable :: eig_error
-      real(dp), allocatable :: phi(:)
+      real(dp), allocatable :: phi(:), cphi(:)
       real(dp) :: t_damp
+      integer :: stat
 
-      allocate (phi(model%n_dof))
+      allocate (phi(model%n_dof), cphi(model%n_dof), stat=stat)
+      if (stat /= 0) then
+         call fatal_error(error, "not enough memory for the matrices of "//trim(fmt_int(model%n_dof))//" DOFs", &
+                          stat_no_memory)
+         return
+      end if
       call stiffness_matrix(model, k)
       call stuck_first_mode(model, k, period, phi, eig_error)
       ! the paper's psi = T xi / pi uses the given T, else the computed one
@@ -135,7 +155,8 @@ contains
       if (allocated(eig_error)) then
          period = 0.0_dp
       else
-         xi = dot_product(phi, matmul(c, phi))/(2.0_dp*(2.0_dp*pi/period)*sum(model%mass*phi**2))
+         cphi = matmul(c, phi)
+         xi = dot_product(phi, cphi)/(2.0_dp*(2.0_dp*pi/period)*sum(model%mass*phi**2))
       end if
    end subroutine structure_matrices
 
@@ -197,11 +218,14 @@ contains
       logical, allocatable :: linked(:)
       real(dp), allocatable :: ks(:, :), kq(:, :), mq(:, :), cq(:, :), lam(:), z(:, :), phi(:), sq(:)
       real(dp) :: kd, big, w, pm, l, mtot
-      integer :: n, nq, i, j, d, ni, nj, imax, kfirst
+      integer :: n, nq, i, j, d, ni, nj, imax, kfirst, stat
 
       n = model%n_dof
       modes%system = system
-      allocate (grp(n), linked(model%n_devices))
+      allocate (grp(n), linked(model%n_devices), ks(n, n), stat=stat)
+      if (stat /= 0) then
+         call no_memory(n); return
+      end if
       ks = k
       do d = 1, model%n_devices
          pm = model%dev(d)%p*model%dev(d)%mu
@@ -225,7 +249,10 @@ contains
          return
       end if
       ! Kq = T' K T, Cq = T' C T, Mq = T' M T by summing over the groups (T is 0/1: O(n^2))
-      allocate (kq(nq, nq), cq(nq, nq), mq(nq, nq))
+      allocate (kq(nq, nq), cq(nq, nq), mq(nq, nq), sq(nq), stat=stat)
+      if (stat /= 0) then
+         call no_memory(nq); return
+      end if
       kq = 0.0_dp; cq = 0.0_dp; mq = 0.0_dp
       do j = 1, n
          if (grp(j) == 0) cycle
@@ -239,7 +266,6 @@ contains
       ! M is diagonal in the reduced coordinates: the standard problem of Mq^-1/2 Kq Mq^-1/2,
       ! whose lowest pairs alone are computed; z = Mq^-1/2 y is M-normalized
       modes%n = min(max(nmax, 0), nq)
-      allocate (sq(nq))
       do i = 1, nq
          sq(i) = 1.0_dp/sqrt(mq(i, i))
       end do
@@ -252,7 +278,10 @@ contains
          big = max(big, sum(abs(kq(:, j))))
       end do
       kfirst = max(modes%n, 1)
-      allocate (lam(kfirst), z(nq, kfirst))
+      allocate (lam(kfirst), z(nq, kfirst), stat=stat)
+      if (stat /= 0) then
+         call no_memory(nq); return
+      end if
       call lowest_pairs(kq, kfirst, lam, z, error)
       if (allocated(error)) return
       do j = 1, kfirst
@@ -261,7 +290,10 @@ contains
       modes%status = modes_flexible
       if (lam(1) <= 1.0e-12_dp*big) modes%status = modes_unrestrained
       allocate (modes%omega2(modes%n), modes%period(modes%n), modes%shape(n, modes%n), &
-                modes%mass_ratio(modes%n), modes%xi(modes%n), phi(n))
+                modes%mass_ratio(modes%n), modes%xi(modes%n), phi(n), stat=stat)
+      if (stat /= 0) then
+         call no_memory(n); return
+      end if
       mtot = sum(model%mass)
       do j = 1, modes%n
          do i = 1, n
@@ -285,6 +317,12 @@ contains
             modes%xi(j) = dot_product(z(:, j), matmul(cq, z(:, j)))/(2.0_dp*w)
          end if
       end do
+   contains
+      subroutine no_memory(size)
+         integer, intent(in) :: size
+         call fatal_error(error, "not enough memory for the natural modes of "//trim(fmt_int(size))// &
+                          " DOFs (an eigenproblem of that size)", stat_no_memory)
+      end subroutine no_memory
    end subroutine natural_modes
 
    !> The k lowest eigenpairs of a symmetric matrix: in band storage after a reverse
@@ -297,7 +335,7 @@ contains
       type(error_type), allocatable, intent(out) :: error
       integer, allocatable :: ei(:), ej(:), perm(:), inv(:)
       real(dp), allocatable :: ab(:, :), vp(:, :)
-      integer :: n, i, j, ne, bw
+      integer :: n, i, j, ne, bw, stat
 
       n = size(a, 1)
       ne = 0
@@ -306,7 +344,10 @@ contains
             if (a(i, j) /= 0.0_dp) ne = ne + 1
          end do
       end do
-      allocate (ei(ne), ej(ne), perm(n), inv(n))
+      allocate (ei(ne), ej(ne), perm(n), inv(n), stat=stat)
+      if (stat /= 0) then
+         call no_memory(); return
+      end if
       ne = 0
       do j = 1, n
          do i = 1, j - 1
@@ -325,7 +366,10 @@ contains
          call lowest_eigen(a, k, lambda, vec, error)
          return
       end if
-      allocate (ab(bw + 1, n), vp(n, k))
+      allocate (ab(bw + 1, n), vp(n, k), stat=stat)
+      if (stat /= 0) then
+         call no_memory(); return
+      end if
       ab = 0.0_dp
       do j = 1, n
          do i = max(1, j - bw), j
@@ -335,6 +379,11 @@ contains
       call lowest_eigen_band(ab, k, lambda, vp, error)
       if (allocated(error)) return
       vec(perm, :) = vp
+   contains
+      subroutine no_memory()
+         call fatal_error(error, "not enough memory for the natural modes of "//trim(fmt_int(n))// &
+                          " DOFs (an eigenproblem of that size)", stat_no_memory)
+      end subroutine no_memory
    end subroutine lowest_pairs
 
    !> The factor b of the stiffness-proportional part of C = a0 M + b K: psi = T xi / pi

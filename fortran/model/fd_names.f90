@@ -165,7 +165,12 @@ contains
    pure integer function law_id(word) result(id)
       character(len=*), intent(in) :: word  !! the word of the deck
 
-      id = keyword_id(laws%keyword_type, word)
+      ! over the table itself: laws%keyword_type, a section of a constant, is copied to a
+      ! temporary at every call
+      do id = 1, size(laws)
+         if (laws(id)%keyword_type%name == lower(trim(word))) return
+      end do
+      id = 0
    end function law_id
 
    !> The keywords of a table for a message: 'a' (note), 'b', 'c'.
@@ -187,12 +192,18 @@ contains
    pure subroutine law_choices(text, regularized)
       character(len=:), allocatable, intent(out) :: text !! the list
       logical, intent(in), optional :: regularized       !! which laws to list (default all)
+      type(keyword_type) :: table(size(laws))
+      integer :: i, n
 
-      if (present(regularized)) then
-         call keyword_choices(pack(laws%keyword_type, laws%regularized .eqv. regularized), text)
-      else
-         call keyword_choices(laws%keyword_type, text)
-      end if
+      n = 0
+      do i = 1, size(laws)
+         if (present(regularized)) then
+            if (laws(i)%regularized .neqv. regularized) cycle
+         end if
+         n = n + 1
+         table(n) = laws(i)%keyword_type
+      end do
+      call keyword_choices(table(1:n), text)
    end subroutine law_choices
 
    !> Name of a friction law, as written in decks ('unknown' for an id not in the table).

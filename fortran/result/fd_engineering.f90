@@ -13,7 +13,7 @@
 !> with a0 = 0 the base shear equals -sum m_i aabs_i, the inertia forces of the masses.
 module fd_engineering
    use fd_kinds, only: dp
-   use fd_error, only: error_type, fmt_int
+   use fd_error, only: error_type, fatal_error, fmt_int, stat_no_memory
    use fd_model, only: model_type, integration_type, label_len, system_stuck, system_free, &
                        damping_stiffness, damping_rayleigh
    use fd_excitation, only: excitation_type, excitation_harmonic
@@ -23,6 +23,7 @@ module fd_engineering
    private
 
    public :: engineering_type, engineering_init, storey_values, observe_engineering, engineering_columns
+   public :: observe_storey_peak
 
    !> The engineering outputs of a run.
    type :: engineering_type
@@ -76,7 +77,7 @@ contains
       type(engineering_type), intent(out) :: eng    !! the outputs, set up
       type(error_type), allocatable, intent(out) :: error !! eigenvalue solver failure
       real(dp), allocatable :: k(:, :), c(:, :)
-      integer :: n, nd, ns, i, s
+      integer :: n, nd, ns, i, s, stat
 
       n = model%n_dof
       nd = model%n_devices
@@ -84,7 +85,10 @@ contains
       eng%excitation = exc%kind
       eng%duration = exc%duration
       if (exc%kind == excitation_harmonic) eng%frequency = exc%frequency
-      allocate (eng%dof_label(n), eng%device_label(nd))
+      allocate (eng%dof_label(n), eng%device_label(nd), stat=stat)
+      if (stat /= 0) then
+         call no_memory('the labels'); return
+      end if
       do i = 1, n
          eng%dof_label(i) = 'DOF '//trim(fmt_int(i))
          if (allocated(model%dof_label)) then
@@ -105,7 +109,10 @@ contains
       end select
       ! natural modes
       if (opts%n_modes > 0) then
-         allocate (k(n, n), c(n, n))
+         allocate (k(n, n), c(n, n), stat=stat)
+         if (stat /= 0) then
+            call no_memory('the modes (two '//trim(fmt_int(n))//' x '//trim(fmt_int(n))//' matrices)'); return
+         end if
          call stiffness_matrix(model, k)
          call damping_matrix(model, k, merge(model%period, period, model%period > 0.0_dp), c)
          call natural_modes(model, k, c, system_stuck, opts%n_modes, eng%stuck, error)
@@ -115,7 +122,10 @@ contains
       end if
       ! storeys and their elements
       eng%n_storeys = ns
-      allocate (eng%storey_i(ns), eng%storey_j(ns), eng%height(ns), eng%storey_label(ns))
+      allocate (eng%storey_i(ns), eng%storey_j(ns), eng%height(ns), eng%storey_label(ns), stat=stat)
+      if (stat /= 0) then
+         call no_memory('the storeys'); return
+      end if
       do s = 1, ns
          eng%storey_i(s) = model%storey_i(s)
          eng%storey_j(s) = model%storey_j(s)
@@ -125,24 +135,39 @@ contains
             if (len_trim(model%storey_label(s)) > 0) eng%storey_label(s) = model%storey_label(s)
          end if
       end do
-      call storey_elements(model, eng)
+      call storey_elements(model, eng, stat)
+      if (stat /= 0) then
+         call no_memory('the elements of the storeys'); return
+      end if
       allocate (eng%drift(ns), eng%shear(0:ns), eng%residual_s(nd), eng%peak_drift(ns), &
-                eng%peak_drift_time(ns), eng%peak_shear(0:ns), eng%peak_shear_time(0:ns))
+                eng%peak_drift_time(ns), eng%peak_shear(0:ns), eng%peak_shear_time(0:ns), stat=stat)
+      if (stat /= 0) then
+         call no_memory('the storeys'); return
+      end if
       eng%drift = 0.0_dp; eng%shear = 0.0_dp; eng%residual_s = 0.0_dp
       eng%peak_drift = 0.0_dp; eng%peak_drift_time = 0.0_dp
       eng%peak_shear = 0.0_dp; eng%peak_shear_time = 0.0_dp
+   contains
+      subroutine no_memory(what)
+         character(len=*), intent(in) :: what
+         call fatal_error(error, "not enough memory for the engineering outputs of "//trim(fmt_int(n))// &
+                          " DOFs, "//trim(fmt_int(nd))//" devices and "//trim(fmt_int(ns))//" storeys: "//what, &
+                          stat_no_memory)
+      end subroutine no_memory
    end subroutine engineering_init
 
    !> The springs and devices of every cut (0 = the base, 1..n_storeys the storeys), with
    !> their sign along the cut, in compressed lists.
-   subroutine storey_elements(model, eng)
+   subroutine storey_elements(model, eng, stat)
       type(model_type), intent(in) :: model
       type(engineering_type), intent(inout) :: eng
+      integer, intent(out) :: stat                 !! not 0: not enough memory
       integer :: ns, cut, e, a, b, nsp, ndv
       real(dp) :: sgn
 
       ns = eng%n_storeys
-      allocate (eng%sp_first(0:ns + 1), eng%dv_first(0:ns + 1))
+      allocate (eng%sp_first(0:ns + 1), eng%dv_first(0:ns + 1), stat=stat)
+      if (stat /= 0) return
       ! count, then fill
       nsp = 0; ndv = 0
       do cut = 0, ns
@@ -153,7 +178,8 @@ contains
             if (on_cut(cut, model%dev(e)%node_i, model%dev(e)%node_j) /= 0.0_dp) ndv = ndv + 1
          end do
       end do
-      allocate (eng%sp_i(nsp), eng%sp_j(nsp), eng%sp_k(nsp), eng%dv_id(ndv), eng%dv_sign(ndv))
+      allocate (eng%sp_i(nsp), eng%sp_j(nsp), eng%sp_k(nsp), eng%dv_id(ndv), eng%dv_sign(ndv), stat=stat)
+      if (stat /= 0) return
       nsp = 0; ndv = 0
       do cut = 0, ns
          eng%sp_first(cut) = nsp + 1
@@ -254,6 +280,33 @@ contains
          end if
       end do
    end subroutine observe_engineering
+
+   !> One value into a peak of the storeys (a technique that knows its solution between
+   !> steps passes the exact extrema, with their times): q numbers the storey quantities in
+   !> the order of the history columns, drift1, V1, drift2, V2, ..., Vb.
+   pure subroutine observe_storey_peak(eng, q, value, t)
+      type(engineering_type), intent(inout) :: eng  !! the outputs
+      integer, intent(in) :: q                      !! storey quantity, 1 .. 2 n_storeys + 1
+      real(dp), intent(in) :: value                 !! |value|
+      real(dp), intent(in) :: t                     !! its time [s]
+      integer :: s
+
+      if (.not. allocated(eng%drift)) return
+      if (q == 2*eng%n_storeys + 1) then
+         s = 0
+      else
+         s = (q + 1)/2
+         if (mod(q, 2) == 1) then
+            if (value > eng%peak_drift(s)) then
+               eng%peak_drift(s) = value; eng%peak_drift_time(s) = t
+            end if
+            return
+         end if
+      end if
+      if (value > eng%peak_shear(s)) then
+         eng%peak_shear(s) = value; eng%peak_shear_time(s) = t
+      end if
+   end subroutine observe_storey_peak
 
    !> Number of history columns the storeys add: drift and shear per storey and the base
    !> shear, when the model names storeys; none otherwise.

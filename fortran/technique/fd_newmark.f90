@@ -12,7 +12,7 @@
 module fd_newmark
    use, intrinsic :: ieee_arithmetic, only: ieee_is_finite
    use fd_kinds, only: dp
-   use fd_error, only: error_type, fatal_error, fmt_real, fmt_int
+   use fd_error, only: error_type, fatal_error, fmt_real, fmt_int, stat_no_memory
    use fd_names, only: laws, law_name, law_choices, excitation_types, technique_name, technique_newmark, &
                        technique_event_driven
    use fd_model, only: model_type, integration_type
@@ -25,6 +25,7 @@ module fd_newmark
    use fd_result, only: result_type
    use fd_observer, only: observer_type, observer_init, sample_due, observe_start, observe_peaks, &
                           observe_sample, observe_transitions, observe_violations, observe_end
+   use fd_step_limits, only: halving_levels, unresolved_band
    implicit none
    private
 
@@ -157,16 +158,6 @@ contains
       res%run_time = real(c1 - c0, dp)/real(max(crate, 1), dp)
    end subroutine run_newmark
 
-   !> Number of halvings from sub down to dt_min.
-   pure integer function halving_levels(sub, dt_min) result(lmax)
-      real(dp), intent(in) :: sub, dt_min
-
-      lmax = 0
-      do while (lmax < 30 .and. sub/2.0_dp**(lmax + 1) >= dt_min*(1.0_dp - 1.0e-12_dp))
-         lmax = lmax + 1
-      end do
-   end function halving_levels
-
    !> Matrices and workspace. The factor cache holds the
    !> step sizes dt1, dt2, dt2/2, ... dt_min with two phase patterns each when memory allows.
    subroutine setup(model, lmax, w, res, error)
@@ -181,24 +172,31 @@ contains
       nd = model%n_devices
       w%n = n
       w%nd = nd
-      w%mass = model%mass
-      allocate (w%k(n, n), w%c(n, n), stat=stat)
+      allocate (w%mass(n), w%k(n, n), w%c(n, n), stat=stat)
       if (stat /= 0) then
-         call fatal_error(error, "not enough memory for the matrices of n_dof = "//trim(fmt_int(n))//" DOFs")
+         call fatal_error(error, "not enough memory for the matrices of n_dof = "//trim(fmt_int(n))//" DOFs", &
+                          stat_no_memory)
          return
       end if
+      w%mass = model%mass
       call structure_matrices(model, w%k, w%c, res%period_stuck, res%xi_stuck, error)
       if (allocated(error)) return
-      allocate (w%u(n), w%v(n), w%a(n), w%u1(n), w%v1(n), w%a1(n), w%rhs(n), w%tmp(n))
-      allocate (w%s(nd), w%sd(nd), w%s1(nd), w%sd1(nd), w%f(nd), w%st(nd), w%st1(nd), w%phase0(nd), w%phase1(nd))
-      allocate (w%changed(nd), w%ok(nd), w%stuck(nd))
+      allocate (w%u(n), w%v(n), w%a(n), w%u1(n), w%v1(n), w%a1(n), w%rhs(n), w%tmp(n), &
+                w%s(nd), w%sd(nd), w%s1(nd), w%sd1(nd), w%f(nd), w%st(nd), w%st1(nd), w%phase0(nd), w%phase1(nd), &
+                w%changed(nd), w%ok(nd), w%stuck(nd), stat=stat)
+      if (stat /= 0) then
+         call fatal_error(error, "not enough memory for the state of n_dof = "//trim(fmt_int(n))//" DOFs", &
+                          stat_no_memory)
+         return
+      end if
       n_slots = min(max_slots, 2*(lmax + 2), max(4, int(cache_bytes/(8.0_dp*n*n))))
       if (nd == 0) n_slots = 1
-      allocate (w%slot(n_slots))
+      allocate (w%slot(n_slots), stat=stat)
       do i = 1, n_slots
-         allocate (w%slot(i)%stuck(nd), w%slot(i)%a(n, n), stat=stat)
+         if (stat == 0) allocate (w%slot(i)%stuck(nd), w%slot(i)%a(n, n), stat=stat)
          if (stat /= 0) then
-            call fatal_error(error, "not enough memory for the factors of n_dof = "//trim(fmt_int(n))//" DOFs")
+            call fatal_error(error, "not enough memory for the factors of n_dof = "//trim(fmt_int(n))//" DOFs", &
+                             stat_no_memory)
             return
          end if
       end do
@@ -335,7 +333,7 @@ contains
       type(workspace), intent(inout) :: w
       type(result_type), intent(inout) :: res
       type(error_type), allocatable, intent(out) :: error
-      integer :: lmax, level, pos, units
+      integer :: lmax, level, pos, units, d
       real(dp) :: h, tl
       logical :: any_changed, any_bad
 
@@ -352,6 +350,15 @@ contains
          if (any_bad .and. opts%check .and. level < lmax) then
             level = level + 1
             cycle
+         end if
+         if (any_bad .and. opts%check) then
+            ! a violation left at dt_min: an error when the band is below what dt_min resolves
+            ! (fd_step_limits), else counted
+            do d = 1, w%nd
+               if (w%ok(d)) cycle
+               call unresolved_band(model, d, tl + h, dt_min, error)
+               if (allocated(error)) return
+            end do
          end if
          call accept(model, exc, tl + h, w, res, any_bad)
          if (level == 0) then

@@ -6,7 +6,7 @@ module test_fd_namelist
    use testdrive, only: new_unittest, unittest_type, error_type, check
    use fd_error, only: fd_error_type => error_type
    use fd_namelist, only: deck_text, group_text, deck_from_string, load_deck, find_group, group_item, &
-                          group_read_error, check_groups, group_opened
+                          group_read_error, check_groups, group_opened, longest_string
    implicit none
    private
 
@@ -27,9 +27,10 @@ module test_fd_namelist
       "     0.005"//nl// &                                                ! 10
       "&END"//nl// &                                                      ! 11
       "&output"//nl// &                                                   ! 12
-      "  dir = 'out'"//nl// &                                             ! 13
+      "  dir = 'out' /  ! closed at the end of a line"//nl// &            ! 13
       achar(9)//"&damping  ! a tab before"//nl// &                        ! 14
-      "/"//nl                                                             ! 15
+      "/"//nl// &                                                         ! 15
+      "$springs n_springs = 0 $end   ! the legacy form"//nl              ! 16
 
 contains
 
@@ -47,7 +48,13 @@ contains
                   new_unittest("unknown and repeated groups", test_check_groups), &
                   new_unittest("one item as a record", test_group_item), &
                   new_unittest("messages naming the variable", test_read_error), &
-                  new_unittest("missing deck file", test_load_missing) &
+                  new_unittest("missing deck file", test_load_missing), &
+                  new_unittest("the legacy $name ... $end", test_legacy), &
+                  new_unittest("nothing outside groups but comments", test_outside), &
+                  new_unittest("'&' and '$' only where they open or close", test_ampersand), &
+                  new_unittest("a NUL character", test_nul), &
+                  new_unittest("a variable given twice", test_twice), &
+                  new_unittest("the longest string of a variable", test_longest) &
                   ]
    end subroutine collect_namelist
 
@@ -85,7 +92,7 @@ contains
       logical :: found
 
       call deck_from_string(sample, 'sample.nml', deck)
-      call check(error, size(deck%lines), 15, 'lines of the deck')
+      call check(error, size(deck%lines), 16, 'lines of the deck')
       if (allocated(error)) return
       call find_group(deck, 'model', grp, found, err)
       call check(error, found .and. .not. allocated(err), '&model found')
@@ -161,7 +168,7 @@ contains
       if (allocated(error)) return
       call check(error, all(grp%item_line == [8, 9]), 'lines 8 and 9')
       if (allocated(error)) return
-      ! the tab-indented group after the unclosed one is found and closed
+      ! the tab-indented group is found and closed
       call find_group(deck, 'damping', grp, found, err)
       call check(error, found .and. .not. allocated(err) .and. grp%first_line == 14, '&damping after a tab')
       if (allocated(error)) return
@@ -176,16 +183,17 @@ contains
       type(fd_error_type), allocatable :: err
       logical :: found
 
-      call deck_from_string(sample, 'sample.nml', deck)
-      call find_group(deck, 'output', grp, found, err)
-      call check(error, found .and. allocated(err), '&output is not closed')
+      call deck_from_string("&model"//nl//"  n_dof = 1 /"//nl//"&output"//nl//"  dir = 'out'"//nl// &
+                            achar(9)//"&damping"//nl//"/"//nl, 'open.nml', deck)
+      call find_group(deck, 'model', grp, found, err)
+      call check(error, allocated(err), 'an unclosed group makes the deck unreadable')
       if (allocated(error)) return
-      call check(error, index(err%message, "sample.nml, group &output (line 12): not closed by '/'") > 0, &
+      call check(error, index(err%message, "open.nml, group &output (line 3): not closed by '/' before line 5") > 0, &
                  err%message)
       if (allocated(error)) return
       call deck_from_string('&model'//nl//'  n_dof = 1'//nl, 'end.nml', deck)
       call find_group(deck, 'model', grp, found, err)
-      call check(error, found .and. allocated(err), 'a group running to the end of the deck')
+      call check(error, allocated(err), 'a group running to the end of the deck')
    end subroutine test_not_closed
 
    subroutine test_missing(error)
@@ -196,7 +204,7 @@ contains
       logical :: found
 
       call deck_from_string(sample, 'sample.nml', deck)
-      call find_group(deck, 'springs', grp, found, err)
+      call find_group(deck, 'integration', grp, found, err)
       call check(error, .not. found .and. .not. allocated(err), 'a missing group: not found, no error')
       if (allocated(error)) return
       call find_group(deck, 'end', grp, found, err)
@@ -209,15 +217,16 @@ contains
       type(fd_error_type), allocatable :: err
 
       call deck_from_string(sample, 'sample.nml', deck)
-      call check_groups(deck, [character(len=10) :: 'model', 'friction', 'excitation', 'output', 'damping'], err)
+      call check_groups(deck, [character(len=10) :: 'model', 'friction', 'excitation', 'output', 'damping', &
+                               'springs'], err)
       call check(error, .not. allocated(err), 'every group known, once')
       if (allocated(error)) return
-      call check_groups(deck, [character(len=10) :: 'model', 'friction', 'excitation', 'damping'], err)
+      call check_groups(deck, [character(len=10) :: 'model', 'friction', 'excitation', 'damping', 'springs'], err)
       call check(error, allocated(err), 'an unknown group')
       if (allocated(error)) return
       call check(error, index(err%message, 'sample.nml, line 12: unknown group &output') > 0, err%message)
       if (allocated(error)) return
-      call check(error, index(err%message, '&model, &friction, &excitation, &damping') > 0, err%message)
+      call check(error, index(err%message, '&model, &friction, &excitation, &damping, &springs') > 0, err%message)
       if (allocated(error)) return
       call deck_from_string('&model /'//nl//'&MODEL'//nl//'/'//nl, 'twice.nml', deck)
       call check_groups(deck, [character(len=10) :: 'model'], err)
@@ -275,5 +284,148 @@ contains
       if (allocated(error)) return
       call check(error, err%message, "deck: file 'no_such_deck_for_the_unit_tests.nml' does not exist")
    end subroutine test_load_missing
+
+   !> '$springs ... $end' is read as '&springs ... /'.
+   subroutine test_legacy(error)
+      type(error_type), allocatable, intent(out) :: error
+      type(deck_text) :: deck
+      type(group_text) :: grp
+      type(fd_error_type), allocatable :: err
+      logical :: found
+      integer :: n_springs, ios
+      namelist /springs/ n_springs
+
+      call deck_from_string(sample, 'sample.nml', deck)
+      call find_group(deck, 'springs', grp, found, err)
+      call check(error, found .and. .not. allocated(err), '$springs found')
+      if (allocated(error)) return
+      call check(error, size(grp%items), 1)
+      if (allocated(error)) return
+      call check(error, grp%items(1)%s, 'n_springs = 0')
+      if (allocated(error)) return
+      call check(error, trim(grp%lines(1)), '&springs n_springs = 0  /', 'what the namelist reader gets')
+      if (allocated(error)) return
+      n_springs = -1
+      read (grp%lines, nml=springs, iostat=ios)
+      call check(error, ios == 0 .and. n_springs == 0, 'the legacy group read by the namelist reader')
+   end subroutine test_legacy
+
+   !> Assignments, '/', and '&name' not first on its line, outside groups: errors naming the line.
+   subroutine test_outside(error)
+      type(error_type), allocatable, intent(out) :: error
+
+      call expect_error('! ok'//nl//'&model /'//nl//'  n_dof = 2'//nl, &
+                        "t.nml, line 3: 'n_dof = 2': an assignment outside any group", error)
+      if (allocated(error)) return
+      call expect_error('&model /'//nl//'/'//nl, "t.nml, line 2: '/': a '/' outside any group", error)
+      if (allocated(error)) return
+      call expect_error('&model /'//nl//'x&friction n_devices = 0 /'//nl, &
+                        "t.nml, line 2: 'x&friction n_devices = 0 /': '&' not read as the start of a group", error)
+      if (allocated(error)) return
+      call expect_error(achar(194)//achar(160)//'&friction n_devices = 0 /'//nl, &
+                        "(here a non-ASCII character, byte 194, comes before it)", error)
+      if (allocated(error)) return
+      call expect_error('Title of the deck'//nl//'&model /'//nl, "t.nml, line 1: 'Title of the deck': text outside", error)
+      if (allocated(error)) return
+      call expect_error('&model n_dof = 2 / mass = 1.0'//nl, &
+                        "t.nml, line 1: 'mass = 1.0' after the end of group &model", error)
+      if (allocated(error)) return
+      call expect_error("&output dir = out/x /"//nl, "t.nml, line 1: 'x /' after the end of group &output", error)
+      if (allocated(error)) return
+      call expect_error('&model /'//nl//'&end'//nl, "t.nml, line 2: '&end' outside any group", error)
+   end subroutine test_outside
+
+   !> '& friction' (a blank after '&'), '&model=', and '&' in a group outside quotes.
+   subroutine test_ampersand(error)
+      type(error_type), allocatable, intent(out) :: error
+
+      call expect_error('& friction'//nl//'/'//nl, "t.nml, line 1: '& friction': '&' must be followed by the group name", &
+                        error)
+      if (allocated(error)) return
+      call expect_error('$ friction'//nl//'$end'//nl, "'$' must be followed by the group name", error)
+      if (allocated(error)) return
+      call expect_error('&model=2 /'//nl, "'&model=2 /' does not open a group", error)
+      if (allocated(error)) return
+      call expect_error('&model n_dof = 2 &x /'//nl, "t.nml, line 1, group &model: '&x /': '&' inside a group", error)
+      if (allocated(error)) return
+      call expect_error('&model'//nl//'  n_dof = 2'//nl//'&springs'//nl//'/'//nl, &
+                        "t.nml, group &model (line 1): not closed by '/' before line 3 ('&springs')", error)
+   end subroutine test_ampersand
+
+   !> A NUL character is an error, in a deck given as text as in a file.
+   subroutine test_nul(error)
+      type(error_type), allocatable, intent(out) :: error
+
+      call expect_error('&model'//nl//'  n_dof = 2'//achar(0)//'3'//nl//'/'//nl, &
+                        "t.nml, line 2: a NUL character (byte 0) in the deck", error)
+   end subroutine test_nul
+
+   !> The same variable (or array element) twice in a group.
+   subroutine test_twice(error)
+      type(error_type), allocatable, intent(out) :: error
+      type(deck_text) :: deck
+      type(group_text) :: grp
+      type(fd_error_type), allocatable :: err
+      logical :: found
+
+      call deck_from_string('&damping'//nl//'  xi = 0.015'//nl//'  XI= 0.05'//nl//'/'//nl, 't.nml', deck)
+      call find_group(deck, 'damping', grp, found, err)
+      call check(error, allocated(err), 'xi given twice')
+      if (allocated(error)) return
+      call check(error, err%message, "t.nml, group &damping, line 3: 'xi' is assigned again (first at line 2); "// &
+                 "give each variable once")
+      if (allocated(error)) return
+      call deck_from_string('&model mass(1) = 1.0, mass(2) = 2.0, mass( 1 ) = 3.0 /'//nl, 't.nml', deck)
+      call find_group(deck, 'model', grp, found, err)
+      call check(error, allocated(err), 'mass(1) given twice')
+      if (allocated(error)) return
+      call deck_from_string('&model mass(1) = 1.0, mass(2) = 2.0 /'//nl, 't.nml', deck)
+      call find_group(deck, 'model', grp, found, err)
+      call check(error, .not. allocated(err), 'two elements of an array')
+   end subroutine test_twice
+
+   !> longest_string: quoted strings of a variable and its elements, a doubled quote counted
+   !> once, other variables ignored; the line of the longest.
+   subroutine test_longest(error)
+      type(error_type), allocatable, intent(out) :: error
+      type(deck_text) :: deck
+      type(group_text) :: grp
+      type(fd_error_type), allocatable :: err
+      logical :: found
+      integer :: length, line
+
+      call deck_from_string("&friction"//nl//"  law = 'velocity', ""hysteretic"""//nl// &
+                            "  law(3) = 'it''s   x', name = '"//repeat('n', 50)//"'"//nl//"/"//nl, 't.nml', deck)
+      call find_group(deck, 'friction', grp, found, err)
+      call check(error, found .and. .not. allocated(err), 'found')
+      if (allocated(error)) return
+      call longest_string(grp, 'law', length, line)
+      call check(error, length == 10 .and. line == 2, "law: 'hysteretic', line 2")
+      if (allocated(error)) return
+      call longest_string(grp, 'name', length, line)
+      call check(error, length == 50 .and. line == 3, 'name: 50 characters, line 3')
+      if (allocated(error)) return
+      call longest_string(grp, 'dir', length, line)
+      call check(error, length == 0 .and. line == 0, 'dir: not given')
+      if (allocated(error)) return
+      call deck_from_string("&friction law(3) = 'it''s    x' /"//nl, 't.nml', deck)
+      call find_group(deck, 'friction', grp, found, err)
+      call longest_string(grp, 'law', length, line)
+      call check(error, length, 9, "it's    x: a doubled quote is one character")
+   end subroutine test_longest
+
+   !> check_groups on a deck gives an error containing `text`.
+   subroutine expect_error(deck_string, text, error)
+      character(len=*), intent(in) :: deck_string, text
+      type(error_type), allocatable, intent(out) :: error
+      type(deck_text) :: deck
+      type(fd_error_type), allocatable :: err
+
+      call deck_from_string(deck_string, 't.nml', deck)
+      call check_groups(deck, [character(len=10) :: 'model', 'friction', 'output', 'springs', 'damping'], err)
+      call check(error, allocated(err), 'an error expected: '//text)
+      if (allocated(error)) return
+      call check(error, index(err%message, text) > 0, err%message)
+   end subroutine expect_error
 
 end module test_fd_namelist

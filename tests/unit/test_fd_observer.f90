@@ -7,7 +7,8 @@ module test_fd_observer
    use fd_error, only: fd_error_type => error_type
    use fd_model, only: model_type, device_type, integration_type, law_velocity
    use fd_excitation, only: excitation_type, excitation_none
-   use fd_result, only: result_type, max_violation_times
+   use fd_result, only: result_type, max_violation_times, check_finite
+   use, intrinsic :: ieee_arithmetic, only: ieee_value, ieee_quiet_nan, ieee_positive_inf
    use fd_observer, only: observer_type, observer_init, sample_due, observe_start, observe_peaks, &
                           observe_sample, observe_transitions, observe_violations, observe_end
    implicit none
@@ -25,7 +26,8 @@ contains
                   new_unittest("peaks and their times", test_peaks), &
                   new_unittest("phase transitions", test_transitions), &
                   new_unittest("correctness violations", test_violations), &
-                  new_unittest("energy balance of a free oscillator", test_energy) &
+                  new_unittest("energy balance of a free oscillator", test_energy), &
+                  new_unittest("a non-finite result named", test_non_finite) &
                   ]
    end subroutine collect_observer
 
@@ -176,5 +178,58 @@ contains
       ! no input, no viscous work: the friction work is the only imbalance
       call check(error, res%e_residual, -(res%e_friction + res%e_device), thr=1.0e-15_dp)
    end subroutine test_energy
+
+   !> check_finite: a finite result passes; an overflowed energy, peak, history value or
+   !> engineering output is an error naming its summary key (or column and time), never a
+   !> null in a summary.
+   subroutine test_non_finite(error)
+      type(error_type), allocatable, intent(out) :: error
+      type(model_type) :: model
+      type(result_type) :: res, bad
+      type(observer_type) :: obs
+      type(fd_error_type), allocatable :: err
+
+      call setup(model, res, obs, error)
+      if (allocated(error)) return
+      call check_finite(res, err)
+      call check(error, .not. allocated(err), 'a finite result')
+      if (allocated(error)) return
+      bad = res
+      bad%e_input = ieee_value(1.0_dp, ieee_positive_inf)
+      call check_finite(bad, err)
+      call check(error, allocated(err), 'an infinite energy')
+      if (allocated(error)) return
+      call check(error, index(err%message, 'energy_input_J = Inf') > 0, err%message)
+      if (allocated(error)) return
+      bad = res
+      bad%peak_force(1) = ieee_value(1.0_dp, ieee_quiet_nan)
+      call check_finite(bad, err)
+      call check(error, allocated(err), 'a NaN peak')
+      if (allocated(error)) return
+      call check(error, index(err%message, 'peak_force_N(1) = NaN') > 0, err%message)
+      if (allocated(error)) return
+      bad = res
+      bad%hist(1, 2) = 0.01_dp
+      bad%hist(4, 2) = -ieee_value(1.0_dp, ieee_positive_inf)
+      call check_finite(bad, err)
+      call check(error, allocated(err), 'an infinite history value')
+      if (allocated(error)) return
+      call check(error, index(err%message, 'history column v1 at t = 0.01 s is -Inf') > 0, err%message)
+      if (allocated(error)) return
+      ! the engineering outputs (fd_engineering) too: base shear, residual device displacement
+      bad = res
+      bad%eng%peak_shear(0) = ieee_value(1.0_dp, ieee_positive_inf)
+      call check_finite(bad, err)
+      call check(error, allocated(err), 'an infinite base shear')
+      if (allocated(error)) return
+      call check(error, index(err%message, 'peak_base_shear_N = Inf') > 0, err%message)
+      if (allocated(error)) return
+      bad = res
+      bad%eng%residual_s(1) = ieee_value(1.0_dp, ieee_quiet_nan)
+      call check_finite(bad, err)
+      call check(error, allocated(err), 'a NaN residual displacement')
+      if (allocated(error)) return
+      call check(error, index(err%message, 'residual_s_m(1) = NaN') > 0, err%message)
+   end subroutine test_non_finite
 
 end module test_fd_observer

@@ -1,5 +1,6 @@
 !> Unit tests of the text-file reader (fd_textio): a file of several read buffers (the
-!> buffer grows geometrically), line ends (LF, CRLF, none at the end), a missing file.
+!> buffer grows geometrically), line ends (LF, CRLF, none at the end), a missing file, a
+!> directory, a file with a NUL character.
 module test_fd_textio
    use testdrive, only: new_unittest, unittest_type, error_type, check, test_failed
    use fd_error, only: fd_error_type => error_type, fmt_int
@@ -16,7 +17,10 @@ contains
 
       testsuite = [ &
                   new_unittest("large file, line ends", test_large_file), &
-                  new_unittest("missing file", test_missing) &
+                  new_unittest("missing file", test_missing), &
+                  new_unittest("a directory", test_directory), &
+                  new_unittest("a NUL character", test_nul), &
+                  new_unittest("an empty file", test_empty) &
                   ]
    end subroutine collect_textio
 
@@ -64,5 +68,54 @@ contains
       if (allocated(error)) return
       call check(error, index(err%message, 'no/such/file.txt') > 0, "message names the file: "//err%message)
    end subroutine test_missing
+
+   !> A directory is not read as an empty file: the message says it is a directory.
+   subroutine test_directory(error)
+      type(error_type), allocatable, intent(out) :: error
+      type(line_type), allocatable :: lines(:)
+      type(fd_error_type), allocatable :: err
+
+      call read_text_file('.', lines, err)
+      call check(error, allocated(err), "a directory must be an error")
+      if (allocated(error)) return
+      call check(error, err%message, "'.' is a directory, not a file")
+   end subroutine test_directory
+
+   !> A NUL byte makes the file binary: an error naming the file and the line.
+   subroutine test_nul(error)
+      type(error_type), allocatable, intent(out) :: error
+      character(len=*), parameter :: path = 'test_fd_textio_nul.tmp'
+      type(line_type), allocatable :: lines(:)
+      type(fd_error_type), allocatable :: err
+      integer :: unit
+
+      open (newunit=unit, file=path, access='stream', form='unformatted', status='replace')
+      write (unit) 'line 1'//achar(10)//'line'//achar(0)//'2'//achar(10)
+      close (unit)
+      call read_text_file(path, lines, err)
+      open (newunit=unit, file=path, status='old')
+      close (unit, status='delete')
+      call check(error, allocated(err), "a NUL character must be an error")
+      if (allocated(error)) return
+      call check(error, err%message, "file '"//path//"', line 2: a NUL character (byte 0): not a text file")
+   end subroutine test_nul
+
+   !> An empty file has no lines, and no error.
+   subroutine test_empty(error)
+      type(error_type), allocatable, intent(out) :: error
+      character(len=*), parameter :: path = 'test_fd_textio_empty.tmp'
+      type(line_type), allocatable :: lines(:)
+      type(fd_error_type), allocatable :: err
+      integer :: unit
+
+      open (newunit=unit, file=path, access='stream', form='unformatted', status='replace')
+      close (unit)
+      call read_text_file(path, lines, err)
+      open (newunit=unit, file=path, status='old')
+      close (unit, status='delete')
+      call check(error, .not. allocated(err), "an empty file is read")
+      if (allocated(error)) return
+      call check(error, size(lines), 0)
+   end subroutine test_empty
 
 end module test_fd_textio
