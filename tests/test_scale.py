@@ -408,6 +408,32 @@ def test_run_control_is_the_same_for_the_coulomb_techniques(tmp_path, technique)
     assert not (tmp_path / "out2").exists() or list((tmp_path / "out2").iterdir()) == []
 
 
+@pytest.mark.parametrize("technique", ["newmark", "event_driven", "moreau_jean"])
+def test_storey_columns_are_kept_whatever_the_selection(technique):
+    """The storeys' columns (drift, V per storey, Vb; for the exact technique their maxima
+    between rows, peak_*) are not selected: a history keeping one DOF and no device still has
+    all of them, equal to the full history's, and a storey's drift is the difference of its
+    floors' displacements."""
+    n = 4
+    g = building(n=n, law="hysteretic" if technique == "newmark" else "coulomb", duration=0.5)
+    g["storeys"] = {"n_storeys": n, "spring": list(range(1, n + 1))}
+    if technique != "newmark":
+        g["integration"] = {"technique": technique, "n1": 5}
+    full = run(g)
+    part = run(g, dofs=[2], devices=[])
+    storeys = [f"{q}{s}" for s in range(1, n + 1) for q in ("drift", "V")] + ["Vb"]
+    names = ["t", "ag", "u2", "v2", "aabs2"] + storeys
+    if technique == "event_driven":
+        names += ["peak_u2", "peak_v2", "peak_aabs2"] + ["peak_" + x for x in storeys]
+    assert part.names == names
+    for name in part.names:
+        assert np.array_equal(part[name], full[name]), name
+    assert part.summary == {**full.summary, "run_time_s": part.summary["run_time_s"]}
+    assert np.allclose(full["drift1"], full["u1"], rtol=0, atol=1e-15)
+    assert np.allclose(full["drift3"], full["u3"] - full["u2"], rtol=0, atol=1e-15)
+    assert np.max(np.abs(full["Vb"])) > 0.0
+
+
 # ----------------------------------------------------------------- capacity, modes
 
 

@@ -10,6 +10,8 @@ module fd_output
    use fd_result, only: result_type
    use fd_record, only: record_info
    use fd_version, only: frictiondyn_version
+   use fd_names, only: excitation_types
+   use fd_matrices, only: modes_type, modes_flexible, modes_rigid, modes_unrestrained
    implicit none
    private
 
@@ -428,7 +430,7 @@ contains
                  trim(merge('true ', 'false', record%detected))//', "units": "'//trim(record%units)// &
                  '", "samples": '//trim(fmt_int(record%npts))//', "dt_s": '//trim(json_real(record%dt))// &
                  ', "scale": '//trim(json_real(record%scale))//', "peak_acc_mps2": '// &
-                 trim(json_real(record%peak_acc)))
+                 trim(json_real(record%peak_acc))//', "sha256": "'//trim(record%sha256)//'"')
             if (allocated(record%title)) then
                call json_escape(record%title, esc)
                call put(', "title": "'//esc//'"')
@@ -490,6 +492,7 @@ contains
       call kv('energy_friction_J', trim(json_real(res%e_friction)))
       call kv('energy_device_elastic_J', trim(json_real(res%e_device)))
       call kv('energy_residual_J', trim(json_real(res%e_residual)))
+      call engineering_keys()
       call kv('samples', trim(fmt_int(res%nout)))
       call put('  "run_time_s": '//trim(json_real(res%run_time))//nl//'}')
       js = buf(1:pos)
@@ -517,6 +520,97 @@ contains
          laws(nlaw + 1:nlaw + len(text)) = text
          nlaw = nlaw + len(text)
       end subroutine put_law
+      !> What produced the run, the names, the modes, the storeys (fd_engineering).
+      subroutine engineering_keys()
+         integer :: i
+         real(dp), allocatable :: ratio(:)
+         call kv('deck_sha256', '"'//trim(model%deck_sha256)//'"')
+         associate (eng => res%eng)
+            if (eng%excitation >= 1 .and. eng%excitation <= size(excitation_types)) then
+               call kv('excitation_type', '"'//trim(excitation_types(eng%excitation)%name)//'"')
+            else
+               call kv('excitation_type', '"unknown"')
+            end if
+            call kv('excitation_frequency_Hz', trim(json_real(eng%frequency)))
+            call kv('duration_s', trim(json_real(eng%duration)))
+            call ks('dof_labels', eng%dof_label)
+            call ks('device_labels', eng%device_label)
+            call kv('damping_a0_per_s', trim(json_real(eng%a0)))
+            call kv('damping_a1_s', trim(json_real(eng%a1)))
+            call modes_keys('stuck', eng%stuck)
+            call modes_keys('free', eng%free)
+            call kr('residual_s_m', eng%residual_s)
+            call kv('peak_base_shear_N', trim(json_real(eng%peak_shear(0))))
+            call kv('peak_base_shear_time_s', trim(json_real(eng%peak_shear_time(0))))
+            call kv('residual_base_shear_N', trim(json_real(eng%shear(0))))
+            call kv('n_storeys', trim(fmt_int(eng%n_storeys)))
+            call ks('storey_labels', eng%storey_label)
+            call put('  "storey_nodes": [')
+            do i = 1, eng%n_storeys
+               call put('['//trim(fmt_int(eng%storey_i(i)))//', '//trim(fmt_int(eng%storey_j(i)))//']')
+               if (i < eng%n_storeys) call put(', ')
+            end do
+            call put('],'//nl)
+            call kr('storey_height_m', eng%height)
+            call kr('peak_drift_m', eng%peak_drift)
+            call kr('peak_drift_time_s', eng%peak_drift_time)
+            call kr('residual_drift_m', eng%drift)
+            allocate (ratio(eng%n_storeys))
+            ratio = 0.0_dp
+            where (eng%height > 0.0_dp) ratio = eng%peak_drift/eng%height
+            call kr('peak_drift_ratio', ratio)
+            where (eng%height > 0.0_dp) ratio = eng%drift/eng%height
+            call kr('residual_drift_ratio', ratio)
+            call kr('peak_storey_shear_N', eng%peak_shear(1:))
+            call kr('peak_storey_shear_time_s', eng%peak_shear_time(1:))
+            call kr('residual_storey_shear_N', eng%shear(1:))
+         end associate
+      end subroutine engineering_keys
+      !> The modes of one system: status, periods (0: a rigid-body mode), shapes, mass ratios, damping.
+      subroutine modes_keys(name, m)
+         character(len=*), intent(in) :: name
+         type(modes_type), intent(in) :: m
+         integer :: j
+         select case (m%status)
+         case (modes_flexible)
+            call kv('modes_'//name//'_status', '"flexible"')
+         case (modes_rigid)
+            call kv('modes_'//name//'_status', '"rigid"')
+         case (modes_unrestrained)
+            call kv('modes_'//name//'_status', '"unrestrained"')
+         case default
+            call kv('modes_'//name//'_status', '"not computed"')
+            call kr('periods_'//name//'_s', [real(dp) ::])
+            call put('  "mode_shapes_'//name//'": [],'//nl)
+            call kr('modal_mass_ratio_'//name, [real(dp) ::])
+            call kr('modal_xi_'//name, [real(dp) ::])
+            return
+         end select
+         ! a rigid-body mode (w = 0): period and damping ratio 0 (its period is infinite)
+         call kr('periods_'//name//'_s', merge(m%period, 0.0_dp, m%omega2 > 0.0_dp))
+         call put('  "mode_shapes_'//name//'": [')
+         do j = 1, m%n
+            call put_reals(m%shape(:, j))
+            if (j < m%n) call put(', ')
+         end do
+         call put('],'//nl)
+         call kr('modal_mass_ratio_'//name, m%mass_ratio)
+         call kr('modal_xi_'//name, merge(m%xi, 0.0_dp, m%omega2 > 0.0_dp))
+      end subroutine modes_keys
+      !> Strings.
+      subroutine ks(key, x)
+         character(len=*), intent(in) :: key
+         character(len=*), intent(in) :: x(:)
+         integer :: k
+         character(len=:), allocatable :: e
+         call put('  "'//key//'": [')
+         do k = 1, size(x)
+            call json_escape(trim(x(k)), e)
+            call put('"'//e//'"')
+            if (k < size(x)) call put(', ')
+         end do
+         call put('],'//nl)
+      end subroutine ks
       subroutine kv(key, val)
          character(len=*), intent(in) :: key, val
          call put('  "'//key//'": '//val//','//nl)
@@ -524,14 +618,21 @@ contains
       subroutine kr(key, x)
          character(len=*), intent(in) :: key
          real(dp), intent(in) :: x(:)
+         call put('  "'//key//'": ')
+         call put_reals(x)
+         call put(','//nl)
+      end subroutine kr
+      !> '[x1, x2, ...]' appended number by number (put: linear in the length).
+      subroutine put_reals(x)
+         real(dp), intent(in) :: x(:)
          integer :: k
-         call put('  "'//key//'": [')
+         call put('[')
          do k = 1, size(x)
             call put(trim(json_real(x(k))))
             if (k < size(x)) call put(', ')
          end do
-         call put('],'//nl)
-      end subroutine kr
+         call put(']')
+      end subroutine put_reals
       subroutine ki(key, x)
          character(len=*), intent(in) :: key
          integer, intent(in) :: x(:)

@@ -22,6 +22,7 @@ module fd_observer
    use fd_run_control, only: run_control, cancel_requested, stat_cancelled
    use fd_history_stream, only: stream_open, stream_row, stream_failed, stream_close
    use fd_output, only: history_header
+   use fd_engineering, only: engineering_init, observe_engineering, storey_values, observe_storey_peak
    implicit none
    private
 
@@ -29,13 +30,15 @@ module fd_observer
    public :: observe_transitions, observe_violations, observe_end, strain_energy
    public :: observe_start_energies, observe_end_energies, observe_poll, observe_stop_error
    public :: observe_peak_value, observe_event, observe_accumulation
-   public :: peak_of_u, peak_of_v, peak_of_aabs, peak_of_s, peak_of_force
+   public :: peak_of_u, peak_of_v, peak_of_aabs, peak_of_s, peak_of_force, peak_of_storey
+   public :: observe_storeys
 
    integer, parameter :: peak_of_u = 1      !! |u| of a DOF
    integer, parameter :: peak_of_v = 2      !! |v| of a DOF
    integer, parameter :: peak_of_aabs = 3   !! |absolute acceleration| of a DOF
    integer, parameter :: peak_of_s = 4      !! |s| of a device
    integer, parameter :: peak_of_force = 5  !! |F| of a device
+   integer, parameter :: peak_of_storey = 6 !! |drift|, |V| of a storey, |Vb|: the history's order
 
    !> Wall-clock time aimed at between two polls that look at the clock [s].
    real(dp), parameter :: poll_target = 0.01_dp
@@ -95,6 +98,9 @@ contains
       call init_result(model, exc, opts, res, obs%nsteps, obs%every, error, obs%dofs, obs%devices, obs%to_result)
       if (allocated(error)) return
       res%technique = opts%technique
+      ! names, modes and storeys (res%period_stuck: set by the technique before)
+      call engineering_init(model, exc, opts, res%period_stuck, res%eng, error)
+      if (allocated(error)) return
       allocate (obs%row(res%ncol))
       obs%row = 0.0_dp
       if (.not. associated(obs%ctl)) return
@@ -191,14 +197,15 @@ contains
          res%peak_s(i) = max(res%peak_s(i), abs(s(i)))
          res%peak_force(i) = max(res%peak_force(i), abs(force(i)))
       end do
+      call observe_engineering(res%eng, t, u, v, s, force)
    end subroutine observe_peaks
 
    !> One value into a peak of the summary (a technique that knows its solution between
    !> steps passes the exact extrema, with their times): quantity peak_of_*, DOF or device i.
    pure subroutine observe_peak_value(res, quantity, i, value, t)
       type(result_type), intent(inout) :: res  !! the result
-      integer, intent(in) :: quantity          !! peak_of_u, _v, _aabs, _s, _force
-      integer, intent(in) :: i                 !! DOF or device
+      integer, intent(in) :: quantity          !! peak_of_u, _v, _aabs, _s, _force, _storey
+      integer, intent(in) :: i                 !! DOF, device, or storey quantity (drift1, V1, ..., Vb)
       real(dp), intent(in) :: value            !! |value|
       real(dp), intent(in) :: t                !! its time [s]
 
@@ -217,8 +224,21 @@ contains
          res%peak_s(i) = max(res%peak_s(i), value)
       case (peak_of_force)
          res%peak_force(i) = max(res%peak_force(i), value)
+      case (peak_of_storey)
+         call observe_storey_peak(res%eng, i, value, t)
       end select
    end subroutine observe_peak_value
+
+   !> The storeys at a state the technique reports besides observe_peaks (a row of the exact
+   !> technique): drifts, shears, their peaks, and the values kept as the residual ones.
+   pure subroutine observe_storeys(res, t, u, v, s, force)
+      type(result_type), intent(inout) :: res  !! the result
+      real(dp), intent(in) :: t                !! time [s]
+      real(dp), intent(in) :: u(:), v(:)       !! relative displacements [m], velocities [m/s]
+      real(dp), intent(in) :: s(:), force(:)   !! device relative displacements [m], forces [N]
+
+      call observe_engineering(res%eng, t, u, v, s, force)
+   end subroutine observe_storeys
 
    !> An event at time t (phases changed): its time is kept (the first max_event_times).
    pure subroutine observe_event(res, t)
@@ -260,7 +280,8 @@ contains
       real(dp), intent(in) :: force(:)         !! device forces [N]
       integer, intent(in) :: phase(:)          !! device phases (0 stick, +-1 slip)
       real(dp), intent(in), optional :: env(:) !! maxima since the previous row: (|u|, |v|, |aabs|)
-                                               !! per DOF, then (|s|, |F|) per device (all of them)
+                                               !! per DOF, (|s|, |F|) per device (all of them), then
+                                               !! (|drift|, |V|) per storey and |Vb| when storeys
       integer :: i, j, c, nq
 
       obs%rows = obs%rows + 1
@@ -290,6 +311,13 @@ contains
                c = c + 4
             end do
          end if
+         ! storeys (always, whatever the selection): (drift, V) each, then the base shear
+         if (res%eng%n_storeys > 0) then
+            i = res%eng%n_storeys
+            call storey_values(res%eng, u, v, force, row(c + 1:c + 2*i - 1:2), row(c + 2:c + 2*i:2), &
+                               row(c + 2*i + 1))
+            c = c + 2*i + 1
+         end if
          if (present(env) .and. res%env_col > 0) then
             nq = 3*size(u)
             if (obs%all_columns) then
@@ -305,6 +333,9 @@ contains
                   row(c + 1:c + 2) = env(nq + 2*i - 1:nq + 2*i)
                   c = c + 2
                end do
+               ! the storeys' maxima, after the devices'
+               nq = nq + 2*size(s)
+               row(c + 1:c + size(env) - nq) = env(nq + 1:)
             end if
          end if
          if (obs%to_result) then

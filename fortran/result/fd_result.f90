@@ -6,6 +6,8 @@ module fd_result
    use fd_error, only: error_type, fatal_error, fmt_int, fmt_real, stat_no_memory
    use fd_model, only: model_type, integration_type, technique_event_driven
    use fd_excitation, only: excitation_type
+   use fd_engineering, only: engineering_type, engineering_columns
+   use fd_matrices, only: modes_type
    implicit none
    private
 
@@ -80,13 +82,15 @@ module fd_result
       real(dp) :: e_device = 0.0_dp    !! elastic energy stored in sticking devices at the end
       real(dp) :: e_residual = 0.0_dp  !! input - (kinetic + strain + viscous + friction + device)
       real(dp) :: run_time = 0.0_dp    !! wall-clock time of the integration [s]
+      ! names, modes, storey drifts and shears, residual values (fd_engineering)
+      type(engineering_type) :: eng    !! the engineering outputs
    end type result_type
 
 contains
 
    !> Whether a run of these settings writes, after the state columns, the maxima of |u|,
-   !> |v|, |aabs| per DOF and |s|, |F| per device since the previous row (the exact
-   !> technique, whose solution between rows is known).
+   !> |v|, |aabs| per DOF, |s|, |F| per device and |drift|, |V| per storey and |Vb| since the
+   !> previous row (the exact technique, whose solution between rows is known).
    pure logical function has_envelope(opts)
       type(integration_type), intent(in) :: opts    !! integration settings
 
@@ -94,9 +98,11 @@ contains
    end function has_envelope
 
    !> Size of the history a run writes: columns t, ag, (u, v, aabs) per DOF and
-   !> (s, sdot, F, phase) per device, then (exact technique) the maxima since the previous
-   !> row (peak_u, peak_v, peak_aabs) per DOF and (peak_s, peak_F) per device, all of the
-   !> DOFs and devices kept when given; samples at t = 0, every `every` dt1 steps and at the end.
+   !> (s, sdot, F, phase) per device, then (drift, V) per storey and Vb when the model names
+   !> storeys, then (exact technique) the maxima since the previous row: (peak_u, peak_v,
+   !> peak_aabs) per DOF, (peak_s, peak_F) per device and (peak_drift, peak_V) per storey and
+   !> peak_Vb; of the DOFs and devices only those kept when given (the storey columns always);
+   !> samples at t = 0, every `every` dt1 steps and at the end.
    pure subroutine history_shape(model, exc, opts, ncol, nout, nsteps, every, n_dof_kept, n_devices_kept)
       type(model_type), intent(in) :: model         !! the model
       type(excitation_type), intent(in) :: exc      !! the table motion
@@ -113,8 +119,8 @@ contains
       ndk = model%n_devices
       if (present(n_dof_kept)) nk = n_dof_kept
       if (present(n_devices_kept)) ndk = n_devices_kept
-      ncol = 2 + 3*nk + 4*ndk
-      if (has_envelope(opts)) ncol = ncol + 3*nk + 2*ndk
+      ncol = 2 + 3*nk + 4*ndk + engineering_columns(model)
+      if (has_envelope(opts)) ncol = ncol + 3*nk + 2*ndk + engineering_columns(model)
       nsteps = max(1, nint(exc%duration/(exc%dt_record/opts%n1)))
       every = opts%output_every
       if (every <= 0) every = opts%n1
@@ -182,6 +188,15 @@ contains
          res%names(c + 4) = 'phase'//trim(fmt_int(kv(i))); res%units(c + 4) = '-'
          c = c + 4
       end do
+      if (engineering_columns(model) > 0) then
+         do i = 1, model%n_storeys
+            res%names(c + 1) = 'drift'//trim(fmt_int(i)); res%units(c + 1) = 'm'
+            res%names(c + 2) = 'V'//trim(fmt_int(i)); res%units(c + 2) = 'N'
+            c = c + 2
+         end do
+         res%names(c + 1) = 'Vb'; res%units(c + 1) = 'N'
+         c = c + 1
+      end if
       if (has_envelope(opts)) then
          res%env_col = c + 1
          res%exact_peaks = .true.
@@ -196,6 +211,15 @@ contains
             res%names(c + 2) = 'peak_F'//trim(fmt_int(kv(i))); res%units(c + 2) = 'N'
             c = c + 2
          end do
+         if (engineering_columns(model) > 0) then
+            do i = 1, model%n_storeys
+               res%names(c + 1) = 'peak_drift'//trim(fmt_int(i)); res%units(c + 1) = 'm'
+               res%names(c + 2) = 'peak_V'//trim(fmt_int(i)); res%units(c + 2) = 'N'
+               c = c + 2
+            end do
+            res%names(c + 1) = 'peak_Vb'; res%units(c + 1) = 'N'
+            c = c + 1
+         end if
       end if
       allocate (res%peak_u(n), res%peak_u_time(n), res%peak_v(n), res%peak_aabs(n), &
                 res%peak_aabs_time(n), res%peak_s(nd), res%peak_force(nd), res%stick_to_slip(nd), &
@@ -233,6 +257,7 @@ contains
       if (allocated(res%peak_aabs)) call vector('peak_aabs_mps2', res%peak_aabs)
       if (allocated(res%peak_s)) call vector('peak_s_m', res%peak_s)
       if (allocated(res%peak_force)) call vector('peak_force_N', res%peak_force)
+      call engineering()
       if (allocated(error) .or. .not. allocated(res%hist)) return
       do j = 1, min(res%nout, size(res%hist, 2))
          do i = 1, size(res%hist, 1)
@@ -242,6 +267,41 @@ contains
          end do
       end do
    contains
+      !> The engineering outputs (fd_engineering): damping, modes (a rigid-body mode's
+      !> infinite period and undefined damping ratio are written as 0), storeys, residuals.
+      subroutine engineering()
+         if (allocated(error)) return
+         call scalar('damping_a0_per_s', res%eng%a0)
+         call scalar('damping_a1_s', res%eng%a1)
+         call modes('stuck', res%eng%stuck)
+         call modes('free', res%eng%free)
+         if (allocated(res%eng%residual_s)) call vector('residual_s_m', res%eng%residual_s)
+         if (allocated(res%eng%peak_drift)) call vector('peak_drift_m', res%eng%peak_drift)
+         if (allocated(res%eng%drift)) call vector('residual_drift_m', res%eng%drift)
+         if (allocated(res%eng%peak_shear)) then
+            call scalar('peak_base_shear_N', res%eng%peak_shear(0))
+            call vector('peak_storey_shear_N', res%eng%peak_shear(1:))
+         end if
+         if (allocated(res%eng%shear)) then
+            call scalar('residual_base_shear_N', res%eng%shear(0))
+            call vector('residual_storey_shear_N', res%eng%shear(1:))
+         end if
+      end subroutine engineering
+      subroutine modes(name, m)
+         character(len=*), intent(in) :: name
+         type(modes_type), intent(in) :: m
+         integer :: k
+         if (m%n == 0 .or. allocated(error)) return
+         do k = 1, m%n
+            if (m%omega2(k) == 0.0_dp) cycle
+            call scalar('periods_'//name//'_s('//trim(fmt_int(k))//')', m%period(k))
+            call scalar('modal_xi_'//name//'('//trim(fmt_int(k))//')', m%xi(k))
+         end do
+         call vector('modal_mass_ratio_'//name, m%mass_ratio)
+         do k = 1, m%n
+            call vector('mode_shapes_'//name//'('//trim(fmt_int(k))//')', m%shape(:, k))
+         end do
+      end subroutine modes
       subroutine scalar(key, x)
          character(len=*), intent(in) :: key
          real(dp), intent(in) :: x

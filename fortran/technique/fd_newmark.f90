@@ -499,7 +499,7 @@ contains
       logical, intent(in) :: any_changed         !! a device changed phase
       logical, intent(in) :: any_bad             !! a device violates the correctness condition
       real(dp) :: ein
-      logical :: changed_k
+      logical :: changed_k, any_force
 
       ! energy of the step, forces at both ends in the step's phases; the state moves on
       call step_energy(w%n, w%mass, w%u, w%v, w%a, w%u1, w%v1, w%a1, w%tmp, w%rhs, ein)
@@ -513,11 +513,14 @@ contains
          w%phase1 = w%st1%phase
          call observe_transitions(res, w%phase0, w%phase1)
       end if
+      ! a phase change, or a sliding force that follows the velocity (mu(v)): the next
+      ! step starts in equilibrium with the new forces
+      any_force = any(w%st1%f0 /= w%st%f0)
       ! device work over the step; the devices move on; the factors follow their stiffness
       ! and damping (whatever changed them)
       call device_step(w%nd, w%st, w%st1, w%s, w%sd, w%s1, w%sd1, w%f, w%w_device, changed_k)
       if (changed_k) w%version = w%version + 1
-      if (any_changed) call consistent_acceleration(model, exc, t1, w)
+      if (any_changed .or. any_force) call consistent_acceleration(model, exc, t1, w)
       call observe_peaks(res, t1, w%u, w%v, w%a, w%ag, w%s, w%f)
    end subroutine accept
 

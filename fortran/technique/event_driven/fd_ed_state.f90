@@ -25,6 +25,8 @@ module fd_ed_state
    !> State of the exact technique.
    type :: ed_state
       integer :: n = 0, nd = 0, nquant = 0                !! DOFs, devices, output quantities
+      integer :: nbase = 0                                 !! quantities of the state (3 n + 2 nd); the
+                                                           !! others (storeys) are the caller's
       real(dp), allocatable :: mass(:), k(:, :), c(:, :)   !! structure
       real(dp), allocatable :: slip(:)                     !! P mu
       logical, allocatable :: active(:)                    !! P mu > 0
@@ -92,9 +94,11 @@ contains
 
    !> Allocate the state of a model: matrices, work arrays, the pattern cache and the
    !> complementarity solver's workspace.
-   subroutine ed_setup(model, st, error)
+   subroutine ed_setup(model, st, extra, error)
       type(model_type), intent(in) :: model         !! the model
       type(ed_state), intent(inout) :: st           !! the state
+      integer, intent(in) :: extra                  !! output quantities the caller appends
+                                                    !! (linear combinations it fills in yc)
       type(error_type), allocatable, intent(out) :: error !! not enough memory
       integer :: n, nd, d, stat, nqt
 
@@ -102,7 +106,8 @@ contains
       nd = model%n_devices
       st%n = n
       st%nd = nd
-      nqt = nq_of(n, nd)
+      st%nbase = nq_of(n, nd)
+      nqt = st%nbase + extra
       st%nquant = nqt
       allocate (st%mass(n), st%k(n, n), st%c(n, n), st%slip(nd), st%active(nd), st%u(n), st%v(n), st%phase(nd), &
                 st%q(n), st%p(n), st%uc(n), st%b1(n), st%f0(max(nd, 1)), &

@@ -14,6 +14,8 @@
 !> - the history is sampled at its rows' times, and the exact extrema of every output
 !>   quantity (the zeros of its derivative) give the peaks of the summary and the maxima
 !>   between the rows (the `peak_*` columns), one-sided values at the events included;
+!>   the storeys' drifts and shears are linear combinations of u, v and F, so polynomials
+!>   too: their peaks are exact in the same way;
 !> - input and viscous work are integrated exactly (products of polynomials), friction
 !>   work is P mu |Delta s| over each slide.
 !>
@@ -38,9 +40,10 @@ module fd_event_driven
    use fd_result, only: result_type
    use fd_observer, only: observer_type, observer_init, observe_start, observe_sample, observe_transitions, &
                           observe_end, observe_peak_value, observe_event, observe_accumulation, &
-                          peak_of_u, peak_of_v, peak_of_aabs, peak_of_s, peak_of_force, observe_poll, &
-                          observe_stop_error
+                          peak_of_u, peak_of_v, peak_of_aabs, peak_of_s, peak_of_force, peak_of_storey, &
+                          observe_poll, observe_stop_error, observe_storeys
    use fd_run_control, only: run_control, stat_cancelled
+   use fd_engineering, only: storey_values, engineering_columns
    use fd_taylor, only: poly_value, poly_value_deriv, poly_abs_bound, first_crossing, stationary_points
    use fd_phase_pattern, only: kmax, cache_find, pattern_entry
    use fd_ed_state, only: ed_state, ed_setup, ed_polynomials, iq_u, iq_v, iq_a, iq_s, iq_f
@@ -66,6 +69,7 @@ module fd_event_driven
       integer, allocatable :: nrt(:), ip(:)               !! their number, the next one
       real(dp), allocatable :: uu(:), vv(:), aa(:)        !! a sample's u, v, relative acceleration
       real(dp), allocatable :: ss(:), sd(:), ff(:)        !! a sample's s, s', F
+      real(dp), allocatable :: cu(:), cv(:), cf(:)        !! one order's coefficients of u, v, F
       real(dp), allocatable :: mp(:)                      !! mq' p coefficients (0:kmax)
       real(dp), allocatable :: ein(:), evi(:)             !! power coefficients (0:2 kmax)
       real(dp) :: w_fric = 0.0_dp                         !! friction work [J]
@@ -123,13 +127,15 @@ contains
       call system_clock(c0, crate)
       call event_driven_check(model, exc, error)
       if (allocated(error)) return
-      call ed_setup(model, w%st, error)
+      ! the storeys' drifts and shears are output quantities after those of the state
+      call ed_setup(model, w%st, engineering_columns(model), error)
       if (allocated(error)) return
       n = model%n_dof
       nd = model%n_devices
       nqt = w%st%nquant
       allocate (w%env(nqt), w%yv(nqt), w%rts(kmax, nqt), w%nrt(nqt), w%ip(nqt), w%uu(n), w%vv(n), w%aa(n), &
-                w%ss(nd), w%sd(nd), w%ff(nd), w%mp(0:kmax), w%ein(0:2*kmax), w%evi(0:2*kmax), stat=stat)
+                w%ss(nd), w%sd(nd), w%ff(nd), w%mp(0:kmax), w%ein(0:2*kmax), w%evi(0:2*kmax), w%cu(n), w%cv(n), &
+                w%cf(nd), stat=stat)
       if (stat /= 0) then
          call fatal_error(error, "not enough memory for the exact technique's work arrays of "// &
                           trim(fmt_int(nqt))//" output quantities")
@@ -168,6 +174,7 @@ contains
          call observe_start(w%obs, st%mass, st%k, st%u, st%v, 0.0_dp, st%fn)
          ! the first row: the state at t = 0
          call ed_polynomials(model, exc, t, 0.0_dp, st)
+         call storey_polynomials()
          call values_at(0.0_dp, w%yv)
          w%env = abs(w%yv)
          call write_row(t, 0.0_dp)
@@ -226,6 +233,7 @@ contains
                   if (st%rem <= 2.0_dp**(-50)*st%size) exit
                   span = 0.5_dp*span
                end do
+               call storey_polynomials()
                kk = st%order
                smin = 8.0_dp*epsilon(1.0_dp)*(abs(t) + span)
                tol = 2.0_dp*epsilon(1.0_dp)*(abs(t) + span)
@@ -306,6 +314,25 @@ contains
          end associate
       end subroutine move_to
 
+      !> The polynomials of the storeys' drifts and shears (drift1, V1, ..., Vb after the
+      !> state's quantities), order by order from those of u, v and F: they are linear in them.
+      subroutine storey_polynomials()
+         integer :: m, nb, ns, n1
+         associate (st => w%st)
+            nb = st%nbase
+            ns = res%eng%n_storeys
+            if (st%nquant == nb .or. ns == 0) return
+            n1 = 3*st%n
+            do m = 0, st%order
+               w%cu = st%yc(m, 1:n1:3)
+               w%cv = st%yc(m, 2:n1:3)
+               w%cf = st%yc(m, n1 + 2:n1 + 2*st%nd:2)
+               call storey_values(res%eng, w%cu, w%cv, w%cf, st%yc(m, nb + 1:nb + 2*ns - 1:2), &
+                                  st%yc(m, nb + 2:nb + 2*ns:2), st%yc(m, nb + 2*ns + 1))
+            end do
+         end associate
+      end subroutine storey_polynomials
+
       !> Values of every quantity at s on the current sub-interval.
       subroutine values_at(s, y)
          real(dp), intent(in) :: s
@@ -336,6 +363,8 @@ contains
                w%ff(dd) = w%yv(iq_f(st%n, dd))
             end do
             call observe_sample(w%obs, res, tr, ag, w%uu, w%vv, w%aa, w%ss, w%sd, w%ff, st%phase, w%env)
+            ! the storeys at the row: the values kept as residual ones at the last
+            call observe_storeys(res, tr, w%uu, w%vv, w%ss, w%ff)
          end associate
       end subroutine write_row
 
@@ -352,6 +381,9 @@ contains
          do dd = 1, w%st%nd
             call observe_peak_value(res, peak_of_s, dd, abs(w%yv(iq_s(w%st%n, dd))), tp)
             call observe_peak_value(res, peak_of_force, dd, abs(w%yv(iq_f(w%st%n, dd))), tp)
+         end do
+         do i = w%st%nbase + 1, w%st%nquant
+            call observe_peak_value(res, peak_of_storey, i - w%st%nbase, abs(w%yv(i)), tp)
          end do
       end subroutine update_global
 
@@ -441,7 +473,9 @@ contains
          integer, intent(in) :: iq
          real(dp), intent(in) :: y, tp
          integer :: i, dd
-         if (iq <= 3*w%st%n) then
+         if (iq > w%st%nbase) then
+            call observe_peak_value(res, peak_of_storey, iq - w%st%nbase, y, tp)
+         else if (iq <= 3*w%st%n) then
             i = (iq + 2)/3
             select case (iq - 3*(i - 1))
             case (1)
