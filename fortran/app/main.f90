@@ -125,6 +125,11 @@ program frictiondyn_main
    call output_paths(cfg%out, hist, summ)
    if (cfg%out%history) write (output_unit, '(a)') '  history: '//hist
    write (output_unit, '(a)') '  summary: '//summ
+   ! a main program's variables are not deallocated when it ends: free them, so that the
+   ! leak checker of the checked build (tools/test_checked.sh) finds nothing
+   deallocate (deck, arg, hist, summ, htmp, stmp, tag)
+   if (allocated(list)) deallocate (list)
+   if (allocated(index_text)) deallocate (index_text)
 
 contains
 
