@@ -254,6 +254,8 @@ contains
       if (.not. found) then
          call missing_group(deck, 'damping', error); return
       end if
+      call check_length(deck, grp, 'damping_type', name_len, error)
+      if (allocated(error)) return
       msg0 = ''
       read (grp%lines, nml=damping, iostat=ios, iomsg=msg0)
       if (ios /= 0) then
@@ -265,8 +267,6 @@ contains
          if (ios == 0) msg = msg0
          call group_read_error(deck, grp, i, msg, error); return
       end if
-      call check_length(deck, grp, 'damping_type', name_len, error)
-      if (allocated(error)) return
       cfg%model%damping = keyword_id(damping_types, damping_type)
       select case (cfg%model%damping)
       case (damping_stiffness)
@@ -317,6 +317,8 @@ contains
       cfg%model%n_devices = 0
       allocate (cfg%model%dev(0))
       if (.not. found) return
+      call check_length(deck, grp, 'law', name_len, error)
+      if (allocated(error)) return
       msg0 = ''
       read (grp%lines, nml=friction, iostat=ios, iomsg=msg0)
       if (ios /= 0) then
@@ -328,8 +330,6 @@ contains
          if (ios == 0) msg = msg0
          call group_read_error(deck, grp, i, msg, error); return
       end if
-      call check_length(deck, grp, 'law', name_len, error)
-      if (allocated(error)) return
       call need_int(deck, 'friction', 'n_devices', n_devices, 0, max_devices, error)
       if (allocated(error)) return
       n = n_devices
@@ -417,6 +417,12 @@ contains
       if (.not. found) then
          call missing_group(deck, 'excitation', error); return
       end if
+      call check_length(deck, grp, 'excitation_type', name_len, error)
+      if (.not. allocated(error)) call check_length(deck, grp, 'record_kind', name_len, error)
+      if (.not. allocated(error)) call check_length(deck, grp, 'record_format', name_len, error)
+      if (.not. allocated(error)) call check_length(deck, grp, 'record_units', name_len, error)
+      if (.not. allocated(error)) call check_length(deck, grp, 'record_file', path_len, error)
+      if (allocated(error)) return
       msg0 = ''
       read (grp%lines, nml=excitation, iostat=ios, iomsg=msg0)
       if (ios /= 0) then
@@ -428,12 +434,6 @@ contains
          if (ios == 0) msg = msg0
          call group_read_error(deck, grp, i, msg, error); return
       end if
-      call check_length(deck, grp, 'excitation_type', name_len, error)
-      if (.not. allocated(error)) call check_length(deck, grp, 'record_kind', name_len, error)
-      if (.not. allocated(error)) call check_length(deck, grp, 'record_format', name_len, error)
-      if (.not. allocated(error)) call check_length(deck, grp, 'record_units', name_len, error)
-      if (.not. allocated(error)) call check_length(deck, grp, 'record_file', path_len, error)
-      if (allocated(error)) return
       ! a record whose file gives DT (AT2) may leave dt_record out
       if (.not. (keyword_id(excitation_types, excitation_type) == excitation_record .and. dt_record == unset)) then
          call need_real(deck, 'excitation', 'dt_record', dt_record, 's', error)
@@ -542,6 +542,8 @@ contains
       call find_group(deck, 'integration', grp, found, error)
       if (allocated(error)) return
       if (found) then
+         call check_length(deck, grp, 'technique', name_len, error)
+         if (allocated(error)) return
          msg0 = ''
          read (grp%lines, nml=integration, iostat=ios, iomsg=msg0)
          if (ios /= 0) then
@@ -554,8 +556,6 @@ contains
             call group_read_error(deck, grp, i, msg, error); return
          end if
       end if
-      call check_length(deck, grp, 'technique', name_len, error)
-      if (allocated(error)) return
       technique_id = keyword_id(techniques, technique)
       if (technique_id == 0) then
          call keyword_choices(techniques, choices)
@@ -620,6 +620,9 @@ contains
       call find_group(deck, 'output', grp, found, error)
       if (allocated(error)) return
       if (found) then
+         call check_length(deck, grp, 'dir', path_len, error)
+         if (.not. allocated(error)) call check_length(deck, grp, 'name', path_len, error)
+         if (allocated(error)) return
          msg0 = ''
          read (grp%lines, nml=output, iostat=ios, iomsg=msg0)
          if (ios /= 0) then
@@ -632,9 +635,6 @@ contains
             call group_read_error(deck, grp, i, msg, error); return
          end if
       end if
-      call check_length(deck, grp, 'dir', path_len, error)
-      if (.not. allocated(error)) call check_length(deck, grp, 'name', path_len, error)
-      if (allocated(error)) return
       if (len_trim(dir) == 0) then
          call bad(deck, 'output', 'dir', "''", 'a directory path', error); return
       end if
@@ -666,8 +666,8 @@ contains
       call fatal_error(error, deck%path//", group &"//group//": "//var//" = "//val//" is invalid: must be "//must)
    end subroutine bad
 
-   !> A string longer than its variable's capacity is an error (the namelist reader would cut
-   !> it), found in the group's text.
+   !> A string longer than its variable's capacity is an error, found in the group's text
+   !> before the namelist read (which would cut it, and warn under -fcheck).
    subroutine check_length(deck, grp, var, cap, error)
       type(deck_text), intent(in) :: deck
       type(group_text), intent(in) :: grp
