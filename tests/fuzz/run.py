@@ -167,7 +167,8 @@ def run_exe(exe: str, case: mutate.Case, where: Path, timeout: float, mem: int):
 
     try:
         p = subprocess.run([exe, case.deck_name], cwd=where, capture_output=True, timeout=timeout,
-                           preexec_fn=None if CHECKED else limit, env=memory_bound(mem))
+                           preexec_fn=None if CHECKED else limit, env=memory_bound(mem),
+                           check=False)
     except subprocess.TimeoutExpired:
         return None
     return p
@@ -194,7 +195,7 @@ def requested_steps(deck: Path) -> float | None:
               "    print(s.shape[0] - 1)\n")
     try:
         p = subprocess.run([sys.executable, "-c", script, str(deck)], capture_output=True,
-                           timeout=60, text=True)
+                           timeout=60, text=True, check=False)
     except subprocess.TimeoutExpired:
         return None
     if p.returncode != 0:
