@@ -24,6 +24,7 @@ contains
    !> Run the analysis a configuration defines (no files written) with the technique of
    !> its &integration: 'newmark' (the velocity and hysteretic laws) or 'event_driven'
    !> (exact Coulomb friction); an error for anything that technique cannot integrate.
+   !> A solver's error names the deck.
    subroutine run_config_solve(cfg, res, error)
       type(run_config), intent(in) :: cfg                 !! model, excitation, settings
       type(result_type), intent(out) :: res               !! histories and summary

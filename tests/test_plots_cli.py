@@ -45,7 +45,8 @@ def test_plot_acceleration_overlays_one_line_per_result(short_runs, tmp_path):
     fig = plots.plot_acceleration(runs, 2, path, t_range=(2.0, 3.0))
     assert is_png(path)
     ax = fig.axes[0]
-    assert ax.get_xlabel() == "t [s]" and ax.get_ylabel() == "aabs2 [m/s²]"
+    assert ax.get_xlabel() == "time [s]" and ax.get_ylabel() == "absolute acceleration [m/s²]"
+    assert ax.get_title() == "DOF 2: absolute acceleration"
     lines = ax.get_lines()
     assert len(lines) == 2
     assert [t.get_text() for t in ax.get_legend().get_texts()] == [
@@ -64,7 +65,7 @@ def test_plot_relative_velocity_with_band(short_runs, tmp_path):
     fig = plots.plot_relative_velocity(r, 1, tmp_path / "v.png", band=1e-3, labels=["hysteretic"])
     assert is_png(tmp_path / "v.png")
     ax = fig.axes[0]
-    assert ax.get_xlabel() == "t [s]" and ax.get_ylabel() == "sdot1 [m/s]"
+    assert ax.get_xlabel() == "time [s]" and ax.get_ylabel() == "relative velocity [m/s]"
     lines = ax.get_lines()
     assert len(lines) == 3  # s' and the +-eps1 band
     assert lines[1].get_ydata()[0] == 1e-3 and lines[2].get_ydata()[0] == -1e-3
@@ -76,7 +77,8 @@ def test_plot_hysteresis_loops_are_bounded_by_p_mu(short_runs, tmp_path):
     fig = plots.plot_hysteresis(runs, 1, tmp_path / "h.png", labels=["hys", "vel"])
     assert is_png(tmp_path / "h.png")
     ax = fig.axes[0]
-    assert ax.get_xlabel() == "s1 [m]" and ax.get_ylabel() == "F1 [N]"
+    assert ax.get_xlabel() == "relative displacement [m]"
+    assert ax.get_ylabel() == "friction force [N]"
     lines = ax.get_lines()
     assert len(lines) == 2
     for ln in lines:  # the loops reach, and never exceed, the slip force P mu
@@ -87,7 +89,7 @@ def test_plot_phase_steps_between_stick_and_slip(short_runs, tmp_path):
     fig = plots.plot_phase(list(short_runs.values()), 1, tmp_path / "p.png")
     assert is_png(tmp_path / "p.png")
     ax = fig.axes[0]
-    assert ax.get_xlabel() == "t [s]" and ax.get_ylabel() == "phase1"
+    assert ax.get_xlabel() == "time [s]" and ax.get_ylabel() == "phase"
     lines = ax.get_lines()
     assert len(lines) == 2 and all(ln.get_drawstyle() == "steps-post" for ln in lines)
     assert set(np.unique(lines[1].get_ydata())) == {-1.0, 0.0, 1.0}
@@ -104,7 +106,11 @@ def test_plot_columns_and_compare(short_runs, tmp_path):
     fig = plots.plot_compare(runs, tmp_path / "cmp.png", t_range=(2.0, 3.0))
     assert is_png(tmp_path / "cmp.png")
     assert len(fig.axes) == 3  # aabs1, aabs2, device 1 loop
-    assert [a.get_ylabel() for a in fig.axes] == ["aabs1 [m/s²]", "aabs2 [m/s²]", "F1 [N]"]
+    assert [a.get_ylabel() for a in fig.axes] == [
+        "absolute acceleration [m/s²]",
+        "absolute acceleration [m/s²]",
+        "friction force [N]",
+    ]
     assert all(len(a.get_lines()) == 2 for a in fig.axes)
 
 

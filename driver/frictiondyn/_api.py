@@ -22,6 +22,7 @@ from . import _core
 __all__ = [
     "DeckError",
     "FrictiondynError",
+    "Modes",
     "OutOfMemoryError",
     "OutputError",
     "OutputSettings",
@@ -299,13 +300,46 @@ _UNITS_LABEL = {"m/s2": "m/s²"}
 
 
 @dataclass
+class Modes:
+    """Natural modes of one system of a run (docs/namelist.md, "Natural modes").
+
+    ``system`` 'stuck' or 'free'; ``status`` 'flexible', 'rigid' (no free DOF: no mode),
+    'unrestrained' (a rigid-body mode, period inf) or 'not computed'; ``periods`` [s]
+    (lowest first), ``shapes`` (modes, n_dof) scaled to a largest component of +1,
+    ``mass_ratios`` (effective modal mass over the total mass), ``xi`` (damping ratios;
+    nan for a rigid-body mode)."""
+
+    system: str
+    status: str
+    periods: np.ndarray
+    shapes: np.ndarray
+    mass_ratios: np.ndarray
+    xi: np.ndarray
+
+    @property
+    def frequencies(self) -> np.ndarray:
+        """Natural frequencies [Hz] (0 for a rigid-body mode)."""
+        return np.where(np.isfinite(self.periods), 1.0 / self.periods, 0.0)
+
+    def __len__(self) -> int:
+        return len(self.periods)
+
+
+def _floats(values) -> np.ndarray:
+    """A JSON list as a float array."""
+    return np.array([float(v) for v in values], dtype=float)
+
+
+@dataclass
 class Result:
     """Time histories and summary of one run.
 
     ``result["u1"]`` is a column by name (see ``names``, ``units``); ``time`` is ``t``;
     ``dof(i)`` and ``device(d)`` group the series of one DOF or device (1-based);
     ``summary`` is the run's summary (peaks, transitions, steps, correctness violations,
-    energy) as a dict.
+    energy) as a dict; ``peak(name, t_range)`` the peak of a series (exact for the exact
+    technique, whose peaks include the extrema between rows and the one-sided values at
+    events).
     """
 
     names: list[str]
@@ -388,10 +422,108 @@ class Result:
             "phase": self[f"phase{d}"],
         }
 
+    def peak(self, name: str, t_range: tuple[float, float] | None = None) -> float:
+        """Largest |name| (``'aabs2'``, ``'u1'``, ``'F1'``, ...) over the run, or over the rows
+        with ``t_range[0] <= t <= t_range[1]``.
+
+        For the exact technique it is exact: its history holds, in ``peak_<name>``, the
+        maxima since the previous row (extrema between rows and one-sided values at events
+        included), so this is the true peak over the time from the range's first row to its
+        last. Otherwise it is the largest sampled value of the rows in the range."""
+        t = self.time
+        if t_range is None:
+            rows = np.arange(len(t))
+        else:
+            rows = np.nonzero((t >= t_range[0] - 1e-12) & (t <= t_range[1] + 1e-12))[0]
+        if rows.size == 0:
+            raise ValueError(f"no history row in the time range {t_range}")
+        values = np.abs(self[name][rows])
+        if f"peak_{name}" not in self:
+            return float(values.max())
+        envelope = self[f"peak_{name}"][rows[1:]]
+        return float(max(values[0], envelope.max(initial=0.0)))
+
     def label(self, name: str) -> str:
         """Axis label 'name [unit]'."""
         unit = self.units.get(name, "")
         return f"{name} [{_UNITS_LABEL.get(unit, unit)}]" if unit and unit != "-" else name
+
+    # --- engineering outputs ------------------------------------------------------------
+
+    def _labels(self, key: str, count: int, default: str) -> list[str]:
+        names = list(self.summary.get(key) or [])
+        return names[:count] + [f"{default} {i}" for i in range(len(names) + 1, count + 1)]
+
+    @property
+    def dof_labels(self) -> list[str]:
+        """The deck's label of each DOF ('DOF i' when not given)."""
+        return self._labels("dof_labels", self.n_dof, "DOF")
+
+    @property
+    def device_labels(self) -> list[str]:
+        """The deck's label of each device ('device d', 'brace b', 'isolator i' by default)."""
+        return self._labels("device_labels", self.n_devices, "device")
+
+    @property
+    def n_storeys(self) -> int:
+        return int(self.summary.get("n_storeys", sum(n.startswith("drift") for n in self.names)))
+
+    @property
+    def storey_labels(self) -> list[str]:
+        """The deck's label of each storey ('storey s' when not given)."""
+        return self._labels("storey_labels", self.n_storeys, "storey")
+
+    def storey(self, s: int) -> dict[str, np.ndarray]:
+        """Drift and storey shear V of storey s (1-based) over time (decks with &storeys)."""
+        return {"drift": self[f"drift{s}"], "V": self[f"V{s}"]}
+
+    @property
+    def base_shear(self) -> np.ndarray:
+        """Base shear over time (column Vb, decks with &storeys)."""
+        return self["Vb"]
+
+    def modes(self, system: str = "stuck") -> Modes:
+        """The natural modes of the 'stuck' or the 'free' system from the summary."""
+        if system not in ("stuck", "free"):
+            raise ValueError(f"system must be 'stuck' or 'free', not {system!r}")
+        s = self.summary
+        if f"modes_{system}_status" not in s:
+            raise KeyError("the summary has no modes (written by an older frictiondyn)")
+        periods = _floats(s[f"periods_{system}_s"])
+        rigid = periods == 0.0  # a rigid-body mode: the summary gives period and xi 0
+        periods[rigid] = np.inf
+        shapes = np.array(s[f"mode_shapes_{system}"], dtype=float).reshape(len(periods), self.n_dof)
+        return Modes(
+            system,
+            s[f"modes_{system}_status"],
+            periods,
+            shapes,
+            _floats(s[f"modal_mass_ratio_{system}"]),
+            np.where(rigid, np.nan, _floats(s[f"modal_xi_{system}"])),
+        )
+
+    def to_dataframe(self, index: str | None = "t"):
+        """The history as a pandas DataFrame (pandas is optional: ImportError without it).
+        Columns are the names (``u1``, ``aabs1``, ...), indexed by ``index`` (time by
+        default; None for a plain range); ``df.attrs["units"]`` maps each name to its unit
+        and ``df.attrs["labels"]`` holds the DOF, device and storey labels."""
+        try:
+            import pandas as pd
+        except ImportError:  # pragma: no cover - depends on the environment
+            raise ImportError(
+                "Result.to_dataframe needs pandas (pip install pandas); the history is "
+                "also Result.data with Result.names"
+            ) from None
+        df = pd.DataFrame(self.data, columns=list(self.names))
+        if index is not None:
+            df = df.set_index(index)
+        df.attrs["units"] = dict(self.units)
+        df.attrs["labels"] = {
+            "dof": self.dof_labels,
+            "device": self.device_labels,
+            "storey": self.storey_labels,
+        }
+        return df
 
     def summary_json(self) -> str:
         """The summary as JSON text: as the library wrote it (reals with 17 significant

@@ -68,10 +68,9 @@ def _stem(path: Path) -> str:
 def _print_summary(result: Result, deck: str) -> None:
     s = result.summary
     print(f"frictiondyn: {deck}")
-    print(
-        f"  stuck period {s['period_stuck_s']:.6g} s; steps dt1 {s['steps_dt1']}, "
-        f"dt2 {s['steps_dt2']}, finer {s['steps_finer']}"
-    )
+    period = s.get("period_stuck_s")
+    stuck = f"stuck period {period:.6g} s" if period else "stuck system has no period"
+    print(f"  {stuck}; steps dt1 {s['steps_dt1']}, dt2 {s['steps_dt2']}, finer {s['steps_finer']}")
     laws = s.get("device_law", [])
     for d in range(result.n_devices):
         law = f" ({laws[d]})" if d < len(laws) else ""
@@ -85,6 +84,17 @@ def _print_summary(result: Result, deck: str) -> None:
             f"  dof {i + 1}: peak |u| {s['peak_u_m'][i]:.6g} m, "
             f"peak |a_abs| {s['peak_aabs_mps2'][i]:.6g} m/s2"
         )
+    storeys = result.storey_labels
+    for k in range(result.n_storeys):
+        height = (s.get("storey_height_m") or [0.0] * result.n_storeys)[k]
+        ratio = (s.get("peak_drift_ratio") or [0.0] * result.n_storeys)[k]
+        extra = f" ({100 * ratio:.3g} %)" if height > 0 else ""
+        print(
+            f"  {storeys[k]}: peak drift {s['peak_drift_m'][k]:.6g} m{extra}, residual "
+            f"{s['residual_drift_m'][k]:.3g} m, peak shear {s['peak_storey_shear_N'][k]:.6g} N"
+        )
+    if "peak_base_shear_N" in s:
+        print(f"  peak base shear {s['peak_base_shear_N']:.6g} N")
     print(f"  correctness violations: {s['correctness_violations']}")
     if s["correctness_violations"]:
         print(
@@ -116,7 +126,12 @@ def cmd_run(args: argparse.Namespace) -> int:
         from . import plots
 
         for p in plots.plot_all(
-            result, summ.parent, summ.name[: -len(".summary.json")], t_range=trange
+            result,
+            summ.parent,
+            summ.name[: -len(".summary.json")],
+            t_range=trange,
+            units=args.units,
+            dpi=args.dpi,
         ):
             print(f"  plot: {p}")
     return 0
@@ -130,7 +145,9 @@ def cmd_plot(args: argparse.Namespace) -> int:
     result = load_result(path)
     directory = Path(args.out) if args.out else path.parent
     directory.mkdir(parents=True, exist_ok=True)
-    for p in plots.plot_all(result, directory, _stem(path), t_range=trange):
+    for p in plots.plot_all(
+        result, directory, _stem(path), t_range=trange, units=args.units, dpi=args.dpi
+    ):
         print(f"plot: {p}")
     return 0
 
@@ -183,13 +200,21 @@ def cmd_compare(args: argparse.Namespace) -> int:
             file=sys.stderr,
         )
     written = [out / f"{args.name}.png"]
-    plots.plot_compare(results, written[0], t_range=trange, labels=labels)
+    kw = {"t_range": trange, "labels": labels, "units": args.units, "dpi": args.dpi}
+    plots.plot_compare(results, written[0], **kw)
     for i in range(1, min(min(r.n_dof for r in results), 10) + 1):
         written.append(out / f"{args.name}_aabs{i}.png")
-        plots.plot_acceleration(results, i, written[-1], t_range=trange, labels=labels)
+        plots.plot_acceleration(results, i, written[-1], **kw)
     for d in range(1, min(min(r.n_devices for r in results), 10) + 1):
         written.append(out / f"{args.name}_hysteresis{d}.png")
-        plots.plot_hysteresis(results, d, written[-1], t_range=trange, labels=labels)
+        plots.plot_hysteresis(results, d, written[-1], **kw)
+    if all(r.n_storeys and "drift1" in r for r in results):
+        for kind, func in (
+            ("drift_profile", plots.plot_drift_profile),
+            ("acceleration_profile", plots.plot_acceleration_profile),
+        ):
+            written.append(out / f"{args.name}_{kind}.png")
+            func(results, written[-1], labels=labels, units=args.units, dpi=args.dpi)
     where = "whole run" if trange is None else f"t = {trange[0]:g} ... {trange[1]:g} s"
     print(f"peaks ({where}); difference relative to {labels[0]}:")
     for i, lab in enumerate(labels):
@@ -244,8 +269,15 @@ def build_parser() -> argparse.ArgumentParser:
         "nargs": 2,
         "type": float,
         "metavar": ("T0", "T1"),
-        "help": "plot only t0 <= t <= t1 [s]",
+        "help": "plot only t0 <= t <= t1 [s] (default: the last 5 cycles of a harmonic run, "
+        "the whole of any other)",
     }
+    units = {
+        "metavar": "UNITS",
+        "help": "units of the plots, e.g. mm,kN,g (length m/cm/mm, force N/kN/MN, "
+        "acceleration m/s2/cm/s2/g, velocity m/s/cm/s/mm/s; default SI)",
+    }
+    dpi = {"type": int, "default": None, "help": "resolution of the PNGs (default 150)"}
     p = sub.add_parser("run", help="run a deck; write its history CSV and summary JSON")
     p.add_argument("deck", help="namelist deck (.nml)")
     p.add_argument(
@@ -253,12 +285,16 @@ def build_parser() -> argparse.ArgumentParser:
     )
     p.add_argument("--plot", action="store_true", help="also write PNGs next to the outputs")
     p.add_argument("--t-range", **trange)
+    p.add_argument("--units", **units)
+    p.add_argument("--dpi", **dpi)
     p.set_defaults(func=cmd_run)
 
     p = sub.add_parser("plot", help="PNGs of a result (.csv or .npz)")
     p.add_argument("result", help="history CSV (with its .summary.json), or .npz")
     p.add_argument("--out", metavar="DIR", help="where the PNGs go (default: next to RESULT)")
     p.add_argument("--t-range", **trange)
+    p.add_argument("--units", **units)
+    p.add_argument("--dpi", **dpi)
     p.set_defaults(func=cmd_plot)
 
     p = sub.add_parser("compare", help="overlay two or more results; print peak differences")
@@ -267,6 +303,8 @@ def build_parser() -> argparse.ArgumentParser:
     p.add_argument("--name", default="compare", help="base name of the PNGs (default: compare)")
     p.add_argument("--labels", nargs="+", metavar="LABEL", help="legend names, one per result")
     p.add_argument("--t-range", **trange)
+    p.add_argument("--units", **units)
+    p.add_argument("--dpi", **dpi)
     p.set_defaults(func=cmd_compare)
 
     p = sub.add_parser("paper", help="recompute the paper's Table 1 and Figs. 2, 3, 4")

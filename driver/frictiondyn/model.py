@@ -23,11 +23,14 @@ __all__ = [
     "Damping",
     "Device",
     "FreeVibration",
+    "FrictionBrace",
     "Harmonic",
     "Integration",
     "Output",
     "Record",
+    "SlidingIsolator",
     "Spring",
+    "Storey",
 ]
 
 
@@ -44,16 +47,134 @@ class Spring:
 class Device:
     """Friction device between node_i and node_j (0 = table): normal force p [N], friction
     coefficient mu, law 'velocity' (band eps [m/s]), 'hysteretic' (f [m], eps1 [m/s]) or
-    'coulomb' (the exact technique). eps, eps1, f: None takes the reader's default."""
+    'coulomb' (the exact technique). eps, eps1, f: None takes the reader's default.
+
+    Velocity-dependent friction (velocity law): ``Device.exponential(...)`` (mu_max,
+    mu_min, mu_rate) or ``Device.table(...)`` (points (v, mu)); mu is then None. ``label``
+    names the device in outputs and plots."""
 
     node_i: int
     node_j: int
     p: float
-    mu: float
+    mu: float | None
     law: str
     eps: float | None = None
     eps1: float | None = None
     f: float | None = None
+    mu_law: str | None = None
+    mu_max: float | None = None
+    mu_min: float | None = None
+    mu_rate: float | None = None
+    mu_table: list[tuple[float, float]] | None = None
+    label: str | None = None
+
+    @classmethod
+    def exponential(
+        cls,
+        node_i: int,
+        node_j: int,
+        p: float,
+        mu_max: float,
+        mu_min: float,
+        mu_rate: float,
+        eps: float | None = None,
+        label: str | None = None,
+    ) -> Device:
+        """Velocity law with mu(v) = mu_max - (mu_max - mu_min) exp(-mu_rate |v|)."""
+        return cls(
+            node_i,
+            node_j,
+            p,
+            None,
+            "velocity",
+            eps=eps,
+            mu_law="exponential",
+            mu_max=mu_max,
+            mu_min=mu_min,
+            mu_rate=mu_rate,
+            label=label,
+        )
+
+    @classmethod
+    def table(
+        cls,
+        node_i: int,
+        node_j: int,
+        p: float,
+        points: list[tuple[float, float]],
+        eps: float | None = None,
+        label: str | None = None,
+    ) -> Device:
+        """Velocity law with mu(v) linear between the points (v [m/s], mu)."""
+        return cls(
+            node_i,
+            node_j,
+            p,
+            None,
+            "velocity",
+            eps=eps,
+            mu_law="table",
+            mu_table=[(float(v), float(m)) for v, m in points],
+            label=label,
+        )
+
+
+@dataclass
+class FrictionBrace:
+    """A friction damper in series with an elastic brace (Pall type) between node_i and
+    node_j: the damper slips at slip_load [N]; the brace's horizontal stiffness [N/m].
+    Written as &braces: one hysteretic device with P mu = slip_load and f = slip_load /
+    stiffness (docs/namelist.md). eps1 None takes the reader's default."""
+
+    node_i: int
+    node_j: int
+    slip_load: float
+    stiffness: float
+    eps1: float | None = None
+    label: str | None = None
+
+
+@dataclass
+class SlidingIsolator:
+    """A flat (radius 0 or None) or curved sliding isolator between node_i and node_j
+    (usually 0, the table) carrying weight [N]: a friction device with P = weight and, when
+    curved, a spring weight / radius. Written as &isolators; law, mu and the other friction
+    values as for Device (mu None with an mu_law 'exponential' or 'table')."""
+
+    node_i: int
+    node_j: int
+    weight: float
+    mu: float | None
+    law: str
+    radius: float | None = None
+    eps: float | None = None
+    eps1: float | None = None
+    f: float | None = None
+    mu_law: str | None = None
+    mu_max: float | None = None
+    mu_min: float | None = None
+    mu_rate: float | None = None
+    mu_table: list[tuple[float, float]] | None = None
+    label: str | None = None
+
+
+@dataclass
+class Storey:
+    """A storey whose drift and shear are reported: upper node_i and lower node_j (0 = the
+    table), or ``Storey.of_spring(s)``, the two nodes of spring s (1-based, of ``springs``).
+    height [m] gives the drift ratio."""
+
+    node_i: int | None = None
+    node_j: int | None = None
+    height: float | None = None
+    label: str | None = None
+    spring: int | None = None
+
+    @classmethod
+    def of_spring(
+        cls, spring: int, height: float | None = None, label: str | None = None
+    ) -> Storey:
+        return cls(height=height, label=label, spring=spring)
 
 
 @dataclass
@@ -72,9 +193,21 @@ class Damping:
     def stiffness(cls, xi: float, period: float | None = None) -> Damping:
         return cls("stiffness", xi=xi, period=period)
 
+    mode_i: int | None = None
+    mode_j: int | None = None
+    mode_system: str | None = None
+
     @classmethod
     def rayleigh(cls, a0: float, a1: float) -> Damping:
         return cls("rayleigh", rayleigh_a0=a0, rayleigh_a1=a1)
+
+    @classmethod
+    def rayleigh_modes(
+        cls, xi: float, mode_i: int, mode_j: int, system: str | None = None
+    ) -> Damping:
+        """Rayleigh damping with the ratio xi at modes mode_i and mode_j (1-based) of the
+        'stuck' (default) or 'free' system: a0, a1 computed by the reader."""
+        return cls("rayleigh", xi=xi, mode_i=mode_i, mode_j=mode_j, mode_system=system)
 
     def group(self) -> dict:
         g: dict = {"damping_type": self.type}
@@ -82,6 +215,9 @@ class Damping:
             _put(g, xi=self.xi, period=self.period)
         elif self.type == "rayleigh":
             _put(g, rayleigh_a0=self.rayleigh_a0, rayleigh_a1=self.rayleigh_a1)
+            _put(
+                g, xi=self.xi, mode_i=self.mode_i, mode_j=self.mode_j, mode_system=self.mode_system
+            )
         return g
 
 
@@ -96,7 +232,7 @@ class Harmonic:
     duration: float
     ramp_cycles: int | None = None
 
-    def group(self, directory: Path | None) -> dict:
+    def group(self, directory: Path | None, cwd: Path | None = None) -> dict:
         g: dict = {
             "excitation_type": "harmonic",
             "amplitude": float(self.amplitude),
@@ -120,12 +256,18 @@ class Record:
     scale: float | None = None
     duration: float | None = None
 
-    def group(self, directory: Path | None) -> dict:
+    def group(self, directory: Path | None, cwd: Path | None = None) -> dict:
+        """The &excitation group; a Record with values writes them to ``directory/file``.
+        With ``cwd``, a relative file of a Record without values is made absolute against it
+        (``Analysis.run`` passes the caller's working directory)."""
+        file = self.file
         if self.values is not None:
             if directory is None:
                 raise ValueError("a Record with values needs a directory to write its file")
             np.savetxt(directory / self.file, np.asarray(self.values, float), fmt="%.17e")
-        g: dict = {"excitation_type": "record", "record_file": self.file}
+        elif cwd is not None and not os.path.isabs(file):
+            file = os.fspath(Path(cwd) / file)
+        g: dict = {"excitation_type": "record", "record_file": file}
         _put(g, record_kind=self.kind, record_scale=self.scale)
         g["dt_record"] = float(self.dt_record)
         _put(g, duration=self.duration)
@@ -139,7 +281,7 @@ class FreeVibration:
     dt_record: float
     duration: float
 
-    def group(self, directory: Path | None) -> dict:
+    def group(self, directory: Path | None, cwd: Path | None = None) -> dict:
         return {
             "excitation_type": "none",
             "dt_record": float(self.dt_record),
@@ -189,6 +331,7 @@ class Output:
     name: str | None = None
     output_every: int | None = None
     write_history: bool | None = None
+    n_modes: int | None = None
 
     def group(self) -> dict:
         g: dict = {}
@@ -198,6 +341,7 @@ class Output:
             name=self.name,
             output_every=self.output_every,
             write_history=self.write_history,
+            n_modes=self.n_modes,
         )
         return g
 
@@ -224,7 +368,29 @@ def _per_device(group: dict, key: str, values: list) -> None:
     """An optional per-device value: left out when no device gives it; a device that does
     not is a null value, which the reader fills with its default."""
     if any(x is not None for x in values):
-        group[key] = [None if x is None else float(x) for x in values]
+        group[key] = [None if x is None else _value(x) for x in values]
+
+
+def _friction_values(group: dict, items: list) -> None:
+    """The per-item friction values shared by &friction and &isolators: mu (None items
+    null), eps, eps1, f, mu(v), labels; tables as mu_table_v(:, i), mu_table_mu(:, i)."""
+    _per_device(group, "mu", [x.mu for x in items])
+    for key in ("eps", "eps1", "f", "mu_law", "mu_max", "mu_min", "mu_rate", "label"):
+        _per_device(group, key, [getattr(x, key) for x in items])
+    if any(x.mu_table is not None for x in items):
+        n = max(len(x.mu_table or []) for x in items)
+        group["mu_table_v"] = [
+            [float(v) for v, _ in x.mu_table] + [None] * (n - len(x.mu_table))
+            if x.mu_table
+            else [None] * n
+            for x in items
+        ]
+        group["mu_table_mu"] = [
+            [float(m) for _, m in x.mu_table] + [None] * (n - len(x.mu_table))
+            if x.mu_table
+            else [None] * n
+            for x in items
+        ]
 
 
 @dataclass
@@ -240,15 +406,22 @@ class Analysis:
     output: Output = field(default_factory=Output)
     u0: list[float] | None = None
     v0: list[float] | None = None
+    braces: list[FrictionBrace] = field(default_factory=list)
+    isolators: list[SlidingIsolator] = field(default_factory=list)
+    storeys: list[Storey] = field(default_factory=list)
+    labels: list[str] | None = None  #: a name per DOF ('floor 3')
 
-    def namelist(self, directory: Path | None = None) -> f90nml.Namelist:
-        """The deck as an f90nml Namelist (writes a Record's values into directory)."""
+    def namelist(self, directory: Path | None = None, cwd: Path | None = None) -> f90nml.Namelist:
+        """The deck as an f90nml Namelist (writes a Record's values into directory; with
+        cwd, a relative record file is made absolute against it)."""
         n = len(self.masses)
         model = {"n_dof": n, "mass": [float(m) for m in self.masses]}
         if self.u0 is not None:
             model["u0"] = [float(x) for x in self.u0]
         if self.v0 is not None:
             model["v0"] = [float(x) for x in self.v0]
+        if self.labels is not None:
+            model["label"] = [str(x) for x in self.labels]
         groups = [("model", model)]
         springs = {"n_springs": len(self.springs)}
         if self.springs:
@@ -267,12 +440,40 @@ class Analysis:
                 "node_j": [x.node_j for x in d],
                 "law": [x.law for x in d],
                 "p": [float(x.p) for x in d],
-                "mu": [float(x.mu) for x in d],
             }
-            for key in ("eps", "eps1", "f"):
-                _per_device(friction, key, [getattr(x, key) for x in d])
+            _friction_values(friction, d)
             groups.append(("friction", friction))
-        groups.append(("excitation", self.excitation.group(directory)))
+        if self.braces:
+            b = self.braces
+            braces = {
+                "n_braces": len(b),
+                "node_i": [x.node_i for x in b],
+                "node_j": [x.node_j for x in b],
+                "slip_load": [float(x.slip_load) for x in b],
+                "stiffness": [float(x.stiffness) for x in b],
+            }
+            for key in ("eps1", "label"):
+                _per_device(braces, key, [getattr(x, key) for x in b])
+            groups.append(("braces", braces))
+        if self.isolators:
+            s = self.isolators
+            isolators = {
+                "n_isolators": len(s),
+                "node_i": [x.node_i for x in s],
+                "node_j": [x.node_j for x in s],
+                "law": [x.law for x in s],
+                "weight": [float(x.weight) for x in s],
+            }
+            _per_device(isolators, "radius", [x.radius for x in s])
+            _friction_values(isolators, s)
+            groups.append(("isolators", isolators))
+        if self.storeys:
+            st = self.storeys
+            storeys: dict = {"n_storeys": len(st)}
+            for key in ("node_i", "node_j", "spring", "height", "label"):
+                _per_device(storeys, key, [getattr(x, key) for x in st])
+            groups.append(("storeys", storeys))
+        groups.append(("excitation", self.excitation.group(directory, cwd)))
         integration = self.integration.group()
         if integration:
             groups.append(("integration", integration))
@@ -284,9 +485,9 @@ class Analysis:
             nml[name] = f90nml.Namelist(values)
         return nml
 
-    def deck_text(self, directory: Path | None = None) -> str:
+    def deck_text(self, directory: Path | None = None, cwd: Path | None = None) -> str:
         buf = io.StringIO()
-        self.namelist(directory).write(buf)
+        self.namelist(directory, cwd).write(buf)
         return buf.getvalue()
 
     def write_deck(self, path: str | os.PathLike) -> Path:
@@ -297,7 +498,9 @@ class Analysis:
 
     def run(self, name: str = "analysis.nml") -> Result:
         """Run through the extension (no deck file needed; a Record's values go to a
-        temporary directory for the duration of the run)."""
+        temporary directory for the duration of the run; a Record's relative ``file`` is
+        the caller's, relative to the current working directory)."""
+        cwd = Path.cwd()
         with tempfile.TemporaryDirectory() as tmp:
             directory = Path(tmp)
-            return run_text(self.deck_text(directory), name=name, base_dir=directory)
+            return run_text(self.deck_text(directory, cwd), name=name, base_dir=directory)

@@ -1,24 +1,39 @@
-"""Plots of one or several Results (matplotlib Figures on the Agg canvas; no pyplot state).
+"""Plots of one or several Results for reports (matplotlib Figures on the Agg canvas; no
+pyplot state).
 
-Every function takes a Result or a sequence of Results (overlaid, one line each), an
-optional output ``path`` (a PNG is written when given) or an ``ax`` to draw into, and
-returns the Figure. Axis labels carry the units, from ``Result.label``. ``t_range``
-restricts the plot to ``t0 <= t <= t1``; ``labels`` name the results in the legend
-(default: the deck's name from the summary).
+Every function takes a Result or a sequence of Results (overlaid, one line each) and
+returns the Figure; keyword options are common to all:
 
-- ``plot_acceleration``: absolute acceleration of a DOF vs time (the paper's Figs. 3a, 4a, 4b)
-- ``plot_relative_velocity``: relative velocity difference of a device vs time (Fig. 3b)
-- ``plot_hysteresis``: friction force vs relative displacement of a device (Fig. 2)
-- ``plot_phase``: stick (0) / slip (+-1) phase of a device vs time
-- ``plot_columns``: any column against another (generic overlay)
-- ``plot_compare``: one panel per DOF (absolute acceleration) and per device (force loop)
-- ``plot_all``: the standard set of PNGs for one Result (used by the command line)
+- ``path``: a PNG (or any format matplotlib writes) is saved there, at ``dpi`` (default 150);
+- ``ax``: draw into this Axes instead of a new figure, so that figures compose as subplots
+  (``fig, axes = plots.figure(2, 2)``, then one call per panel, then ``plots.save``);
+- ``t_range``: ``(t0, t1)``, or ``"all"`` for the whole run; by default the last
+  ``cycles`` (5) cycles of a harmonic run and the whole of any other run. Long histories are
+  thinned to at most ``max_points`` points per line by keeping each interval's minimum and
+  maximum, so peaks survive and the plot is not a solid block of ink;
+- ``units``: ``plots.Units(...)``, or text such as ``"mm,kN,g"`` (length m/cm/mm, force
+  N/kN/MN, acceleration m/s2/cm/s2/g, velocity m/s/cm/s/mm/s); SI by default;
+- ``labels``: legend names of the results (default: the deck's name); the deck's ``label``
+  of each DOF, device and storey names panels and axes ("roof", "damper 2");
+- ``title``: the panel's title (``""`` for none; a descriptive one by default);
+- ``cycles`` (5) and ``max_points`` (5000; 0: no thinning), as above.
+
+The profiles take ``ax``, ``labels``, ``title``, ``units`` and ``dpi``. An unknown option is a
+TypeError naming it.
+
+Time histories: ``plot_acceleration``, ``plot_relative_velocity``, ``plot_phase``,
+``plot_drift``, ``plot_storey_shear``, ``plot_base_shear``, ``plot_columns``; loops:
+``plot_hysteresis`` (device force vs slip), ``plot_storey_loop`` (storey shear vs drift);
+profiles over the height: ``plot_drift_profile``, ``plot_acceleration_profile``; sets:
+``plot_compare`` and ``plot_all`` (what the command line writes).
 """
 
 from __future__ import annotations
 
 import os
 from collections.abc import Sequence
+from dataclasses import dataclass
+from itertools import pairwise
 from pathlib import Path
 
 import numpy as np
@@ -29,21 +44,100 @@ from matplotlib.figure import Figure
 from ._api import Result
 
 __all__ = [
+    "REPORT_UNITS",
+    "SI",
+    "Units",
+    "auto_window",
+    "figure",
     "plot_acceleration",
+    "plot_acceleration_profile",
     "plot_all",
+    "plot_base_shear",
     "plot_columns",
     "plot_compare",
+    "plot_drift",
+    "plot_drift_profile",
     "plot_hysteresis",
     "plot_phase",
     "plot_relative_velocity",
+    "plot_storey_loop",
+    "plot_storey_shear",
+    "save",
+    "thin",
+    "window",
 ]
 
 Results = Result | Sequence[Result]
-TRange = tuple[float, float] | None
+TRange = tuple[float, float] | str | None
 PathLike = str | os.PathLike | None
 
+G = 9.80665  # standard gravity [m/s2], for accelerations in g
+
 _SIZE = (8.0, 4.0)
-_DPI = 120
+_DPI = 150
+_CYCLES = 5
+_MAX_POINTS = 5000
+
+# unit name -> factor from SI, per kind
+_FACTORS = {
+    "length": {"m": 1.0, "cm": 100.0, "mm": 1000.0},
+    "force": {"N": 1.0, "kN": 1e-3, "MN": 1e-6},
+    "acceleration": {"m/s2": 1.0, "cm/s2": 100.0, "g": 1.0 / G},
+    "velocity": {"m/s": 1.0, "cm/s": 100.0, "mm/s": 1000.0},
+}
+# the SI unit of a column -> its kind
+_KIND = {"m": "length", "N": "force", "m/s2": "acceleration", "m/s": "velocity"}
+_PRETTY = {"m/s2": "m/s²", "cm/s2": "cm/s²"}
+
+
+@dataclass(frozen=True)
+class Units:
+    """Units of the plotted quantities (the results stay SI)."""
+
+    length: str = "m"
+    force: str = "N"
+    acceleration: str = "m/s2"
+    velocity: str = "m/s"
+
+    def __post_init__(self) -> None:
+        for kind, table in _FACTORS.items():
+            if getattr(self, kind) not in table:
+                choices = ", ".join(table)
+                raise ValueError(f"{kind} unit {getattr(self, kind)!r}: one of {choices}")
+
+    @classmethod
+    def parse(cls, spec: Units | str | None) -> Units:
+        """Units from ``None`` (SI), a Units, or text naming some units: ``"mm,kN,g"``."""
+        if spec is None:
+            return SI
+        if isinstance(spec, Units):
+            return spec
+        chosen: dict[str, str] = {}
+        for token in str(spec).replace(" ", ",").split(","):
+            if not token:
+                continue
+            kinds = [k for k, table in _FACTORS.items() if token in table]
+            if not kinds:
+                known = ", ".join(u for table in _FACTORS.values() for u in table)
+                raise ValueError(f"unit {token!r} is not one of {known}")
+            chosen[kinds[0]] = token
+        return cls(**chosen)
+
+    def factor(self, si_unit: str) -> float:
+        kind = _KIND.get(si_unit)
+        return _FACTORS[kind][getattr(self, kind)] if kind else 1.0
+
+    def name(self, si_unit: str) -> str:
+        kind = _KIND.get(si_unit)
+        unit = getattr(self, kind) if kind else si_unit
+        return _PRETTY.get(unit, unit)
+
+
+SI = Units()
+REPORT_UNITS = Units("mm", "kN", "g", "mm/s")  #: the usual units of a design report
+
+
+# --------------------------------------------------------------------------- helpers
 
 
 def _as_list(results: Results) -> list[Result]:
@@ -70,7 +164,7 @@ def _labels(results: list[Result], labels: Sequence[str] | None) -> list[str]:
     return [str(x) for x in labels]
 
 
-def window(result: Result, t_range: TRange) -> np.ndarray:
+def window(result: Result, t_range: tuple[float, float] | None) -> np.ndarray:
     """Boolean mask of the rows with t0 <= t <= t1 (every row when t_range is None)."""
     t = result.time
     if t_range is None:
@@ -87,11 +181,73 @@ def window(result: Result, t_range: TRange) -> np.ndarray:
     return mask
 
 
+def auto_window(result: Result, cycles: int = _CYCLES) -> tuple[float, float] | None:
+    """The default time window: the last ``cycles`` cycles of a harmonic run (from the
+    summary's excitation), None (the whole run) otherwise."""
+    s = result.summary or {}
+    freq = s.get("excitation_frequency_Hz")
+    t = result.time
+    if s.get("excitation_type") == "harmonic" and freq and len(t) > 1:
+        t1 = float(t[-1])
+        t0 = max(float(t[0]), t1 - cycles / float(freq))
+        if t0 < t1:
+            return (t0, t1)
+    return None
+
+
+def _resolve(result: Result, t_range: TRange, cycles: int) -> tuple[float, float] | None:
+    if t_range is None:
+        return auto_window(result, cycles)
+    if isinstance(t_range, str):
+        if t_range != "all":
+            raise ValueError(f"t_range {t_range!r}: (t0, t1), 'all' or None")
+        return None
+    return (float(t_range[0]), float(t_range[1]))
+
+
+def thin(
+    x: np.ndarray, y: np.ndarray, max_points: int = _MAX_POINTS
+) -> tuple[np.ndarray, np.ndarray]:
+    """At most about ``max_points`` points of the line (x, y), x increasing: each of
+    max_points / 2 intervals keeps its minimum and maximum of y in their order, so every
+    peak of y is kept. Lines that are short enough are returned as they are."""
+    n = len(x)
+    if max_points <= 0 or n <= max_points:
+        return x, y
+    buckets = max(1, max_points // 2)
+    edges = np.linspace(0, n, buckets + 1).astype(int)
+    keep = []
+    for a, b in pairwise(edges):
+        if b <= a:
+            continue
+        seg = y[a:b]
+        i, j = a + int(np.argmin(seg)), a + int(np.argmax(seg))
+        keep.extend(sorted({i, j}))
+    keep = np.unique(np.array(keep + [0, n - 1]))
+    return x[keep], y[keep]
+
+
 def _figure(size: tuple[float, float]) -> Figure:
     """A Figure on the Agg canvas, outside pyplot (no global state, safe in threads)."""
     fig = Figure(figsize=size, layout="constrained")
     FigureCanvasAgg(fig)
     return fig
+
+
+def figure(
+    rows: int = 1, cols: int = 1, size: tuple[float, float] | None = None, **kw
+) -> tuple[Figure, np.ndarray]:
+    """A figure of rows x cols panels on the Agg canvas and its Axes (a 2-D array), to fill
+    with the plot functions' ``ax=``; ``kw`` go to ``Figure.subplots`` (e.g. sharex)."""
+    fig = _figure(size or (5.0 * cols, 3.2 * rows))
+    axes = fig.subplots(rows, cols, squeeze=False, **kw)
+    return fig, axes
+
+
+def save(fig: Figure, path: str | os.PathLike, dpi: int | None = None) -> Path:
+    """Save a figure (format from the suffix) at ``dpi`` (default 150)."""
+    fig.savefig(os.fspath(path), dpi=dpi or _DPI)
+    return Path(path)
 
 
 def _axes(ax: Axes | None, size: tuple[float, float] = _SIZE) -> tuple[Figure, Axes]:
@@ -101,10 +257,16 @@ def _axes(ax: Axes | None, size: tuple[float, float] = _SIZE) -> tuple[Figure, A
     return fig, fig.add_subplot()
 
 
-def _finish(fig: Figure, path: PathLike) -> Figure:
+def _finish(fig: Figure, path: PathLike, dpi: int | None) -> Figure:
     if path is not None:
-        fig.savefig(os.fspath(path), dpi=_DPI)
+        save(fig, path, dpi)
     return fig
+
+
+def _title(ax: Axes, title: str | None, default: str) -> None:
+    text = default if title is None else title
+    if text:
+        ax.set_title(text)
 
 
 def _check_column(results: list[Result], name: str) -> None:
@@ -115,119 +277,385 @@ def _check_column(results: list[Result], name: str) -> None:
             )
 
 
+_DESCRIPTION = {
+    "t": "time",
+    "ag": "table acceleration",
+    "u": "relative displacement",
+    "v": "relative velocity",
+    "aabs": "absolute acceleration",
+    "s": "relative displacement",
+    "sdot": "relative velocity",
+    "F": "friction force",
+    "phase": "phase",
+    "drift": "drift",
+    "V": "storey shear",
+    "Vb": "base shear",
+}
+
+
+def _prefix(name: str) -> str:
+    return name.rstrip("0123456789")
+
+
+def _axis_label(result: Result, name: str, units: Units, describe: bool) -> str:
+    unit = result.units.get(name, "")
+    text = _DESCRIPTION.get(_prefix(name), name) if describe else name
+    if not unit or unit == "-":
+        return text
+    return f"{text} [{units.name(unit)}]"
+
+
+@dataclass
+class _Options:
+    """The keyword options every time-history and loop plot takes (module docstring)."""
+
+    ax: Axes | None = None
+    t_range: TRange = None
+    labels: Sequence[str] | None = None
+    title: str | None = None
+    units: Units | str | None = None
+    dpi: int | None = None
+    cycles: int = _CYCLES
+    max_points: int = _MAX_POINTS
+
+    @classmethod
+    def of(cls, function: str, options: dict) -> _Options:
+        unknown = set(options) - set(cls.__dataclass_fields__)
+        if unknown:
+            known = ", ".join(cls.__dataclass_fields__)
+            raise TypeError(f"{function}() got unknown options {sorted(unknown)}; options: {known}")
+        return cls(**options)
+
+
 def _overlay(
     ax: Axes,
     results: list[Result],
-    names: list[str],
     x: str,
     y: str,
-    t_range: TRange,
+    opt: _Options,
+    *,
+    describe: bool = True,
     drawstyle: str = "default",
+    loop: bool = False,
 ) -> None:
     _check_column(results, x)
     _check_column(results, y)
-    for r, name in zip(results, names, strict=True):
-        m = window(r, t_range)
-        ax.plot(r[x][m], r[y][m], label=name, linewidth=1.0, drawstyle=drawstyle)
-    ax.set_xlabel(results[0].label(x))
-    ax.set_ylabel(results[0].label(y))
+    units = Units.parse(opt.units)
+    for r, name in zip(results, _labels(results, opt.labels), strict=True):
+        m = window(r, _resolve(r, opt.t_range, opt.cycles))
+        xs = r[x][m] * units.factor(r.units.get(x, ""))
+        ys = r[y][m] * units.factor(r.units.get(y, ""))
+        if not loop and drawstyle == "default":
+            xs, ys = thin(xs, ys, opt.max_points)
+        elif loop and len(xs) > 4 * opt.max_points > 0:
+            step = int(np.ceil(len(xs) / (4 * opt.max_points)))
+            xs, ys = xs[::step], ys[::step]
+        ax.plot(xs, ys, label=name, linewidth=0.9, drawstyle=drawstyle)
+    ax.set_xlabel(_axis_label(results[0], x, units, describe))
+    ax.set_ylabel(_axis_label(results[0], y, units, describe))
     ax.grid(True, linewidth=0.3)
     if len(results) > 1:
         ax.legend(fontsize="small")
 
 
-def plot_columns(
+def _item_label(results: list[Result], kind: str, k: int) -> str:
+    names = getattr(results[0], f"{kind}_labels")
+    return names[k - 1] if 0 < k <= len(names) else f"{kind} {k}"
+
+
+def _plot(
+    function: str,
     results: Results,
+    x: str,
     y: str,
-    path: PathLike = None,
+    default_title: str,
+    path: PathLike,
+    options: dict,
     *,
-    x: str = "t",
-    ax: Axes | None = None,
-    t_range: TRange = None,
-    labels: Sequence[str] | None = None,
-    title: str | None = None,
-) -> Figure:
-    """Column ``y`` against column ``x`` (default time) of each result, overlaid."""
+    size: tuple[float, float] = _SIZE,
+    **overlay,
+) -> tuple[Figure, Axes, _Options]:
+    """One panel of y against x for each result, with the common options; saved when path."""
+    opt = _Options.of(function, options)
     rs = _as_list(results)
-    fig, ax = _axes(ax)
-    _overlay(ax, rs, _labels(rs, labels), x, y, t_range)
-    ax.set_title(title if title is not None else f"{y} vs {x}")
-    return _finish(fig, path)
+    _check_column(rs, y)
+    fig, ax = _axes(opt.ax, size)
+    _overlay(ax, rs, x, y, opt, **overlay)
+    _title(ax, opt.title, default_title)
+    return fig, ax, opt
 
 
-def plot_acceleration(
-    results: Results,
-    dof: int,
-    path: PathLike = None,
-    *,
-    ax: Axes | None = None,
-    t_range: TRange = None,
-    labels: Sequence[str] | None = None,
+# --------------------------------------------------------------------------- time histories
+
+
+def plot_columns(
+    results: Results, y: str, path: PathLike = None, *, x: str = "t", **options
 ) -> Figure:
-    """Absolute acceleration of DOF ``dof`` (1-based) vs time, one line per result."""
-    rs = _as_list(results)
-    fig, ax = _axes(ax)
-    _overlay(ax, rs, _labels(rs, labels), "t", f"aabs{dof}", t_range)
-    ax.set_title(f"absolute acceleration, DOF {dof}")
-    return _finish(fig, path)
+    """Column ``y`` against column ``x`` (default time) of each result, overlaid; the axes
+    are named by the columns ("u1 [m]")."""
+    fig, _, opt = _plot(
+        "plot_columns", results, x, y, f"{y} vs {x}", path, options, describe=False, loop=x != "t"
+    )
+    return _finish(fig, path, opt.dpi)
+
+
+def plot_acceleration(results: Results, dof: int, path: PathLike = None, **options) -> Figure:
+    """Absolute acceleration of DOF ``dof`` (1-based) vs time, one line per result (the
+    paper's Figs. 3a, 4a, 4b)."""
+    name = _item_label(_as_list(results), "dof", dof)
+    fig, _, opt = _plot(
+        "plot_acceleration",
+        results,
+        "t",
+        f"aabs{dof}",
+        f"{name}: absolute acceleration",
+        path,
+        options,
+    )
+    return _finish(fig, path, opt.dpi)
 
 
 def plot_relative_velocity(
-    results: Results,
-    device: int,
-    path: PathLike = None,
-    *,
-    ax: Axes | None = None,
-    t_range: TRange = None,
-    labels: Sequence[str] | None = None,
-    band: float | None = None,
+    results: Results, device: int, path: PathLike = None, *, band: float | None = None, **options
 ) -> Figure:
-    """Relative velocity difference s' of device ``device`` vs time, one line per result.
+    """Relative velocity difference s' of device ``device`` vs time (the paper's Fig. 3b).
     ``band`` (eps or eps1 [m/s]) adds two dashed lines at +-band."""
-    rs = _as_list(results)
-    fig, ax = _axes(ax)
-    _overlay(ax, rs, _labels(rs, labels), "t", f"sdot{device}", t_range)
+    name = _item_label(_as_list(results), "device", device)
+    fig, ax, opt = _plot(
+        "plot_relative_velocity",
+        results,
+        "t",
+        f"sdot{device}",
+        f"{name}: relative velocity",
+        path,
+        options,
+    )
     if band is not None:
+        f = Units.parse(opt.units).factor("m/s")
         for sign in (1.0, -1.0):
-            ax.axhline(sign * band, color="0.4", linestyle="--", linewidth=0.7)
-    ax.set_title(f"relative velocity difference, device {device}")
-    return _finish(fig, path)
+            ax.axhline(sign * band * f, color="0.4", linestyle="--", linewidth=0.7)
+    return _finish(fig, path, opt.dpi)
 
 
-def plot_hysteresis(
-    results: Results,
-    device: int,
-    path: PathLike = None,
-    *,
-    ax: Axes | None = None,
-    t_range: TRange = None,
-    labels: Sequence[str] | None = None,
-) -> Figure:
-    """Friction force F vs relative displacement s of device ``device``: the loops."""
-    rs = _as_list(results)
-    fig, ax = _axes(ax, (6.0, 4.5))
-    _overlay(ax, rs, _labels(rs, labels), f"s{device}", f"F{device}", t_range)
-    ax.set_title(f"friction force vs relative displacement, device {device}")
-    return _finish(fig, path)
-
-
-def plot_phase(
-    results: Results,
-    device: int,
-    path: PathLike = None,
-    *,
-    ax: Axes | None = None,
-    t_range: TRange = None,
-    labels: Sequence[str] | None = None,
-) -> Figure:
-    """Phase of device ``device`` vs time: -1 slip -, 0 stick, +1 slip + (steps)."""
-    rs = _as_list(results)
-    fig, ax = _axes(ax, (8.0, 3.0))
-    _overlay(ax, rs, _labels(rs, labels), "t", f"phase{device}", t_range, drawstyle="steps-post")
+def plot_phase(results: Results, device: int, path: PathLike = None, **options) -> Figure:
+    """Phase of device ``device`` vs time: -1 slip -, 0 stick, +1 slip + (steps; every row)."""
+    name = _item_label(_as_list(results), "device", device)
+    fig, ax, opt = _plot(
+        "plot_phase",
+        results,
+        "t",
+        f"phase{device}",
+        f"{name}: stick/slip phase",
+        path,
+        options,
+        size=(8.0, 3.0),
+        drawstyle="steps-post",
+    )
     ax.set_yticks([-1, 0, 1], ["slip \u2212", "stick", "slip +"])
     ax.set_ylim(-1.3, 1.3)
-    ax.set_title(f"stick/slip phase, device {device}")
-    return _finish(fig, path)
+    return _finish(fig, path, opt.dpi)
+
+
+def plot_drift(results: Results, storey: int, path: PathLike = None, **options) -> Figure:
+    """Drift of storey ``storey`` (1-based; decks with &storeys) vs time."""
+    name = _item_label(_as_list(results), "storey", storey)
+    fig, _, opt = _plot(
+        "plot_drift", results, "t", f"drift{storey}", f"{name}: drift", path, options
+    )
+    return _finish(fig, path, opt.dpi)
+
+
+def plot_storey_shear(results: Results, storey: int, path: PathLike = None, **options) -> Figure:
+    """Storey shear of storey ``storey`` (1-based; decks with &storeys) vs time."""
+    name = _item_label(_as_list(results), "storey", storey)
+    fig, _, opt = _plot(
+        "plot_storey_shear", results, "t", f"V{storey}", f"{name}: storey shear", path, options
+    )
+    return _finish(fig, path, opt.dpi)
+
+
+def plot_base_shear(results: Results, path: PathLike = None, **options) -> Figure:
+    """Base shear vs time (decks with &storeys)."""
+    fig, _, opt = _plot("plot_base_shear", results, "t", "Vb", "base shear", path, options)
+    return _finish(fig, path, opt.dpi)
+
+
+# --------------------------------------------------------------------------- loops
+
+
+def plot_hysteresis(results: Results, device: int, path: PathLike = None, **options) -> Figure:
+    """Friction force F vs relative displacement s of device ``device``: its loops (the
+    paper's Fig. 2)."""
+    name = _item_label(_as_list(results), "device", device)
+    fig, _, opt = _plot(
+        "plot_hysteresis",
+        results,
+        f"s{device}",
+        f"F{device}",
+        f"{name}: force-displacement loop",
+        path,
+        options,
+        size=(6.0, 4.5),
+        loop=True,
+    )
+    return _finish(fig, path, opt.dpi)
+
+
+def plot_storey_loop(results: Results, storey: int, path: PathLike = None, **options) -> Figure:
+    """Storey shear vs drift of storey ``storey``: the loops of the whole storey (frame,
+    damping and devices)."""
+    name = _item_label(_as_list(results), "storey", storey)
+    fig, _, opt = _plot(
+        "plot_storey_loop",
+        results,
+        f"drift{storey}",
+        f"V{storey}",
+        f"{name}: shear vs drift",
+        path,
+        options,
+        size=(6.0, 4.5),
+        loop=True,
+    )
+    return _finish(fig, path, opt.dpi)
+
+
+# --------------------------------------------------------------------------- profiles
+
+
+def _storey_levels(r: Result) -> tuple[np.ndarray, bool]:
+    """Bottom and top level of each storey: heights [m] when the storeys form a stack from
+    the table and some heights are given (a storey without one, such as an isolation layer,
+    counts as 0 m), else storey numbers; (levels (ns, 2), in metres)."""
+    s = r.summary
+    nodes = s.get("storey_nodes") or []
+    heights = list(s.get("storey_height_m") or [])  # 0: not given
+    z = {0: 0.0}
+    if nodes and any(h > 0 for h in heights):
+        pending = list(range(len(nodes)))
+        while pending:
+            done = [k for k in pending if nodes[k][1] in z]
+            if not done:
+                break
+            for k in done:
+                z[nodes[k][0]] = z[nodes[k][1]] + float(heights[k])
+                pending.remove(k)
+        if not pending:
+            return np.array([[z[j], z[i]] for i, j in nodes]), True
+    n = len(nodes)
+    return np.column_stack([np.arange(n), np.arange(1, n + 1)]).astype(float), False
+
+
+def _floor_levels(r: Result) -> tuple[np.ndarray, bool]:
+    """Level of each DOF: its height when the storeys give it, else its number."""
+    levels, metres = _storey_levels(r)
+    nodes = r.summary.get("storey_nodes") or []
+    if metres:
+        z = {i: top for (i, _), (_, top) in zip(nodes, levels, strict=True)}
+        if all(i in z for i in range(1, r.n_dof + 1)):
+            return np.array([z[i] for i in range(1, r.n_dof + 1)]), True
+    return np.arange(1, r.n_dof + 1, dtype=float), False
+
+
+def plot_drift_profile(
+    results: Results,
+    path: PathLike = None,
+    *,
+    ax: Axes | None = None,
+    ratio: bool | None = None,
+    residual: bool = False,
+    labels: Sequence[str] | None = None,
+    title: str | None = None,
+    units: Units | str | None = None,
+    dpi: int | None = None,
+) -> Figure:
+    """Peak inter-storey drift of every storey over the height (decks with &storeys), one
+    profile per result: constant over each storey, against the height when the storeys give
+    it. ``ratio`` plots the drift ratio in % (default: when every storey has a height);
+    ``residual`` adds the residual drifts (dashed)."""
+    rs = _as_list(results)
+    names = _labels(rs, labels)
+    fig, ax = _axes(ax, (4.5, 5.0))
+    u = Units.parse(units)
+    for k, (r, name) in enumerate(zip(rs, names, strict=True)):
+        s = r.summary
+        if not r.n_storeys:
+            raise ValueError(f"{name}: no storeys (give &storeys in the deck)")
+        use_ratio = ratio if ratio is not None else all(h > 0 for h in s["storey_height_m"])
+        key = "drift_ratio" if use_ratio else "drift_m"
+        if use_ratio and not all(h > 0 for h in s["storey_height_m"]):
+            raise ValueError(f"{name}: drift ratios need every storey's height")
+        scale = 100.0 if use_ratio else u.factor("m")
+        levels, metres = _storey_levels(r)
+        color = f"C{k}"
+        for kind, style in (("peak", "-"), ("residual", "--")):
+            if kind == "residual" and not residual:
+                continue
+            values = np.abs(np.array(s[f"{kind}_{key}"], dtype=float)) * scale
+            xs = np.repeat(values, 2)
+            ys = levels.reshape(-1)
+            lab = name if kind == "peak" else f"{name}, residual"
+            ax.plot(xs, ys, style, color=color, linewidth=1.2, label=lab)
+            ax.plot(values, levels.mean(axis=1), "o", color=color, markersize=3.5)
+    r0 = rs[0]
+    levels, metres = _storey_levels(r0)
+    if metres:
+        ax.set_ylabel("height [m]")
+    else:
+        ax.set_yticks(levels.mean(axis=1), r0.storey_labels)
+        ax.set_ylabel("storey")
+    ax.set_ylim(bottom=0.0)
+    ax.set_xlim(0.0, 1.08 * max(ln.get_xdata().max() for ln in ax.get_lines()))
+    use_ratio = ratio if ratio is not None else all(h > 0 for h in r0.summary["storey_height_m"])
+    ax.set_xlabel("drift ratio [%]" if use_ratio else f"drift [{u.name('m')}]")
+    ax.grid(True, linewidth=0.3)
+    if len(rs) > 1 or residual:
+        ax.legend(fontsize="small", loc="best")
+    _title(ax, title, "peak inter-storey drift")
+    return _finish(fig, path, dpi)
+
+
+def plot_acceleration_profile(
+    results: Results,
+    path: PathLike = None,
+    *,
+    ax: Axes | None = None,
+    labels: Sequence[str] | None = None,
+    title: str | None = None,
+    units: Units | str | None = None,
+    dpi: int | None = None,
+) -> Figure:
+    """Peak absolute acceleration of every DOF (floor) over the height, with the table's
+    peak acceleration at level 0, one profile per result (peaks over every step, from the
+    summary; the table's from the history rows)."""
+    rs = _as_list(results)
+    names = _labels(rs, labels)
+    fig, ax = _axes(ax, (4.5, 5.0))
+    u = Units.parse(units)
+    f = u.factor("m/s2")
+    for r, name in zip(rs, names, strict=True):
+        levels, metres = _floor_levels(r)
+        peaks = np.array(r.summary["peak_aabs_mps2"], dtype=float) * f
+        order = np.argsort(levels, kind="stable")
+        ys = np.concatenate([[0.0], levels[order]])
+        xs = np.concatenate([[float(np.max(np.abs(r["ag"]))) * f], peaks[order]])
+        ax.plot(xs, ys, "-o", linewidth=1.2, markersize=3.5, label=name)
+    r0 = rs[0]
+    levels, metres = _floor_levels(r0)
+    if metres:
+        ax.set_ylabel("height [m]")
+    else:
+        ax.set_yticks(np.concatenate([[0.0], levels]), ["table", *r0.dof_labels])
+        ax.set_ylabel("level")
+    ax.set_xlim(0.0, 1.08 * max(ln.get_xdata().max() for ln in ax.get_lines()))
+    ax.set_xlabel(f"peak absolute acceleration [{u.name('m/s2')}]")
+    ax.grid(True, linewidth=0.3)
+    if len(rs) > 1:
+        ax.legend(fontsize="small")
+    _title(ax, title, "peak floor acceleration")
+    return _finish(fig, path, dpi)
+
+
+# --------------------------------------------------------------------------- sets
 
 
 def _common(results: list[Result], attr: str) -> int:
@@ -241,6 +669,9 @@ def plot_compare(
     t_range: TRange = None,
     labels: Sequence[str] | None = None,
     max_panels: int = 8,
+    units: Units | str | None = None,
+    dpi: int | None = None,
+    title: str | None = None,
 ) -> Figure:
     """One figure: absolute acceleration of each DOF and the force loop of each device that
     all results have, overlaid (at most ``max_panels`` panels, DOFs first)."""
@@ -253,10 +684,12 @@ def plot_compare(
     axes = fig.subplots(len(items), 1, squeeze=False)[:, 0]
     for ax, (kind, k) in zip(axes, items, strict=True):
         if kind == "dof":
-            plot_acceleration(rs, k, ax=ax, t_range=t_range, labels=names)
+            plot_acceleration(rs, k, ax=ax, t_range=t_range, labels=names, units=units)
         else:
-            plot_hysteresis(rs, k, ax=ax, t_range=t_range, labels=names)
-    return _finish(fig, path)
+            plot_hysteresis(rs, k, ax=ax, t_range=t_range, labels=names, units=units)
+    if title:
+        fig.suptitle(title)
+    return _finish(fig, path, dpi)
 
 
 def plot_all(
@@ -266,15 +699,20 @@ def plot_all(
     *,
     t_range: TRange = None,
     max_items: int = 10,
+    units: Units | str | None = None,
+    dpi: int | None = None,
 ) -> list[Path]:
     """Write the standard PNGs of one result into ``directory``: ``<stem>_aabs<i>.png`` per
     DOF, ``<stem>_sdot<d>.png``, ``<stem>_hysteresis<d>.png`` and ``<stem>_phase<d>.png`` per
-    device (the first ``max_items`` DOFs and devices). Returns the paths written."""
+    device (the first ``max_items`` DOFs and devices), and with storeys
+    ``<stem>_drift_profile.png``, ``<stem>_acceleration_profile.png`` and
+    ``<stem>_storey_loop<s>.png``. Returns the paths written."""
     directory = Path(directory)
     written: list[Path] = []
+    kw = {"t_range": t_range, "units": units, "dpi": dpi}
     for i in range(1, min(result.n_dof, max_items) + 1):
         p = directory / f"{stem}_aabs{i}.png"
-        plot_acceleration(result, i, p, t_range=t_range)
+        plot_acceleration(result, i, p, **kw)
         written.append(p)
     for d in range(1, min(result.n_devices, max_items) + 1):
         for kind, func in (
@@ -283,6 +721,18 @@ def plot_all(
             ("phase", plot_phase),
         ):
             p = directory / f"{stem}_{kind}{d}.png"
-            func(result, d, p, t_range=t_range)
+            opts = {"t_range": t_range, "dpi": dpi} if func is plot_phase else kw
+            func(result, d, p, **opts)
+            written.append(p)
+    if result.n_storeys and "drift1" in result:
+        p = directory / f"{stem}_drift_profile.png"
+        plot_drift_profile(result, p, units=units, dpi=dpi)
+        written.append(p)
+        p = directory / f"{stem}_acceleration_profile.png"
+        plot_acceleration_profile(result, p, units=units, dpi=dpi)
+        written.append(p)
+        for s in range(1, min(result.n_storeys, max_items) + 1):
+            p = directory / f"{stem}_storey_loop{s}.png"
+            plot_storey_loop(result, s, p, **kw)
             written.append(p)
     return written

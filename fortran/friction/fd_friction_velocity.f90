@@ -1,15 +1,22 @@
 !> The velocity model of friction (Dimova, eqs. 6-11): a viscous coupling c1 = P mu / eps
 !> inside the band |sdot| < eps (eq. 6), the Coulomb force P mu sgn(sdot) outside (eq. 7),
 !> with the sign of the previous step (eq. 8). Correctness condition: eq. 9.
+!>
+!> Velocity-dependent friction (the paper's natural extension of this law): mu may be a
+!> function of the sliding speed |sdot|, mu_max - (mu_max - mu_min) exp(-rate |sdot|) or
+!> linear between the points of a table. Like the sign (eq. 8), mu is taken at the velocity
+!> at the start of the step and held during it (an explicit lag of one step: the force stays a
+!> constant load, so nothing is refactored); inside the band the coupling is P mu(eps) / eps,
+!> continuous with the sliding force at |sdot| = eps.
 module fd_friction_velocity
    use fd_kinds, only: dp
-   use fd_model, only: device_type
+   use fd_model, only: device_type, mu_constant, mu_exponential, mu_table
    use fd_device_state, only: device_state, phase_stick, phase_slip_pos, phase_slip_neg, &
                               job_init, job_update, job_correct
    implicit none
    private
 
-   public :: velocity_law, velocity_init, velocity_update, velocity_correct
+   public :: velocity_law, velocity_init, velocity_update, velocity_correct, sliding_mu
 
 contains
 
@@ -45,7 +52,7 @@ contains
 
       st%phase = phase_stick
       call velocity_update(dev, s, sdot, st, changed)
-      call set_coefficients(dev, st)
+      call set_coefficients(dev, sdot, st)
    end subroutine velocity_init
 
    !> Phase for the next step from the velocity at the end of this one (eqs. 6-8).
@@ -69,7 +76,7 @@ contains
       end if
       changed = st%phase /= old
       st%centre = s
-      call set_coefficients(dev, st)
+      call set_coefficients(dev, sdot, st)
    end subroutine velocity_update
 
    !> Correctness condition, eq. 9, for a step taken in the phase st (checked in sliding).
@@ -84,17 +91,59 @@ contains
       if (st%phase /= phase_stick) ok = sdot_new*sdot_old > dev%eps**2*(1.0_dp - 1.0_dp/n)
    end function velocity_correct
 
-   pure subroutine set_coefficients(dev, st)
+   !> Friction coefficient at the sliding speed |v|: mu itself (constant), the exponential
+   !> mu_max - (mu_max - mu_min) exp(-rate |v|) with mu_max = mu, or linear between the table's
+   !> points (constant before the first and after the last).
+   elemental real(dp) function sliding_mu(dev, v) result(mu)
+      type(device_type), intent(in) :: dev   !! device parameters
+      real(dp), intent(in) :: v              !! sliding velocity (its magnitude is used) [m/s]
+      real(dp) :: speed, w
+      integer :: k, n
+
+      speed = abs(v)
+      select case (dev%mu_law)
+      case (mu_exponential)
+         mu = dev%mu - (dev%mu - dev%mu_min)*exp(-dev%mu_rate*speed)
+      case (mu_table)
+         n = dev%n_mu_points
+         if (speed <= dev%mu_v(1)) then
+            mu = dev%mu_at(1)
+         else if (speed >= dev%mu_v(n)) then
+            mu = dev%mu_at(n)
+         else
+            do k = 2, n
+               if (speed <= dev%mu_v(k)) exit
+            end do
+            w = (speed - dev%mu_v(k - 1))/(dev%mu_v(k) - dev%mu_v(k - 1))
+            mu = dev%mu_at(k - 1) + w*(dev%mu_at(k) - dev%mu_at(k - 1))
+         end if
+      case default
+         mu = dev%mu
+      end select
+   end function sliding_mu
+
+   !> Force coefficients of the phase: the band's coupling P mu(eps) / eps, or the sliding
+   !> force P mu(|sdot|) sgn with sdot the velocity at the start of the step.
+   pure subroutine set_coefficients(dev, sdot, st)
       type(device_type), intent(in) :: dev
+      real(dp), intent(in) :: sdot
       type(device_state), intent(inout) :: st
 
       st%ks = 0.0_dp
-      if (st%phase == phase_stick) then
-         st%cs = dev%p*dev%mu/dev%eps
+      if (dev%mu_law == mu_constant) then
+         if (st%phase == phase_stick) then
+            st%cs = dev%p*dev%mu/dev%eps
+            st%f0 = 0.0_dp
+         else
+            st%cs = 0.0_dp
+            st%f0 = st%phase*dev%p*dev%mu
+         end if
+      else if (st%phase == phase_stick) then
+         st%cs = dev%p*sliding_mu(dev, dev%eps)/dev%eps
          st%f0 = 0.0_dp
       else
          st%cs = 0.0_dp
-         st%f0 = st%phase*dev%p*dev%mu
+         st%f0 = st%phase*dev%p*sliding_mu(dev, sdot)
       end if
    end subroutine set_coefficients
 

@@ -10,7 +10,7 @@ module fd_deck
    use fd_kinds, only: dp
    use fd_error, only: error_type, fatal_error, fmt_int, fmt_real, stat_no_memory
    use fd_textio, only: lower
-   use fd_namelist, only: deck_text, group_text, load_deck, deck_from_string, find_group, group_item, &
+   use fd_namelist, only: deck_text, group_text, deck_from_string, find_group, group_item, &
                           group_read_error, check_groups, longest_string
    use fd_names, only: keyword_id, keyword_choices, law_id, law_choices, &
                        damping_types, damping_stiffness, damping_rayleigh, damping_none, &
@@ -26,8 +26,15 @@ module fd_deck
    use fd_excitation, only: excitation_type
    use fd_record, only: read_record, record_info, record_formats, record_units_list, units_factor
    use fd_technique, only: check_technique
+   use fd_names, only: label_len, max_mu_points, mu_laws, mu_constant, mu_exponential, mu_table, mode_systems, &
+                       system_stuck, law_velocity, law_hysteretic, technique_event_driven, technique_newmark, &
+                       default_mu_law, default_mode_system, default_n_modes, default_radius, &
+                       default_storey_height, law_name
+   use fd_model, only: source_friction, source_brace, source_isolator
+   use fd_matrices, only: modes_type, natural_modes, stiffness_matrix
+   use fd_sha256, only: sha256_text
+   use fd_textio, only: read_file_text
    use fd_step_limits, only: check_step_limits
-   use fd_names, only: technique_newmark
    implicit none
    private
 
@@ -57,21 +64,30 @@ module fd_deck
 
 contains
 
-   !> Read and validate a deck file.
+   !> Read and validate a deck file. Its bytes are read once: split into lines as load_deck
+   !> does, and hashed for the summary (deck_sha256, what `sha256sum` prints).
    subroutine read_deck(path, cfg, error)
       character(len=*), intent(in) :: path                !! deck file
       type(run_config), intent(out) :: cfg                !! what it defines
       type(error_type), allocatable, intent(out) :: error !! first problem found
       type(deck_text) :: deck
+      character(len=:), allocatable :: text
 
+      call read_file_text(path, text, error)
+      if (allocated(error)) then
+         error%message = "deck: "//error%message
+         return
+      end if
       ! a value too large for a double ('1e400' in a deck or a record) overflows to infinity
       ! when it is converted, and is then rejected with a message: a build that traps
       ! overflow (-ffpe-trap, tools/test_checked.sh) must not stop there. The halting mode is
       ! restored when this reader returns (Fortran 2008, 14.3), the overflow handled.
       if (ieee_support_halting(ieee_overflow)) call ieee_set_halting_mode(ieee_overflow, .false.)
-      call load_deck(path, deck, error)
+      call deck_from_string(text, path, deck, error)
       if (.not. allocated(error)) call read_groups(deck, cfg, error)
       call ieee_set_flag(ieee_overflow, .false.)
+      if (allocated(error)) return
+      call sha256_text(text, cfg%model%deck_sha256)
    end subroutine read_deck
 
    !> Read and validate a deck given as text. The path names the deck in messages, gives
@@ -91,6 +107,8 @@ contains
       call deck_from_string(text, path, deck, error)
       if (.not. allocated(error)) call read_groups(deck, cfg, error)
       call ieee_set_flag(ieee_overflow, .false.)
+      if (allocated(error)) return
+      call sha256_text(text, cfg%model%deck_sha256)
    end subroutine read_deck_string
 
    subroutine read_groups(deck, cfg, error)
@@ -100,6 +118,7 @@ contains
 
       cfg%deck_path = deck%path
       call check_groups(deck, [character(len=12) :: 'model', 'springs', 'damping', 'friction', &
+                               'braces', 'isolators', 'storeys', &
                                'excitation', 'integration', 'output'], error)
       if (allocated(error)) return
       call read_model_group(deck, cfg, error)
@@ -110,11 +129,23 @@ contains
       if (allocated(error)) return
       call read_friction_group(deck, cfg, error)
       if (allocated(error)) return
+      ! the engineers' shorthands, expanded into devices and springs, and the storeys
+      call read_braces_group(deck, cfg, error)
+      if (allocated(error)) return
+      call read_isolators_group(deck, cfg, error)
+      if (allocated(error)) return
+      call read_storeys_group(deck, cfg, error)
+      if (allocated(error)) return
       call read_excitation_group(deck, cfg, error)
       if (allocated(error)) return
       call read_integration_group(deck, cfg, error)
       if (allocated(error)) return
       call read_output_group(deck, cfg, error)
+      if (allocated(error)) return
+      ! 'rayleigh' damping from xi at two modes; shorthands the technique cannot integrate
+      call resolve_rayleigh(deck, cfg, error)
+      if (allocated(error)) return
+      call check_shorthands(deck, cfg, error)
       if (allocated(error)) return
       ! what the technique cannot integrate (a law, a table motion)
       call check_technique(cfg%model, cfg%exc, cfg%opts, error)
@@ -134,7 +165,8 @@ contains
       type(error_type), allocatable, intent(out) :: error
       integer :: n_dof
       real(dp), allocatable :: mass(:), u0(:), v0(:)
-      namelist /model/ n_dof, mass, u0, v0
+      character(len=label_len), allocatable :: label(:)
+      namelist /model/ n_dof, mass, u0, v0, label
       type(group_text) :: grp
       character(len=512) :: msg, msg0
       character(len=:), allocatable :: rec
@@ -144,11 +176,16 @@ contains
       n_dof = unset_int
       allocate (mass(max_dof), u0(max_dof), v0(max_dof))
       mass = unset; u0 = unset; v0 = unset
+      allocate (label(max_dof))
+      label = ''
       call find_group(deck, 'model', grp, found, error)
       if (allocated(error)) return
       if (.not. found) then
          call missing_group(deck, 'model', error); return
       end if
+      ! a longer label would be cut by the namelist read: refused from the group's text first
+      call check_length(deck, grp, 'label', label_len - 1, error)
+      if (allocated(error)) return
       msg0 = ''
       read (grp%lines, nml=model, iostat=ios, iomsg=msg0)
       if (ios /= 0) then
@@ -169,6 +206,9 @@ contains
       if (allocated(error)) return
       call optional_reals(deck, 'model', 'v0', v0, n, default_v0, 'm/s', error)
       if (allocated(error)) return
+      call check_labels(deck, grp, 'model', label, n, error)
+      if (allocated(error)) return
+      cfg%model%dof_label = label(1:n)
       cfg%model%n_dof = n
       cfg%model%mass = mass(1:n)
       cfg%model%u0 = u0(1:n)
@@ -230,6 +270,8 @@ contains
       cfg%model%spring_i = node_i(1:n)
       cfg%model%spring_j = node_j(1:n)
       cfg%model%spring_k = k(1:n)
+      allocate (cfg%model%spring_source(n))
+      cfg%model%spring_source = source_friction
    end subroutine read_springs_group
 
    ! ---------------------------------------------------------------- &damping
@@ -239,7 +281,9 @@ contains
       type(error_type), allocatable, intent(out) :: error
       character(len=name_len) :: damping_type
       real(dp) :: xi, period, rayleigh_a0, rayleigh_a1
-      namelist /damping/ damping_type, xi, period, rayleigh_a0, rayleigh_a1
+      integer :: mode_i, mode_j
+      character(len=name_len) :: mode_system
+      namelist /damping/ damping_type, xi, period, rayleigh_a0, rayleigh_a1, mode_i, mode_j, mode_system
       type(group_text) :: grp
       character(len=512) :: msg, msg0
       character(len=:), allocatable :: rec, choices
@@ -249,12 +293,14 @@ contains
       damping_type = ''
       xi = default_xi; period = default_period
       rayleigh_a0 = default_rayleigh_a0; rayleigh_a1 = default_rayleigh_a1
+      mode_i = unset_int; mode_j = unset_int; mode_system = mode_systems(default_mode_system)%name
       call find_group(deck, 'damping', grp, found, error)
       if (allocated(error)) return
       if (.not. found) then
          call missing_group(deck, 'damping', error); return
       end if
       call check_length(deck, grp, 'damping_type', name_len, error)
+      if (.not. allocated(error)) call check_length(deck, grp, 'mode_system', name_len, error)
       if (allocated(error)) return
       msg0 = ''
       read (grp%lines, nml=damping, iostat=ios, iomsg=msg0)
@@ -279,6 +325,8 @@ contains
          if (allocated(error)) return
          call check_real(deck, 'damping', 'rayleigh_a1', rayleigh_a1, 0.0_dp, max_magnitude, 's', error)
          if (allocated(error)) return
+         call rayleigh_modes(deck, xi, rayleigh_a0, rayleigh_a1, mode_i, mode_j, mode_system, cfg, error)
+         if (allocated(error)) return
       case (damping_none)
       case default
          call keyword_choices(damping_types, choices)
@@ -300,7 +348,12 @@ contains
       integer, allocatable :: node_i(:), node_j(:)
       character(len=name_len), allocatable :: law(:)
       real(dp), allocatable :: p(:), mu(:), eps(:), eps1(:), f(:)
-      namelist /friction/ n_devices, node_i, node_j, law, p, mu, eps, eps1, f
+      character(len=name_len), allocatable :: mu_law(:)
+      real(dp), allocatable :: mu_max(:), mu_min(:), mu_rate(:), mu_table_v(:, :), mu_table_mu(:, :)
+      character(len=label_len), allocatable :: label(:)
+      integer, allocatable :: mu_ids(:)
+      namelist /friction/ n_devices, node_i, node_j, law, p, mu, eps, eps1, f, &
+         mu_law, mu_max, mu_min, mu_rate, mu_table_v, mu_table_mu, label
       type(group_text) :: grp
       character(len=512) :: msg, msg0
       character(len=:), allocatable :: rec, idx, choices
@@ -312,12 +365,17 @@ contains
                 mu(max_devices), eps(max_devices), eps1(max_devices), f(max_devices))
       node_i = unset_int; node_j = unset_int; law = ''
       p = unset; mu = unset; eps = unset; eps1 = unset; f = unset
+      call new_mu_inputs(mu_law, mu_max, mu_min, mu_rate, mu_table_v, mu_table_mu, label)
       call find_group(deck, 'friction', grp, found, error)
       if (allocated(error)) return
       cfg%model%n_devices = 0
       allocate (cfg%model%dev(0))
       if (.not. found) return
       call check_length(deck, grp, 'law', name_len, error)
+      if (.not. allocated(error)) call check_length(deck, grp, 'mu_law', name_len, error)
+      if (allocated(error)) return
+      ! a longer label would be cut by the namelist read: refused from the group's text first
+      call check_length(deck, grp, 'label', label_len - 1, error)
       if (allocated(error)) return
       msg0 = ''
       read (grp%lines, nml=friction, iostat=ios, iomsg=msg0)
@@ -338,6 +396,11 @@ contains
       call node_list(deck, 'friction', 'node_j', node_j, n, 0, cfg%model%n_dof, error)
       if (allocated(error)) return
       call need_reals(deck, 'friction', 'p', p, n, 'N', error, positive=.false.)
+      if (allocated(error)) return
+      call read_mu_laws(deck, 'friction', n, mu_law, mu, mu_max, mu_min, mu_rate, mu_table_v, mu_table_mu, &
+                        mu_ids, error)
+      if (allocated(error)) return
+      call check_labels(deck, grp, 'friction', label, n, error)
       if (allocated(error)) return
       call need_reals(deck, 'friction', 'mu', mu, n, '', error, positive=.false.)
       if (allocated(error)) return
@@ -384,6 +447,11 @@ contains
          end if
          cfg%model%dev(i) = device_type(node_i=node_i(i), node_j=node_j(i), law=id, &
                                         p=p(i), mu=mu(i), eps=eps(i), eps1=eps1(i), f=f(i))
+         call apply_mu_law(deck, 'friction', i, mu_ids(i), mu_min(i), mu_rate(i), mu_table_v(:, i), &
+                           mu_table_mu(:, i), cfg%model%dev(i), error)
+         if (allocated(error)) return
+         cfg%model%dev(i)%label = label(i)
+         cfg%model%dev(i)%source_index = i
       end do
       cfg%model%n_devices = n
    end subroutine read_friction_group
@@ -606,9 +674,9 @@ contains
       type(run_config), intent(inout) :: cfg
       type(error_type), allocatable, intent(out) :: error
       character(len=path_len) :: dir, name
-      integer :: output_every
+      integer :: output_every, n_modes
       logical :: write_history
-      namelist /output/ dir, name, output_every, write_history
+      namelist /output/ dir, name, output_every, write_history, n_modes
       type(group_text) :: grp
       character(len=512) :: msg, msg0
       character(len=:), allocatable :: rec
@@ -616,6 +684,7 @@ contains
       logical :: found
 
       dir = default_dir; output_every = default_output_every; write_history = default_write_history
+      n_modes = default_n_modes
       call stem(deck%path, name)
       call find_group(deck, 'output', grp, found, error)
       if (allocated(error)) return
@@ -649,7 +718,660 @@ contains
       cfg%out%name = trim(name)
       cfg%out%history = write_history
       cfg%opts%output_every = output_every
+      if (n_modes < 0) then
+         call bad(deck, 'output', 'n_modes', trim(fmt_int(n_modes)), '>= 0 (0 = no modes)', error)
+         return
+      end if
+      cfg%opts%n_modes = n_modes
    end subroutine read_output_group
+
+   ! ---------------------------------------------------------------- &braces
+   !> Friction dampers in series with an elastic brace (Pall type), a shorthand: brace b
+   !> becomes a hysteretic device with P mu = slip_load (p = slip_load, mu = 1) and
+   !> f = slip_load / stiffness, so that its sticking stiffness P mu / f is the brace's.
+   subroutine read_braces_group(deck, cfg, error)
+      type(deck_text), intent(in) :: deck
+      type(run_config), intent(inout) :: cfg
+      type(error_type), allocatable, intent(out) :: error
+      integer :: n_braces
+      integer, allocatable :: node_i(:), node_j(:)
+      real(dp), allocatable :: slip_load(:), stiffness(:), eps1(:)
+      character(len=label_len), allocatable :: label(:)
+      namelist /braces/ n_braces, node_i, node_j, slip_load, stiffness, eps1, label
+      type(group_text) :: grp
+      type(device_type), allocatable :: dev(:)
+      character(len=512) :: msg, msg0
+      character(len=:), allocatable :: rec, idx
+      integer :: ios, i, n
+      logical :: found
+
+      n_braces = 0
+      allocate (node_i(max_devices), node_j(max_devices), slip_load(max_devices), stiffness(max_devices), &
+                eps1(max_devices), label(max_devices))
+      node_i = unset_int; node_j = unset_int; slip_load = unset; stiffness = unset; eps1 = unset; label = ''
+      call find_group(deck, 'braces', grp, found, error)
+      if (allocated(error) .or. .not. found) return
+      ! a longer label would be cut by the namelist read: refused from the group's text first
+      call check_length(deck, grp, 'label', label_len - 1, error)
+      if (allocated(error)) return
+      msg0 = ''
+      read (grp%lines, nml=braces, iostat=ios, iomsg=msg0)
+      if (ios /= 0) then
+         do i = 1, size(grp%items)
+            call group_item(grp, i, rec); msg = ''
+            read (rec, nml=braces, iostat=ios, iomsg=msg)
+            if (ios /= 0) exit
+         end do
+         if (ios == 0) msg = msg0
+         call group_read_error(deck, grp, i, msg, error); return
+      end if
+      call need_int(deck, 'braces', 'n_braces', n_braces, 0, max_devices - cfg%model%n_devices, error)
+      if (allocated(error)) return
+      n = n_braces
+      call node_list(deck, 'braces', 'node_i', node_i, n, 1, cfg%model%n_dof, error)
+      if (allocated(error)) return
+      call node_list(deck, 'braces', 'node_j', node_j, n, 0, cfg%model%n_dof, error)
+      if (allocated(error)) return
+      call need_reals(deck, 'braces', 'slip_load', slip_load, n, 'N', error, positive=.true.)
+      if (allocated(error)) return
+      call need_reals(deck, 'braces', 'stiffness', stiffness, n, 'N/m', error, positive=.true.)
+      if (allocated(error)) return
+      call optional_reals(deck, 'braces', 'eps1', eps1, n, default_eps1, 'm/s', error, positive=.true.)
+      if (allocated(error)) return
+      call check_labels(deck, grp, 'braces', label, n, error)
+      if (allocated(error)) return
+      allocate (dev(n))
+      do i = 1, n
+         idx = '('//trim(fmt_int(i))//')'
+         if (node_i(i) == node_j(i)) then
+            call bad(deck, 'braces', 'node_j'//idx, trim(fmt_int(node_j(i))), 'different from node_i'//idx//' = '// &
+                     trim(fmt_int(node_i(i)))//': a brace joins two different nodes', error)
+            return
+         end if
+         ! the sticking displacement f = slip_load / stiffness, a length: within the limits
+         call check_magnitude(deck, 'braces', 'slip_load'//idx//' / stiffness'//idx, slip_load(i)/stiffness(i), &
+                              'm', .true., error)
+         if (allocated(error)) return
+         dev(i) = device_type(node_i=node_i(i), node_j=node_j(i), law=law_hysteretic, p=slip_load(i), &
+                              mu=1.0_dp, eps1=eps1(i), f=slip_load(i)/stiffness(i))
+         dev(i)%label = label(i)
+         if (len_trim(label(i)) == 0) dev(i)%label = 'brace '//trim(fmt_int(i))
+         dev(i)%source = source_brace
+         dev(i)%source_index = i
+      end do
+      cfg%model%dev = [cfg%model%dev, dev]
+      cfg%model%n_devices = size(cfg%model%dev)
+   end subroutine read_braces_group
+
+   ! ---------------------------------------------------------------- &isolators
+   !> Sliding isolators, a shorthand: isolator i (flat, or curved with radius R) becomes a
+   !> friction device with the normal force P = weight (its law and mu as in &friction) and,
+   !> when curved, a spring weight / radius between the same nodes (the pendulum's
+   !> restoring stiffness W / R, small displacements).
+   subroutine read_isolators_group(deck, cfg, error)
+      type(deck_text), intent(in) :: deck
+      type(run_config), intent(inout) :: cfg
+      type(error_type), allocatable, intent(out) :: error
+      integer :: n_isolators
+      integer, allocatable :: node_i(:), node_j(:)
+      character(len=name_len), allocatable :: law(:)
+      real(dp), allocatable :: weight(:), mu(:), radius(:), eps(:), eps1(:), f(:)
+      character(len=name_len), allocatable :: mu_law(:)
+      real(dp), allocatable :: mu_max(:), mu_min(:), mu_rate(:), mu_table_v(:, :), mu_table_mu(:, :)
+      character(len=label_len), allocatable :: label(:)
+      integer, allocatable :: mu_ids(:)
+      namelist /isolators/ n_isolators, node_i, node_j, law, weight, mu, radius, eps, eps1, f, &
+         mu_law, mu_max, mu_min, mu_rate, mu_table_v, mu_table_mu, label
+      type(group_text) :: grp
+      type(device_type), allocatable :: dev(:)
+      character(len=512) :: msg, msg0
+      character(len=:), allocatable :: rec, idx, choices
+      integer :: ios, i, n, id
+      logical :: found
+
+      n_isolators = 0
+      allocate (node_i(max_devices), node_j(max_devices), law(max_devices), weight(max_devices), &
+                mu(max_devices), radius(max_devices), eps(max_devices), eps1(max_devices), f(max_devices))
+      node_i = unset_int; node_j = unset_int; law = ''
+      weight = unset; mu = unset; radius = unset; eps = unset; eps1 = unset; f = unset
+      call new_mu_inputs(mu_law, mu_max, mu_min, mu_rate, mu_table_v, mu_table_mu, label)
+      call find_group(deck, 'isolators', grp, found, error)
+      if (allocated(error) .or. .not. found) return
+      ! a longer label would be cut by the namelist read: refused from the group's text first
+      call check_length(deck, grp, 'label', label_len - 1, error)
+      if (allocated(error)) return
+      call check_length(deck, grp, 'law', name_len, error)
+      if (.not. allocated(error)) call check_length(deck, grp, 'mu_law', name_len, error)
+      if (allocated(error)) return
+      msg0 = ''
+      read (grp%lines, nml=isolators, iostat=ios, iomsg=msg0)
+      if (ios /= 0) then
+         do i = 1, size(grp%items)
+            call group_item(grp, i, rec); msg = ''
+            read (rec, nml=isolators, iostat=ios, iomsg=msg)
+            if (ios /= 0) exit
+         end do
+         if (ios == 0) msg = msg0
+         call group_read_error(deck, grp, i, msg, error); return
+      end if
+      call need_int(deck, 'isolators', 'n_isolators', n_isolators, 0, max_devices - cfg%model%n_devices, error)
+      if (allocated(error)) return
+      n = n_isolators
+      call node_list(deck, 'isolators', 'node_i', node_i, n, 1, cfg%model%n_dof, error)
+      if (allocated(error)) return
+      call node_list(deck, 'isolators', 'node_j', node_j, n, 0, cfg%model%n_dof, error)
+      if (allocated(error)) return
+      call need_reals(deck, 'isolators', 'weight', weight, n, 'N', error, positive=.true.)
+      if (allocated(error)) return
+      call read_mu_laws(deck, 'isolators', n, mu_law, mu, mu_max, mu_min, mu_rate, mu_table_v, mu_table_mu, &
+                        mu_ids, error)
+      if (allocated(error)) return
+      call need_reals(deck, 'isolators', 'mu', mu, n, '', error, positive=.false.)
+      if (allocated(error)) return
+      call optional_reals(deck, 'isolators', 'radius', radius, n, default_radius, 'm', error)
+      if (allocated(error)) return
+      call optional_reals(deck, 'isolators', 'eps', eps, n, default_eps, 'm/s', error, positive=.true.)
+      if (allocated(error)) return
+      call optional_reals(deck, 'isolators', 'eps1', eps1, n, default_eps1, 'm/s', error, positive=.true.)
+      if (allocated(error)) return
+      call optional_reals(deck, 'isolators', 'f', f, n, default_f, 'm', error, positive=.true.)
+      if (allocated(error)) return
+      call check_labels(deck, grp, 'isolators', label, n, error)
+      if (allocated(error)) return
+      if (any(law(n + 1:) /= '')) then
+         call bad(deck, 'isolators', 'law', 'with '//trim(fmt_int(findloc(law /= '', .true., 1, back=.true.))) &
+                  //' values', 'at most n_isolators = '//trim(fmt_int(n))//' values', error)
+         return
+      end if
+      allocate (dev(n))
+      do i = 1, n
+         idx = '('//trim(fmt_int(i))//')'
+         if (node_i(i) == node_j(i)) then
+            call bad(deck, 'isolators', 'node_j'//idx, trim(fmt_int(node_j(i))), 'different from node_i'//idx// &
+                     ' = '//trim(fmt_int(node_i(i)))//': an isolator joins two different nodes', error)
+            return
+         end if
+         if (radius(i) < 0.0_dp) then
+            call bad(deck, 'isolators', 'radius'//idx, trim(fmt_real(radius(i))), '>= 0 m (0 = flat)', error)
+            return
+         end if
+         if (radius(i) > 0.0_dp) then
+            call check_magnitude(deck, 'isolators', 'radius'//idx, radius(i), 'm', .true., error)
+            if (allocated(error)) return
+            ! the pendulum's stiffness W / R is a spring: within the magnitude limits
+            call check_magnitude(deck, 'isolators', 'weight'//idx//' / radius'//idx, weight(i)/radius(i), 'N/m', &
+                                 .true., error)
+            if (allocated(error)) return
+         end if
+         if (weight(i)*mu(i) /= 0.0_dp .and. weight(i)*mu(i) < min_scale) then
+            call bad(deck, 'isolators', 'weight'//idx//' * mu'//idx, trim(fmt_real(weight(i)*mu(i))), &
+                     '0 (no friction) or at least '//trim(fmt_real(min_scale))//' N: the friction force W mu of '// &
+                     'an isolator (here W = '//trim(fmt_real(weight(i)))//' N, mu = '//trim(fmt_real(mu(i)))//')', error)
+            return
+         end if
+         id = law_id(law(i))
+         if (id == 0) then
+            call law_choices(choices)
+            if (len_trim(law(i)) == 0) then
+               call bad(deck, 'isolators', 'law'//idx, '(not given)', 'one of '//choices, error)
+            else
+               call bad(deck, 'isolators', 'law'//idx, "'"//trim(law(i))//"'", 'one of '//choices, error)
+            end if
+            return
+         end if
+         dev(i) = device_type(node_i=node_i(i), node_j=node_j(i), law=id, p=weight(i), mu=mu(i), &
+                              eps=eps(i), eps1=eps1(i), f=f(i))
+         call apply_mu_law(deck, 'isolators', i, mu_ids(i), mu_min(i), mu_rate(i), mu_table_v(:, i), &
+                           mu_table_mu(:, i), dev(i), error)
+         if (allocated(error)) return
+         dev(i)%label = label(i)
+         if (len_trim(label(i)) == 0) dev(i)%label = 'isolator '//trim(fmt_int(i))
+         dev(i)%source = source_isolator
+         dev(i)%source_index = i
+         if (radius(i) > 0.0_dp) then
+            ! the restoring stiffness of the curved surface, W / R
+            if (cfg%model%n_springs + 1 > max_springs) then
+               call bad(deck, 'isolators', 'n_isolators', trim(fmt_int(n)), 'such that the springs of the '// &
+                        'curved isolators and those of &springs are at most '//trim(fmt_int(max_springs)), error)
+               return
+            end if
+            cfg%model%spring_i = [cfg%model%spring_i, node_i(i)]
+            cfg%model%spring_j = [cfg%model%spring_j, node_j(i)]
+            cfg%model%spring_k = [cfg%model%spring_k, weight(i)/radius(i)]
+            cfg%model%spring_source = [cfg%model%spring_source, source_isolator]
+            cfg%model%n_springs = cfg%model%n_springs + 1
+         end if
+      end do
+      cfg%model%dev = [cfg%model%dev, dev]
+      cfg%model%n_devices = size(cfg%model%dev)
+   end subroutine read_isolators_group
+
+   ! ---------------------------------------------------------------- &storeys
+   !> The storeys whose drift and shear the outputs report: each a pair of nodes (upper
+   !> node_i, lower node_j) or the two nodes of a spring of &springs, with an optional
+   !> height (for the drift ratio) and label.
+   subroutine read_storeys_group(deck, cfg, error)
+      type(deck_text), intent(in) :: deck
+      type(run_config), intent(inout) :: cfg
+      type(error_type), allocatable, intent(out) :: error
+      integer :: n_storeys
+      integer, allocatable :: node_i(:), node_j(:), spring(:)
+      real(dp), allocatable :: height(:)
+      character(len=label_len), allocatable :: label(:)
+      namelist /storeys/ n_storeys, node_i, node_j, spring, height, label
+      type(group_text) :: grp
+      character(len=512) :: msg, msg0
+      character(len=:), allocatable :: rec, idx
+      integer :: ios, i, n, last
+      logical :: found
+
+      n_storeys = 0
+      allocate (node_i(max_dof), node_j(max_dof), spring(max_dof), height(max_dof), label(max_dof))
+      node_i = unset_int; node_j = unset_int; spring = unset_int; height = unset; label = ''
+      cfg%model%n_storeys = 0
+      allocate (cfg%model%storey_i(0), cfg%model%storey_j(0), cfg%model%storey_height(0), &
+                cfg%model%storey_label(0))
+      call find_group(deck, 'storeys', grp, found, error)
+      if (allocated(error) .or. .not. found) return
+      ! a longer label would be cut by the namelist read: refused from the group's text first
+      call check_length(deck, grp, 'label', label_len - 1, error)
+      if (allocated(error)) return
+      msg0 = ''
+      read (grp%lines, nml=storeys, iostat=ios, iomsg=msg0)
+      if (ios /= 0) then
+         do i = 1, size(grp%items)
+            call group_item(grp, i, rec); msg = ''
+            read (rec, nml=storeys, iostat=ios, iomsg=msg)
+            if (ios /= 0) exit
+         end do
+         if (ios == 0) msg = msg0
+         call group_read_error(deck, grp, i, msg, error); return
+      end if
+      call need_int(deck, 'storeys', 'n_storeys', n_storeys, 0, max_dof, error)
+      if (allocated(error)) return
+      n = n_storeys
+      do i = 1, n
+         idx = '('//trim(fmt_int(i))//')'
+         if (spring(i) /= unset_int) then
+            if (node_i(i) /= unset_int .or. node_j(i) /= unset_int) then
+               call bad(deck, 'storeys', 'spring'//idx, trim(fmt_int(spring(i))), 'given alone: storey '// &
+                        trim(fmt_int(i))//' is a spring or a pair of nodes (node_i'//idx//', node_j'//idx// &
+                        '), not both', error)
+               return
+            end if
+            if (spring(i) < 1 .or. spring(i) > cfg%model%n_springs) then
+               call bad(deck, 'storeys', 'spring'//idx, trim(fmt_int(spring(i))), 'a spring in 1..'// &
+                        trim(fmt_int(cfg%model%n_springs)), error)
+               return
+            end if
+            node_i(i) = cfg%model%spring_i(spring(i))
+            node_j(i) = cfg%model%spring_j(spring(i))
+         end if
+      end do
+      last = findloc(spring /= unset_int, .true., 1, back=.true.)
+      if (last > n) then
+         call bad(deck, 'storeys', 'spring('//trim(fmt_int(last))//')', trim(fmt_int(spring(last))), &
+                  'absent: only '//trim(fmt_int(n))//' value(s) are expected', error)
+         return
+      end if
+      call node_list(deck, 'storeys', 'node_i', node_i, n, 1, cfg%model%n_dof, error)
+      if (allocated(error)) return
+      call node_list(deck, 'storeys', 'node_j', node_j, n, 0, cfg%model%n_dof, error)
+      if (allocated(error)) return
+      call optional_reals(deck, 'storeys', 'height', height, n, default_storey_height, 'm', error)
+      if (allocated(error)) return
+      call check_labels(deck, grp, 'storeys', label, n, error)
+      if (allocated(error)) return
+      do i = 1, n
+         idx = '('//trim(fmt_int(i))//')'
+         if (node_i(i) == node_j(i)) then
+            call bad(deck, 'storeys', 'node_j'//idx, trim(fmt_int(node_j(i))), 'different from node_i'//idx// &
+                     ' = '//trim(fmt_int(node_i(i)))//': a storey lies between two different nodes', error)
+            return
+         end if
+         if (height(i) < 0.0_dp) then
+            call bad(deck, 'storeys', 'height'//idx, trim(fmt_real(height(i))), '>= 0 m (0 = not given)', error)
+            return
+         end if
+         if (height(i) > 0.0_dp) then
+            call check_magnitude(deck, 'storeys', 'height'//idx, height(i), 'm', .true., error)
+            if (allocated(error)) return
+         end if
+      end do
+      cfg%model%n_storeys = n
+      cfg%model%storey_i = node_i(1:n)
+      cfg%model%storey_j = node_j(1:n)
+      cfg%model%storey_height = height(1:n)
+      cfg%model%storey_label = label(1:n)
+   end subroutine read_storeys_group
+
+   ! ---------------------------------------------------------------- mu(v), labels
+   !> The inputs of velocity-dependent friction and labels, unset.
+   subroutine new_mu_inputs(mu_law, mu_max, mu_min, mu_rate, mu_table_v, mu_table_mu, label)
+      character(len=name_len), allocatable, intent(out) :: mu_law(:)
+      real(dp), allocatable, intent(out) :: mu_max(:), mu_min(:), mu_rate(:), mu_table_v(:, :), mu_table_mu(:, :)
+      character(len=label_len), allocatable, intent(out) :: label(:)
+
+      allocate (mu_law(max_devices), mu_max(max_devices), mu_min(max_devices), mu_rate(max_devices), &
+                mu_table_v(max_mu_points, max_devices), mu_table_mu(max_mu_points, max_devices), label(max_devices))
+      mu_law = ''; mu_max = unset; mu_min = unset; mu_rate = unset; mu_table_v = unset; mu_table_mu = unset
+      label = ''
+   end subroutine new_mu_inputs
+
+   !> mu as a function of the sliding velocity for each of n items of a group: mu_law
+   !> ('constant' by default), and for 'exponential' mu_max, mu_min, mu_rate, for 'table' the
+   !> points (mu_table_v(k, i), mu_table_mu(k, i)). For those two, mu is not given: it is set
+   !> here to mu_max, or to the table's last value (what a slide at high speed meets).
+   subroutine read_mu_laws(deck, group, n, mu_law, mu, mu_max, mu_min, mu_rate, tab_v, tab_mu, ids, error)
+      type(deck_text), intent(in) :: deck
+      character(len=*), intent(in) :: group
+      integer, intent(in) :: n
+      character(len=name_len), intent(in) :: mu_law(:)
+      real(dp), intent(inout) :: mu(:)
+      real(dp), intent(inout) :: mu_max(:), mu_min(:), mu_rate(:)
+      real(dp), intent(in) :: tab_v(:, :), tab_mu(:, :)
+      integer, allocatable, intent(out) :: ids(:)
+      type(error_type), allocatable, intent(out) :: error
+      character(len=:), allocatable :: idx, choices, law_of
+      integer :: i, k, np, last
+
+      allocate (ids(n))
+      last = findloc(mu_law /= '', .true., 1, back=.true.)
+      if (last > n) then
+         call bad(deck, group, 'mu_law('//trim(fmt_int(last))//')', "'"//trim(mu_law(last))//"'", &
+                  'absent: only '//trim(fmt_int(n))//' value(s) are expected', error)
+         return
+      end if
+      do k = 1, 3
+         select case (k)
+         case (1)
+            call no_extra(deck, group, 'mu_max', mu_max, n, error)
+         case (2)
+            call no_extra(deck, group, 'mu_min', mu_min, n, error)
+         case (3)
+            call no_extra(deck, group, 'mu_rate', mu_rate, n, error)
+         end select
+         if (allocated(error)) return
+      end do
+      do i = n + 1, size(tab_v, 2)
+         if (any(tab_v(:, i) /= unset) .or. any(tab_mu(:, i) /= unset)) then
+            call bad(deck, group, 'mu_table_v(:, '//trim(fmt_int(i))//')', '(given)', &
+                     'absent: only '//trim(fmt_int(n))//' item(s) are expected', error)
+            return
+         end if
+      end do
+      do i = 1, n
+         idx = '('//trim(fmt_int(i))//')'
+         ids(i) = default_mu_law
+         if (len_trim(mu_law(i)) > 0) ids(i) = keyword_id(mu_laws, mu_law(i))
+         if (ids(i) == 0) then
+            call keyword_choices(mu_laws, choices)
+            call bad(deck, group, 'mu_law'//idx, "'"//trim(mu_law(i))//"'", 'one of '//choices, error)
+            return
+         end if
+         law_of = "mu_law"//idx//" = '"//trim(mu_laws(ids(i))%name)//"'"
+         ! what the chosen form does not use must not be given (a forgotten mu_law)
+         if (ids(i) /= mu_exponential) then
+            if (mu_max(i) /= unset) then
+               call bad(deck, group, 'mu_max'//idx, trim(fmt_real(mu_max(i))), "absent with "//law_of// &
+                        " (set mu_law"//idx//" = 'exponential' to use it)", error); return
+            end if
+            if (mu_min(i) /= unset) then
+               call bad(deck, group, 'mu_min'//idx, trim(fmt_real(mu_min(i))), "absent with "//law_of// &
+                        " (set mu_law"//idx//" = 'exponential' to use it)", error); return
+            end if
+            if (mu_rate(i) /= unset) then
+               call bad(deck, group, 'mu_rate'//idx, trim(fmt_real(mu_rate(i))), "absent with "//law_of// &
+                        " (set mu_law"//idx//" = 'exponential' to use it)", error); return
+            end if
+         end if
+         if (ids(i) /= mu_table) then
+            if (any(tab_v(:, i) /= unset) .or. any(tab_mu(:, i) /= unset)) then
+               call bad(deck, group, 'mu_table_v(:, '//trim(fmt_int(i))//')', '(given)', "absent with "//law_of// &
+                        " (set mu_law"//idx//" = 'table' to use it)", error); return
+            end if
+         end if
+         if (ids(i) == mu_constant) cycle
+         if (mu(i) /= unset) then
+            call bad(deck, group, 'mu'//idx, trim(fmt_real(mu(i))), "absent with "//law_of//": mu(v) is given by "// &
+                     trim(mu_laws(ids(i))%note), error)
+            return
+         end if
+         select case (ids(i))
+         case (mu_exponential)
+            call need_real(deck, group, 'mu_max'//idx, mu_max(i), '', error, positive=.false.)
+            if (allocated(error)) return
+            call need_real(deck, group, 'mu_min'//idx, mu_min(i), '', error, positive=.false.)
+            if (allocated(error)) return
+            call need_real(deck, group, 'mu_rate'//idx, mu_rate(i), 's/m', error, positive=.true.)
+            if (allocated(error)) return
+            mu(i) = mu_max(i)
+         case (mu_table)
+            np = 0
+            do k = 1, size(tab_v, 1)
+               if (tab_v(k, i) == unset .and. tab_mu(k, i) == unset) exit
+               np = k
+            end do
+            if (any(tab_v(np + 1:, i) /= unset) .or. any(tab_mu(np + 1:, i) /= unset)) then
+               call bad(deck, group, 'mu_table_v(:, '//trim(fmt_int(i))//')', '(with a gap)', &
+                        'points 1, 2, ... without a gap', error)
+               return
+            end if
+            if (np < 2) then
+               call bad(deck, group, 'mu_table_v(:, '//trim(fmt_int(i))//')', '('//trim(fmt_int(np))//' point(s))', &
+                        'at least 2 points (v, mu), at most '//trim(fmt_int(max_mu_points)), error)
+               return
+            end if
+            do k = 1, np
+               idx = '('//trim(fmt_int(k))//', '//trim(fmt_int(i))//')'
+               call need_real(deck, group, 'mu_table_v'//idx, tab_v(k, i), 'm/s', error, positive=.false.)
+               if (allocated(error)) return
+               call need_real(deck, group, 'mu_table_mu'//idx, tab_mu(k, i), '', error, positive=.false.)
+               if (allocated(error)) return
+            end do
+            do k = 2, np
+               if (tab_v(k, i) <= tab_v(k - 1, i)) then
+                  call bad(deck, group, 'mu_table_v('//trim(fmt_int(k))//', '//trim(fmt_int(i))//')', &
+                           trim(fmt_real(tab_v(k, i))), '> mu_table_v('//trim(fmt_int(k - 1))//', '// &
+                           trim(fmt_int(i))//') = '//trim(fmt_real(tab_v(k - 1, i)))//': velocities increase', error)
+                  return
+               end if
+            end do
+            mu(i) = tab_mu(np, i)
+         end select
+      end do
+   end subroutine read_mu_laws
+
+   !> Set a device's mu(v) from the checked inputs (read_mu_laws); an error when the form
+   !> is not constant and the device's law is not the velocity law.
+   subroutine apply_mu_law(deck, group, i, id, mu_min, mu_rate, tab_v, tab_mu, dev, error)
+      type(deck_text), intent(in) :: deck
+      character(len=*), intent(in) :: group
+      integer, intent(in) :: i, id
+      real(dp), intent(in) :: mu_min, mu_rate, tab_v(:), tab_mu(:)
+      type(device_type), intent(inout) :: dev
+      type(error_type), allocatable, intent(out) :: error
+      integer :: k
+
+      dev%mu_law = id
+      if (id == mu_constant) return
+      if (dev%law /= law_velocity) then
+         call bad(deck, group, 'mu_law('//trim(fmt_int(i))//')', "'"//trim(mu_laws(id)%name)//"'", &
+                  "'constant' with law("//trim(fmt_int(i))//") = '"//trim(law_name(dev%law))//"': "// &
+                  "velocity-dependent friction is available for the velocity law only (docs/theory.md, 5.4)", error)
+         return
+      end if
+      select case (id)
+      case (mu_exponential)
+         dev%mu_min = mu_min
+         dev%mu_rate = mu_rate
+      case (mu_table)
+         dev%n_mu_points = 0
+         do k = 1, size(tab_v)
+            if (tab_v(k) == unset) exit
+            dev%n_mu_points = k
+            dev%mu_v(k) = tab_v(k)
+            dev%mu_at(k) = tab_mu(k)
+         end do
+      end select
+   end subroutine apply_mu_law
+
+   !> Labels: at most n given; each at most label_len characters (longer ones are cut by the
+   !> reader: refused here when the last character is used, as a likely cut).
+   subroutine check_labels(deck, grp, group, label, n, error)
+      type(deck_text), intent(in) :: deck
+      type(group_text), intent(in) :: grp
+      character(len=*), intent(in) :: group
+      character(len=label_len), intent(in) :: label(:)
+      integer, intent(in) :: n
+      type(error_type), allocatable, intent(out) :: error
+      integer :: last, i
+
+      ! a longer string would be cut by the namelist reader: refused from the group's text
+      call check_length(deck, grp, 'label', label_len - 1, error)
+      if (allocated(error)) return
+      last = findloc(label /= '', .true., 1, back=.true.)
+      if (last > n) then
+         call bad(deck, group, 'label('//trim(fmt_int(last))//')', "'"//trim(label(last))//"'", &
+                  'absent: only '//trim(fmt_int(n))//' value(s) are expected', error)
+         return
+      end if
+      do i = 1, n
+         if (label(i)(label_len:label_len) /= ' ') then
+            call bad(deck, group, 'label('//trim(fmt_int(i))//')', "'"//label(i)//"...'", 'at most '// &
+                     trim(fmt_int(label_len - 1))//' characters long', error)
+            return
+         end if
+         if (index(label(i), '"') > 0 .or. index(label(i), '\') > 0 .or. index(label(i), ',') > 0) then
+            call bad(deck, group, 'label('//trim(fmt_int(i))//')', "'"//trim(label(i))//"'", &
+                     'free of the characters " \ and , (labels name columns and plots)', error)
+            return
+         end if
+      end do
+   end subroutine check_labels
+
+   ! ---------------------------------------------------------------- damping from modes
+   !> 'rayleigh' damping as the ratio xi at two natural modes (mode_i, mode_j of the stuck or
+   !> the free system) instead of a0, a1: checked here, resolved by resolve_rayleigh once the
+   !> devices are known.
+   subroutine rayleigh_modes(deck, xi, a0, a1, mode_i, mode_j, mode_system, cfg, error)
+      type(deck_text), intent(in) :: deck
+      real(dp), intent(in) :: xi, a0, a1
+      integer, intent(in) :: mode_i, mode_j
+      character(len=*), intent(in) :: mode_system
+      type(run_config), intent(inout) :: cfg
+      type(error_type), allocatable, intent(out) :: error
+      character(len=:), allocatable :: choices
+      integer :: sys
+
+      cfg%model%mode_i = 0
+      cfg%model%mode_j = 0
+      if (mode_i == unset_int .and. mode_j == unset_int) return
+      if (mode_i == unset_int .or. mode_j == unset_int) then
+         call fatal_error(error, deck%path//", group &damping: "//trim(merge('mode_i', 'mode_j', mode_i == unset_int))// &
+                          " is not given: 'rayleigh' damping from modes needs xi, mode_i and mode_j")
+         return
+      end if
+      if (a0 /= 0.0_dp .or. a1 /= 0.0_dp) then
+         call bad(deck, 'damping', merge('rayleigh_a0', 'rayleigh_a1', a0 /= 0.0_dp), trim(fmt_real(merge(a0, a1, &
+                  a0 /= 0.0_dp))), 'absent with mode_i, mode_j: give either rayleigh_a0 and rayleigh_a1, or xi '// &
+                  'with mode_i and mode_j', error)
+         return
+      end if
+      if (mode_i < 1) then
+         call bad(deck, 'damping', 'mode_i', trim(fmt_int(mode_i)), '>= 1 (1 = the first mode)', error); return
+      end if
+      if (mode_j < 1) then
+         call bad(deck, 'damping', 'mode_j', trim(fmt_int(mode_j)), '>= 1 (1 = the first mode)', error); return
+      end if
+      call check_real(deck, 'damping', 'xi', xi, 0.0_dp, 1.0_dp, '', error, open_hi=.true.)
+      if (allocated(error)) return
+      sys = keyword_id(mode_systems, mode_system)
+      if (sys == 0) then
+         call keyword_choices(mode_systems, choices)
+         call bad(deck, 'damping', 'mode_system', "'"//trim(mode_system)//"'", 'one of '//choices, error)
+         return
+      end if
+      cfg%model%mode_i = mode_i
+      cfg%model%mode_j = mode_j
+      cfg%model%mode_system = sys
+   end subroutine rayleigh_modes
+
+   !> a0 = 2 xi wi wj / (wi + wj), a1 = 2 xi / (wi + wj): the Rayleigh damping with the ratio
+   !> xi at the circular frequencies wi, wj of modes mode_i, mode_j of the chosen system.
+   subroutine resolve_rayleigh(deck, cfg, error)
+      type(deck_text), intent(in) :: deck
+      type(run_config), intent(inout) :: cfg
+      type(error_type), allocatable, intent(out) :: error
+      type(modes_type) :: modes
+      real(dp), allocatable :: k(:, :), c(:, :)
+      real(dp) :: wi, wj
+      character(len=:), allocatable :: sys
+      integer :: n, mi, mj, bad_mode, stat
+
+      if (cfg%model%damping /= damping_rayleigh .or. cfg%model%mode_i == 0) return
+      n = cfg%model%n_dof
+      mi = cfg%model%mode_i
+      mj = cfg%model%mode_j
+      allocate (k(n, n), c(n, n), stat=stat)
+      if (stat /= 0) then
+         call fatal_error(error, deck%path//", group &damping: not enough memory for the modes of "// &
+                          trim(fmt_int(n))//" DOFs (mode_i, mode_j)", stat_no_memory)
+         return
+      end if
+      c = 0.0_dp
+      call stiffness_matrix(cfg%model, k)
+      call natural_modes(cfg%model, k, c, cfg%model%mode_system, max(mi, mj), modes, error)
+      if (allocated(error)) then
+         error%message = deck%path//", group &damping: the modes for mode_i, mode_j: "//error%message
+         return
+      end if
+      sys = "of the "//trim(mode_systems(cfg%model%mode_system)%name)//" system"
+      if (max(mi, mj) > modes%nq) then
+         call bad(deck, 'damping', merge('mode_j', 'mode_i', mj > mi), trim(fmt_int(max(mi, mj))), &
+                  '<= '//trim(fmt_int(modes%nq))//', the number of modes '//sys//" (mode_system = '"// &
+                  trim(mode_systems(cfg%model%mode_system)%name)//"')", error)
+         return
+      end if
+      bad_mode = 0
+      if (modes%omega2(mj) <= 0.0_dp) bad_mode = mj
+      if (modes%omega2(mi) <= 0.0_dp) bad_mode = mi
+      if (bad_mode > 0) then
+         call bad(deck, 'damping', merge('mode_i', 'mode_j', bad_mode == mi), trim(fmt_int(bad_mode)), &
+                  'a mode with a finite period: mode '//trim(fmt_int(bad_mode))//' '//sys// &
+                  ' is a rigid-body mode (w = 0)', error)
+         return
+      end if
+      wi = sqrt(modes%omega2(mi))
+      wj = sqrt(modes%omega2(mj))
+      cfg%model%rayleigh_a0 = 2.0_dp*cfg%model%xi*wi*wj/(wi + wj)
+      cfg%model%rayleigh_a1 = 2.0_dp*cfg%model%xi/(wi + wj)
+      ! the factors found are held to the limits of given ones
+      call check_magnitude(deck, 'damping', 'rayleigh_a0 (from xi, mode_i, mode_j)', cfg%model%rayleigh_a0, '1/s', &
+                           .false., error)
+      if (.not. allocated(error)) call check_magnitude(deck, 'damping', 'rayleigh_a1 (from xi, mode_i, mode_j)', &
+                                                       cfg%model%rayleigh_a1, 's', .false., error)
+   end subroutine resolve_rayleigh
+
+   !> What the technique cannot do with the shorthands: braces are hysteretic devices, which
+   !> only Newmark integrates (the exact Coulomb techniques' devices are rigid while stuck).
+   subroutine check_shorthands(deck, cfg, error)
+      type(deck_text), intent(in) :: deck
+      type(run_config), intent(inout) :: cfg
+      type(error_type), allocatable, intent(out) :: error
+      integer :: d
+
+      if (cfg%opts%technique == technique_newmark) return
+      do d = 1, cfg%model%n_devices
+         if (cfg%model%dev(d)%source /= source_brace) cycle
+         call fatal_error(error, deck%path//", group &braces: brace "//trim(fmt_int(cfg%model%dev(d)%source_index))// &
+                          " cannot be integrated with technique = '"//trim(technique_name(cfg%opts%technique))// &
+                          "' of &integration: a brace's elastic stiffness in series with the damper is the "// &
+                          "sticking stiffness of the hysteretic law, which only technique = 'newmark' integrates "// &
+                          "(the exact Coulomb techniques' devices are rigid while stuck); set technique = 'newmark'")
+         return
+      end do
+   end subroutine check_shorthands
 
    ! ---------------------------------------------------------------- helpers
    subroutine missing_group(deck, group, error)

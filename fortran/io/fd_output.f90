@@ -10,6 +10,8 @@ module fd_output
    use fd_result, only: result_type
    use fd_record, only: record_info
    use fd_version, only: frictiondyn_version
+   use fd_names, only: excitation_types
+   use fd_matrices, only: modes_type, modes_flexible, modes_rigid, modes_unrestrained
    implicit none
    private
 
@@ -381,7 +383,7 @@ contains
                  trim(merge('true ', 'false', record%detected))//', "units": "'//trim(record%units)// &
                  '", "samples": '//trim(fmt_int(record%npts))//', "dt_s": '//trim(json_real(record%dt))// &
                  ', "scale": '//trim(json_real(record%scale))//', "peak_acc_mps2": '// &
-                 trim(json_real(record%peak_acc))
+                 trim(json_real(record%peak_acc))//', "sha256": "'//trim(record%sha256)//'"'
             if (allocated(record%title)) then
                call json_escape(record%title, esc)
                js = js//', "title": "'//esc//'"'
@@ -413,6 +415,13 @@ contains
       call kv('steps_finer', trim(fmt_int(res%steps_finer)))
       call kv('factorizations', trim(fmt_int(res%factorizations)))
       call kv('events', trim(fmt_int(res%events)))
+      if (res%exact_peaks) then
+         ! the exact technique: peaks are the exact extrema; its event times, accumulations
+         call kv('peaks_exact', 'true')
+         call kr('event_times_s', res%event_time(1:res%n_event_times))
+         call kv('accumulation_points', trim(fmt_int(res%accumulations)))
+         call kr('accumulation_times_s', res%accumulation_time(1:res%n_accumulation_times))
+      end if
       call kv('patterns_solved', trim(fmt_int(res%patterns)))
       call kv('lcp_fallbacks', trim(fmt_int(res%lcp_fallbacks)))
       call kv('correctness_violations', trim(fmt_int(res%violations)))
@@ -425,9 +434,103 @@ contains
       call kv('energy_friction_J', trim(json_real(res%e_friction)))
       call kv('energy_device_elastic_J', trim(json_real(res%e_device)))
       call kv('energy_residual_J', trim(json_real(res%e_residual)))
+      call engineering_keys()
       call kv('samples', trim(fmt_int(res%nout)))
       js = js//'  "run_time_s": '//trim(json_real(res%run_time))//nl//'}'
    contains
+      !> What produced the run, the names, the modes, the storeys (fd_engineering).
+      subroutine engineering_keys()
+         integer :: i
+         real(dp), allocatable :: ratio(:)
+         call kv('deck_sha256', '"'//trim(model%deck_sha256)//'"')
+         associate (eng => res%eng)
+            if (eng%excitation >= 1 .and. eng%excitation <= size(excitation_types)) then
+               call kv('excitation_type', '"'//trim(excitation_types(eng%excitation)%name)//'"')
+            else
+               call kv('excitation_type', '"unknown"')
+            end if
+            call kv('excitation_frequency_Hz', trim(json_real(eng%frequency)))
+            call kv('duration_s', trim(json_real(eng%duration)))
+            call ks('dof_labels', eng%dof_label)
+            call ks('device_labels', eng%device_label)
+            call kv('damping_a0_per_s', trim(json_real(eng%a0)))
+            call kv('damping_a1_s', trim(json_real(eng%a1)))
+            call modes_keys('stuck', eng%stuck)
+            call modes_keys('free', eng%free)
+            call kr('residual_s_m', eng%residual_s)
+            call kv('peak_base_shear_N', trim(json_real(eng%peak_shear(0))))
+            call kv('peak_base_shear_time_s', trim(json_real(eng%peak_shear_time(0))))
+            call kv('residual_base_shear_N', trim(json_real(eng%shear(0))))
+            call kv('n_storeys', trim(fmt_int(eng%n_storeys)))
+            call ks('storey_labels', eng%storey_label)
+            js = js//'  "storey_nodes": ['
+            do i = 1, eng%n_storeys
+               js = js//'['//trim(fmt_int(eng%storey_i(i)))//', '//trim(fmt_int(eng%storey_j(i)))//']'
+               if (i < eng%n_storeys) js = js//', '
+            end do
+            js = js//'],'//nl
+            call kr('storey_height_m', eng%height)
+            call kr('peak_drift_m', eng%peak_drift)
+            call kr('peak_drift_time_s', eng%peak_drift_time)
+            call kr('residual_drift_m', eng%drift)
+            allocate (ratio(eng%n_storeys))
+            ratio = 0.0_dp
+            where (eng%height > 0.0_dp) ratio = eng%peak_drift/eng%height
+            call kr('peak_drift_ratio', ratio)
+            where (eng%height > 0.0_dp) ratio = eng%drift/eng%height
+            call kr('residual_drift_ratio', ratio)
+            call kr('peak_storey_shear_N', eng%peak_shear(1:))
+            call kr('peak_storey_shear_time_s', eng%peak_shear_time(1:))
+            call kr('residual_storey_shear_N', eng%shear(1:))
+         end associate
+      end subroutine engineering_keys
+      !> The modes of one system: status, periods (0: a rigid-body mode), shapes, mass ratios, damping.
+      subroutine modes_keys(name, m)
+         character(len=*), intent(in) :: name
+         type(modes_type), intent(in) :: m
+         character(len=:), allocatable :: list
+         integer :: j
+         select case (m%status)
+         case (modes_flexible)
+            call kv('modes_'//name//'_status', '"flexible"')
+         case (modes_rigid)
+            call kv('modes_'//name//'_status', '"rigid"')
+         case (modes_unrestrained)
+            call kv('modes_'//name//'_status', '"unrestrained"')
+         case default
+            call kv('modes_'//name//'_status', '"not computed"')
+            call kr('periods_'//name//'_s', [real(dp) ::])
+            js = js//'  "mode_shapes_'//name//'": [],'//nl
+            call kr('modal_mass_ratio_'//name, [real(dp) ::])
+            call kr('modal_xi_'//name, [real(dp) ::])
+            return
+         end select
+         ! a rigid-body mode (w = 0): period and damping ratio 0 (its period is infinite)
+         call kr('periods_'//name//'_s', merge(m%period, 0.0_dp, m%omega2 > 0.0_dp))
+         js = js//'  "mode_shapes_'//name//'": ['
+         do j = 1, m%n
+            call json_list(m%shape(:, j), list)
+            js = js//list
+            if (j < m%n) js = js//', '
+         end do
+         js = js//'],'//nl
+         call kr('modal_mass_ratio_'//name, m%mass_ratio)
+         call kr('modal_xi_'//name, merge(m%xi, 0.0_dp, m%omega2 > 0.0_dp))
+      end subroutine modes_keys
+      !> Strings.
+      subroutine ks(key, x)
+         character(len=*), intent(in) :: key
+         character(len=*), intent(in) :: x(:)
+         integer :: k
+         character(len=:), allocatable :: e
+         js = js//'  "'//key//'": ['
+         do k = 1, size(x)
+            call json_escape(trim(x(k)), e)
+            js = js//'"'//e//'"'
+            if (k < size(x)) js = js//', '
+         end do
+         js = js//'],'//nl
+      end subroutine ks
       subroutine kv(key, val)
          character(len=*), intent(in) :: key, val
          js = js//'  "'//key//'": '//val//','//nl
@@ -435,13 +538,9 @@ contains
       subroutine kr(key, x)
          character(len=*), intent(in) :: key
          real(dp), intent(in) :: x(:)
-         integer :: k
-         js = js//'  "'//key//'": ['
-         do k = 1, size(x)
-            js = js//trim(json_real(x(k)))
-            if (k < size(x)) js = js//', '
-         end do
-         js = js//'],'//nl
+         character(len=:), allocatable :: list
+         call json_list(x, list)
+         js = js//'  "'//key//'": '//list//','//nl
       end subroutine kr
       subroutine ki(key, x)
          character(len=*), intent(in) :: key
@@ -468,6 +567,31 @@ contains
          if (j < res%ncol) line = line//','
       end do
    end subroutine history_header
+
+   !> A list of reals as JSON, '[x1, x2, ...]', built in one buffer (appending number by
+   !> number to a growing string copies it each time: quadratic for long lists).
+   pure subroutine json_list(x, text)
+      real(dp), intent(in) :: x(:)
+      character(len=:), allocatable, intent(out) :: text
+      character(len=:), allocatable :: buf
+      character(len=32) :: item
+      integer :: k, n, l
+
+      allocate (character(len=2 + 34*size(x)) :: buf)
+      buf(1:1) = '['
+      n = 1
+      do k = 1, size(x)
+         item = json_real(x(k))
+         l = len_trim(item)
+         buf(n + 1:n + l) = item(1:l)
+         n = n + l
+         if (k < size(x)) then
+            buf(n + 1:n + 2) = ', '
+            n = n + 2
+         end if
+      end do
+      text = buf(1:n)//']'
+   end subroutine json_list
 
    !> A real as JSON: 17 significant digits (null when not finite), left-adjusted.
    pure function json_real(x) result(str)

@@ -11,6 +11,7 @@ module fd_record
    use fd_kinds, only: dp
    use fd_error, only: error_type, fatal_error, fmt_int, fmt_real
    use fd_textio, only: read_file_text, lower
+   use fd_sha256, only: sha256_text
    implicit none
    private
 
@@ -37,6 +38,7 @@ module fd_record
       real(dp) :: scale = 1.0_dp               !! record_scale applied
       real(dp) :: peak_acc = 0.0_dp            !! max |table acceleration| fed to the run [m/s2]
       character(len=:), allocatable :: title   !! AT2: header lines 1 and 2
+      character(len=64) :: sha256 = ''         !! SHA-256 of the file's bytes (as read)
    end type record_info
 
    interface
@@ -72,6 +74,7 @@ contains
       info%scale = scale
       call read_file_text(path, text, error)
       if (allocated(error)) return
+      call sha256_text(text, info%sha256)
       fmt_used = lower(format)
       info%detected = fmt_used == 'auto'
       if (fmt_used == 'auto') call detect_format(path, text, fmt_used)

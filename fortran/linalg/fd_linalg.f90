@@ -8,7 +8,7 @@ module fd_linalg
    private
 
    public :: cholesky_factor, cholesky_solve, sym_matvec, gen_matvec, generalized_eigen
-   public :: lu_solve, least_squares, least_squares_work
+   public :: lu_solve, least_squares, least_squares_work, lowest_eigen, lowest_eigen_band
 
    interface
       subroutine dpotrf(uplo, n, a, lda, info)
@@ -64,6 +64,26 @@ module fd_linalg
          real(dp), intent(out) :: w(*), work(*)
          integer, intent(out) :: info
       end subroutine dsygv
+      subroutine dsyevr(jobz, range, uplo, n, a, lda, vl, vu, il, iu, abstol, m, w, z, ldz, isuppz, &
+                        work, lwork, iwork, liwork, info)
+         import :: dp
+         character(len=1), intent(in) :: jobz, range, uplo
+         integer, intent(in) :: n, lda, il, iu, ldz, lwork, liwork
+         real(dp), intent(inout) :: a(lda, *)
+         real(dp), intent(in) :: vl, vu, abstol
+         integer, intent(out) :: m, isuppz(*), iwork(*), info
+         real(dp), intent(out) :: w(*), z(ldz, *), work(*)
+      end subroutine dsyevr
+      subroutine dsbevx(jobz, range, uplo, n, kd, ab, ldab, q, ldq, vl, vu, il, iu, abstol, m, w, z, &
+                        ldz, work, iwork, ifail, info)
+         import :: dp
+         character(len=1), intent(in) :: jobz, range, uplo
+         integer, intent(in) :: n, kd, ldab, ldq, il, iu, ldz
+         real(dp), intent(inout) :: ab(ldab, *)
+         real(dp), intent(in) :: vl, vu, abstol
+         integer, intent(out) :: m, iwork(*), ifail(*), info
+         real(dp), intent(out) :: q(ldq, *), w(*), z(ldz, *), work(*)
+      end subroutine dsbevx
    end interface
 
 contains
@@ -139,6 +159,76 @@ contains
       call dgelss(size(a, 1), size(a, 2), size(b, 2), a, size(a, 1), b, size(b, 1), sv, -1.0_dp, rank, &
                   work, size(work), info)
    end subroutine least_squares
+
+   !> The k lowest eigenvalues (ascending) and orthonormal eigenvectors of a symmetric
+   !> matrix (LAPACK dsyevr: the tridiagonal reduction, then only the k pairs asked for).
+   subroutine lowest_eigen(a, k, lambda, vec, error)
+      real(dp), intent(in) :: a(:, :)                  !! symmetric matrix (n x n)
+      integer, intent(in) :: k                         !! pairs wanted, 1..n
+      real(dp), intent(out) :: lambda(:)               !! (k) eigenvalues, ascending
+      real(dp), intent(out) :: vec(:, :)               !! (n, k) eigenvectors in columns
+      type(error_type), allocatable, intent(out) :: error !! LAPACK failure
+      real(dp), allocatable :: b(:, :), w(:), work(:)
+      integer, allocatable :: iwork(:), isuppz(:)
+      real(dp) :: query(1)
+      integer :: n, m, info, iquery(1), stat
+
+      n = size(a, 1)
+      allocate (b(n, n), w(n), isuppz(2*max(1, k)), stat=stat)
+      if (stat /= 0) then
+         call no_memory(); return
+      end if
+      b = a
+      call dsyevr('V', 'I', 'U', n, b, n, 0.0_dp, 0.0_dp, 1, k, 0.0_dp, m, w, vec, n, isuppz, &
+                  query, -1, iquery, -1, info)
+      allocate (work(max(1, int(query(1)))), iwork(max(1, iquery(1))), stat=stat)
+      if (stat /= 0) then
+         call no_memory(); return
+      end if
+      call dsyevr('V', 'I', 'U', n, b, n, 0.0_dp, 0.0_dp, 1, k, 0.0_dp, m, w, vec, n, isuppz, &
+                  work, size(work), iwork, size(iwork), info)
+      if (info /= 0 .or. m /= k) then
+         call fatal_error(error, "eigenvalue solver dsyevr failed with info = "//trim(fmt_int(info)))
+         return
+      end if
+      lambda = w(1:k)
+   contains
+      subroutine no_memory()
+         call fatal_error(error, "not enough memory for the eigenproblem of "//trim(fmt_int(n))//" unknowns", &
+                          stat_no_memory)
+      end subroutine no_memory
+   end subroutine lowest_eigen
+
+   !> The k lowest eigenvalues (ascending) and orthonormal eigenvectors of a symmetric band
+   !> matrix in LAPACK's upper band storage, ab(kd + 1 + i - j, j) = a(i, j) (dsbevx: the
+   !> band reduction costs O(n kd^2), not O(n^3)).
+   subroutine lowest_eigen_band(ab, k, lambda, vec, error)
+      real(dp), intent(in) :: ab(:, :)                 !! (kd + 1, n) upper band storage
+      integer, intent(in) :: k                         !! pairs wanted, 1..n
+      real(dp), intent(out) :: lambda(:)               !! (k) eigenvalues, ascending
+      real(dp), intent(out) :: vec(:, :)               !! (n, k) eigenvectors in columns
+      type(error_type), allocatable, intent(out) :: error !! LAPACK failure
+      real(dp), allocatable :: b(:, :), q(:, :), w(:), work(:)
+      integer, allocatable :: iwork(:), ifail(:)
+      integer :: n, kd, m, info, stat
+
+      kd = size(ab, 1) - 1
+      n = size(ab, 2)
+      allocate (b(kd + 1, n), q(n, n), w(n), work(7*n), iwork(5*n), ifail(n), stat=stat)
+      if (stat /= 0) then
+         call fatal_error(error, "not enough memory for the band eigenproblem of "//trim(fmt_int(n))//" unknowns", &
+                          stat_no_memory)
+         return
+      end if
+      b = ab
+      call dsbevx('V', 'I', 'U', n, kd, b, kd + 1, q, n, 0.0_dp, 0.0_dp, 1, k, 0.0_dp, m, w, vec, n, &
+                  work, iwork, ifail, info)
+      if (info /= 0 .or. m /= k) then
+         call fatal_error(error, "eigenvalue solver dsbevx failed with info = "//trim(fmt_int(info)))
+         return
+      end if
+      lambda = w(1:k)
+   end subroutine lowest_eigen_band
 
    !> Eigenvalues (ascending) and M-normalized eigenvectors of K phi = lambda M phi.
    subroutine generalized_eigen(k, m, lambda, phi, error)

@@ -12,7 +12,7 @@ module fd_excitation
 
    public :: excitation_type, table_motion, ramp_end
    public :: excitation_none, excitation_harmonic, excitation_record
-   public :: sine_forcing, max_sines, table_sines, segment_end
+   public :: sine_forcing, max_sines, table_sines, segment_end, table_taylor, forcing_frequency
    public :: forcing_form, forcing_unknown, forcing_zero, forcing_sines, forcing_linear
 
    real(dp), parameter :: pi = acos(-1.0_dp)
@@ -138,17 +138,99 @@ contains
    end subroutine table_sines
 
    !> Where a step from t towards tn must stop so as not to straddle a change of the form
-   !> of the forcing (the end of the harmonic ramp): that time if it lies in (t, tn) (to
-   !> 1e-12 of tn), else tn. (A record's samples fall on the step grid, dt1 = dt_record/n1.)
+   !> of the forcing: the end of the harmonic ramp, or the next sample of a record (the
+   !> acceleration is linear between samples only); that time if it lies in (t, tn) (to
+   !> 1e-12 of tn), else tn. A time within 1e-9 dt_record of a sample counts as that sample.
    pure real(dp) function segment_end(exc, t, tn) result(tb)
       type(excitation_type), intent(in) :: exc !! the table motion
       real(dp), intent(in) :: t                !! start of the step [s]
       real(dp), intent(in) :: tn               !! intended end of the step [s]
+      integer :: k
 
       tb = tn
-      if (exc%kind == excitation_harmonic .and. exc%ramp_cycles > 0) then
-         if (t < ramp_end(exc) .and. ramp_end(exc) < tn - 1.0e-12_dp*tn) tb = ramp_end(exc)
-      end if
+      select case (exc%kind)
+      case (excitation_harmonic)
+         if (exc%ramp_cycles > 0) then
+            if (t < ramp_end(exc) .and. ramp_end(exc) < tn - 1.0e-12_dp*tn) tb = ramp_end(exc)
+         end if
+      case (excitation_record)
+         k = record_segment(exc, t)
+         if (k < size(exc%acc) - 1) then
+            if ((k + 1)*exc%dt_record < tn - 1.0e-12_dp*tn) tb = (k + 1)*exc%dt_record
+         end if
+      end select
    end function segment_end
+
+   !> The sample interval [k dt_r, (k + 1) dt_r) of a record that starts at or contains t
+   !> (a time within 1e-9 dt_r below a sample counts as that sample); size(acc) - 1 or
+   !> more: after the record.
+   pure integer function record_segment(exc, t) result(k)
+      type(excitation_type), intent(in) :: exc !! a record
+      real(dp), intent(in) :: t                !! time [s]
+
+      k = max(0, floor(t/exc%dt_record + 1.0e-9_dp))
+   end function record_segment
+
+   !> Taylor coefficients of the table acceleration about t on the segment that starts at
+   !> t (segment_end): ag(t + s) = sum_{j <= k} g(j) s^j + r_k(s), with
+   !> |r_k(s)| <= gn(k) s^(k+1) for every degree k <= ubound(g) (gn(k) >= sup |ag^(k+1)| /
+   !> (k+1)! over the segment). Harmonic motion: the series of its sines; a record: its
+   !> linear piece (gn(k) = 0 for k >= 1); none, or after a record: 0.
+   pure subroutine table_taylor(exc, t, g, gn)
+      type(excitation_type), intent(in) :: exc !! the table motion
+      real(dp), intent(in) :: t                !! expansion point [s]
+      real(dp), intent(out) :: g(0:)           !! Taylor coefficients (degree >= 1)
+      real(dp), intent(out) :: gn(0:)          !! remainder factors, same bounds
+      type(sine_forcing) :: frc
+      real(dp) :: sw, cw, f, x, slope
+      integer :: kf, k, kk, n
+
+      g = 0.0_dp
+      gn = 0.0_dp
+      kk = ubound(g, 1)
+      select case (exc%kind)
+      case (excitation_harmonic)
+         call table_sines(exc, t, frc)
+         do kf = 1, frc%nf
+            sw = sin(frc%w(kf)*t)
+            cw = cos(frc%w(kf)*t)
+            f = frc%amp(kf)
+            do k = 0, kk
+               if (k > 0) f = f*frc%w(kf)/k
+               select case (mod(k, 4))
+               case (0)
+                  g(k) = g(k) + f*sw
+               case (1)
+                  g(k) = g(k) + f*cw
+               case (2)
+                  g(k) = g(k) - f*sw
+               case default
+                  g(k) = g(k) - f*cw
+               end select
+               gn(k) = gn(k) + abs(f)*frc%w(kf)/(k + 1)
+            end do
+         end do
+      case (excitation_record)
+         n = size(exc%acc)
+         k = record_segment(exc, t)
+         if (k >= n - 1) return
+         x = t/exc%dt_record - k
+         slope = exc%acc(k + 2) - exc%acc(k + 1)
+         g(0) = exc%acc(k + 1) + x*slope
+         g(1) = slope/exc%dt_record
+         gn(0) = abs(g(1))
+      end select
+   end subroutine table_taylor
+
+   !> The highest circular frequency of the table acceleration's sines (harmonic motion,
+   !> its ramp included) [rad/s]; 0 for a record or a table at rest.
+   pure real(dp) function forcing_frequency(exc) result(w)
+      type(excitation_type), intent(in) :: exc !! the table motion
+
+      w = 0.0_dp
+      if (exc%kind /= excitation_harmonic) return
+      w = 2.0_dp*pi*exc%frequency
+      if (exc%ramp_cycles > 0) w = w + pi/ramp_end(exc)
+   end function forcing_frequency
 
 end module fd_excitation

@@ -10,7 +10,9 @@ module fd_model
                        default_eps, default_eps1, default_f, default_xi, default_period, &
                        default_rayleigh_a0, default_rayleigh_a1, default_technique, default_beta, &
                        default_gamma, default_n1, default_n2, default_n, default_check_correctness, &
-                       default_dt_min, default_output_every, default_write_history, default_theta
+                       default_dt_min, default_output_every, default_write_history, default_theta, &
+                       mu_constant, mu_exponential, mu_table, label_len, max_mu_points, &
+                       system_stuck, system_free, default_mu_law, default_mode_system, default_n_modes
    implicit none
    private
 
@@ -18,6 +20,14 @@ module fd_model
    public :: damping_none, damping_stiffness, damping_rayleigh
    public :: law_velocity, law_hysteretic, law_coulomb, law_name
    public :: technique_newmark, technique_event_driven, technique_moreau_jean, technique_name
+   public :: mu_constant, mu_exponential, mu_table, label_len, max_mu_points
+   public :: system_stuck, system_free
+   public :: source_friction, source_brace, source_isolator
+
+   ! where a device (or spring) of the model comes from in the deck
+   integer, parameter :: source_friction = 0  !! &friction (or &springs)
+   integer, parameter :: source_brace = 1     !! &braces (a friction damper in series with a brace)
+   integer, parameter :: source_isolator = 2  !! &isolators (a sliding isolator)
 
    !> One friction device between node_i and node_j (node 0 = the table).
    !> Its relative displacement is s = u(node_i) - u(node_j); its force F acts
@@ -31,6 +41,17 @@ module fd_model
       real(dp) :: eps = default_eps   !! velocity law band eps [m/s], eqs. 6-7
       real(dp) :: eps1 = default_eps1 !! hysteretic end of sliding eps1 [m/s], eq. 2
       real(dp) :: f = default_f       !! hysteretic sticking displacement f [m], eq. 3
+      ! mu as a function of the sliding velocity (velocity law); mu is mu_max for 'exponential'
+      ! and the table's value at its last point for 'table'
+      integer :: mu_law = default_mu_law   !! mu_constant, mu_exponential or mu_table
+      real(dp) :: mu_min = 0.0_dp          !! exponential: mu at zero velocity [-]
+      real(dp) :: mu_rate = 0.0_dp         !! exponential: rate [s/m]
+      integer :: n_mu_points = 0           !! table: points used
+      real(dp) :: mu_v(max_mu_points) = 0.0_dp   !! table: sliding velocities, increasing [m/s]
+      real(dp) :: mu_at(max_mu_points) = 0.0_dp  !! table: mu at each velocity [-]
+      character(len=label_len) :: label = ''     !! name in outputs ('damper 2')
+      integer :: source = source_friction  !! the deck group it comes from
+      integer :: source_index = 0          !! its index in that group
    end type device_type
 
    !> The whole structural model.
@@ -50,6 +71,20 @@ module fd_model
       real(dp) :: rayleigh_a1 = default_rayleigh_a1 !! Rayleigh stiffness factor [s]
       integer :: n_devices = 0                !! number of friction devices
       type(device_type), allocatable :: dev(:) !! the friction devices
+      ! 'rayleigh' damping given as xi at two natural modes (resolved into a0, a1 when read)
+      integer :: mode_i = 0                   !! first mode (0: a0, a1 given)
+      integer :: mode_j = 0                   !! second mode
+      integer :: mode_system = default_mode_system !! modes of the stuck or the free system
+      ! names and storeys, for the engineering outputs
+      character(len=label_len), allocatable :: dof_label(:)    !! name of each DOF ('floor 3')
+      integer :: n_storeys = 0                !! storeys (drift, shear) named by the deck
+      integer, allocatable :: storey_i(:)     !! upper node of each storey (1..n_dof)
+      integer, allocatable :: storey_j(:)     !! lower node (0..n_dof, 0 = table)
+      real(dp), allocatable :: storey_height(:) !! height [m]; 0 = not given
+      character(len=label_len), allocatable :: storey_label(:) !! name of each storey
+      integer, allocatable :: spring_source(:) !! the deck group of each spring (source_*)
+      ! what produced the model (echoed in the summary; the record's hash is in record_info)
+      character(len=64) :: deck_sha256 = ''   !! SHA-256 of the deck
    end type model_type
 
    !> Settings of the time integration: the technique, Newmark and the step control.
@@ -64,6 +99,7 @@ module fd_model
       real(dp) :: dt_min = default_dt_min       !! floor of the step halving [s]; 0 = dt2 / 2**10
       real(dp) :: theta = default_theta         !! theta of the Moreau-Jean technique, 0.5..1
       integer :: output_every = default_output_every !! output every k dt1 steps; 0 = at the record step (n1)
+      integer :: n_modes = default_n_modes      !! natural modes reported per system (&output)
    end type integration_type
 
    !> Where and what to write.

@@ -19,6 +19,8 @@ module fd_names
    public :: damping_types, damping_stiffness, damping_rayleigh, damping_none
    public :: excitation_types, excitation_harmonic, excitation_record, excitation_none
    public :: record_kinds, record_acceleration, record_displacement
+   public :: mu_laws, mu_constant, mu_exponential, mu_table
+   public :: mode_systems, system_stuck, system_free
    public :: keyword_id, keyword_choices, law_id, law_choices, law_name, technique_name
    public :: default_u0, default_v0, default_xi, default_period, default_rayleigh_a0, default_rayleigh_a1
    public :: default_n_devices, default_eps, default_eps1, default_f
@@ -26,8 +28,12 @@ module fd_names
    public :: default_technique, default_beta, default_gamma, default_n1, default_n2, default_n
    public :: default_check_correctness, default_dt_min, default_theta
    public :: default_dir, default_output_every, default_write_history
+   public :: default_mu_law, default_mode_system, default_n_modes, default_radius, default_storey_height
+   public :: label_len, max_mu_points
 
    integer, parameter :: keyword_len = 16   !! length of a keyword in the tables
+   integer, parameter :: label_len = 32     !! length of a label (a DOF's, a device's, a storey's)
+   integer, parameter :: max_mu_points = 32 !! points of a table mu(v)
 
    !> A keyword of the deck and what it means (shown in messages when not empty).
    type :: keyword_type
@@ -85,6 +91,22 @@ module fd_names
    integer, parameter :: record_acceleration = 1 !! the record holds table accelerations
    integer, parameter :: record_displacement = 2 !! the record holds table displacements
 
+   ! ------------------------------------------------------------------ mu(v), velocity law
+   type(keyword_type), parameter :: mu_laws(*) = [ &
+                                    keyword_type('constant', 'mu'), &
+                                    keyword_type('exponential', 'mu_max, mu_min, mu_rate'), &
+                                    keyword_type('table', 'mu_table_v, mu_table_mu')]
+   integer, parameter :: mu_constant = 1    !! mu independent of the sliding velocity
+   integer, parameter :: mu_exponential = 2 !! mu = mu_max - (mu_max - mu_min) exp(-rate |v|)
+   integer, parameter :: mu_table = 3       !! mu linear between (v, mu) points
+
+   ! ------------------------------------------------------------------ systems of the modes
+   type(keyword_type), parameter :: mode_systems(*) = [ &
+                                    keyword_type('stuck', 'every device stuck'), &
+                                    keyword_type('free', 'every device free')]
+   integer, parameter :: system_stuck = 1   !! every device in its sticking phase
+   integer, parameter :: system_free = 2    !! every device removed (no friction)
+
    ! ------------------------------------------------------------------ defaults
    ! &model
    real(dp), parameter :: default_u0 = 0.0_dp            !! initial displacement [m]
@@ -99,6 +121,12 @@ module fd_names
    real(dp), parameter :: default_eps = 1.0e-3_dp        !! velocity band eps [m/s]
    real(dp), parameter :: default_eps1 = 1.0e-3_dp       !! end of sliding eps1 [m/s]
    real(dp), parameter :: default_f = 1.0e-5_dp          !! sticking displacement f [m]
+   integer, parameter :: default_mu_law = mu_constant    !! mu(v) of the velocity law
+   real(dp), parameter :: default_radius = 0.0_dp        !! isolator radius, 0 = flat [m]
+   ! &damping ('rayleigh' from xi at two modes)
+   integer, parameter :: default_mode_system = system_stuck
+   ! &storeys
+   real(dp), parameter :: default_storey_height = 0.0_dp !! 0 = not given [m]
    ! &excitation
    integer, parameter :: default_ramp_cycles = 0         !! no ramp
    integer, parameter :: default_record_kind = record_acceleration
@@ -117,6 +145,7 @@ module fd_names
    character(len=*), parameter :: default_dir = 'out'    !! output directory
    integer, parameter :: default_output_every = 0        !! 0 = every dt_record
    logical, parameter :: default_write_history = .true.
+   integer, parameter :: default_n_modes = 10            !! modes reported per system
 
 contains
 

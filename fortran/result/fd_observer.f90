@@ -8,14 +8,25 @@ module fd_observer
    use fd_error, only: error_type
    use fd_model, only: model_type, integration_type
    use fd_excitation, only: excitation_type
-   use fd_result, only: result_type, init_result, max_violation_times
+   use fd_result, only: result_type, init_result, max_violation_times, max_event_times
    use fd_linalg, only: sym_matvec
+   use fd_engineering, only: engineering_init, observe_engineering, storey_values, observe_storey_peak
    implicit none
    private
 
    public :: observer_type, observer_init, sample_due, observe_start, observe_peaks, observe_sample
    public :: observe_transitions, observe_violations, observe_end, strain_energy
    public :: observe_start_energies, observe_end_energies
+   public :: observe_peak_value, observe_envelope, observe_event, observe_accumulation
+   public :: peak_of_u, peak_of_v, peak_of_aabs, peak_of_s, peak_of_force, peak_of_storey
+   public :: observe_storeys
+
+   integer, parameter :: peak_of_u = 1      !! |u| of a DOF
+   integer, parameter :: peak_of_v = 2      !! |v| of a DOF
+   integer, parameter :: peak_of_aabs = 3   !! |absolute acceleration| of a DOF
+   integer, parameter :: peak_of_s = 4      !! |s| of a device
+   integer, parameter :: peak_of_force = 5  !! |F| of a device
+   integer, parameter :: peak_of_storey = 6 !! |drift|, |V| of a storey, |Vb|: the history's order
 
    !> What the observer keeps between calls.
    type :: observer_type
@@ -42,6 +53,8 @@ contains
       call init_result(model, exc, opts, res, obs%nsteps, obs%every, error)
       if (allocated(error)) return
       res%technique = opts%technique
+      ! names, modes and storeys (res%period_stuck: set by the technique before)
+      call engineering_init(model, exc, opts, res%period_stuck, res%eng, error)
    end subroutine observer_init
 
    !> Whether the history takes a row after dt1 step k (every `every` steps, and the last).
@@ -120,7 +133,81 @@ contains
          res%peak_s(i) = max(res%peak_s(i), abs(s(i)))
          res%peak_force(i) = max(res%peak_force(i), abs(force(i)))
       end do
+      call observe_engineering(res%eng, t, u, v, s, force)
    end subroutine observe_peaks
+
+   !> One value into a peak of the summary (a technique that knows its solution between
+   !> steps passes the exact extrema, with their times): quantity peak_of_*, DOF or device i.
+   pure subroutine observe_peak_value(res, quantity, i, value, t)
+      type(result_type), intent(inout) :: res  !! the result
+      integer, intent(in) :: quantity          !! peak_of_u, _v, _aabs, _s, _force, _storey
+      integer, intent(in) :: i                 !! DOF, device, or storey quantity (drift1, V1, ..., Vb)
+      real(dp), intent(in) :: value            !! |value|
+      real(dp), intent(in) :: t                !! its time [s]
+
+      select case (quantity)
+      case (peak_of_u)
+         if (value > res%peak_u(i)) then
+            res%peak_u(i) = value; res%peak_u_time(i) = t
+         end if
+      case (peak_of_v)
+         res%peak_v(i) = max(res%peak_v(i), value)
+      case (peak_of_aabs)
+         if (value > res%peak_aabs(i)) then
+            res%peak_aabs(i) = value; res%peak_aabs_time(i) = t
+         end if
+      case (peak_of_s)
+         res%peak_s(i) = max(res%peak_s(i), value)
+      case (peak_of_force)
+         res%peak_force(i) = max(res%peak_force(i), value)
+      case (peak_of_storey)
+         call observe_storey_peak(res%eng, i, value, t)
+      end select
+   end subroutine observe_peak_value
+
+   !> The storeys at a state the technique reports besides observe_peaks (a row of the exact
+   !> technique): drifts, shears, their peaks, and the values kept as the residual ones.
+   pure subroutine observe_storeys(res, t, u, v, s, force)
+      type(result_type), intent(inout) :: res  !! the result
+      real(dp), intent(in) :: t                !! time [s]
+      real(dp), intent(in) :: u(:), v(:)       !! relative displacements [m], velocities [m/s]
+      real(dp), intent(in) :: s(:), force(:)   !! device relative displacements [m], forces [N]
+
+      call observe_engineering(res%eng, t, u, v, s, force)
+   end subroutine observe_storeys
+
+   !> The maxima since the previous row (per DOF |u|, |v|, |aabs|, per device |s|, |F|, per
+   !> storey |drift|, |V|, then |Vb|) into the last row written (a history with those
+   !> columns, has_envelope).
+   pure subroutine observe_envelope(obs, res, env)
+      type(observer_type), intent(in) :: obs   !! the observer
+      type(result_type), intent(inout) :: res  !! the result
+      real(dp), intent(in) :: env(:)           !! the maxima, in the columns' order
+
+      if (res%env_col == 0 .or. obs%rows > res%nout .or. obs%rows < 1) return
+      res%hist(res%env_col:res%env_col + size(env) - 1, obs%rows) = env
+   end subroutine observe_envelope
+
+   !> An event at time t (phases changed): its time is kept (the first max_event_times).
+   pure subroutine observe_event(res, t)
+      type(result_type), intent(inout) :: res  !! the result
+      real(dp), intent(in) :: t                !! time of the event [s]
+
+      if (res%n_event_times >= max_event_times) return
+      res%n_event_times = res%n_event_times + 1
+      res%event_time(res%n_event_times) = t
+   end subroutine observe_event
+
+   !> An accumulation point of events (a Zeno sequence) at time t, ended by sticking.
+   pure subroutine observe_accumulation(res, t)
+      type(result_type), intent(inout) :: res  !! the result
+      real(dp), intent(in) :: t                !! its time [s]
+
+      res%accumulations = res%accumulations + 1
+      if (res%n_accumulation_times >= max_violation_times) return
+      res%n_accumulation_times = res%n_accumulation_times + 1
+      res%accumulation_time(res%n_accumulation_times) = t
+   end subroutine observe_accumulation
 
    !> The next row of the history: t, ag, (u, v, aabs) per DOF, (s, s', F, phase) per device.
    pure subroutine observe_sample(obs, res, t, ag, u, v, acc, s, sd, force, phase)
@@ -151,6 +238,12 @@ contains
             res%hist(c + 1:c + 4, row) = [s(i), sd(i), force(i), real(phase(i), dp)]
             c = c + 4
          end do
+         ! storeys: (drift, V) each, then the base shear
+         if (res%eng%n_storeys > 0) then
+            i = res%eng%n_storeys
+            call storey_values(res%eng, u, v, force, res%hist(c + 1:c + 2*i - 1:2, row), &
+                               res%hist(c + 2:c + 2*i:2, row), res%hist(c + 2*i + 1, row))
+         end if
       end associate
    end subroutine observe_sample
 

@@ -4,14 +4,18 @@ module fd_result
    use fd_kinds, only: dp
    use, intrinsic :: ieee_arithmetic, only: ieee_is_finite
    use fd_error, only: error_type, fatal_error, fmt_int, fmt_real, stat_no_memory
-   use fd_model, only: model_type, integration_type
+   use fd_model, only: model_type, integration_type, technique_event_driven
    use fd_excitation, only: excitation_type
+   use fd_engineering, only: engineering_type, engineering_columns
+   use fd_matrices, only: modes_type
    implicit none
    private
 
    public :: result_type, max_violation_times, column_name_len, init_result, history_shape, check_finite
+   public :: max_event_times, has_envelope
 
    integer, parameter :: max_violation_times = 10 !! first violation times kept
+   integer, parameter :: max_event_times = 1000   !! first event times kept (exact technique)
    integer, parameter :: column_name_len = 16     !! length of a column name
 
    !> Everything a run produces.
@@ -48,7 +52,15 @@ module fd_result
       integer :: steps_finer = 0       !! steps taken with dt2/2, dt2/4, ...
       integer :: factorizations = 0    !! factorizations of the effective stiffness
                                        !! (exact technique: matrix exponentials)
-      integer :: events = 0            !! events located (exact technique)
+      integer :: events = 0            !! events located (exact technique): instants at which
+                                       !! phases changed
+      integer :: n_event_times = 0     !! entries used in event_time
+      real(dp) :: event_time(max_event_times) = 0.0_dp !! times of the first events [s]
+      integer :: accumulations = 0     !! accumulation points of events (Zeno), handled
+      integer :: n_accumulation_times = 0 !! entries used in accumulation_time
+      real(dp) :: accumulation_time(max_violation_times) = 0.0_dp !! their first times [s]
+      logical :: exact_peaks = .false. !! peaks are the exact extrema (exact technique)
+      integer :: env_col = 0           !! first column of the maxima between rows (0: none)
       integer :: patterns = 0          !! stick-slip patterns solved in one-step problems (Moreau-Jean)
       integer :: lcp_fallbacks = 0     !! one-step problems that needed Lemke's fallback (Moreau-Jean)
       ! correctness condition, eqs. 9 and 12
@@ -65,12 +77,26 @@ module fd_result
       real(dp) :: e_device = 0.0_dp    !! elastic energy stored in sticking devices at the end
       real(dp) :: e_residual = 0.0_dp  !! input - (kinetic + strain + viscous + friction + device)
       real(dp) :: run_time = 0.0_dp    !! wall-clock time of the integration [s]
+      ! names, modes, storey drifts and shears, residual values (fd_engineering)
+      type(engineering_type) :: eng    !! the engineering outputs
    end type result_type
 
 contains
 
+   !> Whether a run of these settings writes, after the state columns, the maxima of |u|,
+   !> |v|, |aabs| per DOF, |s|, |F| per device and |drift|, |V| per storey and |Vb| since the
+   !> previous row (the exact technique, whose solution between rows is known).
+   pure logical function has_envelope(opts)
+      type(integration_type), intent(in) :: opts    !! integration settings
+
+      has_envelope = opts%technique == technique_event_driven
+   end function has_envelope
+
    !> Size of the history a run writes: columns t, ag, (u, v, aabs) per DOF and
-   !> (s, sdot, F, phase) per device; samples at t = 0, every `every` dt1 steps and at the end.
+   !> (s, sdot, F, phase) per device, then (drift, V) per storey and Vb when the model names
+   !> storeys, then (exact technique) the maxima since the previous row: (peak_u, peak_v,
+   !> peak_aabs) per DOF, (peak_s, peak_F) per device and (peak_drift, peak_V) per storey and
+   !> peak_Vb; samples at t = 0, every `every` dt1 steps and at the end.
    pure subroutine history_shape(model, exc, opts, ncol, nout, nsteps, every)
       type(model_type), intent(in) :: model         !! the model
       type(excitation_type), intent(in) :: exc      !! the table motion
@@ -80,7 +106,8 @@ contains
       integer, intent(out) :: nsteps                !! dt1 steps of the run
       integer, intent(out) :: every                 !! dt1 steps between samples
 
-      ncol = 2 + 3*model%n_dof + 4*model%n_devices
+      ncol = 2 + 3*model%n_dof + 4*model%n_devices + engineering_columns(model)
+      if (has_envelope(opts)) ncol = ncol + 3*model%n_dof + 2*model%n_devices + engineering_columns(model)
       nsteps = max(1, nint(exc%duration/(exc%dt_record/opts%n1)))
       every = opts%output_every
       if (every <= 0) every = opts%n1
@@ -128,6 +155,39 @@ contains
          res%names(c + 4) = 'phase'//trim(fmt_int(i)); res%units(c + 4) = '-'
          c = c + 4
       end do
+      if (engineering_columns(model) > 0) then
+         do i = 1, model%n_storeys
+            res%names(c + 1) = 'drift'//trim(fmt_int(i)); res%units(c + 1) = 'm'
+            res%names(c + 2) = 'V'//trim(fmt_int(i)); res%units(c + 2) = 'N'
+            c = c + 2
+         end do
+         res%names(c + 1) = 'Vb'; res%units(c + 1) = 'N'
+         c = c + 1
+      end if
+      if (has_envelope(opts)) then
+         res%env_col = c + 1
+         res%exact_peaks = .true.
+         do i = 1, n
+            res%names(c + 1) = 'peak_u'//trim(fmt_int(i)); res%units(c + 1) = 'm'
+            res%names(c + 2) = 'peak_v'//trim(fmt_int(i)); res%units(c + 2) = 'm/s'
+            res%names(c + 3) = 'peak_aabs'//trim(fmt_int(i)); res%units(c + 3) = 'm/s2'
+            c = c + 3
+         end do
+         do i = 1, nd
+            res%names(c + 1) = 'peak_s'//trim(fmt_int(i)); res%units(c + 1) = 'm'
+            res%names(c + 2) = 'peak_F'//trim(fmt_int(i)); res%units(c + 2) = 'N'
+            c = c + 2
+         end do
+         if (engineering_columns(model) > 0) then
+            do i = 1, model%n_storeys
+               res%names(c + 1) = 'peak_drift'//trim(fmt_int(i)); res%units(c + 1) = 'm'
+               res%names(c + 2) = 'peak_V'//trim(fmt_int(i)); res%units(c + 2) = 'N'
+               c = c + 2
+            end do
+            res%names(c + 1) = 'peak_Vb'; res%units(c + 1) = 'N'
+            c = c + 1
+         end if
+      end if
       allocate (res%peak_u(n), res%peak_u_time(n), res%peak_v(n), res%peak_aabs(n), &
                 res%peak_aabs_time(n), res%peak_s(nd), res%peak_force(nd), res%stick_to_slip(nd), &
                 res%slip_to_stick(nd), res%reversals(nd), stat=stat)
@@ -164,6 +224,7 @@ contains
       if (allocated(res%peak_aabs)) call vector('peak_aabs_mps2', res%peak_aabs)
       if (allocated(res%peak_s)) call vector('peak_s_m', res%peak_s)
       if (allocated(res%peak_force)) call vector('peak_force_N', res%peak_force)
+      call engineering()
       if (allocated(error) .or. .not. allocated(res%hist)) return
       do j = 1, min(res%nout, size(res%hist, 2))
          do i = 1, size(res%hist, 1)
@@ -176,6 +237,41 @@ contains
          end do
       end do
    contains
+      !> The engineering outputs (fd_engineering): damping, modes (a rigid-body mode's
+      !> infinite period and undefined damping ratio are written as 0), storeys, residuals.
+      subroutine engineering()
+         if (allocated(error)) return
+         call scalar('damping_a0_per_s', res%eng%a0)
+         call scalar('damping_a1_s', res%eng%a1)
+         call modes('stuck', res%eng%stuck)
+         call modes('free', res%eng%free)
+         if (allocated(res%eng%residual_s)) call vector('residual_s_m', res%eng%residual_s)
+         if (allocated(res%eng%peak_drift)) call vector('peak_drift_m', res%eng%peak_drift)
+         if (allocated(res%eng%drift)) call vector('residual_drift_m', res%eng%drift)
+         if (allocated(res%eng%peak_shear)) then
+            call scalar('peak_base_shear_N', res%eng%peak_shear(0))
+            call vector('peak_storey_shear_N', res%eng%peak_shear(1:))
+         end if
+         if (allocated(res%eng%shear)) then
+            call scalar('residual_base_shear_N', res%eng%shear(0))
+            call vector('residual_storey_shear_N', res%eng%shear(1:))
+         end if
+      end subroutine engineering
+      subroutine modes(name, m)
+         character(len=*), intent(in) :: name
+         type(modes_type), intent(in) :: m
+         integer :: k
+         if (m%n == 0 .or. allocated(error)) return
+         do k = 1, m%n
+            if (m%omega2(k) == 0.0_dp) cycle
+            call scalar('periods_'//name//'_s('//trim(fmt_int(k))//')', m%period(k))
+            call scalar('modal_xi_'//name//'('//trim(fmt_int(k))//')', m%xi(k))
+         end do
+         call vector('modal_mass_ratio_'//name, m%mass_ratio)
+         do k = 1, m%n
+            call vector('mode_shapes_'//name//'('//trim(fmt_int(k))//')', m%shape(:, k))
+         end do
+      end subroutine modes
       subroutine scalar(key, x)
          character(len=*), intent(in) :: key
          real(dp), intent(in) :: x

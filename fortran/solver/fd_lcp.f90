@@ -450,7 +450,9 @@ contains
    ! ------------------------------------------------------------------ residuals, messages
 
    !> Relative residual of a standard LCP solution: with zs = max |z_i| and
-   !> ws = max_i (|q_i| + sum_j |M_ij z_j|) (each 1 if zero),
+   !> ws = max_i (|q_i| + sum_j |M_ij| zs) (each 1 if zero): the size w's terms have at the
+   !> solution's scale (with |M_ij z_j| in its place, data q near zero, e.g. subnormal,
+   !> made zs/ws overflow and a solution's w of 1e-309 count as a residual of 1),
    !>   max( max_i |w_i - (M z + q)_i| / ws,  max_i |min(z_i, w_i zs/ws)| / zs ),
    !> zero exactly when z solves the LCP; it measures infeasibility and complementarity.
    pure function lcp_residual(m, q, z, w) result(res)
@@ -989,19 +991,19 @@ contains
          zs = max(zs, abs(z(i)))
          if (box) zs = max(zs, abs(lo(i)), abs(hi(i)))
       end do
+      if (zs == 0.0_dp) zs = 1.0_dp
       ws = 0.0_dp
       eq = 0.0_dp
       do i = 1, n
          s = abs(q(i))
          t = q(i)
          do j = 1, n
-            s = s + abs(m(i, j)*z(j))
+            s = s + abs(m(i, j))*zs
             t = t + m(i, j)*z(j)
          end do
          ws = max(ws, s)
          eq = max(eq, abs(w(i) - t))
       end do
-      if (zs == 0.0_dp) zs = 1.0_dp
       if (ws == 0.0_dp) ws = 1.0_dp
       res = eq/ws
       do i = 1, n

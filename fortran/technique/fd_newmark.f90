@@ -384,6 +384,7 @@ contains
       logical, intent(in) :: any_bad
       integer :: d
       real(dp) :: f0, f1
+      logical :: any_force
 
       ! energy of the step, forces at both ends in the step's phases
       w%tmp = w%u1 - w%u
@@ -403,8 +404,11 @@ contains
       call observe_transitions(res, w%phase0, w%phase1)
       w%u = w%u1; w%v = w%v1; w%a = w%a1; w%ag = w%ag1
       w%s = w%s1; w%sd = w%sd1
+      ! a phase change, or a sliding force that follows the velocity (mu(v)): the next
+      ! step starts in equilibrium with the new forces
+      any_force = any(w%st1%f0 /= w%st%f0)
       w%st = w%st1
-      if (any(w%changed)) call consistent_acceleration(model, exc, t1, w)
+      if (any(w%changed) .or. any_force) call consistent_acceleration(model, exc, t1, w)
       w%f = device_force(w%st, w%s, w%sd)
       call observe_peaks(res, t1, w%u, w%v, w%a, w%ag, w%s, w%f)
    end subroutine accept

@@ -9,12 +9,14 @@ the same (seed, index) always gives the same case.
 Mutations, by what they touch:
 
 - deck lines: deleted, repeated, swapped, truncated at any byte, CRLF or CR line ends;
-- deck values: wrong types, extreme values (1e308, 4.9e-324, -0, huge integers), NaN and Inf,
-  huge counts (n_dof = 10000, 100000*1.0), empty values, repeat counts, misspelled names;
+- deck values (of every group, &storeys, &braces, &isolators too): wrong types, extreme
+  values (1e308, 4.9e-324, -0, huge integers), NaN and Inf, huge counts (n_dof = 10000,
+  100000*1.0), empty values, repeat counts, misspelled names;
 - deck syntax: '& name', 'x&name', a non-breaking space, '$name ... $end', a '/' deleted or
   doubled, text or assignments outside groups, a variable given twice;
 - text: non-ASCII (UTF-8 in comments and strings, Latin-1 bytes, invalid UTF-8), binary
-  lines, very long lines and strings (past the 32 and 1024 character capacities);
+  lines, very long lines and strings (past the 31, 32 and 1024 character capacities of
+  labels, keywords and paths);
 - whole files: empty, binary, a deck that is a directory, a missing deck, non-ASCII and long
   deck file names;
 - records: lines deleted, repeated or truncated, values NaN/Inf/1e308/1e-320, list-directed
@@ -90,7 +92,7 @@ def bases() -> dict[str, tuple[str, dict[str, bytes]]]:
         files = {}
         for m in re.finditer(r"record_file\s*=\s*'([^']+)'", text):
             files[m.group(1)] = (INPUTS / m.group(1)).read_bytes()
-        text = re.sub(r"duration = 40\.0", "duration = 2.0", text)
+        text = re.sub(r"duration = (?:40|30)\.0", "duration = 2.0", text)
         if files and "duration" not in text:
             text = text.replace("excitation_type = 'record'",
                                 "excitation_type = 'record'\n  duration = 3.0", 1)
@@ -121,6 +123,8 @@ STRINGS = [
     "'velocity" + " " * 30 + "x'", "'" + "a" * 33 + "'", "'" + "d" * 1025 + "'",
     "'" + "é" * 600 + "'", "'it''s'", "'a/b'", "'../x'", "'out/sub/deeper'", "'.'",
     "'/nonexistent/dir/x'", "'/proc/x'", "'with space'", "'ü'", "'\t'",
+    "'exponential'", "'table'", "'constant'", "'stuck'", "'free'", "'" + "l" * 31 + "'",
+    "'" + "l" * 32 + "'", "'a,b'", "'a\"b'", "'a\\b'",
 ]
 NON_ASCII = ["µ", "é", "ü", "€", "😀", "\u00a0", "\ufeff", "\u2028", "ε", "Ω"]
 JUNK_LINES = [
@@ -133,9 +137,11 @@ JUNK_LINES = [
 def _value_pool(rng: random.Random, var: str) -> str:
     """A replacement value for variable `var`, from the pool of its kind (or any)."""
     ints = {"n_dof", "n_springs", "n_devices", "node_i", "node_j", "n1", "n2", "ramp_cycles",
-            "output_every"}
+            "output_every", "n_storeys", "n_braces", "n_isolators", "spring", "mode_i", "mode_j",
+            "n_modes"}
     strs = {"law", "damping_type", "excitation_type", "record_kind", "record_file", "dir",
-            "name", "technique", "record_format", "record_units"}
+            "name", "technique", "record_format", "record_units", "mu_law", "mode_system",
+            "label"}
     base = var.split("(")[0].strip().lower()
     r = rng.random()
     if r < 0.6:
@@ -215,14 +221,16 @@ def m_value(rng, text):
 
 
 def m_count(rng, text):
-    var = rng.choice(["n_dof", "n_springs", "n_devices", "n1", "n2", "output_every", "ramp_cycles"])
+    var = rng.choice(["n_dof", "n_springs", "n_devices", "n1", "n2", "output_every", "ramp_cycles",
+                      "n_storeys", "n_braces", "n_isolators", "n_modes"])
     value = rng.choice(EXTREME_INTS)
     out, n = re.subn(rf"\b{var}\s*=\s*[^,\n!/]*", f"{var} = {value}", text, count=1)
     return out, f"{var} = {value}" if n else "no count"
 
 
 def m_huge_array(rng, text):
-    var = rng.choice(["mass", "k", "p", "mu", "u0", "v0", "eps", "node_i", "node_j"])
+    var = rng.choice(["mass", "k", "p", "mu", "u0", "v0", "eps", "node_i", "node_j", "weight",
+                      "slip_load", "height", "radius"])
     value = rng.choice(["100000*1.0", "10001*1.0", "40001*1", "10000*0.5", "2147483647*1.0"])
     out, n = re.subn(rf"\b{var}\s*=\s*[^!\n/]*", f"{var} = {value} ", text, count=1)
     return out, f"{var} = {value}" if n else "no array"

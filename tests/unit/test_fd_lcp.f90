@@ -46,7 +46,8 @@ contains
                   new_unittest("box: block on a moving table", test_box_table), &
                   new_unittest("box: 5-mass chain vs all 3^5 patterns", test_box_chain), &
                   new_unittest("box: random SPD and singular PSD", test_box_random), &
-                  new_unittest("box: random general M always solvable", test_box_general) &
+                  new_unittest("box: random general M always solvable", test_box_general), &
+                  new_unittest("box: subnormal data, bounds of 1", test_box_subnormal) &
                   ]
    end subroutine collect_lcp
 
@@ -1069,5 +1070,26 @@ contains
          deallocate (m, q, lo, hi, z, w)
       end do
    end subroutine test_box_general
+
+   !> A box LCP whose q is subnormal (a record of 2e-309 m/s^2 under a block of limits
+   !> +-1): the solution is z = -q/M inside the box, zero to round-off at the bounds' scale,
+   !> and is solved; the residual is measured at the scale of the bounds (before, zs/ws
+   !> overflowed and the answer z = 0 counted as a residual of 1, "not solved").
+   subroutine test_box_subnormal(error)
+      type(error_type), allocatable, intent(out) :: error
+      type(lcp_work) :: work
+      type(lcp_info) :: info
+      real(dp) :: m(1, 1), q(1), z(1), w(1)
+
+      call new_work(error, work, 1, 1)
+      if (allocated(error)) return
+      m = 2.0_dp
+      q = 2.2250738585072014e-309_dp
+      call box_lcp_solve(work, m, q, [-1.0_dp], [1.0_dp], z, w, info)
+      call check(error, info%status == lcp_solved, 'subnormal q: solved')
+      if (allocated(error)) return
+      call check(error, abs(z(1)) <= 2.0e-309_dp .and. info%residual <= 1.0e-15_dp, &
+                 'subnormal q: z within |q| of zero, residual at round-off')
+   end subroutine test_box_subnormal
 
 end module test_fd_lcp

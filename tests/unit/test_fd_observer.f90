@@ -179,8 +179,9 @@ contains
       call check(error, res%e_residual, -(res%e_friction + res%e_device), thr=1.0e-15_dp)
    end subroutine test_energy
 
-   !> check_finite: a finite result passes; an overflowed energy, peak or history value is an
-   !> error naming its summary key (or column and time), never a null in a summary.
+   !> check_finite: a finite result passes; an overflowed energy, peak, history value or
+   !> engineering output is an error naming its summary key (or column and time), never a
+   !> null in a summary.
    subroutine test_non_finite(error)
       type(error_type), allocatable, intent(out) :: error
       type(model_type) :: model
@@ -214,6 +215,21 @@ contains
       call check(error, allocated(err), 'an infinite history value')
       if (allocated(error)) return
       call check(error, index(err%message, 'history column v1 at t = 0.01 s is -Inf') > 0, err%message)
+      if (allocated(error)) return
+      ! the engineering outputs (fd_engineering) too: base shear, residual device displacement
+      bad = res
+      bad%eng%peak_shear(0) = ieee_value(1.0_dp, ieee_positive_inf)
+      call check_finite(bad, err)
+      call check(error, allocated(err), 'an infinite base shear')
+      if (allocated(error)) return
+      call check(error, index(err%message, 'peak_base_shear_N = Inf') > 0, err%message)
+      if (allocated(error)) return
+      bad = res
+      bad%eng%residual_s(1) = ieee_value(1.0_dp, ieee_quiet_nan)
+      call check_finite(bad, err)
+      call check(error, allocated(err), 'a NaN residual displacement')
+      if (allocated(error)) return
+      call check(error, index(err%message, 'residual_s_m(1) = NaN') > 0, err%message)
    end subroutine test_non_finite
 
 end module test_fd_observer

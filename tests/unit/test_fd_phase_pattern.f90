@@ -1,22 +1,34 @@
-!> Unit tests of the reduced LTI system of a phase pattern and its exact propagators
-!> (fd_phase_pattern) against closed forms: a free damped oscillator, a rigid body under a
-!> constant (sliding friction) force, an undamped oscillator under harmonic table motion
-!> (the particular solution), a free mass under a piecewise-linear record (the first-order
-!> hold), and a mass stuck to the table (no reduced DOF).
+!> Unit tests of the reduced system of a phase pattern, its closed form between events
+!> (Taylor polynomial and remainder bound) and its force map (fd_phase_pattern) against
+!> closed forms: a free damped oscillator, a rigid body under a constant (sliding friction)
+!> force, an undamped oscillator under harmonic table motion, a free mass under a
+!> piecewise-linear record, a mass stuck to the table, the force that keeps two masses
+!> together, devices in parallel sharing their load in proportion to their limits, and the
+!> cache.
 module test_fd_phase_pattern
    use testdrive, only: new_unittest, unittest_type, error_type, check, test_failed
    use fd_kinds, only: dp
    use fd_error, only: fd_error_type => error_type
    use fd_model, only: model_type, device_type, law_coulomb
-   use fd_excitation, only: excitation_type, excitation_none, excitation_harmonic, excitation_record
-   use fd_phase_pattern, only: pattern_type, build_pattern, pattern_exp, pattern_propagators, propagate, &
-                               expand_pattern
+   use fd_excitation, only: excitation_type, excitation_none, excitation_harmonic, excitation_record, &
+                            table_taylor
+   use fd_phase_pattern, only: pattern_type, pattern_cache, cache_init, cache_find, build_pattern, &
+                               pattern_entry, pattern_taylor, remainder_bound, kmax
+   use fd_taylor, only: poly_value
+   use test_fd_helpers, only: check_close
    implicit none
    private
 
    public :: collect_phase_pattern
 
    real(dp), parameter :: pi = acos(-1.0_dp)
+
+   !> A pattern entered at a state, with its Taylor coefficients about t.
+   type :: entered
+      type(pattern_type) :: pat
+      real(dp), allocatable :: q(:), p(:), uc(:), b1(:), f0(:), u(:), v(:)
+      real(dp) :: qc(4, 0:kmax + 1), pc(4, 0:kmax + 1), cp(4, 0:kmax + 1), g(0:kmax), gn(0:kmax)
+   end type entered
 
 contains
 
@@ -25,182 +37,150 @@ contains
 
       testsuite = [ &
                   new_unittest("free damped oscillator", test_damped_oscillator), &
-                  new_unittest("kept propagators of the full step", test_cached_step), &
                   new_unittest("rigid body under a constant force", test_sliding_block), &
-                  new_unittest("harmonic table motion (particular solution)", test_harmonic), &
-                  new_unittest("record (first-order hold)", test_record), &
-                  new_unittest("mass stuck to the table", test_stuck_to_table) &
+                  new_unittest("harmonic table motion", test_harmonic), &
+                  new_unittest("record (linear between samples)", test_record), &
+                  new_unittest("mass stuck to the table", test_stuck_to_table), &
+                  new_unittest("force that keeps two masses together", test_two_masses), &
+                  new_unittest("devices in parallel share in proportion", test_parallel), &
+                  new_unittest("cache: one build per pattern", test_cache) &
                   ]
    end subroutine collect_phase_pattern
 
-   !> One mass, optionally with one device to the table.
-   subroutine one_mass(m, with_device, model)
-      real(dp), intent(in) :: m
-      logical, intent(in) :: with_device
+   !> n masses; devices given by node pairs with limits slip (P = slip, mu = 1).
+   subroutine make_model(mass, ni, nj, slip, model)
+      real(dp), intent(in) :: mass(:)
+      integer, intent(in) :: ni(:), nj(:)
+      real(dp), intent(in) :: slip(:)
       type(model_type), intent(out) :: model
+      integer :: d
 
-      model%n_dof = 1
-      model%mass = [m]
-      model%u0 = [0.0_dp]
-      model%v0 = [0.0_dp]
-      if (with_device) then
-         model%n_devices = 1
-         model%dev = [device_type(node_i=1, node_j=0, law=law_coulomb, p=10.0_dp, mu=0.5_dp)]
-      else
-         model%n_devices = 0
-         allocate (model%dev(0))
-      end if
-   end subroutine one_mass
+      model%n_dof = size(mass)
+      model%mass = mass
+      allocate (model%u0(size(mass)), model%v0(size(mass)))
+      model%u0 = 0.0_dp
+      model%v0 = 0.0_dp
+      model%n_devices = size(ni)
+      allocate (model%dev(size(ni)))
+      do d = 1, size(ni)
+         model%dev(d) = device_type(node_i=ni(d), node_j=nj(d), law=law_coulomb, p=slip(d), mu=1.0_dp)
+      end do
+   end subroutine make_model
 
-   !> Build the pattern of one mass (stiffness k, damping c) at t from (u0, v0).
-   subroutine build_one(model, k, c, phase, exc, t, u0, v0, x, pat, error)
+   !> Build the pattern of the phases, enter it at (u, v) and expand it about t.
+   subroutine enter_at(model, k, c, phase, exc, t, u, v, e, error)
       type(model_type), intent(in) :: model
-      real(dp), intent(in) :: k, c
+      real(dp), intent(in) :: k(:, :), c(:, :)
       integer, intent(in) :: phase(:)
       type(excitation_type), intent(in) :: exc
-      real(dp), intent(in) :: t, u0, v0
-      real(dp), allocatable, intent(inout) :: x(:)
-      type(pattern_type), intent(inout) :: pat
+      real(dp), intent(in) :: t, u(:), v(:)
+      type(entered), intent(inout) :: e
       type(error_type), allocatable, intent(out) :: error
       type(fd_error_type), allocatable :: err
-      real(dp) :: kk(1, 1), cc(1, 1), v(1)
+      real(dp) :: slip(size(phase)), fn(size(u))
       logical :: active(size(phase))
-      real(dp) :: slip(size(phase))
+      integer :: d, n
 
-      kk = k; cc = c; v = v0
-      active = .true.
-      slip = 5.0_dp
-      call build_pattern(model, model%mass, kk, cc, active, phase, slip, exc, t, [u0], v, x, pat, err)
-      if (allocated(err)) call test_failed(error, err%message)
-   end subroutine build_one
-
-   !> Propagate the pattern's state x from t over tau into y (one matrix exponential).
-   subroutine step(pat, exc, t, tau, x, y, error)
-      type(pattern_type), intent(in) :: pat
-      type(excitation_type), intent(in) :: exc
-      real(dp), intent(in) :: t, tau, x(:)
-      real(dp), intent(out) :: y(:)
-      type(error_type), allocatable, intent(out) :: error
-      type(fd_error_type), allocatable :: err
-      real(dp) :: phi(pat%m, pat%m), g1(pat%m, pat%m), g2(pat%m, pat%m), wk(pat%m)
-      integer :: n_expm
-
-      n_expm = 0
-      call pattern_exp(pat, tau, phi, g1, g2, n_expm, err)
+      n = size(u)
+      do d = 1, size(phase)
+         slip(d) = model%dev(d)%p*model%dev(d)%mu
+      end do
+      active = slip > 0.0_dp
+      call build_pattern(model, model%mass, k, c, active, phase, slip, exc, e%pat, err)
       if (allocated(err)) then
-         call test_failed(error, err%message); return
+         call test_failed(error, err%message)
+         return
       end if
-      call check(error, n_expm, 1)
-      if (allocated(error)) return
-      call propagate(exc, pat, t, tau, x, phi, g1, g2, y, wk)
-   end subroutine step
+      allocate (e%q(n), e%p(n), e%uc(n), e%b1(n), e%f0(max(1, size(phase))))
+      e%u = u
+      e%v = v
+      call pattern_entry(e%pat, model, model%mass, k, phase, slip, e%u, e%v, e%q, e%p, e%uc, e%b1, e%f0, fn)
+      call table_taylor(exc, t, e%g(0:e%pat%order), e%gn(0:e%pat%order))
+      call pattern_taylor(e%pat, e%q, e%p, e%b1, e%g(0:e%pat%order), e%qc, e%pc, e%cp)
+   end subroutine enter_at
 
-   !> m u'' + c u' + k u = 0: u = e^(-z w t) (u0 cos wd t + (v0 + z w u0)/wd sin wd t),
-   !> over 1.2 periods (measured error 1.1e-14 of the amplitude: the exponential of A tau,
-   !> |A tau| = 150, is scaled by 2^5 and squared back).
+   !> q(s), p(s) of group 1 from the coefficients, and the remainder bound of u over s.
+   subroutine state_at(e, s, u, v, bound)
+      type(entered), intent(in) :: e
+      real(dp), intent(in) :: s
+      real(dp), intent(out) :: u, v, bound
+      u = poly_value(e%qc(1, 0:e%pat%order), s)
+      v = poly_value(e%pc(1, 0:e%pat%order), s)
+      bound = e%pat%wq(1)*remainder_bound(e%pat, e%qc, e%pc, e%gn(e%pat%order), s)
+   end subroutine state_at
+
+   !> m u'' + c u' + k u = 0 over one sub-interval: the closed form
+   !> u = e^(-z w t) (u0 cos wd t + (v0 + z w u0)/wd sin wd t) to 1e-14 of the amplitude,
+   !> and the remainder bound both above the actual error and below 1e-15 of it.
    subroutine test_damped_oscillator(error)
       type(error_type), allocatable, intent(out) :: error
       type(model_type) :: model
       type(excitation_type) :: exc
-      type(pattern_type) :: pat
-      real(dp), allocatable :: x(:)
-      real(dp) :: y(2), m, k, c, w, z, wd, u0, v0, tau, e, u, v, amp
-      integer :: no_phase(0)
+      type(entered) :: e
+      real(dp) :: m, k, c, w, z, wd, u0, v0, s, ex, u, v, ue, ve, amp, bound, kk(1, 1), cc(1, 1)
+      integer :: i, no_phase(0)
 
       m = 2.0_dp; k = 800.0_dp; z = 0.05_dp
       w = sqrt(k/m); c = 2.0_dp*z*w*m; wd = w*sqrt(1.0_dp - z*z)
-      u0 = 0.01_dp; v0 = -0.3_dp; tau = 0.37_dp
-      call one_mass(m, .false., model)
+      u0 = 0.01_dp; v0 = -0.3_dp
+      call make_model([m], [integer ::], [integer ::], [real(dp) ::], model)
       exc%kind = excitation_none
-      call build_one(model, k, c, no_phase, exc, 0.0_dp, u0, v0, x, pat, error)
+      kk = k; cc = c
+      call enter_at(model, kk, cc, no_phase, exc, 0.0_dp, [u0], [v0], e, error)
       if (allocated(error)) return
-      call check(error, pat%nq, 1)
+      call check(error, e%pat%nq, 1)
       if (allocated(error)) return
-      call step(pat, exc, 0.0_dp, tau, x, y, error)
-      if (allocated(error)) return
-      e = exp(-z*w*tau)
-      u = e*(u0*cos(wd*tau) + (v0 + z*w*u0)/wd*sin(wd*tau))
-      v = e*(v0*cos(wd*tau) - (w*w*u0 + z*w*v0)/wd*sin(wd*tau))
       amp = sqrt(u0**2 + ((v0 + z*w*u0)/wd)**2)
-      call check(error, y(1), u, thr=1.0e-13_dp*amp)
-      if (allocated(error)) return
-      call check(error, y(2), v, thr=1.0e-13_dp*amp*w)
+      do i = 0, 10
+         s = e%pat%delta*i/10.0_dp
+         ex = exp(-z*w*s)
+         ue = ex*(u0*cos(wd*s) + (v0 + z*w*u0)/wd*sin(wd*s))
+         ve = ex*(v0*cos(wd*s) - (w*w*u0 + z*w*v0)/wd*sin(wd*s))
+         call state_at(e, s, u, v, bound)
+         call check_close(error, u, ue, 1.0e-14_dp*amp, "damped oscillator u", absolute=.true.)
+         if (allocated(error)) return
+         call check_close(error, v, ve, 1.0e-14_dp*amp*w, "damped oscillator v", absolute=.true.)
+         if (allocated(error)) return
+         call check(error, bound <= 1.0e-15_dp*amp, "remainder bound above the rounding level")
+         if (allocated(error)) return
+      end do
    end subroutine test_damped_oscillator
 
-   !> The propagators kept for the full step h are those of one exponential over h, made
-   !> once (with the three quadrature nodes: 4 exponentials) and then reused.
-   subroutine test_cached_step(error)
-      type(error_type), allocatable, intent(out) :: error
-      type(model_type) :: model
-      type(excitation_type) :: exc
-      type(pattern_type) :: pat
-      type(fd_error_type), allocatable :: err
-      real(dp), allocatable :: x(:)
-      real(dp) :: phi(2, 2), g1(2, 2), g2(2, 2), p2(2, 2), q1(2, 2), q2(2, 2), h
-      integer :: n_expm, no_phase(0)
-
-      call one_mass(2.0_dp, .false., model)
-      exc%kind = excitation_none
-      call build_one(model, 800.0_dp, 4.0_dp, no_phase, exc, 0.0_dp, 0.01_dp, 0.0_dp, x, pat, error)
-      if (allocated(error)) return
-      h = 2.5e-4_dp
-      n_expm = 0
-      call pattern_propagators(pat, h, h, phi, g1, g2, n_expm, err)
-      call check(error, .not. allocated(err) .and. n_expm == 4, "first full step: 4 exponentials")
-      if (allocated(error)) return
-      call pattern_propagators(pat, h, h, p2, q1, q2, n_expm, err)
-      call check(error, .not. allocated(err) .and. n_expm == 4, "second full step: none")
-      if (allocated(error)) return
-      call check(error, all(p2 == phi) .and. all(q1 == g1) .and. all(q2 == g2), "kept propagators differ")
-      if (allocated(error)) return
-      call pattern_exp(pat, h, p2, q1, q2, n_expm, err)
-      call check(error, all(p2 == phi) .and. all(q1 == g1) .and. all(q2 == g2), &
-                 "kept propagators differ from one exponential over h")
-   end subroutine test_cached_step
-
-   !> A block sliding (phase +1) on the table: u'' = -P mu / m, u = u0 + v0 t - P mu t^2 / (2 m)
-   !> (measured error 1 ulp).
+   !> A block sliding (phase +1) on the table, no spring (a rigid-body mode: A defective):
+   !> u = u0 + v0 t - P mu t^2 / (2 m) exactly, the remainder bound 0.
    subroutine test_sliding_block(error)
       type(error_type), allocatable, intent(out) :: error
       type(model_type) :: model
       type(excitation_type) :: exc
-      type(pattern_type) :: pat
-      real(dp), allocatable :: x(:)
-      real(dp) :: y(2), m, a, u0, v0, tau, u(1), v(1), acc(1), xdot(2)
+      type(entered) :: e
+      real(dp) :: m, a, u0, v0, s, u, v, bound, kk(1, 1), cc(1, 1)
 
-      m = 2.0_dp; u0 = 0.003_dp; v0 = 0.8_dp; tau = 0.21_dp
-      a = 5.0_dp/m                          ! slip force P mu = 5 N (build_one)
-      call one_mass(m, .true., model)
+      m = 2.0_dp; u0 = 0.003_dp; v0 = 0.8_dp; s = 0.21_dp
+      a = 5.0_dp/m
+      call make_model([m], [1], [0], [5.0_dp], model)
       exc%kind = excitation_none
-      call build_one(model, 0.0_dp, 0.0_dp, [1], exc, 0.0_dp, u0, v0, x, pat, error)
+      kk = 0.0_dp; cc = 0.0_dp
+      call enter_at(model, kk, cc, [1], exc, 0.0_dp, [u0], [v0], e, error)
       if (allocated(error)) return
-      call check(error, pat%nq, 1)
+      call check(error, e%pat%nq, 1)
       if (allocated(error)) return
-      call step(pat, exc, 0.0_dp, tau, x, y, error)
+      call state_at(e, s, u, v, bound)
+      call check_close(error, u, u0 + v0*s - 0.5_dp*a*s**2, 4.0_dp*epsilon(1.0_dp), "sliding block u")
       if (allocated(error)) return
-      call check(error, y(1), u0 + v0*tau - 0.5_dp*a*tau**2, thr=4.0_dp*epsilon(1.0_dp)*0.2_dp)
+      call check_close(error, v, v0 - a*s, 4.0_dp*epsilon(1.0_dp), "sliding block v")
       if (allocated(error)) return
-      call check(error, y(2), v0 - a*tau, thr=4.0_dp*epsilon(1.0_dp))
-      if (allocated(error)) return
-      ! the full state: u, v and the constant deceleration
-      call expand_pattern(exc, pat, tau, y, u, v, acc, xdot)
-      call check(error, acc(1), -a, thr=4.0_dp*epsilon(1.0_dp)*a)
-      if (allocated(error)) return
-      call check(error, u(1) == y(1) .and. v(1) == y(2), "expand: u, v differ from the reduced state")
+      call check(error, bound == 0.0_dp, "the quadratic is exact: no remainder")
    end subroutine test_sliding_block
 
-   !> u'' + w0^2 u = a0 w^2 sin(w t) from rest (table displacement a0 sin(w t)):
-   !> u = a0 w^2 / (w0^2 - w^2) (sin w t - (w / w0) sin w0 t); from t = 0, and from the
-   !> closed-form state at t1 = 0.35 s, where the particular solution is not at its start.
-   !> (Measured error 3e-15 of the amplitude.)
+   !> u'' + w0^2 u = a0 w^2 sin(w t) from the closed-form state at t1 = 0.35 s:
+   !> u = a0 w^2 / (w0^2 - w^2) (sin w t - (w / w0) sin w0 t) to 1e-14 of the amplitude.
    subroutine test_harmonic(error)
       type(error_type), allocatable, intent(out) :: error
       type(model_type) :: model
       type(excitation_type) :: exc
-      type(pattern_type) :: pat
-      real(dp), allocatable :: x(:)
-      real(dp) :: y(2), w0, w, a0, amp, t1, tau
-      integer :: no_phase(0)
+      type(entered) :: e
+      real(dp) :: w0, w, a0, amp, t1, s, u, v, bound, kk(1, 1), cc(1, 1)
+      integer :: i, no_phase(0)
 
       w0 = 10.0_dp
       exc%kind = excitation_harmonic
@@ -209,23 +189,21 @@ contains
       exc%ramp_cycles = 0
       a0 = exc%amplitude; w = 2.0_dp*pi*exc%frequency
       amp = a0*w*w/(w0*w0 - w*w)*(1.0_dp + w/w0)
-      call one_mass(1.0_dp, .false., model)
-      call build_one(model, w0*w0, 0.0_dp, no_phase, exc, 0.0_dp, 0.0_dp, 0.0_dp, x, pat, error)
-      if (allocated(error)) return
-      tau = 0.9_dp
-      call step(pat, exc, 0.0_dp, tau, x, y, error)
-      if (allocated(error)) return
-      call check(error, y(1), u_exact(tau), thr=1.0e-14_dp*amp)
-      if (allocated(error)) return
-      call check(error, y(2), v_exact(tau), thr=1.0e-14_dp*amp*w0)
-      if (allocated(error)) return
+      call make_model([1.0_dp], [integer ::], [integer ::], [real(dp) ::], model)
+      kk = w0*w0; cc = 0.0_dp
       t1 = 0.35_dp
-      x = [u_exact(t1), v_exact(t1)]
-      call step(pat, exc, t1, tau, x, y, error)
+      call enter_at(model, kk, cc, no_phase, exc, t1, [u_exact(t1)], [v_exact(t1)], e, error)
       if (allocated(error)) return
-      call check(error, y(1), u_exact(t1 + tau), thr=1.0e-14_dp*amp)
-      if (allocated(error)) return
-      call check(error, y(2), v_exact(t1 + tau), thr=1.0e-14_dp*amp*w0)
+      do i = 0, 8
+         s = e%pat%delta*i/8.0_dp
+         call state_at(e, s, u, v, bound)
+         call check_close(error, u, u_exact(t1 + s), 1.0e-14_dp*amp, "harmonic u", absolute=.true.)
+         if (allocated(error)) return
+         call check_close(error, v, v_exact(t1 + s), 1.0e-14_dp*amp*w0, "harmonic v", absolute=.true.)
+         if (allocated(error)) return
+         call check(error, bound <= 1.0e-15_dp*amp, "remainder bound above the rounding level")
+         if (allocated(error)) return
+      end do
    contains
       real(dp) function u_exact(t)
          real(dp), intent(in) :: t
@@ -238,59 +216,139 @@ contains
    end subroutine test_harmonic
 
    !> A free mass under a record, linear between samples: u'' = -(g0 + g1 t), so
-   !> u = u0 + v0 t - g0 t^2 / 2 - g1 t^3 / 6, over the whole interval and inside it
-   !> (measured error 2 ulps).
+   !> u = u0 + v0 t - g0 t^2 / 2 - g1 t^3 / 6, from a time inside the first interval.
    subroutine test_record(error)
       type(error_type), allocatable, intent(out) :: error
       type(model_type) :: model
       type(excitation_type) :: exc
-      type(pattern_type) :: pat
-      real(dp), allocatable :: x(:)
-      real(dp) :: y(2), g0, g1, u0, v0, tau
-      integer :: i, no_phase(0)
-      real(dp), parameter :: taus(2) = [0.1_dp, 0.06_dp]
+      type(entered) :: e
+      real(dp) :: g0, g1, u0, v0, s, u, v, bound, kk(1, 1), cc(1, 1), t0
+      integer :: no_phase(0)
 
       exc%kind = excitation_record
       exc%dt_record = 0.1_dp
-      exc%acc = [1.5_dp, -0.5_dp]
-      g0 = 1.5_dp; g1 = -20.0_dp
+      exc%acc = [1.5_dp, -0.5_dp, 7.0_dp]
+      t0 = 0.04_dp
+      g1 = -20.0_dp
+      g0 = 1.5_dp + g1*t0
       u0 = 0.002_dp; v0 = 0.05_dp
-      call one_mass(3.0_dp, .false., model)
-      call build_one(model, 0.0_dp, 0.0_dp, no_phase, exc, 0.0_dp, u0, v0, x, pat, error)
+      call make_model([3.0_dp], [integer ::], [integer ::], [real(dp) ::], model)
+      kk = 0.0_dp; cc = 0.0_dp
+      call enter_at(model, kk, cc, no_phase, exc, t0, [u0], [v0], e, error)
       if (allocated(error)) return
-      do i = 1, 2
-         tau = taus(i)
-         call step(pat, exc, 0.0_dp, tau, x, y, error)
-         if (allocated(error)) return
-         call check(error, y(1), u0 + v0*tau - g0*tau**2/2.0_dp - g1*tau**3/6.0_dp, thr=1.0e-17_dp)
-         if (allocated(error)) return
-         call check(error, y(2), v0 - g0*tau - g1*tau**2/2.0_dp, thr=1.0e-15_dp)
-         if (allocated(error)) return
-      end do
+      s = 0.06_dp
+      call state_at(e, s, u, v, bound)
+      call check_close(error, u, u0 + v0*s - g0*s**2/2.0_dp - g1*s**3/6.0_dp, 1.0e-15_dp, "record u")
+      if (allocated(error)) return
+      call check_close(error, v, v0 - g0*s - g1*s**2/2.0_dp, 1.0e-15_dp, "record v")
+      if (allocated(error)) return
+      call check(error, bound == 0.0_dp, "the cubic is exact: no remainder")
    end subroutine test_record
 
-   !> A sticking device to the table links the mass to it: no reduced DOF, and the expanded
-   !> state keeps its displacement with no velocity or acceleration (the velocity projected
-   !> on the constraint).
+   !> A sticking device to the table links the mass to it: no reduced DOF; the device
+   !> carries F = -m ag (the table drags the mass): fag = -m, and the velocity is projected.
    subroutine test_stuck_to_table(error)
       type(error_type), allocatable, intent(out) :: error
       type(model_type) :: model
       type(excitation_type) :: exc
-      type(pattern_type) :: pat
-      real(dp), allocatable :: x(:)
-      real(dp) :: u(1), v(1), acc(1), xdot(0)
+      type(entered) :: e
+      real(dp) :: kk(1, 1), cc(1, 1)
 
       exc%kind = excitation_harmonic
       exc%amplitude = 0.01_dp
       exc%frequency = 2.0_dp
-      call one_mass(2.0_dp, .true., model)
-      call build_one(model, 100.0_dp, 1.0_dp, [0], exc, 0.3_dp, 0.004_dp, 1.0e-12_dp, x, pat, error)
+      call make_model([2.0_dp], [1], [0], [5.0_dp], model)
+      kk = 100.0_dp; cc = 1.0_dp
+      call enter_at(model, kk, cc, [0], exc, 0.3_dp, [0.004_dp], [1.0e-12_dp], e, error)
       if (allocated(error)) return
-      call check(error, pat%nq == 0 .and. pat%m == 0 .and. size(x) == 0, "stuck to the table: no reduced DOF")
+      call check(error, e%pat%nq == 0 .and. e%pat%ns == 1, "stuck to the table: no reduced DOF")
       if (allocated(error)) return
-      call expand_pattern(exc, pat, 0.5_dp, x, u, v, acc, xdot)
-      call check(error, u(1) == 0.004_dp .and. v(1) == 0.0_dp .and. acc(1) == 0.0_dp, &
-                 "stuck to the table: the mass moved")
+      call check(error, e%uc(1) == 0.004_dp .and. e%v(1) == 0.0_dp, "offset kept, velocity projected")
+      if (allocated(error)) return
+      call check_close(error, e%pat%fag(1), -2.0_dp, 1e-15_dp, "F = -m ag")
+      if (allocated(error)) return
+      ! and the spring's force on the offset: F = -k u - m ag
+      call check_close(error, e%f0(1), -100.0_dp*0.004_dp, 1e-15_dp, "F0 = -k u")
    end subroutine test_stuck_to_table
+
+   !> Two masses on springs to the table, held together by a sticking device (the paper's
+   !> model, stuck): from m1's equation, F = -(m1 aabs + k1 u + c1 v), aabs = -(k1 + k2) u/(m1 + m2)
+   !> (damping c = psi K).
+   subroutine test_two_masses(error)
+      type(error_type), allocatable, intent(out) :: error
+      type(model_type) :: model
+      type(excitation_type) :: exc
+      type(entered) :: e
+      real(dp) :: k(2, 2), c(2, 2), m1, m2, k1, k2, psi, u, v, aabs, f, ag
+      integer :: i
+
+      m1 = 6.301_dp; m2 = 2.53_dp; k1 = 1084.0_dp; k2 = 2895.0_dp; psi = 1.4e-3_dp
+      call make_model([m1, m2], [1], [2], [61.81_dp*0.22_dp], model)
+      k = 0.0_dp
+      k(1, 1) = k1; k(2, 2) = k2
+      c = psi*k
+      exc%kind = excitation_harmonic
+      exc%amplitude = 0.004052_dp
+      exc%frequency = 4.104_dp
+      u = 0.003_dp; v = -0.05_dp
+      call enter_at(model, k, c, [0], exc, 0.1_dp, [u, u], [v, v], e, error)
+      if (allocated(error)) return
+      call check(error, e%pat%nq == 1 .and. e%pat%ns == 1, "one group, one sticking device")
+      if (allocated(error)) return
+      ag = e%g(0)
+      aabs = -((k1 + k2)*u + psi*(k1 + k2)*v)/(m1 + m2)
+      f = -(m1*aabs + k1*u + psi*k1*v)
+      do i = 1, 1
+         call check_close(error, e%pat%fq(1, 1)*e%q(1) + e%pat%fp(1, 1)*e%p(1) + e%pat%fag(1)*ag + e%f0(1), f, &
+                          1e-13_dp, "force that keeps the masses together")
+         if (allocated(error)) return
+      end do
+   end subroutine test_two_masses
+
+   !> Two devices in parallel between a mass and the table, limits 1 and 3: the force
+   !> -m ag is shared 1 : 3 (they reach their limits together).
+   subroutine test_parallel(error)
+      type(error_type), allocatable, intent(out) :: error
+      type(model_type) :: model
+      type(excitation_type) :: exc
+      type(entered) :: e
+      real(dp) :: kk(1, 1), cc(1, 1)
+
+      exc%kind = excitation_harmonic
+      exc%amplitude = 0.01_dp
+      exc%frequency = 2.0_dp
+      call make_model([2.0_dp], [1, 1], [0, 0], [1.0_dp, 3.0_dp], model)
+      kk = 0.0_dp; cc = 0.0_dp
+      call enter_at(model, kk, cc, [0, 0], exc, 0.3_dp, [0.0_dp], [0.0_dp], e, error)
+      if (allocated(error)) return
+      call check_close(error, e%pat%fag(1), -0.5_dp, 1e-14_dp, "share of the limit-1 device")
+      if (allocated(error)) return
+      call check_close(error, e%pat%fag(2), -1.5_dp, 1e-14_dp, "share of the limit-3 device")
+   end subroutine test_parallel
+
+   !> The cache builds a pattern once and finds it again; a new one gets a new slot.
+   subroutine test_cache(error)
+      type(error_type), allocatable, intent(out) :: error
+      type(model_type) :: model
+      type(excitation_type) :: exc
+      type(pattern_cache) :: cache
+      type(fd_error_type), allocatable :: err
+      real(dp) :: k(2, 2), c(2, 2)
+      integer :: s1, s2, s3
+
+      call make_model([1.0_dp, 2.0_dp], [1, 2], [0, 1], [1.0_dp, 1.0_dp], model)
+      k = 0.0_dp; k(1, 1) = 10.0_dp; k(2, 2) = 5.0_dp
+      c = 0.0_dp
+      exc%kind = excitation_none
+      call cache_init(cache, 2, 2, err)
+      call check(error, .not. allocated(err), "cache_init")
+      if (allocated(error)) return
+      call cache_find(cache, model, model%mass, k, c, [.true., .true.], [0, 1], [1.0_dp, 1.0_dp], exc, [0], s1, err)
+      call cache_find(cache, model, model%mass, k, c, [.true., .true.], [1, -1], [1.0_dp, 1.0_dp], exc, [0], s2, err)
+      call cache_find(cache, model, model%mass, k, c, [.true., .true.], [0, 1], [1.0_dp, 1.0_dp], exc, [0], s3, err)
+      call check(error, .not. allocated(err), "cache_find")
+      if (allocated(error)) return
+      call check(error, s1 == s3 .and. s1 /= s2 .and. cache%builds == 2, "one build per pattern")
+   end subroutine test_cache
 
 end module test_fd_phase_pattern

@@ -20,6 +20,10 @@ program tester
    use test_fd_root_finder, only: collect_root_finder
    use test_fd_phase_pattern, only: collect_phase_pattern
    use test_fd_observer, only: collect_observer
+   use test_fd_sha256, only: collect_sha256
+   use test_fd_engineering, only: collect_engineering
+   use test_fd_friction_mu, only: collect_friction_mu
+   use test_fd_taylor, only: collect_taylor
    use test_fd_banded, only: collect_banded
    use test_fd_stick_groups, only: collect_stick_groups
    use test_fd_group_system, only: collect_group_system
@@ -49,6 +53,10 @@ program tester
    testsuites = [testsuites, new_testsuite("root_finder", collect_root_finder)]
    testsuites = [testsuites, new_testsuite("phase_pattern", collect_phase_pattern)]
    testsuites = [testsuites, new_testsuite("observer", collect_observer)]
+   testsuites = [testsuites, new_testsuite("sha256", collect_sha256)]
+   testsuites = [testsuites, new_testsuite("engineering", collect_engineering)]
+   testsuites = [testsuites, new_testsuite("friction_mu", collect_friction_mu)]
+   testsuites = [testsuites, new_testsuite("taylor", collect_taylor)]
    testsuites = [testsuites, new_testsuite("banded", collect_banded)]
    testsuites = [testsuites, new_testsuite("stick_groups", collect_stick_groups)]
    testsuites = [testsuites, new_testsuite("group_system", collect_group_system)]

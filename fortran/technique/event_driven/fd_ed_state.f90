@@ -1,129 +1,276 @@
-!> The state of the exact event-driven technique at an instant: the structure's matrices,
-!> the full state (u, v, relative acceleration) and the reduced state x of the current
-!> phase pattern, the devices' phases and forces, and the work arrays sized with the
-!> pattern, so that a step between events allocates nothing.
+!> The state of the exact event-driven technique: the structure's matrices, the full state
+!> (u, v) at the current instant, the devices' phases, the cache of phase patterns and
+!> the current pattern's entry data, and every work array, sized once (ed_setup) so that
+!> the loop allocates nothing (a pattern allocates only when it is first built).
+!>
+!> On a sub-interval [0, S] from the current instant (ed_polynomials) it holds the Taylor
+!> polynomials of every output quantity (per DOF u, v, absolute acceleration; per device
+!> s and F) and of every event function (per device two: a sliding device's sgn s', and
+!> nothing; a sticking device's P mu - F and P mu + F), each with the bound of its
+!> remainder and its rounding level eta.
 module fd_ed_state
    use fd_kinds, only: dp
-   use fd_error, only: error_type
+   use fd_error, only: error_type, fatal_error, fmt_int
    use fd_model, only: model_type
-   use fd_excitation, only: excitation_type
-   use fd_linalg, only: least_squares_work
+   use fd_excitation, only: excitation_type, table_taylor
    use fd_device_state, only: phase_stick
-   use fd_phase_pattern, only: pattern_type, build_pattern, expand_pattern, pattern_propagators
+   use fd_lcp, only: lcp_work, lcp_init
+   use fd_taylor, only: poly_abs_bound, max_depth
+   use fd_phase_pattern, only: pattern_type, pattern_cache, cache_init, pattern_series, kmax
    implicit none
    private
 
-   public :: ed_state, ed_setup, set_pattern, expand_state, step_propagators
+   public :: ed_state, ed_setup, ed_polynomials, nq_of, iq_u, iq_v, iq_a, iq_s, iq_f
 
    !> State of the exact technique.
    type :: ed_state
-      integer :: n = 0, nd = 0                             !! DOFs, devices
+      integer :: n = 0, nd = 0, nquant = 0                !! DOFs, devices, output quantities
+      integer :: nbase = 0                                 !! quantities of the state (3 n + 2 nd); the
+                                                           !! others (storeys) are the caller's
       real(dp), allocatable :: mass(:), k(:, :), c(:, :)   !! structure
-      real(dp), allocatable :: u(:), v(:), acc(:)          !! full state and relative acceleration
-      real(dp), allocatable :: x(:)                        !! reduced state
-      integer, allocatable :: phase(:)                     !! 0 stick, +-1 slip
-      logical, allocatable :: fresh(:)                     !! slip started at s' = 0 this event
-      logical, allocatable :: active(:)                    !! P mu > 0
-      real(dp), allocatable :: force(:)                    !! device forces (stuck: required)
       real(dp), allocatable :: slip(:)                     !! P mu
-      type(pattern_type) :: pat                            !! the current phase pattern
-      integer :: n_expm = 0                                !! matrix exponentials computed
-      ! work sized with each pattern (m = 2 nq)
-      real(dp), allocatable :: ph(:, :), q1(:, :), q2(:, :)   !! propagators over tau_ph
-      real(dp) :: tau_ph = -1.0_dp                            !! their step (-1: none)
-      real(dp), allocatable :: pg(:, :), pq1(:, :), pq2(:, :) !! propagators at a quadrature node
-      real(dp), allocatable :: y(:), y2(:), wk(:), xdot(:)    !! states and work (m)
-      ! least-squares work of the stuck forces, sized with each pattern
-      integer :: ns = 0                                       !! sticking active devices
-      integer, allocatable :: ids(:)                          !! their indices
-      real(dp), allocatable :: bm(:, :), rr(:, :), sv(:), lwk(:) !! least-squares work
+      logical, allocatable :: active(:)                    !! P mu > 0
+      real(dp), allocatable :: u(:), v(:)                  !! full state at the current instant
+      integer, allocatable :: phase(:)                     !! 0 stick, +-1 slide
+      type(pattern_cache) :: cache                         !! the patterns met
+      integer :: cur = 0                                   !! slot of the current pattern
+      ! entry data of the current pattern
+      real(dp), allocatable :: q(:), p(:)                  !! reduced state (nq used of n)
+      real(dp), allocatable :: uc(:), b1(:), f0(:)         !! offsets (n), load (nq), force constants (ns)
+      ! polynomials on the current sub-interval
+      real(dp), allocatable :: qc(:, :), pc(:, :), cp(:, :) !! Taylor coefficients (n, 0:kmax+1)
+      real(dp), allocatable :: g(:), gn(:)                 !! table acceleration, remainder factors (0:kmax)
+      real(dp) :: rem = 0.0_dp                             !! remainder bound of the state's norm
+      real(dp) :: size = 0.0_dp                            !! the state polynomial's size
+      integer :: order = 2                                 !! Taylor degree K of the sub-interval
+      real(dp) :: span = 0.0_dp                            !! sub-interval length S
+      real(dp), allocatable :: yc(:, :)                    !! quantities (0:kmax, nquant)
+      real(dp), allocatable :: yrem(:)                     !! their remainder bounds
+      real(dp), allocatable :: ec(:, :)                    !! event functions (0:kmax, 2 nd)
+      real(dp), allocatable :: erem(:), eta(:)             !! remainder bounds, rounding levels
+      real(dp), allocatable :: offs(:)                     !! value below 0 accepted at the last decision
+      logical, allocatable :: eon(:)                       !! event function in use
+      ! polynomial kernels' work
+      real(dp), allocatable :: pw(:, :), pw2(:), pc1(:), roots(:)
+      ! complementarity problems of the phase decision
+      type(lcp_work) :: lcp
+      real(dp), allocatable :: wm(:, :), lq(:), lqa(:), lo(:), hi(:), z(:), w(:), zs(:)
+      integer, allocatable :: cand(:), sig(:), newph(:), oldph(:)
+      logical, allocatable :: crossed(:), near(:)
+      ! vectors over the DOFs and over the devices
+      real(dp), allocatable :: fn(:), pe(:), pa(:), qa(:, :), pq(:, :)
+      real(dp), allocatable :: aab(:)                      !! magnitude of the terms of each group's acceleration
    end type ed_state
 
 contains
 
-   !> Allocate the state of a model (stat /= 0: not enough memory for the matrices).
-   subroutine ed_setup(model, st, stat)
-      type(model_type), intent(in) :: model   !! the model
-      type(ed_state), intent(inout) :: st     !! the state
-      integer, intent(out) :: stat            !! allocation status
-      integer :: n, nd, d
+   !> Number of output quantities: u, v, aabs per DOF, s, F per device.
+   pure integer function nq_of(n, nd)
+      integer, intent(in) :: n, nd
+      nq_of = 3*n + 2*nd
+   end function nq_of
+
+   !> Index of u_i, v_i, aabs_i, s_d, F_d among the output quantities.
+   pure integer function iq_u(i)
+      integer, intent(in) :: i
+      iq_u = 3*i - 2
+   end function iq_u
+   pure integer function iq_v(i)
+      integer, intent(in) :: i
+      iq_v = 3*i - 1
+   end function iq_v
+   pure integer function iq_a(i)
+      integer, intent(in) :: i
+      iq_a = 3*i
+   end function iq_a
+   pure integer function iq_s(n, d)
+      integer, intent(in) :: n, d
+      iq_s = 3*n + 2*d - 1
+   end function iq_s
+   pure integer function iq_f(n, d)
+      integer, intent(in) :: n, d
+      iq_f = 3*n + 2*d
+   end function iq_f
+
+   !> Allocate the state of a model: matrices, work arrays, the pattern cache and the
+   !> complementarity solver's workspace.
+   subroutine ed_setup(model, st, extra, error)
+      type(model_type), intent(in) :: model         !! the model
+      type(ed_state), intent(inout) :: st           !! the state
+      integer, intent(in) :: extra                  !! output quantities the caller appends
+                                                    !! (linear combinations it fills in yc)
+      type(error_type), allocatable, intent(out) :: error !! not enough memory
+      integer :: n, nd, d, stat, nqt
 
       n = model%n_dof
       nd = model%n_devices
       st%n = n
       st%nd = nd
+      st%nbase = nq_of(n, nd)
+      nqt = st%nbase + extra
+      st%nquant = nqt
+      allocate (st%mass(n), st%k(n, n), st%c(n, n), st%slip(nd), st%active(nd), st%u(n), st%v(n), st%phase(nd), &
+                st%q(n), st%p(n), st%uc(n), st%b1(n), st%f0(max(nd, 1)), &
+                st%qc(n, 0:kmax + 1), st%pc(n, 0:kmax + 1), st%cp(n, 0:kmax + 1), st%g(0:kmax), st%gn(0:kmax), &
+                st%yc(0:kmax, nqt), st%yrem(nqt), st%ec(0:kmax, 2*nd), st%erem(2*nd), st%eta(2*nd), &
+                st%offs(2*nd), st%eon(2*nd), st%pw(0:kmax, 0:max_depth), st%pw2(0:kmax), st%pc1(0:kmax), &
+                st%roots(kmax), st%wm(nd, nd), st%lq(nd), st%lqa(nd), st%lo(nd), st%hi(nd), st%z(nd), st%w(nd), &
+                st%zs(nd), st%cand(nd), st%sig(nd), st%newph(nd), st%oldph(nd), st%crossed(nd), st%near(nd), &
+                st%fn(n), st%pe(n), st%pa(n), st%aab(n), st%qa(n, 0:kmax + 1), st%pq(n, 0:kmax + 1), stat=stat)
+      if (stat /= 0) then
+         call fatal_error(error, "not enough memory for the exact technique's state of n_dof = "// &
+                          trim(fmt_int(n))//" DOFs and n_devices = "//trim(fmt_int(nd))//" devices")
+         return
+      end if
       st%mass = model%mass
-      allocate (st%k(n, n), st%c(n, n), st%u(n), st%v(n), st%acc(n), stat=stat)
-      if (stat /= 0) return
-      allocate (st%phase(nd), st%fresh(nd), st%active(nd), st%force(nd), st%slip(nd))
-      st%fresh = .false.
-      st%force = 0.0_dp
       do d = 1, nd
          st%slip(d) = model%dev(d)%p*model%dev(d)%mu
          st%active(d) = st%slip(d) > 0.0_dp
       end do
+      st%phase = phase_stick
+      st%offs = 0.0_dp
+      st%eon = .false.
+      st%crossed = .false.
+      call cache_init(st%cache, n, nd, error)
+      if (allocated(error)) return
+      if (nd > 0) then
+         call lcp_init(st%lcp, nd, nd, error)
+         if (allocated(error)) return
+      end if
    end subroutine ed_setup
 
-   !> Build the pattern of the current phases at time t (reduced state from u, v; v
-   !> projected on the constraints) and size the work arrays with it.
-   subroutine set_pattern(model, exc, t, st, error)
+   !> The polynomials of the current pattern on [0, span] from the current instant t:
+   !> Taylor coefficients of the state, every output quantity and every event function,
+   !> their remainder bounds and rounding levels.
+   subroutine ed_polynomials(model, exc, t, span, st)
       type(model_type), intent(in) :: model         !! the model
       type(excitation_type), intent(in) :: exc      !! the table motion
-      real(dp), intent(in) :: t                     !! time [s]
+      real(dp), intent(in) :: t                     !! the current instant [s]
+      real(dp), intent(in) :: span                  !! sub-interval length S
       type(ed_state), intent(inout) :: st           !! the state
-      type(error_type), allocatable, intent(out) :: error !! no steady state of the forcing
-      integer :: m, n, ns, d
+      integer :: i, d, kk, gi, gj, r, ni, nj, e, j
+      real(dp) :: rg, sk, a0, x
 
-      call build_pattern(model, st%mass, st%k, st%c, st%active, st%phase, st%slip, exc, t, st%u, st%v, &
-                         st%x, st%pat, error)
-      if (allocated(error)) return
-      m = st%pat%m
-      n = st%n
-      if (allocated(st%ph)) deallocate (st%ph, st%q1, st%q2, st%pg, st%pq1, st%pq2, st%y, st%y2, st%wk, st%xdot)
-      allocate (st%ph(m, m), st%q1(m, m), st%q2(m, m), st%pg(m, m), st%pq1(m, m), st%pq2(m, m), &
-                st%y(m), st%y2(m), st%wk(m), st%xdot(m))
-      st%tau_ph = -1.0_dp
-      ns = count(st%active .and. st%phase == phase_stick)
-      st%ns = ns
-      if (allocated(st%ids)) deallocate (st%ids, st%bm, st%rr, st%sv, st%lwk)
-      allocate (st%ids(ns), st%bm(n, ns), st%rr(max(n, ns), 1), st%sv(max(1, min(n, ns))))
-      ns = 0
-      do d = 1, st%nd
-         if (.not. st%active(d) .or. st%phase(d) /= phase_stick) cycle
-         ns = ns + 1
-         st%ids(ns) = d
-      end do
-      allocate (st%lwk(least_squares_work(n, ns)))
-   end subroutine set_pattern
-
-   !> Full u, v and relative acceleration at time t from the reduced state x (or, with
-   !> trial, from the trial state y).
-   subroutine expand_state(exc, t, st, trial)
-      type(excitation_type), intent(in) :: exc      !! the table motion
-      real(dp), intent(in) :: t                     !! time [s]
-      type(ed_state), intent(inout) :: st           !! the state: u, v, acc set
-      logical, intent(in), optional :: trial        !! expand y, not x
-
-      if (present(trial)) then
-         if (trial) then
-            call expand_pattern(exc, st%pat, t, st%y, st%u, st%v, st%acc, st%xdot)
-            return
-         end if
-      end if
-      call expand_pattern(exc, st%pat, t, st%x, st%u, st%v, st%acc, st%xdot)
-   end subroutine expand_state
-
-   !> Make ph, q1, q2 the propagators over tau (those kept for the full step h if tau = h).
-   subroutine step_propagators(st, tau, h, error)
-      type(ed_state), intent(inout) :: st           !! the state
-      real(dp), intent(in) :: tau                   !! time step [s]
-      real(dp), intent(in) :: h                     !! the full step [s]
-      type(error_type), allocatable, intent(out) :: error !! failure of an exponential
-
-      st%tau_ph = -1.0_dp
-      call pattern_propagators(st%pat, tau, h, st%ph, st%q1, st%q2, st%n_expm, error)
-      if (allocated(error)) return
-      st%tau_ph = tau
-   end subroutine step_propagators
+      associate (pat => st%cache%slot(st%cur))
+         st%span = span
+         ! the degree the pattern needs at most (its a priori bound) and a margin
+         kk = min(kmax, pat%order + 4)
+         call table_taylor(exc, t, st%g(0:kk), st%gn(0:kk))
+         call pattern_series(pat, st%q, st%p, st%b1, st%g(0:kk), st%gn(0:kk), span, st%qc, st%pc, st%cp, &
+                             st%order, st%rem, st%size)
+         kk = st%order
+         rg = st%gn(kk)*span**(kk + 1)          ! remainder of ag
+         ! the magnitude of the terms that make up each group's acceleration: the rounding
+         ! level of the velocities' and forces' variation over the sub-interval
+         do i = 1, pat%nq
+            a0 = abs(st%b1(i)) + abs(st%g(0))
+            do j = 1, pat%nq
+               a0 = a0 + abs(pat%kt(i, j)*st%q(j)) + abs(pat%ct(i, j)*st%p(j))
+            end do
+            st%aab(i) = a0
+         end do
+         ! per DOF: u, v, aabs
+         do i = 1, st%n
+            gi = pat%grp(i)
+            if (gi == 0) then
+               st%yc(0:kk, iq_u(i)) = 0.0_dp
+               st%yc(0, iq_u(i)) = st%uc(i)
+               st%yc(0:kk, iq_v(i)) = 0.0_dp
+               st%yc(0:kk, iq_a(i)) = st%g(0:kk)
+               st%yrem(iq_u(i)) = 0.0_dp
+               st%yrem(iq_v(i)) = 0.0_dp
+               st%yrem(iq_a(i)) = rg
+            else
+               st%yc(0:kk, iq_u(i)) = st%qc(gi, 0:kk)
+               st%yc(0, iq_u(i)) = st%yc(0, iq_u(i)) + st%uc(i)
+               st%yc(0:kk, iq_v(i)) = st%pc(gi, 0:kk)
+               do j = 0, kk
+                  st%yc(j, iq_a(i)) = (j + 1)*st%pc(gi, j + 1) + st%g(j)
+               end do
+               st%yrem(iq_u(i)) = pat%wq(gi)*st%rem
+               st%yrem(iq_v(i)) = pat%wp(gi)*st%rem
+               st%yrem(iq_a(i)) = pat%wacc(gi)*st%rem
+            end if
+         end do
+         ! per device: s, F, and the event functions
+         do d = 1, st%nd
+            ni = model%dev(d)%node_i
+            nj = model%dev(d)%node_j
+            st%yc(0:kk, iq_s(st%n, d)) = st%yc(0:kk, iq_u(ni))
+            gi = pat%grp(ni)
+            gj = 0
+            if (nj > 0) then
+               st%yc(0:kk, iq_s(st%n, d)) = st%yc(0:kk, iq_s(st%n, d)) - st%yc(0:kk, iq_u(nj))
+               gj = pat%grp(nj)
+            end if
+            st%yrem(iq_s(st%n, d)) = 0.0_dp
+            if (gi /= gj) then
+               if (gi > 0) st%yrem(iq_s(st%n, d)) = pat%wq(gi)*st%rem
+               if (gj > 0) st%yrem(iq_s(st%n, d)) = st%yrem(iq_s(st%n, d)) + pat%wq(gj)*st%rem
+            end if
+            e = 2*d - 1
+            r = pat%row(d)
+            if (.not. st%active(d)) then
+               st%yc(0:kk, iq_f(st%n, d)) = 0.0_dp
+               st%yrem(iq_f(st%n, d)) = 0.0_dp
+               st%eon(e:e + 1) = .false.
+            else if (r == 0) then
+               ! sliding: F = sgn P mu; event function sgn s'
+               st%yc(0:kk, iq_f(st%n, d)) = 0.0_dp
+               st%yc(0, iq_f(st%n, d)) = st%phase(d)*st%slip(d)
+               st%yrem(iq_f(st%n, d)) = 0.0_dp
+               st%eon(e) = .true.
+               st%eon(e + 1) = .false.
+               a0 = 0.0_dp
+               st%erem(e) = 0.0_dp
+               do j = 0, kk
+                  x = 0.0_dp
+                  if (gi > 0) x = st%pc(gi, j)
+                  if (gj > 0) x = x - st%pc(gj, j)
+                  st%ec(j, e) = st%phase(d)*x
+               end do
+               if (gi > 0) then
+                  a0 = a0 + abs(st%pc(gi, 0)) + span*st%aab(gi)
+                  st%erem(e) = st%erem(e) + pat%wp(gi)*st%rem
+               end if
+               if (gj > 0) then
+                  a0 = a0 + abs(st%pc(gj, 0)) + span*st%aab(gj)
+                  st%erem(e) = st%erem(e) + pat%wp(gj)*st%rem
+               end if
+               st%eta(e) = 256.0_dp*epsilon(1.0_dp)*(a0 + poly_abs_bound(st%ec(0:kk, e), span))
+            else
+               ! sticking: F from the force map; event functions P mu - F and P mu + F
+               associate (f => st%yc(0:kk, iq_f(st%n, d)))
+                  a0 = abs(st%f0(r)) + abs(pat%fag(r)*st%g(0)) + st%slip(d)
+                  do j = 0, kk
+                     sk = pat%fag(r)*st%g(j)
+                     do i = 1, pat%nq
+                        sk = sk + pat%fq(r, i)*st%qc(i, j) + pat%fp(r, i)*st%pc(i, j)
+                     end do
+                     f(j + 1) = sk
+                  end do
+                  f(1) = f(1) + st%f0(r)
+                  a0 = a0 + span*abs(pat%fag(r)*st%g(1))
+                  do i = 1, pat%nq
+                     a0 = a0 + abs(pat%fq(r, i)*st%qc(i, 0)) + abs(pat%fp(r, i)*st%pc(i, 0)) + &
+                          span*(abs(pat%fq(r, i)*st%pc(i, 0)) + abs(pat%fp(r, i))*st%aab(i))
+                  end do
+                  st%yrem(iq_f(st%n, d)) = pat%wf(r)*st%rem + abs(pat%fag(r))*rg
+                  st%ec(0:kk, e) = -f
+                  st%ec(0:kk, e + 1) = f
+                  st%ec(0, e) = st%ec(0, e) + st%slip(d)
+                  st%ec(0, e + 1) = st%ec(0, e + 1) + st%slip(d)
+                  st%eta(e) = 256.0_dp*epsilon(1.0_dp)*(a0 + poly_abs_bound(f, span))
+               end associate
+               st%eon(e:e + 1) = .true.
+               st%eta(e + 1) = st%eta(e)
+               st%erem(e:e + 1) = st%yrem(iq_f(st%n, d))
+            end if
+         end do
+         do e = 1, 2*st%nd
+            st%eta(e) = max(st%eta(e), 4.0_dp*st%erem(e), tiny(1.0_dp))
+         end do
+      end associate
+   end subroutine ed_polynomials
 
 end module fd_ed_state

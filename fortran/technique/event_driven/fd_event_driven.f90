@@ -3,12 +3,25 @@
 !>
 !> A sticking device is a rigid link (s' = 0) carrying whatever force |F| <= P mu keeps it
 !> stuck; a sliding device carries F = P mu sgn(s'). Between events each phase pattern is a
-!> linear time-invariant system integrated exactly (fd_phase_pattern). The loop steps by
-!> dt1 = dt_record / n1 (the sampling grid); in each step the event functions
-!> (fd_phase_decision) are evaluated on the exact solution, the first zero of one that has
-!> become <= 0 is located to round-off by Brent's method (fd_root_finder), the state is
-!> advanced there and the phases are decided again. Input and viscous work are integrated
-!> by 3-point Gauss-Legendre on the exact state; friction work is exact.
+!> linear time-invariant system whose solution is, on every sub-interval, a Taylor
+!> polynomial with a remainder bounded below the rounding level (fd_phase_pattern). On
+!> each sub-interval:
+!>
+!> - every event function (a sliding device's sgn s', a sticking device's P mu -+ F) is a
+!>   polynomial; the first instant at which one falls below minus its rounding level is
+!>   found by isolation (fd_taylor: a lower bound, Descartes' rule, bisection): no sign
+!>   change inside the sub-interval can be missed, whatever the sampling step;
+!> - the history is sampled at its rows' times, and the exact extrema of every output
+!>   quantity (the zeros of its derivative) give the peaks of the summary and the maxima
+!>   between the rows (the `peak_*` columns), one-sided values at the events included;
+!>   the storeys' drifts and shears are linear combinations of u, v and F, so polynomials
+!>   too: their peaks are exact in the same way;
+!> - input and viscous work are integrated exactly (products of polynomials), friction
+!>   work is P mu |Delta s| over each slide.
+!>
+!> At an event the phases are decided by the complementarity problems of the instant
+!> (fd_phase_decision). Sub-intervals do not depend on the sampling step dt1: the events
+!> found are the same for every dt1.
 module fd_event_driven
    use, intrinsic :: ieee_arithmetic, only: ieee_is_finite
    use fd_kinds, only: dp
@@ -18,45 +31,48 @@ module fd_event_driven
    use fd_model, only: model_type, integration_type
    use fd_excitation, only: excitation_type, table_motion, segment_end, forcing_form, forcing_unknown
    use fd_matrices, only: structure_matrices
-   use fd_kinematics, only: device_kinematics, device_relative
-   use fd_linalg, only: sym_matvec
+   use fd_kinematics, only: device_relative
    use fd_device_state, only: phase_stick
    use fd_result, only: result_type
-   use fd_observer, only: observer_type, observer_init, sample_due, observe_start, observe_peaks, &
-                          observe_sample, observe_transitions, observe_end
-   use fd_root_finder, only: root_function, brent_root
-   use fd_phase_pattern, only: forcing_changed, propagate, pattern_exp, quad_x, quad_w
-   use fd_ed_state, only: ed_state, ed_setup, set_pattern, expand_state, step_propagators
-   use fd_phase_decision, only: decide_phases, stuck_forces, event_values
+   use fd_observer, only: observer_type, observer_init, observe_start, observe_sample, observe_transitions, &
+                          observe_end, observe_peak_value, observe_envelope, observe_event, observe_accumulation, &
+                          peak_of_u, peak_of_v, peak_of_aabs, peak_of_s, peak_of_force, peak_of_storey, &
+                          observe_storeys
+   use fd_engineering, only: storey_values, engineering_columns
+   use fd_taylor, only: poly_value, poly_value_deriv, poly_abs_bound, first_crossing, stationary_points
+   use fd_phase_pattern, only: kmax, cache_find, pattern_entry
+   use fd_ed_state, only: ed_state, ed_setup, ed_polynomials, iq_u, iq_v, iq_a, iq_s, iq_f
+   use fd_phase_decision, only: decide_phases, device_list, rtol_decision
    implicit none
    private
 
    public :: run_event_driven, event_driven_check
 
+   integer, parameter :: ring_size = 64          !! events in the accumulation window
+   !> Most sub-intervals a run may need (about an hour of integration): a pattern whose
+   !> frequencies need more for the rest of the run is an error, not a run without end.
+   real(dp), parameter :: max_subintervals = 1.0e9_dp
+   real(dp), parameter :: accumulation_span = 1.0e-9_dp !! [s], times max(1, t): the window
+
    !> Everything the loop works on.
    type :: ed_work
       type(ed_state) :: st                                !! state at the current instant
-      type(observer_type) :: obs                          !! peaks, history, energy balance
-      real(dp), allocatable :: g_end(:), g_try(:), s0(:)  !! event values, start positions (nd)
-      real(dp), allocatable :: s(:), sd(:)                !! device kinematics (nd)
-      integer, allocatable :: old(:)                      !! phases before an event (nd)
-      real(dp), allocatable :: rn(:), vv(:)               !! work (n)
+      type(observer_type) :: obs                          !! history, energy balance
+      real(dp), allocatable :: env(:)                     !! max |quantity| since the last row
+      real(dp), allocatable :: yv(:)                      !! quantities at a point
+      real(dp), allocatable :: rts(:, :)                  !! stationary points (kmax, nquant)
+      integer, allocatable :: nrt(:), ip(:)               !! their number, the next one
+      real(dp), allocatable :: uu(:), vv(:), aa(:)        !! a sample's u, v, relative acceleration
+      real(dp), allocatable :: ss(:), sd(:), ff(:)        !! a sample's s, s', F
+      real(dp), allocatable :: cu(:), cv(:), cf(:)        !! one order's coefficients of u, v, F
+      real(dp), allocatable :: mp(:)                      !! mq' p coefficients (0:kmax)
+      real(dp), allocatable :: ein(:), evi(:)             !! power coefficients (0:2 kmax)
       real(dp) :: w_fric = 0.0_dp                         !! friction work [J]
-      integer :: n_events = 0                             !! events located
+      integer :: n_events = 0                             !! event instants at which phases changed
+      real(dp) :: ring(ring_size) = -huge(1.0_dp)         !! times of the last events
+      integer :: ring_pos = 0
+      real(dp) :: last_accumulation = -huge(1.0_dp)       !! time of the last accumulation point
    end type ed_work
-
-   !> Event function g_d(tau) of one device over a step from tc, on the exact solution:
-   !> the object Brent's method evaluates.
-   type, extends(root_function) :: event_function
-      type(model_type), pointer :: model => null()        !! the model
-      type(excitation_type), pointer :: exc => null()     !! the table motion
-      type(ed_work), pointer :: w => null()               !! the loop's state
-      integer :: device = 0                               !! d
-      real(dp) :: tc = 0.0_dp                             !! start of the step [s]
-      real(dp) :: h = 0.0_dp                              !! the full step [s]
-   contains
-      procedure :: evaluate => event_at
-   end type event_function
 
 contains
 
@@ -96,22 +112,30 @@ contains
       type(excitation_type), intent(in), target :: exc     !! table motion
       type(integration_type), intent(in) :: opts           !! n1 and output_every are used
       type(result_type), intent(out) :: res                !! histories and summary
-      type(error_type), allocatable, intent(out) :: error  !! event chattering, singular phase
+      type(error_type), allocatable, intent(out) :: error  !! a phase decision failed, not finite
       type(ed_work), target :: w
-      real(dp) :: h, t, tn, tb, xg, vg, ag
-      integer :: k, c0, c1, crate, stat
+      real(dp) :: h, t, t_end, s_row, sv
+      integer :: c0, c1, crate, d, stat, nrow, nqt, n, nd
+      logical :: changed
 
       call system_clock(c0, crate)
       call event_driven_check(model, exc, error)
       if (allocated(error)) return
-      call ed_setup(model, w%st, stat)
+      ! the storeys' drifts and shears are output quantities after those of the state
+      call ed_setup(model, w%st, engineering_columns(model), error)
+      if (allocated(error)) return
+      n = model%n_dof
+      nd = model%n_devices
+      nqt = w%st%nquant
+      allocate (w%env(nqt), w%yv(nqt), w%rts(kmax, nqt), w%nrt(nqt), w%ip(nqt), w%uu(n), w%vv(n), w%aa(n), &
+                w%ss(nd), w%sd(nd), w%ff(nd), w%mp(0:kmax), w%ein(0:2*kmax), w%evi(0:2*kmax), w%cu(n), w%cv(n), &
+                w%cf(nd), stat=stat)
       if (stat /= 0) then
-         call fatal_error(error, "not enough memory for the matrices of n_dof = "//trim(fmt_int(model%n_dof))//" DOFs")
+         call fatal_error(error, "not enough memory for the exact technique's work arrays of "// &
+                          trim(fmt_int(nqt))//" output quantities")
          return
       end if
       associate (st => w%st)
-         allocate (w%g_end(st%nd), w%g_try(st%nd), w%s0(st%nd), w%s(st%nd), w%sd(st%nd), w%old(st%nd))
-         allocate (w%rn(st%n), w%vv(st%n))
          call structure_matrices(model, st%k, st%c, res%period_stuck, res%xi_stuck, error)
          if (allocated(error)) return
          call observer_init(model, exc, opts, res, w%obs, error)
@@ -120,234 +144,489 @@ contains
          res%dt1 = h
          res%dt2 = 0.0_dp
          res%dt_min = 0.0_dp
+         t_end = w%obs%nsteps*h
+         res%steps_dt1 = w%obs%nsteps
 
+         ! the initial phases: a device moving at t = 0 slides its way, the others are
+         ! candidates for sticking, decided by the complementarity problems
          st%u = model%u0
          st%v = model%v0
          t = 0.0_dp
-         st%phase = 0
-         do k = 1, st%nd
-            if (st%active(k) .and. abs(device_relative(model, k, st%v)) > 0.0_dp) &
-               st%phase(k) = int(sign(1.0_dp, device_relative(model, k, st%v)))
-            if (.not. st%active(k)) st%phase(k) = 0
+         do d = 1, st%nd
+            st%phase(d) = phase_stick
+            st%near(d) = .false.
+            st%crossed(d) = .false.
+            sv = device_relative(model, d, st%v)
+            if (st%active(d) .and. sv /= 0.0_dp) st%phase(d) = int(sign(1.0_dp, sv))
          end do
-         call decide_phases(model, exc, t, st, error)
-         if (allocated(error)) return
-         call observe_start(w%obs, st%mass, st%k, st%u, st%v, 0.0_dp, w%rn)
-         call table_motion(exc, t, xg, vg, ag)
-         call device_kinematics(model, st%u, st%v, w%s, w%sd)
-         call observe_sample(w%obs, res, t, ag, st%u, st%v, st%acc, w%s, w%sd, st%force, st%phase)
-
-         do k = 1, w%obs%nsteps
-            tn = k*h
-            ! step to tn, stopping at a change of the form of the forcing (end of the ramp)
-            do
-               tb = segment_end(exc, t, tn)
-               call advance(model, exc, t, tb, h, w, res, error)
-               if (allocated(error)) return
-               t = tb
-               if (forcing_changed(st%pat, exc, t)) then
-                  call set_pattern(model, exc, t, st, error)   ! the ramp ended: steady forcing
-                  if (allocated(error)) return
-               end if
-               if (tb >= tn) exit
-            end do
-            t = tn
-            res%steps_dt1 = res%steps_dt1 + 1
-            call table_motion(exc, t, xg, vg, ag)
-            call device_kinematics(model, st%u, st%v, w%s, w%sd)
-            call observe_peaks(res, t, st%u, st%v, st%acc, ag, w%s, st%force)
-            if (sample_due(w%obs, k)) then
-               if (.not. all(ieee_is_finite(st%u))) then
-                  call fatal_error(error, "event-driven technique: the solution is not finite at t = "// &
-                                   trim(fmt_real(t))//" s")
-                  return
-               end if
-               call observe_sample(w%obs, res, t, ag, st%u, st%v, st%acc, w%s, w%sd, st%force, st%phase)
-            end if
-         end do
-         call observe_end(w%obs, res, st%mass, st%k, st%u, st%v, 0.0_dp, w%w_fric, w%rn)
-         res%factorizations = st%n_expm
+         st%cur = 0
+         call decide_phases(model, exc, t, st, changed, error)
+         if (allocated(error)) then
+            call with_context(error)
+            return
+         end if
+         call observe_start(w%obs, st%mass, st%k, st%u, st%v, 0.0_dp, st%fn)
+         ! the first row: the state at t = 0
+         call ed_polynomials(model, exc, t, 0.0_dp, st)
+         call storey_polynomials()
+         call values_at(0.0_dp, w%yv)
+         w%env = abs(w%yv)
+         call write_row(t, 0.0_dp)
+         call update_global(0.0_dp, t)
+         nrow = 1
+         s_row = next_row_time(nrow)
+         call advance_run(error)
+         if (allocated(error)) then
+            call with_context(error)
+            return
+         end if
+         call observe_end(w%obs, res, st%mass, st%k, st%u, st%v, 0.0_dp, w%w_fric, st%fn)
+         res%factorizations = st%cache%builds
          res%events = w%n_events
       end associate
       call system_clock(c1)
       res%run_time = real(c1 - c0, dp)/real(max(crate, 1), dp)
-   end subroutine run_event_driven
+   contains
 
-   !> Advance from t to tb (<= one step h), locating and handling every event on the way.
-   subroutine advance(model, exc, t, tb, h, w, res, error)
-      type(model_type), intent(in), target :: model        !! the model
-      type(excitation_type), intent(in), target :: exc     !! the table motion
-      real(dp), intent(in) :: t                            !! start [s]
-      real(dp), intent(in) :: tb                           !! end [s]
-      real(dp), intent(in) :: h                            !! the full step [s]
-      type(ed_work), intent(inout), target :: w            !! the loop's state
-      type(result_type), intent(inout) :: res              !! transitions, energy
-      type(error_type), allocatable, intent(out) :: error  !! failed exponential or solve,
-                                                           !! chattering
-      type(event_function) :: ev
-      real(dp) :: tc, tau, tau_ev
-      integer :: d, stalls
-      logical :: fired
+      !> Time of history row nrow (dt1 step every*nrow, the last row at nsteps).
+      real(dp) function next_row_time(k) result(tr)
+         integer, intent(in) :: k
+         tr = min(k*w%obs%every, w%obs%nsteps)*h
+      end function next_row_time
 
-      ev%model => model
-      ev%exc => exc
-      ev%w => w
-      ev%h = h
-      tc = t
-      stalls = 0
-      associate (st => w%st)
-         do
-            if (tc >= tb) exit
-            tau = tb - tc
-            ! a full step (tb - tc differs from h by the rounding of k h): use the kept propagators
-            if (abs(tau - h) <= 1.0e-9_dp*h) tau = h
-            call step_propagators(st, tau, h, error)
-            if (allocated(error)) return
-            call state_at(model, exc, tc, tau, st, w%g_end, error)
-            if (allocated(error)) return
-            ! which events fire in (tc, tc + tau]? g_d(0) >= 0 (holding, or sliding on)
-            fired = .false.
-            tau_ev = tau
-            ev%tc = tc
-            do d = 1, st%nd
-               if (w%g_end(d) > 0.0_dp) cycle
-               if (st%phase(d) /= phase_stick .and. st%fresh(d) .and. w%g_end(d) == 0.0_dp) cycle
-               fired = .true.
-               ev%device = d
-               call brent_root(ev, 0.0_dp, 1.0_dp, tau, w%g_end(d), tau_ev, error, origin=tc)
-               if (allocated(error)) return
-               tau = min(tau, tau_ev)
-            end do
-            ! integrate energy over [tc, tc + tau] and move there
-            call energy(exc, tc, tau, h, w, res, error)
-            if (allocated(error)) return
-            if (st%pat%m > 0) then
-               ! the root finder leaves the propagators of its last trial: those over tau
-               ! again unless they are the kept ones of the full step or of the whole interval
-               if ((tau /= tb - tc .and. tau /= h) .or. st%tau_ph /= tau) then
-                  call step_propagators(st, tau, h, error)
-                  if (allocated(error)) return
+      subroutine with_context(err)
+         type(error_type), intent(inout) :: err
+         if (index(err%message, "event-driven technique") == 0) &
+            err%message = "event-driven technique at t = "//trim(fmt_real(t))//" s: "//err%message
+      end subroutine with_context
+
+      !> The loop over sub-intervals from t = 0 to t_end.
+      subroutine advance_run(err)
+         type(error_type), allocatable, intent(out) :: err
+         real(dp) :: span, tb, s_use, s_ev, thr, smin, tol, t_new
+         integer :: e, kk, halvings
+         logical :: fired, found, fresh
+
+         associate (st => w%st)
+            fresh = .true.
+            do while (t < t_end)
+               tb = segment_end(exc, t, t_end)
+               if (t_end - t > max_subintervals*st%cache%slot(st%cur)%delta) then
+                  call fatal_error(err, "the structure's highest frequency with the current phases "// &
+                                   "needs sub-intervals of "//trim(fmt_real(st%cache%slot(st%cur)%delta))// &
+                                   " s: more than "//trim(fmt_real(max_subintervals))//" for the "// &
+                                   trim(fmt_real(t_end - t))//" s left; check for a stiff spring on a "// &
+                                   "small mass (the frequencies sqrt(k/m)), or use the velocity law")
+                  return
                end if
-               call propagate(exc, st%pat, tc, tau, st%x, st%ph, st%q1, st%q2, st%y, st%wk)
-               st%x = st%y
-            end if
-            do d = 1, st%nd
-               w%s0(d) = device_relative(model, d, st%u)
-            end do
-            call expand_state(exc, tc + tau, st)
-            do d = 1, st%nd
-               if (st%active(d) .and. st%phase(d) /= phase_stick) &
-                  w%w_fric = w%w_fric + st%slip(d)*abs(device_relative(model, d, st%u) - w%s0(d))
-            end do
-            if (fired) then
-               tc = tc + tau
-            else
-               tc = tb   ! the whole remaining interval (tau may be snapped to h)
-            end if
-            if (fired) then
-               if (tau <= 1.0e-13_dp*max(1.0_dp, tc)) then
-                  stalls = stalls + 1
-                  if (stalls > 50) then
-                     call fatal_error(error, "event-driven technique: events accumulate at t = "// &
-                                      trim(fmt_real(tc))//" s (stick-slip chattering)")
-                     return
-                  end if
-               else
-                  stalls = 0
+               span = min(st%cache%slot(st%cur)%delta, tb - t)
+               ! the polynomials, with a remainder below the rounding level of the state
+               do halvings = 0, 40
+                  call ed_polynomials(model, exc, t, span, st)
+                  if (st%rem <= 2.0_dp**(-50)*st%size) exit
+                  span = 0.5_dp*span
+               end do
+               call storey_polynomials()
+               kk = st%order
+               smin = 8.0_dp*epsilon(1.0_dp)*(abs(t) + span)
+               tol = 2.0_dp*epsilon(1.0_dp)*(abs(t) + span)
+               if (fresh) then
+                  ! after a decision: a value below zero within the decision's tolerance is
+                  ! accepted; the band starts below it
+                  do e = 1, 2*st%nd
+                     st%offs(e) = 0.0_dp
+                     if (st%eon(e)) st%offs(e) = min(0.0_dp, st%ec(0, e))
+                  end do
+                  fresh = .false.
                end if
-               w%n_events = w%n_events + 1
-               w%old = st%phase
-               call decide_phases(model, exc, tc, st, error)
-               if (allocated(error)) return
-               call observe_transitions(res, w%old, st%phase)
-            else
-               st%fresh = .false.
-               call stuck_forces(model, exc, tc, st, error)
-               if (allocated(error)) return
-            end if
-         end do
-      end associate
-   end subroutine advance
-
-   !> Event values gv at tc + tt (ph, q1, q2 must be the propagators over tt); the state
-   !> is left expanded at tc.
-   subroutine state_at(model, exc, tc, tt, st, gv, error)
-      type(model_type), intent(in) :: model         !! the model
-      type(excitation_type), intent(in) :: exc      !! the table motion
-      real(dp), intent(in) :: tc                    !! start of the step [s]
-      real(dp), intent(in) :: tt                    !! time into the step [s]
-      type(ed_state), intent(inout) :: st           !! the state
-      real(dp), intent(out) :: gv(:)                !! event values
-      type(error_type), allocatable, intent(out) :: error !! failed least-squares solve
-
-      if (st%pat%m > 0) then
-         call propagate(exc, st%pat, tc, tt, st%x, st%ph, st%q1, st%q2, st%y, st%wk)
-         call expand_state(exc, tc + tt, st, trial=.true.)
-      else
-         call expand_state(exc, tc + tt, st)
-      end if
-      call stuck_forces(model, exc, tc + tt, st, error)
-      if (allocated(error)) return
-      call event_values(model, st, gv)
-      ! back to the state at tc (expand overwrote u, v, acc)
-      call expand_state(exc, tc, st)
-   end subroutine state_at
-
-   !> g_d at tc + x on the exact solution (one matrix exponential, unless x = h).
-   subroutine event_at(self, x, fx, error)
-      class(event_function), intent(inout) :: self         !! the event function
-      real(dp), intent(in) :: x                            !! time into the step [s]
-      real(dp), intent(out) :: fx                          !! g_d
-      type(error_type), allocatable, intent(out) :: error  !! failed exponential or solve
-
-      fx = 0.0_dp
-      call step_propagators(self%w%st, x, self%h, error)
-      if (allocated(error)) return
-      call state_at(self%model, self%exc, self%tc, x, self%w%st, self%w%g_try, error)
-      if (allocated(error)) return
-      fx = self%w%g_try(self%device)
-   end subroutine event_at
-
-   !> Input and viscous work over [tc, tc + tt] by 3-point Gauss-Legendre on the exact state.
-   subroutine energy(exc, tc, tt, h, w, res, error)
-      type(excitation_type), intent(in) :: exc      !! the table motion
-      real(dp), intent(in) :: tc                    !! start [s]
-      real(dp), intent(in) :: tt                    !! length [s]
-      real(dp), intent(in) :: h                     !! the full step [s]
-      type(ed_work), intent(inout) :: w             !! the loop's state
-      type(result_type), intent(inout) :: res       !! e_input and e_viscous accumulated
-      type(error_type), allocatable, intent(out) :: error !! failed exponential
-      real(dp) :: xg, vg, ag
-      integer :: ig, i
-
-      if (tt <= 0.0_dp) return
-      associate (st => w%st, pat => w%st%pat)
-         do ig = 1, 3
-            if (pat%m > 0) then
-               if (tt == h .and. pat%h == h) then
-                  call propagate(exc, pat, tc, quad_x(ig)*tt, st%x, pat%gphi(:, :, ig), pat%gg1(:, :, ig), &
-                                 pat%gg2(:, :, ig), st%y2, st%wk)
-               else
-                  call pattern_exp(pat, quad_x(ig)*tt, st%pg, st%pq1, st%pq2, st%n_expm, error)
-                  if (allocated(error)) return
-                  call propagate(exc, pat, tc, quad_x(ig)*tt, st%x, st%pg, st%pq1, st%pq2, st%y2, st%wk)
-               end if
-               do i = 1, st%n
-                  if (pat%grp(i) == 0) then
-                     w%vv(i) = 0.0_dp
+               ! the first crossing of any event function: g <= min(0, offs) - eta
+               s_use = span
+               fired = .false.
+               do e = 1, 2*st%nd
+                  if (.not. st%eon(e)) cycle
+                  thr = st%offs(e) - st%eta(e)
+                  st%pc1(0:kk) = st%ec(0:kk, e)
+                  st%pc1(0) = st%pc1(0) - thr - st%erem(e)
+                  if (st%pc1(0) <= 0.0_dp) then
+                     s_ev = 0.0_dp
+                     found = .true.
                   else
-                     w%vv(i) = st%y2(pat%nq + pat%grp(i))
+                     call first_crossing(st%pc1(0:kk), s_use, smin, tol, st%pw(0:kk, :), st%pw2(0:kk), s_ev, found)
+                  end if
+                  if (found .and. s_ev <= s_use) then
+                     s_use = s_ev
+                     fired = .true.
                   end if
                end do
-            else
-               w%vv = 0.0_dp
-            end if
-            call table_motion(exc, tc + quad_x(ig)*tt, xg, vg, ag)
-            res%e_input = res%e_input - quad_w(ig)*tt*ag*sum(st%mass*w%vv)
-            call sym_matvec(st%c, w%vv, w%rn, 1.0_dp, 0.0_dp)
-            res%e_viscous = res%e_viscous + quad_w(ig)*tt*dot_product(w%vv, w%rn)
+               ! rows, peaks and maxima between rows, energy, friction work over [0, s_use]
+               call observe_subinterval(s_use, err)
+               if (allocated(err)) return
+               if (fired) then
+                  t_new = t + s_use
+               else if (span == tb - t) then
+                  t_new = tb
+               else
+                  t_new = t + span
+               end if
+               call move_to(s_use)
+               t = t_new
+               if (fired) then
+                  call event_at(err)
+                  if (allocated(err)) return
+                  fresh = .true.
+               end if
+            end do
+         end associate
+      end subroutine advance_run
+
+      !> Move the state to s on the current sub-interval.
+      subroutine move_to(s)
+         real(dp), intent(in) :: s
+         integer :: i, gi
+         associate (st => w%st, pat => w%st%cache%slot(w%st%cur))
+            do gi = 1, pat%nq
+               st%q(gi) = poly_value(st%qc(gi, 0:st%order), s)
+               st%p(gi) = poly_value(st%pc(gi, 0:st%order), s)
+            end do
+            do i = 1, st%n
+               gi = pat%grp(i)
+               if (gi == 0) then
+                  st%u(i) = st%uc(i)
+                  st%v(i) = 0.0_dp
+               else
+                  st%u(i) = st%q(gi) + st%uc(i)
+                  st%v(i) = st%p(gi)
+               end if
+            end do
+         end associate
+      end subroutine move_to
+
+      !> The polynomials of the storeys' drifts and shears (drift1, V1, ..., Vb after the
+      !> state's quantities), order by order from those of u, v and F: they are linear in them.
+      subroutine storey_polynomials()
+         integer :: m, nb, ns, n1
+         associate (st => w%st)
+            nb = st%nbase
+            ns = res%eng%n_storeys
+            if (st%nquant == nb .or. ns == 0) return
+            n1 = 3*st%n
+            do m = 0, st%order
+               w%cu = st%yc(m, 1:n1:3)
+               w%cv = st%yc(m, 2:n1:3)
+               w%cf = st%yc(m, n1 + 2:n1 + 2*st%nd:2)
+               call storey_values(res%eng, w%cu, w%cv, w%cf, st%yc(m, nb + 1:nb + 2*ns - 1:2), &
+                                  st%yc(m, nb + 2:nb + 2*ns:2), st%yc(m, nb + 2*ns + 1))
+            end do
+         end associate
+      end subroutine storey_polynomials
+
+      !> Values of every quantity at s on the current sub-interval.
+      subroutine values_at(s, y)
+         real(dp), intent(in) :: s
+         real(dp), intent(out) :: y(:)
+         integer :: iq
+         do iq = 1, w%st%nquant
+            y(iq) = poly_value(w%st%yc(0:w%st%order, iq), s)
          end do
-      end associate
-   end subroutine energy
+      end subroutine values_at
+
+      !> The history row at time tr (s on the current sub-interval), with the maxima since
+      !> the last row.
+      subroutine write_row(tr, s)
+         real(dp), intent(in) :: tr, s
+         real(dp) :: xg, vg, ag, dv
+         integer :: i, dd
+         associate (st => w%st)
+            call table_motion(exc, tr, xg, vg, ag)
+            do i = 1, st%n
+               w%uu(i) = w%yv(iq_u(i))
+               w%vv(i) = w%yv(iq_v(i))
+               w%aa(i) = w%yv(iq_a(i)) - ag
+            end do
+            do dd = 1, st%nd
+               w%ss(dd) = w%yv(iq_s(st%n, dd))
+               call poly_value_deriv(st%yc(0:st%order, iq_s(st%n, dd)), s, xg, dv)
+               w%sd(dd) = dv
+               w%ff(dd) = w%yv(iq_f(st%n, dd))
+            end do
+            call observe_sample(w%obs, res, tr, ag, w%uu, w%vv, w%aa, w%ss, w%sd, w%ff, st%phase)
+            call observe_envelope(w%obs, res, w%env)
+            ! the storeys at the row: the values kept as residual ones at the last
+            call observe_storeys(res, tr, w%uu, w%vv, w%ss, w%ff)
+         end associate
+      end subroutine write_row
+
+      !> Peaks of the summary from the values yv at time tp.
+      subroutine update_global(s, tp)
+         real(dp), intent(in) :: s, tp
+         integer :: i, dd
+         if (s < 0.0_dp) return
+         do i = 1, w%st%n
+            call observe_peak_value(res, peak_of_u, i, abs(w%yv(iq_u(i))), tp)
+            call observe_peak_value(res, peak_of_v, i, abs(w%yv(iq_v(i))), tp)
+            call observe_peak_value(res, peak_of_aabs, i, abs(w%yv(iq_a(i))), tp)
+         end do
+         do dd = 1, w%st%nd
+            call observe_peak_value(res, peak_of_s, dd, abs(w%yv(iq_s(w%st%n, dd))), tp)
+            call observe_peak_value(res, peak_of_force, dd, abs(w%yv(iq_f(w%st%n, dd))), tp)
+         end do
+         do i = w%st%nbase + 1, w%st%nquant
+            call observe_peak_value(res, peak_of_storey, i - w%st%nbase, abs(w%yv(i)), tp)
+         end do
+      end subroutine update_global
+
+      !> Over [0, s_use] of the current sub-interval: the rows that fall in it, the exact
+      !> extrema (summary peaks, maxima between rows), the input and viscous work, and the
+      !> friction work.
+      subroutine observe_subinterval(s_use, err)
+         real(dp), intent(in) :: s_use
+         type(error_type), allocatable, intent(out) :: err
+         real(dp) :: smin, tol, x, y, sr
+         integer :: iq, kk, j
+         associate (st => w%st)
+            kk = st%order
+            smin = 8.0_dp*epsilon(1.0_dp)*(abs(t) + s_use)
+            tol = 2.0_dp*epsilon(1.0_dp)*(abs(t) + s_use)
+            ! the one-sided values at the start (after an event: the right limits)
+            call values_at(0.0_dp, w%yv)
+            do iq = 1, st%nquant
+               w%env(iq) = max(w%env(iq), abs(w%yv(iq)))
+            end do
+            call update_global(0.0_dp, t)
+            ! stationary points of every quantity in (0, s_use)
+            do iq = 1, st%nquant
+               w%nrt(iq) = 0
+               w%ip(iq) = 1
+               if (s_use > 0.0_dp) &
+                  call stationary_points(st%yc(0:kk, iq), s_use, smin, tol, st%pw(0:kk, :), st%pw2(0:kk), &
+                                         w%rts(:, iq), w%nrt(iq))
+            end do
+            ! rows inside (0, s_use], each with the maxima since the previous row
+            do while (nrow <= res%nout .and. s_row - t <= s_use)
+               sr = max(0.0_dp, s_row - t)
+               call absorb_until(sr)
+               call values_at(sr, w%yv)
+               if (.not. all(ieee_is_finite(w%yv))) then
+                  call fatal_error(err, "event-driven technique at t = "//trim(fmt_real(s_row))// &
+                                   " s: the solution is not finite (an overflow); check the masses, the "// &
+                                   "stiffnesses, the initial displacements u0 and velocities v0, and the table motion")
+                  return
+               end if
+               do iq = 1, st%nquant
+                  w%env(iq) = max(w%env(iq), abs(w%yv(iq)))
+               end do
+               call write_row(s_row, sr)
+               w%env = abs(w%yv)
+               nrow = nrow + 1
+               s_row = next_row_time(nrow)
+            end do
+            call absorb_until(s_use)
+            ! the end point (before an event: the left limits)
+            call values_at(s_use, w%yv)
+            do iq = 1, st%nquant
+               w%env(iq) = max(w%env(iq), abs(w%yv(iq)))
+            end do
+            call update_global(s_use, t + s_use)
+            call energy(s_use)
+            ! friction work: P mu |Delta s| over the slide
+            do j = 1, st%nd
+               if (.not. st%active(j) .or. st%phase(j) == phase_stick) cycle
+               x = poly_value(st%yc(0:kk, iq_s(st%n, j)), s_use)
+               y = st%yc(0, iq_s(st%n, j))
+               w%w_fric = w%w_fric + st%slip(j)*abs(x - y)
+            end do
+         end associate
+      end subroutine observe_subinterval
+
+      !> Take the stationary points up to s into the maxima (envelope and summary).
+      subroutine absorb_until(s)
+         real(dp), intent(in) :: s
+         integer :: iq, kk
+         real(dp) :: x, y
+         kk = w%st%order
+         do iq = 1, w%st%nquant
+            do while (w%ip(iq) <= w%nrt(iq))
+               x = w%rts(w%ip(iq), iq)
+               if (x > s) exit
+               y = abs(poly_value(w%st%yc(0:kk, iq), x))
+               w%env(iq) = max(w%env(iq), y)
+               call peak_one(iq, y, t + x)
+               w%ip(iq) = w%ip(iq) + 1
+            end do
+         end do
+      end subroutine absorb_until
+
+      !> One quantity's value into the summary's peak.
+      subroutine peak_one(iq, y, tp)
+         integer, intent(in) :: iq
+         real(dp), intent(in) :: y, tp
+         integer :: i, dd
+         if (iq > w%st%nbase) then
+            call observe_peak_value(res, peak_of_storey, iq - w%st%nbase, y, tp)
+         else if (iq <= 3*w%st%n) then
+            i = (iq + 2)/3
+            select case (iq - 3*(i - 1))
+            case (1)
+               call observe_peak_value(res, peak_of_u, i, y, tp)
+            case (2)
+               call observe_peak_value(res, peak_of_v, i, y, tp)
+            case default
+               call observe_peak_value(res, peak_of_aabs, i, y, tp)
+            end select
+         else
+            dd = (iq - 3*w%st%n + 1)/2
+            if (mod(iq - 3*w%st%n, 2) == 1) then
+               call observe_peak_value(res, peak_of_s, dd, y, tp)
+            else
+               call observe_peak_value(res, peak_of_force, dd, y, tp)
+            end if
+         end if
+      end subroutine peak_one
+
+      !> Input work -int ag mq'p and viscous work int p'Cq p over [0, s], exactly (the
+      !> polynomials' products integrated term by term).
+      subroutine energy(s)
+         real(dp), intent(in) :: s
+         integer :: j, m, kk, gi
+         real(dp) :: ein, evi, sp
+         associate (st => w%st, pat => w%st%cache%slot(w%st%cur))
+            if (pat%nq == 0 .or. s <= 0.0_dp) return
+            kk = st%order
+            do m = 0, kk
+               w%mp(m) = 0.0_dp
+               do gi = 1, pat%nq
+                  w%mp(m) = w%mp(m) + pat%mq(gi)*st%pc(gi, m)
+               end do
+            end do
+            w%ein(0:2*kk) = 0.0_dp
+            w%evi(0:2*kk) = 0.0_dp
+            ! p_j' Cq p_m = p_m' Cq p_j: the terms m > j count twice
+            do m = 0, kk
+               do j = 0, kk
+                  w%ein(j + m) = w%ein(j + m) + st%g(j)*w%mp(m)
+               end do
+               sp = 0.0_dp
+               do gi = 1, pat%nq
+                  sp = sp + st%pc(gi, m)*st%cp(gi, m)
+               end do
+               w%evi(2*m) = w%evi(2*m) + sp
+               do j = 0, m - 1
+                  sp = 0.0_dp
+                  do gi = 1, pat%nq
+                     sp = sp + st%pc(gi, j)*st%cp(gi, m)
+                  end do
+                  w%evi(j + m) = w%evi(j + m) + 2.0_dp*sp
+               end do
+            end do
+            ein = 0.0_dp
+            evi = 0.0_dp
+            do m = 2*kk, 0, -1
+               ein = ein*s + w%ein(m)/(m + 1)
+               evi = evi*s + w%evi(m)/(m + 1)
+            end do
+            res%e_input = res%e_input - ein*s
+            res%e_viscous = res%e_viscous + evi*s
+         end associate
+      end subroutine energy
+
+      !> An event at t: which devices are at it, the decision, and the accumulation guard.
+      subroutine event_at(err)
+         type(error_type), allocatable, intent(out) :: err
+         integer :: dd, e, oldest
+         real(dp) :: x, vs, thr
+         logical :: chg
+         associate (st => w%st)
+            ! the polynomials at the event instant (the old pattern, span 0): crossed
+            ! functions and sliders at zero velocity
+            call ed_polynomials(model, exc, t, 0.0_dp, st)
+            do dd = 1, st%nd
+               st%crossed(dd) = .false.
+               st%near(dd) = .false.
+               do e = 2*dd - 1, 2*dd
+                  if (.not. st%eon(e)) cycle
+                  thr = st%offs(e) - st%eta(e)
+                  if (st%ec(0, e) - st%erem(e) <= thr) st%crossed(dd) = .true.
+               end do
+               if (st%active(dd) .and. st%phase(dd) /= phase_stick) then
+                  x = device_relative(model, dd, st%v)
+                  vs = abs(st%v(model%dev(dd)%node_i))
+                  if (model%dev(dd)%node_j > 0) vs = vs + abs(st%v(model%dev(dd)%node_j))
+                  st%near(dd) = st%crossed(dd) .or. abs(x) <= max(rtol_decision*vs, 4.0_dp*st%eta(2*dd - 1))
+               end if
+            end do
+            call decide_phases(model, exc, t, st, chg, err)
+            if (allocated(err)) return
+            if (.not. chg) return
+            w%n_events = w%n_events + 1
+            call observe_transitions(res, st%oldph, st%phase)
+            call observe_event(res, t)
+            ! accumulation guard: ring_size phase changes within the window
+            w%ring_pos = mod(w%ring_pos, ring_size) + 1
+            w%ring(w%ring_pos) = t
+            oldest = mod(w%ring_pos, ring_size) + 1
+            if (t - w%ring(oldest) <= accumulation_span*max(1.0_dp, abs(t))) then
+               if (t - w%last_accumulation <= accumulation_span*max(1.0_dp, abs(t))) then
+                  call fatal_error(err, "event-driven technique at t = "//trim(fmt_real(t))//" s: events "// &
+                                   "accumulate again where sticking at the limit of the sequence should have "// &
+                                   "ended them; try technique = 'newmark' with law = 'velocity', or report the deck")
+                  return
+               end if
+               w%last_accumulation = t
+               call accumulation(err)
+               if (allocated(err)) return
+               w%ring = -huge(1.0_dp)
+            end if
+         end associate
+      end subroutine event_at
+
+      !> An accumulation of events (a Zeno sequence) at t: the devices at zero relative
+      !> velocity stick at the limit of the sequence, provided their forces hold.
+      subroutine accumulation(err)
+         type(error_type), allocatable, intent(out) :: err
+         integer :: dd, r, nbad
+         real(dp) :: x, vs, xg, vg, ag, f
+         character(len=:), allocatable :: list
+         associate (st => w%st)
+            st%oldph = st%phase
+            st%newph = st%phase
+            do dd = 1, st%nd
+               if (.not. st%active(dd) .or. st%phase(dd) == phase_stick) cycle
+               x = device_relative(model, dd, st%v)
+               vs = abs(st%v(model%dev(dd)%node_i))
+               if (model%dev(dd)%node_j > 0) vs = vs + abs(st%v(model%dev(dd)%node_j))
+               if (abs(x) <= 1.0e-9_dp*max(vs, tiny(1.0_dp))) st%newph(dd) = phase_stick
+            end do
+            call cache_find(st%cache, model, st%mass, st%k, st%c, st%active, st%newph, st%slip, exc, [st%cur], &
+                            st%cur, err)
+            if (allocated(err)) return
+            call pattern_entry(st%cache%slot(st%cur), model, st%mass, st%k, st%newph, st%slip, st%u, st%v, &
+                               st%q, st%p, st%uc, st%b1, st%f0, st%fn)
+            st%phase = st%newph
+            call table_motion(exc, t, xg, vg, ag)
+            nbad = 0
+            associate (pat => st%cache%slot(st%cur))
+               do r = 1, pat%ns
+                  f = pat%fag(r)*ag + st%f0(r) + sum(pat%fq(r, 1:pat%nq)*st%q(1:pat%nq)) + &
+                      sum(pat%fp(r, 1:pat%nq)*st%p(1:pat%nq))
+                  if (abs(f) > st%slip(pat%ids(r))*(1.0_dp + 1.0e-6_dp)) then
+                     nbad = nbad + 1
+                     st%cand(nbad) = pat%ids(r)
+                  end if
+               end do
+            end associate
+            if (nbad > 0) then
+               call device_list(st%cand, nbad, list)
+               call fatal_error(err, "event-driven technique at t = "//trim(fmt_real(t))//" s: "// &
+                                trim(fmt_int(ring_size))//" phase changes within "// &
+                                trim(fmt_real(accumulation_span*max(1.0_dp, abs(t))))//" s, and sticking at their "// &
+                                "limit would need forces above P mu in "//list//"; try technique = "// &
+                                "'newmark' with law = 'velocity', or report the deck")
+               return
+            end if
+            call observe_transitions(res, st%oldph, st%phase)
+            call observe_accumulation(res, t)
+         end associate
+      end subroutine accumulation
+   end subroutine run_event_driven
 
 end module fd_event_driven

@@ -1,184 +1,416 @@
-!> The event and phase decision of the exact technique at an instant: the forces that keep
-!> the sticking devices stuck, the event functions whose zeros are the events, and the
-!> decision of which devices stick and which slide (decide_phases: the one call a
-!> complementarity solver replaces).
+!> The phase decision of the exact technique at an instant: which devices stick, which
+!> slide and which way, from the linear complementarity problems of the instant
+!> (docs/theory.md, section 9).
+!>
+!> **Level 0 (accelerations).** The candidates are the sticking devices and the sliding
+!> ones at zero relative velocity; every other device slides on with F = sgn P mu. With
+!> p the forces on the structure but the candidates' friction (table inertia, springs,
+!> dampers, the other sliders), the candidates' relative accelerations are
+!> s'' = B'M^-1 p - W F, W = B'M^-1 B (M diagonal: W is formed directly), and Coulomb's
+!> law is the box LCP (fd_lcp): z = F in [-P mu, P mu], w = -s'' = W z - B'M^-1 p. Its w
+!> is unique (W symmetric positive semidefinite); a candidate with w < 0 slides +, with
+!> w > 0 slides -, with w = 0 (to its rounding tolerance) holds at this order. The
+!> holding ones stick with the forces of their pattern's force map (fd_phase_pattern);
+!> those whose force is at its limit are degenerate: sticking and sliding give the same
+!> acceleration, and the next derivative decides.
+!>
+!> **Levels L = 1, 2, 3 (the next derivatives).** Let D be the degenerate devices, sgn_d
+!> the sign of their force. In the pattern P1 in which they slide with F = sgn P mu (the
+!> other holders stick), their relative motion starts with s' = s'' = 0; if the lower
+!> levels were degenerate too, the first nonzero term of s'' is of order L. A device of D
+!> that sticks instead changes its force by dF = f_L tau^L, which changes s'' by
+!> -W1 dF at that order (W1: the Delassus operator of D in P1). Coulomb's law at order L
+!> is the standard LCP
+!>   r = q_L + diag(sgn) W1 diag(sgn) y,  y >= 0, r >= 0, y'r = 0,
+!> y = -sgn f_L (the force falls from its limit), r = sgn s^(L+2) (the device moves its
+!> way), q_L = sgn s^(L+2) of P1. r > 0: slides; y > 0: sticks; both 0: the next level.
+!>
+!> **Undecided at level 3.** A device whose derivatives vanish to the rounding level to
+!> order 5 is at a tie (e.g. a storey whose force stays at its limit while the storey
+!> below slides): it keeps its phase, unless its own event function crossed its band,
+!> the sign that its force (or velocity) has left the limit (or zero): then it changes
+!> phase. Either way the choice is exact to the rounding level, and a wrong one is
+!> corrected at the next event (the event function leaves its band again).
+!>
+!> **Redundant devices** (in parallel, in a closed loop of sticking devices): the forces
+!> of the pattern share the load in proportion to the limits; where that share exceeds a
+!> limit while the LCP's forces do not, the LCP's share is kept (a constant in the null
+!> space of the incidence) until the next event.
 module fd_phase_decision
+   use, intrinsic :: ieee_arithmetic, only: ieee_is_finite
    use fd_kinds, only: dp
    use fd_error, only: error_type, fatal_error, fmt_int, fmt_real
    use fd_model, only: model_type
-   use fd_excitation, only: excitation_type, table_motion
+   use fd_excitation, only: excitation_type, table_motion, table_taylor
    use fd_kinematics, only: device_relative, add_device
-   use fd_linalg, only: sym_matvec, least_squares
    use fd_device_state, only: phase_stick
-   use fd_ed_state, only: ed_state, set_pattern, expand_state
+   use fd_lcp, only: box_lcp_solve, lcp_solve, lcp_info, lcp_solved, lcp_status_text
+   use fd_phase_pattern, only: cache_find, pattern_entry, pattern_taylor
+   use fd_ed_state, only: ed_state
    implicit none
    private
 
-   public :: decide_phases, stuck_forces, event_values
+   public :: decide_phases, device_list, rtol_decision, max_level
 
-   real(dp), parameter :: at_limit = 1.0_dp - 1.0e-9_dp  !! |F| / P mu that counts as the limit
+   real(dp), parameter :: rtol_decision = 1.0e-11_dp  !! zero, relative to the magnitude of the terms
+   integer, parameter :: max_level = 3                !! highest derivative level of the decision
 
 contains
 
-   !> Forces of the devices at the expanded state (st%u, v, acc at time t): P mu sgn s' for
-   !> a sliding device, 0 for an inactive one, and for the sticking ones the forces that
-   !> keep them stuck, B F = p - M a - C v - K u - sum_slip b P mu sgn, solved in the
-   !> least-squares sense (minimum norm for a statically indeterminate loop).
-   subroutine stuck_forces(model, exc, t, st, error)
+   !> Decide the phases at time t from the state st%u, st%v and the phases before
+   !> (st%phase); st%near flags the sliding devices at zero relative velocity (to their
+   !> tolerance) and st%crossed the devices whose event function has crossed its band.
+   !> On return st%phase, st%cur and the entry data (q, p, uc, b1, f0) are those of the
+   !> new pattern, v is projected on its constraints, and `changed` tells whether any
+   !> phase changed.
+   subroutine decide_phases(model, exc, t, st, changed, error)
       type(model_type), intent(in) :: model         !! the model
       type(excitation_type), intent(in) :: exc      !! the table motion
       real(dp), intent(in) :: t                     !! time [s]
-      type(ed_state), intent(inout) :: st           !! the state: force set
-      type(error_type), allocatable, intent(out) :: error !! failure of the least-squares solve
-      real(dp) :: xg, vg, ag
-      integer :: d, k, info
+      type(ed_state), intent(inout) :: st           !! the state
+      logical, intent(out) :: changed               !! some phase changed
+      type(error_type), allocatable, intent(out) :: error !! a complementarity problem unsolved
+      integer :: nc, a, b, d, i, j, n, nd, ndg, lev, slot0, slot1, r, gi, gj, kk
+      real(dp) :: xg, vg, ag, sc, f, fa
+      type(lcp_info) :: info
+      logical :: any_viol
 
-      do d = 1, st%nd
+      n = st%n
+      nd = st%nd
+      changed = .false.
+      slot0 = 0
+      slot1 = 0
+      st%oldph = st%phase
+      st%newph = st%phase
+      call table_motion(exc, t, xg, vg, ag)
+      ! ---- level 0: the box LCP of the candidates
+      nc = 0
+      do d = 1, nd
          if (.not. st%active(d)) then
-            st%force(d) = 0.0_dp
-         else if (st%phase(d) /= phase_stick) then
-            st%force(d) = st%phase(d)*st%slip(d)
+            st%newph(d) = phase_stick
+            cycle
+         end if
+         if (st%phase(d) == phase_stick .or. st%near(d)) then
+            nc = nc + 1
+            st%cand(nc) = d
          end if
       end do
-      if (st%ns == 0) return
-      call table_motion(exc, t, xg, vg, ag)
-      associate (r => st%rr, bm => st%bm)
-         r(1:st%n, 1) = -st%mass*(ag + st%acc)
-         call sym_matvec(st%c, st%v, r(1:st%n, 1), -1.0_dp, 1.0_dp)
-         call sym_matvec(st%k, st%u, r(1:st%n, 1), -1.0_dp, 1.0_dp)
-         do d = 1, st%nd
-            if (st%active(d) .and. st%phase(d) /= phase_stick) call add_device(model, d, -st%force(d), r(1:st%n, 1))
+      if (nc > 0) then
+         ! p = -M 1 ag - C v - K u - sum_(other sliders) b sgn P mu, and its magnitude
+         do i = 1, n
+            st%pe(i) = -st%mass(i)*ag
+            st%pa(i) = abs(st%mass(i)*ag)
          end do
-         bm = 0.0_dp
-         do k = 1, st%ns
-            call add_device(model, st%ids(k), 1.0_dp, bm(:, k))
+         do j = 1, n
+            do i = 1, n
+               st%pe(i) = st%pe(i) - st%c(i, j)*st%v(j) - st%k(i, j)*st%u(j)
+               st%pa(i) = st%pa(i) + abs(st%c(i, j)*st%v(j)) + abs(st%k(i, j)*st%u(j))
+            end do
          end do
-         call least_squares(bm, r, st%sv, st%lwk, info)
-         if (info /= 0) then
-            call fatal_error(error, "event-driven technique: the least-squares solve for the forces of "// &
-                             trim(fmt_int(st%ns))//" sticking devices failed at t = "//trim(fmt_real(t))// &
-                             " s (LAPACK dgelss info = "//trim(fmt_int(info))//")")
+         do d = 1, nd
+            if (.not. st%active(d) .or. st%phase(d) == phase_stick .or. st%near(d)) cycle
+            call add_device(model, d, -st%phase(d)*st%slip(d), st%pe)
+            st%pa(model%dev(d)%node_i) = st%pa(model%dev(d)%node_i) + st%slip(d)
+            if (model%dev(d)%node_j > 0) st%pa(model%dev(d)%node_j) = st%pa(model%dev(d)%node_j) + st%slip(d)
+         end do
+         if (.not. all(ieee_is_finite(st%pe))) then
+            call fatal_error(error, "event-driven technique at t = "//trim(fmt_real(t))//" s: the forces on "// &
+                             "the structure are not finite (an overflow); check the masses, the stiffnesses, "// &
+                             "the initial displacements u0 and velocities v0, and the table motion")
             return
          end if
-         do k = 1, st%ns
-            st%force(st%ids(k)) = r(k, 1)
+         do a = 1, nc
+            st%lq(a) = -rel_over_mass(model, st%cand(a), st%pe, st%mass)
+            st%lqa(a) = abs_over_mass(model, st%cand(a), st%pa, st%mass)
+            do b = 1, nc
+               st%wm(a, b) = delassus(model, st%cand(a), st%cand(b), st%mass)
+            end do
+            st%lo(a) = -st%slip(st%cand(a))
+            st%hi(a) = st%slip(st%cand(a))
+         end do
+         call box_lcp_solve(st%lcp, st%wm(1:nc, 1:nc), st%lq(1:nc), st%lo(1:nc), st%hi(1:nc), st%z(1:nc), &
+                            st%w(1:nc), info)
+         if (info%status /= lcp_solved) then
+            call lcp_failed("the box LCP of the accelerations", nc, st%cand, info, t, error)
+            return
+         end if
+         do a = 1, nc
+            d = st%cand(a)
+            st%zs(d) = st%z(a)
+            sc = st%lqa(a)
+            do b = 1, nc
+               sc = sc + abs(st%wm(a, b)*st%z(b))
+            end do
+            if (st%w(a) < -rtol_decision*sc) then
+               st%newph(d) = 1
+            else if (st%w(a) > rtol_decision*sc) then
+               st%newph(d) = -1
+            else
+               st%newph(d) = phase_stick
+            end if
+         end do
+      end if
+      ! ---- the pattern of level 0 and its forces: the degenerate devices
+      call enter(st%newph, slot0, error)
+      if (allocated(error)) return
+      ndg = 0
+      associate (pat => st%cache%slot(slot0))
+         do r = 1, pat%ns
+            d = pat%ids(r)
+            call force_now(slot0, r, ag, f, fa)
+            if (abs(f) >= st%slip(d) - rtol_decision*(fa + st%slip(d))) then
+               ndg = ndg + 1
+               st%cand(ndg) = d
+               st%sig(ndg) = int(sign(1.0_dp, f))
+            end if
          end do
       end associate
-   end subroutine stuck_forces
-
-   !> Event functions at the expanded state, with the forces set: sliding devices sgn s'
-   !> (> 0 while sliding on), sticking devices P mu - |F| (> 0 while the device holds),
-   !> inactive devices 1. An event is a zero of one of them.
-   pure subroutine event_values(model, st, g)
-      type(model_type), intent(in) :: model         !! the model
-      type(ed_state), intent(in) :: st              !! the state
-      real(dp), intent(out) :: g(:)                 !! event function of each device
-      integer :: d
-
-      do d = 1, st%nd
-         if (.not. st%active(d)) then
-            g(d) = 1.0_dp
-         else if (st%phase(d) == phase_stick) then
-            g(d) = st%slip(d) - abs(st%force(d))
+      ! ---- levels 1..max_level: the next derivatives of the degenerate devices
+      slot1 = slot0
+      do lev = 1, max_level
+         if (ndg == 0) exit
+         do a = 1, ndg
+            st%newph(st%cand(a)) = st%sig(a)
+         end do
+         call enter(st%newph, slot1, error)
+         if (allocated(error)) return
+         associate (pat => st%cache%slot(slot1))
+            kk = lev + 2
+            call table_taylor(exc, t, st%g(0:kk), st%gn(0:kk))
+            call pattern_taylor(pat, st%q, st%p, st%b1, st%g(0:kk), st%qc, st%pc, st%cp)
+            call abs_taylor(lev + 2)
+            do a = 1, ndg
+               d = st%cand(a)
+               gi = pat%grp(model%dev(d)%node_i)
+               gj = 0
+               if (model%dev(d)%node_j > 0) gj = pat%grp(model%dev(d)%node_j)
+               st%lq(a) = 0.0_dp
+               st%lqa(a) = 0.0_dp
+               if (gi > 0) then
+                  st%lq(a) = st%qc(gi, lev + 2)
+                  st%lqa(a) = st%qa(gi, lev + 2)
+               end if
+               if (gj > 0) then
+                  st%lq(a) = st%lq(a) - st%qc(gj, lev + 2)
+                  st%lqa(a) = st%lqa(a) + st%qa(gj, lev + 2)
+               end if
+               st%lq(a) = st%sig(a)*st%lq(a)
+               do b = 1, ndg
+                  st%wm(a, b) = st%sig(a)*st%sig(b)*group_delassus(model, st%cand(a), st%cand(b), pat%grp, pat%mq)
+               end do
+            end do
+         end associate
+         call lcp_solve(st%lcp, st%wm(1:ndg, 1:ndg), st%lq(1:ndg), st%z(1:ndg), st%w(1:ndg), info)
+         if (info%status /= lcp_solved) then
+            call lcp_failed("the LCP of derivative level "//trim(fmt_int(lev)), ndg, st%cand, info, t, error)
+            return
+         end if
+         ! decided: r > 0 slides, y > 0 sticks; the others go to the next level
+         b = 0
+         do a = 1, ndg
+            d = st%cand(a)
+            sc = st%lqa(a)
+            do i = 1, ndg
+               sc = sc + abs(st%wm(a, i)*st%z(i))
+            end do
+            if (st%w(a) > rtol_decision*sc) then
+               st%newph(d) = st%sig(a)
+            else if (st%z(a)*st%wm(a, a) > rtol_decision*sc) then
+               st%newph(d) = phase_stick
+            else
+               st%newph(d) = phase_stick
+               b = b + 1
+               st%cand(b) = d
+               st%sig(b) = st%sig(a)
+            end if
+         end do
+         ndg = b
+      end do
+      ! ---- ties undecided at the last level: keep the phase, unless the event crossed
+      do a = 1, ndg
+         d = st%cand(a)
+         if (st%crossed(d)) then
+            if (st%oldph(d) == phase_stick) then
+               st%newph(d) = st%sig(a)
+            else
+               st%newph(d) = phase_stick
+            end if
+         else if (st%oldph(d) == st%sig(a)) then
+            st%newph(d) = st%sig(a)
          else
-            g(d) = st%phase(d)*device_relative(model, d, st%v)
+            st%newph(d) = phase_stick
          end if
       end do
-   end subroutine event_values
-
-   !> Decide the phases at an instant. On entry st holds the state at t (u, v) and the
-   !> phases before t (phase; fresh: slides begun at s' = 0 at this instant); on return
-   !> the phases decided, their pattern, the reduced state x, u, v (projected on the
-   !> constraints), acc and the device forces at t.
-   !>
-   !> The rule (docs/theory.md, section 9): candidates for sticking are the sticking
-   !> devices and the sliding ones at a velocity zero; the forces that keep all candidates
-   !> stuck come from one least-squares solve; the candidate needing most above P mu
-   !> slides in the direction of its force (kept only if the device then accelerates that
-   !> way), and the solve is repeated; then every device that began sliding is checked
-   !> again. A greedy rule, not a complete solution of the complementarity problem.
-   subroutine decide_phases(model, exc, t, st, error)
-      type(model_type), intent(in) :: model         !! the model
-      type(excitation_type), intent(in) :: exc      !! the table motion
-      real(dp), intent(in) :: t                     !! time [s]
-      type(ed_state), intent(inout) :: st           !! the state, with the phases decided
-      type(error_type), allocatable, intent(out) :: error !! no steady state, failed solve
-      logical, allocatable :: held(:)
-      real(dp) :: ratio, worst, sd
-      integer :: d, dw, iter, pass
-
-      allocate (held(st%nd))
-      dw = 0
-      held = .false.
-      ! the state is expanded at t; candidates: stuck ones, and sliders at a velocity zero
-      do d = 1, st%nd
-         if (.not. st%active(d) .or. st%phase(d) == phase_stick) cycle
-         sd = st%phase(d)*device_relative(model, d, st%v)
-         if (sd <= 0.0_dp .and. .not. st%fresh(d)) st%phase(d) = phase_stick
-      end do
-      ! release, one at a time, the candidate that needs most above P mu (at the limit counts:
-      ! its force got there increasing), in the direction of its force; keep the release only
-      ! if the device then accelerates that way, else it holds
-      do pass = 1, st%nd + 1
-         dw = 0
-         do iter = 1, 2*st%nd + 2
-            call set_pattern(model, exc, t, st, error)
-            if (allocated(error)) return
-            call expand_state(exc, t, st)
-            call stuck_forces(model, exc, t, st, error)
-            if (allocated(error)) return
-            if (dw > 0) then
-               if (st%phase(dw)*device_relative(model, dw, st%acc) <= 0.0_dp) then
-                  st%phase(dw) = phase_stick
-                  st%fresh(dw) = .false.
-                  held(dw) = .true.
-                  dw = 0
-                  cycle
-               end if
-            end if
-            worst = at_limit
-            dw = 0
-            do d = 1, st%nd
-               if (.not. st%active(d) .or. st%phase(d) /= phase_stick .or. held(d)) cycle
-               ratio = abs(st%force(d))/st%slip(d)
-               if (ratio >= worst) then
-                  worst = ratio
-                  dw = d
-               end if
+      ! ---- the new pattern
+      call enter(st%newph, slot1, error)
+      if (allocated(error)) return
+      st%cur = slot1
+      st%phase = st%newph
+      changed = any(st%phase /= st%oldph)
+      ! redundant sticking devices: keep the LCP's share where the pattern's exceeds a limit
+      if (nc > 0) then
+         associate (pat => st%cache%slot(slot1))
+            any_viol = .false.
+            do r = 1, pat%ns
+               call force_now(slot1, r, ag, f, fa)
+               st%w(r) = f
+               if (abs(f) > st%slip(pat%ids(r)) + rtol_decision*(fa + st%slip(pat%ids(r)))) any_viol = .true.
             end do
-            if (dw == 0) exit
-            st%phase(dw) = int(sign(1.0_dp, st%force(dw)))
-            st%fresh(dw) = .true.
-         end do
-         ! a device released earlier may no longer accelerate in its direction once others
-         ! were released: it holds, and the decision is made again
-         dw = 0
-         worst = 0.0_dp
-         do d = 1, st%nd
-            if (.not. st%fresh(d) .or. st%phase(d) == phase_stick) cycle
-            ratio = st%phase(d)*device_relative(model, d, st%acc)
-            if (ratio <= worst) then
-               worst = ratio
-               dw = d
+            if (any_viol) then
+               do r = 1, pat%ns
+                  st%f0(r) = st%f0(r) + (st%zs(pat%ids(r)) - st%w(r))
+               end do
             end if
-         end do
-         if (dw == 0) exit
-         st%phase(dw) = phase_stick
-         st%fresh(dw) = .false.
-         held(dw) = .true.
-      end do
-      if (dw /= 0) then
-         ! out of passes: leave the state consistent with the phases decided last
-         call set_pattern(model, exc, t, st, error)
-         if (allocated(error)) return
-         call expand_state(exc, t, st)
-         call stuck_forces(model, exc, t, st, error)
-         if (allocated(error)) return
+         end associate
       end if
-      do d = 1, st%nd
-         if (st%phase(d) /= phase_stick) cycle
-         st%fresh(d) = .false.
-      end do
+   contains
+
+      !> Find (or build) the pattern of the phases ph and enter it at the state.
+      subroutine enter(ph, slot, err)
+         integer, intent(in) :: ph(:)
+         integer, intent(out) :: slot
+         type(error_type), allocatable, intent(out) :: err
+         call cache_find(st%cache, model, st%mass, st%k, st%c, st%active, ph, st%slip, exc, [st%cur, slot0, slot1], &
+                         slot, err)
+         if (allocated(err)) then
+            err%message = "event-driven technique at t = "//trim(fmt_real(t))//" s: "//err%message
+            return
+         end if
+         call pattern_entry(st%cache%slot(slot), model, st%mass, st%k, ph, st%slip, st%u, st%v, st%q, st%p, &
+                            st%uc, st%b1, st%f0, st%fn)
+      end subroutine enter
+
+      !> The force of the r-th sticking device of the pattern in slot (the one entered
+      !> last) now, and the magnitude of its terms.
+      subroutine force_now(slot, r, agt, fr, fabs)
+         integer, intent(in) :: slot, r
+         real(dp), intent(in) :: agt
+         real(dp), intent(out) :: fr, fabs
+         integer :: m
+         associate (pat => st%cache%slot(slot))
+            fr = pat%fag(r)*agt + st%f0(r)
+            fabs = abs(pat%fag(r)*agt) + abs(st%f0(r))
+            do m = 1, pat%nq
+               fr = fr + pat%fq(r, m)*st%q(m) + pat%fp(r, m)*st%p(m)
+               fabs = fabs + abs(pat%fq(r, m)*st%q(m)) + abs(pat%fp(r, m)*st%p(m))
+            end do
+         end associate
+      end subroutine force_now
+
+      !> Magnitudes of the Taylor recursion's terms (|A| |x_k| + ...) to degree m: the
+      !> scale against which a level's q_L counts as zero.
+      subroutine abs_taylor(m)
+         integer, intent(in) :: m
+         integer :: k1, ii, jj
+         associate (pat => st%cache%slot(slot1))
+            do ii = 1, pat%nq
+               st%qa(ii, 0) = abs(st%q(ii))
+               st%pq(ii, 0) = abs(st%p(ii))
+            end do
+            do k1 = 0, m - 1
+               do ii = 1, pat%nq
+                  st%qa(ii, k1 + 1) = st%pq(ii, k1)/(k1 + 1)
+                  st%pq(ii, k1 + 1) = abs(st%g(k1))
+                  if (k1 == 0) st%pq(ii, 1) = st%pq(ii, 1) + abs(st%b1(ii))
+               end do
+               do jj = 1, pat%nq
+                  do ii = 1, pat%nq
+                     st%pq(ii, k1 + 1) = st%pq(ii, k1 + 1) + abs(pat%kt(ii, jj))*st%qa(jj, k1) + &
+                                         abs(pat%ct(ii, jj))*st%pq(jj, k1)
+                  end do
+               end do
+               do ii = 1, pat%nq
+                  st%pq(ii, k1 + 1) = st%pq(ii, k1 + 1)/(k1 + 1)
+               end do
+            end do
+         end associate
+      end subroutine abs_taylor
    end subroutine decide_phases
+
+   !> b_d' M^-1 y.
+   pure real(dp) function rel_over_mass(model, d, y, mass) result(x)
+      type(model_type), intent(in) :: model
+      integer, intent(in) :: d
+      real(dp), intent(in) :: y(:), mass(:)
+      x = y(model%dev(d)%node_i)/mass(model%dev(d)%node_i)
+      if (model%dev(d)%node_j > 0) x = x - y(model%dev(d)%node_j)/mass(model%dev(d)%node_j)
+   end function rel_over_mass
+
+   !> |b_d|' M^-1 y.
+   pure real(dp) function abs_over_mass(model, d, y, mass) result(x)
+      type(model_type), intent(in) :: model
+      integer, intent(in) :: d
+      real(dp), intent(in) :: y(:), mass(:)
+      x = y(model%dev(d)%node_i)/mass(model%dev(d)%node_i)
+      if (model%dev(d)%node_j > 0) x = x + y(model%dev(d)%node_j)/mass(model%dev(d)%node_j)
+   end function abs_over_mass
+
+   !> b_a' M^-1 b_b.
+   pure real(dp) function delassus(model, a, b, mass) result(x)
+      type(model_type), intent(in) :: model
+      integer, intent(in) :: a, b
+      real(dp), intent(in) :: mass(:)
+      integer :: ia, ja, ib, jb
+      ia = model%dev(a)%node_i; ja = model%dev(a)%node_j
+      ib = model%dev(b)%node_i; jb = model%dev(b)%node_j
+      x = 0.0_dp
+      if (ia == ib) x = x + 1.0_dp/mass(ia)
+      if (ja > 0 .and. ja == jb) x = x + 1.0_dp/mass(ja)
+      if (jb > 0 .and. ia == jb) x = x - 1.0_dp/mass(ia)
+      if (ja > 0 .and. ja == ib) x = x - 1.0_dp/mass(ja)
+   end function delassus
+
+   !> b_a' T Mq^-1 T' b_b in a pattern with groups grp and group masses mq.
+   pure real(dp) function group_delassus(model, a, b, grp, mq) result(x)
+      type(model_type), intent(in) :: model
+      integer, intent(in) :: a, b
+      integer, intent(in) :: grp(:)
+      real(dp), intent(in) :: mq(:)
+      integer :: ga(2), gb(2), i, j
+      real(dp), parameter :: sg(2) = [1.0_dp, -1.0_dp]
+      ga = 0
+      gb = 0
+      ga(1) = grp(model%dev(a)%node_i)
+      if (model%dev(a)%node_j > 0) ga(2) = grp(model%dev(a)%node_j)
+      gb(1) = grp(model%dev(b)%node_i)
+      if (model%dev(b)%node_j > 0) gb(2) = grp(model%dev(b)%node_j)
+      x = 0.0_dp
+      do i = 1, 2
+         if (ga(i) == 0) cycle
+         do j = 1, 2
+            if (gb(j) == ga(i)) x = x + sg(i)*sg(j)/mq(ga(i))
+         end do
+      end do
+   end function group_delassus
+
+   !> "device d" or "devices d1, d2, ..." of the devices idx(1:m) (at most 20 named).
+   subroutine device_list(idx, m, text)
+      integer, intent(in) :: idx(:)
+      integer, intent(in) :: m
+      character(len=:), allocatable, intent(out) :: text
+      integer :: a
+      text = 'devices '
+      if (m == 1) text = 'device '
+      do a = 1, min(m, 20)
+         text = text//trim(fmt_int(idx(a)))
+         if (a < min(m, 20)) text = text//', '
+      end do
+      if (m > 20) text = text//', ...'
+   end subroutine device_list
+
+   subroutine lcp_failed(what, m, idx, info, t, error)
+      character(len=*), intent(in) :: what
+      integer, intent(in) :: m
+      integer, intent(in) :: idx(:)
+      type(lcp_info), intent(in) :: info
+      real(dp), intent(in) :: t
+      type(error_type), allocatable, intent(out) :: error
+      character(len=:), allocatable :: list
+      call device_list(idx, m, list)
+      call fatal_error(error, "event-driven technique at t = "//trim(fmt_real(t))//" s: "//what// &
+                       " of "//list//" was not solved ("//trim(lcp_status_text(info%status))//", residual "// &
+                       trim(fmt_real(info%residual))//"); try a small change of the slip loads P mu of "// &
+                       "these devices, or technique = 'newmark' with law = 'velocity'")
+   end subroutine lcp_failed
 
 end module fd_phase_decision

@@ -1,57 +1,207 @@
-!> The reduced linear system of one phase pattern of the exact technique, and its exact
-!> propagators. With the sticking devices rigid links, the nodes they join form groups
-!> (none for a group holding the table); one reduced coordinate q per group, u = T q + u_c:
-!>   x = (q, q'),  x' = A x + b1 + bag ag(t),  A = [[0, I], [-Mq^-1 Kq, -Mq^-1 Cq]]
-!> (b1: the sliding forces and the springs' response to the offsets u_c; bag: the
-!> table's inertia). Over a time tau it is integrated exactly,
-!>   x(t + tau) = phi (x - xp(t)) + xp(t + tau) + gam1 (b1 + bag g0) + gam2 bag g1,
-!> with the particular solution xp of a table acceleration that is a sum of sines, or the
-!> first-order hold ag = g0 + g1 tau of one that is linear between samples.
+!> The reduced linear system of one phase pattern of the exact technique, its closed form
+!> between events, and the cache of the patterns met.
+!>
+!> With the sticking devices rigid links, the nodes they join form groups (none for a
+!> group holding the table); one reduced coordinate q per group, u = T q + uc (uc: the
+!> constant offsets inside each group), p = q':
+!>   Mq p' = -Kq q - Cq p + T'(-K uc - sum_slide b_d sgn_d P mu_d) - Mq 1 ag(t)
+!> (Mq = T'MT diagonal, Kq = T'KT, Cq = T'CT). The sticking devices carry the forces
+!> B_S F = r(q, p, ag) that keep them stuck, r = -M (1 ag + u'') - C u' - K u - B_sl F_sl;
+!> F is the solution that minimizes sum F_d^2 / (P mu_d) (unique for a statically
+!> determinate set; for redundant devices, e.g. in parallel, it shares the force in
+!> proportion to the limits, so that they reach them together): F = D (B_S D)^+ r,
+!> D = diag(sqrt(P mu)), a linear map of (q, p, ag) plus a constant set at each entry.
+!>
+!> **Closed form.** On a sub-interval [0, S] from an instant a, x = (q, p) is its Taylor
+!> polynomial of degree K, x_0 = x(a), x_{k+1} = (A x_k + [k = 0] b1 + bag g_k)/(k + 1)
+!> (g_k: the table acceleration's Taylor coefficients, exact for sines and linear
+!> pieces), plus a remainder R. In the norm ||x||^2 = p'Mq p + q'(Kq + alpha^2 Mq) q the
+!> free motion grows at most like exp(alpha s / 2) (d/ds of the norm's square is
+!> -2 p'Cq p + 2 alpha^2 q'Mq p <= alpha ||x||^2), and x^(K+1) is a free motion driven by
+!> ag^(K+1), so that
+!>   ||R(s)|| <= exp(alpha s/2) (||x_{K+1}|| s^(K+1) + s^(K+2) sqrt(1'Mq 1) gnext),
+!> gnext >= sup |ag^(K+1)| / (K+1)!: a bound computed on every sub-interval, whatever
+!> the pattern (rigid-body modes, a sliding mass without spring, critical damping: no
+!> eigen-decomposition, nothing defective). S and K are chosen per pattern so that the
+!> bound is below the rounding level: S = 1 / (2 w + c + w_f) (w^2, c: bounds of the
+!> spectra of Mq^-1 Kq and Mq^-1 Cq; w_f: the table's highest frequency), alpha = 1/S.
+!> A component is bounded by the norm: |q_g| <= ||x|| / (alpha sqrt(mq_g)),
+!> |p_g| <= ||x|| / sqrt(mq_g), which gives the remainder of every output quantity.
+!>
+!> **Cache.** A pattern is built once (its groups, reduced matrices and force map: one
+!> SVD) and kept in a cache keyed by the phases, so that an event costs a lookup; the
+!> cache holds at most `nslots` patterns (least recently used replaced).
 module fd_phase_pattern
    use fd_kinds, only: dp
-   use fd_error, only: error_type, fatal_error, fmt_real, fmt_int
+   use fd_error, only: error_type, fatal_error, fmt_int
    use fd_model, only: model_type
-   use fd_excitation, only: excitation_type, table_motion, sine_forcing, max_sines, table_sines, &
-                            forcing_form, forcing_linear
+   use fd_excitation, only: excitation_type, forcing_frequency
    use fd_matrices, only: link_groups
    use fd_kinematics, only: add_device
-   use fd_expm, only: lti_propagators
-   use fd_linalg, only: gen_matvec, lu_solve
+   use fd_linalg, only: least_squares, least_squares_work
    use fd_device_state, only: phase_stick
    implicit none
    private
 
-   public :: pattern_type, build_pattern, forcing_changed, pattern_propagators, pattern_exp
-   public :: propagate, expand_pattern, quad_x, quad_w
+   public :: pattern_type, pattern_cache, cache_init, cache_find, build_pattern, pattern_entry
+   public :: pattern_taylor, pattern_series, remainder_bound, kmax
 
-   real(dp), parameter :: pi = acos(-1.0_dp)
-   !> 3-point Gauss-Legendre rule on [0, 1], nodes and weights: the energy quadrature of the
-   !> exact technique, whose propagators the pattern keeps for the full step.
-   real(dp), parameter :: quad_x(3) = [0.5_dp - sqrt(0.15_dp), 0.5_dp, 0.5_dp + sqrt(0.15_dp)]
-   real(dp), parameter :: quad_w(3) = [5.0_dp/18.0_dp, 8.0_dp/18.0_dp, 5.0_dp/18.0_dp]
+   integer, parameter :: kmax = 40                !! largest Taylor degree
+   real(dp), parameter :: theta = 1.0_dp          !! (2 w + c + w_f) S: sub-interval length
+   real(dp), parameter :: max_sub = 1.0_dp        !! longest sub-interval [s]
 
-   !> The reduced linear system of one phase pattern, and its propagators.
+   !> One phase pattern: groups, reduced matrices, force map, sub-interval and degree.
    type :: pattern_type
-      integer :: nq = 0, m = 0                       !! reduced DOFs, state size 2 nq
+      integer, allocatable :: key(:)                 !! phases (nd): the cache key
+      integer :: nq = 0                              !! reduced coordinates
+      integer :: ns = 0                              !! sticking active devices
       integer, allocatable :: grp(:)                 !! group of each DOF (0 = with the table)
-      real(dp), allocatable :: uc(:)                 !! offsets: u = T q + uc
-      real(dp), allocatable :: a(:, :)               !! state matrix (m x m)
-      real(dp), allocatable :: b1(:), bag(:)         !! constant input, input of ag
-      real(dp), allocatable :: minv_tt(:, :)         !! Mq^-1 T' (nq x n)
-      real(dp) :: h = -1.0_dp                        !! step of the cached propagators
-      real(dp), allocatable :: phi(:, :), g1(:, :), g2(:, :)           !! over h
-      real(dp), allocatable :: gphi(:, :, :), gg1(:, :, :), gg2(:, :, :) !! over h quad_x
-      type(sine_forcing) :: frc                      !! forcing of the particular solution
-      logical :: linear = .false.                    !! ag linear between samples (first-order hold)
-      real(dp), allocatable :: xp_s(:, :), xp_c(:, :) !! xp = sum_k xp_s(:,k) sin + xp_c(:,k) cos
+      integer, allocatable :: ids(:)                 !! the sticking devices (ns)
+      integer, allocatable :: row(:)                 !! row of device d in the force map (0: none)
+      real(dp), allocatable :: mq(:)                 !! group masses (nq)
+      real(dp), allocatable :: kt(:, :), ct(:, :)    !! Mq^-1 Kq, Mq^-1 Cq (nq, nq)
+      real(dp), allocatable :: pinv(:, :)            !! D (B_S D)^+ (ns, n), D = diag(sqrt(P mu))
+      real(dp), allocatable :: fq(:, :), fp(:, :)    !! force map: F = fq q + fp p + fag ag + f0
+      real(dp), allocatable :: fag(:)                !! (ns)
+      real(dp) :: delta = 0.0_dp                     !! sub-interval length S [s]
+      real(dp) :: alpha = 0.0_dp                     !! norm weight 1/S [1/s]
+      integer :: order = 2                           !! Taylor degree K
+      real(dp), allocatable :: wq(:), wp(:)          !! |q_g| <= wq ||x||, |p_g| <= wp ||x||
+      real(dp), allocatable :: wacc(:), wf(:)        !! same for accelerations (nq), forces (ns)
+      real(dp) :: msum = 0.0_dp                      !! sqrt(sum mq): the norm of the table's load
+      real(dp) :: w2 = 0.0_dp                        !! bound of the spectrum of Mq^-1 Kq
+      integer :: last_use = 0                        !! clock of the last use
    end type pattern_type
+
+   !> The patterns met, keyed by their phases.
+   type :: pattern_cache
+      integer :: nslots = 0                          !! capacity
+      integer :: nused = 0                           !! slots holding a pattern
+      integer :: clock = 0                           !! use counter
+      integer :: builds = 0                          !! patterns built
+      integer :: tsize = 0                           !! hash table size (power of 2)
+      type(pattern_type), allocatable :: slot(:)     !! the patterns
+      integer, allocatable :: table(:)               !! hash -> slot (0: empty)
+   end type pattern_cache
 
 contains
 
-   !> Build the reduced system of the phases at time t, its reduced state x from the full
-   !> state (q: the mass-weighted mean of each group), and project the velocities v on the
-   !> constraints (they hold to round-off at an event).
-   subroutine build_pattern(model, mass, k, c, active, phase, slip, exc, t, u, v, x, pat, error)
+   !> Size the cache of a model with n DOFs and nd devices: as many patterns as 3^nd, at
+   !> most 4096, and at most what 256 MB hold.
+   subroutine cache_init(cache, n, nd, error)
+      type(pattern_cache), intent(out) :: cache           !! the cache
+      integer, intent(in) :: n                            !! DOFs
+      integer, intent(in) :: nd                           !! devices
+      type(error_type), allocatable, intent(out) :: error !! not enough memory
+      real(dp) :: bytes
+      integer :: stat
+
+      bytes = 8.0_dp*(2.0_dp*n*n + 4.0_dp*nd*n + 10.0_dp*n + 4.0_dp*nd) + 2000.0_dp
+      cache%nslots = int(min(4096.0_dp, 3.0_dp**min(nd, 12), max(8.0_dp, 2.56e8_dp/bytes)))
+      cache%tsize = 16
+      do while (cache%tsize < 2*cache%nslots)
+         cache%tsize = 2*cache%tsize
+      end do
+      allocate (cache%slot(cache%nslots), cache%table(0:cache%tsize - 1), stat=stat)
+      if (stat /= 0) then
+         call fatal_error(error, "not enough memory for the cache of "//trim(fmt_int(cache%nslots))// &
+                          " phase patterns")
+         return
+      end if
+      cache%table = 0
+   end subroutine cache_init
+
+   pure integer function hash_of(phase, tsize) result(h)
+      integer, intent(in) :: phase(:)
+      integer, intent(in) :: tsize
+      integer :: d
+      integer, parameter :: i8 = selected_int_kind(18)
+      integer(i8) :: x
+
+      x = 1469598103_i8
+      do d = 1, size(phase)
+         x = mod(x*31_i8 + int(phase(d) + 2, i8), 2147483647_i8)
+      end do
+      h = int(iand(x, int(tsize - 1, i8)))
+   end function hash_of
+
+   !> The slot of the pattern with these phases, building it when new (or replacing the
+   !> least recently used one in a full cache; `pinned` slots are not replaced).
+   subroutine cache_find(cache, model, mass, k, c, active, phase, slip, exc, pinned, islot, error)
+      type(pattern_cache), intent(inout) :: cache   !! the cache
+      type(model_type), intent(in) :: model         !! the model
+      real(dp), intent(in) :: mass(:)               !! lumped masses
+      real(dp), intent(in) :: k(:, :), c(:, :)      !! stiffness, damping
+      logical, intent(in) :: active(:)              !! devices with P mu > 0
+      integer, intent(in) :: phase(:)               !! phases (0 stick, +-1 slide)
+      real(dp), intent(in) :: slip(:)               !! P mu
+      type(excitation_type), intent(in) :: exc      !! the table motion
+      integer, intent(in) :: pinned(:)              !! slots not to replace
+      integer, intent(out) :: islot                 !! the pattern's slot
+      type(error_type), allocatable, intent(out) :: error !! failed build
+      integer :: h, j, oldest
+
+      cache%clock = cache%clock + 1
+      h = hash_of(phase, cache%tsize)
+      do
+         islot = cache%table(h)
+         if (islot == 0) exit
+         if (all(cache%slot(islot)%key == phase)) then
+            cache%slot(islot)%last_use = cache%clock
+            return
+         end if
+         h = iand(h + 1, cache%tsize - 1)
+      end do
+      ! new pattern: a free slot, or the least recently used one
+      if (cache%nused < cache%nslots) then
+         cache%nused = cache%nused + 1
+         islot = cache%nused
+         cache%table(h) = islot
+      else
+         oldest = huge(1)
+         islot = 1
+         do j = 1, cache%nslots
+            if (any(pinned == j)) cycle
+            if (cache%slot(j)%last_use < oldest) then
+               oldest = cache%slot(j)%last_use
+               islot = j
+            end if
+         end do
+         call free_pattern(cache%slot(islot))
+         cache%slot(islot)%key = phase    ! (re)allocated: the new pattern's key
+         call rehash(cache)
+      end if
+      call build_pattern(model, mass, k, c, active, phase, slip, exc, cache%slot(islot), error)
+      if (allocated(error)) return
+      cache%slot(islot)%last_use = cache%clock
+      cache%builds = cache%builds + 1
+   end subroutine cache_find
+
+   subroutine rehash(cache)
+      type(pattern_cache), intent(inout) :: cache
+      integer :: j, h
+
+      cache%table = 0
+      do j = 1, cache%nused
+         if (.not. allocated(cache%slot(j)%key)) cycle
+         h = hash_of(cache%slot(j)%key, cache%tsize)
+         do while (cache%table(h) /= 0)
+            h = iand(h + 1, cache%tsize - 1)
+         end do
+         cache%table(h) = j
+      end do
+   end subroutine rehash
+
+   subroutine free_pattern(pat)
+      type(pattern_type), intent(inout) :: pat
+      if (allocated(pat%key)) deallocate (pat%key)
+      if (allocated(pat%grp)) deallocate (pat%grp, pat%ids, pat%row, pat%mq, pat%kt, pat%ct, pat%pinv, &
+                                           pat%fq, pat%fp, pat%fag, pat%wq, pat%wp, pat%wacc, pat%wf)
+   end subroutine free_pattern
+
+   !> Build the pattern of these phases: groups, reduced matrices, force map, sub-interval
+   !> length and Taylor degree.
+   subroutine build_pattern(model, mass, k, c, active, phase, slip, exc, pat, error)
       type(model_type), intent(in) :: model         !! the model (device nodes)
       real(dp), intent(in) :: mass(:)               !! lumped masses
       real(dp), intent(in) :: k(:, :)               !! springs' stiffness
@@ -59,243 +209,346 @@ contains
       logical, intent(in) :: active(:)              !! devices with P mu > 0
       integer, intent(in) :: phase(:)               !! device phases (0 stick, +-1 slip)
       real(dp), intent(in) :: slip(:)               !! P mu of each device
-      type(excitation_type), intent(in) :: exc      !! the table motion
-      real(dp), intent(in) :: t                     !! time [s]
-      real(dp), intent(in) :: u(:)                  !! displacements
-      real(dp), intent(inout) :: v(:)               !! velocities, projected on return
-      real(dp), allocatable, intent(inout) :: x(:)  !! reduced state (2 nq)
+      type(excitation_type), intent(in) :: exc      !! the table motion (its frequencies)
       type(pattern_type), intent(inout) :: pat      !! the pattern
-      type(error_type), allocatable, intent(out) :: error !! no steady state of the forcing
-      integer, allocatable :: ipiv(:)
-      real(dp), allocatable :: tq(:, :), mq(:), kq(:, :), cq(:, :), f1(:), fg(:), lhs(:, :), rhs(:, :)
-      real(dp), allocatable :: mgrp(:), vq(:)
-      integer :: n, i, d, nq, m, kf, info, j
+      type(error_type), allocatable, intent(out) :: error !! no memory, failed SVD
+      real(dp), allocatable :: kq(:, :), cq(:, :), a(:, :), b(:, :), sv(:), lwk(:), mk(:, :), mc(:, :)
+      integer :: n, nd, nq, ns, i, j, g, d, r, info, stat
+      real(dp) :: w2, cb, wf, lam, mu, term, sd
+      integer :: kk
 
       n = size(mass)
-      if (allocated(pat%grp)) deallocate (pat%grp)
-      allocate (pat%grp(n))
-      call link_groups(model, active .and. phase == phase_stick, pat%grp, nq)
-      m = 2*nq
-      pat%nq = nq
-      pat%m = m
-      allocate (tq(n, nq))
-      tq = 0.0_dp
-      do i = 1, n
-         if (pat%grp(i) > 0) tq(i, pat%grp(i)) = 1.0_dp
-      end do
-      ! reduced coordinates from the current state: q = mass-weighted mean of the group
-      allocate (mgrp(nq), vq(nq))
-      mgrp = matmul(transpose(tq), mass)
-      x = [matmul(transpose(tq), mass*u)/mgrp, matmul(transpose(tq), mass*v)/mgrp]
-      pat%uc = u - matmul(tq, x(1:nq))
-      ! project the velocities on the constraints (they hold to round-off at an event)
-      v = matmul(tq, x(nq + 1:m))
-      mq = mgrp
-      kq = matmul(transpose(tq), matmul(k, tq))
-      cq = matmul(transpose(tq), matmul(c, tq))
-      ! loads: constant part (offsets and sliding forces), and the table's inertia
-      allocate (f1(n))
-      f1 = -matmul(k, pat%uc)
-      do d = 1, size(phase)
-         if (.not. active(d) .or. phase(d) == phase_stick) cycle
-         call add_device(model, d, -phase(d)*slip(d), f1)
-      end do
-      fg = -mass
-      pat%minv_tt = transpose(tq)
-      do i = 1, nq
-         pat%minv_tt(i, :) = pat%minv_tt(i, :)/mq(i)
-      end do
-      if (allocated(pat%a)) deallocate (pat%a)
-      allocate (pat%a(m, m))
-      pat%a = 0.0_dp
-      do i = 1, nq
-         pat%a(i, nq + i) = 1.0_dp
-         pat%a(nq + i, 1:nq) = -kq(i, :)/mq(i)
-         pat%a(nq + i, nq + 1:m) = -cq(i, :)/mq(i)
-      end do
-      pat%b1 = [spread(0.0_dp, 1, nq), matmul(pat%minv_tt, f1)]
-      pat%bag = [spread(0.0_dp, 1, nq), matmul(pat%minv_tt, fg)]
-      pat%h = -1.0_dp
-      ! particular solution of the harmonic forcing: xp = P sin + Q cos per frequency,
-      ! (A^2 + w^2 I) Q = -w amp bag, P = A Q / w
-      call table_sines(exc, t, pat%frc)
-      pat%linear = forcing_form(exc) == forcing_linear
-      if (allocated(pat%xp_s)) deallocate (pat%xp_s, pat%xp_c)
-      allocate (pat%xp_s(m, max_sines), pat%xp_c(m, max_sines))
-      pat%xp_s = 0.0_dp
-      pat%xp_c = 0.0_dp
-      if (m > 0) then
-         allocate (ipiv(m), lhs(m, m), rhs(m, 1))
-         do kf = 1, pat%frc%nf
-            lhs = matmul(pat%a, pat%a)
-            do j = 1, m
-               lhs(j, j) = lhs(j, j) + pat%frc%w(kf)**2
-            end do
-            rhs(:, 1) = -pat%frc%w(kf)*pat%frc%amp(kf)*pat%bag
-            call lu_solve(lhs, rhs, ipiv, info)
-            if (info /= 0) then
-               call fatal_error(error, "event-driven technique: the table frequency "// &
-                                trim(fmt_real(pat%frc%w(kf)/(2.0_dp*pi)))//" Hz is a natural frequency of an "// &
-                                "undamped phase of the structure (no steady state exists)")
-               return
-            end if
-            pat%xp_c(:, kf) = rhs(:, 1)
-            pat%xp_s(:, kf) = matmul(pat%a, rhs(:, 1))/pat%frc%w(kf)
-         end do
-      end if
-   end subroutine build_pattern
-
-   !> Whether the form of the forcing at t (the number of sines) differs from the one the
-   !> pattern was built with: the harmonic ramp has ended, and the pattern must be rebuilt.
-   pure logical function forcing_changed(pat, exc, t)
-      type(pattern_type), intent(in) :: pat         !! the pattern
-      type(excitation_type), intent(in) :: exc      !! the table motion
-      real(dp), intent(in) :: t                     !! time [s]
-      type(sine_forcing) :: frc
-
-      call table_sines(exc, t, frc)
-      forcing_changed = pat%frc%nf /= frc%nf
-   end function forcing_changed
-
-   !> Particular solution (harmonic forcing) at time t, into y.
-   pure subroutine xp_into(pat, t, y)
-      type(pattern_type), intent(in) :: pat
-      real(dp), intent(in) :: t
-      real(dp), intent(out) :: y(:)
-      integer :: kf
-
-      y = 0.0_dp
-      do kf = 1, pat%frc%nf
-         y = y + pat%xp_s(:, kf)*sin(pat%frc%w(kf)*t) + pat%xp_c(:, kf)*cos(pat%frc%w(kf)*t)
-      end do
-   end subroutine xp_into
-
-   !> Reduced state y at t + tau from the state x at t, with the propagators over tau.
-   subroutine propagate(exc, pat, t, tau, x, phi, g1, g2, y, wk)
-      type(excitation_type), intent(in) :: exc      !! the table motion
-      type(pattern_type), intent(in) :: pat         !! the pattern
-      real(dp), intent(in) :: t                     !! start time [s]
-      real(dp), intent(in) :: tau                   !! time step [s]
-      real(dp), intent(in) :: x(:)                  !! reduced state at t
-      real(dp), intent(in) :: phi(:, :)             !! exp(A tau)
-      real(dp), intent(in) :: g1(:, :)              !! response to a constant input over tau
-      real(dp), intent(in) :: g2(:, :)              !! response to a ramp input over tau
-      real(dp), intent(out) :: y(:)                 !! reduced state at t + tau
-      real(dp), intent(inout) :: wk(:)              !! work (m)
-      real(dp) :: ag0, ag1, xg, vg
-
-      if (pat%m == 0) return
-      ! y = phi (x - xp(t)) + xp(t + tau) + gam1 b1 [+ first-order hold of a record]
-      call xp_into(pat, t, wk)
-      wk = x - wk
-      call gen_matvec(phi, wk, y, 1.0_dp, 0.0_dp)
-      call xp_into(pat, t + tau, wk)
-      y = y + wk
-      call gen_matvec(g1, pat%b1, y, 1.0_dp, 1.0_dp)
-      if (pat%linear) then
-         ! steps never straddle a sample, so ag is linear over the step
-         call table_motion(exc, t, xg, vg, ag0)
-         call table_motion(exc, t + tau, xg, vg, ag1)
-         call gen_matvec(g1, pat%bag, y, ag0, 1.0_dp)
-         call gen_matvec(g2, pat%bag, y, (ag1 - ag0)/tau, 1.0_dp)
-      end if
-   end subroutine propagate
-
-   !> Propagators over tau, computed (one matrix exponential, counted in n_expm).
-   subroutine pattern_exp(pat, tau, phi, g1, g2, n_expm, error)
-      type(pattern_type), intent(in) :: pat         !! the pattern
-      real(dp), intent(in) :: tau                   !! time step [s]
-      real(dp), intent(out) :: phi(:, :)            !! exp(A tau)
-      real(dp), intent(out) :: g1(:, :)             !! response to a constant input
-      real(dp), intent(out) :: g2(:, :)             !! response to a ramp input
-      integer, intent(inout) :: n_expm              !! matrix exponentials computed
-      type(error_type), allocatable, intent(out) :: error !! failure of the exponential
-      integer :: info
-
-      if (pat%m == 0) return
-      call lti_propagators(pat%a, tau, phi, g1, g2, info)
-      n_expm = n_expm + 1
-      if (info /= 0) call expm_failed(tau, info, error)
-   end subroutine pattern_exp
-
-   !> Propagators over tau: for the full step h those kept in the pattern (computed, with
-   !> those at the quadrature nodes, the first time), else computed.
-   subroutine pattern_propagators(pat, tau, h, phi, g1, g2, n_expm, error)
-      type(pattern_type), intent(inout) :: pat      !! the pattern (its cache)
-      real(dp), intent(in) :: tau                   !! time step [s]
-      real(dp), intent(in) :: h                     !! the full step [s]
-      real(dp), intent(out) :: phi(:, :)            !! exp(A tau)
-      real(dp), intent(out) :: g1(:, :)             !! response to a constant input
-      real(dp), intent(out) :: g2(:, :)             !! response to a ramp input
-      integer, intent(inout) :: n_expm              !! matrix exponentials computed
-      type(error_type), allocatable, intent(out) :: error !! failure of an exponential
-      integer :: info, ig
-
-      if (pat%m == 0) return
-      if (tau == h) then
-         if (pat%h /= h) then
-            if (allocated(pat%phi)) deallocate (pat%phi, pat%g1, pat%g2, pat%gphi, pat%gg1, pat%gg2)
-            allocate (pat%phi(pat%m, pat%m), pat%g1(pat%m, pat%m), pat%g2(pat%m, pat%m))
-            allocate (pat%gphi(pat%m, pat%m, 3), pat%gg1(pat%m, pat%m, 3), pat%gg2(pat%m, pat%m, 3))
-            call lti_propagators(pat%a, h, pat%phi, pat%g1, pat%g2, info)
-            n_expm = n_expm + 1
-            if (info /= 0) then
-               call expm_failed(h, info, error)
-               return
-            end if
-            do ig = 1, 3
-               call lti_propagators(pat%a, quad_x(ig)*h, pat%gphi(:, :, ig), pat%gg1(:, :, ig), &
-                                    pat%gg2(:, :, ig), info)
-               n_expm = n_expm + 1
-               if (info /= 0) then
-                  call expm_failed(quad_x(ig)*h, info, error)
-                  return
-               end if
-            end do
-            pat%h = h
-         end if
-         phi = pat%phi; g1 = pat%g1; g2 = pat%g2
+      nd = size(phase)
+      call free_pattern(pat)
+      allocate (pat%key(nd), pat%grp(n), pat%row(nd), stat=stat)
+      if (stat /= 0) then
+         call no_memory(n, nd, error)
          return
       end if
-      call pattern_exp(pat, tau, phi, g1, g2, n_expm, error)
-   end subroutine pattern_propagators
-
-   subroutine expm_failed(tau, info, error)
-      real(dp), intent(in) :: tau
-      integer, intent(in) :: info
-      type(error_type), allocatable, intent(out) :: error
-
-      call fatal_error(error, "event-driven technique: the matrix exponential of a phase over "// &
-                       trim(fmt_real(tau))//" s failed (LAPACK info = "//trim(fmt_int(info))//")")
-   end subroutine expm_failed
-
-   !> Full displacement, velocity and relative acceleration at time t from a reduced state.
-   subroutine expand_pattern(exc, pat, t, x, u, v, acc, xdot)
-      type(excitation_type), intent(in) :: exc      !! the table motion
-      type(pattern_type), intent(in) :: pat         !! the pattern
-      real(dp), intent(in) :: t                     !! time [s]
-      real(dp), intent(in) :: x(:)                  !! reduced state at t
-      real(dp), intent(out) :: u(:)                 !! displacements
-      real(dp), intent(out) :: v(:)                 !! velocities
-      real(dp), intent(out) :: acc(:)               !! relative accelerations
-      real(dp), intent(inout) :: xdot(:)            !! work (m): x' at t
-      real(dp) :: xg, vg, ag
-      integer :: i, g, nq
-
-      nq = pat%nq
-      call table_motion(exc, t, xg, vg, ag)
-      if (pat%m > 0) then
-         xdot = pat%b1 + pat%bag*ag
-         call gen_matvec(pat%a, x, xdot, 1.0_dp, 1.0_dp)
+      pat%key = phase
+      call link_groups(model, active .and. phase == phase_stick, pat%grp, nq)
+      ns = count(active .and. phase == phase_stick)
+      pat%nq = nq
+      pat%ns = ns
+      allocate (pat%ids(ns), pat%mq(nq), pat%kt(nq, nq), pat%ct(nq, nq), pat%pinv(ns, n), pat%fq(ns, nq), &
+                pat%fp(ns, nq), pat%fag(ns), pat%wq(nq), pat%wp(nq), pat%wacc(nq), pat%wf(ns), &
+                kq(nq, nq), cq(nq, nq), stat=stat)
+      if (stat /= 0) then
+         call no_memory(n, nd, error)
+         return
       end if
-      do i = 1, size(u)
+      pat%row = 0
+      r = 0
+      do d = 1, nd
+         if (.not. active(d) .or. phase(d) /= phase_stick) cycle
+         r = r + 1
+         pat%ids(r) = d
+         pat%row(d) = r
+      end do
+      pat%mq = 0.0_dp
+      kq = 0.0_dp
+      cq = 0.0_dp
+      do i = 1, n
+         if (pat%grp(i) == 0) cycle
+         pat%mq(pat%grp(i)) = pat%mq(pat%grp(i)) + mass(i)
+         do j = 1, n
+            if (pat%grp(j) == 0) cycle
+            kq(pat%grp(i), pat%grp(j)) = kq(pat%grp(i), pat%grp(j)) + k(i, j)
+            cq(pat%grp(i), pat%grp(j)) = cq(pat%grp(i), pat%grp(j)) + c(i, j)
+         end do
+      end do
+      do g = 1, nq
+         pat%kt(g, :) = kq(g, :)/pat%mq(g)
+         pat%ct(g, :) = cq(g, :)/pat%mq(g)
+      end do
+      ! sub-interval and degree (module header)
+      w2 = 0.0_dp
+      cb = 0.0_dp
+      do g = 1, nq
+         w2 = max(w2, sum(abs(pat%kt(g, :))))
+         cb = max(cb, sum(abs(pat%ct(g, :))))
+      end do
+      wf = forcing_frequency(exc)
+      pat%delta = min(max_sub, theta/max(2.0_dp*sqrt(w2) + cb + wf, theta/max_sub))
+      pat%alpha = 1.0_dp/pat%delta
+      lam = sqrt(w2 + pat%alpha**2) + sqrt(w2) + cb
+      mu = max(lam, wf)*pat%delta
+      term = exp(0.5_dp)
+      kk = 0
+      do
+         kk = kk + 1
+         term = term*mu/kk
+         if ((term <= 2.0_dp**(-54) .and. kk >= 3) .or. kk == kmax + 1) exit
+      end do
+      pat%order = max(5, kk - 1)
+      pat%w2 = w2
+      pat%msum = sqrt(sum(pat%mq))
+      do g = 1, nq
+         pat%wp(g) = 1.0_dp/sqrt(pat%mq(g))
+         pat%wq(g) = pat%wp(g)/pat%alpha
+      end do
+      do g = 1, nq
+         pat%wacc(g) = sum(abs(pat%kt(g, :))*pat%wq) + sum(abs(pat%ct(g, :))*pat%wp)
+      end do
+      if (ns == 0) return
+      ! force map F = D (B_S D)^+ r, r = (M T Kt - K T) q + (M T Ct - C T) p - m[grp = 0] ag + ...
+      allocate (a(n, ns), b(max(n, ns), n), sv(min(n, ns)), lwk(least_squares_work(n, ns)), mk(n, nq), &
+                mc(n, nq), stat=stat)
+      if (stat /= 0) then
+         call no_memory(n, nd, error)
+         return
+      end if
+      a = 0.0_dp
+      do r = 1, ns
+         call add_device(model, pat%ids(r), sqrt(slip(pat%ids(r))), a(:, r))
+      end do
+      b = 0.0_dp
+      do i = 1, n
+         b(i, i) = 1.0_dp
+      end do
+      call least_squares(a, b, sv, lwk, info)
+      if (info /= 0) then
+         call fatal_error(error, "the SVD of the "//trim(fmt_int(ns))//" sticking devices' incidence failed "// &
+                          "(LAPACK dgelss info = "//trim(fmt_int(info))//")")
+         return
+      end if
+      ! (singular values below the rounding level count as zero: dgelss with rcond = eps)
+      do r = 1, ns
+         pat%pinv(r, :) = sqrt(slip(pat%ids(r)))*b(r, 1:n)
+      end do
+      do i = 1, n
+         g = pat%grp(i)
+         do j = 1, nq
+            sd = 0.0_dp
+            term = 0.0_dp
+            if (g > 0) then
+               sd = mass(i)*pat%kt(g, j)
+               term = mass(i)*pat%ct(g, j)
+            end if
+            mk(i, j) = sd
+            mc(i, j) = term
+         end do
+         do j = 1, n
+            g = pat%grp(j)
+            if (g == 0) cycle
+            mk(i, g) = mk(i, g) - k(i, j)
+            mc(i, g) = mc(i, g) - c(i, j)
+         end do
+      end do
+      pat%fq = matmul(pat%pinv, mk)
+      pat%fp = matmul(pat%pinv, mc)
+      pat%fag = 0.0_dp
+      do i = 1, n
+         if (pat%grp(i) == 0) pat%fag = pat%fag - pat%pinv(:, i)*mass(i)
+      end do
+      do r = 1, ns
+         pat%wf(r) = sum(abs(pat%fq(r, :))*pat%wq) + sum(abs(pat%fp(r, :))*pat%wp)
+      end do
+   end subroutine build_pattern
+
+   subroutine no_memory(n, nd, error)
+      integer, intent(in) :: n, nd
+      type(error_type), allocatable, intent(out) :: error
+      call fatal_error(error, "not enough memory for a phase pattern of "//trim(fmt_int(n))//" DOFs and "// &
+                       trim(fmt_int(nd))//" devices")
+   end subroutine no_memory
+
+   !> Enter a pattern at a state (u, v): the reduced state (q: the mass-weighted mean of
+   !> each group), the offsets uc, v projected on the constraints, the constant load b1 and
+   !> the constant term f0 of the force map. Work fn (n) is overwritten.
+   pure subroutine pattern_entry(pat, model, mass, k, phase, slip, u, v, q, p, uc, b1, f0, fn)
+      type(pattern_type), intent(in) :: pat         !! the pattern
+      type(model_type), intent(in) :: model         !! the model (device nodes)
+      real(dp), intent(in) :: mass(:)               !! lumped masses
+      real(dp), intent(in) :: k(:, :)               !! springs' stiffness
+      integer, intent(in) :: phase(:)               !! the pattern's phases
+      real(dp), intent(in) :: slip(:)               !! P mu
+      real(dp), intent(in) :: u(:)                  !! displacements
+      real(dp), intent(inout) :: v(:)               !! velocities, projected on return
+      real(dp), intent(out) :: q(:), p(:)           !! reduced state (nq used)
+      real(dp), intent(out) :: uc(:)                !! offsets (n)
+      real(dp), intent(out) :: b1(:)                !! constant load of the reduced system (nq used)
+      real(dp), intent(out) :: f0(:)                !! constant term of the force map (ns used)
+      real(dp), intent(inout) :: fn(:)              !! work (n)
+      integer :: i, j, g, n, d, r
+
+      n = size(mass)
+      q(1:pat%nq) = 0.0_dp
+      p(1:pat%nq) = 0.0_dp
+      do i = 1, n
+         g = pat%grp(i)
+         if (g == 0) cycle
+         q(g) = q(g) + mass(i)*u(i)
+         p(g) = p(g) + mass(i)*v(i)
+      end do
+      do g = 1, pat%nq
+         q(g) = q(g)/pat%mq(g)
+         p(g) = p(g)/pat%mq(g)
+      end do
+      do i = 1, n
          g = pat%grp(i)
          if (g == 0) then
-            u(i) = pat%uc(i); v(i) = 0.0_dp; acc(i) = 0.0_dp
+            uc(i) = u(i)
+            v(i) = 0.0_dp
          else
-            u(i) = x(g) + pat%uc(i); v(i) = x(nq + g); acc(i) = xdot(nq + g)
+            uc(i) = u(i) - q(g)
+            v(i) = p(g)
          end if
       end do
-   end subroutine expand_pattern
+      ! fn = -K uc - sum_slide b sgn P mu
+      fn = 0.0_dp
+      do j = 1, n
+         if (uc(j) == 0.0_dp) cycle
+         do i = 1, n
+            fn(i) = fn(i) - k(i, j)*uc(j)
+         end do
+      end do
+      do d = 1, size(phase)
+         if (phase(d) == phase_stick .or. slip(d) <= 0.0_dp) cycle
+         call add_device(model, d, -phase(d)*slip(d), fn)
+      end do
+      b1(1:pat%nq) = 0.0_dp
+      do i = 1, n
+         g = pat%grp(i)
+         if (g > 0) b1(g) = b1(g) + fn(i)
+      end do
+      do g = 1, pat%nq
+         b1(g) = b1(g)/pat%mq(g)
+      end do
+      ! f0 = pinv (fn - M T b1)
+      do i = 1, n
+         g = pat%grp(i)
+         if (g > 0) fn(i) = fn(i) - mass(i)*b1(g)
+      end do
+      do r = 1, pat%ns
+         f0(r) = 0.0_dp
+         do i = 1, n
+            f0(r) = f0(r) + pat%pinv(r, i)*fn(i)
+         end do
+      end do
+   end subroutine pattern_entry
+
+   !> Taylor coefficients of the reduced state about an instant to degree K + 1, K =
+   !> ubound(g): qc(:, k), pc(:, k) for k = 0..K+1 from q, p and the table acceleration's
+   !> coefficients g(0:K), and cp(:, k) = Cq pc(:, k) (k = 0..K).
+   pure subroutine pattern_taylor(pat, q, p, b1, g, qc, pc, cp)
+      type(pattern_type), intent(in) :: pat         !! the pattern
+      real(dp), intent(in) :: q(:), p(:)            !! reduced state (nq)
+      real(dp), intent(in) :: b1(:)                 !! constant load (nq)
+      real(dp), intent(in) :: g(0:)                 !! table acceleration's coefficients (0:K)
+      real(dp), intent(out) :: qc(:, 0:), pc(:, 0:) !! coefficients (n, 0:K+1), rows 1..nq used
+      real(dp), intent(out) :: cp(:, 0:)            !! Cq pc (n, 0:K)
+      integer :: kk, nq
+
+      nq = pat%nq
+      if (nq == 0) return
+      qc(1:nq, 0) = q(1:nq)
+      pc(1:nq, 0) = p(1:nq)
+      do kk = 0, ubound(g, 1)
+         call taylor_step(pat, kk, g(kk), b1, qc, pc, cp)
+      end do
+   end subroutine pattern_taylor
+
+   !> Taylor coefficients of the reduced state about an instant over [0, span], to the
+   !> lowest degree K (at least 5) at which the bound of the remainder's norm (module
+   !> header; q'Kq q bounded by w2 q'Mq q) falls below 2^-52 of the polynomial's size,
+   !> sum_k ||x_k|| span^k, or to ubound(g). g, gn: the table acceleration's coefficients
+   !> and remainder factors (0:kcap). Returns K and the bound.
+   pure subroutine pattern_series(pat, q, p, b1, g, gn, span, qc, pc, cp, order, rem, size)
+      type(pattern_type), intent(in) :: pat         !! the pattern
+      real(dp), intent(in) :: q(:), p(:)            !! reduced state (nq)
+      real(dp), intent(in) :: b1(:)                 !! constant load (nq)
+      real(dp), intent(in) :: g(0:), gn(0:)         !! table acceleration (0:kmax)
+      real(dp), intent(in) :: span                  !! sub-interval length S
+      real(dp), intent(out) :: qc(:, 0:), pc(:, 0:) !! coefficients (n, 0:kmax+1), rows 1..nq used
+      real(dp), intent(out) :: cp(:, 0:)            !! Cq pc (n, 0:kmax)
+      integer, intent(out) :: order                 !! the degree K
+      real(dp), intent(out) :: rem                  !! bound of the remainder's norm over [0, S]
+      real(dp), intent(out) :: size                 !! sum_k ||x_k|| S^k
+      integer :: kk, nq, i
+      real(dp) :: e, sk, grow, nrm
+
+      nq = pat%nq
+      order = 5
+      rem = 0.0_dp
+      size = 0.0_dp
+      if (nq == 0) return
+      qc(1:nq, 0) = q(1:nq)
+      pc(1:nq, 0) = p(1:nq)
+      grow = exp(0.5_dp*pat%alpha*span)
+      size = 0.0_dp
+      sk = 1.0_dp
+      do kk = 0, ubound(g, 1)
+         call taylor_step(pat, kk, g(kk), b1, qc, pc, cp)
+         e = 0.0_dp
+         nrm = 0.0_dp
+         do i = 1, nq
+            nrm = nrm + pat%mq(i)*(pc(i, kk)**2 + (pat%w2 + pat%alpha**2)*qc(i, kk)**2)
+            e = e + pat%mq(i)*(pc(i, kk + 1)**2 + (pat%w2 + pat%alpha**2)*qc(i, kk + 1)**2)
+         end do
+         size = size + sqrt(nrm)*sk
+         sk = sk*span
+         rem = grow*(sqrt(e)*sk + sk*span*pat%msum*gn(kk))
+         order = kk
+         if (kk >= 5 .and. rem <= 2.0_dp**(-52)*size) exit
+      end do
+   end subroutine pattern_series
+
+   !> One step of the Taylor recursion: the coefficients of degree kk + 1 of q and p, and
+   !> cp(:, kk) = Cq pc(:, kk), from those of degree kk (gk: the table acceleration's
+   !> coefficient of degree kk; b1 enters at kk = 0).
+   pure subroutine taylor_step(pat, kk, gk, b1, qc, pc, cp)
+      type(pattern_type), intent(in) :: pat             !! the pattern
+      integer, intent(in) :: kk                         !! degree done
+      real(dp), intent(in) :: gk                        !! table acceleration, degree kk
+      real(dp), intent(in) :: b1(:)                     !! constant load (nq)
+      real(dp), intent(inout) :: qc(:, 0:), pc(:, 0:)   !! coefficients
+      real(dp), intent(inout) :: cp(:, 0:)              !! Cq pc
+      integer :: i, j, nq
+      real(dp) :: f
+
+      nq = pat%nq
+      f = 1.0_dp/(kk + 1)
+      do i = 1, nq
+         qc(i, kk + 1) = pc(i, kk)*f
+         pc(i, kk + 1) = -gk
+         cp(i, kk) = 0.0_dp
+      end do
+      if (kk == 0) pc(1:nq, 1) = pc(1:nq, 1) + b1(1:nq)
+      do j = 1, nq
+         do i = 1, nq
+            pc(i, kk + 1) = pc(i, kk + 1) - pat%kt(i, j)*qc(j, kk)
+            cp(i, kk) = cp(i, kk) + pat%ct(i, j)*pc(j, kk)
+         end do
+      end do
+      do i = 1, nq
+         pc(i, kk + 1) = (pc(i, kk + 1) - cp(i, kk))*f
+         cp(i, kk) = cp(i, kk)*pat%mq(i)
+      end do
+   end subroutine taylor_step
+
+   !> The bound on the norm of the remainder of the degree-K Taylor polynomial of the state
+   !> over [0, s] (module header), from x_{K+1} = (qc(:, K+1), pc(:, K+1)).
+   pure real(dp) function remainder_bound(pat, qc, pc, gnext, s) result(r)
+      type(pattern_type), intent(in) :: pat         !! the pattern
+      real(dp), intent(in) :: qc(:, 0:), pc(:, 0:)  !! coefficients (to K+1)
+      real(dp), intent(in) :: gnext                 !! bound of |ag^(K+1)| / (K+1)!
+      real(dp), intent(in) :: s                     !! sub-interval length
+      integer :: i, j, kk
+      real(dp) :: e, kqq
+
+      r = 0.0_dp
+      if (pat%nq == 0) return
+      kk = pat%order + 1
+      e = 0.0_dp
+      do i = 1, pat%nq
+         kqq = 0.0_dp
+         do j = 1, pat%nq
+            kqq = kqq + pat%kt(i, j)*qc(j, kk)
+         end do
+         e = e + pat%mq(i)*(pc(i, kk)**2 + qc(i, kk)*kqq + (pat%alpha*qc(i, kk))**2)
+      end do
+      r = exp(0.5_dp*pat%alpha*s)*(sqrt(max(e, 0.0_dp))*s**kk + s**(kk + 1)*pat%msum*gnext)
+   end function remainder_bound
 
 end module fd_phase_pattern

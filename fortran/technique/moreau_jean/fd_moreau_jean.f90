@@ -13,7 +13,8 @@
 !> the fallback. No eps, no f; first order in time (docs/theory.md, section 12).
 !>
 !> Reported to the observer at the end of every step: u1, v1, the absolute acceleration
-!> from equilibrium at t + h with the step's mean friction forces F_d = lambda_d / h, the
+!> from equilibrium at t + h (Coulomb's law at the level of accelerations given v1) and the
+!> device forces of that equilibrium (so that storey shears equal the inertia forces), the
 !> devices' phases (sticking, sliding which way) and transitions. Energy: input and viscous
 !> work and the friction work sum lambda_d Delta s_d / h over each step; the balance closes
 !> to round-off for theta = 1/2 and leaves the method's numerical dissipation for theta > 1/2.
@@ -52,6 +53,7 @@ module fd_moreau_jean
       logical, allocatable :: pending(:)                  !! (nd) stopped from a slide at the last step
       integer, allocatable :: ta(:), tb(:)                !! (nd) transitions handed to the observer
       real(dp), allocatable :: g_step(:), g_force(:)      !! (ne) bounds: P mu h, P mu
+      real(dp), allocatable :: f_edge(:)                  !! (ne) edge forces at the end of a step [N]
       real(dp) :: w_fric = 0.0_dp                         !! friction work [J]
    end type mj_work
 
@@ -176,7 +178,7 @@ contains
       call solve_impulses(w%p, w%r, w%rabs, 1.0_dp, 0.0_dp, w%g_force, w%acc, error)
       if (allocated(error)) return
       w%p%locked = .false.
-      call device_state(model, w, 1.0_dp, w%phase0)
+      call device_state(model, w, w%p%lam, w%phase0)
       w%counted = w%phase0
       w%pending = .false.
       call energies(w, e_kin, e_str)
@@ -210,10 +212,19 @@ contains
          call gs_k_matvec(w%p%gs, w%kx, w%r, -1.0_dp, 0.0_dp)
          w%r = w%r - model%mass*(ag1 + w%a0*w%v1)
          call pattern_acceleration(w%p, w%r, w%g_force, w%acc)
+         ! the device forces of that equilibrium (not the step's mean lambda / h): the forces at
+         ! t1 the storey shears and hysteresis loops are made of, in equilibrium with acc
+         do e = 1, w%ne
+            if (w%p%sa(e) == 0) then
+               w%f_edge(e) = w%p%fa(e)
+            else
+               w%f_edge(e) = w%p%sa(e)*w%g_force(e)
+            end if
+         end do
          w%u = w%u1
          w%v = w%v1
          ag0 = ag1
-         call device_state(model, w, 1.0_dp/h, w%phase1)
+         call device_state(model, w, w%f_edge, w%phase1)
          call count_transitions(w, res, .false.)
          w%phase0 = w%phase1
          call observe_peaks(res, t1, w%u, w%v, w%acc, ag1, w%s, w%force)
@@ -294,7 +305,7 @@ contains
       end if
       allocate (w%u(n), w%v(n), w%u1(n), w%v1(n), w%acc(n), w%r(n), w%du(n), w%kx(n), w%rabs(n), &
                 w%s(nd), w%sd(nd), w%force(nd), w%phase0(nd), w%phase1(nd), w%counted(nd), w%pending(nd), &
-                w%ta(nd), w%tb(nd), w%g_step(w%ne), w%g_force(w%ne), stat=stat)
+                w%ta(nd), w%tb(nd), w%g_step(w%ne), w%g_force(w%ne), w%f_edge(w%ne), stat=stat)
       if (stat /= 0) call no_memory(error, n)
    end subroutine setup
 
@@ -306,11 +317,12 @@ contains
                        stat_no_memory)
    end subroutine no_memory
 
-   !> Device kinematics, forces (impulses times `per`) and phases from the solver's edges.
-   pure subroutine device_state(model, w, per, phase)
+   !> Device kinematics, forces (shared out of the edge forces f_edge) and phases (the
+   !> statuses of the step's one-step problem) from the solver's edges.
+   pure subroutine device_state(model, w, f_edge, phase)
       type(model_type), intent(in) :: model
       type(mj_work), intent(inout) :: w
-      real(dp), intent(in) :: per
+      real(dp), intent(in) :: f_edge(:)
       integer, intent(out) :: phase(:)
       integer :: d, e
 
@@ -321,7 +333,7 @@ contains
             w%force(d) = 0.0_dp
             phase(d) = 0
          else
-            w%force(d) = w%p%es%dev_sign(d)*w%p%es%dev_share(d)*w%p%lam(e)*per
+            w%force(d) = w%p%es%dev_sign(d)*w%p%es%dev_share(d)*f_edge(e)
             phase(d) = w%p%es%dev_sign(d)*w%p%sigma(e)
          end if
       end do

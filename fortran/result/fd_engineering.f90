@@ -1,0 +1,320 @@
+!> What a design engineer reads from a run, kept by the observer for every technique:
+!> the names of the DOFs, devices and storeys; the natural modes with every device stuck
+!> and with every device free; the damping actually used (C = a0 M + a1 K); per storey the
+!> drift (and drift ratio), the storey shear and their peaks and residual values; the base
+!> shear; the residual relative displacement of every device.
+!>
+!> A storey is a pair of nodes (upper node_i, lower node_j; 0 = the table). Its drift is
+!> u(node_i) - u(node_j); its shear is the force carried by every element joining exactly
+!> those two nodes: each spring k's elastic force k (drift) and its share b k (drift rate)
+!> of the stiffness-proportional damping C = a0 M + b K, and each device's friction force,
+!> positive when it resists a positive drift. The base shear is the same sum over every
+!> element joined to the table. Mass-proportional damping (a0 M) is carried by no element:
+!> with a0 = 0 the base shear equals -sum m_i aabs_i, the inertia forces of the masses.
+module fd_engineering
+   use fd_kinds, only: dp
+   use fd_error, only: error_type, fatal_error, fmt_int, stat_no_memory
+   use fd_model, only: model_type, integration_type, label_len, system_stuck, system_free, &
+                       damping_stiffness, damping_rayleigh
+   use fd_excitation, only: excitation_type, excitation_harmonic
+   use fd_matrices, only: modes_type, natural_modes, stiffness_matrix, damping_matrix, &
+                          stiffness_damping_factor
+   implicit none
+   private
+
+   public :: engineering_type, engineering_init, storey_values, observe_engineering, engineering_columns
+   public :: observe_storey_peak
+
+   !> The engineering outputs of a run.
+   type :: engineering_type
+      ! the run
+      integer :: excitation = 0                 !! excitation id (fd_names)
+      real(dp) :: frequency = 0.0_dp            !! table frequency (harmonic) [Hz]
+      real(dp) :: duration = 0.0_dp             !! analysed duration [s]
+      ! names
+      character(len=label_len), allocatable :: dof_label(:)     !! name of each DOF
+      character(len=label_len), allocatable :: device_label(:)  !! name of each device
+      character(len=label_len), allocatable :: storey_label(:)  !! name of each storey
+      ! damping used, C = a0 M + a1 K
+      real(dp) :: a0 = 0.0_dp                   !! mass factor [1/s]
+      real(dp) :: a1 = 0.0_dp                   !! stiffness factor [s]
+      ! natural modes
+      type(modes_type) :: stuck                 !! every device stuck
+      type(modes_type) :: free                  !! every device free
+      ! storeys; cut 0 is the base (every element joined to the table)
+      integer :: n_storeys = 0                  !! storeys
+      integer, allocatable :: storey_i(:)       !! upper node
+      integer, allocatable :: storey_j(:)       !! lower node (0 = table)
+      real(dp), allocatable :: height(:)        !! storey height [m] (0: not given)
+      integer, allocatable :: sp_first(:)       !! (0:n_storeys+1): springs of cut c at sp_first(c):sp_first(c+1)-1
+      integer, allocatable :: sp_i(:), sp_j(:)  !! their nodes
+      real(dp), allocatable :: sp_k(:)          !! their stiffness, signed along the cut [N/m]
+      integer, allocatable :: dv_first(:)       !! (0:n_storeys+1): devices of cut c
+      integer, allocatable :: dv_id(:)          !! device indices
+      real(dp), allocatable :: dv_sign(:)       !! +1 or -1 along the cut
+      ! values at the last state observed (the residual values at the end of the run)
+      real(dp), allocatable :: drift(:)         !! (n_storeys) drift [m]
+      real(dp), allocatable :: shear(:)         !! (0:n_storeys) shear, 0 = base [N]
+      real(dp), allocatable :: residual_s(:)    !! (n_devices) device relative displacement [m]
+      ! peaks over the accepted states
+      real(dp), allocatable :: peak_drift(:)       !! max |drift| [m]
+      real(dp), allocatable :: peak_drift_time(:)  !! its time [s]
+      real(dp), allocatable :: peak_shear(:)       !! (0:n_storeys) max |shear| [N]
+      real(dp), allocatable :: peak_shear_time(:)  !! (0:n_storeys) its time [s]
+   end type engineering_type
+
+contains
+
+   !> Set up the engineering outputs of a run: names (defaults 'DOF i', 'device d', 'storey
+   !> s'), the damping used, the modes (opts%n_modes of each system; none when 0), and the
+   !> elements of each storey and of the base. `period` is the stuck first period the
+   !> technique computed (structure_matrices), which the paper's damping C = psi K uses.
+   subroutine engineering_init(model, exc, opts, period, eng, error)
+      type(model_type), intent(in) :: model         !! the model run
+      type(excitation_type), intent(in) :: exc      !! the table motion
+      type(integration_type), intent(in) :: opts    !! n_modes
+      real(dp), intent(in) :: period                !! stuck first period [s] (0: none)
+      type(engineering_type), intent(out) :: eng    !! the outputs, set up
+      type(error_type), allocatable, intent(out) :: error !! eigenvalue solver failure
+      real(dp), allocatable :: k(:, :), c(:, :)
+      integer :: n, nd, ns, i, s, stat
+
+      n = model%n_dof
+      nd = model%n_devices
+      ns = model%n_storeys
+      eng%excitation = exc%kind
+      eng%duration = exc%duration
+      if (exc%kind == excitation_harmonic) eng%frequency = exc%frequency
+      allocate (eng%dof_label(n), eng%device_label(nd), stat=stat)
+      if (stat /= 0) then
+         call no_memory('the labels'); return
+      end if
+      do i = 1, n
+         eng%dof_label(i) = 'DOF '//trim(fmt_int(i))
+         if (allocated(model%dof_label)) then
+            if (len_trim(model%dof_label(i)) > 0) eng%dof_label(i) = model%dof_label(i)
+         end if
+      end do
+      do i = 1, nd
+         eng%device_label(i) = model%dev(i)%label
+         if (len_trim(eng%device_label(i)) == 0) eng%device_label(i) = 'device '//trim(fmt_int(i))
+      end do
+      ! C = a0 M + a1 K
+      select case (model%damping)
+      case (damping_stiffness)
+         eng%a1 = stiffness_damping_factor(model, period)
+      case (damping_rayleigh)
+         eng%a0 = model%rayleigh_a0
+         eng%a1 = model%rayleigh_a1
+      end select
+      ! natural modes
+      if (opts%n_modes > 0) then
+         allocate (k(n, n), c(n, n), stat=stat)
+         if (stat /= 0) then
+            call no_memory('the modes (two '//trim(fmt_int(n))//' x '//trim(fmt_int(n))//' matrices)'); return
+         end if
+         call stiffness_matrix(model, k)
+         call damping_matrix(model, k, merge(model%period, period, model%period > 0.0_dp), c)
+         call natural_modes(model, k, c, system_stuck, opts%n_modes, eng%stuck, error)
+         if (allocated(error)) return
+         call natural_modes(model, k, c, system_free, opts%n_modes, eng%free, error)
+         if (allocated(error)) return
+      end if
+      ! storeys and their elements
+      eng%n_storeys = ns
+      allocate (eng%storey_i(ns), eng%storey_j(ns), eng%height(ns), eng%storey_label(ns), stat=stat)
+      if (stat /= 0) then
+         call no_memory('the storeys'); return
+      end if
+      do s = 1, ns
+         eng%storey_i(s) = model%storey_i(s)
+         eng%storey_j(s) = model%storey_j(s)
+         eng%height(s) = model%storey_height(s)
+         eng%storey_label(s) = 'storey '//trim(fmt_int(s))
+         if (allocated(model%storey_label)) then
+            if (len_trim(model%storey_label(s)) > 0) eng%storey_label(s) = model%storey_label(s)
+         end if
+      end do
+      call storey_elements(model, eng, stat)
+      if (stat /= 0) then
+         call no_memory('the elements of the storeys'); return
+      end if
+      allocate (eng%drift(ns), eng%shear(0:ns), eng%residual_s(nd), eng%peak_drift(ns), &
+                eng%peak_drift_time(ns), eng%peak_shear(0:ns), eng%peak_shear_time(0:ns), stat=stat)
+      if (stat /= 0) then
+         call no_memory('the storeys'); return
+      end if
+      eng%drift = 0.0_dp; eng%shear = 0.0_dp; eng%residual_s = 0.0_dp
+      eng%peak_drift = 0.0_dp; eng%peak_drift_time = 0.0_dp
+      eng%peak_shear = 0.0_dp; eng%peak_shear_time = 0.0_dp
+   contains
+      subroutine no_memory(what)
+         character(len=*), intent(in) :: what
+         call fatal_error(error, "not enough memory for the engineering outputs of "//trim(fmt_int(n))// &
+                          " DOFs, "//trim(fmt_int(nd))//" devices and "//trim(fmt_int(ns))//" storeys: "//what, &
+                          stat_no_memory)
+      end subroutine no_memory
+   end subroutine engineering_init
+
+   !> The springs and devices of every cut (0 = the base, 1..n_storeys the storeys), with
+   !> their sign along the cut, in compressed lists.
+   subroutine storey_elements(model, eng, stat)
+      type(model_type), intent(in) :: model
+      type(engineering_type), intent(inout) :: eng
+      integer, intent(out) :: stat                 !! not 0: not enough memory
+      integer :: ns, cut, e, a, b, nsp, ndv
+      real(dp) :: sgn
+
+      ns = eng%n_storeys
+      allocate (eng%sp_first(0:ns + 1), eng%dv_first(0:ns + 1), stat=stat)
+      if (stat /= 0) return
+      ! count, then fill
+      nsp = 0; ndv = 0
+      do cut = 0, ns
+         do e = 1, model%n_springs
+            if (on_cut(cut, model%spring_i(e), model%spring_j(e)) /= 0.0_dp) nsp = nsp + 1
+         end do
+         do e = 1, model%n_devices
+            if (on_cut(cut, model%dev(e)%node_i, model%dev(e)%node_j) /= 0.0_dp) ndv = ndv + 1
+         end do
+      end do
+      allocate (eng%sp_i(nsp), eng%sp_j(nsp), eng%sp_k(nsp), eng%dv_id(ndv), eng%dv_sign(ndv), stat=stat)
+      if (stat /= 0) return
+      nsp = 0; ndv = 0
+      do cut = 0, ns
+         eng%sp_first(cut) = nsp + 1
+         eng%dv_first(cut) = ndv + 1
+         do e = 1, model%n_springs
+            a = model%spring_i(e); b = model%spring_j(e)
+            sgn = on_cut(cut, a, b)
+            if (sgn == 0.0_dp) cycle
+            nsp = nsp + 1
+            eng%sp_i(nsp) = a; eng%sp_j(nsp) = b; eng%sp_k(nsp) = sgn*model%spring_k(e)
+         end do
+         do e = 1, model%n_devices
+            sgn = on_cut(cut, model%dev(e)%node_i, model%dev(e)%node_j)
+            if (sgn == 0.0_dp) cycle
+            ndv = ndv + 1
+            eng%dv_id(ndv) = e; eng%dv_sign(ndv) = sgn
+         end do
+      end do
+      eng%sp_first(ns + 1) = nsp + 1
+      eng%dv_first(ns + 1) = ndv + 1
+   contains
+      !> +1 if the element (a, b) lies on the cut in its direction, -1 reversed, 0 not on it.
+      real(dp) function on_cut(cut, a, b) result(sgn)
+         integer, intent(in) :: cut, a, b
+         sgn = 0.0_dp
+         if (cut == 0) then
+            if (b == 0) sgn = 1.0_dp
+            if (a == 0) sgn = -1.0_dp
+         else if (a == eng%storey_i(cut) .and. b == eng%storey_j(cut)) then
+            sgn = 1.0_dp
+         else if (a == eng%storey_j(cut) .and. b == eng%storey_i(cut)) then
+            sgn = -1.0_dp
+         end if
+      end function on_cut
+   end subroutine storey_elements
+
+   !> Drift and shear of every storey, and the base shear, at one state.
+   pure subroutine storey_values(eng, u, v, force, drift, shear, base)
+      type(engineering_type), intent(in) :: eng  !! the set-up outputs
+      real(dp), intent(in) :: u(:)               !! relative displacements [m]
+      real(dp), intent(in) :: v(:)               !! relative velocities [m/s]
+      real(dp), intent(in) :: force(:)           !! device forces [N]
+      real(dp), intent(out) :: drift(:)          !! (n_storeys) drift [m]
+      real(dp), intent(out) :: shear(:)          !! (n_storeys) storey shear [N]
+      real(dp), intent(out) :: base              !! base shear [N]
+      integer :: s
+
+      do s = 1, eng%n_storeys
+         drift(s) = node_value(u, eng%storey_i(s)) - node_value(u, eng%storey_j(s))
+         shear(s) = cut_force(s)
+      end do
+      base = cut_force(0)
+   contains
+      pure real(dp) function cut_force(cut) result(f)
+         integer, intent(in) :: cut
+         integer :: e
+         real(dp) :: du, dv
+         f = 0.0_dp
+         do e = eng%sp_first(cut), eng%sp_first(cut + 1) - 1
+            du = node_value(u, eng%sp_i(e)) - node_value(u, eng%sp_j(e))
+            dv = node_value(v, eng%sp_i(e)) - node_value(v, eng%sp_j(e))
+            f = f + eng%sp_k(e)*(du + eng%a1*dv)
+         end do
+         do e = eng%dv_first(cut), eng%dv_first(cut + 1) - 1
+            f = f + eng%dv_sign(e)*force(eng%dv_id(e))
+         end do
+      end function cut_force
+      pure real(dp) function node_value(x, node)
+         real(dp), intent(in) :: x(:)
+         integer, intent(in) :: node
+         node_value = 0.0_dp
+         if (node > 0) node_value = x(node)
+      end function node_value
+   end subroutine storey_values
+
+   !> One accepted state: drifts and shears, their peaks, and the values kept as the
+   !> residual ones (those of the last state observed).
+   pure subroutine observe_engineering(eng, t, u, v, s, force)
+      type(engineering_type), intent(inout) :: eng  !! the outputs
+      real(dp), intent(in) :: t                     !! time [s]
+      real(dp), intent(in) :: u(:)                  !! relative displacements [m]
+      real(dp), intent(in) :: v(:)                  !! relative velocities [m/s]
+      real(dp), intent(in) :: s(:)                  !! device relative displacements [m]
+      real(dp), intent(in) :: force(:)              !! device forces [N]
+      integer :: i
+
+      if (.not. allocated(eng%drift)) return
+      eng%residual_s = s
+      call storey_values(eng, u, v, force, eng%drift, eng%shear(1:), eng%shear(0))
+      do i = 1, eng%n_storeys
+         if (abs(eng%drift(i)) > eng%peak_drift(i)) then
+            eng%peak_drift(i) = abs(eng%drift(i)); eng%peak_drift_time(i) = t
+         end if
+      end do
+      do i = 0, eng%n_storeys
+         if (abs(eng%shear(i)) > eng%peak_shear(i)) then
+            eng%peak_shear(i) = abs(eng%shear(i)); eng%peak_shear_time(i) = t
+         end if
+      end do
+   end subroutine observe_engineering
+
+   !> One value into a peak of the storeys (a technique that knows its solution between
+   !> steps passes the exact extrema, with their times): q numbers the storey quantities in
+   !> the order of the history columns, drift1, V1, drift2, V2, ..., Vb.
+   pure subroutine observe_storey_peak(eng, q, value, t)
+      type(engineering_type), intent(inout) :: eng  !! the outputs
+      integer, intent(in) :: q                      !! storey quantity, 1 .. 2 n_storeys + 1
+      real(dp), intent(in) :: value                 !! |value|
+      real(dp), intent(in) :: t                     !! its time [s]
+      integer :: s
+
+      if (.not. allocated(eng%drift)) return
+      if (q == 2*eng%n_storeys + 1) then
+         s = 0
+      else
+         s = (q + 1)/2
+         if (mod(q, 2) == 1) then
+            if (value > eng%peak_drift(s)) then
+               eng%peak_drift(s) = value; eng%peak_drift_time(s) = t
+            end if
+            return
+         end if
+      end if
+      if (value > eng%peak_shear(s)) then
+         eng%peak_shear(s) = value; eng%peak_shear_time(s) = t
+      end if
+   end subroutine observe_storey_peak
+
+   !> Number of history columns the storeys add: drift and shear per storey and the base
+   !> shear, when the model names storeys; none otherwise.
+   pure integer function engineering_columns(model) result(ncol)
+      type(model_type), intent(in) :: model  !! the model
+
+      ncol = 0
+      if (model%n_storeys > 0) ncol = 2*model%n_storeys + 1
+   end function engineering_columns
+
+end module fd_engineering
