@@ -351,6 +351,10 @@ def test_a_refinement_within_the_bound_runs(run):
 
 # ---------------------------------------------------------------- memory
 
+# the checked build (tools/test_checked.sh): executables and the extension under the address
+# sanitizer, whose start-up reserves more address space than any RLIMIT_AS a test would set
+CHECKED = bool(os.environ.get("FRICTIONDYN_CHECKED"))
+
 LIMIT = textwrap.dedent(
     """
     import resource, sys
@@ -386,11 +390,17 @@ def test_the_executable_out_of_memory_is_an_error_not_a_crash(tmp_path):
     (tmp_path / "big.nml").write_text(big_deck(4000))
     script = LIMIT + textwrap.dedent(
         f"""
-        import subprocess
+        import os, subprocess
+        env = dict(os.environ)
         def limit():
             resource.setrlimit(resource.RLIMIT_AS, (300 * 2**20, 300 * 2**20))
+        if {CHECKED!r}:
+            # the address sanitizer reserves terabytes of address space when it starts: there,
+            # an allocation over 100 MB fails instead (malloc returns NULL, as under the limit)
+            env["ASAN_OPTIONS"] = env.get("ASAN_OPTIONS", "") + ":max_allocation_size_mb=100"
+            limit = None
         r = subprocess.run([{frictiondyn.executable()!r}, 'big.nml'], preexec_fn=limit,
-                           capture_output=True, text=True)
+                           capture_output=True, text=True, env=env)
         print(r.returncode)
         print(r.stderr)
         """
@@ -448,3 +458,53 @@ def test_no_summary_of_a_successful_run_holds_null():
         r = frictiondyn.run_text(text, deck.name, base_dir=INPUTS)
         assert "null" not in r.summary_text, deck.name
         assert "NaN" not in json.dumps(r.summary), deck.name
+
+
+def star_deck(n: int) -> str:
+    """n masses, each on a spring to the table and to mass 1 and on a Coulomb device to the
+    table, integrated by Moreau-Jean: the band of its reduced system is as wide as the model,
+    n**2 numbers (8000 DOFs: 512 MB)."""
+    nodes = ", ".join(str(i) for i in range(1, n + 1))
+    others = ", ".join(str(i) for i in range(2, n + 1))
+    return textwrap.dedent(
+        f"""
+        &model n_dof = {n}, mass = {n}*1.0 /
+        &springs n_springs = {2 * n - 1}, node_i = {nodes}, {others},
+                 node_j = {n}*0, {n - 1}*1, k = {2 * n - 1}*1.0e4 /
+        &damping damping_type = 'none' /
+        &friction n_devices = {n}, node_i = {nodes}, node_j = {n}*0, law = {n}*'coulomb',
+                  p = {n}*10.0, mu = {n}*0.3 /
+        &excitation excitation_type = 'harmonic', amplitude = 0.01, frequency = 2.0,
+                    dt_record = 0.01, duration = 0.02 /
+        &integration technique = 'moreau_jean' /
+        """
+    ).lstrip()
+
+
+def test_moreau_jean_out_of_memory_is_an_error_not_a_crash(tmp_path):
+    """The Moreau-Jean technique's work space (its edges, the reduced band system, the
+    solver's arrays) is sized by the deck too: an 8000-DOF star under the 300 MB limit of
+    test_the_executable_out_of_memory... is an error naming what could not be had (its
+    allocations were unchecked: the gfortran runtime aborted)."""
+    (tmp_path / "star.nml").write_text(star_deck(8000))
+    script = LIMIT + textwrap.dedent(
+        f"""
+        import os, subprocess
+        env = dict(os.environ)
+        def limit():
+            resource.setrlimit(resource.RLIMIT_AS, (300 * 2**20, 300 * 2**20))
+        if {CHECKED!r}:
+            env["ASAN_OPTIONS"] = env.get("ASAN_OPTIONS", "") + ":max_allocation_size_mb=100"
+            limit = None
+        r = subprocess.run([{frictiondyn.executable()!r}, 'star.nml'], preexec_fn=limit,
+                           capture_output=True, text=True, env=env)
+        print(r.returncode)
+        print(r.stderr)
+        """
+    )
+    r = subprocess.run([sys.executable, "-c", script], cwd=tmp_path, capture_output=True,
+                       text=True, timeout=300, check=False)
+    code, _, err = r.stdout.partition("\n")
+    assert code == "1", r.stdout + r.stderr
+    assert "star.nml" in err and "not enough memory" in err and "8000" in err, err
+    assert not (tmp_path / "out").exists()

@@ -141,6 +141,17 @@ program frictiondyn_main
    if (cfg%out%history) write (output_unit, '(a)') '  history: '//hist
    write (output_unit, '(a)') '  summary: '//summ
    end associate
+   ! a main program's variables are not deallocated when it ends: free them, so that the
+   ! leak checker of the checked build (tools/test_checked.sh) finds nothing
+   if (allocated(deck)) deallocate (deck)
+   if (allocated(arg)) deallocate (arg)
+   if (allocated(hist)) deallocate (hist)
+   if (allocated(summ)) deallocate (summ)
+   if (allocated(htmp)) deallocate (htmp)
+   if (allocated(stmp)) deallocate (stmp)
+   if (allocated(tag)) deallocate (tag)
+   if (allocated(list)) deallocate (list)
+   if (allocated(index_text)) deallocate (index_text)
 
 contains
 

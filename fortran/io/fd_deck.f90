@@ -193,6 +193,9 @@ contains
          call no_memory(deck, 'model', i, 'DOFs', error); return
       end if
       label = ''
+      ! a longer label would be cut by the namelist read: refused from the group's text first
+      call check_length(deck, grp, 'label', label_len - 1, error)
+      if (allocated(error)) return
       msg0 = ''
       read (grp%lines, nml=model, iostat=ios, iomsg=msg0)
       if (ios /= 0) then
@@ -310,6 +313,9 @@ contains
       if (.not. found) then
          call missing_group(deck, 'damping', error); return
       end if
+      call check_length(deck, grp, 'damping_type', name_len, error)
+      if (.not. allocated(error)) call check_length(deck, grp, 'mode_system', name_len, error)
+      if (allocated(error)) return
       msg0 = ''
       read (grp%lines, nml=damping, iostat=ios, iomsg=msg0)
       if (ios /= 0) then
@@ -321,9 +327,6 @@ contains
          if (ios == 0) msg = msg0
          call group_read_error(deck, grp, i, msg, error); return
       end if
-      call check_length(deck, grp, 'damping_type', name_len, error)
-      if (.not. allocated(error)) call check_length(deck, grp, 'mode_system', name_len, error)
-      if (allocated(error)) return
       cfg%model%damping = keyword_id(damping_types, damping_type)
       select case (cfg%model%damping)
       case (damping_stiffness)
@@ -388,6 +391,12 @@ contains
       if (ios /= 0) then
          call no_memory(deck, 'friction', i, 'devices', error); return
       end if
+      call check_length(deck, grp, 'law', name_len, error)
+      if (.not. allocated(error)) call check_length(deck, grp, 'mu_law', name_len, error)
+      if (allocated(error)) return
+      ! a longer label would be cut by the namelist read: refused from the group's text first
+      call check_length(deck, grp, 'label', label_len - 1, error)
+      if (allocated(error)) return
       msg0 = ''
       read (grp%lines, nml=friction, iostat=ios, iomsg=msg0)
       if (ios /= 0) then
@@ -399,9 +408,6 @@ contains
          if (ios == 0) msg = msg0
          call group_read_error(deck, grp, i, msg, error); return
       end if
-      call check_length(deck, grp, 'law', name_len, error)
-      if (.not. allocated(error)) call check_length(deck, grp, 'mu_law', name_len, error)
-      if (allocated(error)) return
       call need_int(deck, 'friction', 'n_devices', n_devices, 0, max_devices, error)
       if (allocated(error)) return
       n = n_devices
@@ -499,6 +505,12 @@ contains
       if (.not. found) then
          call missing_group(deck, 'excitation', error); return
       end if
+      call check_length(deck, grp, 'excitation_type', name_len, error)
+      if (.not. allocated(error)) call check_length(deck, grp, 'record_kind', name_len, error)
+      if (.not. allocated(error)) call check_length(deck, grp, 'record_format', name_len, error)
+      if (.not. allocated(error)) call check_length(deck, grp, 'record_units', name_len, error)
+      if (.not. allocated(error)) call check_length(deck, grp, 'record_file', path_len, error)
+      if (allocated(error)) return
       msg0 = ''
       read (grp%lines, nml=excitation, iostat=ios, iomsg=msg0)
       if (ios /= 0) then
@@ -510,12 +522,6 @@ contains
          if (ios == 0) msg = msg0
          call group_read_error(deck, grp, i, msg, error); return
       end if
-      call check_length(deck, grp, 'excitation_type', name_len, error)
-      if (.not. allocated(error)) call check_length(deck, grp, 'record_kind', name_len, error)
-      if (.not. allocated(error)) call check_length(deck, grp, 'record_format', name_len, error)
-      if (.not. allocated(error)) call check_length(deck, grp, 'record_units', name_len, error)
-      if (.not. allocated(error)) call check_length(deck, grp, 'record_file', path_len, error)
-      if (allocated(error)) return
       ! a record whose file gives DT (AT2) may leave dt_record out
       if (.not. (keyword_id(excitation_types, excitation_type) == excitation_record .and. dt_record == unset)) then
          call need_real(deck, 'excitation', 'dt_record', dt_record, 's', error)
@@ -625,6 +631,9 @@ contains
       call find_group(deck, 'integration', grp, found, error)
       if (allocated(error)) return
       if (found) then
+         call check_length(deck, grp, 'technique', name_len, error)
+         if (.not. allocated(error)) call check_length(deck, grp, 'linear_system', name_len, error)
+         if (allocated(error)) return
          msg0 = ''
          read (grp%lines, nml=integration, iostat=ios, iomsg=msg0)
          if (ios /= 0) then
@@ -637,9 +646,6 @@ contains
             call group_read_error(deck, grp, i, msg, error); return
          end if
       end if
-      call check_length(deck, grp, 'technique', name_len, error)
-      if (.not. allocated(error)) call check_length(deck, grp, 'linear_system', name_len, error)
-      if (allocated(error)) return
       technique_id = keyword_id(techniques, technique)
       if (technique_id == 0) then
          call keyword_choices(techniques, choices)
@@ -719,6 +725,9 @@ contains
       call find_group(deck, 'output', grp, found, error)
       if (allocated(error)) return
       if (found) then
+         call check_length(deck, grp, 'dir', path_len, error)
+         if (.not. allocated(error)) call check_length(deck, grp, 'name', path_len, error)
+         if (allocated(error)) return
          msg0 = ''
          read (grp%lines, nml=output, iostat=ios, iomsg=msg0)
          if (ios /= 0) then
@@ -731,9 +740,6 @@ contains
             call group_read_error(deck, grp, i, msg, error); return
          end if
       end if
-      call check_length(deck, grp, 'dir', path_len, error)
-      if (.not. allocated(error)) call check_length(deck, grp, 'name', path_len, error)
-      if (allocated(error)) return
       if (len_trim(dir) == 0) then
          call bad(deck, 'output', 'dir', "''", 'a directory path', error); return
       end if
@@ -823,6 +829,9 @@ contains
          call no_memory(deck, 'braces', i, 'braces', error); return
       end if
       node_i = unset_int; node_j = unset_int; slip_load = unset; stiffness = unset; eps1 = unset; label = ''
+      ! a longer label would be cut by the namelist read: refused from the group's text first
+      call check_length(deck, grp, 'label', label_len - 1, error)
+      if (allocated(error)) return
       msg0 = ''
       read (grp%lines, nml=braces, iostat=ios, iomsg=msg0)
       if (ios /= 0) then
@@ -909,6 +918,12 @@ contains
       end if
       node_i = unset_int; node_j = unset_int; law = ''
       weight = unset; mu = unset; radius = unset; eps = unset; eps1 = unset; f = unset
+      ! a longer label would be cut by the namelist read: refused from the group's text first
+      call check_length(deck, grp, 'label', label_len - 1, error)
+      if (allocated(error)) return
+      call check_length(deck, grp, 'law', name_len, error)
+      if (.not. allocated(error)) call check_length(deck, grp, 'mu_law', name_len, error)
+      if (allocated(error)) return
       msg0 = ''
       read (grp%lines, nml=isolators, iostat=ios, iomsg=msg0)
       if (ios /= 0) then
@@ -920,9 +935,6 @@ contains
          if (ios == 0) msg = msg0
          call group_read_error(deck, grp, i, msg, error); return
       end if
-      call check_length(deck, grp, 'law', name_len, error)
-      if (.not. allocated(error)) call check_length(deck, grp, 'mu_law', name_len, error)
-      if (allocated(error)) return
       call need_int(deck, 'isolators', 'n_isolators', n_isolators, 0, max_devices - cfg%model%n_devices, error)
       if (allocated(error)) return
       n = n_isolators
@@ -1046,6 +1058,9 @@ contains
          call no_memory(deck, 'storeys', i, 'storeys', error); return
       end if
       node_i = unset_int; node_j = unset_int; spring = unset_int; height = unset; label = ''
+      ! a longer label would be cut by the namelist read: refused from the group's text first
+      call check_length(deck, grp, 'label', label_len - 1, error)
+      if (allocated(error)) return
       msg0 = ''
       read (grp%lines, nml=storeys, iostat=ios, iomsg=msg0)
       if (ios /= 0) then
@@ -1495,8 +1510,8 @@ contains
                        " entries of "//what, stat_no_memory)
    end subroutine no_memory
 
-   !> A string longer than its variable's capacity is an error (the namelist reader would cut
-   !> it), found in the group's text.
+   !> A string longer than its variable's capacity is an error, found in the group's text
+   !> before the namelist read (which would cut it, and warn under -fcheck).
    subroutine check_length(deck, grp, var, cap, error)
       type(deck_text), intent(in) :: deck
       type(group_text), intent(in) :: grp

@@ -56,11 +56,13 @@ FAILURES = [
     "null in a summary",
 ]
 RUNTIME_ERRORS = re.compile(
-    r"Fortran runtime error|Program received signal|Backtrace|Segmentation|Operating system "
-    r"error|Allocation would exceed|double free|corrupted|AddressSanitizer|runtime error:|"
+    r"Fortran runtime (error|warning)|Program received signal|Backtrace|Segmentation|"
+    r"Operating system error|Allocation would exceed|double free|corrupted|AddressSanitizer|runtime error:|"
     r"ERROR STOP|Error termination"
 )
 GROUPS = ("model", "springs", "damping", "friction", "excitation", "integration", "output")
+# the checked build (tools/test_checked.sh): the sanitizers bound memory (memory_bound)
+CHECKED = bool(os.environ.get("FRICTIONDYN_CHECKED"))
 LONG_STEPS = 1e7  # dt1 steps from which a valid deck that runs past the time limit asks for it
 
 
@@ -89,7 +91,7 @@ class Worker:
         self.proc = None
 
     def start(self):
-        env = dict(os.environ, OPENBLAS_NUM_THREADS="1", PYTHONFAULTHANDLER="1")
+        env = dict(memory_bound(self.mem), OPENBLAS_NUM_THREADS="1", PYTHONFAULTHANDLER="1")
         self.proc = subprocess.Popen(
             [sys.executable, str(Path(__file__).with_name("worker.py")), str(self.mem)],
             stdin=subprocess.PIPE, stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True,
@@ -148,13 +150,25 @@ def executable() -> str:
     return frictiondyn.executable()
 
 
+def memory_bound(mem: int) -> dict[str, str]:
+    """The environment of a run bounded to mem MiB. The address space is limited (RLIMIT_AS:
+    run_exe, worker.py) but in the checked build (tools/test_checked.sh), whose address
+    sanitizer reserves terabytes of address space as it starts: there an allocation larger
+    than mem MiB fails (malloc returns NULL, allocator_may_return_null is set) instead."""
+    env = dict(os.environ)
+    if CHECKED:
+        env["ASAN_OPTIONS"] = env.get("ASAN_OPTIONS", "") + f":max_allocation_size_mb={mem}"
+    return env
+
+
 def run_exe(exe: str, case: mutate.Case, where: Path, timeout: float, mem: int):
     def limit():
         resource.setrlimit(resource.RLIMIT_AS, (mem * 2**20, mem * 2**20))
 
     try:
         p = subprocess.run([exe, case.deck_name], cwd=where, capture_output=True, timeout=timeout,
-                           preexec_fn=limit)
+                           preexec_fn=None if CHECKED else limit, env=memory_bound(mem),
+                           check=False)
     except subprocess.TimeoutExpired:
         return None
     return p
@@ -172,23 +186,27 @@ def without_run_time(text: str) -> str:
 
 
 def requested_steps(deck: Path) -> float | None:
-    """duration / (dt_record / n1) of a deck the reader accepts (read by the library in a
-    process of its own), None when unknown."""
+    """Steps of dt1 = dt_record / n1 a deck the reader accepts asks for (read by the library
+    in a process of its own: the history's rows, one every output_every dt1 steps, or every
+    n1 steps when output_every = 0, also for a record deck whose duration is its record's),
+    None when unknown."""
     script = ("import sys, frictiondyn\n"
-              "with frictiondyn.Session(sys.argv[1]) as s: pass\n")
+              "with frictiondyn.Session(sys.argv[1]) as s:\n"
+              "    print(s.shape[0] - 1)\n")
     try:
-        ok = subprocess.run([sys.executable, "-c", script, str(deck)], capture_output=True,
-                            timeout=60).returncode == 0
+        p = subprocess.run([sys.executable, "-c", script, str(deck)], capture_output=True,
+                           timeout=60, text=True, check=False)
     except subprocess.TimeoutExpired:
         return None
-    if not ok:
+    if p.returncode != 0:
         return None
     try:
         import f90nml
 
         nml = f90nml.read(str(deck))
-        exc, integ = nml["excitation"], nml.get("integration", {})
-        return float(exc["duration"]) / (float(exc["dt_record"]) / float(integ.get("n1", 20)))
+        n1 = int(nml.get("integration", {}).get("n1", 20))
+        every = int(nml.get("output", {}).get("output_every", 0))
+        return float(p.stdout.split()[-1]) * (every if every > 0 else n1)
     except Exception:  # noqa: BLE001 - a deck f90nml cannot read: unknown
         return None
 

@@ -52,7 +52,9 @@ contains
       if (allocated(error)) return
       allocate (order(m%n), w(m%n, m%n), stuck(es%ne), b(m%n), x(m%n))
       call rcm_order(m%n, [m%si, m%di], [m%sj, m%dj], order)
-      call gs_setup(gs, m%mass, m%si, m%sj, m%sk, capacity)
+      call gs_setup(gs, m%mass, m%si, m%sj, m%sk, capacity, err)
+      call check(error, .not. allocated(err), "gs_setup")
+      if (allocated(error)) return
       kbmax = 0
       do k = 1, npat
          do e = 1, es%ne
@@ -119,12 +121,15 @@ contains
       type(mj_model) :: m
       type(rng_type) :: rng
       type(group_system) :: gs
+      type(fd_error_type), allocatable :: err
       real(dp), allocatable :: w(:, :), x(:), y(:)
       integer :: i
 
       rng%s = 2
       call frame_model(rng, 7, m)
-      call gs_setup(gs, m%mass, m%si, m%sj, m%sk, 4)
+      call gs_setup(gs, m%mass, m%si, m%sj, m%sk, 4, err)
+      call check(error, .not. allocated(err), "gs_setup")
+      if (allocated(error)) return
       allocate (w(m%n, m%n), x(m%n), y(m%n))
       call dense_w(m, 0.0_dp, 1.0_dp, w)
       do i = 1, m%n
@@ -166,7 +171,9 @@ contains
          allocate (order(m%n), k(m%n, m%n), mm(m%n, m%n))
          call rcm_order(m%n, [m%si, m%di], [m%sj, m%dj], order)
          call groups_build(es, [(.true., i=1, es%ne)], order)
-         call gs_setup(gs, m%mass, m%si, m%sj, m%sk, 2)
+         call gs_setup(gs, m%mass, m%si, m%sj, m%sk, 2, err)
+         call check(error, .not. allocated(err), "gs_setup")
+         if (allocated(error)) return
          call gs_lowest_eigenvalue(gs, es%grp, es%nr, low, scale, err)
          call check(error, .not. allocated(err), "dsbgvx")
          if (allocated(error)) return

@@ -12,7 +12,7 @@
 !> set-up, never made for a chain.
 module fd_group_system
    use fd_kinds, only: dp
-   use fd_error, only: error_type, fatal_error, fmt_int, fmt_real
+   use fd_error, only: error_type, fatal_error, fmt_int, fmt_real, stat_no_memory
    implicit none
    private
 
@@ -81,13 +81,15 @@ module fd_group_system
 contains
 
    !> Set up: springs and masses, storage for a reduced band up to `capacity`.
-   subroutine gs_setup(gs, mass, si, sj, sk, capacity)
+   subroutine gs_setup(gs, mass, si, sj, sk, capacity, error)
       type(group_system), intent(out) :: gs      !! the system
       real(dp), intent(in) :: mass(:)            !! masses [kg] (n = size)
       integer, intent(in) :: si(:)               !! first node of each spring (1..n)
       integer, intent(in) :: sj(:)               !! second node of each spring (0..n)
       real(dp), intent(in) :: sk(:)              !! spring stiffness [N/m]
       integer, intent(in) :: capacity            !! half-bandwidth to allocate for (>= 1)
+      type(error_type), allocatable, intent(out) :: error !! not enough memory
+      integer :: stat
 
       gs%n = size(mass)
       gs%ns = size(si)
@@ -96,7 +98,11 @@ contains
       gs%sj = sj
       gs%sk = sk
       gs%capacity = max(1, min(capacity, max(gs%n - 1, 1)))
-      allocate (gs%ab((gs%capacity + 1)*gs%n), gs%dd(gs%n), gs%de(gs%n))
+      allocate (gs%ab((gs%capacity + 1)*gs%n), gs%dd(gs%n), gs%de(gs%n), stat=stat)
+      if (stat /= 0) then
+         call no_memory(error, gs%n, gs%capacity)
+         return
+      end if
       gs%ab = 0.0_dp
       gs%dd = 0.0_dp
       gs%de = 0.0_dp
@@ -110,7 +116,7 @@ contains
       real(dp), intent(in) :: alpha              !! coefficient of M, > 0
       real(dp), intent(in) :: beta               !! coefficient of K, >= 0
       type(error_type), allocatable, intent(out) :: error !! not positive definite
-      integer :: s, a, b, kb, ld, i, info
+      integer :: s, a, b, kb, ld, i, info, stat
 
       gs%factored = .false.
       gs%nr = nr
@@ -144,7 +150,11 @@ contains
                gs%capacity = min(2*gs%capacity, gs%n - 1)
             end do
             deallocate (gs%ab)
-            allocate (gs%ab((gs%capacity + 1)*gs%n))
+            allocate (gs%ab((gs%capacity + 1)*gs%n), stat=stat)
+            if (stat /= 0) then
+               call no_memory(error, gs%n, gs%capacity)
+               return
+            end if
             gs%growths = gs%growths + 1
          end if
          ld = kb + 1
@@ -250,10 +260,15 @@ contains
       type(error_type), allocatable, intent(out) :: error !! LAPACK failure
       real(dp), allocatable :: ab(:, :), bb(:, :), w(:), work(:), q(:, :), z(:, :)
       integer, allocatable :: iwork(:), ifail(:)
-      integer :: s, a, b, kb, i, m, info
+      integer :: s, a, b, kb, i, m, info, stat
 
       kb = reduced_bandwidth(gs, grp)
-      allocate (ab(kb + 1, nr), bb(1, nr), w(nr), work(7*nr), iwork(5*nr), ifail(nr), q(1, 1), z(1, 1))
+      allocate (ab(kb + 1, nr), bb(1, nr), w(nr), work(7*nr), iwork(5*nr), ifail(nr), q(1, 1), z(1, 1), &
+                stat=stat)
+      if (stat /= 0) then
+         call no_memory(error, gs%n, kb)
+         return
+      end if
       ab = 0.0_dp
       bb = 0.0_dp
       do i = 1, gs%n
@@ -308,5 +323,14 @@ contains
 
       gs_size = gs%nr
    end function gs_size
+
+   !> The error of a failed allocation for a band of n rows and half-bandwidth kb.
+   subroutine no_memory(error, n, kb)
+      type(error_type), allocatable, intent(out) :: error !! set: stat_no_memory
+      integer, intent(in) :: n                            !! rows
+      integer, intent(in) :: kb                           !! half-bandwidth
+      call fatal_error(error, "not enough memory for the reduced band system of "//trim(fmt_int(n))// &
+                       " DOFs (half-bandwidth "//trim(fmt_int(kb))//")", stat_no_memory)
+   end subroutine no_memory
 
 end module fd_group_system

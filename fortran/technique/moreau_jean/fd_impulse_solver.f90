@@ -45,7 +45,7 @@
 !> band, see fd_group_system; never for a chain).
 module fd_impulse_solver
    use fd_kinds, only: dp
-   use fd_error, only: error_type, fatal_error, fmt_int
+   use fd_error, only: error_type, fatal_error, fmt_int, stat_no_memory
    use fd_rcm, only: rcm_order, graph_bandwidth
    use fd_stick_groups, only: edge_set, edges_setup, groups_build, recover_impulses, expand, restrict, &
                               add_edge, edge_relative
@@ -113,7 +113,7 @@ contains
       real(dp), intent(in) :: pmu(:)                !! P mu of each device [N]
       type(error_type), allocatable, intent(out) :: error !! bad device nodes, workspace
       integer, allocatable :: inv(:), ei(:), ej(:)
-      integer :: n, ne, i, kbw
+      integer :: n, ne, i, kbw, stat
 
       n = size(mass)
       p%n = n
@@ -122,7 +122,11 @@ contains
       ne = p%es%ne
       p%ne = ne
       ! the nodes in RCM order of the graph of springs and edges: groups numbered in it
-      allocate (p%node_order(n), inv(n))
+      allocate (p%node_order(n), inv(n), stat=stat)
+      if (stat /= 0) then
+         call no_memory(error, n)
+         return
+      end if
       ei = [si, p%es%ei]
       ej = [sj, p%es%ej]
       call rcm_order(n, ei, ej, p%node_order)
@@ -130,11 +134,16 @@ contains
          inv(p%node_order(i)) = i
       end do
       kbw = graph_bandwidth(ei, ej, inv)
-      call gs_setup(p%gs, mass, si, sj, sk, max(2*kbw, 8))
-      allocate (p%sigma(ne), p%lam(ne), p%w(ne), p%locked(ne), p%fstuck(ne))
-      allocate (p%stuck(ne), p%changed(ne), p%viol(ne), p%doubt(ne), p%dlist(ne))
-      allocate (p%f(n), p%q(n), p%rho(0:n), p%sc(0:n), p%lsc(ne), p%col(n), p%rabs(n))
-      allocate (p%lam_prev(ne), p%w_prev(ne), p%sa(ne), p%fa(ne), p%amax(ne), p%queue(ne), p%wt(ne))
+      call gs_setup(p%gs, mass, si, sj, sk, max(2*kbw, 8), error)
+      if (allocated(error)) return
+      allocate (p%sigma(ne), p%lam(ne), p%w(ne), p%locked(ne), p%fstuck(ne), &
+                p%stuck(ne), p%changed(ne), p%viol(ne), p%doubt(ne), p%dlist(ne), &
+                p%f(n), p%q(n), p%rho(0:n), p%sc(0:n), p%lsc(ne), p%col(n), p%rabs(n), &
+                p%lam_prev(ne), p%w_prev(ne), p%sa(ne), p%fa(ne), p%amax(ne), p%queue(ne), p%wt(ne), stat=stat)
+      if (stat /= 0) then
+         call no_memory(error, n)
+         return
+      end if
       do i = 1, ne
          p%amax(i) = 1.0_dp/mass(p%es%ei(i))
          if (p%es%ej(i) > 0) p%amax(i) = p%amax(i) + 1.0_dp/mass(p%es%ej(i))
@@ -153,8 +162,18 @@ contains
          call lcp_init(p%lcp, p%pmax, p%pmax, error)
          if (allocated(error)) return
       end if
-      allocate (p%amat(p%pmax, p%pmax), p%qv(p%pmax), p%lo(p%pmax), p%hi(p%pmax), p%z(p%pmax), p%wz(p%pmax))
+      allocate (p%amat(p%pmax, p%pmax), p%qv(p%pmax), p%lo(p%pmax), p%hi(p%pmax), p%z(p%pmax), p%wz(p%pmax), &
+                stat=stat)
+      if (stat /= 0) call no_memory(error, n)
    end subroutine solver_setup
+
+   !> The error of a failed allocation of the solver's work space.
+   subroutine no_memory(error, n)
+      type(error_type), allocatable, intent(out) :: error !! set: stat_no_memory
+      integer, intent(in) :: n                            !! number of DOFs
+      call fatal_error(error, "not enough memory for the Moreau-Jean solver of n_dof = "//trim(fmt_int(n))// &
+                       " DOFs", stat_no_memory)
+   end subroutine no_memory
 
    !> Solve the one-step problem W v1 = r - B lambda with the complementarity conditions
    !> (module header), from the pattern in p%sigma (the previous solution: warm start). On

@@ -21,7 +21,7 @@
 module fd_moreau_jean
    use, intrinsic :: ieee_arithmetic, only: ieee_is_finite
    use fd_kinds, only: dp
-   use fd_error, only: error_type, fatal_error, fmt_real, fmt_int
+   use fd_error, only: error_type, fatal_error, fmt_real, fmt_int, stat_no_memory
    use fd_names, only: law_coulomb, law_name, excitation_types, technique_name, technique_moreau_jean, &
                        technique_newmark, damping_stiffness, damping_rayleigh
    use fd_model, only: model_type, integration_type
@@ -101,10 +101,16 @@ contains
       real(dp), intent(out) :: period               !! first period T [s]
       type(error_type), allocatable, intent(out) :: error !! no free DOF, rigid-body mode
       real(dp) :: lam, scale
+      integer :: stat
       logical, allocatable :: all_stuck(:)
 
       period = 0.0_dp
-      allocate (all_stuck(p%ne))
+      allocate (all_stuck(p%ne), stat=stat)
+      if (stat /= 0) then
+         call fatal_error(error, "not enough memory for the stuck system's "//trim(fmt_int(p%ne))//" edges", &
+                          stat_no_memory)
+         return
+      end if
       all_stuck = .true.
       call groups_build(p%es, all_stuck, p%node_order)
       p%fvalid = .false.
@@ -258,14 +264,25 @@ contains
       type(error_type), allocatable, intent(out) :: error
       type(error_type), allocatable :: eig_error
       real(dp) :: period, t_damp, om
-      integer :: n, nd
+      integer :: n, nd, stat
+      integer, allocatable :: dev_i(:), dev_j(:)
+      real(dp), allocatable :: pmu(:)
 
       n = model%n_dof
       nd = model%n_devices
       w%n = n
       w%nd = nd
-      call solver_setup(w%p, model%mass, model%spring_i, model%spring_j, model%spring_k, model%dev%node_i, &
-                        model%dev%node_j, model%dev%p*model%dev%mu, error)
+      ! the devices' nodes and forces as arrays of their own (a component of an array of
+      ! derived type passed as an argument is copied to a temporary at the call)
+      allocate (dev_i(nd), dev_j(nd), pmu(nd), stat=stat)
+      if (stat /= 0) then
+         call no_memory(error, n)
+         return
+      end if
+      dev_i = model%dev%node_i
+      dev_j = model%dev%node_j
+      pmu = model%dev%p*model%dev%mu
+      call solver_setup(w%p, model%mass, model%spring_i, model%spring_j, model%spring_k, dev_i, dev_j, pmu, error)
       if (allocated(error)) return
       w%ne = w%p%ne
       ! C = a0 M + a1 K: the paper's psi K with the given or the stuck period, or Rayleigh
@@ -295,11 +312,19 @@ contains
          om = 2.0_dp*pi/period
          res%xi_stuck = (w%a0 + w%a1*om**2)/(2.0_dp*om)
       end if
-      allocate (w%u(n), w%v(n), w%u1(n), w%v1(n), w%acc(n), w%r(n), w%du(n), w%kx(n), w%rabs(n))
-      allocate (w%s(nd), w%sd(nd), w%force(nd), w%phase0(nd), w%phase1(nd), w%counted(nd), w%pending(nd))
-      allocate (w%ta(nd), w%tb(nd))
-      allocate (w%g_step(w%ne), w%g_force(w%ne), w%f_edge(w%ne))
+      allocate (w%u(n), w%v(n), w%u1(n), w%v1(n), w%acc(n), w%r(n), w%du(n), w%kx(n), w%rabs(n), &
+                w%s(nd), w%sd(nd), w%force(nd), w%phase0(nd), w%phase1(nd), w%counted(nd), w%pending(nd), &
+                w%ta(nd), w%tb(nd), w%g_step(w%ne), w%g_force(w%ne), w%f_edge(w%ne), stat=stat)
+      if (stat /= 0) call no_memory(error, n)
    end subroutine setup
+
+   !> The error of an allocation sized by the deck that failed.
+   subroutine no_memory(error, n)
+      type(error_type), allocatable, intent(out) :: error !! set: stat_no_memory
+      integer, intent(in) :: n                            !! the deck's n_dof
+      call fatal_error(error, "not enough memory for the state of n_dof = "//trim(fmt_int(n))//" DOFs", &
+                       stat_no_memory)
+   end subroutine no_memory
 
    !> Device kinematics, forces (shared out of the edge forces f_edge) and phases (the
    !> statuses of the step's one-step problem) from the solver's edges.
