@@ -313,11 +313,16 @@ try:
 except KeyboardInterrupt:
     print("interrupted after", time.perf_counter() - t0)
 """
-    proc = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True, timeout=120)
-    assert "interrupted after" in proc.stdout, proc.stdout + proc.stderr
-    assert float(proc.stdout.split()[-1]) < 5.0
-    out = tmp_path / "out"
-    assert not out.exists() or list(out.iterdir()) == []
+    # five times: the session freed under a running solve crashed 2 runs in 6 (a race)
+    for _ in range(5):
+        proc = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True, timeout=120)
+        assert proc.returncode == 0 and "interrupted after" in proc.stdout, (
+            proc.returncode,
+            proc.stdout + proc.stderr,
+        )
+        assert float(proc.stdout.split()[-1]) < 5.0
+        out = tmp_path / "out"
+        assert not out.exists() or list(out.iterdir()) == []
 
 
 @pytest.mark.skipif(sys.platform == "win32", reason="POSIX signals")
