@@ -26,15 +26,9 @@ module fd_session
    use fd_run_control, only: progress_callback, control_reset
    use fd_history_stream, only: stream_close, stream_discard
    use fd_output, only: make_dir, temp_output_paths, remove_made_dirs
+   use fd_fileops, only: c_getpid
    implicit none
    private
-
-   interface
-      function c_getpid() bind(c, name='fd_getpid') result(pid)
-         import :: c_int
-         integer(c_int) :: pid
-      end function c_getpid
-   end interface
 
    public :: session_type, session_open, session_open_text, session_adopt, session_solve
    public :: session_shape, session_text, session_set_output_dir, session_write, session_write_files

@@ -11,6 +11,7 @@ module fd_history_stream
    use, intrinsic :: iso_c_binding, only: c_char, c_int, c_long, c_double, c_null_char
    use fd_kinds, only: dp
    use fd_error, only: error_type, fatal_error
+   use fd_fileops, only: c_file_create, c_file_write, c_file_close, c_unlink, c_rename, c_errno_text
    implicit none
    private
 
@@ -40,40 +41,6 @@ module fd_history_stream
          character(kind=c_char), intent(inout) :: buf(*)
          integer(c_long) :: nbytes
       end function c_format_row
-      function c_create(path, fd) bind(c, name='fd_file_create') result(err)
-         import :: c_char, c_int
-         character(kind=c_char), intent(in) :: path(*)
-         integer(c_int), intent(out) :: fd
-         integer(c_int) :: err
-      end function c_create
-      function c_write(fd, buf, length) bind(c, name='fd_file_write') result(err)
-         import :: c_char, c_int, c_long
-         integer(c_int), value :: fd
-         character(kind=c_char), intent(in) :: buf(*)
-         integer(c_long), value :: length
-         integer(c_int) :: err
-      end function c_write
-      function c_close(fd) bind(c, name='fd_file_close') result(err)
-         import :: c_int
-         integer(c_int), value :: fd
-         integer(c_int) :: err
-      end function c_close
-      function c_unlink(path) bind(c, name='fd_unlink') result(err)
-         import :: c_char, c_int
-         character(kind=c_char), intent(in) :: path(*)
-         integer(c_int) :: err
-      end function c_unlink
-      function c_rename(old, new) bind(c, name='fd_rename') result(err)
-         import :: c_char, c_int
-         character(kind=c_char), intent(in) :: old(*), new(*)
-         integer(c_int) :: err
-      end function c_rename
-      subroutine c_errno_text(err, buf, length) bind(c, name='fd_errno_text')
-         import :: c_char, c_int
-         integer(c_int), value :: err
-         character(kind=c_char), intent(out) :: buf(*)
-         integer(c_int), value :: length
-      end subroutine c_errno_text
    end interface
 
 contains
@@ -91,7 +58,7 @@ contains
          call fatal_error(error, "stream_open: a stream is already open on '"//st%path//"'")
          return
       end if
-      err = c_create(path//c_null_char, st%fd)
+      err = c_file_create(path//c_null_char, st%fd)
       if (err /= 0) then
          st%fd = -1
          call os_error(error, "cannot create '"//path//"'", err)
@@ -135,7 +102,7 @@ contains
       type(history_stream), intent(inout) :: st
 
       if (st%pos == 0 .or. st%err /= 0) return
-      st%err = c_write(st%fd, st%buf, int(st%pos, c_long))
+      st%err = c_file_write(st%fd, st%buf, int(st%pos, c_long))
       st%pos = 0
    end subroutine flush_buffer
 
@@ -165,7 +132,7 @@ contains
          return
       end if
       call flush_buffer(st)
-      err = c_close(st%fd)
+      err = c_file_close(st%fd)
       st%fd = -1
       if (st%err == 0) st%err = err
       if (allocated(st%buf)) deallocate (st%buf)
@@ -180,7 +147,7 @@ contains
       type(history_stream), intent(inout) :: st   !! the stream
       integer(c_int) :: err
 
-      if (st%fd >= 0) err = c_close(st%fd)
+      if (st%fd >= 0) err = c_file_close(st%fd)
       st%fd = -1
       if (allocated(st%buf)) deallocate (st%buf)
       if (allocated(st%path)) then

@@ -12,6 +12,8 @@ module fd_output
    use fd_version, only: frictiondyn_version
    use fd_names, only: excitation_types
    use fd_matrices, only: modes_type, modes_flexible, modes_rigid, modes_unrestrained
+   use fd_fileops, only: c_lock_acquire, c_lock_release, c_unlink, c_rename, c_errno_text, c_getpid, &
+                         c_file_create, c_file_write, c_file_close
    implicit none
    private
 
@@ -30,56 +32,6 @@ module fd_output
          integer(c_int), value :: mode
          integer(c_int) :: stat
       end function c_mkdir
-      function c_lock_acquire(path, fd) bind(c, name='fd_lock_acquire') result(err)
-         import :: c_char, c_int
-         character(kind=c_char), intent(in) :: path(*)
-         integer(c_int), intent(out) :: fd
-         integer(c_int) :: err
-      end function c_lock_acquire
-      function c_lock_release(path, fd) bind(c, name='fd_lock_release') result(err)
-         import :: c_char, c_int
-         character(kind=c_char), intent(in) :: path(*)
-         integer(c_int), value :: fd
-         integer(c_int) :: err
-      end function c_lock_release
-      function c_unlink(path) bind(c, name='fd_unlink') result(err)
-         import :: c_char, c_int
-         character(kind=c_char), intent(in) :: path(*)
-         integer(c_int) :: err
-      end function c_unlink
-      function c_rename(old, new) bind(c, name='fd_rename') result(err)
-         import :: c_char, c_int
-         character(kind=c_char), intent(in) :: old(*), new(*)
-         integer(c_int) :: err
-      end function c_rename
-      subroutine c_errno_text(err, buf, length) bind(c, name='fd_errno_text')
-         import :: c_char, c_int
-         integer(c_int), value :: err
-         character(kind=c_char), intent(out) :: buf(*)
-         integer(c_int), value :: length
-      end subroutine c_errno_text
-      function c_file_create(path, fd) bind(c, name='fd_file_create') result(err)
-         import :: c_char, c_int
-         character(kind=c_char), intent(in) :: path(*)
-         integer(c_int), intent(out) :: fd
-         integer(c_int) :: err
-      end function c_file_create
-      function c_file_write(fd, buf, length) bind(c, name='fd_file_write') result(err)
-         import :: c_char, c_int, c_long
-         integer(c_int), value :: fd
-         character(kind=c_char), intent(in) :: buf(*)
-         integer(c_long), value :: length
-         integer(c_int) :: err
-      end function c_file_write
-      function c_file_close(fd) bind(c, name='fd_file_close') result(err)
-         import :: c_int
-         integer(c_int), value :: fd
-         integer(c_int) :: err
-      end function c_file_close
-      function c_getpid() bind(c, name='fd_getpid') result(pid)
-         import :: c_int
-         integer(c_int) :: pid
-      end function c_getpid
    end interface
 
    integer(c_int), parameter :: enoent = 2, eexist = 17

@@ -362,14 +362,14 @@ contains
    !> wall clock (the interval adapts to the cost of a step) it publishes the time reached,
    !> calls the progress callback when its interval has passed, and says whether the run must
    !> stop: a stop was requested, or the history file could not be written.
-   subroutine observe_poll(obs, t, stop)
+   subroutine observe_poll(obs, t, halt)
       type(observer_type), intent(inout) :: obs !! the observer
       real(dp), intent(in) :: t                !! time reached [s]
-      logical, intent(out) :: stop             !! the technique must return observe_stop_error's error
+      logical, intent(out) :: halt             !! the technique must return observe_stop_error's error
       integer(int64) :: now
       real(dp) :: elapsed
 
-      stop = .false.
+      halt = .false.
       obs%countdown = obs%countdown - 1
       if (obs%countdown > 0) return
       if (.not. associated(obs%ctl)) then
@@ -387,11 +387,11 @@ contains
       end if
       obs%countdown = obs%poll_every
       obs%ctl%time = t
-      if (cancel_requested(obs%ctl%cancel)) stop = .true.
+      if (cancel_requested(obs%ctl%cancel)) halt = .true.
       if (allocated(obs%ctl%stream_path)) then
-         if (stream_failed(obs%ctl%stream)) stop = .true.
+         if (stream_failed(obs%ctl%stream)) halt = .true.
       end if
-      if (stop) then
+      if (halt) then
          obs%stopped = .true.
          obs%stop_time = t
          return

@@ -1,0 +1,74 @@
+!> The Fortran interfaces of fd_fileops.c, in one place: POSIX file creation, writes,
+!> close, rename, unlink, the output lock, errno texts and the process id (gfortran's own
+!> I/O loses a full disk silently and will not open one file on two units; docs/batch.md).
+!> Every function returns 0 or an errno.
+module fd_fileops
+   use, intrinsic :: iso_c_binding, only: c_char, c_int, c_long
+   implicit none
+   private
+
+   public :: c_lock_acquire, c_lock_release, c_unlink, c_rename, c_errno_text, c_getpid
+   public :: c_file_create, c_file_write, c_file_close
+
+   interface
+      !> Take the lock file `path` (created, held while fd is open).
+      function c_lock_acquire(path, fd) bind(c, name='fd_lock_acquire') result(err)
+         import :: c_char, c_int
+         character(kind=c_char), intent(in) :: path(*)
+         integer(c_int), intent(out) :: fd
+         integer(c_int) :: err
+      end function c_lock_acquire
+      !> Release and remove the lock file.
+      function c_lock_release(path, fd) bind(c, name='fd_lock_release') result(err)
+         import :: c_char, c_int
+         character(kind=c_char), intent(in) :: path(*)
+         integer(c_int), value :: fd
+         integer(c_int) :: err
+      end function c_lock_release
+      !> Remove a file.
+      function c_unlink(path) bind(c, name='fd_unlink') result(err)
+         import :: c_char, c_int
+         character(kind=c_char), intent(in) :: path(*)
+         integer(c_int) :: err
+      end function c_unlink
+      !> Rename a file (atomic within a file system).
+      function c_rename(old, new) bind(c, name='fd_rename') result(err)
+         import :: c_char, c_int
+         character(kind=c_char), intent(in) :: old(*), new(*)
+         integer(c_int) :: err
+      end function c_rename
+      !> The text of an errno, NUL-terminated in buf.
+      subroutine c_errno_text(err, buf, length) bind(c, name='fd_errno_text')
+         import :: c_char, c_int
+         integer(c_int), value :: err
+         character(kind=c_char), intent(out) :: buf(*)
+         integer(c_int), value :: length
+      end subroutine c_errno_text
+      !> The process id.
+      function c_getpid() bind(c, name='fd_getpid') result(pid)
+         import :: c_int
+         integer(c_int) :: pid
+      end function c_getpid
+      !> Create a file exclusively (an existing one is an error).
+      function c_file_create(path, fd) bind(c, name='fd_file_create') result(err)
+         import :: c_char, c_int
+         character(kind=c_char), intent(in) :: path(*)
+         integer(c_int), intent(out) :: fd
+         integer(c_int) :: err
+      end function c_file_create
+      !> Write all of buf (retrying short writes).
+      function c_file_write(fd, buf, length) bind(c, name='fd_file_write') result(err)
+         import :: c_char, c_int, c_long
+         integer(c_int), value :: fd
+         character(kind=c_char), intent(in) :: buf(*)
+         integer(c_long), value :: length
+         integer(c_int) :: err
+      end function c_file_write
+      !> Flush to disk (fsync) and close.
+      function c_file_close(fd) bind(c, name='fd_file_close') result(err)
+         import :: c_int
+         integer(c_int), value :: fd
+         integer(c_int) :: err
+      end function c_file_close
+   end interface
+end module fd_fileops
