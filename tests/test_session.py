@@ -124,7 +124,9 @@ def test_to_csv_writes_through_the_library_and_a_changed_summary_as_json(tmp_pat
 def test_solve_releases_the_gil(tmp_path):
     """While one thread solves, Python code runs in another (the ground for cancelling a run
     from the main thread): the main thread's loop never stalls for the length of the solve."""
-    deck = _short_deck(tmp_path, duration="40.0", law="hysteretic")
+    # 200 s: long enough that the solve takes well over 0.05 s on a fast machine (40 s took
+    # 0.048 s with the banded Newmark, too short to show the loop running beside it)
+    deck = _short_deck(tmp_path, duration="200.0", law="hysteretic")
     with Session(deck) as s:
         worker = threading.Thread(target=s.solve)
         gaps = []
@@ -136,7 +138,7 @@ def test_solve_releases_the_gil(tmp_path):
             last = now
         elapsed = time.perf_counter() - start
         worker.join()
-        assert s.result().data.shape == (8001, 12)  # 40 s, a row every dt_r
+        assert s.result().data.shape == (40001, 12)  # 200 s, a row every dt_r
     # with the GIL held, the loop would stop for the whole solve (tenths of a second)
     assert elapsed > 0.05
     assert max(gaps) < 0.5 * elapsed, (max(gaps), elapsed)
