@@ -234,34 +234,45 @@ contains
       real(dp), intent(out) :: drift(:)          !! (n_storeys) drift [m]
       real(dp), intent(out) :: shear(:)          !! (n_storeys) storey shear [N]
       real(dp), intent(out) :: base              !! base shear [N]
-      integer :: s
+      real(dp) :: f, du, dv
+      integer :: s, cut, e, i, j
 
+      ! (written out, without function calls: this runs at every accepted step)
       do s = 1, eng%n_storeys
-         drift(s) = node_value(u, eng%storey_i(s)) - node_value(u, eng%storey_j(s))
-         shear(s) = cut_force(s)
+         i = eng%storey_i(s)
+         j = eng%storey_j(s)
+         du = 0.0_dp
+         if (i > 0) du = u(i)
+         if (j > 0) du = du - u(j)
+         drift(s) = du
       end do
-      base = cut_force(0)
-   contains
-      pure real(dp) function cut_force(cut) result(f)
-         integer, intent(in) :: cut
-         integer :: e
-         real(dp) :: du, dv
+      ! the force across each cut (0: the base): the springs' and the devices' crossing it
+      do cut = 0, eng%n_storeys
          f = 0.0_dp
          do e = eng%sp_first(cut), eng%sp_first(cut + 1) - 1
-            du = node_value(u, eng%sp_i(e)) - node_value(u, eng%sp_j(e))
-            dv = node_value(v, eng%sp_i(e)) - node_value(v, eng%sp_j(e))
+            i = eng%sp_i(e)
+            j = eng%sp_j(e)
+            du = 0.0_dp
+            dv = 0.0_dp
+            if (i > 0) then
+               du = u(i)
+               dv = v(i)
+            end if
+            if (j > 0) then
+               du = du - u(j)
+               dv = dv - v(j)
+            end if
             f = f + eng%sp_k(e)*(du + eng%a1*dv)
          end do
          do e = eng%dv_first(cut), eng%dv_first(cut + 1) - 1
             f = f + eng%dv_sign(e)*force(eng%dv_id(e))
          end do
-      end function cut_force
-      pure real(dp) function node_value(x, node)
-         real(dp), intent(in) :: x(:)
-         integer, intent(in) :: node
-         node_value = 0.0_dp
-         if (node > 0) node_value = x(node)
-      end function node_value
+         if (cut == 0) then
+            base = f
+         else
+            shear(cut) = f
+         end if
+      end do
    end subroutine storey_values
 
    !> One accepted state: drifts and shears, their peaks, and the values kept as the
@@ -276,7 +287,9 @@ contains
       integer :: i
 
       if (.not. allocated(eng%drift)) return
-      eng%residual_s = s
+      do i = 1, size(s)
+         eng%residual_s(i) = s(i)
+      end do
       call storey_values(eng, u, v, force, eng%drift, eng%shear(1:), eng%shear(0))
       do i = 1, eng%n_storeys
          if (abs(eng%drift(i)) > eng%peak_drift(i)) then
