@@ -195,6 +195,7 @@ def child_main(args) -> int:
             k: s[k]
             for k in (
                 "steps_dt1",
+                "steps_nested",
                 "steps_dt2",
                 "steps_finer",
                 "factorizations",
@@ -239,7 +240,7 @@ def newmark_steps(stats: dict) -> int | None:
     """Newmark steps a frictiondyn run took (dt1, dt2 and finer)."""
     if "steps_dt1" not in stats:
         return None
-    return int(stats["steps_dt1"] + stats["steps_dt2"] + stats["steps_finer"])
+    return int(stats["steps_dt1"] + stats.get("steps_nested", 0) + stats["steps_dt2"] + stats["steps_finer"])
 
 
 def run_child(code: str, spec: str, args, deck: Path | None, timeout: float) -> dict:
@@ -312,6 +313,7 @@ def run_case(spec: str, args, history: dict, om, fd) -> dict:
         rec["law"] = case.law
     else:
         rec["law"] = case.law
+        rec["refinement"] = case.refinement
         rec["opensees_material"] = case.opensees_material
     print(
         f"\n== {case.name}: {case.n_dof} DOFs, {case.n_steps} steps of {case.dt * 1e3:g} ms",
@@ -571,29 +573,36 @@ def tables(results: list[dict], peak_tol: float) -> str:
                 f"{_fmt(r.get('fd_analysis_run_s'), '.4f')} | {_fmt(ops_e2e, '.4f')} | "
                 f"{_fmt(e2e, '.1f')}x | {_peak_text(r)} |"
             )
-    for law, material in (("hysteretic", "ElasticPP"), ("velocity", "CoulombDamper")):
+    for law, material, refinement in (
+        ("hysteretic", "ElasticPP", "step"),
+        ("hysteretic", "ElasticPP", "nested"),
+        ("velocity", "CoulombDamper", "step"),
+    ):
         b = [
             r
             for r in results
-            if r["case"].startswith("building") and r.get("law", "hysteretic") == law
+            if r["case"].startswith("building")
+            and r.get("law", "hysteretic") == law
+            and r.get("refinement", "step") == refinement
         ]
         if not b:
             continue
         out.append(
             f"\nShear building, a friction damper ({law} law = {material} link) in every "
-            "storey:\n"
+            f"storey; frictiondyn's refinement '{refinement}':\n"
         )
         out.append(
             "| storeys N | steps | frictiondyn us/step wall (CPU) | OpenSees us/step wall (CPU) | "
             "frictiondyn is, wall (CPU) | frictiondyn Newmark steps, us each (CPU) | "
             "peaks differ by | frictiondyn peak RSS MB | OpenSees peak RSS MB | "
-            "frictiondyn steps dt1 + dt2, transitions |"
+            "frictiondyn steps dt1 + nested + dt2, transitions |"
         )
         out.append("|---|---|---|---|---|---|---|---|---|---|")
         for r in b:
             st = r["single_run"]["fd"].get("stats", {})
             steps = (
-                f"{st['steps_dt1']} + {st['steps_dt2']}, {st.get('stick_to_slip', '?')}"
+                f"{st['steps_dt1']} + {st.get('steps_nested', 0)} + {st['steps_dt2']}, "
+                f"{st.get('stick_to_slip', '?')}"
                 if "steps_dt1" in st
                 else "n/a"
             )
@@ -652,7 +661,9 @@ def plot(results: list[dict], path: Path, meta: dict) -> None:
     b = [
         r
         for r in results
-        if r["case"].startswith("building") and r.get("law", "hysteretic") == "hysteretic"
+        if r["case"].startswith("building")
+        and r.get("law", "hysteretic") == "hysteretic"
+        and r.get("refinement", "step") == "step"
     ]
     if not b:
         return
@@ -874,6 +885,11 @@ def parse_args(argv=None):
     )
     ap.add_argument("--no-test4", action="store_true", help="skip the paper's test 4")
     ap.add_argument(
+        "--nested",
+        action="store_true",
+        help="also the buildings with frictiondyn's nested refinement (refinement = 'nested')",
+    )
+    ap.add_argument(
         "--no-buildings",
         action="store_true",
         help="only the paper's test 4",
@@ -984,6 +1000,8 @@ def main(argv=None) -> int:
     )
     specs = [] if args.no_test4 else ["test4:hysteretic", "test4:velocity"]
     specs += [f"building:{n}" for n in args.sizes]
+    if args.nested:
+        specs += [f"building_nested:{n}" for n in args.sizes]
     args.out.mkdir(parents=True, exist_ok=True)
     json_path = args.out / "compare_opensees.json"
     results: list[dict] = []

@@ -258,6 +258,9 @@ class BuildingCase:
     #: paper's velocity law, band eps; OpenSees: CoulombDamper, the same force law)
     law: str = "hysteretic"
     eps: float = 1.0e-3
+    #: frictiondyn's refinement of a dt1 step with a phase change: 'step' (the paper's, the
+    #: default) or 'nested' (docs/theory.md section 6)
+    refinement: str = "step"
 
     def __post_init__(self) -> None:
         n = self.n_storeys
@@ -280,6 +283,8 @@ class BuildingCase:
     @property
     def name(self) -> str:
         suffix = "" if self.law == "hysteretic" else f"_{self.law}"
+        if self.refinement != "step":
+            suffix += f"_{self.refinement}"
         return f"building{suffix}_{self.n_storeys}"
 
     @property
@@ -313,7 +318,9 @@ class BuildingCase:
             excitation=fd.Record(
                 self.dt_record, values=self.record, duration=duration or self.duration
             ),
-            integration=fd.Integration(n1=self.n1),
+            integration=fd.Integration(
+                n1=self.n1, refinement=None if self.refinement == "step" else self.refinement
+            ),
         )
 
     def short_analysis(self):
@@ -378,14 +385,18 @@ def _chain_eigenvalues(k: np.ndarray, m: float, count: int = 3) -> np.ndarray:
 
 
 def make_case(spec: str, quick: bool = False):
-    """'test4:hysteretic', 'test4:velocity', 'building:N' or 'building_velocity:N' (quick: the
-    short smoke versions)."""
+    """'test4:hysteretic', 'test4:velocity', 'building:N', 'building_velocity:N' or
+    'building_nested:N' (the hysteretic building with nested refinement) (quick: the short
+    smoke versions)."""
     kind, _, arg = spec.partition(":")
     if kind == "test4":
         return Test4Case(arg, duration=2.0 if quick else 10.0)
-    if kind in ("building", "building_velocity"):
+    if kind in ("building", "building_velocity", "building_nested"):
         law = "velocity" if kind == "building_velocity" else "hysteretic"
-        return BuildingCase(int(arg), duration=5.0 if quick else 20.0, law=law)
+        refinement = "nested" if kind == "building_nested" else "step"
+        return BuildingCase(
+            int(arg), duration=5.0 if quick else 20.0, law=law, refinement=refinement
+        )
     raise ValueError(f"unknown case {spec!r}")
 
 

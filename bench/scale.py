@@ -4,6 +4,7 @@ how fast Ctrl-C stops a run.
 
     .venv/bin/python bench/scale.py                        # all of it (about 30 min)
     .venv/bin/python bench/scale.py --sizes 10,100 --no-extras   # a quick look
+    .venv/bin/python bench/scale.py --sizes 10,100,1000 --no-extras --refinement nested
     .venv/bin/python bench/scale.py --out docs/performance       # what docs/performance.md shows
 
 The building is bench/opensees_models.py's BuildingCase (a friction damper in every storey,
@@ -67,6 +68,7 @@ def child(args) -> int:
         "run_time_s": st["run_time_s"],
         "steps_dt1": st["steps_dt1"],
         "steps_dt2": st["steps_dt2"],
+        "steps_nested": st["steps_nested"],
         "steps_finer": st["steps_finer"],
         "factorizations": st["factorizations"],
         "factor_updates": st["factor_updates"],
@@ -95,12 +97,12 @@ def run_child(deck: Path, n: int) -> dict:
     raise RuntimeError(f"child failed: {p.stderr.strip()[-500:]}")
 
 
-def make_deck(work: Path, n: int, law: str, duration: float) -> Path:
+def make_deck(work: Path, n: int, law: str, duration: float, refinement: str = "step") -> Path:
     sys.path.insert(0, str(HERE))
     import opensees_models as om
 
-    case = om.BuildingCase(n, duration=duration, law=law)
-    d = work / f"{law}_{n}_{duration:g}"
+    case = om.BuildingCase(n, duration=duration, law=law, refinement=refinement)
+    d = work / f"{law}_{refinement}_{n}_{duration:g}"
     d.mkdir(parents=True, exist_ok=True)
     return case.analysis().write_deck(d / "building.nml")
 
@@ -120,9 +122,9 @@ def scaling(args, work: Path) -> dict:
     for law in args.laws:
         rows = []
         for n in args.sizes:
-            deck = make_deck(work, n, law, args.duration)
+            deck = make_deck(work, n, law, args.duration, args.refinement)
             r = run_child(deck, n)
-            nm = r["steps_dt1"] + r["steps_dt2"] + r["steps_finer"]
+            nm = r["steps_dt1"] + r["steps_nested"] + r["steps_dt2"] + r["steps_finer"]
             steps = round(args.duration / 1e-3)
             r.update(
                 n=n,
@@ -136,7 +138,8 @@ def scaling(args, work: Path) -> dict:
             print(
                 f"{law:10s} N = {n:6d}: {r['cpu_us_per_step']:10.1f} us/dt1 step, "
                 f"{r['cpu_us_per_newmark_step']:8.2f} us/Newmark step (CPU; wall "
-                f"{r['run_us_per_step']:.1f}, {r['run_us_per_newmark_step']:.2f}), steps {r['steps_dt1']} + {r['steps_dt2']} + "
+                f"{r['run_us_per_step']:.1f}, {r['run_us_per_newmark_step']:.2f}), steps {r['steps_dt1']} + "
+                f"{r['steps_nested']} + {r['steps_dt2']} + "
                 f"{r['steps_finer']}, {r['transitions']} transitions, factor: "
                 f"{r['factorizations']} full, {r['partial_factorizations']} partial, "
                 f"{r['factor_updates']} updates; deck read {r['open_s']:.3f} s; peak RSS "
@@ -250,6 +253,12 @@ def main(argv=None) -> int:
     ap.add_argument("--sizes", default="10,100,1000,10000")
     ap.add_argument("--laws", default="hysteretic,velocity")
     ap.add_argument("--duration", type=float, default=20.0)
+    ap.add_argument(
+        "--refinement",
+        default="step",
+        choices=["step", "nested"],
+        help="frictiondyn's refinement of a dt1 step with a phase change (docs/theory.md section 6)",
+    )
     ap.add_argument("--memory-size", type=int, default=1000)
     ap.add_argument("--no-extras", action="store_true", help="only the scaling")
     ap.add_argument("--out", type=Path, default=ROOT / "out" / "bench")

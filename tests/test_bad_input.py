@@ -71,6 +71,11 @@ CASES = [
     ("unknown law", _set("friction", "law", "coloumb"), ["&friction", "law(1)", "coloumb"]),
     ("more than 2e9 steps", _set("excitation", "duration", 4.0e7), ["&integration", "n1", "2e9"]),
     ("dt_min above dt2", _set("integration", "dt_min", 1.0), ["&integration", "dt_min", "= 1"]),
+    (
+        "unknown refinement",
+        _set("integration", "refinement", "fine"),
+        ["&integration", "refinement", "'fine'", "'step'", "'nested'"],
+    ),
 ]
 
 

@@ -296,7 +296,9 @@ class FreeVibration:
 class Integration:
     """Technique, Newmark and step-control settings (docs/namelist.md, &integration); None
     takes the reader's default. ``technique`` is 'newmark', 'event_driven' (exact, for
-    'coulomb' devices) or 'moreau_jean' (time stepping for 'coulomb' devices; ``theta``)."""
+    'coulomb' devices) or 'moreau_jean' (time stepping for 'coulomb' devices; ``theta``).
+    ``refinement`` is 'step' (the paper: a dt1 step with a phase change redone as n2 steps
+    dt2) or 'nested' (split by the prime factors of n2, only where a phase changes)."""
 
     technique: str | None = None
     beta: float | None = None
@@ -307,6 +309,7 @@ class Integration:
     check_correctness: bool | None = None
     dt_min: float | None = None
     theta: float | None = None
+    refinement: str | None = None
 
     def group(self) -> dict:
         g: dict = {}
@@ -321,6 +324,7 @@ class Integration:
             check_correctness=self.check_correctness,
             dt_min=self.dt_min,
             theta=self.theta,
+            refinement=self.refinement,
         )
         return g
 

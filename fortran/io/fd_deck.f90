@@ -21,7 +21,7 @@ module fd_deck
                        default_ramp_cycles, default_record_kind, default_record_scale, default_technique, &
                        default_beta, default_gamma, default_n1, default_n2, default_n, default_theta, &
                        default_check_correctness, default_dt_min, default_dir, default_output_every, &
-                       default_write_history, linear_systems, default_linear_system
+                       default_write_history, linear_systems, default_linear_system, refinements, default_refinement
    use fd_model, only: model_type, integration_type, device_type, output_type
    use fd_excitation, only: excitation_type
    use fd_record, only: read_record, record_info, record_formats, record_units_list, units_factor
@@ -613,19 +613,21 @@ contains
       type(deck_text), intent(in) :: deck
       type(run_config), intent(inout) :: cfg
       type(error_type), allocatable, intent(out) :: error
-      character(len=name_len) :: technique, linear_system
+      character(len=name_len) :: technique, linear_system, refinement
       real(dp) :: beta, gamma, n, dt_min, theta
       integer :: n1, n2
       logical :: check_correctness
-      namelist /integration/ technique, beta, gamma, n1, n2, n, check_correctness, dt_min, theta, linear_system
+      namelist /integration/ technique, beta, gamma, n1, n2, n, check_correctness, dt_min, theta, linear_system, &
+                             refinement
       type(group_text) :: grp
       character(len=512) :: msg, msg0
       character(len=:), allocatable :: rec, choices
-      integer :: ios, i, technique_id, system_id
+      integer :: ios, i, technique_id, system_id, refinement_id
       logical :: found
 
       technique = technique_name(default_technique)
       linear_system = linear_systems(default_linear_system)%name
+      refinement = refinements(default_refinement)%name
       beta = default_beta; gamma = default_gamma; n1 = default_n1; n2 = default_n2; n = default_n
       check_correctness = default_check_correctness; dt_min = default_dt_min; theta = default_theta
       call find_group(deck, 'integration', grp, found, error)
@@ -633,6 +635,7 @@ contains
       if (found) then
          call check_length(deck, grp, 'technique', name_len, error)
          if (.not. allocated(error)) call check_length(deck, grp, 'linear_system', name_len, error)
+         if (.not. allocated(error)) call check_length(deck, grp, 'refinement', name_len, error)
          if (allocated(error)) return
          msg0 = ''
          read (grp%lines, nml=integration, iostat=ios, iomsg=msg0)
@@ -656,6 +659,12 @@ contains
       if (system_id == 0) then
          call keyword_choices(linear_systems, choices)
          call bad(deck, 'integration', 'linear_system', "'"//trim(linear_system)//"'", 'one of '//choices, error)
+         return
+      end if
+      refinement_id = keyword_id(refinements, refinement)
+      if (refinement_id == 0) then
+         call keyword_choices(refinements, choices)
+         call bad(deck, 'integration', 'refinement', "'"//trim(refinement)//"'", 'one of '//choices, error)
          return
       end if
       call check_real(deck, 'integration', 'beta', beta, 0.0_dp, 0.5_dp, '', error, open_lo=.true.)
@@ -695,6 +704,7 @@ contains
       cfg%opts%dt_min = dt_min
       cfg%opts%theta = theta
       cfg%opts%linear_system = system_id
+      cfg%opts%refinement = refinement_id
    end subroutine read_integration_group
 
    ! ---------------------------------------------------------------- &output

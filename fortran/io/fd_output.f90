@@ -411,6 +411,7 @@ contains
       call ki('slip_reversals', res%reversals)
       call kv('steps_dt1', trim(fmt_int(res%steps_dt1)))
       call kv('steps_dt2', trim(fmt_int(res%steps_dt2)))
+      call kv('steps_nested', trim(fmt_int(res%steps_nested)))
       call kv('steps_finer', trim(fmt_int(res%steps_finer)))
       call kv('factorizations', trim(fmt_int(res%factorizations)))
       call kv('factor_updates', trim(fmt_int(res%factor_updates)))

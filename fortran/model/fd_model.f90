@@ -11,7 +11,7 @@ module fd_model
                        default_rayleigh_a0, default_rayleigh_a1, default_technique, default_beta, &
                        default_gamma, default_n1, default_n2, default_n, default_check_correctness, &
                        default_dt_min, default_output_every, default_write_history, default_theta, &
-                       default_linear_system, &
+                       default_linear_system, default_refinement, &
                        mu_constant, mu_exponential, mu_table, label_len, max_mu_points, &
                        system_stuck, system_free, default_mu_law, default_mode_system, default_n_modes
    implicit none
@@ -101,6 +101,7 @@ module fd_model
       real(dp) :: theta = default_theta         !! theta of the Moreau-Jean technique, 0.5..1
       integer :: output_every = default_output_every !! output every k dt1 steps; 0 = at the record step (n1)
       integer :: linear_system = default_linear_system !! storage of the effective stiffness (fd_names)
+      integer :: refinement = default_refinement !! how a dt1 step is refined (fd_names)
       integer :: n_modes = default_n_modes      !! natural modes reported per system (&output)
    end type integration_type
 

@@ -20,6 +20,7 @@ module fd_names
    public :: excitation_types, excitation_harmonic, excitation_record, excitation_none
    public :: record_kinds, record_acceleration, record_displacement
    public :: linear_systems, linear_system_auto, linear_system_dense, linear_system_banded
+   public :: refinements, refinement_step, refinement_nested
    public :: mu_laws, mu_constant, mu_exponential, mu_table
    public :: mode_systems, system_stuck, system_free
    public :: keyword_id, keyword_choices, law_id, law_choices, law_name, technique_name
@@ -28,6 +29,7 @@ module fd_names
    public :: default_ramp_cycles, default_record_kind, default_record_scale
    public :: default_technique, default_beta, default_gamma, default_n1, default_n2, default_n
    public :: default_check_correctness, default_dt_min, default_theta, default_linear_system
+   public :: default_refinement
    public :: default_dir, default_output_every, default_write_history
    public :: default_mu_law, default_mode_system, default_n_modes, default_radius, default_storey_height
    public :: label_len, max_mu_points
@@ -100,6 +102,12 @@ module fd_names
    integer, parameter :: linear_system_auto = 1   !! storage chosen by the kernel (fd_banded)
    integer, parameter :: linear_system_dense = 2  !! dense effective stiffness
    integer, parameter :: linear_system_banded = 3 !! banded, reverse Cuthill-McKee ordering
+   ! ------------------------------------------------------------------ step refinement (Newmark)
+   type(keyword_type), parameter :: refinements(*) = [ &
+                                    keyword_type('step', 'the paper: whole dt1 step in dt2 steps'), &
+                                    keyword_type('nested', 'split by the factors of n2')]
+   integer, parameter :: refinement_step = 1   !! a refined dt1 step is redone as n2 steps dt2
+   integer, parameter :: refinement_nested = 2 !! split level by level, only the pieces that change
    ! ------------------------------------------------------------------ mu(v), velocity law
    type(keyword_type), parameter :: mu_laws(*) = [ &
                                     keyword_type('constant', 'mu'), &
@@ -151,6 +159,7 @@ module fd_names
    real(dp), parameter :: default_dt_min = 0.0_dp        !! 0 = dt2 / 2**10 [s]
    real(dp), parameter :: default_theta = 0.5_dp         !! theta of the Moreau-Jean technique
    integer, parameter :: default_linear_system = linear_system_auto
+   integer, parameter :: default_refinement = refinement_step
    ! &output
    character(len=*), parameter :: default_dir = 'out'    !! output directory
    integer, parameter :: default_output_every = 0        !! 0 = every dt_record

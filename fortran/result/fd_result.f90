@@ -50,6 +50,7 @@ module fd_result
       ! steps
       integer :: steps_dt1 = 0         !! steps taken with dt1
       integer :: steps_dt2 = 0         !! steps taken with dt2
+      integer :: steps_nested = 0      !! steps of the sizes between dt1 and dt2 (refinement 'nested')
       integer :: steps_finer = 0       !! steps taken with dt2/2, dt2/4, ...
       integer :: factorizations = 0    !! factorizations of the effective stiffness
                                        !! (exact technique: matrix exponentials)

@@ -4,6 +4,10 @@
 !> device changes phase is redone from its start with n2 steps dt2 = dt1 / n2. A step that
 !> violates the correctness condition (eqs. 9, 12) is redone with dt2 and then by halving
 !> down to dt_min; a violation left at the floor is counted and reported, never hidden.
+!> With `refinement = 'nested'` the redone dt1 step is split by the prime factors of n2,
+!> smallest first (n2 = 50: dt1/2, dt1/10, dt2), and only a piece whose own trial step has a
+!> phase change or a violation is split further: transitions are still taken in steps of
+!> dt2, the stretches of the dt1 step without one in the largest piece that has none.
 !>
 !> In each phase a device is linear, F = ks s + cs s' + f0, so a step solves one linear
 !> system with the effective stiffness K^ = K + (gamma/(beta h)) C + M/(beta h^2) +
@@ -22,7 +26,7 @@ module fd_newmark
    use fd_kinds, only: dp
    use fd_error, only: error_type, fatal_error, fmt_real, fmt_int, stat_no_memory
    use fd_names, only: laws, law_name, law_choices, excitation_types, technique_name, technique_newmark, &
-                       technique_event_driven, linear_system_dense, linear_system_banded
+                       technique_event_driven, linear_system_dense, linear_system_banded, refinement_nested
    use fd_model, only: model_type, integration_type
    use fd_excitation, only: excitation_type, table_motion, table_acceleration
    use fd_matrices, only: structure_damping
@@ -37,7 +41,7 @@ module fd_newmark
    use fd_observer, only: observer_type, observer_init, sample_due, observe_start_energies, observe_peaks, &
                           observe_sample, observe_transitions, observe_violations, observe_end_energies, &
                           observe_poll, observe_stop_error
-   use fd_step_limits, only: halving_levels, unresolved_band
+   use fd_step_limits, only: halving_levels, unresolved_band, max_nested, nested_splits
    implicit none
    private
 
@@ -60,7 +64,10 @@ module fd_newmark
       integer :: lmax = 0                             !! halvings below dt2
       real(dp) :: a0 = 0.0_dp, a1c = 0.0_dp           !! C = a0 M + a1c K
       real(dp), allocatable :: mass(:)
-      type(level_type), allocatable :: lev(:)         !! 1: dt1, 2: dt2, 2 + l: dt2 / 2**l
+      type(level_type), allocatable :: lev(:)         !! 1: dt1, 2: dt2, 2 + l: dt2 / 2**l,
+                                                      !! lmax + 2 + k: level k of nested refinement
+      integer :: nested = 0                           !! levels of nested refinement (0: the paper's)
+      integer :: split(max_nested) = 1                !! ratio of nested level k - 1 to level k
       integer :: version = 0                          !! counts the accepted phase changes
       real(dp), allocatable :: u(:), v(:), a(:), u1(:), v1(:), a1(:), rhs(:), tmp(:)
       real(dp), allocatable :: s(:), sd(:), s1(:), sd1(:), f(:), kd(:)
@@ -159,6 +166,9 @@ contains
             ! redone as one step of dt2 = dt1 from the same state and phases: the trial itself
             call accept(model, exc, t0 + dt1, w, res, any_changed, any_bad)
             res%steps_dt2 = res%steps_dt2 + 1
+         else if (w%nested > 0) then
+            call advance_nested(model, exc, opts, t0, 0, w, res, error)
+            if (allocated(error)) return
          else
             do j = 1, opts%n2
                call advance_refined(model, exc, opts, t0 + (j - 1)*dt2, dt2, w, res, error)
@@ -238,7 +248,9 @@ contains
       res%storage = merge(1, 2, spd_is_dense(base))
       res%bandwidth = spd_bandwidth(base)
       w%lmax = lmax
-      allocate (w%lev(lmax + 2), stat=stat)
+      w%nested = 0
+      if (opts%refinement == refinement_nested) call nested_splits(opts%n2, w%split, w%nested)
+      allocate (w%lev(lmax + 2 + max(w%nested - 1, 0)), stat=stat)
       if (stat /= 0) then
          call fatal_error(error, "not enough memory for the effective stiffness of n_dof = "//trim(fmt_int(n))// &
                           " DOFs", stat_no_memory)
@@ -246,11 +258,13 @@ contains
       end if
       b = opts%beta
       g = opts%gamma
-      do l = 1, lmax + 2
+      do l = 1, size(w%lev)
          if (l == 1) then
             h = dt1
-         else
+         else if (l <= lmax + 2) then
             h = dt2/2.0_dp**(l - 2)
+         else
+            h = dt1/real(product(w%split(1:l - lmax - 2)), dp)
          end if
          w%lev(l)%h = h
          w%lev(l)%c0 = 1.0_dp/(b*h*h); w%lev(l)%c1 = g/(b*h)
@@ -432,6 +446,55 @@ contains
       call friction_step(model%dev, opts%n_corr, w%s1, w%sd1, w%sd, w%st, w%st1, w%changed, w%ok, &
                          any_changed, any_bad)
    end subroutine judge
+
+   !> Nested refinement: cover the piece [t, t + h_k] of level k (0: the dt1 step), whose own
+   !> trial step changed a phase or violated the correctness condition, with the split(k + 1)
+   !> pieces of level k + 1. Each is tried as one step and accepted when no device changes
+   !> phase (nor violates the condition, when checked); else it is split again, down to the
+   !> last level, dt2, which advance_refined covers as the paper's refinement does.
+   recursive subroutine advance_nested(model, exc, opts, t, k, w, res, error)
+      type(model_type), intent(in) :: model
+      type(excitation_type), intent(in) :: exc
+      type(integration_type), intent(in) :: opts
+      real(dp), intent(in) :: t                  !! start of the piece [s]
+      integer, intent(in) :: k                   !! its level
+      type(workspace), intent(inout) :: w
+      type(result_type), intent(inout) :: res
+      type(error_type), allocatable, intent(out) :: error
+      integer :: j, lv
+      real(dp) :: h, tj
+      logical :: any_changed, any_bad, stop
+
+      if (k + 1 == w%nested) then
+         lv = 2
+      else
+         lv = w%lmax + 2 + k + 1
+      end if
+      h = w%lev(lv)%h
+      do j = 1, w%split(k + 1)
+         tj = t + (j - 1)*h
+         if (lv == 2) then
+            call advance_refined(model, exc, opts, tj, h, w, res, error)
+            if (allocated(error)) return
+            cycle
+         end if
+         call try_step(exc, tj, lv, w, error)
+         if (allocated(error)) return
+         call judge(model, opts, w, any_changed, any_bad)
+         if (any_changed .or. (any_bad .and. opts%check)) then
+            call advance_nested(model, exc, opts, tj, k + 1, w, res, error)
+            if (allocated(error)) return
+         else
+            call accept(model, exc, tj + h, w, res, any_changed, any_bad)
+            res%steps_nested = res%steps_nested + 1
+            call observe_poll(w%obs, tj + h, stop)
+            if (stop) then
+               call observe_stop_error(w%obs, error)
+               return
+            end if
+         end if
+      end do
+   end subroutine advance_nested
 
    !> Cover [t, t + sub] with steps sub, sub/2, ... down to dt_min, halving while the
    !> correctness condition fails (when the check is on).

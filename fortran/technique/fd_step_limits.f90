@@ -20,7 +20,7 @@ module fd_step_limits
    private
 
    public :: max_refinement, max_stiffness_ratio, halving_levels, finest_step, band_floor, band_of
-   public :: check_step_limits, unresolved_band
+   public :: check_step_limits, unresolved_band, max_nested, nested_splits
 
    !> Most Newmark steps one dt1 step may be refined into: n2 steps dt2, each halved L times.
    integer, parameter :: max_refinement = 2**20
@@ -28,6 +28,8 @@ module fd_step_limits
    !> of its masses in the effective stiffness: beyond, the factorization loses more than 12
    !> of the 16 digits of double precision.
    real(dp), parameter :: max_stiffness_ratio = 1.0e12_dp
+   !> Most levels of nested refinement: the prime factors of n2 <= 2**20.
+   integer, parameter :: max_nested = 20
 
 contains
 
@@ -41,6 +43,36 @@ contains
          lmax = lmax + 1
       end do
    end function halving_levels
+
+   !> The levels of nested refinement (`refinement = 'nested'`): the prime factors of n2,
+   !> smallest first, so that dt1 / splits(1) / ... / splits(levels) = dt2. A prime n2 gives
+   !> one level, the paper's refinement; n2 = 1 none.
+   pure subroutine nested_splits(n2, splits, levels)
+      integer, intent(in) :: n2                   !! dt1 / dt2, 1 .. 2**20
+      integer, intent(out) :: splits(max_nested)  !! ratio of each level to the next finer one
+      integer, intent(out) :: levels              !! number of levels
+      integer :: m, p
+
+      splits = 1
+      levels = 0
+      m = n2
+      p = 2
+      do while (m > 1 .and. levels < max_nested)
+         if (p*p > m) then
+            ! what is left is prime
+            levels = levels + 1
+            splits(levels) = m
+            exit
+         end if
+         if (mod(m, p) == 0) then
+            levels = levels + 1
+            splits(levels) = p
+            m = m/p
+         else
+            p = p + 1
+         end if
+      end do
+   end subroutine nested_splits
 
    !> The floor of the step halving: dt_min, or dt2 / 2**10 when it is 0.
    pure real(dp) function finest_step(exc, opts) result(dt_min)

@@ -153,7 +153,7 @@ def history_error(approx: Result, exact: Result, test: int) -> tuple[float, floa
 
 def cost(r: Result) -> int:
     s = r.summary
-    return int(s["steps_dt1"] + s["steps_dt2"] + s["steps_finer"])
+    return int(s["steps_dt1"] + s["steps_nested"] + s["steps_dt2"] + s["steps_finer"])
 
 
 def observed_order(x, y) -> float:
