@@ -26,7 +26,7 @@ module fd_engineering
    public :: observe_storey_peak, modes_dense_dofs
 
    !> Above this many DOFs the modes are found without an n x n matrix (natural_modes_sparse)
-   integer, parameter :: modes_dense_dofs = 2000
+   integer, parameter :: modes_dense_dofs = 200
 
    !> The engineering outputs of a run.
    type :: engineering_type
