@@ -105,7 +105,8 @@ def analyses(draw) -> fd.Analysis:
         u0 = [draw(st.floats(-0.01, 0.01, **finite)) for _ in range(n)]
         v0 = [draw(st.floats(-0.2, 0.2, **finite)) for _ in range(n)]
     integration = fd.Integration(technique="event_driven" if exact else None, n1=n1,
-                                 n2=None if exact else n2)
+                                 n2=None if exact else n2,
+                                 refinement=None if exact else draw(st.sampled_from([None, "nested"])))
     return fd.Analysis(masses=masses, springs=springs, excitation=excitation, damping=damping,
                        devices=devices, integration=integration,
                        output=fd.Output(output_every=1), u0=u0, v0=v0)
