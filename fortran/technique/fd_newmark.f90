@@ -242,8 +242,18 @@ contains
       case default
          path = spd_auto
       end select
-      call spd_setup(base, model%mass, model%spring_i, model%spring_j, model%spring_k, model%dev%node_i, &
-                     model%dev%node_j, error, a0=a0, a1=a1, path=path)
+      ! the devices' nodes as arrays of their own before the set-up (a component of an array of
+      ! derived type passed as an argument is copied to a temporary at the call)
+      allocate (w%di(nd), w%dj(nd), stat=stat)
+      if (stat /= 0) then
+         call fatal_error(error, "not enough memory for the nodes of n_devices = "//trim(fmt_int(nd))//" devices", &
+                          stat_no_memory)
+         return
+      end if
+      w%di = model%dev%node_i
+      w%dj = model%dev%node_j
+      call spd_setup(base, model%mass, model%spring_i, model%spring_j, model%spring_k, w%di, w%dj, error, &
+                     a0=a0, a1=a1, path=path)
       if (allocated(error)) return
       res%storage = merge(1, 2, spd_is_dense(base))
       res%bandwidth = spd_bandwidth(base)
@@ -281,8 +291,6 @@ contains
                           stat_no_memory)
          return
       end if
-      w%di = model%dev%node_i
-      w%dj = model%dev%node_j
    end subroutine setup
 
    !> Acceleration in equilibrium with the current phases: M a = p - C v - K u - sum b F.

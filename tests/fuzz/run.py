@@ -8,7 +8,8 @@ Each case (tests/fuzz/mutate.py: a bundled deck or record with 1 to 3 mutations,
 the same seed and index) is written twice into a directory of its own: one copy is run by the
 executable (`frictiondyn DECK`), the other by a long-lived Python worker (tests/fuzz/worker.py:
 Session(deck).solve(), result(), write(), and run_text of the same text). Each run is bounded
-in time (--timeout) and in memory (--mem, an address-space limit), and its outcome classified:
+in time (--timeout, times $FRICTIONDYN_TIME_SCALE: time_scale) and in memory (--mem, an
+address-space limit), and its outcome classified:
 
 - success: both ran, wrote the same files (byte for byte, but for run_time_s), no null;
 - clean error: both refused with the same message, naming the deck file (or the record file,
@@ -63,6 +64,24 @@ RUNTIME_ERRORS = re.compile(
 GROUPS = ("model", "springs", "damping", "friction", "excitation", "integration", "output")
 # the checked build (tools/test_checked.sh): the sanitizers bound memory (memory_bound)
 CHECKED = bool(os.environ.get("FRICTIONDYN_CHECKED"))
+
+
+def time_scale() -> float:
+    """The factor by which every time bound of a case is multiplied: $FRICTIONDYN_TIME_SCALE,
+    1 when unset. The checked build (tools/test_checked.sh) sets it, its instrumented code
+    being several times slower (case 180 of seed 2024, the campaign's longest: 6.8 s in the
+    normal build, 28 s in the checked one): the same work is bounded, not a shorter run."""
+    text = os.environ.get("FRICTIONDYN_TIME_SCALE", "1")
+    try:
+        scale = float(text)
+    except ValueError:
+        scale = float("nan")
+    if not 0.0 < scale < float("inf"):
+        raise ValueError(f"FRICTIONDYN_TIME_SCALE = {text!r}: a positive number is needed")
+    return scale
+
+
+TIME_SCALE = time_scale()
 LONG_STEPS = 1e7  # dt1 steps from which a valid deck that runs past the time limit asks for it
 
 
@@ -195,7 +214,7 @@ def requested_steps(deck: Path) -> float | None:
               "    print(s.shape[0] - 1)\n")
     try:
         p = subprocess.run([sys.executable, "-c", script, str(deck)], capture_output=True,
-                           timeout=60, text=True, check=False)
+                           timeout=60 * TIME_SCALE, text=True, check=False)
     except subprocess.TimeoutExpired:
         return None
     if p.returncode != 0:
@@ -319,6 +338,7 @@ def campaign(count: int, seed: int, timeout: float = 60.0, mem: int = 2048, firs
              keep: Path | None = None, progress=None, only: int | None = None) -> list[Outcome]:
     bases = mutate.bases()
     worker = Worker(mem)
+    timeout = timeout * TIME_SCALE  # the same work bounded in a slower build (time_scale)
     outcomes = []
     indices = [only] if only is not None else range(first, first + count)
     with tempfile.TemporaryDirectory(prefix="frictiondyn-fuzz-") as tmp:
@@ -410,8 +430,9 @@ def main(argv=None) -> int:
         args.json.write_text(json.dumps(rep, indent=2, ensure_ascii=False))
     command = (f"--case {args.case} --seed {args.seed}" if args.case is not None
                else f"--count {args.count} --seed {args.seed} --first {args.first}")
+    scaled = f", time bounds x {TIME_SCALE:g}: FRICTIONDYN_TIME_SCALE" if TIME_SCALE != 1 else ""
     print(f"fuzz campaign: seed {args.seed}, {rep['runs']} cases (tests/fuzz/run.py {command}, "
-          f"--timeout {args.timeout:g} --mem {args.mem})")
+          f"--timeout {args.timeout:g} --mem {args.mem}{scaled})")
     for key in ["runs", "successes", "clean errors", "long by request", *FAILURES]:
         print(f"  {key:24s} {rep[key]}")
     print(f"  {'wall time [s]':24s} {rep['wall time [s]']}")

@@ -93,7 +93,9 @@ def pytest_runtest_makereport(item, call):
     report = outcome.get_result()
     found = []
     for title, text in report.sections:
-        if title.startswith("Captured") and FINDING.search(text):
+        # a phase's report carries the output of the phases before it too ("Captured stderr
+        # call" again in teardown's): each output is searched in its own phase's report only
+        if title.startswith("Captured") and title.endswith(report.when) and FINDING.search(text):
             found.append(f"{title}:\n{text[-3000:]}")
     if report.when == "teardown" or report.when == "call":
         found.extend(_seen)
