@@ -31,7 +31,7 @@ module fd_deck
                        default_mu_law, default_mode_system, default_n_modes, default_radius, &
                        default_storey_height, law_name
    use fd_model, only: source_friction, source_brace, source_isolator
-   use fd_matrices, only: modes_type, natural_modes, stiffness_matrix
+   use fd_matrices, only: modes_type, natural_modes, natural_modes_sparse, stiffness_matrix, modes_dense_dofs
    use fd_sha256, only: sha256_text
    use fd_textio, only: read_file_text
    use fd_step_limits, only: check_step_limits
@@ -1411,15 +1411,20 @@ contains
       n = cfg%model%n_dof
       mi = cfg%model%mode_i
       mj = cfg%model%mode_j
-      allocate (k(n, n), c(n, n), stat=stat)
-      if (stat /= 0) then
-         call fatal_error(error, deck%path//", group &damping: not enough memory for the modes of "// &
-                          trim(fmt_int(n))//" DOFs (mode_i, mode_j)", stat_no_memory)
-         return
+      if (n > modes_dense_dofs) then
+         ! a large model: no n x n matrix (fd_modes' subspace iteration on the elements)
+         call natural_modes_sparse(cfg%model, 0.0_dp, 0.0_dp, cfg%model%mode_system, max(mi, mj), modes, error)
+      else
+         allocate (k(n, n), c(n, n), stat=stat)
+         if (stat /= 0) then
+            call fatal_error(error, deck%path//", group &damping: not enough memory for the modes of "// &
+                             trim(fmt_int(n))//" DOFs (mode_i, mode_j)", stat_no_memory)
+            return
+         end if
+         c = 0.0_dp
+         call stiffness_matrix(cfg%model, k)
+         call natural_modes(cfg%model, k, c, cfg%model%mode_system, max(mi, mj), modes, error)
       end if
-      c = 0.0_dp
-      call stiffness_matrix(cfg%model, k)
-      call natural_modes(cfg%model, k, c, cfg%model%mode_system, max(mi, mj), modes, error)
       if (allocated(error)) then
          error%message = deck%path//", group &damping: the modes for mode_i, mode_j: "//error%message
          return

@@ -18,6 +18,11 @@ module fd_matrices
    public :: system_modes, structure_damping
    public :: modes_type, natural_modes, natural_modes_sparse, stiffness_damping_factor
    public :: modes_none, modes_flexible, modes_rigid, modes_unrestrained
+   public :: modes_dense_dofs
+
+   !> Above this many DOFs the modes are found without an n x n matrix (natural_modes_sparse):
+   !> the dense matrices would make peak memory grow as n**2 (issue 13)
+   integer, parameter :: modes_dense_dofs = 200
 
    ! what the eigenproblem of a system found
    integer, parameter :: modes_none = 0          !! not computed

@@ -18,15 +18,12 @@ module fd_engineering
                        damping_stiffness, damping_rayleigh
    use fd_excitation, only: excitation_type, excitation_harmonic
    use fd_matrices, only: modes_type, natural_modes, natural_modes_sparse, stiffness_matrix, damping_matrix, &
-                          stiffness_damping_factor
+                          stiffness_damping_factor, modes_dense_dofs
    implicit none
    private
 
    public :: engineering_type, engineering_init, storey_values, observe_engineering, engineering_columns
-   public :: observe_storey_peak, modes_dense_dofs
-
-   !> Above this many DOFs the modes are found without an n x n matrix (natural_modes_sparse)
-   integer, parameter :: modes_dense_dofs = 200
+   public :: observe_storey_peak
 
    !> The engineering outputs of a run.
    type :: engineering_type
