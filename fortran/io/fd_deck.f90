@@ -12,7 +12,7 @@ module fd_deck
    use fd_textio, only: lower
    use fd_namelist, only: deck_text, group_text, deck_from_string, find_group, group_item, &
                           group_read_error, check_groups, longest_string
-   use fd_names, only: keyword_id, keyword_choices, law_id, law_choices, &
+   use fd_names, only: keyword_type, keyword_id, keyword_choices, law_id, law_choices, &
                        damping_types, damping_stiffness, damping_rayleigh, damping_none, &
                        excitation_types, excitation_harmonic, excitation_record, excitation_none, &
                        record_kinds, record_displacement, techniques, technique_name, &
@@ -553,12 +553,8 @@ contains
          end if
          call check_magnitude(deck, 'excitation', 'record_scale', record_scale, '', .true., error)
          if (allocated(error)) return
-         kind_id = keyword_id(record_kinds, record_kind)
-         if (kind_id == 0) then
-            call keyword_choices(record_kinds, choices)
-            call bad(deck, 'excitation', 'record_kind', "'"//trim(record_kind)//"'", 'one of '//choices, error)
-            return
-         end if
+         call keyword_value(deck, 'excitation', 'record_kind', record_kinds, record_kind, kind_id, error)
+         if (allocated(error)) return
          select case (lower(trim(record_format)))
          case ('auto', 'at2', 'values', 'time_value')
          case default
@@ -621,7 +617,7 @@ contains
                              refinement
       type(group_text) :: grp
       character(len=512) :: msg, msg0
-      character(len=:), allocatable :: rec, choices
+      character(len=:), allocatable :: rec
       integer :: ios, i, technique_id, system_id, refinement_id
       logical :: found
 
@@ -649,24 +645,12 @@ contains
             call group_read_error(deck, grp, i, msg, error); return
          end if
       end if
-      technique_id = keyword_id(techniques, technique)
-      if (technique_id == 0) then
-         call keyword_choices(techniques, choices)
-         call bad(deck, 'integration', 'technique', "'"//trim(technique)//"'", 'one of '//choices, error)
-         return
-      end if
-      system_id = keyword_id(linear_systems, linear_system)
-      if (system_id == 0) then
-         call keyword_choices(linear_systems, choices)
-         call bad(deck, 'integration', 'linear_system', "'"//trim(linear_system)//"'", 'one of '//choices, error)
-         return
-      end if
-      refinement_id = keyword_id(refinements, refinement)
-      if (refinement_id == 0) then
-         call keyword_choices(refinements, choices)
-         call bad(deck, 'integration', 'refinement', "'"//trim(refinement)//"'", 'one of '//choices, error)
-         return
-      end if
+      call keyword_value(deck, 'integration', 'technique', techniques, technique, technique_id, error)
+      if (allocated(error)) return
+      call keyword_value(deck, 'integration', 'linear_system', linear_systems, linear_system, system_id, error)
+      if (allocated(error)) return
+      call keyword_value(deck, 'integration', 'refinement', refinements, refinement, refinement_id, error)
+      if (allocated(error)) return
       call check_real(deck, 'integration', 'beta', beta, 0.0_dp, 0.5_dp, '', error, open_lo=.true.)
       if (allocated(error)) return
       call check_real(deck, 'integration', 'gamma', gamma, 0.5_dp, 1.0_dp, '', error)
@@ -1359,7 +1343,6 @@ contains
       character(len=*), intent(in) :: mode_system
       type(run_config), intent(inout) :: cfg
       type(error_type), allocatable, intent(out) :: error
-      character(len=:), allocatable :: choices
       integer :: sys
 
       cfg%model%mode_i = 0
@@ -1384,12 +1367,8 @@ contains
       end if
       call check_real(deck, 'damping', 'xi', xi, 0.0_dp, 1.0_dp, '', error, open_hi=.true.)
       if (allocated(error)) return
-      sys = keyword_id(mode_systems, mode_system)
-      if (sys == 0) then
-         call keyword_choices(mode_systems, choices)
-         call bad(deck, 'damping', 'mode_system', "'"//trim(mode_system)//"'", 'one of '//choices, error)
-         return
-      end if
+      call keyword_value(deck, 'damping', 'mode_system', mode_systems, mode_system, sys, error)
+      if (allocated(error)) return
       cfg%model%mode_i = mode_i
       cfg%model%mode_j = mode_j
       cfg%model%mode_system = sys
@@ -1507,6 +1486,22 @@ contains
       type(error_type), allocatable, intent(out) :: error
       call fatal_error(error, deck%path//": required group &"//group//" is missing")
    end subroutine missing_group
+
+   !> The id of `text` in the keyword table `table` (fd_names), or an error naming the group,
+   !> the variable, the value and the choices.
+   subroutine keyword_value(deck, group, var, table, text, id, error)
+      type(deck_text), intent(in) :: deck
+      character(len=*), intent(in) :: group, var, text
+      type(keyword_type), intent(in) :: table(:)
+      integer, intent(out) :: id
+      type(error_type), allocatable, intent(out) :: error
+      character(len=:), allocatable :: choices
+
+      id = keyword_id(table, text)
+      if (id /= 0) return
+      call keyword_choices(table, choices)
+      call bad(deck, group, var, "'"//trim(text)//"'", 'one of '//choices, error)
+   end subroutine keyword_value
 
    subroutine bad(deck, group, var, val, must, error)
       type(deck_text), intent(in) :: deck
