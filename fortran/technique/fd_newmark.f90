@@ -66,8 +66,8 @@ module fd_newmark
       real(dp), allocatable :: mass(:)
       type(level_type), allocatable :: lev(:)         !! 1: dt1, 2: dt2, 2 + l: dt2 / 2**l,
                                                       !! lmax + 2 + k: level k of nested refinement
-      integer :: nested = 0                           !! levels of nested refinement (0: the paper's)
-      integer :: split(max_nested) = 1                !! ratio of nested level k - 1 to level k
+      integer :: nested = 1                           !! levels of the refinement (the paper's: 1)
+      integer :: split(max_nested) = 1                !! ratio of level k - 1 to level k (dt1 / dt2 = product)
       integer :: version = 0                          !! counts the accepted phase changes
       real(dp), allocatable :: u(:), v(:), a(:), u1(:), v1(:), a1(:), rhs(:), tmp(:)
       real(dp), allocatable :: s(:), sd(:), s1(:), sd1(:), f(:), kd(:)
@@ -123,7 +123,7 @@ contains
       type(run_control), intent(inout), target, optional :: ctl !! the run's control
       type(workspace) :: w
       real(dp) :: dt1, dt2, t0
-      integer :: k, j, c0, c1, crate, l
+      integer :: k, c0, c1, crate, l
       logical :: any_changed, any_bad, stop
 
       call system_clock(c0, crate)
@@ -166,14 +166,9 @@ contains
             ! redone as one step of dt2 = dt1 from the same state and phases: the trial itself
             call accept(model, exc, t0 + dt1, w, res, any_changed, any_bad)
             res%steps_dt2 = res%steps_dt2 + 1
-         else if (w%nested > 0) then
+         else
             call advance_nested(model, exc, opts, t0, 0, w, res, error)
             if (allocated(error)) return
-         else
-            do j = 1, opts%n2
-               call advance_refined(model, exc, opts, t0 + (j - 1)*dt2, dt2, w, res, error)
-               if (allocated(error)) return
-            end do
          end if
          if (sample_due(w%obs, k)) then
             if (.not. all(ieee_is_finite(w%u)) .or. .not. all(ieee_is_finite(w%a))) then
@@ -258,9 +253,14 @@ contains
       res%storage = merge(1, 2, spd_is_dense(base))
       res%bandwidth = spd_bandwidth(base)
       w%lmax = lmax
+      ! the levels of the refinement: the paper's is one, dt1 to dt2 = dt1 / n2
       w%nested = 0
       if (opts%refinement == refinement_nested) call nested_splits(opts%n2, w%split, w%nested)
-      allocate (w%lev(lmax + 2 + max(w%nested - 1, 0)), stat=stat)
+      if (w%nested == 0) then
+         w%nested = 1
+         w%split(1) = opts%n2
+      end if
+      allocate (w%lev(lmax + 2 + w%nested - 1), stat=stat)
       if (stat /= 0) then
          call fatal_error(error, "not enough memory for the effective stiffness of n_dof = "//trim(fmt_int(n))// &
                           " DOFs", stat_no_memory)
@@ -455,11 +455,12 @@ contains
                          any_changed, any_bad)
    end subroutine judge
 
-   !> Nested refinement: cover the piece [t, t + h_k] of level k (0: the dt1 step), whose own
+   !> The refinement: cover the piece [t, t + h_k] of level k (0: the dt1 step), whose own
    !> trial step changed a phase or violated the correctness condition, with the split(k + 1)
-   !> pieces of level k + 1. Each is tried as one step and accepted when no device changes
-   !> phase (nor violates the condition, when checked); else it is split again, down to the
-   !> last level, dt2, which advance_refined covers as the paper's refinement does.
+   !> pieces of level k + 1. The last level is dt2, whose pieces advance_refined covers (the
+   !> paper's refinement has only that level: n2 steps dt2). The pieces of an intermediate
+   !> level (nested refinement) are each tried as one step and accepted when no device
+   !> changes phase (nor violates the condition, when checked); else split again.
    recursive subroutine advance_nested(model, exc, opts, t, k, w, res, error)
       type(model_type), intent(in) :: model
       type(excitation_type), intent(in) :: exc
