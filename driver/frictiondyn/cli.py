@@ -72,8 +72,10 @@ def _print_summary(result: Result, deck: str) -> None:
     print(f"frictiondyn: {deck}")
     period = s.get("period_stuck_s")
     stuck = f"stuck period {period:.6g} s" if period else "stuck system has no period"
-    nested = f", nested {s['steps_nested']}" if s.get("steps_nested") else ""
-    print(f"  {stuck}; steps dt1 {s['steps_dt1']}{nested}, dt2 {s['steps_dt2']}, finer {s['steps_finer']}")
+    print(
+        f"  {stuck}; steps dt1 {s['steps_dt1']}, nested {s.get('steps_nested', 0)}, dt2 {s['steps_dt2']}, "
+        f"finer {s['steps_finer']}"
+    )
     laws = s.get("device_law", [])
     for d in range(result.n_devices):
         law = f" ({laws[d]})" if d < len(laws) else ""

@@ -121,13 +121,8 @@ program frictiondyn_main
       write (error_unit, '(10(1x,f0.6))') res%violation_time(1:res%n_violation_times)
    end if
    write (output_unit, '(a)') 'frictiondyn: '//deck
-   if (res%steps_nested > 0) then
-      write (output_unit, '(a,f0.6,a,i0,a,i0,a,i0,a,i0)') '  stuck period ', res%period_stuck, ' s; steps dt1 ', &
-         res%steps_dt1, ', nested ', res%steps_nested, ', dt2 ', res%steps_dt2, ', finer ', res%steps_finer
-   else
-      write (output_unit, '(a,f0.6,a,i0,a,i0,a,i0,a)') '  stuck period ', res%period_stuck, ' s; steps dt1 ', &
-         res%steps_dt1, ', dt2 ', res%steps_dt2, ', finer ', res%steps_finer, ''
-   end if
+   write (output_unit, '(a,f0.6,a,i0,a,i0,a,i0,a,i0)') '  stuck period ', res%period_stuck, ' s; steps dt1 ', &
+      res%steps_dt1, ', nested ', res%steps_nested, ', dt2 ', res%steps_dt2, ', finer ', res%steps_finer
    if (allocated(cfg%record%path)) then
       write (output_unit, '(a,i0,a,es12.5,a)') '  record '//cfg%record%path//' ('//trim(cfg%record%format)// &
          trim(merge(', detected', '          ', cfg%record%detected))//', '//trim(cfg%record%units)//'): ', &
