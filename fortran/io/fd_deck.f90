@@ -115,7 +115,7 @@ contains
    end subroutine read_deck_string
 
    subroutine read_groups(deck, cfg, error)
-      type(deck_text), intent(in) :: deck
+      type(deck_text), intent(inout) :: deck   !! (check_groups keeps its groups' places)
       type(run_config), intent(inout) :: cfg
       type(error_type), allocatable, intent(out) :: error
 

@@ -15,12 +15,6 @@ module fd_namelist
 
    character(len=*), parameter :: blanks = ' '//achar(9)  !! what separates words on a line
 
-   !> A whole deck in memory.
-   type :: deck_text
-      character(len=:), allocatable :: path          !! the deck file
-      type(line_type), allocatable :: lines(:)       !! its lines
-   end type deck_text
-
    !> Where one group lies in a deck.
    type :: group_span
       character(len=64) :: name = ''   !! group name, lower case
@@ -31,6 +25,15 @@ module fd_namelist
       integer :: last_col = 0          !! its column
       integer :: close_len = 1         !! its length: 1 for '/', 4 for '&end', '$end'
    end type group_span
+
+   !> A whole deck in memory.
+   type :: deck_text
+      character(len=:), allocatable :: path          !! the deck file
+      type(line_type), allocatable :: lines(:)       !! its lines
+      !> its groups, once check_groups has found the deck well formed (find_group then
+      !> looks them up instead of scanning the deck again for every group)
+      type(group_span), allocatable :: spans(:)
+   end type deck_text
 
    !> One group of a deck, ready for an internal namelist read.
    type :: group_text
@@ -93,12 +96,13 @@ contains
    !> Every group of the deck must be one of the known names, and appear once; the deck
    !> must be well formed (see scan_deck).
    subroutine check_groups(deck, known, error)
-      type(deck_text), intent(in) :: deck                 !! the deck
+      type(deck_text), intent(inout) :: deck              !! the deck (its groups kept: deck%spans)
       character(len=*), intent(in) :: known(:)            !! names of the known groups
       type(error_type), allocatable, intent(out) :: error !! unknown or repeated group, or bad text
       type(group_span), allocatable :: spans(:)
       integer :: i, j, count(size(known))
 
+      if (allocated(deck%spans)) deallocate (deck%spans)
       call scan_deck(deck, spans, error)
       if (allocated(error)) return
       count = 0
@@ -118,6 +122,7 @@ contains
             return
          end if
       end do
+      call move_alloc(spans, deck%spans)
    contains
       function join(words) result(str)
          character(len=*), intent(in) :: words(:)
@@ -155,8 +160,8 @@ contains
       do i = 1, size(deck%lines)
          associate (line => deck%lines(i)%s)
             nl = len(line)
-            where = deck%path//", line "//trim(fmt_int(i))
             if (index(line, achar(0)) > 0) then
+               where = deck%path//", line "//trim(fmt_int(i))   ! formatted only for a message
                call fatal_error(error, where//": a NUL character (byte 0) in the deck: not a text file")
                return
             end if
@@ -166,6 +171,7 @@ contains
                if (b == 0) cycle
                if (line(b:b) == '!') cycle
                if (line(b:b) /= '&' .and. line(b:b) /= '$') then
+                  where = deck%path//", line "//trim(fmt_int(i))   ! formatted only for a message
                   call outside_text(where, line, b, error)
                   return
                end if
@@ -175,16 +181,19 @@ contains
                   e = e + 1
                end do
                if (e == b + 1) then
+                  where = deck%path//", line "//trim(fmt_int(i))   ! formatted only for a message
                   call fatal_error(error, where//": '"//trim(shown(line(b:)))//"': '"//line(b:b)// &
                                    "' must be followed by the group name, with no blank ('"//line(b:b)//"name')")
                   return
                end if
                if (lower(line(b + 1:e - 1)) == 'end') then
+                  where = deck%path//", line "//trim(fmt_int(i))   ! formatted only for a message
                   call fatal_error(error, where//": '"//line(b:e - 1)//"' outside any group (a group closed twice?)")
                   return
                end if
                if (e <= nl) then
                   if (scan(line(e:e), blanks//',/!') == 0) then
+                     where = deck%path//", line "//trim(fmt_int(i))   ! formatted only for a message
                      call fatal_error(error, where//": '"//trim(shown(line(b:)))//"' does not open a group: "// &
                                       "a group name is letters, digits and '_', followed by a blank")
                      return
@@ -224,6 +233,7 @@ contains
                      cur%last_line = i; cur%last_col = k; cur%close_len = 4
                      exit
                   end if
+                  where = deck%path//", line "//trim(fmt_int(i))   ! formatted only for a message
                   call fatal_error(error, where//", group &"//trim(cur%name)//": '"//trim(shown(line(k:)))//"': '"//ch// &
                                    "' inside a group, outside quotes (a group ends with '/'; a group opens on a line "// &
                                    "of its own)")
@@ -246,6 +256,7 @@ contains
                   b = verify(line(k:), blanks)
                   if (b > 0) then
                      if (line(k + b - 1:k + b - 1) /= '!') then
+                        where = deck%path//", line "//trim(fmt_int(i))   ! formatted only for a message
                         call fatal_error(error, where//": '"//trim(shown(line(k + b - 1:)))//"' after the end of group &"// &
                                          trim(cur%name)//": a group ends its line (only a comment may follow)")
                         return
@@ -347,8 +358,12 @@ contains
 
       grp%name = name
       found = .false.
-      call scan_deck(deck, spans, error)
-      if (allocated(error)) return
+      if (allocated(deck%spans)) then
+         spans = deck%spans
+      else
+         call scan_deck(deck, spans, error)
+         if (allocated(error)) return
+      end if
       do i = 1, size(spans)
          if (spans(i)%name == name) exit
       end do
