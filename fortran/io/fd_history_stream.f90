@@ -34,13 +34,14 @@ module fd_history_stream
    end type history_stream
 
    interface
-      function c_format_row(x, n, buf) bind(c, name='fd_format_row') result(nbytes)
+      !> Pure: it writes buf and nbytes only, from x only (no state, no I/O).
+      pure subroutine c_format_row(x, n, buf, nbytes) bind(c, name='fd_format_row')
          import :: c_double, c_int, c_char, c_long
          real(c_double), intent(in) :: x(*)
          integer(c_int), value :: n
          character(kind=c_char), intent(inout) :: buf(*)
-         integer(c_long) :: nbytes
-      end function c_format_row
+         integer(c_long), intent(out) :: nbytes
+      end subroutine c_format_row
    end interface
 
 contains
@@ -85,17 +86,17 @@ contains
       if (st%fd < 0 .or. st%err /= 0) return
       if (st%pos + stream_value_width*size(row) > len(st%buf)) call flush_buffer(st)
       if (st%err /= 0) return
-      nb = c_format_row(row, int(size(row), c_int), st%buf(st%pos + 1:))
+      call c_format_row(row, int(size(row), c_int), st%buf(st%pos + 1:), nb)
       st%pos = st%pos + int(nb)
    end subroutine stream_row
 
    !> The text of a row as the stream writes it (25 characters a value, the last a newline).
-   subroutine format_row(row, text)
+   pure subroutine format_row(row, text)
       real(dp), intent(in) :: row(:)                        !! values
       character(kind=c_char, len=*), intent(inout) :: text  !! at least 25 size(row) characters
       integer(c_long) :: nb
 
-      nb = c_format_row(row, int(size(row), c_int), text)
+      call c_format_row(row, int(size(row), c_int), text, nb)
    end subroutine format_row
 
    subroutine flush_buffer(st)

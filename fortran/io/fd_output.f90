@@ -10,6 +10,7 @@ module fd_output
    use fd_result, only: result_type
    use fd_record, only: record_info
    use fd_version, only: frictiondyn_version
+   use fd_history_stream, only: format_row, stream_value_width
    use fd_names, only: excitation_types
    use fd_matrices, only: modes_type, modes_flexible, modes_rigid, modes_unrestrained
    use fd_fileops, only: c_lock_acquire, c_lock_release, c_unlink, c_rename, c_errno_text, c_getpid, &
@@ -627,12 +628,15 @@ contains
       use, intrinsic :: ieee_arithmetic, only: ieee_is_finite
       real(dp), intent(in) :: x
       character(len=32) :: str
+      character(len=stream_value_width) :: row
       if (.not. ieee_is_finite(x)) then
          str = 'null'
          return
       end if
-      write (str, '(es24.16e3)') x
-      str = adjustl(str)
+      ! the stream's formatter: the digits of write (str, '(es24.16e3)') x, byte for byte,
+      ! without libgfortran's format parsing (a summary has a few values per DOF and device)
+      call format_row([x], row)
+      str = adjustl(row(1:stream_value_width - 1))
    end function json_real
 
    pure subroutine json_escape(s, r)

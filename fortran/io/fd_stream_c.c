@@ -42,12 +42,13 @@ static void format_es24(double x, char *out)
     memcpy(out + 24 - len, text, len);
 }
 
-/* The row x[0..n-1] as "v,v,...,v\n" (25 n bytes) into buf; returns the bytes written. */
-long fd_format_row(const double *x, int n, char *buf)
+/* The row x[0..n-1] as "v,v,...,v\n" (25 n bytes) into buf; *nbytes: the bytes written
+ * (a subroutine, not a function, so that Fortran can declare it pure). */
+void fd_format_row(const double *x, int n, char *buf, long *nbytes)
 {
     for (int i = 0; i < n; i++) {
         format_es24(x[i], buf + 25 * (long)i);
         buf[25 * (long)i + 24] = (i + 1 < n) ? ',' : '\n';
     }
-    return 25 * (long)n;
+    *nbytes = 25 * (long)n;
 }
