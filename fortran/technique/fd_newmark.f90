@@ -26,7 +26,7 @@ module fd_newmark
    use fd_kinds, only: dp
    use fd_error, only: error_type, fatal_error, fmt_real, fmt_int, stat_no_memory
    use fd_names, only: laws, law_name, law_choices, excitation_types, technique_name, technique_newmark, &
-                       technique_event_driven, linear_system_dense, linear_system_banded, refinement_nested
+                       technique_event_driven, technique_moreau_jean, linear_system_dense, linear_system_banded, refinement_nested
    use fd_model, only: model_type, integration_type
    use fd_excitation, only: excitation_type, table_motion, table_acceleration
    use fd_matrices, only: structure_damping
@@ -102,8 +102,9 @@ contains
          call fatal_error(error, "group &friction: "//idx//" = '"//trim(law_name(law))//"' is invalid with "// &
                           "technique = '"//trim(technique_name(technique_newmark))//"' of &integration: '"// &
                           trim(law_name(law))//"' is exact (set-valued) friction, which Newmark cannot integrate; "// &
-                          "set technique = '"//trim(technique_name(technique_event_driven))//"' in &integration, "// &
-                          "or "//idx//" to a regularized law: "//allowed)
+                          "set technique = '"//trim(technique_name(technique_event_driven))//"' (a few devices, "// &
+                          "exact event times) or '"//trim(technique_name(technique_moreau_jean))//"' (many devices, "// &
+                          "first order in time) in &integration, or "//idx//" to a regularized law: "//allowed)
          return
       end do
       if (exc%kind < 1 .or. exc%kind > size(excitation_types)) then
