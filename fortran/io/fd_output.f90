@@ -7,7 +7,7 @@ module fd_output
    use fd_kinds, only: dp
    use fd_error, only: error_type, fatal_error, fmt_int, fmt_real
    use fd_model, only: model_type, output_type, law_name, technique_name
-   use fd_result, only: result_type
+   use fd_result, only: result_type, resolution_names
    use fd_record, only: record_info
    use fd_version, only: frictiondyn_version
    use fd_history_stream, only: format_row, stream_value_width
@@ -400,6 +400,9 @@ contains
       call kv('dt1_s', trim(json_real(res%dt1)))
       call kv('dt2_s', trim(json_real(res%dt2)))
       call kv('dt_min_s', trim(json_real(res%dt_min)))
+      call kv('omega_max_rad_s', trim(json_real(res%omega_max)))
+      call kv('omega_max_dt1', trim(json_real(res%omega_max*res%dt1)))
+      call kv('mode_resolution', '"'//trim(resolution_names(res%mode_resolution))//'"')
       call kr('peak_u_m', res%peak_u)
       call kr('peak_u_time_s', res%peak_u_time)
       call kr('peak_v_mps', res%peak_v)
@@ -629,13 +632,15 @@ contains
       real(dp), intent(in) :: x
       character(len=32) :: str
       character(len=stream_value_width) :: row
+      real(dp) :: one(1)
       if (.not. ieee_is_finite(x)) then
          str = 'null'
          return
       end if
       ! the stream's formatter: the digits of write (str, '(es24.16e3)') x, byte for byte,
       ! without libgfortran's format parsing (a summary has a few values per DOF and device)
-      call format_row([x], row)
+      one(1) = x
+      call format_row(one, row)
       str = adjustl(row(1:stream_value_width - 1))
    end function json_real
 
