@@ -26,6 +26,7 @@ module fd_modes
    private
 
    public :: lowest_modes, modes_auto, modes_dense, modes_iterative, modes_dense_max
+   public :: highest_eigenvalue
 
    integer, parameter :: modes_auto = 0        !! dense up to modes_dense_max DOFs, else iterative
    integer, parameter :: modes_dense = 1       !! LAPACK dsygv on the dense matrices
@@ -40,6 +41,20 @@ module fd_modes
    !> Eigenvalues closer than this (relative) are a multiple one: their vectors are not unique.
    real(dp), parameter :: cluster_tol = 1.0e-6_dp
    integer, parameter :: max_iterations = 500
+   !> Lanczos steps of highest_eigenvalue at most, and the relative change of its largest
+   !> Ritz value below which it stops.
+   integer, parameter :: lanczos_max_steps = 120
+   real(dp), parameter :: lanczos_tol = 1.0e-10_dp
+
+   interface
+      !> LAPACK: every eigenvalue of a symmetric tridiagonal matrix (ascending, in d).
+      pure subroutine dsterf(n, d, e, info)
+         import :: dp
+         integer, intent(in) :: n
+         real(dp), intent(inout) :: d(*), e(*)
+         integer, intent(out) :: info
+      end subroutine dsterf
+   end interface
 
 contains
 
@@ -257,6 +272,136 @@ contains
          if (b > 0) relative = relative - v(b)
       end function relative
    end subroutine subspace_modes
+
+   !> The largest eigenvalue of K phi = lambda M phi (the square of the highest natural
+   !> circular frequency), from below and from above:
+   !>
+   !> - lambda: the largest Ritz value of a Lanczos run on M^-1/2 K M^-1/2 (matrix free, from
+   !>   the elements: O(elements) a step, three vectors of n; no reorthogonalization, which
+   !>   does not move the extreme Ritz value). A Ritz value never exceeds the largest
+   !>   eigenvalue (Courant-Fischer), so lambda is a lower bound, to rounding; the Lanczos
+   !>   run converges to the top of the spectrum first (Kaniel-Paige), and stops when the
+   !>   largest Ritz value changes by less than lanczos_tol or after lanczos_max_steps.
+   !>   Exact (dsygv) for n <= modes_dense_max.
+   !> - bound: Gershgorin's upper bound of the same matrix.
+   !>
+   !> What a caller may conclude: lambda > x proves the largest eigenvalue above x; bound <= x
+   !> proves it at most x.
+   subroutine highest_eigenvalue(mass, ei, ej, ek, lambda, bound, error)
+      real(dp), intent(in) :: mass(:)             !! masses m_i > 0 [kg], n = size(mass)
+      integer, intent(in) :: ei(:)                !! first node of each element (0..n)
+      integer, intent(in) :: ej(:)                !! second node of each element (0..n, 0 = fixed)
+      real(dp), intent(in) :: ek(:)               !! element stiffness [N/m], >= 0
+      real(dp), intent(out) :: lambda             !! largest Ritz value [1/s^2] (a lower bound)
+      real(dp), intent(out) :: bound              !! Gershgorin bound [1/s^2] (an upper bound)
+      type(error_type), allocatable, intent(out) :: error !! bad input, no memory, LAPACK failure
+      real(dp), allocatable :: rs(:), q0(:), q1(:), w(:), alpha(:), beta(:), d(:), e(:), lam(:), phi(:, :)
+      real(dp) :: nrm, top, prev, x
+      integer :: n, ne, i, a, b, k, info, stat
+
+      n = size(mass)
+      ne = size(ek)
+      lambda = 0.0_dp
+      bound = 0.0_dp
+      if (size(ei) /= ne .or. size(ej) /= ne) then
+         call fatal_error(error, "highest_eigenvalue: the element lists differ in length")
+         return
+      end if
+      if (n == 0) return
+      if (any(mass <= 0.0_dp)) then
+         call fatal_error(error, "highest_eigenvalue: a mass is not positive")
+         return
+      end if
+      if (any(ei < 0 .or. ei > n .or. ej < 0 .or. ej > n)) then
+         call fatal_error(error, "highest_eigenvalue: an element node is outside 0.."//trim(fmt_int(n)))
+         return
+      end if
+      ! Gershgorin on D K D, D = M^-1/2: row i holds k_e / m_i on the diagonal and
+      ! k_e / sqrt(m_i m_j) off it, for each element e at i
+      allocate (rs(n), stat=stat)
+      if (stat /= 0) then
+         call fatal_error(error, "highest_eigenvalue: not enough memory for "//trim(fmt_int(n))//" DOFs", &
+                          stat_no_memory)
+         return
+      end if
+      rs = 0.0_dp
+      do i = 1, ne
+         a = ei(i); b = ej(i)
+         if (a == b) cycle
+         if (a > 0) rs(a) = rs(a) + abs(ek(i))/mass(a)
+         if (b > 0) rs(b) = rs(b) + abs(ek(i))/mass(b)
+         if (a > 0 .and. b > 0) then
+            x = abs(ek(i))/sqrt(mass(a)*mass(b))
+            rs(a) = rs(a) + x
+            rs(b) = rs(b) + x
+         end if
+      end do
+      bound = maxval(rs)
+      if (bound == 0.0_dp) return
+      if (n <= modes_dense_max) then   ! dsygv: every eigenvalue, the largest exact
+         allocate (lam(1), phi(n, 1), stat=stat)
+         if (stat /= 0) then
+            call fatal_error(error, "highest_eigenvalue: not enough memory", stat_no_memory)
+            return
+         end if
+         call dense_modes(mass, ei, ej, ek, 1, lam, phi, lambda, error)
+         return
+      end if
+      ! Lanczos on A = D K D from a reproducible pseudo-random start
+      allocate (q0(n), q1(n), w(n), alpha(lanczos_max_steps), beta(lanczos_max_steps), d(lanczos_max_steps), &
+                e(lanczos_max_steps), stat=stat)
+      if (stat /= 0) then
+         call fatal_error(error, "highest_eigenvalue: not enough memory for "//trim(fmt_int(n))//" DOFs", &
+                          stat_no_memory)
+         return
+      end if
+      do i = 1, n
+         q1(i) = start_value(i, 1)
+      end do
+      q1 = q1/norm2(q1)
+      q0 = 0.0_dp
+      prev = -1.0_dp
+      top = 0.0_dp
+      do k = 1, min(lanczos_max_steps, n)
+         ! w = D K D q1 - beta_(k-1) q0
+         do i = 1, n
+            rs(i) = q1(i)/sqrt(mass(i))
+         end do
+         w = 0.0_dp
+         do i = 1, ne
+            a = ei(i); b = ej(i)
+            x = 0.0_dp
+            if (a > 0) x = rs(a)
+            if (b > 0) x = x - rs(b)
+            x = ek(i)*x
+            if (a > 0) w(a) = w(a) + x
+            if (b > 0) w(b) = w(b) - x
+         end do
+         do i = 1, n
+            w(i) = w(i)/sqrt(mass(i))
+         end do
+         if (k > 1) w = w - beta(k - 1)*q0
+         alpha(k) = dot_product(w, q1)
+         w = w - alpha(k)*q1
+         nrm = norm2(w)
+         beta(k) = nrm
+         ! the largest eigenvalue of the tridiagonal T_k (alpha, beta(1:k-1))
+         d(1:k) = alpha(1:k)
+         e(1:k) = beta(1:k)
+         call dsterf(k, d, e, info)
+         if (info /= 0) then
+            call fatal_error(error, "highest_eigenvalue: dsterf failed with info = "//trim(fmt_int(info)))
+            return
+         end if
+         top = d(k)
+         if (nrm <= epsilon(1.0_dp)*bound) exit            ! an invariant subspace: T_k is exact
+         if (abs(top - prev) <= lanczos_tol*abs(top)) exit
+         prev = top
+         q0 = q1
+         q1 = w/nrm
+      end do
+      lambda = min(top, bound)
+   end subroutine highest_eigenvalue
 
    !> A reproducible pseudo-random number in [-1, 1) for entry (i, j) of the start vectors
    !> (a hash of i and j: no generator state).

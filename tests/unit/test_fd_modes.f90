@@ -2,12 +2,13 @@
 !> factor against the closed form of a uniform chain and against LAPACK's dense dsygv on
 !> randomly numbered chains and a plane frame; the mode shapes M-normalized, K-orthogonal,
 !> and the residual of K phi = lambda M phi at round-off; a structure with a rigid-body mode
-!> recognised (lambda ~ 0 against the scale of the spectrum).
+!> recognised (lambda ~ 0 against the scale of the spectrum). The highest eigenvalue
+!> (highest_eigenvalue: Lanczos, with Gershgorin's bound) against closed forms and dsygv.
 module test_fd_modes
    use testdrive, only: new_unittest, unittest_type, error_type, check
    use fd_kinds, only: dp
    use fd_error, only: lib_error => error_type
-   use fd_modes, only: lowest_modes, modes_dense, modes_iterative
+   use fd_modes, only: lowest_modes, modes_dense, modes_iterative, highest_eigenvalue
    use test_fd_helpers, only: check_close
    implicit none
    private
@@ -25,7 +26,10 @@ contains
                   new_unittest("uniform chain closed form", test_chain_closed_form), &
                   new_unittest("iterative equals dense", test_against_dense), &
                   new_unittest("frame modes and residuals", test_frame), &
-                  new_unittest("rigid-body mode has lambda ~ 0", test_rigid) &
+                  new_unittest("rigid-body mode has lambda ~ 0", test_rigid), &
+                  new_unittest("highest eigenvalue: two masses, closed form", test_highest_two), &
+                  new_unittest("highest eigenvalue: chain, closed form and bounds", test_highest_chain), &
+                  new_unittest("highest eigenvalue: Lanczos equals dsygv", test_highest_against_dense) &
                   ]
    end subroutine collect_modes
 
@@ -153,6 +157,91 @@ contains
          if (b > 0) value = phi(b, i)
       end function value
    end subroutine test_frame
+
+   !> Two masses, each on a spring to the table and coupled by a third: the larger root of
+   !> m1 m2 l^2 - (m1 (k2 + kc) + m2 (k1 + kc)) l + k1 k2 + kc (k1 + k2) = 0, to 1e-12 (the
+   !> dense path), and Gershgorin's bound above it.
+   subroutine test_highest_two(error)
+      type(error_type), allocatable, intent(out) :: error
+      real(dp), parameter :: m1 = 6.301_dp, m2 = 2.530_dp, k1 = 1084.0_dp, k2 = 2895.0_dp, kc = 1.36e6_dp
+      real(dp) :: lam, bound, b, c, exact
+      type(lib_error), allocatable :: err
+
+      call highest_eigenvalue([m1, m2], [1, 2, 1], [0, 0, 2], [k1, k2, kc], lam, bound, err)
+      call check(error, .not. allocated(err), 'highest_eigenvalue failed: '//text(err))
+      if (allocated(error)) return
+      b = (m1*(k2 + kc) + m2*(k1 + kc))/(m1*m2)
+      c = (k1*k2 + kc*(k1 + k2))/(m1*m2)
+      exact = 0.5_dp*(b + sqrt(b*b - 4.0_dp*c))
+      call check_close(error, lam, exact, 1.0e-12_dp, 'two-mass highest eigenvalue')
+      if (allocated(error)) return
+      call check(error, bound >= exact*(1.0_dp - 1.0e-14_dp), 'Gershgorin bounds the highest eigenvalue')
+   end subroutine test_highest_two
+
+   !> A fixed-base chain of n equal masses (the Lanczos path, n = 3000): the largest
+   !> eigenvalue (4 k / m) sin^2((2n - 1) pi / (2 (2n + 1))); the Ritz value is below it (to
+   !> rounding) and within 1e-4 of it (4.6e-5 after 120 steps: the top of a chain's spectrum
+   !> is crowded, neighbours 2e-6 of it apart, and the Ritz value converges to the crowd, not
+   !> to one eigenvalue; ample to compare a step with the shortest period), and Gershgorin's
+   !> bound 4 k / m is above it.
+   subroutine test_highest_chain(error)
+      type(error_type), allocatable, intent(out) :: error
+      integer, parameter :: n = 3000
+      real(dp), parameter :: m = 3.0_dp, k = 1.0e6_dp
+      real(dp), allocatable :: mass(:), ek(:)
+      integer, allocatable :: ei(:), ej(:)
+      real(dp) :: lam, bound, exact
+      integer :: i
+      type(lib_error), allocatable :: err
+
+      allocate (mass(n), ek(n), ei(n), ej(n))
+      mass = m
+      do i = 1, n
+         ei(i) = i; ej(i) = i - 1; ek(i) = k
+      end do
+      call highest_eigenvalue(mass, ei, ej, ek, lam, bound, err)
+      call check(error, .not. allocated(err), 'highest_eigenvalue failed: '//text(err))
+      if (allocated(error)) return
+      exact = 4.0_dp*k/m*sin((2*n - 1)*pi/(2.0_dp*(2*n + 1)))**2
+      call check(error, lam <= exact*(1.0_dp + 1.0e-13_dp), 'the Ritz value is a lower bound')
+      if (allocated(error)) return
+      call check_close(error, lam, exact, 1.0e-4_dp, 'chain highest eigenvalue')
+      if (allocated(error)) return
+      call check_close(error, bound, 4.0_dp*k/m, 1.0e-14_dp, "Gershgorin's bound of a uniform chain")
+   end subroutine test_highest_chain
+
+   !> Randomly numbered chains of random masses and springs, n = 150 (the Lanczos path): the
+   !> highest eigenvalue equals dsygv's to 1e-8 (a spectrum without a crowd at its top: the
+   !> masses and springs vary by a factor 2).
+   subroutine test_highest_against_dense(error)
+      type(error_type), allocatable, intent(out) :: error
+      integer, parameter :: n = 150
+      real(dp) :: mass(n), ek(n), l1(1), p1(n, 1), s1, lam, bound
+      integer :: ei(n), ej(n), q(n), i, trial
+      type(lib_error), allocatable :: err
+
+      do trial = 1, 3
+         call permutation(n, 13*trial, q)
+         do i = 1, n
+            mass(q(i)) = 1.0_dp + hashed(i, trial)
+            ei(i) = q(i)
+            ej(i) = 0
+            if (i > 1) ej(i) = q(i - 1)
+            ek(i) = 1.0e3_dp*(1.0_dp + hashed(i + n, trial))
+         end do
+         ! dsygv's largest eigenvalue: the scale lowest_modes reports on its dense path
+         call lowest_modes(mass, ei, ej, ek, 1, l1, p1, s1, err, path=modes_dense)
+         call check(error, .not. allocated(err), 'dense modes failed: '//text(err))
+         if (allocated(error)) return
+         call highest_eigenvalue(mass, ei, ej, ek, lam, bound, err)
+         call check(error, .not. allocated(err), 'highest_eigenvalue failed: '//text(err))
+         if (allocated(error)) return
+         call check_close(error, lam, s1, 1.0e-8_dp, 'highest eigenvalue against dsygv')
+         if (allocated(error)) return
+         call check(error, bound >= s1*(1.0_dp - 1.0e-14_dp), 'Gershgorin bounds the highest eigenvalue')
+         if (allocated(error)) return
+      end do
+   end subroutine test_highest_against_dense
 
    !> Two masses joined by a spring, nothing to the table: a rigid-body mode (lambda below
    !> 1e-12 of the spectrum's scale) and the spring's mode, 2 k / m for equal masses; both paths.
