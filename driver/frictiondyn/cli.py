@@ -19,6 +19,7 @@ Errors print one line ``frictiondyn: error: ...`` on standard error and exit wit
 from __future__ import annotations
 
 import argparse
+import math
 import os
 import sys
 from collections.abc import Sequence
@@ -105,6 +106,15 @@ def _print_summary(result: Result, deck: str) -> None:
         print(
             f"frictiondyn: warning: {s['correctness_violations']} step(s) violate the "
             "correctness condition (eqs. 9, 12)",
+            file=sys.stderr,
+        )
+    if s.get("mode_resolution") == "unresolved":
+        print(
+            f"frictiondyn: warning: dt1 = {s['dt1_s']:.3g} s does not resolve the highest modes "
+            f"(shortest period {2 * math.pi / s['omega_max_rad_s']:.3g} s, omega_max dt1 = "
+            f"{s['omega_max_dt1']:.3g} > 2): their response has the wrong period; peak absolute "
+            "accelerations may carry it (drifts and shears much less); raise n1 until "
+            "omega_max dt1 <= 2 to resolve them",
             file=sys.stderr,
         )
 

@@ -19,6 +19,7 @@ program frictiondyn_main
                          session_set_progress
    use fd_progress_line, only: progress_wanted, progress_show, progress_clear
    use fd_version, only: frictiondyn_version
+   use fd_result, only: resolution_unresolved
    implicit none
 
    interface
@@ -119,6 +120,13 @@ program frictiondyn_main
       write (error_unit, '(a,i0,a)') 'frictiondyn: warning: ', res%violations, &
          ' step(s) violate the correctness condition (eqs. 9, 12); first at t [s] ='
       write (error_unit, '(10(1x,f0.6))') res%violation_time(1:res%n_violation_times)
+   end if
+   if (res%mode_resolution == resolution_unresolved) then
+      write (error_unit, '(a,es10.3,a,es10.3,a,f0.2,a)') 'frictiondyn: warning: dt1 = ', res%dt1, &
+         ' s does not resolve the highest modes (shortest period ', 2*acos(-1.0_dp)/res%omega_max, &
+         ' s, omega_max dt1 = ', res%omega_max*res%dt1, ' > 2): their response has the wrong period;'
+      write (error_unit, '(a)') '  peak absolute accelerations may carry it (drifts and shears much less);'// &
+         ' raise n1 until omega_max dt1 <= 2 to resolve them'
    end if
    write (output_unit, '(a)') 'frictiondyn: '//deck
    write (output_unit, '(a,f0.6,a,i0,a,i0,a,i0,a,i0)') '  stuck period ', res%period_stuck, ' s; steps dt1 ', &

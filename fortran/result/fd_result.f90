@@ -14,9 +14,17 @@ module fd_result
    public :: result_type, max_violation_times, column_name_len, init_result, history_shape, check_finite
    public :: nonfinite_history_error
    public :: max_event_times, has_envelope
+   public :: resolution_none, resolution_resolved, resolution_unresolved, resolution_names
 
    integer, parameter :: max_violation_times = 10 !! first violation times kept
    integer, parameter :: max_event_times = 1000   !! first event times kept (exact technique)
+   ! whether dt1 resolves the highest natural modes (fd_mode_resolution)
+   integer, parameter :: resolution_none = 1        !! not applicable: no step (event-driven)
+   integer, parameter :: resolution_resolved = 2    !! omega_max dt1 <= 2
+   integer, parameter :: resolution_unresolved = 3  !! omega_max dt1 > 2
+   !> their names in the summary
+   character(len=14), parameter :: resolution_names(3) = [character(len=14) :: 'not applicable', 'resolved', &
+                                                          'unresolved']
    integer, parameter :: column_name_len = 16     !! length of a column name
 
    !> Everything a run produces.
@@ -34,6 +42,9 @@ module fd_result
       real(dp) :: dt1 = 0.0_dp             !! main step [s]
       real(dp) :: dt2 = 0.0_dp             !! step around phase changes [s]
       real(dp) :: dt_min = 0.0_dp          !! floor of step halving [s]
+      real(dp) :: omega_max = 0.0_dp       !! highest natural circular frequency integrated at dt1 [rad/s]
+      real(dp) :: omega_bound = 0.0_dp     !! an upper bound of it (Gershgorin) [rad/s]
+      integer :: mode_resolution = resolution_none !! whether dt1 resolves the highest modes
       integer :: technique = 0             !! technique id of the run (fd_names)
       ! peaks per DOF (over every step taken)
       real(dp), allocatable :: peak_u(:)        !! max |u| [m]

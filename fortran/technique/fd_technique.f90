@@ -16,6 +16,7 @@ module fd_technique
    use fd_newmark, only: run_newmark, newmark_check
    use fd_event_driven, only: run_event_driven, event_driven_check
    use fd_moreau_jean, only: run_moreau_jean, moreau_jean_check
+   use fd_mode_resolution, only: mode_resolution
    implicit none
    private
 
@@ -64,6 +65,8 @@ contains
       case default
          call unknown_technique(opts%technique, error)
       end select
+      ! whether the step resolves the highest modes: one report for every stepping technique
+      if (.not. allocated(error)) call mode_resolution(model, res, error)
    end subroutine run_technique
 
    subroutine unknown_technique(technique, error)
