@@ -5,7 +5,6 @@ program tester
    use testdrive, only: run_testsuite, new_testsuite, testsuite_type, select_suite, run_selected, &
                         get_argument
    use test_fd_format, only: collect_format
-   use test_fd_expm, only: collect_expm
    use test_fd_linalg, only: collect_linalg
    use test_fd_matrices, only: collect_matrices
    use test_fd_friction, only: collect_friction
@@ -41,7 +40,6 @@ program tester
    ! one suite a line (union-merge friendly: see .gitattributes)
    allocate (testsuites(0))
    testsuites = [testsuites, new_testsuite("format", collect_format)]
-   testsuites = [testsuites, new_testsuite("expm", collect_expm)]
    testsuites = [testsuites, new_testsuite("linalg", collect_linalg)]
    testsuites = [testsuites, new_testsuite("matrices", collect_matrices)]
    testsuites = [testsuites, new_testsuite("friction", collect_friction)]
