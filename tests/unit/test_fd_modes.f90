@@ -67,18 +67,11 @@ contains
       type(error_type), allocatable, intent(out) :: error
       integer, parameter :: n = 60, nev = 4
       real(dp) :: mass(n), ek(n), l1(nev), l2(nev), p1(n, nev), p2(n, nev), s1, s2, r
-      integer :: ei(n), ej(n), q(n), i, j, trial
+      integer :: ei(n), ej(n), j, trial
       type(lib_error), allocatable :: err
 
       do trial = 1, 3
-         call permutation(n, 17*trial, q)
-         do i = 1, n
-            mass(q(i)) = 1.0_dp + hashed(i, trial)
-            ei(i) = q(i)
-            ej(i) = 0
-            if (i > 1) ej(i) = q(i - 1)
-            ek(i) = 1.0e3_dp*(1.0_dp + hashed(i + n, trial))
-         end do
+         call random_chain(17*trial, trial, mass, ei, ej, ek)
          call lowest_modes(mass, ei, ej, ek, nev, l1, p1, s1, err, path=modes_dense)
          call check(error, .not. allocated(err), 'dense modes failed: '//text(err))
          if (allocated(error)) return
@@ -217,18 +210,11 @@ contains
       type(error_type), allocatable, intent(out) :: error
       integer, parameter :: n = 150
       real(dp) :: mass(n), ek(n), l1(1), p1(n, 1), s1, lam, bound
-      integer :: ei(n), ej(n), q(n), i, trial
+      integer :: ei(n), ej(n), trial
       type(lib_error), allocatable :: err
 
       do trial = 1, 3
-         call permutation(n, 13*trial, q)
-         do i = 1, n
-            mass(q(i)) = 1.0_dp + hashed(i, trial)
-            ei(i) = q(i)
-            ej(i) = 0
-            if (i > 1) ej(i) = q(i - 1)
-            ek(i) = 1.0e3_dp*(1.0_dp + hashed(i + n, trial))
-         end do
+         call random_chain(13*trial, trial, mass, ei, ej, ek)
          ! dsygv's largest eigenvalue: the scale lowest_modes reports on its dense path
          call lowest_modes(mass, ei, ej, ek, 1, l1, p1, s1, err, path=modes_dense)
          call check(error, .not. allocated(err), 'dense modes failed: '//text(err))
@@ -269,6 +255,25 @@ contains
       msg = ''
       if (allocated(err)) msg = err%message
    end function text
+
+   !> A randomly numbered chain (permutation seed s) of masses 1..2 kg and springs 1..2 kN/m
+   !> (hash seed trial), n = size(mass) nodes, fixed at one end.
+   pure subroutine random_chain(s, trial, mass, ei, ej, ek)
+      integer, intent(in) :: s, trial
+      real(dp), intent(out) :: mass(:), ek(:)
+      integer, intent(out) :: ei(:), ej(:)
+      integer :: q(size(mass)), i, n
+
+      n = size(mass)
+      call permutation(n, s, q)
+      do i = 1, n
+         mass(q(i)) = 1.0_dp + hashed(i, trial)
+         ei(i) = q(i)
+         ej(i) = 0
+         if (i > 1) ej(i) = q(i - 1)
+         ek(i) = 1.0e3_dp*(1.0_dp + hashed(i + n, trial))
+      end do
+   end subroutine random_chain
 
    pure subroutine permutation(n, s, q)
       integer, intent(in) :: n, s
