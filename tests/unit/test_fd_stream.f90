@@ -41,6 +41,8 @@ contains
          end do
          if (trial == 1) then
             x = [0.0_dp, -0.0_dp, 1.0_dp, -1.0_dp, tiny(1.0_dp), huge(1.0_dp), 4.9e-324_dp, -2.2250738585072e-310_dp]
+         else if (trial > 3000) then
+            x = hard_value(trial - 3000)
          else if (trial == 2) then
             x(1) = ieee_value(x(1), ieee_quiet_nan)
             x(2) = ieee_value(x(2), ieee_positive_inf)
@@ -64,6 +66,28 @@ contains
          end if
       end do
    contains
+      !> Values where the 17-digit rounding is hardest: the doubles next to powers of ten
+      !> (and to 10^k (1 - 1e-17), which round up to the next power), and the doubles nearest
+      !> to decimals whose 18th significant digit is 5 (halfway between two 17-digit
+      !> mantissas, to within an ulp: the fast path must leave them to snprintf), with exponents
+      !> over the range of both paths.
+      function hard_value(t) result(v)
+         integer, intent(in) :: t
+         real(dp) :: v(m), p, d
+         integer :: k, i
+         k = mod(t*37, 580) - 290
+         p = 10.0_dp**k
+         v(1) = nearest(p, 1.0_dp)
+         v(2) = nearest(p, -1.0_dp)
+         v(3) = p*(1.0_dp - 1.0e-17_dp)
+         v(4) = -nearest(v(3), -1.0_dp)
+         do i = 5, m
+            ! d: a 17-digit mantissa from a hash, then +1/2 in its last place
+            d = 1.0e16_dp + aint(modulo(sin(real(t*29 + i*11, dp))*43758.5453_dp, 1.0_dp)*9.0e16_dp)
+            v(i) = (d + 0.5_dp)*10.0_dp**(k - 16)
+            if (i == m) v(i) = nearest(v(i), 1.0_dp)
+         end do
+      end function hard_value
       !> Values over the whole range of exponents, both signs.
       real(dp) function value(t, i)
          integer, intent(in) :: t, i
