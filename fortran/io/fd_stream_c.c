@@ -20,7 +20,7 @@
  *
  * glibc's "%.16E" is exact because it works in multiple precision (about 5000 instructions a
  * value, more than a whole Newmark step of a small model). Here y = |x| 10^(16 - E) is formed
- * in double-double arithmetic (about 106 bits, relative error below 1e-30 after the at most
+ * in double-double arithmetic (about 106 bits, relative error of order 1e-30 after the at most
  * ten products of the binary powering of 10^k), so that round(y) is the 17-digit integer
  * mantissa whenever y is farther than DD_MARGIN from a half-integer; otherwise, and for 0,
  * NaN, infinities and |x| outside [1e-290, 1e290] (where 10^(16 - E) would leave the range
@@ -126,7 +126,11 @@ static void format_es24(double x, char *out)
     double a = fabs(x);
     long long m;
     int e;
-    if (a >= 1.0e-290 && a <= 1.0e290 && digits17(a, &m, &e)) {
+    if (isnan(x)) { /* first: an ordered comparison with a NaN raises FE_INVALID */
+        text = "NaN";
+    } else if (isinf(x)) {
+        text = x > 0 ? "Infinity" : "-Infinity";
+    } else if (a >= 1.0e-290 && a <= 1.0e290 && digits17(a, &m, &e)) {
         /* "-d.dddddddddddddddE+eee", right-justified */
         char *p = full;
         char dig[17];
@@ -147,10 +151,6 @@ static void format_es24(double x, char *out)
         *p++ = (char)('0' + (e / 10) % 10);
         *p++ = (char)('0' + e % 10);
         *p = '\0';
-    } else if (isnan(x)) {
-        text = "NaN";
-    } else if (isinf(x)) {
-        text = x > 0 ? "Infinity" : "-Infinity";
     } else {
         /* the exact path: "-d.dddddddddddddddddE-xx" as printed, exponent widened to 3 digits */
         snprintf(tmp, sizeof tmp, "%.16E", x);
