@@ -108,21 +108,39 @@ def main() -> None:
     exact_test4(max(args.repeat, 5))
 
     exe = fd.executable()
+    deck = (ROOT / "inputs" / "test4_velocity.nml").read_text()
     with tempfile.TemporaryDirectory() as tmp:
-        times = []
+        # the same run with and without the history file: the difference is its formatting
+        # and writing (8001 rows x 12 values)
+        quiet = Path(tmp) / "quiet.nml"
+        quiet.write_text(deck.replace("&output", "&output\n  write_history = .false.", 1))
+        times: dict[str, list[float]] = {"csv": [], "none": []}
         for _ in range(args.repeat):
-            t0 = time.perf_counter()
-            subprocess.run(
-                [exe, str(ROOT / "inputs" / "test4_velocity.nml")],
-                cwd=tmp,
-                check=True,
-                capture_output=True,
-            )
-            times.append(time.perf_counter() - t0)
+            for key, path in (("csv", ROOT / "inputs" / "test4_velocity.nml"), ("none", quiet)):
+                t0 = time.perf_counter()
+                subprocess.run([exe, str(path)], cwd=tmp, check=True, capture_output=True)
+                times[key].append(time.perf_counter() - t0)
         size = (Path(tmp) / "out" / "test4_velocity.csv").stat().st_size
+    t_csv, t_none = statistics.median(times["csv"]), statistics.median(times["none"])
     print(
         f"\nexecutable on inputs/test4_velocity.nml (8001 x 12 CSV, {size / 1e6:.1f} MB): "
-        f"{statistics.median(times):.4f} s"
+        f"{t_csv:.4f} s; without the history file {t_none:.4f} s: "
+        f"{1e9 * (t_csv - t_none) / (8001 * 12):.0f} ns a value written"
+    )
+
+    # the fixed cost of a run through the extension: a deck of one record step (20 steps)
+    short = paper_analysis(4, "hysteretic")
+    short.excitation.duration = short.excitation.dt_record
+    for _ in range(20):
+        short.run()
+    cpu = []
+    for _ in range(200):
+        c0 = time.process_time()
+        short.run()
+        cpu.append(time.process_time() - c0)
+    print(
+        f"fixed cost of Analysis.run() (test 4, one record step: deck, set-up, summary, "
+        f"Result): {1e3 * statistics.median(cpu):.2f} ms CPU (median of 200)"
     )
 
     print(
