@@ -9,6 +9,7 @@ from __future__ import annotations
 import contextlib
 import io
 import math
+import warnings
 
 import frictiondyn as fd
 from frictiondyn.cli import main as cli
@@ -76,6 +77,7 @@ def building(n: int, law: str, technique: str | None) -> fd.Analysis:
     )
 
 
+@pytest.mark.filterwarnings("ignore::frictiondyn.FrictiondynWarning")
 @pytest.mark.parametrize("n", [20, 300])
 def test_building_against_numpy(n):
     """Shear buildings of 20 (dsygv) and 300 storeys (Lanczos): Newmark with hysteretic
@@ -121,6 +123,7 @@ def one_dof(omega_dt: float, dt: float = 0.01, steps: int = 40) -> fd.Analysis:
     )
 
 
+@pytest.mark.filterwarnings("ignore::frictiondyn.FrictiondynWarning")
 @pytest.mark.parametrize("omega_dt", [0.5, 4.0, 40.0])
 def test_reported_period_is_the_trapezoidal_rule(omega_dt):
     """What the report means: average acceleration integrates a mode of omega dt1 with the
@@ -150,3 +153,20 @@ def test_executable_and_cli_warn(tmp_path, run):
     assert WARNING in err.getvalue() and "omega_max dt1 = 4 > 2" in err.getvalue()
     soft = one_dof(0.5).write_deck(tmp_path / "soft.nml")
     assert WARNING not in ok(run(soft.read_text(), name="soft")).stderr
+
+
+def test_python_warns():
+    """The Python API warns (FrictiondynWarning) where the executable does: an unresolved
+    step, and steps that violate the correctness condition (the paper's Fig. 3 deck); a
+    resolved run is silent."""
+    with pytest.warns(fd.FrictiondynWarning, match="does not resolve the highest modes"):
+        one_dof(4.0).run()
+    from frictiondyn.paper import paper_analysis
+
+    coarse = paper_analysis(4, "hysteretic", coarse=True, duration=2.0)
+    with pytest.warns(fd.FrictiondynWarning, match="violate the correctness condition"):
+        r = coarse.run()
+    assert r.summary["correctness_violations"] > 0
+    with warnings.catch_warnings():
+        warnings.simplefilter("error", fd.FrictiondynWarning)
+        one_dof(0.5).run()

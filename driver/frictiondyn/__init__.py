@@ -10,6 +10,7 @@ from __future__ import annotations
 from ._api import (
     DeckError,
     FrictiondynError,
+    FrictiondynWarning,
     Modes,
     OutOfMemoryError,
     OutputError,
@@ -48,6 +49,7 @@ __all__ = [
     "FreeVibration",
     "FrictionBrace",
     "FrictiondynError",
+    "FrictiondynWarning",
     "Harmonic",
     "Integration",
     "Modes",

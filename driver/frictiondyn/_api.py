@@ -19,8 +19,10 @@ threads overlap.
 from __future__ import annotations
 
 import json
+import math
 import os
 import threading
+import warnings
 from collections.abc import Callable, Sequence
 from dataclasses import dataclass, field
 from pathlib import Path
@@ -32,6 +34,7 @@ from . import _core
 __all__ = [
     "DeckError",
     "FrictiondynError",
+    "FrictiondynWarning",
     "Modes",
     "OutOfMemoryError",
     "OutputError",
@@ -70,6 +73,37 @@ class RunCancelled(FrictiondynError):
 class OutOfMemoryError(FrictiondynError, MemoryError):
     """Memory for what the deck asks (its matrices, its history) cannot be had; the message
     says what and how large. Also a MemoryError."""
+
+
+class FrictiondynWarning(UserWarning):
+    """A run that finished but whose answer needs care, as the executable warns on standard
+    error: steps that violate the correctness condition (eqs. 9, 12), or a step dt1 that does
+    not resolve the structure's highest modes (summary ``mode_resolution``). Issued when the
+    Result is made (``Session.result``, ``run``, ``Analysis.run``); the summary holds the
+    figures. Filter it with the ``warnings`` module like any other warning."""
+
+
+def _warn_about(summary: dict, deck: str) -> None:
+    """FrictiondynWarnings for what the summary reports (the executable's warnings)."""
+    n = summary.get("correctness_violations", 0)
+    if n:
+        times = ", ".join(f"{t:g}" for t in summary.get("violation_times_s", []))
+        warnings.warn(
+            f"{deck}: {n} step(s) violate the correctness condition (eqs. 9, 12); first at "
+            f"t = {times} s",
+            FrictiondynWarning,
+            stacklevel=3,
+        )
+    if summary.get("mode_resolution") == "unresolved":
+        w = summary["omega_max_rad_s"]
+        warnings.warn(
+            f"{deck}: dt1 = {summary['dt1_s']:.3g} s does not resolve the highest modes "
+            f"(shortest period {2 * math.pi / w:.3g} s, omega_max dt1 = "
+            f"{summary['omega_max_dt1']:.3g} > 2): their response has the wrong period; peak "
+            "absolute accelerations may carry it; raise n1 until omega_max dt1 <= 2",
+            FrictiondynWarning,
+            stacklevel=3,
+        )
 
 
 # the status codes of the extension (driver/frictiondyn/_core.f90)
@@ -406,6 +440,8 @@ class Session:
             result.output = OutputSettings(
                 self._text(_OUTPUT_DIR), self._text(_OUTPUT_NAME), bool(history)
             )
+            deck = self._text(_DECK)
+        _warn_about(result.summary, deck)
         return result
 
     def write(self, out: str | os.PathLike | None = None) -> tuple[Path | None, Path]:

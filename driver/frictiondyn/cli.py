@@ -22,11 +22,12 @@ import argparse
 import math
 import os
 import sys
+import warnings
 from collections.abc import Sequence
 from pathlib import Path
 
 from . import __version__
-from ._api import FrictiondynError, Result, Session, run
+from ._api import FrictiondynError, FrictiondynWarning, Result, Session, run
 
 __all__ = ["load_result", "main"]
 
@@ -170,7 +171,9 @@ def cmd_run(args: argparse.Namespace) -> int:
             session.solve(progress=bar, history=args.plot)
         finally:
             bar.close()
-        result = session.result()
+        with warnings.catch_warnings():  # _print_summary prints them, as the executable does
+            warnings.simplefilter("ignore", FrictiondynWarning)
+            result = session.result()
         csv, summ = session.write()
     _print_summary(result, args.deck)
     if csv is not None:
