@@ -12,10 +12,10 @@ import math
 import warnings
 
 import frictiondyn as fd
-from frictiondyn.cli import main as cli
 import numpy as np
 import pytest
 from conftest import INPUTS, K1, K2, M1, M2, MU, P, ok
+from frictiondyn.cli import main as cli
 
 WARNING = "does not resolve the highest modes"
 
