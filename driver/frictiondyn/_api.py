@@ -95,15 +95,18 @@ def _warn_about(summary: dict, deck: str) -> None:
             stacklevel=3,
         )
     if summary.get("mode_resolution") == "unresolved":
-        w = summary["omega_max_rad_s"]
-        warnings.warn(
-            f"{deck}: dt1 = {summary['dt1_s']:.3g} s does not resolve the highest modes "
-            f"(shortest period {2 * math.pi / w:.3g} s, omega_max dt1 = "
-            f"{summary['omega_max_dt1']:.3g} > 2): their response has the wrong period; peak "
-            "absolute accelerations may carry it; raise n1 until omega_max dt1 <= 2",
-            FrictiondynWarning,
-            stacklevel=3,
-        )
+        warnings.warn(f"{deck}: {unresolved_message(summary)}", FrictiondynWarning, stacklevel=3)
+
+
+def unresolved_message(summary: dict) -> str:
+    """What a summary with ``mode_resolution = "unresolved"`` means (the warning's text)."""
+    return (
+        f"dt1 = {summary['dt1_s']:.3g} s does not resolve the highest modes (shortest period "
+        f"{2 * math.pi / summary['omega_max_rad_s']:.3g} s, omega_max dt1 = "
+        f"{summary['omega_max_dt1']:.3g} > 2): their response has the wrong period; peak "
+        "absolute accelerations may carry it (drifts and shears much less); raise n1 until "
+        "omega_max dt1 <= 2 to resolve them"
+    )
 
 
 # the status codes of the extension (driver/frictiondyn/_core.f90)

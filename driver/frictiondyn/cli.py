@@ -19,7 +19,6 @@ Errors print one line ``frictiondyn: error: ...`` on standard error and exit wit
 from __future__ import annotations
 
 import argparse
-import math
 import os
 import sys
 import warnings
@@ -27,7 +26,7 @@ from collections.abc import Sequence
 from pathlib import Path
 
 from . import __version__
-from ._api import FrictiondynError, FrictiondynWarning, Result, Session, run
+from ._api import FrictiondynError, FrictiondynWarning, Result, Session, run, unresolved_message
 
 __all__ = ["load_result", "main"]
 
@@ -110,14 +109,7 @@ def _print_summary(result: Result, deck: str) -> None:
             file=sys.stderr,
         )
     if s.get("mode_resolution") == "unresolved":
-        print(
-            f"frictiondyn: warning: dt1 = {s['dt1_s']:.3g} s does not resolve the highest modes "
-            f"(shortest period {2 * math.pi / s['omega_max_rad_s']:.3g} s, omega_max dt1 = "
-            f"{s['omega_max_dt1']:.3g} > 2): their response has the wrong period; peak absolute "
-            "accelerations may carry it (drifts and shears much less); raise n1 until "
-            "omega_max dt1 <= 2 to resolve them",
-            file=sys.stderr,
-        )
+        print(f"frictiondyn: warning: {unresolved_message(s)}", file=sys.stderr)
 
 
 def _trange(value: Sequence[float] | None) -> tuple[float, float] | None:
