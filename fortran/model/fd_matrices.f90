@@ -6,7 +6,7 @@ module fd_matrices
    use, intrinsic :: ieee_arithmetic, only: ieee_value, ieee_positive_inf, ieee_quiet_nan
    use fd_kinds, only: dp
    use fd_error, only: error_type, fatal_error, fmt_real, fmt_int, stat_no_memory
-   use fd_model, only: model_type, damping_none, damping_stiffness, damping_rayleigh, law_hysteretic, &
+   use fd_model, only: model_type, damping_none, damping_stiffness, damping_rayleigh, law_hysteretic, sticking_stiffness, &
                        system_stuck, system_free
    use fd_linalg, only: generalized_eigen, lowest_eigen, lowest_eigen_band
    use fd_rcm, only: rcm_order
@@ -344,8 +344,8 @@ contains
       do d = 1, model%n_devices
          pm = model%dev(d)%p*model%dev(d)%mu
          linked(d) = system == system_stuck .and. pm > 0.0_dp .and. model%dev(d)%law /= law_hysteretic
-         if (system == system_stuck .and. pm > 0.0_dp .and. model%dev(d)%law == law_hysteretic) then
-            kd = pm/model%dev(d)%f
+         kd = sticking_stiffness(model%dev(d))
+         if (system == system_stuck .and. kd > 0.0_dp) then
             ni = model%dev(d)%node_i; nj = model%dev(d)%node_j
             ks(ni, ni) = ks(ni, ni) + kd
             if (nj > 0) then
@@ -456,7 +456,7 @@ contains
       integer, allocatable :: grp(:), ea(:), eb(:), root(:)
       logical, allocatable :: linked(:), grounded(:)
       real(dp), allocatable :: mq(:), ek(:), lam(:), z(:, :), phi(:), ebig(:)
-      real(dp) :: pm, big, sigma, scale, w, l, mtot, kz
+      real(dp) :: pm, kd, big, sigma, scale, w, l, mtot, kz
       integer :: n, nq, ne, ns, nd, i, j, a, b, s, d, imax, m, stat
       logical :: shifted
 
@@ -493,9 +493,8 @@ contains
       end do
       if (system == system_stuck) then
          do d = 1, nd
-            pm = model%dev(d)%p*model%dev(d)%mu
-            if (pm > 0.0_dp .and. model%dev(d)%law == law_hysteretic) &
-               call element(model%dev(d)%node_i, model%dev(d)%node_j, pm/model%dev(d)%f)
+            kd = sticking_stiffness(model%dev(d))
+            if (kd > 0.0_dp) call element(model%dev(d)%node_i, model%dev(d)%node_j, kd)
          end do
       end if
       ! a bound of the largest eigenvalue of Mq^-1 Kq (Gershgorin), and the groups held to

@@ -43,7 +43,6 @@ module fd_result
       real(dp) :: dt2 = 0.0_dp             !! step around phase changes [s]
       real(dp) :: dt_min = 0.0_dp          !! floor of step halving [s]
       real(dp) :: omega_max = 0.0_dp       !! highest natural circular frequency integrated at dt1 [rad/s]
-      real(dp) :: omega_bound = 0.0_dp     !! an upper bound of it (Gershgorin) [rad/s]
       integer :: mode_resolution = resolution_none !! whether dt1 resolves the highest modes
       integer :: technique = 0             !! technique id of the run (fd_names)
       ! peaks per DOF (over every step taken)

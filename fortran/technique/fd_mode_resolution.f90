@@ -18,8 +18,8 @@
 module fd_mode_resolution
    use fd_kinds, only: dp
    use fd_error, only: error_type, fatal_error, fmt_int, stat_no_memory
-   use fd_names, only: law_hysteretic, technique_newmark, technique_moreau_jean
-   use fd_model, only: model_type
+   use fd_names, only: technique_newmark, technique_moreau_jean
+   use fd_model, only: model_type, sticking_stiffness
    use fd_modes, only: highest_eigenvalue
    use fd_result, only: result_type, resolution_none, resolution_resolved, resolution_unresolved
    implicit none
@@ -33,20 +33,19 @@ module fd_mode_resolution
 contains
 
    !> Sets res%omega_max (the highest natural circular frequency of the system the technique
-   !> integrates at dt1, a lower bound accurate to 1e-4: fd_modes' Lanczos), res%omega_bound
-   !> (Gershgorin's upper bound) and res%mode_resolution, from res%technique and res%dt1.
+   !> integrates at dt1, a lower bound accurate to 1e-4: fd_modes' Lanczos) and
+   !> res%mode_resolution, from res%technique and res%dt1.
    subroutine mode_resolution(model, res, error)
       type(model_type), intent(in) :: model               !! the model
       type(result_type), intent(inout) :: res             !! the result of the run
       type(error_type), allocatable, intent(out) :: error !! no memory, solver failure
       integer, allocatable :: ei(:), ej(:)
       real(dp), allocatable :: ek(:)
-      real(dp) :: lam, bound, pm
+      real(dp) :: lam, bound, kd
       integer :: ns, nd, ne, d, stat
 
       res%mode_resolution = resolution_none
       res%omega_max = 0.0_dp
-      res%omega_bound = 0.0_dp
       if (res%technique /= technique_newmark .and. res%technique /= technique_moreau_jean) return
       if (res%dt1 <= 0.0_dp .or. model%n_dof == 0) return
       ns = model%n_springs
@@ -63,12 +62,12 @@ contains
       ne = ns
       if (res%technique == technique_newmark) then
          do d = 1, nd
-            pm = model%dev(d)%p*model%dev(d)%mu
-            if (model%dev(d)%law /= law_hysteretic .or. pm <= 0.0_dp) cycle
+            kd = sticking_stiffness(model%dev(d))
+            if (kd <= 0.0_dp) cycle
             ne = ne + 1
             ei(ne) = model%dev(d)%node_i
             ej(ne) = model%dev(d)%node_j
-            ek(ne) = pm/model%dev(d)%f
+            ek(ne) = kd
          end do
       end if
       call highest_eigenvalue(model%mass, ei(1:ne), ej(1:ne), ek(1:ne), lam, bound, error)
@@ -77,7 +76,6 @@ contains
          return
       end if
       res%omega_max = sqrt(max(lam, 0.0_dp))
-      res%omega_bound = sqrt(max(bound, 0.0_dp))
       if (res%omega_max*res%dt1 > resolution_limit) then
          res%mode_resolution = resolution_unresolved
       else

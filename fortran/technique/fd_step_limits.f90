@@ -14,7 +14,7 @@ module fd_step_limits
    use fd_kinds, only: dp
    use fd_error, only: error_type, fatal_error, fmt_int, fmt_real
    use fd_names, only: law_velocity, law_hysteretic
-   use fd_model, only: model_type, integration_type
+   use fd_model, only: model_type, integration_type, sticking_stiffness
    use fd_excitation, only: excitation_type
    implicit none
    private
@@ -158,7 +158,7 @@ contains
             kd = opts%gamma/(opts%beta*dt1)*(pmu/model%dev(d)%eps)
          case (law_hysteretic)
             var = 'f'//idx//' = '//trim(fmt_real(model%dev(d)%f))
-            kd = pmu/model%dev(d)%f
+            kd = sticking_stiffness(model%dev(d))
          case default
             cycle
          end select
