@@ -24,8 +24,9 @@
  * ten products of the binary powering of 10^k), so that round(y) is the 17-digit integer
  * mantissa whenever y is farther than DD_MARGIN from a half-integer; otherwise, and for 0,
  * NaN, infinities and |x| outside [1e-290, 1e290] (where 10^(16 - E) would leave the range
- * of doubles), format_es24 takes the exact path, snprintf. An exact tie cannot occur: a double is never
- * halfway between two 17-digit decimals (the halfway point would need more than 53 bits).
+ * of doubles), format_es24 takes the exact path, snprintf. An exact tie cannot occur: a
+ * double is never halfway between two 17-digit decimals (the halfway point would need more
+ * than 53 bits).
  * tests/unit/test_fd_stream.f90 compares both paths with gfortran's own ES24.16E3 writes. */
 typedef struct {
     double hi, lo;
@@ -58,7 +59,7 @@ static dd_t dd_div(double a, dd_t b)
     return quick_two_sum(q1, r / b.hi);
 }
 
-/* 10^k, 0 <= k <= 400, by binary powering from 10^(2^i) (exact up to 10^16 in one double). */
+/* 10^k, 0 <= k <= 306, by binary powering from 10^(2^i) (exact up to 10^16 in one double). */
 static dd_t dd_pow10(int k)
 {
     dd_t r = {1.0, 0.0}, b = {10.0, 0.0};

@@ -295,7 +295,7 @@ contains
       real(dp), intent(out) :: lambda             !! largest Ritz value [1/s^2] (a lower bound)
       real(dp), intent(out) :: bound              !! Gershgorin bound [1/s^2] (an upper bound)
       type(error_type), allocatable, intent(out) :: error !! bad input, no memory, LAPACK failure
-      real(dp), allocatable :: rs(:), q0(:), q1(:), w(:), alpha(:), beta(:), d(:), e(:), lam(:), phi(:, :)
+      real(dp), allocatable :: rs(:), dm(:), q0(:), q1(:), w(:), alpha(:), beta(:), d(:), e(:), lam(:), phi(:, :)
       real(dp) :: nrm, top, prev, x
       integer :: n, ne, i, a, b, k, info, stat
 
@@ -348,14 +348,15 @@ contains
          return
       end if
       ! Lanczos on A = D K D from a reproducible pseudo-random start
-      allocate (q0(n), q1(n), w(n), alpha(lanczos_max_steps), beta(lanczos_max_steps), d(lanczos_max_steps), &
-                e(lanczos_max_steps), stat=stat)
+      allocate (dm(n), q0(n), q1(n), w(n), alpha(lanczos_max_steps), beta(lanczos_max_steps), &
+                d(lanczos_max_steps), e(lanczos_max_steps), stat=stat)
       if (stat /= 0) then
          call fatal_error(error, "highest_eigenvalue: not enough memory for "//trim(fmt_int(n))//" DOFs", &
                           stat_no_memory)
          return
       end if
       do i = 1, n
+         dm(i) = 1.0_dp/sqrt(mass(i))   ! D, once
          q1(i) = start_value(i, 1)
       end do
       q1 = q1/norm2(q1)
@@ -363,9 +364,9 @@ contains
       prev = -1.0_dp
       top = 0.0_dp
       do k = 1, min(lanczos_max_steps, n)
-         ! w = D K D q1 - beta_(k-1) q0
+         ! w = D K D q1 - beta_(k-1) q0 (rs, free after Gershgorin, holds D q1)
          do i = 1, n
-            rs(i) = q1(i)/sqrt(mass(i))
+            rs(i) = dm(i)*q1(i)
          end do
          w = 0.0_dp
          do i = 1, ne
@@ -378,7 +379,7 @@ contains
             if (b > 0) w(b) = w(b) - x
          end do
          do i = 1, n
-            w(i) = w(i)/sqrt(mass(i))
+            w(i) = dm(i)*w(i)
          end do
          if (k > 1) w = w - beta(k - 1)*q0
          alpha(k) = dot_product(w, q1)
