@@ -83,30 +83,26 @@ class FrictiondynWarning(UserWarning):
     figures. Filter it with the ``warnings`` module like any other warning."""
 
 
-def _warn_about(summary: dict, deck: str) -> None:
-    """FrictiondynWarnings for what the summary reports (the executable's warnings)."""
+def summary_warnings(summary: dict) -> list[str]:
+    """The warnings a summary calls for, as the executable prints them on standard error
+    (without its "frictiondyn: warning: " prefix): correctness violations, and a step dt1
+    that does not resolve the highest modes."""
+    out = []
     n = summary.get("correctness_violations", 0)
     if n:
         times = ", ".join(f"{t:g}" for t in summary.get("violation_times_s", []))
-        warnings.warn(
-            f"{deck}: {n} step(s) violate the correctness condition (eqs. 9, 12); first at "
-            f"t = {times} s",
-            FrictiondynWarning,
-            stacklevel=3,
+        out.append(
+            f"{n} step(s) violate the correctness condition (eqs. 9, 12); first at t = {times} s"
         )
     if summary.get("mode_resolution") == "unresolved":
-        warnings.warn(f"{deck}: {unresolved_message(summary)}", FrictiondynWarning, stacklevel=3)
-
-
-def unresolved_message(summary: dict) -> str:
-    """What a summary with ``mode_resolution = "unresolved"`` means (the warning's text)."""
-    return (
-        f"dt1 = {summary['dt1_s']:.3g} s does not resolve the highest modes (shortest period "
-        f"{2 * math.pi / summary['omega_max_rad_s']:.3g} s, omega_max dt1 = "
-        f"{summary['omega_max_dt1']:.3g} > 2): their response has the wrong period; peak "
-        "absolute accelerations may carry it (drifts and shears much less); raise n1 until "
-        "omega_max dt1 <= 2 to resolve them"
-    )
+        out.append(
+            f"dt1 = {summary['dt1_s']:.3g} s does not resolve the highest modes (shortest period "
+            f"{2 * math.pi / summary['omega_max_rad_s']:.3g} s, omega_max dt1 = "
+            f"{summary['omega_max_dt1']:.3g} > 2): their response has the wrong period; peak "
+            "absolute accelerations may carry it (drifts and shears much less); raise n1 until "
+            "omega_max dt1 <= 2 to resolve them"
+        )
+    return out
 
 
 # the status codes of the extension (driver/frictiondyn/_core.f90)
@@ -444,7 +440,8 @@ class Session:
                 self._text(_OUTPUT_DIR), self._text(_OUTPUT_NAME), bool(history)
             )
             deck = self._text(_DECK)
-        _warn_about(result.summary, deck)
+        for message in summary_warnings(result.summary):
+            warnings.warn(f"{deck}: {message}", FrictiondynWarning, stacklevel=2)
         return result
 
     def write(self, out: str | os.PathLike | None = None) -> tuple[Path | None, Path]:

@@ -26,7 +26,7 @@ from collections.abc import Sequence
 from pathlib import Path
 
 from . import __version__
-from ._api import FrictiondynError, FrictiondynWarning, Result, Session, run, unresolved_message
+from ._api import FrictiondynError, FrictiondynWarning, Result, Session, run, summary_warnings
 
 __all__ = ["load_result", "main"]
 
@@ -102,14 +102,8 @@ def _print_summary(result: Result, deck: str) -> None:
     if "peak_base_shear_N" in s:
         print(f"  peak base shear {s['peak_base_shear_N']:.6g} N")
     print(f"  correctness violations: {s['correctness_violations']}")
-    if s["correctness_violations"]:
-        print(
-            f"frictiondyn: warning: {s['correctness_violations']} step(s) violate the "
-            "correctness condition (eqs. 9, 12)",
-            file=sys.stderr,
-        )
-    if s.get("mode_resolution") == "unresolved":
-        print(f"frictiondyn: warning: {unresolved_message(s)}", file=sys.stderr)
+    for message in summary_warnings(s):
+        print(f"frictiondyn: warning: {message}", file=sys.stderr)
 
 
 def _trange(value: Sequence[float] | None) -> tuple[float, float] | None:
