@@ -47,25 +47,28 @@ contains
    !> the trial state s1, sd1) and the correctness condition of the step (eqs. 9, 12), with
    !> whether any phase changed and any device violates the condition. What friction_update
    !> and friction_correct do device by device, in one loop that calls each law's routines
-   !> directly (the time step's per-device cost in a large structure). A device whose law has
-   !> no case here keeps its state (friction_init rejected it before the first step).
-   subroutine friction_step(dev, n, s1, sd1, sd, st, st1, changed, ok, any_changed, any_bad)
-      type(device_type), intent(in) :: dev(:)   !! devices
+   !> directly (the time step's per-device cost in a large structure; explicit shapes, since
+   !> building array descriptors at every call cost more than a two-mass model's laws). A
+   !> device whose law has no case here keeps its state (friction_init rejected it before the
+   !> first step).
+   subroutine friction_step(nd, dev, n, s1, sd1, sd, st, st1, changed, ok, any_changed, any_bad)
+      integer, intent(in) :: nd                 !! devices
+      type(device_type), intent(in) :: dev(nd)  !! devices
       real(dp), intent(in) :: n                 !! n > 1 of the correctness condition
-      real(dp), intent(in) :: s1(:)             !! relative displacements at the step's end [m]
-      real(dp), intent(in) :: sd1(:)            !! relative velocities at the step's end [m/s]
-      real(dp), intent(in) :: sd(:)             !! relative velocities at its start [m/s]
-      type(device_state), intent(in) :: st(:)   !! states during the step
-      type(device_state), intent(inout) :: st1(:) !! states for the next step
-      logical, intent(out) :: changed(:)        !! the phase changed
-      logical, intent(out) :: ok(:)             !! the step satisfies the condition
+      real(dp), intent(in) :: s1(nd)            !! relative displacements at the step's end [m]
+      real(dp), intent(in) :: sd1(nd)           !! relative velocities at the step's end [m/s]
+      real(dp), intent(in) :: sd(nd)            !! relative velocities at its start [m/s]
+      type(device_state), intent(in) :: st(nd)  !! states during the step
+      type(device_state), intent(inout) :: st1(nd) !! states for the next step
+      logical, intent(out) :: changed(nd)       !! the phase changed
+      logical, intent(out) :: ok(nd)            !! the step satisfies the condition
       logical, intent(out) :: any_changed       !! some phase changed
       logical, intent(out) :: any_bad           !! some device violates the condition
       integer :: d
 
       any_changed = .false.
       any_bad = .false.
-      do d = 1, size(dev)
+      do d = 1, nd
          st1(d) = st(d)
          select case (dev(d)%law)
          case (law_hysteretic)

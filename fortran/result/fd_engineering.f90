@@ -231,71 +231,92 @@ contains
       real(dp), intent(out) :: drift(:)          !! (n_storeys) drift [m]
       real(dp), intent(out) :: shear(:)          !! (n_storeys) storey shear [N]
       real(dp), intent(out) :: base              !! base shear [N]
-      real(dp) :: f, du, dv
-      integer :: s, cut, e, i, j
+      integer :: s
 
-      ! (written out, without function calls: this runs at every accepted step)
       do s = 1, eng%n_storeys
-         i = eng%storey_i(s)
-         j = eng%storey_j(s)
-         du = 0.0_dp
-         if (i > 0) du = u(i)
-         if (j > 0) du = du - u(j)
-         drift(s) = du
+         drift(s) = storey_drift(eng, s, u)
+         shear(s) = cut_force(eng, s, u, v, force)
       end do
-      ! the force across each cut (0: the base): the springs' and the devices' crossing it
-      do cut = 0, eng%n_storeys
-         f = 0.0_dp
-         do e = eng%sp_first(cut), eng%sp_first(cut + 1) - 1
-            i = eng%sp_i(e)
-            j = eng%sp_j(e)
-            du = 0.0_dp
-            dv = 0.0_dp
-            if (i > 0) then
-               du = u(i)
-               dv = v(i)
-            end if
-            if (j > 0) then
-               du = du - u(j)
-               dv = dv - v(j)
-            end if
-            f = f + eng%sp_k(e)*(du + eng%a1*dv)
-         end do
-         do e = eng%dv_first(cut), eng%dv_first(cut + 1) - 1
-            f = f + eng%dv_sign(e)*force(eng%dv_id(e))
-         end do
-         if (cut == 0) then
-            base = f
-         else
-            shear(cut) = f
-         end if
-      end do
+      base = cut_force(eng, 0, u, v, force)
    end subroutine storey_values
 
+   !> Drift of storey s, u(node_i) - u(node_j) (node 0: the table).
+   pure real(dp) function storey_drift(eng, s, u) result(du)
+      type(engineering_type), intent(in) :: eng  !! the set-up outputs
+      integer, intent(in) :: s                   !! storey
+      real(dp), intent(in) :: u(:)               !! relative displacements [m]
+      integer :: i, j
+
+      i = eng%storey_i(s)
+      j = eng%storey_j(s)
+      du = 0.0_dp
+      if (i > 0) du = u(i)
+      if (j > 0) du = du - u(j)
+   end function storey_drift
+
+   !> The force across cut `cut` (0: the base): the springs' (elastic and stiffness-damping)
+   !> and the devices' crossing it.
+   pure real(dp) function cut_force(eng, cut, u, v, force) result(f)
+      type(engineering_type), intent(in) :: eng  !! the set-up outputs
+      integer, intent(in) :: cut                 !! 0 (base) .. n_storeys
+      real(dp), intent(in) :: u(:)               !! relative displacements [m]
+      real(dp), intent(in) :: v(:)               !! relative velocities [m/s]
+      real(dp), intent(in) :: force(:)           !! device forces [N]
+      real(dp) :: du, dv
+      integer :: e, i, j
+
+      f = 0.0_dp
+      do e = eng%sp_first(cut), eng%sp_first(cut + 1) - 1
+         i = eng%sp_i(e)
+         j = eng%sp_j(e)
+         du = 0.0_dp
+         dv = 0.0_dp
+         if (i > 0) then
+            du = u(i)
+            dv = v(i)
+         end if
+         if (j > 0) then
+            du = du - u(j)
+            dv = dv - v(j)
+         end if
+         f = f + eng%sp_k(e)*(du + eng%a1*dv)
+      end do
+      do e = eng%dv_first(cut), eng%dv_first(cut + 1) - 1
+         f = f + eng%dv_sign(e)*force(eng%dv_id(e))
+      end do
+   end function cut_force
+
    !> One accepted state: drifts and shears, their peaks, and the values kept as the
-   !> residual ones (those of the last state observed).
-   pure subroutine observe_engineering(eng, t, u, v, s, force)
+   !> residual ones (those of the last state observed). Runs at every accepted step: the
+   !> values go straight into the peaks (no array sections passed, no temporaries).
+   pure subroutine observe_engineering(eng, t, n, nd, u, v, s, force)
       type(engineering_type), intent(inout) :: eng  !! the outputs
       real(dp), intent(in) :: t                     !! time [s]
-      real(dp), intent(in) :: u(:)                  !! relative displacements [m]
-      real(dp), intent(in) :: v(:)                  !! relative velocities [m/s]
-      real(dp), intent(in) :: s(:)                  !! device relative displacements [m]
-      real(dp), intent(in) :: force(:)              !! device forces [N]
+      integer, intent(in) :: n                      !! DOFs
+      integer, intent(in) :: nd                     !! devices
+      real(dp), intent(in) :: u(n)                  !! relative displacements [m]
+      real(dp), intent(in) :: v(n)                  !! relative velocities [m/s]
+      real(dp), intent(in) :: s(nd)                 !! device relative displacements [m]
+      real(dp), intent(in) :: force(nd)             !! device forces [N]
+      real(dp) :: x
       integer :: i
 
       if (.not. allocated(eng%drift)) return
-      do i = 1, size(s)
+      do i = 1, nd
          eng%residual_s(i) = s(i)
       end do
-      call storey_values(eng, u, v, force, eng%drift, eng%shear(1:), eng%shear(0))
       do i = 1, eng%n_storeys
-         if (abs(eng%drift(i)) > eng%peak_drift(i)) then
-            eng%peak_drift(i) = abs(eng%drift(i)); eng%peak_drift_time(i) = t
+         x = storey_drift(eng, i, u)
+         eng%drift(i) = x
+         if (abs(x) > eng%peak_drift(i)) then
+            eng%peak_drift(i) = abs(x); eng%peak_drift_time(i) = t
          end if
       end do
       do i = 0, eng%n_storeys
-         if (abs(eng%shear(i)) > eng%peak_shear(i)) then
-            eng%peak_shear(i) = abs(eng%shear(i)); eng%peak_shear_time(i) = t
+         x = cut_force(eng, i, u, v, force)
+         eng%shear(i) = x
+         if (abs(x) > eng%peak_shear(i)) then
+            eng%peak_shear(i) = abs(x); eng%peak_shear_time(i) = t
          end if
       end do
    end subroutine observe_engineering

@@ -171,19 +171,23 @@ contains
 
    !> Peaks over the accepted states: |u| (and its time), |v|, |absolute acceleration| (and
    !> its time) per DOF, |s| and |F| per device.
-   pure subroutine observe_peaks(res, t, u, v, acc, ag, s, force)
+   pure subroutine observe_peaks(res, t, n, nd, u, v, acc, ag, s, force)
       type(result_type), intent(inout) :: res  !! the result
       real(dp), intent(in) :: t                !! time [s]
-      real(dp), intent(in), contiguous :: u(:)   !! relative displacements [m]
-      real(dp), intent(in), contiguous :: v(:)   !! relative velocities [m/s]
-      real(dp), intent(in), contiguous :: acc(:) !! relative accelerations [m/s2]
+      integer, intent(in) :: n                 !! DOFs
+      integer, intent(in) :: nd                !! devices
+      real(dp), intent(in) :: u(n)             !! relative displacements [m]
+      real(dp), intent(in) :: v(n)             !! relative velocities [m/s]
+      real(dp), intent(in) :: acc(n)           !! relative accelerations [m/s2]
       real(dp), intent(in) :: ag               !! table acceleration [m/s2]
-      real(dp), intent(in), contiguous :: s(:)   !! device relative displacements [m]
-      real(dp), intent(in), contiguous :: force(:) !! device forces [N]
+      real(dp), intent(in) :: s(nd)            !! device relative displacements [m]
+      real(dp), intent(in) :: force(nd)        !! device forces [N]
       real(dp) :: x
       integer :: i
 
-      do i = 1, size(u)
+      ! (explicit shapes: this runs at every accepted step, and a call that builds array
+      ! descriptors costs more than a two-mass model's peaks)
+      do i = 1, n
          if (abs(u(i)) > res%peak_u(i)) then
             res%peak_u(i) = abs(u(i)); res%peak_u_time(i) = t
          end if
@@ -193,11 +197,11 @@ contains
             res%peak_aabs(i) = x; res%peak_aabs_time(i) = t
          end if
       end do
-      do i = 1, size(s)
+      do i = 1, nd
          res%peak_s(i) = max(res%peak_s(i), abs(s(i)))
          res%peak_force(i) = max(res%peak_force(i), abs(force(i)))
       end do
-      call observe_engineering(res%eng, t, u, v, s, force)
+      call observe_engineering(res%eng, t, n, nd, u, v, s, force)
    end subroutine observe_peaks
 
    !> One value into a peak of the summary (a technique that knows its solution between
@@ -237,7 +241,7 @@ contains
       real(dp), intent(in) :: u(:), v(:)       !! relative displacements [m], velocities [m/s]
       real(dp), intent(in) :: s(:), force(:)   !! device relative displacements [m], forces [N]
 
-      call observe_engineering(res%eng, t, u, v, s, force)
+      call observe_engineering(res%eng, t, size(u), size(s), u, v, s, force)
    end subroutine observe_storeys
 
    !> An event at time t (phases changed): its time is kept (the first max_event_times).

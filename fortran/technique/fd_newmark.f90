@@ -153,7 +153,7 @@ contains
       w%f = device_force(w%st, w%s, w%sd)
       w%phase0 = w%st%phase
       call observe_sample(w%obs, res, 0.0_dp, w%ag, w%u, w%v, w%a, w%s, w%sd, w%f, w%phase0)
-      call observe_peaks(res, 0.0_dp, w%u, w%v, w%a, w%ag, w%s, w%f)
+      call observe_peaks(res, 0.0_dp, w%n, w%nd, w%u, w%v, w%a, w%ag, w%s, w%f)
 
       do k = 1, w%obs%nsteps
          t0 = (k - 1)*dt1
@@ -354,6 +354,7 @@ contains
       real(dp), intent(out) :: vt(n), ut(n), rhs(n)
       integer :: i
 
+      !GCC$ ivdep
       do i = 1, n
          vt(i) = v(i) + g1h*a(i)
          ut(i) = u(i) + (h*v(i) + b2h2*a(i))
@@ -399,6 +400,7 @@ contains
       real(dp), intent(inout) :: u1(n)
       integer :: d, i, j
 
+      !GCC$ ivdep
       do i = 1, n
          a1(i) = a1s(i)
          u1(i) = u1(i) + bh2*a1s(i)
@@ -452,7 +454,7 @@ contains
       type(workspace), intent(inout) :: w
       logical, intent(out) :: any_changed, any_bad
 
-      call friction_step(model%dev, opts%n_corr, w%s1, w%sd1, w%sd, w%st, w%st1, w%changed, w%ok, &
+      call friction_step(w%nd, model%dev, opts%n_corr, w%s1, w%sd1, w%sd, w%st, w%st1, w%changed, w%ok, &
                          any_changed, any_bad)
    end subroutine judge
 
@@ -577,7 +579,7 @@ contains
       ! energy of the step, forces at both ends in the step's phases; the state moves on
       call step_energy(w%n, w%mass, w%u, w%v, w%a, w%u1, w%v1, w%a1, w%tmp, w%rhs, ein)
       res%e_input = res%e_input - 0.5_dp*(w%ag + w%ag1)*ein
-      res%e_viscous = res%e_viscous + 0.5_dp*viscous_work(model, w%a0, w%a1c, w%mass, w%tmp, w%rhs)
+      res%e_viscous = res%e_viscous + 0.5_dp*viscous_work(model, w%a0, w%a1c, w%n, w%mass, w%tmp, w%rhs)
       w%ag = w%ag1
       ! violations of the correctness condition left in an accepted step
       if (any_bad) call observe_violations(res, t1, w%ok)
@@ -586,15 +588,13 @@ contains
          w%phase1 = w%st1%phase
          call observe_transitions(res, w%phase0, w%phase1)
       end if
-      ! a phase change, or a sliding force that follows the velocity (mu(v)): the next
-      ! step starts in equilibrium with the new forces
-      any_force = any(w%st1%f0 /= w%st%f0)
       ! device work over the step; the devices move on; the factors follow their stiffness
-      ! and damping (whatever changed them)
-      call device_step(w%nd, w%st, w%st1, w%s, w%sd, w%s1, w%sd1, w%f, w%w_device, changed_k)
+      ! and damping (whatever changed them); after a phase change, or a sliding force that
+      ! follows the velocity (mu(v)), the next step starts in equilibrium with the new forces
+      call device_step(w%nd, w%st, w%st1, w%s, w%sd, w%s1, w%sd1, w%f, w%w_device, changed_k, any_force)
       if (changed_k) w%version = w%version + 1
       if (any_changed .or. any_force) call consistent_acceleration(model, exc, t1, w)
-      call observe_peaks(res, t1, w%u, w%v, w%a, w%ag, w%s, w%f)
+      call observe_peaks(res, t1, w%n, w%nd, w%u, w%v, w%a, w%ag, w%s, w%f)
    end subroutine accept
 
    !> The state moves to the trial state; du = u1 - u (in du), v + v1 (in vsum) and
@@ -618,16 +618,17 @@ contains
    end subroutine step_energy
 
    !> (v + v1)' C du of a step, C = a0 M + a1 K, K from the springs (no matrix product).
-   pure real(dp) function viscous_work(model, a0, a1, mass, du, vsum) result(e)
+   pure real(dp) function viscous_work(model, a0, a1, n, mass, du, vsum) result(e)
       type(model_type), intent(in) :: model
       real(dp), intent(in) :: a0, a1
-      real(dp), intent(in) :: mass(:), du(:), vsum(:)
+      integer, intent(in) :: n
+      real(dp), intent(in) :: mass(n), du(n), vsum(n)
       real(dp) :: ek, x, y
       integer :: i, s
 
       e = 0.0_dp
       if (a0 /= 0.0_dp) then
-         do i = 1, size(du)
+         do i = 1, n
             e = e + mass(i)*vsum(i)*du(i)
          end do
          e = a0*e
@@ -653,8 +654,8 @@ contains
 
    !> Work of the device forces over the step (trapezoid, the step's phases); the devices move
    !> on to the trial state (s, s', state) and their force in it; whether a stiffness or
-   !> damping changed.
-   pure subroutine device_step(nd, st, st1, s, sd, s1, sd1, f, w, changed_k)
+   !> damping changed, and whether a constant force f0 changed.
+   pure subroutine device_step(nd, st, st1, s, sd, s1, sd1, f, w, changed_k, changed_f0)
       integer, intent(in) :: nd
       type(device_state), intent(inout) :: st(nd)
       type(device_state), intent(in) :: st1(nd)
@@ -662,11 +663,12 @@ contains
       real(dp), intent(in) :: s1(nd), sd1(nd)
       real(dp), intent(out) :: f(nd)
       real(dp), intent(inout) :: w
-      logical, intent(out) :: changed_k
+      logical, intent(out) :: changed_k, changed_f0
       real(dp) :: f0, f1
       integer :: d
 
       changed_k = .false.
+      changed_f0 = .false.
       do d = 1, nd
          f0 = st(d)%ks*s(d) + st(d)%cs*sd(d) + st(d)%f0
          f1 = st(d)%ks*s1(d) + st(d)%cs*sd1(d) + st(d)%f0
@@ -674,6 +676,7 @@ contains
          s(d) = s1(d)
          sd(d) = sd1(d)
          changed_k = changed_k .or. st1(d)%ks /= st(d)%ks .or. st1(d)%cs /= st(d)%cs
+         changed_f0 = changed_f0 .or. st1(d)%f0 /= st(d)%f0
          st(d) = st1(d)
          f(d) = st(d)%ks*s(d) + st(d)%cs*sd(d) + st(d)%f0
       end do

@@ -96,11 +96,11 @@ contains
 
       call setup(model, res, obs, error)
       if (allocated(error)) return
-      call observe_peaks(res, 0.1_dp, [0.01_dp, 0.0_dp], [0.5_dp, -0.1_dp], [1.0_dp, 0.0_dp], 2.0_dp, &
+      call observe_peaks(res, 0.1_dp, 2, 1, [0.01_dp, 0.0_dp], [0.5_dp, -0.1_dp], [1.0_dp, 0.0_dp], 2.0_dp, &
                          [0.01_dp], [3.0_dp])
-      call observe_peaks(res, 0.2_dp, [-0.03_dp, 0.02_dp], [-0.7_dp, 0.2_dp], [-1.0_dp, 0.0_dp], -4.0_dp, &
+      call observe_peaks(res, 0.2_dp, 2, 1, [-0.03_dp, 0.02_dp], [-0.7_dp, 0.2_dp], [-1.0_dp, 0.0_dp], -4.0_dp, &
                          [-0.05_dp], [-1.0_dp])
-      call observe_peaks(res, 0.3_dp, [0.02_dp, 0.01_dp], [0.1_dp, 0.3_dp], [0.0_dp, 5.5_dp], 0.0_dp, &
+      call observe_peaks(res, 0.3_dp, 2, 1, [0.02_dp, 0.01_dp], [0.1_dp, 0.3_dp], [0.0_dp, 5.5_dp], 0.0_dp, &
                          [0.02_dp], [2.0_dp])
       ! |u| and its time; |v|; |a + ag| (absolute acceleration) and its time
       call check(error, all(res%peak_u == [0.03_dp, 0.02_dp]) .and. all(res%peak_u_time == [0.2_dp, 0.2_dp]), &

@@ -188,7 +188,7 @@ contains
       call energies(w, e_kin, e_str)
       call observe_start_energies(w%obs, e_kin, e_str, 0.0_dp)
       call observe_sample(w%obs, res, 0.0_dp, ag0, w%u, w%v, w%acc, w%s, w%sd, w%force, w%phase0)
-      call observe_peaks(res, 0.0_dp, w%u, w%v, w%acc, ag0, w%s, w%force)
+      call observe_peaks(res, 0.0_dp, size(w%u), size(w%s), w%u, w%v, w%acc, ag0, w%s, w%force)
 
       do k = 1, w%obs%nsteps
          t1 = k*h
@@ -231,7 +231,7 @@ contains
          call device_state(model, w, w%f_edge, w%phase1)
          call count_transitions(w, res, .false.)
          w%phase0 = w%phase1
-         call observe_peaks(res, t1, w%u, w%v, w%acc, ag1, w%s, w%force)
+         call observe_peaks(res, t1, size(w%u), size(w%s), w%u, w%v, w%acc, ag1, w%s, w%force)
          res%steps_dt1 = res%steps_dt1 + 1
          if (sample_due(w%obs, k)) then
             if (.not. all(ieee_is_finite(w%u)) .or. .not. all(ieee_is_finite(w%acc))) then
