@@ -1007,17 +1007,7 @@ contains
       end if
       associate (n => sys%n, w1 => sys%w1, w2 => sys%w2, perm => sys%perm, mass => sys%mass)
          if (sys%dense .and. n <= spd_dense_max_n) then
-            ! scalar loops: a vector load of what scalar stores just wrote stalls the store
-            ! forwarding, and n is a few DOFs
-            !GCC$ novector
-            do i = 1, n
-               w1(i) = x(i) + sys%a1*z(i)
-            end do
-            call small_symv(n, sys%kmat, w1, w2, 1.0_dp, 0.0_dp)
-            !GCC$ novector
-            do i = 1, n
-               y(i) = y(i) + alpha*(w2(i) + sys%a0*mass(i)*z(i))
-            end do
+            call small_kc_matvec(n, sys%kmat, sys%a0, sys%a1, mass, x, z, y, alpha)
          else if (sys%dense) then
             do i = 1, n
                w1(i) = x(i) + sys%a1*z(i)
@@ -1177,6 +1167,39 @@ contains
          y(j) = temp1*a(j + j*kb) + temp2
       end do
    end subroutine band_symv
+
+   !> y = y + alpha (K (x + a1 z) + a0 M z) for a small dense K (upper triangle, n x n
+   !> column-major, n <= spd_dense_max_n): the product in the order of small_symv (that of the
+   !> reference dsymv), in one routine with explicit shapes and without work arrays, since at
+   !> a step of a two-mass model the calls and array descriptors cost more than the product.
+   !> Scalar loops: a vector load of what scalar stores just wrote stalls the store forwarding.
+   pure subroutine small_kc_matvec(n, a, a0, a1, mass, x, z, y, alpha)
+      integer, intent(in) :: n
+      real(dp), intent(in) :: a(n, n), a0, a1, mass(n), x(n), z(n), alpha
+      real(dp), intent(inout) :: y(n)
+      real(dp) :: w(spd_dense_max_n), kw(spd_dense_max_n), temp1, temp2
+      integer :: i, j
+
+      !GCC$ novector
+      do i = 1, n
+         w(i) = x(i) + a1*z(i)
+         kw(i) = 0.0_dp
+      end do
+      do j = 1, n
+         temp1 = w(j)
+         temp2 = 0.0_dp
+         !GCC$ novector
+         do i = 1, j - 1
+            kw(i) = kw(i) + temp1*a(i, j)
+            temp2 = temp2 + a(i, j)*w(i)
+         end do
+         kw(j) = kw(j) + temp1*a(j, j) + temp2
+      end do
+      !GCC$ novector
+      do i = 1, n
+         y(i) = y(i) + alpha*(kw(i) + a0*mass(i)*z(i))
+      end do
+   end subroutine small_kc_matvec
 
    !> y = alpha A x + beta y for a small symmetric A (upper triangle, n x n column-major): the
    !> operations of the reference BLAS dsymv ('U'), in its order (y not read when beta = 0).
