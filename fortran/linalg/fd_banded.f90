@@ -1005,10 +1005,13 @@ contains
          call band_matvec(sys, sys%cmat, z, y, alpha, 1.0_dp)
          return
       end if
+      if (sys%dense .and. sys%n <= spd_dense_max_n) then
+         ! (before the associate below, whose five names cost more than this product)
+         call small_kc_matvec(sys%n, sys%kmat, sys%a0, sys%a1, sys%mass, x, z, y, alpha)
+         return
+      end if
       associate (n => sys%n, w1 => sys%w1, w2 => sys%w2, perm => sys%perm, mass => sys%mass)
-         if (sys%dense .and. n <= spd_dense_max_n) then
-            call small_kc_matvec(n, sys%kmat, sys%a0, sys%a1, mass, x, z, y, alpha)
-         else if (sys%dense) then
+         if (sys%dense) then
             do i = 1, n
                w1(i) = x(i) + sys%a1*z(i)
             end do
