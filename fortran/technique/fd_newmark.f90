@@ -661,7 +661,9 @@ contains
       type(device_state), intent(in) :: st1(nd)
       real(dp), intent(inout) :: s(nd), sd(nd)
       real(dp), intent(in) :: s1(nd), sd1(nd)
-      real(dp), intent(out) :: f(nd)
+      real(dp), intent(inout) :: f(nd)         !! in: the forces at the start (the step's phases: set
+                                               !! by the last call, or at the start of the run); out:
+                                               !! at the end, in the phases for the next step
       real(dp), intent(inout) :: w
       logical, intent(out) :: changed_k, changed_f0
       real(dp) :: f0, f1
@@ -670,7 +672,7 @@ contains
       changed_k = .false.
       changed_f0 = .false.
       do d = 1, nd
-         f0 = st(d)%ks*s(d) + st(d)%cs*sd(d) + st(d)%f0
+         f0 = f(d)
          f1 = st(d)%ks*s1(d) + st(d)%cs*sd1(d) + st(d)%f0
          w = w + 0.5_dp*(f0 + f1)*(s1(d) - s(d))
          s(d) = s1(d)
