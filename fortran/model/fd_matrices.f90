@@ -329,21 +329,21 @@ contains
       type(modes_type), intent(out) :: modes         !! the modes
       type(error_type), allocatable, intent(out) :: error !! LAPACK failure
       integer, allocatable :: grp(:)
-      logical, allocatable :: linked(:)
-      real(dp), allocatable :: ks(:, :), kq(:, :), mq(:, :), cq(:, :), lam(:), z(:, :), phi(:), sq(:)
-      real(dp) :: kd, big, w, pm, l, mtot
-      integer :: n, nq, i, j, d, ni, nj, imax, kfirst, stat
+      real(dp), allocatable :: ks(:, :), kq(:, :), mq(:, :), cq(:, :), lam(:), z(:, :), sq(:), zcz(:)
+      real(dp) :: kd, big
+      integer :: n, nq, i, j, d, ni, nj, kfirst, stat
 
       n = model%n_dof
       modes%system = system
-      allocate (grp(n), linked(model%n_devices), ks(n, n), stat=stat)
+      call system_groups(model, system, grp, modes, stat)
+      if (stat == 0) allocate (ks(n, n), stat=stat)
       if (stat /= 0) then
          call no_memory(n); return
       end if
+      nq = modes%nq
+      if (nq == 0) return
       ks = k
       do d = 1, model%n_devices
-         pm = model%dev(d)%p*model%dev(d)%mu
-         linked(d) = system == system_stuck .and. pm > 0.0_dp .and. model%dev(d)%law /= law_hysteretic
          kd = sticking_stiffness(model%dev(d))
          if (system == system_stuck .and. kd > 0.0_dp) then
             ni = model%dev(d)%node_i; nj = model%dev(d)%node_j
@@ -355,13 +355,6 @@ contains
             end if
          end if
       end do
-      call link_groups(model, linked, grp, nq)
-      modes%nq = nq
-      if (nq == 0) then
-         modes%status = modes_rigid
-         allocate (modes%omega2(0), modes%period(0), modes%shape(n, 0), modes%mass_ratio(0), modes%xi(0))
-         return
-      end if
       ! Kq = T' K T, Cq = T' C T, Mq = T' M T by summing over the groups (T is 0/1: O(n^2))
       allocate (kq(nq, nq), cq(nq, nq), mq(nq, nq), sq(nq), stat=stat)
       if (stat /= 0) then
@@ -392,7 +385,7 @@ contains
          big = max(big, sum(abs(kq(:, j))))
       end do
       kfirst = max(modes%n, 1)
-      allocate (lam(kfirst), z(nq, kfirst), stat=stat)
+      allocate (lam(kfirst), z(nq, kfirst), zcz(modes%n), stat=stat)
       if (stat /= 0) then
          call no_memory(nq); return
       end if
@@ -403,12 +396,68 @@ contains
       end do
       modes%status = modes_flexible
       if (lam(1) <= 1.0e-12_dp*big) modes%status = modes_unrestrained
+      ! z is M-normalized in the reduced coordinates: z' Mq z = 1
+      do j = 1, modes%n
+         zcz(j) = dot_product(z(:, j), matmul(cq, z(:, j)))
+      end do
+      call store_modes(grp, model%mass, lam, z, lam(1:modes%n) <= 1.0e-12_dp*big, zcz, modes, stat)
+      if (stat /= 0) call no_memory(n)
+   contains
+      subroutine no_memory(size)
+         integer, intent(in) :: size
+         call fatal_error(error, "not enough memory for the natural modes of "//trim(fmt_int(size))// &
+                          " DOFs (an eigenproblem of that size)", stat_no_memory)
+      end subroutine no_memory
+   end subroutine natural_modes
+
+   !> The rigid groups of a system (link_groups): stuck, every device with P mu > 0 that is
+   !> no spring (velocity law, Coulomb) links its nodes; free, none does. modes%nq is their
+   !> number; a system with none (every DOF held to the table) is rigid: no mode.
+   subroutine system_groups(model, system, grp, modes, stat)
+      type(model_type), intent(in) :: model          !! the model
+      integer, intent(in) :: system                  !! system_stuck or system_free
+      integer, allocatable, intent(out) :: grp(:)    !! group of each DOF, 0 = with the table
+      type(modes_type), intent(inout) :: modes       !! its nq; status and arrays if rigid
+      integer, intent(out) :: stat                   !! 0, or not enough memory
+      logical, allocatable :: linked(:)
+      real(dp) :: pm
+      integer :: d
+
+      allocate (grp(model%n_dof), linked(model%n_devices), stat=stat)
+      if (stat /= 0) return
+      do d = 1, model%n_devices
+         pm = model%dev(d)%p*model%dev(d)%mu
+         linked(d) = system == system_stuck .and. pm > 0.0_dp .and. model%dev(d)%law /= law_hysteretic
+      end do
+      call link_groups(model, linked, grp, modes%nq)
+      if (modes%nq > 0) return
+      modes%status = modes_rigid
+      allocate (modes%omega2(0), modes%period(0), modes%shape(model%n_dof, 0), modes%mass_ratio(0), modes%xi(0))
+   end subroutine system_groups
+
+   !> The modes' arrays from the lowest modes%n eigenpairs (lam, z) of the reduced system of
+   !> the rigid groups grp (z' Mq z = 1): each shape expanded to every DOF and scaled so
+   !> that its component of largest magnitude is +1, its effective mass ratio; a rigid-body
+   !> mode (rigid) has w = 0, an infinite period and no damping ratio, the others
+   !> w = sqrt(lam) and xi = zcz / (2 w), zcz = z' Cq z.
+   subroutine store_modes(grp, mass, lam, z, rigid, zcz, modes, stat)
+      integer, intent(in) :: grp(:)                  !! group of each DOF, 0 = with the table
+      real(dp), intent(in) :: mass(:)                !! masses of the DOFs
+      real(dp), intent(in) :: lam(:)                 !! eigenvalues w^2, increasing
+      real(dp), intent(in) :: z(:, :)                !! eigenvectors (nq, >= modes%n)
+      logical, intent(in) :: rigid(:)                !! (modes%n) a rigid-body mode
+      real(dp), intent(in) :: zcz(:)                 !! (modes%n) z' Cq z
+      type(modes_type), intent(inout) :: modes       !! n set; its arrays
+      integer, intent(out) :: stat                   !! 0, or not enough memory
+      real(dp), allocatable :: phi(:)
+      real(dp) :: w, l, mtot
+      integer :: n, i, j, imax
+
+      n = size(grp)
       allocate (modes%omega2(modes%n), modes%period(modes%n), modes%shape(n, modes%n), &
                 modes%mass_ratio(modes%n), modes%xi(modes%n), phi(n), stat=stat)
-      if (stat /= 0) then
-         call no_memory(n); return
-      end if
-      mtot = sum(model%mass)
+      if (stat /= 0) return
+      mtot = sum(mass)
       do j = 1, modes%n
          do i = 1, n
             phi(i) = 0.0_dp
@@ -417,9 +466,9 @@ contains
          imax = maxloc(abs(phi), 1)
          phi = phi/phi(imax)
          modes%shape(:, j) = phi
-         l = sum(model%mass*phi)
-         modes%mass_ratio(j) = l*l/sum(model%mass*phi**2)/mtot
-         if (lam(j) <= 1.0e-12_dp*big) then
+         l = sum(mass*phi)
+         modes%mass_ratio(j) = l*l/sum(mass*phi**2)/mtot
+         if (rigid(j)) then
             modes%omega2(j) = 0.0_dp
             modes%period(j) = ieee_value(1.0_dp, ieee_positive_inf)
             modes%xi(j) = ieee_value(1.0_dp, ieee_quiet_nan)
@@ -427,17 +476,10 @@ contains
             modes%omega2(j) = lam(j)
             w = sqrt(lam(j))
             modes%period(j) = 2.0_dp*pi/w
-            ! z is M-normalized in the reduced coordinates: z' Mq z = 1
-            modes%xi(j) = dot_product(z(:, j), matmul(cq, z(:, j)))/(2.0_dp*w)
+            modes%xi(j) = zcz(j)/(2.0_dp*w)
          end if
       end do
-   contains
-      subroutine no_memory(size)
-         integer, intent(in) :: size
-         call fatal_error(error, "not enough memory for the natural modes of "//trim(fmt_int(size))// &
-                          " DOFs (an eigenproblem of that size)", stat_no_memory)
-      end subroutine no_memory
-   end subroutine natural_modes
+   end subroutine store_modes
 
    !> The natural modes of a large model without an n x n matrix: the springs (and, stuck,
    !> the hysteretic devices' sticking stiffness) as elements of the reduced system of the
@@ -454,31 +496,23 @@ contains
       type(modes_type), intent(out) :: modes         !! the modes
       type(error_type), allocatable, intent(out) :: error !! solver failure, no memory
       integer, allocatable :: grp(:), ea(:), eb(:), root(:)
-      logical, allocatable :: linked(:), grounded(:)
-      real(dp), allocatable :: mq(:), ek(:), lam(:), z(:, :), phi(:), ebig(:)
-      real(dp) :: pm, kd, big, sigma, scale, w, l, mtot, kz
-      integer :: n, nq, ne, ns, nd, i, j, a, b, s, d, imax, m, stat
+      logical, allocatable :: grounded(:)
+      real(dp), allocatable :: mq(:), ek(:), lam(:), z(:, :), ebig(:), zcz(:)
+      real(dp) :: kd, big, sigma, scale, w, kz
+      integer :: n, nq, ne, ns, nd, i, j, a, b, s, d, m, stat
       logical :: shifted
 
       n = model%n_dof
       ns = model%n_springs
       nd = model%n_devices
       modes%system = system
-      allocate (grp(n), linked(nd), ea(ns + nd + n), eb(ns + nd + n), ek(ns + nd + n), stat=stat)
+      call system_groups(model, system, grp, modes, stat)
+      if (stat == 0) allocate (ea(ns + nd + n), eb(ns + nd + n), ek(ns + nd + n), stat=stat)
       if (stat /= 0) then
          call no_memory(n); return
       end if
-      do d = 1, nd
-         pm = model%dev(d)%p*model%dev(d)%mu
-         linked(d) = system == system_stuck .and. pm > 0.0_dp .and. model%dev(d)%law /= law_hysteretic
-      end do
-      call link_groups(model, linked, grp, nq)
-      modes%nq = nq
-      if (nq == 0) then
-         modes%status = modes_rigid
-         allocate (modes%omega2(0), modes%period(0), modes%shape(n, 0), modes%mass_ratio(0), modes%xi(0))
-         return
-      end if
+      nq = modes%nq
+      if (nq == 0) return
       allocate (mq(nq), root(0:nq), grounded(0:nq), ebig(nq), stat=stat)
       if (stat /= 0) then
          call no_memory(nq); return
@@ -525,7 +559,7 @@ contains
       end if
       modes%n = min(max(nmax, 0), nq)
       m = max(modes%n, 1)
-      allocate (lam(m), z(nq, m), stat=stat)
+      allocate (lam(m), z(nq, m), zcz(modes%n), stat=stat)
       if (stat /= 0) then
          call no_memory(nq); return
       end if
@@ -539,38 +573,17 @@ contains
       big = max(big, scale)
       modes%status = modes_flexible
       if (shifted) modes%status = modes_unrestrained
-      allocate (modes%omega2(modes%n), modes%period(modes%n), modes%shape(n, modes%n), &
-                modes%mass_ratio(modes%n), modes%xi(modes%n), phi(n), stat=stat)
-      if (stat /= 0) then
-         call no_memory(n); return
-      end if
-      mtot = sum(model%mass)
+      ! z' Cq z = a0 + a1 z' Kq z, Kq of the springs (z' Mq z = 1)
       do j = 1, modes%n
-         do i = 1, n
-            phi(i) = 0.0_dp
-            if (grp(i) /= 0) phi(i) = z(grp(i), j)
-         end do
-         ! z' Kq z of the springs (z' Mq z = 1), before the shape is scaled
          kz = 0.0_dp
          do s = 1, ns
-            w = node_phi(model%spring_i(s)) - node_phi(model%spring_j(s))
+            w = node_z(model%spring_i(s), j) - node_z(model%spring_j(s), j)
             kz = kz + model%spring_k(s)*w*w
          end do
-         imax = maxloc(abs(phi), 1)
-         modes%shape(:, j) = phi/phi(imax)
-         l = sum(model%mass*modes%shape(:, j))
-         modes%mass_ratio(j) = l*l/sum(model%mass*modes%shape(:, j)**2)/mtot
-         if (lam(j) <= 1.0e-9_dp*big .and. shifted) then
-            modes%omega2(j) = 0.0_dp
-            modes%period(j) = ieee_value(1.0_dp, ieee_positive_inf)
-            modes%xi(j) = ieee_value(1.0_dp, ieee_quiet_nan)
-         else
-            modes%omega2(j) = lam(j)
-            w = sqrt(lam(j))
-            modes%period(j) = 2.0_dp*pi/w
-            modes%xi(j) = (a0 + a1*kz)/(2.0_dp*w)
-         end if
+         zcz(j) = a0 + a1*kz
       end do
+      call store_modes(grp, model%mass, lam, z, lam(1:modes%n) <= 1.0e-9_dp*big .and. shifted, zcz, modes, stat)
+      if (stat /= 0) call no_memory(n)
    contains
       subroutine element(ni, nj, k)
          integer, intent(in) :: ni, nj
@@ -590,11 +603,13 @@ contains
             find = root(find)
          end do
       end function find
-      pure real(dp) function node_phi(node)
-         integer, intent(in) :: node
-         node_phi = 0.0_dp
-         if (node > 0) node_phi = phi(node)
-      end function node_phi
+      !> Component j of z at a node (0 on the table and in its group).
+      pure real(dp) function node_z(node, j)
+         integer, intent(in) :: node, j
+         node_z = 0.0_dp
+         if (node == 0) return
+         if (grp(node) /= 0) node_z = z(grp(node), j)
+      end function node_z
       subroutine no_memory(size)
          integer, intent(in) :: size
          call fatal_error(error, "not enough memory for the natural modes of "//trim(fmt_int(size))// &
