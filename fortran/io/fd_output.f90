@@ -11,7 +11,7 @@ module fd_output
    use fd_record, only: record_info
    use fd_version, only: frictiondyn_version
    use fd_history_stream, only: format_row, stream_value_width
-   use fd_names, only: excitation_types
+   use fd_names, only: excitation_types, keyword_len
    use fd_matrices, only: modes_type, modes_flexible, modes_rigid, modes_unrestrained
    use fd_fileops, only: c_lock_acquire, c_lock_release, c_unlink, c_rename, c_errno_text, c_getpid, &
                          c_file_create, c_file_write, c_file_close
@@ -359,16 +359,10 @@ contains
       character(len=:), allocatable, intent(out) :: js     !! the JSON text
       type(record_info), intent(in), optional :: record    !! the record read, if any
       character(len=1), parameter :: nl = achar(10)
-      character(len=:), allocatable :: laws, esc, buf
-      integer :: pos, nlaw
+      character(len=:), allocatable :: esc, buf
+      integer :: pos
       integer :: d
 
-      nlaw = 0
-      allocate (character(len=64) :: laws)
-      do d = 1, model%n_devices
-         call put_law('"'//trim(law_name(model%dev(d)%law))//'"')
-         if (d < model%n_devices) call put_law(', ')
-      end do
       call json_escape(deck_path, esc)
       pos = 0
       allocate (character(len=4096 + 64*(res%n_dof + res%n_devices)*8) :: buf)
@@ -394,7 +388,7 @@ contains
       call kv('n_dof', trim(fmt_int(res%n_dof)))
       call kv('n_devices', trim(fmt_int(res%n_devices)))
       call kv('technique', '"'//trim(technique_name(res%technique))//'"')
-      call put('  "device_law": ['//laws(1:nlaw)//'],'//nl)
+      call ks('device_law', [character(len=keyword_len) :: (law_name(model%dev(d)%law), d=1, model%n_devices)])
       call kv('period_stuck_s', trim(json_real(res%period_stuck)))
       call kv('xi_stuck', trim(json_real(res%xi_stuck)))
       call kv('dt1_s', trim(json_real(res%dt1)))
@@ -466,17 +460,6 @@ contains
          buf(pos + 1:pos + len(text)) = text
          pos = pos + len(text)
       end subroutine put
-      subroutine put_law(text)
-         character(len=*), intent(in) :: text
-         character(len=:), allocatable :: bigger
-         if (nlaw + len(text) > len(laws)) then
-            allocate (character(len=2*(nlaw + len(text))) :: bigger)
-            bigger(1:nlaw) = laws(1:nlaw)
-            call move_alloc(bigger, laws)
-         end if
-         laws(nlaw + 1:nlaw + len(text)) = text
-         nlaw = nlaw + len(text)
-      end subroutine put_law
       !> What produced the run, the names, the modes, the storeys (fd_engineering).
       subroutine engineering_keys()
          integer :: i
