@@ -292,12 +292,8 @@ contains
                end if
             end if
             if (found) return
-            if (settled) then
-               lev = lev - 1
-               if (lev < 0) return
-               cycle
-            end if
-            side(lev) = 0
+            ! split the piece, or leave it (settled: as if both halves were done)
+            side(lev) = merge(2, 0, settled)
          end if
          call next_piece(work, n, a, w, side, lev)
          if (lev < 0) return
@@ -369,12 +365,8 @@ contains
                   end if
                end if
             end if
-            if (settled) then
-               lev = lev - 1
-               if (lev < 0) return
-               cycle
-            end if
-            side(lev) = 0
+            ! split the piece, or leave it (settled: as if both halves were done)
+            side(lev) = merge(2, 0, settled)
          end if
          call next_piece(work, n, a, w, side, lev)
          if (lev < 0) return
