@@ -410,77 +410,6 @@ contains
       end subroutine no_memory
    end subroutine natural_modes
 
-   !> The rigid groups of a system (link_groups): stuck, every device with P mu > 0 that is
-   !> no spring (velocity law, Coulomb) links its nodes; free, none does. modes%nq is their
-   !> number; a system with none (every DOF held to the table) is rigid: no mode.
-   subroutine system_groups(model, system, grp, modes, stat)
-      type(model_type), intent(in) :: model          !! the model
-      integer, intent(in) :: system                  !! system_stuck or system_free
-      integer, allocatable, intent(out) :: grp(:)    !! group of each DOF, 0 = with the table
-      type(modes_type), intent(inout) :: modes       !! its nq; status and arrays if rigid
-      integer, intent(out) :: stat                   !! 0, or not enough memory
-      logical, allocatable :: linked(:)
-      real(dp) :: pm
-      integer :: d
-
-      allocate (grp(model%n_dof), linked(model%n_devices), stat=stat)
-      if (stat /= 0) return
-      do d = 1, model%n_devices
-         pm = model%dev(d)%p*model%dev(d)%mu
-         linked(d) = system == system_stuck .and. pm > 0.0_dp .and. model%dev(d)%law /= law_hysteretic
-      end do
-      call link_groups(model, linked, grp, modes%nq)
-      if (modes%nq > 0) return
-      modes%status = modes_rigid
-      allocate (modes%omega2(0), modes%period(0), modes%shape(model%n_dof, 0), modes%mass_ratio(0), modes%xi(0))
-   end subroutine system_groups
-
-   !> The modes' arrays from the lowest modes%n eigenpairs (lam, z) of the reduced system of
-   !> the rigid groups grp (z' Mq z = 1): each shape expanded to every DOF and scaled so
-   !> that its component of largest magnitude is +1, its effective mass ratio; a rigid-body
-   !> mode (rigid) has w = 0, an infinite period and no damping ratio, the others
-   !> w = sqrt(lam) and xi = zcz / (2 w), zcz = z' Cq z.
-   subroutine store_modes(grp, mass, lam, z, rigid, zcz, modes, stat)
-      integer, intent(in) :: grp(:)                  !! group of each DOF, 0 = with the table
-      real(dp), intent(in) :: mass(:)                !! masses of the DOFs
-      real(dp), intent(in) :: lam(:)                 !! eigenvalues w^2, increasing
-      real(dp), intent(in) :: z(:, :)                !! eigenvectors (nq, >= modes%n)
-      logical, intent(in) :: rigid(:)                !! (modes%n) a rigid-body mode
-      real(dp), intent(in) :: zcz(:)                 !! (modes%n) z' Cq z
-      type(modes_type), intent(inout) :: modes       !! n set; its arrays
-      integer, intent(out) :: stat                   !! 0, or not enough memory
-      real(dp), allocatable :: phi(:)
-      real(dp) :: w, l, mtot
-      integer :: n, i, j, imax
-
-      n = size(grp)
-      allocate (modes%omega2(modes%n), modes%period(modes%n), modes%shape(n, modes%n), &
-                modes%mass_ratio(modes%n), modes%xi(modes%n), phi(n), stat=stat)
-      if (stat /= 0) return
-      mtot = sum(mass)
-      do j = 1, modes%n
-         do i = 1, n
-            phi(i) = 0.0_dp
-            if (grp(i) /= 0) phi(i) = z(grp(i), j)
-         end do
-         imax = maxloc(abs(phi), 1)
-         phi = phi/phi(imax)
-         modes%shape(:, j) = phi
-         l = sum(mass*phi)
-         modes%mass_ratio(j) = l*l/sum(mass*phi**2)/mtot
-         if (rigid(j)) then
-            modes%omega2(j) = 0.0_dp
-            modes%period(j) = ieee_value(1.0_dp, ieee_positive_inf)
-            modes%xi(j) = ieee_value(1.0_dp, ieee_quiet_nan)
-         else
-            modes%omega2(j) = lam(j)
-            w = sqrt(lam(j))
-            modes%period(j) = 2.0_dp*pi/w
-            modes%xi(j) = zcz(j)/(2.0_dp*w)
-         end if
-      end do
-   end subroutine store_modes
-
    !> The natural modes of a large model without an n x n matrix: the springs (and, stuck,
    !> the hysteretic devices' sticking stiffness) as elements of the reduced system of the
    !> rigid groups, whose lowest pairs fd_modes finds by subspace iteration with the banded
@@ -616,6 +545,77 @@ contains
                           " DOFs", stat_no_memory)
       end subroutine no_memory
    end subroutine natural_modes_sparse
+
+   !> The rigid groups of a system (link_groups): stuck, every device with P mu > 0 that is
+   !> no spring (velocity law, Coulomb) links its nodes; free, none does. modes%nq is their
+   !> number; a system with none (every DOF held to the table) is rigid: no mode.
+   subroutine system_groups(model, system, grp, modes, stat)
+      type(model_type), intent(in) :: model          !! the model
+      integer, intent(in) :: system                  !! system_stuck or system_free
+      integer, allocatable, intent(out) :: grp(:)    !! group of each DOF, 0 = with the table
+      type(modes_type), intent(inout) :: modes       !! its nq; status and arrays if rigid
+      integer, intent(out) :: stat                   !! 0, or not enough memory
+      logical, allocatable :: linked(:)
+      real(dp) :: pm
+      integer :: d
+
+      allocate (grp(model%n_dof), linked(model%n_devices), stat=stat)
+      if (stat /= 0) return
+      do d = 1, model%n_devices
+         pm = model%dev(d)%p*model%dev(d)%mu
+         linked(d) = system == system_stuck .and. pm > 0.0_dp .and. model%dev(d)%law /= law_hysteretic
+      end do
+      call link_groups(model, linked, grp, modes%nq)
+      if (modes%nq > 0) return
+      modes%status = modes_rigid
+      allocate (modes%omega2(0), modes%period(0), modes%shape(model%n_dof, 0), modes%mass_ratio(0), modes%xi(0))
+   end subroutine system_groups
+
+   !> The modes' arrays from the lowest modes%n eigenpairs (lam, z) of the reduced system of
+   !> the rigid groups grp (z' Mq z = 1): each shape expanded to every DOF and scaled so
+   !> that its component of largest magnitude is +1, its effective mass ratio; a rigid-body
+   !> mode (rigid) has w = 0, an infinite period and no damping ratio, the others
+   !> w = sqrt(lam) and xi = zcz / (2 w), zcz = z' Cq z.
+   subroutine store_modes(grp, mass, lam, z, rigid, zcz, modes, stat)
+      integer, intent(in) :: grp(:)                  !! group of each DOF, 0 = with the table
+      real(dp), intent(in) :: mass(:)                !! masses of the DOFs
+      real(dp), intent(in) :: lam(:)                 !! eigenvalues w^2, increasing
+      real(dp), intent(in) :: z(:, :)                !! eigenvectors (nq, >= modes%n)
+      logical, intent(in) :: rigid(:)                !! (modes%n) a rigid-body mode
+      real(dp), intent(in) :: zcz(:)                 !! (modes%n) z' Cq z
+      type(modes_type), intent(inout) :: modes       !! n set; its arrays
+      integer, intent(out) :: stat                   !! 0, or not enough memory
+      real(dp), allocatable :: phi(:)
+      real(dp) :: w, l, mtot
+      integer :: n, i, j, imax
+
+      n = size(grp)
+      allocate (modes%omega2(modes%n), modes%period(modes%n), modes%shape(n, modes%n), &
+                modes%mass_ratio(modes%n), modes%xi(modes%n), phi(n), stat=stat)
+      if (stat /= 0) return
+      mtot = sum(mass)
+      do j = 1, modes%n
+         do i = 1, n
+            phi(i) = 0.0_dp
+            if (grp(i) /= 0) phi(i) = z(grp(i), j)
+         end do
+         imax = maxloc(abs(phi), 1)
+         phi = phi/phi(imax)
+         modes%shape(:, j) = phi
+         l = sum(mass*phi)
+         modes%mass_ratio(j) = l*l/sum(mass*phi**2)/mtot
+         if (rigid(j)) then
+            modes%omega2(j) = 0.0_dp
+            modes%period(j) = ieee_value(1.0_dp, ieee_positive_inf)
+            modes%xi(j) = ieee_value(1.0_dp, ieee_quiet_nan)
+         else
+            modes%omega2(j) = lam(j)
+            w = sqrt(lam(j))
+            modes%period(j) = 2.0_dp*pi/w
+            modes%xi(j) = zcz(j)/(2.0_dp*w)
+         end if
+      end do
+   end subroutine store_modes
 
    !> The k lowest eigenpairs of a symmetric matrix: in band storage after a reverse
    !> Cuthill-McKee ordering when its bandwidth is small (a building: 1 to a few), O(n b^2);
