@@ -191,15 +191,8 @@ contains
 
       allocate (phi(model%n_dof))
       call stuck_first_mode(model, period, phi, eig_error)
-      t_damp = period
-      if (model%damping == damping_stiffness .and. model%period > 0.0_dp) then
-         t_damp = model%period
-      else if (model%damping == damping_stiffness .and. allocated(eig_error)) then
-         call move_alloc(eig_error, error)
-         error%message = "&damping: damping_type = 'stiffness' needs the stuck first period, but "// &
-                         error%message
-         return
-      end if
+      call damping_period(model, period, eig_error, t_damp, error)
+      if (allocated(error)) return
       select case (model%damping)
       case (damping_stiffness)
          a0 = 0.0_dp
@@ -254,16 +247,8 @@ contains
       end if
       call stiffness_matrix(model, k)
       call stuck_first_mode(model, period, phi, eig_error)
-      ! the paper's psi = T xi / pi uses the given T, else the computed one
-      t_damp = period
-      if (model%damping == damping_stiffness .and. model%period > 0.0_dp) then
-         t_damp = model%period
-      else if (model%damping == damping_stiffness .and. allocated(eig_error)) then
-         call move_alloc(eig_error, error)
-         error%message = "&damping: damping_type = 'stiffness' needs the stuck first period, but "// &
-                         error%message
-         return
-      end if
+      call damping_period(model, period, eig_error, t_damp, error)
+      if (allocated(error)) return
       call damping_matrix(model, k, t_damp, c)
       xi = 0.0_dp
       if (allocated(eig_error)) then
@@ -273,6 +258,26 @@ contains
          xi = dot_product(phi, cphi)/(2.0_dp*(2.0_dp*pi/period)*sum(model%mass*phi**2))
       end if
    end subroutine structure_matrices
+
+   !> The period T of the paper's damping psi = T xi / pi: the deck's (model%period), else
+   !> the stuck first period; for damping 'stiffness' without either, an error (the stuck
+   !> first mode's, which eig_error holds, moved into it).
+   subroutine damping_period(model, period, eig_error, t_damp, error)
+      type(model_type), intent(in) :: model                    !! the model
+      real(dp), intent(in) :: period                           !! stuck first period [s]
+      type(error_type), allocatable, intent(inout) :: eig_error !! why it has none (stuck_first_mode)
+      real(dp), intent(out) :: t_damp                          !! T [s]
+      type(error_type), allocatable, intent(out) :: error      !! 'stiffness' damping without a period
+
+      t_damp = period
+      if (model%damping == damping_stiffness .and. model%period > 0.0_dp) then
+         t_damp = model%period
+      else if (model%damping == damping_stiffness .and. allocated(eig_error)) then
+         call move_alloc(eig_error, error)
+         error%message = "&damping: damping_type = 'stiffness' needs the stuck first period, but "// &
+                         error%message
+      end if
+   end subroutine damping_period
 
    !> Groups of DOFs joined by rigid links (the devices flagged in `linked`), by union-find
    !> over the nodes 0..n_dof: grp(i) = 1..nq for a group that moves, 0 for a DOF linked
