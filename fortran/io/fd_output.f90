@@ -13,7 +13,7 @@ module fd_output
    use fd_history_stream, only: format_row, stream_value_width
    use fd_names, only: excitation_types, keyword_len
    use fd_matrices, only: modes_type, modes_flexible, modes_rigid, modes_unrestrained
-   use fd_fileops, only: c_lock_acquire, c_lock_release, c_unlink, c_rename, c_errno_text, c_getpid, &
+   use fd_fileops, only: c_lock_acquire, c_lock_release, c_unlink, c_rename, os_error, c_getpid, &
                          c_file_create, c_file_write, c_file_close
    implicit none
    private
@@ -208,16 +208,6 @@ contains
          if (history) e = c_unlink(htmp//c_null_char)
       end subroutine discard
    end subroutine write_output_files
-
-   !> An error naming what failed and the system's reason (errno text).
-   subroutine os_error(error, what, err)
-      type(error_type), allocatable, intent(out) :: error
-      character(len=*), intent(in) :: what
-      integer(c_int), intent(in) :: err
-      character(kind=c_char, len=256) :: buf
-      call c_errno_text(err, buf, int(len(buf), c_int))
-      call fatal_error(error, what//": "//buf(1:max(0, index(buf, c_null_char) - 1)))
-   end subroutine os_error
 
    !> Create a directory and its missing parents; `made`, when given, is the first (outermost)
    !> directory this call created (not allocated: none), for remove_made_dirs.
