@@ -85,7 +85,7 @@ contains
       integer, allocatable :: grp(:), ea(:), eb(:)
       real(dp), allocatable :: mq(:), ek(:), lam(:), z(:, :)
       real(dp) :: scale
-      integer :: n, i, s, a, b, ne, m, stat
+      integer :: n, i, s, ne, m, stat
 
       omega2 = 0.0_dp
       phi = 0.0_dp
@@ -104,17 +104,10 @@ contains
       if (stat /= 0) then
          call no_memory(nq); return
       end if
-      mq = 0.0_dp
-      do i = 1, n
-         if (grp(i) /= 0) mq(grp(i)) = mq(grp(i)) + model%mass(i)
-      end do
+      call group_masses(grp, model%mass, mq)
       ne = 0
       do s = 1, model%n_springs
-         a = group_of(model%spring_i(s)); b = group_of(model%spring_j(s))
-         if (a == b) cycle                     ! inside one rigid group (or both on the table)
-         ne = ne + 1
-         ea(ne) = max(a, b); eb(ne) = min(a, b)
-         ek(ne) = model%spring_k(s)
+         call add_element(grp, model%spring_i(s), model%spring_j(s), model%spring_k(s), ea, eb, ek, ne)
       end do
       m = min(nev, nq)
       allocate (lam(m), z(nq, m), stat=stat)
@@ -138,11 +131,6 @@ contains
          call fatal_error(error, "not enough memory for the eigenproblem of "//trim(fmt_int(size))// &
                           " DOFs", stat_no_memory)
       end subroutine no_memory
-      pure integer function group_of(node)
-         integer, intent(in) :: node
-         group_of = 0
-         if (node > 0) group_of = grp(node)
-      end function group_of
    end subroutine system_modes
 
    !> First natural period of the stuck system (every device with P mu > 0 a rigid link
@@ -451,18 +439,15 @@ contains
       if (stat /= 0) then
          call no_memory(nq); return
       end if
-      mq = 0.0_dp
-      do i = 1, n
-         if (grp(i) /= 0) mq(grp(i)) = mq(grp(i)) + model%mass(i)
-      end do
+      call group_masses(grp, model%mass, mq)
       ne = 0
       do s = 1, ns
-         call element(model%spring_i(s), model%spring_j(s), model%spring_k(s))
+         call add_element(grp, model%spring_i(s), model%spring_j(s), model%spring_k(s), ea, eb, ek, ne)
       end do
       if (system == system_stuck) then
          do d = 1, nd
             kd = sticking_stiffness(model%dev(d))
-            if (kd > 0.0_dp) call element(model%dev(d)%node_i, model%dev(d)%node_j, kd)
+            if (kd > 0.0_dp) call add_element(grp, model%dev(d)%node_i, model%dev(d)%node_j, kd, ea, eb, ek, ne)
          end do
       end if
       ! a bound of the largest eigenvalue of Mq^-1 Kq (Gershgorin), and the groups held to
@@ -519,17 +504,6 @@ contains
       call store_modes(grp, model%mass, lam, z, lam(1:modes%n) <= 1.0e-9_dp*big .and. shifted, zcz, modes, stat)
       if (stat /= 0) call no_memory(n)
    contains
-      subroutine element(ni, nj, k)
-         integer, intent(in) :: ni, nj
-         real(dp), intent(in) :: k
-         integer :: ga, gb
-         ga = 0; gb = 0
-         if (ni > 0) ga = grp(ni)
-         if (nj > 0) gb = grp(nj)
-         if (ga == gb) return              ! inside one rigid group (or both on the table)
-         ne = ne + 1
-         ea(ne) = max(ga, gb); eb(ne) = min(ga, gb); ek(ne) = k
-      end subroutine element
       pure integer function find(x)
          integer, intent(in) :: x
          find = x
@@ -550,6 +524,39 @@ contains
                           " DOFs", stat_no_memory)
       end subroutine no_memory
    end subroutine natural_modes_sparse
+
+   !> The mass of each rigid group (link_groups): the sum of its DOFs' masses.
+   pure subroutine group_masses(grp, mass, mq)
+      integer, intent(in) :: grp(:)          !! group of each DOF, 0 = with the table
+      real(dp), intent(in) :: mass(:)        !! masses of the DOFs
+      real(dp), intent(out) :: mq(:)         !! mass of each group
+      integer :: i
+
+      mq = 0.0_dp
+      do i = 1, size(grp)
+         if (grp(i) /= 0) mq(grp(i)) = mq(grp(i)) + mass(i)
+      end do
+   end subroutine group_masses
+
+   !> A spring k between nodes ni and nj (0 = the table) as an element of the reduced system
+   !> of the rigid groups grp: (ea, eb, ek)(ne + 1) with ea > eb (eb = 0: the table); none
+   !> when both nodes are in one group (or on the table).
+   pure subroutine add_element(grp, ni, nj, k, ea, eb, ek, ne)
+      integer, intent(in) :: grp(:)          !! group of each DOF, 0 = with the table
+      integer, intent(in) :: ni, nj          !! the spring's nodes
+      real(dp), intent(in) :: k              !! its stiffness
+      integer, intent(inout) :: ea(:), eb(:) !! the elements' groups
+      real(dp), intent(inout) :: ek(:)       !! their stiffness
+      integer, intent(inout) :: ne           !! the elements so far
+      integer :: ga, gb
+
+      ga = 0; gb = 0
+      if (ni > 0) ga = grp(ni)
+      if (nj > 0) gb = grp(nj)
+      if (ga == gb) return
+      ne = ne + 1
+      ea(ne) = max(ga, gb); eb(ne) = min(ga, gb); ek(ne) = k
+   end subroutine add_element
 
    !> The rigid groups of a system (link_groups): stuck, every device with P mu > 0 that is
    !> no spring (velocity law, Coulomb) links its nodes; free, none does. modes%nq is their
