@@ -281,27 +281,19 @@ contains
       root = [(i, i=0, model%n_dof)]
       do d = 1, model%n_devices
          if (.not. linked(d)) cycle
-         a = find(model%dev(d)%node_i); b = find(model%dev(d)%node_j)
+         a = find(root, model%dev(d)%node_i); b = find(root, model%dev(d)%node_j)
          if (a /= b) root(max(a, b)) = min(a, b)
       end do
       col = 0
       nq = 0
       do i = 1, model%n_dof
-         a = find(i)
+         a = find(root, i)
          if (a /= 0 .and. col(a) == 0) then
             nq = nq + 1
             col(a) = nq
          end if
          grp(i) = col(a)
       end do
-   contains
-      pure integer function find(x)
-         integer, intent(in) :: x
-         find = x
-         do while (root(find) /= find)
-            find = root(find)
-         end do
-      end function find
    end subroutine link_groups
 
    !> Natural modes of the structure, K phi = w^2 M phi, the lowest nmax of them.
@@ -459,13 +451,13 @@ contains
          ebig(a) = ebig(a) + 2.0_dp*ek(i)/mq(a)
          if (b > 0) ebig(b) = ebig(b) + 2.0_dp*ek(i)/mq(b)
          if (ek(i) <= 0.0_dp) cycle
-         a = find(a); b = find(b)
+         a = find(root, a); b = find(root, b)
          if (a /= b) root(max(a, b)) = min(a, b)
       end do
       big = maxval(ebig)
       grounded = .false.
       do i = 1, nq
-         grounded(i) = find(i) == 0
+         grounded(i) = find(root, i) == 0
       end do
       shifted = .not. all(grounded(1:nq))
       sigma = 0.0_dp
@@ -504,13 +496,6 @@ contains
       call store_modes(grp, model%mass, lam, z, lam(1:modes%n) <= 1.0e-9_dp*big .and. shifted, zcz, modes, stat)
       if (stat /= 0) call no_memory(n)
    contains
-      pure integer function find(x)
-         integer, intent(in) :: x
-         find = x
-         do while (root(find) /= find)
-            find = root(find)
-         end do
-      end function find
       !> Component j of z at a node (0 on the table and in its group).
       pure real(dp) function node_z(node, j)
          integer, intent(in) :: node, j
@@ -524,6 +509,109 @@ contains
                           " DOFs", stat_no_memory)
       end subroutine no_memory
    end subroutine natural_modes_sparse
+
+   !> The k lowest eigenpairs of a symmetric matrix: in band storage after a reverse
+   !> Cuthill-McKee ordering when its bandwidth is small (a building: 1 to a few), O(n b^2);
+   !> as a dense matrix otherwise.
+   subroutine lowest_pairs(a, k, lambda, vec, error)
+      real(dp), intent(in) :: a(:, :)
+      integer, intent(in) :: k
+      real(dp), intent(out) :: lambda(:), vec(:, :)
+      type(error_type), allocatable, intent(out) :: error
+      integer, allocatable :: ei(:), ej(:), perm(:), inv(:)
+      real(dp), allocatable :: ab(:, :), vp(:, :)
+      integer :: n, i, j, ne, bw, stat
+
+      n = size(a, 1)
+      ne = 0
+      do j = 1, n
+         do i = 1, j - 1
+            if (a(i, j) /= 0.0_dp) ne = ne + 1
+         end do
+      end do
+      allocate (ei(ne), ej(ne), perm(n), inv(n), stat=stat)
+      if (stat /= 0) then
+         call no_memory(); return
+      end if
+      ne = 0
+      do j = 1, n
+         do i = 1, j - 1
+            if (a(i, j) == 0.0_dp) cycle
+            ne = ne + 1
+            ei(ne) = i; ej(ne) = j
+         end do
+      end do
+      call rcm_order(n, ei, ej, perm)
+      inv(perm) = [(i, i=1, n)]
+      bw = 0
+      do i = 1, ne
+         bw = max(bw, abs(inv(ei(i)) - inv(ej(i))))
+      end do
+      if (n < 32 .or. 4*bw > n) then
+         call lowest_eigen(a, k, lambda, vec, error)
+         return
+      end if
+      allocate (ab(bw + 1, n), vp(n, k), stat=stat)
+      if (stat /= 0) then
+         call no_memory(); return
+      end if
+      ab = 0.0_dp
+      do j = 1, n
+         do i = max(1, j - bw), j
+            ab(bw + 1 + i - j, j) = a(perm(i), perm(j))
+         end do
+      end do
+      call lowest_eigen_band(ab, k, lambda, vp, error)
+      if (allocated(error)) return
+      vec(perm, :) = vp
+   contains
+      subroutine no_memory()
+         call fatal_error(error, "not enough memory for the natural modes of "//trim(fmt_int(n))// &
+                          " DOFs (an eigenproblem of that size)", stat_no_memory)
+      end subroutine no_memory
+   end subroutine lowest_pairs
+
+   !> The factor b of the stiffness-proportional part of C = a0 M + b K: psi = T xi / pi
+   !> ('stiffness': T the given period, else the stuck first period), a1 ('rayleigh'), 0
+   !> ('none'). A spring k carries the viscous force b k times its rate of deformation.
+   pure real(dp) function stiffness_damping_factor(model, period) result(b)
+      type(model_type), intent(in) :: model  !! the model
+      real(dp), intent(in) :: period         !! stuck first period [s] (for 'stiffness')
+
+      select case (model%damping)
+      case (damping_stiffness)
+         if (model%period > 0.0_dp) then
+            b = model%period*model%xi/pi
+         else
+            b = period*model%xi/pi
+         end if
+      case (damping_rayleigh)
+         b = model%rayleigh_a1
+      case default
+         b = 0.0_dp
+      end select
+   end function stiffness_damping_factor
+
+   !> Viscous damping matrix of the model.
+   pure subroutine damping_matrix(model, k, period, c)
+      type(model_type), intent(in) :: model !! the model
+      real(dp), intent(in) :: k(:, :)       !! springs' stiffness
+      real(dp), intent(in) :: period        !! stuck first period T [s] (for damping_stiffness)
+      real(dp), intent(out) :: c(:, :)      !! C [N s/m]
+      integer :: i
+
+      select case (model%damping)
+      case (damping_stiffness)
+         c = (period*model%xi/pi)*k
+      case (damping_rayleigh)
+         c = model%rayleigh_a1*k
+         do i = 1, model%n_dof
+            c(i, i) = c(i, i) + model%rayleigh_a0*model%mass(i)
+         end do
+      case default
+         c = 0.0_dp
+      end select
+   end subroutine damping_matrix
 
    !> The mass of each rigid group (link_groups): the sum of its DOFs' masses.
    pure subroutine group_masses(grp, mass, mq)
@@ -629,107 +717,14 @@ contains
       end do
    end subroutine store_modes
 
-   !> The k lowest eigenpairs of a symmetric matrix: in band storage after a reverse
-   !> Cuthill-McKee ordering when its bandwidth is small (a building: 1 to a few), O(n b^2);
-   !> as a dense matrix otherwise.
-   subroutine lowest_pairs(a, k, lambda, vec, error)
-      real(dp), intent(in) :: a(:, :)
-      integer, intent(in) :: k
-      real(dp), intent(out) :: lambda(:), vec(:, :)
-      type(error_type), allocatable, intent(out) :: error
-      integer, allocatable :: ei(:), ej(:), perm(:), inv(:)
-      real(dp), allocatable :: ab(:, :), vp(:, :)
-      integer :: n, i, j, ne, bw, stat
-
-      n = size(a, 1)
-      ne = 0
-      do j = 1, n
-         do i = 1, j - 1
-            if (a(i, j) /= 0.0_dp) ne = ne + 1
-         end do
+   !> The root of x in a union-find forest (root(x) = x at a root).
+   pure integer function find(root, x)
+      integer, intent(in) :: root(0:)   !! parent of each node
+      integer, intent(in) :: x          !! the node
+      find = x
+      do while (root(find) /= find)
+         find = root(find)
       end do
-      allocate (ei(ne), ej(ne), perm(n), inv(n), stat=stat)
-      if (stat /= 0) then
-         call no_memory(); return
-      end if
-      ne = 0
-      do j = 1, n
-         do i = 1, j - 1
-            if (a(i, j) == 0.0_dp) cycle
-            ne = ne + 1
-            ei(ne) = i; ej(ne) = j
-         end do
-      end do
-      call rcm_order(n, ei, ej, perm)
-      inv(perm) = [(i, i=1, n)]
-      bw = 0
-      do i = 1, ne
-         bw = max(bw, abs(inv(ei(i)) - inv(ej(i))))
-      end do
-      if (n < 32 .or. 4*bw > n) then
-         call lowest_eigen(a, k, lambda, vec, error)
-         return
-      end if
-      allocate (ab(bw + 1, n), vp(n, k), stat=stat)
-      if (stat /= 0) then
-         call no_memory(); return
-      end if
-      ab = 0.0_dp
-      do j = 1, n
-         do i = max(1, j - bw), j
-            ab(bw + 1 + i - j, j) = a(perm(i), perm(j))
-         end do
-      end do
-      call lowest_eigen_band(ab, k, lambda, vp, error)
-      if (allocated(error)) return
-      vec(perm, :) = vp
-   contains
-      subroutine no_memory()
-         call fatal_error(error, "not enough memory for the natural modes of "//trim(fmt_int(n))// &
-                          " DOFs (an eigenproblem of that size)", stat_no_memory)
-      end subroutine no_memory
-   end subroutine lowest_pairs
-
-   !> The factor b of the stiffness-proportional part of C = a0 M + b K: psi = T xi / pi
-   !> ('stiffness': T the given period, else the stuck first period), a1 ('rayleigh'), 0
-   !> ('none'). A spring k carries the viscous force b k times its rate of deformation.
-   pure real(dp) function stiffness_damping_factor(model, period) result(b)
-      type(model_type), intent(in) :: model  !! the model
-      real(dp), intent(in) :: period         !! stuck first period [s] (for 'stiffness')
-
-      select case (model%damping)
-      case (damping_stiffness)
-         if (model%period > 0.0_dp) then
-            b = model%period*model%xi/pi
-         else
-            b = period*model%xi/pi
-         end if
-      case (damping_rayleigh)
-         b = model%rayleigh_a1
-      case default
-         b = 0.0_dp
-      end select
-   end function stiffness_damping_factor
-
-   !> Viscous damping matrix of the model.
-   pure subroutine damping_matrix(model, k, period, c)
-      type(model_type), intent(in) :: model !! the model
-      real(dp), intent(in) :: k(:, :)       !! springs' stiffness
-      real(dp), intent(in) :: period        !! stuck first period T [s] (for damping_stiffness)
-      real(dp), intent(out) :: c(:, :)      !! C [N s/m]
-      integer :: i
-
-      select case (model%damping)
-      case (damping_stiffness)
-         c = (period*model%xi/pi)*k
-      case (damping_rayleigh)
-         c = model%rayleigh_a1*k
-         do i = 1, model%n_dof
-            c(i, i) = c(i, i) + model%rayleigh_a0*model%mass(i)
-         end do
-      case default
-         c = 0.0_dp
-      end select
-   end subroutine damping_matrix
+   end function find
 
 end module fd_matrices
