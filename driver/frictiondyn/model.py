@@ -432,18 +432,12 @@ def _friction_values(group: dict, items: list) -> None:
         _per_device(group, key, [getattr(x, key) for x in items])
     if any(x.mu_table is not None for x in items):
         n = max(len(x.mu_table or []) for x in items)
-        group["mu_table_v"] = [
-            [float(v) for v, _ in x.mu_table] + [None] * (n - len(x.mu_table))
-            if x.mu_table
-            else [None] * n
-            for x in items
-        ]
-        group["mu_table_mu"] = [
-            [float(m) for _, m in x.mu_table] + [None] * (n - len(x.mu_table))
-            if x.mu_table
-            else [None] * n
-            for x in items
-        ]
+        for key, column in (("mu_table_v", 0), ("mu_table_mu", 1)):
+            group[key] = [
+                [float(point[column]) for point in x.mu_table or []]
+                + [None] * (n - len(x.mu_table or []))
+                for x in items
+            ]
 
 
 @dataclass

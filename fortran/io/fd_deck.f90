@@ -10,8 +10,8 @@ module fd_deck
    use fd_kinds, only: dp
    use fd_error, only: error_type, fatal_error, fmt_int, fmt_real, stat_no_memory
    use fd_textio, only: lower
-   use fd_namelist, only: deck_text, group_text, deck_from_string, find_group, group_item, &
-                          group_read_error, check_groups, longest_string
+   use fd_namelist, only: deck_text, group_text, deck_from_string, find_group, &
+                          next_read, check_groups, longest_string
    use fd_names, only: keyword_type, keyword_id, keyword_choices, law_id, law_choices, &
                        damping_types, damping_stiffness, damping_rayleigh, damping_none, &
                        excitation_types, excitation_harmonic, excitation_record, excitation_none, &
@@ -171,17 +171,13 @@ contains
       character(len=label_len), allocatable :: label(:)
       namelist /model/ n_dof, mass, u0, v0, label
       type(group_text) :: grp
-      character(len=512) :: msg, msg0
-      character(len=:), allocatable :: rec
+      character(len=512) :: msg
       integer :: ios, i, n
-      logical :: found
+      logical :: more
 
       n_dof = unset_int
-      call find_group(deck, 'model', grp, found, error)
+      call required_group(deck, 'model', grp, error)
       if (allocated(error)) return
-      if (.not. found) then
-         call missing_group(deck, 'model', error); return
-      end if
       i = array_capacity(grp, 'n_dof', max_dof)
       allocate (mass(i), u0(i), v0(i), stat=ios)
       if (ios /= 0) then
@@ -196,17 +192,12 @@ contains
       ! a longer label would be cut by the namelist read: refused from the group's text first
       call check_length(deck, grp, 'label', label_len - 1, error)
       if (allocated(error)) return
-      msg0 = ''
-      read (grp%lines, nml=model, iostat=ios, iomsg=msg0)
-      if (ios /= 0) then
-         do i = 1, size(grp%items)
-            call group_item(grp, i, rec); msg = ''
-            read (rec, nml=model, iostat=ios, iomsg=msg)
-            if (ios /= 0) exit
-         end do
-         if (ios == 0) msg = msg0
-         call group_read_error(deck, grp, i, msg, error); return
-      end if
+      do
+         read (grp%lines, nml=model, iostat=ios, iomsg=msg)
+         call next_read(deck, grp, ios, msg, more, error)
+         if (.not. more) exit
+      end do
+      if (allocated(error)) return
       call need_int(deck, 'model', 'n_dof', n_dof, 1, max_dof, error)
       if (allocated(error)) return
       n = n_dof
@@ -235,34 +226,25 @@ contains
       real(dp), allocatable :: k(:)
       namelist /springs/ n_springs, node_i, node_j, k
       type(group_text) :: grp
-      character(len=512) :: msg, msg0
-      character(len=:), allocatable :: rec
+      character(len=512) :: msg
       integer :: ios, i, n
-      logical :: found
+      logical :: more
 
       n_springs = unset_int
-      call find_group(deck, 'springs', grp, found, error)
+      call required_group(deck, 'springs', grp, error)
       if (allocated(error)) return
-      if (.not. found) then
-         call missing_group(deck, 'springs', error); return
-      end if
       i = array_capacity(grp, 'n_springs', max_springs)
       allocate (node_i(i), node_j(i), k(i), stat=ios)
       if (ios /= 0) then
          call no_memory(deck, 'springs', i, 'springs', error); return
       end if
       node_i = unset_int; node_j = unset_int; k = unset
-      msg0 = ''
-      read (grp%lines, nml=springs, iostat=ios, iomsg=msg0)
-      if (ios /= 0) then
-         do i = 1, size(grp%items)
-            call group_item(grp, i, rec); msg = ''
-            read (rec, nml=springs, iostat=ios, iomsg=msg)
-            if (ios /= 0) exit
-         end do
-         if (ios == 0) msg = msg0
-         call group_read_error(deck, grp, i, msg, error); return
-      end if
+      do
+         read (grp%lines, nml=springs, iostat=ios, iomsg=msg)
+         call next_read(deck, grp, ios, msg, more, error)
+         if (.not. more) exit
+      end do
+      if (allocated(error)) return
       call need_int(deck, 'springs', 'n_springs', n_springs, 0, max_springs, error)
       if (allocated(error)) return
       n = n_springs
@@ -273,12 +255,8 @@ contains
       call need_reals(deck, 'springs', 'k', k, n, 'N/m', error, positive=.true.)
       if (allocated(error)) return
       do i = 1, n
-         if (node_i(i) == node_j(i)) then
-            call bad(deck, 'springs', 'node_j('//trim(fmt_int(i))//')', trim(fmt_int(node_j(i))), &
-                     'different from node_i('//trim(fmt_int(i))//') = '// &
-                     trim(fmt_int(node_i(i)))//': a spring joins two different nodes', error)
-            return
-         end if
+         call distinct_nodes(deck, 'springs', i, node_i(i), node_j(i), 'a spring joins two different nodes', error)
+         if (allocated(error)) return
       end do
       cfg%model%n_springs = n
       cfg%model%spring_i = node_i(1:n)
@@ -299,34 +277,26 @@ contains
       character(len=name_len) :: mode_system
       namelist /damping/ damping_type, xi, period, rayleigh_a0, rayleigh_a1, mode_i, mode_j, mode_system
       type(group_text) :: grp
-      character(len=512) :: msg, msg0
-      character(len=:), allocatable :: rec, choices
-      integer :: ios, i
-      logical :: found
+      character(len=512) :: msg
+      character(len=:), allocatable :: choices
+      integer :: ios
+      logical :: more
 
       damping_type = ''
       xi = default_xi; period = default_period
       rayleigh_a0 = default_rayleigh_a0; rayleigh_a1 = default_rayleigh_a1
       mode_i = unset_int; mode_j = unset_int; mode_system = mode_systems(default_mode_system)%name
-      call find_group(deck, 'damping', grp, found, error)
+      call required_group(deck, 'damping', grp, error)
       if (allocated(error)) return
-      if (.not. found) then
-         call missing_group(deck, 'damping', error); return
-      end if
       call check_length(deck, grp, 'damping_type', name_len, error)
       if (.not. allocated(error)) call check_length(deck, grp, 'mode_system', name_len, error)
       if (allocated(error)) return
-      msg0 = ''
-      read (grp%lines, nml=damping, iostat=ios, iomsg=msg0)
-      if (ios /= 0) then
-         do i = 1, size(grp%items)
-            call group_item(grp, i, rec); msg = ''
-            read (rec, nml=damping, iostat=ios, iomsg=msg)
-            if (ios /= 0) exit
-         end do
-         if (ios == 0) msg = msg0
-         call group_read_error(deck, grp, i, msg, error); return
-      end if
+      do
+         read (grp%lines, nml=damping, iostat=ios, iomsg=msg)
+         call next_read(deck, grp, ios, msg, more, error)
+         if (.not. more) exit
+      end do
+      if (allocated(error)) return
       cfg%model%damping = keyword_id(damping_types, damping_type)
       select case (cfg%model%damping)
       case (damping_stiffness)
@@ -369,10 +339,10 @@ contains
       namelist /friction/ n_devices, node_i, node_j, law, p, mu, eps, eps1, f, &
          mu_law, mu_max, mu_min, mu_rate, mu_table_v, mu_table_mu, label
       type(group_text) :: grp
-      character(len=512) :: msg, msg0
-      character(len=:), allocatable :: rec, idx, choices
+      character(len=512) :: msg
+      character(len=:), allocatable :: idx
       integer :: ios, i, n, id
-      logical :: found
+      logical :: found, more
 
       n_devices = default_n_devices
       call find_group(deck, 'friction', grp, found, error)
@@ -397,17 +367,12 @@ contains
       ! a longer label would be cut by the namelist read: refused from the group's text first
       call check_length(deck, grp, 'label', label_len - 1, error)
       if (allocated(error)) return
-      msg0 = ''
-      read (grp%lines, nml=friction, iostat=ios, iomsg=msg0)
-      if (ios /= 0) then
-         do i = 1, size(grp%items)
-            call group_item(grp, i, rec); msg = ''
-            read (rec, nml=friction, iostat=ios, iomsg=msg)
-            if (ios /= 0) exit
-         end do
-         if (ios == 0) msg = msg0
-         call group_read_error(deck, grp, i, msg, error); return
-      end if
+      do
+         read (grp%lines, nml=friction, iostat=ios, iomsg=msg)
+         call next_read(deck, grp, ios, msg, more, error)
+         if (.not. more) exit
+      end do
+      if (allocated(error)) return
       call need_int(deck, 'friction', 'n_devices', n_devices, 0, max_devices, error)
       if (allocated(error)) return
       n = n_devices
@@ -444,27 +409,16 @@ contains
       end if
       do i = 1, n
          idx = '('//trim(fmt_int(i))//')'
-         if (node_i(i) == node_j(i)) then
-            call bad(deck, 'friction', 'node_j'//idx, trim(fmt_int(node_j(i))), 'different from node_i'//idx//' = '// &
-                     trim(fmt_int(node_i(i)))//': a device joins two different nodes', error)
-            return
-         end if
+         call distinct_nodes(deck, 'friction', i, node_i(i), node_j(i), 'a device joins two different nodes', error)
+         if (allocated(error)) return
          if (p(i)*mu(i) /= 0.0_dp .and. p(i)*mu(i) < min_scale) then
             call bad(deck, 'friction', 'p'//idx//' * mu'//idx, trim(fmt_real(p(i)*mu(i))), '0 (no friction) or at '// &
                      'least '//trim(fmt_real(min_scale))//' N: the friction force P mu of a device (here P = '// &
                      trim(fmt_real(p(i)))//' N, mu = '//trim(fmt_real(mu(i)))//')', error)
             return
          end if
-         id = law_id(law(i))
-         if (id == 0) then
-            call law_choices(choices)
-            if (len_trim(law(i)) == 0) then
-               call bad(deck, 'friction', 'law'//idx, '(not given)', 'one of '//choices, error)
-            else
-               call bad(deck, 'friction', 'law'//idx, "'"//trim(law(i))//"'", 'one of '//choices, error)
-            end if
-            return
-         end if
+         call device_law(deck, 'friction', i, law(i), id, error)
+         if (allocated(error)) return
          cfg%model%dev(i) = device_type(node_i=node_i(i), node_j=node_j(i), law=id, &
                                         p=p(i), mu=mu(i), eps=eps(i), eps1=eps1(i), f=f(i))
          call apply_mu_law(deck, 'friction', i, mu_ids(i), mu_min(i), mu_rate(i), mu_table_v(:, i), &
@@ -490,38 +444,30 @@ contains
       namelist /excitation/ excitation_type, amplitude, frequency, ramp_cycles, duration, dt_record, &
          record_file, record_kind, record_scale, record_format, record_units
       type(group_text) :: grp
-      character(len=512) :: msg, msg0
-      character(len=:), allocatable :: rec, path, choices
-      integer :: ios, i
-      logical :: found
+      character(len=512) :: msg
+      character(len=:), allocatable :: path, choices
+      integer :: ios
+      logical :: more
 
       excitation_type = ''; record_kind = record_kinds(default_record_kind)%name; record_file = ''
       amplitude = unset; frequency = unset; duration = unset; dt_record = unset
       record_scale = default_record_scale
       ramp_cycles = default_ramp_cycles
       record_format = 'auto'; record_units = ''
-      call find_group(deck, 'excitation', grp, found, error)
+      call required_group(deck, 'excitation', grp, error)
       if (allocated(error)) return
-      if (.not. found) then
-         call missing_group(deck, 'excitation', error); return
-      end if
       call check_length(deck, grp, 'excitation_type', name_len, error)
       if (.not. allocated(error)) call check_length(deck, grp, 'record_kind', name_len, error)
       if (.not. allocated(error)) call check_length(deck, grp, 'record_format', name_len, error)
       if (.not. allocated(error)) call check_length(deck, grp, 'record_units', name_len, error)
       if (.not. allocated(error)) call check_length(deck, grp, 'record_file', path_len, error)
       if (allocated(error)) return
-      msg0 = ''
-      read (grp%lines, nml=excitation, iostat=ios, iomsg=msg0)
-      if (ios /= 0) then
-         do i = 1, size(grp%items)
-            call group_item(grp, i, rec); msg = ''
-            read (rec, nml=excitation, iostat=ios, iomsg=msg)
-            if (ios /= 0) exit
-         end do
-         if (ios == 0) msg = msg0
-         call group_read_error(deck, grp, i, msg, error); return
-      end if
+      do
+         read (grp%lines, nml=excitation, iostat=ios, iomsg=msg)
+         call next_read(deck, grp, ios, msg, more, error)
+         if (.not. more) exit
+      end do
+      if (allocated(error)) return
       ! a record whose file gives DT (AT2) may leave dt_record out
       if (.not. (keyword_id(excitation_types, excitation_type) == excitation_record .and. dt_record == unset)) then
          call need_real(deck, 'excitation', 'dt_record', dt_record, 's', error)
@@ -616,10 +562,9 @@ contains
       namelist /integration/ technique, beta, gamma, n1, n2, n, check_correctness, dt_min, theta, linear_system, &
                              refinement
       type(group_text) :: grp
-      character(len=512) :: msg, msg0
-      character(len=:), allocatable :: rec
-      integer :: ios, i, technique_id, system_id, refinement_id
-      logical :: found
+      character(len=512) :: msg
+      integer :: ios, technique_id, system_id, refinement_id
+      logical :: found, more
 
       technique = technique_name(default_technique)
       linear_system = linear_systems(default_linear_system)%name
@@ -633,17 +578,12 @@ contains
          if (.not. allocated(error)) call check_length(deck, grp, 'linear_system', name_len, error)
          if (.not. allocated(error)) call check_length(deck, grp, 'refinement', name_len, error)
          if (allocated(error)) return
-         msg0 = ''
-         read (grp%lines, nml=integration, iostat=ios, iomsg=msg0)
-         if (ios /= 0) then
-            do i = 1, size(grp%items)
-               call group_item(grp, i, rec); msg = ''
-               read (rec, nml=integration, iostat=ios, iomsg=msg)
-               if (ios /= 0) exit
-            end do
-            if (ios == 0) msg = msg0
-            call group_read_error(deck, grp, i, msg, error); return
-         end if
+         do
+            read (grp%lines, nml=integration, iostat=ios, iomsg=msg)
+            call next_read(deck, grp, ios, msg, more, error)
+            if (.not. more) exit
+         end do
+         if (allocated(error)) return
       end if
       call keyword_value(deck, 'integration', 'technique', techniques, technique, technique_id, error)
       if (allocated(error)) return
@@ -702,10 +642,9 @@ contains
       integer, allocatable :: history_dofs(:), history_devices(:)
       namelist /output/ dir, name, output_every, write_history, history_dofs, history_devices, n_modes
       type(group_text) :: grp
-      character(len=512) :: msg, msg0
-      character(len=:), allocatable :: rec
-      integer :: ios, i
-      logical :: found
+      character(len=512) :: msg
+      integer :: ios
+      logical :: found, more
 
       dir = default_dir; output_every = default_output_every; write_history = default_write_history
       allocate (history_dofs(cfg%model%n_dof + 2), history_devices(cfg%model%n_devices + 2), stat=ios)
@@ -722,17 +661,12 @@ contains
          call check_length(deck, grp, 'dir', path_len, error)
          if (.not. allocated(error)) call check_length(deck, grp, 'name', path_len, error)
          if (allocated(error)) return
-         msg0 = ''
-         read (grp%lines, nml=output, iostat=ios, iomsg=msg0)
-         if (ios /= 0) then
-            do i = 1, size(grp%items)
-               call group_item(grp, i, rec); msg = ''
-               read (rec, nml=output, iostat=ios, iomsg=msg)
-               if (ios /= 0) exit
-            end do
-            if (ios == 0) msg = msg0
-            call group_read_error(deck, grp, i, msg, error); return
-         end if
+         do
+            read (grp%lines, nml=output, iostat=ios, iomsg=msg)
+            call next_read(deck, grp, ios, msg, more, error)
+            if (.not. more) exit
+         end do
+         if (allocated(error)) return
       end if
       if (len_trim(dir) == 0) then
          call bad(deck, 'output', 'dir', "''", 'a directory path', error); return
@@ -809,10 +743,10 @@ contains
       namelist /braces/ n_braces, node_i, node_j, slip_load, stiffness, eps1, label
       type(group_text) :: grp
       type(device_type), allocatable :: dev(:)
-      character(len=512) :: msg, msg0
-      character(len=:), allocatable :: rec, idx
+      character(len=512) :: msg
+      character(len=:), allocatable :: idx
       integer :: ios, i, n
-      logical :: found
+      logical :: found, more
 
       n_braces = 0
       call find_group(deck, 'braces', grp, found, error)
@@ -826,17 +760,12 @@ contains
       ! a longer label would be cut by the namelist read: refused from the group's text first
       call check_length(deck, grp, 'label', label_len - 1, error)
       if (allocated(error)) return
-      msg0 = ''
-      read (grp%lines, nml=braces, iostat=ios, iomsg=msg0)
-      if (ios /= 0) then
-         do i = 1, size(grp%items)
-            call group_item(grp, i, rec); msg = ''
-            read (rec, nml=braces, iostat=ios, iomsg=msg)
-            if (ios /= 0) exit
-         end do
-         if (ios == 0) msg = msg0
-         call group_read_error(deck, grp, i, msg, error); return
-      end if
+      do
+         read (grp%lines, nml=braces, iostat=ios, iomsg=msg)
+         call next_read(deck, grp, ios, msg, more, error)
+         if (.not. more) exit
+      end do
+      if (allocated(error)) return
       call need_int(deck, 'braces', 'n_braces', n_braces, 0, max_devices - cfg%model%n_devices, error)
       if (allocated(error)) return
       n = n_braces
@@ -855,11 +784,8 @@ contains
       allocate (dev(n))
       do i = 1, n
          idx = '('//trim(fmt_int(i))//')'
-         if (node_i(i) == node_j(i)) then
-            call bad(deck, 'braces', 'node_j'//idx, trim(fmt_int(node_j(i))), 'different from node_i'//idx//' = '// &
-                     trim(fmt_int(node_i(i)))//': a brace joins two different nodes', error)
-            return
-         end if
+         call distinct_nodes(deck, 'braces', i, node_i(i), node_j(i), 'a brace joins two different nodes', error)
+         if (allocated(error)) return
          ! the sticking displacement f = slip_load / stiffness, a length: within the limits
          call check_magnitude(deck, 'braces', 'slip_load'//idx//' / stiffness'//idx, slip_load(i)/stiffness(i), &
                               'm', .true., error)
@@ -896,10 +822,10 @@ contains
          mu_law, mu_max, mu_min, mu_rate, mu_table_v, mu_table_mu, label
       type(group_text) :: grp
       type(device_type), allocatable :: dev(:)
-      character(len=512) :: msg, msg0
-      character(len=:), allocatable :: rec, idx, choices
+      character(len=512) :: msg
+      character(len=:), allocatable :: idx
       integer :: ios, i, n, id
-      logical :: found
+      logical :: found, more
 
       n_isolators = 0
       call find_group(deck, 'isolators', grp, found, error)
@@ -918,17 +844,12 @@ contains
       call check_length(deck, grp, 'law', name_len, error)
       if (.not. allocated(error)) call check_length(deck, grp, 'mu_law', name_len, error)
       if (allocated(error)) return
-      msg0 = ''
-      read (grp%lines, nml=isolators, iostat=ios, iomsg=msg0)
-      if (ios /= 0) then
-         do i = 1, size(grp%items)
-            call group_item(grp, i, rec); msg = ''
-            read (rec, nml=isolators, iostat=ios, iomsg=msg)
-            if (ios /= 0) exit
-         end do
-         if (ios == 0) msg = msg0
-         call group_read_error(deck, grp, i, msg, error); return
-      end if
+      do
+         read (grp%lines, nml=isolators, iostat=ios, iomsg=msg)
+         call next_read(deck, grp, ios, msg, more, error)
+         if (.not. more) exit
+      end do
+      if (allocated(error)) return
       call need_int(deck, 'isolators', 'n_isolators', n_isolators, 0, max_devices - cfg%model%n_devices, error)
       if (allocated(error)) return
       n = n_isolators
@@ -961,11 +882,8 @@ contains
       allocate (dev(n))
       do i = 1, n
          idx = '('//trim(fmt_int(i))//')'
-         if (node_i(i) == node_j(i)) then
-            call bad(deck, 'isolators', 'node_j'//idx, trim(fmt_int(node_j(i))), 'different from node_i'//idx// &
-                     ' = '//trim(fmt_int(node_i(i)))//': an isolator joins two different nodes', error)
-            return
-         end if
+         call distinct_nodes(deck, 'isolators', i, node_i(i), node_j(i), 'an isolator joins two different nodes', error)
+         if (allocated(error)) return
          if (radius(i) < 0.0_dp) then
             call bad(deck, 'isolators', 'radius'//idx, trim(fmt_real(radius(i))), '>= 0 m (0 = flat)', error)
             return
@@ -984,16 +902,8 @@ contains
                      'an isolator (here W = '//trim(fmt_real(weight(i)))//' N, mu = '//trim(fmt_real(mu(i)))//')', error)
             return
          end if
-         id = law_id(law(i))
-         if (id == 0) then
-            call law_choices(choices)
-            if (len_trim(law(i)) == 0) then
-               call bad(deck, 'isolators', 'law'//idx, '(not given)', 'one of '//choices, error)
-            else
-               call bad(deck, 'isolators', 'law'//idx, "'"//trim(law(i))//"'", 'one of '//choices, error)
-            end if
-            return
-         end if
+         call device_law(deck, 'isolators', i, law(i), id, error)
+         if (allocated(error)) return
          dev(i) = device_type(node_i=node_i(i), node_j=node_j(i), law=id, p=weight(i), mu=mu(i), &
                               eps=eps(i), eps1=eps1(i), f=f(i))
          call apply_mu_law(deck, 'isolators', i, mu_ids(i), mu_min(i), mu_rate(i), mu_table_v(:, i), &
@@ -1035,10 +945,10 @@ contains
       character(len=label_len), allocatable :: label(:)
       namelist /storeys/ n_storeys, node_i, node_j, spring, height, label
       type(group_text) :: grp
-      character(len=512) :: msg, msg0
-      character(len=:), allocatable :: rec, idx
+      character(len=512) :: msg
+      character(len=:), allocatable :: idx
       integer :: ios, i, n, last
-      logical :: found
+      logical :: found, more
 
       n_storeys = 0
       cfg%model%n_storeys = 0
@@ -1055,17 +965,12 @@ contains
       ! a longer label would be cut by the namelist read: refused from the group's text first
       call check_length(deck, grp, 'label', label_len - 1, error)
       if (allocated(error)) return
-      msg0 = ''
-      read (grp%lines, nml=storeys, iostat=ios, iomsg=msg0)
-      if (ios /= 0) then
-         do i = 1, size(grp%items)
-            call group_item(grp, i, rec); msg = ''
-            read (rec, nml=storeys, iostat=ios, iomsg=msg)
-            if (ios /= 0) exit
-         end do
-         if (ios == 0) msg = msg0
-         call group_read_error(deck, grp, i, msg, error); return
-      end if
+      do
+         read (grp%lines, nml=storeys, iostat=ios, iomsg=msg)
+         call next_read(deck, grp, ios, msg, more, error)
+         if (.not. more) exit
+      end do
+      if (allocated(error)) return
       call need_int(deck, 'storeys', 'n_storeys', n_storeys, 0, max_dof, error)
       if (allocated(error)) return
       n = n_storeys
@@ -1103,11 +1008,8 @@ contains
       if (allocated(error)) return
       do i = 1, n
          idx = '('//trim(fmt_int(i))//')'
-         if (node_i(i) == node_j(i)) then
-            call bad(deck, 'storeys', 'node_j'//idx, trim(fmt_int(node_j(i))), 'different from node_i'//idx// &
-                     ' = '//trim(fmt_int(node_i(i)))//': a storey lies between two different nodes', error)
-            return
-         end if
+         call distinct_nodes(deck, 'storeys', i, node_i(i), node_j(i), 'a storey lies between two different nodes', error)
+         if (allocated(error)) return
          if (height(i) < 0.0_dp) then
             call bad(deck, 'storeys', 'height'//idx, trim(fmt_real(height(i))), '>= 0 m (0 = not given)', error)
             return
@@ -1480,12 +1382,52 @@ contains
       end do
    end function array_capacity
 
-   subroutine missing_group(deck, group, error)
+   !> The text of a group the deck must have (find_group), or an error saying it is missing.
+   subroutine required_group(deck, group, grp, error)
+      type(deck_text), intent(in) :: deck
+      character(len=*), intent(in) :: group               !! group name, lower case
+      type(group_text), intent(out) :: grp                !! the group's text
+      type(error_type), allocatable, intent(out) :: error !! missing, or find_group's error
+      logical :: found
+      call find_group(deck, group, grp, found, error)
+      if (allocated(error) .or. found) return
+      call fatal_error(error, deck%path//": required group &"//group//" is missing")
+   end subroutine required_group
+
+   !> Item i of a group joins two different nodes.
+   subroutine distinct_nodes(deck, group, i, node_i, node_j, rule, error)
       type(deck_text), intent(in) :: deck
       character(len=*), intent(in) :: group
+      integer, intent(in) :: i                            !! the item
+      integer, intent(in) :: node_i, node_j               !! its nodes
+      character(len=*), intent(in) :: rule                !! what the item is, for the message
       type(error_type), allocatable, intent(out) :: error
-      call fatal_error(error, deck%path//": required group &"//group//" is missing")
-   end subroutine missing_group
+      character(len=:), allocatable :: idx
+      if (node_i /= node_j) return
+      idx = '('//trim(fmt_int(i))//')'
+      call bad(deck, group, 'node_j'//idx, trim(fmt_int(node_j)), 'different from node_i'//idx//' = '// &
+               trim(fmt_int(node_i))//': '//rule, error)
+   end subroutine distinct_nodes
+
+   !> The id of law(i) of a device (fd_names), or an error naming the choices.
+   subroutine device_law(deck, group, i, law, id, error)
+      type(deck_text), intent(in) :: deck
+      character(len=*), intent(in) :: group
+      integer, intent(in) :: i                            !! the device (item) of the group
+      character(len=*), intent(in) :: law                 !! its law as given, blank if not
+      integer, intent(out) :: id                          !! the law's id
+      type(error_type), allocatable, intent(out) :: error
+      character(len=:), allocatable :: choices, idx
+      id = law_id(law)
+      if (id /= 0) return
+      call law_choices(choices)
+      idx = '('//trim(fmt_int(i))//')'
+      if (len_trim(law) == 0) then
+         call bad(deck, group, 'law'//idx, '(not given)', 'one of '//choices, error)
+      else
+         call bad(deck, group, 'law'//idx, "'"//trim(law)//"'", 'one of '//choices, error)
+      end if
+   end subroutine device_law
 
    !> The id of `text` in the keyword table `table` (fd_names), or an error naming the group,
    !> the variable, the value and the choices.

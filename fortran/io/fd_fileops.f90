@@ -1,14 +1,15 @@
 !> The Fortran interfaces of fd_fileops.c, in one place: POSIX file creation, writes,
 !> close, rename, unlink, the output lock, errno texts and the process id (gfortran's own
 !> I/O loses a full disk silently and will not open one file on two units; docs/batch.md).
-!> Every function returns 0 or an errno.
+!> Every function returns 0 or an errno; os_error turns one into an error naming what failed.
 module fd_fileops
-   use, intrinsic :: iso_c_binding, only: c_char, c_int, c_long
+   use, intrinsic :: iso_c_binding, only: c_char, c_int, c_long, c_null_char
+   use fd_error, only: error_type, fatal_error
    implicit none
    private
 
    public :: c_lock_acquire, c_lock_release, c_unlink, c_rename, c_errno_text, c_getpid
-   public :: c_file_create, c_file_write, c_file_close
+   public :: c_file_create, c_file_write, c_file_close, os_error
 
    interface
       !> Take the lock file `path` (created, held while fd is open).
@@ -71,4 +72,16 @@ module fd_fileops
          integer(c_int) :: err
       end function c_file_close
    end interface
+
+contains
+
+   !> An error naming what failed and the system's reason (errno text).
+   subroutine os_error(error, what, err)
+      type(error_type), allocatable, intent(out) :: error !! the error
+      character(len=*), intent(in) :: what                !! what failed
+      integer(c_int), intent(in) :: err                   !! its errno
+      character(kind=c_char, len=256) :: buf
+      call c_errno_text(err, buf, int(len(buf), c_int))
+      call fatal_error(error, what//": "//buf(1:max(0, index(buf, c_null_char) - 1)))
+   end subroutine os_error
 end module fd_fileops

@@ -11,7 +11,7 @@ module fd_history_stream
    use, intrinsic :: iso_c_binding, only: c_char, c_int, c_long, c_double, c_null_char
    use fd_kinds, only: dp
    use fd_error, only: error_type, fatal_error
-   use fd_fileops, only: c_file_create, c_file_write, c_file_close, c_unlink, c_rename, c_errno_text
+   use fd_fileops, only: c_file_create, c_file_write, c_file_close, c_unlink, c_rename, os_error
    implicit none
    private
 
@@ -176,15 +176,5 @@ contains
       end if
       deallocate (st%path)
    end subroutine stream_commit
-
-   !> An error naming what failed and the system's reason.
-   subroutine os_error(error, what, err)
-      type(error_type), allocatable, intent(out) :: error
-      character(len=*), intent(in) :: what
-      integer(c_int), intent(in) :: err
-      character(kind=c_char, len=256) :: buf
-      call c_errno_text(err, buf, int(len(buf), c_int))
-      call fatal_error(error, what//": "//buf(1:max(0, index(buf, c_null_char) - 1)))
-   end subroutine os_error
 
 end module fd_history_stream

@@ -2,15 +2,15 @@
 !> formed (every character either in a group, in a comment or blank: scan_deck), the text
 !> of one group found in it, and messages that name the file, group, line, variable and value.
 !> The group readers in fd_deck do the namelist reads themselves (a namelist can only be
-!> read where it is declared); on failure they re-read the group one assignment at a
-!> time with group_item to find the variable and value at fault.
+!> read where it is declared), in a loop with next_read: on failure the group is re-read
+!> one assignment at a time (group_item) to find the variable and value at fault.
 module fd_namelist
    use fd_error, only: error_type, fatal_error, fmt_int, stat_no_memory
    use fd_textio, only: line_type, read_text_file, split_lines, lower
    implicit none
    private
 
-   public :: deck_text, group_text, load_deck, deck_from_string, find_group, group_item, group_read_error
+   public :: deck_text, group_text, load_deck, deck_from_string, find_group, group_item, group_read_error, next_read
    public :: check_groups, group_opened, scan_deck, group_span, longest_string
 
    character(len=*), parameter :: blanks = ' '//achar(9)  !! what separates words on a line
@@ -42,6 +42,10 @@ module fd_namelist
       integer :: first_line = 0                      !! deck line of '&name'
       type(line_type), allocatable :: items(:)       !! the assignments 'var = value'
       integer, allocatable :: item_line(:)           !! deck line of each assignment
+      !> what lines holds (next_read): 0 the whole group; i > 0 its assignment i alone, re-read
+      !> after the whole group failed to read
+      integer :: item = 0
+      character(len=:), allocatable :: whole_msg     !! the reader's message on the whole group
    end type group_text
 
 contains
@@ -666,6 +670,46 @@ contains
 
       record = '&'//grp%name//' '//grp%items(i)%s//' /'
    end subroutine group_item
+
+   !> After a namelist read of grp%lines (its iostat ios and iomsg msg): whether to read
+   !> grp%lines again. When the whole group fails to read, grp%lines then holds each of its
+   !> assignments alone in turn (group_item) until one fails, and error names it
+   !> (group_read_error); if each reads alone, error gives the message on the whole group.
+   !> A group reader declares the namelist and loops:
+   !>
+   !>     do
+   !>        read (grp%lines, nml=x, iostat=ios, iomsg=msg)
+   !>        call next_read(deck, grp, ios, msg, more, error)
+   !>        if (.not. more) exit
+   !>     end do
+   !>     if (allocated(error)) return
+   subroutine next_read(deck, grp, ios, msg, more, error)
+      type(deck_text), intent(in) :: deck                 !! the deck
+      type(group_text), intent(inout) :: grp              !! the group; its lines, the next text to read
+      integer, intent(in) :: ios                          !! iostat of the read
+      character(len=*), intent(inout) :: msg              !! its iomsg; blank for the next read
+      logical, intent(out) :: more                        !! read grp%lines again
+      type(error_type), allocatable, intent(out) :: error !! the group cannot be read
+      character(len=:), allocatable :: record
+
+      more = .false.
+      if (grp%item == 0) then
+         if (ios == 0) return
+         grp%whole_msg = msg
+      else if (ios /= 0) then
+         call group_read_error(deck, grp, grp%item, msg, error); return
+      end if
+      if (grp%item == size(grp%items)) then
+         call group_read_error(deck, grp, 0, grp%whole_msg, error); return
+      end if
+      grp%item = grp%item + 1
+      call group_item(grp, grp%item, record)
+      deallocate (grp%lines)
+      allocate (character(len=len(record)) :: grp%lines(1))
+      grp%lines(1) = record
+      msg = ''
+      more = .true.
+   end subroutine next_read
 
    !> Error for a group that could not be read: names the assignment at fault when the
    !> one-by-one re-read found it (bad >= 1), else reports the reader's message.

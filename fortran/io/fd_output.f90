@@ -11,9 +11,9 @@ module fd_output
    use fd_record, only: record_info
    use fd_version, only: frictiondyn_version
    use fd_history_stream, only: format_row, stream_value_width
-   use fd_names, only: excitation_types
+   use fd_names, only: excitation_types, keyword_len
    use fd_matrices, only: modes_type, modes_flexible, modes_rigid, modes_unrestrained
-   use fd_fileops, only: c_lock_acquire, c_lock_release, c_unlink, c_rename, c_errno_text, c_getpid, &
+   use fd_fileops, only: c_lock_acquire, c_lock_release, c_unlink, c_rename, os_error, c_getpid, &
                          c_file_create, c_file_write, c_file_close
    implicit none
    private
@@ -209,16 +209,6 @@ contains
       end subroutine discard
    end subroutine write_output_files
 
-   !> An error naming what failed and the system's reason (errno text).
-   subroutine os_error(error, what, err)
-      type(error_type), allocatable, intent(out) :: error
-      character(len=*), intent(in) :: what
-      integer(c_int), intent(in) :: err
-      character(kind=c_char, len=256) :: buf
-      call c_errno_text(err, buf, int(len(buf), c_int))
-      call fatal_error(error, what//": "//buf(1:max(0, index(buf, c_null_char) - 1)))
-   end subroutine os_error
-
    !> Create a directory and its missing parents; `made`, when given, is the first (outermost)
    !> directory this call created (not allocated: none), for remove_made_dirs.
    subroutine make_dir(dir, error, made)
@@ -359,16 +349,10 @@ contains
       character(len=:), allocatable, intent(out) :: js     !! the JSON text
       type(record_info), intent(in), optional :: record    !! the record read, if any
       character(len=1), parameter :: nl = achar(10)
-      character(len=:), allocatable :: laws, esc, buf
-      integer :: pos, nlaw
+      character(len=:), allocatable :: esc, buf
+      integer :: pos
       integer :: d
 
-      nlaw = 0
-      allocate (character(len=64) :: laws)
-      do d = 1, model%n_devices
-         call put_law('"'//trim(law_name(model%dev(d)%law))//'"')
-         if (d < model%n_devices) call put_law(', ')
-      end do
       call json_escape(deck_path, esc)
       pos = 0
       allocate (character(len=4096 + 64*(res%n_dof + res%n_devices)*8) :: buf)
@@ -391,17 +375,17 @@ contains
             call put('},'//nl)
          end if
       end if
-      call kv('n_dof', trim(fmt_int(res%n_dof)))
-      call kv('n_devices', trim(fmt_int(res%n_devices)))
+      call kint('n_dof', res%n_dof)
+      call kint('n_devices', res%n_devices)
       call kv('technique', '"'//trim(technique_name(res%technique))//'"')
-      call put('  "device_law": ['//laws(1:nlaw)//'],'//nl)
-      call kv('period_stuck_s', trim(json_real(res%period_stuck)))
-      call kv('xi_stuck', trim(json_real(res%xi_stuck)))
-      call kv('dt1_s', trim(json_real(res%dt1)))
-      call kv('dt2_s', trim(json_real(res%dt2)))
-      call kv('dt_min_s', trim(json_real(res%dt_min)))
-      call kv('omega_max_rad_s', trim(json_real(res%omega_max)))
-      call kv('omega_max_dt1', trim(json_real(res%omega_max*res%dt1)))
+      call ks('device_law', [character(len=keyword_len) :: (law_name(model%dev(d)%law), d=1, model%n_devices)])
+      call kreal('period_stuck_s', res%period_stuck)
+      call kreal('xi_stuck', res%xi_stuck)
+      call kreal('dt1_s', res%dt1)
+      call kreal('dt2_s', res%dt2)
+      call kreal('dt_min_s', res%dt_min)
+      call kreal('omega_max_rad_s', res%omega_max)
+      call kreal('omega_max_dt1', res%omega_max*res%dt1)
       call kv('mode_resolution', '"'//trim(resolution_names(res%mode_resolution))//'"')
       call kr('peak_u_m', res%peak_u)
       call kr('peak_u_time_s', res%peak_u_time)
@@ -413,13 +397,13 @@ contains
       call ki('stick_to_slip', res%stick_to_slip)
       call ki('slip_to_stick', res%slip_to_stick)
       call ki('slip_reversals', res%reversals)
-      call kv('steps_dt1', trim(fmt_int(res%steps_dt1)))
-      call kv('steps_nested', trim(fmt_int(res%steps_nested)))
-      call kv('steps_dt2', trim(fmt_int(res%steps_dt2)))
-      call kv('steps_finer', trim(fmt_int(res%steps_finer)))
-      call kv('factorizations', trim(fmt_int(res%factorizations)))
-      call kv('factor_updates', trim(fmt_int(res%factor_updates)))
-      call kv('partial_factorizations', trim(fmt_int(res%partial_factorizations)))
+      call kint('steps_dt1', res%steps_dt1)
+      call kint('steps_nested', res%steps_nested)
+      call kint('steps_dt2', res%steps_dt2)
+      call kint('steps_finer', res%steps_finer)
+      call kint('factorizations', res%factorizations)
+      call kint('factor_updates', res%factor_updates)
+      call kint('partial_factorizations', res%partial_factorizations)
       select case (res%storage)
       case (1)
          call kv('linear_system', '"dense"')
@@ -428,29 +412,29 @@ contains
       case default
          call kv('linear_system', '"none"')
       end select
-      call kv('half_bandwidth', trim(fmt_int(res%bandwidth)))
-      call kv('events', trim(fmt_int(res%events)))
+      call kint('half_bandwidth', res%bandwidth)
+      call kint('events', res%events)
       if (res%exact_peaks) then
          ! the exact technique: peaks are the exact extrema; its event times, accumulations
          call kv('peaks_exact', 'true')
          call kr('event_times_s', res%event_time(1:res%n_event_times))
-         call kv('accumulation_points', trim(fmt_int(res%accumulations)))
+         call kint('accumulation_points', res%accumulations)
          call kr('accumulation_times_s', res%accumulation_time(1:res%n_accumulation_times))
       end if
-      call kv('patterns_solved', trim(fmt_int(res%patterns)))
-      call kv('lcp_fallbacks', trim(fmt_int(res%lcp_fallbacks)))
-      call kv('correctness_violations', trim(fmt_int(res%violations)))
+      call kint('patterns_solved', res%patterns)
+      call kint('lcp_fallbacks', res%lcp_fallbacks)
+      call kint('correctness_violations', res%violations)
       call kr('violation_times_s', res%violation_time(1:res%n_violation_times))
       call ki('violation_devices', res%violation_device(1:res%n_violation_times))
-      call kv('energy_input_J', trim(json_real(res%e_input)))
-      call kv('energy_kinetic_J', trim(json_real(res%e_kinetic)))
-      call kv('energy_strain_J', trim(json_real(res%e_strain)))
-      call kv('energy_viscous_J', trim(json_real(res%e_viscous)))
-      call kv('energy_friction_J', trim(json_real(res%e_friction)))
-      call kv('energy_device_elastic_J', trim(json_real(res%e_device)))
-      call kv('energy_residual_J', trim(json_real(res%e_residual)))
+      call kreal('energy_input_J', res%e_input)
+      call kreal('energy_kinetic_J', res%e_kinetic)
+      call kreal('energy_strain_J', res%e_strain)
+      call kreal('energy_viscous_J', res%e_viscous)
+      call kreal('energy_friction_J', res%e_friction)
+      call kreal('energy_device_elastic_J', res%e_device)
+      call kreal('energy_residual_J', res%e_residual)
       call engineering_keys()
-      call kv('samples', trim(fmt_int(res%nout)))
+      call kint('samples', res%nout)
       call put('  "run_time_s": '//trim(json_real(res%run_time))//nl//'}')
       js = buf(1:pos)
    contains
@@ -466,17 +450,6 @@ contains
          buf(pos + 1:pos + len(text)) = text
          pos = pos + len(text)
       end subroutine put
-      subroutine put_law(text)
-         character(len=*), intent(in) :: text
-         character(len=:), allocatable :: bigger
-         if (nlaw + len(text) > len(laws)) then
-            allocate (character(len=2*(nlaw + len(text))) :: bigger)
-            bigger(1:nlaw) = laws(1:nlaw)
-            call move_alloc(bigger, laws)
-         end if
-         laws(nlaw + 1:nlaw + len(text)) = text
-         nlaw = nlaw + len(text)
-      end subroutine put_law
       !> What produced the run, the names, the modes, the storeys (fd_engineering).
       subroutine engineering_keys()
          integer :: i
@@ -488,19 +461,19 @@ contains
             else
                call kv('excitation_type', '"unknown"')
             end if
-            call kv('excitation_frequency_Hz', trim(json_real(eng%frequency)))
-            call kv('duration_s', trim(json_real(eng%duration)))
+            call kreal('excitation_frequency_Hz', eng%frequency)
+            call kreal('duration_s', eng%duration)
             call ks('dof_labels', eng%dof_label)
             call ks('device_labels', eng%device_label)
-            call kv('damping_a0_per_s', trim(json_real(eng%a0)))
-            call kv('damping_a1_s', trim(json_real(eng%a1)))
+            call kreal('damping_a0_per_s', eng%a0)
+            call kreal('damping_a1_s', eng%a1)
             call modes_keys('stuck', eng%stuck)
             call modes_keys('free', eng%free)
             call kr('residual_s_m', eng%residual_s)
-            call kv('peak_base_shear_N', trim(json_real(eng%peak_shear(0))))
-            call kv('peak_base_shear_time_s', trim(json_real(eng%peak_shear_time(0))))
-            call kv('residual_base_shear_N', trim(json_real(eng%shear(0))))
-            call kv('n_storeys', trim(fmt_int(eng%n_storeys)))
+            call kreal('peak_base_shear_N', eng%peak_shear(0))
+            call kreal('peak_base_shear_time_s', eng%peak_shear_time(0))
+            call kreal('residual_base_shear_N', eng%shear(0))
+            call kint('n_storeys', eng%n_storeys)
             call ks('storey_labels', eng%storey_label)
             call put('  "storey_nodes": [')
             do i = 1, eng%n_storeys
@@ -572,6 +545,18 @@ contains
          character(len=*), intent(in) :: key, val
          call put('  "'//key//'": '//val//','//nl)
       end subroutine kv
+      !> An integer.
+      subroutine kint(key, n)
+         character(len=*), intent(in) :: key
+         integer, intent(in) :: n
+         call kv(key, trim(fmt_int(n)))
+      end subroutine kint
+      !> A real number (null when not finite, json_real).
+      subroutine kreal(key, x)
+         character(len=*), intent(in) :: key
+         real(dp), intent(in) :: x
+         call kv(key, trim(json_real(x)))
+      end subroutine kreal
       subroutine kr(key, x)
          character(len=*), intent(in) :: key
          real(dp), intent(in) :: x(:)

@@ -85,7 +85,7 @@ contains
       integer, allocatable :: grp(:), ea(:), eb(:)
       real(dp), allocatable :: mq(:), ek(:), lam(:), z(:, :)
       real(dp) :: scale
-      integer :: n, i, s, a, b, ne, m, stat
+      integer :: n, i, s, ne, m, stat
 
       omega2 = 0.0_dp
       phi = 0.0_dp
@@ -104,17 +104,10 @@ contains
       if (stat /= 0) then
          call no_memory(nq); return
       end if
-      mq = 0.0_dp
-      do i = 1, n
-         if (grp(i) /= 0) mq(grp(i)) = mq(grp(i)) + model%mass(i)
-      end do
+      call group_masses(grp, model%mass, mq)
       ne = 0
       do s = 1, model%n_springs
-         a = group_of(model%spring_i(s)); b = group_of(model%spring_j(s))
-         if (a == b) cycle                     ! inside one rigid group (or both on the table)
-         ne = ne + 1
-         ea(ne) = max(a, b); eb(ne) = min(a, b)
-         ek(ne) = model%spring_k(s)
+         call add_element(grp, model%spring_i(s), model%spring_j(s), model%spring_k(s), ea, eb, ek, ne)
       end do
       m = min(nev, nq)
       allocate (lam(m), z(nq, m), stat=stat)
@@ -138,11 +131,6 @@ contains
          call fatal_error(error, "not enough memory for the eigenproblem of "//trim(fmt_int(size))// &
                           " DOFs", stat_no_memory)
       end subroutine no_memory
-      pure integer function group_of(node)
-         integer, intent(in) :: node
-         group_of = 0
-         if (node > 0) group_of = grp(node)
-      end function group_of
    end subroutine system_modes
 
    !> First natural period of the stuck system (every device with P mu > 0 a rigid link
@@ -191,15 +179,8 @@ contains
 
       allocate (phi(model%n_dof))
       call stuck_first_mode(model, period, phi, eig_error)
-      t_damp = period
-      if (model%damping == damping_stiffness .and. model%period > 0.0_dp) then
-         t_damp = model%period
-      else if (model%damping == damping_stiffness .and. allocated(eig_error)) then
-         call move_alloc(eig_error, error)
-         error%message = "&damping: damping_type = 'stiffness' needs the stuck first period, but "// &
-                         error%message
-         return
-      end if
+      call damping_period(model, period, eig_error, t_damp, error)
+      if (allocated(error)) return
       select case (model%damping)
       case (damping_stiffness)
          a0 = 0.0_dp
@@ -254,16 +235,8 @@ contains
       end if
       call stiffness_matrix(model, k)
       call stuck_first_mode(model, period, phi, eig_error)
-      ! the paper's psi = T xi / pi uses the given T, else the computed one
-      t_damp = period
-      if (model%damping == damping_stiffness .and. model%period > 0.0_dp) then
-         t_damp = model%period
-      else if (model%damping == damping_stiffness .and. allocated(eig_error)) then
-         call move_alloc(eig_error, error)
-         error%message = "&damping: damping_type = 'stiffness' needs the stuck first period, but "// &
-                         error%message
-         return
-      end if
+      call damping_period(model, period, eig_error, t_damp, error)
+      if (allocated(error)) return
       call damping_matrix(model, k, t_damp, c)
       xi = 0.0_dp
       if (allocated(eig_error)) then
@@ -273,6 +246,26 @@ contains
          xi = dot_product(phi, cphi)/(2.0_dp*(2.0_dp*pi/period)*sum(model%mass*phi**2))
       end if
    end subroutine structure_matrices
+
+   !> The period T of the paper's damping psi = T xi / pi: the deck's (model%period), else
+   !> the stuck first period; for damping 'stiffness' without either, an error (the stuck
+   !> first mode's, which eig_error holds, moved into it).
+   subroutine damping_period(model, period, eig_error, t_damp, error)
+      type(model_type), intent(in) :: model                    !! the model
+      real(dp), intent(in) :: period                           !! stuck first period [s]
+      type(error_type), allocatable, intent(inout) :: eig_error !! why it has none (stuck_first_mode)
+      real(dp), intent(out) :: t_damp                          !! T [s]
+      type(error_type), allocatable, intent(out) :: error      !! 'stiffness' damping without a period
+
+      t_damp = period
+      if (model%damping == damping_stiffness .and. model%period > 0.0_dp) then
+         t_damp = model%period
+      else if (model%damping == damping_stiffness .and. allocated(eig_error)) then
+         call move_alloc(eig_error, error)
+         error%message = "&damping: damping_type = 'stiffness' needs the stuck first period, but "// &
+                         error%message
+      end if
+   end subroutine damping_period
 
    !> Groups of DOFs joined by rigid links (the devices flagged in `linked`), by union-find
    !> over the nodes 0..n_dof: grp(i) = 1..nq for a group that moves, 0 for a DOF linked
@@ -288,27 +281,19 @@ contains
       root = [(i, i=0, model%n_dof)]
       do d = 1, model%n_devices
          if (.not. linked(d)) cycle
-         a = find(model%dev(d)%node_i); b = find(model%dev(d)%node_j)
+         a = find(root, model%dev(d)%node_i); b = find(root, model%dev(d)%node_j)
          if (a /= b) root(max(a, b)) = min(a, b)
       end do
       col = 0
       nq = 0
       do i = 1, model%n_dof
-         a = find(i)
+         a = find(root, i)
          if (a /= 0 .and. col(a) == 0) then
             nq = nq + 1
             col(a) = nq
          end if
          grp(i) = col(a)
       end do
-   contains
-      pure integer function find(x)
-         integer, intent(in) :: x
-         find = x
-         do while (root(find) /= find)
-            find = root(find)
-         end do
-      end function find
    end subroutine link_groups
 
    !> Natural modes of the structure, K phi = w^2 M phi, the lowest nmax of them.
@@ -329,21 +314,21 @@ contains
       type(modes_type), intent(out) :: modes         !! the modes
       type(error_type), allocatable, intent(out) :: error !! LAPACK failure
       integer, allocatable :: grp(:)
-      logical, allocatable :: linked(:)
-      real(dp), allocatable :: ks(:, :), kq(:, :), mq(:, :), cq(:, :), lam(:), z(:, :), phi(:), sq(:)
-      real(dp) :: kd, big, w, pm, l, mtot
-      integer :: n, nq, i, j, d, ni, nj, imax, kfirst, stat
+      real(dp), allocatable :: ks(:, :), kq(:, :), mq(:, :), cq(:, :), lam(:), z(:, :), sq(:), zcz(:)
+      real(dp) :: kd, big
+      integer :: n, nq, i, j, d, ni, nj, kfirst, stat
 
       n = model%n_dof
       modes%system = system
-      allocate (grp(n), linked(model%n_devices), ks(n, n), stat=stat)
+      call system_groups(model, system, grp, modes, stat)
+      if (stat == 0) allocate (ks(n, n), stat=stat)
       if (stat /= 0) then
          call no_memory(n); return
       end if
+      nq = modes%nq
+      if (nq == 0) return
       ks = k
       do d = 1, model%n_devices
-         pm = model%dev(d)%p*model%dev(d)%mu
-         linked(d) = system == system_stuck .and. pm > 0.0_dp .and. model%dev(d)%law /= law_hysteretic
          kd = sticking_stiffness(model%dev(d))
          if (system == system_stuck .and. kd > 0.0_dp) then
             ni = model%dev(d)%node_i; nj = model%dev(d)%node_j
@@ -355,13 +340,6 @@ contains
             end if
          end if
       end do
-      call link_groups(model, linked, grp, nq)
-      modes%nq = nq
-      if (nq == 0) then
-         modes%status = modes_rigid
-         allocate (modes%omega2(0), modes%period(0), modes%shape(n, 0), modes%mass_ratio(0), modes%xi(0))
-         return
-      end if
       ! Kq = T' K T, Cq = T' C T, Mq = T' M T by summing over the groups (T is 0/1: O(n^2))
       allocate (kq(nq, nq), cq(nq, nq), mq(nq, nq), sq(nq), stat=stat)
       if (stat /= 0) then
@@ -392,7 +370,7 @@ contains
          big = max(big, sum(abs(kq(:, j))))
       end do
       kfirst = max(modes%n, 1)
-      allocate (lam(kfirst), z(nq, kfirst), stat=stat)
+      allocate (lam(kfirst), z(nq, kfirst), zcz(modes%n), stat=stat)
       if (stat /= 0) then
          call no_memory(nq); return
       end if
@@ -403,34 +381,12 @@ contains
       end do
       modes%status = modes_flexible
       if (lam(1) <= 1.0e-12_dp*big) modes%status = modes_unrestrained
-      allocate (modes%omega2(modes%n), modes%period(modes%n), modes%shape(n, modes%n), &
-                modes%mass_ratio(modes%n), modes%xi(modes%n), phi(n), stat=stat)
-      if (stat /= 0) then
-         call no_memory(n); return
-      end if
-      mtot = sum(model%mass)
+      ! z is M-normalized in the reduced coordinates: z' Mq z = 1
       do j = 1, modes%n
-         do i = 1, n
-            phi(i) = 0.0_dp
-            if (grp(i) /= 0) phi(i) = z(grp(i), j)
-         end do
-         imax = maxloc(abs(phi), 1)
-         phi = phi/phi(imax)
-         modes%shape(:, j) = phi
-         l = sum(model%mass*phi)
-         modes%mass_ratio(j) = l*l/sum(model%mass*phi**2)/mtot
-         if (lam(j) <= 1.0e-12_dp*big) then
-            modes%omega2(j) = 0.0_dp
-            modes%period(j) = ieee_value(1.0_dp, ieee_positive_inf)
-            modes%xi(j) = ieee_value(1.0_dp, ieee_quiet_nan)
-         else
-            modes%omega2(j) = lam(j)
-            w = sqrt(lam(j))
-            modes%period(j) = 2.0_dp*pi/w
-            ! z is M-normalized in the reduced coordinates: z' Mq z = 1
-            modes%xi(j) = dot_product(z(:, j), matmul(cq, z(:, j)))/(2.0_dp*w)
-         end if
+         zcz(j) = dot_product(z(:, j), matmul(cq, z(:, j)))
       end do
+      call store_modes(grp, model%mass, lam, z, lam(1:modes%n) <= 1.0e-12_dp*big, zcz, modes, stat)
+      if (stat /= 0) call no_memory(n)
    contains
       subroutine no_memory(size)
          integer, intent(in) :: size
@@ -454,47 +410,36 @@ contains
       type(modes_type), intent(out) :: modes         !! the modes
       type(error_type), allocatable, intent(out) :: error !! solver failure, no memory
       integer, allocatable :: grp(:), ea(:), eb(:), root(:)
-      logical, allocatable :: linked(:), grounded(:)
-      real(dp), allocatable :: mq(:), ek(:), lam(:), z(:, :), phi(:), ebig(:)
-      real(dp) :: pm, kd, big, sigma, scale, w, l, mtot, kz
-      integer :: n, nq, ne, ns, nd, i, j, a, b, s, d, imax, m, stat
+      logical, allocatable :: grounded(:)
+      real(dp), allocatable :: mq(:), ek(:), lam(:), z(:, :), ebig(:), zcz(:)
+      real(dp) :: kd, big, sigma, scale, w, kz
+      integer :: n, nq, ne, ns, nd, i, j, a, b, s, d, m, stat
       logical :: shifted
 
       n = model%n_dof
       ns = model%n_springs
       nd = model%n_devices
       modes%system = system
-      allocate (grp(n), linked(nd), ea(ns + nd + n), eb(ns + nd + n), ek(ns + nd + n), stat=stat)
+      call system_groups(model, system, grp, modes, stat)
+      if (stat == 0) allocate (ea(ns + nd + n), eb(ns + nd + n), ek(ns + nd + n), stat=stat)
       if (stat /= 0) then
          call no_memory(n); return
       end if
-      do d = 1, nd
-         pm = model%dev(d)%p*model%dev(d)%mu
-         linked(d) = system == system_stuck .and. pm > 0.0_dp .and. model%dev(d)%law /= law_hysteretic
-      end do
-      call link_groups(model, linked, grp, nq)
-      modes%nq = nq
-      if (nq == 0) then
-         modes%status = modes_rigid
-         allocate (modes%omega2(0), modes%period(0), modes%shape(n, 0), modes%mass_ratio(0), modes%xi(0))
-         return
-      end if
+      nq = modes%nq
+      if (nq == 0) return
       allocate (mq(nq), root(0:nq), grounded(0:nq), ebig(nq), stat=stat)
       if (stat /= 0) then
          call no_memory(nq); return
       end if
-      mq = 0.0_dp
-      do i = 1, n
-         if (grp(i) /= 0) mq(grp(i)) = mq(grp(i)) + model%mass(i)
-      end do
+      call group_masses(grp, model%mass, mq)
       ne = 0
       do s = 1, ns
-         call element(model%spring_i(s), model%spring_j(s), model%spring_k(s))
+         call add_element(grp, model%spring_i(s), model%spring_j(s), model%spring_k(s), ea, eb, ek, ne)
       end do
       if (system == system_stuck) then
          do d = 1, nd
             kd = sticking_stiffness(model%dev(d))
-            if (kd > 0.0_dp) call element(model%dev(d)%node_i, model%dev(d)%node_j, kd)
+            if (kd > 0.0_dp) call add_element(grp, model%dev(d)%node_i, model%dev(d)%node_j, kd, ea, eb, ek, ne)
          end do
       end if
       ! a bound of the largest eigenvalue of Mq^-1 Kq (Gershgorin), and the groups held to
@@ -506,13 +451,13 @@ contains
          ebig(a) = ebig(a) + 2.0_dp*ek(i)/mq(a)
          if (b > 0) ebig(b) = ebig(b) + 2.0_dp*ek(i)/mq(b)
          if (ek(i) <= 0.0_dp) cycle
-         a = find(a); b = find(b)
+         a = find(root, a); b = find(root, b)
          if (a /= b) root(max(a, b)) = min(a, b)
       end do
       big = maxval(ebig)
       grounded = .false.
       do i = 1, nq
-         grounded(i) = find(i) == 0
+         grounded(i) = find(root, i) == 0
       end do
       shifted = .not. all(grounded(1:nq))
       sigma = 0.0_dp
@@ -525,7 +470,7 @@ contains
       end if
       modes%n = min(max(nmax, 0), nq)
       m = max(modes%n, 1)
-      allocate (lam(m), z(nq, m), stat=stat)
+      allocate (lam(m), z(nq, m), zcz(modes%n), stat=stat)
       if (stat /= 0) then
          call no_memory(nq); return
       end if
@@ -539,62 +484,25 @@ contains
       big = max(big, scale)
       modes%status = modes_flexible
       if (shifted) modes%status = modes_unrestrained
-      allocate (modes%omega2(modes%n), modes%period(modes%n), modes%shape(n, modes%n), &
-                modes%mass_ratio(modes%n), modes%xi(modes%n), phi(n), stat=stat)
-      if (stat /= 0) then
-         call no_memory(n); return
-      end if
-      mtot = sum(model%mass)
+      ! z' Cq z = a0 + a1 z' Kq z, Kq of the springs (z' Mq z = 1)
       do j = 1, modes%n
-         do i = 1, n
-            phi(i) = 0.0_dp
-            if (grp(i) /= 0) phi(i) = z(grp(i), j)
-         end do
-         ! z' Kq z of the springs (z' Mq z = 1), before the shape is scaled
          kz = 0.0_dp
          do s = 1, ns
-            w = node_phi(model%spring_i(s)) - node_phi(model%spring_j(s))
+            w = node_z(model%spring_i(s), j) - node_z(model%spring_j(s), j)
             kz = kz + model%spring_k(s)*w*w
          end do
-         imax = maxloc(abs(phi), 1)
-         modes%shape(:, j) = phi/phi(imax)
-         l = sum(model%mass*modes%shape(:, j))
-         modes%mass_ratio(j) = l*l/sum(model%mass*modes%shape(:, j)**2)/mtot
-         if (lam(j) <= 1.0e-9_dp*big .and. shifted) then
-            modes%omega2(j) = 0.0_dp
-            modes%period(j) = ieee_value(1.0_dp, ieee_positive_inf)
-            modes%xi(j) = ieee_value(1.0_dp, ieee_quiet_nan)
-         else
-            modes%omega2(j) = lam(j)
-            w = sqrt(lam(j))
-            modes%period(j) = 2.0_dp*pi/w
-            modes%xi(j) = (a0 + a1*kz)/(2.0_dp*w)
-         end if
+         zcz(j) = a0 + a1*kz
       end do
+      call store_modes(grp, model%mass, lam, z, lam(1:modes%n) <= 1.0e-9_dp*big .and. shifted, zcz, modes, stat)
+      if (stat /= 0) call no_memory(n)
    contains
-      subroutine element(ni, nj, k)
-         integer, intent(in) :: ni, nj
-         real(dp), intent(in) :: k
-         integer :: ga, gb
-         ga = 0; gb = 0
-         if (ni > 0) ga = grp(ni)
-         if (nj > 0) gb = grp(nj)
-         if (ga == gb) return              ! inside one rigid group (or both on the table)
-         ne = ne + 1
-         ea(ne) = max(ga, gb); eb(ne) = min(ga, gb); ek(ne) = k
-      end subroutine element
-      pure integer function find(x)
-         integer, intent(in) :: x
-         find = x
-         do while (root(find) /= find)
-            find = root(find)
-         end do
-      end function find
-      pure real(dp) function node_phi(node)
-         integer, intent(in) :: node
-         node_phi = 0.0_dp
-         if (node > 0) node_phi = phi(node)
-      end function node_phi
+      !> Component j of z at a node (0 on the table and in its group).
+      pure real(dp) function node_z(node, j)
+         integer, intent(in) :: node, j
+         node_z = 0.0_dp
+         if (node == 0) return
+         if (grp(node) /= 0) node_z = z(grp(node), j)
+      end function node_z
       subroutine no_memory(size)
          integer, intent(in) :: size
          call fatal_error(error, "not enough memory for the natural modes of "//trim(fmt_int(size))// &
@@ -704,5 +612,119 @@ contains
          c = 0.0_dp
       end select
    end subroutine damping_matrix
+
+   !> The mass of each rigid group (link_groups): the sum of its DOFs' masses.
+   pure subroutine group_masses(grp, mass, mq)
+      integer, intent(in) :: grp(:)          !! group of each DOF, 0 = with the table
+      real(dp), intent(in) :: mass(:)        !! masses of the DOFs
+      real(dp), intent(out) :: mq(:)         !! mass of each group
+      integer :: i
+
+      mq = 0.0_dp
+      do i = 1, size(grp)
+         if (grp(i) /= 0) mq(grp(i)) = mq(grp(i)) + mass(i)
+      end do
+   end subroutine group_masses
+
+   !> A spring k between nodes ni and nj (0 = the table) as an element of the reduced system
+   !> of the rigid groups grp: (ea, eb, ek)(ne + 1) with ea > eb (eb = 0: the table); none
+   !> when both nodes are in one group (or on the table).
+   pure subroutine add_element(grp, ni, nj, k, ea, eb, ek, ne)
+      integer, intent(in) :: grp(:)          !! group of each DOF, 0 = with the table
+      integer, intent(in) :: ni, nj          !! the spring's nodes
+      real(dp), intent(in) :: k              !! its stiffness
+      integer, intent(inout) :: ea(:), eb(:) !! the elements' groups
+      real(dp), intent(inout) :: ek(:)       !! their stiffness
+      integer, intent(inout) :: ne           !! the elements so far
+      integer :: ga, gb
+
+      ga = 0; gb = 0
+      if (ni > 0) ga = grp(ni)
+      if (nj > 0) gb = grp(nj)
+      if (ga == gb) return
+      ne = ne + 1
+      ea(ne) = max(ga, gb); eb(ne) = min(ga, gb); ek(ne) = k
+   end subroutine add_element
+
+   !> The rigid groups of a system (link_groups): stuck, every device with P mu > 0 that is
+   !> no spring (velocity law, Coulomb) links its nodes; free, none does. modes%nq is their
+   !> number; a system with none (every DOF held to the table) is rigid: no mode.
+   subroutine system_groups(model, system, grp, modes, stat)
+      type(model_type), intent(in) :: model          !! the model
+      integer, intent(in) :: system                  !! system_stuck or system_free
+      integer, allocatable, intent(out) :: grp(:)    !! group of each DOF, 0 = with the table
+      type(modes_type), intent(inout) :: modes       !! its nq; status and arrays if rigid
+      integer, intent(out) :: stat                   !! 0, or not enough memory
+      logical, allocatable :: linked(:)
+      real(dp) :: pm
+      integer :: d
+
+      allocate (grp(model%n_dof), linked(model%n_devices), stat=stat)
+      if (stat /= 0) return
+      do d = 1, model%n_devices
+         pm = model%dev(d)%p*model%dev(d)%mu
+         linked(d) = system == system_stuck .and. pm > 0.0_dp .and. model%dev(d)%law /= law_hysteretic
+      end do
+      call link_groups(model, linked, grp, modes%nq)
+      if (modes%nq > 0) return
+      modes%status = modes_rigid
+      allocate (modes%omega2(0), modes%period(0), modes%shape(model%n_dof, 0), modes%mass_ratio(0), modes%xi(0))
+   end subroutine system_groups
+
+   !> The modes' arrays from the lowest modes%n eigenpairs (lam, z) of the reduced system of
+   !> the rigid groups grp (z' Mq z = 1): each shape expanded to every DOF and scaled so
+   !> that its component of largest magnitude is +1, its effective mass ratio; a rigid-body
+   !> mode (rigid) has w = 0, an infinite period and no damping ratio, the others
+   !> w = sqrt(lam) and xi = zcz / (2 w), zcz = z' Cq z.
+   subroutine store_modes(grp, mass, lam, z, rigid, zcz, modes, stat)
+      integer, intent(in) :: grp(:)                  !! group of each DOF, 0 = with the table
+      real(dp), intent(in) :: mass(:)                !! masses of the DOFs
+      real(dp), intent(in) :: lam(:)                 !! eigenvalues w^2, increasing
+      real(dp), intent(in) :: z(:, :)                !! eigenvectors (nq, >= modes%n)
+      logical, intent(in) :: rigid(:)                !! (modes%n) a rigid-body mode
+      real(dp), intent(in) :: zcz(:)                 !! (modes%n) z' Cq z
+      type(modes_type), intent(inout) :: modes       !! n set; its arrays
+      integer, intent(out) :: stat                   !! 0, or not enough memory
+      real(dp), allocatable :: phi(:)
+      real(dp) :: w, l, mtot
+      integer :: n, i, j, imax
+
+      n = size(grp)
+      allocate (modes%omega2(modes%n), modes%period(modes%n), modes%shape(n, modes%n), &
+                modes%mass_ratio(modes%n), modes%xi(modes%n), phi(n), stat=stat)
+      if (stat /= 0) return
+      mtot = sum(mass)
+      do j = 1, modes%n
+         do i = 1, n
+            phi(i) = 0.0_dp
+            if (grp(i) /= 0) phi(i) = z(grp(i), j)
+         end do
+         imax = maxloc(abs(phi), 1)
+         phi = phi/phi(imax)
+         modes%shape(:, j) = phi
+         l = sum(mass*phi)
+         modes%mass_ratio(j) = l*l/sum(mass*phi**2)/mtot
+         if (rigid(j)) then
+            modes%omega2(j) = 0.0_dp
+            modes%period(j) = ieee_value(1.0_dp, ieee_positive_inf)
+            modes%xi(j) = ieee_value(1.0_dp, ieee_quiet_nan)
+         else
+            modes%omega2(j) = lam(j)
+            w = sqrt(lam(j))
+            modes%period(j) = 2.0_dp*pi/w
+            modes%xi(j) = zcz(j)/(2.0_dp*w)
+         end if
+      end do
+   end subroutine store_modes
+
+   !> The root of x in a union-find forest (root(x) = x at a root).
+   pure integer function find(root, x)
+      integer, intent(in) :: root(0:)   !! parent of each node
+      integer, intent(in) :: x          !! the node
+      find = x
+      do while (root(find) /= find)
+         find = root(find)
+      end do
+   end function find
 
 end module fd_matrices

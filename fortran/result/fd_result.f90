@@ -153,6 +153,9 @@ contains
       integer, intent(in), optional :: dofs(:)      !! DOFs in the history (ascending)
       integer, intent(in), optional :: devices(:)   !! devices in the history (ascending)
       logical, intent(in), optional :: keep         !! hold the rows here (default true)
+      ! the history's columns of a DOF (and its peaks', envelope)
+      character(len=4), parameter :: dof_names(3) = [character(len=4) :: 'u', 'v', 'aabs']
+      character(len=4), parameter :: dof_units(3) = [character(len=4) :: 'm', 'm/s', 'm/s2']
       integer, allocatable :: kd(:), kv(:)
       integer :: n, nd, i, c, stat, rows
 
@@ -161,14 +164,14 @@ contains
       res%n_dof = n
       res%n_devices = nd
       if (present(dofs)) then
-         kd = dofs
+         allocate (kd, source=dofs)
       else
-         kd = [(i, i=1, n)]
+         allocate (kd, source=[(i, i=1, n)])
       end if
       if (present(devices)) then
-         kv = devices
+         allocate (kv, source=devices)
       else
-         kv = [(i, i=1, nd)]
+         allocate (kv, source=[(i, i=1, nd)])
       end if
       call history_shape(model, exc, opts, res%ncol, res%nout, nsteps, every, size(kd), size(kv))
       rows = res%nout
@@ -186,51 +189,15 @@ contains
       res%names(1) = 't'; res%units(1) = 's'
       res%names(2) = 'ag'; res%units(2) = 'm/s2'
       c = 2
-      do i = 1, size(kd)
-         res%names(c + 1) = 'u'//trim(fmt_int(kd(i))); res%units(c + 1) = 'm'
-         res%names(c + 2) = 'v'//trim(fmt_int(kd(i))); res%units(c + 2) = 'm/s'
-         res%names(c + 3) = 'aabs'//trim(fmt_int(kd(i))); res%units(c + 3) = 'm/s2'
-         c = c + 3
-      end do
-      do i = 1, size(kv)
-         res%names(c + 1) = 's'//trim(fmt_int(kv(i))); res%units(c + 1) = 'm'
-         res%names(c + 2) = 'sdot'//trim(fmt_int(kv(i))); res%units(c + 2) = 'm/s'
-         res%names(c + 3) = 'F'//trim(fmt_int(kv(i))); res%units(c + 3) = 'N'
-         res%names(c + 4) = 'phase'//trim(fmt_int(kv(i))); res%units(c + 4) = '-'
-         c = c + 4
-      end do
-      if (engineering_columns(model) > 0) then
-         do i = 1, model%n_storeys
-            res%names(c + 1) = 'drift'//trim(fmt_int(i)); res%units(c + 1) = 'm'
-            res%names(c + 2) = 'V'//trim(fmt_int(i)); res%units(c + 2) = 'N'
-            c = c + 2
-         end do
-         res%names(c + 1) = 'Vb'; res%units(c + 1) = 'N'
-         c = c + 1
-      end if
+      call add_columns(res, c, '', kd, dof_names, dof_units)
+      call add_columns(res, c, '', kv, [character(len=5) :: 's', 'sdot', 'F', 'phase'], [character(len=3) :: 'm', 'm/s', 'N', '-'])
+      if (engineering_columns(model) > 0) call storey_columns(res, c, '', model%n_storeys)
       if (has_envelope(opts)) then
          res%env_col = c + 1
          res%exact_peaks = .true.
-         do i = 1, size(kd)
-            res%names(c + 1) = 'peak_u'//trim(fmt_int(kd(i))); res%units(c + 1) = 'm'
-            res%names(c + 2) = 'peak_v'//trim(fmt_int(kd(i))); res%units(c + 2) = 'm/s'
-            res%names(c + 3) = 'peak_aabs'//trim(fmt_int(kd(i))); res%units(c + 3) = 'm/s2'
-            c = c + 3
-         end do
-         do i = 1, size(kv)
-            res%names(c + 1) = 'peak_s'//trim(fmt_int(kv(i))); res%units(c + 1) = 'm'
-            res%names(c + 2) = 'peak_F'//trim(fmt_int(kv(i))); res%units(c + 2) = 'N'
-            c = c + 2
-         end do
-         if (engineering_columns(model) > 0) then
-            do i = 1, model%n_storeys
-               res%names(c + 1) = 'peak_drift'//trim(fmt_int(i)); res%units(c + 1) = 'm'
-               res%names(c + 2) = 'peak_V'//trim(fmt_int(i)); res%units(c + 2) = 'N'
-               c = c + 2
-            end do
-            res%names(c + 1) = 'peak_Vb'; res%units(c + 1) = 'N'
-            c = c + 1
-         end if
+         call add_columns(res, c, 'peak_', kd, dof_names, dof_units)
+         call add_columns(res, c, 'peak_', kv, [character(len=1) :: 's', 'F'], [character(len=1) :: 'm', 'N'])
+         if (engineering_columns(model) > 0) call storey_columns(res, c, 'peak_', model%n_storeys)
       end if
       allocate (res%peak_u(n), res%peak_u_time(n), res%peak_v(n), res%peak_aabs(n), &
                 res%peak_aabs_time(n), res%peak_s(nd), res%peak_force(nd), res%stick_to_slip(nd), &
@@ -245,6 +212,39 @@ contains
       res%peak_s = 0.0_dp; res%peak_force = 0.0_dp
       res%stick_to_slip = 0; res%slip_to_stick = 0; res%reversals = 0
    end subroutine init_result
+
+   !> For each id, the history's columns prefix//name//id [unit], one for each name, from
+   !> column c + 1; c becomes the last column named.
+   pure subroutine add_columns(res, c, prefix, ids, names, units)
+      type(result_type), intent(inout) :: res       !! its names and units
+      integer, intent(inout) :: c                   !! the last column named
+      character(len=*), intent(in) :: prefix        !! before each name ('peak_' for the envelope)
+      integer, intent(in) :: ids(:)                 !! DOFs, devices or storeys
+      character(len=*), intent(in) :: names(:)      !! the quantities of each
+      character(len=*), intent(in) :: units(:)      !! their units
+      integer :: j, k
+
+      do j = 1, size(ids)
+         do k = 1, size(names)
+            res%names(c + k) = prefix//trim(names(k))//trim(fmt_int(ids(j))); res%units(c + k) = units(k)
+         end do
+         c = c + size(names)
+      end do
+   end subroutine add_columns
+
+   !> The history's columns of each storey's drift and shear, then of the base shear.
+   pure subroutine storey_columns(res, c, prefix, n_storeys)
+      type(result_type), intent(inout) :: res       !! its names and units
+      integer, intent(inout) :: c                   !! the last column named
+      character(len=*), intent(in) :: prefix        !! before each name ('peak_' for the envelope)
+      integer, intent(in) :: n_storeys              !! storeys of the model
+      integer :: j
+
+      call add_columns(res, c, prefix, [(j, j=1, n_storeys)], [character(len=5) :: 'drift', 'V'], &
+                       [character(len=1) :: 'm', 'N'])
+      res%names(c + 1) = prefix//'Vb'; res%units(c + 1) = 'N'
+      c = c + 1
+   end subroutine storey_columns
 
    !> Every number of a result must be finite: an error names the first quantity that is not
    !> (its summary key, or its history column and time), never a null in a summary.

@@ -4,9 +4,10 @@
 !> messages that name the variable and value at fault.
 module test_fd_namelist
    use testdrive, only: new_unittest, unittest_type, error_type, check
+   use fd_kinds, only: dp
    use fd_error, only: fd_error_type => error_type
    use fd_namelist, only: deck_text, group_text, deck_from_string, load_deck, find_group, group_item, &
-                          group_read_error, check_groups, group_opened, longest_string
+                          group_read_error, check_groups, group_opened, longest_string, next_read
    implicit none
    private
 
@@ -48,6 +49,7 @@ contains
                   new_unittest("unknown and repeated groups", test_check_groups), &
                   new_unittest("one item as a record", test_group_item), &
                   new_unittest("messages naming the variable", test_read_error), &
+                  new_unittest("read loop finding the assignment at fault", test_next_read), &
                   new_unittest("missing deck file", test_load_missing), &
                   new_unittest("the legacy $name ... $end", test_legacy), &
                   new_unittest("nothing outside groups but comments", test_outside), &
@@ -273,6 +275,49 @@ contains
       call group_read_error(deck, grp, 0, 'End of file', err)
       call check(error, err%message, 'bad.nml, group &integration (line 1): cannot be read: End of file')
    end subroutine test_read_error
+
+   !> A group read in a loop with next_read: once when it reads; else again one assignment
+   !> at a time up to the one at fault, which the message names.
+   subroutine test_next_read(error)
+      type(error_type), allocatable, intent(out) :: error
+      type(deck_text) :: deck
+      type(group_text) :: grp
+      type(fd_error_type), allocatable :: err
+      integer :: n1, reads, ios
+      real(dp) :: n
+      character(len=512) :: msg
+      logical :: found, more
+      namelist /integration/ n1, n
+
+      call deck_from_string('&integration'//nl//'  n1 = 20'//nl//'  n = 1.5'//nl//'/'//nl, 'good.nml', deck)
+      call find_group(deck, 'integration', grp, found, err)
+      n1 = 0; n = 0.0_dp; reads = 0
+      do
+         reads = reads + 1
+         read (grp%lines, nml=integration, iostat=ios, iomsg=msg)
+         call next_read(deck, grp, ios, msg, more, err)
+         if (.not. more) exit
+      end do
+      call check(error, .not. allocated(err) .and. reads == 1 .and. n1 == 20 .and. n == 1.5_dp, &
+                 'a group that reads is read once')
+      if (allocated(error)) return
+      call deck_from_string('&integration'//nl//'  n1 = 20'//nl//'  n = 1.5x'//nl//'  n1 = 3'//nl//'/'//nl, &
+                            'bad.nml', deck)
+      call find_group(deck, 'integration', grp, found, err)
+      reads = 0
+      do
+         reads = reads + 1
+         read (grp%lines, nml=integration, iostat=ios, iomsg=msg)
+         call next_read(deck, grp, ios, msg, more, err)
+         if (.not. more) exit
+      end do
+      call check(error, reads, 3, 'the whole group, then assignments 1 and 2')
+      if (allocated(error)) return
+      call check(error, allocated(err), 'an error')
+      if (allocated(error)) return
+      call check(error, index(err%message, "bad.nml, group &integration, line 3: variable 'n' has a bad value '1.5x' (") &
+                 == 1, err%message)
+   end subroutine test_next_read
 
    subroutine test_load_missing(error)
       type(error_type), allocatable, intent(out) :: error

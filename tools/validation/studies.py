@@ -1,7 +1,8 @@
 """The verification studies behind docs/validation.md (validate.py writes the report; the
 tests in tests/test_validation.py assert the same numbers on reduced versions). Every run
 goes through the f2py extension; the model, Table 1 and the steady-state classifier are the
-package's (frictiondyn.paper), the closed forms are in oracles.py.
+package's (frictiondyn.paper), the closed forms are the tests' (tests/oracles.py: one copy,
+independent of the solver and outside the package).
 
 Studies:
 1. the exact technique against closed forms (rigid body, free oscillators, Den Hartog);
@@ -51,9 +52,11 @@ from frictiondyn.paper import (
     steady_state,
     steady_window,
 )
-from oracles import den_hartog, linear_response
+ROOT = Path(__file__).resolve().parents[2]
+sys.path.append(str(ROOT / "tests"))
+from oracles import den_hartog, linear_response  # the closed forms, one copy (tests/oracles.py)
 
-sys.path.insert(0, str(Path(__file__).resolve().parents[2] / "bench"))
+sys.path.insert(0, str(ROOT / "bench"))
 from opensees_models import BuildingCase  # the benchmark's building, one definition
 
 DELTA = 0.05  # m/s: level of |s'| whose crossings time the slides (above the sticking noise)

@@ -93,7 +93,7 @@ contains
       real(dp), intent(in) :: c(0:)   !! coefficients (degree >= 0)
       real(dp), intent(in) :: len     !! interval length L >= 0
       real(dp), intent(in), optional :: sgn !! +1 (default) or -1
-      real(dp) :: c0, c1, c2, sv, tail, sg
+      real(dp) :: c0, c1, c2, tail, sg
       integer :: n, k
 
       sg = 1.0_dp
@@ -104,11 +104,7 @@ contains
       c2 = 0.0_dp
       if (n >= 1) c1 = sg*c(1)
       if (n >= 2) c2 = sg*c(2)
-      b = min(c0, c0 + len*(c1 + len*c2))
-      if (c2 > 0.0_dp) then
-         sv = -c1/(2.0_dp*c2)
-         if (sv > 0.0_dp .and. sv < len) b = min(b, c0 + sv*(c1 + sv*c2))
-      end if
+      b = quadratic_min(c0, c1, c2, len)
       tail = 0.0_dp
       do k = n, 3, -1
          tail = tail*len + abs(c(k))
@@ -117,13 +113,26 @@ contains
       b = b - tail
    end function poly_lower_bound
 
+   !> The minimum of c0 + c1 s + c2 s^2 over [0, L]: at an end, or at the vertex inside.
+   pure real(dp) function quadratic_min(c0, c1, c2, len) result(b)
+      real(dp), intent(in) :: c0, c1, c2  !! coefficients
+      real(dp), intent(in) :: len         !! interval length L >= 0
+      real(dp) :: sv
+
+      b = min(c0, c0 + len*(c1 + len*c2))
+      if (c2 > 0.0_dp) then
+         sv = -c1/(2.0_dp*c2)
+         if (sv > 0.0_dp .and. sv < len) b = min(b, c0 + sv*(c1 + sv*c2))
+      end if
+   end function quadratic_min
+
    !> A lower bound of sgn p' on [0, L], from the coefficients of p (poly_lower_bound of
    !> the derivative's coefficients (k + 1) c(k + 1)).
    pure real(dp) function deriv_lower_bound(c, len, sgn) result(b)
       real(dp), intent(in) :: c(0:)   !! coefficients of p (degree >= 1)
       real(dp), intent(in) :: len     !! interval length L >= 0
       real(dp), intent(in) :: sgn     !! +1 or -1
-      real(dp) :: c0, c1, c2, sv, tail
+      real(dp) :: c0, c1, c2, tail
       integer :: n, k
 
       n = ubound(c, 1)
@@ -134,11 +143,7 @@ contains
       c2 = 0.0_dp
       if (n >= 2) c1 = sgn*2.0_dp*c(2)
       if (n >= 3) c2 = sgn*3.0_dp*c(3)
-      b = min(c0, c0 + len*(c1 + len*c2))
-      if (c2 > 0.0_dp) then
-         sv = -c1/(2.0_dp*c2)
-         if (sv > 0.0_dp .and. sv < len) b = min(b, c0 + sv*(c1 + sv*c2))
-      end if
+      b = quadratic_min(c0, c1, c2, len)
       tail = 0.0_dp
       do k = n, 4, -1
          tail = tail*len + k*abs(c(k))
@@ -292,12 +297,8 @@ contains
                end if
             end if
             if (found) return
-            if (settled) then
-               lev = lev - 1
-               if (lev < 0) return
-               cycle
-            end if
-            side(lev) = 0
+            ! split the piece, or leave it (settled: as if both halves were done)
+            side(lev) = merge(2, 0, settled)
          end if
          call next_piece(work, n, a, w, side, lev)
          if (lev < 0) return
@@ -369,12 +370,8 @@ contains
                   end if
                end if
             end if
-            if (settled) then
-               lev = lev - 1
-               if (lev < 0) return
-               cycle
-            end if
-            side(lev) = 0
+            ! split the piece, or leave it (settled: as if both halves were done)
+            side(lev) = merge(2, 0, settled)
          end if
          call next_piece(work, n, a, w, side, lev)
          if (lev < 0) return
