@@ -1486,7 +1486,8 @@ contains
       if (x == unset_int) then
          call fatal_error(error, deck%path//", group &"//group//": "//var//" is not given"); return
       end if
-      if (x < lo .or. x > hi) call bad(deck, group, var, trim(fmt_int(x)), 'in '//trim(fmt_int(lo))//'..'//trim(fmt_int(hi)), error)
+      if (x < lo .or. x > hi) &
+         call bad(deck, group, var, trim(fmt_int(x)), 'in '//trim(fmt_int(lo))//'..'//trim(fmt_int(hi)), error)
    end subroutine need_int
 
    subroutine need_real(deck, group, var, x, unit, error, positive)
