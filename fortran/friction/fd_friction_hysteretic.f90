@@ -61,23 +61,24 @@ contains
       call set_coefficients(dev, st)
    end subroutine hysteretic_init
 
-   !> Phase for the next step from the state at the end of this one (eqs. 2-4).
+   !> Phase for the next step from the state at the end of this one (eqs. 2-4). st comes from
+   !> hysteretic_init or an earlier update: its coefficients (ks = P mu / f while sticking)
+   !> are those of its phase.
    pure subroutine hysteretic_update(dev, s, sdot, st, changed)
       type(device_type), intent(in) :: dev      !! device parameters
       real(dp), intent(in) :: s                 !! relative displacement [m]
       real(dp), intent(in) :: sdot              !! relative velocity [m/s]
       type(device_state), intent(inout) :: st   !! state, updated
       logical, intent(out) :: changed           !! the phase changed
-      real(dp) :: k, force, slip
+      real(dp) :: force, slip
       integer :: old
 
       old = st%phase
-      k = dev%p*dev%mu/dev%f
       slip = dev%p*dev%mu
       if (slip == 0.0_dp) then
          ! no friction capacity: F = 0 (k = 0), never slips
       else if (st%phase == phase_stick) then
-         force = k*(s - st%centre)
+         force = st%ks*(s - st%centre)                           ! st%ks = P mu / f while sticking
          if (abs(force) >= slip) then
             st%phase = merge(phase_slip_pos, phase_slip_neg, force > 0.0_dp)
             st%armed = abs(sdot) >= dev%eps1
@@ -104,7 +105,9 @@ contains
          st%centre = s - old*dev%f
          st%armed = .false.
       end if
-      call set_coefficients(dev, st)
+      ! the coefficients change with the phase only: while sliding the force is P mu sgn
+      ! whatever the centre, while sticking the centre stays (a division a device a step less)
+      if (changed) call set_coefficients(dev, st)
    end subroutine hysteretic_update
 
    !> Correctness condition, eq. 12, for a step taken in the phase st: checked in an armed
