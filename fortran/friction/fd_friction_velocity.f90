@@ -56,6 +56,8 @@ contains
    end subroutine velocity_init
 
    !> Phase for the next step from the velocity at the end of this one (eqs. 6-8).
+   !> st comes from velocity_init or an earlier update: its coefficients are those of its
+   !> phase.
    pure subroutine velocity_update(dev, s, sdot, st, changed)
       type(device_type), intent(in) :: dev      !! device parameters
       real(dp), intent(in) :: s                 !! relative displacement [m]
@@ -76,7 +78,9 @@ contains
       end if
       changed = st%phase /= old
       st%centre = s
-      call set_coefficients(dev, sdot, st)
+      ! with a constant mu the coefficients change with the phase only (a division a device
+      ! a step less); a velocity-dependent mu follows sdot at every step
+      if (changed .or. dev%mu_law /= mu_constant) call set_coefficients(dev, sdot, st)
    end subroutine velocity_update
 
    !> Correctness condition, eq. 9, for a step taken in the phase st (checked in sliding).
