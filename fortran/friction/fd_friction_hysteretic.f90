@@ -10,7 +10,7 @@
 !> An armed slide whose velocity has crossed to the other side of the band reverses.
 module fd_friction_hysteretic
    use fd_kinds, only: dp
-   use fd_model, only: device_type
+   use fd_model, only: device_type, sticking_stiffness
    use fd_device_state, only: device_state, phase_stick, phase_slip_pos, phase_slip_neg, &
                               job_init, job_update, job_correct
    implicit none
@@ -78,7 +78,7 @@ contains
       if (slip == 0.0_dp) then
          ! no friction capacity: F = 0 (k = 0), never slips
       else if (st%phase == phase_stick) then
-         force = st%ks*(s - st%centre)                           ! st%ks = P mu / f while sticking
+         force = st%ks*(s - st%centre)                           ! st%ks: sticking_stiffness
          if (abs(force) >= slip) then
             st%phase = merge(phase_slip_pos, phase_slip_neg, force > 0.0_dp)
             st%armed = abs(sdot) >= dev%eps1
@@ -131,7 +131,7 @@ contains
 
       st%cs = 0.0_dp
       if (st%phase == phase_stick) then
-         k = dev%p*dev%mu/dev%f
+         k = sticking_stiffness(dev)
          st%ks = k
          st%f0 = -k*st%centre
       else

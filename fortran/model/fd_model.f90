@@ -119,9 +119,9 @@ contains
 
    !> The sticking spring of a device, k = P mu / f (eq. 3): a hysteretic device with P mu > 0;
    !> 0 for the others (a velocity-law device sticks through damping, a Coulomb one rigidly).
-   !> The stuck system's modes, the step limits and the step-resolution report take it from
-   !> here; the law (fd_friction_hysteretic) forms the same k = P mu / f itself, in the
-   !> time-step loop, where a call to another module costs 1.3 % of a two-mass step.
+   !> The hysteretic law (at a change of phase; between changes it reads k from the device's
+   !> state), the stuck system's modes, the step limits and the step-resolution report take
+   !> it from here.
    elemental real(dp) function sticking_stiffness(dev) result(k)
       type(device_type), intent(in) :: dev  !! the device
 

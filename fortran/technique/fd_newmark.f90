@@ -147,10 +147,11 @@ contains
       call device_kinematics(model, w%u, w%v, w%s, w%sd)
       call friction_init(model%dev, w%s, w%sd, w%st, error)
       if (allocated(error)) return
+      ! the devices' forces, kept from here on by device_step
+      w%f = device_force(w%st, w%s, w%sd)
       call consistent_acceleration(model, exc, 0.0_dp, w)
       call observe_start_energies(w%obs, 0.5_dp*sum(w%mass*w%v**2), strain_energy(model, w%u), &
                                   device_energy(w%st, w%s))
-      w%f = device_force(w%st, w%s, w%sd)
       w%phase0 = w%st%phase
       call observe_sample(w%obs, res, 0.0_dp, w%ag, w%u, w%v, w%a, w%s, w%sd, w%f, w%phase0)
       call observe_peaks(res, 0.0_dp, w%n, w%nd, w%u, w%v, w%a, w%ag, w%s, w%f)
@@ -177,7 +178,6 @@ contains
                                 " s: the integration diverged (check beta, gamma and the step)")
                return
             end if
-            w%f = device_force(w%st, w%s, w%sd)
             w%phase0 = w%st%phase
             call observe_sample(w%obs, res, k*dt1, w%ag, w%u, w%v, w%a, w%s, w%sd, w%f, w%phase0)
          end if
@@ -294,7 +294,8 @@ contains
       end if
    end subroutine setup
 
-   !> Acceleration in equilibrium with the current phases: M a = p - C v - K u - sum b F.
+   !> Acceleration in equilibrium with the current phases: M a = p - C v - K u - sum b F
+   !> (F: the devices' forces kept in w%f).
    subroutine consistent_acceleration(model, exc, t, w)
       type(model_type), intent(in) :: model
       type(excitation_type), intent(in) :: exc
@@ -308,7 +309,7 @@ contains
       call spd_c_matvec(w%lev(1)%sys, w%v, w%rhs, -1.0_dp, 1.0_dp)
       call spd_k_matvec(w%lev(1)%sys, w%u, w%rhs, -1.0_dp, 1.0_dp)
       do d = 1, w%nd
-         call add_device(model, d, -device_force(w%st(d), w%s(d), w%sd(d)), w%rhs)
+         call add_device(model, d, -w%f(d), w%rhs)
       end do
       w%a = w%rhs/w%mass
    end subroutine consistent_acceleration
