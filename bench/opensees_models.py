@@ -259,7 +259,7 @@ class BuildingCase:
     law: str = "hysteretic"
     eps: float = 1.0e-3
     #: frictiondyn's refinement of a dt1 step with a phase change: 'step' (the paper's, the
-    #: default) or 'nested' (docs/theory.md section 6)
+    #: default), 'nested' or 'implicit' (docs/theory.md section 6)
     refinement: str = "step"
 
     def __post_init__(self) -> None:
@@ -386,14 +386,14 @@ def _chain_eigenvalues(k: np.ndarray, m: float, count: int = 3) -> np.ndarray:
 
 def make_case(spec: str, quick: bool = False):
     """'test4:hysteretic', 'test4:velocity', 'building:N', 'building_velocity:N' or
-    'building_nested:N' (the hysteretic building with nested refinement) (quick: the short
-    smoke versions)."""
+    'building_nested:N' / 'building_implicit:N' (the hysteretic building with nested
+    refinement / implicit phases) (quick: the short smoke versions)."""
     kind, _, arg = spec.partition(":")
     if kind == "test4":
         return Test4Case(arg, duration=2.0 if quick else 10.0)
-    if kind in ("building", "building_velocity", "building_nested"):
+    if kind in ("building", "building_velocity", "building_nested", "building_implicit"):
         law = "velocity" if kind == "building_velocity" else "hysteretic"
-        refinement = "nested" if kind == "building_nested" else "step"
+        refinement = {"building_nested": "nested", "building_implicit": "implicit"}.get(kind, "step")
         return BuildingCase(
             int(arg), duration=5.0 if quick else 20.0, law=law, refinement=refinement
         )

@@ -77,6 +77,11 @@ def _print_summary(result: Result, deck: str) -> None:
         f"  {stuck}; steps dt1 {s['steps_dt1']}, nested {s.get('steps_nested', 0)}, dt2 {s['steps_dt2']}, "
         f"finer {s['steps_finer']}"
     )
+    if s.get("steps_implicit", 0) + s.get("implicit_fallbacks", 0) > 0:
+        print(
+            f"  implicit phases: {s['steps_implicit']} dt1 steps settled ({s['implicit_redos']} trials "
+            f"redone), {s['implicit_fallbacks']} refined as the paper's"
+        )
     laws = s.get("device_law", [])
     for d in range(result.n_devices):
         law = f" ({laws[d]})" if d < len(laws) else ""

@@ -298,7 +298,9 @@ class Integration:
     takes the reader's default. ``technique`` is 'newmark', 'event_driven' (exact, for
     'coulomb' devices) or 'moreau_jean' (time stepping for 'coulomb' devices; ``theta``).
     ``refinement`` is 'step' (the paper: a dt1 step with a phase change redone as n2 steps
-    dt2) or 'nested' (split by the prime factors of n2, only where a phase changes)."""
+    dt2), 'nested' (split by the prime factors of n2, only where a phase changes) or
+    'implicit' (the dt1 step redone in the phases it ends in, as Newton-Raphson codes such as
+    OpenSees resolve an elastic-perfectly-plastic link; transitions located to within dt1)."""
 
     technique: str | None = None
     beta: float | None = None

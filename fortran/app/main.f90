@@ -131,6 +131,9 @@ program frictiondyn_main
    write (output_unit, '(a)') 'frictiondyn: '//deck
    write (output_unit, '(a,f0.6,a,i0,a,i0,a,i0,a,i0)') '  stuck period ', res%period_stuck, ' s; steps dt1 ', &
       res%steps_dt1, ', nested ', res%steps_nested, ', dt2 ', res%steps_dt2, ', finer ', res%steps_finer
+   if (res%steps_implicit + res%implicit_fallbacks > 0) &
+      write (output_unit, '(a,i0,a,i0,a,i0,a)') '  implicit phases: ', res%steps_implicit, ' dt1 steps settled (', &
+      res%implicit_redos, ' trials redone), ', res%implicit_fallbacks, ' refined as the paper''s'
    if (allocated(cfg%record%path)) then
       write (output_unit, '(a,i0,a,es12.5,a)') '  record '//cfg%record%path//' ('//trim(cfg%record%format)// &
          trim(merge(', detected', '          ', cfg%record%detected))//', '//trim(cfg%record%units)//'): ', &

@@ -9,11 +9,11 @@ module fd_friction
    use fd_model, only: device_type, law_velocity, law_hysteretic, law_name
    use fd_device_state, only: device_state, job_init, job_update, job_correct
    use fd_friction_velocity, only: velocity_law, velocity_update, velocity_correct
-   use fd_friction_hysteretic, only: hysteretic_law, hysteretic_update, hysteretic_correct
+   use fd_friction_hysteretic, only: hysteretic_law, hysteretic_update, hysteretic_correct, hysteretic_settle
    implicit none
    private
 
-   public :: friction_init, friction_update, friction_correct, friction_step
+   public :: friction_init, friction_update, friction_correct, friction_step, friction_settle
 
 contains
 
@@ -85,6 +85,37 @@ contains
          any_bad = any_bad .or. .not. ok(d)
       end do
    end subroutine friction_step
+
+   !> `refinement = 'implicit'`: the state of every device in which to take a step that ends
+   !> in the phases of st1 (the law's update at the end of the last trial), from the states at
+   !> its start st0; can is .false. when a device's change cannot be taken in one phase (the
+   !> step is then refined). A device that keeps its phase keeps st0. The velocity law's coefficients depend on its
+   !> phase only (and, with mu(v), on the velocity its update was given): st1 itself.
+   subroutine friction_settle(nd, dev, st0, st1, st, can)
+      integer, intent(in) :: nd                 !! devices
+      type(device_type), intent(in) :: dev(nd)  !! devices
+      type(device_state), intent(in) :: st0(nd) !! states at the step's start
+      type(device_state), intent(in) :: st1(nd) !! the update's states at the step's end
+      type(device_state), intent(inout) :: st(nd) !! states to take the step in
+      logical, intent(out) :: can               !! every change can be taken in one phase
+      logical :: ok
+      integer :: d
+
+      can = .true.
+      do d = 1, nd
+         if (st1(d)%phase == st0(d)%phase) then
+            st(d) = st0(d)
+            cycle
+         end if
+         select case (dev(d)%law)
+         case (law_hysteretic)
+            call hysteretic_settle(st0(d), st1(d), st(d), ok)
+            can = can .and. ok
+         case default
+            st(d) = st1(d)
+         end select
+      end do
+   end subroutine friction_settle
 
    !> Initial phase and force coefficients of every device; an error for a device whose
    !> law is not a regularized law of this dispatch.

@@ -16,7 +16,7 @@ module fd_friction_hysteretic
    implicit none
    private
 
-   public :: hysteretic_law, hysteretic_init, hysteretic_update, hysteretic_correct
+   public :: hysteretic_law, hysteretic_init, hysteretic_update, hysteretic_correct, hysteretic_settle
 
 contains
 
@@ -123,6 +123,33 @@ contains
       if (st%phase /= phase_stick .and. st%armed) &
          ok = sdot_new*sdot_old > dev%eps1**2*(1.0_dp - 1.0_dp/n)
    end function hysteretic_correct
+
+   !> The state in which to take a step that ends in st1's phase (`refinement = 'implicit'`),
+   !> from the state at its start st0: the elastic-perfectly-plastic return mapping.
+   !> - A slide that starts: the constant force P mu sgn of st1, unarmed (eq. 12 compares the
+   !>   velocities at the two ends of a step inside a slide; this step starts sticking).
+   !> - A slide that ends: the step in the slide itself, st0; the sticking state after it
+   !>   (hysteretic_update) keeps the force P mu sgn continuous at the step's end.
+   !> - The same phase: st0.
+   !> - A reversal (an armed slide whose velocity crossed the band within the step) is not
+   !>   taken in one phase (can = .false.): the velocity passed through the band, where the
+   !>   device may stick, and a step in the opposite slide would reverse the force at once.
+   pure subroutine hysteretic_settle(st0, st1, st, can)
+      type(device_state), intent(in) :: st0     !! state at the step's start
+      type(device_state), intent(in) :: st1     !! the update's state at the step's end
+      type(device_state), intent(out) :: st     !! state to take the step in
+      logical, intent(out) :: can               !! the step can be taken in one phase
+
+      can = .true.
+      st = st0
+      if (st1%phase == st0%phase .or. st1%phase == phase_stick) return
+      if (st0%phase == phase_stick) then
+         st = st1
+         st%armed = .false.
+      else
+         can = .false.
+      end if
+   end subroutine hysteretic_settle
 
    pure subroutine set_coefficients(dev, st)
       type(device_type), intent(in) :: dev

@@ -20,7 +20,7 @@ module fd_names
    public :: excitation_types, excitation_harmonic, excitation_record, excitation_none
    public :: record_kinds, record_acceleration, record_displacement
    public :: linear_systems, linear_system_auto, linear_system_dense, linear_system_banded
-   public :: refinements, refinement_step, refinement_nested
+   public :: refinements, refinement_step, refinement_nested, refinement_implicit
    public :: mu_laws, mu_constant, mu_exponential, mu_table
    public :: mode_systems, system_stuck, system_free
    public :: keyword_id, keyword_choices, law_id, law_choices, law_name, technique_name
@@ -105,9 +105,11 @@ module fd_names
    ! ------------------------------------------------------------------ step refinement (Newmark)
    type(keyword_type), parameter :: refinements(*) = [ &
                                     keyword_type('step', 'the paper: whole dt1 step in dt2 steps'), &
-                                    keyword_type('nested', 'split by the factors of n2')]
+                                    keyword_type('nested', 'split by the factors of n2'), &
+                                    keyword_type('implicit', 'the dt1 step in the phases it ends in')]
    integer, parameter :: refinement_step = 1   !! a refined dt1 step is redone as n2 steps dt2
    integer, parameter :: refinement_nested = 2 !! split level by level, only the pieces that change
+   integer, parameter :: refinement_implicit = 3 !! the dt1 step redone in the phases it ends in
    ! ------------------------------------------------------------------ mu(v), velocity law
    type(keyword_type), parameter :: mu_laws(*) = [ &
                                     keyword_type('constant', 'mu'), &

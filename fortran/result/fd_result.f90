@@ -61,6 +61,9 @@ module fd_result
       integer :: steps_dt1 = 0         !! steps taken with dt1
       integer :: steps_dt2 = 0         !! steps taken with dt2
       integer :: steps_nested = 0      !! steps of the sizes between dt1 and dt2 (refinement 'nested')
+      integer :: steps_implicit = 0    !! dt1 steps taken in the phases they end in (refinement 'implicit')
+      integer :: implicit_redos = 0    !! trial steps redone to settle the phases (refinement 'implicit')
+      integer :: implicit_fallbacks = 0 !! dt1 steps whose phases did not settle, refined as 'step'
       integer :: steps_finer = 0       !! steps taken with dt2/2, dt2/4, ...
       integer :: factorizations = 0    !! factorizations of the effective stiffness
                                        !! (exact technique: matrix exponentials)

@@ -26,7 +26,8 @@ module fd_newmark
    use fd_kinds, only: dp
    use fd_error, only: error_type, fatal_error, fmt_real, fmt_int, stat_no_memory
    use fd_names, only: laws, law_name, law_choices, excitation_types, technique_name, technique_newmark, &
-                       technique_event_driven, technique_moreau_jean, linear_system_dense, linear_system_banded, refinement_nested
+                       technique_event_driven, technique_moreau_jean, linear_system_dense, linear_system_banded, &
+                       refinement_nested, refinement_implicit
    use fd_model, only: model_type, integration_type
    use fd_excitation, only: excitation_type, table_motion, table_acceleration
    use fd_matrices, only: structure_damping
@@ -35,13 +36,13 @@ module fd_newmark
                         spd_c_matvec, spd_kc_matvec, spd_auto, spd_dense, spd_banded, spd_is_dense, spd_bandwidth, &
                         spd_copy
    use fd_device_state, only: device_state, device_force
-   use fd_friction, only: friction_init, friction_step
+   use fd_friction, only: friction_init, friction_step, friction_settle
    use fd_result, only: result_type
    use fd_run_control, only: run_control
    use fd_observer, only: observer_type, observer_init, sample_due, observe_start_energies, observe_peaks, &
                           observe_sample, observe_transitions, observe_violations, observe_end_energies, &
                           observe_poll, observe_stop_error
-   use fd_step_limits, only: halving_levels, unresolved_band, max_nested, nested_splits
+   use fd_step_limits, only: halving_levels, unresolved_band, max_nested, nested_splits, max_settle
    implicit none
    private
 
@@ -73,7 +74,9 @@ module fd_newmark
       real(dp), allocatable :: s(:), sd(:), s1(:), sd1(:), f(:), kd(:)
       integer, allocatable :: di(:), dj(:)            !! device nodes (dj = 0: the table)
       type(device_state), allocatable :: st(:), st1(:)
+      type(device_state), allocatable :: st0(:)       !! states at the start ('implicit' refinement)
       integer, allocatable :: phase0(:), phase1(:)    !! phases of st, st1 for the observer
+      integer, allocatable :: phase_end(:)            !! phases a step is taken for ('implicit')
       logical, allocatable :: changed(:), ok(:)
       real(dp) :: ag = 0.0_dp, ag1 = 0.0_dp
       real(dp) :: w_device = 0.0_dp                   !! work of the device forces [J]
@@ -125,7 +128,7 @@ contains
       type(workspace) :: w
       real(dp) :: dt1, dt2, t0
       integer :: k, c0, c1, crate, l
-      logical :: any_changed, any_bad, stop
+      logical :: any_changed, any_bad, stop, settled
 
       call system_clock(c0, crate)
       call newmark_check(model, exc, error)
@@ -164,6 +167,14 @@ contains
          if (w%nd == 0 .or. .not. (any_changed .or. (any_bad .and. opts%check))) then
             call accept(model, exc, t0 + dt1, w, res, any_changed, .false.)
             res%steps_dt1 = res%steps_dt1 + 1
+         else if (opts%refinement == refinement_implicit .and. any_changed) then
+            ! redone in the phases it ends in; refined as the paper's when they do not settle
+            call settle_phases(model, exc, opts, t0, w, res, settled, error)
+            if (allocated(error)) return
+            if (.not. settled) then
+               call advance_nested(model, exc, opts, t0, 0, w, res, error)
+               if (allocated(error)) return
+            end if
          else if (opts%n2 == 1 .and. .not. (any_bad .and. opts%check)) then
             ! redone as one step of dt2 = dt1 from the same state and phases: the trial itself
             call accept(model, exc, t0 + dt1, w, res, any_changed, any_bad)
@@ -285,8 +296,8 @@ contains
          if (allocated(error)) return
       end do
       allocate (w%u(n), w%v(n), w%a(n), w%u1(n), w%v1(n), w%a1(n), w%rhs(n), w%tmp(n), &
-                w%s(nd), w%sd(nd), w%s1(nd), w%sd1(nd), w%f(nd), w%kd(nd), w%st(nd), w%st1(nd), &
-                w%phase0(nd), w%phase1(nd), w%changed(nd), w%ok(nd), stat=stat)
+                w%s(nd), w%sd(nd), w%s1(nd), w%sd1(nd), w%f(nd), w%kd(nd), w%st(nd), w%st1(nd), w%st0(nd), &
+                w%phase0(nd), w%phase1(nd), w%phase_end(nd), w%changed(nd), w%ok(nd), stat=stat)
       if (stat /= 0) then
          call fatal_error(error, "not enough memory for the state of n_dof = "//trim(fmt_int(n))//" DOFs", &
                           stat_no_memory)
@@ -564,6 +575,92 @@ contains
          end do
       end do
    end subroutine advance_refined
+
+   !> `refinement = 'implicit'`: the dt1 step from t, whose trial in the phases at its start
+   !> ended with a phase change, taken in the phases it ends in (an active-set iteration, as a
+   !> Newton-Raphson code resolves an elastic-perfectly-plastic link; a transition is located
+   !> to within dt1, not dt2). Each law says in which state a step that ends in a phase is
+   !> taken (friction_settle: a hysteretic slide that starts, in its sliding force; one that
+   !> ends, in the slide, the force continuous at its end; a reversal through the band is
+   !> not taken in one phase). The step is redone in those states
+   !> until the phases at its end, judged from the states at its start, are those it was taken
+   !> for. It is accepted when they are, the states it was taken in lead to the same phases
+   !> at its end, and (checked) no device that keeps its phase violates the correctness
+   !> condition; its transitions are counted from the phases at the start. Otherwise (a change
+   !> no single phase takes, a second change at the end, a violation, phases back to those
+   !> at the start, or max_settle trials) the start is restored and settled is .false.: the
+   !> caller refines the step as the paper does. A trial updates the dt1 factor for the
+   !> devices whose stiffness or damping differs, never refactoring it.
+   subroutine settle_phases(model, exc, opts, t, w, res, settled, error)
+      type(model_type), intent(in) :: model
+      type(excitation_type), intent(in) :: exc
+      type(integration_type), intent(in) :: opts
+      real(dp), intent(in) :: t
+      type(workspace), intent(inout) :: w
+      type(result_type), intent(inout) :: res
+      logical, intent(out) :: settled
+      type(error_type), allocatable, intent(out) :: error
+      logical :: any_changed, any_bad, can
+      integer :: it, d
+
+      settled = .false.
+      w%st0 = w%st
+      w%phase0 = w%st0%phase
+      do it = 1, max_settle
+         ! the phases at the end of the last trial, and the states to take the step in
+         w%phase_end = w%st1%phase
+         call friction_settle(w%nd, model%dev, w%st0, w%st1, w%st, can)
+         if (.not. can) exit
+         if (it > 1 .or. .not. same_phases(w%nd, w%st, w%phase0)) then
+            w%version = w%version + 1
+            call try_step(exc, t, 1, w, error)
+            if (allocated(error)) return
+            res%implicit_redos = res%implicit_redos + 1
+            ! the phases this trial ends in, judged from the start
+            call friction_step(w%nd, model%dev, opts%n_corr, w%s1, w%sd1, w%sd, w%st0, w%st1, w%changed, w%ok, &
+                               any_changed, any_bad)
+            if (.not. any_changed) exit
+            if (.not. same_phases(w%nd, w%st1, w%phase_end)) cycle
+         end if
+         ! from the states the step was taken in, the same phases at its end; the condition in
+         ! the devices that keep their phase through the step (it is a condition inside a
+         ! phase: a changing device's velocities at the two ends belong to different phases)
+         call judge(model, opts, w, any_changed, any_bad)
+         if (.not. same_phases(w%nd, w%st1, w%phase_end)) exit
+         any_bad = .false.
+         do d = 1, w%nd
+            if (w%phase_end(d) /= w%phase0(d)) w%ok(d) = .true.
+            any_bad = any_bad .or. .not. w%ok(d)
+         end do
+         if (any_bad .and. opts%check) exit
+         ! transitions at the start (a slide that starts), then those at the end (in accept)
+         w%phase1 = w%st%phase
+         call observe_transitions(res, w%phase0, w%phase1)
+         call accept(model, exc, t + w%lev(1)%h, w, res, any_changed, any_bad)
+         res%steps_implicit = res%steps_implicit + 1
+         settled = .true.
+         return
+      end do
+      w%st = w%st0
+      w%version = w%version + 1
+      res%implicit_fallbacks = res%implicit_fallbacks + 1
+   end subroutine settle_phases
+
+   !> Every device's phase in st is phase.
+   pure logical function same_phases(nd, st, phase) result(same)
+      integer, intent(in) :: nd
+      type(device_state), intent(in) :: st(nd)
+      integer, intent(in) :: phase(nd)
+      integer :: d
+
+      same = .true.
+      do d = 1, nd
+         if (st(d)%phase /= phase(d)) then
+            same = .false.
+            return
+         end if
+      end do
+   end function same_phases
 
    !> Make the trial state the current one: phases, counters, energy, peaks.
    subroutine accept(model, exc, t1, w, res, any_changed, any_bad)

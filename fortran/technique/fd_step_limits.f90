@@ -20,7 +20,7 @@ module fd_step_limits
    private
 
    public :: max_refinement, max_stiffness_ratio, halving_levels, finest_step, band_floor, band_of
-   public :: check_step_limits, unresolved_band, max_nested, nested_splits
+   public :: check_step_limits, unresolved_band, max_nested, nested_splits, max_settle
 
    !> Most Newmark steps one dt1 step may be refined into: n2 steps dt2, each halved L times.
    integer, parameter :: max_refinement = 2**20
@@ -30,6 +30,9 @@ module fd_step_limits
    real(dp), parameter :: max_stiffness_ratio = 1.0e12_dp
    !> Most levels of nested refinement: the prime factors of n2 <= 2**20.
    integer, parameter :: max_nested = 20
+   !> Most trials of a dt1 step in the phases it ends in (`refinement = 'implicit'`) before the
+   !> step is refined as the paper's instead.
+   integer, parameter :: max_settle = 8
 
 contains
 
