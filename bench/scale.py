@@ -256,7 +256,7 @@ def main(argv=None) -> int:
     ap.add_argument(
         "--refinement",
         default="step",
-        choices=["step", "nested"],
+        choices=["step", "nested", "implicit"],
         help="frictiondyn's refinement of a dt1 step with a phase change (docs/theory.md section 6)",
     )
     ap.add_argument("--memory-size", type=int, default=1000)

@@ -1,7 +1,8 @@
 !> Unit tests of the paper's two friction laws as state machines (fd_friction_hysteretic,
 !> fd_friction_velocity): phase changes at the thresholds of eqs. 2-4 and 6-8, the force
 !> coefficients each phase gives (F = ks s + cs sdot + f0), continuity of the force at the
-!> changes, and the correctness conditions of eqs. 9 and 12.
+!> changes, and the correctness conditions of eqs. 9 and 12; and the states in which
+!> `refinement = 'implicit'` takes a step that ends in a new phase (the return mapping).
 !>
 !> The values are chosen exact in binary (P mu = 5 N, f = 2**-10 m, eps = eps1 = 2**-7 m/s),
 !> so that "at the threshold" is exactly at it.
@@ -10,7 +11,8 @@ module test_fd_friction
    use fd_kinds, only: dp
    use fd_model, only: device_type, law_velocity, law_hysteretic
    use fd_device_state, only: device_state, device_force, phase_stick, phase_slip_pos, phase_slip_neg
-   use fd_friction_hysteretic, only: hysteretic_init, hysteretic_update, hysteretic_correct
+   use fd_friction_hysteretic, only: hysteretic_init, hysteretic_update, hysteretic_correct, hysteretic_settle
+   use fd_friction, only: friction_settle
    use fd_friction_velocity, only: velocity_init, velocity_update, velocity_correct
    implicit none
    private
@@ -36,6 +38,8 @@ contains
                   new_unittest("hysteretic: reversal", test_hys_reversal), &
                   new_unittest("hysteretic: no capacity", test_hys_zero), &
                   new_unittest("hysteretic: eq. 12", test_hys_correct), &
+                  new_unittest("hysteretic: states of an implicit step", test_hys_settle), &
+                  new_unittest("implicit step: states of both laws", test_friction_settle), &
                   new_unittest("velocity: the band, eqs. 6-7", test_vel_band), &
                   new_unittest("velocity: force continuous at the band", test_vel_continuity), &
                   new_unittest("velocity: no capacity", test_vel_zero), &
@@ -221,6 +225,92 @@ contains
       if (allocated(error)) return
       call check(error, st%centre, 0.02_dp + f, 'centre = s + f')
    end subroutine test_hys_reversal
+
+   !> `refinement = 'implicit'`: a slide that starts is taken in its sliding force P mu sgn
+   !> throughout (never above P mu), unarmed (eq. 12 is for steps inside a slide); a slide
+   !> that ends is the step in the slide, and the sticking state after it (the update's)
+   !> keeps the force continuous; the same phase keeps its state; a reversal through the
+   !> band cannot be taken in one phase.
+   subroutine test_hys_settle(error)
+      type(error_type), allocatable, intent(out) :: error
+      type(device_state) :: st0, st1, st
+      type(device_type) :: dev
+      logical :: changed, can
+
+      dev = device(law_hysteretic)
+      ! a slide that starts: the trial's stick ended beyond f, at 2 f, with |sdot| >= eps1
+      call hysteretic_init(dev, 0.0_dp, 0.0_dp, st0)
+      st1 = st0
+      call hysteretic_update(dev, 2.0_dp*f, 3.0_dp*band, st1, changed)
+      call check(error, changed .and. st1%armed, 'the trial ends in an armed slide')
+      if (allocated(error)) return
+      call hysteretic_settle(st0, st1, st, can)
+      call check(error, can .and. st%phase == phase_slip_pos .and. .not. st%armed, &
+                 'the step is taken sliding +, unarmed')
+      if (allocated(error)) return
+      call check(error, force(st, 0.3_dp, -7.0_dp), pmu, 'F = P mu whatever s and sdot: no overshoot')
+      if (allocated(error)) return
+      call check(error, hysteretic_correct(dev, n_corr, st, 0.0_dp, 3.0_dp*band), &
+                 'eq. 12 not applied to the first step of a slide')
+      if (allocated(error)) return
+      ! a slide that ends (eq. 2): the step in the slide, then sticking at F = P mu
+      call hysteretic_init(dev, 0.0_dp, 3.0_dp*band, st0)
+      st1 = st0
+      call hysteretic_update(dev, 2.0_dp**(-6), 0.5_dp*band, st1, changed)
+      call check(error, changed .and. st1%phase == phase_stick, 'the trial ends sticking')
+      if (allocated(error)) return
+      call hysteretic_settle(st0, st1, st, can)
+      call check(error, can .and. st%phase == phase_slip_pos .and. st%f0 == st0%f0 .and. st%armed, &
+                 'the step is the slide itself')
+      if (allocated(error)) return
+      call check(error, force(st1, 2.0_dp**(-6), 0.0_dp), force(st, 2.0_dp**(-6), 0.5_dp*band), &
+                 'F continuous at the step end')
+      if (allocated(error)) return
+      ! no change: the start state itself
+      call hysteretic_settle(st0, st0, st, can)
+      call check(error, can .and. st%phase == st0%phase .and. st%centre == st0%centre .and. &
+                 st%armed .eqv. st0%armed, 'the same phase keeps its state')
+      if (allocated(error)) return
+      ! a reversal through the band
+      st1 = st0
+      call hysteretic_update(dev, 0.02_dp, -2.0_dp*band, st1, changed)
+      call check(error, st1%phase == phase_slip_neg, 'the trial reverses')
+      if (allocated(error)) return
+      call hysteretic_settle(st0, st1, st, can)
+      call check(error, .not. can, 'a reversal is not taken in one phase')
+   end subroutine test_hys_settle
+
+   !> friction_settle over both laws: a device that keeps its phase keeps its state, a
+   !> velocity-law device takes the coefficients of the phase it ends in, a hysteretic one
+   !> the return mapping's; can is false as soon as one device cannot be settled.
+   subroutine test_friction_settle(error)
+      type(error_type), allocatable, intent(out) :: error
+      type(device_type) :: dev(3)
+      type(device_state) :: st0(3), st1(3), st(3)
+      logical :: changed, can
+
+      dev(1) = device(law_velocity)
+      dev(2) = device(law_hysteretic)
+      dev(3) = device(law_hysteretic)
+      call velocity_init(dev(1), 0.0_dp, 0.0_dp, st0(1))      ! in the band
+      call hysteretic_init(dev(2), 0.0_dp, 0.0_dp, st0(2))    ! sticking
+      call hysteretic_init(dev(3), 0.0_dp, 3.0_dp*band, st0(3)) ! sliding +
+      st1 = st0
+      call velocity_update(dev(1), 0.0_dp, 2.0_dp*band, st1(1), changed)    ! leaves the band
+      call hysteretic_update(dev(2), 0.5_dp*f, 0.0_dp, st1(2), changed)      ! keeps sticking
+      call friction_settle(3, dev, st0, st1, st, can)
+      call check(error, can, 'every change can be settled')
+      if (allocated(error)) return
+      call check(error, st(1)%phase == phase_slip_pos .and. st(1)%f0 == pmu .and. st(1)%cs == 0.0_dp, &
+                 'velocity law: the sliding force of the phase it ends in')
+      if (allocated(error)) return
+      call check(error, st(2)%phase == phase_stick .and. st(2)%centre == st0(2)%centre, &
+                 'unchanged: the start state')
+      if (allocated(error)) return
+      call hysteretic_update(dev(3), 0.02_dp, -2.0_dp*band, st1(3), changed) ! reversal
+      call friction_settle(3, dev, st0, st1, st, can)
+      call check(error, .not. can, 'one reversal: the step cannot be settled')
+   end subroutine test_friction_settle
 
    subroutine test_hys_zero(error)
       type(error_type), allocatable, intent(out) :: error
