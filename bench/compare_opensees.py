@@ -315,9 +315,10 @@ def run_case(spec: str, args, history: dict, om, fd) -> dict:
         "duration_s": case.duration,
         "notes": [],
     }
-    if kind == "test4":
+    if kind.startswith("test4"):
         rec["opensees_material"] = case.opensees_material
         rec["law"] = case.law
+        rec["refinement"] = case.refinement
     else:
         rec["law"] = case.law
         rec["refinement"] = case.refinement
@@ -412,7 +413,7 @@ def run_case(spec: str, args, history: dict, om, fd) -> dict:
             print("   " + note, flush=True)
     variants = []
     if "fd" in timed:
-        variants += ["fd", "fd_short"] + (["fd_e2e"] if kind == "test4" else [])
+        variants += ["fd", "fd_short"] + (["fd_e2e"] if kind.startswith("test4") else [])
     if "ops" in timed:
         variants.append("ops")
     times: dict[str, list[float]] = {v: [] for v in variants}
@@ -573,8 +574,9 @@ def tables(results: list[dict], peak_tol: float) -> str:
         for r in t4:
             e2e = r.get("ratio_end_to_end")
             ops_e2e = (r["ops_analyze_s"] + r["ops_build_s"]) if "ops_analyze_s" in r else None
+            law = r["law"] if r.get("refinement", "step") == "step" else f"{r['law']} ({r['refinement']})"
             out.append(
-                f"| {r['law']} | {r['opensees_material']} | {r['steps']} | "
+                f"| {law} | {r['opensees_material']} | {r['steps']} | "
                 f"{_us(r, 'fd', '.2f')} | {_us(r, 'ops', '.2f')} | "
                 f"{_ratio_text(r)} ({_ratio_text(r, 'ratio_cpu')}) | "
                 f"{_fmt(r.get('fd_analysis_run_s'), '.4f')} | {_fmt(ops_e2e, '.4f')} | "
@@ -900,7 +902,7 @@ def parse_args(argv=None):
     ap.add_argument(
         "--implicit",
         action="store_true",
-        help="also the buildings with frictiondyn's implicit phases (refinement = 'implicit')",
+        help="also test 4 and the buildings with frictiondyn's implicit phases (refinement = 'implicit')",
     )
     ap.add_argument(
         "--no-buildings",
@@ -1016,6 +1018,8 @@ def main(argv=None) -> int:
     if args.nested:
         specs += [f"building_nested:{n}" for n in args.sizes]
     if args.implicit:
+        if not args.no_test4:
+            specs += ["test4_implicit:hysteretic", "test4_implicit:velocity"]
         specs += [f"building_implicit:{n}" for n in args.sizes]
     args.out.mkdir(parents=True, exist_ok=True)
     json_path = args.out / "compare_opensees.json"

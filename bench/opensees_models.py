@@ -82,6 +82,9 @@ class Test4Case:
 
     law: str  # 'hysteretic' or 'velocity'
     duration: float = 10.0
+    #: frictiondyn's handling of a dt1 step with a phase change: the deck's (the paper's
+    #: refinement) or 'implicit' (docs/theory.md section 6)
+    refinement: str = "step"
 
     def __post_init__(self) -> None:
         nml = f90nml.read(INPUTS / f"test4_{self.law}.nml")
@@ -126,7 +129,8 @@ class Test4Case:
 
     @property
     def name(self) -> str:
-        return f"test4_{self.law}"
+        suffix = "" if self.refinement == "step" else f"_{self.refinement}"
+        return f"test4_{self.law}{suffix}"
 
     @property
     def opensees_material(self) -> str:
@@ -169,7 +173,12 @@ class Test4Case:
                 self.dt_record,
                 duration or self.duration,
             ),
-            integration=fd.Integration(n1=self.n1, n2=self.n2, n=self.n),
+            integration=fd.Integration(
+                n1=self.n1,
+                n2=self.n2,
+                n=self.n,
+                refinement=None if self.refinement == "step" else self.refinement,
+            ),
         )
 
     def short_analysis(self):
@@ -385,12 +394,14 @@ def _chain_eigenvalues(k: np.ndarray, m: float, count: int = 3) -> np.ndarray:
 
 
 def make_case(spec: str, quick: bool = False):
-    """'test4:hysteretic', 'test4:velocity', 'building:N', 'building_velocity:N' or
+    """'test4:hysteretic', 'test4:velocity' (and 'test4_implicit:...', with implicit phases),
+    'building:N', 'building_velocity:N' or
     'building_nested:N' / 'building_implicit:N' (the hysteretic building with nested
     refinement / implicit phases) (quick: the short smoke versions)."""
     kind, _, arg = spec.partition(":")
-    if kind == "test4":
-        return Test4Case(arg, duration=2.0 if quick else 10.0)
+    if kind in ("test4", "test4_implicit"):
+        refinement = "implicit" if kind == "test4_implicit" else "step"
+        return Test4Case(arg, duration=2.0 if quick else 10.0, refinement=refinement)
     if kind in ("building", "building_velocity", "building_nested", "building_implicit"):
         law = "velocity" if kind == "building_velocity" else "hysteretic"
         refinement = {"building_nested": "nested", "building_implicit": "implicit"}.get(kind, "step")

@@ -70,6 +70,8 @@ def child(args) -> int:
         "steps_dt2": st["steps_dt2"],
         "steps_nested": st["steps_nested"],
         "steps_finer": st["steps_finer"],
+        "steps_implicit": st["steps_implicit"],
+        "implicit_redos": st["implicit_redos"],
         "factorizations": st["factorizations"],
         "factor_updates": st["factor_updates"],
         "partial_factorizations": st["partial_factorizations"],
@@ -124,7 +126,12 @@ def scaling(args, work: Path) -> dict:
         for n in args.sizes:
             deck = make_deck(work, n, law, args.duration, args.refinement)
             r = run_child(deck, n)
-            nm = r["steps_dt1"] + r["steps_nested"] + r["steps_dt2"] + r["steps_finer"]
+            # Newmark steps solved: accepted ones, and with implicit phases the settled dt1
+            # steps and their redone trials
+            nm = (
+                r["steps_dt1"] + r["steps_nested"] + r["steps_dt2"] + r["steps_finer"]
+                + r["steps_implicit"] + r["implicit_redos"]
+            )
             steps = round(args.duration / 1e-3)
             r.update(
                 n=n,
@@ -140,7 +147,10 @@ def scaling(args, work: Path) -> dict:
                 f"{r['cpu_us_per_newmark_step']:8.2f} us/Newmark step (CPU; wall "
                 f"{r['run_us_per_step']:.1f}, {r['run_us_per_newmark_step']:.2f}), steps {r['steps_dt1']} + "
                 f"{r['steps_nested']} + {r['steps_dt2']} + "
-                f"{r['steps_finer']}, {r['transitions']} transitions, factor: "
+                f"{r['steps_finer']}"
+                + (f" + implicit {r['steps_implicit']} (+ {r['implicit_redos']} redone)"
+                   if r["steps_implicit"] else "")
+                + f", {r['transitions']} transitions, factor: "
                 f"{r['factorizations']} full, {r['partial_factorizations']} partial, "
                 f"{r['factor_updates']} updates; deck read {r['open_s']:.3f} s; peak RSS "
                 f"{r['rss_peak_mb']:.0f} MB",
