@@ -8,7 +8,7 @@ module fd_friction
    use fd_error, only: error_type, fatal_error, fmt_int
    use fd_model, only: device_type, law_velocity, law_hysteretic, law_name
    use fd_device_state, only: device_state, job_init, job_update, job_correct
-   use fd_friction_velocity, only: velocity_law, velocity_update, velocity_correct
+   use fd_friction_velocity, only: velocity_law, velocity_update, velocity_correct, velocity_settle
    use fd_friction_hysteretic, only: hysteretic_law, hysteretic_update, hysteretic_correct, hysteretic_settle
    implicit none
    private
@@ -87,13 +87,14 @@ contains
    end subroutine friction_step
 
    !> `refinement = 'implicit'`: the state of every device in which to take a step that ends
-   !> in the phases of st1 (the law's update at the end of the last trial), from the states at
-   !> its start st0; can is .false. when a device's change cannot be taken in one phase (the
-   !> step is then refined). A device that keeps its phase keeps st0. The velocity law's coefficients depend on its
-   !> phase only (and, with mu(v), on the velocity its update was given): st1 itself.
-   subroutine friction_settle(nd, dev, st0, st1, st, can)
+   !> in the phases of st1 (the law's update at the end of the last trial, where the relative
+   !> velocities were sd1), from the states at its start st0; can is .false. when a device's
+   !> change cannot be taken in one phase (the step is then refined). A device that keeps its
+   !> phase keeps st0; each law says the rest (hysteretic_settle, velocity_settle).
+   subroutine friction_settle(nd, dev, sd1, st0, st1, st, can)
       integer, intent(in) :: nd                 !! devices
       type(device_type), intent(in) :: dev(nd)  !! devices
+      real(dp), intent(in) :: sd1(nd)           !! relative velocities at the last trial's end [m/s]
       type(device_state), intent(in) :: st0(nd) !! states at the step's start
       type(device_state), intent(in) :: st1(nd) !! the update's states at the step's end
       type(device_state), intent(inout) :: st(nd) !! states to take the step in
@@ -109,11 +110,14 @@ contains
          end if
          select case (dev(d)%law)
          case (law_hysteretic)
-            call hysteretic_settle(st0(d), st1(d), st(d), ok)
-            can = can .and. ok
+            call hysteretic_settle(dev(d), sd1(d), st0(d), st1(d), st(d), ok)
+         case (law_velocity)
+            call velocity_settle(st0(d), st1(d), st(d), ok)
          case default
-            st(d) = st1(d)
+            st(d) = st0(d)
+            ok = .false.
          end select
+         can = can .and. ok
       end do
    end subroutine friction_settle
 

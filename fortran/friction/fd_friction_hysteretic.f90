@@ -125,16 +125,21 @@ contains
    end function hysteretic_correct
 
    !> The state in which to take a step that ends in st1's phase (`refinement = 'implicit'`),
-   !> from the state at its start st0: the elastic-perfectly-plastic return mapping.
+   !> from the state at its start st0: the elastic-perfectly-plastic return mapping. sdot is
+   !> the relative velocity at the end of the last trial.
    !> - A slide that starts: the constant force P mu sgn of st1, unarmed (eq. 12 compares the
    !>   velocities at the two ends of a step inside a slide; this step starts sticking).
-   !> - A slide that ends: the step in the slide itself, st0; the sticking state after it
-   !>   (hysteretic_update) keeps the force P mu sgn continuous at the step's end.
+   !> - A slide that ends within the band: the step in the slide itself, st0; the sticking
+   !>   state after it (hysteretic_update) keeps the force P mu sgn continuous at the step's
+   !>   end.
    !> - The same phase: st0.
-   !> - A reversal (an armed slide whose velocity crossed the band within the step) is not
-   !>   taken in one phase (can = .false.): the velocity passed through the band, where the
-   !>   device may stick, and a step in the opposite slide would reverse the force at once.
-   pure subroutine hysteretic_settle(st0, st1, st, can)
+   !> - A reversal (an armed slide whose velocity crossed the band), or a slide that ends with
+   !>   its velocity turned beyond the band (an unarmed slide ends at any turn), is not taken
+   !>   in one phase (can = .false.): the velocity passed through the band, where the device
+   !>   may stick, and neither the slide's force nor the opposite one holds through the step.
+   pure subroutine hysteretic_settle(dev, sdot, st0, st1, st, can)
+      type(device_type), intent(in) :: dev      !! device parameters
+      real(dp), intent(in) :: sdot              !! relative velocity at the last trial's end [m/s]
       type(device_state), intent(in) :: st0     !! state at the step's start
       type(device_state), intent(in) :: st1     !! the update's state at the step's end
       type(device_state), intent(out) :: st     !! state to take the step in
@@ -142,12 +147,14 @@ contains
 
       can = .true.
       st = st0
-      if (st1%phase == st0%phase .or. st1%phase == phase_stick) return
+      if (st1%phase == st0%phase) return
       if (st0%phase == phase_stick) then
          st = st1
          st%armed = .false.
-      else
+      else if (st1%phase /= phase_stick) then
          can = .false.
+      else
+         can = sdot*st0%phase > -dev%eps1
       end if
    end subroutine hysteretic_settle
 

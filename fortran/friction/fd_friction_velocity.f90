@@ -16,7 +16,7 @@ module fd_friction_velocity
    implicit none
    private
 
-   public :: velocity_law, velocity_init, velocity_update, velocity_correct, sliding_mu
+   public :: velocity_law, velocity_init, velocity_update, velocity_correct, velocity_settle, sliding_mu
 
 contains
 
@@ -94,6 +94,21 @@ contains
       ok = .true.
       if (st%phase /= phase_stick) ok = sdot_new*sdot_old > dev%eps**2*(1.0_dp - 1.0_dp/n)
    end function velocity_correct
+
+   !> The state in which to take a step that ends in st1's phase (`refinement = 'implicit'`),
+   !> from the state at its start st0: the coefficients of the phase it ends in (st1: the band's
+   !> coupling, or the sliding force with mu at the velocity the update was given, not iterated).
+   !> A reversal, slip to the opposite slip, passed through the band within the step and is not
+   !> taken in one phase (can = .false.): the force would reverse at the step's start.
+   pure subroutine velocity_settle(st0, st1, st, can)
+      type(device_state), intent(in) :: st0     !! state at the step's start
+      type(device_state), intent(in) :: st1     !! the update's state at the step's end
+      type(device_state), intent(out) :: st     !! state to take the step in
+      logical, intent(out) :: can               !! the step can be taken in one phase
+
+      st = st1
+      can = st0%phase == phase_stick .or. st1%phase == phase_stick .or. st1%phase == st0%phase
+   end subroutine velocity_settle
 
    !> Friction coefficient at the sliding speed |v|: mu itself (constant), the exponential
    !> mu_max - (mu_max - mu_min) exp(-rate |v|) with mu_max = mu, or linear between the table's

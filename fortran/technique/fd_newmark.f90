@@ -8,6 +8,9 @@
 !> smallest first (n2 = 50: dt1/2, dt1/10, dt2), and only a piece whose own trial step has a
 !> phase change or a violation is split further: transitions are still taken in steps of
 !> dt2, the stretches of the dt1 step without one in the largest piece that has none.
+!> With `refinement = 'implicit'` (not the paper's) such a step is instead taken again in the
+!> phases it ends in (settle_phases: the return mapping of a Newton-Raphson code), and refined
+!> only when they do not settle.
 !>
 !> In each phase a device is linear, F = ks s + cs s' + f0, so a step solves one linear
 !> system with the effective stiffness K^ = K + (gamma/(beta h)) C + M/(beta h^2) +
@@ -581,7 +584,8 @@ contains
    !> Newton-Raphson code resolves an elastic-perfectly-plastic link; a transition is located
    !> to within dt1, not dt2). Each law says in which state a step that ends in a phase is
    !> taken (friction_settle: a hysteretic slide that starts, in its sliding force; one that
-   !> ends, in the slide, the force continuous at its end; a reversal through the band is
+   !> ends within the band, in the slide, the force continuous at its end; a velocity-law
+   !> device in its end phase's coefficients; a reversal through the band, of either law, is
    !> not taken in one phase). The step is redone in those states
    !> until the phases at its end, judged from the states at its start, are those it was taken
    !> for. It is accepted when they are, the states it was taken in lead to the same phases
@@ -590,7 +594,8 @@ contains
    !> no single phase takes, a second change at the end, a violation, phases back to those
    !> at the start, or max_settle trials) the start is restored and settled is .false.: the
    !> caller refines the step as the paper does. A trial updates the dt1 factor for the
-   !> devices whose stiffness or damping differs, never refactoring it.
+   !> devices whose stiffness or damping differs (spd_update_devices: rank-one updates, or a
+   !> refactorization from the first changed column), never a full refactorization.
    subroutine settle_phases(model, exc, opts, t, w, res, settled, error)
       type(model_type), intent(in) :: model
       type(excitation_type), intent(in) :: exc
@@ -609,7 +614,7 @@ contains
       do it = 1, max_settle
          ! the phases at the end of the last trial, and the states to take the step in
          w%phase_end = w%st1%phase
-         call friction_settle(w%nd, model%dev, w%st0, w%st1, w%st, can)
+         call friction_settle(w%nd, model%dev, w%sd1, w%st0, w%st1, w%st, can)
          if (.not. can) exit
          if (it > 1 .or. .not. same_phases(w%nd, w%st, w%phase0)) then
             w%version = w%version + 1

@@ -13,7 +13,7 @@ module test_fd_friction
    use fd_device_state, only: device_state, device_force, phase_stick, phase_slip_pos, phase_slip_neg
    use fd_friction_hysteretic, only: hysteretic_init, hysteretic_update, hysteretic_correct, hysteretic_settle
    use fd_friction, only: friction_settle
-   use fd_friction_velocity, only: velocity_init, velocity_update, velocity_correct
+   use fd_friction_velocity, only: velocity_init, velocity_update, velocity_correct, velocity_settle
    implicit none
    private
 
@@ -244,7 +244,7 @@ contains
       call hysteretic_update(dev, 2.0_dp*f, 3.0_dp*band, st1, changed)
       call check(error, changed .and. st1%armed, 'the trial ends in an armed slide')
       if (allocated(error)) return
-      call hysteretic_settle(st0, st1, st, can)
+      call hysteretic_settle(dev, 3.0_dp*band, st0, st1, st, can)
       call check(error, can .and. st%phase == phase_slip_pos .and. .not. st%armed, &
                  'the step is taken sliding +, unarmed')
       if (allocated(error)) return
@@ -259,7 +259,7 @@ contains
       call hysteretic_update(dev, 2.0_dp**(-6), 0.5_dp*band, st1, changed)
       call check(error, changed .and. st1%phase == phase_stick, 'the trial ends sticking')
       if (allocated(error)) return
-      call hysteretic_settle(st0, st1, st, can)
+      call hysteretic_settle(dev, 0.5_dp*band, st0, st1, st, can)
       call check(error, can .and. st%phase == phase_slip_pos .and. st%f0 == st0%f0 .and. st%armed, &
                  'the step is the slide itself')
       if (allocated(error)) return
@@ -267,7 +267,7 @@ contains
                  'F continuous at the step end')
       if (allocated(error)) return
       ! no change: the start state itself
-      call hysteretic_settle(st0, st0, st, can)
+      call hysteretic_settle(dev, 3.0_dp*band, st0, st0, st, can)
       call check(error, can .and. st%phase == st0%phase .and. st%centre == st0%centre .and. &
                  st%armed .eqv. st0%armed, 'the same phase keeps its state')
       if (allocated(error)) return
@@ -276,8 +276,26 @@ contains
       call hysteretic_update(dev, 0.02_dp, -2.0_dp*band, st1, changed)
       call check(error, st1%phase == phase_slip_neg, 'the trial reverses')
       if (allocated(error)) return
-      call hysteretic_settle(st0, st1, st, can)
+      call hysteretic_settle(dev, -2.0_dp*band, st0, st1, st, can)
       call check(error, .not. can, 'a reversal is not taken in one phase')
+      if (allocated(error)) return
+      ! an unarmed slide ends at any turn of its velocity: within the band it is settled, beyond
+      ! it (the velocity crossed the band) it is not
+      call hysteretic_init(dev, 0.0_dp, 0.0_dp, st0)
+      call hysteretic_update(dev, f, 0.5_dp*band, st0, changed)
+      call check(error, st0%phase == phase_slip_pos .and. .not. st0%armed, 'an unarmed slide')
+      if (allocated(error)) return
+      st1 = st0
+      call hysteretic_update(dev, f, -0.5_dp*band, st1, changed)
+      call check(error, st1%phase == phase_stick, 'turns: sticks')
+      if (allocated(error)) return
+      call hysteretic_settle(dev, -0.5_dp*band, st0, st1, st, can)
+      call check(error, can .and. st%phase == phase_slip_pos, 'turned within the band: the step in the slide')
+      if (allocated(error)) return
+      st1 = st0
+      call hysteretic_update(dev, f, -2.0_dp*band, st1, changed)
+      call hysteretic_settle(dev, -2.0_dp*band, st0, st1, st, can)
+      call check(error, st1%phase == phase_stick .and. .not. can, 'turned beyond the band: not settled')
    end subroutine test_hys_settle
 
    !> friction_settle over both laws: a device that keeps its phase keeps its state, a
@@ -298,7 +316,7 @@ contains
       st1 = st0
       call velocity_update(dev(1), 0.0_dp, 2.0_dp*band, st1(1), changed)    ! leaves the band
       call hysteretic_update(dev(2), 0.5_dp*f, 0.0_dp, st1(2), changed)      ! keeps sticking
-      call friction_settle(3, dev, st0, st1, st, can)
+      call friction_settle(3, dev, [2.0_dp*band, 0.0_dp, 3.0_dp*band], st0, st1, st, can)
       call check(error, can, 'every change can be settled')
       if (allocated(error)) return
       call check(error, st(1)%phase == phase_slip_pos .and. st(1)%f0 == pmu .and. st(1)%cs == 0.0_dp, &
@@ -308,8 +326,24 @@ contains
                  'unchanged: the start state')
       if (allocated(error)) return
       call hysteretic_update(dev(3), 0.02_dp, -2.0_dp*band, st1(3), changed) ! reversal
-      call friction_settle(3, dev, st0, st1, st, can)
+      call friction_settle(3, dev, [2.0_dp*band, 0.0_dp, -2.0_dp*band], st0, st1, st, can)
       call check(error, .not. can, 'one reversal: the step cannot be settled')
+      if (allocated(error)) return
+      ! the velocity law's reversal, slip + to slip -, passed through the band
+      call velocity_init(dev(1), 0.0_dp, 2.0_dp*band, st0(1))
+      st1(1) = st0(1)
+      call velocity_update(dev(1), 0.0_dp, -2.0_dp*band, st1(1), changed)
+      call check(error, st0(1)%phase == phase_slip_pos .and. st1(1)%phase == phase_slip_neg, &
+                 'velocity law: the trial reverses')
+      if (allocated(error)) return
+      call velocity_settle(st0(1), st1(1), st(1), can)
+      call check(error, .not. can, 'velocity law: a reversal is not taken in one phase')
+      if (allocated(error)) return
+      st1(1) = st0(1)
+      call velocity_update(dev(1), 0.0_dp, 0.5_dp*band, st1(1), changed)
+      call velocity_settle(st0(1), st1(1), st(1), can)
+      call check(error, can .and. st(1)%phase == phase_stick .and. st(1)%cs == pmu/band, &
+                 'velocity law: into the band, its coupling P mu / eps')
    end subroutine test_friction_settle
 
    subroutine test_hys_zero(error)
