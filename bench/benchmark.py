@@ -99,7 +99,7 @@ def main() -> None:
     ]:
         t, r = timed(an, args.repeat)
         s = r.summary
-        steps = s["steps_dt1"] + s.get("steps_nested", 0) + s["steps_dt2"] + s["steps_finer"]
+        steps = fd.newmark_steps(s)
         print(
             f"{label:<34}{t:>10.4f}{steps:>10}{s['events']:>8}{s['factorizations']:>10}"
             f"{s['stick_to_slip'][0] + s['slip_to_stick'][0]:>12}{s['correctness_violations']:>11}"

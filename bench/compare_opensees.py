@@ -240,14 +240,13 @@ def fd_keep(case) -> dict:
 
 
 def newmark_steps(stats: dict) -> int | None:
-    """Newmark steps a frictiondyn run solved: accepted dt1, nested, dt2 and finer steps, and
-    with implicit phases the settled dt1 steps and their redone trials."""
+    """Newmark steps a frictiondyn run solved (frictiondyn.newmark_steps); None for a run
+    without step counts."""
     if "steps_dt1" not in stats:
         return None
-    return int(
-        stats["steps_dt1"] + stats.get("steps_nested", 0) + stats.get("steps_implicit", 0)
-        + stats.get("implicit_redos", 0) + stats["steps_dt2"] + stats["steps_finer"]
-    )
+    from frictiondyn import newmark_steps as steps
+
+    return steps(stats)
 
 
 def run_child(code: str, spec: str, args, deck: Path | None, timeout: float) -> dict:

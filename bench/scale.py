@@ -120,18 +120,15 @@ def exponents(pts: list[tuple[int, float]]) -> dict:
 
 
 def scaling(args, work: Path) -> dict:
+    from frictiondyn import newmark_steps
+
     res: dict = {}
     for law in args.laws:
         rows = []
         for n in args.sizes:
             deck = make_deck(work, n, law, args.duration, args.refinement)
             r = run_child(deck, n)
-            # Newmark steps solved: accepted ones, and with implicit phases the settled dt1
-            # steps and their redone trials
-            nm = (
-                r["steps_dt1"] + r["steps_nested"] + r["steps_dt2"] + r["steps_finer"]
-                + r["steps_implicit"] + r["implicit_redos"]
-            )
+            nm = newmark_steps(r)
             steps = round(args.duration / 1e-3)
             r.update(
                 n=n,

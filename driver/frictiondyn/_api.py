@@ -83,6 +83,15 @@ class FrictiondynWarning(UserWarning):
     figures. Filter it with the ``warnings`` module like any other warning."""
 
 
+def newmark_steps(summary: dict) -> int:
+    """The steps a Newmark run solved, from its summary: the accepted dt1, nested, dt2 and
+    finer steps, and with implicit phases the settled dt1 steps and their redone trials (the
+    rejected first trial of a refined dt1 step is not counted). The exact technique's
+    summary counts dt1 intervals in steps_dt1, which this adds as they are."""
+    keys = ("steps_dt1", "steps_nested", "steps_dt2", "steps_finer", "steps_implicit", "implicit_redos")
+    return int(sum(summary.get(k, 0) for k in keys))
+
+
 def summary_warnings(summary: dict) -> list[str]:
     """The warnings a summary calls for, as the executable prints them on standard error
     (without its "frictiondyn: warning: " prefix): correctness violations, and a step dt1

@@ -125,14 +125,14 @@ contains
    end function hysteretic_correct
 
    !> The state in which to take a step that ends in st1's phase (`refinement = 'implicit'`),
-   !> from the state at its start st0: the elastic-perfectly-plastic return mapping. sdot is
-   !> the relative velocity at the end of the last trial.
+   !> from the state at its start st0, for a device whose phase changes (friction_settle keeps
+   !> the others): the elastic-perfectly-plastic return mapping. sdot is the relative
+   !> velocity at the end of the last trial.
    !> - A slide that starts: the constant force P mu sgn of st1, unarmed (eq. 12 compares the
    !>   velocities at the two ends of a step inside a slide; this step starts sticking).
    !> - A slide that ends within the band: the step in the slide itself, st0; the sticking
    !>   state after it (hysteretic_update) keeps the force P mu sgn continuous at the step's
    !>   end.
-   !> - The same phase: st0.
    !> - A reversal (an armed slide whose velocity crossed the band), or a slide that ends with
    !>   its velocity turned beyond the band (an unarmed slide ends at any turn), is not taken
    !>   in one phase (can = .false.): the velocity passed through the band, where the device
@@ -147,7 +147,6 @@ contains
 
       can = .true.
       st = st0
-      if (st1%phase == st0%phase) return
       if (st0%phase == phase_stick) then
          st = st1
          st%armed = .false.

@@ -96,7 +96,8 @@ contains
    end function velocity_correct
 
    !> The state in which to take a step that ends in st1's phase (`refinement = 'implicit'`),
-   !> from the state at its start st0: the coefficients of the phase it ends in (st1: the band's
+   !> from the state at its start st0, for a device whose phase changes (friction_settle keeps
+   !> the others): the coefficients of the phase it ends in (st1: the band's
    !> coupling, or the sliding force with mu at the velocity the update was given, not iterated).
    !> A reversal, slip to the opposite slip, passed through the band within the step and is not
    !> taken in one phase (can = .false.): the force would reverse at the step's start.
@@ -107,7 +108,7 @@ contains
       logical, intent(out) :: can               !! the step can be taken in one phase
 
       st = st1
-      can = st0%phase == phase_stick .or. st1%phase == phase_stick .or. st1%phase == st0%phase
+      can = st0%phase == phase_stick .or. st1%phase == phase_stick
    end subroutine velocity_settle
 
    !> Friction coefficient at the sliding speed |v|: mu itself (constant), the exponential

@@ -605,10 +605,11 @@ contains
       type(result_type), intent(inout) :: res
       logical, intent(out) :: settled
       type(error_type), allocatable, intent(out) :: error
-      logical :: any_changed, any_bad, can
+      logical :: any_changed, any_bad, can, redone
       integer :: it, d
 
       settled = .false.
+      redone = .false.
       w%st0 = w%st
       w%phase0 = w%st0%phase
       do it = 1, max_settle
@@ -618,6 +619,7 @@ contains
          if (.not. can) exit
          if (it > 1 .or. .not. same_phases(w%nd, w%st, w%phase0)) then
             w%version = w%version + 1
+            redone = .true.
             call try_step(exc, t, 1, w, error)
             if (allocated(error)) return
             res%implicit_redos = res%implicit_redos + 1
@@ -646,8 +648,9 @@ contains
          settled = .true.
          return
       end do
+      ! the start's states again; a factor that a redone trial updated follows them back
       w%st = w%st0
-      w%version = w%version + 1
+      if (redone) w%version = w%version + 1
       res%implicit_fallbacks = res%implicit_fallbacks + 1
    end subroutine settle_phases
 

@@ -72,7 +72,7 @@ def measure(r: fd.Result, exact: fd.Result, seconds: float) -> dict:
         "rms": float(np.sqrt(np.mean((roof - roof_x) ** 2)) / rms_x),
         "hf": high_frequency(r.time[m], roof) / rms_x,
         "residual": max(abs(x) for x in s["residual_drift_m"]),
-        "steps": s["steps_dt1"] + s["steps_nested"] + s["steps_dt2"] + s["steps_finer"],
+        "steps": fd.newmark_steps(s),
         "time": seconds,
     }
 

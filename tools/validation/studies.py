@@ -27,7 +27,7 @@ from dataclasses import dataclass, field, replace
 from pathlib import Path
 
 import numpy as np
-from frictiondyn import Result, SolverError
+from frictiondyn import Result, SolverError, newmark_steps
 from frictiondyn.model import (
     Analysis,
     Damping,
@@ -155,8 +155,7 @@ def history_error(approx: Result, exact: Result, test: int) -> tuple[float, floa
 
 
 def cost(r: Result) -> int:
-    s = r.summary
-    return int(s["steps_dt1"] + s["steps_nested"] + s["steps_dt2"] + s["steps_finer"])
+    return newmark_steps(r.summary)
 
 
 def observed_order(x, y) -> float:
