@@ -89,7 +89,30 @@ contains
    pure function fmt_int(i) result(str)
       integer, intent(in) :: i                !! value to format
       character(len=16) :: str                !! the value as text, left-adjusted
-      write (str, '(i0)') i
+      character(len=11) :: digits
+      integer :: k, m, q
+
+      ! the digits of -|i| (every 32-bit integer has one, -huge(i) - 1 included), without an
+      ! internal write: the deck reader and the result's set-up format a few hundred of them,
+      ! and an internal write costs some 4000 instructions
+      if (i < 0) then
+         m = i
+      else
+         m = -i
+      end if
+      k = len(digits) + 1
+      do
+         q = m/10
+         k = k - 1
+         digits(k:k) = achar(iachar('0') + (10*q - m))
+         m = q
+         if (m == 0) exit
+      end do
+      if (i < 0) then
+         k = k - 1
+         digits(k:k) = '-'
+      end if
+      str = digits(k:)
    end function fmt_int
 
 end module fd_error

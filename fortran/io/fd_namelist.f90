@@ -545,13 +545,22 @@ contains
    pure subroutine item_variable(item, var)
       character(len=*), intent(in) :: item
       character(len=:), allocatable, intent(out) :: var
-      integer :: i, eq
+      integer :: i, eq, n
 
-      var = ''
+      ! (counted first and allocated once: a character appended at a time reallocated the
+      ! name at every character, for every assignment of every group looked up)
       eq = index(item, '=')
-      if (eq == 0) return
+      n = 0
       do i = 1, eq - 1
-         if (item(i:i) /= ' ' .and. item(i:i) /= achar(9)) var = var//lower(item(i:i))
+         if (item(i:i) /= ' ' .and. item(i:i) /= achar(9)) n = n + 1
+      end do
+      allocate (character(len=n) :: var)
+      n = 0
+      do i = 1, eq - 1
+         if (item(i:i) /= ' ' .and. item(i:i) /= achar(9)) then
+            n = n + 1
+            var(n:n) = lower(item(i:i))
+         end if
       end do
    end subroutine item_variable
 

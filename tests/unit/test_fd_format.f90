@@ -66,6 +66,33 @@ contains
       call check(error, trim(fmt_int(-42)), '-42')
       if (allocated(error)) return
       call check(error, trim(fmt_int(huge(1))), '2147483647')
+      if (allocated(error)) return
+      call check(error, trim(fmt_int(-huge(1) - 1)), '-2147483648')
+      if (allocated(error)) return
+      call check(error, trim(fmt_int(0)), '0')
+      if (allocated(error)) return
+      call same_as_write(error)
    end subroutine test_int
+
+   !> fmt_int against the processor's own i0 edit descriptor, over every power of ten and
+   !> its neighbours, both signs.
+   subroutine same_as_write(error)
+      type(error_type), allocatable, intent(out) :: error
+      character(len=16) :: ref
+      integer :: p, d, x
+
+      x = 1
+      do p = 0, 9
+         do d = -1, 1
+            write (ref, '(i0)') x + d
+            call check(error, trim(fmt_int(x + d)), trim(ref))
+            if (allocated(error)) return
+            write (ref, '(i0)') -(x + d)
+            call check(error, trim(fmt_int(-(x + d))), trim(ref))
+            if (allocated(error)) return
+         end do
+         if (p < 9) x = 10*x
+      end do
+   end subroutine same_as_write
 
 end module test_fd_format
