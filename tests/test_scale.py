@@ -27,7 +27,7 @@ from pathlib import Path
 import frictiondyn as fd
 import numpy as np
 import pytest
-from conftest import deck_text, steady_amplitude
+from conftest import ROOT, deck_text, steady_amplitude
 
 N = 10
 
@@ -323,6 +323,34 @@ except KeyboardInterrupt:
         assert float(proc.stdout.split()[-1]) < 5.0
         out = tmp_path / "out"
         assert not out.exists() or list(out.iterdir()) == []
+
+
+@pytest.mark.skipif(sys.platform == "win32", reason="POSIX signals and fork")
+def test_the_kept_worker_after_ctrl_c_and_in_a_forked_child(tmp_path):
+    """The main thread's solves run in one worker thread kept between them: a solve after an
+    interrupted one, and a solve in a child forked after one, give the first solve's history
+    bit for bit, and the process never holds more than one worker."""
+    code = f"""
+import os, signal, threading, numpy as np, frictiondyn as fd
+short = {str(ROOT / "inputs" / "test4_velocity.nml")!r}
+first = fd.run(short).data
+threading.Timer(0.5, lambda: os.kill(os.getpid(), signal.SIGINT)).start()
+try:
+    fd.run({str(long_deck(tmp_path))!r})
+    raise SystemExit("not interrupted")
+except KeyboardInterrupt:
+    pass
+again = fd.run(short).data
+workers = [t for t in threading.enumerate() if t.name == "frictiondyn-solver"]
+pid = os.fork()
+if pid == 0:
+    os._exit(0 if np.array_equal(fd.run(short).data, first) else 3)
+_, status = os.waitpid(pid, 0)
+print(np.array_equal(again, first), len(workers), os.waitstatus_to_exitcode(status))
+"""
+    proc = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True, timeout=120)
+    assert proc.returncode == 0, proc.stdout + proc.stderr
+    assert proc.stdout.split() == ["True", "1", "0"], proc.stdout + proc.stderr
 
 
 @pytest.mark.skipif(sys.platform == "win32", reason="POSIX signals")

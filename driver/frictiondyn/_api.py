@@ -9,7 +9,7 @@ manager). Every non-zero status becomes an exception here, in one place.
 The history is held once: the library writes its rows straight into a numpy array this module
 allocates (``Result.data`` is a view of it), and only the DOFs and devices selected are kept
 (``Session.select``, ``run(dofs=..., devices=...)``); ``Session.stream`` writes it to its file
-as the run goes instead. A solve runs in a worker thread when called from the main thread:
+as the run goes instead. A solve runs in a worker thread (one, kept for the next solve) when called from the main thread:
 Ctrl-C (in a terminal or a notebook) asks the library to stop, which it does within a poll
 (about 10 ms), and KeyboardInterrupt is raised; a ``progress(t, duration)`` callback is called
 about ten times a second meanwhile. The Fortran work runs without the GIL: runs in several
@@ -21,6 +21,7 @@ from __future__ import annotations
 import json
 import math
 import os
+import queue
 import threading
 import warnings
 from collections.abc import Callable, Sequence
@@ -127,6 +128,56 @@ _ERRORS = {
 _POLL = 0.05
 #: the progress callback: (time reached [s], duration [s])
 ProgressCallback = Callable[[float, float], object]
+
+
+class _Worker:
+    """The thread that runs the main thread's solves, started at the first and kept for the
+    next ones: a thread started for every solve, and the cold caches of the core it starts
+    on, cost about 0.15 ms a run (3 % of the paper's test 4 through Analysis.run(); more of
+    a sweep of short decks). One solve at a time: a solve asked for while it is busy (a
+    progress callback that runs another deck) gets a thread of its own, as every solve did
+    before. A forked child starts its own worker (the parent's thread is not in it)."""
+
+    def __init__(self) -> None:
+        self._busy = threading.Lock()  # held from a solve's hand-over until it has run
+        self._jobs: queue.SimpleQueue | None = None
+
+    def start(self, fn: Callable[[], None]) -> None:
+        """Run fn() in the worker, or in a thread of its own when the worker is busy."""
+        # (a worker that has just set its solve's Event releases within microseconds)
+        if not self._busy.acquire(timeout=0.01):
+            threading.Thread(target=fn, name="frictiondyn-solve", daemon=True).start()
+            return
+        try:
+            if self._jobs is None:
+                self._jobs = queue.SimpleQueue()
+                threading.Thread(
+                    target=self._serve, args=(self._jobs,), name="frictiondyn-solver", daemon=True
+                ).start()
+            self._jobs.put(fn)
+        except BaseException:
+            self._busy.release()
+            raise
+
+    def _serve(self, jobs: queue.SimpleQueue) -> None:
+        while True:
+            fn = jobs.get()
+            try:
+                fn()
+            finally:
+                self._busy.release()
+
+
+_WORKER = _Worker()
+
+
+def _new_worker() -> None:
+    global _WORKER
+    _WORKER = _Worker()
+
+
+if hasattr(os, "register_at_fork"):
+    os.register_at_fork(after_in_child=_new_worker)
 
 
 def _no_history() -> np.ndarray:
@@ -411,8 +462,10 @@ class Session:
             finally:
                 done.set()
 
-        worker = threading.Thread(target=work, name="frictiondyn-solve", daemon=True)
-        worker.start()
+        if threading.current_thread() is threading.main_thread():
+            _WORKER.start(work)
+        else:  # (solves in several threads overlap: each its own)
+            threading.Thread(target=work, name="frictiondyn-solve", daemon=True).start()
         try:
             while not done.wait(_POLL):
                 if progress is not None:
