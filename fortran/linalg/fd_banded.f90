@@ -32,6 +32,7 @@ module fd_banded
    public :: spd_solve, spd_k_matvec, spd_c_matvec, spd_kc_matvec
    public :: spd_size, spd_bandwidth, spd_is_dense, spd_device_kd, spd_error_estimate
    public :: spd_auto, spd_dense, spd_banded, spd_dense_max_n, spd_choose, spd_rank_one, spd_refactor
+   public :: band_potf2
 
    integer, parameter :: spd_auto = 0    !! storage chosen by size and bandwidth
    integer, parameter :: spd_dense = 1   !! dense storage, dpotrf
@@ -621,6 +622,8 @@ contains
             call dpotf2('U', n - p + 1, fac(idx(sys, p, p)), n, info)
          else if (sys%dense) then
             call dpotrf('U', n - p + 1, fac(idx(sys, p, p)), n, info)
+         else if (kb <= narrow_band) then
+            call band_potf2(n - p + 1, kb, fac(idx(sys, p, p) - kb), sys%ld, info)
          else if (kb <= unblocked_max) then
             call dpbtf2('U', n - p + 1, kb, fac(idx(sys, p, p) - kb), sys%ld, info)
          else
@@ -1141,6 +1144,50 @@ contains
          end do
       end do
    end subroutine band_solve
+
+   !> The band Cholesky factor U' U of a narrow band in LAPACK's upper band storage (what
+   !> dpbtf2('U', n, kd, ab, ldab, info) computes): the reference dpbtf2's loops with those of
+   !> the dscal and dsyr it calls, in their order, so the same bits as LAPACK on the reference
+   !> BLAS. For a band of 1 or 2 the two calls a column cost more than their arithmetic (259
+   !> instructions a column for a chain). info: 0, or the column of the first pivot that is
+   !> not positive (NaN included, which dpbtf2 would carry on with).
+   pure subroutine band_potf2(n, kd, ab, ldab, info)
+      integer, intent(in) :: n                   !! order
+      integer, intent(in) :: kd                  !! superdiagonals, 0 <= kd < ldab
+      integer, intent(in) :: ldab                !! leading dimension, A(i, j) in ab(kd + 1 + i - j, j)
+      real(dp), intent(inout) :: ab(ldab, *)     !! in: A's upper band; out: U's
+      integer, intent(out) :: info               !! 0, or the column of a pivot <= 0 or NaN
+      integer :: j, kn, p, q
+      real(dp) :: ajj, r, temp
+
+      info = 0
+      do j = 1, n
+         ajj = ab(kd + 1, j)
+         if (.not. (ajj > 0.0_dp)) then
+            info = j
+            return
+         end if
+         ajj = sqrt(ajj)
+         ab(kd + 1, j) = ajj
+         kn = min(kd, n - j)
+         if (kn == 0) cycle
+         ! dscal(kn, 1/ajj, ab(kd, j + 1), ldab - 1): row j of U right of the diagonal
+         r = 1.0_dp/ajj
+         do q = 1, kn
+            ab(kd + 1 - q, j + q) = r*ab(kd + 1 - q, j + q)
+         end do
+         ! dsyr('U', kn, -1, that row, ldab - 1, ab(kd + 1, j + 1), ldab - 1): the trailing
+         ! block within the band loses its outer product
+         do q = 1, kn
+            if (ab(kd + 1 - q, j + q) /= 0.0_dp) then
+               temp = -ab(kd + 1 - q, j + q)
+               do p = 1, q
+                  ab(kd + 1 + p - q, j + q) = ab(kd + 1 + p - q, j + q) + ab(kd + 1 - p, j + p)*temp
+               end do
+            end if
+         end do
+      end do
+   end subroutine band_potf2
 
    !> y = A x for a symmetric band A (upper band layout, A(i, j) at i + j kb): the loops of
    !> the reference dsbmv, written for a narrow band (a chain's is 1: a tridiagonal product).

@@ -13,7 +13,7 @@ module test_fd_banded
    use fd_banded, only: spd_system, spd_setup, spd_factor, spd_update_device, spd_update_devices, &
                         spd_solve, spd_k_matvec, spd_c_matvec, spd_bandwidth, spd_is_dense, &
                         spd_error_estimate, spd_auto, spd_dense, spd_banded, spd_dense_max_n, &
-                        spd_choose, spd_rank_one, spd_refactor
+                        spd_choose, spd_rank_one, spd_refactor, band_potf2
    implicit none
    private
 
@@ -46,7 +46,8 @@ contains
                   new_unittest("partial refactorization", test_partial), &
                   new_unittest("update local when inertia dominates", test_local_update), &
                   new_unittest("storage chosen by size", test_auto_path), &
-                  new_unittest("bad input named", test_errors) &
+                  new_unittest("bad input named", test_errors), &
+                  new_unittest("narrow band factor is dpbtf2's", test_band_potf2) &
                   ]
    end subroutine collect_banded
 
@@ -872,5 +873,66 @@ contains
       character(len=12) :: s
       write (s, '(es10.3)') x
    end function rtoa
+
+   !> The narrow-band factor (band_potf2) against LAPACK's dpbtf2, whose loops and BLAS calls
+   !> it writes out: the same bits on random positive definite bands of 0 to 8 superdiagonals
+   !> (diagonally dominant, as an effective stiffness is, and merely positive definite), and
+   !> the same column for the first pivot that is not positive.
+   subroutine test_band_potf2(error)
+      type(error_type), allocatable, intent(out) :: error
+      interface
+         subroutine dpbtf2(uplo, n, kd, ab, ldab, info)
+            import :: dp
+            character(len=1), intent(in) :: uplo
+            integer, intent(in) :: n, kd, ldab
+            real(dp), intent(inout) :: ab(ldab, *)
+            integer, intent(out) :: info
+         end subroutine dpbtf2
+      end interface
+      real(dp), allocatable :: a(:, :), b(:, :), c(:, :)
+      integer :: kd, n, i, j, trial, info_a, info_b
+      integer, parameter :: sizes(3) = [1, 7, 60]
+
+      call seed(17)
+      do kd = 0, 8
+         do trial = 1, 3
+            n = sizes(trial)
+            allocate (a(kd + 1, n), c(kd + 1, n))
+            ! trials 1 and 2: a dominant diagonal; 3: the diagonal scaled down to about the
+            ! edge of definiteness (positive definite or not: both must agree)
+            do j = 1, n
+               do i = 1, kd
+                  a(i, j) = urand(-1.0_dp, 1.0_dp)
+               end do
+               a(kd + 1, j) = real(2*kd, dp)*merge(1.0_dp, 0.51_dp, trial < 3) + urand(0.0_dp, 1.0_dp)
+            end do
+            c = a
+            call band_potf2(n, kd, a, kd + 1, info_a)
+            call dpbtf2('U', n, kd, c, kd + 1, info_b)
+            call check(error, info_a, info_b, "info, band of "//trim(itoa(kd)))
+            if (allocated(error)) return
+            if (info_a == 0) then
+               call check(error, all(a == c), "the factor differs from dpbtf2's, band of "//trim(itoa(kd)))
+               if (allocated(error)) return
+            end if
+            deallocate (a, c)
+         end do
+         ! not positive definite at column 5: both stop there
+         n = 9
+         allocate (b(kd + 1, n), c(kd + 1, n))
+         b = 0.0_dp
+         b(kd + 1, :) = 1.0_dp
+         if (kd > 0) b(kd, 5) = 2.0_dp   ! A(4, 5) = 2 > sqrt(A(4, 4) A(5, 5))
+         if (kd == 0) b(1, 5) = -1.0_dp
+         c = b
+         call band_potf2(n, kd, b, kd + 1, info_a)
+         call dpbtf2('U', n, kd, c, kd + 1, info_b)
+         call check(error, info_a, 5, "info of an indefinite band of "//trim(itoa(kd)))
+         if (allocated(error)) return
+         call check(error, info_b, 5, "dpbtf2's info of an indefinite band of "//trim(itoa(kd)))
+         if (allocated(error)) return
+         deallocate (b, c)
+      end do
+   end subroutine test_band_potf2
 
 end module test_fd_banded
