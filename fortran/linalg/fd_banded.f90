@@ -1087,6 +1087,13 @@ contains
       real(dp) :: temp
       integer :: i, j
 
+      if (n == 2) then  ! the loops below for two DOFs, written out (the paper's two masses)
+         b(1) = b(1)*rdiag(1)
+         b(2) = (b(2) - u(1, 2)*b(1))*rdiag(2)
+         b(2) = b(2)*rdiag(2)
+         b(1) = (b(1) - b(2)*u(1, 2))*rdiag(1)
+         return
+      end if
       do j = 1, n
          temp = b(j)
          !GCC$ novector
@@ -1230,6 +1237,16 @@ contains
       real(dp) :: w(spd_dense_max_n), kw(spd_dense_max_n), temp1, temp2
       integer :: i, j
 
+      if (n == 2) then  ! the loops below for two DOFs, written out, every operation kept
+         w(1) = x(1) + a1*z(1)
+         w(2) = x(2) + a1*z(2)
+         kw(1) = 0.0_dp + w(1)*a(1, 1) + 0.0_dp
+         kw(1) = kw(1) + w(2)*a(1, 2)
+         kw(2) = 0.0_dp + w(2)*a(2, 2) + (0.0_dp + a(1, 2)*w(1))
+         y(1) = y(1) + alpha*(kw(1) + a0*mass(1)*z(1))
+         y(2) = y(2) + alpha*(kw(2) + a0*mass(2)*z(2))
+         return
+      end if
       !GCC$ novector
       do i = 1, n
          w(i) = x(i) + a1*z(i)

@@ -13,7 +13,7 @@ module test_fd_banded
    use fd_banded, only: spd_system, spd_setup, spd_factor, spd_update_device, spd_update_devices, &
                         spd_solve, spd_k_matvec, spd_c_matvec, spd_bandwidth, spd_is_dense, &
                         spd_error_estimate, spd_auto, spd_dense, spd_banded, spd_dense_max_n, &
-                        spd_choose, spd_rank_one, spd_refactor, band_potf2
+                        spd_choose, spd_rank_one, spd_refactor, band_potf2, spd_kc_matvec
    implicit none
    private
 
@@ -47,7 +47,8 @@ contains
                   new_unittest("update local when inertia dominates", test_local_update), &
                   new_unittest("storage chosen by size", test_auto_path), &
                   new_unittest("bad input named", test_errors), &
-                  new_unittest("narrow band factor is dpbtf2's", test_band_potf2) &
+                  new_unittest("narrow band factor is dpbtf2's", test_band_potf2), &
+                  new_unittest("small K^ products in dsymv's order", test_small_kc) &
                   ]
    end subroutine collect_banded
 
@@ -934,5 +935,77 @@ contains
          deallocate (b, c)
       end do
    end subroutine test_band_potf2
+
+   !> The Newmark product K (x + a1 z) + a0 M z of a few DOFs (the dense path up to
+   !> spd_dense_max_n DOFs, two DOFs written out) is the reference dsymv's loops on the upper
+   !> triangle, in their order: the same bits as those loops written here; and its two-DOF
+   !> solve agrees with the dense reference. Chains of 1 to 8 DOFs, zeros (signed) included.
+   subroutine test_small_kc(error)
+      type(error_type), allocatable, intent(out) :: error
+      type(problem) :: pb
+      type(spd_system) :: sys
+      type(lib_error), allocatable :: err
+      real(dp), allocatable :: k(:, :), x(:), z(:), y(:), yref(:), w(:), kw(:), kd(:), b(:)
+      real(dp) :: temp1, temp2, alpha, diff
+      integer :: n, i, j, trial
+
+      call seed(23)
+      do n = 1, spd_dense_max_n
+         call chain(n, pb, .true.)
+         pb%pi = [integer ::]
+         pb%pj = [integer ::]
+         pb%pc = [real(dp) ::]
+         pb%a0 = 1.0e3_dp  ! the mass term as large as the stiffness term: no rounding hides either
+         call setup(pb, sys, spd_dense, spd_choose, error=error)
+         if (allocated(error)) return
+         call dense_k(pb, k)
+         do trial = 1, 20
+            call random_vector(n, x)
+            call random_vector(n, z)
+            call random_vector(n, y)
+            if (trial == 2) then  ! at rest: the products are signed zeros
+               x = 0.0_dp
+               z = -0.0_dp
+               y = -0.0_dp
+            end if
+            alpha = -1.0_dp
+            if (trial > 2) alpha = urand(-2.0_dp, 2.0_dp)
+            ! the reference: dsymv ('U', n, 1, K, w) then y + alpha (K w + a0 M z)
+            w = x + pb%a1*z
+            allocate (kw(n))
+            kw = 0.0_dp
+            do j = 1, n
+               temp1 = w(j)
+               temp2 = 0.0_dp
+               do i = 1, j - 1
+                  kw(i) = kw(i) + temp1*k(i, j)
+                  temp2 = temp2 + k(i, j)*w(i)
+               end do
+               kw(j) = kw(j) + temp1*k(j, j) + temp2
+            end do
+            yref = y
+            do i = 1, n
+               yref(i) = yref(i) + alpha*(kw(i) + pb%a0*pb%mass(i)*z(i))
+            end do
+            deallocate (kw)
+            call spd_kc_matvec(sys, x, z, y, alpha)
+            call check(error, all(y == yref .and. (sign(1.0_dp, y) == sign(1.0_dp, yref))), &
+                       "n = "//trim(itoa(n))//": K^ product differs from dsymv's order")
+            if (allocated(error)) return
+         end do
+         if (n == 2) then
+            allocate (kd(n))
+            kd = [stick_kd(), 0.0_dp]
+            call random_vector(n, b)
+            call spd_factor(sys, c0, c1, kd, err)
+            call pass(err, error)
+            if (allocated(error)) return
+            call compare(pb, sys, kd, b, diff, error)
+            if (allocated(error)) return
+            call check(error, diff <= 1.0e-14_dp, "two DOFs: solve differs from dense by "//trim(rtoa(diff)))
+            if (allocated(error)) return
+         end if
+      end do
+   end subroutine test_small_kc
 
 end module test_fd_banded
