@@ -353,6 +353,25 @@ print(np.array_equal(again, first), len(workers), os.waitstatus_to_exitcode(stat
     assert proc.stdout.split() == ["True", "1", "0"], proc.stdout + proc.stderr
 
 
+def test_the_kept_worker_serves_on_after_a_job_that_raised():
+    """A job that raises in the kept worker (here the extension refusing a history buffer) is
+    reported and fails that solve (status 3); the worker still runs the next solve (a worker
+    that died with it would leave the next solve waiting for ever: hence the subprocess and
+    its timeout)."""
+    code = f"""
+import frictiondyn as fd
+from frictiondyn import _api
+deck = {str(ROOT / "inputs" / "test4_velocity.nml")!r}
+with _api.Session(deck) as s:
+    print(_api.Session._run(s._handle, 1, "not an array", None))
+print(fd.run(deck).data.shape[0])
+"""
+    proc = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True, timeout=60)
+    assert proc.returncode == 0, proc.stdout + proc.stderr
+    assert proc.stdout.split() == ["3", "8001"], proc.stdout + proc.stderr
+    assert "Exception in thread frictiondyn-solver" in proc.stderr and "TypeError" in proc.stderr
+
+
 @pytest.mark.skipif(sys.platform == "win32", reason="POSIX signals")
 def test_sigint_to_the_executable_leaves_no_output(tmp_path):
     deck = long_deck(tmp_path)

@@ -22,6 +22,7 @@ import json
 import math
 import os
 import queue
+import sys
 import threading
 import warnings
 from collections.abc import Callable, Sequence
@@ -164,6 +165,8 @@ class _Worker:
             fn = jobs.get()
             try:
                 fn()
+            except BaseException:  # reported as a thread's end would be; the worker serves on
+                threading.excepthook(threading.ExceptHookArgs((*sys.exc_info(), threading.current_thread())))
             finally:
                 self._busy.release()
 
