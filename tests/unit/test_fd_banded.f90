@@ -881,15 +881,7 @@ contains
    !> the same column for the first pivot that is not positive.
    subroutine test_band_potf2(error)
       type(error_type), allocatable, intent(out) :: error
-      interface
-         subroutine dpbtf2(uplo, n, kd, ab, ldab, info)
-            import :: dp
-            character(len=1), intent(in) :: uplo
-            integer, intent(in) :: n, kd, ldab
-            real(dp), intent(inout) :: ab(ldab, *)
-            integer, intent(out) :: info
-         end subroutine dpbtf2
-      end interface
+      external :: dpbtf2   ! LAPACK (fd_banded declares its interface)
       real(dp), allocatable :: a(:, :), b(:, :), c(:, :)
       integer :: kd, n, i, j, trial, info_a, info_b
       integer, parameter :: sizes(3) = [1, 7, 60]
