@@ -325,39 +325,9 @@ except KeyboardInterrupt:
         assert not out.exists() or list(out.iterdir()) == []
 
 
-@pytest.mark.skipif(sys.platform == "win32", reason="POSIX signals and fork")
-def test_the_kept_worker_after_ctrl_c_and_in_a_forked_child(tmp_path):
-    """The main thread's solves run in one worker thread kept between them: a solve after an
-    interrupted one, and a solve in a child forked after one, give the first solve's history
-    bit for bit, and the process never holds more than one worker."""
-    code = f"""
-import os, signal, threading, numpy as np, frictiondyn as fd
-short = {str(ROOT / "inputs" / "test4_velocity.nml")!r}
-first = fd.run(short).data
-threading.Timer(0.5, lambda: os.kill(os.getpid(), signal.SIGINT)).start()
-try:
-    fd.run({str(long_deck(tmp_path))!r})
-    raise SystemExit("not interrupted")
-except KeyboardInterrupt:
-    pass
-again = fd.run(short).data
-workers = [t for t in threading.enumerate() if t.name == "frictiondyn-solver"]
-pid = os.fork()
-if pid == 0:
-    os._exit(0 if np.array_equal(fd.run(short).data, first) else 3)
-_, status = os.waitpid(pid, 0)
-print(np.array_equal(again, first), len(workers), os.waitstatus_to_exitcode(status))
-"""
-    proc = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True, timeout=120)
-    assert proc.returncode == 0, proc.stdout + proc.stderr
-    assert proc.stdout.split() == ["True", "1", "0"], proc.stdout + proc.stderr
-
-
-def test_the_kept_worker_serves_on_after_a_job_that_raised():
-    """A job that raises in the kept worker (here the extension refusing a history buffer) is
-    reported and fails that solve (status 3); the worker still runs the next solve (a worker
-    that died with it would leave the next solve waiting for ever: hence the subprocess and
-    its timeout)."""
+def test_a_solve_whose_call_raised_in_its_thread_fails_and_the_next_runs():
+    """A solve whose call raises in its thread (here the extension refusing a history buffer)
+    is reported and fails with status 3; the next solve runs."""
     code = f"""
 import frictiondyn as fd
 from frictiondyn import _api
@@ -369,7 +339,57 @@ print(fd.run(deck).data.shape[0])
     proc = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True, timeout=60)
     assert proc.returncode == 0, proc.stdout + proc.stderr
     assert proc.stdout.split() == ["3", "8001"], proc.stdout + proc.stderr
-    assert "Exception in thread frictiondyn-solver" in proc.stderr and "TypeError" in proc.stderr
+    assert "Exception in thread frictiondyn-solve" in proc.stderr and "TypeError" in proc.stderr
+
+
+def test_a_progress_callback_that_raises_stops_the_run(tmp_path):
+    """An exception from the progress callback is raised from solve, promptly (the run would
+    take minutes), after the solve has stopped: before, the session was freed under the
+    running solve and the process died (SIGSEGV)."""
+    code = f"""
+import time, frictiondyn as fd
+def progress(t, duration):
+    if t > 0.0:
+        raise ValueError("stop here")
+t0 = time.perf_counter()
+try:
+    fd.run({str(long_deck(tmp_path))!r}, progress=progress)
+except ValueError as e:
+    print(e.args[0].split()[0], time.perf_counter() - t0)
+"""
+    for _ in range(3):
+        proc = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True, timeout=120)
+        assert proc.returncode == 0, (proc.returncode, proc.stdout + proc.stderr)
+        word, seconds = proc.stdout.split()
+        assert word == "stop" and float(seconds) < 5.0, proc.stdout
+
+
+@pytest.mark.parametrize("launched", [True, False])
+def test_ctrl_c_while_the_solve_thread_starts(tmp_path, launched):
+    """Ctrl-C can land inside Thread.start, after the thread was launched or before: either
+    way KeyboardInterrupt is raised promptly, the session is not freed under a running solve
+    (the process lives on), and the next solve runs. The interrupt is made deterministic by
+    a Thread.start that raises it once, after or before starting the thread."""
+    code = f"""
+import threading, time, frictiondyn as fd
+start = threading.Thread.start
+def interrupted_start(self):
+    threading.Thread.start = start
+    if {launched!r}:
+        start(self)
+    raise KeyboardInterrupt
+threading.Thread.start = interrupted_start
+t0 = time.perf_counter()
+try:
+    fd.run({str(long_deck(tmp_path))!r})
+except KeyboardInterrupt:
+    print("interrupted", time.perf_counter() - t0)
+print(fd.run({str(ROOT / "inputs" / "test4_velocity.nml")!r}).data.shape[0])
+"""
+    proc = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True, timeout=120)
+    assert proc.returncode == 0, (proc.returncode, proc.stdout + proc.stderr)
+    words = proc.stdout.split()
+    assert words[0] == "interrupted" and float(words[1]) < 5.0 and words[2] == "8001", proc.stdout
 
 
 @pytest.mark.skipif(sys.platform == "win32", reason="POSIX signals")

@@ -9,7 +9,7 @@ manager). Every non-zero status becomes an exception here, in one place.
 The history is held once: the library writes its rows straight into a numpy array this module
 allocates (``Result.data`` is a view of it), and only the DOFs and devices selected are kept
 (``Session.select``, ``run(dofs=..., devices=...)``); ``Session.stream`` writes it to its file
-as the run goes instead. A solve runs in a worker thread (one, kept for the next solve) when called from the main thread:
+as the run goes instead. A solve runs in a worker thread when called from the main thread:
 Ctrl-C (in a terminal or a notebook) asks the library to stop, which it does within a poll
 (about 10 ms), and KeyboardInterrupt is raised; a ``progress(t, duration)`` callback is called
 about ten times a second meanwhile. The Fortran work runs without the GIL: runs in several
@@ -21,9 +21,8 @@ from __future__ import annotations
 import json
 import math
 import os
-import queue
-import sys
 import threading
+import time
 import warnings
 from collections.abc import Callable, Sequence
 from dataclasses import dataclass, field
@@ -127,60 +126,32 @@ _ERRORS = {
 }
 #: seconds between looks at a solve running in the worker thread (Ctrl-C, progress)
 _POLL = 0.05
+#: seconds a thread that was started is given to say it runs (_stop_solve)
+_LAUNCH_WAIT = 2.0
 #: the progress callback: (time reached [s], duration [s])
 ProgressCallback = Callable[[float, float], object]
 
 
-class _Worker:
-    """The thread that runs the main thread's solves, started at the first and kept for the
-    next ones: a thread started for every solve, and the cold caches of the core it starts
-    on, cost about 0.15 ms a run (3 % of the paper's test 4 through Analysis.run(); more of
-    a sweep of short decks). One solve at a time: a solve asked for while it is busy (a
-    progress callback that runs another deck) gets a thread of its own, as every solve did
-    before. A forked child starts its own worker (the parent's thread is not in it)."""
-
-    def __init__(self) -> None:
-        self._busy = threading.Lock()  # held from a solve's hand-over until it has run
-        self._jobs: queue.SimpleQueue | None = None
-
-    def start(self, fn: Callable[[], None]) -> None:
-        """Run fn() in the worker, or in a thread of its own when the worker is busy."""
-        # (a worker that has just set its solve's Event releases within microseconds)
-        if not self._busy.acquire(timeout=0.01):
-            threading.Thread(target=fn, name="frictiondyn-solve", daemon=True).start()
-            return
+def _stop_solve(h: int, begun: threading.Event, done: threading.Event) -> None:
+    """Stop a solve that may be running in its thread and wait until it has ended; Ctrl-C
+    meanwhile is ignored. A thread whose start was interrupted may not have been launched: a
+    launched one says so at once (``begun``; the waiting main thread holds no GIL). The cancel
+    is repeated at every poll: a solve that had not started yet clears a cancel made before
+    it, and was then waited for to its end."""
+    deadline = time.monotonic() + _LAUNCH_WAIT
+    while not begun.is_set() and time.monotonic() < deadline:
         try:
-            if self._jobs is None:
-                self._jobs = queue.SimpleQueue()
-                threading.Thread(
-                    target=self._serve, args=(self._jobs,), name="frictiondyn-solver", daemon=True
-                ).start()
-            self._jobs.put(fn)
-        except BaseException:
-            self._busy.release()
-            raise
-
-    def _serve(self, jobs: queue.SimpleQueue) -> None:
-        while True:
-            fn = jobs.get()
-            try:
-                fn()
-            except BaseException:  # reported as a thread's end would be; the worker serves on
-                threading.excepthook(threading.ExceptHookArgs((*sys.exc_info(), threading.current_thread())))
-            finally:
-                self._busy.release()
-
-
-_WORKER = _Worker()
-
-
-def _new_worker() -> None:
-    global _WORKER
-    _WORKER = _Worker()
-
-
-if hasattr(os, "register_at_fork"):
-    os.register_at_fork(after_in_child=_new_worker)
+            begun.wait(0.01)
+        except KeyboardInterrupt:
+            continue
+    if not begun.is_set():
+        return
+    while not done.is_set():
+        _core.fd_session_cancel(h)
+        try:
+            done.wait(_POLL)
+        except KeyboardInterrupt:
+            continue
 
 
 def _no_history() -> np.ndarray:
@@ -457,30 +428,27 @@ class Session:
         # KeyboardInterrupt that lands inside Thread.join can leave is_alive() False while
         # the thread still runs (CPython 3.11), and the session was then freed under the
         # running solve (a segmentation fault in 2 of 6 Ctrl-C runs).
-        done = threading.Event()
+        begun, done = threading.Event(), threading.Event()
 
         def work() -> None:
+            begun.set()
             try:
                 out.append(int(_core.fd_session_solve(h, mode, buf)))
             finally:
                 done.set()
 
-        if threading.current_thread() is threading.main_thread():
-            _WORKER.start(work)
-        else:  # (solves in several threads overlap: each its own)
-            threading.Thread(target=work, name="frictiondyn-solve", daemon=True).start()
+        worker = threading.Thread(target=work, name="frictiondyn-solve", daemon=True)
         try:
+            worker.start()
             while not done.wait(_POLL):
                 if progress is not None:
                     t, duration = _core.fd_session_progress(h)
                     progress(float(t), float(duration))
-        except KeyboardInterrupt:
-            _core.fd_session_cancel(h)
-            while not done.is_set():  # the solver stops within a poll: wait for it, so that
-                try:  # the session is never freed under a running solve
-                    done.wait()
-                except KeyboardInterrupt:
-                    continue
+        except BaseException:
+            # Ctrl-C, or a progress callback that raised: the solve is stopped and waited
+            # for before the exception goes on, so that the session is never freed under it
+            # (a callback's exception did so, and the process died)
+            _stop_solve(h, begun, done)
             raise
         if progress is not None:
             t, duration = _core.fd_session_progress(h)
