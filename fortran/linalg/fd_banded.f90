@@ -61,7 +61,10 @@ module fd_banded
    !> Cost model, in flop equivalents, measured by `bash bench/banded.sh calibrate` (about
    !> 0.37 ns each): a rank-one modification costs w_update + band per column touched (it is
    !> bound by the latency of a square root and two divisions, not by its 4 band flops), a
-   !> refactorization w_factor + band^2 + 2 band per column (dpbtf2's two BLAS calls).
+   !> refactorization w_factor + band^2 + 2 band per column (dpbtf2's two BLAS calls). A band
+   !> up to narrow_band is now refactored by band_potf2, without those calls, so this prices
+   !> its refactorization high; the weights are kept as measured, since changing them changes
+   !> which of the two is chosen, and with it the factor's last bits and the counts.
    real(dp), parameter :: w_update = 64.0_dp, w_factor = 90.0_dp
 
    !> What the factor has cost so far; the caller may report it.
