@@ -289,11 +289,17 @@ def test_a_record_sample_of_1e308_is_rejected_up_front(tmp_path):
                        files=files)
 
 
-def test_a_stiffness_beyond_the_digits_of_the_step_is_rejected(tmp_path):
-    """The hysteretic law with f = 1e-29 m between two masses: 'not positive definite' before."""
-    text = short_deck("hysteretic").replace("f = 1.0e-5 ", "f = 1.0e-29")
-    assert_both_reject(tmp_path, text, ["&friction", "f(1) = 1.0E-29", "1000000000000.0 times",
-                                        "raise n1"])
+@pytest.mark.parametrize("law, old, new, named", [
+    ("hysteretic", "f = 1.0e-5 ", "f = 1.0e-29", "f(1) = 1.0E-29"),
+    ("velocity", "eps = 1.0e-3 ", "eps = 1.0e-29", "eps(1) = 1.0E-29"),
+])
+def test_a_stiffness_beyond_the_digits_of_the_step_is_rejected(tmp_path, law, old, new, named):
+    """The hysteretic law with f = 1e-29 m between two masses ('not positive definite'
+    before), and the velocity law's band eps = 1e-29 m/s (its sticking damping P mu / eps in
+    the effective stiffness): the deck's own variable is named."""
+    assert old in short_deck(law)
+    text = short_deck(law).replace(old, new)
+    assert_both_reject(tmp_path, text, ["&friction", named, "1000000000000.0 times", "raise n1"])
 
 
 # ---------------------------------------------------------------- bounded work
