@@ -78,8 +78,10 @@ class OutOfMemoryError(FrictiondynError, MemoryError):
 
 class FrictiondynWarning(UserWarning):
     """A run that finished but whose answer needs care, as the executable warns on standard
-    error: steps that violate the correctness condition (eqs. 9, 12), or a step dt1 that does
-    not resolve the structure's highest modes (summary ``mode_resolution``). Issued when the
+    error: steps that violate the correctness condition (eqs. 9, 12), a step dt1 that does
+    not resolve the structure's highest modes (summary ``mode_resolution``), or one that
+    dephases the ringing of a sticking spring on which a device's stick-slip decisions rest
+    (summary ``stick_resolution``). Issued when the
     Result is made (``Session.result``, ``run``, ``Analysis.run``); the summary holds the
     figures. Filter it with the ``warnings`` module like any other warning."""
 
@@ -95,8 +97,8 @@ def newmark_steps(summary: dict) -> int:
 
 def summary_warnings(summary: dict) -> list[str]:
     """The warnings a summary calls for, as the executable prints them on standard error
-    (without its "frictiondyn: warning: " prefix): correctness violations, and a step dt1
-    that does not resolve the highest modes."""
+    (without its "frictiondyn: warning: " prefix): correctness violations, a step dt1 that
+    does not resolve the highest modes, and one that dephases a sticking spring's ringing."""
     out = []
     n = summary.get("correctness_violations", 0)
     if n:
@@ -111,6 +113,19 @@ def summary_warnings(summary: dict) -> list[str]:
             f"{summary['omega_max_dt1']:.3g} > 2): their response has the wrong period; peak "
             "absolute accelerations may carry it (drifts and shears much less); raise n1 until "
             "omega_max dt1 <= 2 to resolve them"
+        )
+    if summary.get("stick_resolution") == "unresolved":
+        ratio = summary["stick_ringing_ratio"]
+        d = max(range(len(ratio)), key=lambda i: ratio[i])
+        more = sum(r > 1 for r in ratio) - 1
+        out.append(
+            f"the sticking spring of device {d + 1} rings with {summary['stick_ringing_N'][d]:.3g} N "
+            f"against a margin of {summary['stick_margin_N'][d]:.3g} N to sliding, and dt1 = "
+            f"{summary['dt1_s']:.3g} s puts its frequency "
+            f"{100 * abs(summary['stick_frequency_error'][d]):.2f} % off, enough to dephase that "
+            f"ringing within a stick phase (stick_ringing_ratio = {ratio[d]:.2f} > 1): its "
+            "stick-slip transitions depend on the step; raise n1 (halving dt1 quarters that error)"
+            + (f" ({more} more device(s) likewise: summary stick_ringing_ratio)" if more else "")
         )
     return out
 

@@ -43,7 +43,7 @@ program frictiondyn_main
    type(error_type), allocatable :: error
    character(len=:), allocatable :: deck, list, index_text, arg, hist, summ, htmp, stmp, tag
    character(kind=c_char, len=300) :: tagbuf
-   integer :: nargs, i, idx, ios
+   integer :: nargs, i, idx, ios, d
    interface
       !> C's exit: ends the program with a status and no message (Fortran 2008 has no
       !> silent STOP with a code; STOP's QUIET= is Fortran 2018).
@@ -127,6 +127,17 @@ program frictiondyn_main
          ' s, omega_max dt1 = ', res%omega_max*res%dt1, ' > 2): their response has the wrong period;'
       write (error_unit, '(a)') '  peak absolute accelerations may carry it (drifts and shears much less);'// &
          ' raise n1 until omega_max dt1 <= 2 to resolve them'
+   end if
+   if (res%stick_resolution == resolution_unresolved) then
+      d = maxloc(res%stick_ringing_ratio, 1)
+      write (error_unit, '(a,i0,a,es10.3,a,es10.3,a)') 'frictiondyn: warning: the sticking spring of device ', d, &
+         ' rings with', res%stick_ringing(d), ' N against a margin of', res%stick_margin(d), ' N to sliding,'
+      write (error_unit, '(a,es10.3,a,f0.2,a,f0.2,a)') '  and dt1 = ', res%dt1, ' s puts its frequency ', &
+         100*abs(res%stick_freq_error(d)), ' % off, enough to dephase that ringing within a stick phase '// &
+         '(stick_ringing_ratio = ', res%stick_ringing_ratio(d), ' > 1):'
+      write (error_unit, '(a)') '  its stick-slip transitions depend on the step; raise n1 (halving dt1 quarters that error)'
+      if (count(res%stick_ringing_ratio > 1.0_dp) > 1) write (error_unit, '(a,i0,a)') '  (', &
+         count(res%stick_ringing_ratio > 1.0_dp) - 1, ' more device(s) likewise: summary stick_ringing_ratio)'
    end if
    write (output_unit, '(a)') 'frictiondyn: '//deck
    write (output_unit, '(a,f0.6,a,i0,a,i0,a,i0,a,i0)') '  stuck period ', res%period_stuck, ' s; steps dt1 ', &

@@ -44,6 +44,8 @@ module fd_result
       real(dp) :: dt_min = 0.0_dp          !! floor of step halving [s]
       real(dp) :: omega_max = 0.0_dp       !! highest natural circular frequency integrated at dt1 [rad/s]
       integer :: mode_resolution = resolution_none !! whether dt1 resolves the highest modes
+      integer :: stick_resolution = resolution_none !! whether dt1 resolves the sticking springs'
+                                                    !! ringing (fd_stick_ringing)
       integer :: technique = 0             !! technique id of the run (fd_names)
       ! peaks per DOF (over every step taken)
       real(dp), allocatable :: peak_u(:)        !! max |u| [m]
@@ -57,6 +59,10 @@ module fd_result
       integer, allocatable :: stick_to_slip(:)  !! stick-to-slip transitions
       integer, allocatable :: slip_to_stick(:)  !! slip-to-stick transitions
       integer, allocatable :: reversals(:)      !! slip+ to slip- and back, without sticking
+      real(dp), allocatable :: stick_freq_error(:)    !! 1 - omega~/omega of the sticking spring's mode
+      real(dp), allocatable :: stick_ringing_ratio(:) !! largest ringing / margin of a dephased stick phase
+      real(dp), allocatable :: stick_ringing(:)       !! that phase's ringing amplitude [N]
+      real(dp), allocatable :: stick_margin(:)        !! that phase's margin P mu - max |F| [N]
       ! steps
       integer :: steps_dt1 = 0         !! steps taken with dt1
       integer :: steps_dt2 = 0         !! steps taken with dt2
@@ -204,7 +210,8 @@ contains
       end if
       allocate (res%peak_u(n), res%peak_u_time(n), res%peak_v(n), res%peak_aabs(n), &
                 res%peak_aabs_time(n), res%peak_s(nd), res%peak_force(nd), res%stick_to_slip(nd), &
-                res%slip_to_stick(nd), res%reversals(nd), stat=stat)
+                res%slip_to_stick(nd), res%reversals(nd), res%stick_freq_error(nd), &
+                res%stick_ringing_ratio(nd), res%stick_ringing(nd), res%stick_margin(nd), stat=stat)
       if (stat /= 0) then
          call fatal_error(error, "not enough memory for the summary of "//trim(fmt_int(n))//" DOFs and "// &
                           trim(fmt_int(nd))//" devices", stat_no_memory)
@@ -214,6 +221,8 @@ contains
       res%peak_aabs = 0.0_dp; res%peak_aabs_time = 0.0_dp
       res%peak_s = 0.0_dp; res%peak_force = 0.0_dp
       res%stick_to_slip = 0; res%slip_to_stick = 0; res%reversals = 0
+      res%stick_freq_error = 0.0_dp; res%stick_ringing_ratio = 0.0_dp
+      res%stick_ringing = 0.0_dp; res%stick_margin = 0.0_dp
    end subroutine init_result
 
    !> For each id, the history's columns prefix//name//id [unit], one for each name, from

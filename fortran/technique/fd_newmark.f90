@@ -46,6 +46,8 @@ module fd_newmark
                           observe_sample, observe_transitions, observe_violations, observe_end_energies, &
                           observe_poll, observe_stop_error
    use fd_step_limits, only: halving_levels, unresolved_band, max_nested, nested_splits, max_settle
+   use fd_stick_ringing, only: ringing_type, ringing_init, ringing_changed, ringing_finish, stat_time, stat_sd2, &
+                               stat_fmax, stat_damping
    implicit none
    private
 
@@ -83,7 +85,9 @@ module fd_newmark
       logical, allocatable :: changed(:), ok(:)
       real(dp) :: ag = 0.0_dp, ag1 = 0.0_dp
       real(dp) :: w_device = 0.0_dp                   !! work of the device forces [J]
+      real(dp) :: t = 0.0_dp                          !! time of the accepted state [s]
       type(observer_type) :: obs                      !! peaks, history, energy balance
+      type(ringing_type) :: ring                      !! the sticking springs' ringing
    end type workspace
 
 contains
@@ -155,6 +159,8 @@ contains
       if (allocated(error)) return
       ! the devices' forces, kept from here on by device_step
       w%f = device_force(w%st, w%s, w%sd)
+      call ringing_init(model, dt1, opts%beta, opts%gamma, w%a0, w%a1c, w%ring, res, error)
+      if (allocated(error)) return
       call consistent_acceleration(model, exc, 0.0_dp, w)
       call observe_start_energies(w%obs, 0.5_dp*sum(w%mass*w%v**2), strain_energy(model, w%u), &
                                   device_energy(w%st, w%s))
@@ -201,6 +207,7 @@ contains
             return
          end if
       end do
+      call ringing_finish(w%ring, w%st%phase, res)
       call observe_end_energies(w%obs, res, 0.5_dp*sum(w%mass*w%v**2), strain_energy(model, w%u), &
                                 device_energy(w%st, w%s), &
                               w%w_device)
@@ -698,6 +705,12 @@ contains
       ! and damping (whatever changed them); after a phase change, or a sliding force that
       ! follows the velocity (mu(v)), the next step starts in equilibrium with the new forces
       call device_step(w%nd, w%st, w%st1, w%s, w%sd, w%s1, w%sd1, w%f, w%w_device, changed_k, any_force)
+      ! the sticking springs' ringing: the step joins its phases' statistics (fd_stick_ringing)
+      if (w%ring%n > 0) then
+         call phase_statistics(w%nd, t1 - w%t, w%st, w%sd, w%f, w%ring%stats)
+         if (any_changed) call ringing_changed(w%ring, w%phase0, w%phase1, res)
+      end if
+      w%t = t1
       if (changed_k) w%version = w%version + 1
       if (any_changed .or. any_force) call consistent_acceleration(model, exc, t1, w)
       call observe_peaks(res, t1, w%n, w%nd, w%u, w%v, w%a, w%ag, w%s, w%f)
@@ -789,6 +802,26 @@ contains
          f(d) = st(d)%ks*s(d) + st(d)%cs*sd(d) + st(d)%f0
       end do
    end subroutine device_step
+
+   !> An accepted step of length h joins the statistics of the devices' phases
+   !> (fd_stick_ringing's stats): its length, s'^2 h and |F| at its end (after a change of
+   !> phase, the new phase's force: P mu when a stick phase ends in a slide), and cs h (cs of
+   !> the phase it ends in). Here, beside the step, so that it is inlined.
+   pure subroutine phase_statistics(nd, h, st, sd, f, stats)
+      integer, intent(in) :: nd
+      real(dp), intent(in) :: h
+      type(device_state), intent(in) :: st(nd)
+      real(dp), intent(in) :: sd(nd), f(nd)
+      real(dp), intent(inout) :: stats(4, nd)
+      integer :: d
+
+      do d = 1, nd
+         stats(stat_time, d) = stats(stat_time, d) + h
+         stats(stat_sd2, d) = stats(stat_sd2, d) + sd(d)*sd(d)*h
+         stats(stat_fmax, d) = max(stats(stat_fmax, d), abs(f(d)))
+         stats(stat_damping, d) = stats(stat_damping, d) + st(d)%cs*h
+      end do
+   end subroutine phase_statistics
 
    !> Strain energy of the springs, 1/2 u' K u = sum_s k_s (u_i - u_j)^2 / 2 (no cancellation).
    pure real(dp) function strain_energy(model, u) result(e)

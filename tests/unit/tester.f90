@@ -30,6 +30,7 @@ program tester
    use test_fd_group_system, only: collect_group_system
    use test_fd_impulse_solver, only: collect_impulse_solver
    use test_fd_step_limits, only: collect_step_limits
+   use test_fd_stick_ringing, only: collect_stick_ringing
    implicit none
    integer :: stat, is
    character(len=:), allocatable :: suite_name, test_name
@@ -65,6 +66,7 @@ program tester
    testsuites = [testsuites, new_testsuite("group_system", collect_group_system)]
    testsuites = [testsuites, new_testsuite("impulse_solver", collect_impulse_solver)]
    testsuites = [testsuites, new_testsuite("step_limits", collect_step_limits)]
+   testsuites = [testsuites, new_testsuite("stick_ringing", collect_stick_ringing)]
 
    call get_argument(1, suite_name)
    call get_argument(2, test_name)
