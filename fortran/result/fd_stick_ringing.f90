@@ -53,7 +53,7 @@ module fd_stick_ringing
    integer, parameter :: stat_time = 1, stat_sd2 = 2, stat_fmax = 3, stat_damping = 4
 
    !> The devices watched, and every device's statistics of its current phase, which the
-   !> technique accumulates at each accepted step (fd_newmark's device_step).
+   !> technique accumulates at each accepted step (fd_newmark's phase_statistics).
    type :: ringing_type
       integer :: n = 0                          !! devices with a sticking spring
       integer, allocatable :: dev(:)            !! their numbers
