@@ -207,7 +207,8 @@ contains
             return
          end if
       end do
-      call ringing_finish(w%ring, w%st%phase, res)
+      w%phase0 = w%st%phase
+      call ringing_finish(w%ring, w%phase0, res)
       call observe_end_energies(w%obs, res, 0.5_dp*sum(w%mass*w%v**2), strain_energy(model, w%u), &
                                 device_energy(w%st, w%s), &
                               w%w_device)
