@@ -124,7 +124,8 @@ def summary_warnings(summary: dict) -> list[str]:
             f"{summary['dt1_s']:.3g} s puts its frequency "
             f"{100 * abs(summary['stick_frequency_error'][d]):.2f} % off, enough to dephase that "
             f"ringing within a stick phase (stick_ringing_ratio = {ratio[d]:.2f} > 1): its "
-            "stick-slip transitions depend on the step; raise n1 (halving dt1 quarters that error)"
+            "stick-slip transitions may depend on the step; check with a larger n1 (halving dt1 "
+            "quarters that error)"
             + (f" ({more} more device(s) likewise: summary stick_ringing_ratio)" if more else "")
         )
     return out

@@ -135,7 +135,8 @@ program frictiondyn_main
       write (error_unit, '(a,es10.3,a,f0.2,a,f0.2,a)') '  and dt1 = ', res%dt1, ' s puts its frequency ', &
          100*abs(res%stick_freq_error(d)), ' % off, enough to dephase that ringing within a stick phase '// &
          '(stick_ringing_ratio = ', res%stick_ringing_ratio(d), ' > 1):'
-      write (error_unit, '(a)') '  its stick-slip transitions depend on the step; raise n1 (halving dt1 quarters that error)'
+      write (error_unit, '(a)') '  its stick-slip transitions may depend on the step; check with a larger n1 (halving dt1 '// &
+         'quarters that error)'
       if (count(res%stick_ringing_ratio > 1.0_dp) > 1) write (error_unit, '(a,i0,a)') '  (', &
          count(res%stick_ringing_ratio > 1.0_dp) - 1, ' more device(s) likewise: summary stick_ringing_ratio)'
    end if
