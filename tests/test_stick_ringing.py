@@ -117,9 +117,14 @@ def test_the_warning_is_where_the_step_decides_the_slides(run):
     and no warning."""
     runs = {n1: ok(run(ringing_deck(n1), name=f"n{n1}")) for n1 in (24, 96, 192)}
     s = {n1: r.summary() for n1, r in runs.items()}
-    assert s[24]["stick_to_slip"][1] == 81 and s[192]["stick_to_slip"][1] == 0
+    assert s[24]["stick_to_slip"][1] > 20 and s[192]["stick_to_slip"][1] == 0
     assert s[24]["stick_resolution"] == "unresolved"
-    assert s[24]["stick_frequency_error"][1] == pytest.approx(0.02763, abs=1e-5)
+    # device 2: P mu / f between masses 2 and 3 (m_r = m2 m3 / (m2 + m3)), average acceleration
+    m2, m3 = 1.6740255989932191, 0.412215758813636
+    k = 8.590329151685118 * 0.14430488432298288 / 1.8658319928435527e-06
+    w = math.sqrt(k * (m2 + m3) / (m2 * m3)) * s[24]["dt1_s"]
+    assert s[24]["stick_frequency_error"][1] == pytest.approx(trapezoidal_error(w), rel=1e-9)
+    assert 0.027 < trapezoidal_error(w) < 0.028
     assert s[24]["stick_ringing_ratio"][1] > 2
     assert s[24]["stick_margin_N"][1] == 0.0  # its worst stick phase ends in a slide
     assert WARNING + " 2 " in runs[24].stderr
@@ -135,9 +140,14 @@ def test_the_warning_is_where_the_step_decides_the_slides(run):
 
 @pytest.mark.parametrize("test", [1, 2, 3, 4, 5])
 def test_the_paper_decks_are_resolved(run, test):
-    """The paper's hysteretic decks, whose transition counts do not change when n1 is
-    doubled (tests 1, 4, 5) or change by a few in thousands: no warning."""
-    r = ok(run((INPUTS / f"test{test}_hysteretic.nml").read_text(), name=f"test{test}"))
+    """The paper's hysteretic decks: their stick-slip counts at n1 and 2 n1 agree (within
+    max(2, 1 %): the step does not decide them), and no warning."""
+    text = (INPUTS / f"test{test}_hysteretic.nml").read_text()
+    assert "  n1 = 20\n" in text
+    r = ok(run(text, name=f"test{test}"))
+    fine = ok(run(text.replace("  n1 = 20\n", "  n1 = 40\n"), name=f"test{test}_fine")).summary()
+    count, reference = r.summary()["stick_to_slip"][0], fine["stick_to_slip"][0]
+    assert abs(count - reference) <= max(2, 0.01 * reference)
     assert r.summary()["stick_resolution"] == "resolved"
     assert WARNING not in r.stderr
 
@@ -147,7 +157,9 @@ def test_the_coarse_fig3_deck_is_reported(run):
     24 % low, and its highest modes are not resolved either): reported."""
     r = ok(run((INPUTS / "fig3_coarse.nml").read_text(), name="fig3"))
     s = r.summary()
-    assert s["stick_frequency_error"][0] == pytest.approx(0.2386, abs=1e-4)
+    omega = math.sqrt(P * MU / 1e-5 * (M1 + M2) / (M1 * M2))
+    assert s["stick_frequency_error"][0] == pytest.approx(trapezoidal_error(omega * s["dt1_s"]), rel=1e-9)
+    assert s["stick_frequency_error"][0] > 0.2
     assert s["stick_resolution"] == "unresolved" and s["stick_ringing_ratio"][0] > 1
     assert WARNING + " 1 " in r.stderr
 

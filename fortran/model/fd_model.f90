@@ -24,7 +24,7 @@ module fd_model
    public :: mu_constant, mu_exponential, mu_table, label_len, max_mu_points
    public :: system_stuck, system_free
    public :: source_friction, source_brace, source_isolator
-   public :: sticking_stiffness
+   public :: sticking_stiffness, moved_mass
 
    ! where a device (or spring) of the model comes from in the deck
    integer, parameter :: source_friction = 0  !! &friction (or &springs)
@@ -128,5 +128,17 @@ contains
       k = 0.0_dp
       if (dev%law == law_hysteretic .and. dev%p*dev%mu > 0.0_dp) k = dev%p*dev%mu/dev%f
    end function sticking_stiffness
+
+   !> The mass device d moves against its other end: m_i to the table, m_i m_j / (m_i + m_j)
+   !> between two DOFs (the step limits' band floor, the mode of its sticking spring).
+   pure real(dp) function moved_mass(model, d) result(m)
+      type(model_type), intent(in) :: model  !! the model
+      integer, intent(in) :: d               !! the device
+
+      associate (i => model%dev(d)%node_i, j => model%dev(d)%node_j)
+         m = model%mass(i)
+         if (j > 0) m = model%mass(i)*model%mass(j)/(model%mass(i) + model%mass(j))
+      end associate
+   end function moved_mass
 
 end module fd_model

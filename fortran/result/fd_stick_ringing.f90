@@ -35,7 +35,7 @@
 module fd_stick_ringing
    use fd_kinds, only: dp
    use fd_error, only: error_type, fatal_error, fmt_int, stat_no_memory
-   use fd_model, only: model_type, sticking_stiffness
+   use fd_model, only: model_type, sticking_stiffness, moved_mass
    use fd_names, only: law_velocity
    use fd_device_state, only: device_state, phase_stick
    use fd_result, only: result_type, resolution_none, resolution_resolved, resolution_unresolved
@@ -170,7 +170,7 @@ contains
          call spring_damping(j)
          rg%dev(q) = d
          rg%k(q) = k
-         rg%mr(q) = mi*ai*ai + mj*aj*aj   ! m_i m_j / (m_i + m_j), or m_i
+         rg%mr(q) = moved_mass(model, d)
          rg%omega(q) = sqrt(k/rg%mr(q))
          rg%pmu(q) = model%dev(d)%p*model%dev(d)%mu
          x = rg%omega(q)*dt1

@@ -14,7 +14,7 @@ module fd_step_limits
    use fd_kinds, only: dp
    use fd_error, only: error_type, fatal_error, fmt_int, fmt_real
    use fd_names, only: law_velocity, law_hysteretic
-   use fd_model, only: model_type, integration_type, sticking_stiffness
+   use fd_model, only: model_type, integration_type, sticking_stiffness, moved_mass
    use fd_excitation, only: excitation_type
    implicit none
    private
@@ -111,16 +111,6 @@ contains
 
       floor = model%dev(d)%p*model%dev(d)%mu*dt_min/moved_mass(model, d)
    end function band_floor
-
-   pure real(dp) function moved_mass(model, d) result(m)
-      type(model_type), intent(in) :: model
-      integer, intent(in) :: d
-      integer :: i, j
-
-      i = model%dev(d)%node_i; j = model%dev(d)%node_j
-      m = model%mass(i)
-      if (j > 0) m = model%mass(i)*model%mass(j)/(model%mass(i) + model%mass(j))
-   end function moved_mass
 
    !> The limits checked when the deck is read: the work of a refinement, the digits of the
    !> effective stiffness. Messages start with "group &...": the deck reader prefixes the deck.
