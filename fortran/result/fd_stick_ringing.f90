@@ -117,7 +117,7 @@ contains
       type(error_type), allocatable, intent(out) :: error !! not enough memory
       integer, allocatable :: sp_first(:), sp_list(:), vd_first(:), vd_list(:), di(:), dj(:)
       logical, allocatable :: velocity(:)
-      real(dp) :: k, mi, mj, ai, aj, c, x, wt, zn
+      real(dp) :: k, ai, aj, c, x, wt, zn
       integer :: nd, ns, d, q, i, j, nb, stat
       logical :: osc
 
@@ -164,13 +164,13 @@ contains
          call mode_of(d)
          rg%first(q) = nb + 1
          call band_devices(.true.)
-         ! the structure's damping on the mode: a0 M, and a1 K of the springs at its nodes
-         c = a0*(mi*ai*ai + mj*aj*aj)
-         call spring_damping(i)
-         call spring_damping(j)
          rg%dev(q) = d
          rg%k(q) = k
          rg%mr(q) = moved_mass(model, d)
+         ! the structure's damping on the mode: a0 M (a0 m_r), and a1 K of the springs at its nodes
+         c = a0*rg%mr(q)
+         call spring_damping(i)
+         call spring_damping(j)
          rg%omega(q) = sqrt(k/rg%mr(q))
          rg%pmu(q) = model%dev(d)%p*model%dev(d)%mu
          x = rg%omega(q)*dt1
@@ -190,15 +190,11 @@ contains
          integer, intent(in) :: d
          i = di(d)
          j = dj(d)
-         mi = model%mass(i)
+         ai = 1.0_dp
+         aj = 0.0_dp
          if (j > 0) then
-            mj = model%mass(j)
-            ai = mj/(mi + mj)
-            aj = mi/(mi + mj)
-         else
-            mj = 0.0_dp
-            ai = 1.0_dp
-            aj = 0.0_dp
+            ai = model%mass(j)/(model%mass(i) + model%mass(j))
+            aj = model%mass(i)/(model%mass(i) + model%mass(j))
          end if
       end subroutine mode_of
       !> The mode's shape at a node.
