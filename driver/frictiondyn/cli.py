@@ -9,6 +9,9 @@
   from ``Result.to_npz``), next to it or in ``--out``.
 - ``compare A B [...]``: overlay two or more results (CSV, .npz, or decks, which are run)
   and print the differences of their peaks.
+- ``converge DECK [--factor F] [--levels L] [--rtol R] [--json FILE]``: a time-step
+  convergence study: the deck at n1, F·n1, ... side by side; prints what moves; exit status 3
+  when the answer depends on the step (``frictiondyn.convergence``).
 - ``paper OUTDIR``: the paper's Table 1 classification and Figs. 2, 3a, 3b, 4a, 4b.
 - ``sweep SPEC.toml`` / ``sweep collect DIR`` / ``sweep plot DIR X Y``: parameter sweeps,
   locally or as a Slurm job array (``frictiondyn.sweep``, docs/batch.md).
@@ -19,6 +22,7 @@ Errors print one line ``frictiondyn: error: ...`` on standard error and exit wit
 from __future__ import annotations
 
 import argparse
+import json
 import os
 import sys
 import warnings
@@ -279,6 +283,23 @@ def cmd_compare(args: argparse.Namespace) -> int:
     return 0
 
 
+def cmd_converge(args: argparse.Namespace) -> int:
+    from .convergence import step_convergence
+
+    report = step_convergence(args.deck, factor=args.factor, levels=args.levels, rtol=args.rtol)
+    print(report)
+    if args.json:
+        target = Path(args.json)
+        tmp = target.with_name(f".{target.name}.{os.getpid()}.tmp")
+        try:
+            tmp.write_text(json.dumps(report.to_dict(), indent=1) + "\n")
+            os.replace(tmp, target)
+        finally:
+            tmp.unlink(missing_ok=True)
+        print(f"  report: {target}")
+    return 0 if report.converged else 3
+
+
 def cmd_paper(args: argparse.Namespace) -> int:
     from .paper import reproduce
 
@@ -355,6 +376,19 @@ def build_parser() -> argparse.ArgumentParser:
     p.add_argument("--units", **units)
     p.add_argument("--dpi", **dpi)
     p.set_defaults(func=cmd_compare)
+
+    p = sub.add_parser(
+        "converge", help="time-step convergence study: the deck at n1, 2 n1, ...; exit 3 if it moves"
+    )
+    p.add_argument("deck", help="namelist deck (.nml)")
+    p.add_argument("--factor", type=int, default=2, help="n1 grows by this each level (default 2)")
+    p.add_argument("--levels", type=int, default=1, help="finer runs (default 1: n1 and factor n1)")
+    p.add_argument(
+        "--rtol", type=float, default=0.01,
+        help="largest change allowed between levels, relative (default 0.01)",
+    )
+    p.add_argument("--json", metavar="FILE", help="also write the whole comparison as JSON")
+    p.set_defaults(func=cmd_converge)
 
     p = sub.add_parser("paper", help="recompute the paper's Table 1 and Figs. 2, 3, 4")
     p.add_argument("outdir", help="directory for the PNGs and report.md")
