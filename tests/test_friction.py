@@ -96,9 +96,16 @@ def test_block_with_initial_velocity_stops_where_the_closed_form_says(run, law):
         # sliding ends when |v| drops below the band eps, i.e. eps/(mu g) before t_stop
         assert t[i] == pytest.approx(t_stop - EPS / (mu * G), abs=dt)
     else:
-        # eq. 2 ends the slide eps1/(mu g) early, but the residual forward velocity re-yields
-        # the elastic-plastic spring at once (one-step sticks); the slide ends when v = 0
-        assert t_stop - EPS / (mu * G) - dt <= t[i] <= t_stop + dt
+        # the slide ends at its turn (eqs. 1, 2: the first step with v <= 0), not when |v|
+        # enters the band (eps1 / (mu g) = 0.34 ms, 3 steps, earlier)
+        assert t_stop <= t[i] <= t_stop + dt
+        assert np.all(h["phase1"][:i] == 1)  # one slide until then, no stick within it
+        # and counted once: before the stuck block's swing on its sticking spring touches
+        # -P mu (a marginal touch, F(0) = P mu at v = 0, seen at 0.396 s) one stop, no slide.
+        # Eq. 2 read literally counted a one-step stick inside the refined step: 1 and 2
+        short = {"excitation_type": "none", "dt_record": 0.001, "duration": 0.3}
+        c = ok(run(block(law, mu, v0=v0, excitation=short), name="short")).summary()
+        assert c["stick_to_slip"] == [0] and c["slip_to_stick"] == [1]
     end = t > t_stop + 0.05
     if law == "velocity":
         # creeps inside the band: extra travel <= eps * (eps / mu g)
@@ -232,15 +239,11 @@ def test_fig3_coarse_deck_fails_and_the_corrected_one_agrees_with_the_velocity_l
         assert r.returncode == 0, r.stderr
         runs[name] = r
     coarse = runs["fig3_coarse"].summary()
-    # the paper's Fig. 3b: sign changes of the relative velocity inside sliding phases
-    assert coarse["correctness_violations"] == 388
-    assert coarse["slip_reversals"] == [287]
+    # the paper's Fig. 3b: sign changes of the relative velocity within one step of a slide
+    # (a reversal through the band, slip_reversals) and steps violating eq. 12
+    assert coarse["correctness_violations"] == 413
+    assert coarse["slip_reversals"] == [312]
     assert "violate the correctness condition" in runs["fig3_coarse"].stderr
-    h = runs["fig3_coarse"].history()
-    slip = h["phase1"] != 0
-    same_phase = (h["phase1"][1:] == h["phase1"][:-1]) & slip[1:]
-    sign_flips = np.sum(same_phase & (np.sign(h["sdot1"][1:]) != np.sign(h["sdot1"][:-1])))
-    assert sign_flips == 20  # seen in the rows written (every dt_r)
     corrected = runs["test4_hysteretic"].summary()
     assert corrected["correctness_violations"] == 0
     assert corrected["slip_reversals"] == [0]

@@ -85,7 +85,15 @@ contains
          end if
       else if (st%armed) then
          if (abs(sdot) < dev%eps1) then
-            st%phase = phase_stick                                ! eq. 2
+            if (sdot*st%phase > 0.0_dp) then
+               ! in the band, still along the slide: the slide goes on to its turn (eq. 1),
+               ! unarmed. Ended here (eq. 2 read literally), the residual velocity carried
+               ! the elastic force past P mu within a step: a one-step stick, and two
+               ! transitions counted for one stop
+               st%armed = .false.
+            else
+               st%phase = phase_stick                             ! eq. 2, at the turn
+            end if
          else if (sdot*st%phase < 0.0_dp) then
             st%phase = -st%phase                                  ! crossed the band: reverse
          end if

@@ -34,7 +34,7 @@ contains
                   new_unittest("hysteretic: stick to slip at |F| = P mu", test_hys_yield), &
                   new_unittest("hysteretic: centre follows the slip", test_hys_centre), &
                   new_unittest("hysteretic: unarmed slide", test_hys_unarmed), &
-                  new_unittest("hysteretic: eq. 2 ends an armed slide", test_hys_eq2), &
+                  new_unittest("hysteretic: eqs. 1, 2 end an armed slide at its turn", test_hys_eq2), &
                   new_unittest("hysteretic: reversal", test_hys_reversal), &
                   new_unittest("hysteretic: no capacity", test_hys_zero), &
                   new_unittest("hysteretic: eq. 12", test_hys_correct), &
@@ -138,8 +138,8 @@ contains
       if (allocated(error)) return
       call check(error, st%centre, 0.125_dp - f, 'centre = s - f while sliding')
       if (allocated(error)) return
-      call hysteretic_update(dev, s_end, 0.5_dp*band, st, changed)   ! eq. 2
-      call check(error, st%phase == phase_stick .and. changed .and. .not. st%armed, 'eq. 2 ends the slide')
+      call hysteretic_update(dev, s_end, 0.0_dp, st, changed)   ! eqs. 1, 2: the turn
+      call check(error, st%phase == phase_stick .and. changed .and. .not. st%armed, 'the turn ends the slide')
       if (allocated(error)) return
       call check(error, st%centre, s_end - f, 'centre = s - f at the end of the slide')
       if (allocated(error)) return
@@ -189,24 +189,46 @@ contains
       call check(error, st%phase == phase_stick .and. changed, 'sdot against the slide ends it')
    end subroutine test_hys_unarmed
 
-   !> An armed slide ends by eq. 2 as soon as |sdot| < eps1, and not at |sdot| = eps1.
+   !> An armed slide ends by eq. 2 when |sdot| < eps1 and sdot has turned (sdot sgn <= 0: the
+   !> extremum of s, eq. 1), and not at |sdot| = eps1. In the band still along the slide it
+   !> slides on, unarmed, to its turn: ended there, the residual velocity would carry the
+   !> elastic force past P mu within a step (a one-step stick, two transitions for one stop).
    subroutine test_hys_eq2(error)
       type(error_type), allocatable, intent(out) :: error
       type(device_state) :: st, st0
       type(device_type) :: dev
       logical :: changed
+      real(dp), parameter :: s1 = -2.0_dp**(-6)
 
       dev = device(law_hysteretic)
       call hysteretic_init(dev, 0.0_dp, -3.0_dp*band, st)
       st0 = st
-      call hysteretic_update(dev, -2.0_dp**(-6), -band, st, changed)
-      call check(error, st%phase == phase_slip_neg .and. .not. changed, '|sdot| = eps1: still sliding')
+      call hysteretic_update(dev, s1, -band, st, changed)
+      call check(error, st%phase == phase_slip_neg .and. .not. changed .and. st%armed, &
+                 '|sdot| = eps1: still sliding, armed')
       if (allocated(error)) return
       st = st0
-      call hysteretic_update(dev, -2.0_dp**(-6), -band*(1.0_dp - 2.0_dp**(-40)), st, changed)
-      call check(error, st%phase == phase_stick .and. changed, '|sdot| just below eps1: sticks (eq. 2)')
+      call hysteretic_update(dev, s1, -band*(1.0_dp - 2.0_dp**(-40)), st, changed)
+      call check(error, st%phase == phase_slip_neg .and. .not. changed .and. .not. st%armed, &
+                 '|sdot| just below eps1, along the slide: slides on, unarmed')
       if (allocated(error)) return
-      call check(error, force(st, -2.0_dp**(-6), 0.0_dp), -pmu, 'F continuous at -P mu')
+      call check(error, force(st, s1, -0.5_dp*band), -pmu, 'F = -P mu sliding on')
+      if (allocated(error)) return
+      call hysteretic_update(dev, s1 - f/8, 2.0_dp**(-30), st, changed)
+      call check(error, st%phase == phase_stick .and. changed, 'sticks at the turn')
+      if (allocated(error)) return
+      call check(error, force(st, s1 - f/8, 0.0_dp), -pmu, 'F continuous at -P mu')
+      if (allocated(error)) return
+      st = st0
+      call hysteretic_update(dev, s1, 0.5_dp*band, st, changed)
+      call check(error, st%phase == phase_stick .and. changed .and. .not. st%armed, &
+                 'turned within the band in one step: sticks (eq. 2)')
+      if (allocated(error)) return
+      call check(error, force(st, s1, 0.0_dp), -pmu, 'F continuous at -P mu')
+      if (allocated(error)) return
+      st = st0
+      call hysteretic_update(dev, s1, 0.0_dp, st, changed)
+      call check(error, st%phase == phase_stick .and. changed, 'sdot = 0: sticks (eq. 1)')
    end subroutine test_hys_eq2
 
    !> An armed slide whose velocity crossed the band in one step reverses.
@@ -253,17 +275,18 @@ contains
       call check(error, hysteretic_correct(dev, n_corr, st, 0.0_dp, 3.0_dp*band), &
                  'eq. 12 not applied to the first step of a slide')
       if (allocated(error)) return
-      ! a slide that ends (eq. 2): the step in the slide, then sticking at F = P mu
+      ! a slide that ends (eqs. 1, 2: turned within the band): the step in the slide, then
+      ! sticking at F = P mu
       call hysteretic_init(dev, 0.0_dp, 3.0_dp*band, st0)
       st1 = st0
-      call hysteretic_update(dev, 2.0_dp**(-6), 0.5_dp*band, st1, changed)
+      call hysteretic_update(dev, 2.0_dp**(-6), -0.5_dp*band, st1, changed)
       call check(error, changed .and. st1%phase == phase_stick, 'the trial ends sticking')
       if (allocated(error)) return
-      call hysteretic_settle(dev, 0.5_dp*band, st0, st1, st, can)
+      call hysteretic_settle(dev, -0.5_dp*band, st0, st1, st, can)
       call check(error, can .and. st%phase == phase_slip_pos .and. st%f0 == st0%f0 .and. st%armed, &
                  'the step is the slide itself')
       if (allocated(error)) return
-      call check(error, force(st1, 2.0_dp**(-6), 0.0_dp), force(st, 2.0_dp**(-6), 0.5_dp*band), &
+      call check(error, force(st1, 2.0_dp**(-6), 0.0_dp), force(st, 2.0_dp**(-6), -0.5_dp*band), &
                  'F continuous at the step end')
       if (allocated(error)) return
       ! a reversal through the band
