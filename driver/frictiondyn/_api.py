@@ -81,7 +81,8 @@ class FrictiondynWarning(UserWarning):
     error: steps that violate the correctness condition (eqs. 9, 12), a step dt1 that does
     not resolve the structure's highest modes (summary ``mode_resolution``), or one that
     dephases the ringing of a sticking spring on which a device's stick-slip decisions rest
-    (summary ``stick_resolution``). Issued when the
+    (summary ``stick_resolution``), or an integration that dissipated or created more than
+    5 % of the energy (summary ``energy_balance``). Issued when the
     Result is made (``Session.result``, ``run``, ``Analysis.run``); the summary holds the
     figures. Filter it with the ``warnings`` module like any other warning."""
 
@@ -98,7 +99,8 @@ def newmark_steps(summary: dict) -> int:
 def summary_warnings(summary: dict) -> list[str]:
     """The warnings a summary calls for, as the executable prints them on standard error
     (without its "frictiondyn: warning: " prefix): correctness violations, a step dt1 that
-    does not resolve the highest modes, and one that dephases a sticking spring's ringing."""
+    does not resolve the highest modes, a step that dephases a sticking spring's ringing, and
+    an integration that dissipated (or created) more than 5 % of the energy."""
     out = []
     n = summary.get("correctness_violations", 0)
     if n:
@@ -127,6 +129,15 @@ def summary_warnings(summary: dict) -> list[str]:
             "stick-slip transitions may depend on the step; check with a larger n1 (halving dt1 "
             "quarters that error)"
             + (f" ({more} more device(s) likewise: summary stick_ringing_ratio)" if more else "")
+        )
+    balance = summary.get("energy_balance")
+    if balance in ("dissipative", "energy gain"):
+        ratio = summary["energy_residual_ratio"]
+        out.append(
+            f"the integration {'dissipated' if ratio > 0 else 'created'} {100 * abs(ratio):.1f} % of "
+            "the energy the structure held and received (|energy_residual_ratio| > 0.05): numerical "
+            "damping (Newmark gamma > 1/2, Moreau-Jean theta > 1/2) or an unstable step the physics "
+            "does not have; the motion carries it: raise n1 (it shrinks with dt1) or use 1/2"
         )
     return out
 

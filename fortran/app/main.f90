@@ -19,7 +19,7 @@ program frictiondyn_main
                          session_set_progress
    use fd_progress_line, only: progress_wanted, progress_show, progress_clear
    use fd_version, only: frictiondyn_version
-   use fd_result, only: resolution_unresolved
+   use fd_result, only: resolution_unresolved, residual_ratio_limit
    implicit none
 
    interface
@@ -139,6 +139,13 @@ program frictiondyn_main
          'quarters that error)'
       if (count(res%stick_ringing_ratio > 1.0_dp) > 1) write (error_unit, '(a,i0,a)') '  (', &
          count(res%stick_ringing_ratio > 1.0_dp) - 1, ' more device(s) likewise: summary stick_ringing_ratio)'
+   end if
+   if (abs(res%e_residual_ratio) > residual_ratio_limit) then
+      write (error_unit, '(a,a,1x,f0.1,a,f4.2,a)') 'frictiondyn: warning: the integration ', &
+         trim(merge('dissipated', 'created   ', res%e_residual_ratio > 0.0_dp)), 100*abs(res%e_residual_ratio), &
+         ' % of the energy the structure held and received (|energy_residual_ratio| > ', residual_ratio_limit, '):'
+      write (error_unit, '(a)') '  numerical damping (Newmark gamma > 1/2, Moreau-Jean theta > 1/2) or an unstable '// &
+         'step the physics does not have; the motion carries it: raise n1 (it shrinks with dt1) or use 1/2'
    end if
    write (output_unit, '(a)') 'frictiondyn: '//deck
    write (output_unit, '(a,f0.6,a,i0,a,i0,a,i0,a,i0)') '  stuck period ', res%period_stuck, ' s; steps dt1 ', &

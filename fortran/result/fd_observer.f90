@@ -497,6 +497,7 @@ contains
       real(dp), intent(in) :: e_str            !! springs' strain energy at the end [J]
       real(dp), intent(in) :: e_device         !! elastic energy stored in devices at the end [J]
       real(dp), intent(in) :: w_device         !! work of the device forces over the run [J]
+      real(dp) :: scale
 
       res%e_kinetic = e_kin - obs%e_kin0
       res%e_strain = e_str - obs%e_str0
@@ -504,6 +505,11 @@ contains
       res%e_friction = w_device - res%e_device
       res%e_residual = res%e_input - (res%e_kinetic + res%e_strain + res%e_viscous + &
                                       res%e_friction + res%e_device)
+      ! the residual against the energy that passed through the structure: what it held at
+      ! the start and what the table put in or took out, step by step
+      scale = obs%e_kin0 + obs%e_str0 + abs(obs%e_dev0) + res%e_input_gross
+      res%e_residual_ratio = 0.0_dp
+      if (scale > 0.0_dp) res%e_residual_ratio = res%e_residual/scale
       if (associated(obs%ctl)) obs%ctl%time = obs%ctl%duration   ! the run is complete
    end subroutine observe_end_energies
 

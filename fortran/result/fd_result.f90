@@ -15,6 +15,7 @@ module fd_result
    public :: nonfinite_history_error
    public :: max_event_times, has_envelope
    public :: resolution_none, resolution_resolved, resolution_unresolved, resolution_names
+   public :: residual_ratio_limit, energy_balance_name
 
    integer, parameter :: max_violation_times = 10 !! first violation times kept
    integer, parameter :: max_event_times = 1000   !! first event times kept (exact technique)
@@ -26,6 +27,9 @@ module fd_result
    character(len=14), parameter :: resolution_names(3) = [character(len=14) :: 'not applicable', 'resolved', &
                                                           'unresolved']
    integer, parameter :: column_name_len = 16     !! length of a column name
+   !> |e_residual_ratio| above this: the integration dissipated (or created) a share of the
+   !> energy that the motion feels (docs/theory.md section 7)
+   real(dp), parameter :: residual_ratio_limit = 0.05_dp
 
    !> Everything a run produces.
    type :: result_type
@@ -101,12 +105,30 @@ module fd_result
       real(dp) :: e_friction = 0.0_dp  !! friction dissipation
       real(dp) :: e_device = 0.0_dp    !! elastic energy stored in sticking devices at the end
       real(dp) :: e_residual = 0.0_dp  !! input - (kinetic + strain + viscous + friction + device)
+      real(dp) :: e_input_gross = 0.0_dp !! sum over the steps of |input work of the step|
+      real(dp) :: e_residual_ratio = 0.0_dp !! e_residual / (initial energy + e_input_gross)
       real(dp) :: run_time = 0.0_dp    !! wall-clock time of the integration [s]
       ! names, modes, storey drifts and shears, residual values (fd_engineering)
       type(engineering_type) :: eng    !! the engineering outputs
    end type result_type
 
 contains
+
+   !> The summary's energy_balance: "closed" when |e_residual_ratio| <= residual_ratio_limit,
+   !> "dissipative" (numerical damping: Newmark gamma > 1/2, Moreau-Jean theta > 1/2) or
+   !> "energy gain" beyond it.
+   pure function energy_balance_name(ratio) result(name)
+      real(dp), intent(in) :: ratio   !! e_residual_ratio
+      character(len=:), allocatable :: name
+
+      if (abs(ratio) <= residual_ratio_limit) then
+         name = 'closed'
+      else if (ratio > 0.0_dp) then
+         name = 'dissipative'
+      else
+         name = 'energy gain'
+      end if
+   end function energy_balance_name
 
    !> Whether a run of these settings writes, after the state columns, the maxima of |u|,
    !> |v|, |aabs| per DOF, |s|, |F| per device and |drift|, |V| per storey and |Vb| since the

@@ -692,7 +692,9 @@ contains
 
       ! energy of the step, forces at both ends in the step's phases; the state moves on
       call step_energy(w%n, w%mass, w%u, w%v, w%a, w%u1, w%v1, w%a1, w%tmp, w%rhs, ein)
-      res%e_input = res%e_input - 0.5_dp*(w%ag + w%ag1)*ein
+      ein = 0.5_dp*(w%ag + w%ag1)*ein
+      res%e_input = res%e_input - ein
+      res%e_input_gross = res%e_input_gross + abs(ein)
       res%e_viscous = res%e_viscous + 0.5_dp*viscous_work(model, w%a0, w%a1c, w%n, w%mass, w%tmp, w%rhs)
       w%ag = w%ag1
       ! violations of the correctness condition left in an accepted step

@@ -537,6 +537,7 @@ contains
                evi = evi*s + w%evi(m)/(m + 1)
             end do
             res%e_input = res%e_input - ein*s
+            res%e_input_gross = res%e_input_gross + abs(ein*s)
             res%e_viscous = res%e_viscous + evi*s
          end associate
       end subroutine energy

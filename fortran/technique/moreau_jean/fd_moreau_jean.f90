@@ -138,7 +138,7 @@ contains
       type(error_type), allocatable, intent(out) :: error !! singular system, LCP failure, stop
       type(run_control), intent(inout), target, optional :: ctl !! the run's control (fd_run_control)
       type(mj_work) :: w
-      real(dp) :: h, th, alpha, beta, cm, ck, t1, ag0, ag1, agt, xg, vg, e_kin, e_str
+      real(dp) :: h, th, alpha, beta, cm, ck, t1, ag0, ag1, agt, xg, vg, e_kin, e_str, ein
       integer :: k, e, c0, c1, crate
       logical :: stop
 
@@ -205,7 +205,9 @@ contains
          w%u1 = w%u + h*((1.0_dp - th)*w%v + th*w%v1)
          ! energy of the step: input, viscous and friction work over du = h v_theta
          w%du = w%u1 - w%u
-         res%e_input = res%e_input - agt*sum(model%mass*w%du)
+         ein = agt*sum(model%mass*w%du)
+         res%e_input = res%e_input - ein
+         res%e_input_gross = res%e_input_gross + abs(ein)
          call gs_k_matvec(w%p%gs, w%du, w%kx, 1.0_dp, 0.0_dp)
          res%e_viscous = res%e_viscous + (w%a0*sum(model%mass*w%du**2) + w%a1*dot_product(w%du, w%kx))/h
          do e = 1, w%ne
