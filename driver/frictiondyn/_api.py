@@ -133,11 +133,18 @@ def summary_warnings(summary: dict) -> list[str]:
     balance = summary.get("energy_balance")
     if balance in ("dissipative", "energy gain"):
         ratio = summary["energy_residual_ratio"]
+        cause = (
+            "numerical damping (Newmark gamma > 1/2, Moreau-Jean theta > 1/2) the physics does "
+            "not have; the motion carries it: raise n1 (it shrinks with dt1) or use gamma = "
+            "theta = 1/2"
+            if ratio > 0
+            else "an energy error of the step (Newmark beta /= 1/4, or a step beyond its rule's "
+            "stability limit) the physics does not have; the motion carries it: raise n1 or use "
+            "beta = 1/4"
+        )
         out.append(
             f"the integration {'dissipated' if ratio > 0 else 'created'} {100 * abs(ratio):.1f} % of "
-            "the energy the structure held and received (|energy_residual_ratio| > 0.05): numerical "
-            "damping (Newmark gamma > 1/2, Moreau-Jean theta > 1/2) or an unstable step the physics "
-            "does not have; the motion carries it: raise n1 (it shrinks with dt1) or use 1/2"
+            f"the energy the structure held and received (|energy_residual_ratio| > 0.05): {cause}"
         )
     return out
 

@@ -144,8 +144,13 @@ program frictiondyn_main
       write (error_unit, '(a,a,1x,f0.1,a,f4.2,a)') 'frictiondyn: warning: the integration ', &
          trim(merge('dissipated', 'created   ', res%e_residual_ratio > 0.0_dp)), 100*abs(res%e_residual_ratio), &
          ' % of the energy the structure held and received (|energy_residual_ratio| > ', residual_ratio_limit, '):'
-      write (error_unit, '(a)') '  numerical damping (Newmark gamma > 1/2, Moreau-Jean theta > 1/2) or an unstable '// &
-         'step the physics does not have; the motion carries it: raise n1 (it shrinks with dt1) or use 1/2'
+      if (res%e_residual_ratio > 0.0_dp) then
+         write (error_unit, '(a)') '  numerical damping (Newmark gamma > 1/2, Moreau-Jean theta > 1/2) the physics '// &
+            'does not have; the motion carries it: raise n1 (it shrinks with dt1) or use gamma = theta = 1/2'
+      else
+         write (error_unit, '(a)') '  an energy error of the step (Newmark beta /= 1/4, or a step beyond its rule''s '// &
+            'stability limit) the physics does not have; the motion carries it: raise n1 or use beta = 1/4'
+      end if
    end if
    write (output_unit, '(a)') 'frictiondyn: '//deck
    write (output_unit, '(a,f0.6,a,i0,a,i0,a,i0,a,i0)') '  stuck period ', res%period_stuck, ' s; steps dt1 ', &
