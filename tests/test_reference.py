@@ -15,7 +15,8 @@ What is compared:
 - floats (peaks, their times, violation times, periods, step sizes): relative 1e-9;
 - energies (``energy_*``): absolute 1e-9 * energy_input_J; the small terms (the residual,
   friction work of a deck that never slides) are round-off and have no relative meaning;
-  the residual's ratio to the energy through the structure (round-off at gamma = 1/2),
+  the residual's ratio to the energy through the structure (round-off at gamma = 1/2), the
+  harmonic step errors (small differences of two amplitudes),
   mode shapes and modal mass ratios: absolute 1e-9;
 - history rows named by the reference's ``row`` column, each column to 1e-8 * its largest
   reference magnitude; the phase column exactly.
@@ -66,7 +67,7 @@ def _event_driven(ref: dict) -> bool:
 ROUNDOFF_COUNTS: dict = {}  # none at present (the event-driven technique's count became exact)
 # fractions of 1 with components that may be 0 (mode shapes scaled to a largest component
 # of 1, effective modal masses over the total): compared to RTOL absolutely
-ABSOLUTE_KEYS = ("mode_shapes_", "modal_mass_ratio_", "energy_residual_ratio")
+ABSOLUTE_KEYS = ("mode_shapes_", "modal_mass_ratio_", "energy_residual_ratio", "harmonic_step_error")
 
 
 # ------------------------------------------------------------------ comparison

@@ -116,6 +116,16 @@ def summary_warnings(summary: dict) -> list[str]:
             "absolute accelerations may carry it (drifts and shears much less); raise n1 until "
             "omega_max dt1 <= 2 to resolve them"
         )
+    if summary.get("harmonic_resolution") == "unresolved":
+        err = summary["harmonic_step_error"]
+        i = max(range(len(err)), key=lambda k: err[k])
+        steps = 1.0 / (summary["excitation_frequency_Hz"] * summary["dt1_s"])
+        out.append(
+            f"dt1 = {summary['dt1_s']:.3g} s takes {steps:.2f} steps in a period of the table's "
+            f"motion: the step alone moves the linear steady-state amplitude of DOF {i + 1} by "
+            f"{100 * err[i]:.1f} % (harmonic_step_error > 0.05, the stuck or the free system); the "
+            "response has the wrong amplitude; raise n1"
+        )
     if summary.get("stick_resolution") == "unresolved":
         ratio = summary["stick_ringing_ratio"]
         d = max(range(len(ratio)), key=lambda i: ratio[i])

@@ -128,6 +128,14 @@ program frictiondyn_main
       write (error_unit, '(a)') '  peak absolute accelerations may carry it (drifts and shears much less);'// &
          ' raise n1 until omega_max dt1 <= 2 to resolve them'
    end if
+   if (res%harmonic_resolution == resolution_unresolved) then
+      d = maxloc(res%harmonic_error, 1)
+      write (error_unit, '(a,es10.3,a,f0.2,a,i0,a,f0.1,a)') 'frictiondyn: warning: dt1 = ', res%dt1, &
+         ' s takes ', 1.0_dp/(res%eng%frequency*res%dt1), ' steps in a period of the table''s motion: the step '// &
+         'alone moves the linear steady-state amplitude of DOF ', d, ' by ', 100*res%harmonic_error(d), &
+         ' % (harmonic_step_error > 0.05, the stuck or the free system);'
+      write (error_unit, '(a)') '  the response has the wrong amplitude; raise n1'
+   end if
    if (res%stick_resolution == resolution_unresolved) then
       d = maxloc(res%stick_ringing_ratio, 1)
       write (error_unit, '(a,i0,a,es10.3,a,es10.3,a)') 'frictiondyn: warning: the sticking spring of device ', d, &

@@ -387,6 +387,8 @@ contains
       call kreal('omega_max_rad_s', res%omega_max)
       call kreal('omega_max_dt1', res%omega_max*res%dt1)
       call kv('mode_resolution', '"'//trim(resolution_names(res%mode_resolution))//'"')
+      if (allocated(res%harmonic_error)) call kr('harmonic_step_error', res%harmonic_error)
+      call kv('harmonic_resolution', '"'//trim(resolution_names(res%harmonic_resolution))//'"')
       call kr('stick_frequency_error', res%stick_freq_error)
       call kr('stick_ringing_ratio', res%stick_ringing_ratio)
       call kr('stick_ringing_N', res%stick_ringing)

@@ -48,6 +48,7 @@ module fd_result
       real(dp) :: dt_min = 0.0_dp          !! floor of step halving [s]
       real(dp) :: omega_max = 0.0_dp       !! highest natural circular frequency integrated at dt1 [rad/s]
       integer :: mode_resolution = resolution_none !! whether dt1 resolves the highest modes
+      integer :: harmonic_resolution = resolution_none !! whether dt1 resolves the table's frequency
       integer :: stick_resolution = resolution_none !! whether dt1 resolves the sticking springs'
                                                     !! ringing (fd_stick_ringing)
       integer :: technique = 0             !! technique id of the run (fd_names)
@@ -63,6 +64,7 @@ module fd_result
       integer, allocatable :: stick_to_slip(:)  !! stick-to-slip transitions
       integer, allocatable :: slip_to_stick(:)  !! slip-to-stick transitions
       integer, allocatable :: reversals(:)      !! slip+ to slip- and back, without sticking
+      real(dp), allocatable :: harmonic_error(:)      !! per DOF: the step's error in the linear steady state
       real(dp), allocatable :: stick_freq_error(:)    !! 1 - omega~/omega of the sticking spring's mode
       real(dp), allocatable :: stick_ringing_ratio(:) !! largest ringing / margin of a dephased stick phase
       real(dp), allocatable :: stick_ringing(:)       !! that phase's ringing amplitude [N]

@@ -17,6 +17,7 @@ module fd_technique
    use fd_event_driven, only: run_event_driven, event_driven_check
    use fd_moreau_jean, only: run_moreau_jean, moreau_jean_check
    use fd_mode_resolution, only: mode_resolution
+   use fd_harmonic_resolution, only: harmonic_resolution
    implicit none
    private
 
@@ -67,6 +68,8 @@ contains
       end select
       ! whether the step resolves the highest modes: one report for every stepping technique
       if (.not. allocated(error)) call mode_resolution(model, res, error)
+      ! and the table's frequency, when it has one (Newmark)
+      if (.not. allocated(error)) call harmonic_resolution(model, opts%beta, opts%gamma, res, error)
    end subroutine run_technique
 
    subroutine unknown_technique(technique, error)

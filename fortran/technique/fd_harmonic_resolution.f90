@@ -1,0 +1,134 @@
+!> Whether the main step resolves a harmonic table motion: the error the step alone makes in
+!> the linear steady state of the structure at the table's frequency, for the stuck and the
+!> free system, from closed forms (Newmark).
+!>
+!> Under a harmonic table motion sampled at the steps, a linear system integrated by Newmark's
+!> method has a steady state whose amplitude follows in closed form from the recursion
+!> (z = exp(i w dt), the response of each mode U = P / (1 / g_u + 2 xi wn g_v / g_u + wn^2),
+!> g_v = dt ((1 - gamma) + gamma z) / (z - 1), g_u = (dt g_v + dt^2 ((1/2 - beta) + beta z)) /
+!> (z - 1); for average acceleration this is the bilinear transform: the mode sees the
+!> forcing at (2 / dt) tan(w dt / 2)). Against the exact response 1 / (wn^2 - w^2 + 2 i xi wn
+!> w), summed over the summary's modes with their participation, it gives for each DOF how far
+!> the step moves the steady-state amplitude. A friction run is not linear, but it moves
+!> between these two systems, and a step that moves both by 20 % cannot give the right
+!> answer (a fuzz deck at n1 = 1, 6.4 steps in the table's period: peak displacement 267 %
+!> off, no other report). Above harmonic_error_limit the summary says "unresolved" and the
+!> executable and the command line warn. Not applicable: a record or no table motion (their
+!> content is not one frequency), no modes computed (n_modes = 0), or another technique.
+module fd_harmonic_resolution
+   use fd_kinds, only: dp
+   use fd_error, only: error_type, fatal_error, fmt_int, stat_no_memory
+   use fd_names, only: technique_newmark, excitation_harmonic
+   use fd_matrices, only: modes_type, modes_flexible, modes_unrestrained
+   use fd_model, only: model_type
+   use fd_result, only: result_type, resolution_none, resolution_resolved, resolution_unresolved
+   implicit none
+   private
+
+   public :: harmonic_resolution, newmark_response, harmonic_error_limit
+
+   !> relative change of a DOF's linear steady-state amplitude above which the step does not
+   !> resolve the table's frequency
+   real(dp), parameter :: harmonic_error_limit = 0.05_dp
+
+contains
+
+   !> Steady-state response U / P of a mode (unit modal mass, circular frequency wn, damping
+   !> ratio xi) to a force P exp(i w t) sampled at the steps dt of Newmark's (beta, gamma).
+   !> ok = .false. when w dt is a multiple of 2 pi (the steps see a constant force).
+   pure subroutine newmark_response(w, wn, xi, dt, beta, gamma, h, ok)
+      real(dp), intent(in) :: w, wn, xi     !! forcing and natural circular frequency [rad/s], damping ratio
+      real(dp), intent(in) :: dt            !! step [s]
+      real(dp), intent(in) :: beta, gamma   !! Newmark's parameters
+      complex(dp), intent(out) :: h         !! U / P [s2]
+      logical, intent(out) :: ok            !! the steps resolve a frequency at all
+      complex(dp) :: z, zm1, gv, gu
+      real(dp) :: x
+
+      x = w*dt
+      ! z - 1 = 2 i sin(x / 2) exp(i x / 2), without the cancellation of exp(i x) - 1
+      zm1 = cmplx(0.0_dp, 2.0_dp*sin(0.5_dp*x), dp)*cmplx(cos(0.5_dp*x), sin(0.5_dp*x), dp)
+      ok = abs(zm1) > 1e-12_dp
+      h = (0.0_dp, 0.0_dp)
+      if (.not. ok) return
+      z = zm1 + 1.0_dp
+      gv = dt*((1.0_dp - gamma) + gamma*z)/zm1
+      gu = (dt*gv + dt*dt*((0.5_dp - beta) + beta*z))/zm1
+      h = 1.0_dp/(1.0_dp/gu + 2.0_dp*xi*wn*gv/gu + wn*wn)
+   end subroutine newmark_response
+
+   !> Sets res%harmonic_error (per DOF, the larger over the stuck and the free system of
+   !> | |U_step| / |U| - 1 |, for the DOFs whose amplitude |U| is at least 1 % of the largest)
+   !> and res%harmonic_resolution, from the summary's modes (res%eng), the table's frequency,
+   !> res%dt1 and Newmark's beta, gamma.
+   subroutine harmonic_resolution(model, beta, gamma, res, error)
+      type(model_type), intent(in) :: model               !! the model (masses)
+      real(dp), intent(in) :: beta, gamma                 !! Newmark's parameters
+      type(result_type), intent(inout) :: res             !! the result of the run
+      type(error_type), allocatable, intent(out) :: error !! not enough memory
+      complex(dp), allocatable :: ue(:), ud(:)
+      integer :: n, stat
+      logical :: any_system, ok
+
+      n = model%n_dof
+      res%harmonic_resolution = resolution_none
+      if (allocated(res%harmonic_error)) deallocate (res%harmonic_error)
+      allocate (res%harmonic_error(n), ue(n), ud(n), stat=stat)
+      if (stat /= 0) then
+         call fatal_error(error, "the step against the table's frequency: not enough memory for "// &
+                          trim(fmt_int(n))//" DOFs", stat_no_memory)
+         return
+      end if
+      res%harmonic_error = 0.0_dp
+      if (res%technique /= technique_newmark .or. res%eng%excitation /= excitation_harmonic) return
+      if (res%dt1 <= 0.0_dp .or. .not. (res%eng%frequency > 0.0_dp)) return
+      any_system = .false.
+      ok = .true.
+      call one_system(res%eng%stuck)
+      call one_system(res%eng%free)
+      if (.not. any_system) return
+      res%harmonic_resolution = resolution_resolved
+      if (.not. ok .or. any(res%harmonic_error > harmonic_error_limit)) &
+         res%harmonic_resolution = resolution_unresolved
+
+   contains
+
+      subroutine one_system(modes)
+         type(modes_type), intent(in) :: modes
+         complex(dp) :: hd, he
+         real(dp) :: w, wn, gamma_k, big, xi
+         integer :: k, i
+         logical :: ok_k
+
+         if (modes%status /= modes_flexible .and. modes%status /= modes_unrestrained) return
+         if (modes%n < 1) return
+         any_system = .true.
+         w = 2.0_dp*acos(-1.0_dp)*res%eng%frequency
+         ue = (0.0_dp, 0.0_dp)
+         ud = (0.0_dp, 0.0_dp)
+         do k = 1, modes%n
+            wn = sqrt(max(modes%omega2(k), 0.0_dp))
+            xi = modes%xi(k)
+            gamma_k = sum(model%mass(1:n)*modes%shape(:, k))/sum(model%mass(1:n)*modes%shape(:, k)**2)
+            call newmark_response(w, wn, xi, res%dt1, beta, gamma, hd, ok_k)
+            he = cmplx(wn*wn - w*w, 2.0_dp*xi*wn*w, dp)
+            if (.not. ok_k .or. he == (0.0_dp, 0.0_dp)) then
+               ! the steps see a constant force, or an undamped resonance (no steady state):
+               ! no step resolves its amplitude
+               ok = .false.
+               res%harmonic_error = 1.0_dp
+               return
+            end if
+            ue = ue + (gamma_k/he)*modes%shape(:, k)
+            ud = ud + (gamma_k*hd)*modes%shape(:, k)
+         end do
+         big = maxval(abs(ue))
+         if (.not. (big > 0.0_dp)) return
+         do i = 1, n
+            if (abs(ue(i)) >= 0.01_dp*big) &
+               res%harmonic_error(i) = max(res%harmonic_error(i), abs(abs(ud(i))/abs(ue(i)) - 1.0_dp))
+         end do
+      end subroutine one_system
+   end subroutine harmonic_resolution
+
+end module fd_harmonic_resolution
