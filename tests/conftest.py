@@ -20,6 +20,11 @@ INPUTS = ROOT / "inputs"
 sys.path.append(str(ROOT / "tools" / "validation"))
 
 G = 9.81  # m/s2, the weight of block()
+# The paper's Fig. 3 deck (inputs/fig3_coarse.nml, check off): its steps that violate eq. 12
+# and its slide reversals (sign changes of s' within a step, Fig. 3b). Regression values of a
+# deliberately incorrect run, kept in one place: tests/reference holds them too, and
+# tools/update_reference.py is where an intended change of them starts.
+FIG3_VIOLATIONS, FIG3_REVERSALS = 413, 312
 
 EPS, F_STICK = 1e-3, 1e-5  # band eps = eps1 [m/s] and sticking displacement f [m] of block()
 

@@ -6,6 +6,8 @@ from __future__ import annotations
 import numpy as np
 import pytest
 from conftest import (
+    FIG3_REVERSALS,
+    FIG3_VIOLATIONS,
     EPS,
     F_STICK,
     INPUTS,
@@ -241,8 +243,8 @@ def test_fig3_coarse_deck_fails_and_the_corrected_one_agrees_with_the_velocity_l
     coarse = runs["fig3_coarse"].summary()
     # the paper's Fig. 3b: sign changes of the relative velocity within one step of a slide
     # (a reversal through the band, slip_reversals) and steps violating eq. 12
-    assert coarse["correctness_violations"] == 413
-    assert coarse["slip_reversals"] == [312]
+    assert coarse["correctness_violations"] == FIG3_VIOLATIONS
+    assert coarse["slip_reversals"] == [FIG3_REVERSALS]
     assert "violate the correctness condition" in runs["fig3_coarse"].stderr
     corrected = runs["test4_hysteretic"].summary()
     assert corrected["correctness_violations"] == 0

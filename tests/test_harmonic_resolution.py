@@ -141,3 +141,51 @@ def test_not_applicable_to_records_and_without_modes(run):
     assert s["harmonic_resolution"] == "not applicable" and not any(s["harmonic_step_error"])
     s = ok(run(SEED_23037.replace("N1", "1").replace("n_modes = 2", "n_modes = 0"))).summary()
     assert s["harmonic_resolution"] == "not applicable"
+
+
+BLOCK = """
+&model
+  n_dof = 1
+  mass = 1.0
+/
+&springs
+  n_springs = 0
+/
+&damping
+  damping_type = 'none'
+/
+&friction
+  n_devices = 1
+  node_i = 1
+  node_j = 0
+  law = 'velocity'
+  p = 9.81
+  mu = 0.05
+/
+&excitation
+  excitation_type = 'harmonic'
+  dt_record = 0.03
+  amplitude = 0.01
+  frequency = 10.0
+  duration = 3.0
+/
+&integration
+  n1 = N1
+/
+"""
+
+
+def test_a_sliding_block_its_rigid_body_mode(run):
+    """A block on a friction interface has no stuck mode (the stuck system does not move) and
+    one rigid-body free mode, whose damping ratio is undefined: its steady state under the
+    sampled table motion is -1/Omega^2 against -1/w^2, Omega = (2 / dt) tan(w dt / 2), 53 % off
+    at 3.3 steps a period (a reviewer found it skipped as "resolved" while the peaks were 32 %
+    off); resolved at n1 = 64."""
+    coarse = ok(run(BLOCK.replace("N1", "1"), name="coarse")).summary()
+    fine = ok(run(BLOCK.replace("N1", "64"), name="fine")).summary()
+    assert coarse["modes_free_status"] == "unrestrained"
+    x = 2 * math.pi * 10.0 * coarse["dt1_s"]
+    assert coarse["harmonic_step_error"][0] == pytest.approx(1 - (x / 2 / math.tan(x / 2)) ** 2, rel=1e-12)
+    assert coarse["harmonic_resolution"] == "unresolved"
+    assert fine["harmonic_resolution"] == "resolved" and fine["harmonic_step_error"][0] < 2e-4
+    assert abs(coarse["peak_u_m"][0] / fine["peak_u_m"][0] - 1) > 0.1

@@ -106,3 +106,34 @@ def test_the_warning_from_python_and_the_command_line(tmp_path):
     with contextlib.redirect_stderr(err), contextlib.redirect_stdout(io.StringIO()):
         assert cli(["run", str(deck), "--out", str(tmp_path / "out"), "--quiet"]) == 0
     assert "frictiondyn: warning: the integration dissipated" in err.getvalue()
+
+
+def test_the_energy_through_a_driven_structure(run):
+    """The denominator for a driven run: the sum over the steps of |input work of the step|,
+    -(1/2)(ag + ag1) m du, recomputed here from the history written at every step (gamma =
+    0.6, the resonant oscillator of test_convergence at n1 = 2: dissipative)."""
+    from test_convergence import OSCILLATOR
+
+    text = OSCILLATOR.replace("N1", "2\n  gamma = 0.6, beta = 0.3025") + "&output\n  output_every = 1\n/\n"
+    r = ok(run(text))
+    s, h = r.summary(), r.history()
+    work = -0.5 * (h["ag"][1:] + h["ag"][:-1]) * 1.0 * np.diff(h["u1"])
+    gross = np.sum(np.abs(work))
+    assert s["energy_input_J"] == pytest.approx(np.sum(work), rel=1e-9)
+    assert s["energy_residual_ratio"] == pytest.approx(s["energy_residual_J"] / gross, rel=1e-9)
+    assert s["energy_balance"] == "dissipative" and s["energy_residual_ratio"] > 0.05
+
+
+def test_an_energy_error_is_not_called_numerical_damping(run):
+    """Linear acceleration (gamma = 1/2, beta = 1/6) has no numerical damping, but its energy
+    is not conserved by the accounting: a positive residual (w dt = 1.6, stable below
+    sqrt(12)) is an "energy error", and the warning names beta, not gamma."""
+    r = ok(run(oscillator(0.08, 200, 0.5, 1 / 6)))
+    s = r.summary()
+    e0 = 0.5 * K * U0 * U0
+    expected = (e0 - newmark_energy(0.08, 200, 0.5, 1 / 6)) / e0
+    assert s["energy_residual_ratio"] == pytest.approx(expected, rel=1e-9)
+    assert abs(expected) > 0.05
+    assert s["energy_balance"] == "energy error"
+    assert "an energy error of the step (Newmark beta /= 1/4" in r.stderr
+    assert "numerical damping" not in r.stderr

@@ -13,7 +13,7 @@ from pathlib import Path
 import frictiondyn
 import numpy as np
 import pytest
-from conftest import INPUTS, MU, TABLE1, P
+from conftest import FIG3_REVERSALS, FIG3_VIOLATIONS, INPUTS, MU, TABLE1, P
 from frictiondyn import Output, Result, plots
 from frictiondyn.paper import paper_analysis
 from oracles import PAPER_OBSERVATION
@@ -168,7 +168,7 @@ def test_cli_run_writes_what_the_executable_writes(name, tmp_path):
     assert f"peak |a_abs| {s['peak_aabs_mps2'][0]:.6g} m/s2" in r.stdout
     assert f"correctness violations: {s['correctness_violations']}" in r.stdout
     if name == "fig3_coarse":  # the violations are also a warning, as the executable's
-        assert s["correctness_violations"] == 413
+        assert s["correctness_violations"] == FIG3_VIOLATIONS
         assert "violate the correctness condition" in r.stderr
 
 
@@ -262,7 +262,7 @@ def test_cli_paper_reproduces_table1_and_writes_the_figures(tmp_path):
     m = re.search(
         r"coarse run leaves (\d+) correctness violations .* and (\d+) slip reversals", report
     )
-    assert m and int(m.group(1)) == 413 and int(m.group(2)) == 312
+    assert m and int(m.group(1)) == FIG3_VIOLATIONS and int(m.group(2)) == FIG3_REVERSALS
     assert "The corrected run: 0 violations, 0 slip reversals" in report
     # Fig. 4: the two laws' steady-state peaks agree within 3 % (measured 0.34 % and 1.74 %)
     diffs = re.findall(r"\| (?:upper|lower) \(m\d\) \| [\d.]+ \| [\d.]+ \| ([+-][\d.]+) %", report)

@@ -81,8 +81,10 @@ class FrictiondynWarning(UserWarning):
     error: steps that violate the correctness condition (eqs. 9, 12), a step dt1 that does
     not resolve the structure's highest modes (summary ``mode_resolution``), or one that
     dephases the ringing of a sticking spring on which a device's stick-slip decisions rest
-    (summary ``stick_resolution``), or an integration that dissipated or created more than
-    5 % of the energy (summary ``energy_balance``). Issued when the
+    (summary ``stick_resolution``), a step that moves the linear steady state under a
+    harmonic table motion by more than 5 % (summary ``harmonic_resolution``), or an
+    integration that dissipated or created more than 5 % of the energy (summary
+    ``energy_balance``). Issued when the
     Result is made (``Session.result``, ``run``, ``Analysis.run``); the summary holds the
     figures. Filter it with the ``warnings`` module like any other warning."""
 
@@ -99,8 +101,9 @@ def newmark_steps(summary: dict) -> int:
 def summary_warnings(summary: dict) -> list[str]:
     """The warnings a summary calls for, as the executable prints them on standard error
     (without its "frictiondyn: warning: " prefix): correctness violations, a step dt1 that
-    does not resolve the highest modes, a step that dephases a sticking spring's ringing, and
-    an integration that dissipated (or created) more than 5 % of the energy."""
+    does not resolve the highest modes, one that misses a harmonic table motion's steady
+    state, one that dephases a sticking spring's ringing, and an integration that dissipated
+    (or created) more than 5 % of the energy."""
     out = []
     n = summary.get("correctness_violations", 0)
     if n:
@@ -141,13 +144,13 @@ def summary_warnings(summary: dict) -> list[str]:
             + (f" ({more} more device(s) likewise: summary stick_ringing_ratio)" if more else "")
         )
     balance = summary.get("energy_balance")
-    if balance in ("dissipative", "energy gain"):
+    if balance in ("dissipative", "energy error"):
         ratio = summary["energy_residual_ratio"]
         cause = (
             "numerical damping (Newmark gamma > 1/2, Moreau-Jean theta > 1/2) the physics does "
             "not have; the motion carries it: raise n1 (it shrinks with dt1) or use gamma = "
             "theta = 1/2"
-            if ratio > 0
+            if balance == "dissipative"
             else "an energy error of the step (Newmark beta /= 1/4, or a step beyond its rule's "
             "stability limit) the physics does not have; the motion carries it: raise n1 or use "
             "beta = 1/4"

@@ -286,10 +286,14 @@ def cmd_compare(args: argparse.Namespace) -> int:
 def cmd_converge(args: argparse.Namespace) -> int:
     from .convergence import step_convergence
 
-    report = step_convergence(args.deck, factor=args.factor, levels=args.levels, rtol=args.rtol)
+    target = Path(args.json) if args.json else None
+    if target is not None and not target.parent.is_dir():  # before the study, not after it
+        raise CliError(f"--json {target}: its directory {target.parent} does not exist")
+    report = step_convergence(
+        args.deck, factor=args.factor, levels=args.levels, rtol=args.rtol, threads=args.threads
+    )
     print(report)
-    if args.json:
-        target = Path(args.json)
+    if target is not None:
         tmp = target.with_name(f".{target.name}.{os.getpid()}.tmp")
         try:
             tmp.write_text(json.dumps(report.to_dict(), indent=1) + "\n")
@@ -388,6 +392,10 @@ def build_parser() -> argparse.ArgumentParser:
         help="largest change allowed between levels, relative (default 0.01)",
     )
     p.add_argument("--json", metavar="FILE", help="also write the whole comparison as JSON")
+    p.add_argument(
+        "--threads", type=int, default=None,
+        help="levels run side by side (default: the levels, at most the CPUs available)",
+    )
     p.set_defaults(func=cmd_converge)
 
     p = sub.add_parser("paper", help="recompute the paper's Table 1 and Figs. 2, 3, 4")

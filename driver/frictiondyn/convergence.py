@@ -21,13 +21,13 @@ import json
 import math
 import os
 from collections.abc import Sequence
-from concurrent.futures import ThreadPoolExecutor, wait
+from concurrent.futures import FIRST_EXCEPTION, ThreadPoolExecutor, wait
 from dataclasses import dataclass, field
 from pathlib import Path
 
 import f90nml
 
-from ._api import _SUMMARY, DeckError, Session, summary_warnings
+from ._api import _SUMMARY, DeckError, FrictiondynError, Session, summary_warnings
 
 __all__ = ["ConvergenceReport", "Quantity", "step_convergence"]
 
@@ -158,8 +158,8 @@ class ConvergenceReport:
 
 def _deck(deck: str | os.PathLike) -> tuple[f90nml.Namelist, Path]:
     path = Path(deck)
-    try:
-        text = path.read_text()
+    try:  # the deck's bytes as the library reads them (a Latin-1 comment is no error)
+        text = path.read_bytes().decode("utf-8", "surrogateescape")
     except FileNotFoundError:
         raise DeckError(f"{path}: no such deck") from None
     except (OSError, UnicodeDecodeError) as exc:
@@ -239,6 +239,14 @@ def _compare(summaries: list[dict], rtol: float) -> list[Quantity]:
     return out
 
 
+def _cpus() -> int:
+    """The CPUs this process may use (its affinity: taskset, a Slurm allocation)."""
+    try:
+        return len(os.sched_getaffinity(0))
+    except (AttributeError, OSError):
+        return os.cpu_count() or 1
+
+
 def step_convergence(
     deck: str | os.PathLike,
     factor: int = 2,
@@ -253,7 +261,7 @@ def step_convergence(
     hardly moves is judged against the structure's motion); a residual drift or slip is
     judged against the largest peak drift or slip, the friction energy against the energy
     input; a stick-slip count may move by max(2, 10 %). ``threads``: runs side by side
-    (default: as many as there are levels, at most the CPUs). Raises DeckError for a bad
+    (default: as many as there are levels, at most the CPUs this process may use). Raises DeckError for a bad
     deck, or for the event-driven technique (exact: its n1 only samples the history).
     """
     if isinstance(factor, bool) or not isinstance(factor, int) or factor < 2:
@@ -273,17 +281,21 @@ def step_convergence(
     factors = [factor**k for k in range(levels + 1)]
     texts = [_level_text(nml, f) for f in factors]
     n1 = [int(f90nml.reads(t)["integration"]["n1"]) for t in texts]
-    names = [f"{path.stem}.n1_{n}{path.suffix}" for n in n1]
-    workers = max(1, threads or min(len(texts), os.cpu_count() or 1))
+    workers = max(1, threads or min(len(texts), _cpus()))
     sessions: list[Session] = []
+    level = n1[0]
     try:
-        for text, name in zip(texts, names):
-            sessions.append(Session.from_text(text, name, path.parent))
+        for text, level in zip(texts, n1):
+            sessions.append(Session.from_text(text, path.name, path.parent))
             sessions[-1].select([], [])  # the summary has every peak; no history is kept
         with ThreadPoolExecutor(max_workers=workers) as pool:
             futures = [pool.submit(s.solve, None, False) for s in sessions]
             try:
-                for f in futures:
+                wait(futures, return_when=FIRST_EXCEPTION)  # a failed level stops the others at once
+                for f, level in zip(futures, n1):
+                    if f.done() and f.exception() is not None:
+                        f.result()  # raises it
+                for f, level in zip(futures, n1):
                     f.result()
             except BaseException:  # Ctrl-C or a failed level: stop the others, then raise
                 for f in futures:
@@ -294,6 +306,8 @@ def step_convergence(
                     wait(futures, timeout=0.05)
                 raise
         summaries = [json.loads(s._text(_SUMMARY)) for s in sessions]
+    except FrictiondynError as exc:  # say which level
+        raise type(exc)(f"{exc} (in the step convergence study, the level n1 = {level})") from None
     finally:
         for s in sessions:
             s.close()

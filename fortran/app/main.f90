@@ -19,7 +19,7 @@ program frictiondyn_main
                          session_set_progress
    use fd_progress_line, only: progress_wanted, progress_show, progress_clear
    use fd_version, only: frictiondyn_version
-   use fd_result, only: resolution_unresolved, residual_ratio_limit
+   use fd_result, only: resolution_unresolved, residual_ratio_limit, energy_balance_name
    implicit none
 
    interface
@@ -43,6 +43,7 @@ program frictiondyn_main
    type(error_type), allocatable :: error
    character(len=:), allocatable :: deck, list, index_text, arg, hist, summ, htmp, stmp, tag
    character(kind=c_char, len=300) :: tagbuf
+   character(len=32) :: num
    integer :: nargs, i, idx, ios, d
    interface
       !> C's exit: ends the program with a status and no message (Fortran 2008 has no
@@ -130,8 +131,10 @@ program frictiondyn_main
    end if
    if (res%harmonic_resolution == resolution_unresolved) then
       d = maxloc(res%harmonic_error, 1)
-      write (error_unit, '(a,es10.3,a,f0.2,a,i0,a,f0.1,a)') 'frictiondyn: warning: dt1 = ', res%dt1, &
-         ' s takes ', 1.0_dp/(res%eng%frequency*res%dt1), ' steps in a period of the table''s motion: the step '// &
+      write (num, '(f0.2)') 1.0_dp/(res%eng%frequency*res%dt1)
+      if (num(1:1) == '.') num = '0'//num        ! f0.2 drops the leading zero
+      write (error_unit, '(a,es10.3,a,a,a,i0,a,f0.1,a)') 'frictiondyn: warning: dt1 = ', res%dt1, &
+         ' s takes ', trim(num), ' steps in a period of the table''s motion: the step '// &
          'alone moves the linear steady-state amplitude of DOF ', d, ' by ', 100*res%harmonic_error(d), &
          ' % (harmonic_step_error > 0.05, the stuck or the free system);'
       write (error_unit, '(a)') '  the response has the wrong amplitude; raise n1'
@@ -152,7 +155,7 @@ program frictiondyn_main
       write (error_unit, '(a,a,1x,f0.1,a,f4.2,a)') 'frictiondyn: warning: the integration ', &
          trim(merge('dissipated', 'created   ', res%e_residual_ratio > 0.0_dp)), 100*abs(res%e_residual_ratio), &
          ' % of the energy the structure held and received (|energy_residual_ratio| > ', residual_ratio_limit, '):'
-      if (res%e_residual_ratio > 0.0_dp) then
+      if (energy_balance_name(res%e_residual_ratio, res%damping_method) == 'dissipative') then
          write (error_unit, '(a)') '  numerical damping (Newmark gamma > 1/2, Moreau-Jean theta > 1/2) the physics '// &
             'does not have; the motion carries it: raise n1 (it shrinks with dt1) or use gamma = theta = 1/2'
       else

@@ -3,11 +3,15 @@
 !> constant force P mu sgn(sdot) while sliding. Correctness condition: eq. 12.
 !>
 !> Sliding starts when |F| reaches P mu (eqs. 3-4); the centre of the elastic range moves
-!> with the plastic slip so that F stays continuous. Sliding ends by eq. 2, |sdot| < eps1,
-!> but only once |sdot| has reached eps1 in this sliding phase ("armed"): at the onset of
-!> sliding |sdot| is far below eps1, and eq. 2 read literally would end every sliding phase
-!> at once. Before that, sliding ends when sdot turns against the sliding direction.
-!> An armed slide whose velocity has crossed to the other side of the band reverses.
+!> with the plastic slip so that F stays continuous. Sliding ends at the turn of sdot (eq. 1,
+!> the extremum of s), located to the step: an armed slide (|sdot| has reached eps1 in this
+!> sliding phase) sticks in the step whose sdot has turned within the band |sdot| < eps1
+!> (eq. 2); one whose sdot enters the band still along the slide goes on, unarmed (ended
+!> there, its residual velocity carried the elastic force past P mu within a step: a
+!> one-step stick, two transitions for one stop). An unarmed slide (the onset, where |sdot|
+!> is far below eps1 and eq. 2 read literally would end it at once) ends when sdot turns
+!> against the sliding direction. An armed slide whose velocity crossed the whole band
+!> within one step reverses. docs/theory.md section 5.2.
 module fd_friction_hysteretic
    use fd_kinds, only: dp
    use fd_model, only: device_type, sticking_stiffness

@@ -444,7 +444,7 @@ contains
       call kreal('energy_device_elastic_J', res%e_device)
       call kreal('energy_residual_J', res%e_residual)
       call kreal('energy_residual_ratio', res%e_residual_ratio)
-      call kv('energy_balance', '"'//energy_balance_name(res%e_residual_ratio)//'"')
+      call kv('energy_balance', '"'//energy_balance_name(res%e_residual_ratio, res%damping_method)//'"')
       call engineering_keys()
       call kint('samples', res%nout)
       call put('  "run_time_s": '//trim(json_real(res%run_time))//nl//'}')

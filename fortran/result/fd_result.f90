@@ -109,6 +109,7 @@ module fd_result
       real(dp) :: e_residual = 0.0_dp  !! input - (kinetic + strain + viscous + friction + device)
       real(dp) :: e_input_gross = 0.0_dp !! sum over the steps of |input work of the step|
       real(dp) :: e_residual_ratio = 0.0_dp !! e_residual / (initial energy + e_input_gross)
+      logical :: damping_method = .false. !! the method damps (Newmark gamma, Moreau-Jean theta > 1/2)
       real(dp) :: run_time = 0.0_dp    !! wall-clock time of the integration [s]
       ! names, modes, storey drifts and shears, residual values (fd_engineering)
       type(engineering_type) :: eng    !! the engineering outputs
@@ -116,19 +117,21 @@ module fd_result
 
 contains
 
-   !> The summary's energy_balance: "closed" when |e_residual_ratio| <= residual_ratio_limit,
-   !> "dissipative" (numerical damping: Newmark gamma > 1/2, Moreau-Jean theta > 1/2) or
-   !> "energy gain" beyond it.
-   pure function energy_balance_name(ratio) result(name)
-      real(dp), intent(in) :: ratio   !! e_residual_ratio
+   !> The summary's energy_balance: "closed" when |e_residual_ratio| <= residual_ratio_limit;
+   !> beyond, "dissipative" when the ratio is positive and the method damps (damping_method:
+   !> Newmark gamma > 1/2, Moreau-Jean theta > 1/2), else "energy error" (Newmark beta /= 1/4,
+   !> a step beyond its rule's stability limit).
+   pure function energy_balance_name(ratio, damping_method) result(name)
+      real(dp), intent(in) :: ratio          !! e_residual_ratio
+      logical, intent(in) :: damping_method  !! the method has numerical damping
       character(len=:), allocatable :: name
 
       if (abs(ratio) <= residual_ratio_limit) then
          name = 'closed'
-      else if (ratio > 0.0_dp) then
+      else if (ratio > 0.0_dp .and. damping_method) then
          name = 'dissipative'
       else
-         name = 'energy gain'
+         name = 'energy error'
       end if
    end function energy_balance_name
 

@@ -4,11 +4,12 @@
 !>
 !> Under a harmonic table motion sampled at the steps, a linear system integrated by Newmark's
 !> method has a steady state whose amplitude follows in closed form from the recursion
-!> (z = exp(i w dt), the response of each mode U = P / (1 / g_u + 2 xi wn g_v / g_u + wn^2),
+!> (z = exp(i w dt), the response of each mode U = P / (1 / g_u + c g_v / g_u + wn^2), c its
+!> damping per unit modal mass (2 xi wn; a0 for a rigid-body mode),
 !> g_v = dt ((1 - gamma) + gamma z) / (z - 1), g_u = (dt g_v + dt^2 ((1/2 - beta) + beta z)) /
 !> (z - 1); for average acceleration this is the bilinear transform: the mode sees the
-!> forcing at (2 / dt) tan(w dt / 2)). Against the exact response 1 / (wn^2 - w^2 + 2 i xi wn
-!> w), summed over the summary's modes with their participation, it gives for each DOF how far
+!> forcing at (2 / dt) tan(w dt / 2)). Against the exact response 1 / (wn^2 - w^2 + i c w),
+!> summed over the summary's modes with their participation, it gives for each DOF how far
 !> the step moves the steady-state amplitude. A friction run is not linear, but it moves
 !> between these two systems, and a step that moves both by 20 % cannot give the right
 !> answer (a fuzz deck at n1 = 1, 6.4 steps in the table's period: peak displacement 267 %
@@ -16,6 +17,7 @@
 !> executable and the command line warn. Not applicable: a record or no table motion (their
 !> content is not one frequency), no modes computed (n_modes = 0), or another technique.
 module fd_harmonic_resolution
+   use, intrinsic :: ieee_arithmetic, only: ieee_is_finite
    use fd_kinds, only: dp
    use fd_error, only: error_type, fatal_error, fmt_int, stat_no_memory
    use fd_names, only: technique_newmark, excitation_harmonic
@@ -34,10 +36,12 @@ module fd_harmonic_resolution
 contains
 
    !> Steady-state response U / P of a mode (unit modal mass, circular frequency wn, damping
-   !> ratio xi) to a force P exp(i w t) sampled at the steps dt of Newmark's (beta, gamma).
-   !> ok = .false. when w dt is a multiple of 2 pi (the steps see a constant force).
-   pure subroutine newmark_response(w, wn, xi, dt, beta, gamma, h, ok)
-      real(dp), intent(in) :: w, wn, xi     !! forcing and natural circular frequency [rad/s], damping ratio
+   !> c per unit modal mass, 2 xi wn) to a force P exp(i w t) sampled at the steps dt of
+   !> Newmark's (beta, gamma). ok = .false. when w dt is a multiple of 2 pi (the steps see a
+   !> constant force).
+   pure subroutine newmark_response(w, wn, c, dt, beta, gamma, h, ok)
+      real(dp), intent(in) :: w, wn         !! forcing and natural circular frequency [rad/s]
+      real(dp), intent(in) :: c             !! damping per unit modal mass [1/s]
       real(dp), intent(in) :: dt            !! step [s]
       real(dp), intent(in) :: beta, gamma   !! Newmark's parameters
       complex(dp), intent(out) :: h         !! U / P [s2]
@@ -54,7 +58,7 @@ contains
       z = zm1 + 1.0_dp
       gv = dt*((1.0_dp - gamma) + gamma*z)/zm1
       gu = (dt*gv + dt*dt*((0.5_dp - beta) + beta*z))/zm1
-      h = 1.0_dp/(1.0_dp/gu + 2.0_dp*xi*wn*gv/gu + wn*wn)
+      h = 1.0_dp/(1.0_dp/gu + c*gv/gu + wn*wn)
    end subroutine newmark_response
 
    !> Sets res%harmonic_error (per DOF, the larger over the stuck and the free system of
@@ -96,7 +100,7 @@ contains
       subroutine one_system(modes)
          type(modes_type), intent(in) :: modes
          complex(dp) :: hd, he
-         real(dp) :: w, wn, gamma_k, big, xi
+         real(dp) :: w, wn, gamma_k, big, c
          integer :: k, i
          logical :: ok_k
 
@@ -108,10 +112,12 @@ contains
          ud = (0.0_dp, 0.0_dp)
          do k = 1, modes%n
             wn = sqrt(max(modes%omega2(k), 0.0_dp))
-            xi = modes%xi(k)
+            ! C = a0 M + a1 K: phi' C phi / phi' M phi = a0 + a1 wn^2 (2 xi wn), also for a
+            ! rigid-body mode (whose damping ratio is undefined)
+            c = res%eng%a0 + res%eng%a1*wn*wn
             gamma_k = sum(model%mass(1:n)*modes%shape(:, k))/sum(model%mass(1:n)*modes%shape(:, k)**2)
-            call newmark_response(w, wn, xi, res%dt1, beta, gamma, hd, ok_k)
-            he = cmplx(wn*wn - w*w, 2.0_dp*xi*wn*w, dp)
+            call newmark_response(w, wn, c, res%dt1, beta, gamma, hd, ok_k)
+            he = cmplx(wn*wn - w*w, c*w, dp)
             if (.not. ok_k .or. he == (0.0_dp, 0.0_dp)) then
                ! the steps see a constant force, or an undamped resonance (no steady state):
                ! no step resolves its amplitude
@@ -122,6 +128,14 @@ contains
             ue = ue + (gamma_k/he)*modes%shape(:, k)
             ud = ud + (gamma_k*hd)*modes%shape(:, k)
          end do
+         ! not finite (tested without an ordered comparison, which a NaN would trap in the
+         ! checked build): the estimate failed, which is not a "resolved"
+         if (.not. (all(ieee_is_finite(real(ue))) .and. all(ieee_is_finite(aimag(ue))) .and. &
+                    all(ieee_is_finite(real(ud))) .and. all(ieee_is_finite(aimag(ud))))) then
+            ok = .false.
+            res%harmonic_error = 1.0_dp
+            return
+         end if
          big = maxval(abs(ue))
          if (.not. (big > 0.0_dp)) return
          do i = 1, n

@@ -6,6 +6,7 @@
 !> adding a technique is its module, its row in fd_names' technique table and one case in
 !> each routine here.
 module fd_technique
+   use fd_kinds, only: dp
    use fd_error, only: error_type, fatal_error, fmt_int
    use fd_names, only: technique_newmark, technique_event_driven, technique_moreau_jean, techniques, &
                        keyword_choices
@@ -66,6 +67,10 @@ contains
       case default
          call unknown_technique(opts%technique, error)
       end select
+      ! whether a residual of the energy balance can be the method's numerical damping (set
+      ! after the run: each technique's res is intent(out))
+      res%damping_method = (opts%technique == technique_newmark .and. opts%gamma > 0.5_dp) .or. &
+                           (opts%technique == technique_moreau_jean .and. opts%theta > 0.5_dp)
       ! whether the step resolves the highest modes: one report for every stepping technique
       if (.not. allocated(error)) call mode_resolution(model, res, error)
       ! and the table's frequency, when it has one (Newmark)
