@@ -7,7 +7,7 @@ module fd_output
    use fd_kinds, only: dp
    use fd_error, only: error_type, fatal_error, fmt_int, fmt_real
    use fd_model, only: model_type, output_type, law_name, technique_name
-   use fd_result, only: result_type, resolution_names, energy_balance_name
+   use fd_result, only: result_type, resolution_names, energy_balance, energy_balance_names
    use fd_record, only: record_info
    use fd_version, only: frictiondyn_version
    use fd_history_stream, only: format_row, stream_value_width
@@ -444,7 +444,8 @@ contains
       call kreal('energy_device_elastic_J', res%e_device)
       call kreal('energy_residual_J', res%e_residual)
       call kreal('energy_residual_ratio', res%e_residual_ratio)
-      call kv('energy_balance', '"'//energy_balance_name(res%e_residual_ratio, res%damping_method)//'"')
+      call kv('energy_balance', '"'//trim(energy_balance_names(energy_balance(res%e_residual_ratio, &
+                                                                                res%damping_method)))//'"')
       call engineering_keys()
       call kint('samples', res%nout)
       call put('  "run_time_s": '//trim(json_real(res%run_time))//nl//'}')

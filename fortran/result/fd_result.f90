@@ -15,7 +15,8 @@ module fd_result
    public :: nonfinite_history_error
    public :: max_event_times, has_envelope
    public :: resolution_none, resolution_resolved, resolution_unresolved, resolution_names
-   public :: residual_ratio_limit, energy_balance_name
+   public :: residual_ratio_limit, energy_balance, energy_balance_names
+   public :: balance_closed, balance_dissipative, balance_error
 
    integer, parameter :: max_violation_times = 10 !! first violation times kept
    integer, parameter :: max_event_times = 1000   !! first event times kept (exact technique)
@@ -30,6 +31,12 @@ module fd_result
    !> |e_residual_ratio| above this: the integration dissipated (or created) a share of the
    !> energy that the motion feels (docs/theory.md section 7)
    real(dp), parameter :: residual_ratio_limit = 0.05_dp
+   integer, parameter :: balance_closed = 1       !! |ratio| <= residual_ratio_limit
+   integer, parameter :: balance_dissipative = 2  !! the method's numerical damping beyond it
+   integer, parameter :: balance_error = 3        !! an energy error of the step beyond it
+   !> their names in the summary
+   character(len=12), parameter :: energy_balance_names(3) = [character(len=12) :: 'closed', 'dissipative', &
+                                                              'energy error']
 
    !> Everything a run produces.
    type :: result_type
@@ -117,23 +124,24 @@ module fd_result
 
 contains
 
-   !> The summary's energy_balance: "closed" when |e_residual_ratio| <= residual_ratio_limit;
-   !> beyond, "dissipative" when the ratio is positive and the method damps (damping_method:
-   !> Newmark gamma > 1/2, Moreau-Jean theta > 1/2), else "energy error" (Newmark beta /= 1/4,
-   !> a step beyond its rule's stability limit).
-   pure function energy_balance_name(ratio, damping_method) result(name)
+   !> The summary's energy_balance: balance_closed when |e_residual_ratio| <=
+   !> residual_ratio_limit; beyond, balance_dissipative when the ratio is positive and the
+   !> method damps (damping_method: Newmark gamma > 1/2, Moreau-Jean theta > 1/2), else
+   !> balance_error (Newmark beta /= 1/4, a step beyond its rule's stability limit). Named by
+   !> energy_balance_names (a fixed-length table, as resolution_names: a deferred-length
+   !> function result came back empty in one of many concurrent runs of the checked build).
+   pure integer function energy_balance(ratio, damping_method)
       real(dp), intent(in) :: ratio          !! e_residual_ratio
       logical, intent(in) :: damping_method  !! the method has numerical damping
-      character(len=:), allocatable :: name
 
       if (abs(ratio) <= residual_ratio_limit) then
-         name = 'closed'
+         energy_balance = balance_closed
       else if (ratio > 0.0_dp .and. damping_method) then
-         name = 'dissipative'
+         energy_balance = balance_dissipative
       else
-         name = 'energy error'
+         energy_balance = balance_error
       end if
-   end function energy_balance_name
+   end function energy_balance
 
    !> Whether a run of these settings writes, after the state columns, the maxima of |u|,
    !> |v|, |aabs| per DOF, |s|, |F| per device and |drift|, |V| per storey and |Vb| since the
