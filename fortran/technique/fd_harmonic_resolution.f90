@@ -112,9 +112,15 @@ contains
          ud = (0.0_dp, 0.0_dp)
          do k = 1, modes%n
             wn = sqrt(max(modes%omega2(k), 0.0_dp))
-            ! C = a0 M + a1 K: phi' C phi / phi' M phi = a0 + a1 wn^2 (2 xi wn), also for a
-            ! rigid-body mode (whose damping ratio is undefined)
-            c = res%eng%a0 + res%eng%a1*wn*wn
+            ! the damping per unit modal mass phi' C phi / phi' M phi: 2 xi wn; for a rigid-body
+            ! mode (its damping ratio undefined: NaN) a0 of C = a0 M + a1 K, since K phi = 0
+            ! (not a0 + a1 wn^2 for every mode: the stuck system's K holds the sticking
+            ! springs, which C's K does not)
+            if (modes%omega2(k) > 0.0_dp) then
+               c = 2.0_dp*modes%xi(k)*wn
+            else
+               c = res%eng%a0
+            end if
             gamma_k = sum(model%mass(1:n)*modes%shape(:, k))/sum(model%mass(1:n)*modes%shape(:, k)**2)
             call newmark_response(w, wn, c, res%dt1, beta, gamma, hd, ok_k)
             he = cmplx(wn*wn - w*w, c*w, dp)
