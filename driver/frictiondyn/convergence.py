@@ -214,11 +214,7 @@ def _compare(summaries: list[dict], rtol: float) -> list[Quantity]:
         floor = FLOOR * max(abs(x) for r in rows for x in r)
         peaks = None
         if peak_key is not None:  # a residual: judged against the peak of the same item
-            peaks = []
-            for s in summaries:
-                p = s.get(peak_key, 0.0)
-                p = p if isinstance(p, list) else [p]
-                peaks.append(p if len(p) == n else [max((abs(x) for x in p), default=0.0)] * n)
+            peaks = [s[peak_key] if isinstance(s[peak_key], list) else [s[peak_key]] for s in summaries]
         for i, item in enumerate(_items(kind, summaries[0], n)):
             values = [float(r[i]) for r in rows]
             size = max(max(abs(v) for v in values), floor)

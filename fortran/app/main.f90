@@ -19,7 +19,7 @@ program frictiondyn_main
                          session_set_progress
    use fd_progress_line, only: progress_wanted, progress_show, progress_clear
    use fd_version, only: frictiondyn_version
-   use fd_result, only: resolution_unresolved, residual_ratio_limit, energy_balance, balance_dissipative
+   use fd_result, only: resolution_unresolved, residual_ratio_limit, balance_closed, balance_dissipative
    implicit none
 
    interface
@@ -151,11 +151,11 @@ program frictiondyn_main
       if (count(res%stick_ringing_ratio > 1.0_dp) > 1) write (error_unit, '(a,i0,a)') '  (', &
          count(res%stick_ringing_ratio > 1.0_dp) - 1, ' more device(s) likewise: summary stick_ringing_ratio)'
    end if
-   if (abs(res%e_residual_ratio) > residual_ratio_limit) then
+   if (res%energy_balance /= balance_closed) then
       write (error_unit, '(a,a,1x,f0.1,a,f4.2,a)') 'frictiondyn: warning: the integration ', &
          trim(merge('dissipated', 'created   ', res%e_residual_ratio > 0.0_dp)), 100*abs(res%e_residual_ratio), &
          ' % of the energy the structure held and received (|energy_residual_ratio| > ', residual_ratio_limit, '):'
-      if (energy_balance(res%e_residual_ratio, res%damping_method) == balance_dissipative) then
+      if (res%energy_balance == balance_dissipative) then
          write (error_unit, '(a)') '  numerical damping (Newmark gamma > 1/2, Moreau-Jean theta > 1/2) the physics '// &
             'does not have; the motion carries it: raise n1 (it shrinks with dt1) or use gamma = theta = 1/2'
       else

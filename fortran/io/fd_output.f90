@@ -7,7 +7,7 @@ module fd_output
    use fd_kinds, only: dp
    use fd_error, only: error_type, fatal_error, fmt_int, fmt_real
    use fd_model, only: model_type, output_type, law_name, technique_name
-   use fd_result, only: result_type, resolution_names, energy_balance, energy_balance_names
+   use fd_result, only: result_type, resolution_names, energy_balance_names
    use fd_record, only: record_info
    use fd_version, only: frictiondyn_version
    use fd_history_stream, only: format_row, stream_value_width
@@ -387,7 +387,7 @@ contains
       call kreal('omega_max_rad_s', res%omega_max)
       call kreal('omega_max_dt1', res%omega_max*res%dt1)
       call kv('mode_resolution', '"'//trim(resolution_names(res%mode_resolution))//'"')
-      if (allocated(res%harmonic_error)) call kr('harmonic_step_error', res%harmonic_error)
+      call kr('harmonic_step_error', res%harmonic_error)
       call kv('harmonic_resolution', '"'//trim(resolution_names(res%harmonic_resolution))//'"')
       call kr('stick_frequency_error', res%stick_freq_error)
       call kr('stick_ringing_ratio', res%stick_ringing_ratio)
@@ -444,8 +444,7 @@ contains
       call kreal('energy_device_elastic_J', res%e_device)
       call kreal('energy_residual_J', res%e_residual)
       call kreal('energy_residual_ratio', res%e_residual_ratio)
-      call kv('energy_balance', '"'//trim(energy_balance_names(energy_balance(res%e_residual_ratio, &
-                                                                                res%damping_method)))//'"')
+      call kv('energy_balance', '"'//trim(energy_balance_names(res%energy_balance))//'"')
       call engineering_keys()
       call kint('samples', res%nout)
       call put('  "run_time_s": '//trim(json_real(res%run_time))//nl//'}')

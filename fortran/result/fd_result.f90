@@ -15,7 +15,7 @@ module fd_result
    public :: nonfinite_history_error
    public :: max_event_times, has_envelope
    public :: resolution_none, resolution_resolved, resolution_unresolved, resolution_names
-   public :: residual_ratio_limit, energy_balance, energy_balance_names
+   public :: residual_ratio_limit, energy_balance_of, energy_balance_names
    public :: balance_closed, balance_dissipative, balance_error
 
    integer, parameter :: max_violation_times = 10 !! first violation times kept
@@ -116,7 +116,7 @@ module fd_result
       real(dp) :: e_residual = 0.0_dp  !! input - (kinetic + strain + viscous + friction + device)
       real(dp) :: e_input_gross = 0.0_dp !! sum over the steps of |input work of the step|
       real(dp) :: e_residual_ratio = 0.0_dp !! e_residual / (initial energy + e_input_gross)
-      logical :: damping_method = .false. !! the method damps (Newmark gamma, Moreau-Jean theta > 1/2)
+      integer :: energy_balance = balance_closed !! e_residual_ratio's verdict (energy_balance_of)
       real(dp) :: run_time = 0.0_dp    !! wall-clock time of the integration [s]
       ! names, modes, storey drifts and shears, residual values (fd_engineering)
       type(engineering_type) :: eng    !! the engineering outputs
@@ -124,13 +124,13 @@ module fd_result
 
 contains
 
-   !> The summary's energy_balance: balance_closed when |e_residual_ratio| <=
+   !> The summary's energy_balance (res%energy_balance, set once after the run): balance_closed when |e_residual_ratio| <=
    !> residual_ratio_limit; beyond, balance_dissipative when the ratio is positive and the
    !> method damps (damping_method: Newmark gamma > 1/2, Moreau-Jean theta > 1/2), else
    !> balance_error (Newmark beta /= 1/4, a step beyond its rule's stability limit). Named by
    !> energy_balance_names (a fixed-length table, as resolution_names: a deferred-length
    !> function result came back empty in one of many concurrent runs of the checked build).
-   pure integer function energy_balance(ratio, damping_method)
+   pure integer function energy_balance_of(ratio, damping_method) result(energy_balance)
       real(dp), intent(in) :: ratio          !! e_residual_ratio
       logical, intent(in) :: damping_method  !! the method has numerical damping
 
@@ -141,7 +141,7 @@ contains
       else
          energy_balance = balance_error
       end if
-   end function energy_balance
+   end function energy_balance_of
 
    !> Whether a run of these settings writes, after the state columns, the maxima of |u|,
    !> |v|, |aabs| per DOF, |s|, |F| per device and |drift|, |V| per storey and |Vb| since the
@@ -245,7 +245,7 @@ contains
       end if
       allocate (res%peak_u(n), res%peak_u_time(n), res%peak_v(n), res%peak_aabs(n), &
                 res%peak_aabs_time(n), res%peak_s(nd), res%peak_force(nd), res%stick_to_slip(nd), &
-                res%slip_to_stick(nd), res%reversals(nd), res%stick_freq_error(nd), &
+                res%slip_to_stick(nd), res%reversals(nd), res%harmonic_error(n), res%stick_freq_error(nd), &
                 res%stick_ringing_ratio(nd), res%stick_ringing(nd), res%stick_margin(nd), stat=stat)
       if (stat /= 0) then
          call fatal_error(error, "not enough memory for the summary of "//trim(fmt_int(n))//" DOFs and "// &
@@ -256,6 +256,7 @@ contains
       res%peak_aabs = 0.0_dp; res%peak_aabs_time = 0.0_dp
       res%peak_s = 0.0_dp; res%peak_force = 0.0_dp
       res%stick_to_slip = 0; res%slip_to_stick = 0; res%reversals = 0
+      res%harmonic_error = 0.0_dp
       res%stick_freq_error = 0.0_dp; res%stick_ringing_ratio = 0.0_dp
       res%stick_ringing = 0.0_dp; res%stick_margin = 0.0_dp
    end subroutine init_result

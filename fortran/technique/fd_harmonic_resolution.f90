@@ -76,16 +76,15 @@ contains
 
       n = model%n_dof
       res%harmonic_resolution = resolution_none
-      if (allocated(res%harmonic_error)) deallocate (res%harmonic_error)
-      allocate (res%harmonic_error(n), ue(n), ud(n), stat=stat)
+      res%harmonic_error = 0.0_dp               ! allocated with the summary (init_result)
+      if (res%technique /= technique_newmark .or. res%eng%excitation /= excitation_harmonic) return
+      if (res%dt1 <= 0.0_dp .or. .not. (res%eng%frequency > 0.0_dp)) return
+      allocate (ue(n), ud(n), stat=stat)
       if (stat /= 0) then
          call fatal_error(error, "the step against the table's frequency: not enough memory for "// &
                           trim(fmt_int(n))//" DOFs", stat_no_memory)
          return
       end if
-      res%harmonic_error = 0.0_dp
-      if (res%technique /= technique_newmark .or. res%eng%excitation /= excitation_harmonic) return
-      if (res%dt1 <= 0.0_dp .or. .not. (res%eng%frequency > 0.0_dp)) return
       any_system = .false.
       ok = .true.
       call one_system(res%eng%stuck)

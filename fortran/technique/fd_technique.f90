@@ -12,7 +12,7 @@ module fd_technique
                        keyword_choices
    use fd_model, only: model_type, integration_type
    use fd_excitation, only: excitation_type
-   use fd_result, only: result_type
+   use fd_result, only: result_type, energy_balance_of
    use fd_run_control, only: run_control
    use fd_newmark, only: run_newmark, newmark_check
    use fd_event_driven, only: run_event_driven, event_driven_check
@@ -67,10 +67,11 @@ contains
       case default
          call unknown_technique(opts%technique, error)
       end select
-      ! whether a residual of the energy balance can be the method's numerical damping (set
-      ! after the run: each technique's res is intent(out))
-      res%damping_method = (opts%technique == technique_newmark .and. opts%gamma > 0.5_dp) .or. &
-                           (opts%technique == technique_moreau_jean .and. opts%theta > 0.5_dp)
+      ! the energy balance's verdict; a residual is the method's numerical damping when the
+      ! method damps (set after the run: each technique's res is intent(out))
+      res%energy_balance = energy_balance_of(res%e_residual_ratio, &
+                                             (opts%technique == technique_newmark .and. opts%gamma > 0.5_dp) .or. &
+                                             (opts%technique == technique_moreau_jean .and. opts%theta > 0.5_dp))
       ! whether the step resolves the highest modes: one report for every stepping technique
       if (.not. allocated(error)) call mode_resolution(model, res, error)
       ! and the table's frequency, when it has one (Newmark)
