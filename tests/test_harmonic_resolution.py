@@ -1,4 +1,4 @@
-"""Whether dt1 resolves a harmonic table motion (fortran/technique/fd_harmonic_resolution.f90):
+"""Whether dt1 resolves a harmonic table motion (fortran/technique/resolution/fd_harmonic_resolution.f90):
 the reported error of the linear steady state against the bilinear transform (average
 acceleration) and against the steady state the run itself reaches (three Newmark rules); the
 paper's decks resolved; a fuzz deck whose peaks are 267 % off at n1 = 1 reported, with the

@@ -67,7 +67,13 @@ def _event_driven(ref: dict) -> bool:
 ROUNDOFF_COUNTS: dict = {}  # none at present (the event-driven technique's count became exact)
 # fractions of 1 with components that may be 0 (mode shapes scaled to a largest component
 # of 1, effective modal masses over the total): compared to RTOL absolutely
-ABSOLUTE_KEYS = ("mode_shapes_", "modal_mass_ratio_", "energy_residual_ratio", "harmonic_step_error")
+ABSOLUTE_KEYS = (
+    "mode_shapes_",
+    "modal_mass_ratio_",
+    "energy_residual_ratio",
+    "harmonic_step_error",
+    "record_step_error",
+)
 
 
 # ------------------------------------------------------------------ comparison

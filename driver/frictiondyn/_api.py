@@ -82,7 +82,8 @@ class FrictiondynWarning(UserWarning):
     not resolve the structure's highest modes (summary ``mode_resolution``), or one that
     dephases the ringing of a sticking spring on which a device's stick-slip decisions rest
     (summary ``stick_resolution``), a step that moves the linear steady state under a
-    harmonic table motion by more than 5 % (summary ``harmonic_resolution``), or an
+    harmonic table motion by more than 5 % (summary ``harmonic_resolution``), one that moves
+    the peak linear response to a record by more than 5 % (summary ``record_resolution``), or an
     integration that dissipated or created more than 5 % of the energy (summary
     ``energy_balance``). Issued when the
     Result is made (``Session.result``, ``run``, ``Analysis.run``); the summary holds the
@@ -102,8 +103,8 @@ def summary_warnings(summary: dict) -> list[str]:
     """The warnings a summary calls for, as the executable prints them on standard error
     (without its "frictiondyn: warning: " prefix): correctness violations, a step dt1 that
     does not resolve the highest modes, one that misses a harmonic table motion's steady
-    state, one that dephases a sticking spring's ringing, and an integration that dissipated
-    (or created) more than 5 % of the energy."""
+    state or a record's peak linear response, one that dephases a sticking spring's ringing,
+    and an integration that dissipated (or created) more than 5 % of the energy."""
     out = []
     n = summary.get("correctness_violations", 0)
     if n:
@@ -128,6 +129,15 @@ def summary_warnings(summary: dict) -> list[str]:
             f"motion: the step alone moves the linear steady-state amplitude of DOF {i + 1} by "
             f"{100 * err[i]:.1f} % (harmonic_step_error > 0.05, the stuck or the free system); the "
             "response has the wrong amplitude; raise n1"
+        )
+    if summary.get("record_resolution") == "unresolved":
+        err = summary["record_step_error"]
+        i = max(range(len(err)), key=lambda k: err[k])
+        out.append(
+            f"dt1 = {summary['dt1_s']:.3g} s does not resolve the record: the step alone moves the "
+            f"peak linear response of DOF {i + 1} by {100 * err[i]:.1f} % (record_step_error > 0.05, "
+            "the stuck or the free system); the modes near the record's dominant frequencies have "
+            "the wrong period and the response the wrong amplitude; raise n1"
         )
     if summary.get("stick_resolution") == "unresolved":
         ratio = summary["stick_ringing_ratio"]

@@ -139,6 +139,14 @@ program frictiondyn_main
          ' % (harmonic_step_error > 0.05, the stuck or the free system);'
       write (error_unit, '(a)') '  the response has the wrong amplitude; raise n1'
    end if
+   if (res%record_resolution == resolution_unresolved) then
+      d = maxloc(res%record_error, 1)
+      write (error_unit, '(a,es10.3,a,i0,a,f0.1,a)') 'frictiondyn: warning: dt1 = ', res%dt1, &
+         ' s does not resolve the record: the step alone moves the peak linear response of DOF ', d, &
+         ' by ', 100*res%record_error(d), ' % (record_step_error > 0.05, the stuck or the free system);'
+      write (error_unit, '(a)') '  the modes near the record''s dominant frequencies have the wrong period '// &
+         'and the response the wrong amplitude; raise n1'
+   end if
    if (res%stick_resolution == resolution_unresolved) then
       d = maxloc(res%stick_ringing_ratio, 1)
       write (error_unit, '(a,i0,a,es10.3,a,es10.3,a)') 'frictiondyn: warning: the sticking spring of device ', d, &

@@ -389,6 +389,8 @@ contains
       call kv('mode_resolution', '"'//trim(resolution_names(res%mode_resolution))//'"')
       call kr('harmonic_step_error', res%harmonic_error)
       call kv('harmonic_resolution', '"'//trim(resolution_names(res%harmonic_resolution))//'"')
+      call kr('record_step_error', res%record_error)
+      call kv('record_resolution', '"'//trim(resolution_names(res%record_resolution))//'"')
       call kr('stick_frequency_error', res%stick_freq_error)
       call kr('stick_ringing_ratio', res%stick_ringing_ratio)
       call kr('stick_ringing_N', res%stick_ringing)

@@ -56,6 +56,7 @@ module fd_result
       real(dp) :: omega_max = 0.0_dp       !! highest natural circular frequency integrated at dt1 [rad/s]
       integer :: mode_resolution = resolution_none !! whether dt1 resolves the highest modes
       integer :: harmonic_resolution = resolution_none !! whether dt1 resolves the table's frequency
+      integer :: record_resolution = resolution_none !! whether dt1 resolves the recorded table motion
       integer :: stick_resolution = resolution_none !! whether dt1 resolves the sticking springs'
                                                     !! ringing (fd_stick_ringing)
       integer :: technique = 0             !! technique id of the run (fd_names)
@@ -72,6 +73,7 @@ module fd_result
       integer, allocatable :: slip_to_stick(:)  !! slip-to-stick transitions
       integer, allocatable :: reversals(:)      !! slip+ to slip- and back, without sticking
       real(dp), allocatable :: harmonic_error(:)      !! per DOF: the step's error in the linear steady state
+      real(dp), allocatable :: record_error(:)        !! per DOF: the step's error in the linear peak response
       real(dp), allocatable :: stick_freq_error(:)    !! 1 - omega~/omega of the sticking spring's mode
       real(dp), allocatable :: stick_ringing_ratio(:) !! largest ringing / margin of a dephased stick phase
       real(dp), allocatable :: stick_ringing(:)       !! that phase's ringing amplitude [N]
@@ -245,7 +247,7 @@ contains
       end if
       allocate (res%peak_u(n), res%peak_u_time(n), res%peak_v(n), res%peak_aabs(n), &
                 res%peak_aabs_time(n), res%peak_s(nd), res%peak_force(nd), res%stick_to_slip(nd), &
-                res%slip_to_stick(nd), res%reversals(nd), res%harmonic_error(n), res%stick_freq_error(nd), &
+                res%slip_to_stick(nd), res%reversals(nd), res%harmonic_error(n), res%record_error(n), res%stick_freq_error(nd), &
                 res%stick_ringing_ratio(nd), res%stick_ringing(nd), res%stick_margin(nd), stat=stat)
       if (stat /= 0) then
          call fatal_error(error, "not enough memory for the summary of "//trim(fmt_int(n))//" DOFs and "// &
@@ -256,7 +258,7 @@ contains
       res%peak_aabs = 0.0_dp; res%peak_aabs_time = 0.0_dp
       res%peak_s = 0.0_dp; res%peak_force = 0.0_dp
       res%stick_to_slip = 0; res%slip_to_stick = 0; res%reversals = 0
-      res%harmonic_error = 0.0_dp
+      res%harmonic_error = 0.0_dp; res%record_error = 0.0_dp
       res%stick_freq_error = 0.0_dp; res%stick_ringing_ratio = 0.0_dp
       res%stick_ringing = 0.0_dp; res%stick_margin = 0.0_dp
    end subroutine init_result

@@ -19,6 +19,7 @@ module fd_technique
    use fd_moreau_jean, only: run_moreau_jean, moreau_jean_check
    use fd_mode_resolution, only: mode_resolution
    use fd_harmonic_resolution, only: harmonic_resolution
+   use fd_record_resolution, only: record_resolution
    implicit none
    private
 
@@ -74,8 +75,9 @@ contains
                                              (opts%technique == technique_moreau_jean .and. opts%theta > 0.5_dp))
       ! whether the step resolves the highest modes: one report for every stepping technique
       if (.not. allocated(error)) call mode_resolution(model, res, error)
-      ! and the table's frequency, when it has one (Newmark)
+      ! and the table's motion (Newmark): a harmonic's frequency, a record's spectrum
       if (.not. allocated(error)) call harmonic_resolution(model, opts%beta, opts%gamma, res, error)
+      if (.not. allocated(error)) call record_resolution(model, exc, opts%beta, opts%gamma, res, error)
    end subroutine run_technique
 
    subroutine unknown_technique(technique, error)
