@@ -18,7 +18,7 @@ module fd_matrices
    public :: system_modes, structure_damping
    public :: modes_type, natural_modes, natural_modes_sparse, stiffness_damping_factor
    public :: modes_none, modes_flexible, modes_rigid, modes_unrestrained
-   public :: modes_dense_dofs
+   public :: modes_dense_dofs, mode_damping, mode_participation
 
    !> Above this many DOFs the modes are found without an n x n matrix (natural_modes_sparse):
    !> the dense matrices would make peak memory grow as n**2 (issue 13)
@@ -46,6 +46,32 @@ module fd_matrices
    real(dp), parameter :: pi = acos(-1.0_dp)
 
 contains
+
+   !> Damping per unit modal mass phi' C phi / phi' M phi of mode k: 2 xi wn; for a rigid-body
+   !> mode (its damping ratio undefined: NaN) a0 of C = a0 M + a1 K, since K phi = 0 (not
+   !> a0 + a1 wn^2 for every mode: the stuck system's K holds the sticking springs, which C's
+   !> K does not).
+   pure real(dp) function mode_damping(modes, k, a0) result(c)
+      type(modes_type), intent(in) :: modes !! the system's modes
+      integer, intent(in) :: k              !! the mode
+      real(dp), intent(in) :: a0            !! C's mass factor [1/s]
+
+      if (modes%omega2(k) > 0.0_dp) then
+         c = 2.0_dp*modes%xi(k)*sqrt(modes%omega2(k))
+      else
+         c = a0
+      end if
+   end function mode_damping
+
+   !> Participation of mode k in a motion of the table (every DOF along it):
+   !> phi' M 1 / phi' M phi.
+   pure real(dp) function mode_participation(modes, k, mass) result(g)
+      type(modes_type), intent(in) :: modes !! the system's modes
+      integer, intent(in) :: k              !! the mode
+      real(dp), intent(in) :: mass(:)       !! the DOFs' masses [kg]
+
+      g = sum(mass*modes%shape(:, k))/sum(mass*modes%shape(:, k)**2)
+   end function mode_participation
 
    !> Stiffness matrix of the springs (relative coordinates; node 0 is the table).
    pure subroutine stiffness_matrix(model, k)

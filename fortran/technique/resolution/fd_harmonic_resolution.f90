@@ -21,7 +21,7 @@ module fd_harmonic_resolution
    use fd_kinds, only: dp
    use fd_error, only: error_type, fatal_error, fmt_int, stat_no_memory
    use fd_names, only: technique_newmark, excitation_harmonic
-   use fd_matrices, only: modes_type, modes_flexible, modes_unrestrained
+   use fd_matrices, only: modes_type, modes_flexible, modes_unrestrained, mode_damping, mode_participation
    use fd_model, only: model_type
    use fd_result, only: result_type, resolution_none, resolution_resolved, resolution_unresolved
    implicit none
@@ -111,16 +111,8 @@ contains
          ud = (0.0_dp, 0.0_dp)
          do k = 1, modes%n
             wn = sqrt(max(modes%omega2(k), 0.0_dp))
-            ! the damping per unit modal mass phi' C phi / phi' M phi: 2 xi wn; for a rigid-body
-            ! mode (its damping ratio undefined: NaN) a0 of C = a0 M + a1 K, since K phi = 0
-            ! (not a0 + a1 wn^2 for every mode: the stuck system's K holds the sticking
-            ! springs, which C's K does not)
-            if (modes%omega2(k) > 0.0_dp) then
-               c = 2.0_dp*modes%xi(k)*wn
-            else
-               c = res%eng%a0
-            end if
-            gamma_k = sum(model%mass(1:n)*modes%shape(:, k))/sum(model%mass(1:n)*modes%shape(:, k)**2)
+            c = mode_damping(modes, k, res%eng%a0)
+            gamma_k = mode_participation(modes, k, model%mass(1:n))
             call newmark_response(w, wn, c, res%dt1, beta, gamma, hd, ok_k)
             he = cmplx(wn*wn - w*w, c*w, dp)
             if (.not. ok_k .or. he == (0.0_dp, 0.0_dp)) then

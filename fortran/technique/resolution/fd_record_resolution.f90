@@ -24,7 +24,7 @@ module fd_record_resolution
    use fd_kinds, only: dp
    use fd_error, only: error_type, fatal_error, fmt_int, stat_no_memory
    use fd_names, only: technique_newmark, excitation_record
-   use fd_matrices, only: modes_type, modes_flexible, modes_unrestrained
+   use fd_matrices, only: modes_type, modes_flexible, modes_unrestrained, mode_damping, mode_participation
    use fd_model, only: model_type
    use fd_excitation, only: excitation_type, table_acceleration
    use fd_result, only: result_type, resolution_none, resolution_resolved, resolution_unresolved
@@ -138,9 +138,11 @@ contains
       h = res%dt1
       do m = 1, nm
          if (m <= ns) then
-            call damping_of(res%eng%stuck, m, wn, c)
+            wn = sqrt(max(res%eng%stuck%omega2(m), 0.0_dp))
+            c = mode_damping(res%eng%stuck, m, res%eng%a0)
          else
-            call damping_of(res%eng%free, m - ns, wn, c)
+            wn = sqrt(max(res%eng%free%omega2(m - ns), 0.0_dp))
+            c = mode_damping(res%eng%free, m - ns, res%eng%a0)
          end if
          call mode_maps(wn, c, m)
       end do
@@ -202,21 +204,6 @@ contains
          if (modes%status == modes_flexible .or. modes%status == modes_unrestrained) k = max(modes%n, 0)
       end function modes_of
 
-      !> Circular frequency and damping per unit modal mass of mode k, as in
-      !> fd_harmonic_resolution: 2 xi wn; a0 for a rigid-body mode.
-      subroutine damping_of(modes, k, wn, c)
-         type(modes_type), intent(in) :: modes
-         integer, intent(in) :: k
-         real(dp), intent(out) :: wn, c
-
-         wn = sqrt(max(modes%omega2(k), 0.0_dp))
-         if (modes%omega2(k) > 0.0_dp) then
-            c = 2.0_dp*modes%xi(k)*wn
-         else
-            c = res%eng%a0
-         end if
-      end subroutine damping_of
-
       !> The system's modes (from position first + 1 in the pass) combined DOF by DOF into
       !> res%record_error: the square root of the sum of squares of their peaks' changes against
       !> that of their exact peaks, with their participation. .false. when not finite.
@@ -231,7 +218,7 @@ contains
          ux = 0.0_dp
          du = 0.0_dp
          do k = 1, modes%n
-            part = sum(model%mass(1:n)*modes%shape(:, k))/sum(model%mass(1:n)*modes%shape(:, k)**2)
+            part = mode_participation(modes, k, model%mass(1:n))
             do i = 1, n
                ux(i) = ux(i) + (modes%shape(i, k)*part*peak_e(first + k))**2
                du(i) = du(i) + (modes%shape(i, k)*part*(peak_n(first + k) - peak_e(first + k)))**2
