@@ -2,7 +2,8 @@
 
 No single run can tell whether its step is small enough for the stick-slip history it
 computed: the reports of a run (correctness violations, ``mode_resolution``,
-``stick_resolution``) each catch one mechanism, and in a fuzz campaign of random decks about
+``stick_resolution``, ``harmonic_resolution``, ``record_resolution``, ``energy_balance``)
+each catch one mechanism, and in a fuzz campaign of random decks about
 one run in eight had stick-slip counts that moved with the step with none of them raised
 (docs/theory.md, section 6). The general check is the engineer's: run again with a smaller
 step and see whether the answer moves. ``step_convergence(deck)`` does that: it runs the deck
