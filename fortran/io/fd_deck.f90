@@ -5,7 +5,8 @@
 !> every default come from fd_names. docs/namelist.md documents every variable.
 module fd_deck
    use, intrinsic :: ieee_arithmetic, only: ieee_is_finite
-   use, intrinsic :: ieee_exceptions, only: ieee_set_halting_mode, ieee_support_halting, ieee_overflow, &
+   use, intrinsic :: ieee_exceptions, only: ieee_set_halting_mode, ieee_get_halting_mode, ieee_support_halting, &
+                                            ieee_overflow, &
                                             ieee_set_flag
    use fd_kinds, only: dp
    use fd_error, only: error_type, fatal_error, fmt_int, fmt_real, stat_no_memory
@@ -75,6 +76,7 @@ contains
       type(error_type), allocatable, intent(out) :: error !! first problem found
       type(deck_text) :: deck
       character(len=:), allocatable :: text
+      logical :: halting
 
       call read_file_text(path, text, error)
       if (allocated(error)) then
@@ -84,11 +86,14 @@ contains
       ! a value too large for a double ('1e400' in a deck or a record) overflows to infinity
       ! when it is converted, and is then rejected with a message: a build that traps
       ! overflow (-ffpe-trap, tools/test_checked.sh) must not stop there. The halting mode is
-      ! restored when this reader returns (Fortran 2008, 14.3), the overflow handled.
+      ! saved, switched off while the deck is read, the overflow flag cleared and the mode
+      ! set back (gfortran does not restore it on return, as Fortran 2008's 14.3 would).
+      call ieee_get_halting_mode(ieee_overflow, halting)
       if (ieee_support_halting(ieee_overflow)) call ieee_set_halting_mode(ieee_overflow, .false.)
       call deck_from_string(text, path, deck, error)
       if (.not. allocated(error)) call read_groups(deck, cfg, error)
       call ieee_set_flag(ieee_overflow, .false.)
+      if (ieee_support_halting(ieee_overflow)) call ieee_set_halting_mode(ieee_overflow, halting)
       if (allocated(error)) return
       call sha256_text(text, cfg%model%deck_sha256)
    end subroutine read_deck
@@ -101,15 +106,19 @@ contains
       type(run_config), intent(out) :: cfg                !! what it defines
       type(error_type), allocatable, intent(out) :: error !! first problem found
       type(deck_text) :: deck
+      logical :: halting
 
       ! a value too large for a double ('1e400' in a deck or a record) overflows to infinity
       ! when it is converted, and is then rejected with a message: a build that traps
       ! overflow (-ffpe-trap, tools/test_checked.sh) must not stop there. The halting mode is
-      ! restored when this reader returns (Fortran 2008, 14.3), the overflow handled.
+      ! saved, switched off while the deck is read, the overflow flag cleared and the mode
+      ! set back (gfortran does not restore it on return, as Fortran 2008's 14.3 would).
+      call ieee_get_halting_mode(ieee_overflow, halting)
       if (ieee_support_halting(ieee_overflow)) call ieee_set_halting_mode(ieee_overflow, .false.)
       call deck_from_string(text, path, deck, error)
       if (.not. allocated(error)) call read_groups(deck, cfg, error)
       call ieee_set_flag(ieee_overflow, .false.)
+      if (ieee_support_halting(ieee_overflow)) call ieee_set_halting_mode(ieee_overflow, halting)
       if (allocated(error)) return
       call sha256_text(text, cfg%model%deck_sha256)
    end subroutine read_deck_string

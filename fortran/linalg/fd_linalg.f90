@@ -4,8 +4,9 @@
 module fd_linalg
    use fd_kinds, only: dp
    use fd_error, only: error_type, fatal_error, fmt_int, stat_no_memory
-   use, intrinsic :: ieee_exceptions, only: ieee_set_halting_mode, ieee_support_halting, ieee_set_flag, &
-                                            ieee_invalid, ieee_divide_by_zero, ieee_overflow
+   use, intrinsic :: ieee_exceptions, only: ieee_set_halting_mode, ieee_get_halting_mode, ieee_support_halting, &
+                                            ieee_set_flag, ieee_flag_type, ieee_invalid, ieee_divide_by_zero, &
+                                            ieee_overflow
    implicit none
    private
 
@@ -170,46 +171,61 @@ contains
       real(dp), intent(out) :: lambda(:)               !! (k) eigenvalues, ascending
       real(dp), intent(out) :: vec(:, :)               !! (n, k) eigenvectors in columns
       type(error_type), allocatable, intent(out) :: error !! LAPACK failure
-      real(dp), allocatable :: b(:, :), w(:), work(:)
-      integer, allocatable :: iwork(:), isuppz(:)
-      real(dp) :: query(1)
-      integer :: n, m, info, iquery(1), stat
+      type(ieee_flag_type), parameter :: quiet(3) = [ieee_invalid, ieee_divide_by_zero, ieee_overflow]
+      logical :: halting(3)
+      integer :: e
 
-      n = size(a, 1)
       ! dsyevr's MRRR algorithm (dstemr) computes with infinities and NaNs on purpose (it
       ! tests LAPACK's ieeeok): a build that traps them (-ffpe-trap, tools/test_checked.sh)
-      ! must not stop inside LAPACK. The halting modes are restored when this returns
-      ! (Fortran 2008, 14.3), the flags LAPACK raised are cleared, the result checked below.
-      if (ieee_support_halting(ieee_invalid)) call ieee_set_halting_mode(ieee_invalid, .false.)
-      if (ieee_support_halting(ieee_divide_by_zero)) call ieee_set_halting_mode(ieee_divide_by_zero, .false.)
-      if (ieee_support_halting(ieee_overflow)) call ieee_set_halting_mode(ieee_overflow, .false.)
-      allocate (b(n, n), w(n), isuppz(2*max(1, k)), stat=stat)
-      if (stat /= 0) then
-         call no_memory(); return
-      end if
-      b = a
-      call dsyevr('V', 'I', 'U', n, b, n, 0.0_dp, 0.0_dp, 1, k, 0.0_dp, m, w, vec, n, isuppz, &
-                  query, -1, iquery, -1, info)
-      allocate (work(max(1, int(query(1)))), iwork(max(1, iquery(1))), stat=stat)
-      if (stat /= 0) then
-         call no_memory(); return
-      end if
-      call dsyevr('V', 'I', 'U', n, b, n, 0.0_dp, 0.0_dp, 1, k, 0.0_dp, m, w, vec, n, isuppz, &
-                  work, size(work), iwork, size(iwork), info)
-      if (info /= 0 .or. m /= k) then
-         call fatal_error(error, "eigenvalue solver dsyevr failed with info = "//trim(fmt_int(info)))
-         return
-      end if
-      call ieee_set_flag(ieee_invalid, .false.)
-      call ieee_set_flag(ieee_divide_by_zero, .false.)
-      call ieee_set_flag(ieee_overflow, .false.)
-      if (any(w(1:k) /= w(1:k)) .or. any(abs(w(1:k)) > huge(1.0_dp))) then
-         call fatal_error(error, "eigenvalue solver dsyevr returned values that are not finite")
-         return
-      end if
-      lambda = w(1:k)
+      ! must not stop inside LAPACK. The halting modes are saved, switched off for the solve,
+      ! the flags LAPACK raised cleared, and the modes set back as they were (gfortran does
+      ! not restore them on return here, as Fortran 2008's 14.3 would: without this, every
+      ! run of the checked build stopped trapping at its first eigenproblem).
+      call ieee_get_halting_mode(quiet, halting)
+      do e = 1, size(quiet)
+         if (ieee_support_halting(quiet(e))) call ieee_set_halting_mode(quiet(e), .false.)
+      end do
+      call solve()
+      call ieee_set_flag(quiet, .false.)
+      do e = 1, size(quiet)
+         if (ieee_support_halting(quiet(e))) call ieee_set_halting_mode(quiet(e), halting(e))
+      end do
+
    contains
-      subroutine no_memory()
+
+      subroutine solve()
+         real(dp), allocatable :: b(:, :), w(:), work(:)
+         integer, allocatable :: iwork(:), isuppz(:)
+         real(dp) :: query(1)
+         integer :: n, m, info, iquery(1), stat
+
+         n = size(a, 1)
+         allocate (b(n, n), w(n), isuppz(2*max(1, k)), stat=stat)
+         if (stat /= 0) then
+            call no_memory(n); return
+         end if
+         b = a
+         call dsyevr('V', 'I', 'U', n, b, n, 0.0_dp, 0.0_dp, 1, k, 0.0_dp, m, w, vec, n, isuppz, &
+                     query, -1, iquery, -1, info)
+         allocate (work(max(1, int(query(1)))), iwork(max(1, iquery(1))), stat=stat)
+         if (stat /= 0) then
+            call no_memory(n); return
+         end if
+         call dsyevr('V', 'I', 'U', n, b, n, 0.0_dp, 0.0_dp, 1, k, 0.0_dp, m, w, vec, n, isuppz, &
+                     work, size(work), iwork, size(iwork), info)
+         if (info /= 0 .or. m /= k) then
+            call fatal_error(error, "eigenvalue solver dsyevr failed with info = "//trim(fmt_int(info)))
+            return
+         end if
+         if (any(w(1:k) /= w(1:k)) .or. any(abs(w(1:k)) > huge(1.0_dp))) then
+            call fatal_error(error, "eigenvalue solver dsyevr returned values that are not finite")
+            return
+         end if
+         lambda = w(1:k)
+      end subroutine solve
+
+      subroutine no_memory(n)
+         integer, intent(in) :: n
          call fatal_error(error, "not enough memory for the eigenproblem of "//trim(fmt_int(n))//" unknowns", &
                           stat_no_memory)
       end subroutine no_memory
