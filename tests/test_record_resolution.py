@@ -192,3 +192,96 @@ def test_not_applicable_to_harmonic_motion_and_without_modes(run, record_file):
     deck = OSCILLATOR.replace("N1", "1").replace("EVERY", "0\n  n_modes = 0")
     s = ok(run(deck, files={"rec.AT2": record_file})).summary()
     assert s["record_resolution"] == "not applicable"
+
+
+def _deck_with(groups: str, n1: int, extra_integration: str = "", duration: float = 8.0) -> str:
+    """The oscillator's deck with other &model..&friction groups (the record of the fixture)."""
+    return (
+        groups
+        + f"""
+&excitation
+  excitation_type = 'record'
+  record_file = 'rec.AT2'
+  duration = {duration}
+/
+&integration
+  n1 = {n1}{extra_integration}
+/
+"""
+    )
+
+
+OSCILLATOR_GROUPS = f"""
+&model
+  n_dof = MASSES
+/
+&springs
+  n_springs = 1
+  node_i = 1
+  node_j = 0
+  k = {(2 * math.pi * 12.0) ** 2!r}
+/
+&damping
+  damping_type = 'rayleigh'
+  rayleigh_a1 = 0.0005
+/
+"""
+
+
+def test_a_rigid_body_mode_does_not_hide_the_others(run, record_file):
+    """A friction tuned-mass damper: a second mass held to a 12 Hz oscillator only by a
+    velocity-law device. Stuck, the two are one 2 kg oscillator; free, the system is the 1 kg
+    oscillator and a rigid-body mode whose drift (no a0 to bound it) would swamp the
+    oscillator's peaks. That mode is left out, so the check gives DOF 1 the larger of the two
+    oscillators' own errors (here the free one's: dropping it would report the smaller) and
+    DOF 2 the stuck one's, to round-off."""
+    files = {"rec.AT2": record_file}
+    tmd = OSCILLATOR_GROUPS.replace("MASSES", "2\n  mass = 1.0, 1.0") + """
+&friction
+  n_devices = 1
+  node_i = 2
+  node_j = 1
+  law = 'velocity'
+  p = 9.81
+  mu = 0.1
+  eps = 0.001
+/
+"""
+    s = ok(run(_deck_with(tmd, 3, duration=30.0), name="tmd", files=files)).summary()
+    alone = [
+        _deck_with(OSCILLATOR_GROUPS.replace("MASSES", f"1\n  mass = {m}"), 3, duration=30.0)
+        for m in (1.0, 2.0)
+    ]
+    free, stuck = (
+        ok(run(deck, name=f"alone{i}", files=files)).summary()["record_step_error"][0]
+        for i, deck in enumerate(alone)
+    )
+    assert free > 1.5 * stuck > 0  # 1.9 % against 0.6 %
+    assert s["record_step_error"][0] == pytest.approx(free, rel=1e-9)
+    assert s["record_step_error"][1] == pytest.approx(stuck, rel=1e-9)
+
+
+def test_a_mode_beyond_the_step_is_unresolved_not_estimated(run, record_file):
+    """Linear acceleration (beta = 1/6) is stable up to omega dt1 = sqrt(12): a sticking
+    spring P mu / f = 1e5 N/m on 1 kg at dt1 = 0.02 s (omega dt1 = 6.3) is beyond it. The
+    run survives (the device slides), but no estimate of that mode exists: record_step_error
+    is 1 and record_resolution "unresolved", next to mode_resolution; nothing overflows, over
+    a record and 4 s of free vibration after it."""
+    groups = OSCILLATOR_GROUPS.replace("MASSES", "1\n  mass = 1.0") + """
+&friction
+  n_devices = 1
+  node_i = 1
+  node_j = 0
+  law = 'hysteretic'
+  p = 0.1
+  mu = 0.1
+  f = 1.0e-7
+/
+"""
+    deck = _deck_with(groups, 1, "\n  beta = 0.1666666666666667", duration=12.0)
+    r = ok(run(deck, files={"rec.AT2": record_file}))
+    s = r.summary()
+    assert s["omega_max_dt1"] > math.sqrt(12) and s["mode_resolution"] == "unresolved"
+    assert s["record_step_error"] == [1.0] and s["record_resolution"] == "unresolved"
+    assert all(math.isfinite(x) for x in s["peak_u_m"] + s["peak_aabs_mps2"])
+    assert "does not resolve the record" in r.stderr

@@ -18,7 +18,7 @@ module fd_matrices
    public :: system_modes, structure_damping
    public :: modes_type, natural_modes, natural_modes_sparse, stiffness_damping_factor
    public :: modes_none, modes_flexible, modes_rigid, modes_unrestrained
-   public :: modes_dense_dofs, mode_damping, mode_participation
+   public :: modes_dense_dofs, modes_kept, mode_damping, mode_participation
 
    !> Above this many DOFs the modes are found without an n x n matrix (natural_modes_sparse):
    !> the dense matrices would make peak memory grow as n**2 (issue 13)
@@ -46,6 +46,15 @@ module fd_matrices
    real(dp), parameter :: pi = acos(-1.0_dp)
 
 contains
+
+   !> The modes a system's summary holds that an estimate can use: its n kept modes when it
+   !> has modes (flexible or unrestrained), else 0 (rigid, not computed).
+   pure integer function modes_kept(modes) result(k)
+      type(modes_type), intent(in) :: modes !! the system's modes
+
+      k = 0
+      if (modes%status == modes_flexible .or. modes%status == modes_unrestrained) k = max(modes%n, 0)
+   end function modes_kept
 
    !> Damping per unit modal mass phi' C phi / phi' M phi of mode k: 2 xi wn; for a rigid-body
    !> mode (its damping ratio undefined: NaN) a0 of C = a0 M + a1 K, since K phi = 0 (not

@@ -21,7 +21,7 @@ module fd_harmonic_resolution
    use fd_kinds, only: dp
    use fd_error, only: error_type, fatal_error, fmt_int, stat_no_memory
    use fd_names, only: technique_newmark, excitation_harmonic
-   use fd_matrices, only: modes_type, modes_flexible, modes_unrestrained, mode_damping, mode_participation
+   use fd_matrices, only: modes_type, modes_kept, mode_damping, mode_participation
    use fd_model, only: model_type
    use fd_result, only: result_type, resolution_none, resolution_resolved, resolution_unresolved
    implicit none
@@ -103,8 +103,7 @@ contains
          integer :: k, i
          logical :: ok_k
 
-         if (modes%status /= modes_flexible .and. modes%status /= modes_unrestrained) return
-         if (modes%n < 1) return
+         if (modes_kept(modes) == 0) return
          any_system = .true.
          w = 2.0_dp*acos(-1.0_dp)*res%eng%frequency
          ue = (0.0_dp, 0.0_dp)

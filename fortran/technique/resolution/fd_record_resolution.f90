@@ -18,13 +18,17 @@
 !> run is not linear, but it moves between these two systems. Not applicable: a harmonic
 !> (fd_harmonic_resolution) or no table motion, no modes computed (n_modes = 0), or another
 !> technique than Newmark. Only the summary's modes are seen (the lowest n_modes):
-!> omega_max dt1 (fd_mode_resolution) covers the highest.
+!> omega_max dt1 (fd_mode_resolution) covers the highest. Rigid-body modes are left out (their
+!> drift, unbounded without a0, has no step error to speak of and would swamp the others'
+!> peaks). A summary mode beyond omega dt1 = 2 or beyond Newmark's stability limit has no
+!> estimate: the error is then 1 and the report "unresolved", as when an estimate is not
+!> finite.
 module fd_record_resolution
    use, intrinsic :: ieee_arithmetic, only: ieee_is_finite
    use fd_kinds, only: dp
    use fd_error, only: error_type, fatal_error, fmt_int, stat_no_memory
    use fd_names, only: technique_newmark, excitation_record
-   use fd_matrices, only: modes_type, modes_flexible, modes_unrestrained, mode_damping, mode_participation
+   use fd_matrices, only: modes_type, modes_kept, mode_damping, mode_participation
    use fd_model, only: model_type
    use fd_excitation, only: excitation_type, table_acceleration
    use fd_result, only: result_type, resolution_none, resolution_resolved, resolution_unresolved
@@ -113,7 +117,7 @@ contains
       type(result_type), intent(inout) :: res             !! the result of the run
       type(error_type), allocatable, intent(out) :: error !! not enough memory
       real(dp), allocatable :: ux(:), du(:), ex(:, :), nx(:, :), z(:, :), peak_e(:), peak_n(:)
-      real(dp) :: h, p0, p1, wn, c, q, v
+      real(dp) :: h, p0, p1, wn, c, q, v, limit
       integer :: n, stat, nm, ns, m, step
       logical :: ok
 
@@ -122,10 +126,10 @@ contains
       res%record_error = 0.0_dp               ! allocated with the summary (init_result)
       if (res%technique /= technique_newmark .or. res%eng%excitation /= excitation_record) return
       if (res%dt1 <= 0.0_dp .or. .not. (exc%duration > 0.0_dp)) return
-      ns = modes_of(res%eng%stuck)
+      ns = modes_kept(res%eng%stuck)
       nm = ns
       ! without devices the free system is the stuck one
-      if (model%n_devices > 0) nm = ns + modes_of(res%eng%free)
+      if (model%n_devices > 0) nm = ns + modes_kept(res%eng%free)
       if (nm == 0) return
       ! the maps by mode, one row of 8 (exact) and of 12 (Newmark) coefficients per mode: the
       ! pass below runs across the modes, each coefficient contiguous
@@ -136,6 +140,10 @@ contains
          return
       end if
       h = res%dt1
+      ! the largest wn dt1 the check integrates: mode_resolution's limit 2, and Newmark's
+      ! stability limit 1 / sqrt(gamma / 2 - beta) when it is conditionally stable
+      limit = 2.0_dp
+      if (beta < 0.5_dp*gamma) limit = min(limit, 1.0_dp/sqrt(0.5_dp*gamma - beta))
       do m = 1, nm
          if (m <= ns) then
             wn = sqrt(max(res%eng%stuck%omega2(m), 0.0_dp))
@@ -144,7 +152,21 @@ contains
             wn = sqrt(max(res%eng%free%omega2(m - ns), 0.0_dp))
             c = mode_damping(res%eng%free, m - ns, res%eng%a0)
          end if
-         call mode_maps(wn, c, m)
+         if (.not. (wn*h < limit)) then
+            ! a summary mode the step cannot integrate (mode_resolution reports it): no
+            ! estimate, and not a "resolved"
+            res%record_error = 1.0_dp
+            res%record_resolution = resolution_unresolved
+            return
+         end if
+         if (wn > 0.0_dp) then
+            call mode_maps(wn, c, m)
+         else
+            ! a rigid-body mode: left out (its drift, unbounded without a0, has no step error
+            ! to speak of and would swamp the other modes' peaks)
+            ex(m, :) = 0.0_dp
+            nx(m, :) = 0.0_dp
+         end if
       end do
       ! every mode from rest, with unit participation: q'' + c q' + wn^2 q = -ag, through the
       ! run's dt1 steps (fd_result's count) at the accelerations the run saw; z: the exact
@@ -196,14 +218,6 @@ contains
          nx(m, :) = [nmap(1, :), nmap(2, :), nmap(3, :), np]
       end subroutine mode_maps
 
-      !> The modes the check uses of a system: its summary's, when it has any.
-      integer function modes_of(modes) result(k)
-         type(modes_type), intent(in) :: modes
-
-         k = 0
-         if (modes%status == modes_flexible .or. modes%status == modes_unrestrained) k = max(modes%n, 0)
-      end function modes_of
-
       !> The system's modes (from position first + 1 in the pass) combined DOF by DOF into
       !> res%record_error: the square root of the sum of squares of their peaks' changes against
       !> that of their exact peaks, with their participation. .false. when not finite.
@@ -214,7 +228,7 @@ contains
          integer :: k, i
 
          finite = .true.
-         if (modes_of(modes) == 0) return
+         if (modes_kept(modes) == 0) return
          ux = 0.0_dp
          du = 0.0_dp
          do k = 1, modes%n
