@@ -171,6 +171,11 @@ contains
             call with_context(error)
             return
          end if
+         call check_subintervals(error)
+         if (allocated(error)) then
+            call with_context(error)
+            return
+         end if
          call observe_start(w%obs, st%mass, st%k, st%u, st%v, 0.0_dp, st%fn)
          ! the first row: the state at t = 0
          call ed_polynomials(model, exc, t, 0.0_dp, st)
@@ -207,6 +212,23 @@ contains
             err%message = "event-driven technique at t = "//trim(fmt_real(t))//" s: "//err%message
       end subroutine with_context
 
+      !> An error when the current phases' highest frequency needs more than max_subintervals
+      !> sub-intervals for the rest of the run (before their polynomials are built: at 1e30
+      !> rad/s their Taylor coefficients overflow).
+      subroutine check_subintervals(err)
+         type(error_type), allocatable, intent(out) :: err
+
+         associate (delta => w%st%cache%slot(w%st%cur)%delta)
+            if (t_end - t > max_subintervals*delta) then
+               call fatal_error(err, "the structure's highest frequency with the current phases "// &
+                                "needs sub-intervals of "//trim(fmt_real(delta))// &
+                                " s: more than "//trim(fmt_real(max_subintervals))//" for the "// &
+                                trim(fmt_real(t_end - t))//" s left; check for a stiff spring on a "// &
+                                "small mass (the frequencies sqrt(k/m)), or use the velocity law")
+            end if
+         end associate
+      end subroutine check_subintervals
+
       !> The loop over sub-intervals from t = 0 to t_end.
       subroutine advance_run(err)
          type(error_type), allocatable, intent(out) :: err
@@ -218,14 +240,8 @@ contains
             fresh = .true.
             do while (t < t_end)
                tb = segment_end(exc, t, t_end)
-               if (t_end - t > max_subintervals*st%cache%slot(st%cur)%delta) then
-                  call fatal_error(err, "the structure's highest frequency with the current phases "// &
-                                   "needs sub-intervals of "//trim(fmt_real(st%cache%slot(st%cur)%delta))// &
-                                   " s: more than "//trim(fmt_real(max_subintervals))//" for the "// &
-                                   trim(fmt_real(t_end - t))//" s left; check for a stiff spring on a "// &
-                                   "small mass (the frequencies sqrt(k/m)), or use the velocity law")
-                  return
-               end if
+               call check_subintervals(err)
+               if (allocated(err)) return
                span = min(st%cache%slot(st%cur)%delta, tb - t)
                ! the polynomials, with a remainder below the rounding level of the state
                do halvings = 0, 40
