@@ -20,9 +20,9 @@
 !> technique than Newmark. Only the summary's modes are seen (the lowest n_modes):
 !> omega_max dt1 (fd_mode_resolution) covers the highest. Rigid-body modes are left out (their
 !> drift, unbounded without a0, has no step error to speak of and would swamp the others'
-!> peaks). A summary mode beyond omega dt1 = 2 or beyond Newmark's stability limit has no
-!> estimate: the error is then 1 and the report "unresolved", as when an estimate is not
-!> finite.
+!> peaks), and so are summary modes beyond omega dt1 = 2 or Newmark's stability limit
+!> (mode_resolution reports them; an estimate of them would be meaningless or diverge). An
+!> estimate that is not finite gives the error 1 and "unresolved".
 module fd_record_resolution
    use, intrinsic :: ieee_arithmetic, only: ieee_is_finite
    use fd_kinds, only: dp
@@ -118,7 +118,7 @@ contains
       type(error_type), allocatable, intent(out) :: error !! not enough memory
       real(dp), allocatable :: ux(:), du(:), ex(:, :), nx(:, :), z(:, :), peak_e(:), peak_n(:)
       real(dp) :: h, p0, p1, wn, c, q, v, limit
-      integer :: n, stat, nm, ns, m, step
+      integer :: n, stat, nm, ns, m, step, used
       logical :: ok
 
       n = model%n_dof
@@ -144,6 +144,7 @@ contains
       ! stability limit 1 / sqrt(gamma / 2 - beta) when it is conditionally stable
       limit = 2.0_dp
       if (beta < 0.5_dp*gamma) limit = min(limit, 1.0_dp/sqrt(0.5_dp*gamma - beta))
+      used = 0
       do m = 1, nm
          if (m <= ns) then
             wn = sqrt(max(res%eng%stuck%omega2(m), 0.0_dp))
@@ -152,22 +153,18 @@ contains
             wn = sqrt(max(res%eng%free%omega2(m - ns), 0.0_dp))
             c = mode_damping(res%eng%free, m - ns, res%eng%a0)
          end if
-         if (.not. (wn*h < limit)) then
-            ! a summary mode the step cannot integrate (mode_resolution reports it): no
-            ! estimate, and not a "resolved"
-            res%record_error = 1.0_dp
-            res%record_resolution = resolution_unresolved
-            return
-         end if
-         if (wn > 0.0_dp) then
+         if (wn > 0.0_dp .and. wn*h < limit) then
             call mode_maps(wn, c, m)
+            used = used + 1
          else
-            ! a rigid-body mode: left out (its drift, unbounded without a0, has no step error
-            ! to speak of and would swamp the other modes' peaks)
+            ! left out: a rigid-body mode (its drift, unbounded without a0, has no step error
+            ! to speak of and would swamp the other modes' peaks), and a mode the step cannot
+            ! integrate (beyond omega dt1 = 2, which mode_resolution reports, or unstable)
             ex(m, :) = 0.0_dp
             nx(m, :) = 0.0_dp
          end if
       end do
+      if (used == 0) return                   ! no mode to estimate: not applicable
       ! every mode from rest, with unit participation: q'' + c q' + wn^2 q = -ag, through the
       ! run's dt1 steps (fd_result's count) at the accelerations the run saw; z: the exact
       ! (q, q') and Newmark's (q, q', q'')
