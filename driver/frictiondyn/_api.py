@@ -135,8 +135,8 @@ def summary_warnings(summary: dict) -> list[str]:
         i = max(range(len(err)), key=lambda k: err[k])
         out.append(
             f"dt1 = {summary['dt1_s']:.3g} s does not resolve the record: the step alone moves the "
-            f"peak linear response of DOF {i + 1} by {100 * err[i]:.1f} % (record_step_error > 0.05, "
-            "the stuck or the free system); the modes near the record's dominant frequencies have "
+            f"peak linear response of DOF {i + 1} by {100 * err[i]:.1f} % "
+            "(record_step_error > 0.05, the stuck or the free system); the modes near the record's dominant frequencies have "
             "the wrong period and the response the wrong amplitude; raise n1"
         )
     if summary.get("stick_resolution") == "unresolved":

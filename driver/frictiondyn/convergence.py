@@ -215,7 +215,7 @@ def _compare(summaries: list[dict], rtol: float) -> list[Quantity]:
         floor = FLOOR * max(abs(x) for r in rows for x in r)
         peaks = None
         if peak_key is not None:  # a residual: judged against the peak of the same item
-            peaks = [s[peak_key] if isinstance(s[peak_key], list) else [s[peak_key]] for s in summaries]
+            peaks = [p if isinstance(p, list) else [p] for p in (s[peak_key] for s in summaries)]
         for i, item in enumerate(_items(kind, summaries[0], n)):
             values = [float(r[i]) for r in rows]
             size = max(max(abs(v) for v in values), floor)
@@ -258,8 +258,9 @@ def step_convergence(
     hardly moves is judged against the structure's motion); a residual drift or slip is
     judged against the largest peak drift or slip, the friction energy against the energy
     input; a stick-slip count may move by max(2, 10 %). ``threads``: runs side by side
-    (default: as many as there are levels, at most the CPUs this process may use). Raises DeckError for a bad
-    deck, or for the event-driven technique (exact: its n1 only samples the history).
+    (default: as many as there are levels, at most the CPUs this process may use). Raises
+    DeckError for a bad deck, or for the event-driven technique (exact: its n1 only samples
+    the history).
     """
     if isinstance(factor, bool) or not isinstance(factor, int) or factor < 2:
         raise ValueError(f"factor = {factor!r}: must be an integer >= 2")
@@ -288,7 +289,8 @@ def step_convergence(
         with ThreadPoolExecutor(max_workers=workers) as pool:
             futures = [pool.submit(s.solve, None, False) for s in sessions]
             try:
-                wait(futures, return_when=FIRST_EXCEPTION)  # a failed level stops the others at once
+                # a failed level stops the others at once
+                wait(futures, return_when=FIRST_EXCEPTION)
                 for f, level in zip(futures, n1):
                     if f.done() and f.exception() is not None:
                         f.result()  # raises it

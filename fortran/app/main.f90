@@ -167,8 +167,8 @@ program frictiondyn_main
          write (error_unit, '(a)') '  numerical damping (Newmark gamma > 1/2, Moreau-Jean theta > 1/2) the physics '// &
             'does not have; the motion carries it: raise n1 (it shrinks with dt1) or use gamma = theta = 1/2'
       else
-         write (error_unit, '(a)') '  an energy error of the step (Newmark beta /= 1/4, or a step beyond its rule''s '// &
-            'stability limit) the physics does not have; the motion carries it: raise n1 or use beta = 1/4'
+         write (error_unit, '(a)') '  an energy error of the step (Newmark beta /= 1/4, or a step beyond '// &
+            'its rule''s stability limit) the physics does not have; the motion carries it: raise n1 or use beta = 1/4'
       end if
    end if
    write (output_unit, '(a)') 'frictiondyn: '//deck

@@ -74,28 +74,14 @@ contains
       character(len=*), intent(in) :: path                !! deck file
       type(run_config), intent(out) :: cfg                !! what it defines
       type(error_type), allocatable, intent(out) :: error !! first problem found
-      type(deck_text) :: deck
       character(len=:), allocatable :: text
-      logical :: halting
 
       call read_file_text(path, text, error)
       if (allocated(error)) then
          error%message = "deck: "//error%message
          return
       end if
-      ! a value too large for a double ('1e400' in a deck or a record) overflows to infinity
-      ! when it is converted, and is then rejected with a message: a build that traps
-      ! overflow (-ffpe-trap, tools/test_checked.sh) must not stop there. The halting mode is
-      ! saved, switched off while the deck is read, the overflow flag cleared and the mode
-      ! set back (gfortran does not restore it on return, as Fortran 2008's 14.3 would).
-      call ieee_get_halting_mode(ieee_overflow, halting)
-      if (ieee_support_halting(ieee_overflow)) call ieee_set_halting_mode(ieee_overflow, .false.)
-      call deck_from_string(text, path, deck, error)
-      if (.not. allocated(error)) call read_groups(deck, cfg, error)
-      call ieee_set_flag(ieee_overflow, .false.)
-      if (ieee_support_halting(ieee_overflow)) call ieee_set_halting_mode(ieee_overflow, halting)
-      if (allocated(error)) return
-      call sha256_text(text, cfg%model%deck_sha256)
+      call read_deck_string(text, path, cfg, error)
    end subroutine read_deck
 
    !> Read and validate a deck given as text. The path names the deck in messages, gives

@@ -126,10 +126,11 @@ module fd_result
 
 contains
 
-   !> The summary's energy_balance (res%energy_balance, set once after the run): balance_closed when |e_residual_ratio| <=
-   !> residual_ratio_limit; beyond, balance_dissipative when the ratio is positive and the
-   !> method damps (damping_method: Newmark gamma > 1/2, Moreau-Jean theta > 1/2), else
-   !> balance_error (Newmark beta /= 1/4, a step beyond its rule's stability limit). Named by
+   !> The summary's energy_balance (res%energy_balance, set once after the run):
+   !> balance_closed when |e_residual_ratio| <= residual_ratio_limit; beyond, balance_dissipative
+   !> when the ratio is positive and the method damps (damping_method: Newmark gamma > 1/2,
+   !> Moreau-Jean theta > 1/2), else balance_error (Newmark beta /= 1/4, a step beyond its
+   !> rule's stability limit). Named by
    !> energy_balance_names (a fixed-length table, as resolution_names: a deferred-length
    !> function result came back empty in one of many concurrent runs of the checked build).
    pure integer function energy_balance_of(ratio, damping_method) result(energy_balance)
@@ -247,8 +248,9 @@ contains
       end if
       allocate (res%peak_u(n), res%peak_u_time(n), res%peak_v(n), res%peak_aabs(n), &
                 res%peak_aabs_time(n), res%peak_s(nd), res%peak_force(nd), res%stick_to_slip(nd), &
-                res%slip_to_stick(nd), res%reversals(nd), res%harmonic_error(n), res%record_error(n), res%stick_freq_error(nd), &
-                res%stick_ringing_ratio(nd), res%stick_ringing(nd), res%stick_margin(nd), stat=stat)
+                res%slip_to_stick(nd), res%reversals(nd), res%harmonic_error(n), res%record_error(n), &
+                res%stick_freq_error(nd), res%stick_ringing_ratio(nd), res%stick_ringing(nd), &
+                res%stick_margin(nd), stat=stat)
       if (stat /= 0) then
          call fatal_error(error, "not enough memory for the summary of "//trim(fmt_int(n))//" DOFs and "// &
                           trim(fmt_int(nd))//" devices", stat_no_memory)
