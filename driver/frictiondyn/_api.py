@@ -133,11 +133,17 @@ def summary_warnings(summary: dict) -> list[str]:
     if summary.get("record_resolution") == "unresolved":
         err = summary["record_step_error"]
         i = max(range(len(err)), key=lambda k: err[k])
+        if not summary.get("n_devices"):
+            system = "the structure"
+        elif err == summary.get("record_step_error_stuck"):
+            system = "the stuck system: no device slid"
+        else:
+            system = "the free system: a device slid"
         out.append(
             f"dt1 = {summary['dt1_s']:.3g} s does not resolve the record: the step alone moves the "
             f"peak linear response of DOF {i + 1} by {100 * err[i]:.1f} % "
-            "(record_step_error > 0.05, the stuck or the free system); the modes near the record's dominant frequencies have "
-            "the wrong period and the response the wrong amplitude; raise n1"
+            f"(record_step_error > 0.05, {system}); the modes near the record's dominant "
+            "frequencies have the wrong period and the response the wrong amplitude; raise n1"
         )
     if summary.get("stick_resolution") == "unresolved":
         ratio = summary["stick_ringing_ratio"]

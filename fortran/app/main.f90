@@ -44,6 +44,7 @@ program frictiondyn_main
    character(len=:), allocatable :: deck, list, index_text, arg, hist, summ, htmp, stmp, tag
    character(kind=c_char, len=300) :: tagbuf
    character(len=32) :: num
+   character(len=40) :: sys_name
    integer :: nargs, i, idx, ios, d
    interface
       !> C's exit: ends the program with a status and no message (Fortran 2008 has no
@@ -141,9 +142,16 @@ program frictiondyn_main
    end if
    if (res%record_resolution == resolution_unresolved) then
       d = maxloc(res%record_error, 1)
+      if (res%n_devices == 0) then
+         sys_name = 'the structure'
+      else if (all(res%record_error == res%record_error_stuck)) then
+         sys_name = 'the stuck system: no device slid'
+      else
+         sys_name = 'the free system: a device slid'
+      end if
       write (error_unit, '(a,es10.3,a,i0,a,f0.1,a)') 'frictiondyn: warning: dt1 = ', res%dt1, &
          ' s does not resolve the record: the step alone moves the peak linear response of DOF ', d, &
-         ' by ', 100*res%record_error(d), ' % (record_step_error > 0.05, the stuck or the free system);'
+         ' by ', 100*res%record_error(d), ' % (record_step_error > 0.05, '//trim(sys_name)//');'
       write (error_unit, '(a)') '  the modes near the record''s dominant frequencies have the wrong period '// &
          'and the response the wrong amplitude; raise n1'
    end if

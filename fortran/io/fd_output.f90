@@ -390,6 +390,8 @@ contains
       call kr('harmonic_step_error', res%harmonic_error)
       call kv('harmonic_resolution', '"'//trim(resolution_names(res%harmonic_resolution))//'"')
       call kr('record_step_error', res%record_error)
+      call kr('record_step_error_stuck', res%record_error_stuck)
+      call kr('record_step_error_free', res%record_error_free)
       call kv('record_resolution', '"'//trim(resolution_names(res%record_resolution))//'"')
       call kr('stick_frequency_error', res%stick_freq_error)
       call kr('stick_ringing_ratio', res%stick_ringing_ratio)

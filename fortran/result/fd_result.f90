@@ -60,6 +60,7 @@ module fd_result
       integer :: stick_resolution = resolution_none !! whether dt1 resolves the sticking springs'
                                                     !! ringing (fd_stick_ringing)
       integer :: technique = 0             !! technique id of the run (fd_names)
+      logical :: started_sliding = .false. !! a device was sliding at t = 0 (Newmark)
       ! peaks per DOF (over every step taken)
       real(dp), allocatable :: peak_u(:)        !! max |u| [m]
       real(dp), allocatable :: peak_u_time(:)   !! time of max |u| [s]
@@ -74,6 +75,9 @@ module fd_result
       integer, allocatable :: reversals(:)      !! slip+ to slip- and back, without sticking
       real(dp), allocatable :: harmonic_error(:)      !! per DOF: the step's error in the linear steady state
       real(dp), allocatable :: record_error(:)        !! per DOF: the step's error in the linear peak response
+                                                      !! of the system the run was in
+      real(dp), allocatable :: record_error_stuck(:)  !! the same, of the stuck system
+      real(dp), allocatable :: record_error_free(:)   !! the same, of the free system
       real(dp), allocatable :: stick_freq_error(:)    !! 1 - omega~/omega of the sticking spring's mode
       real(dp), allocatable :: stick_ringing_ratio(:) !! largest ringing / margin of a dephased stick phase
       real(dp), allocatable :: stick_ringing(:)       !! that phase's ringing amplitude [N]
@@ -249,6 +253,7 @@ contains
       allocate (res%peak_u(n), res%peak_u_time(n), res%peak_v(n), res%peak_aabs(n), &
                 res%peak_aabs_time(n), res%peak_s(nd), res%peak_force(nd), res%stick_to_slip(nd), &
                 res%slip_to_stick(nd), res%reversals(nd), res%harmonic_error(n), res%record_error(n), &
+                res%record_error_stuck(n), res%record_error_free(n), &
                 res%stick_freq_error(nd), res%stick_ringing_ratio(nd), res%stick_ringing(nd), &
                 res%stick_margin(nd), stat=stat)
       if (stat /= 0) then
@@ -261,6 +266,7 @@ contains
       res%peak_s = 0.0_dp; res%peak_force = 0.0_dp
       res%stick_to_slip = 0; res%slip_to_stick = 0; res%reversals = 0
       res%harmonic_error = 0.0_dp; res%record_error = 0.0_dp
+      res%record_error_stuck = 0.0_dp; res%record_error_free = 0.0_dp
       res%stick_freq_error = 0.0_dp; res%stick_ringing_ratio = 0.0_dp
       res%stick_ringing = 0.0_dp; res%stick_margin = 0.0_dp
    end subroutine init_result

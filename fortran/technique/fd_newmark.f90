@@ -38,7 +38,7 @@ module fd_newmark
    use fd_banded, only: spd_system, spd_setup, spd_factor, spd_update_devices, spd_solve, spd_k_matvec, &
                         spd_c_matvec, spd_kc_matvec, spd_auto, spd_dense, spd_banded, spd_is_dense, spd_bandwidth, &
                         spd_copy
-   use fd_device_state, only: device_state, device_force
+   use fd_device_state, only: device_state, device_force, phase_stick
    use fd_friction, only: friction_init, friction_step, friction_settle
    use fd_result, only: result_type
    use fd_run_control, only: run_control
@@ -165,6 +165,7 @@ contains
       call observe_start_energies(w%obs, 0.5_dp*sum(w%mass*w%v**2), strain_energy(model, w%u), &
                                   device_energy(w%st, w%s))
       w%phase0 = w%st%phase
+      res%started_sliding = any(w%phase0 /= phase_stick)
       call observe_sample(w%obs, res, 0.0_dp, w%ag, w%u, w%v, w%a, w%s, w%sd, w%f, w%phase0)
       call observe_peaks(res, 0.0_dp, w%n, w%nd, w%u, w%v, w%a, w%ag, w%s, w%f)
 
