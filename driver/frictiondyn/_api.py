@@ -133,12 +133,12 @@ def summary_warnings(summary: dict) -> list[str]:
     if summary.get("record_resolution") == "unresolved":
         err = summary["record_step_error"]
         i = max(range(len(err)), key=lambda k: err[k])
-        if not summary.get("n_devices"):
-            system = "the structure"
-        elif err == summary.get("record_step_error_stuck"):
-            system = "the stuck system: no device slid"
-        else:
-            system = "the free system: a device slid"
+        system = {
+            "stuck": "the stuck system: no device slid",
+            "free": "the free system: a device slid",
+            "stuck and free": "the larger of the stuck and the free system: no device slid, "
+            "one is velocity-law",
+        }.get(summary.get("record_step_system"), "the structure")
         out.append(
             f"dt1 = {summary['dt1_s']:.3g} s does not resolve the record: the step alone moves the "
             f"peak linear response of DOF {i + 1} by {100 * err[i]:.1f} % "

@@ -19,7 +19,8 @@ program frictiondyn_main
                          session_set_progress
    use fd_progress_line, only: progress_wanted, progress_show, progress_clear
    use fd_version, only: frictiondyn_version
-   use fd_result, only: resolution_unresolved, residual_ratio_limit, balance_closed, balance_dissipative
+   use fd_result, only: resolution_unresolved, residual_ratio_limit, balance_closed, balance_dissipative, &
+                        record_system_stuck, record_system_free, record_system_both
    implicit none
 
    interface
@@ -44,7 +45,7 @@ program frictiondyn_main
    character(len=:), allocatable :: deck, list, index_text, arg, hist, summ, htmp, stmp, tag
    character(kind=c_char, len=300) :: tagbuf
    character(len=32) :: num
-   character(len=40) :: sys_name
+   character(len=80) :: sys_name
    integer :: nargs, i, idx, ios, d
    interface
       !> C's exit: ends the program with a status and no message (Fortran 2008 has no
@@ -142,13 +143,16 @@ program frictiondyn_main
    end if
    if (res%record_resolution == resolution_unresolved) then
       d = maxloc(res%record_error, 1)
-      if (res%n_devices == 0) then
-         sys_name = 'the structure'
-      else if (all(res%record_error == res%record_error_stuck)) then
+      select case (res%record_system)
+      case (record_system_stuck)
          sys_name = 'the stuck system: no device slid'
-      else
+      case (record_system_free)
          sys_name = 'the free system: a device slid'
-      end if
+      case (record_system_both)
+         sys_name = 'the larger of the stuck and the free system: no device slid, one is velocity-law'
+      case default
+         sys_name = 'the structure'
+      end select
       write (error_unit, '(a,es10.3,a,i0,a,f0.1,a)') 'frictiondyn: warning: dt1 = ', res%dt1, &
          ' s does not resolve the record: the step alone moves the peak linear response of DOF ', d, &
          ' by ', 100*res%record_error(d), ' % (record_step_error > 0.05, '//trim(sys_name)//');'

@@ -7,7 +7,7 @@ module fd_output
    use fd_kinds, only: dp
    use fd_error, only: error_type, fatal_error, fmt_int, fmt_real
    use fd_model, only: model_type, output_type, law_name, technique_name
-   use fd_result, only: result_type, resolution_names, energy_balance_names
+   use fd_result, only: result_type, resolution_names, energy_balance_names, record_system_names
    use fd_record, only: record_info
    use fd_version, only: frictiondyn_version
    use fd_history_stream, only: format_row, stream_value_width
@@ -393,6 +393,7 @@ contains
       call kr('record_step_error_stuck', res%record_error_stuck)
       call kr('record_step_error_free', res%record_error_free)
       call kv('record_resolution', '"'//trim(resolution_names(res%record_resolution))//'"')
+      call kv('record_step_system', '"'//trim(record_system_names(res%record_system))//'"')
       call kr('stick_frequency_error', res%stick_freq_error)
       call kr('stick_ringing_ratio', res%stick_ringing_ratio)
       call kr('stick_ringing_N', res%stick_ringing)

@@ -17,6 +17,8 @@ module fd_result
    public :: resolution_none, resolution_resolved, resolution_unresolved, resolution_names
    public :: residual_ratio_limit, energy_balance_of, energy_balance_names
    public :: balance_closed, balance_dissipative, balance_error
+   public :: record_system_none, record_system_structure, record_system_stuck, record_system_free, &
+             record_system_both, record_system_names
 
    integer, parameter :: max_violation_times = 10 !! first violation times kept
    integer, parameter :: max_event_times = 1000   !! first event times kept (exact technique)
@@ -27,6 +29,15 @@ module fd_result
    !> their names in the summary
    character(len=14), parameter :: resolution_names(3) = [character(len=14) :: 'not applicable', 'resolved', &
                                                           'unresolved']
+   ! the system whose record_error the record step check judges (fd_record_resolution)
+   integer, parameter :: record_system_none = 1      !! not applicable
+   integer, parameter :: record_system_structure = 2 !! no device: the structure
+   integer, parameter :: record_system_stuck = 3     !! no device slid, every device hysteretic
+   integer, parameter :: record_system_free = 4      !! a device slid
+   integer, parameter :: record_system_both = 5      !! no device slid, a velocity-law one: the larger
+   !> their names in the summary
+   character(len=14), parameter :: record_system_names(5) = [character(len=14) :: 'not applicable', &
+      'structure', 'stuck', 'free', 'stuck and free']
    integer, parameter :: column_name_len = 16     !! length of a column name
    !> |e_residual_ratio| above this: the integration dissipated (or created) a share of the
    !> energy that the motion feels (docs/theory.md section 7)
@@ -57,6 +68,7 @@ module fd_result
       integer :: mode_resolution = resolution_none !! whether dt1 resolves the highest modes
       integer :: harmonic_resolution = resolution_none !! whether dt1 resolves the table's frequency
       integer :: record_resolution = resolution_none !! whether dt1 resolves the recorded table motion
+      integer :: record_system = 1         !! the system record_error judges (record_system_*)
       integer :: stick_resolution = resolution_none !! whether dt1 resolves the sticking springs'
                                                     !! ringing (fd_stick_ringing)
       integer :: technique = 0             !! technique id of the run (fd_names)

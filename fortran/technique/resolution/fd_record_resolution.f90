@@ -3,27 +3,32 @@
 !> the free system, against the exact response.
 !>
 !> A record is sampled at dt_record and interpolated linearly, so the table acceleration is
-!> linear within every step dt1 = dt_record / n1. A mode q'' + c q' + wn^2 q = -ag(t) then has
-!> an exact discrete solution at the steps (the piecewise-exact method; here the exponential
-!> of the mode's matrix with the load's value and slope appended, exact_step_map), and
-!> Newmark's (beta, gamma) the recursion the run itself takes. Both are run through the
-!> record from the run's initial conditions, mode by mode, in one pass (memory independent
-!> of the duration). A mode near a peak of the record's spectrum, lightly damped and
-!> integrated with the wrong period, responds with the wrong amplitude: at n1 = 1 (dt1 = dt_record = 0.02 s) a fuzz deck's
-!> 9 Hz mode came out with its peak 98 % too large while omega_max dt1 = 1.7 said "resolved".
-!> For each DOF the modes' peak changes are combined by the square root of the sum of their
+!> linear within every step dt1 = dt_record / n1. A mode q'' + c q' + wn^2 q = -g ag(t) (g its
+!> participation) then has an exact discrete solution at the steps (the piecewise-exact
+!> method; here the exponential of the mode's matrix with the load's value and slope
+!> appended, exact_step_map), and Newmark's (beta, gamma) the recursion the run itself takes.
+!> Both are run through the record from the run's initial conditions, mode by mode, in one
+!> pass (memory independent of the duration). A mode near a peak of the record's spectrum,
+!> lightly damped and integrated with the wrong period, responds with the wrong amplitude: at
+!> n1 = 1 (dt1 = dt_record = 0.02 s) a fuzz deck's 9 Hz mode came out with its peak 98 % too
+!> large while omega_max dt1 = 1.7 said "resolved". For each DOF the peak is read about the
+!> system's equilibrium (the devices stuck at their initial lengths): exactly with one mode;
+!> with several, the modes' peak changes are combined by the square root of the sum of their
 !> squares (the modal combination of a response-spectrum analysis), against the same
-!> combination of the exact peaks: record_step_error. Above record_error_limit the summary
-!> says "unresolved" and the executable, the command line and the Python API warn. A friction
-!> run is not linear, but it moves between these two systems: the verdict judges the stuck
-!> system when no device slid (the run is that linear system) and the free one when a device
-!> did (the stuck system's error, over the whole record, overstates that of short stick
-!> phases); both are in the summary. Not applicable: a harmonic
-!> (fd_harmonic_resolution) or no table motion, no modes computed (n_modes = 0), or another
-!> technique than Newmark. Only the summary's modes are seen (the lowest n_modes):
-!> omega_max dt1 (fd_mode_resolution) covers the highest. Rigid-body modes are left out (their
-!> drift, unbounded without a0, has no step error to speak of and would swamp the others'
-!> peaks), and so are summary modes beyond omega dt1 = 2 or Newmark's stability limit
+!> combination of the exact peaks plus the equilibrium's offset: record_step_error. Above
+!> record_error_limit the summary says "unresolved" and the executable, the command line and
+!> the Python API warn. A friction run is not linear, but it moves between these two systems:
+!> the verdict (record_system) judges the stuck system when no device slid and every device
+!> is hysteretic (the run is then that linear system), the free one when a device slid (the
+!> stuck system's error, over the whole record, overstates that of short stick phases), and
+!> the larger of the two when none slid but one is a velocity-law device (a dashpot within
+!> its band, neither rigid nor absent); both systems' figures are in the summary. Not
+!> applicable: a harmonic (fd_harmonic_resolution) or no table motion, no mode of the judged
+!> system to estimate (n_modes = 0, or only the modes left out below), or another technique
+!> than Newmark. Only the summary's modes are seen (the lowest n_modes): omega_max dt1
+!> (fd_mode_resolution) covers the highest. Rigid-body modes are left out (their drift,
+!> unbounded without a0, has no step error to speak of and would swamp the others' peaks),
+!> and so are summary modes beyond omega dt1 = 2 or Newmark's stability limit
 !> (mode_resolution reports them; an estimate of them would be meaningless or diverge). An
 !> estimate that is not finite gives the error 1 and "unresolved".
 module fd_record_resolution
@@ -32,9 +37,11 @@ module fd_record_resolution
    use fd_error, only: error_type, fatal_error, fmt_int, stat_no_memory
    use fd_names, only: technique_newmark, excitation_record
    use fd_matrices, only: modes_type, modes_kept, mode_damping, mode_participation
-   use fd_model, only: model_type
+   use fd_model, only: model_type, law_hysteretic
    use fd_excitation, only: excitation_type, table_acceleration
-   use fd_result, only: result_type, resolution_none, resolution_resolved, resolution_unresolved
+   use fd_result, only: result_type, resolution_none, resolution_resolved, resolution_unresolved, &
+                        record_system_none, record_system_structure, record_system_stuck, &
+                        record_system_free, record_system_both
    implicit none
    private
 
@@ -120,26 +127,46 @@ contains
       real(dp), intent(in) :: beta, gamma                 !! Newmark's parameters
       type(result_type), intent(inout) :: res             !! the result of the run
       type(error_type), allocatable, intent(out) :: error !! not enough memory
-      real(dp), allocatable :: ux(:), du(:), ku0(:), ex(:, :), nx(:, :), z(:, :), peak_e(:), peak_n(:)
+      real(dp), allocatable :: off(:), ku0(:), ex(:, :), nx(:, :), z(:, :), q0(:), ext(:, :)
       real(dp) :: h, p0, p1, q, v, limit
-      integer :: n, stat, nm, ns, m, step, used
-      logical :: ok
+      integer :: n, stat, nm, ns, m, step, used(2), judged
+      logical :: ok, slid
 
       n = model%n_dof
       res%record_resolution = resolution_none
+      res%record_system = record_system_none
       res%record_error = 0.0_dp               ! allocated with the summary (init_result)
       res%record_error_stuck = 0.0_dp
       res%record_error_free = 0.0_dp
       if (res%technique /= technique_newmark .or. res%eng%excitation /= excitation_record) return
       if (res%dt1 <= 0.0_dp .or. .not. (exc%duration > 0.0_dp)) return
+      ! the system the run was in, which the verdict judges: the stuck one when no device slid
+      ! and every device is hysteretic (a sticking spring: the run is then that linear
+      ! system); the free one when a device slid (from the start or by a transition: the
+      ! stuck system's modes, run through the whole record, overstate the error of short
+      ! stick phases; on 51 613 fuzz decks, judging it there too added 411 flags, 99 of them
+      ! wrong runs); both, the larger, when no device slid and one is a velocity-law device
+      ! (within its band a dashpot P mu / eps, neither a rigid link nor absent)
+      slid = res%started_sliding .or. any(res%stick_to_slip > 0) .or. any(res%slip_to_stick > 0) &
+             .or. any(res%reversals > 0)
+      if (model%n_devices == 0) then
+         judged = record_system_structure
+      else if (slid) then
+         judged = record_system_free
+      else if (all(model%dev(1:model%n_devices)%law == law_hysteretic)) then
+         judged = record_system_stuck
+      else
+         judged = record_system_both
+      end if
       ns = modes_kept(res%eng%stuck)
       nm = ns
       ! without devices the free system is the stuck one
       if (model%n_devices > 0) nm = ns + modes_kept(res%eng%free)
       if (nm == 0) return
       ! the maps by mode, one row of 8 (exact) and of 12 (Newmark) coefficients per mode: the
-      ! pass below runs across the modes, each coefficient contiguous
-      allocate (ux(n), du(n), ku0(n), ex(nm, 8), nx(nm, 12), z(nm, 5), peak_e(nm), peak_n(nm), stat=stat)
+      ! pass below runs across the modes, each coefficient contiguous; ext: each mode's
+      ! largest and smallest q, exact and by Newmark
+      allocate (off(n), ku0(n), ex(nm, 8), nx(nm, 12), z(nm, 5), q0(nm), ext(nm, 4), stat=stat)
       if (stat /= 0) then
          call fatal_error(error, "the step against the record: not enough memory for "// &
                           trim(fmt_int(n))//" DOFs", stat_no_memory)
@@ -159,14 +186,26 @@ contains
       used = 0
       do m = 1, nm
          if (m <= ns) then
-            call mode_start(res%eng%stuck, m, m)
+            call mode_start(res%eng%stuck, m, m, used(1))
          else
-            call mode_start(res%eng%free, m - ns, m)
+            call mode_start(res%eng%free, m - ns, m, used(2))
          end if
       end do
-      if (used == 0) return                   ! no mode to estimate: not applicable
-      peak_e = abs(z(:, 1))
-      peak_n = peak_e
+      if (nm == ns) used(2) = used(1)
+      ! no mode of the judged system to estimate: not applicable
+      select case (judged)
+      case (record_system_structure, record_system_stuck)
+         if (used(1) == 0) return
+      case (record_system_free)
+         if (used(2) == 0) return
+      case default
+         if (used(1) + used(2) == 0) return
+      end select
+      q0 = z(:, 1)
+      ext(:, 1) = q0
+      ext(:, 2) = q0
+      ext(:, 3) = q0
+      ext(:, 4) = q0
       do step = 1, max(1, nint(exc%duration/h))
          p1 = -table_acceleration(exc, step*h)
          !GCC$ ivdep
@@ -174,18 +213,21 @@ contains
             q = ex(m, 1)*z(m, 1) + ex(m, 2)*z(m, 2) + ex(m, 5)*p0 + ex(m, 7)*p1
             z(m, 2) = ex(m, 3)*z(m, 1) + ex(m, 4)*z(m, 2) + ex(m, 6)*p0 + ex(m, 8)*p1
             z(m, 1) = q
-            peak_e(m) = max(peak_e(m), abs(q))
+            ext(m, 1) = max(ext(m, 1), q)
+            ext(m, 2) = min(ext(m, 2), q)
             q = nx(m, 1)*z(m, 3) + nx(m, 2)*z(m, 4) + nx(m, 3)*z(m, 5) + nx(m, 10)*p1
             v = nx(m, 4)*z(m, 3) + nx(m, 5)*z(m, 4) + nx(m, 6)*z(m, 5) + nx(m, 11)*p1
             z(m, 5) = nx(m, 7)*z(m, 3) + nx(m, 8)*z(m, 4) + nx(m, 9)*z(m, 5) + nx(m, 12)*p1
             z(m, 4) = v
             z(m, 3) = q
-            peak_n(m) = max(peak_n(m), abs(q))
+            ext(m, 3) = max(ext(m, 3), q)
+            ext(m, 4) = min(ext(m, 4), q)
          end do
          p0 = p1
       end do
-      ok = combine(res%eng%stuck, 0, res%record_error_stuck)
-      if (ok .and. nm > ns) ok = combine(res%eng%free, ns, res%record_error_free)
+      ok = combine(res%eng%stuck, 0, used(1), res%record_error_stuck)
+      if (ok .and. nm > ns) ok = combine(res%eng%free, ns, used(2), res%record_error_free)
+      res%record_system = judged
       if (.not. ok) then
          res%record_error = 1.0_dp
          res%record_error_stuck = 1.0_dp
@@ -194,16 +236,14 @@ contains
          return
       end if
       if (nm == ns) res%record_error_free = res%record_error_stuck
-      ! the verdict judges the system the run was in: the stuck one when no device ever slid
-      ! (the run is then that linear system), else the free one. The stuck system's modes run
-      ! through the whole record overstate a sliding run's error: its stick phases are short
-      ! (on 51 613 fuzz decks, judging it there too added 411 flags, 99 of them wrong runs)
-      if (model%n_devices > 0 .and. (res%started_sliding .or. any(res%stick_to_slip > 0) .or. &
-                                     any(res%slip_to_stick > 0) .or. any(res%reversals > 0))) then
+      select case (judged)
+      case (record_system_free)
          res%record_error = res%record_error_free
-      else
+      case (record_system_both)
+         res%record_error = max(res%record_error_stuck, res%record_error_free)
+      case default
          res%record_error = res%record_error_stuck
-      end if
+      end select
       res%record_resolution = resolution_resolved
       if (any(res%record_error > record_error_limit)) res%record_resolution = resolution_unresolved
 
@@ -214,13 +254,14 @@ contains
       !> and its start. The initial conditions' modal coordinates are taken about the system's
       !> equilibrium with its devices stuck where they start (their rest lengths the initial
       !> ones; none for the free system): q(0) = phi' K u0 / (wn^2 phi' M phi), with K the
-      !> springs' alone, and q'(0) = phi' M v0 / phi' M phi. Left out (a zero row): a rigid-body
-      !> mode (its drift, unbounded without a0, has no step error to speak of and would swamp
-      !> the other modes' peaks), and a mode the step cannot integrate (beyond omega dt1 = 2,
-      !> which mode_resolution reports, or unstable).
-      subroutine mode_start(modes, k, m)
+      !> springs' alone, and q'(0) = phi' M v0 / phi' M phi. Left out (a zero row, not
+      !> counted in used): a rigid-body mode (its drift, unbounded without a0, has no step
+      !> error to speak of and would swamp the other modes' peaks), and a mode the step cannot
+      !> integrate (beyond omega dt1 = 2, which mode_resolution reports, or unstable).
+      subroutine mode_start(modes, k, m, used)
          type(modes_type), intent(in) :: modes
          integer, intent(in) :: k, m
+         integer, intent(inout) :: used
          real(dp) :: phi(2, 2), g0(2), g1(2), nmap(3, 3), np(3), g, mk, wn, c
 
          ex(m, :) = 0.0_dp
@@ -241,36 +282,63 @@ contains
          z(m, 5) = g*p0 - c*z(m, 2) - wn*wn*z(m, 1)
       end subroutine mode_start
 
-      !> The system's modes (from position first + 1 in the pass) combined DOF by DOF into err:
-      !> the square root of the sum of squares of their peaks' changes against that of their
-      !> exact peaks. .false. when not finite.
-      logical function combine(modes, first, err) result(finite)
+      !> The system's modes (from position first + 1 in the pass) combined DOF by DOF into err.
+      !> The run's displacement is u = off + sum_k phi_k q_k, off = u0 - sum_k phi_k q_k(0)
+      !> the system's equilibrium (and the part of u0 in the modes left out). With one mode
+      !> estimated, a DOF's peak is max |off + phi q| over the mode's largest and smallest q,
+      !> exact and by Newmark, and err the change of that peak against it (exact). With several,
+      !> the peak is estimated as |off| + the square root of the sum of squares of the modes'
+      !> peaks |phi q|, and err is that of the peaks' changes against it. .false. when not
+      !> finite.
+      logical function combine(modes, first, nused, err) result(finite)
          type(modes_type), intent(in) :: modes
          integer, intent(in) :: first
+         integer, intent(in) :: nused      !! modes estimated (not left out)
          real(dp), intent(inout) :: err(:)
-         real(dp) :: big
-         integer :: k, i
+         real(dp) :: big, pe, pn, peak(n), change(n)
+         integer :: k, i, m
 
          finite = .true.
          if (modes_kept(modes) == 0) return
-         ux = 0.0_dp
-         du = 0.0_dp
+         off = model%u0(1:n)
          do k = 1, modes%n
-            do i = 1, n
-               ux(i) = ux(i) + (modes%shape(i, k)*peak_e(first + k))**2
-               du(i) = du(i) + (modes%shape(i, k)*(peak_n(first + k) - peak_e(first + k)))**2
-            end do
+            off = off - modes%shape(:, k)*q0(first + k)
          end do
+         peak = 0.0_dp
+         change = 0.0_dp
+         if (nused == 1) then
+            ! the one mode estimated (the others' rows are zero: they add nothing)
+            do k = 1, modes%n
+               m = first + k
+               if (all(ex(m, :) == 0.0_dp)) cycle
+               do i = 1, n
+                  pe = max(abs(off(i) + modes%shape(i, k)*ext(m, 1)), abs(off(i) + modes%shape(i, k)*ext(m, 2)))
+                  pn = max(abs(off(i) + modes%shape(i, k)*ext(m, 3)), abs(off(i) + modes%shape(i, k)*ext(m, 4)))
+                  peak(i) = pe
+                  change(i) = abs(pn - pe)
+               end do
+            end do
+         else
+            do k = 1, modes%n
+               m = first + k
+               pe = max(ext(m, 1), -ext(m, 2))
+               pn = max(ext(m, 3), -ext(m, 4))
+               do i = 1, n
+                  peak(i) = peak(i) + (modes%shape(i, k)*pe)**2
+                  change(i) = change(i) + (modes%shape(i, k)*(pn - pe))**2
+               end do
+            end do
+            peak = abs(off) + sqrt(peak)
+            change = sqrt(change)
+         end if
          ! tested without an ordered comparison, which a NaN would trap in the checked build:
          ! an estimate that failed is not a "resolved"
-         finite = all(ieee_is_finite(ux)) .and. all(ieee_is_finite(du))
+         finite = all(ieee_is_finite(peak)) .and. all(ieee_is_finite(change))
          if (.not. finite) return
-         ux = sqrt(ux)
-         du = sqrt(du)
-         big = maxval(ux)
+         big = maxval(peak)
          if (.not. (big > 0.0_dp)) return
          do i = 1, n
-            if (ux(i) >= 0.01_dp*big) err(i) = max(err(i), du(i)/ux(i))
+            if (peak(i) >= 0.01_dp*big) err(i) = max(err(i), change(i)/peak(i))
          end do
       end function combine
    end subroutine record_resolution
