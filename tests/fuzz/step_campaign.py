@@ -32,7 +32,8 @@ sys.path.insert(0, str(Path(__file__).resolve().parent))
 import physics  # noqa: E402
 
 KEEP = ("n_dof", "n_devices", "peak_u_m", "record_step_error", "record_step_error_stuck",
-        "record_step_error_free", "record_resolution", "mode_resolution", "stick_resolution",
+        "record_step_error_free", "record_step_system", "record_resolution", "mode_resolution",
+        "stick_resolution",
         "energy_balance", "correctness_violations", "stick_to_slip", "slip_to_stick",
         "slip_reversals")
 REFINE = 16           # the reference's n1 is REFINE times the deck's
