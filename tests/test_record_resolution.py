@@ -57,6 +57,22 @@ def record_file(tmp_path_factory):
     return write_at2(rec, tmp_path_factory.mktemp("rec") / "rec.AT2").read_text()
 
 
+def _true_errors(run, deck_at, n1: int, files: dict, name: str):
+    """The deck (deck_at(n1, every)) at n1 with every step written and at 64 n1 with every
+    64th (the same instants): the coarse run and each DOF's |peak |u| / the fine run's - 1|,
+    the error the step alone makes in the peak read at the steps."""
+    coarse = ok(run(deck_at(n1, 1), name=name, files=files))
+    fine = ok(run(deck_at(64 * n1, 64), name=name + "_fine", files=files))
+    s, h_c, h_f = coarse.summary(), coarse.history(), fine.history()
+    assert len(h_c["t"]) == len(h_f["t"]) and np.allclose(h_c["t"], h_f["t"], atol=1e-9)
+    true = []
+    for i in range(1, s["n_dof"] + 1):
+        peak = s["peak_u_m"][i - 1]
+        assert peak == pytest.approx(np.max(np.abs(h_c[f"u{i}"])), rel=1e-12)  # every step written
+        true.append(abs(peak / np.max(np.abs(h_f[f"u{i}"])) - 1))
+    return coarse, true
+
+
 INITIAL = {
     "rest": "",
     # the peak in the record's response, of a changed phase: 2.1 % and 1.5 % at n1 = 2 and 4,
@@ -75,19 +91,13 @@ def test_the_error_is_the_runs_own(run, record_file, n1, initial):
     exact piecewise-linear response is what a run 64 times finer gives at the same instants
     (the rows every 64 of its steps). The two agree to the fine run's own error, from rest and
     from initial conditions (which the check starts from, as the run does)."""
-    files = {"rec.AT2": record_file}
     deck = OSCILLATOR.replace("mass = 1.0", "mass = 1.0" + INITIAL[initial])
-    coarse_deck = deck.replace("N1", str(n1)).replace("EVERY", "1")
-    coarse = ok(run(coarse_deck, name="coarse", files=files))
-    fine_deck = deck.replace("N1", str(64 * n1)).replace("EVERY", "64")
-    fine = ok(run(fine_deck, name="fine", files=files))
+
+    def deck_at(n, every):
+        return deck.replace("N1", str(n)).replace("EVERY", str(every))
+
+    coarse, (measured,) = _true_errors(run, deck_at, n1, {"rec.AT2": record_file}, "oscillator")
     s = coarse.summary()
-    h_c, h_f = coarse.history(), fine.history()
-    assert len(h_c["t"]) == len(h_f["t"]) and np.allclose(h_c["t"], h_f["t"], atol=1e-9)
-    peak_c = s["peak_u_m"][0]
-    assert peak_c == pytest.approx(np.max(np.abs(h_c["u1"])), rel=1e-12)  # every step written
-    exact = np.max(np.abs(h_f["u1"]))
-    measured = abs(peak_c / exact - 1)
     assert s["record_step_error"][0] == pytest.approx(measured, abs=5e-4)  # 21 %, 3.0 %, 1.1 %
     resolved = s["record_step_error"][0] <= 0.05
     assert s["record_resolution"] == ("resolved" if resolved else "unresolved")
@@ -218,8 +228,12 @@ def test_not_applicable_to_harmonic_motion_and_without_modes(run, record_file):
     assert s["record_resolution"] == "not applicable"
 
 
-def _deck_with(groups: str, n1: int, extra_integration: str = "", duration: float = 8.0) -> str:
-    """The oscillator's deck with other &model..&friction groups (the record of the fixture)."""
+def _deck_with(
+    groups: str, n1: int, extra_integration: str = "", duration: float = 8.0, every: int = 0
+) -> str:
+    """The oscillator's deck with other &model..&friction groups (the record of the fixture);
+    with every > 0, a history row every that many steps."""
+    output = f"&output\n  output_every = {every}\n/\n" if every else ""
     return (
         groups
         + f"""
@@ -232,6 +246,7 @@ def _deck_with(groups: str, n1: int, extra_integration: str = "", duration: floa
   n1 = {n1}{extra_integration}
 /
 """
+        + output
     )
 
 
@@ -296,20 +311,6 @@ def test_a_rigid_body_mode_does_not_hide_the_others(run, record_file):
     assert locked["record_step_error"] == pytest.approx([free, stuck], rel=1e-9)
 
 
-def _true_errors(run, groups: str, n1: int, files: dict, name: str):
-    """The deck at n1 and 64 n1 (rows every 64 steps: the same instants): its summary, its
-    stderr and each DOF's |peak |u| / converged peak - 1|."""
-    coarse = ok(run(_deck_with(groups, n1, "\n/\n&output\n  output_every = 1"), name=name,
-                    files=files))
-    fine = ok(run(_deck_with(groups, 64 * n1, "\n/\n&output\n  output_every = 64"),
-                  name=name + "_fine", files=files))
-    s, h_c, h_f = coarse.summary(), coarse.history(), fine.history()
-    assert np.allclose(h_c["t"], h_f["t"], atol=1e-9)
-    true = [abs(np.max(np.abs(h_c[f"u{i}"])) / np.max(np.abs(h_f[f"u{i}"])) - 1)
-            for i in range(1, s["n_dof"] + 1)]
-    return s, coarse.stderr, true
-
-
 def test_a_stuck_device_with_an_initial_offset(run, record_file):
     """One mass on a spring and a hysteretic device that never slides (P mu huge), its sticking
     spring as stiff as the spring, u0 = -3 mm: the run oscillates about the stuck system's
@@ -329,7 +330,11 @@ def test_a_stuck_device_with_an_initial_offset(run, record_file):
   f = {1.0e6 / k!r}
 /
 """
-    s, err, true = _true_errors(run, groups, 4, {"rec.AT2": record_file}, "offset")
+    def deck_at(n, every):
+        return _deck_with(groups, n, every=every)
+
+    coarse, true = _true_errors(run, deck_at, 4, {"rec.AT2": record_file}, "offset")
+    s, err = coarse.summary(), coarse.stderr
     assert s["stick_to_slip"] == [0] and s["record_step_system"] == "stuck"
     assert true[0] > 0.05
     assert s["record_step_error"][0] == pytest.approx(true[0], abs=5e-4)
@@ -354,7 +359,11 @@ def test_a_weak_velocity_law_coupling_is_judged_both_ways(run, record_file):
   eps = 1.0
 /
 """
-    s, err, true = _true_errors(run, groups, 1, {"rec.AT2": record_file}, "weak")
+    def deck_at(n, every):
+        return _deck_with(groups, n, every=every)
+
+    coarse, true = _true_errors(run, deck_at, 1, {"rec.AT2": record_file}, "weak")
+    s, err = coarse.summary(), coarse.stderr
     assert s["stick_to_slip"] == [0] and s["slip_to_stick"] == [0] and true[0] > 0.1
     assert max(s["record_step_error_stuck"]) < 0.01 < 0.1 < s["record_step_error_free"][0]
     assert s["record_step_system"] == "stuck and free"

@@ -129,8 +129,9 @@ contains
       type(error_type), allocatable, intent(out) :: error !! not enough memory
       real(dp), allocatable :: off(:), ku0(:), ex(:, :), nx(:, :), z(:, :), q0(:), ext(:, :)
       real(dp) :: h, p0, p1, q, v, limit
-      integer :: n, stat, nm, ns, m, step, used(2), judged
-      logical :: ok, slid
+      integer :: n, stat, nm, ns, m, step, judged
+      logical :: ok, slid, some
+      logical, allocatable :: kept(:)
 
       n = model%n_dof
       res%record_resolution = resolution_none
@@ -165,8 +166,9 @@ contains
       if (nm == 0) return
       ! the maps by mode, one row of 8 (exact) and of 12 (Newmark) coefficients per mode: the
       ! pass below runs across the modes, each coefficient contiguous; ext: each mode's
-      ! largest and smallest q, exact and by Newmark
-      allocate (off(n), ku0(n), ex(nm, 8), nx(nm, 12), z(nm, 5), q0(nm), ext(nm, 4), stat=stat)
+      ! largest and smallest q, exact and by Newmark; kept: the mode is estimated
+      allocate (off(n), ku0(n), ex(nm, 8), nx(nm, 12), z(nm, 5), q0(nm), ext(nm, 4), kept(nm), &
+                stat=stat)
       if (stat /= 0) then
          call fatal_error(error, "the step against the record: not enough memory for "// &
                           trim(fmt_int(n))//" DOFs", stat_no_memory)
@@ -183,24 +185,24 @@ contains
       ! run saw; z: the exact (q, q') and Newmark's (q, q', q'')
       z = 0.0_dp
       p0 = -table_acceleration(exc, 0.0_dp)
-      used = 0
       do m = 1, nm
          if (m <= ns) then
-            call mode_start(res%eng%stuck, m, m, used(1))
+            call mode_start(res%eng%stuck, m, m)
          else
-            call mode_start(res%eng%free, m - ns, m, used(2))
+            call mode_start(res%eng%free, m - ns, m)
          end if
       end do
-      if (nm == ns) used(2) = used(1)
-      ! no mode of the judged system to estimate: not applicable
+      ! no mode of the judged system to estimate: not applicable (without devices the free
+      ! system's modes are the stuck one's)
       select case (judged)
-      case (record_system_structure, record_system_stuck)
-         if (used(1) == 0) return
       case (record_system_free)
-         if (used(2) == 0) return
+         some = any(kept(ns + 1:nm))
+      case (record_system_both)
+         some = any(kept)
       case default
-         if (used(1) + used(2) == 0) return
+         some = any(kept(1:ns))
       end select
+      if (.not. some) return
       q0 = z(:, 1)
       ext(:, 1) = q0
       ext(:, 2) = q0
@@ -225,8 +227,8 @@ contains
          end do
          p0 = p1
       end do
-      ok = combine(res%eng%stuck, 0, used(1), res%record_error_stuck)
-      if (ok .and. nm > ns) ok = combine(res%eng%free, ns, used(2), res%record_error_free)
+      ok = combine(res%eng%stuck, 0, res%record_error_stuck)
+      if (ok .and. nm > ns) ok = combine(res%eng%free, ns, res%record_error_free)
       res%record_system = judged
       if (.not. ok) then
          res%record_error = 1.0_dp
@@ -254,22 +256,21 @@ contains
       !> and its start. The initial conditions' modal coordinates are taken about the system's
       !> equilibrium with its devices stuck where they start (their rest lengths the initial
       !> ones; none for the free system): q(0) = phi' K u0 / (wn^2 phi' M phi), with K the
-      !> springs' alone, and q'(0) = phi' M v0 / phi' M phi. Left out (a zero row, not
-      !> counted in used): a rigid-body mode (its drift, unbounded without a0, has no step
+      !> springs' alone, and q'(0) = phi' M v0 / phi' M phi. Left out (kept false, a zero
+      !> row): a rigid-body mode (its drift, unbounded without a0, has no step
       !> error to speak of and would swamp the other modes' peaks), and a mode the step cannot
       !> integrate (beyond omega dt1 = 2, which mode_resolution reports, or unstable).
-      subroutine mode_start(modes, k, m, used)
+      subroutine mode_start(modes, k, m)
          type(modes_type), intent(in) :: modes
          integer, intent(in) :: k, m
-         integer, intent(inout) :: used
          real(dp) :: phi(2, 2), g0(2), g1(2), nmap(3, 3), np(3), g, mk, wn, c
 
          ex(m, :) = 0.0_dp
          nx(m, :) = 0.0_dp
          wn = sqrt(max(modes%omega2(k), 0.0_dp))
          c = mode_damping(modes, k, res%eng%a0)
-         if (.not. (wn > 0.0_dp .and. wn*h < limit)) return
-         used = used + 1
+         kept(m) = wn > 0.0_dp .and. wn*h < limit
+         if (.not. kept(m)) return
          g = mode_participation(modes, k, model%mass(1:n))
          call exact_step_map(wn, c, h, phi, g0, g1)
          ex(m, :) = [phi(1, 1), phi(1, 2), phi(2, 1), phi(2, 2), g*g0(1), g*g0(2), g*g1(1), g*g1(2)]
@@ -290,10 +291,9 @@ contains
       !> the peak is estimated as |off| + the square root of the sum of squares of the modes'
       !> peaks |phi q|, and err is that of the peaks' changes against it. .false. when not
       !> finite.
-      logical function combine(modes, first, nused, err) result(finite)
+      logical function combine(modes, first, err) result(finite)
          type(modes_type), intent(in) :: modes
          integer, intent(in) :: first
-         integer, intent(in) :: nused      !! modes estimated (not left out)
          real(dp), intent(inout) :: err(:)
          real(dp) :: big, pe, pn, peak(n), change(n)
          integer :: k, i, m
@@ -306,17 +306,15 @@ contains
          end do
          peak = 0.0_dp
          change = 0.0_dp
-         if (nused == 1) then
-            ! the one mode estimated (the others' rows are zero: they add nothing)
-            do k = 1, modes%n
-               m = first + k
-               if (all(ex(m, :) == 0.0_dp)) cycle
-               do i = 1, n
-                  pe = max(abs(off(i) + modes%shape(i, k)*ext(m, 1)), abs(off(i) + modes%shape(i, k)*ext(m, 2)))
-                  pn = max(abs(off(i) + modes%shape(i, k)*ext(m, 3)), abs(off(i) + modes%shape(i, k)*ext(m, 4)))
-                  peak(i) = pe
-                  change(i) = abs(pn - pe)
-               end do
+         if (count(kept(first + 1:first + modes%n)) == 1) then
+            ! the one mode estimated (the others left out stay at q = 0)
+            k = findloc(kept(first + 1:first + modes%n), .true., 1)
+            m = first + k
+            do i = 1, n
+               pe = max(abs(off(i) + modes%shape(i, k)*ext(m, 1)), abs(off(i) + modes%shape(i, k)*ext(m, 2)))
+               pn = max(abs(off(i) + modes%shape(i, k)*ext(m, 3)), abs(off(i) + modes%shape(i, k)*ext(m, 4)))
+               peak(i) = pe
+               change(i) = abs(pn - pe)
             end do
          else
             do k = 1, modes%n
