@@ -11,6 +11,7 @@ module fd_excitation
    private
 
    public :: excitation_type, table_motion, table_acceleration, ramp_end
+   public :: grid_motion, grid_init, grid_acceleration
    public :: excitation_none, excitation_harmonic, excitation_record
    public :: sine_forcing, max_sines, table_sines, segment_end, table_taylor, forcing_frequency
    public :: forcing_form, forcing_unknown, forcing_zero, forcing_sines, forcing_linear
@@ -30,6 +31,26 @@ module fd_excitation
       real(dp) :: w(max_sines) = 0.0_dp        !! circular frequencies [rad/s]
       real(dp) :: amp(max_sines) = 0.0_dp      !! amplitudes [m/s2]
    end type sine_forcing
+
+   integer, parameter :: grid_block = 64      !! grid points per block of grid_motion
+
+   !> The table acceleration at the points t = k h of a grid (the ends of a run's dt1 steps)
+   !> of harmonic motion without a ramp, without a sine per point: with k = b + j, b a multiple
+   !> of grid_block, sin(w k h) = sin(w b h) cos(w j h) + cos(w b h) sin(w j h), the sine and
+   !> cosine of w j h tabulated once and those of w b h taken once per block. Each term is
+   !> rounded once, so the value is within a few ulp of the amplitude of a0 w^2 sin(w k h)
+   !> (nothing accumulates from block to block); other table motions take table_acceleration.
+   !> State of one run (it lives in the run's workspace).
+   type :: grid_motion
+      logical :: tabulated = .false.              !! harmonic without a ramp: the tables hold
+      real(dp) :: h = 0.0_dp                      !! grid step [s]
+      real(dp) :: w = 0.0_dp                      !! circular frequency [rad/s]
+      real(dp) :: amp = 0.0_dp                    !! -a0 w^2 [m/s2]
+      integer :: block = -1                       !! block whose sine and cosine are in sb, cb
+      real(dp) :: sb = 0.0_dp, cb = 0.0_dp        !! sin and cos of w b h
+      real(dp) :: sj(0:grid_block - 1) = 0.0_dp   !! sin(w j h)
+      real(dp) :: cj(0:grid_block - 1) = 0.0_dp   !! cos(w j h)
+   end type grid_motion
 
    !> The table motion of one run.
    type :: excitation_type
@@ -104,6 +125,48 @@ contains
          call table_motion(exc, t, xg, vg, ag)
       end if
    end function table_acceleration
+
+   !> Set up the grid t = k h of the table acceleration (grid_motion).
+   pure subroutine grid_init(exc, h, grid)
+      type(excitation_type), intent(in) :: exc !! the table motion
+      real(dp), intent(in) :: h                !! grid step [s]
+      type(grid_motion), intent(out) :: grid   !! the grid
+      integer :: j
+
+      grid%h = h
+      grid%tabulated = exc%kind == excitation_harmonic .and. exc%ramp_cycles == 0
+      if (.not. grid%tabulated) return
+      grid%w = 2.0_dp*pi*exc%frequency
+      grid%amp = -(exc%amplitude*(grid%w*grid%w))
+      do j = 0, grid_block - 1
+         grid%sj(j) = sin(grid%w*(j*h))
+         grid%cj(j) = cos(grid%w*(j*h))
+      end do
+   end subroutine grid_init
+
+   !> Table acceleration at t = k h of the grid (table_acceleration's value to round-off).
+   pure subroutine grid_acceleration(exc, grid, k, ag)
+      type(excitation_type), intent(in) :: exc   !! the table motion
+      type(grid_motion), intent(inout) :: grid   !! the grid (grid_init)
+      integer, intent(in) :: k                   !! grid point, >= 0
+      real(dp), intent(out) :: ag                !! table acceleration at k h [m/s2]
+      real(dp) :: x
+      integer :: b, j
+
+      if (.not. grid%tabulated) then
+         ag = table_acceleration(exc, k*grid%h)
+         return
+      end if
+      b = k/grid_block
+      j = k - b*grid_block
+      if (b /= grid%block) then
+         x = grid%w*(real(b, dp)*grid_block*grid%h)
+         grid%sb = sin(x)
+         grid%cb = cos(x)
+         grid%block = b
+      end if
+      ag = grid%amp*(grid%sb*grid%cj(j) + grid%cb*grid%sj(j))
+   end subroutine grid_acceleration
 
    !> End of the cosine ramp of harmonic table motion, t_r = ramp_cycles / frequency [s].
    pure real(dp) function ramp_end(exc)

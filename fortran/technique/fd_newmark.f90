@@ -32,7 +32,8 @@ module fd_newmark
                        technique_event_driven, technique_moreau_jean, linear_system_dense, linear_system_banded, &
                        refinement_nested, refinement_implicit
    use fd_model, only: model_type, integration_type
-   use fd_excitation, only: excitation_type, table_motion, table_acceleration
+   use fd_excitation, only: excitation_type, table_motion, table_acceleration, grid_motion, grid_init, &
+                            grid_acceleration
    use fd_matrices, only: structure_damping
    use fd_kinematics, only: device_kinematics, add_device
    use fd_banded, only: spd_system, spd_setup, spd_factor, spd_update_devices, spd_solve, spd_k_matvec, &
@@ -86,6 +87,8 @@ module fd_newmark
       real(dp) :: ag = 0.0_dp, ag1 = 0.0_dp
       real(dp) :: w_device = 0.0_dp                   !! work of the device forces [J]
       real(dp) :: t = 0.0_dp                          !! time of the accepted state [s]
+      integer :: k = 0                                !! the dt1 step being taken, from k - 1 to k
+      type(grid_motion) :: grid                       !! table acceleration at the dt1 steps' ends
       type(observer_type) :: obs                      !! peaks, history, energy balance
       type(ringing_type) :: ring                      !! the sticking springs' ringing
    end type workspace
@@ -150,6 +153,7 @@ contains
       if (allocated(error)) return
       call observer_init(model, exc, opts, res, w%obs, error, ctl)
       if (allocated(error)) return
+      call grid_init(exc, dt1, w%grid)
 
       ! initial state: devices from the initial conditions, acceleration from equilibrium
       w%u = model%u0
@@ -171,6 +175,7 @@ contains
 
       do k = 1, w%obs%nsteps
          t0 = (k - 1)*dt1
+         w%k = k
          call try_step(exc, t0, 1, w, error)
          if (allocated(error)) return
          call judge(model, opts, w, any_changed, any_bad)
@@ -358,7 +363,12 @@ contains
          if (allocated(error)) return
       end if
       h = w%lev(lv)%h
-      ag1 = table_acceleration(exc, t + h)
+      if (lv == 1) then
+         ! a dt1 step ends at k dt1 (w%k), a point of the grid
+         call grid_acceleration(exc, w%grid, w%k, ag1)
+      else
+         ag1 = table_acceleration(exc, t + h)
+      end if
       w%ag1 = ag1
       call predict(w%n, h, w%lev(lv)%g1h, w%lev(lv)%b2h2, ag1, w%mass, w%u, w%v, w%a, w%tmp, w%u1, w%rhs)
       call spd_kc_matvec(w%lev(lv)%sys, w%u1, w%tmp, w%rhs, -1.0_dp)

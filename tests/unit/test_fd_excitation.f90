@@ -1,11 +1,13 @@
 !> Unit tests of the table motion (fd_excitation): the harmonic motion against its closed
 !> form, displacement, velocity and acceleration consistent by central differences with and
 !> without the cosine ramp, the ramp starting from rest and ending continuously, and the
-!> linear interpolation of a record, with the table at rest after its end.
+!> linear interpolation of a record, with the table at rest after its end; the table
+!> acceleration on a time step's grid (grid_motion) against the sine at every point.
 module test_fd_excitation
    use testdrive, only: new_unittest, unittest_type, error_type, check
    use fd_kinds, only: dp
-   use fd_excitation, only: excitation_type, table_motion, excitation_none, excitation_harmonic, excitation_record
+   use fd_excitation, only: excitation_type, table_motion, excitation_none, excitation_harmonic, excitation_record, &
+                            table_acceleration, grid_motion, grid_init, grid_acceleration
    use test_fd_helpers, only: check_close
    implicit none
    private
@@ -27,7 +29,9 @@ contains
                   new_unittest("ramp starts from rest", test_ramp_start), &
                   new_unittest("ramp ends continuously", test_ramp_end), &
                   new_unittest("record interpolation", test_record), &
-                  new_unittest("table at rest", test_none) &
+                  new_unittest("table at rest", test_none), &
+                  new_unittest("grid acceleration against the sine", test_grid), &
+                  new_unittest("grid of other motions", test_grid_other) &
                   ]
    end subroutine collect_excitation
 
@@ -182,5 +186,69 @@ contains
       call table_motion(exc, 0.3_dp, xg, vg, ag)
       call check(error, xg == 0.0_dp .and. vg == 0.0_dp .and. ag == 0.0_dp, 'no excitation: the table at rest')
    end subroutine test_none
+
+   !> Test 4's dt1 grid (h = 0.25 ms) over 100 s, in order, backwards and by jumps: every point
+   !> within (8 + 2 w t) ulp of a w^2 of the sine of table_acceleration (both round the
+   !> argument w t, whose ulp grows with t; the grid adds one rounding per term). The bound is
+   !> reached: the largest difference is asserted above a quarter of it, so the check is
+   !> not looser than the grid's error (on this grid it is 0.8 of it).
+   subroutine test_grid(error)
+      type(error_type), allocatable, intent(out) :: error
+      type(excitation_type) :: exc
+      type(grid_motion) :: grid
+      real(dp), parameter :: h = 0.005_dp/20
+      real(dp) :: w, ag, ref, bound, worst
+      integer :: k, m, p
+
+      exc = harmonic(0)
+      w = 2.0_dp*pi*freq
+      call grid_init(exc, h, grid)
+      worst = 0.0_dp
+      do m = 1, 3
+         do k = 0, 400000
+            select case (m)
+            case (1)
+               p = k
+            case (2)
+               p = 400000 - k
+            case default
+               p = mod(5003*k, 400001)   ! 5003 * 400000 < 2**31
+            end select
+            call grid_acceleration(exc, grid, p, ag)
+            ref = table_acceleration(exc, p*h)
+            bound = (8.0_dp + 2.0_dp*w*p*h)*epsilon(1.0_dp)*amp*w*w
+            if (m == 1) worst = max(worst, abs(ag - ref)/bound)
+            call check(error, abs(ag - ref) <= bound, 'grid acceleration off the sine')
+            if (allocated(error)) return
+         end do
+      end do
+      call check(error, worst > 0.25_dp, 'the bound of the grid test is loose')
+   end subroutine test_grid
+
+   !> A ramp or a record is not tabulated: the grid gives table_acceleration's bits.
+   subroutine test_grid_other(error)
+      type(error_type), allocatable, intent(out) :: error
+      type(excitation_type) :: exc
+      type(grid_motion) :: grid
+      real(dp), parameter :: h = 0.005_dp/7
+      real(dp) :: ag
+      integer :: k, c
+
+      do c = 1, 2
+         if (c == 1) then
+            exc = harmonic(3)
+         else
+            exc%kind = excitation_record
+            exc%dt_record = 0.005_dp
+            exc%acc = [(sin(0.3_dp*k), k=0, 99)]
+         end if
+         call grid_init(exc, h, grid)
+         do k = 0, 200
+            call grid_acceleration(exc, grid, k, ag)
+            call check(error, ag == table_acceleration(exc, k*h), 'grid of a ramp or a record')
+            if (allocated(error)) return
+         end do
+      end do
+   end subroutine test_grid_other
 
 end module test_fd_excitation
