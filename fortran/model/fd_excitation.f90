@@ -1,6 +1,7 @@
 !> Table motion: harmonic table displacement with an optional cosine ramp, or a recorded
 !> table acceleration sampled at dt_record and linearly interpolated in between. Every
-!> technique takes the table motion from here: its value at a time (table_motion), and,
+!> technique takes the table motion from here: its value at a time (table_motion) or at the
+!> points of a time step's grid (grid_motion, without a sine per step), and,
 !> for a technique that integrates the forcing exactly, its form on a segment of time:
 !> a sum of sines (harmonic motion, the ramp included), linear between samples (a record),
 !> or zero (forcing_form, table_sines, ramp_end).
