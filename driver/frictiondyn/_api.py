@@ -83,9 +83,10 @@ class FrictiondynWarning(UserWarning):
     dephases the ringing of a sticking spring on which a device's stick-slip decisions rest
     (summary ``stick_resolution``), a step that moves the linear steady state under a
     harmonic table motion by more than 5 % (summary ``harmonic_resolution``), one that moves
-    the peak linear response to a record by more than 5 % (summary ``record_resolution``), or an
-    integration that dissipated or created more than 5 % of the energy (summary
-    ``energy_balance``). Issued when the
+    the peak linear response to a record by more than 5 % (summary ``record_resolution``), an
+    integration that dissipated or created more than 5 % of the energy, or, with the average
+    acceleration rule, whose energy balance misses by more than round-off (1e-8: digits
+    lost) (summary ``energy_balance``). Issued when the
     Result is made (``Session.result``, ``run``, ``Analysis.run``); the summary holds the
     figures. Filter it with the ``warnings`` module like any other warning."""
 
@@ -160,7 +161,18 @@ def summary_warnings(summary: dict) -> list[str]:
             + (f" ({more} more device(s) likewise: summary stick_ringing_ratio)" if more else "")
         )
     balance = summary.get("energy_balance")
-    if balance in ("dissipative", "energy error"):
+    if balance == "digits lost":
+        out.append(
+            "the energy balance of the average acceleration rule closes at round-off, and this "
+            f"run's residual is {abs(summary['energy_residual_ratio']):.1e} of the energy the "
+            "structure held and received (|energy_residual_ratio| > 1e-08): the integration lost "
+            "digits to round-off, typically in a coupling far stiffer than dt1 resolves (a "
+            "velocity-law band whose P mu / eps is huge for its masses: (P mu / eps) dt1 / (2 m) "
+            ">> 1 leaves an alternating force in the band); its forces and accelerations, and "
+            "possibly its displacements, carry that error: widen eps, soften the coupling or "
+            "raise n1"
+        )
+    elif balance in ("dissipative", "energy error"):
         ratio = summary["energy_residual_ratio"]
         cause = (
             "numerical damping (Newmark gamma > 1/2, Moreau-Jean theta > 1/2) the physics does "

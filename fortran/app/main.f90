@@ -19,7 +19,8 @@ program frictiondyn_main
                          session_set_progress
    use fd_progress_line, only: progress_wanted, progress_show, progress_clear
    use fd_version, only: frictiondyn_version
-   use fd_result, only: resolution_unresolved, residual_ratio_limit, balance_closed, balance_dissipative, &
+   use fd_result, only: resolution_unresolved, residual_ratio_limit, roundoff_ratio_limit, balance_closed, &
+                        balance_dissipative, balance_digits, &
                         record_system_stuck, record_system_free, record_system_both
    implicit none
 
@@ -171,7 +172,15 @@ program frictiondyn_main
       if (count(res%stick_ringing_ratio > 1.0_dp) > 1) write (error_unit, '(a,i0,a)') '  (', &
          count(res%stick_ringing_ratio > 1.0_dp) - 1, ' more device(s) likewise: summary stick_ringing_ratio)'
    end if
-   if (res%energy_balance /= balance_closed) then
+   if (res%energy_balance == balance_digits) then
+      write (error_unit, '(a,es7.1,a,es7.1,a)') 'frictiondyn: warning: the energy balance of the average '// &
+         'acceleration rule closes at round-off, and this run''s residual is ', abs(res%e_residual_ratio), &
+         ' of the energy the structure held and received (|energy_residual_ratio| > ', roundoff_ratio_limit, '):'
+      write (error_unit, '(a)') '  the integration lost digits to round-off, typically in a coupling far stiffer '// &
+         'than dt1 resolves (a velocity-law band whose P mu / eps is huge for its masses: (P mu / eps) dt1 / '// &
+         '(2 m) >> 1 leaves an alternating force in the band); its forces and accelerations, and possibly its '// &
+         'displacements, carry that error: widen eps, soften the coupling or raise n1'
+   else if (res%energy_balance /= balance_closed) then
       write (error_unit, '(a,a,1x,f0.1,a,f4.2,a)') 'frictiondyn: warning: the integration ', &
          trim(merge('dissipated', 'created   ', res%e_residual_ratio > 0.0_dp)), 100*abs(res%e_residual_ratio), &
          ' % of the energy the structure held and received (|energy_residual_ratio| > ', residual_ratio_limit, '):'

@@ -69,10 +69,13 @@ contains
          call unknown_technique(opts%technique, error)
       end select
       ! the energy balance's verdict; a residual is the method's numerical damping when the
-      ! method damps (set after the run: each technique's res is intent(out))
+      ! method damps, and round-off when its accounting is exact (average acceleration) (set
+      ! after the run: each technique's res is intent(out))
       res%energy_balance = energy_balance_of(res%e_residual_ratio, &
                                              (opts%technique == technique_newmark .and. opts%gamma > 0.5_dp) .or. &
-                                             (opts%technique == technique_moreau_jean .and. opts%theta > 0.5_dp))
+                                             (opts%technique == technique_moreau_jean .and. opts%theta > 0.5_dp), &
+                                             opts%technique == technique_newmark .and. opts%beta == 0.25_dp .and. &
+                                             opts%gamma == 0.5_dp)
       ! whether the step resolves the highest modes: one report for every stepping technique
       if (.not. allocated(error)) call mode_resolution(model, res, error)
       ! and the table's motion (Newmark): a harmonic's frequency, a record's spectrum
