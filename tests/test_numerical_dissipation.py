@@ -199,7 +199,7 @@ def test_digits_lost_in_a_stiff_velocity_band(run):
     near +-0.4 P mu for the whole run, decaying by the trapezoidal rule's (1 - x) / (1 + x) a
     step, where the exact technique's holding force is a few newtons (measured: ratio 3.3e-6,
     late force 3.98e6 N against 6.9 N). With the same
-    momentum and no relative velocity in the band the balance closes (1.0e-9 at P = 1e10)."""
+    momentum and no relative velocity in the band the balance closes (1.0e-11 at P = 1e9)."""
     bad = ok(run(stiff_band(1.0e8, "-0.3, 0.1"), name="bad"))
     exact = ok(run(stiff_band(1.0e8, "-0.3, 0.1", technique="event_driven"), name="exact"))
     s = bad.summary()
@@ -213,7 +213,7 @@ def test_digits_lost_in_a_stiff_velocity_band(run):
     assert f_bad == pytest.approx(c1 * 0.4 * ((x - 1) / (x + 1)) ** 201, rel=1e-3)
     assert f_exact < 10.0 and f_bad > 1e5 * f_exact
     assert exact.summary()["energy_balance"] == "closed"
-    calm = ok(run(stiff_band(1.0e10, "-0.16666666666666667, -0.16666666666666667"), name="calm"))
+    calm = ok(run(stiff_band(1.0e9, "-0.16666666666666667, -0.16666666666666667"), name="calm"))
     c = calm.summary()
     assert abs(c["energy_residual_ratio"]) < 1e-8 and c["energy_balance"] == "closed"
     assert "lost digits" not in calm.stderr
@@ -249,3 +249,14 @@ def test_digits_lost_where_the_peak_is_silently_wrong(run, tmp_path):
     assert py["energy_balance"] == "digits lost"
     assert any("lost digits to round-off" in w for w in words)
     assert any(f"{abs(py['energy_residual_ratio']):.1e}" in w for w in words)
+
+
+def test_only_average_acceleration_has_the_round_off_limit(run):
+    """beta = 1/4 with gamma = 0.6 damps numerically (the step's amplification below 1): its
+    residual, a share of the energy well above round-off and below 0.05 (7.0e-3 over 200
+    steps at omega dt = 0.02), is the method's, and the balance is "closed" under the 0.05
+    limit, not "digits lost"."""
+    r = ok(run(oscillator(0.001, 200, 0.6, 0.25)))
+    s = r.summary()
+    assert 1e-6 < s["energy_residual_ratio"] < 0.05
+    assert s["energy_balance"] == "closed" and "warning" not in r.stderr

@@ -105,7 +105,8 @@ def summary_warnings(summary: dict) -> list[str]:
     (without its "frictiondyn: warning: " prefix): correctness violations, a step dt1 that
     does not resolve the highest modes, one that misses a harmonic table motion's steady
     state or a record's peak linear response, one that dephases a sticking spring's ringing,
-    and an integration that dissipated (or created) more than 5 % of the energy."""
+    an integration that dissipated (or created) more than 5 % of the energy, and one by the
+    average acceleration rule whose energy balance misses round-off (digits lost)."""
     out = []
     n = summary.get("correctness_violations", 0)
     if n:
@@ -166,11 +167,12 @@ def summary_warnings(summary: dict) -> list[str]:
             "the energy balance of the average acceleration rule closes at round-off, and this "
             f"run's residual is {abs(summary['energy_residual_ratio']):.1e} of the energy the "
             "structure held and received (|energy_residual_ratio| > 1e-08): the integration lost "
-            "digits to round-off, typically in a coupling far stiffer than dt1 resolves (a "
-            "velocity-law band whose P mu / eps is huge for its masses: (P mu / eps) dt1 / (2 m) "
-            ">> 1 leaves an alternating force in the band); its forces and accelerations, and "
-            "possibly its displacements, carry that error: widen eps, soften the coupling or "
-            "raise n1"
+            "digits to round-off, typically in a coupling far stiffer than dt1 resolves: a "
+            "velocity-law band whose P mu / eps is huge for its masses (x = (P mu / eps) dt1 / "
+            "(2 m_r) >> 1, m_r the reduced mass of its two nodes, leaves an alternating force in "
+            "the band), or a very stiff spring; its forces and accelerations, and possibly its "
+            "displacements, carry that error: widen eps or soften the coupling; a larger n1 "
+            "helps only once it brings x below 1 (the alternating force can outlast this warning)"
         )
     elif balance in ("dissipative", "energy error"):
         ratio = summary["energy_residual_ratio"]

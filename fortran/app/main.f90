@@ -177,9 +177,11 @@ program frictiondyn_main
          'acceleration rule closes at round-off, and this run''s residual is ', abs(res%e_residual_ratio), &
          ' of the energy the structure held and received (|energy_residual_ratio| > ', roundoff_ratio_limit, '):'
       write (error_unit, '(a)') '  the integration lost digits to round-off, typically in a coupling far stiffer '// &
-         'than dt1 resolves (a velocity-law band whose P mu / eps is huge for its masses: (P mu / eps) dt1 / '// &
-         '(2 m) >> 1 leaves an alternating force in the band); its forces and accelerations, and possibly its '// &
-         'displacements, carry that error: widen eps, soften the coupling or raise n1'
+         'than dt1 resolves: a velocity-law band whose P mu / eps is huge for its masses (x = (P mu / eps) dt1 / '// &
+         '(2 m_r) >> 1, m_r the reduced mass of its two nodes, leaves an alternating force in the band), or a '// &
+         'very stiff spring; its forces and accelerations, and possibly its displacements, carry that error: '// &
+         'widen eps or soften the coupling; a larger n1 helps only once it brings x below 1 (the alternating '// &
+         'force can outlast this warning)'
    else if (res%energy_balance /= balance_closed) then
       write (error_unit, '(a,a,1x,f0.1,a,f4.2,a)') 'frictiondyn: warning: the integration ', &
          trim(merge('dissipated', 'created   ', res%e_residual_ratio > 0.0_dp)), 100*abs(res%e_residual_ratio), &
