@@ -145,17 +145,20 @@ contains
       end do
    end subroutine grid_init
 
-   !> Table acceleration at t = k h of the grid (table_acceleration's value to round-off).
-   pure subroutine grid_acceleration(exc, grid, k, ag)
+   !> Table acceleration at t = k h of the grid: from the tables for the harmonic motion they
+   !> hold (table_acceleration's value to round-off), else table_acceleration at t, the same
+   !> time as the caller computes it (a record's value to the bit).
+   pure subroutine grid_acceleration(exc, grid, k, t, ag)
       type(excitation_type), intent(in) :: exc   !! the table motion
       type(grid_motion), intent(inout) :: grid   !! the grid (grid_init)
       integer, intent(in) :: k                   !! grid point, >= 0
+      real(dp), intent(in) :: t                  !! its time, k h up to round-off [s]
       real(dp), intent(out) :: ag                !! table acceleration at k h [m/s2]
       real(dp) :: x
       integer :: b, j
 
       if (.not. grid%tabulated) then
-         ag = table_acceleration(exc, k*grid%h)
+         ag = table_acceleration(exc, t)
          return
       end if
       b = k/grid_block

@@ -363,10 +363,9 @@ contains
          if (allocated(error)) return
       end if
       h = w%lev(lv)%h
-      if (lv == 1 .and. w%grid%tabulated) then
-         ! a dt1 step of harmonic motion ends at k dt1 (w%k), a point of the grid (other
-         ! motions at t + h, to the bit as before)
-         call grid_acceleration(exc, w%grid, w%k, ag1)
+      if (lv == 1) then
+         ! a dt1 step ends at k dt1 (w%k), a point of the grid
+         call grid_acceleration(exc, w%grid, w%k, t + h, ag1)
       else
          ag1 = table_acceleration(exc, t + h)
       end if

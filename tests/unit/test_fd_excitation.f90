@@ -214,7 +214,7 @@ contains
             case default
                p = mod(5003*k, 400001)   ! 5003 * 400000 < 2**31
             end select
-            call grid_acceleration(exc, grid, p, ag)
+            call grid_acceleration(exc, grid, p, p*h, ag)
             ref = table_acceleration(exc, p*h)
             bound = (8.0_dp + 2.0_dp*w*p*h)*epsilon(1.0_dp)*amp*w*w
             if (m == 1) worst = max(worst, abs(ag - ref)/bound)
@@ -225,7 +225,8 @@ contains
       call check(error, worst > 0.25_dp, 'the bound of the grid test is loose')
    end subroutine test_grid
 
-   !> A ramp or a record is not tabulated: the grid gives table_acceleration's bits.
+   !> A ramp or a record is not tabulated: the grid gives table_acceleration's bits at the
+   !> time passed.
    subroutine test_grid_other(error)
       type(error_type), allocatable, intent(out) :: error
       type(excitation_type) :: exc
@@ -244,7 +245,7 @@ contains
          end if
          call grid_init(exc, h, grid)
          do k = 0, 200
-            call grid_acceleration(exc, grid, k, ag)
+            call grid_acceleration(exc, grid, k, k*h, ag)
             call check(error, ag == table_acceleration(exc, k*h), 'grid of a ramp or a record')
             if (allocated(error)) return
          end do
