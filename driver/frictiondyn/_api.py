@@ -81,7 +81,8 @@ class FrictiondynWarning(UserWarning):
     error: steps that violate the correctness condition (eqs. 9, 12), a step dt1 that does
     not resolve the structure's highest modes (summary ``mode_resolution``), or one that
     dephases the ringing of a sticking spring on which a device's stick-slip decisions rest
-    (summary ``stick_resolution``), a step that moves the linear steady state under a
+    (summary ``stick_resolution``), a velocity-law band whose force the step leaves
+    alternating from step to step (summary ``band_resolution``), a step that moves the linear steady state under a
     harmonic table motion by more than 5 % (summary ``harmonic_resolution``), one that moves
     the peak linear response to a record by more than 5 % (summary ``record_resolution``), an
     integration that dissipated or created more than 5 % of the energy, or, with the average
@@ -105,6 +106,7 @@ def summary_warnings(summary: dict) -> list[str]:
     (without its "frictiondyn: warning: " prefix): correctness violations, a step dt1 that
     does not resolve the highest modes, one that misses a harmonic table motion's steady
     state or a record's peak linear response, one that dephases a sticking spring's ringing,
+    a velocity-law band whose force alternates from step to step,
     an integration that dissipated (or created) more than 5 % of the energy, and one by the
     average acceleration rule whose energy balance misses round-off (digits lost)."""
     out = []
@@ -160,6 +162,25 @@ def summary_warnings(summary: dict) -> list[str]:
             "stick-slip transitions may depend on the step; check with a larger n1 (halving dt1 "
             "quarters that error)"
             + (f" ({more} more device(s) likewise: summary stick_ringing_ratio)" if more else "")
+        )
+    if summary.get("band_resolution") == "unresolved":
+        amp = summary["band_alternation_N"]
+        d = max(range(len(amp)), key=lambda i: amp[i])
+        x = summary["band_x"][d]
+        more = sum(a > 0 for a in amp) - 1
+        remedy = (
+            f"raise n1 until dt1 < {summary['dt1_s'] / x:.3g} s (x < 1)" if x > 1 else "raise n1"
+        )
+        out.append(
+            f"the force of device {d + 1} alternates from step to step inside its velocity band, "
+            f"by +-{amp[d]:.3g} N for {summary['band_alternation_s'][d]:.3g} s in all "
+            "(band_alternation_N, band_alternation_s): the average acceleration rule damps the "
+            "band's coupling only where x = (P mu / eps) dt1 / (2 m_r) < 1 (m_r the reduced mass "
+            f"of its nodes), and here x = {x:.3g}; the device's force history and the absolute "
+            "accelerations of its nodes carry the alternation, its displacements do not: "
+            f"{remedy} or widen eps (exact Coulomb friction, law = 'coulomb' with technique = "
+            "'event_driven', has no band)"
+            + (f" ({more} more device(s) likewise: summary band_alternation_N)" if more else "")
         )
     balance = summary.get("energy_balance")
     if balance == "digits lost":

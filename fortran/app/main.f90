@@ -172,6 +172,25 @@ program frictiondyn_main
       if (count(res%stick_ringing_ratio > 1.0_dp) > 1) write (error_unit, '(a,i0,a)') '  (', &
          count(res%stick_ringing_ratio > 1.0_dp) - 1, ' more device(s) likewise: summary stick_ringing_ratio)'
    end if
+   if (res%band_resolution == resolution_unresolved) then
+      d = maxloc(res%band_alternation, 1)
+      write (error_unit, '(a,i0,a,es9.3,a,es9.3,a)') 'frictiondyn: warning: the force of device ', d, &
+         ' alternates from step to step inside its velocity band, by +-', res%band_alternation(d), ' N for ', &
+         res%band_alternation_time(d), ' s in all (band_alternation_N, band_alternation_s):'
+      write (error_unit, '(a,es9.3,a)') '  the average acceleration rule damps the band''s coupling only where '// &
+         'x = (P mu / eps) dt1 / (2 m_r) < 1 (m_r the reduced mass of its nodes), and here x = ', res%band_x(d), &
+         '; the device''s force history and the absolute accelerations of its nodes carry the alternation, '// &
+         'its displacements do not:'
+      if (res%band_x(d) > 1.0_dp) then
+         write (error_unit, '(a,es9.3,a)') '  raise n1 until dt1 < ', res%dt1/res%band_x(d), ' s (x < 1) or '// &
+            'widen eps (exact Coulomb friction, law = ''coulomb'' with technique = ''event_driven'', has no band)'
+      else
+         write (error_unit, '(a)') '  raise n1 or widen eps (exact Coulomb friction, law = ''coulomb'' with '// &
+            'technique = ''event_driven'', has no band)'
+      end if
+      if (count(res%band_alternation > 0.0_dp) > 1) write (error_unit, '(a,i0,a)') '  (', &
+         count(res%band_alternation > 0.0_dp) - 1, ' more device(s) likewise: summary band_alternation_N)'
+   end if
    if (res%energy_balance == balance_digits) then
       write (error_unit, '(a,es7.1,a,es7.1,a)') 'frictiondyn: warning: the energy balance of the average '// &
          'acceleration rule closes at round-off, and this run''s residual is ', abs(res%e_residual_ratio), &

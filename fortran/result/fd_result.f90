@@ -77,6 +77,8 @@ module fd_result
       integer :: record_system = 1         !! the system record_error judges (record_system_*)
       integer :: stick_resolution = resolution_none !! whether dt1 resolves the sticking springs'
                                                     !! ringing (fd_stick_ringing)
+      integer :: band_resolution = resolution_none  !! whether the step damps the velocity-law
+                                                    !! bands (fd_band_alternation)
       integer :: technique = 0             !! technique id of the run (fd_names)
       logical :: started_sliding = .false. !! a device was sliding at t = 0 (Newmark)
       ! peaks per DOF (over every step taken)
@@ -100,6 +102,10 @@ module fd_result
       real(dp), allocatable :: stick_ringing_ratio(:) !! largest ringing / margin of a dephased stick phase
       real(dp), allocatable :: stick_ringing(:)       !! that phase's ringing amplitude [N]
       real(dp), allocatable :: stick_margin(:)        !! that phase's margin P mu - max |F| [N]
+      real(dp), allocatable :: band_x(:)              !! velocity law: (P mu / eps) dt1 / (2 m_r)
+      real(dp), allocatable :: band_alternation(:)    !! largest step-to-step alternation of the
+                                                      !! band's force counted [N]
+      real(dp), allocatable :: band_alternation_time(:) !! time of the steps counted [s]
       ! steps
       integer :: steps_dt1 = 0         !! steps taken with dt1
       integer :: steps_dt2 = 0         !! steps taken with dt2
@@ -280,7 +286,8 @@ contains
                 res%slip_to_stick(nd), res%reversals(nd), res%harmonic_error(n), res%record_error(n), &
                 res%record_error_stuck(n), res%record_error_free(n), &
                 res%stick_freq_error(nd), res%stick_ringing_ratio(nd), res%stick_ringing(nd), &
-                res%stick_margin(nd), stat=stat)
+                res%stick_margin(nd), res%band_x(nd), res%band_alternation(nd), &
+                res%band_alternation_time(nd), stat=stat)
       if (stat /= 0) then
          call fatal_error(error, "not enough memory for the summary of "//trim(fmt_int(n))//" DOFs and "// &
                           trim(fmt_int(nd))//" devices", stat_no_memory)
@@ -294,6 +301,7 @@ contains
       res%record_error_stuck = 0.0_dp; res%record_error_free = 0.0_dp
       res%stick_freq_error = 0.0_dp; res%stick_ringing_ratio = 0.0_dp
       res%stick_ringing = 0.0_dp; res%stick_margin = 0.0_dp
+      res%band_x = 0.0_dp; res%band_alternation = 0.0_dp; res%band_alternation_time = 0.0_dp
    end subroutine init_result
 
    !> For each id, the history's columns prefix//name//id [unit], one for each name, from

@@ -49,6 +49,7 @@ module fd_newmark
    use fd_step_limits, only: halving_levels, unresolved_band, max_nested, nested_splits, max_settle
    use fd_stick_ringing, only: ringing_type, ringing_init, ringing_changed, ringing_finish, stat_time, stat_sd2, &
                                stat_fmax, stat_damping
+   use fd_band_alternation, only: alternation_type, alternation_init, alternation_step, alternation_finish
    implicit none
    private
 
@@ -91,6 +92,7 @@ module fd_newmark
       type(grid_motion) :: grid                       !! table acceleration at the dt1 steps' ends
       type(observer_type) :: obs                      !! peaks, history, energy balance
       type(ringing_type) :: ring                      !! the sticking springs' ringing
+      type(alternation_type) :: alt                   !! the velocity-law bands' alternation
    end type workspace
 
 contains
@@ -165,6 +167,8 @@ contains
       w%f = device_force(w%st, w%s, w%sd)
       call ringing_init(model, dt1, opts%beta, opts%gamma, w%a0, w%a1c, w%ring, res, error)
       if (allocated(error)) return
+      call alternation_init(model, dt1, w%alt, res, error)
+      if (allocated(error)) return
       call consistent_acceleration(model, exc, 0.0_dp, w)
       call observe_start_energies(w%obs, 0.5_dp*sum(w%mass*w%v**2), strain_energy(model, w%u), &
                                   device_energy(w%st, w%s))
@@ -215,6 +219,7 @@ contains
       end do
       w%phase0 = w%st%phase
       call ringing_finish(w%ring, w%phase0, res)
+      call alternation_finish(res)
       call observe_end_energies(w%obs, res, 0.5_dp*sum(w%mass*w%v**2), strain_energy(model, w%u), &
                                 device_energy(w%st, w%s), &
                               w%w_device)
@@ -724,6 +729,9 @@ contains
          call phase_statistics(w%nd, t1 - w%t, w%st, w%sd, w%f, w%ring%stats)
          if (any_changed) call ringing_changed(w%ring, w%phase0, w%phase1, res)
       end if
+      ! the velocity-law bands' forces: an alternation from step to step (fd_band_alternation)
+      if (w%alt%n > 0) call alternation_step(w%alt, w%nd, t1 - w%t, w%st, w%f, res%band_alternation, &
+                                             res%band_alternation_time)
       w%t = t1
       if (changed_k) w%version = w%version + 1
       if (any_changed .or. any_force) call consistent_acceleration(model, exc, t1, w)

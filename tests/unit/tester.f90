@@ -31,6 +31,7 @@ program tester
    use test_fd_impulse_solver, only: collect_impulse_solver
    use test_fd_step_limits, only: collect_step_limits
    use test_fd_stick_ringing, only: collect_stick_ringing
+   use test_fd_band_alternation, only: collect_band_alternation
    use test_fd_harmonic_resolution, only: collect_harmonic_resolution
    use test_fd_record_resolution, only: collect_record_resolution
    implicit none
@@ -69,6 +70,7 @@ program tester
    testsuites = [testsuites, new_testsuite("impulse_solver", collect_impulse_solver)]
    testsuites = [testsuites, new_testsuite("step_limits", collect_step_limits)]
    testsuites = [testsuites, new_testsuite("stick_ringing", collect_stick_ringing)]
+   testsuites = [testsuites, new_testsuite("band_alternation", collect_band_alternation)]
    testsuites = [testsuites, new_testsuite("harmonic_resolution", collect_harmonic_resolution)]
    testsuites = [testsuites, new_testsuite("record_resolution", collect_record_resolution)]
 
