@@ -193,7 +193,8 @@ def summary_warnings(summary: dict) -> list[str]:
             "(2 m_r) >> 1, m_r the reduced mass of its two nodes, leaves an alternating force in "
             "the band), or a very stiff spring; its forces and accelerations, and possibly its "
             "displacements, carry that error: widen eps or soften the coupling; a larger n1 "
-            "helps only once it brings x below 1 (the alternating force can outlast this warning)"
+            "helps only once it brings x below 1 (the alternating force can outlast this warning; "
+            "band_resolution reports it)"
         )
     elif balance in ("dissipative", "energy error"):
         ratio = summary["energy_residual_ratio"]

@@ -200,7 +200,7 @@ program frictiondyn_main
          '(2 m_r) >> 1, m_r the reduced mass of its two nodes, leaves an alternating force in the band), or a '// &
          'very stiff spring; its forces and accelerations, and possibly its displacements, carry that error: '// &
          'widen eps or soften the coupling; a larger n1 helps only once it brings x below 1 (the alternating '// &
-         'force can outlast this warning)'
+         'force can outlast this warning; band_resolution reports it)'
    else if (res%energy_balance /= balance_closed) then
       write (error_unit, '(a,a,1x,f0.1,a,f4.2,a)') 'frictiondyn: warning: the integration ', &
          trim(merge('dissipated', 'created   ', res%e_residual_ratio > 0.0_dp)), 100*abs(res%e_residual_ratio), &
