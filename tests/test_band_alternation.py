@@ -21,9 +21,10 @@ FLOOR = 0.05  # fd_band_alternation's alternation_floor: the share of P mu count
 def test_a_stiff_band_alternates_by_the_trapezoidal_factor(run):
     """Two masses coupled by a band of c1 = P mu / eps = 1e7 N s/m (x = c1 dt1 / (2 m_r) =
     7.5e4) released with 0.4 m/s between them: the trapezoidal rule leaves that velocity
-    alternating, multiplied by r = (1 - x) / (1 + x) a step. The first count is at the sixth
-    force in the band, |D| / 4 = c1 0.4 |r|^3 (1 + |r|)^2 / 4, and every later step stays
-    above 5 % of P mu (|r|^800 = 0.979), so the time counted is the run less five steps. The
+    alternating, multiplied by r = (1 - x) / (1 + x) a step. The run of second differences
+    starts at the third step's force, |D| / 4 = c1 0.4 |r| (1 + |r|)^2 / 4, and every later
+    step stays above 5 % of P mu (|r|^800 = 0.979), so the time counted is the run less two
+    steps. The
     exact technique holds the masses together with a few newtons: after 1 s the difference
     of the forces is the alternation itself, decayed by |r|^200 = 0.995; the displacements
     agree."""
@@ -33,9 +34,9 @@ def test_a_stiff_band_alternates_by_the_trapezoidal_factor(run):
     x = c1 * dt1 / (2 * mr)
     assert s["band_x"][0] == pytest.approx(x, rel=1e-12)
     q = (x - 1) / (x + 1)
-    expect = c1 * 0.4 * q**3 * (1 + q) ** 2 / 4
-    assert s["band_alternation_N"][0] == pytest.approx(expect, rel=1e-4)
-    assert s["band_alternation_s"][0] == pytest.approx(4.0 - 5 * dt1, abs=1e-9)
+    expect = c1 * 0.4 * q * (1 + q) ** 2 / 4
+    assert s["band_alternation_N"][0] == pytest.approx(expect, rel=1e-5)
+    assert s["band_alternation_s"][0] == pytest.approx(4.0 - 2 * dt1, abs=1e-9)
     assert s["band_resolution"] == "unresolved"
     assert "alternates from step to step inside its velocity band" in r.stderr
     assert "dt1 < 6.667E-08 s (x < 1)" in r.stderr
@@ -59,7 +60,7 @@ def test_numerical_damping_is_no_cure(run):
     deck = stiff_band(1e8, "0.0, 0.4").replace("n1 = 4", "n1 = 4\n  gamma = 0.6\n  beta = 0.3025")
     r = ok(run(deck))
     s = r.summary()
-    assert s["band_alternation_s"][0] <= 2 * 0.005  # gone within two steps of the count
+    assert s["band_alternation_s"][0] <= 5 * 0.005  # the run's five steps, then gone
     assert max(s["peak_u_m"]) > 50 * 0.0074
     assert s["energy_balance"] == "energy error"
 
@@ -108,18 +109,18 @@ SEED_1181 = """
 
 
 def test_the_alternation_multiplies_the_peak_accelerations(run):
-    """Seed 1181: the two devices in their band (x = 78 each, 156 together) hold masses 2 and
-    3 together. The exact technique's holding force is at most 10.4 N a device; the velocity
-    law's alternates by 9.5 N a device for 0.046 s, so its peak force is 20.1 N (93 % over)
+    """Seed 1181: the two devices in their band (x = 78 each alone, 156 together) hold masses 2
+    and 3 together. The exact technique's holding force is at most 10.4 N a device; the
+    velocity law's alternates by 9.9 N a device for 0.047 s, so its peak force is 20.1 N (93 % over)
     and the peak absolute accelerations of DOFs 2 and 3 are 3 and 4 times the exact ones,
     while every displacement agrees to 1e-4 (3.8e-5: the band's creep). The warning names it, and its amplitude accounts
-    for the acceleration of DOF 3 (two devices, 2 A / m3) to 10 %."""
+    for the acceleration of DOF 3 (two devices, 2 A / m3) to 3 %."""
     r = ok(run(SEED_1181.format(law="velocity", technique="newmark")))
     e = ok(run(SEED_1181.format(law="coulomb", technique="event_driven")))
     s, x = r.summary(), e.summary()
     assert s["band_resolution"] == "unresolved"
     assert "the force of device 1 alternates" in r.stderr and "1 more device(s)" in r.stderr
-    assert s["band_x"] == pytest.approx([78.101] * 2, rel=1e-4)
+    assert s["band_x"] == pytest.approx([2 * 78.101] * 2, rel=1e-4)
     amp = s["band_alternation_N"][0]
     assert s["band_alternation_N"][1] == amp and FLOOR * 103.215 * 0.28692 < amp
     assert s["peak_force_N"][0] > 1.9 * x["peak_force_N"][0]
@@ -128,7 +129,7 @@ def test_the_alternation_multiplies_the_peak_accelerations(run):
     assert s["peak_u_m"] == pytest.approx(x["peak_u_m"], rel=1e-4)
     h, g = r.history(), e.history()
     err3 = np.max(np.abs(h["aabs3"] - g["aabs3"]))
-    assert 2 * amp / 7.933205110759262 == pytest.approx(err3, rel=0.1)
+    assert 2 * amp / 7.933205110759262 == pytest.approx(err3, rel=0.03)
 
 
 @pytest.mark.parametrize("test", [1, 2, 3, 4, 5])
@@ -160,7 +161,7 @@ def test_python_warns_alike():
     band = [t for t in text if "alternates from step to step" in t]
     assert len(band) == 1
     assert f"by +-{res.summary['band_alternation_N'][0]:.3g} N" in band[0]
-    assert "dt1 < 4e-06 s (x < 1)" in band[0] and "1 more device(s)" in band[0]
+    assert "dt1 < 2e-06 s (x < 1)" in band[0] and "1 more device(s)" in band[0]
 
 
 def test_hysteretic_decks_are_not_applicable(run):

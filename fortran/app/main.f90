@@ -178,7 +178,8 @@ program frictiondyn_main
          ' alternates from step to step inside its velocity band, by +-', res%band_alternation(d), ' N for ', &
          res%band_alternation_time(d), ' s in all (band_alternation_N, band_alternation_s):'
       write (error_unit, '(a,es9.3,a)') '  the average acceleration rule damps the band''s coupling only where '// &
-         'x = (P mu / eps) dt1 / (2 m_r) < 1 (m_r the reduced mass of its nodes), and here x = ', res%band_x(d), &
+         'x = (dt1 / 2) (c_i / m_i + c_j / m_j) < 1 (c_n: the couplings P mu / eps of the velocity-law devices '// &
+         'at its node n; (P mu / eps) dt1 / (2 m_r) for a device alone), and here x = ', res%band_x(d), &
          '; the device''s force history and the absolute accelerations of its nodes carry the alternation, '// &
          'its displacements do not:'
       if (res%band_x(d) > 1.0_dp) then

@@ -18,17 +18,20 @@
 !>
 !> Measured on the force of each velocity-law device at its accepted steps inside the band
 !> (alternation_step, called by the technique after each accepted step; no allocation in the
-!> loop): the second difference D_k = F_k - 2 F_(k-1) + F_(k-2) over three steps in the band.
+!> loop): the second difference D_k = F_k - 2 F_(k-1) + F_(k-2) over three forces in the band.
 !> An alternation of amplitude A gives |D| ~ 4 A with the sign of D changing at every step; a
-!> smooth force |D| ~ h^2 |F''|; a kink (the band's entry, a neighbour's transition) one large
-!> D, not a run of them. An alternation is counted once D has changed sign alternation_run
-!> times in a row, each |D| above 4 alternation_floor P mu: the largest |D| / 4 is the
-!> device's band_alternation (N), the steps' time its band_alternation_time (s). A device with
-!> a count is 'unresolved' (band_resolution); every run also reports the devices' x at dt1.
+!> smooth force |D| ~ h^2 |F''|; a jump of the force one sign change (D = J, -J, 0) and a kink
+!> one large D. A run of D's above 4 alternation_floor P mu, each of the sign opposite to the
+!> last, is an alternation once it has changed sign alternation_run times (six forces in the
+!> band, which a jump or a kink cannot give); it is counted from its first D on: the largest
+!> |D| / 4 of the counted runs is the device's band_alternation (N), their steps' time its
+!> band_alternation_time (s). A device with a count is 'unresolved' (band_resolution). Every
+!> run also reports each device's x at dt1 with the couplings of every velocity-law device at
+!> its nodes (band_x: exact for one device or devices in parallel on two masses alone).
 module fd_band_alternation
    use fd_kinds, only: dp
    use fd_error, only: error_type, fatal_error, fmt_int, stat_no_memory
-   use fd_model, only: model_type, moved_mass
+   use fd_model, only: model_type
    use fd_names, only: law_velocity
    use fd_device_state, only: device_state, phase_stick
    use fd_friction_velocity, only: sliding_mu
@@ -49,10 +52,13 @@ module fd_band_alternation
    type :: band_watch
       integer :: dev = 0                      !! its number
       integer :: nin = 0                      !! of f1, f2, those in the band (0, 1 or 2)
-      integer :: run = 0                      !! sign changes of D in a row above the floor
+      integer :: run = -1                     !! sign changes in the current run of D's above
+                                              !! the floor (-1: no run)
       real(dp) :: floor4 = 0.0_dp             !! 4 alternation_floor P mu: the |D| counted [N]
       real(dp) :: f1 = 0.0_dp, f2 = 0.0_dp    !! forces at the last two accepted steps [N]
       real(dp) :: d1 = 0.0_dp                 !! the last D [N]
+      real(dp) :: dmax = 0.0_dp               !! the run's largest |D| [N]
+      real(dp) :: trun = 0.0_dp               !! the run's time not yet counted [s]
    end type band_watch
 
    !> The velocity-law devices watched (one array of records: the step loads one descriptor).
@@ -64,25 +70,30 @@ module fd_band_alternation
 contains
 
    !> The devices watched, every device's x at dt1 (res%band_x), and band_resolution
-   !> 'resolved' when there is one ('not applicable' otherwise).
+   !> 'resolved' when there is one ('not applicable' otherwise). x of a device between nodes
+   !> i and j: (dt1 / 2) (c_i / m_i + c_j / m_j), c_n the band couplings P mu(eps) / eps of
+   !> every velocity-law device at node n (the table, n = 0, adds nothing): c1 dt1 / (2 m_r)
+   !> for one device.
    subroutine alternation_init(model, dt1, al, res, error)
       type(model_type), intent(in) :: model         !! the model
       real(dp), intent(in) :: dt1                   !! main step [s]
       type(alternation_type), intent(out) :: al     !! the devices watched
       type(result_type), intent(inout) :: res       !! band_x and band_resolution set
       type(error_type), allocatable, intent(out) :: error !! not enough memory
+      real(dp), allocatable :: c(:)
       integer :: d, q, stat
       real(dp) :: pmu
 
       res%band_resolution = resolution_none
       al%n = count(watched(model%dev(1:model%n_devices)%law, model%dev(1:model%n_devices)%p* &
                            model%dev(1:model%n_devices)%mu))
-      allocate (al%w(al%n), stat=stat)
+      allocate (al%w(al%n), c(0:model%n_dof), stat=stat)
       if (stat /= 0) then
          call fatal_error(error, "not enough memory for the bands of "//trim(fmt_int(al%n))// &
                           " velocity-law devices", stat_no_memory)
          return
       end if
+      c = 0.0_dp
       q = 0
       do d = 1, model%n_devices
          associate (dev => model%dev(d))
@@ -90,7 +101,14 @@ contains
             q = q + 1
             pmu = dev%p*sliding_mu(dev, dev%eps)
             al%w(q) = band_watch(dev=d, floor4=4.0_dp*alternation_floor*pmu)
-            res%band_x(d) = pmu/dev%eps*dt1/(2.0_dp*moved_mass(model, d))
+            c(dev%node_i) = c(dev%node_i) + pmu/dev%eps
+            c(dev%node_j) = c(dev%node_j) + pmu/dev%eps
+         end associate
+      end do
+      do q = 1, al%n
+         associate (i => model%dev(al%w(q)%dev)%node_i, j => model%dev(al%w(q)%dev)%node_j)
+            res%band_x(al%w(q)%dev) = 0.5_dp*dt1*c(i)/model%mass(i)
+            if (j > 0) res%band_x(al%w(q)%dev) = res%band_x(al%w(q)%dev) + 0.5_dp*dt1*c(j)/model%mass(j)
          end associate
       end do
       if (al%n > 0) res%band_resolution = resolution_resolved
@@ -125,24 +143,30 @@ contains
             d = b%dev
             if (st(d)%phase /= phase_stick) then
                b%nin = 0
-               b%run = 0
+               b%run = -1
                cycle
             end if
             if (b%nin == 2) then
                dd = f(d) - 2.0_dp*b%f1 + b%f2
-               if (abs(dd) > b%floor4 .and. dd*b%d1 < 0.0_dp) then
+               if (abs(dd) <= b%floor4) then
+                  b%run = -1
+               else if (b%run >= 0 .and. dd*b%d1 < 0.0_dp) then
                   b%run = b%run + 1
-                  if (b%run >= alternation_run) then
-                     amp(d) = max(amp(d), 0.25_dp*abs(dd))
-                     time(d) = time(d) + h
-                  end if
+                  b%dmax = max(b%dmax, abs(dd))
+                  b%trun = b%trun + h
                else
-                  b%run = 0
+                  b%run = 0                   ! a run starts here
+                  b%dmax = abs(dd)
+                  b%trun = h
+               end if
+               if (b%run >= alternation_run) then
+                  amp(d) = max(amp(d), 0.25_dp*b%dmax)
+                  time(d) = time(d) + b%trun
+                  b%trun = 0.0_dp
                end if
                b%d1 = dd
             else
                b%nin = b%nin + 1
-               b%d1 = 0.0_dp
             end if
             b%f2 = b%f1
             b%f1 = f(d)
