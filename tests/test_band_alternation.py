@@ -1,5 +1,5 @@
 """A velocity-law band whose force the step leaves alternating (summary ``band_x``,
-``band_alternation_N``, ``band_alternation_s``, ``band_resolution``; docs/theory.md section 8):
+``band_alternation_N``, ``band_alternation_s``, ``band_resolution``; docs/theory.md section 6):
 the trapezoidal rule's factor (1 - x) / (1 + x) on a stiff band, the alternation against the
 exact technique (in the forces and accelerations, not the displacements), a random deck whose
 accelerations it multiplied, and the paper's decks, whose x > 1 leaves none."""
@@ -50,6 +50,28 @@ def test_a_stiff_band_alternates_by_the_trapezoidal_factor(run):
     for k in (1, 2):
         assert s["peak_u_m"][k - 1] == pytest.approx(e.summary()["peak_u_m"][k - 1], rel=1e-3)
     assert e.summary()["band_resolution"] == "not applicable"
+
+
+
+@pytest.mark.parametrize(
+    "law, factor",
+    [
+        ("mu_law = 'table'\n  mu_table_v = 1.0, 2.0\n  mu_table_mu = 0.1, 0.0", 1.0),
+        ("mu_law = 'exponential'\n  mu_max = 0.0\n  mu_min = 0.1\n  mu_rate = 1.0", np.exp(-1.0)),
+    ],
+)
+def test_a_band_with_a_speed_dependent_mu_is_watched(run, law, factor):
+    """A speed-dependent mu whose value at the table's last point (or mu_max) is 0 but whose
+    band coupling P mu(eps) / eps is the constant law's 1e7 N s/m times mu(eps) / 0.1 (1 for
+    the table, exp(-1) for the exponential at eps = 1 m/s): x scales by that factor, and the
+    alternation, c1 0.4 |r| (1 + |r|)^2 / 4 with |r| near 1, by it too. (These devices were
+    once taken for devices without friction: never watched, and never sliding.)"""
+    const = ok(run(stiff_band(1e8, "0.0, 0.4"))).summary()
+    deck = stiff_band(1e8, "0.0, 0.4").replace("  mu = 0.1\n", "  " + law + "\n")
+    s = ok(run(deck)).summary()
+    assert s["band_x"][0] == pytest.approx(factor * const["band_x"][0], rel=1e-12)
+    assert s["band_alternation_N"][0] == pytest.approx(factor * const["band_alternation_N"][0], rel=1e-4)
+    assert s["band_resolution"] == "unresolved"
 
 
 def test_numerical_damping_is_no_cure(run):

@@ -169,18 +169,22 @@ def summary_warnings(summary: dict) -> list[str]:
         x = summary["band_x"][d]
         more = sum(a > 0 for a in amp) - 1
         remedy = (
-            f"raise n1 until dt1 < {summary['dt1_s'] / x:.3g} s (x < 1)" if x > 1 else "raise n1"
+            f"raise n1 until dt1 < {summary['dt1_s'] / x:.3g} s (x < 1) or widen eps (exact "
+            "Coulomb friction, law = 'coulomb' with technique = 'event_driven', has no band)"
+            if x > 1
+            else "with x <= 1 another mode the step does not resolve drives it (a stiff spring, "
+            "a hysteretic device's sticking spring: see mode_resolution and stick_resolution): "
+            "raise n1"
         )
         out.append(
             f"the force of device {d + 1} alternates from step to step inside its velocity band, "
             f"by +-{amp[d]:.3g} N for {summary['band_alternation_s'][d]:.3g} s in all "
-            "(band_alternation_N, band_alternation_s): the average acceleration rule damps the "
-            "band's coupling only where x = (dt1 / 2) (c_i / m_i + c_j / m_j) < 1 (c_n: the "
-            "couplings P mu / eps of the velocity-law devices at its node n; (P mu / eps) dt1 / "
-            f"(2 m_r) for a device alone), and here x = {x:.3g}; the device's force history and the absolute "
-            "accelerations of its nodes carry the alternation, its displacements do not: "
-            f"{remedy} or widen eps (exact Coulomb friction, law = 'coulomb' with technique = "
-            "'event_driven', has no band)"
+            "(band_alternation_N, band_alternation_s): Newmark's rule damps the band's coupling "
+            "only where x = (1 - gamma) dt1 (c_i / m_i + c_j / m_j) < 1 (c_n: the couplings "
+            "P mu / eps of the velocity-law devices at its node n; (P mu / eps) dt1 / (2 m_r) for a "
+            f"device alone and average acceleration), and here x = {x:.3g}; the device's force "
+            "history and the absolute accelerations of its nodes carry the alternation (with "
+            f"average acceleration, its displacements do not): {remedy}"
             + (f" ({more} more device(s) likewise: summary band_alternation_N)" if more else "")
         )
     balance = summary.get("energy_balance")

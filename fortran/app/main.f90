@@ -177,17 +177,17 @@ program frictiondyn_main
       write (error_unit, '(a,i0,a,es9.3,a,es9.3,a)') 'frictiondyn: warning: the force of device ', d, &
          ' alternates from step to step inside its velocity band, by +-', res%band_alternation(d), ' N for ', &
          res%band_alternation_time(d), ' s in all (band_alternation_N, band_alternation_s):'
-      write (error_unit, '(a,es9.3,a)') '  the average acceleration rule damps the band''s coupling only where '// &
-         'x = (dt1 / 2) (c_i / m_i + c_j / m_j) < 1 (c_n: the couplings P mu / eps of the velocity-law devices '// &
-         'at its node n; (P mu / eps) dt1 / (2 m_r) for a device alone), and here x = ', res%band_x(d), &
-         '; the device''s force history and the absolute accelerations of its nodes carry the alternation, '// &
-         'its displacements do not:'
+      write (error_unit, '(a,es9.3,a)') '  Newmark''s rule damps the band''s coupling only where '// &
+         'x = (1 - gamma) dt1 (c_i / m_i + c_j / m_j) < 1 (c_n: the couplings P mu / eps of the velocity-law '// &
+         'devices at its node n; (P mu / eps) dt1 / (2 m_r) for a device alone and average acceleration), and '// &
+         'here x = ', res%band_x(d), '; the device''s force history and the absolute accelerations of its nodes '// &
+         'carry the alternation (with average acceleration, its displacements do not):'
       if (res%band_x(d) > 1.0_dp) then
          write (error_unit, '(a,es9.3,a)') '  raise n1 until dt1 < ', res%dt1/res%band_x(d), ' s (x < 1) or '// &
             'widen eps (exact Coulomb friction, law = ''coulomb'' with technique = ''event_driven'', has no band)'
       else
-         write (error_unit, '(a)') '  raise n1 or widen eps (exact Coulomb friction, law = ''coulomb'' with '// &
-            'technique = ''event_driven'', has no band)'
+         write (error_unit, '(a)') '  with x <= 1 another mode the step does not resolve drives it (a stiff spring, '// &
+            'a hysteretic device''s sticking spring: see mode_resolution and stick_resolution): raise n1'
       end if
       if (count(res%band_alternation > 0.0_dp) > 1) write (error_unit, '(a,i0,a)') '  (', &
          count(res%band_alternation > 0.0_dp) - 1, ' more device(s) likewise: summary band_alternation_N)'

@@ -67,7 +67,7 @@ contains
       integer :: old
 
       old = st%phase
-      if (dev%p*dev%mu == 0.0_dp) then
+      if (dev%p*largest_mu(dev) == 0.0_dp) then
          st%phase = phase_stick                 ! no friction capacity: F = 0, never slips
       else if (abs(sdot) < dev%eps) then
          st%phase = phase_stick
@@ -141,6 +141,16 @@ contains
          mu = dev%mu
       end select
    end function sliding_mu
+
+   !> The largest mu of the law at any sliding speed: mu itself (constant and exponential, where
+   !> it is mu_max; the larger of it and mu_min), or the table's largest value.
+   pure real(dp) function largest_mu(dev) result(mu)
+      type(device_type), intent(in) :: dev   !! device parameters
+
+      mu = dev%mu
+      if (dev%mu_law == mu_table) mu = maxval(dev%mu_at(1:dev%n_mu_points))
+      if (dev%mu_law == mu_exponential) mu = max(dev%mu, dev%mu_min)
+   end function largest_mu
 
    !> Force coefficients of the phase: the band's coupling P mu(eps) / eps, or the sliding
    !> force P mu(|sdot|) sgn with sdot the velocity at the start of the step.

@@ -26,12 +26,13 @@
 !> band, which a jump or a kink cannot give); it is counted from its first D on: the largest
 !> |D| / 4 of the counted runs is the device's band_alternation (N), their steps' time its
 !> band_alternation_time (s). A device with a count is 'unresolved' (band_resolution). Every
-!> run also reports each device's x at dt1 with the couplings of every velocity-law device at
-!> its nodes (band_x: exact for one device or devices in parallel on two masses alone).
+!> run also reports each device's 2 (1 - gamma) x at dt1, negative factor above 1, with the
+!> couplings of every velocity-law device at its nodes (band_x: exact for one device or
+!> devices in parallel on two masses alone).
 module fd_band_alternation
    use fd_kinds, only: dp
    use fd_error, only: error_type, fatal_error, fmt_int, stat_no_memory
-   use fd_model, only: model_type
+   use fd_model, only: model_type, device_type
    use fd_names, only: law_velocity
    use fd_device_state, only: device_state, phase_stick
    use fd_friction_velocity, only: sliding_mu
@@ -71,22 +72,23 @@ contains
 
    !> The devices watched, every device's x at dt1 (res%band_x), and band_resolution
    !> 'resolved' when there is one ('not applicable' otherwise). x of a device between nodes
-   !> i and j: (dt1 / 2) (c_i / m_i + c_j / m_j), c_n the band couplings P mu(eps) / eps of
-   !> every velocity-law device at node n (the table, n = 0, adds nothing): c1 dt1 / (2 m_r)
-   !> for one device.
-   subroutine alternation_init(model, dt1, al, res, error)
+   !> i and j: (1 - gamma) dt1 (c_i / m_i + c_j / m_j), c_n the band couplings P mu(eps) / eps
+   !> of every velocity-law device at node n (the table, n = 0, adds nothing), so that the
+   !> step's factor on the band is negative where x > 1: c1 dt1 / (2 m_r) for one device and
+   !> average acceleration.
+   subroutine alternation_init(model, dt1, gamma, al, res, error)
       type(model_type), intent(in) :: model         !! the model
       real(dp), intent(in) :: dt1                   !! main step [s]
+      real(dp), intent(in) :: gamma                 !! Newmark's gamma
       type(alternation_type), intent(out) :: al     !! the devices watched
       type(result_type), intent(inout) :: res       !! band_x and band_resolution set
       type(error_type), allocatable, intent(out) :: error !! not enough memory
       real(dp), allocatable :: c(:)
       integer :: d, q, stat
-      real(dp) :: pmu
+      real(dp) :: pmu, scale
 
       res%band_resolution = resolution_none
-      al%n = count(watched(model%dev(1:model%n_devices)%law, model%dev(1:model%n_devices)%p* &
-                           model%dev(1:model%n_devices)%mu))
+      al%n = count(watched(model%dev(1:model%n_devices)))
       allocate (al%w(al%n), c(0:model%n_dof), stat=stat)
       if (stat /= 0) then
          call fatal_error(error, "not enough memory for the bands of "//trim(fmt_int(al%n))// &
@@ -97,7 +99,7 @@ contains
       q = 0
       do d = 1, model%n_devices
          associate (dev => model%dev(d))
-            if (.not. watched(dev%law, dev%p*dev%mu)) cycle
+            if (.not. watched(dev)) cycle
             q = q + 1
             pmu = dev%p*sliding_mu(dev, dev%eps)
             al%w(q) = band_watch(dev=d, floor4=4.0_dp*alternation_floor*pmu)
@@ -105,21 +107,23 @@ contains
             c(dev%node_j) = c(dev%node_j) + pmu/dev%eps
          end associate
       end do
+      scale = max(0.0_dp, 1.0_dp - gamma)*dt1
       do q = 1, al%n
          associate (i => model%dev(al%w(q)%dev)%node_i, j => model%dev(al%w(q)%dev)%node_j)
-            res%band_x(al%w(q)%dev) = 0.5_dp*dt1*c(i)/model%mass(i)
-            if (j > 0) res%band_x(al%w(q)%dev) = res%band_x(al%w(q)%dev) + 0.5_dp*dt1*c(j)/model%mass(j)
+            res%band_x(al%w(q)%dev) = scale*c(i)/model%mass(i)
+            if (j > 0) res%band_x(al%w(q)%dev) = res%band_x(al%w(q)%dev) + scale*c(j)/model%mass(j)
          end associate
       end do
       if (al%n > 0) res%band_resolution = resolution_resolved
    end subroutine alternation_init
 
-   !> A device the step may leave alternating: the velocity law with a band (P mu > 0).
-   elemental logical function watched(law, pmu)
-      integer, intent(in) :: law
-      real(dp), intent(in) :: pmu
+   !> A device the step may leave alternating: the velocity law with a band coupling,
+   !> P mu(eps) > 0.
+   elemental logical function watched(dev)
+      type(device_type), intent(in) :: dev
 
-      watched = law == law_velocity .and. pmu > 0.0_dp
+      watched = .false.
+      if (dev%law == law_velocity) watched = dev%p*sliding_mu(dev, dev%eps) > 0.0_dp
    end function watched
 
    !> An accepted step of length h: the watched devices' forces at its end (f, in the phases

@@ -167,7 +167,7 @@ contains
       w%f = device_force(w%st, w%s, w%sd)
       call ringing_init(model, dt1, opts%beta, opts%gamma, w%a0, w%a1c, w%ring, res, error)
       if (allocated(error)) return
-      call alternation_init(model, dt1, w%alt, res, error)
+      call alternation_init(model, dt1, opts%gamma, w%alt, res, error)
       if (allocated(error)) return
       call consistent_acceleration(model, exc, 0.0_dp, w)
       call observe_start_energies(w%obs, 0.5_dp*sum(w%mass*w%v**2), strain_energy(model, w%u), &

@@ -100,14 +100,14 @@ def run_deck(c: dict, n1: int, every: int, timeout: float) -> dict:
 
 
 def alternating_rows(y: np.ndarray, floor: float) -> np.ndarray:
-    """Rows at which y's second difference has changed sign three times in a row, each above
-    4 floor (the detector's rule, on every row)."""
+    """Rows at which y's second difference has changed sign three times in a row, the four
+    differences each above 4 floor (the detector's rule, on every row)."""
     d = np.zeros(len(y))
     d[2:] = y[2:] - 2 * y[1:-1] + y[:-2]
     rows = np.zeros(len(y), bool)
     run = 0
     for n in range(3, len(y)):
-        run = run + 1 if d[n] * d[n - 1] < 0 and abs(d[n]) > 4 * floor else 0
+        run = run + 1 if d[n] * d[n - 1] < 0 and min(abs(d[n]), abs(d[n - 1])) > 4 * floor else 0
         rows[n] = run >= 3
     return rows
 
