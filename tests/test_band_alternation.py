@@ -52,7 +52,6 @@ def test_a_stiff_band_alternates_by_the_trapezoidal_factor(run):
     assert e.summary()["band_resolution"] == "not applicable"
 
 
-
 @pytest.mark.parametrize(
     "law, factor",
     [
@@ -70,7 +69,9 @@ def test_a_band_with_a_speed_dependent_mu_is_watched(run, law, factor):
     deck = stiff_band(1e8, "0.0, 0.4").replace("  mu = 0.1\n", "  " + law + "\n")
     s = ok(run(deck)).summary()
     assert s["band_x"][0] == pytest.approx(factor * const["band_x"][0], rel=1e-12)
-    assert s["band_alternation_N"][0] == pytest.approx(factor * const["band_alternation_N"][0], rel=1e-4)
+    assert s["band_alternation_N"][0] == pytest.approx(
+        factor * const["band_alternation_N"][0], rel=1e-4
+    )
     assert s["band_resolution"] == "unresolved"
 
 
@@ -133,10 +134,11 @@ SEED_1181 = """
 def test_the_alternation_multiplies_the_peak_accelerations(run):
     """Seed 1181: the two devices in their band (x = 78 each alone, 156 together) hold masses 2
     and 3 together. The exact technique's holding force is at most 10.4 N a device; the
-    velocity law's alternates by 9.9 N a device for 0.047 s, so its peak force is 20.1 N (93 % over)
-    and the peak absolute accelerations of DOFs 2 and 3 are 3 and 4 times the exact ones,
-    while every displacement agrees to 1e-4 (3.8e-5: the band's creep). The warning names it, and its amplitude accounts
-    for the acceleration of DOF 3 (two devices, 2 A / m3) to 3 %."""
+    velocity law's alternates by 9.9 N a device for 0.047 s, so its peak force is 20.1 N (93 %
+    over) and the peak absolute accelerations of DOFs 2 and 3 are 3 and 4 times the exact
+    ones, while every displacement agrees to 1e-4 (3.8e-5: the band's creep). The warning
+    names it, and its amplitude accounts for the acceleration of DOF 3 (two devices,
+    2 A / m3) to 3 %."""
     r = ok(run(SEED_1181.format(law="velocity", technique="newmark")))
     e = ok(run(SEED_1181.format(law="coulomb", technique="event_driven")))
     s, x = r.summary(), e.summary()

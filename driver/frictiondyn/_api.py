@@ -82,8 +82,9 @@ class FrictiondynWarning(UserWarning):
     not resolve the structure's highest modes (summary ``mode_resolution``), or one that
     dephases the ringing of a sticking spring on which a device's stick-slip decisions rest
     (summary ``stick_resolution``), a velocity-law band whose force the step leaves
-    alternating from step to step (summary ``band_resolution``), a step that moves the linear steady state under a
-    harmonic table motion by more than 5 % (summary ``harmonic_resolution``), one that moves
+    alternating from step to step (summary ``band_resolution``), a step that moves the linear
+    steady state under a harmonic table motion by more than 5 % (summary
+    ``harmonic_resolution``), one that moves
     the peak linear response to a record by more than 5 % (summary ``record_resolution``), an
     integration that dissipated or created more than 5 % of the energy, or, with the average
     acceleration rule, whose energy balance misses by more than round-off (1e-8: digits

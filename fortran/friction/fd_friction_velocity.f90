@@ -67,10 +67,10 @@ contains
       integer :: old
 
       old = st%phase
-      if (dev%p*largest_mu(dev) == 0.0_dp) then
-         st%phase = phase_stick                 ! no friction capacity: F = 0, never slips
-      else if (abs(sdot) < dev%eps) then
+      if (abs(sdot) < dev%eps) then
          st%phase = phase_stick
+      else if (dev%p*largest_mu(dev) == 0.0_dp) then
+         st%phase = phase_stick                 ! no friction capacity: F = 0, never slips
       else if (sdot > 0.0_dp) then
          st%phase = phase_slip_pos
       else

@@ -26,9 +26,9 @@
 !> band, which a jump or a kink cannot give); it is counted from its first D on: the largest
 !> |D| / 4 of the counted runs is the device's band_alternation (N), their steps' time its
 !> band_alternation_time (s). A device with a count is 'unresolved' (band_resolution). Every
-!> run also reports each device's 2 (1 - gamma) x at dt1, negative factor above 1, with the
-!> couplings of every velocity-law device at its nodes (band_x: exact for one device or
-!> devices in parallel on two masses alone).
+!> run also reports each device's band_x = 2 (1 - gamma) x at dt1, above 1 where the factor
+!> r is negative, with the couplings of every velocity-law device at its nodes (exact for one
+!> device or devices in parallel on two masses alone).
 module fd_band_alternation
    use fd_kinds, only: dp
    use fd_error, only: error_type, fatal_error, fmt_int, stat_no_memory
@@ -64,7 +64,7 @@ module fd_band_alternation
 
    !> The velocity-law devices watched (one array of records: the step loads one descriptor).
    type :: alternation_type
-      integer :: n = 0                        !! devices watched: velocity law, P mu > 0
+      integer :: n = 0                        !! devices watched: velocity law, P mu(eps) > 0
       type(band_watch), allocatable :: w(:)   !! each of them
    end type alternation_type
 

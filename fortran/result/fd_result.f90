@@ -102,7 +102,7 @@ module fd_result
       real(dp), allocatable :: stick_ringing_ratio(:) !! largest ringing / margin of a dephased stick phase
       real(dp), allocatable :: stick_ringing(:)       !! that phase's ringing amplitude [N]
       real(dp), allocatable :: stick_margin(:)        !! that phase's margin P mu - max |F| [N]
-      real(dp), allocatable :: band_x(:)              !! velocity law: (P mu / eps) dt1 / (2 m_r)
+      real(dp), allocatable :: band_x(:)              !! velocity law: (1 - gamma) dt1 (c_i / m_i + c_j / m_j)
       real(dp), allocatable :: band_alternation(:)    !! largest step-to-step alternation of the
                                                       !! band's force counted [N]
       real(dp), allocatable :: band_alternation_time(:) !! time of the steps counted [s]

@@ -38,12 +38,19 @@ import numpy as np
 sys.path.insert(0, str(Path(__file__).resolve().parent))
 import physics  # noqa: E402
 
-LIMIT = 0.05          # a share of P mu: the history error called wrong, the detector's floor
-MAX_REFINE = 64       # the largest m tried for the reference
+LIMIT = 0.05  # a share of P mu: the history error called wrong, the detector's floor
+MAX_REFINE = 64  # the largest m tried for the reference
 TIMEOUT = (120.0, 180.0)  # seconds: the run, the reference
-EXE = ""              # set in main (a copy, so that a rebuild during the campaign is harmless)
-KEEP = ("band_x", "band_alternation_N", "band_alternation_s", "peak_force_N", "peak_aabs_mps2",
-        "peak_u_m", "dt1_s")
+EXE = ""  # set in main (a copy, so that a rebuild during the campaign is harmless)
+KEEP = (
+    "band_x",
+    "band_alternation_N",
+    "band_alternation_s",
+    "peak_force_N",
+    "peak_aabs_mps2",
+    "peak_u_m",
+    "dt1_s",
+)
 
 
 def mu_at(dev: dict, v: float) -> float:
@@ -76,13 +83,16 @@ def run_deck(c: dict, n1: int, every: int, timeout: float) -> dict:
     """The deck at n1, a row every `every` steps: its summary, history and warnings."""
     where = Path(tempfile.mkdtemp(prefix=f"band_campaign_{c['seed']}_"))
     try:
-        deck = physics.deck_text(c, "step", n1=n1).replace("output_every = 1", f"output_every = {every}")
+        deck = physics.deck_text(c, "step", n1=n1).replace(
+            "output_every = 1", f"output_every = {every}"
+        )
         (where / "deck.nml").write_text(deck)
         if c["exc"]["type"] == "record":
             (where / "rec.txt").write_text(physics.record_text(c))
         try:
-            p = subprocess.run([EXE, "deck.nml"], cwd=where, capture_output=True, text=True,
-                               timeout=timeout)
+            p = subprocess.run(
+                [EXE, "deck.nml"], cwd=where, capture_output=True, text=True, timeout=timeout
+            )
         except subprocess.TimeoutExpired:
             return {"rc": "timeout"}
         if p.returncode != 0:
@@ -92,9 +102,12 @@ def run_deck(c: dict, n1: int, every: int, timeout: float) -> dict:
             names = [h.split("[")[0] for h in fh.readline().strip().split(",")]
             data = np.loadtxt(fh, delimiter=",", ndmin=2)
         warnings = [ln for ln in p.stderr.splitlines() if ln.startswith("frictiondyn: warning:")]
-        return {"rc": 0, "s": {k: summary[k] for k in KEEP},
-                "h": {n: data[:, i] for i, n in enumerate(names)},
-                "other_warning": any("alternates from step to step" not in w for w in warnings)}
+        return {
+            "rc": 0,
+            "s": {k: summary[k] for k in KEEP},
+            "h": {n: data[:, i] for i, n in enumerate(names)},
+            "other_warning": any("alternates from step to step" not in w for w in warnings),
+        }
     finally:
         shutil.rmtree(where, ignore_errors=True)
 
@@ -138,7 +151,9 @@ def compare(base: dict, ref: dict, devices: list) -> dict:
             "alternating": sorted(where),
             "peak_F": rel(base["s"]["peak_force_N"][k - 1], ref["s"]["peak_force_N"][k - 1]),
         }
-    out["peak_aabs"] = max(rel(a, b) for a, b in zip(base["s"]["peak_aabs_mps2"], ref["s"]["peak_aabs_mps2"]))
+    out["peak_aabs"] = max(
+        rel(a, b) for a, b in zip(base["s"]["peak_aabs_mps2"], ref["s"]["peak_aabs_mps2"])
+    )
     out["peak_u"] = max(rel(a, b) for a, b in zip(base["s"]["peak_u_m"], ref["s"]["peak_u_m"]))
     return out
 
@@ -158,8 +173,15 @@ def one(seed: int) -> dict:
     s = base["s"]
     rec["dt1"] = s["dt1_s"]
     rec["other_warning"] = base["other_warning"]
-    rec["dev"] = {str(k): {"pmu": pmu, "band_x": s["band_x"][k - 1], "A": s["band_alternation_N"][k - 1] / pmu,
-                           "time": s["band_alternation_s"][k - 1]} for k, pmu, _ in devices}
+    rec["dev"] = {
+        str(k): {
+            "pmu": pmu,
+            "band_x": s["band_x"][k - 1],
+            "A": s["band_alternation_N"][k - 1] / pmu,
+            "time": s["band_alternation_s"][k - 1],
+        }
+        for k, pmu, _ in devices
+    }
     if m == 1:
         rec["self"] = True
     elif m <= MAX_REFINE:
@@ -185,43 +207,74 @@ def share(a: int, b: int) -> str:
 def report(path: Path) -> None:
     recs = [json.loads(x) for x in path.read_text().splitlines() if x.strip()]
     ran = [r for r in recs if r["rc"] == 0]
-    print(f"seeds with a velocity-law device: {len(recs)}; run: {len(ran)}; refused or failed: "
-          f"{len(recs) - len(ran)}; own reference (m = 1): {sum('self' in r for r in ran)}; "
-          f"no reference (m > {MAX_REFINE}): {sum(r['m'] is None for r in ran)}")
+    print(
+        f"seeds with a velocity-law device: {len(recs)}; run: {len(ran)}; refused or failed: "
+        f"{len(recs) - len(ran)}; own reference (m = 1): {sum('self' in r for r in ran)}; "
+        f"no reference (m > {MAX_REFINE}): {sum(r['m'] is None for r in ran)}"
+    )
     devs = [(r, k, d) for r in ran for k, d in r["dev"].items()]
     flagged = [(r, k, d) for r, k, d in devs if d["A"] > 0]
     runs = {r["seed"]: r for r, _, _ in flagged}
-    print(f"flagged: {len(runs)} runs, {len(flagged)} devices (of {len(ran)} runs, {len(devs)} devices); "
-          f"with a reference: {sum('cmp' in r for r in runs.values())} runs, "
-          f"{sum('cmp' in r for r, _, _ in flagged)} devices; own reference: {sum('self' in r for r, _, _ in flagged)}")
+    print(
+        f"flagged: {len(runs)} runs, {len(flagged)} devices (of {len(ran)} runs, "
+        f"{len(devs)} devices); with a reference: {sum('cmp' in r for r in runs.values())} runs, "
+        f"{sum('cmp' in r for r, _, _ in flagged)} devices; "
+        f"own reference: {sum('self' in r for r, _, _ in flagged)}"
+    )
     ref = [(r, d, r["cmp"]["dev"][k]) for r, k, d in devs if "cmp" in r]
     fl = [(r, d, e) for r, d, e in ref if d["A"] > 0]
     un = [(r, d, e) for r, d, e in ref if d["A"] == 0]
     for name, group in (("flagged", fl), ("not flagged", un)):
         err = [e["error"] for _, _, e in group]
-        print(f"{name} devices with a reference: error > {LIMIT} P mu: "
-              f"{share(sum(x > LIMIT for x in err), len(err))}; median error {np.median(err) if err else 0:.3g} P mu")
-    print(f"flagged: error / band_alternation_N (min / q25 / median / q75 / max): "
-          f"{quartiles([e['error'] / d['A'] for _, d, e in fl])}; in the band: "
-          f"{quartiles([e['error_band'] / d['A'] for _, d, e in fl])}")
-    for name, sel in (("flagged", [r for r in runs.values() if "cmp" in r]),
-                      ("not flagged", [r for r in ran if "cmp" in r and r["seed"] not in runs])):
-        moved = [max(r["cmp"]["peak_aabs"], max(e["peak_F"] for e in r["cmp"]["dev"].values())) > LIMIT
-                 for r in sel]
-        print(f"{name} runs: a peak |F| or |aabs| more than 5 % off: {share(sum(moved), len(sel))}; "
-              f"a peak |u|: {sum(r['cmp']['peak_u'] > LIMIT for r in sel)}")
+        print(
+            f"{name} devices with a reference: error > {LIMIT} P mu: "
+            f"{share(sum(x > LIMIT for x in err), len(err))}; "
+            f"median error {np.median(err) if err else 0:.3g} P mu"
+        )
+    print(
+        f"flagged: error / band_alternation_N (min / q25 / median / q75 / max): "
+        f"{quartiles([e['error'] / d['A'] for _, d, e in fl])}; in the band: "
+        f"{quartiles([e['error_band'] / d['A'] for _, d, e in fl])}"
+    )
+    for name, sel in (
+        ("flagged", [r for r in runs.values() if "cmp" in r]),
+        ("not flagged", [r for r in ran if "cmp" in r and r["seed"] not in runs]),
+    ):
+        moved = [
+            max(r["cmp"]["peak_aabs"], max(e["peak_F"] for e in r["cmp"]["dev"].values())) > LIMIT
+            for r in sel
+        ]
+        print(
+            f"{name} runs: a peak |F| or |aabs| more than 5 % off: {share(sum(moved), len(sel))}; "
+            f"a peak |u|: {sum(r['cmp']['peak_u'] > LIMIT for r in sel)}"
+        )
     alt = [(d, e) for _, d, e in ref if e["error"] > LIMIT and e["alternating"]]
-    print(f"recall (error > {LIMIT} P mu, alternating where the force does): "
-          f"{share(sum(d['A'] > 0 for d, _ in alt), len(alt))}")
-    place = lambda e: "in the band" if "in" in e else "at its edge only" if "edge" in e else "outside only"
+    print(
+        f"recall (error > {LIMIT} P mu, alternating where the force does): "
+        f"{share(sum(d['A'] > 0 for d, _ in alt), len(alt))}"
+    )
+
+    def place(rows: list[str]) -> str:
+        return (
+            "in the band"
+            if "in" in rows
+            else "at its edge only"
+            if "edge" in rows
+            else "outside only"
+        )
+
     for where in ("in the band", "at its edge only", "outside only"):
         sel = [d for d, e in alt if place(e["alternating"]) == where]
         print(f"  alternating {where}: {share(sum(d['A'] > 0 for d in sel), len(sel))}")
     print(f"flagged devices with band_x < 1: {sum(d['band_x'] < 1 for _, _, d in flagged)}")
     steps = [d["time"] / r["dt1"] for r, _, d in flagged]
-    print(f"flagged: band_alternation_s (s) {quartiles([d['time'] for _, _, d in flagged])}; "
-          f"under 10 dt1: {sum(x < 10 for x in steps)}, under 1 dt1: {sum(x < 1 for x in steps)}")
-    print(f"flagged runs with no other warning: {sum(not r['other_warning'] for r in runs.values())}")
+    print(
+        f"flagged: band_alternation_s (s) {quartiles([d['time'] for _, _, d in flagged])}; "
+        f"under 10 dt1: {sum(x < 10 for x in steps)}, under 1 dt1: {sum(x < 1 for x in steps)}"
+    )
+    print(
+        f"flagged runs with no other warning: {sum(not r['other_warning'] for r in runs.values())}"
+    )
 
 
 def main() -> int:
@@ -241,8 +294,11 @@ def main() -> int:
         done = set()
         if args.out.exists():
             done = {json.loads(x)["seed"] for x in args.out.read_text().splitlines() if x.strip()}
-        seeds = [s for s in range(args.first, args.last + 1)
-                 if s not in done and band_devices(physics.gen_case(s))]
+        seeds = [
+            s
+            for s in range(args.first, args.last + 1)
+            if s not in done and band_devices(physics.gen_case(s))
+        ]
         with args.out.open("a") as f, Pool(args.jobs) as pool:
             for rec in pool.imap_unordered(one, seeds, chunksize=4):
                 f.write(json.dumps(rec) + "\n")
