@@ -135,6 +135,19 @@ def test_paper_stuck_period_and_damping(tmp_path):
     assert s["xi_stuck"] == pytest.approx(0.015, rel=1e-14)
 
 
+@pytest.mark.parametrize("table", ["0.0, 1.0\n  mu_table_mu = 0.22, 0.0", "0.5, 1.0\n  mu_table_mu = 0.0, 0.22"])
+def test_a_speed_dependent_mu_that_reaches_zero_still_sticks(run, table):
+    """A velocity-law device whose mu is 0 at one end of its table still has a friction
+    capacity, so the stuck system holds it as a rigid link: T = 2 pi sqrt((m1 + m2) / (k1 + k2))
+    as with the constant mu (before, the table's last mu decided: 0 gave the two bars apart)."""
+    text = (INPUTS / "test4_velocity.nml").read_text().replace("duration = 40.0", "duration = 0.1")
+    text = text.replace("mu = 0.22", "mu_law = 'table'\n  mu_table_v = " + table)
+    r = run(text)
+    assert r.returncode == 0, r.stderr
+    t_rigid = 2 * np.pi * np.sqrt((M1 + M2) / (K1 + K2))
+    assert r.summary()["period_stuck_s"] == pytest.approx(t_rigid, rel=1e-12)
+
+
 def test_stuck_period_with_a_device_to_the_table(run):
     """A device locking DOF 3 to the table removes it; two devices joining 1-2 merge them."""
     m = [2.0, 1.0, 1.5, 0.5]

@@ -302,6 +302,21 @@ def test_a_stiffness_beyond_the_digits_of_the_step_is_rejected(tmp_path, law, ol
     assert_both_reject(tmp_path, text, ["&friction", named, "1000000000000.0 times", "raise n1"])
 
 
+def test_a_speed_dependent_band_beyond_the_digits_of_the_step_is_rejected(tmp_path):
+    """The band's coupling is P mu(eps) / eps: a table falling from mu = 0.5 to 1e-6 (a
+    static-to-kinetic drop) with eps = 1e-18 m/s has a coupling 5e5 times what its last mu
+    gives. The check takes mu(eps) (it took the last mu: a ratio of 8.7e8, accepted): the
+    damping in the message is gamma / (beta dt1) P mu(eps) / eps."""
+    text = short_deck("velocity").replace(
+        "mu = 0.22\n  eps = 1.0e-3 ",
+        "mu_law = 'table'\n  mu_table_v = 0.0, 1.0\n  mu_table_mu = 0.5, 1.0e-6\n  eps = 1.0e-18 ")
+    assert "1.0e-18" in text
+    msg = assert_both_reject(tmp_path, text, ["&friction", "eps(1) = 1.0E-18", "1000000000000.0 times"])
+    kd = float(msg.split("sticking stiffness of device 1, ")[1].split()[0])
+    mu_eps = 0.5 + (1.0e-6 - 0.5) * 1.0e-18
+    assert kd == pytest.approx(0.5 / (0.25 * 2.5e-4) * 61.81 * mu_eps / 1.0e-18, rel=1e-12)
+
+
 # ---------------------------------------------------------------- bounded work
 
 def test_a_band_no_step_resolves_stops_the_run_at_once(tmp_path):

@@ -10,7 +10,7 @@
 !> continuous with the sliding force at |sdot| = eps.
 module fd_friction_velocity
    use fd_kinds, only: dp
-   use fd_model, only: device_type, mu_constant, mu_exponential, mu_table
+   use fd_model, only: device_type, mu_constant, mu_exponential, mu_table, largest_mu
    use fd_device_state, only: device_state, phase_stick, phase_slip_pos, phase_slip_neg, &
                               job_init, job_update, job_correct
    implicit none
@@ -141,16 +141,6 @@ contains
          mu = dev%mu
       end select
    end function sliding_mu
-
-   !> The largest mu of the law at any sliding speed: mu itself (constant and exponential, where
-   !> it is mu_max; the larger of it and mu_min), or the table's largest value.
-   pure real(dp) function largest_mu(dev) result(mu)
-      type(device_type), intent(in) :: dev   !! device parameters
-
-      mu = dev%mu
-      if (dev%mu_law == mu_table) mu = maxval(dev%mu_at(1:dev%n_mu_points))
-      if (dev%mu_law == mu_exponential) mu = max(dev%mu, dev%mu_min)
-   end function largest_mu
 
    !> Force coefficients of the phase: the band's coupling P mu(eps) / eps, or the sliding
    !> force P mu(|sdot|) sgn with sdot the velocity at the start of the step.

@@ -24,7 +24,7 @@ module fd_model
    public :: mu_constant, mu_exponential, mu_table, label_len, max_mu_points
    public :: system_stuck, system_free
    public :: source_friction, source_brace, source_isolator
-   public :: sticking_stiffness, moved_mass
+   public :: sticking_stiffness, moved_mass, largest_mu
 
    ! where a device (or spring) of the model comes from in the deck
    integer, parameter :: source_friction = 0  !! &friction (or &springs)
@@ -128,6 +128,17 @@ contains
       k = 0.0_dp
       if (dev%law == law_hysteretic .and. dev%p*dev%mu > 0.0_dp) k = dev%p*dev%mu/dev%f
    end function sticking_stiffness
+
+   !> The largest friction coefficient of a device at any sliding speed: mu itself (constant
+   !> law; exponential, where it is mu_max; the larger of it and mu_min), or the table's largest
+   !> value. P times it is the device's friction capacity: a device with none never slips.
+   elemental real(dp) function largest_mu(dev) result(mu)
+      type(device_type), intent(in) :: dev   !! device parameters
+
+      mu = dev%mu
+      if (dev%mu_law == mu_table) mu = maxval(dev%mu_at(1:dev%n_mu_points))
+      if (dev%mu_law == mu_exponential) mu = max(dev%mu, dev%mu_min)
+   end function largest_mu
 
    !> The mass device d moves against its other end: m_i to the table, m_i m_j / (m_i + m_j)
    !> between two DOFs (the step limits' band floor, the mode of its sticking spring).

@@ -14,7 +14,8 @@ module fd_step_limits
    use fd_kinds, only: dp
    use fd_error, only: error_type, fatal_error, fmt_int, fmt_real
    use fd_names, only: law_velocity, law_hysteretic
-   use fd_model, only: model_type, integration_type, sticking_stiffness, moved_mass
+   use fd_model, only: model_type, integration_type, sticking_stiffness, moved_mass, largest_mu
+   use fd_friction_velocity, only: sliding_mu
    use fd_excitation, only: excitation_type
    implicit none
    private
@@ -103,13 +104,14 @@ contains
    end function band_of
 
    !> P mu dt_min / m: the velocity change device d's friction force makes in the step dt_min
-   !> on the mass it moves (m_i to the table, m_i m_j / (m_i + m_j) between two DOFs).
+   !> on the mass it moves (m_i to the table, m_i m_j / (m_i + m_j) between two DOFs); mu the
+   !> largest of a speed-dependent mu.
    pure real(dp) function band_floor(model, d, dt_min) result(floor)
       type(model_type), intent(in) :: model  !! the model
       integer, intent(in) :: d               !! the device
       real(dp), intent(in) :: dt_min         !! the finest step [s]
 
-      floor = model%dev(d)%p*model%dev(d)%mu*dt_min/moved_mass(model, d)
+      floor = model%dev(d)%p*largest_mu(model%dev(d))*dt_min/moved_mass(model, d)
    end function band_floor
 
    !> The limits checked when the deck is read: the work of a refinement, the digits of the
@@ -142,11 +144,14 @@ contains
       end if
       do d = 1, model%n_devices
          i = model%dev(d)%node_i; j = model%dev(d)%node_j
-         pmu = model%dev(d)%p*model%dev(d)%mu
+         pmu = model%dev(d)%p*largest_mu(model%dev(d))
          if (j <= 0 .or. pmu == 0.0_dp) cycle
          select case (model%dev(d)%law)
          case (law_velocity)
-            kd = opts%gamma/(opts%beta*dt1)*(pmu/model%dev(d)%eps)
+            ! the band's coupling P mu(eps) / eps (a speed-dependent mu at eps)
+            associate (dev => model%dev(d))
+               kd = opts%gamma/(opts%beta*dt1)*(dev%p*sliding_mu(dev, dev%eps)/dev%eps)
+            end associate
          case (law_hysteretic)
             kd = sticking_stiffness(model%dev(d))
          case default
