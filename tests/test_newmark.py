@@ -135,7 +135,9 @@ def test_paper_stuck_period_and_damping(tmp_path):
     assert s["xi_stuck"] == pytest.approx(0.015, rel=1e-14)
 
 
-@pytest.mark.parametrize("table", ["0.0, 1.0\n  mu_table_mu = 0.22, 0.0", "0.5, 1.0\n  mu_table_mu = 0.0, 0.22"])
+@pytest.mark.parametrize(
+    "table", ["0.0, 1.0\n  mu_table_mu = 0.22, 0.0", "0.5, 1.0\n  mu_table_mu = 0.0, 0.22"]
+)
 def test_a_speed_dependent_mu_that_reaches_zero_still_sticks(run, table):
     """A velocity-law device whose mu is 0 at one end of its table still has a friction
     capacity, so the stuck system holds it as a rigid link: T = 2 pi sqrt((m1 + m2) / (k1 + k2))

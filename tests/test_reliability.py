@@ -311,7 +311,8 @@ def test_a_speed_dependent_band_beyond_the_digits_of_the_step_is_rejected(tmp_pa
         "mu = 0.22\n  eps = 1.0e-3 ",
         "mu_law = 'table'\n  mu_table_v = 0.0, 1.0\n  mu_table_mu = 0.5, 1.0e-6\n  eps = 1.0e-18 ")
     assert "1.0e-18" in text
-    msg = assert_both_reject(tmp_path, text, ["&friction", "eps(1) = 1.0E-18", "1000000000000.0 times"])
+    msg = assert_both_reject(tmp_path, text,
+                             ["&friction", "eps(1) = 1.0E-18", "1000000000000.0 times"])
     kd = float(msg.split("sticking stiffness of device 1, ")[1].split()[0])
     mu_eps = 0.5 + (1.0e-6 - 0.5) * 1.0e-18
     assert kd == pytest.approx(0.5 / (0.25 * 2.5e-4) * 61.81 * mu_eps / 1.0e-18, rel=1e-12)

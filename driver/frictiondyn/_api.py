@@ -78,7 +78,9 @@ class OutOfMemoryError(FrictiondynError, MemoryError):
 
 class FrictiondynWarning(UserWarning):
     """A run that finished but whose answer needs care, as the executable warns on standard
-    error: steps that violate the correctness condition (eqs. 9, 12), a step dt1 that does
+    error: steps that violate the correctness condition (eqs. 9, 12), steps that could not
+    take a speed-dependent mu at the velocity at their end (summary
+    ``mu_unconverged_steps``), a step dt1 that does
     not resolve the structure's highest modes (summary ``mode_resolution``), or one that
     dephases the ringing of a sticking spring on which a device's stick-slip decisions rest
     (summary ``stick_resolution``), a velocity-law band whose force the step leaves
@@ -104,7 +106,8 @@ def newmark_steps(summary: dict) -> int:
 
 def summary_warnings(summary: dict) -> list[str]:
     """The warnings a summary calls for, as the executable prints them on standard error
-    (without its "frictiondyn: warning: " prefix): correctness violations, a step dt1 that
+    (without its "frictiondyn: warning: " prefix): correctness violations, steps whose
+    speed-dependent mu did not converge, a step dt1 that
     does not resolve the highest modes, one that misses a harmonic table motion's steady
     state or a record's peak linear response, one that dephases a sticking spring's ringing,
     a velocity-law band whose force alternates from step to step,
@@ -116,6 +119,18 @@ def summary_warnings(summary: dict) -> list[str]:
         times = ", ".join(f"{t:g}" for t in summary.get("violation_times_s", []))
         out.append(
             f"{n} step(s) violate the correctness condition (eqs. 9, 12); first at t = {times} s"
+        )
+    n = summary.get("mu_unconverged_steps", 0)
+    if n:
+        out.append(
+            f"{n} step(s) could not take a speed-dependent mu at the velocity at their end, "
+            f"first at t = {summary['mu_unconverged_s']:.3e} s (mu_unconverged_steps, "
+            "mu_unconverged_s): the fixed point f0 = P mu(|s'|) of such a step contracts by about "
+            "P |dmu/dv| gamma h / m_r a pass, here not below 1 (a misfit of "
+            f"{summary['mu_unconverged_misfit']:.3e} of P mu left); those steps hold mu at their "
+            "start instead, an error of first order in the step: the mu curve is too steep for "
+            "the step: raise n1 or lower dt_min, and keep check_correctness on (such a step is "
+            "then refined)"
         )
     if summary.get("mode_resolution") == "unresolved":
         out.append(

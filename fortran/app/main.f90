@@ -125,6 +125,16 @@ program frictiondyn_main
          ' step(s) violate the correctness condition (eqs. 9, 12); first at t [s] ='
       write (error_unit, '(10(1x,f0.6))') res%violation_time(1:res%n_violation_times)
    end if
+   if (res%mu_unconverged > 0) then
+      write (error_unit, '(a,i0,a,es9.3,a)') 'frictiondyn: warning: ', res%mu_unconverged, &
+         ' step(s) could not take a speed-dependent mu at the velocity at their end, first at t = ', &
+         res%mu_unconverged_time, ' s (mu_unconverged_steps, mu_unconverged_s):'
+      write (error_unit, '(a,es9.3,a)') '  the fixed point f0 = P mu(|s''|) of such a step contracts by about '// &
+         'P |dmu/dv| gamma h / m_r a pass, here not below 1 (a misfit of ', res%mu_misfit, ' of P mu left); '// &
+         'those steps hold mu at their start instead, an error of first order in the step:'
+      write (error_unit, '(a)') '  the mu curve is too steep for the step: raise n1 or lower dt_min, and keep '// &
+         'check_correctness on (such a step is then refined)'
+   end if
    if (res%mode_resolution == resolution_unresolved) then
       write (error_unit, '(a,es10.3,a,es10.3,a,f0.2,a)') 'frictiondyn: warning: dt1 = ', res%dt1, &
          ' s does not resolve the highest modes (shortest period ', 2*acos(-1.0_dp)/res%omega_max, &

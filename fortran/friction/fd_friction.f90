@@ -6,14 +6,15 @@
 module fd_friction
    use fd_kinds, only: dp
    use fd_error, only: error_type, fatal_error, fmt_int
-   use fd_model, only: device_type, law_velocity, law_hysteretic, law_name
+   use fd_model, only: device_type, law_velocity, law_hysteretic, law_name, mu_constant
    use fd_device_state, only: device_state, job_init, job_update, job_correct
-   use fd_friction_velocity, only: velocity_law, velocity_update, velocity_correct, velocity_settle
+   use fd_friction_velocity, only: velocity_law, velocity_update, velocity_correct, velocity_settle, velocity_follow
    use fd_friction_hysteretic, only: hysteretic_law, hysteretic_update, hysteretic_correct, hysteretic_settle
    implicit none
    private
 
    public :: friction_init, friction_update, friction_correct, friction_step, friction_settle
+   public :: follows_velocity, friction_follow
 
 contains
 
@@ -120,6 +121,43 @@ contains
          can = can .and. ok
       end do
    end subroutine friction_settle
+
+   !> Whether a device's sliding force depends on the velocity within a step (a velocity-law
+   !> device with a speed-dependent mu): the time-step loop iterates such forces to the
+   !> velocity at the step's end (friction_follow).
+   elemental logical function follows_velocity(dev) result(follows)
+      type(device_type), intent(in) :: dev      !! device parameters
+
+      select case (dev%law)
+      case (law_velocity)
+         follows = dev%mu_law /= mu_constant
+      case default
+         follows = .false.
+      end select
+   end function follows_velocity
+
+   !> For the devices fl(1:nf) (those follows_velocity picks), the change df of their constant
+   !> force f0 that the relative velocities sd1 at the step's end ask for: each law's own force
+   !> at sd1 in the phase st minus st%f0 (velocity_follow). Nothing is changed.
+   pure subroutine friction_follow(nf, fl, dev, sd1, st, df)
+      integer, intent(in) :: nf                 !! devices followed
+      integer, intent(in) :: fl(nf)             !! their numbers
+      type(device_type), intent(in) :: dev(:)   !! all devices
+      real(dp), intent(in) :: sd1(:)            !! relative velocities at the step's end [m/s]
+      type(device_state), intent(in) :: st(:)   !! states during the step
+      real(dp), intent(out) :: df(nf)           !! the change of each one's f0 [N]
+      integer :: q, d
+
+      do q = 1, nf
+         d = fl(q)
+         select case (dev(d)%law)
+         case (law_velocity)
+            df(q) = velocity_follow(dev(d), sd1(d), st(d)) - st(d)%f0
+         case default
+            df(q) = 0.0_dp
+         end select
+      end do
+   end subroutine friction_follow
 
    !> Initial phase and force coefficients of every device; an error for a device whose
    !> law is not a regularized law of this dispatch.

@@ -4,10 +4,11 @@
 !>
 !> Velocity-dependent friction (the paper's natural extension of this law): mu may be a
 !> function of the sliding speed |sdot|, mu_max - (mu_max - mu_min) exp(-rate |sdot|) or
-!> linear between the points of a table. Like the sign (eq. 8), mu is taken at the velocity
-!> at the start of the step and held during it (an explicit lag of one step: the force stays a
-!> constant load, so nothing is refactored); inside the band the coupling is P mu(eps) / eps,
-!> continuous with the sliding force at |sdot| = eps.
+!> linear between the points of a table. The sign is the previous step's (eq. 8); mu is the
+!> one at the velocity at the step's end, as a Newton code's trial takes it: the time-step
+!> loop iterates the sliding force P mu(|sdot|) sgn to a fixed point of the step
+!> (velocity_follow gives it; the force stays a load, so nothing is refactored). Inside the
+!> band the coupling is P mu(eps) / eps, continuous with the sliding force at |sdot| = eps.
 module fd_friction_velocity
    use fd_kinds, only: dp
    use fd_model, only: device_type, mu_constant, mu_exponential, mu_table, largest_mu
@@ -17,6 +18,7 @@ module fd_friction_velocity
    private
 
    public :: velocity_law, velocity_init, velocity_update, velocity_correct, velocity_settle, sliding_mu
+   public :: velocity_follow
 
 contains
 
@@ -69,12 +71,14 @@ contains
       old = st%phase
       if (abs(sdot) < dev%eps) then
          st%phase = phase_stick
-      else if (dev%p*largest_mu(dev) == 0.0_dp) then
-         st%phase = phase_stick                 ! no friction capacity: F = 0, never slips
       else if (sdot > 0.0_dp) then
          st%phase = phase_slip_pos
       else
          st%phase = phase_slip_neg
+      end if
+      ! no friction capacity: F = 0, never slips (mu <= largest_mu, mu >= 0: the cheap test first)
+      if (st%phase /= phase_stick .and. dev%p*dev%mu == 0.0_dp) then
+         if (dev%p*largest_mu(dev) == 0.0_dp) st%phase = phase_stick
       end if
       changed = st%phase /= old
       st%centre = s
@@ -98,7 +102,8 @@ contains
    !> The state in which to take a step that ends in st1's phase (`refinement = 'implicit'`),
    !> from the state at its start st0, for a device whose phase changes (friction_settle keeps
    !> the others): the coefficients of the phase it ends in (st1: the band's
-   !> coupling, or the sliding force with mu at the velocity the update was given, not iterated).
+   !> coupling, or the sliding force with mu at the velocity the update was given, which the
+   !> step then iterates to the velocity at its own end).
    !> A reversal, slip to the opposite slip, passed through the band within the step and is not
    !> taken in one phase (can = .false.): the force would reverse at the step's start.
    pure subroutine velocity_settle(st0, st1, st, can)
@@ -110,6 +115,19 @@ contains
       st = st1
       can = st0%phase == phase_stick .or. st1%phase == phase_stick
    end subroutine velocity_settle
+
+   !> The constant force of the phase st at the relative velocity sdot at the step's end: a
+   !> sliding device with a speed-dependent mu, P mu(|sdot|) in the phase's direction; any
+   !> other, st%f0 as it is. The fixed point f0 = velocity_follow(dev, sdot(f0), st) is the
+   !> implicit step the time-step loop takes (fd_newmark's follow_forces).
+   elemental real(dp) function velocity_follow(dev, sdot, st) result(f0)
+      type(device_type), intent(in) :: dev   !! device parameters
+      real(dp), intent(in) :: sdot           !! relative velocity at the step's end [m/s]
+      type(device_state), intent(in) :: st   !! phase during the step
+
+      f0 = st%f0
+      if (dev%mu_law /= mu_constant .and. st%phase /= phase_stick) f0 = st%phase*dev%p*sliding_mu(dev, sdot)
+   end function velocity_follow
 
    !> Friction coefficient at the sliding speed |v|: mu itself (constant), the exponential
    !> mu_max - (mu_max - mu_min) exp(-rate |v|) with mu_max = mu, or linear between the table's
@@ -143,7 +161,8 @@ contains
    end function sliding_mu
 
    !> Force coefficients of the phase: the band's coupling P mu(eps) / eps, or the sliding
-   !> force P mu(|sdot|) sgn with sdot the velocity at the start of the step.
+   !> force P mu(|sdot|) sgn with sdot the velocity at the start of the step (the step's
+   !> first guess: the loop iterates it to the velocity at the step's end).
    pure subroutine set_coefficients(dev, sdot, st)
       type(device_type), intent(in) :: dev
       real(dp), intent(in) :: sdot

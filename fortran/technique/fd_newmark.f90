@@ -31,7 +31,7 @@ module fd_newmark
    use fd_names, only: laws, law_name, law_choices, excitation_types, technique_name, technique_newmark, &
                        technique_event_driven, technique_moreau_jean, linear_system_dense, linear_system_banded, &
                        refinement_nested, refinement_implicit
-   use fd_model, only: model_type, integration_type
+   use fd_model, only: model_type, integration_type, device_type, largest_mu
    use fd_excitation, only: excitation_type, table_motion, table_acceleration, grid_motion, grid_init, &
                             grid_acceleration
    use fd_matrices, only: structure_damping
@@ -40,13 +40,14 @@ module fd_newmark
                         spd_c_matvec, spd_kc_matvec, spd_auto, spd_dense, spd_banded, spd_is_dense, spd_bandwidth, &
                         spd_copy
    use fd_device_state, only: device_state, device_force, phase_stick
-   use fd_friction, only: friction_init, friction_step, friction_settle
+   use fd_friction, only: friction_init, friction_step, friction_settle, follows_velocity, friction_follow
    use fd_result, only: result_type
    use fd_run_control, only: run_control
    use fd_observer, only: observer_type, observer_init, sample_due, observe_start_energies, observe_peaks, &
                           observe_sample, observe_transitions, observe_violations, observe_end_energies, &
                           observe_poll, observe_stop_error
-   use fd_step_limits, only: halving_levels, unresolved_band, max_nested, nested_splits, max_settle
+   use fd_step_limits, only: halving_levels, unresolved_band, max_nested, nested_splits, max_settle, max_follow, &
+                             follow_tol
    use fd_stick_ringing, only: ringing_type, ringing_init, ringing_changed, ringing_finish, stat_time, stat_sd2, &
                                stat_fmax, stat_damping
    use fd_band_alternation, only: alternation_type, alternation_init, alternation_step, alternation_finish
@@ -85,6 +86,14 @@ module fd_newmark
       integer, allocatable :: phase0(:), phase1(:)    !! phases of st, st1 for the observer
       integer, allocatable :: phase_end(:)            !! phases a step is taken for ('implicit')
       logical, allocatable :: changed(:), ok(:)
+      ! the devices whose sliding force follows the velocity (a speed-dependent mu)
+      integer :: nf = 0                               !! their number
+      integer, allocatable :: fl(:)                   !! their device numbers
+      real(dp), allocatable :: df(:), cap(:)          !! a pass's change of f0; P mu_largest [N]
+      real(dp), allocatable :: follow_sum(:)          !! the change of f0 in the step so far [N]
+      logical :: follow_failed = .false.              !! the trial's forces did not converge
+      real(dp) :: follow_misfit = 0.0_dp              !! then the largest |df| / cap left
+      integer :: follow_passes = 0                    !! solves the fixed point took in all
       real(dp) :: ag = 0.0_dp, ag1 = 0.0_dp
       real(dp) :: w_device = 0.0_dp                   !! work of the device forces [J]
       real(dp) :: t = 0.0_dp                          !! time of the accepted state [s]
@@ -180,7 +189,7 @@ contains
       do k = 1, w%obs%nsteps
          t0 = (k - 1)*dt1
          w%k = k
-         call try_step(exc, t0, 1, w, error)
+         call try_step(model, exc, t0, 1, w, error)
          if (allocated(error)) return
          call judge(model, opts, w, any_changed, any_bad)
          if (w%nd == 0 .or. .not. (any_changed .or. (any_bad .and. opts%check))) then
@@ -220,6 +229,7 @@ contains
       w%phase0 = w%st%phase
       call ringing_finish(w%ring, w%phase0, res)
       call alternation_finish(res)
+      res%mu_passes = w%follow_passes
       call observe_end_energies(w%obs, res, 0.5_dp*sum(w%mass*w%v**2), strain_energy(model, w%u), &
                                 device_energy(w%st, w%s), &
                               w%w_device)
@@ -325,6 +335,15 @@ contains
                           stat_no_memory)
          return
       end if
+      w%nf = count(follows_velocity(model%dev))
+      allocate (w%fl(w%nf), w%df(w%nf), w%cap(w%nf), w%follow_sum(w%nf), stat=stat)
+      if (stat /= 0) then
+         call fatal_error(error, "not enough memory for the state of n_devices = "//trim(fmt_int(nd))//" devices", &
+                          stat_no_memory)
+         return
+      end if
+      w%fl = pack([(l, l=1, nd)], follows_velocity(model%dev))
+      w%cap = model%dev(w%fl)%p*largest_mu(model%dev(w%fl))
    end subroutine setup
 
    !> Acceleration in equilibrium with the current phases: M a = p - C v - K u - sum b F
@@ -355,7 +374,8 @@ contains
    !> The solve's error is relative to a1 itself (the incremental form's is relative to
    !> c0 du ~ v / (beta h), large at small steps): rank-one updates of the factor keep the
    !> equilibrium at round-off.
-   subroutine try_step(exc, t, lv, w, error)
+   subroutine try_step(model, exc, t, lv, w, error)
+      type(model_type), intent(in) :: model
       type(excitation_type), intent(in) :: exc
       real(dp), intent(in) :: t
       integer, intent(in) :: lv
@@ -382,7 +402,80 @@ contains
       if (allocated(error)) return
       call correct(w%n, w%nd, w%lev(lv)%bh2, w%lev(lv)%gh, w%di, w%dj, w%rhs, w%tmp, w%a1, w%u1, w%v1, &
                    w%s1, w%sd1)
+      if (w%nf > 0) call follow_forces(model%dev, lv, w, error)
    end subroutine try_step
+
+   !> A speed-dependent mu at the velocity at the step's end (implicit, as a Newton-Raphson
+   !> code's trial takes it): the sliding forces f0 of the devices that follow the velocity are
+   !> iterated to the step's fixed point f0 = P mu(|s'1(f0)|) sgn. The trial is affine in each
+   !> f0, so a pass adds the change df along b_d to the load, solves with the step's factor
+   !> (nothing is refactored) and moves the trial state by the solution. It contracts by about
+   !> rho = P |dmu/dv| gamma h / m_r a pass. Converged when no |df| exceeds follow_tol
+   !> P mu_largest. When a pass does not shrink the misfit enough to reach that within
+   !> max_follow passes (rho near or above 1: a steep mu for the step), the trial goes back to the forces it started with (mu at the
+   !> velocity at the step's start) and w%follow_failed is set: the step is then refined, and
+   !> counted if it is accepted so.
+   subroutine follow_forces(dev, lv, w, error)
+      type(device_type), intent(in) :: dev(:)
+      integer, intent(in) :: lv
+      type(workspace), intent(inout), target :: w
+      type(error_type), allocatable, intent(out) :: error
+      real(dp) :: misfit, last
+      integer :: it, q
+
+      w%follow_failed = .false.
+      w%follow_sum = 0.0_dp
+      last = huge(1.0_dp)
+      do it = 0, max_follow
+         call friction_follow(w%nf, w%fl, dev, w%sd1, w%st, w%df)
+         misfit = 0.0_dp
+         do q = 1, w%nf
+            if (abs(w%df(q)) > follow_tol*w%cap(q)) misfit = max(misfit, abs(w%df(q))/w%cap(q))
+         end do
+         if (misfit == 0.0_dp) return
+         ! the contraction of the last pass, kept up, would not bring the misfit below
+         ! follow_tol within the passes left (or it does not contract at all)
+         if (it == max_follow .or. .not. misfit < last) exit
+         if (it > 0 .and. misfit*(misfit/last)**(max_follow - it) > follow_tol) exit
+         last = misfit
+         call move_forces(lv, w, error)
+         if (allocated(error)) return
+      end do
+      ! back to the trial with the forces it started with
+      w%follow_failed = .true.
+      w%follow_misfit = misfit
+      w%df = -w%follow_sum
+      call move_forces(lv, w, error)
+   end subroutine follow_forces
+
+   !> The trial state with the followed devices' f0 changed by w%df: the change of the load
+   !> along each b_d solved with the step's factor, the state moved by the solution.
+   subroutine move_forces(lv, w, error)
+      integer, intent(in) :: lv
+      type(workspace), intent(inout), target :: w
+      type(error_type), allocatable, intent(out) :: error
+      integer :: q, d, i
+
+      do i = 1, w%n
+         w%rhs(i) = 0.0_dp
+      end do
+      do q = 1, w%nf
+         d = w%fl(q)
+         w%st(d)%f0 = w%st(d)%f0 + w%df(q)
+         w%follow_sum(q) = w%follow_sum(q) + w%df(q)
+         w%rhs(w%di(d)) = w%rhs(w%di(d)) - w%lev(lv)%c0*w%df(q)
+         if (w%dj(d) > 0) w%rhs(w%dj(d)) = w%rhs(w%dj(d)) + w%lev(lv)%c0*w%df(q)
+      end do
+      call spd_solve(w%lev(lv)%sys, w%rhs, error)
+      if (allocated(error)) return
+      w%follow_passes = w%follow_passes + 1
+      do i = 1, w%n
+         w%a1(i) = w%a1(i) + w%rhs(i)
+         w%u1(i) = w%u1(i) + w%lev(lv)%bh2*w%rhs(i)
+         w%v1(i) = w%v1(i) + w%lev(lv)%gh*w%rhs(i)
+      end do
+      call relative_motion(w%n, w%nd, w%di, w%dj, w%u1, w%v1, w%s1, w%sd1)
+   end subroutine move_forces
 
    !> Predictors v~ = v + (1 - gamma) h a (in vt), u~ = u + h v + (1/2 - beta) h^2 a (in ut),
    !> and the table's inertia load -M ag1 (in rhs).
@@ -437,7 +530,7 @@ contains
       real(dp), intent(in) :: a1s(n), vt(n)
       real(dp), intent(out) :: a1(n), v1(n), s1(nd), sd1(nd)
       real(dp), intent(inout) :: u1(n)
-      integer :: d, i, j
+      integer :: i
 
       !GCC$ ivdep
       do i = 1, n
@@ -445,6 +538,17 @@ contains
          u1(i) = u1(i) + bh2*a1s(i)
          v1(i) = vt(i) + gh*a1s(i)
       end do
+      call relative_motion(n, nd, di, dj, u1, v1, s1, sd1)
+   end subroutine correct
+
+   !> The devices' relative displacements and velocities, s = u_i - u_j, s' = v_i - v_j.
+   pure subroutine relative_motion(n, nd, di, dj, u1, v1, s1, sd1)
+      integer, intent(in) :: n, nd
+      integer, intent(in) :: di(nd), dj(nd)
+      real(dp), intent(in) :: u1(n), v1(n)
+      real(dp), intent(out) :: s1(nd), sd1(nd)
+      integer :: d, i, j
+
       do d = 1, nd
          i = di(d)
          j = dj(d)
@@ -456,7 +560,7 @@ contains
             sd1(d) = v1(i)
          end if
       end do
-   end subroutine correct
+   end subroutine relative_motion
 
    !> The factored effective stiffness of level lv for the current phases: factored the
    !> first time the level is used, updated (never refactored from scratch) when the
@@ -486,7 +590,8 @@ contains
       end associate
    end subroutine factor_for
 
-   !> Phases after the trial step, and the correctness condition of the step.
+   !> Phases after the trial step, and the correctness condition of the step (with the
+   !> convergence of a speed-dependent mu's forces).
    subroutine judge(model, opts, w, any_changed, any_bad)
       type(model_type), intent(in) :: model
       type(integration_type), intent(in) :: opts
@@ -495,6 +600,8 @@ contains
 
       call friction_step(w%nd, model%dev, opts%n_corr, w%s1, w%sd1, w%sd, w%st, w%st1, w%changed, w%ok, &
                          any_changed, any_bad)
+      ! a speed-dependent mu whose forces did not converge in the step: refined as a violation
+      any_bad = any_bad .or. w%follow_failed
    end subroutine judge
 
    !> The refinement: cover the piece [t, t + h_k] of level k (0: the dt1 step), whose own
@@ -529,7 +636,7 @@ contains
             if (allocated(error)) return
             cycle
          end if
-         call try_step(exc, tj, lv, w, error)
+         call try_step(model, exc, tj, lv, w, error)
          if (allocated(error)) return
          call judge(model, opts, w, any_changed, any_bad)
          if (any_changed .or. (any_bad .and. opts%check)) then
@@ -568,7 +675,7 @@ contains
       do while (pos < units)
          h = w%lev(2 + level)%h
          tl = t + sub*real(pos, dp)/real(units, dp)
-         call try_step(exc, tl, 2 + level, w, error)
+         call try_step(model, exc, tl, 2 + level, w, error)
          if (allocated(error)) return
          call judge(model, opts, w, any_changed, any_bad)
          if (any_bad .and. opts%check .and. level < lmax) then
@@ -644,7 +751,7 @@ contains
          if (it > 1 .or. .not. same_phases(w%nd, w%st, w%phase0)) then
             w%version = w%version + 1
             redone = .true.
-            call try_step(exc, t, 1, w, error)
+            call try_step(model, exc, t, 1, w, error)
             if (allocated(error)) return
             res%implicit_redos = res%implicit_redos + 1
             ! the phases this trial ends in, judged from the start
@@ -658,7 +765,7 @@ contains
          ! phase: a changing device's velocities at the two ends belong to different phases)
          call judge(model, opts, w, any_changed, any_bad)
          if (.not. same_phases(w%nd, w%st1, w%phase_end)) exit
-         any_bad = .false.
+         any_bad = w%follow_failed
          do d = 1, w%nd
             if (w%phase_end(d) /= w%phase0(d)) w%ok(d) = .true.
             any_bad = any_bad .or. .not. w%ok(d)
@@ -715,6 +822,12 @@ contains
       w%ag = w%ag1
       ! violations of the correctness condition left in an accepted step
       if (any_bad) call observe_violations(res, t1, w%ok)
+      ! a speed-dependent mu's forces that did not converge, left in an accepted step
+      if (w%follow_failed) then
+         res%mu_unconverged = res%mu_unconverged + 1
+         if (res%mu_unconverged == 1) res%mu_unconverged_time = t1
+         res%mu_misfit = max(res%mu_misfit, w%follow_misfit)
+      end if
       if (any_changed) then
          w%phase0 = w%st%phase
          w%phase1 = w%st1%phase

@@ -21,7 +21,7 @@ module fd_step_limits
    private
 
    public :: max_refinement, max_stiffness_ratio, halving_levels, finest_step, band_floor, band_of
-   public :: check_step_limits, unresolved_band, max_nested, nested_splits, max_settle
+   public :: check_step_limits, unresolved_band, max_nested, nested_splits, max_settle, max_follow, follow_tol
 
    !> Most Newmark steps one dt1 step may be refined into: n2 steps dt2, each halved L times.
    integer, parameter :: max_refinement = 2**20
@@ -34,6 +34,14 @@ module fd_step_limits
    !> Most trials of a dt1 step in the phases it ends in (`refinement = 'implicit'`) before the
    !> step is refined as the paper's instead.
    integer, parameter :: max_settle = 8
+
+   !> Most passes of the fixed point on the sliding forces of a speed-dependent mu within one
+   !> step (each a solve with the step's factor); beyond, the step is refined as for a
+   !> violation of the correctness condition, and counted when it is accepted unconverged.
+   integer, parameter :: max_follow = 50
+   !> A pass has converged when no followed force changes by more than follow_tol times the
+   !> device's capacity P mu_largest.
+   real(dp), parameter :: follow_tol = 1.0e-10_dp
 
 contains
 
