@@ -130,7 +130,8 @@ program frictiondyn_main
          ' step(s) could not take a speed-dependent mu at the velocity at their end, first at t = ', &
          res%mu_unconverged_time, ' s (mu_unconverged_steps, mu_unconverged_s):'
       write (error_unit, '(a,es9.3,a)') '  the fixed point f0 = P mu(|s''|) of such a step contracts by about '// &
-         'P |dmu/dv| gamma h / m_r a pass, here not below 1 (a misfit of ', res%mu_misfit, ' of P mu left); '// &
+         'rho = P |dmu/dv| gamma h / m_r a pass and converges within its passes for rho below about 0.6; here '// &
+         'it did not (its last pass still changed a force by ', res%mu_misfit, ' of P mu); '// &
          'those steps hold mu at their start instead, an error of first order in the step:'
       write (error_unit, '(a)') '  the mu curve is too steep for the step: raise n1 or lower dt_min, and keep '// &
          'check_correctness on (such a step is then refined)'

@@ -11,14 +11,13 @@
 !> band the coupling is P mu(eps) / eps, continuous with the sliding force at |sdot| = eps.
 module fd_friction_velocity
    use fd_kinds, only: dp
-   use fd_model, only: device_type, mu_constant, mu_exponential, mu_table, largest_mu
+   use fd_model, only: device_type, mu_constant, largest_mu, sliding_mu
    use fd_device_state, only: device_state, phase_stick, phase_slip_pos, phase_slip_neg, &
                               job_init, job_update, job_correct
    implicit none
    private
 
-   public :: velocity_law, velocity_init, velocity_update, velocity_correct, velocity_settle, sliding_mu
-   public :: velocity_follow
+   public :: velocity_law, velocity_init, velocity_update, velocity_correct, velocity_settle, velocity_follow
 
 contains
 
@@ -128,37 +127,6 @@ contains
       f0 = st%f0
       if (dev%mu_law /= mu_constant .and. st%phase /= phase_stick) f0 = st%phase*dev%p*sliding_mu(dev, sdot)
    end function velocity_follow
-
-   !> Friction coefficient at the sliding speed |v|: mu itself (constant), the exponential
-   !> mu_max - (mu_max - mu_min) exp(-rate |v|) with mu_max = mu, or linear between the table's
-   !> points (constant before the first and after the last).
-   elemental real(dp) function sliding_mu(dev, v) result(mu)
-      type(device_type), intent(in) :: dev   !! device parameters
-      real(dp), intent(in) :: v              !! sliding velocity (its magnitude is used) [m/s]
-      real(dp) :: speed, w
-      integer :: k, n
-
-      speed = abs(v)
-      select case (dev%mu_law)
-      case (mu_exponential)
-         mu = dev%mu - (dev%mu - dev%mu_min)*exp(-dev%mu_rate*speed)
-      case (mu_table)
-         n = dev%n_mu_points
-         if (speed <= dev%mu_v(1)) then
-            mu = dev%mu_at(1)
-         else if (speed >= dev%mu_v(n)) then
-            mu = dev%mu_at(n)
-         else
-            do k = 2, n
-               if (speed <= dev%mu_v(k)) exit
-            end do
-            w = (speed - dev%mu_v(k - 1))/(dev%mu_v(k) - dev%mu_v(k - 1))
-            mu = dev%mu_at(k - 1) + w*(dev%mu_at(k) - dev%mu_at(k - 1))
-         end if
-      case default
-         mu = dev%mu
-      end select
-   end function sliding_mu
 
    !> Force coefficients of the phase: the band's coupling P mu(eps) / eps, or the sliding
    !> force P mu(|sdot|) sgn with sdot the velocity at the start of the step (the step's

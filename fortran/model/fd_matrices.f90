@@ -7,7 +7,7 @@ module fd_matrices
    use fd_kinds, only: dp
    use fd_error, only: error_type, fatal_error, fmt_real, fmt_int, stat_no_memory
    use fd_model, only: model_type, damping_none, damping_stiffness, damping_rayleigh, law_hysteretic, sticking_stiffness, &
-                       largest_mu, &
+                       holds_when_stuck, &
                        system_stuck, system_free
    use fd_linalg, only: generalized_eigen, lowest_eigen, lowest_eigen_band
    use fd_rcm, only: rcm_order
@@ -169,8 +169,8 @@ contains
       end subroutine no_memory
    end subroutine system_modes
 
-   !> First natural period of the stuck system (every device with a friction capacity,
-   !> P largest_mu > 0, a rigid link between its nodes) and its mode shape.
+   !> First natural period of the stuck system (every device that holds its nodes together
+   !> while it sticks, holds_when_stuck, a rigid link between them) and its mode shape.
    subroutine stuck_first_mode(model, period, phi, error)
       type(model_type), intent(in) :: model          !! the model
       real(dp), intent(out) :: period                !! first period T [s]
@@ -181,7 +181,7 @@ contains
 
       period = 0.0_dp
       phi = 0.0_dp
-      call system_modes(model, model%dev%p*largest_mu(model%dev) > 0.0_dp, 1, w2, z, nq, error)
+      call system_modes(model, holds_when_stuck(model%dev), 1, w2, z, nq, error)
       if (allocated(error)) then
          if (nq == 0) then
             error%message = "the stuck system has no free DOF: every mass is locked to the table &
@@ -692,14 +692,13 @@ contains
       type(modes_type), intent(inout) :: modes       !! its nq; status and arrays if rigid
       integer, intent(out) :: stat                   !! 0, or not enough memory
       logical, allocatable :: linked(:)
-      real(dp) :: pm
       integer :: d
 
       allocate (grp(model%n_dof), linked(model%n_devices), stat=stat)
       if (stat /= 0) return
       do d = 1, model%n_devices
-         pm = model%dev(d)%p*largest_mu(model%dev(d))
-         linked(d) = system == system_stuck .and. pm > 0.0_dp .and. model%dev(d)%law /= law_hysteretic
+         linked(d) = system == system_stuck .and. holds_when_stuck(model%dev(d)) .and. &
+                     model%dev(d)%law /= law_hysteretic
       end do
       call link_groups(model, linked, grp, modes%nq)
       if (modes%nq > 0) return

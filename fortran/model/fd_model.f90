@@ -24,7 +24,7 @@ module fd_model
    public :: mu_constant, mu_exponential, mu_table, label_len, max_mu_points
    public :: system_stuck, system_free
    public :: source_friction, source_brace, source_isolator
-   public :: sticking_stiffness, moved_mass, largest_mu
+   public :: sticking_stiffness, moved_mass, largest_mu, sliding_mu, holds_when_stuck
 
    ! where a device (or spring) of the model comes from in the deck
    integer, parameter :: source_friction = 0  !! &friction (or &springs)
@@ -128,6 +128,50 @@ contains
       k = 0.0_dp
       if (dev%law == law_hysteretic .and. dev%p*dev%mu > 0.0_dp) k = dev%p*dev%mu/dev%f
    end function sticking_stiffness
+
+   !> Friction coefficient at the sliding speed |v|: mu itself (constant), the exponential
+   !> mu_max - (mu_max - mu_min) exp(-rate |v|) with mu_max = mu, or linear between the table's
+   !> points (constant before the first and after the last).
+   elemental real(dp) function sliding_mu(dev, v) result(mu)
+      type(device_type), intent(in) :: dev   !! device parameters
+      real(dp), intent(in) :: v              !! sliding velocity (its magnitude is used) [m/s]
+      real(dp) :: speed, w
+      integer :: k, n
+
+      speed = abs(v)
+      select case (dev%mu_law)
+      case (mu_exponential)
+         mu = dev%mu - (dev%mu - dev%mu_min)*exp(-dev%mu_rate*speed)
+      case (mu_table)
+         n = dev%n_mu_points
+         if (speed <= dev%mu_v(1)) then
+            mu = dev%mu_at(1)
+         else if (speed >= dev%mu_v(n)) then
+            mu = dev%mu_at(n)
+         else
+            do k = 2, n
+               if (speed <= dev%mu_v(k)) exit
+            end do
+            w = (speed - dev%mu_v(k - 1))/(dev%mu_v(k) - dev%mu_v(k - 1))
+            mu = dev%mu_at(k - 1) + w*(dev%mu_at(k) - dev%mu_at(k - 1))
+         end if
+      case default
+         mu = dev%mu
+      end select
+   end function sliding_mu
+
+   !> Whether a device holds its nodes together while it sticks (a link of the stuck system):
+   !> a velocity-law device through its band's coupling P mu(eps) / eps, so P mu(eps) > 0 (a
+   !> speed-dependent mu that is 0 in the band holds nothing); any other with P mu > 0.
+   elemental logical function holds_when_stuck(dev) result(holds)
+      type(device_type), intent(in) :: dev   !! device parameters
+
+      if (dev%law == law_velocity) then
+         holds = dev%p*sliding_mu(dev, dev%eps) > 0.0_dp
+      else
+         holds = dev%p*dev%mu > 0.0_dp
+      end if
+   end function holds_when_stuck
 
    !> The largest friction coefficient of a device at any sliding speed: mu itself (constant
    !> law; exponential, where it is mu_max; the larger of it and mu_min), or the table's largest

@@ -32,10 +32,9 @@
 module fd_band_alternation
    use fd_kinds, only: dp
    use fd_error, only: error_type, fatal_error, fmt_int, stat_no_memory
-   use fd_model, only: model_type, device_type
+   use fd_model, only: model_type, device_type, sliding_mu
    use fd_names, only: law_velocity
    use fd_device_state, only: device_state, phase_stick
-   use fd_friction_velocity, only: sliding_mu
    use fd_result, only: result_type, resolution_none, resolution_resolved, resolution_unresolved
    implicit none
    private

@@ -395,6 +395,9 @@ contains
          ag1 = table_acceleration(exc, t + h)
       end if
       w%ag1 = ag1
+      ! a speed-dependent mu's sliding forces start from the velocity at the step's start,
+      ! whatever an earlier trial of the step left in them (follow_forces takes them on)
+      if (w%nf > 0) call start_forces(model%dev, w)
       call predict(w%n, h, w%lev(lv)%g1h, w%lev(lv)%b2h2, ag1, w%mass, w%u, w%v, w%a, w%tmp, w%u1, w%rhs)
       call spd_kc_matvec(w%lev(lv)%sys, w%u1, w%tmp, w%rhs, -1.0_dp)
       call device_loads(w%n, w%nd, w%di, w%dj, w%st, w%u1, w%tmp, w%lev(lv)%c0, w%rhs)
@@ -410,11 +413,13 @@ contains
    !> iterated to the step's fixed point f0 = P mu(|s'1(f0)|) sgn. The trial is affine in each
    !> f0, so a pass adds the change df along b_d to the load, solves with the step's factor
    !> (nothing is refactored) and moves the trial state by the solution. It contracts by about
-   !> rho = P |dmu/dv| gamma h / m_r a pass. Converged when no |df| exceeds follow_tol
+   !> rho = P |dmu/dv| gamma h / m_r a pass (the x of the slope's dashpot P dmu/dv: rho >= 1 is
+   !> where the step would leave it alternating). Converged when no |df| exceeds follow_tol
    !> P mu_largest. When a pass does not shrink the misfit enough to reach that within
-   !> max_follow passes (rho near or above 1: a steep mu for the step), the trial goes back to the forces it started with (mu at the
-   !> velocity at the step's start) and w%follow_failed is set: the step is then refined, and
-   !> counted if it is accepted so.
+   !> max_follow passes (rho above about 0.6: a mu too steep for the step), the trial goes
+   !> back to the forces it started with (mu at the velocity at the step's start,
+   !> start_forces) and w%follow_failed is set: the step is then refined, and counted if it
+   !> is accepted so.
    subroutine follow_forces(dev, lv, w, error)
       type(device_type), intent(in) :: dev(:)
       integer, intent(in) :: lv
@@ -447,6 +452,19 @@ contains
       w%df = -w%follow_sum
       call move_forces(lv, w, error)
    end subroutine follow_forces
+
+   !> The followed devices' f0 at the relative velocities at the step's start (w%sd): the
+   !> first guess of the fixed point, and what an unconverged step keeps.
+   subroutine start_forces(dev, w)
+      type(device_type), intent(in) :: dev(:)
+      type(workspace), intent(inout) :: w
+      integer :: q
+
+      call friction_follow(w%nf, w%fl, dev, w%sd, w%st, w%df)
+      do q = 1, w%nf
+         w%st(w%fl(q))%f0 = w%st(w%fl(q))%f0 + w%df(q)
+      end do
+   end subroutine start_forces
 
    !> The trial state with the followed devices' f0 changed by w%df: the change of the load
    !> along each b_d solved with the step's factor, the state moved by the solution.

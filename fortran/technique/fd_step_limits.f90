@@ -14,8 +14,7 @@ module fd_step_limits
    use fd_kinds, only: dp
    use fd_error, only: error_type, fatal_error, fmt_int, fmt_real
    use fd_names, only: law_velocity, law_hysteretic
-   use fd_model, only: model_type, integration_type, sticking_stiffness, moved_mass, largest_mu
-   use fd_friction_velocity, only: sliding_mu
+   use fd_model, only: model_type, integration_type, sticking_stiffness, moved_mass, largest_mu, sliding_mu
    use fd_excitation, only: excitation_type
    implicit none
    private

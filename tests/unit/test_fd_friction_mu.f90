@@ -5,9 +5,9 @@
 module test_fd_friction_mu
    use testdrive, only: new_unittest, unittest_type, error_type, check
    use fd_kinds, only: dp
-   use fd_model, only: device_type, law_velocity, mu_constant, mu_exponential, mu_table
+   use fd_model, only: device_type, law_velocity, mu_constant, mu_exponential, mu_table, sliding_mu
    use fd_device_state, only: device_state, phase_stick, phase_slip_pos, phase_slip_neg
-   use fd_friction_velocity, only: sliding_mu, velocity_init, velocity_update, velocity_follow
+   use fd_friction_velocity, only: velocity_init, velocity_update, velocity_follow
    use fd_friction, only: follows_velocity, friction_follow
    use test_fd_helpers, only: check_close
    implicit none
