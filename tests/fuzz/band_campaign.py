@@ -129,12 +129,17 @@ def rel(a: float, b: float) -> float:
     return abs(a - b) / abs(b) if b else float(a != 0.0)
 
 
+def common_rows(bh: dict, rh: dict) -> tuple[np.ndarray, np.ndarray]:
+    """The rows of two histories at the same times: their indices in each."""
+    pick = np.clip(np.searchsorted(rh["t"], bh["t"] - 1e-9 * (1 + bh["t"])), 0, len(rh["t"]) - 1)
+    common = np.abs(rh["t"][pick] - bh["t"]) <= 1e-9 * (1 + bh["t"])
+    return np.nonzero(common)[0], pick[common]
+
+
 def compare(base: dict, ref: dict, devices: list) -> dict:
     """The base run's errors against the reference at their common rows."""
     bh, rh = base["h"], ref["h"]
-    pick = np.clip(np.searchsorted(rh["t"], bh["t"] - 1e-9 * (1 + bh["t"])), 0, len(rh["t"]) - 1)
-    common = np.abs(rh["t"][pick] - bh["t"]) <= 1e-9 * (1 + bh["t"])
-    ib, ir = np.nonzero(common)[0], pick[common]
+    ib, ir = common_rows(bh, rh)
     out = {"dev": {}}
     for k, pmu, _ in devices:
         f = bh[f"F{k}"][ib]

@@ -56,9 +56,7 @@ def capacity(d: dict) -> float:
 def errors(run: dict, ref: dict, devices: list) -> dict:
     """The run's errors against the reference at their common rows."""
     h, r = run["h"], ref["h"]
-    pick = np.clip(np.searchsorted(r["t"], h["t"] - 1e-9 * (1 + h["t"])), 0, len(r["t"]) - 1)
-    common = np.abs(r["t"][pick] - h["t"]) <= 1e-9 * (1 + h["t"])
-    ib, ir = np.nonzero(common)[0], pick[common]
+    ib, ir = band_campaign.common_rows(h, r)
     out = {"F": {}}
     for k, d in devices:
         cap = capacity(d)
