@@ -140,7 +140,7 @@ module fd_result
       integer :: mu_passes = 0         !! solves of the fixed point on the sliding forces
       integer :: mu_unconverged = 0    !! steps accepted with those forces unconverged
       real(dp) :: mu_unconverged_time = 0.0_dp !! end of the first one [s]
-      real(dp) :: mu_misfit = 0.0_dp   !! the largest change left, |df| / (P mu_largest) [-]
+      real(dp) :: mu_misfit = 0.0_dp   !! the largest change their last pass asked for, |df| / (P mu_largest) [-]
       ! energy [J] (relative frame)
       real(dp) :: e_input = 0.0_dp     !! work of the table's inertia loads
       real(dp) :: e_kinetic = 0.0_dp   !! kinetic energy at the end (minus initial)
