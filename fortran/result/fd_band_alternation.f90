@@ -32,7 +32,7 @@
 module fd_band_alternation
    use fd_kinds, only: dp
    use fd_error, only: error_type, fatal_error, fmt_int, stat_no_memory
-   use fd_model, only: model_type, device_type, sliding_mu
+   use fd_model, only: model_type, device_type, sliding_mu, holds_when_stuck
    use fd_names, only: law_velocity
    use fd_device_state, only: device_state, phase_stick
    use fd_result, only: result_type, resolution_none, resolution_resolved, resolution_unresolved
@@ -117,12 +117,11 @@ contains
    end subroutine alternation_init
 
    !> A device the step may leave alternating: the velocity law with a band coupling,
-   !> P mu(eps) > 0.
+   !> P mu(eps) > 0 (one that holds its nodes while it sticks).
    elemental logical function watched(dev)
       type(device_type), intent(in) :: dev
 
-      watched = .false.
-      if (dev%law == law_velocity) watched = dev%p*sliding_mu(dev, dev%eps) > 0.0_dp
+      watched = dev%law == law_velocity .and. holds_when_stuck(dev)
    end function watched
 
    !> An accepted step of length h: the watched devices' forces at its end (f, in the phases

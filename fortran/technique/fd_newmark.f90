@@ -90,9 +90,8 @@ module fd_newmark
       integer :: nf = 0                               !! their number
       integer, allocatable :: fl(:)                   !! their device numbers
       real(dp), allocatable :: df(:), cap(:)          !! a pass's change of f0; P mu_largest [N]
-      real(dp), allocatable :: follow_sum(:)          !! the change of f0 in the step so far [N]
       logical :: follow_failed = .false.              !! the trial's forces did not converge
-      real(dp) :: follow_misfit = 0.0_dp              !! then the largest |df| / cap left
+      real(dp) :: follow_misfit = 0.0_dp              !! then its last pass's largest |df| / cap
       integer :: follow_passes = 0                    !! solves the fixed point took in all
       real(dp) :: ag = 0.0_dp, ag1 = 0.0_dp
       real(dp) :: w_device = 0.0_dp                   !! work of the device forces [J]
@@ -336,7 +335,7 @@ contains
          return
       end if
       w%nf = count(follows_velocity(model%dev))
-      allocate (w%fl(w%nf), w%df(w%nf), w%cap(w%nf), w%follow_sum(w%nf), stat=stat)
+      allocate (w%fl(w%nf), w%df(w%nf), w%cap(w%nf), stat=stat)
       if (stat /= 0) then
          call fatal_error(error, "not enough memory for the state of n_devices = "//trim(fmt_int(nd))//" devices", &
                           stat_no_memory)
@@ -429,7 +428,6 @@ contains
       integer :: it, q
 
       w%follow_failed = .false.
-      w%follow_sum = 0.0_dp
       last = huge(1.0_dp)
       do it = 0, max_follow
          call friction_follow(w%nf, w%fl, dev, w%sd1, w%st, w%df)
@@ -446,10 +444,10 @@ contains
          call move_forces(lv, w, error)
          if (allocated(error)) return
       end do
-      ! back to the trial with the forces it started with
+      ! back to the trial with the forces it started with, mu at the step's start (start_forces)
       w%follow_failed = .true.
       w%follow_misfit = misfit
-      w%df = -w%follow_sum
+      call friction_follow(w%nf, w%fl, dev, w%sd, w%st, w%df)
       call move_forces(lv, w, error)
    end subroutine follow_forces
 
@@ -480,7 +478,6 @@ contains
       do q = 1, w%nf
          d = w%fl(q)
          w%st(d)%f0 = w%st(d)%f0 + w%df(q)
-         w%follow_sum(q) = w%follow_sum(q) + w%df(q)
          w%rhs(w%di(d)) = w%rhs(w%di(d)) - w%lev(lv)%c0*w%df(q)
          if (w%dj(d) > 0) w%rhs(w%dj(d)) = w%rhs(w%dj(d)) + w%lev(lv)%c0*w%df(q)
       end do
