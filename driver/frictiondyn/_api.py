@@ -194,8 +194,8 @@ def summary_warnings(summary: dict) -> list[str]:
             "raise n1"
         )
         out.append(
-            f"the force of device {d + 1} alternates from step to step inside its velocity band, "
-            f"by +-{amp[d]:.3g} N for {summary['band_alternation_s'][d]:.3g} s in all "
+            f"the force of device {d + 1} alternates from step to step in its velocity band or at "
+            f"its edge, by +-{amp[d]:.3g} N for {summary['band_alternation_s'][d]:.3g} s in all "
             "(band_alternation_N, band_alternation_s): Newmark's rule damps the band's coupling "
             "only where x = (1 - gamma) dt1 (c_i / m_i + c_j / m_j) < 1 (c_n: the couplings "
             "P mu / eps of the velocity-law devices at its node n; (P mu / eps) dt1 / (2 m_r) for a "

@@ -186,7 +186,7 @@ program frictiondyn_main
    if (res%band_resolution == resolution_unresolved) then
       d = maxloc(res%band_alternation, 1)
       write (error_unit, '(a,i0,a,es9.3,a,es9.3,a)') 'frictiondyn: warning: the force of device ', d, &
-         ' alternates from step to step inside its velocity band, by +-', res%band_alternation(d), ' N for ', &
+         ' alternates from step to step in its velocity band or at its edge, by +-', res%band_alternation(d), ' N for ', &
          res%band_alternation_time(d), ' s in all (band_alternation_N, band_alternation_s):'
       write (error_unit, '(a,es9.3,a)') '  Newmark''s rule damps the band''s coupling only where '// &
          'x = (1 - gamma) dt1 (c_i / m_i + c_j / m_j) < 1 (c_n: the couplings P mu / eps of the velocity-law '// &

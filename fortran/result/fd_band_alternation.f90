@@ -16,19 +16,29 @@
 !> (fd_result's 'digits lost' catches the extreme), and the static x > 1 cannot tell a run
 !> that has it from one that does not (the paper's tests 1-3 have x = 1.3-1.9 and none).
 !>
-!> Measured on the force of each velocity-law device at its accepted steps inside the band
-!> (alternation_step, called by the technique after each accepted step; no allocation in the
-!> loop): the second difference D_k = F_k - 2 F_(k-1) + F_(k-2) over three forces in the band.
-!> An alternation of amplitude A gives |D| ~ 4 A with the sign of D changing at every step; a
-!> smooth force |D| ~ h^2 |F''|; a jump of the force one sign change (D = J, -J, 0) and a kink
-!> one large D. A run of D's above 4 alternation_floor P mu, each of the sign opposite to the
-!> last, is an alternation once it has changed sign alternation_run times (six forces in the
-!> band, which a jump or a kink cannot give); it is counted from its first D on: the largest
-!> |D| / 4 of the counted runs is the device's band_alternation (N), their steps' time its
-!> band_alternation_time (s). A device with a count is 'unresolved' (band_resolution). Every
-!> run also reports each device's band_x = 2 (1 - gamma) x at dt1, above 1 where the factor
-!> r is negative, with the couplings of every velocity-law device at its nodes (exact for one
-!> device or devices in parallel on two masses alone).
+!> At the band's edge the same factor leaves the device in the band and out of it in turn: a
+!> band step sends |s'| just above eps, the slide's P mu brings it back (a sliding force
+!> alternating with a band force c1 s' short of it, both of one sign).
+!>
+!> Measured on the force of each velocity-law device at its accepted steps (alternation_step,
+!> called by the technique after each accepted step; no allocation in the loop): the second
+!> difference D_k = 2 (h_(k-1) (F_k - F_(k-1)) - h_k (F_(k-1) - F_(k-2))) / (h_k + h_(k-1))
+!> (F_k - 2 F_(k-1) + F_(k-2) for steps of one length) over three forces in a row of which at
+!> least one is in the band: a run may start with the slide before the band (the device enters
+!> it with the force P mu, the alternation's first term), and three sliding forces in a row end
+!> it (a slide's force alternating is the correctness condition's to report). Weighted by the
+!> steps' lengths h, D is 0 on a linear course whatever the steps (a force crossing the band in
+!> dt2 and dt1 steps is not an alternation). An alternation of amplitude A gives |D| = 4 A with
+!> the sign of D changing at every step; a smooth force |D| ~ h^2 |F''|; a jump of the force
+!> one sign change (D = J, -J, 0), a one-step spike two, and a kink one large D. A run of D's
+!> above 4 alternation_floor P mu, each of the sign opposite to the last, is an alternation
+!> once it has changed sign alternation_run times (six forces, which a jump, a spike or a kink
+!> cannot give); it is counted from its first D on: the largest |D| / 4 of the counted runs is
+!> the device's band_alternation (N), their steps' time its band_alternation_time (s). A
+!> device with a count is 'unresolved' (band_resolution). Every run also reports each device's
+!> band_x = 2 (1 - gamma) x at dt1, above 1 where the factor r is negative, with the couplings
+!> of every velocity-law device at its nodes (exact for one device or devices in parallel on
+!> two masses alone).
 module fd_band_alternation
    use fd_kinds, only: dp
    use fd_error, only: error_type, fatal_error, fmt_int, stat_no_memory
@@ -45,18 +55,20 @@ module fd_band_alternation
    !> Share of P mu below which an alternation is not counted.
    real(dp), parameter :: alternation_floor = 0.05_dp
    !> Sign changes of D in a row, each above the floor, before an alternation is counted:
-   !> six forces in the band, which a kink cannot give.
+   !> six forces, which a jump, a spike or a kink cannot give.
    integer, parameter :: alternation_run = 3
 
    !> A device watched and what the step needs of its last forces.
    type :: band_watch
       integer :: dev = 0                      !! its number
-      integer :: nin = 0                      !! of f1, f2, those in the band (0, 1 or 2)
+      integer :: nin = 0                      !! of f1, f2, those seen (0, 1 or 2)
+      logical :: band1 = .false., band2 = .false. !! f1, f2 in the band
       integer :: run = -1                     !! sign changes in the current run of D's above
                                               !! the floor (-1: no run)
       real(dp) :: floor4 = 0.0_dp             !! 4 alternation_floor P mu: the |D| counted [N]
       real(dp) :: f1 = 0.0_dp, f2 = 0.0_dp    !! forces at the last two accepted steps [N]
-      real(dp) :: d1 = 0.0_dp                 !! the last D [N]
+      real(dp) :: d1 = 0.0_dp                 !! the last D, times its steps' mean length [N s]
+      real(dp) :: h1 = 0.0_dp                 !! the step that ended at f1 [s]
       real(dp) :: dmax = 0.0_dp               !! the run's largest |D| [N]
       real(dp) :: trun = 0.0_dp               !! the run's time not yet counted [s]
    end type band_watch
@@ -137,28 +149,31 @@ contains
       real(dp), intent(in) :: f(nd)                 !! every device's force at the step's end [N]
       real(dp), intent(inout) :: amp(nd)            !! per device: largest alternation counted [N]
       real(dp), intent(inout) :: time(nd)           !! per device: time of the counted steps [s]
-      real(dp) :: dd
+      real(dp) :: dd, hs
       integer :: q, d
+      logical :: inband
 
       do q = 1, al%n
          associate (b => al%w(q))
             d = b%dev
-            if (st(d)%phase /= phase_stick) then
-               b%nin = 0
-               b%run = -1
-               cycle
-            end if
-            if (b%nin == 2) then
-               dd = f(d) - 2.0_dp*b%f1 + b%f2
-               if (abs(dd) <= b%floor4) then
+            inband = st(d)%phase == phase_stick
+            if (b%nin < 2) then
+               b%nin = b%nin + 1
+            else if (.not. (inband .or. b%band1 .or. b%band2)) then
+               b%run = -1                     ! three sliding forces
+            else
+               ! dd = D hs, hs the two steps' mean length: divided only where it counts
+               hs = 0.5_dp*(h + b%h1)
+               dd = b%h1*(f(d) - b%f1) - h*(b%f1 - b%f2)
+               if (abs(dd) <= b%floor4*hs) then
                   b%run = -1
                else if (b%run >= 0 .and. dd*b%d1 < 0.0_dp) then
                   b%run = b%run + 1
-                  b%dmax = max(b%dmax, abs(dd))
+                  b%dmax = max(b%dmax, abs(dd)/hs)
                   b%trun = b%trun + h
                else
                   b%run = 0                   ! a run starts here
-                  b%dmax = abs(dd)
+                  b%dmax = abs(dd)/hs
                   b%trun = h
                end if
                if (b%run >= alternation_run) then
@@ -167,11 +182,12 @@ contains
                   b%trun = 0.0_dp
                end if
                b%d1 = dd
-            else
-               b%nin = b%nin + 1
             end if
             b%f2 = b%f1
             b%f1 = f(d)
+            b%band2 = b%band1
+            b%band1 = inband
+            b%h1 = h
          end associate
       end do
    end subroutine alternation_step

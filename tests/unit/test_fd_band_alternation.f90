@@ -1,11 +1,12 @@
 !> Unit tests of the band alternation count (fd_band_alternation's alternation_step) on force
 !> sequences whose second differences are known in closed form: a decaying alternation on a
 !> linear course (its amplitude and counted time from the closed form), a jump and a kink
-!> (not counted), an alternation broken by slip steps (not counted), and one below the floor.
+!> (not counted), band and slide in turn at the band's edge (counted), an alternation of
+!> sliding forces or one broken by slides (not counted), and one below the floor.
 module test_fd_band_alternation
    use testdrive, only: new_unittest, unittest_type, error_type, check
    use fd_kinds, only: dp
-   use fd_device_state, only: device_state, phase_stick, phase_slip_pos
+   use fd_device_state, only: device_state, phase_stick, phase_slip_pos, phase_slip_neg
    use fd_band_alternation, only: alternation_type, band_watch, alternation_step, alternation_floor, alternation_run
    implicit none
    private
@@ -23,7 +24,9 @@ contains
       testsuite = [ &
                   new_unittest("a decaying alternation: its amplitude and time in closed form", test_decaying), &
                   new_unittest("a jump and a kink are not alternations", test_kinks), &
-                  new_unittest("slip steps break the count", test_broken), &
+                  new_unittest("band and slide in turn: the band's edge", test_edge), &
+                  new_unittest("slides alone, or slides between, break the count", test_broken), &
+                  new_unittest("steps of two lengths: a line is not counted, +-A is", test_uneven), &
                   new_unittest("below the floor: not counted", test_floor) &
                   ]
    end subroutine collect_band_alternation
@@ -36,14 +39,16 @@ contains
       al%w = [band_watch(dev=1, floor4=4*alternation_floor*pmu)]
    end subroutine watch_one
 
-   !> Feed forces f(0:) in the phases phase(0:); the amplitude and time counted.
-   subroutine feed(f, phase, amp, time)
+   !> Feed forces f(0:) in the phases phase(0:), after steps of length h (or steps(0:));
+   !> the amplitude and time counted.
+   subroutine feed(f, phase, amp, time, steps)
       real(dp), intent(in) :: f(0:)
       integer, intent(in) :: phase(0:)
       real(dp), intent(out) :: amp, time
+      real(dp), intent(in), optional :: steps(0:)
       type(alternation_type) :: al
       type(device_state) :: st(1)
-      real(dp) :: a(1), t(1)
+      real(dp) :: a(1), t(1), hk
       integer :: k
 
       call watch_one(al)
@@ -51,7 +56,9 @@ contains
       t = 0.0_dp
       do k = 0, ubound(f, 1)
          st(1)%phase = phase(k)
-         call alternation_step(al, 1, h, st, f(k:k), a, t)
+         hk = h
+         if (present(steps)) hk = steps(k)
+         call alternation_step(al, 1, hk, st, f(k:k), a, t)
       end do
       amp = a(1)
       time = t(1)
@@ -107,8 +114,47 @@ contains
       call check(error, amp == 0.0_dp .and. time == 0.0_dp, "a kink is not counted")
    end subroutine test_kinks
 
-   !> A full alternation +-P mu interrupted by a slip step every fifth step: at most four
-   !> forces in the band in a row, never the six a count needs.
+   !> The band's edge: band forces -P mu (1 - b q^j) short of the slide's (k = 2 j) in turn
+   !> with sliding forces -P mu (k odd). In closed form D_2j = P mu b q^(j-1) (1 + q) and
+   !> D_2j+1 = -2 P mu b q^j: alternating, decaying, the first the largest; counted from k = 2
+   !> on while |D| exceeds 4 alternation_floor P mu.
+   subroutine test_edge(error)
+      type(error_type), allocatable, intent(out) :: error
+      integer, parameter :: kmax = 60
+      real(dp), parameter :: b = 0.25_dp, q = 0.9_dp
+      real(dp) :: f(0:kmax), amp, time, dk
+      integer :: phase(0:kmax), k, counted
+
+      do k = 0, kmax
+         if (mod(k, 2) == 0) then
+            phase(k) = phase_stick
+            f(k) = -pmu*(1 - b*q**(k/2))
+         else
+            phase(k) = phase_slip_neg
+            f(k) = -pmu
+         end if
+      end do
+      call feed(f, phase, amp, time)
+      counted = 0
+      do k = 2, kmax
+         if (mod(k, 2) == 0) then
+            dk = pmu*b*q**(k/2 - 1)*(1 + q)
+         else
+            dk = 2*pmu*b*q**(k/2)
+         end if
+         if (dk <= 4*alternation_floor*pmu) exit
+         counted = counted + 1
+      end do
+      call check(error, counted > alternation_run + 5, "the closed form counts steps")
+      if (allocated(error)) return
+      call check(error, abs(amp - pmu*b*(1 + q)/4) <= 1e-12_dp*pmu, "amplitude |D| / 4 of the run's first D")
+      if (allocated(error)) return
+      call check(error, abs(time - counted*h) <= 1e-12_dp, "time: the run's steps")
+   end subroutine test_edge
+
+   !> A full alternation +-P mu in slides alone (the correctness condition's to report), then
+   !> with one band force every fifth step: at most three D's in a row reach the band, never
+   !> the four a count needs.
    subroutine test_broken(error)
       type(error_type), allocatable, intent(out) :: error
       real(dp) :: f(0:99), amp, time
@@ -116,16 +162,57 @@ contains
 
       do k = 0, 99
          f(k) = pmu*(-1)**k
-         phase(k) = merge(phase_slip_pos, phase_stick, mod(k, 5) == 4)
+      end do
+      phase = phase_slip_pos
+      call feed(f, phase, amp, time)
+      call check(error, amp == 0.0_dp .and. time == 0.0_dp, "a slide's forces are not counted")
+      if (allocated(error)) return
+      do k = 0, 99
+         phase(k) = merge(phase_stick, phase_slip_pos, mod(k, 5) == 4)
       end do
       call feed(f, phase, amp, time)
-      call check(error, amp == 0.0_dp .and. time == 0.0_dp, "no six forces in the band in a row")
+      call check(error, amp == 0.0_dp .and. time == 0.0_dp, "three D's in a row reach the band")
       if (allocated(error)) return
       phase = phase_stick
       call feed(f, phase, amp, time)
       call check(error, abs(amp - pmu) <= 1e-12_dp*pmu .and. abs(time - (100 - 2)*h) <= 1e-12_dp, &
                  "the same forces all in the band: +-P mu from the third on")
    end subroutine test_broken
+
+   !> Steps of two lengths in turn, h and h / 7 (as dt1 and dt2 steps where transitions are
+   !> refined): a force on a steep line, F = P mu (-1 + 0.8 t / h) (a force crossing the band),
+   !> whose unweighted F_k - 2 F_(k-1) + F_(k-2) = +-0.8 P mu 6 / 7 would alternate, is not
+   !> counted; the same line plus +-A (A = 0.3 P mu) is, with |D| / 4 = A for every D.
+   subroutine test_uneven(error)
+      type(error_type), allocatable, intent(out) :: error
+      integer, parameter :: kmax = 40
+      real(dp) :: f(0:kmax), steps(0:kmax), tk, amp, time, d2, d3
+      integer :: phase(0:kmax), k
+
+      phase = phase_stick
+      tk = 0.0_dp
+      do k = 0, kmax
+         steps(k) = merge(h/7, h, mod(k, 2) == 1)
+         tk = tk + steps(k)
+         f(k) = pmu*(-1 + 0.8_dp*tk/h)
+      end do
+      d2 = f(2) - 2*f(1) + f(0)
+      d3 = f(3) - 2*f(2) + f(1)
+      call check(error, d2*d3 < 0 .and. min(abs(d2), abs(d3)) > 4*alternation_floor*pmu, &
+                 "the steps would make the unweighted difference alternate")
+      if (allocated(error)) return
+      call feed(f, phase, amp, time, steps)
+      call check(error, amp == 0.0_dp .and. time == 0.0_dp, "a line over uneven steps")
+      if (allocated(error)) return
+      do k = 0, kmax
+         f(k) = f(k) + 0.3_dp*pmu*(-1)**k
+      end do
+      call feed(f, phase, amp, time, steps)
+      call check(error, abs(amp - 0.3_dp*pmu) <= 1e-12_dp*pmu, "+-A over uneven steps: A")
+      if (allocated(error)) return
+      call check(error, abs(time - (sum(steps) - steps(0) - steps(1))) <= 1e-12_dp, &
+                 "counted from the first D on")
+   end subroutine test_uneven
 
    !> A steady alternation of 0.9 of the floor: |D| = 3.6 floor P mu, below 4 floor P mu.
    subroutine test_floor(error)
