@@ -176,16 +176,21 @@ def test_the_papers_decks_have_no_alternation(run, test):
         assert x > 1
 
 
-def test_python_warns_alike():
-    """Python issues the executable's warning, with the same figures."""
+def test_python_warns_alike(run):
+    """Python issues the executable's warnings word for word (one text, fd_warnings), with
+    the summary's figures."""
+    deck = SEED_1181.format(law="velocity", technique="newmark")
     with warnings.catch_warnings(record=True) as caught:
         warnings.simplefilter("always")
-        res = fd.run_text(SEED_1181.format(law="velocity", technique="newmark"))
+        res = fd.run_text(deck)
     text = [str(w.message) for w in caught if issubclass(w.category, fd.FrictiondynWarning)]
+    exe = ok(run(deck)).stderr.splitlines()
+    prefix = "frictiondyn: warning: "
+    assert [t.split(": ", 1)[1] for t in text] == [x[len(prefix) :] for x in exe if x.startswith(prefix)]
     band = [t for t in text if "alternates from step to step" in t]
     assert len(band) == 1
-    assert f"by +-{res.summary['band_alternation_N'][0]:.3g} N" in band[0]
-    assert "dt1 < 2e-06 s (x < 1)" in band[0] and "1 more device(s)" in band[0]
+    assert f"by +-{res.summary['band_alternation_N'][0]:.3E} N" in band[0]
+    assert "dt1 < 2.001E-06 s (x < 1)" in band[0] and "1 more device(s)" in band[0]
 
 
 def test_hysteretic_decks_are_not_applicable(run):

@@ -141,7 +141,7 @@ def test_reported_period_is_the_trapezoidal_rule(omega_dt):
 
 def test_executable_and_cli_warn(tmp_path, run):
     """An unresolved step is run (exit 0) and reported on stderr by the executable and by the
-    command line, with omega_max dt1; a resolved one is not."""
+    command line, with omega_max dt1, in the same words; a resolved one is not."""
     deck = one_dof(4.0).write_deck(tmp_path / "stiff.nml")
     r = ok(run(deck.read_text(), name="stiff"))
     assert WARNING in r.stderr
@@ -150,7 +150,8 @@ def test_executable_and_cli_warn(tmp_path, run):
     err = io.StringIO()
     with contextlib.redirect_stderr(err), contextlib.redirect_stdout(io.StringIO()):
         assert cli(["run", str(deck), "--out", str(tmp_path / "cli")]) == 0
-    assert WARNING in err.getvalue() and "omega_max dt1 = 4 > 2" in err.getvalue()
+    line = [x for x in r.stderr.splitlines() if WARNING in x]
+    assert len(line) == 1 and line[0] in err.getvalue().splitlines()
     soft = one_dof(0.5).write_deck(tmp_path / "soft.nml")
     assert WARNING not in ok(run(soft.read_text(), name="soft")).stderr
 

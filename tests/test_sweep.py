@@ -216,6 +216,25 @@ def test_slurm_script(tmp_path):
     assert sw.array_ranges([0, 1, 2, 5, 7, 8]) == "0-2,5,7-8"
 
 
+def test_results_csv_counts_each_runs_warnings(tmp_path):
+    """A spring of 1e9 N/m on 10 kg (omega dt1 = 1e4 dt1 > 2) warns that dt1 does not resolve
+    the highest mode, the 1e4 N/m one does not: results.csv counts each run's warnings and
+    holds their texts, those of its summary."""
+    (tmp_path / "base.nml").write_text(deck_text(tiny()))
+    (tmp_path / "s.toml").write_text('base = "base.nml"\n[cross]\n"springs.k" = [1.0e4, 1.0e9]\n')
+    subprocess.run([*SWEEP, str(tmp_path / "s.toml"), "--out", str(tmp_path / "o"), "--quiet"],
+                   check=True, capture_output=True)
+    with open(tmp_path / "o" / "results.csv", newline="") as fh:
+        rows = list(csv.DictReader(fh))
+    assert [r["springs.k"] for r in rows] == ["10000.0", "1000000000.0"]
+    assert rows[0]["warnings"] == "0" and rows[0]["warning_text"] == ""
+    assert int(rows[1]["warnings"]) >= 1
+    assert "does not resolve the highest modes" in rows[1]["warning_text"]
+    for row in rows:
+        summary = json.loads((tmp_path / "o" / "runs" / f"{row['run']}.summary.json").read_text())
+        assert row["warning_text"] == " | ".join(summary["warnings"])
+
+
 def test_results_csv_columns(tmp_path):
     (tmp_path / "base.nml").write_text(deck_text(tiny()))
     (tmp_path / "s.toml").write_text('base = "base.nml"\n[cross]\n"friction.mu" = [0.1, 0.2]\n')

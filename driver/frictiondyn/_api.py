@@ -19,7 +19,6 @@ threads overlap.
 from __future__ import annotations
 
 import json
-import math
 import os
 import threading
 import time
@@ -105,135 +104,16 @@ def newmark_steps(summary: dict) -> int:
 
 
 def summary_warnings(summary: dict) -> list[str]:
-    """The warnings a summary calls for, as the executable prints them on standard error
-    (without its "frictiondyn: warning: " prefix): correctness violations, steps whose
-    speed-dependent mu did not converge, a step dt1 that
-    does not resolve the highest modes, one that misses a harmonic table motion's steady
-    state or a record's peak linear response, one that dephases a sticking spring's ringing,
-    a velocity-law band whose force alternates from step to step,
-    an integration that dissipated (or created) more than 5 % of the energy, and one by the
-    average acceleration rule whose energy balance misses round-off (digits lost)."""
-    out = []
-    n = summary.get("correctness_violations", 0)
-    if n:
-        times = ", ".join(f"{t:g}" for t in summary.get("violation_times_s", []))
-        out.append(
-            f"{n} step(s) violate the correctness condition (eqs. 9, 12); first at t = {times} s"
-        )
-    n = summary.get("mu_unconverged_steps", 0)
-    if n:
-        out.append(
-            f"{n} step(s) could not take a speed-dependent mu at the velocity at their end, "
-            f"first at t = {summary['mu_unconverged_s']:.3e} s (mu_unconverged_steps, "
-            "mu_unconverged_s): the fixed point f0 = P mu(|s'|) of such a step contracts by about "
-            "rho = P |dmu/dv| gamma h / m_r a pass and converges within its passes for rho below "
-            "about 0.6; here it did not (its last pass still changed a force by "
-            f"{summary['mu_unconverged_misfit']:.3e} of P mu); those steps hold mu at their "
-            "start instead, an error of first order in the step: the mu curve is too steep for "
-            "the step: raise n1 or lower dt_min, and keep check_correctness on (such a step is "
-            "then refined)"
-        )
-    if summary.get("mode_resolution") == "unresolved":
-        out.append(
-            f"dt1 = {summary['dt1_s']:.3g} s does not resolve the highest modes (shortest period "
-            f"{2 * math.pi / summary['omega_max_rad_s']:.3g} s, omega_max dt1 = "
-            f"{summary['omega_max_dt1']:.3g} > 2): their response has the wrong period; peak "
-            "absolute accelerations may carry it (drifts and shears much less); raise n1 until "
-            "omega_max dt1 <= 2 to resolve them"
-        )
-    if summary.get("harmonic_resolution") == "unresolved":
-        err = summary["harmonic_step_error"]
-        i = max(range(len(err)), key=lambda k: err[k])
-        steps = 1.0 / (summary["excitation_frequency_Hz"] * summary["dt1_s"])
-        out.append(
-            f"dt1 = {summary['dt1_s']:.3g} s takes {steps:.2f} steps in a period of the table's "
-            f"motion: the step alone moves the linear steady-state amplitude of DOF {i + 1} by "
-            f"{100 * err[i]:.1f} % (harmonic_step_error > 0.05, the stuck or the free system); the "
-            "response has the wrong amplitude; raise n1"
-        )
-    if summary.get("record_resolution") == "unresolved":
-        err = summary["record_step_error"]
-        i = max(range(len(err)), key=lambda k: err[k])
-        system = {
-            "stuck": "the stuck system: no device slid",
-            "free": "the free system: a device slid",
-            "stuck and free": "the larger of the stuck and the free system: no device slid, "
-            "one is velocity-law",
-        }.get(summary.get("record_step_system"), "the structure")
-        out.append(
-            f"dt1 = {summary['dt1_s']:.3g} s does not resolve the record: the step alone moves the "
-            f"peak linear response of DOF {i + 1} by {100 * err[i]:.1f} % "
-            f"(record_step_error > 0.05, {system}); the modes near the record's dominant "
-            "frequencies have the wrong period and the response the wrong amplitude; raise n1"
-        )
-    if summary.get("stick_resolution") == "unresolved":
-        ratio = summary["stick_ringing_ratio"]
-        d = max(range(len(ratio)), key=lambda i: ratio[i])
-        more = sum(r > 1 for r in ratio) - 1
-        out.append(
-            f"the sticking spring of device {d + 1} rings with {summary['stick_ringing_N'][d]:.3g} N "
-            f"against a margin of {summary['stick_margin_N'][d]:.3g} N to sliding, and dt1 = "
-            f"{summary['dt1_s']:.3g} s puts its frequency "
-            f"{100 * abs(summary['stick_frequency_error'][d]):.2f} % off, enough to dephase that "
-            f"ringing within a stick phase (stick_ringing_ratio = {ratio[d]:.2f} > 1): its "
-            "stick-slip transitions may depend on the step; check with a larger n1 (halving dt1 "
-            "quarters that error)"
-            + (f" ({more} more device(s) likewise: summary stick_ringing_ratio)" if more else "")
-        )
-    if summary.get("band_resolution") == "unresolved":
-        amp = summary["band_alternation_N"]
-        d = max(range(len(amp)), key=lambda i: amp[i])
-        x = summary["band_x"][d]
-        more = sum(a > 0 for a in amp) - 1
-        remedy = (
-            f"raise n1 until dt1 < {summary['dt1_s'] / x:.3g} s (x < 1) or widen eps (exact "
-            "Coulomb friction, law = 'coulomb' with technique = 'event_driven', has no band)"
-            if x > 1
-            else "with x <= 1 another mode the step does not resolve drives it (a stiff spring, "
-            "a hysteretic device's sticking spring: see mode_resolution and stick_resolution): "
-            "raise n1"
-        )
-        out.append(
-            f"the force of device {d + 1} alternates from step to step in its velocity band or at "
-            f"its edge, by +-{amp[d]:.3g} N for {summary['band_alternation_s'][d]:.3g} s in all "
-            "(band_alternation_N, band_alternation_s): Newmark's rule damps the band's coupling "
-            "only where x = (1 - gamma) dt1 (c_i / m_i + c_j / m_j) < 1 (c_n: the couplings "
-            "P mu / eps of the velocity-law devices at its node n; (P mu / eps) dt1 / (2 m_r) for a "
-            f"device alone and average acceleration), and here x = {x:.3g}; the device's force "
-            "history and the absolute accelerations of its nodes carry the alternation (with "
-            f"average acceleration, its displacements do not): {remedy}"
-            + (f" ({more} more device(s) likewise: summary band_alternation_N)" if more else "")
-        )
-    balance = summary.get("energy_balance")
-    if balance == "digits lost":
-        out.append(
-            "the energy balance of the average acceleration rule closes at round-off, and this "
-            f"run's residual is {abs(summary['energy_residual_ratio']):.1e} of the energy the "
-            "structure held and received (|energy_residual_ratio| > 1e-08): the integration lost "
-            "digits to round-off, typically in a coupling far stiffer than dt1 resolves: a "
-            "velocity-law band whose P mu / eps is huge for its masses (x = (P mu / eps) dt1 / "
-            "(2 m_r) >> 1, m_r the reduced mass of its two nodes, leaves an alternating force in "
-            "the band), or a very stiff spring; its forces and accelerations, and possibly its "
-            "displacements, carry that error: widen eps or soften the coupling; a larger n1 "
-            "helps only once it brings x below 1 (the alternating force can outlast this warning; "
-            "band_resolution reports it)"
-        )
-    elif balance in ("dissipative", "energy error"):
-        ratio = summary["energy_residual_ratio"]
-        cause = (
-            "numerical damping (Newmark gamma > 1/2, Moreau-Jean theta > 1/2) the physics does "
-            "not have; the motion carries it: raise n1 (it shrinks with dt1) or use gamma = "
-            "theta = 1/2"
-            if balance == "dissipative"
-            else "an energy error of the step (Newmark beta /= 1/4, or a step beyond its rule's "
-            "stability limit) the physics does not have; the motion carries it: raise n1 or use "
-            "beta = 1/4"
-        )
-        out.append(
-            f"the integration {'dissipated' if ratio > 0 else 'created'} {100 * abs(ratio):.1f} % of "
-            f"the energy the structure held and received (|energy_residual_ratio| > 0.05): {cause}"
-        )
-    return out
+    """The warnings a run calls for, as the executable prints them on standard error (without
+    its "frictiondyn: warning: " prefix): the summary's ``warnings``, worded once by the
+    library (fortran/result/fd_warnings.f90): correctness violations, steps whose
+    speed-dependent mu did not converge, a step dt1 that does not resolve the highest modes,
+    one that misses a harmonic table motion's steady state or a record's peak linear response,
+    one that dephases a sticking spring's ringing, a velocity-law band whose force alternates
+    from step to step, an integration that dissipated (or created) more than 5 % of the
+    energy, and one by the average acceleration rule whose energy balance misses round-off
+    (digits lost). A summary written by an older build, without the key, has none."""
+    return [str(w) for w in summary.get("warnings", [])]
 
 
 # the status codes of the extension (driver/frictiondyn/_core.f90)

@@ -542,9 +542,12 @@ def collect(sweep: Sweep, write: bool = True) -> Collected:
         row["frictiondyn_version"] = (summ or {}).get("frictiondyn_version", "")
         if summ is not None:
             flat: dict[str, Any] = {}
-            _flatten("", {k: v for k, v in summ.items() if k not in ("deck", "frictiondyn_version")},
-                     flat)
+            skip = ("deck", "frictiondyn_version", "warnings")
+            _flatten("", {k: v for k, v in summ.items() if k not in skip}, flat)
             row.update(flat)
+            # the run's warnings (fd_warnings): how many, and their texts in one cell
+            row["warnings"] = len(summ.get("warnings", []))
+            row["warning_text"] = " | ".join(summ.get("warnings", []))
         rows.append(row)
     table = sweep.directory / "results.csv"
     if write:

@@ -19,9 +19,7 @@ program frictiondyn_main
                          session_set_progress
    use fd_progress_line, only: progress_wanted, progress_show, progress_clear
    use fd_version, only: frictiondyn_version
-   use fd_result, only: resolution_unresolved, residual_ratio_limit, roundoff_ratio_limit, balance_closed, &
-                        balance_dissipative, balance_digits, &
-                        record_system_stuck, record_system_free, record_system_both
+   use fd_warnings, only: warning_text, run_warnings
    implicit none
 
    interface
@@ -45,9 +43,8 @@ program frictiondyn_main
    type(error_type), allocatable :: error
    character(len=:), allocatable :: deck, list, index_text, arg, hist, summ, htmp, stmp, tag
    character(kind=c_char, len=300) :: tagbuf
-   character(len=32) :: num
-   character(len=80) :: sys_name
-   integer :: nargs, i, idx, ios, d
+   type(warning_text), allocatable :: warns(:)
+   integer :: nargs, i, idx, ios
    interface
       !> C's exit: ends the program with a status and no message (Fortran 2008 has no
       !> silent STOP with a code; STOP's QUIET= is Fortran 2018).
@@ -120,111 +117,11 @@ program frictiondyn_main
    if (allocated(error)) call fail(error%message)
 
    associate (res => ses%res, cfg => ses%cfg)
-   if (res%violations > 0) then
-      write (error_unit, '(a,i0,a)') 'frictiondyn: warning: ', res%violations, &
-         ' step(s) violate the correctness condition (eqs. 9, 12); first at t [s] ='
-      write (error_unit, '(10(1x,f0.6))') res%violation_time(1:res%n_violation_times)
-   end if
-   if (res%mu_unconverged > 0) then
-      write (error_unit, '(a,i0,a,es9.3,a)') 'frictiondyn: warning: ', res%mu_unconverged, &
-         ' step(s) could not take a speed-dependent mu at the velocity at their end, first at t = ', &
-         res%mu_unconverged_time, ' s (mu_unconverged_steps, mu_unconverged_s):'
-      write (error_unit, '(a,es9.3,a)') '  the fixed point f0 = P mu(|s''|) of such a step contracts by about '// &
-         'rho = P |dmu/dv| gamma h / m_r a pass and converges within its passes for rho below about 0.6; here '// &
-         'it did not (its last pass still changed a force by ', res%mu_misfit, ' of P mu); '// &
-         'those steps hold mu at their start instead, an error of first order in the step:'
-      write (error_unit, '(a)') '  the mu curve is too steep for the step: raise n1 or lower dt_min, and keep '// &
-         'check_correctness on (such a step is then refined)'
-   end if
-   if (res%mode_resolution == resolution_unresolved) then
-      write (error_unit, '(a,es10.3,a,es10.3,a,f0.2,a)') 'frictiondyn: warning: dt1 = ', res%dt1, &
-         ' s does not resolve the highest modes (shortest period ', 2*acos(-1.0_dp)/res%omega_max, &
-         ' s, omega_max dt1 = ', res%omega_max*res%dt1, ' > 2): their response has the wrong period;'
-      write (error_unit, '(a)') '  peak absolute accelerations may carry it (drifts and shears much less);'// &
-         ' raise n1 until omega_max dt1 <= 2 to resolve them'
-   end if
-   if (res%harmonic_resolution == resolution_unresolved) then
-      d = maxloc(res%harmonic_error, 1)
-      write (num, '(f0.2)') 1.0_dp/(res%eng%frequency*res%dt1)
-      if (num(1:1) == '.') num = '0'//num        ! f0.2 drops the leading zero
-      write (error_unit, '(a,es10.3,a,a,a,i0,a,f0.1,a)') 'frictiondyn: warning: dt1 = ', res%dt1, &
-         ' s takes ', trim(num), ' steps in a period of the table''s motion: the step '// &
-         'alone moves the linear steady-state amplitude of DOF ', d, ' by ', 100*res%harmonic_error(d), &
-         ' % (harmonic_step_error > 0.05, the stuck or the free system);'
-      write (error_unit, '(a)') '  the response has the wrong amplitude; raise n1'
-   end if
-   if (res%record_resolution == resolution_unresolved) then
-      d = maxloc(res%record_error, 1)
-      select case (res%record_system)
-      case (record_system_stuck)
-         sys_name = 'the stuck system: no device slid'
-      case (record_system_free)
-         sys_name = 'the free system: a device slid'
-      case (record_system_both)
-         sys_name = 'the larger of the stuck and the free system: no device slid, one is velocity-law'
-      case default
-         sys_name = 'the structure'
-      end select
-      write (error_unit, '(a,es10.3,a,i0,a,f0.1,a)') 'frictiondyn: warning: dt1 = ', res%dt1, &
-         ' s does not resolve the record: the step alone moves the peak linear response of DOF ', d, &
-         ' by ', 100*res%record_error(d), ' % (record_step_error > 0.05, '//trim(sys_name)//');'
-      write (error_unit, '(a)') '  the modes near the record''s dominant frequencies have the wrong period '// &
-         'and the response the wrong amplitude; raise n1'
-   end if
-   if (res%stick_resolution == resolution_unresolved) then
-      d = maxloc(res%stick_ringing_ratio, 1)
-      write (error_unit, '(a,i0,a,es10.3,a,es10.3,a)') 'frictiondyn: warning: the sticking spring of device ', d, &
-         ' rings with', res%stick_ringing(d), ' N against a margin of', res%stick_margin(d), ' N to sliding,'
-      write (error_unit, '(a,es10.3,a,f0.2,a,f0.2,a)') '  and dt1 = ', res%dt1, ' s puts its frequency ', &
-         100*abs(res%stick_freq_error(d)), ' % off, enough to dephase that ringing within a stick phase '// &
-         '(stick_ringing_ratio = ', res%stick_ringing_ratio(d), ' > 1):'
-      write (error_unit, '(a)') '  its stick-slip transitions may depend on the step; check with a larger n1 (halving dt1 '// &
-         'quarters that error)'
-      if (count(res%stick_ringing_ratio > 1.0_dp) > 1) write (error_unit, '(a,i0,a)') '  (', &
-         count(res%stick_ringing_ratio > 1.0_dp) - 1, ' more device(s) likewise: summary stick_ringing_ratio)'
-   end if
-   if (res%band_resolution == resolution_unresolved) then
-      d = maxloc(res%band_alternation, 1)
-      write (error_unit, '(a,i0,a,es9.3,a,es9.3,a)') 'frictiondyn: warning: the force of device ', d, &
-         ' alternates from step to step in its velocity band or at its edge, by +-', res%band_alternation(d), ' N for ', &
-         res%band_alternation_time(d), ' s in all (band_alternation_N, band_alternation_s):'
-      write (error_unit, '(a,es9.3,a)') '  Newmark''s rule damps the band''s coupling only where '// &
-         'x = (1 - gamma) dt1 (c_i / m_i + c_j / m_j) < 1 (c_n: the couplings P mu / eps of the velocity-law '// &
-         'devices at its node n; (P mu / eps) dt1 / (2 m_r) for a device alone and average acceleration), and '// &
-         'here x = ', res%band_x(d), '; the device''s force history and the absolute accelerations of its nodes '// &
-         'carry the alternation (with average acceleration, its displacements do not):'
-      if (res%band_x(d) > 1.0_dp) then
-         write (error_unit, '(a,es9.3,a)') '  raise n1 until dt1 < ', res%dt1/res%band_x(d), ' s (x < 1) or '// &
-            'widen eps (exact Coulomb friction, law = ''coulomb'' with technique = ''event_driven'', has no band)'
-      else
-         write (error_unit, '(a)') '  with x <= 1 another mode the step does not resolve drives it (a stiff spring, '// &
-            'a hysteretic device''s sticking spring: see mode_resolution and stick_resolution): raise n1'
-      end if
-      if (count(res%band_alternation > 0.0_dp) > 1) write (error_unit, '(a,i0,a)') '  (', &
-         count(res%band_alternation > 0.0_dp) - 1, ' more device(s) likewise: summary band_alternation_N)'
-   end if
-   if (res%energy_balance == balance_digits) then
-      write (error_unit, '(a,es7.1,a,es7.1,a)') 'frictiondyn: warning: the energy balance of the average '// &
-         'acceleration rule closes at round-off, and this run''s residual is ', abs(res%e_residual_ratio), &
-         ' of the energy the structure held and received (|energy_residual_ratio| > ', roundoff_ratio_limit, '):'
-      write (error_unit, '(a)') '  the integration lost digits to round-off, typically in a coupling far stiffer '// &
-         'than dt1 resolves: a velocity-law band whose P mu / eps is huge for its masses (x = (P mu / eps) dt1 / '// &
-         '(2 m_r) >> 1, m_r the reduced mass of its two nodes, leaves an alternating force in the band), or a '// &
-         'very stiff spring; its forces and accelerations, and possibly its displacements, carry that error: '// &
-         'widen eps or soften the coupling; a larger n1 helps only once it brings x below 1 (the alternating '// &
-         'force can outlast this warning; band_resolution reports it)'
-   else if (res%energy_balance /= balance_closed) then
-      write (error_unit, '(a,a,1x,f0.1,a,f4.2,a)') 'frictiondyn: warning: the integration ', &
-         trim(merge('dissipated', 'created   ', res%e_residual_ratio > 0.0_dp)), 100*abs(res%e_residual_ratio), &
-         ' % of the energy the structure held and received (|energy_residual_ratio| > ', residual_ratio_limit, '):'
-      if (res%energy_balance == balance_dissipative) then
-         write (error_unit, '(a)') '  numerical damping (Newmark gamma > 1/2, Moreau-Jean theta > 1/2) the physics '// &
-            'does not have; the motion carries it: raise n1 (it shrinks with dt1) or use gamma = theta = 1/2'
-      else
-         write (error_unit, '(a)') '  an energy error of the step (Newmark beta /= 1/4, or a step beyond '// &
-            'its rule''s stability limit) the physics does not have; the motion carries it: raise n1 or use beta = 1/4'
-      end if
-   end if
+   ! the warnings the result calls for (fd_warnings: the summary holds the same texts)
+   call run_warnings(res, warns)
+   do i = 1, size(warns)
+      write (error_unit, '(a)') 'frictiondyn: warning: '//warns(i)%text
+   end do
    write (output_unit, '(a)') 'frictiondyn: '//deck
    write (output_unit, '(a,f0.6,a,i0,a,i0,a,i0,a,i0)') '  stuck period ', res%period_stuck, ' s; steps dt1 ', &
       res%steps_dt1, ', nested ', res%steps_nested, ', dt2 ', res%steps_dt2, ', finer ', res%steps_finer

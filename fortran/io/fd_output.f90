@@ -9,6 +9,7 @@ module fd_output
    use fd_model, only: model_type, output_type, law_name, technique_name
    use fd_result, only: result_type, resolution_names, energy_balance_names, record_system_names
    use fd_record, only: record_info
+   use fd_warnings, only: warning_text, run_warnings
    use fd_version, only: frictiondyn_version
    use fd_history_stream, only: format_row, stream_value_width
    use fd_names, only: excitation_types, keyword_len
@@ -460,6 +461,7 @@ contains
       call kv('energy_balance', '"'//trim(energy_balance_names(res%energy_balance))//'"')
       call engineering_keys()
       call kint('samples', res%nout)
+      call warnings_key()
       call put('  "run_time_s": '//trim(json_real(res%run_time))//nl//'}')
       js = buf(1:pos)
    contains
@@ -552,6 +554,20 @@ contains
          call kr('modal_mass_ratio_'//name, m%mass_ratio)
          call kr('modal_xi_'//name, merge(m%xi, 0.0_dp, m%omega2 > 0.0_dp))
       end subroutine modes_keys
+      !> The run's warnings (fd_warnings), one string each.
+      subroutine warnings_key()
+         type(warning_text), allocatable :: w(:)
+         character(len=:), allocatable :: e
+         integer :: k
+         call run_warnings(res, w)
+         call put('  "warnings": [')
+         do k = 1, size(w)
+            call json_escape(w(k)%text, e)
+            call put(nl//'    "'//e//'"')
+            if (k < size(w)) call put(',')
+         end do
+         call put(']'//','//nl)
+      end subroutine warnings_key
       !> Strings.
       subroutine ks(key, x)
          character(len=*), intent(in) :: key

@@ -34,6 +34,7 @@ program tester
    use test_fd_band_alternation, only: collect_band_alternation
    use test_fd_harmonic_resolution, only: collect_harmonic_resolution
    use test_fd_record_resolution, only: collect_record_resolution
+   use test_fd_warnings, only: collect_warnings
    implicit none
    integer :: stat, is
    character(len=:), allocatable :: suite_name, test_name
@@ -73,6 +74,7 @@ program tester
    testsuites = [testsuites, new_testsuite("band_alternation", collect_band_alternation)]
    testsuites = [testsuites, new_testsuite("harmonic_resolution", collect_harmonic_resolution)]
    testsuites = [testsuites, new_testsuite("record_resolution", collect_record_resolution)]
+   testsuites = [testsuites, new_testsuite("warnings", collect_warnings)]
 
    call get_argument(1, suite_name)
    call get_argument(2, test_name)

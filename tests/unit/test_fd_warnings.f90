@@ -1,0 +1,102 @@
+!> Unit tests of the warnings' texts (fd_warnings), the one wording the executable prints,
+!> the summary holds and Python issues: none for a clean result; the figures a warning
+!> carries, from a result set by hand (its formats: fixed with a zero before the point,
+!> scientific with three digits); the device a warning names and the count of the others.
+module test_fd_warnings
+   use testdrive, only: new_unittest, unittest_type, error_type, check
+   use fd_kinds, only: dp
+   use fd_result, only: result_type, resolution_unresolved, balance_dissipative, balance_error
+   use fd_warnings, only: warning_text, run_warnings
+   implicit none
+   private
+
+   public :: collect_warnings
+
+contains
+
+   subroutine collect_warnings(testsuite)
+      type(unittest_type), allocatable, intent(out) :: testsuite(:)
+
+      testsuite = [ &
+                  new_unittest("a clean result: none", test_none), &
+                  new_unittest("violations: the first times listed", test_violations), &
+                  new_unittest("the band: the device, its figures, the others", test_band), &
+                  new_unittest("the energy balance: dissipated or created", test_energy) &
+                  ]
+   end subroutine collect_warnings
+
+   subroutine test_none(error)
+      type(error_type), allocatable, intent(out) :: error
+      type(result_type) :: res
+      type(warning_text), allocatable :: w(:)
+
+      call run_warnings(res, w)
+      call check(error, size(w), 0)
+   end subroutine test_none
+
+   !> 12 violations, the first max_violation_times = 10 of them kept: listed, with six decimals.
+   subroutine test_violations(error)
+      type(error_type), allocatable, intent(out) :: error
+      type(result_type) :: res
+      type(warning_text), allocatable :: w(:)
+      integer :: k
+
+      res%violations = 12
+      res%n_violation_times = 10
+      res%violation_time(1:10) = [(0.05_dp*k, k=1, 10)]
+      call run_warnings(res, w)
+      call check(error, size(w), 1)
+      if (allocated(error)) return
+      call check(error, w(1)%text, '12 step(s) violate the correctness condition (eqs. 9, 12); first at t = '// &
+                 '0.050000, 0.100000, 0.150000, 0.200000, 0.250000, 0.300000, 0.350000, 0.400000, 0.450000, '// &
+                 '0.500000 s')
+   end subroutine test_violations
+
+   !> Two devices alternate: the larger (device 3, x = 4 at dt1 = 0.01 s) is named, with the
+   !> step that brings x below 1, dt1 / x = 2.5e-3 s, and one more device.
+   subroutine test_band(error)
+      type(error_type), allocatable, intent(out) :: error
+      type(result_type) :: res
+      type(warning_text), allocatable :: w(:)
+
+      res%band_resolution = resolution_unresolved
+      res%dt1 = 0.01_dp
+      res%band_alternation = [0.5_dp, 0.0_dp, 2.5_dp]
+      res%band_alternation_time = [0.1_dp, 0.0_dp, 0.125_dp]
+      res%band_x = [2.0_dp, 0.5_dp, 4.0_dp]
+      call run_warnings(res, w)
+      call check(error, size(w), 1)
+      if (allocated(error)) return
+      call check(error, index(w(1)%text, 'the force of device 3 alternates from step to step in its velocity '// &
+                              'band or at its edge, by +-2.500E+00 N for 1.250E-01 s in all') == 1, w(1)%text)
+      if (allocated(error)) return
+      call check(error, index(w(1)%text, 'and here x = 4.000E+00;') > 0, 'x')
+      if (allocated(error)) return
+      call check(error, index(w(1)%text, 'raise n1 until dt1 < 2.500E-03 s (x < 1)') > 0, 'the step')
+      if (allocated(error)) return
+      call check(error, index(w(1)%text, '(1 more device(s) likewise: summary band_alternation_N)') > 0, &
+                 'the others')
+   end subroutine test_band
+
+   !> A ratio of 0.0734 dissipated (7.3 %), or -0.0734 created, against the limit 0.05.
+   subroutine test_energy(error)
+      type(error_type), allocatable, intent(out) :: error
+      type(result_type) :: res
+      type(warning_text), allocatable :: w(:)
+
+      res%energy_balance = balance_dissipative
+      res%e_residual_ratio = 0.0734_dp
+      call run_warnings(res, w)
+      call check(error, size(w), 1)
+      if (allocated(error)) return
+      call check(error, index(w(1)%text, 'the integration dissipated 7.3 % of the energy the structure held '// &
+                              'and received (|energy_residual_ratio| > 0.05): numerical damping') == 1, w(1)%text)
+      if (allocated(error)) return
+      res%energy_balance = balance_error
+      res%e_residual_ratio = -0.0734_dp
+      call run_warnings(res, w)
+      call check(error, index(w(1)%text, 'the integration created 7.3 % of the energy') == 1 .and. &
+                 index(w(1)%text, 'an energy error of the step') > 0, w(1)%text)
+   end subroutine test_energy
+
+end module test_fd_warnings
