@@ -122,6 +122,7 @@ program frictiondyn_main
    do i = 1, size(warns)
       write (error_unit, '(a)') 'frictiondyn: warning: '//warns(i)%text
    end do
+   deallocate (warns)
    write (output_unit, '(a)') 'frictiondyn: '//deck
    write (output_unit, '(a,f0.6,a,i0,a,i0,a,i0,a,i0)') '  stuck period ', res%period_stuck, ' s; steps dt1 ', &
       res%steps_dt1, ', nested ', res%steps_nested, ', dt2 ', res%steps_dt2, ', finer ', res%steps_finer
