@@ -124,6 +124,25 @@ def test_the_energy_through_a_driven_structure(run):
     assert s["energy_balance"] == "dissipative" and s["energy_residual_ratio"] > 0.05
 
 
+def test_a_run_that_blows_up_is_reported_not_stopped(run):
+    """Linear acceleration beyond its stability limit (w dt = 4 > sqrt(12)): 100 steps grow
+    the energy by a factor of about 1e51, still finite, so the run ends and warns. The ratio,
+    the closed form's (newmark_energy), is written in scientific notation: a fixed format of
+    that size overflowed its record and stopped the executable, and with it the Python
+    interpreter, before the summary was written (found by a review at stop 30)."""
+    deck = oscillator(0.2, 100, 0.5, 1 / 6)
+    r = ok(run(deck))
+    s = r.summary()
+    e0 = 0.5 * K * U0 * U0
+    expected = (e0 - newmark_energy(0.2, 100, 0.5, 1 / 6)) / e0
+    assert s["energy_residual_ratio"] == pytest.approx(expected, rel=1e-9)
+    assert expected < -1e40
+    line = f"the integration created {100 * abs(expected):.1E} % of the energy"
+    assert line in r.stderr and any(line in w for w in s["warnings"])
+    with pytest.warns(fd.FrictiondynWarning, match="the integration created"):
+        fd.run_text(deck)
+
+
 def test_an_energy_error_is_not_called_numerical_damping(run):
     """Linear acceleration (gamma = 1/2, beta = 1/6) has no numerical damping, but its energy
     is not conserved by the accounting: a positive residual (w dt = 1.6, stable below

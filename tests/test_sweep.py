@@ -233,6 +233,13 @@ def test_results_csv_counts_each_runs_warnings(tmp_path):
     for row in rows:
         summary = json.loads((tmp_path / "o" / "runs" / f"{row['run']}.summary.json").read_text())
         assert row["warning_text"] == " | ".join(summary["warnings"])
+    # a summary of an older build has no key: the cells say nothing rather than 0
+    old = tmp_path / "o" / "runs" / f"{rows[1]['run']}.summary.json"
+    old.write_text(json.dumps({k: v for k, v in json.loads(old.read_text()).items() if k != "warnings"}))
+    subprocess.run([*SWEEP, "collect", str(tmp_path / "o")], check=True, capture_output=True)
+    with open(tmp_path / "o" / "results.csv", newline="") as fh:
+        rows = list(csv.DictReader(fh))
+    assert rows[0]["warnings"] == "0" and rows[1]["warnings"] == rows[1]["warning_text"] == ""
 
 
 def test_results_csv_columns(tmp_path):

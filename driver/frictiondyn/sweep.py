@@ -545,9 +545,13 @@ def collect(sweep: Sweep, write: bool = True) -> Collected:
             skip = ("deck", "frictiondyn_version", "warnings")
             _flatten("", {k: v for k, v in summ.items() if k not in skip}, flat)
             row.update(flat)
-            # the run's warnings (fd_warnings): how many, and their texts in one cell
-            row["warnings"] = len(summ.get("warnings", []))
-            row["warning_text"] = " | ".join(summ.get("warnings", []))
+            # the run's warnings (fd_warnings): how many, and their texts in one cell (empty
+            # cells for a summary of an older build, which does not say)
+            if "warnings" in summ:
+                row["warnings"] = len(summ["warnings"])
+                row["warning_text"] = " | ".join(summ["warnings"])
+            else:
+                row["warnings"] = row["warning_text"] = ""
         rows.append(row)
     table = sweep.directory / "results.csv"
     if write:

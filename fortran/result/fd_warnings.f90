@@ -172,27 +172,38 @@ contains
       if (n > 0) s = ' ('//trim(fmt_int(n))//' more device(s) likewise: summary '//key//')'
    end function likewise
 
-   !> x in scientific notation with d digits after the point (1.234E-03), left-adjusted.
+   !> x in scientific notation with d digits after the point (1.234E-03), left-adjusted; a
+   !> three-digit exponent without its E (1.000+300), as Fortran writes it; NaN, Infinity.
    pure function es(x, d) result(s)
       real(dp), intent(in) :: x
       integer, intent(in) :: d
       character(len=:), allocatable :: s
-      character(len=32) :: buf, fmt
+      character(len=40) :: buf, fmt
+      integer :: ios
 
       write (fmt, '(a,i0,a,i0,a)') '(es', d + 8, '.', d, ')'
-      write (buf, fmt) x
+      write (buf, fmt, iostat=ios) x
+      if (ios /= 0) buf = '?'
       s = trim(adjustl(buf))
    end function es
 
-   !> x with d digits after the point, a zero before it (0.05, -0.5), left-adjusted.
+   !> x with d digits after the point, a zero before it (0.05, -0.5), left-adjusted; from
+   !> 1e6 on (a run that blows up: an energy ratio of 1e40), or not finite, as es gives it.
    pure function fx(x, d) result(s)
+      use, intrinsic :: ieee_arithmetic, only: ieee_is_finite
       real(dp), intent(in) :: x
       integer, intent(in) :: d
       character(len=:), allocatable :: s
       character(len=40) :: buf, fmt
+      integer :: ios
 
+      if (.not. ieee_is_finite(x) .or. abs(x) >= 1.0e6_dp) then
+         s = es(x, d)
+         return
+      end if
       write (fmt, '(a,i0,a)') '(f0.', d, ')'
-      write (buf, fmt) x
+      write (buf, fmt, iostat=ios) x
+      if (ios /= 0) buf = '?'
       s = trim(adjustl(buf))
       if (s(1:1) == '.') then
          s = '0'//s

@@ -21,7 +21,8 @@ contains
                   new_unittest("a clean result: none", test_none), &
                   new_unittest("violations: the first times listed", test_violations), &
                   new_unittest("the band: the device, its figures, the others", test_band), &
-                  new_unittest("the energy balance: dissipated or created", test_energy) &
+                  new_unittest("the energy balance: dissipated or created", test_energy), &
+                  new_unittest("a run that blew up: figures of 1e40", test_huge) &
                   ]
    end subroutine collect_warnings
 
@@ -98,5 +99,30 @@ contains
       call check(error, index(w(1)%text, 'the integration created 7.3 % of the energy') == 1 .and. &
                  index(w(1)%text, 'an energy error of the step') > 0, w(1)%text)
    end subroutine test_energy
+
+   !> A run that grows without bound reaches energy ratios and ringing ratios of 1e40 before
+   !> its numbers stop being finite: written in scientific notation (a fixed format of
+   !> that size would overflow its record and stop the program).
+   subroutine test_huge(error)
+      type(error_type), allocatable, intent(out) :: error
+      type(result_type) :: res
+      type(warning_text), allocatable :: w(:)
+
+      res%energy_balance = balance_error
+      res%e_residual_ratio = -1.0e40_dp
+      res%stick_resolution = resolution_unresolved
+      res%dt1 = 0.2_dp
+      res%stick_freq_error = [0.5_dp]
+      res%stick_ringing = [1.0e45_dp]
+      res%stick_margin = [0.0_dp]
+      res%stick_ringing_ratio = [1.0e40_dp]
+      call run_warnings(res, w)
+      call check(error, size(w), 2)
+      if (allocated(error)) return
+      call check(error, index(w(1)%text, 'rings with 1.000E+45 N against a margin of 0.000E+00 N') > 0 .and. &
+                 index(w(1)%text, '(stick_ringing_ratio = 1.00E+40 > 1)') > 0, w(1)%text)
+      if (allocated(error)) return
+      call check(error, index(w(2)%text, 'the integration created 1.0E+42 % of the energy') == 1, w(2)%text)
+   end subroutine test_huge
 
 end module test_fd_warnings
