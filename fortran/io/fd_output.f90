@@ -566,7 +566,7 @@ contains
             call put(nl//'    "'//e//'"')
             if (k < size(w)) call put(',')
          end do
-         call put(']'//','//nl)
+         call put('],'//nl)
       end subroutine warnings_key
       !> Strings.
       subroutine ks(key, x)

@@ -128,7 +128,7 @@ contains
       type(excitation_type), intent(in) :: exc      !! the table motion
       type(integration_type), intent(in) :: opts    !! Newmark's settings
       type(error_type), allocatable, intent(out) :: error !! the first limit broken
-      real(dp) :: dt1, dt2, pmu, kd, ratio
+      real(dp) :: dt1, dt2, kd, ratio
       integer :: levels, d, s, i, j
       character(len=:), allocatable :: var, idx
 
@@ -151,8 +151,7 @@ contains
       end if
       do d = 1, model%n_devices
          i = model%dev(d)%node_i; j = model%dev(d)%node_j
-         pmu = model%dev(d)%p*largest_mu(model%dev(d))
-         if (j <= 0 .or. pmu == 0.0_dp) cycle
+         if (j <= 0) cycle
          select case (model%dev(d)%law)
          case (law_velocity)
             ! the band's coupling P mu(eps) / eps (a speed-dependent mu at eps)
