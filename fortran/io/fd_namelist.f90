@@ -245,6 +245,14 @@ contains
                end if
                k = k + 1
             end do
+            ! a text continued on the next line: the namelist reader gets the group's lines as
+            ! records padded with blanks, which would go into the text (or end it there)
+            if (quote /= ' ') then
+               call fatal_error(error, deck%path//", line "//trim(fmt_int(i))//", group &"//trim(cur%name)// &
+                                ": a text ("//quote//"...) is not closed on its line; close each text on the "// &
+                                "line where it starts")
+               return
+            end if
             if (cur%last_line == i) then
                inside = .false.
                if (n == size(spans)) then
@@ -357,7 +365,7 @@ contains
       type(group_span), allocatable :: spans(:)
       type(group_span) :: sp
       integer :: i, first, last, width, n, cap, c1, c2, j, stat
-      character(len=:), allocatable :: body, line, var
+      character(len=:), allocatable :: body, line, var, first_var
       integer, allocatable :: line_of(:)
 
       grp%name = name
@@ -391,6 +399,13 @@ contains
       do i = first, last
          line = deck%lines(i)%s
          if (i == last) line = line(1:sp%last_col - 1)//' /'
+         ! comments blanked: gfortran's reader takes a value separator followed by a comment
+         ! and the end of the line for a null value ('u0 = 0.01, ! m' then '0.02' on the next
+         ! line would give u0 = 0.01, (unchanged), 0.02)
+         c1 = 1
+         if (i == first) c1 = sp%name_end + 1
+         c2 = comment_column(line, c1)
+         if (c2 > 0) line(c2:) = ' '
          if (i == first) line(sp%first_col:sp%first_col) = '&'
          grp%lines(i - first + 1) = line
          cap = cap + len(line) + 1
@@ -420,9 +435,16 @@ contains
       end if
       if (i > 0) then
          call item_variable(grp%items(i)%s, var)
-         call fatal_error(error, deck%path//", group &"//name//", line "//trim(fmt_int(grp%item_line(i)))// &
-                          ": '"//var//"' is assigned again (first at line "//trim(fmt_int(grp%item_line(j)))// &
-                          "); give each variable once")
+         call item_variable(grp%items(j)%s, first_var)
+         if (var == first_var) then
+            call fatal_error(error, deck%path//", group &"//name//", line "//trim(fmt_int(grp%item_line(i)))// &
+                             ": '"//var//"' is assigned again (first at line "//trim(fmt_int(grp%item_line(j)))// &
+                             "); give each variable once")
+         else
+            call fatal_error(error, deck%path//", group &"//name//", line "//trim(fmt_int(grp%item_line(i)))// &
+                             ": '"//var//"' sets again what '"//first_var//"' set at line "// &
+                             trim(fmt_int(grp%item_line(j)))//"; give each variable or element once")
+         end if
       end if
    contains
       subroutine no_memory()
@@ -438,22 +460,32 @@ contains
       integer, intent(out) :: i                  !! the repeated one, 0 if none
       integer, intent(out) :: j                  !! the earlier one it repeats
       integer, intent(out) :: stat               !! 0, or not enough memory
-      character(len=64), allocatable :: names(:)
+      integer, parameter :: pairwise_max = 2000  !! longest run of one variable compared pair by pair
+      character(len=64), allocatable :: names(:), bases(:)
       character(len=:), allocatable :: var
       integer, allocatable :: order(:), tmp(:)
-      integer :: k, n, width, lo, mid, hi, a, b, c
+      integer :: k, n, width, lo, mid, hi, a, b, c, r0, r1, p, q, ip, iq
 
       i = 0; j = 0
       n = size(items)
-      allocate (names(n), order(n), tmp(n), stat=stat)
+      allocate (names(n), bases(n), order(n), tmp(n), stat=stat)
       if (stat /= 0 .or. n < 2) return
       do k = 1, n
          call item_variable(items(k)%s, var)
          names(k) = var
          if (len(var) > len(names)) names(k) = ''   ! not a variable of any group: the reader rejects it
+         c = index(names(k), '(')
+         bases(k) = names(k)
+         if (c > 0) then
+            bases(k) = names(k)(1:c - 1)
+         else if (len_trim(names(k)) > 0 .and. len_trim(names(k)) < len(names) - 12) then
+            ! a whole array given m values sets its elements 1 to m ('mass = 1.0, 2.0' leaves
+            ! mass(3) to a later 'mass(3) = ...'): written as that section
+            names(k) = trim(names(k))//'(1:'//trim(fmt_int(max(1, value_count(items(k)%s))))//')'
+         end if
          order(k) = k
       end do
-      ! bottom-up merge sort of order by (name, position): stable
+      ! bottom-up merge sort of order by (variable, position): stable
       width = 1
       do while (width < n)
          lo = 1
@@ -466,7 +498,7 @@ contains
                   tmp(c) = order(a); a = a + 1
                else if (a >= mid) then
                   tmp(c) = order(b); b = b + 1
-               else if (llt(names(order(b)), names(order(a)))) then
+               else if (llt(bases(order(b)), bases(order(a)))) then
                   tmp(c) = order(b); b = b + 1
                else
                   tmp(c) = order(a); a = a + 1
@@ -478,14 +510,178 @@ contains
          order = tmp
          width = 2*width
       end do
-      ! equal names are adjacent, in deck order: report the repeat that comes first in the deck
-      do k = 2, n
-         if (names(order(k)) /= names(order(k - 1)) .or. len_trim(names(order(k))) == 0) cycle
-         if (i == 0 .or. order(k) < i) then
-            i = order(k); j = order(k - 1)
+      ! the assignments of one variable are adjacent, in deck order: two of them that set the
+      ! same element ('mass = ...' and 'mass(2) = ...', 'mass(1:2)' and 'mass(02)') repeat it;
+      ! report the repeat that comes first in the deck
+      r0 = 1
+      do while (r0 <= n)
+         r1 = r0
+         do while (r1 < n)
+            if (bases(order(r1 + 1)) /= bases(order(r0))) exit
+            r1 = r1 + 1
+         end do
+         if (r1 > r0 .and. len_trim(bases(order(r0))) > 0) then
+            do q = r0 + 1, r1
+               do p = r0, q - 1
+                  if (r1 - r0 >= pairwise_max .and. p < q - 1) exit   ! a very long run: neighbours only
+                  ip = order(p); iq = order(q)
+                  if (.not. same_elements(trim(names(ip)), trim(names(iq)))) cycle
+                  if (i == 0 .or. iq < i) then
+                     i = iq; j = ip
+                  end if
+                  exit
+               end do
+            end do
          end if
+         r0 = r1 + 1
       end do
    end subroutine repeated_item
+
+   !> Whether two assignments of one variable ('mass', 'mass(2)', 'mu_table_v(1:3,2)',
+   !> 'label(1)(1:4)', lower case without blanks) set a common element. A whole variable
+   !> overlaps any part of it; subscripts that are integers or triplets ('l:u:s', bounds
+   !> omitted) are compared as sets, others as text; a substring belongs to its element.
+   pure logical function same_elements(a, b)
+      character(len=*), intent(in) :: a, b
+      character(len=:), allocatable :: sa, sb
+      integer :: ka, kb, ea, eb
+
+      same_elements = .true.
+      call subscript(a, sa)
+      call subscript(b, sb)
+      if (len(sa) == 0 .or. len(sb) == 0) return
+      if (count_char(sa, ',') /= count_char(sb, ',')) then
+         ! a whole array (its first elements, '(1:m)') and an element of a 2-D one: taken to
+         ! overlap; otherwise a different rank, which the reader rejects
+         same_elements = index(a, '(1:') == len(a) - len(sa) - 1 .or. index(b, '(1:') == len(b) - len(sb) - 1
+         return
+      end if
+      ka = 1; kb = 1
+      do
+         ea = index(sa(ka:), ','); eb = index(sb(kb:), ',')
+         if (ea == 0) then
+            same_elements = dims_overlap(sa(ka:), sb(kb:))
+            if (same_elements) then   ! the same element: two substrings of it may be apart
+               call subscript(a(index(a, ')') + 1:), sa)
+               call subscript(b(index(b, ')') + 1:), sb)
+               if (len(sa) > 0 .and. len(sb) > 0) same_elements = dims_overlap(sa, sb)
+            end if
+            return
+         end if
+         if (.not. dims_overlap(sa(ka:ka + ea - 2), sb(kb:kb + eb - 2))) then
+            same_elements = .false.
+            return
+         end if
+         ka = ka + ea; kb = kb + eb
+      end do
+   contains
+      !> The text between the first parentheses ('' for a whole variable).
+      pure subroutine subscript(v, sub)
+         character(len=*), intent(in) :: v
+         character(len=:), allocatable, intent(out) :: sub
+         integer :: o, cl
+         sub = ''
+         o = index(v, '(')
+         if (o == 0) return
+         cl = index(v(o:), ')')
+         if (cl == 0) return
+         sub = v(o + 1:o + cl - 2)
+      end subroutine subscript
+   end function same_elements
+
+   !> Whether two subscripts of one dimension ('3', '1:4', '2:10:2', ':') share an index.
+   pure logical function dims_overlap(da, db)
+      character(len=*), intent(in) :: da, db
+      integer, parameter :: big = 2**30 - 1   !! an omitted bound
+      integer :: la, ua, sa, lb, ub, sb, k, x
+      logical :: oka, okb
+
+      call triplet(da, la, ua, sa, oka)
+      call triplet(db, lb, ub, sb, okb)
+      if (.not. (oka .and. okb)) then
+         dims_overlap = da == db
+         return
+      end if
+      dims_overlap = .false.
+      if (ua < la .or. ub < lb) return                       ! an empty section
+      if (max(la, lb) > min(ua, ub)) return                  ! disjoint ranges
+      dims_overlap = .true.
+      if (sa == 1 .or. sb == 1) return
+      if ((ua - la)/sa > 100000 .and. (ub - lb)/sb > 100000) return   ! long strided sections: their ranges
+      ! the shorter progression's indices, each tested against the other
+      if ((ua - la)/sa <= (ub - lb)/sb) then
+         do k = 0, (ua - la)/sa
+            x = la + k*sa
+            if (x >= lb .and. x <= ub .and. mod(x - lb, sb) == 0) return
+         end do
+      else
+         do k = 0, (ub - lb)/sb
+            x = lb + k*sb
+            if (x >= la .and. x <= ua .and. mod(x - la, sa) == 0) return
+         end do
+      end if
+      dims_overlap = .false.
+   contains
+      !> A subscript as the ascending progression lo, lo + st, ..., hi; ok = .false. when it is
+      !> not integers (bounds omitted count as unbounded).
+      pure subroutine triplet(d, lo, hi, st, ok)
+         character(len=*), intent(in) :: d
+         integer, intent(out) :: lo, hi, st
+         logical, intent(out) :: ok
+         integer :: c1, c2, f, l
+         lo = -big; hi = big; st = 1
+         c1 = index(d, ':')
+         if (c1 == 0) then
+            call int_of(d, lo, ok)
+            hi = lo
+            return
+         end if
+         c2 = index(d(c1 + 1:), ':')
+         if (c2 > 0) c2 = c1 + c2
+         ok = .true.
+         if (c1 > 1) call int_of(d(1:c1 - 1), lo, ok)
+         if (.not. ok) return
+         l = len(d)
+         if (c2 > 0) l = c2 - 1
+         if (l > c1) call int_of(d(c1 + 1:l), hi, ok)
+         if (.not. ok) return
+         if (c2 > 0) then
+            call int_of(d(c2 + 1:), st, ok)
+            if (.not. ok .or. st == 0) then
+               ok = .false.
+               return
+            end if
+         end if
+         if (st < 0) then   ! l:u:-s runs down from l to u: the same set as last..l, ascending
+            if (c1 == 1 .or. l == c1) then
+               ok = .false.   ! an omitted bound with a negative stride: compared as text
+               return
+            end if
+            f = lo
+            lo = hi; hi = f; st = -st
+            if (hi >= lo) lo = hi - ((hi - lo)/st)*st
+         else if (hi >= lo .and. hi < big) then
+            hi = lo + ((hi - lo)/st)*st
+         end if
+      end subroutine triplet
+
+      pure subroutine int_of(t, v, ok)
+         character(len=*), intent(in) :: t
+         integer, intent(out) :: v
+         logical, intent(out) :: ok
+         integer :: ios, k0
+         v = 0
+         k0 = 1
+         if (len(t) > 0) then
+            if (t(1:1) == '+' .or. t(1:1) == '-') k0 = 2
+         end if
+         ok = len(t) >= k0 .and. len(t) <= 9
+         if (ok) ok = verify(t(k0:), '0123456789') == 0
+         if (.not. ok) return
+         read (t, *, iostat=ios) v
+         ok = ios == 0
+      end subroutine int_of
+   end function dims_overlap
 
    !> The longest string an assignment of variable `var` (or of its elements, 'var(i)') gives
    !> in the group, in characters (a doubled quote counts once), and the deck line of that
@@ -572,18 +768,11 @@ contains
       integer, intent(inout) :: line_of(:)          !! deck line of each character
       integer, intent(inout) :: n                   !! characters used
       integer, intent(in) :: lineno
-      integer :: i
-      character(len=1) :: quote
+      integer :: i, last
 
-      quote = ' '
-      do i = c1, len(line)
-         if (quote /= ' ') then
-            if (line(i:i) == quote) quote = ' '
-         else if (line(i:i) == '"' .or. line(i:i) == "'") then
-            quote = line(i:i)
-         else if (line(i:i) == '!') then
-            exit
-         end if
+      last = comment_column(line, c1) - 1
+      if (last < 0) last = len(line)
+      do i = c1, last
          n = n + 1
          body(n:n) = line(i:i)
          line_of(n) = lineno
@@ -592,6 +781,86 @@ contains
       body(n:n) = ' '
       line_of(n) = lineno
    end subroutine append_line
+
+   !> Column of the '!' that starts a line's comment (outside quotes, from column c1); 0 if
+   !> the line has none.
+   pure integer function comment_column(line, c1) result(col)
+      character(len=*), intent(in) :: line
+      integer, intent(in) :: c1
+      integer :: i
+      character(len=1) :: quote
+
+      col = 0
+      quote = ' '
+      do i = c1, len(line)
+         if (quote /= ' ') then
+            if (line(i:i) == quote) quote = ' '
+         else if (line(i:i) == '"' .or. line(i:i) == "'") then
+            quote = line(i:i)
+         else if (line(i:i) == '!') then
+            col = i
+            return
+         end if
+      end do
+   end function comment_column
+
+   !> How many values an assignment 'var = v1, v2 ...' gives, as a namelist reader counts
+   !> them: separated by commas or blanks, 'r*c' and 'r*' count r, an empty place between
+   !> two commas counts 1 (texts in quotes are one value).
+   pure integer function value_count(item) result(nv)
+      character(len=*), intent(in) :: item
+      integer :: i, eq, t0, st, r, ios
+      character(len=1) :: quote
+      logical :: in_value, after_comma
+
+      nv = 0
+      eq = index(item, '=')
+      if (eq == 0) return
+      quote = ' '
+      in_value = .false.
+      after_comma = .true.
+      t0 = 0
+      do i = eq + 1, len(item) + 1
+         if (i <= len(item)) then
+            if (quote /= ' ') then
+               if (item(i:i) == quote) quote = ' '
+               cycle
+            end if
+            if (item(i:i) == '"' .or. item(i:i) == "'") then
+               quote = item(i:i)
+               if (.not. in_value) then
+                  in_value = .true.; t0 = i
+               end if
+               cycle
+            end if
+            if (item(i:i) /= ',' .and. item(i:i) /= ' ' .and. item(i:i) /= achar(9)) then
+               if (.not. in_value) then
+                  in_value = .true.; t0 = i
+               end if
+               cycle
+            end if
+         end if
+         if (in_value) then   ! a value ends: 'r*...' counts r
+            r = 1
+            st = index(item(t0:i - 1), '*')
+            if (st > 1) then
+               if (verify(item(t0:t0 + st - 2), '0123456789') == 0 .and. st <= 10) then
+                  read (item(t0:t0 + st - 2), *, iostat=ios) r
+                  if (ios /= 0) r = 1
+               end if
+            end if
+            nv = nv + r
+            in_value = .false.
+            after_comma = .false.
+         end if
+         if (i <= len(item)) then
+            if (item(i:i) == ',') then
+               if (after_comma) nv = nv + 1   ! an empty place: a null value
+               after_comma = .true.
+            end if
+         end if
+      end do
+   end function value_count
 
    !> Split a group body at the start of each 'name =' or 'name(index) ='.
    pure subroutine split_items(body, line_of, items, item_line, stat)
@@ -619,23 +888,23 @@ contains
             cycle
          end if
          if (body(i:i) /= '=') cycle
-         ! walk back over blanks, an index in parentheses, and the name
+         ! walk back over blanks, an index and a substring in parentheses ('label(1)(1:4)'),
+         ! and the name
          j = i - 1
          do while (j >= 1)
             if (body(j:j) /= ' ') exit
             j = j - 1
          end do
-         if (j >= 1) then
-            if (body(j:j) == ')') then
-               depth = 0
-               do while (j >= 1)
-                  if (body(j:j) == ')') depth = depth + 1
-                  if (body(j:j) == '(') depth = depth - 1
-                  j = j - 1
-                  if (depth == 0) exit
-               end do
-            end if
-         end if
+         do while (j >= 1)
+            if (body(j:j) /= ')') exit
+            depth = 0
+            do while (j >= 1)
+               if (body(j:j) == ')') depth = depth + 1
+               if (body(j:j) == '(') depth = depth - 1
+               j = j - 1
+               if (depth == 0) exit
+            end do
+         end do
          do while (j >= 1)
             if (.not. is_name_char(body(j:j)) .and. body(j:j) /= '%') exit
             j = j - 1

@@ -56,6 +56,9 @@ contains
                   new_unittest("'&' and '$' only where they open or close", test_ampersand), &
                   new_unittest("a NUL character", test_nul), &
                   new_unittest("a variable given twice", test_twice), &
+                  new_unittest("an element given twice in another form", test_twice_forms), &
+                  new_unittest("a comment after a separator is no value", test_comment_no_value), &
+                  new_unittest("a text not closed on its line", test_open_text), &
                   new_unittest("the longest string of a variable", test_longest) &
                   ]
    end subroutine collect_namelist
@@ -428,6 +431,106 @@ contains
       call find_group(deck, 'model', grp, found, err)
       call check(error, .not. allocated(err), 'two elements of an array')
    end subroutine test_twice
+
+   !> The same element set by two assignments of different forms: a whole array (its first
+   !> m elements, m counted as the namelist reader counts values), a section, an element with
+   !> another spelling of its index, a substring. Parts that do not meet are not repeats.
+   subroutine test_twice_forms(error)
+      type(error_type), allocatable, intent(out) :: error
+      character(len=*), parameter :: repeats(*) = [character(len=60) :: &
+         'mass = 1.0, 2.0'//nl//'mass(2) = 3.0', &
+         'mass(2) = 3.0'//nl//'mass = 1.0, 2.0', &
+         'mass = 1.0 2.0'//nl//'mass(2) = 3.0', &
+         'mass = 3*1.0'//nl//'mass(3) = 3.0', &
+         'mass = , 2.0'//nl//'mass(2) = 3.0', &
+         'mass(1:2) = 1.0, 2.0'//nl//'mass(02) = 3.0', &
+         'mass(9:1:-2) = 5*1.0'//nl//'mass(5) = 3.0', &
+         "label = 'a, b', 'c'"//nl//"label(2) = 'x'", &
+         "label(1)(1:2) = 'ab'"//nl//"label(1) = 'x'", &
+         "label(1)(1:2) = 'ab'"//nl//"label(1)(2:3) = 'x'"]
+      character(len=*), parameter :: apart(*) = [character(len=60) :: &
+         'mass = 1.0, 2.0'//nl//'mass(3) = 3.0', &
+         'mass = 2*1.0'//nl//'mass(3) = 3.0', &
+         "label = 'a, b', 'c'"//nl//"label(3) = 'x'", &
+         'mass(1:9:2) = 5*1.0'//nl//'mass(2:10:2) = 5*3.0', &
+         'mu_table_v(:, 1) = 1.0, 2.0'//nl//'mu_table_v(:, 2) = 1.0', &
+         "label(1)(1:2) = 'ab'"//nl//"label(1)(3:4) = 'x'"]
+      type(deck_text) :: deck
+      type(group_text) :: grp
+      type(fd_error_type), allocatable :: err
+      logical :: found
+      integer :: k
+
+      do k = 1, size(repeats)
+         call deck_from_string('&model'//nl//trim(repeats(k))//nl//'/'//nl, 't.nml', deck)
+         call find_group(deck, 'model', grp, found, err)
+         call check(error, allocated(err), 'a repeat: '//trim(repeats(k)))
+         if (allocated(error)) return
+         call check(error, index(err%message, 't.nml, group &model, line 3: ') == 1 .and. &
+                    index(err%message, 'at line 2; give each variable or element once') > 0, err%message)
+         if (allocated(error)) return
+      end do
+      call deck_from_string('&model'//nl//'mass = 1.0, 2.0'//nl//'mass(2) = 3.0'//nl//'/'//nl, 't.nml', deck)
+      call find_group(deck, 'model', grp, found, err)
+      call check(error, err%message, "t.nml, group &model, line 3: 'mass(2)' sets again what 'mass' set at "// &
+                 "line 2; give each variable or element once")
+      if (allocated(error)) return
+      do k = 1, size(apart)
+         call deck_from_string('&model'//nl//trim(apart(k))//nl//'/'//nl, 't.nml', deck)
+         call find_group(deck, 'model', grp, found, err)
+         call check(error, .not. allocated(err), 'not a repeat: '//trim(apart(k)))
+         if (allocated(error)) return
+      end do
+   end subroutine test_twice_forms
+
+   !> gfortran's namelist reader takes a separator followed by a comment and the end of the
+   !> line for a null value; the group's lines reach it without their comments, so the
+   !> values read are those the deck writes (the standard: a comment is ignored).
+   subroutine test_comment_no_value(error)
+      type(error_type), allocatable, intent(out) :: error
+      type(deck_text) :: deck
+      type(group_text) :: grp
+      type(fd_error_type), allocatable :: err
+      logical :: found
+      integer :: ios
+      real(dp) :: u0(3), v0(2)
+      namelist /model/ u0, v0
+
+      u0 = -1.0_dp; v0 = -1.0_dp
+      call deck_from_string('&model'//nl//'  u0 = 0.01,   ! first storey'//nl//'       0.02   ! second'//nl// &
+                            '  v0 = ! m/s'//nl//'  0.5'//nl//'/'//nl, 't.nml', deck)
+      call find_group(deck, 'model', grp, found, err)
+      call check(error, found .and. .not. allocated(err), 'found')
+      if (allocated(error)) return
+      read (grp%lines, nml=model, iostat=ios)
+      call check(error, ios, 0, 'read')
+      if (allocated(error)) return
+      call check(error, all(u0 == [0.01_dp, 0.02_dp, -1.0_dp]), 'u0 = 0.01, 0.02, (unchanged)')
+      if (allocated(error)) return
+      call check(error, all(v0 == [0.5_dp, -1.0_dp]), 'v0 = 0.5, (unchanged)')
+   end subroutine test_comment_no_value
+
+   !> A text continued on the next line: an error naming the line, not the reader's padded
+   !> records' reading of it.
+   subroutine test_open_text(error)
+      type(error_type), allocatable, intent(out) :: error
+      type(deck_text) :: deck
+      type(group_text) :: grp
+      type(fd_error_type), allocatable :: err
+      logical :: found
+
+      call deck_from_string("&model"//nl//"  label = 'upper"//nl//"  block', 'lower'"//nl//"/"//nl, 't.nml', deck)
+      call find_group(deck, 'model', grp, found, err)
+      call check(error, allocated(err), 'an error')
+      if (allocated(error)) return
+      call check(error, err%message, "t.nml, line 2, group &model: a text ('...) is not closed on its line; "// &
+                 "close each text on the line where it starts")
+      if (allocated(error)) return
+      call deck_from_string("&model"//nl//"  label = 'it''s ! not a comment', ""a 'b'"" ! one"//nl//"/"//nl, &
+                            't.nml', deck)
+      call find_group(deck, 'model', grp, found, err)
+      call check(error, .not. allocated(err), 'texts closed on their line')
+   end subroutine test_open_text
 
    !> longest_string: quoted strings of a variable and its elements, a doubled quote counted
    !> once, other variables ignored; the line of the longest.
