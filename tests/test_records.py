@@ -81,6 +81,45 @@ def test_at2_and_two_columns_give_the_same_response(run, spelling):
     assert r_g.summary()["record"]["format"] == "time_value"
 
 
+@pytest.mark.parametrize(
+    "line3, units, factor",
+    [
+        ("ACCELERATION TIME SERIES IN UNITS OF G", "g", G),
+        ("ACCELERATION TIME SERIES IN UNITS OF G.", "g", G),
+        ("ACCELERATION TIME SERIES UNITS: CM/S/S", "cm/s2", 0.01),
+        ("ACCELERATION TIME SERIES (CM/S2)", "cm/s2", 0.01),
+        ("ACCELERATION TIME SERIES IN UNITS OF CM/SEC**2", "cm/s2", 0.01),
+        ("ACCELERATION TIME SERIES, UNITS = M/S^2", "m/s2", 1.0),
+        ("ACCELERATION TIME SERIES, M 6.7", "g", G),  # no unit named: PEER's g
+    ],
+)
+def test_at2_units_as_line_3_writes_them(run, line3, units, factor):
+    """Line 3's units in the spellings real files use: the table acceleration is the value
+    times the factor of the units the line names (a unit misread as g is a factor of 981)."""
+    a = [0.0, 50.0, -120.0, 30.0, 0.0, 10.0]
+    text = at2_text(a).replace("ACCELERATION TIME SERIES IN UNITS OF G", line3)
+    r = ok(run(oscillator(record_excitation("rec.AT2")), files={"rec.AT2": text}))
+    assert r.summary()["record"]["units"] == units
+    np.testing.assert_allclose(r.history()["ag"][:6], np.array(a) * factor, rtol=1e-12)
+
+
+def test_at2_units_gal_are_cm_s2(run):
+    """record_units = 'gal' agrees with a header in cm/s2 (the same unit)."""
+    text = at2_text([0.0, 50.0, -120.0, 30.0, 0.0, 10.0], units="CM/S/S")
+    r = ok(run(oscillator(record_excitation("rec.AT2", record_units="gal")), files={"rec.AT2": text}))
+    np.testing.assert_allclose(r.history()["ag"][:3], [0.0, 0.5, -1.2], rtol=1e-12)
+
+
+def test_commented_plain_record_is_not_taken_for_at2(run):
+    """A one-value-a-line file whose '#' comments name NPTS and DT on its fourth line is
+    read as 'values' (m/s2), not as an AT2 file in g."""
+    text = "# synthetic\n# generated\n# seed 1\n# NPTS = 5, DT = 0.01 s\n0.0\n0.5\n-1.0\n2.0\n0.0\n"
+    r = ok(run(oscillator(record_excitation("rec.txt", dt_record=0.01)), files={"rec.txt": text}))
+    rec = r.summary()["record"]
+    assert rec["format"] == "values" and rec["units"] == "m/s2"
+    assert rec["peak_acc_mps2"] == pytest.approx(2.0, rel=1e-15)
+
+
 def test_record_units_and_scale_compose(run):
     """cm/s2 values with record_scale 2: the table acceleration is value * 0.01 * 2."""
     a = np.array([0.0, 50.0, -120.0, 30.0, 0.0])
@@ -138,6 +177,10 @@ AT2_BAD = [
      ["line 3", "velocity time series"]),
     ("units contradict", at2_text([0.1] * 6, units="CM/S/S"),
      ["line 3", "units of 'cm/s2'", "record_units = 'g'"]),
+    ("DT in milliseconds", at2_text([0.1] * 6, dt="5 MSEC").replace(" SEC\n", "\n", 1),
+     ["line 4", "DT is followed by 'MSEC'", "seconds"]),
+    ("units unknown", at2_text([0.1] * 6, units="FT/S2"),
+     ["line 3", "units of 'ft/s2'", "set record_units"]),
     ("three header lines", "H1\nH2\nACCELERATION TIME SERIES IN UNITS OF G\n",
      ["ends at line 3", "four header lines"]),
 ]

@@ -9,7 +9,7 @@ module fd_record
    use, intrinsic :: ieee_arithmetic, only: ieee_is_finite, ieee_is_nan
    use, intrinsic :: iso_c_binding, only: c_char, c_double, c_ptr, c_null_ptr, c_null_char
    use fd_kinds, only: dp
-   use fd_error, only: error_type, fatal_error, fmt_int, fmt_real
+   use fd_error, only: error_type, fatal_error, fmt_int, fmt_real, stat_no_memory
    use fd_textio, only: read_file_text, lower
    use fd_sha256, only: sha256_text
    implicit none
@@ -181,6 +181,8 @@ contains
       do while (next <= len(text))
          call next_line(text, next, lo, hi)
          line = line + 1
+         ! a plain file's comments ('#', '!') are no PEER header, even when they name NPTS and DT
+         if (is_comment(text(lo:hi))) exit
          if (line == 4) then
             if (index(upper(text(lo:hi)), 'NPTS') > 0 .and. index(upper(text(lo:hi)), 'DT') > 0) then
                format = 'at2'
@@ -215,9 +217,9 @@ contains
       type(error_type), allocatable, intent(out) :: error
       integer :: next, lo, hi, line, npts, n, stat, bad_lo, bad_hi, k
       integer :: hlo(4), hhi(4)
-      real(dp) :: dt
+      real(dp) :: dt, f_declared, f_given
       character(len=:), allocatable :: h3, declared, where
-      logical :: has_tab
+      logical :: has_tab, ok, ok_declared
 
       next = 1
       do line = 1, 4
@@ -251,10 +253,25 @@ contains
          return
       end if
       call header_units(h3, declared)
-      if (len(declared) > 0 .and. len(units) > 0 .and. declared /= units) then
-         call fatal_error(error, where//": the header declares units of '"//declared//"' but record_units = '"// &
-                          units//"'")
-         return
+      if (len(declared) > 0) then
+         call units_factor(declared, is_displacement, f_declared, ok_declared)
+         if (len(units) == 0 .and. .not. ok_declared) then
+            call fatal_error(error, where//": the header declares units of '"//declared//"' ('"// &
+                             trim(text(hlo(3):hhi(3)))//"'), which are not units of a"// &
+                             trim(merge(' displacement ', 'n acceleration', is_displacement))// &
+                             " record known here; set record_units, one of "//record_units_list)
+            return
+         end if
+         ! record_units given: it must say what the header says ('gal' is 'cm/s2'); a header
+         ! whose units are not known here leaves record_units to say them
+         if (len(units) > 0 .and. ok_declared) then
+            call units_factor(units, is_displacement, f_given, ok)
+            if (.not. ok .or. f_given /= f_declared) then
+               call fatal_error(error, where//": the header declares units of '"//declared//"' but record_units = '"// &
+                                units//"'")
+               return
+            end if
+         end if
       end if
       if (len(units) == 0) then
          units = declared
@@ -273,7 +290,12 @@ contains
       end if
       info%dt = dt
       ! values
-      allocate (val(npts))
+      allocate (val(npts), stat=stat)
+      if (stat /= 0) then
+         call fatal_error(error, "record file '"//path//"', line 4: NPTS = "//trim(fmt_int(npts))// &
+                          ": not enough memory for that many values", stat_no_memory)
+         return
+      end if
       n = 0
       line = 4
       do while (next <= len(text))
@@ -300,35 +322,76 @@ contains
       end if
    end subroutine read_at2
 
-   !> Units declared on AT2 line 3 ("... IN UNITS OF G"), lower case; '' when absent.
+   !> Units declared on AT2 line 3, lower case: the word after UNITS ("... IN UNITS OF G",
+   !> "UNITS: CM/S/S", "UNITS (G)"), else a unit written on the line on its own or in
+   !> parentheses ("ACCELERATION (CM/S2)"); '' when the line names none (PEER's files then
+   !> hold g). A word after UNITS that is no unit known here is returned as it is (lower
+   !> case): the caller refuses it rather than take g.
    pure subroutine header_units(h3, units)
       character(len=*), intent(in) :: h3
       character(len=:), allocatable, intent(out) :: units
-      integer :: k, e
+      character(len=*), parameter :: separators = ' ,:;=()[]'//achar(9)//achar(13)
       character(len=:), allocatable :: w
+      integer :: k, e, pos
+      logical :: after_units
 
       units = ''
-      k = index(h3, 'UNITS OF')
-      if (k == 0) return
-      w = adjustl(h3(k + 8:))
-      e = scan(w, ' ,'//achar(9)//achar(13))
-      if (e > 0) w = w(1:e - 1)
-      select case (w)
-      case ('G')
-         units = 'g'
-      case ('CM/S/S', 'CM/SEC/SEC', 'CM/S2', 'CM/SEC2', 'CM/S^2', 'CM/SEC^2', 'GAL')
-         units = 'cm/s2'
-      case ('M/S/S', 'M/SEC/SEC', 'M/S2', 'M/SEC2', 'M/S^2')
-         units = 'm/s2'
-      case ('CM')
-         units = 'cm'
-      case ('M')
-         units = 'm'
-      case ('MM')
-         units = 'mm'
-      case default
-         units = lower(w)
-      end select
+      after_units = .false.
+      pos = 1
+      do
+         k = verify(h3(pos:), separators)
+         if (k == 0) exit
+         k = pos + k - 1
+         e = scan(h3(k:), separators)
+         if (e == 0) then
+            e = len(h3)
+         else
+            e = k + e - 2
+         end if
+         w = h3(k:e)
+         pos = e + 1
+         do while (len(w) > 1 .and. w(len(w):len(w)) == '.')   ! 'G.' at a sentence's end
+            w = w(1:len(w) - 1)
+         end do
+         if (w == 'UNITS' .or. w == 'UNIT') then
+            after_units = .true.
+            cycle
+         end if
+         if (after_units .and. (w == 'OF' .or. w == 'IN' .or. w == 'ARE' .or. w == 'IS')) cycle
+         units = known_unit(w)
+         if (after_units) then
+            if (len(units) == 0) units = lower(w)
+            return
+         end if
+         ! without UNITS: only spellings that are no ordinary word ('G' and 'M' are left alone)
+         if (len(units) > 0 .and. w /= 'G' .and. w /= 'M') return
+         units = ''
+         if (pos > len(h3)) exit
+      end do
+   contains
+      pure function known_unit(w) result(u)
+         character(len=*), intent(in) :: w
+         character(len=:), allocatable :: u
+         select case (w)
+         case ('G')
+            u = 'g'
+         case ('CM/S/S', 'CM/SEC/SEC', 'CM/S2', 'CM/SEC2', 'CM/S^2', 'CM/SEC^2', 'CM/S**2', 'CM/SEC**2', 'GAL', &
+               'CM/S/SEC', 'CMS2')
+            u = 'cm/s2'
+         case ('M/S/S', 'M/SEC/SEC', 'M/S2', 'M/SEC2', 'M/S^2', 'M/SEC^2', 'M/S**2', 'M/SEC**2')
+            u = 'm/s2'
+         case ('MM/S/S', 'MM/SEC/SEC', 'MM/S2', 'MM/SEC2', 'MM/S^2', 'MM/SEC^2', 'MM/S**2', 'MM/SEC**2')
+            u = 'mm/s2'
+         case ('CM')
+            u = 'cm'
+         case ('M')
+            u = 'm'
+         case ('MM')
+            u = 'mm'
+         case default
+            u = ''
+         end select
+      end function known_unit
    end subroutine header_units
 
    !> NPTS and DT of AT2 line 4, in the spellings of the PEER files:
@@ -339,7 +402,7 @@ contains
       real(dp), intent(out) :: dt
       type(error_type), allocatable, intent(out) :: error
       character(len=:), allocatable :: up, where, expect, tok(:)
-      character(len=64) :: num(2)
+      character(len=64) :: num(2), unit
       integer :: k, nnum, stat, ios
       logical :: keyed
 
@@ -359,8 +422,18 @@ contains
       num = ''
       if (keyed) then
          call keyed_value(up, 'NPTS', num(1))
-         call keyed_value(up, 'DT', num(2))
+         call keyed_value(up, 'DT', num(2), unit)
          nnum = count(num /= '')
+         ! DT is read in seconds: another unit after it ('DT= 5 MSEC') is refused
+         select case (trim(unit))
+         case ('', 'SEC', 'SECS', 'S', 'SECOND', 'SECONDS')
+         case default
+            if (unit(1:4) /= 'NPTS') then
+               call fatal_error(error, where//": DT is followed by '"//trim(unit)//"'; DT is read in seconds "// &
+                                "(SEC), give it so ('"//trim(line)//"')")
+               return
+            end if
+         end select
       else
          call words(up, tok)
          nnum = 0
@@ -399,12 +472,16 @@ contains
          call fatal_error(error, where//": DT = "//trim(num(2))//" s must be > 0")
       end if
    contains
-      !> The word after "KEY=" (KEY as a whole word), '' when absent.
-      pure subroutine keyed_value(s, key, v)
+      !> The word after "KEY=" (KEY as a whole word), '' when absent; after: the word that
+      !> follows it.
+      pure subroutine keyed_value(s, key, v, after)
          character(len=*), intent(in) :: s, key
          character(len=*), intent(out) :: v
-         integer :: p, q, e
+         character(len=*), intent(out), optional :: after
+         character(len=len(s)) :: rest
+         integer :: p, q, e, e2
          v = ''
+         if (present(after)) after = ''
          p = 0
          do
             q = index(s(p + 1:), key)
@@ -417,10 +494,20 @@ contains
             if (e == 0) return
             e = p + len(key) - 1 + e
             if (s(e:e) /= '=') cycle
-            v = adjustl(s(e + 1:))
-            e = scan(v, ' ,;'//achar(9)//achar(13))
-            if (e > 0) v = v(1:e - 1)
-            if (v == 'SEC' .or. v == 'NPTS' .or. v == 'DT') v = ''
+            rest = adjustl(s(e + 1:))
+            e = scan(rest, ' ,;'//achar(9)//achar(13))
+            v = rest
+            if (e > 0) v = rest(1:e - 1)
+            if (v == 'SEC' .or. v == 'NPTS' .or. v == 'DT') then
+               v = ''
+               return
+            end if
+            if (present(after) .and. e > 0) then
+               rest = adjustl(rest(e + 1:))
+               e2 = scan(rest, ' ,;'//achar(9)//achar(13))
+               if (e2 > 0) rest = rest(1:e2 - 1)
+               after = rest
+            end if
             return
          end do
       end subroutine keyed_value
