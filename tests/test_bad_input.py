@@ -52,6 +52,11 @@ CASES = [
         ["&damping", "damping_type", "modal"],
     ),
     ("xi >= 1", _set("damping", "xi", 1.5), ["&damping", "xi", "1.5"]),
+    (
+        "rayleigh xi without modes",  # it would be left unused: an undamped run
+        lambda g: g["damping"].update(damping_type="rayleigh", xi=0.05),
+        ["&damping", "xi = 0.05", "mode_i and mode_j"],
+    ),
     ("zero frequency", _set("excitation", "frequency", 0.0), ["&excitation", "frequency", "= 0 "]),
     ("negative duration", _set("excitation", "duration", -1.0), ["&excitation", "duration", "-1"]),
     ("unknown excitation", _set("excitation", "excitation_type", "sine"), ["&excitation", "sine"]),

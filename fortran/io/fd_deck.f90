@@ -1244,7 +1244,14 @@ contains
 
       cfg%model%mode_i = 0
       cfg%model%mode_j = 0
-      if (mode_i == unset_int .and. mode_j == unset_int) return
+      if (mode_i == unset_int .and. mode_j == unset_int) then
+         ! xi with 'rayleigh' is a ratio at two modes: without them it would be left unused
+         ! and the structure damped by a0, a1 alone (undamped when they are not given)
+         if (xi /= default_xi) call bad(deck, 'damping', 'xi', trim(fmt_real(xi)), "absent with 'rayleigh' "// &
+                                        "damping unless mode_i and mode_j are given (xi is the ratio at those "// &
+                                        "two modes); or give rayleigh_a0 and rayleigh_a1 alone", error)
+         return
+      end if
       if (mode_i == unset_int .or. mode_j == unset_int) then
          call fatal_error(error, deck%path//", group &damping: "//trim(merge('mode_i', 'mode_j', mode_i == unset_int))// &
                           " is not given: 'rayleigh' damping from modes needs xi, mode_i and mode_j")
