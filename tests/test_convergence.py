@@ -109,6 +109,18 @@ def test_levels_are_the_deck_at_finer_steps(tmp_path):
             assert s[key] == ref[key], (k, key)
 
 
+def test_a_deck_with_elements_and_an_empty_n1(tmp_path):
+    """u0 given from element 2 (f90nml holds its start apart) and n1 = , (an empty value:
+    the default 20): level 0 is the deck itself, level 1 the deck at n1 = 40."""
+    text = (INPUTS / "test4_hysteretic.nml").read_text().replace("40.0", "1.0")
+    text = text.replace("&model\n", "&model\n  u0(2) = 0.002\n", 1).replace("n1 = 20", "n1 = ,")
+    report = step_convergence(write(tmp_path, text), levels=1)
+    assert report.n1 == [20, 40]
+    alone = fd.run_text(text, base_dir=INPUTS).summary
+    for key in ("peak_u_m", "peak_s_m", "stick_to_slip", "energy_friction_J"):
+        assert report.summaries[0][key] == alone[key], key
+
+
 @pytest.mark.parametrize("test", [1, 2, 3, 4, 5])
 def test_the_papers_decks_converge(test):
     """The paper's decks at their own step: both laws' peaks, energies and counts agree with

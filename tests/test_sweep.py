@@ -155,6 +155,68 @@ def test_failed_run_is_recorded_and_the_others_complete(tmp_path):
     assert bad.returncode == 1 and "'nope' is not a column" in bad.stderr
 
 
+def test_elements_given_from_above_1_stay_where_the_deck_puts_them(tmp_path):
+    """A base deck giving u0(2) alone, and a speed-dependent mu by its table's second
+    column: f90nml keeps such starts apart from the values, and a sweep that copied only
+    the values moved u0(2) to u0(1) (peak |u| 2-8 % off, exit 0). Each run of a sweep that
+    varies only a label equals the base deck run alone, and a swept element of u0 lands at
+    its index: u0(1) = 0.001 with the base's u0(2) = 0.002 kept."""
+    text = (INPUTS / "test4_velocity.nml").read_text().replace("40.0", "2.0")
+    text = text.replace("&model\n", "&model\n  u0(2) = 0.002\n", 1)
+    assert "u0(2) = 0.002" in text
+    (tmp_path / "base.nml").write_text(text)
+    (tmp_path / "s.toml").write_text(
+        'base = "base.nml"\n[zip]\nlabel = ["a"]\n"model.mass" = [[6.301, 2.530]]\n'
+    )
+    r = subprocess.run([*SWEEP, str(tmp_path / "s.toml"), "--out", str(tmp_path / "o"),
+                        "--quiet"], capture_output=True, text=True)
+    assert r.returncode == 0, r.stderr
+    alone = frictiondyn.run_text(text, base_dir=INPUTS)
+    run = json.loads((tmp_path / "o" / "runs" / "r0000.summary.json").read_text())
+    for key in ("peak_u_m", "peak_s_m", "stick_to_slip", "energy_friction_J"):
+        assert run[key] == alone.summary[key], key
+    h = frictiondyn.read_history(tmp_path / "o" / "runs" / "r0000.csv")
+    assert h["u1"][0] == 0.0 and h["u2"][0] == 0.002
+    # an element swept: element 1 of the array, the base deck's element 2 kept
+    (tmp_path / "s.toml").write_text('base = "base.nml"\n[zip]\n"model.u0(1)" = [0.001]\n')
+    r = subprocess.run([*SWEEP, str(tmp_path / "s.toml"), "--out", str(tmp_path / "o2"),
+                        "--quiet"], capture_output=True, text=True)
+    assert r.returncode == 0, r.stderr
+    h = frictiondyn.read_history(tmp_path / "o2" / "runs" / "r0000.csv")
+    assert h["u1"][0] == 0.001 and h["u2"][0] == 0.002
+
+
+@pytest.mark.parametrize(
+    "change, words",
+    [
+        (("u0 = 0.0, 0.0", "u0(2:1:-1) = 0.002, 0.001"), ["cannot read it as the library does",
+                                                         "0.002 is not assigned"]),
+        (("node_j = 0, 0", "node_j = 0; 0"), ["written again it gives", "node_j"]),
+        (("k = 1084.0, 2895.0", "k = 1084.0, 2895.0_8"), ["group &springs", "'k'"]),
+    ],
+    ids=["negative stride", "semicolon", "underscore"],
+)
+def test_a_base_deck_f90nml_reads_otherwise_is_refused(tmp_path, change, words):
+    """Decks the library reads (the first two) or refuses (the third) but that f90nml,
+    which writes a sweep's decks, reads otherwise (drops the values of a negative-stride
+    section; takes ';' for a value; takes 2895.0_8 for 2895.08): the sweep refuses the
+    base deck with the reason, before it writes or runs anything."""
+    text = (INPUTS / "test4_velocity.nml").read_text()
+    old, new = change
+    if old not in text:  # the paper's decks give u0 only by its default
+        text = text.replace("&model\n", f"&model\n  {old}\n", 1)
+    text = text.replace(old, new, 1)
+    assert new in text
+    (tmp_path / "base.nml").write_text(text)
+    (tmp_path / "s.toml").write_text('base = "base.nml"\n[zip]\nlabel = ["a"]\n')
+    r = subprocess.run([*SWEEP, str(tmp_path / "s.toml"), "--out", str(tmp_path / "o"),
+                        "--quiet"], capture_output=True, text=True)
+    assert r.returncode == 1 and "base deck" in r.stderr, r.stderr
+    for w in words:
+        assert w in r.stderr, (w, r.stderr)
+    assert not list((tmp_path / "o" / "decks").glob("*.nml")) if (tmp_path / "o").exists() else True
+
+
 def test_changed_spec_reruns_only_changed_decks(tmp_path):
     (tmp_path / "base.nml").write_text(deck_text(tiny()))
     spec = tmp_path / "s.toml"

@@ -17,7 +17,6 @@ answer moves). docs/python.md documents both.
 
 from __future__ import annotations
 
-import io
 import json
 import math
 import os
@@ -29,6 +28,9 @@ from pathlib import Path
 import f90nml
 
 from ._api import _SUMMARY, DeckError, FrictiondynError, Session, summary_warnings
+from ._nml import copy_namelist, read_namelist, write_namelist
+
+DEFAULT_N1 = 20  # n1 when a deck does not give it (fortran/model/fd_names.f90, default_n1)
 
 __all__ = ["ConvergenceReport", "Quantity", "step_convergence"]
 
@@ -165,29 +167,22 @@ def _deck(deck: str | os.PathLike) -> tuple[f90nml.Namelist, Path]:
         raise DeckError(f"{path}: no such deck") from None
     except (OSError, UnicodeDecodeError) as exc:
         raise DeckError(f"{path}: cannot read the deck ({exc})") from None
-    with Session.from_text(text, path.name, path.parent):  # the library's own checks first
-        pass
-    try:
-        nml = f90nml.reads(text)
-    except Exception as exc:  # f90nml raises several kinds
-        raise DeckError(f"{path}: cannot read the deck ({exc})") from None
-    return nml, path
+    return read_namelist(text, path), path
 
 
 def _level_text(nml: f90nml.Namelist, factor: int) -> str:
     """The deck with its step divided by ``factor``: n1, and dt_min and output_every (given
     in seconds and in dt1 steps) with it."""
-    out = f90nml.Namelist({g: f90nml.Namelist(v) for g, v in nml.items()})
+    out = copy_namelist(nml)
     integ = out.setdefault("integration", f90nml.Namelist())
-    integ["n1"] = int(integ.get("n1", 20)) * factor
+    n1 = integ.get("n1")  # absent, or an empty value (n1 = ,): the library's default
+    integ["n1"] = (DEFAULT_N1 if n1 is None else int(n1)) * factor
     if integ.get("dt_min"):
         integ["dt_min"] = float(integ["dt_min"]) / factor
     output = out.get("output")
     if output is not None and output.get("output_every"):
         output["output_every"] = int(output["output_every"]) * factor
-    buf = io.StringIO()
-    out.write(buf)
-    return buf.getvalue()
+    return write_namelist(out)
 
 
 def _items(kind: str, summary: dict, n: int) -> list[str]:

@@ -51,7 +51,9 @@ from typing import Any
 import f90nml
 
 from . import __version__
+from ._api import FrictiondynError
 from ._exe import executable
+from ._nml import copy_namelist, read_namelist, write_namelist
 
 try:
     import tomllib
@@ -178,8 +180,14 @@ def _set(nml: f90nml.Namelist, key: str, value: Any, where: str) -> None:
         nml[group] = f90nml.Namelist()
     if idx is None:
         nml[group][var] = value
+        nml[group].start_index.pop(var, None)  # the value given is the array from element 1
         return
     i = int(idx)
+    if var in nml[group].start_index:
+        raise SweepError(
+            f"{where}: {key}: the base deck gives {group}.{var} by sections of a 2-D array; "
+            f"vary the whole array"
+        )
     cur = nml[group].get(var)
     cur = list(cur) if isinstance(cur, list) else ([] if cur is None else [cur])
     if not 1 <= i <= len(cur):
@@ -208,9 +216,7 @@ def _write_atomic(path: Path, data: str | bytes) -> None:
 
 
 def _deck_text(nml: f90nml.Namelist, header: str) -> str:
-    buf = io.StringIO()
-    nml.write(buf)
-    return header + buf.getvalue()
+    return header + write_namelist(nml)
 
 
 def expand(spec_path: str | os.PathLike, directory: str | os.PathLike | None = None) -> Sweep:
@@ -236,13 +242,17 @@ def expand(spec_path: str | os.PathLike, directory: str | os.PathLike | None = N
             raise SweepError(f"{where}: deck = {base!r} is not a path")
         base_path = (base_dir / base).resolve()
         if base not in bases:
-            try:
-                bases[base] = f90nml.read(str(base_path))
+            try:  # the deck's bytes as the library reads them (a Latin-1 comment is no error)
+                text = base_path.read_bytes().decode("utf-8", "surrogateescape")
             except FileNotFoundError:
                 raise SweepError(f"{where}: base deck {base_path} does not exist") from None
-            except Exception as exc:  # f90nml raises several kinds
+            except OSError as exc:
                 raise SweepError(f"{where}: cannot read the base deck {base_path}: {exc}") from None
-        nml = _copy_namelist(bases[base])
+            try:
+                bases[base] = read_namelist(text, base_path)
+            except FrictiondynError as exc:
+                raise SweepError(f"{where}: base deck: {exc}") from None
+        nml = copy_namelist(bases[base])
         # a relative record file is relative to the deck that names it
         exc_group = nml.get("excitation", {})
         rec = exc_group.get("record_file") if exc_group else None
@@ -268,7 +278,7 @@ def expand(spec_path: str | os.PathLike, directory: str | os.PathLike | None = N
         shown = ", ".join(f"{k} = {_short(v)}" for k, v in params.items())
         text = _deck_text(nml, f"! frictiondyn sweep '{name}', run {rid}: {shown}\n")
         deck = sdir / "decks" / f"{rid}.nml"
-        data = text.encode()
+        data = text.encode("utf-8", "surrogateescape")
         old = deck.read_bytes() if deck.exists() else None
         if old != data:
             for stale in (f"runs/{rid}.summary.json", f"runs/{rid}.csv", f"runs/{rid}.error.txt"):
@@ -298,16 +308,6 @@ def expand(spec_path: str | os.PathLike, directory: str | os.PathLike | None = N
     }
     _write_atomic(sdir / "manifest.json", json.dumps(manifest, indent=1) + "\n")
     return sweep
-
-
-def _copy_namelist(nml: f90nml.Namelist) -> f90nml.Namelist:
-    out = f90nml.Namelist()
-    for group, variables in nml.items():
-        g = f90nml.Namelist()
-        for k, v in variables.items():
-            g[k] = list(v) if isinstance(v, list) else v
-        out[group] = g
-    return out
 
 
 def _short(v: Any) -> str:
