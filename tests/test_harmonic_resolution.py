@@ -194,3 +194,32 @@ def test_a_sliding_block_its_rigid_body_mode(run):
     assert coarse["harmonic_resolution"] == "unresolved"
     assert fine["harmonic_resolution"] == "resolved" and fine["harmonic_step_error"][0] < 2e-4
     assert abs(coarse["peak_u_m"][0] / fine["peak_u_m"][0] - 1) > 0.1
+
+
+MJ_SDOF = """&model n_dof = 1, mass = 1.0 /
+&springs n_springs = 1, node_i = 1, node_j = 0, k = 39.47841760435743 /
+&damping damping_type = 'none' /
+&friction n_devices = 1, node_i = 1, node_j = 0, p = 0.3, mu = 1.0, law = 'coulomb' /
+&excitation excitation_type = 'harmonic', amplitude = 0.0312719702599808, frequency = 0.9,
+  dt_record = 0.2, duration = 60.0, ramp_cycles = 5 /
+&integration technique = 'TECH', n1 = N1 /
+"""
+
+
+def test_moreau_jean_is_judged_by_its_own_recursion():
+    """A mass of 1 Hz on a Coulomb surface (F_f = 0.3 F0) under the table at 0.9 Hz, by
+    Moreau-Jean at dt1 = 0.2 s (5.6 steps a period): the step moves the linear steady state
+    to the theta-method's resonance and the peak is several times the exact one (event-driven
+    technique, which matches Den Hartog's steady state). The run says so (unresolved, warned);
+    at n1 = 64 it is resolved and the peak within 1 % of the exact one. Before stop 31 the
+    coarse run reported nothing."""
+    exact = fd.run_text(MJ_SDOF.replace("TECH", "event_driven").replace("N1", "20")).summary
+    with warnings.catch_warnings(record=True) as w:
+        warnings.simplefilter("always")
+        coarse = fd.run_text(MJ_SDOF.replace("TECH", "moreau_jean").replace("N1", "1")).summary
+    assert coarse["harmonic_resolution"] == "unresolved"
+    assert any("the step alone moves the linear steady-state amplitude" in str(x.message) for x in w)
+    assert coarse["peak_u_m"][0] > 3 * exact["peak_u_m"][0]  # what the warning is about
+    fine = fd.run_text(MJ_SDOF.replace("TECH", "moreau_jean").replace("N1", "64")).summary
+    assert fine["harmonic_resolution"] == "resolved" and fine["harmonic_step_error"][0] < 0.01
+    assert fine["peak_u_m"][0] == pytest.approx(exact["peak_u_m"][0], rel=0.01)

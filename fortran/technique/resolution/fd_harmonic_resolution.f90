@@ -14,20 +14,22 @@
 !> between these two systems, and a step that moves both by 20 % cannot give the right
 !> answer (a fuzz deck at n1 = 1, 6.4 steps in the table's period: peak displacement 267 %
 !> off, no other report). Above harmonic_error_limit the summary says "unresolved" and the
-!> executable and the command line warn. Not applicable: a record or no table motion (their
-!> content is not one frequency), no modes computed (n_modes = 0), or another technique.
+!> executable and the command line warn. The Moreau-Jean technique's theta-method is judged
+!> the same way, by its own closed form (theta_response). Not applicable: a record or no
+!> table motion (their content is not one frequency), no modes computed (n_modes = 0), or
+!> the event-driven technique (no step).
 module fd_harmonic_resolution
    use, intrinsic :: ieee_arithmetic, only: ieee_is_finite
    use fd_kinds, only: dp
    use fd_error, only: error_type, fatal_error, fmt_int, stat_no_memory
-   use fd_names, only: technique_newmark, excitation_harmonic
+   use fd_names, only: technique_newmark, technique_moreau_jean, excitation_harmonic
    use fd_matrices, only: modes_type, modes_kept, mode_damping, mode_participation
    use fd_model, only: model_type
    use fd_result, only: result_type, resolution_none, resolution_resolved, resolution_unresolved
    implicit none
    private
 
-   public :: harmonic_resolution, newmark_response, harmonic_error_limit
+   public :: harmonic_resolution, newmark_response, theta_response, harmonic_error_limit
 
    !> relative change of a DOF's linear steady-state amplitude above which the step does not
    !> resolve the table's frequency
@@ -61,13 +63,39 @@ contains
       h = 1.0_dp/(1.0_dp/gu + c*gv/gu + wn*wn)
    end subroutine newmark_response
 
+   !> The same for the Moreau-Jean technique's theta-method (fd_moreau_jean): over a step
+   !> v1 - v = dt (p_theta - c v_theta - wn^2 u_theta), u1 = u + dt v_theta, with
+   !> x_theta = (1 - theta) x + theta x1 for v and u and the force interpolated the same way.
+   !> With a = (1 - theta) + theta z and g = (z - 1) / (dt a): U / P = 1 / (g^2 + c g + wn^2)
+   !> (for theta = 1/2 the bilinear transform, as Newmark's average acceleration).
+   pure subroutine theta_response(w, wn, c, dt, theta, h, ok)
+      real(dp), intent(in) :: w, wn         !! forcing and natural circular frequency [rad/s]
+      real(dp), intent(in) :: c             !! damping per unit modal mass [1/s]
+      real(dp), intent(in) :: dt            !! step [s]
+      real(dp), intent(in) :: theta         !! the method's theta, 1/2 to 1
+      complex(dp), intent(out) :: h         !! U / P [s2]
+      logical, intent(out) :: ok            !! the steps resolve a frequency at all
+      complex(dp) :: zm1, a, g
+      real(dp) :: x
+
+      x = w*dt
+      zm1 = cmplx(0.0_dp, 2.0_dp*sin(0.5_dp*x), dp)*cmplx(cos(0.5_dp*x), sin(0.5_dp*x), dp)
+      a = 1.0_dp + theta*zm1
+      ok = abs(zm1) > 1e-12_dp .and. abs(a) > 1e-12_dp
+      h = (0.0_dp, 0.0_dp)
+      if (.not. ok) return
+      g = zm1/(dt*a)
+      h = 1.0_dp/(g*g + c*g + wn*wn)
+   end subroutine theta_response
+
    !> Sets res%harmonic_error (per DOF, the larger over the stuck and the free system of
    !> | |U_step| / |U| - 1 |, for the DOFs whose amplitude |U| is at least 1 % of the largest)
    !> and res%harmonic_resolution, from the summary's modes (res%eng), the table's frequency,
    !> res%dt1 and Newmark's beta, gamma.
-   subroutine harmonic_resolution(model, beta, gamma, res, error)
+   subroutine harmonic_resolution(model, beta, gamma, theta, res, error)
       type(model_type), intent(in) :: model               !! the model (masses)
       real(dp), intent(in) :: beta, gamma                 !! Newmark's parameters
+      real(dp), intent(in) :: theta                       !! Moreau-Jean's theta
       type(result_type), intent(inout) :: res             !! the result of the run
       type(error_type), allocatable, intent(out) :: error !! not enough memory
       complex(dp), allocatable :: ue(:), ud(:)
@@ -77,7 +105,8 @@ contains
       n = model%n_dof
       res%harmonic_resolution = resolution_none
       res%harmonic_error = 0.0_dp               ! allocated with the summary (init_result)
-      if (res%technique /= technique_newmark .or. res%eng%excitation /= excitation_harmonic) return
+      if (res%technique /= technique_newmark .and. res%technique /= technique_moreau_jean) return
+      if (res%eng%excitation /= excitation_harmonic) return
       if (res%dt1 <= 0.0_dp .or. .not. (res%eng%frequency > 0.0_dp)) return
       allocate (ue(n), ud(n), stat=stat)
       if (stat /= 0) then
@@ -112,7 +141,11 @@ contains
             wn = sqrt(max(modes%omega2(k), 0.0_dp))
             c = mode_damping(modes, k, res%eng%a0)
             gamma_k = mode_participation(modes, k, model%mass(1:n))
-            call newmark_response(w, wn, c, res%dt1, beta, gamma, hd, ok_k)
+            if (res%technique == technique_moreau_jean) then
+               call theta_response(w, wn, c, res%dt1, theta, hd, ok_k)
+            else
+               call newmark_response(w, wn, c, res%dt1, beta, gamma, hd, ok_k)
+            end if
             he = cmplx(wn*wn - w*w, c*w, dp)
             if (.not. ok_k .or. he == (0.0_dp, 0.0_dp)) then
                ! the steps see a constant force, or an undamped resonance (no steady state):
