@@ -78,10 +78,9 @@ contains
                                              opts%gamma == 0.5_dp)
       ! whether the step resolves the highest modes: one report for every stepping technique
       if (.not. allocated(error)) call mode_resolution(model, res, error)
-      ! and the table's motion: a harmonic's frequency (Newmark, Moreau-Jean), a record's
-      ! spectrum (Newmark)
+      ! and the table's motion: a harmonic's frequency, a record's spectrum
       if (.not. allocated(error)) call harmonic_resolution(model, opts%beta, opts%gamma, opts%theta, res, error)
-      if (.not. allocated(error)) call record_resolution(model, exc, opts%beta, opts%gamma, res, error)
+      if (.not. allocated(error)) call record_resolution(model, exc, opts%beta, opts%gamma, opts%theta, res, error)
    end subroutine run_technique
 
    subroutine unknown_technique(technique, error)

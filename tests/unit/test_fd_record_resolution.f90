@@ -7,7 +7,8 @@
 module test_fd_record_resolution
    use testdrive, only: new_unittest, unittest_type, error_type, check
    use fd_kinds, only: dp
-   use fd_record_resolution, only: exact_step_map, newmark_step_map
+   use fd_record_resolution, only: exact_step_map, newmark_step_map, theta_step_map
+   use fd_harmonic_resolution, only: theta_response
    implicit none
    private
 
@@ -24,7 +25,9 @@ contains
                   new_unittest("exact step: damped free vibration, under- and overdamped", test_damped), &
                   new_unittest("exact step: a rigid body under a linear load", test_rigid), &
                   new_unittest("Newmark map: average acceleration's phase 2 atan(wn dt / 2)", test_newmark_aa), &
-                  new_unittest("Newmark map: the recursion of linear acceleration", test_newmark_recursion) &
+                  new_unittest("Newmark map: the recursion of linear acceleration", test_newmark_recursion), &
+                  new_unittest("theta map: its steady state under a harmonic load is theta_response's", &
+                               test_theta_map) &
                   ]
    end subroutine collect_record_resolution
 
@@ -150,5 +153,33 @@ contains
       call check(error, abs(z(1) - q) < 1e-13_dp*maxval(abs([q, 1e-3_dp])) .and. abs(z(2) - v) < 1e-12_dp .and. &
                  abs(z(3) - a) < 1e-11_dp, "the map steps as the recursion")
    end subroutine test_newmark_recursion
+
+   !> Moreau-Jean's map run under p = exp(i w t) (real and imaginary parts as two runs) to its
+   !> steady state, against the closed form of fd_harmonic_resolution (derived apart, by the
+   !> z-transform of the recursion), for three thetas.
+   subroutine test_theta_map(error)
+      type(error_type), allocatable, intent(out) :: error
+      real(dp), parameter :: w = 8.0_dp, wn = 10.0_dp, c = 2.0_dp, h = 0.02_dp
+      real(dp), parameter :: theta(3) = [0.5_dp, 0.75_dp, 1.0_dp]
+      real(dp) :: nm(3, 3), np(3), zr(3), zi(3), pr, pi_
+      complex(dp) :: resp, u
+      logical :: ok
+      integer :: j, n
+
+      do j = 1, 3
+         call theta_step_map(wn, c, h, theta(j), nm, np)
+         zr = [0.0_dp, 0.0_dp, 1.0_dp]   ! (q, q', p(0)): p = cos(w t)
+         zi = [0.0_dp, 0.0_dp, 0.0_dp]   ! p = sin(w t)
+         do n = 1, 3000                  ! 60 s: the transient is down by exp(-60)
+            pr = cos(w*n*h); pi_ = sin(w*n*h)
+            zr = matmul(nm, zr) + np*pr
+            zi = matmul(nm, zi) + np*pi_
+         end do
+         u = cmplx(zr(1), zi(1), dp)/cmplx(pr, pi_, dp)
+         call theta_response(w, wn, c, h, theta(j), resp, ok)
+         call check(error, ok .and. abs(u - resp) <= 1e-10_dp*abs(resp), "the map's steady state")
+         if (allocated(error)) return
+      end do
+   end subroutine test_theta_map
 
 end module test_fd_record_resolution

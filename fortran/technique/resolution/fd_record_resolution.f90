@@ -24,8 +24,9 @@
 !> the larger of the two when none slid but one is a velocity-law device (a dashpot within
 !> its band, neither rigid nor absent); both systems' figures are in the summary. Not
 !> applicable: a harmonic (fd_harmonic_resolution) or no table motion, no mode of the judged
-!> system to estimate (n_modes = 0, or only the modes left out below), or another technique
-!> than Newmark. Only the summary's modes are seen (the lowest n_modes): omega_max dt1
+!> system to estimate (n_modes = 0, or only the modes left out below), or the event-driven
+!> technique (no step). The Moreau-Jean technique is judged by its own recursion
+!> (theta_step_map), its Coulomb devices as hysteretic ones (no slide: the stuck system). Only the summary's modes are seen (the lowest n_modes): omega_max dt1
 !> (fd_mode_resolution) covers the highest. Rigid-body modes are left out (their drift,
 !> unbounded without a0, has no step error to speak of and would swamp the others' peaks),
 !> and so are summary modes beyond omega dt1 = 2 or Newmark's stability limit
@@ -35,7 +36,7 @@ module fd_record_resolution
    use, intrinsic :: ieee_arithmetic, only: ieee_is_finite
    use fd_kinds, only: dp
    use fd_error, only: error_type, fatal_error, fmt_int, stat_no_memory
-   use fd_names, only: technique_newmark, excitation_record
+   use fd_names, only: technique_newmark, technique_moreau_jean, excitation_record, law_coulomb
    use fd_matrices, only: modes_type, modes_kept, mode_damping, mode_participation
    use fd_model, only: model_type, law_hysteretic
    use fd_excitation, only: excitation_type, table_acceleration
@@ -45,7 +46,7 @@ module fd_record_resolution
    implicit none
    private
 
-   public :: record_resolution, exact_step_map, newmark_step_map, record_error_limit
+   public :: record_resolution, exact_step_map, newmark_step_map, theta_step_map, record_error_limit
 
    !> relative change of a DOF's combined peak linear response above which the step does not
    !> resolve the record
@@ -116,15 +117,36 @@ contains
       np(2) = gamma*h*np(3)
    end subroutine newmark_step_map
 
+   !> The Moreau-Jean technique's theta-method (fd_moreau_jean: v1 - v = h (p_theta - c v_theta
+   !> - wn^2 u_theta), u1 = u + h v_theta, the load interpolated as v and u) of the same mode
+   !> as a map in the layout of newmark_step_map, its third component the step's starting
+   !> load instead of the acceleration: (q, q', p)(h) = nm (q, q', p)(0) + np p(h).
+   pure subroutine theta_step_map(wn, c, h, theta, nm, np)
+      real(dp), intent(in) :: wn, c, h, theta
+      real(dp), intent(out) :: nm(3, 3), np(3)
+      real(dp) :: d
+
+      ! v_theta = (v + theta h ((1 - theta) p0 + theta p1) - theta h wn^2 u) / d
+      d = 1.0_dp + theta*h*c + (theta*h*wn)**2
+      nm(1, :) = [1.0_dp - theta*h*h*wn*wn/d, h/d, theta*(1.0_dp - theta)*h*h/d]
+      np(1) = theta*theta*h*h/d
+      nm(2, :) = [-h*wn*wn/d, (1.0_dp/d - (1.0_dp - theta))/theta, (1.0_dp - theta)*h/d]
+      np(2) = theta*h/d
+      nm(3, :) = 0.0_dp
+      np(3) = 1.0_dp
+   end subroutine theta_step_map
+
    !> Sets res%record_error_stuck and res%record_error_free (per DOF, for the DOFs whose
    !> combined exact peak is at least 1 % of the largest), res%record_error (that of the
    !> system the run was in) and res%record_resolution,
    !> from the summary's modes (res%eng), the record (exc), res%dt1, the run's duration and
-   !> Newmark's beta, gamma. One pass through the record for the modes of both systems.
-   subroutine record_resolution(model, exc, beta, gamma, res, error)
+   !> Newmark's beta, gamma (Moreau-Jean's theta). One pass through the record for the modes
+   !> of both systems.
+   subroutine record_resolution(model, exc, beta, gamma, theta, res, error)
       type(model_type), intent(in) :: model               !! the model (masses, springs, u0, v0)
       type(excitation_type), intent(in) :: exc            !! the table motion
       real(dp), intent(in) :: beta, gamma                 !! Newmark's parameters
+      real(dp), intent(in) :: theta                       !! Moreau-Jean's theta
       type(result_type), intent(inout) :: res             !! the result of the run
       type(error_type), allocatable, intent(out) :: error !! not enough memory
       real(dp), allocatable :: off(:), ku0(:), ex(:, :), nx(:, :), z(:, :), q0(:), ext(:, :)
@@ -139,7 +161,8 @@ contains
       res%record_error = 0.0_dp               ! allocated with the summary (init_result)
       res%record_error_stuck = 0.0_dp
       res%record_error_free = 0.0_dp
-      if (res%technique /= technique_newmark .or. res%eng%excitation /= excitation_record) return
+      if (res%technique /= technique_newmark .and. res%technique /= technique_moreau_jean) return
+      if (res%eng%excitation /= excitation_record) return
       if (res%dt1 <= 0.0_dp .or. .not. (exc%duration > 0.0_dp)) return
       ! the system the run was in, which the verdict judges: the stuck one when no device slid
       ! and every device is hysteretic (a sticking spring: the run is then that linear
@@ -154,7 +177,8 @@ contains
          judged = record_system_structure
       else if (slid) then
          judged = record_system_free
-      else if (all(model%dev(1:model%n_devices)%law == law_hysteretic)) then
+      else if (all(model%dev(1:model%n_devices)%law == law_hysteretic .or. &
+                   model%dev(1:model%n_devices)%law == law_coulomb)) then
          judged = record_system_stuck
       else
          judged = record_system_both
@@ -178,7 +202,8 @@ contains
       ! the largest wn dt1 the check integrates: mode_resolution's limit 2, and Newmark's
       ! stability limit 1 / sqrt(gamma / 2 - beta) when it is conditionally stable
       limit = 2.0_dp
-      if (beta < 0.5_dp*gamma) limit = min(limit, 1.0_dp/sqrt(0.5_dp*gamma - beta))
+      if (res%technique == technique_newmark .and. beta < 0.5_dp*gamma) &
+         limit = min(limit, 1.0_dp/sqrt(0.5_dp*gamma - beta))
       call springs_times(model, model%u0, ku0)
       ! every mode q'' + c q' + wn^2 q = -g ag (g its participation) from the run's initial
       ! conditions, through the run's dt1 steps (fd_result's count) at the accelerations the
@@ -274,13 +299,21 @@ contains
          g = mode_participation(modes, k, model%mass(1:n))
          call exact_step_map(wn, c, h, phi, g0, g1)
          ex(m, :) = [phi(1, 1), phi(1, 2), phi(2, 1), phi(2, 2), g*g0(1), g*g0(2), g*g1(1), g*g1(2)]
-         call newmark_step_map(wn, c, h, beta, gamma, nmap, np)
+         if (res%technique == technique_moreau_jean) then
+            call theta_step_map(wn, c, h, theta, nmap, np)
+         else
+            call newmark_step_map(wn, c, h, beta, gamma, nmap, np)
+         end if
          nx(m, :) = [nmap(1, :), nmap(2, :), nmap(3, :), g*np]
          mk = sum(model%mass(1:n)*modes%shape(:, k)**2)
          z(m, 1) = sum(modes%shape(:, k)*ku0)/(wn*wn*mk)
          z(m, 2) = sum(modes%shape(:, k)*model%mass(1:n)*model%v0(1:n))/mk
          z(m, 3:4) = z(m, 1:2)
-         z(m, 5) = g*p0 - c*z(m, 2) - wn*wn*z(m, 1)
+         if (res%technique == technique_moreau_jean) then
+            z(m, 5) = g*p0                                ! the step's starting load
+         else
+            z(m, 5) = g*p0 - c*z(m, 2) - wn*wn*z(m, 1)    ! the acceleration
+         end if
       end subroutine mode_start
 
       !> The system's modes (from position first + 1 in the pass) combined DOF by DOF into err.
