@@ -42,6 +42,8 @@ module fd_ed_state
       real(dp), allocatable :: g(:), gn(:)                 !! table acceleration, remainder factors (0:kmax)
       real(dp) :: rem = 0.0_dp                             !! remainder bound of the state's norm
       real(dp) :: size = 0.0_dp                            !! the state polynomial's size
+      real(dp) :: grem = 0.0_dp                            !! remainder bound of the table acceleration
+      real(dp) :: gsize = 0.0_dp                           !! the table acceleration polynomial's size
       integer :: order = 2                                 !! Taylor degree K of the sub-interval
       real(dp) :: span = 0.0_dp                            !! sub-interval length S
       real(dp), allocatable :: yc(:, :)                    !! quantities (0:kmax, nquant)
@@ -157,9 +159,9 @@ contains
          kk = min(kmax, pat%order + 4)
          call table_taylor(exc, t, st%g(0:kk), st%gn(0:kk))
          call pattern_series(pat, st%q, st%p, st%b1, st%g(0:kk), st%gn(0:kk), span, st%qc, st%pc, st%cp, &
-                             st%order, st%rem, st%size)
+                             st%order, st%rem, st%size, st%grem, st%gsize)
          kk = st%order
-         rg = st%gn(kk)*span**(kk + 1)          ! remainder of ag
+         rg = st%grem                           ! remainder of ag: gn(K) S^(K+1)
          ! the magnitude of the terms that make up each group's acceleration: the rounding
          ! level of the velocities' and forces' variation over the sub-interval
          do i = 1, pat%nq

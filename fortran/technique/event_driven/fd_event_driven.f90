@@ -243,12 +243,20 @@ contains
                call check_subintervals(err)
                if (allocated(err)) return
                span = min(st%cache%slot(st%cur)%delta, tb - t)
-               ! the polynomials, with a remainder below the rounding level of the state
+               ! the polynomials, with remainders below the rounding level of the state and
+               ! of the table acceleration (which alone drives a pattern with no free coordinate)
                do halvings = 0, 40
                   call ed_polynomials(model, exc, t, span, st)
-                  if (st%rem <= 2.0_dp**(-50)*st%size) exit
+                  if (st%rem <= 2.0_dp**(-50)*st%size .and. st%grem <= 2.0_dp**(-50)*st%gsize) exit
                   span = 0.5_dp*span
                end do
+               if (halvings > 40) then   ! no sub-interval bounds the series: no event is certain
+                  call fatal_error(err, "the exact technique at t = "//trim(fmt_real(t))//" s: the Taylor "// &
+                                   "series' remainder stays above the rounding level on sub-intervals down to "// &
+                                   trim(fmt_real(span))//" s, so events cannot be located; use moreau_jean "// &
+                                   "or the velocity law")
+                  return
+               end if
                call storey_polynomials()
                kk = st%order
                smin = 8.0_dp*epsilon(1.0_dp)*(abs(t) + span)

@@ -23,7 +23,9 @@
 !> gnext >= sup |ag^(K+1)| / (K+1)!: a bound computed on every sub-interval, whatever
 !> the pattern (rigid-body modes, a sliding mass without spring, critical damping: no
 !> eigen-decomposition, nothing defective). S and K are chosen per pattern so that the
-!> bound is below the rounding level: S = 1 / (2 w + c + w_f) (w^2, c: bounds of the
+!> bound, and the table acceleration's own remainder gn(K) S^(K+1) (it enters the sticking
+!> forces and the absolute accelerations directly: with nq = 0 it is the whole solution),
+!> are below the rounding level: S = 1 / (2 w + c + w_f) (w^2, c: bounds of the
 !> spectra of Mq^-1 Kq and Mq^-1 Cq; w_f: the table's highest frequency), alpha = 1/S.
 !> A component is bounded by the norm: |q_g| <= ||x|| / (alpha sqrt(mq_g)),
 !> |p_g| <= ||x|| / sqrt(mq_g), which gives the remainder of every output quantity.
@@ -450,11 +452,14 @@ contains
    end subroutine pattern_taylor
 
    !> Taylor coefficients of the reduced state about an instant over [0, span], to the
-   !> lowest degree K (at least 5) at which the bound of the remainder's norm (module
-   !> header; q'Kq q bounded by w2 q'Mq q) falls below 2^-52 of the polynomial's size,
-   !> sum_k ||x_k|| span^k, or to ubound(g). g, gn: the table acceleration's coefficients
-   !> and remainder factors (0:kcap). Returns K and the bound.
-   pure subroutine pattern_series(pat, q, p, b1, g, gn, span, qc, pc, cp, order, rem, size)
+   !> lowest degree K (at least 5) at which both remainders are below 2^-52 of their
+   !> polynomials' sizes: the state's (the bound of its norm, module header; q'Kq q bounded
+   !> by w2 q'Mq q) below 2^-52 sum_k ||x_k|| S^k, and the table acceleration's own,
+   !> gn(K) S^(K+1), below 2^-52 sum_k |g_k| S^k (the table acceleration enters the output
+   !> quantities and the sticking forces directly, not only through the state: for a pattern
+   !> with no free coordinate, nq = 0, it is all there is); or to ubound(g). g, gn: the table
+   !> acceleration's coefficients and remainder factors (0:kcap). Returns K and the bounds.
+   pure subroutine pattern_series(pat, q, p, b1, g, gn, span, qc, pc, cp, order, rem, size, grem, gsize)
       type(pattern_type), intent(in) :: pat         !! the pattern
       real(dp), intent(in) :: q(:), p(:)            !! reduced state (nq)
       real(dp), intent(in) :: b1(:)                 !! constant load (nq)
@@ -465,6 +470,8 @@ contains
       integer, intent(out) :: order                 !! the degree K
       real(dp), intent(out) :: rem                  !! bound of the remainder's norm over [0, S]
       real(dp), intent(out) :: size                 !! sum_k ||x_k|| S^k
+      real(dp), intent(out) :: grem                 !! bound of the table acceleration's remainder
+      real(dp), intent(out) :: gsize                !! sum_k |g_k| S^k
       integer :: kk, nq, i
       real(dp) :: e, sk, grow, nrm
 
@@ -472,25 +479,32 @@ contains
       order = 5
       rem = 0.0_dp
       size = 0.0_dp
-      if (nq == 0) return
-      qc(1:nq, 0) = q(1:nq)
-      pc(1:nq, 0) = p(1:nq)
-      grow = exp(0.5_dp*pat%alpha*span)
-      size = 0.0_dp
+      grem = 0.0_dp
+      gsize = 0.0_dp
+      grow = 1.0_dp
+      if (nq > 0) then
+         qc(1:nq, 0) = q(1:nq)
+         pc(1:nq, 0) = p(1:nq)
+         grow = exp(0.5_dp*pat%alpha*span)
+      end if
       sk = 1.0_dp
       do kk = 0, ubound(g, 1)
-         call taylor_step(pat, kk, g(kk), b1, qc, pc, cp)
-         e = 0.0_dp
-         nrm = 0.0_dp
-         do i = 1, nq
-            nrm = nrm + pat%mq(i)*(pc(i, kk)**2 + (pat%w2 + pat%alpha**2)*qc(i, kk)**2)
-            e = e + pat%mq(i)*(pc(i, kk + 1)**2 + (pat%w2 + pat%alpha**2)*qc(i, kk + 1)**2)
-         end do
-         size = size + sqrt(nrm)*sk
+         gsize = gsize + abs(g(kk))*sk
+         if (nq > 0) then
+            call taylor_step(pat, kk, g(kk), b1, qc, pc, cp)
+            e = 0.0_dp
+            nrm = 0.0_dp
+            do i = 1, nq
+               nrm = nrm + pat%mq(i)*(pc(i, kk)**2 + (pat%w2 + pat%alpha**2)*qc(i, kk)**2)
+               e = e + pat%mq(i)*(pc(i, kk + 1)**2 + (pat%w2 + pat%alpha**2)*qc(i, kk + 1)**2)
+            end do
+            size = size + sqrt(nrm)*sk
+         end if
          sk = sk*span
-         rem = grow*(sqrt(e)*sk + sk*span*pat%msum*gn(kk))
+         grem = gn(kk)*sk
+         if (nq > 0) rem = grow*(sqrt(e)*sk + sk*span*pat%msum*gn(kk))
          order = kk
-         if (kk >= 5 .and. rem <= 2.0_dp**(-52)*size) exit
+         if (kk >= 5 .and. rem <= 2.0_dp**(-52)*size .and. grem <= 2.0_dp**(-52)*gsize) exit
       end do
    end subroutine pattern_series
 
