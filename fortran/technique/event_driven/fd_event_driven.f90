@@ -58,6 +58,10 @@ module fd_event_driven
    !> frequencies need more for the rest of the run is an error, not a run without end.
    real(dp), parameter :: max_subintervals = 1.0e9_dp
    real(dp), parameter :: accumulation_span = 1.0e-9_dp !! [s], times max(1, t): the window
+   !> Most events (phases changed or not) within one accumulation window: beyond it the
+   !> time no longer advances (the same decision again and again), an error, not a run
+   !> without end. An accumulation (Zeno) ends after 2 ring_size phase changes at most.
+   integer, parameter :: max_burst = 1000
 
    !> Everything the loop works on.
    type :: ed_work
@@ -77,6 +81,8 @@ module fd_event_driven
       real(dp) :: ring(ring_size) = -huge(1.0_dp)         !! times of the last events
       integer :: ring_pos = 0
       real(dp) :: last_accumulation = -huge(1.0_dp)       !! time of the last accumulation point
+      real(dp) :: burst_t0 = -huge(1.0_dp)                !! first event of the current window
+      integer :: burst_n = 0                              !! events since burst_t0 within the window
    end type ed_work
 
 contains
@@ -593,6 +599,17 @@ contains
             end do
             call decide_phases(model, exc, t, st, chg, err)
             if (allocated(err)) return
+            ! no event loop without end: at most max_burst events within one window
+            if (t - w%burst_t0 <= accumulation_span*max(1.0_dp, abs(t))) then
+               w%burst_n = w%burst_n + 1
+               if (w%burst_n >= max_burst) then
+                  call stalled_events(err)
+                  return
+               end if
+            else
+               w%burst_t0 = t
+               w%burst_n = 1
+            end if
             if (.not. chg) return
             w%n_events = w%n_events + 1
             call observe_transitions(res, st%oldph, st%phase)
@@ -615,6 +632,32 @@ contains
             end if
          end associate
       end subroutine event_at
+
+      !> The error of max_burst events within one window: the time does not advance.
+      subroutine stalled_events(err)
+         type(error_type), allocatable, intent(out) :: err
+         integer :: dd, m
+         character(len=:), allocatable :: list
+         associate (st => w%st)
+            m = 0
+            do dd = 1, st%nd
+               if (.not. (st%crossed(dd) .or. st%near(dd))) cycle
+               m = m + 1
+               st%cand(m) = dd
+            end do
+            if (m > 0) then
+               call device_list(st%cand, m, list)
+               list = ", last at "//list
+            else
+               list = ""
+            end if
+            call fatal_error(err, "event-driven technique at t = "//trim(fmt_real(t))//" s: "// &
+                             trim(fmt_int(max_burst))//" events within "// &
+                             trim(fmt_real(t - w%burst_t0))//" s"//list//", the same instant decided again "// &
+                             "and again (the time does not advance); try technique = 'moreau_jean', or "// &
+                             "technique = 'newmark' with law = 'velocity', or report the deck")
+         end associate
+      end subroutine stalled_events
 
       !> An accumulation of events (a Zeno sequence) at t: the devices at zero relative
       !> velocity stick at the limit of the sequence, provided their forces hold.

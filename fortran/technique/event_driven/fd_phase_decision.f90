@@ -34,8 +34,12 @@
 !>
 !> **Redundant devices** (in parallel, in a closed loop of sticking devices): the forces
 !> of the pattern share the load in proportion to the limits; where that share exceeds a
-!> limit while the LCP's forces do not, the LCP's share is kept (a constant in the null
-!> space of the incidence) until the next event.
+!> limit while the LCP's forces do not, the share of least max |F_d| / (P mu_d) with the
+!> same resultant is kept (a constant in the null space of the incidence, found by
+!> bisection on box LCPs of shrunk bounds) until the next event: every force then has the
+!> widest margin to its limit that the loop allows. (The LCP's own share is a vertex of
+!> the box: a force on its limit, which crosses it again at once when the pattern's share
+!> grows beyond it; the same decision then came back every 1e-13 s, a run without end.)
 module fd_phase_decision
    use, intrinsic :: ieee_arithmetic, only: ieee_is_finite
    use fd_kinds, only: dp
@@ -73,7 +77,7 @@ contains
       integer :: nc, a, b, d, i, j, n, nd, ndg, lev, slot0, slot1, r, gi, gj, kk
       real(dp) :: xg, vg, ag, sc, f, fa
       type(lcp_info) :: info
-      logical :: any_viol
+      logical :: any_viol, centred
 
       n = st%n
       nd = st%nd
@@ -247,7 +251,8 @@ contains
       st%cur = slot1
       st%phase = st%newph
       changed = any(st%phase /= st%oldph)
-      ! redundant sticking devices: keep the LCP's share where the pattern's exceeds a limit
+      ! redundant sticking devices: where the pattern's share exceeds a limit, the share of
+      ! least max |F_d| / (P mu_d) (a closed loop); else the LCP's share
       if (nc > 0) then
          associate (pat => st%cache%slot(slot1))
             any_viol = .false.
@@ -257,13 +262,103 @@ contains
                if (abs(f) > st%slip(pat%ids(r)) + rtol_decision*(fa + st%slip(pat%ids(r)))) any_viol = .true.
             end do
             if (any_viol) then
-               do r = 1, pat%ns
-                  st%f0(r) = st%f0(r) + (st%zs(pat%ids(r)) - st%w(r))
-               end do
+               centred = .false.
+               if (pat%ns > n - pat%nq) call least_ratio_share(slot1, centred)
+               if (.not. centred) then
+                  do r = 1, pat%ns
+                     st%f0(r) = st%f0(r) + (st%zs(pat%ids(r)) - st%w(r))
+                  end do
+               end if
             end if
          end associate
       end if
    contains
+
+      !> Redundant sticking devices (more than the constraints they impose: a closed loop)
+      !> whose share by the force map (st%w(1:ns)) exceeds a limit: the forces F with the
+      !> same resultant B_S F and the least max |F_d| / (P mu_d), found by bisection on
+      !> lambda of the box LCP z in [-lambda P mu, lambda P mu], w = W (z - F) (w = 0 iff
+      !> B_S z = B_S F, W = B_S' M^-1 B_S); f0 takes the difference, projected on the null
+      !> space of B_S (the motion does not change). Every force is then inside its limits
+      !> by the widest margin the loop allows, so that the next crossing of a limit is a
+      !> real event or at least a finite time away, not the same instant again (a vertex of
+      !> the box, the LCP's share, sits on a limit and crosses it at once). done is false
+      !> when no share within the limits was found (the caller keeps the LCP's).
+      subroutine least_ratio_share(slot, done)
+         integer, intent(in) :: slot
+         logical, intent(out) :: done
+         real(dp), parameter :: lam_tol = 1.0e-9_dp   !! bisection's resolution of lambda
+         real(dp), parameter :: w_tol = 1.0e-10_dp    !! w = 0, relative to its terms
+         integer :: ns, aa, bb, it, ia
+         real(dp) :: lam, lam_lo, lam_hi, scale
+         logical :: feasible
+         type(lcp_info) :: inf
+
+         done = .false.
+         associate (pat => st%cache%slot(slot))
+            ns = pat%ns
+            ! the pattern's share F (lqa) and its resultant y = B_S F (pe)
+            st%pe = 0.0_dp
+            do aa = 1, ns
+               st%lqa(aa) = st%w(aa)
+               call add_device(model, pat%ids(aa), st%lqa(aa), st%pe)
+            end do
+            do aa = 1, ns
+               st%lq(aa) = -rel_over_mass(model, pat%ids(aa), st%pe, st%mass)
+               do bb = 1, ns
+                  st%wm(aa, bb) = delassus(model, pat%ids(aa), pat%ids(bb), st%mass)
+               end do
+            end do
+            lam_lo = 0.0_dp
+            lam_hi = 1.0_dp
+            lam = 1.0_dp
+            do it = 0, 60
+               if (it > 0) lam = 0.5_dp*(lam_lo + lam_hi)
+               do aa = 1, ns
+                  st%lo(aa) = -lam*st%slip(pat%ids(aa))
+                  st%hi(aa) = lam*st%slip(pat%ids(aa))
+               end do
+               call box_lcp_solve(st%lcp, st%wm(1:ns, 1:ns), st%lq(1:ns), st%lo(1:ns), st%hi(1:ns), st%z(1:ns), &
+                                  st%w(1:ns), inf)
+               feasible = inf%status == lcp_solved
+               if (feasible) then
+                  do aa = 1, ns
+                     scale = 0.0_dp
+                     do bb = 1, ns
+                        scale = scale + abs(st%wm(aa, bb))*(abs(st%z(bb)) + abs(st%lqa(bb)))
+                     end do
+                     if (abs(st%w(aa)) > w_tol*scale) feasible = .false.
+                  end do
+               end if
+               if (feasible) then
+                  lam_hi = lam
+                  st%zs(1:ns) = st%z(1:ns)
+                  done = .true.
+               else
+                  if (it == 0) exit
+                  lam_lo = lam
+               end if
+               if (lam_hi - lam_lo <= lam_tol) exit
+            end do
+            if (.not. done) then
+               st%w(1:ns) = st%lqa(1:ns)   ! the pattern's share, for the caller
+               return
+            end if
+            ! the difference, projected on the null space of B_S: c - D (B_S D)^+ B_S c
+            st%pe = 0.0_dp
+            do aa = 1, ns
+               st%zs(aa) = st%zs(aa) - st%lqa(aa)
+               call add_device(model, pat%ids(aa), st%zs(aa), st%pe)
+            end do
+            do aa = 1, ns
+               scale = st%zs(aa)
+               do ia = 1, n
+                  scale = scale - pat%pinv(aa, ia)*st%pe(ia)
+               end do
+               st%f0(aa) = st%f0(aa) + scale
+            end do
+         end associate
+      end subroutine least_ratio_share
 
       !> Find (or build) the pattern of the phases ph and enter it at the state.
       subroutine enter(ph, slot, err)
