@@ -110,6 +110,14 @@ def test_at2_units_gal_are_cm_s2(run):
     np.testing.assert_allclose(r.history()["ag"][:3], [0.0, 0.5, -1.2], rtol=1e-12)
 
 
+def test_at2_with_a_byte_order_mark(run):
+    """An AT2 file saved by an editor that writes a UTF-8 byte order mark reads as without."""
+    a = [0.0, 0.1, -0.2, 0.05, 0.0, 0.02]
+    plain = ok(run(oscillator(record_excitation("rec.AT2")), files={"rec.AT2": at2_text(a)}))
+    marked = ok(run(oscillator(record_excitation("rec.AT2")), files={"rec.AT2": "\ufeff" + at2_text(a)}))
+    assert np.array_equal(plain.history().data, marked.history().data)
+
+
 def test_commented_plain_record_is_not_taken_for_at2(run):
     """A one-value-a-line file whose '#' comments name NPTS and DT on its fourth line is
     read as 'values' (m/s2), not as an AT2 file in g."""

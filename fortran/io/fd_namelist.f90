@@ -58,8 +58,24 @@ contains
 
       deck%path = path
       call read_text_file(path, deck%lines, error)
-      if (allocated(error)) error%message = "deck: "//error%message
+      if (allocated(error)) then
+         error%message = "deck: "//error%message
+         return
+      end if
+      call drop_bom(deck)
    end subroutine load_deck
+
+   !> A UTF-8 byte order mark before the first line (some Windows editors write one) is no
+   !> text of the deck.
+   pure subroutine drop_bom(deck)
+      type(deck_text), intent(inout) :: deck
+      character(len=*), parameter :: bom = achar(239)//achar(187)//achar(191)
+
+      if (.not. allocated(deck%lines)) return
+      if (size(deck%lines) == 0) return
+      if (len(deck%lines(1)%s) < 3) return
+      if (deck%lines(1)%s(1:3) == bom) deck%lines(1)%s = deck%lines(1)%s(4:)
+   end subroutine drop_bom
 
    !> A deck given as text (lines separated by newlines); path names it in messages and
    !> is the base of relative record paths.
@@ -74,6 +90,7 @@ contains
       call split_lines(text, deck%lines, stat)
       if (stat /= 0 .and. present(error)) call fatal_error(error, path//": not enough memory for the lines "// &
                                                            "of the deck ("//trim(fmt_int(len(text)))//" bytes)")
+      if (stat == 0) call drop_bom(deck)
    end subroutine deck_from_string
 
    !> The group a line opens ('&name' or the legacy '$name' as its first word, after blanks

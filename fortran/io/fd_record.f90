@@ -75,6 +75,10 @@ contains
       call read_file_text(path, text, error)
       if (allocated(error)) return
       call sha256_text(text, info%sha256)
+      ! a UTF-8 byte order mark (some Windows editors write one) is no text of the record
+      if (len(text) >= 3) then
+         if (text(1:3) == achar(239)//achar(187)//achar(191)) text = text(4:)
+      end if
       fmt_used = lower(format)
       info%detected = fmt_used == 'auto'
       if (fmt_used == 'auto') call detect_format(path, text, fmt_used)

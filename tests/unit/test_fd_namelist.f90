@@ -59,6 +59,7 @@ contains
                   new_unittest("an element given twice in another form", test_twice_forms), &
                   new_unittest("a comment after a separator is no value", test_comment_no_value), &
                   new_unittest("a text not closed on its line", test_open_text), &
+                  new_unittest("a UTF-8 byte order mark before the first line", test_bom), &
                   new_unittest("the longest string of a variable", test_longest) &
                   ]
    end subroutine collect_namelist
@@ -531,6 +532,25 @@ contains
       call find_group(deck, 'model', grp, found, err)
       call check(error, .not. allocated(err), 'texts closed on their line')
    end subroutine test_open_text
+
+   !> A byte order mark (EF BB BF, written by some Windows editors) before '&model' is no
+   !> text outside a group; the same bytes elsewhere are (a non-breaking space's family).
+   subroutine test_bom(error)
+      type(error_type), allocatable, intent(out) :: error
+      character(len=*), parameter :: bom = achar(239)//achar(187)//achar(191)
+      type(deck_text) :: deck
+      type(group_text) :: grp
+      type(fd_error_type), allocatable :: err
+      logical :: found
+
+      call deck_from_string(bom//'&model n_dof = 1 /'//nl, 't.nml', deck)
+      call find_group(deck, 'model', grp, found, err)
+      call check(error, found .and. .not. allocated(err), 'the group after the mark is found')
+      if (allocated(error)) return
+      call deck_from_string('! x'//nl//bom//'&model n_dof = 1 /'//nl, 't.nml', deck)
+      call find_group(deck, 'model', grp, found, err)
+      call check(error, allocated(err), 'the bytes on another line are text outside a group')
+   end subroutine test_bom
 
    !> longest_string: quoted strings of a variable and its elements, a doubled quote counted
    !> once, other variables ignored; the line of the longest.
