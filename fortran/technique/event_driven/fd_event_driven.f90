@@ -133,8 +133,10 @@ contains
       call system_clock(c0, crate)
       call event_driven_check(model, exc, error)
       if (allocated(error)) return
-      ! the storeys' drifts and shears are output quantities after those of the state
-      call ed_setup(model, w%st, engineering_columns(model), error)
+      ! the storeys' drifts and shears are output quantities after those of the state, and
+      ! the base shear always (without storeys it has no history column, but its peak is
+      ! in the summary and is found exactly like the others)
+      call ed_setup(model, w%st, max(1, engineering_columns(model)), error)
       if (allocated(error)) return
       n = model%n_dof
       nd = model%n_devices
@@ -351,7 +353,7 @@ contains
          associate (st => w%st)
             nb = st%nbase
             ns = res%eng%n_storeys
-            if (st%nquant == nb .or. ns == 0) return
+            if (st%nquant == nb) return
             n1 = 3*st%n
             do m = 0, st%order
                w%cu = st%yc(m, 1:n1:3)
@@ -392,7 +394,9 @@ contains
                w%sd(dd) = dv
                w%ff(dd) = w%yv(iq_f(st%n, dd))
             end do
-            call observe_sample(w%obs, res, tr, ag, w%uu, w%vv, w%aa, w%ss, w%sd, w%ff, st%phase, w%env)
+            ! the maxima of the history's columns (without storeys, not the base shear's)
+            call observe_sample(w%obs, res, tr, ag, w%uu, w%vv, w%aa, w%ss, w%sd, w%ff, st%phase, &
+                                w%env(1:merge(st%nquant, st%nbase, res%eng%n_storeys > 0)))
             ! the storeys at the row: the values kept as residual ones at the last
             call observe_storeys(res, tr, w%uu, w%vv, w%ss, w%ff)
          end associate
