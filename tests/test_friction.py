@@ -306,6 +306,27 @@ def test_energy_balance_of_newmark_runs(run, law):
     assert abs(s["energy_residual_J"]) < 1e-10 * total
 
 
+@pytest.mark.parametrize("duration", [2.5, 3.0, 40.0])
+def test_stored_energy_is_the_springs_in_either_phase(run, duration):
+    """The hysteretic law's spring holds F^2 / (2 k), k = P mu / f, sliding as well as
+    sticking (eq. 3: it is released only when the force falls): energy_device_elastic_J is
+    that at the end (the run starts with F = 0), and the friction work is the rest of the
+    device work. (Before stop 31 a device sliding at the end stored nothing, and its
+    spring's energy, here P mu f / 2, was booked as friction.)"""
+    g = paper_groups(4, "hysteretic")
+    g["excitation"]["duration"] = duration
+    g["output"] = {"output_every": 1}
+    r = ok(run(g))
+    s, h = r.summary(), r.history()
+    pmu = g["friction"]["p"] * g["friction"]["mu"]
+    k = pmu / g["friction"].get("f", 1.0e-5)
+    f_end = h["F1"][-1]
+    assert s["energy_device_elastic_J"] == pytest.approx(f_end**2 / (2 * k), rel=1e-9)
+    parts = (s["energy_kinetic_J"] + s["energy_strain_J"] + s["energy_viscous_J"]
+             + s["energy_friction_J"] + s["energy_device_elastic_J"])
+    assert abs(s["energy_input_J"] - parts) < 1e-10 * s["energy_input_J"]
+
+
 def chain3(law, p):
     m = [3.0, 2.0, 1.5]
     return {

@@ -9,12 +9,13 @@ module fd_friction
    use fd_model, only: device_type, law_velocity, law_hysteretic, law_name, mu_constant
    use fd_device_state, only: device_state, job_init, job_update, job_correct
    use fd_friction_velocity, only: velocity_law, velocity_update, velocity_correct, velocity_settle, velocity_follow
-   use fd_friction_hysteretic, only: hysteretic_law, hysteretic_update, hysteretic_correct, hysteretic_settle
+   use fd_friction_hysteretic, only: hysteretic_law, hysteretic_update, hysteretic_correct, hysteretic_settle, &
+                                     hysteretic_energy
    implicit none
    private
 
    public :: friction_init, friction_update, friction_correct, friction_step, friction_settle
-   public :: follows_velocity, friction_follow
+   public :: follows_velocity, friction_follow, friction_energy
 
 contains
 
@@ -121,6 +122,21 @@ contains
          can = can .and. ok
       end do
    end subroutine friction_settle
+
+   !> Elastic energy a device stores at relative displacement s in its state (the hysteretic
+   !> law's spring; the velocity law stores none: its band is a dashpot).
+   elemental real(dp) function friction_energy(dev, st, s) result(e)
+      type(device_type), intent(in) :: dev      !! device parameters
+      type(device_state), intent(in) :: st      !! its state
+      real(dp), intent(in) :: s                 !! relative displacement [m]
+
+      select case (dev%law)
+      case (law_hysteretic)
+         e = hysteretic_energy(dev, st, s)
+      case default
+         e = 0.0_dp
+      end select
+   end function friction_energy
 
    !> Whether a device's sliding force depends on the velocity within a step (a velocity-law
    !> device with a speed-dependent mu): the time-step loop iterates such forces to the

@@ -21,8 +21,24 @@ module fd_friction_hysteretic
    private
 
    public :: hysteretic_law, hysteretic_init, hysteretic_update, hysteretic_correct, hysteretic_settle
+   public :: hysteretic_energy
 
 contains
+
+   !> Elastic energy stored in the device's spring: F^2 / (2 k) with k = P mu / f, in either
+   !> phase (eq. 3: sliding, the spring holds P mu; it is released only when the force falls).
+   elemental real(dp) function hysteretic_energy(dev, st, s) result(e)
+      type(device_type), intent(in) :: dev     !! device parameters
+      type(device_state), intent(in) :: st     !! its state
+      real(dp), intent(in) :: s                !! relative displacement [m]
+      real(dp) :: k, force
+
+      e = 0.0_dp
+      k = sticking_stiffness(dev)
+      if (k <= 0.0_dp) return
+      force = st%ks*s + st%f0          ! no damping in the law: the spring's force
+      e = 0.5_dp*force*force/k
+   end function hysteretic_energy
 
    !> The law's entry for the dispatch (fd_friction): init, update or correct, by job.
    elemental subroutine hysteretic_law(job, dev, n, s, sdot, sdot_old, st, changed, ok)

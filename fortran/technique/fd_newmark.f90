@@ -40,7 +40,8 @@ module fd_newmark
                         spd_c_matvec, spd_kc_matvec, spd_auto, spd_dense, spd_banded, spd_is_dense, spd_bandwidth, &
                         spd_copy
    use fd_device_state, only: device_state, device_force, phase_stick
-   use fd_friction, only: friction_init, friction_step, friction_settle, follows_velocity, friction_follow
+   use fd_friction, only: friction_init, friction_step, friction_settle, follows_velocity, friction_follow, &
+                          friction_energy
    use fd_result, only: result_type
    use fd_run_control, only: run_control
    use fd_observer, only: observer_type, observer_init, sample_due, observe_start_energies, observe_peaks, &
@@ -179,7 +180,7 @@ contains
       if (allocated(error)) return
       call consistent_acceleration(model, exc, 0.0_dp, w)
       call observe_start_energies(w%obs, 0.5_dp*sum(w%mass*w%v**2), strain_energy(model, w%u), &
-                                  device_energy(w%st, w%s))
+                                  device_energy(model, w%st, w%s))
       w%phase0 = w%st%phase
       res%started_sliding = any(w%phase0 /= phase_stick)
       call observe_sample(w%obs, res, 0.0_dp, w%ag, w%u, w%v, w%a, w%s, w%sd, w%f, w%phase0)
@@ -230,7 +231,7 @@ contains
       call alternation_finish(res)
       res%mu_passes = w%follow_passes
       call observe_end_energies(w%obs, res, 0.5_dp*sum(w%mass*w%v**2), strain_energy(model, w%u), &
-                                device_energy(w%st, w%s), &
+                                device_energy(model, w%st, w%s), &
                               w%w_device)
       do l = 1, size(w%lev)
          associate (stats => w%lev(l)%sys%stats)
@@ -990,16 +991,13 @@ contains
       e = 0.5_dp*e
    end function strain_energy
 
-   !> Elastic energy stored in devices whose phase has a stiffness (hysteretic sticking).
-   pure real(dp) function device_energy(st, s) result(e)
+   !> Elastic energy stored in the devices (each law's: fd_friction's friction_energy).
+   pure real(dp) function device_energy(model, st, s) result(e)
+      type(model_type), intent(in) :: model
       type(device_state), intent(in) :: st(:)
       real(dp), intent(in) :: s(:)
-      integer :: d
 
-      e = 0.0_dp
-      do d = 1, size(st)
-         if (st(d)%ks > 0.0_dp) e = e + 0.5_dp*st(d)%ks*(s(d) + st(d)%f0/st(d)%ks)**2
-      end do
+      e = sum(friction_energy(model%dev(1:size(st)), st, s))
    end function device_energy
 
 end module fd_newmark
