@@ -5,6 +5,7 @@ of the result files, and the accessors."""
 from __future__ import annotations
 
 import copy
+import dataclasses
 import io
 import shutil
 from concurrent.futures import ThreadPoolExecutor
@@ -363,3 +364,156 @@ def test_many_concurrent_runs_of_the_same_files_are_identical(tmp_path):
     for d, r in zip(work, results, strict=True):
         assert np.array_equal(r.data, serial[d].data)
         same_summary(r.summary, serial[d].summary)
+
+
+# --- the Python writer: what the user gave reaches the reader ----------------------------
+
+
+def quick(duration: float = 1.0, **kw) -> Analysis:
+    """short_analysis with any of its parts replaced."""
+    return dataclasses.replace(short_analysis(duration=duration), **kw)
+
+
+@pytest.mark.parametrize(
+    "given, lower",
+    [
+        (Damping("Stiffness", xi=0.05), Damping.stiffness(0.05)),
+        (Damping("stiffness ", xi=0.05), Damping.stiffness(0.05)),
+        (Damping("RAYLEIGH", rayleigh_a0=0.5, rayleigh_a1=0.002), Damping.rayleigh(0.5, 0.002)),
+    ],
+)
+def test_damping_type_in_any_case_damps_as_the_lower_case_deck(given, lower):
+    """The reader takes damping_type in any case: the values given must reach it (they were
+    dropped, and the run was undamped)."""
+    damped = quick(duration=1.0, damping=given).run()
+    same = quick(duration=1.0, damping=lower).run()
+    undamped = quick(duration=1.0, damping=Damping()).run()
+    assert damped.summary["peak_aabs_mps2"] == same.summary["peak_aabs_mps2"]
+    assert np.array_equal(damped.data, same.data)
+    assert damped.summary["damping_a1_s"] > 0
+    assert damped.summary["peak_aabs_mps2"] != undamped.summary["peak_aabs_mps2"]
+
+
+def test_write_deck_of_two_in_memory_records_keeps_each_its_own(tmp_path):
+    """Two decks written into one directory, each with a Record of values: each deck runs
+    its own record (the second used to overwrite the first's record.txt)."""
+    t = np.arange(201) * 0.005
+    a = quick(excitation=Record(0.005, values=2.0 * np.sin(2 * np.pi * t)))
+    b = quick(excitation=Record(0.005, values=0.5 * np.sin(6 * np.pi * t)))
+    a.write_deck(tmp_path / "a.nml")
+    b.write_deck(tmp_path / "b.nml")
+    ra, rb = frictiondyn.run(tmp_path / "a.nml"), frictiondyn.run(tmp_path / "b.nml")
+    assert np.array_equal(ra.data, a.run().data)
+    assert np.array_equal(rb.data, b.run().data)
+    assert ra.summary["record"]["peak_acc_mps2"] == 2.0
+    assert {p.name for p in tmp_path.glob("*.record.txt")} == {"a.record.txt", "b.record.txt"}
+
+
+@pytest.mark.parametrize("relative", [False, True])
+def test_run_never_writes_a_records_values_over_the_callers_file(tmp_path, monkeypatch, relative):
+    """Analysis.run writes a Record's values only inside its temporary directory."""
+    monkeypatch.chdir(tmp_path)
+    (tmp_path / "sub").mkdir()
+    mine = tmp_path / "sub" / "x.txt"
+    mine.write_text("1.0\n2.0\n3.0\n")
+    values = 0.7 * np.sin(2 * np.pi * np.arange(201) * 0.005)
+    file = "sub/x.txt" if relative else str(mine)
+    r = quick(excitation=Record(0.005, file=file, values=values)).run()
+    assert mine.read_text() == "1.0\n2.0\n3.0\n"
+    assert r.summary["record"]["peak_acc_mps2"] == pytest.approx(np.abs(values).max(), rel=1e-15)
+
+
+@pytest.mark.parametrize("name", ["h.csv", "h.dat", "history", "h.CSV", "a.b.csv"])
+def test_to_csv_and_from_files_name_the_summary_alike(tmp_path, name):
+    r = quick(duration=0.5).run()
+    other = quick(duration=0.5, damping=Damping()).run()
+    other.write_summary(tmp_path / "h.summary.json")  # another run's summary nearby
+    r.to_csv(tmp_path / name)
+    back = Result.from_files(tmp_path / name)
+    assert np.array_equal(back.data, r.data)
+    assert back.summary == r.summary
+    assert frictiondyn.read_history(tmp_path / name).summary == r.summary
+
+
+def test_from_files_without_its_summary_raises_unless_told(tmp_path):
+    r = quick(duration=0.5).run()
+    r.to_csv(tmp_path / "h.dat")
+    (tmp_path / "h.dat.summary.json").unlink()
+    with pytest.raises(FileNotFoundError, match="h.dat.summary.json"):
+        Result.from_files(tmp_path / "h.dat")
+    alone = Result.from_files(tmp_path / "h.dat", summary=False)
+    assert alone.summary == {} and np.array_equal(alone.data, r.data)
+
+
+def test_a_selection_left_at_none_keeps_the_decks_selection_of_that_kind():
+    a = quick(duration=0.5, output=Output(history_dofs=[2], history_devices=[]))
+    cols = lambda r: [n for n in r.names if n[:1] in "uvsFp" or n.startswith("aabs")]
+    assert cols(a.run()) == ["u2", "v2", "aabs2"]
+    assert cols(a.run(devices=[1])) == ["u2", "v2", "aabs2", "s1", "sdot1", "F1", "phase1"]
+    assert cols(a.run(dofs=[1])) == ["u1", "v1", "aabs1"]
+    with frictiondyn.Session.from_text(a.deck_text()) as s:
+        assert s.selection == ([2], [])
+        s.select(devices=[1]).select(dofs=[1])
+        assert s.selection == ([1], [1])
+
+
+@pytest.mark.parametrize(
+    "sel",
+    [
+        {"dofs": [1.9]},
+        {"dofs": [1.0]},
+        {"dofs": [True]},
+        {"dofs": np.array([2**32 + 2])},
+        {"dofs": np.array([-(2**32) + 1])},
+        {"dofs": [2, 1]},
+        {"dofs": [1, 1]},
+        {"dofs": 2},
+        {"dofs": "2"},
+        {"devices": [np.float64(1.0)]},
+        {"devices": [2]},
+    ],
+)
+def test_bad_history_selections_are_refused_not_coerced(sel):
+    (arg,) = sel
+    with pytest.raises(DeckError, match=f"history selection: {arg}"):
+        quick(duration=0.5).run(**sel)
+
+
+def test_a_non_integral_history_dof_in_output_is_refused():
+    with pytest.raises(DeckError, match="history_dofs must be an integer, not 1.7"):
+        quick(duration=0.5, output=Output(history_dofs=[1.7])).run()
+    with pytest.raises(DeckError, match="history_dofs must be an integer, not True"):
+        quick(duration=0.5, output=Output(history_dofs=[True])).deck_text()
+
+
+def test_a_dof_label_none_is_the_default_and_a_bare_string_is_refused():
+    r = quick(duration=0.5, labels=["roof", None]).run()
+    assert r.dof_labels == ["roof", "DOF 2"]
+    with pytest.raises(TypeError, match="labels must be a list"):
+        quick(duration=0.5, labels="ab").run()
+
+
+def test_paths_numpy_numbers_and_integral_floats_are_written_as_deck_values(tmp_path, monkeypatch):
+    monkeypatch.chdir(tmp_path)
+    values = 0.7 * np.sin(2 * np.pi * np.arange(201) * 0.005)
+    np.savetxt(tmp_path / "rec.txt", values, fmt="%.17e")
+    a = quick(
+        excitation=Record(0.005, file=Path("rec.txt")),
+        output=Output(dir=Path("outdir"), output_every=np.int64(2), n_modes=2.0),
+        integration=Integration(n1=20.0, n2=np.array(50)),
+    )
+    a.springs = [Spring(np.int64(1), np.int32(0), K1), Spring(2.0, 0, K2)]
+    a.devices = [Device(np.int64(1), np.int64(2), p=P, mu=MU, law="velocity")]
+    text = a.write_deck(tmp_path / "w.nml").read_text()
+    assert "record_file = 'rec.txt'" in text and "dir = 'outdir'" in text
+    assert "n1 = 20\n" in text and "n2 = 50\n" in text and "output_every = 2\n" in text
+    assert "node_i = 1, 2\n" in text
+    assert np.array_equal(frictiondyn.run(tmp_path / "w.nml").data, a.run().data)
+    for bad, field in [
+        (Integration(n1=20.5), "n1"),
+        (Integration(n2=True), "n2"),
+    ]:
+        with pytest.raises(DeckError, match=f"{field} must be an integer"):
+            quick(integration=bad).deck_text()
+    with pytest.raises(DeckError, match="node_i must be an integer, not 1.5"):
+        quick(devices=[Device(1.5, 2, p=P, mu=MU, law="velocity")]).deck_text()

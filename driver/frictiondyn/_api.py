@@ -12,7 +12,7 @@ allocates (``Result.data`` is a view of it), and only the DOFs and devices selec
 as the run goes instead. A solve runs in a worker thread when called from the main thread:
 Ctrl-C (in a terminal or a notebook) asks the library to stop, which it does within a poll
 (about 10 ms), and KeyboardInterrupt is raised; a ``progress(t, duration)`` callback is called
-about ten times a second meanwhile. The Fortran work runs without the GIL: runs in several
+about twenty times a second meanwhile. The Fortran work runs without the GIL: runs in several
 threads overlap.
 """
 
@@ -183,6 +183,41 @@ def _history_array(ncol: int, nout: int) -> np.ndarray:
     return np.empty((ncol, nout), dtype=np.float64, order="F")
 
 
+def _index_list(values: object, arg: str, what: str, n: int) -> np.ndarray:
+    """A history selection (``dofs``, ``devices``) as an int32 array, checked before any
+    conversion: a sequence (not a string) of integers (not bools; integral floats are
+    refused too) in 1..n, increasing without repeats, as a deck must give it."""
+    if isinstance(values, (str, bytes)) or np.ndim(values) != 1:
+        raise DeckError(
+            f"history selection: {arg} must be a list of {what} numbers, not {values!r}"
+        )
+    items = values.tolist() if isinstance(values, np.ndarray) else list(values)
+    out = []
+    for x in items:
+        if isinstance(x, np.generic):
+            x = x.item()
+        if isinstance(x, bool) or not isinstance(x, int):
+            raise DeckError(f"history selection: {arg}: {x!r} is not a {what} number (an integer)")
+        if not 1 <= x <= n:
+            raise DeckError(f"history selection: {arg}: {what} {x} is not in 1..{n}")
+        if out and x <= out[-1]:
+            raise DeckError(
+                f"history selection: {arg}: the {what}s must be given in increasing order "
+                f"without repeats ({out[-1]} then {x})"
+            )
+        out.append(x)
+    return np.array(out, dtype=np.int32)
+
+
+def _summary_path(csv: str | os.PathLike) -> Path:
+    """The summary JSON that goes with a history CSV: a ``.csv`` suffix (any case) replaced by
+    ``.summary.json``, any other name with ``.summary.json`` appended (``h.dat`` ->
+    ``h.dat.summary.json``), as the executable and ``to_csv`` name it."""
+    csv = Path(csv)
+    stem = csv.name[: -len(".csv")] if csv.name.lower().endswith(".csv") else csv.name
+    return csv.with_name(stem + ".summary.json")
+
+
 # the texts a session gives (fortran/fd_session.f90)
 _HEADER, _SUMMARY, _OUTPUT_DIR, _OUTPUT_NAME, _HISTORY_PATH, _SUMMARY_PATH, _DECK, _ERROR = range(
     1, 9
@@ -344,17 +379,36 @@ class Session:
     def select(
         self, dofs: Sequence[int] | None = None, devices: Sequence[int] | None = None
     ) -> Session:
-        """Keep only these DOFs and devices (1-based) in the history; None keeps all of them,
-        an empty list none. Before ``solve``; the summary still covers every DOF and device."""
+        """Keep only these DOFs and devices (1-based, increasing, no repeats) in the history;
+        None keeps the current selection of that kind (the deck's ``&output`` one, or the last
+        ``select``'s; every one when neither chose), an empty list none. Before ``solve``; the
+        summary still covers every DOF and device. A number that is not an integer (a bool, a
+        float, a string) or out of range, or a list out of order, raises DeckError."""
         with self._lock:
             h = self._live()
             n_dof, n_dev = self._sizes()
-            d = np.arange(1, n_dof + 1) if dofs is None else np.asarray(dofs, dtype=np.int32)
-            v = np.arange(1, n_dev + 1) if devices is None else np.asarray(devices, dtype=np.int32)
-            d, v = np.sort(d).astype(np.int32), np.sort(v).astype(np.int32)
+            cur_d, cur_v = self._selection(n_dof, n_dev)
+            d = cur_d if dofs is None else _index_list(dofs, "dofs", "DOF", n_dof)
+            v = cur_v if devices is None else _index_list(devices, "devices", "device", n_dev)
             _, status = _core.fd_session_select(h, d, v)
             self._check(status)
         return self
+
+    def _selection(self, n_dof: int, n_dev: int) -> tuple[np.ndarray, np.ndarray]:
+        """The DOFs and devices the history keeps now (int32 arrays)."""
+        d, nd, v, nv, status = _core.fd_session_selection(
+            self._handle, max(n_dof, 1), max(n_dev, 1)
+        )
+        self._check(status)
+        return np.array(d[: int(nd)], dtype=np.int32), np.array(v[: int(nv)], dtype=np.int32)
+
+    @property
+    def selection(self) -> tuple[list[int], list[int]]:
+        """(DOFs, devices) the history keeps now (the deck's, or ``select``'s)."""
+        with self._lock:
+            self._live()
+            d, v = self._selection(*self._sizes())
+        return [int(x) for x in d], [int(x) for x in v]
 
     def _sizes(self) -> tuple[int, int]:
         """(DOFs, devices) of the deck."""
@@ -393,7 +447,7 @@ class Session:
     def solve(self, progress: ProgressCallback | None = None, history: bool = True) -> Session:
         """Run the deck (once). ``history``: keep the history (the columns selected) in
         memory, in one numpy array that ``result`` wraps; False keeps only the summary (and
-        the streamed file). ``progress(t, duration)`` is called about ten times a second.
+        the streamed file). ``progress(t, duration)`` is called about twenty times a second.
         Ctrl-C stops the run within about 10 ms of the solver and raises KeyboardInterrupt.
         Raises SolverError when the analysis fails."""
         with self._lock:
@@ -522,8 +576,8 @@ def run(
 ) -> Result:
     """Run a namelist deck file and return its Result (no output file is written).
 
-    ``dofs``, ``devices``: keep only these (1-based) in the history (None: all; the summary
-    covers all). ``progress(t, duration)``: called about ten times a second. Ctrl-C stops
+    ``dofs``, ``devices``: keep only these (1-based, increasing) in the history (each None:
+    the deck's ``&output`` selection of that kind, all by default; the summary covers all). ``progress(t, duration)``: called about twenty times a second. Ctrl-C stops
     the run and raises KeyboardInterrupt. Raises DeckError for a missing, malformed or
     invalid deck, SolverError when the analysis fails.
     """
@@ -620,16 +674,27 @@ class Result:
         return cls(names, units, data, summary)
 
     @classmethod
-    def from_files(cls, csv: str | os.PathLike, summary: str | os.PathLike | None = None) -> Result:
-        """A Result from the executable's (or to_csv's) CSV and its summary JSON."""
+    def from_files(
+        cls, csv: str | os.PathLike, summary: str | os.PathLike | None | bool = None
+    ) -> Result:
+        """A Result from the executable's (or to_csv's) CSV and its summary JSON: ``summary``
+        None reads the one next to the CSV (``_summary_path``: ``h.csv`` ->
+        ``h.summary.json``, ``h.dat`` -> ``h.dat.summary.json``) and raises
+        FileNotFoundError when it is missing; False reads none (``summary`` is then {})."""
         csv = Path(csv)
         with csv.open() as fh:
             header = fh.readline().strip()
         data = np.loadtxt(csv, delimiter=",", skiprows=1, ndmin=2)
-        if summary is None:
-            candidate = csv.with_name(csv.name[: -len(".csv")] + ".summary.json")
-            summary = candidate if candidate.exists() else None
-        text = Path(summary).read_text().removesuffix("\n") if summary is not None else {}
+        if summary is False:
+            return cls.from_arrays(header, data, {})
+        if summary is None or summary is True:
+            summary = _summary_path(csv)
+            if not summary.exists():
+                raise FileNotFoundError(
+                    f"{csv}: no summary {summary.name} next to it (pass summary=False to read "
+                    "the history alone, or the summary's path)"
+                )
+        text = Path(summary).read_text().removesuffix("\n")
         return cls.from_arrays(header, data, text)
 
     @classmethod
@@ -791,10 +856,11 @@ class Result:
 
     def to_csv(self, path: str | os.PathLike) -> Path:
         """Write the history (header ``name[unit],...``, ``es24.16e3`` values) and the summary
-        next to it as <stem>.summary.json with the library's writer, exactly as the
-        executable does; each file goes to a temporary name renamed when complete."""
+        next to it (``<stem>.summary.json`` for ``<stem>.csv``, any case; ``<name>.summary.json``
+        for any other name, as ``from_files`` looks for it) with the library's writer, exactly
+        as the executable does; each file goes to a temporary name renamed when complete."""
         path = Path(path)
-        summary = path.with_name(path.name.removesuffix(".csv") + ".summary.json")
+        summary = _summary_path(path)
         with Session._adopt(self.data, self._header(), self.summary_json()) as session:
             session._write_files(path, summary, self.data)
         return path
@@ -820,9 +886,10 @@ class Result:
         return path
 
 
-def read_history(path: str | os.PathLike) -> Result:
-    """The executable's history CSV (with its summary JSON next to it, when present)."""
-    return Result.from_files(path)
+def read_history(path: str | os.PathLike, summary: str | os.PathLike | None | bool = None) -> Result:
+    """The executable's history CSV with its summary JSON (``Result.from_files``: the one next
+    to it by default, FileNotFoundError when missing; ``summary=False``: none)."""
+    return Result.from_files(path, summary)
 
 
 def read_summary(path: str | os.PathLike) -> dict:

@@ -246,6 +246,54 @@ contains
    include 'fd_core_common.inc'
 end subroutine fd_session_sizes
 
+!> The DOFs and devices the history keeps now: the deck's &output selection, or the last
+!> fd_session_select's (every one when neither selects). The buffers hold n_dof and
+!> n_devices numbers (fd_session_sizes; at least 1 each); ndofs, ndevices of them are set.
+subroutine fd_session_selection(handle, n_dof, n_devices, dofs, ndofs, devices, ndevices, status)
+   use, intrinsic :: iso_c_binding, only: c_int, c_int64_t
+   use fd_session, only: session_type, session_from_handle, session_read
+   use frictiondyn, only: error_type
+   use fd_error, only: fatal_error
+   implicit none
+   integer(c_int64_t), intent(in) :: handle      !! the session
+   integer(c_int), intent(in) :: n_dof           !! size of dofs
+   integer(c_int), intent(in) :: n_devices       !! size of devices
+   integer(c_int), intent(out) :: dofs(n_dof)    !! the DOFs kept (1..ndofs)
+   integer(c_int), intent(out) :: ndofs          !! how many
+   integer(c_int), intent(out) :: devices(n_devices) !! the devices kept (1..ndevices)
+   integer(c_int), intent(out) :: ndevices       !! how many
+   integer(c_int), intent(out) :: status         !! 0 or an error code
+   type(session_type), pointer :: s
+   type(error_type), allocatable :: error
+   integer :: i, nd, nv
+
+   dofs = 0; devices = 0; ndofs = 0; ndevices = 0
+   call session_from_handle(handle, s)
+   status = merge(0_c_int, 3_c_int, associated(s))
+   if (status /= 0) return
+   if (.not. s%from_deck .or. s%state < session_read) call fatal_error(error, 'the session holds no deck')
+   if (.not. allocated(error)) then
+      if (s%ctl%select_all) then
+         nd = s%cfg%model%n_dof; nv = s%cfg%model%n_devices
+      else
+         nd = size(s%ctl%dofs); nv = size(s%ctl%devices)
+      end if
+      if (nd > n_dof .or. nv > n_devices) call fatal_error(error, 'selection buffer too small')
+   end if
+   call keep_error(s, error, 3, status)
+   if (status /= 0) return
+   if (s%ctl%select_all) then
+      dofs(1:nd) = [(int(i, c_int), i=1, nd)]
+      devices(1:nv) = [(int(i, c_int), i=1, nv)]
+   else
+      dofs(1:nd) = int(s%ctl%dofs, c_int)
+      devices(1:nv) = int(s%ctl%devices, c_int)
+   end if
+   ndofs = int(nd, c_int); ndevices = int(nv, c_int)
+contains
+   include 'fd_core_common.inc'
+end subroutine fd_session_selection
+
 !> Write the history to the deck's output file as the run goes (fd_session_write commits it).
 subroutine fd_session_stream(handle, status)
    use, intrinsic :: iso_c_binding, only: c_int, c_int64_t

@@ -30,7 +30,7 @@ from collections.abc import Sequence
 from pathlib import Path
 
 from . import __version__
-from ._api import FrictiondynError, FrictiondynWarning, Result, Session, run, summary_warnings
+from ._api import FrictiondynError, FrictiondynWarning, Result, Session, _summary_path, run, summary_warnings
 
 __all__ = ["load_result", "main"]
 
@@ -52,8 +52,8 @@ def load_result(path: str | os.PathLike) -> Result:
         raise CliError(f"{p}: no such file")
     suffix = p.suffix.lower()
     try:
-        if suffix == ".csv":
-            return Result.from_files(p)
+        if suffix == ".csv":  # its summary when present (plots need none)
+            return Result.from_files(p, None if _summary_path(p).exists() else False)
         if suffix == ".npz":
             return Result.from_npz(p)
     except (OSError, ValueError, KeyError) as exc:

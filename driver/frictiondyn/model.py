@@ -19,7 +19,7 @@ from pathlib import Path
 import f90nml
 import numpy as np
 
-from ._api import Result, run_text
+from ._api import DeckError, Result, run_text
 
 __all__ = [
     "Analysis",
@@ -184,7 +184,8 @@ class Storey:
 class Damping:
     """Viscous damping: 'stiffness' (C = psi K, psi = T xi / pi; T computed when the period
     is not given), 'rayleigh' (C = a0 M + a1 K) or 'none'. Values left at None take the
-    reader's defaults."""
+    reader's defaults. The type and every value given are written as they are: the reader
+    takes the type in any case, and ignores a value the type does not use."""
 
     type: str = "none"
     xi: float | None = None
@@ -213,14 +214,17 @@ class Damping:
         return cls("rayleigh", xi=xi, mode_i=mode_i, mode_j=mode_j, mode_system=system)
 
     def group(self) -> dict:
-        g: dict = {"damping_type": self.type}
-        if self.type == "stiffness":
-            _put(g, xi=self.xi, period=self.period)
-        elif self.type == "rayleigh":
-            _put(g, rayleigh_a0=self.rayleigh_a0, rayleigh_a1=self.rayleigh_a1)
-            _put(
-                g, xi=self.xi, mode_i=self.mode_i, mode_j=self.mode_j, mode_system=self.mode_system
-            )
+        g: dict = {"damping_type": _value(self.type)}
+        _put(
+            g,
+            xi=self.xi,
+            period=self.period,
+            rayleigh_a0=self.rayleigh_a0,
+            rayleigh_a1=self.rayleigh_a1,
+            mode_i=_opt_int(self.mode_i, "mode_i"),
+            mode_j=_opt_int(self.mode_j, "mode_j"),
+            mode_system=self.mode_system,
+        )
         return g
 
 
@@ -235,13 +239,15 @@ class Harmonic:
     duration: float
     ramp_cycles: int | None = None
 
-    def group(self, directory: Path | None, cwd: Path | None = None) -> dict:
+    def group(
+        self, directory: Path | None, cwd: Path | None = None, record_name: str | None = None
+    ) -> dict:
         g: dict = {
             "excitation_type": "harmonic",
             "amplitude": float(self.amplitude),
             "frequency": float(self.frequency),
         }
-        _put(g, ramp_cycles=self.ramp_cycles)
+        _put(g, ramp_cycles=_opt_int(self.ramp_cycles, "ramp_cycles"))
         g.update(dt_record=float(self.dt_record), duration=float(self.duration))
         return g
 
@@ -249,25 +255,34 @@ class Harmonic:
 @dataclass
 class Record:
     """Recorded table acceleration (or displacement) sampled at dt_record: a file, or
-    values that are written to ``file`` next to the deck. kind, scale, duration: None takes
-    the reader's default (acceleration, 1, the whole record)."""
+    values that are written to a file for the run: by ``write_deck`` to ``file`` (relative
+    to the deck's directory), or when ``file`` is None to ``<deck stem>.record.txt`` next to
+    the deck; by ``run`` to a temporary directory (the base name of ``file``, or
+    ``<stem of run's name>.record.txt``). kind, scale, duration: None takes the reader's default (acceleration,
+    1, the whole record)."""
 
     dt_record: float
-    file: str = "record.txt"
+    file: str | os.PathLike | None = None
     values: np.ndarray | None = None
     kind: str | None = None
     scale: float | None = None
     duration: float | None = None
 
-    def group(self, directory: Path | None, cwd: Path | None = None) -> dict:
-        """The &excitation group; a Record with values writes them to ``directory/file``.
-        With ``cwd``, a relative file of a Record without values is made absolute against it
-        (``Analysis.run`` passes the caller's working directory)."""
-        file = self.file
+    def group(
+        self, directory: Path | None, cwd: Path | None = None, record_name: str | None = None
+    ) -> dict:
+        """The &excitation group; a Record with values writes them to ``directory`` under
+        ``record_name`` (default: ``file``, or ``record.txt``). With ``cwd``, a relative file
+        of a Record without values is made absolute against it (``Analysis.run`` passes the
+        caller's working directory)."""
+        file = None if self.file is None else os.fspath(self.file)
         if self.values is not None:
             if directory is None:
                 raise ValueError("a Record with values needs a directory to write its file")
-            np.savetxt(directory / self.file, np.asarray(self.values, float), fmt="%.17e")
+            file = record_name or file or "record.txt"
+            np.savetxt(Path(directory) / file, np.asarray(self.values, float), fmt="%.17e")
+        elif file is None:
+            raise DeckError("a Record needs a file or values")
         elif cwd is not None and not os.path.isabs(file):
             file = os.fspath(Path(cwd) / file)
         g: dict = {"excitation_type": "record", "record_file": file}
@@ -284,7 +299,9 @@ class FreeVibration:
     dt_record: float
     duration: float
 
-    def group(self, directory: Path | None, cwd: Path | None = None) -> dict:
+    def group(
+        self, directory: Path | None, cwd: Path | None = None, record_name: str | None = None
+    ) -> dict:
         return {
             "excitation_type": "none",
             "dt_record": float(self.dt_record),
@@ -320,8 +337,8 @@ class Integration:
             technique=self.technique,
             beta=self.beta,
             gamma=self.gamma,
-            n1=self.n1,
-            n2=self.n2,
+            n1=_opt_int(self.n1, "n1"),
+            n2=_opt_int(self.n2, "n2"),
             n=self.n,
             check_correctness=self.check_correctness,
             dt_min=self.dt_min,
@@ -352,26 +369,57 @@ class Output:
             g,
             dir=self.dir,
             name=self.name,
-            output_every=self.output_every,
+            output_every=_opt_int(self.output_every, "output_every"),
             write_history=self.write_history,
-            n_modes=self.n_modes,
+            n_modes=_opt_int(self.n_modes, "n_modes"),
         )
         for key in ("history_dofs", "history_devices"):
             value = getattr(self, key)
             if value is not None:
-                g[key] = [int(x) for x in value] if len(value) else 0
+                if isinstance(value, (str, bytes)) or np.ndim(value) != 1:
+                    raise DeckError(f"&output {key} must be a list of numbers, not {value!r}")
+                g[key] = [_int(x, key) for x in value] if len(value) else 0
         return g
 
 
 def _value(x: object) -> object:
-    """A value as the deck holds it (numpy scalars to Python's)."""
-    if isinstance(x, (bool, np.bool_)):
+    """A value as the deck holds it (numpy scalars and 0-d arrays to Python's, a path to its
+    str)."""
+    if isinstance(x, np.ndarray) and x.ndim == 0:
+        x = x.item()
+    if isinstance(x, np.generic):
+        x = x.item()
+    if isinstance(x, os.PathLike):
+        return os.fspath(x)
+    if isinstance(x, bool):
         return bool(x)
-    if isinstance(x, (int, np.integer)):
+    if isinstance(x, int):
         return int(x)
-    if isinstance(x, (float, np.floating)):
+    if isinstance(x, float):
         return float(x)
+    if isinstance(x, str):
+        return str(x)
     return x
+
+
+def _int(x: object, name: str) -> int:
+    """An integer setting (a node, n1, output_every, ...) as a Python int: a numpy integer or
+    an integral float (20.0) is converted; a bool or a non-integral value raises DeckError
+    naming the setting."""
+    v = _value(x)
+    if isinstance(v, float) and v.is_integer():
+        return int(v)
+    if isinstance(v, int) and not isinstance(v, bool):
+        return v
+    raise DeckError(f"{name} must be an integer, not {x!r}")
+
+
+def _opt_int(x: object, name: str) -> int | None:
+    return None if x is None else _int(x, name)
+
+
+def _nodes(items: list, key: str) -> list[int]:
+    return [_int(getattr(x, key), key) for x in items]
 
 
 def _put(group: dict, **values: object) -> None:
@@ -460,16 +508,18 @@ class Analysis:
     storeys: list[Storey] = field(default_factory=list)
     labels: list[str] | None = None  #: a name per DOF ('floor 3')
 
-    def namelist(self, directory: Path | None = None, cwd: Path | None = None) -> f90nml.Namelist:
+    def namelist(
+        self, directory: Path | None = None, cwd: Path | None = None, record_name: str | None = None
+    ) -> f90nml.Namelist:
         """The deck as an f90nml Namelist (writes a Record's values into directory; with
         cwd, a relative record file is made absolute against it)."""
         nml = f90nml.Namelist()
-        for name, values in self.groups(directory, cwd):
+        for name, values in self.groups(directory, cwd, record_name):
             nml[name] = f90nml.Namelist(values)
         return nml
 
     def groups(
-        self, directory: Path | None = None, cwd: Path | None = None
+        self, directory: Path | None = None, cwd: Path | None = None, record_name: str | None = None
     ) -> list[tuple[str, dict]]:
         """The deck's groups and their values, in order (writes a Record's values into
         directory; with cwd, a relative record file is made absolute against it)."""
@@ -480,13 +530,16 @@ class Analysis:
         if self.v0 is not None:
             model["v0"] = [float(x) for x in self.v0]
         if self.labels is not None:
-            model["label"] = [str(x) for x in self.labels]
+            if isinstance(self.labels, (str, bytes)):
+                raise TypeError(f"labels must be a list (a label per DOF), not {self.labels!r}")
+            # None: the default label of that DOF (a null value in the deck)
+            _per_device(model, "label", [None if x is None else str(x) for x in self.labels])
         groups = [("model", model)]
         springs = {"n_springs": len(self.springs)}
         if self.springs:
             springs.update(
-                node_i=[s.node_i for s in self.springs],
-                node_j=[s.node_j for s in self.springs],
+                node_i=_nodes(self.springs, "node_i"),
+                node_j=_nodes(self.springs, "node_j"),
                 k=[float(s.k) for s in self.springs],
             )
         groups.append(("springs", springs))
@@ -495,8 +548,8 @@ class Analysis:
             d = self.devices
             friction = {
                 "n_devices": len(d),
-                "node_i": [x.node_i for x in d],
-                "node_j": [x.node_j for x in d],
+                "node_i": _nodes(d, "node_i"),
+                "node_j": _nodes(d, "node_j"),
                 "law": [x.law for x in d],
                 "p": [float(x.p) for x in d],
             }
@@ -506,8 +559,8 @@ class Analysis:
             b = self.braces
             braces = {
                 "n_braces": len(b),
-                "node_i": [x.node_i for x in b],
-                "node_j": [x.node_j for x in b],
+                "node_i": _nodes(b, "node_i"),
+                "node_j": _nodes(b, "node_j"),
                 "slip_load": [float(x.slip_load) for x in b],
                 "stiffness": [float(x.stiffness) for x in b],
             }
@@ -518,8 +571,8 @@ class Analysis:
             s = self.isolators
             isolators = {
                 "n_isolators": len(s),
-                "node_i": [x.node_i for x in s],
-                "node_j": [x.node_j for x in s],
+                "node_i": _nodes(s, "node_i"),
+                "node_j": _nodes(s, "node_j"),
                 "law": [x.law for x in s],
                 "weight": [float(x.weight) for x in s],
             }
@@ -529,10 +582,12 @@ class Analysis:
         if self.storeys:
             st = self.storeys
             storeys: dict = {"n_storeys": len(st)}
-            for key in ("node_i", "node_j", "spring", "height", "label"):
+            for key in ("node_i", "node_j", "spring"):
+                _per_device(storeys, key, [_opt_int(getattr(x, key), key) for x in st])
+            for key in ("height", "label"):
                 _per_device(storeys, key, [getattr(x, key) for x in st])
             groups.append(("storeys", storeys))
-        groups.append(("excitation", self.excitation.group(directory, cwd)))
+        groups.append(("excitation", self.excitation.group(directory, cwd, record_name)))
         integration = self.integration.group()
         if integration:
             groups.append(("integration", integration))
@@ -541,17 +596,27 @@ class Analysis:
             groups.append(("output", out))
         return groups
 
-    def deck_text(self, directory: Path | None = None, cwd: Path | None = None) -> str:
-        """The deck as namelist text (writes a Record's values into directory; with cwd, a
-        relative record file is made absolute against it)."""
+    def deck_text(
+        self, directory: Path | None = None, cwd: Path | None = None, record_name: str | None = None
+    ) -> str:
+        """The deck as namelist text (writes a Record's values into directory, under
+        record_name or the Record's file; with cwd, a relative record file is made absolute
+        against it)."""
         return "\n".join(
-            _group_text(name, values) for name, values in self.groups(directory, cwd)
+            _group_text(name, values)
+            for name, values in self.groups(directory, cwd, record_name)
         )
 
     def write_deck(self, path: str | os.PathLike) -> Path:
-        """Write the deck (and a Record's values next to it) for the executable."""
+        """Write the deck (and a Record's values next to it: to its ``file``, or when that is
+        None to ``<deck stem>.record.txt``, so that decks written into one directory do not
+        share one record file) for the executable."""
         path = Path(path)
-        path.write_text(self.deck_text(path.parent))
+        name = None
+        ex = self.excitation
+        if isinstance(ex, Record) and ex.values is not None and ex.file is None:
+            name = path.stem + ".record.txt"
+        path.write_text(self.deck_text(path.parent, record_name=name))
         return path
 
     def run(
@@ -562,13 +627,22 @@ class Analysis:
         progress: Callable[[float, float], object] | None = None,
     ) -> Result:
         """Run through the extension (no deck file needed; a Record's values go to a
-        temporary directory for the duration of the run; a Record's relative ``file`` is
-        the caller's, relative to the current working directory). ``dofs``, ``devices``,
-        ``progress``: as for ``frictiondyn.run``."""
+        temporary directory for the duration of the run, under the base name of its
+        ``file``: no file of the caller's is written; a Record's relative ``file`` without
+        values is the caller's, relative to the current working directory). ``dofs``,
+        ``devices``, ``progress``: as for ``frictiondyn.run`` (each None: the ``output``'s
+        history_dofs, history_devices)."""
         kw = {"dofs": dofs, "devices": devices, "progress": progress}
         cwd = Path.cwd()
         if not isinstance(self.excitation, Record) or self.excitation.values is None:
             return run_text(self.deck_text(None, cwd), name=name, base_dir=".", **kw)
+        file = self.excitation.file
+        # only inside the temporary directory: a file given with a directory (absolute or
+        # not) is never written to
+        # (no file: named as write_deck names it, <stem of name>.record.txt)
+        default = Path(name).stem + ".record.txt"
+        record_name = default if file is None else (Path(os.fspath(file)).name or default)
         with tempfile.TemporaryDirectory() as tmp:
             directory = Path(tmp)
-            return run_text(self.deck_text(directory, cwd), name=name, base_dir=directory, **kw)
+            text = self.deck_text(directory, cwd, record_name)
+            return run_text(text, name=name, base_dir=directory, **kw)
