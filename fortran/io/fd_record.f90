@@ -362,7 +362,7 @@ contains
             cycle
          end if
          if (after_units .and. (w == 'OF' .or. w == 'IN' .or. w == 'ARE' .or. w == 'IS')) cycle
-         units = known_unit(w)
+         units = trim(known_unit(w))
          if (after_units) then
             if (len(units) == 0) units = lower(w)
             return
@@ -373,9 +373,10 @@ contains
          if (pos > len(h3)) exit
       end do
    contains
+      !> (fixed-length text, trimmed where used: README's rule on character results)
       pure function known_unit(w) result(u)
          character(len=*), intent(in) :: w
-         character(len=:), allocatable :: u
+         character(len=8) :: u
          select case (w)
          case ('G')
             u = 'g'
