@@ -530,3 +530,28 @@ def test_moreau_jean_out_of_memory_is_an_error_not_a_crash(tmp_path):
     assert code == "1", r.stdout + r.stderr
     assert "star.nml" in err and "not enough memory" in err and "8000" in err, err
     assert not (tmp_path / "out").exists()
+
+
+def test_no_character_function_with_an_allocatable_result():
+    """README's rule for the Fortran library: no function with a character(len=:),
+    allocatable result. gfortran 12 keeps such a result's length in a static variable of
+    the caller, and runs side by side in threads then mix their texts up (stop 30's warning
+    texts did: test_many_concurrent_runs_of_the_same_files_are_identical failed once in CI).
+    Every function's result declaration in fortran/ and the extension is read."""
+    root = ROOT
+    sources = sorted((root / "fortran").rglob("*.f90")) + sorted((root / "driver").rglob("*.f90"))
+    assert len(sources) > 40
+    head = re.compile(r"^\s*(?:(?:pure|elemental|recursive|impure)\s+)*(?:[\w(),= ]+\s+)?function\s+(\w+)"
+                      r"\s*\([^)]*\)\s*(?:result\s*\(\s*(\w+)\s*\))?", re.I | re.M)
+    bad = []
+    for f in sources:
+        text = f.read_text(errors="replace")
+        for m in head.finditer(text):
+            name, res = m.group(1), m.group(2) or m.group(1)
+            end = re.search(r"^\s*end\s+function", text[m.end():], re.I | re.M)
+            body = text[m.end(): m.end() + (end.start() if end else 0)]
+            decl = re.compile(r"character\s*\(\s*len\s*=\s*:\s*\)\s*,\s*allocatable[^\n!]*::[^\n!]*\b"
+                              + re.escape(res) + r"\b", re.I)
+            if decl.search(body):
+                bad.append(f"{f.relative_to(root)}: {name}")
+    assert not bad, bad
