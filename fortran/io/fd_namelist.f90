@@ -436,10 +436,10 @@ contains
       n = 0
       do i = first, last
          c1 = 1
-         c2 = len(deck%lines(i)%s)
+         c2 = len_trim(grp%lines(i - first + 1))    ! its comment blanked above
          if (i == first) c1 = sp%name_end + 1
          if (i == last) c2 = sp%last_col - 1
-         call append_line(deck%lines(i)%s(1:c2), c1, body, line_of, n, i)
+         call append_line(grp%lines(i - first + 1)(1:max(c2, c1 - 1)), c1, body, line_of, n, i)
       end do
       call split_items(body(1:n), line_of(1:n), grp%items, grp%item_line, stat)
       if (stat /= 0) then
@@ -539,8 +539,8 @@ contains
          end do
          if (r1 > r0 .and. len_trim(bases(order(r0))) > 0) then
             do q = r0 + 1, r1
-               do p = r0, q - 1
-                  if (r1 - r0 >= pairwise_max .and. p < q - 1) exit   ! a very long run: neighbours only
+               ! each earlier one; in a very long run its neighbour only (deck order)
+               do p = merge(q - 1, r0, r1 - r0 >= pairwise_max), q - 1
                   ip = order(p); iq = order(q)
                   if (.not. same_elements(trim(names(ip)), trim(names(iq)))) cycle
                   if (i == 0 .or. iq < i) then
@@ -777,7 +777,7 @@ contains
       end do
    end subroutine item_variable
 
-   !> Append a deck line, from column c1, to the body of a group without its comment.
+   !> Append a group's line (its comment blanked), from column c1, to the group's body.
    pure subroutine append_line(line, c1, body, line_of, n, lineno)
       character(len=*), intent(in) :: line
       integer, intent(in) :: c1
@@ -785,11 +785,9 @@ contains
       integer, intent(inout) :: line_of(:)          !! deck line of each character
       integer, intent(inout) :: n                   !! characters used
       integer, intent(in) :: lineno
-      integer :: i, last
+      integer :: i
 
-      last = comment_column(line, c1) - 1
-      if (last < 0) last = len(line)
-      do i = c1, last
+      do i = c1, len(line)
          n = n + 1
          body(n:n) = line(i:i)
          line_of(n) = lineno

@@ -459,6 +459,7 @@ contains
       type(deck_text) :: deck
       type(group_text) :: grp
       type(fd_error_type), allocatable :: err
+      character(len=:), allocatable :: text
       logical :: found
       integer :: k
 
@@ -482,6 +483,23 @@ contains
          call check(error, .not. allocated(err), 'not a repeat: '//trim(apart(k)))
          if (allocated(error)) return
       end do
+      ! 2100 elements one by one (beyond the pairwise comparison: neighbours in deck order),
+      ! the last given again at once
+      text = '&model'//nl
+      do k = 1, 2100
+         text = text//'mass('//trim(fmt_k(k))//') = 1.0'//nl
+      end do
+      call deck_from_string(text//'mass(2100) = 2.0'//nl//'/'//nl, 't.nml', deck)
+      call find_group(deck, 'model', grp, found, err)
+      call check(error, allocated(err), 'a repeat in a run of 2101 assignments')
+      if (allocated(error)) return
+      call check(error, index(err%message, "line 2102: 'mass(2100)' is assigned again") > 0, err%message)
+   contains
+      function fmt_k(i) result(t)
+         integer, intent(in) :: i
+         character(len=12) :: t
+         write (t, '(i0)') i
+      end function fmt_k
    end subroutine test_twice_forms
 
    !> gfortran's namelist reader takes a separator followed by a comment and the end of the
