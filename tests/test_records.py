@@ -188,7 +188,7 @@ AT2_BAD = [
     ("DT in milliseconds", at2_text([0.1] * 6, dt="5 MSEC").replace(" SEC\n", "\n", 1),
      ["line 4", "DT is followed by 'MSEC'", "seconds"]),
     ("units unknown", at2_text([0.1] * 6, units="FT/S2"),
-     ["line 3", "units of 'ft/s2'", "set record_units"]),
+     ["line 3", "units of 'ft/s2'", "convert the record"]),
     ("three header lines", "H1\nH2\nACCELERATION TIME SERIES IN UNITS OF G\n",
      ["ends at line 3", "four header lines"]),
 ]

@@ -258,17 +258,18 @@ contains
       end if
       call header_units(h3, declared)
       if (len(declared) > 0) then
+         ! units the header declares must be known (record_units given or not: a record_units
+         ! that contradicted a unit not known here would go unnoticed)
          call units_factor(declared, is_displacement, f_declared, ok_declared)
-         if (len(units) == 0 .and. .not. ok_declared) then
+         if (.not. ok_declared) then
             call fatal_error(error, where//": the header declares units of '"//declared//"' ('"// &
                              trim(text(hlo(3):hhi(3)))//"'), which are not units of a"// &
                              trim(merge(' displacement ', 'n acceleration', is_displacement))// &
-                             " record known here; set record_units, one of "//record_units_list)
+                             " record known here ("//record_units_list//"): convert the record")
             return
          end if
-         ! record_units given: it must say what the header says ('gal' is 'cm/s2'); a header
-         ! whose units are not known here leaves record_units to say them
-         if (len(units) > 0 .and. ok_declared) then
+         ! record_units given: it must say what the header says ('gal' is 'cm/s2')
+         if (len(units) > 0) then
             call units_factor(units, is_displacement, f_given, ok)
             if (.not. ok .or. f_given /= f_declared) then
                call fatal_error(error, where//": the header declares units of '"//declared//"' but record_units = '"// &
@@ -370,7 +371,6 @@ contains
          ! without UNITS: only spellings that are no ordinary word ('G' and 'M' are left alone)
          if (len(units) > 0 .and. w /= 'G' .and. w /= 'M') return
          units = ''
-         if (pos > len(h3)) exit
       end do
    contains
       !> (fixed-length text, trimmed where used: README's rule on character results)
