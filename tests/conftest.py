@@ -2,6 +2,7 @@
 
 from __future__ import annotations
 
+import os
 import subprocess
 import sys
 from dataclasses import dataclass
@@ -159,3 +160,20 @@ def steady_amplitude(t: np.ndarray, x: np.ndarray, freq: float, cycles: int) -> 
     a = np.column_stack([np.sin(w * t[m]), np.cos(w * t[m])])
     coef, *_ = np.linalg.lstsq(a, x[m], rcond=None)
     return float(np.hypot(*coef))
+
+
+@pytest.fixture
+def small_fs(tmp_path):
+    """A 160 KiB tmpfs (mounted as root); unmounted afterwards."""
+    if os.geteuid() != 0:
+        pytest.skip("mounting a tmpfs needs root (CI runs as root)")
+    mnt = tmp_path / "fs"
+    mnt.mkdir()
+    r = subprocess.run(["mount", "-t", "tmpfs", "-o", "size=160k", "tmpfs", str(mnt)],
+                       capture_output=True, text=True)
+    if r.returncode != 0:
+        pytest.skip(f"cannot mount a tmpfs here: {r.stderr.strip()}")
+    try:
+        yield mnt
+    finally:
+        subprocess.run(["umount", "-l", str(mnt)], check=False)

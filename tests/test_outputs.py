@@ -6,7 +6,6 @@ SIGINT); the executable's command line (--list/--index, --version, --help)."""
 from __future__ import annotations
 
 import json
-import os
 import signal
 import subprocess
 import time
@@ -85,23 +84,6 @@ def test_threads_writing_one_name_through_the_library(tmp_path):
         assert set(pool.map(one, [a, b] * 40)) == {0}
     pair_is_consistent(tmp_path / "out")
     assert leftovers(tmp_path / "out") == []
-
-
-@pytest.fixture
-def small_fs(tmp_path):
-    """A 160 KiB tmpfs (mounted as root); unmounted afterwards."""
-    if os.geteuid() != 0:
-        pytest.skip("mounting a tmpfs needs root (CI runs as root)")
-    mnt = tmp_path / "fs"
-    mnt.mkdir()
-    r = subprocess.run(["mount", "-t", "tmpfs", "-o", "size=160k", "tmpfs", str(mnt)],
-                       capture_output=True, text=True)
-    if r.returncode != 0:
-        pytest.skip(f"cannot mount a tmpfs here: {r.stderr.strip()}")
-    try:
-        yield mnt
-    finally:
-        subprocess.run(["umount", "-l", str(mnt)], check=False)
 
 
 def test_full_file_system_fails_with_a_message_and_keeps_earlier_outputs(tmp_path, small_fs):

@@ -18,6 +18,7 @@ threads overlap.
 
 from __future__ import annotations
 
+import contextlib
 import json
 import os
 import threading
@@ -874,15 +875,33 @@ class Result:
         return path
 
     def to_npz(self, path: str | os.PathLike) -> Path:
-        """Write names, units, data and the summary (as JSON) to a .npz file."""
+        """Write names, units, data and the summary (as JSON) to a .npz file (``.npz`` is
+        added to a name without it, as numpy does) and return its path. The file is written
+        under a temporary name in the same folder and renamed when complete, so that an
+        earlier file of the name is replaced whole or not at all. Raises OutputError (naming
+        the file and the system's reason) when it cannot be written; nothing is left then."""
         path = Path(path)
-        np.savez(
-            path,
-            names=np.array(self.names),
-            units=np.array([self.units[n] for n in self.names]),
-            data=self.data,
-            summary=np.array(self.summary_json()),
-        )
+        if path.suffix != ".npz":
+            path = path.with_name(path.name + ".npz")
+        tmp = path.with_name(f".{path.name}.{os.getpid()}.{threading.get_ident()}.tmp")
+        try:
+            with open(tmp, "xb") as f:
+                np.savez(
+                    f,
+                    names=np.array(self.names),
+                    units=np.array([self.units[n] for n in self.names]),
+                    data=self.data,
+                    summary=np.array(self.summary_json()),
+                )
+                f.flush()
+                os.fsync(f.fileno())
+            os.replace(tmp, path)
+        except BaseException as e:
+            with contextlib.suppress(OSError):
+                tmp.unlink(missing_ok=True)
+            if isinstance(e, OSError):
+                raise OutputError(f"cannot write '{path}': {e.strerror or e}") from None
+            raise
         return path
 
 

@@ -4,11 +4,16 @@ module fd_error
    implicit none
    private
 
-   public :: error_type, fatal_error, fmt_real, fmt_int, stat_no_memory
+   public :: error_type, fatal_error, fmt_real, fmt_int, stat_no_memory, stat_output
 
    !> The stat of an error raised because memory could not be had (an allocation the size
    !> of the input failed): the caller may tell it from a bad input.
    integer, parameter :: stat_no_memory = 5
+
+   !> The stat of an error raised because a file could not be written (its system reason:
+   !> a full disk, a quota, a file-size limit, a permission): the caller may tell it from a
+   !> bad input or a failure of the solver, whichever step met it.
+   integer, parameter :: stat_output = 4
 
    !> An error raised by the library, handed back to the caller.
    type :: error_type

@@ -4,7 +4,7 @@
 !> Every function returns 0 or an errno; os_error turns one into an error naming what failed.
 module fd_fileops
    use, intrinsic :: iso_c_binding, only: c_char, c_int, c_long, c_null_char
-   use fd_error, only: error_type, fatal_error
+   use fd_error, only: error_type, fatal_error, stat_output
    implicit none
    private
 
@@ -75,13 +75,13 @@ module fd_fileops
 
 contains
 
-   !> An error naming what failed and the system's reason (errno text).
+   !> An error naming what failed and the system's reason (errno text), of stat_output.
    subroutine os_error(error, what, err)
       type(error_type), allocatable, intent(out) :: error !! the error
       character(len=*), intent(in) :: what                !! what failed
       integer(c_int), intent(in) :: err                   !! its errno
       character(kind=c_char, len=256) :: buf
       call c_errno_text(err, buf, int(len(buf), c_int))
-      call fatal_error(error, what//": "//buf(1:max(0, index(buf, c_null_char) - 1)))
+      call fatal_error(error, what//": "//buf(1:max(0, index(buf, c_null_char) - 1)), stat_output)
    end subroutine os_error
 end module fd_fileops
