@@ -145,7 +145,7 @@ def test_executable_and_cli_warn(tmp_path, run):
     deck = one_dof(4.0).write_deck(tmp_path / "stiff.nml")
     r = ok(run(deck.read_text(), name="stiff"))
     assert WARNING in r.stderr
-    assert "omega_max dt1 = 4.00 > 2" in r.stderr
+    assert "omega_max_dt1 = 4.00 > 2" in r.stderr
     assert r.summary()["mode_resolution"] == "unresolved"
     err = io.StringIO()
     with contextlib.redirect_stderr(err), contextlib.redirect_stdout(io.StringIO()):

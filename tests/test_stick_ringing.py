@@ -128,7 +128,7 @@ def test_the_warning_is_where_the_step_decides_the_slides(run):
     assert s[24]["stick_ringing_ratio"][1] > 2
     assert s[24]["stick_margin_N"][1] == 0.0  # its worst stick phase ends in a slide
     assert WARNING + " 2 " in runs[24].stderr
-    assert "stick_ringing_ratio = " in runs[24].stderr and "larger n1" in runs[24].stderr
+    assert "stick_ringing_ratio = " in runs[24].stderr and "raise n1" in runs[24].stderr
     # the other devices have no sticking spring
     assert [s[24]["stick_ringing_ratio"][d] for d in (0, 2, 3)] == [0.0, 0.0, 0.0]
     assert s[96]["stick_to_slip"] == s[192]["stick_to_slip"]

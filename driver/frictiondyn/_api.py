@@ -21,6 +21,7 @@ from __future__ import annotations
 import contextlib
 import json
 import os
+import sys
 import threading
 import time
 import warnings
@@ -115,6 +116,19 @@ def summary_warnings(summary: dict) -> list[str]:
     energy, and one by the average acceleration rule whose energy balance misses round-off
     (digits lost). A summary written by an older build, without the key, has none."""
     return [str(w) for w in summary.get("warnings", [])]
+
+
+def _user_stacklevel() -> int:
+    """The ``stacklevel`` for a warning issued by the caller of this function that points at
+    the first frame outside this package: the user's line (``fd.run(...)``, a script or a
+    notebook cell), not the package's own call."""
+    here = Path(__file__).resolve().parent
+    frame = sys._getframe(1)  # the function that issues the warning: stacklevel 1
+    level = 1
+    while frame is not None and Path(frame.f_code.co_filename).resolve().parent == here:
+        frame = frame.f_back
+        level += 1
+    return level
 
 
 # the status codes of the extension (driver/frictiondyn/_core.f90)
@@ -530,7 +544,7 @@ class Session:
             )
             deck = self._text(_DECK)
         for message in summary_warnings(result.summary):
-            warnings.warn(f"{deck}: {message}", FrictiondynWarning, stacklevel=2)
+            warnings.warn(f"{deck}: {message}", FrictiondynWarning, stacklevel=_user_stacklevel())
         return result
 
     def write(self, out: str | os.PathLike | None = None) -> tuple[Path | None, Path]:

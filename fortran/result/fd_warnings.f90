@@ -6,8 +6,9 @@
 !> the highest modes, a harmonic table motion's steady state or a record's peak linear
 !> response, a sticking spring's ringing that the step dephases, a velocity-law band's force
 !> left alternating, and an energy balance that misses (more than 5 %, or beyond round-off
-!> with the average acceleration rule). The figures are those of the summary's keys, which
-!> each text names.
+!> with the average acceleration rule). Each is one line: what happened, with the figures of
+!> the summary key it names, what to change, and the section of docs/warnings.md that
+!> explains it.
 module fd_warnings
    use fd_kinds, only: dp
    use fd_error, only: fmt_int
@@ -35,97 +36,73 @@ contains
 
       allocate (w(0))
       if (res%violations > 0) then
-         s = trim(fmt_int(res%violations))//' step(s) violate the correctness condition (eqs. 9, 12); first at t ='
-         do k = 1, res%n_violation_times         ! the first max_violation_times kept
+         s = trim(fmt_int(res%violations))//' step(s) violate the correctness condition (eqs. 9, 12), first at t ='
+         do k = 1, min(3, res%n_violation_times)   ! the first three; the summary keeps more
             s = s//' '//trim(fx(res%violation_time(k), 6))
-            if (k < res%n_violation_times) s = s//','
+            if (k < min(3, res%n_violation_times)) s = s//','
          end do
-         call push(w, s//' s')
+         if (res%n_violation_times > 3) s = s//', ...'
+         call push(w, s//' s (correctness_violations): lower dt_min or widen eps, eps1'//trim(see('correctness')))
       end if
       if (res%mu_unconverged > 0) then
-         call push(w, trim(fmt_int(res%mu_unconverged))//' step(s) could not take a speed-dependent mu at '// &
-                  'the velocity at their end, first at t = '//trim(es(res%mu_unconverged_time, 3))// &
-                  ' s (mu_unconverged_steps, mu_unconverged_s): the fixed point f0 = P mu(|s''|) of such a '// &
-                  'step contracts by about rho = P |dmu/dv| gamma h / m_r a pass and converges within its '// &
-                  'passes for rho below about 0.6; here it did not (its last pass still changed a force by '// &
-                  trim(es(res%mu_misfit, 3))//' of P mu); those steps hold mu at their start instead, an error of '// &
-                  'first order in the step: the mu curve is too steep for the step: raise n1 or lower '// &
-                  'dt_min, and keep check_correctness on (such a step is then refined)')
+         call push(w, trim(fmt_int(res%mu_unconverged))//' step(s) could not take a speed-dependent mu at their '// &
+                  'end velocity, first at t = '//trim(es(res%mu_unconverged_time, 3))//' s (mu_unconverged_'// &
+                  'steps, last change '//trim(es(res%mu_misfit, 3))//' of P mu): raise n1 or lower dt_min'// &
+                  trim(see('mu-unconverged')))
       end if
       if (res%mode_resolution == resolution_unresolved) then
          call push(w, 'dt1 = '//trim(es(res%dt1, 3))//' s does not resolve the highest modes (shortest period '// &
-                  trim(es(2*acos(-1.0_dp)/res%omega_max, 3))//' s, omega_max dt1 = '//trim(fx(res%omega_max*res%dt1, 2))// &
-                  ' > 2): their response has the wrong period; peak absolute accelerations may carry it '// &
-                  '(drifts and shears much less); raise n1 until omega_max dt1 <= 2 to resolve them')
+                  trim(es(2*acos(-1.0_dp)/res%omega_max, 3))//' s, omega_max_dt1 = '// &
+                  trim(fx(res%omega_max*res%dt1, 2))//' > 2): peak accelerations may be off; raise n1'// &
+                  trim(see('mode-resolution')))
       end if
       if (res%harmonic_resolution == resolution_unresolved) then
          d = maxloc(res%harmonic_error, 1)
          call push(w, 'dt1 = '//trim(es(res%dt1, 3))//' s takes '//trim(fx(1.0_dp/(res%eng%frequency*res%dt1), 2))// &
-                  ' steps in a period of the table''s motion: the step alone moves the linear steady-state '// &
-                  'amplitude of DOF '//trim(fmt_int(d))//' by '//trim(fx(100*res%harmonic_error(d), 1))// &
-                  ' % (harmonic_step_error > 0.05, the stuck or the free system); the response has the '// &
-                  'wrong amplitude; raise n1')
+                  ' steps a table period: the step alone moves the linear steady-state amplitude of DOF '// &
+                  trim(fmt_int(d))//' by '//trim(fx(100*res%harmonic_error(d), 1))//' % (harmonic_step_error > 0.05); '// &
+                  'raise n1'//trim(see('harmonic-resolution')))
       end if
       if (res%record_resolution == resolution_unresolved) then
          d = maxloc(res%record_error, 1)
          call push(w, 'dt1 = '//trim(es(res%dt1, 3))//' s does not resolve the record: the step alone moves the peak '// &
                   'linear response of DOF '//trim(fmt_int(d))//' by '//trim(fx(100*res%record_error(d), 1))// &
-                  ' % (record_step_error > 0.05, '//trim(record_system_text(res%record_system))//'); the modes '// &
-                  'near the record''s dominant frequencies have the wrong period and the response the '// &
-                  'wrong amplitude; raise n1')
+                  ' % (record_step_error > 0.05, '//trim(record_system_text(res%record_system))//'); raise n1'// &
+                  trim(see('record-resolution')))
       end if
       if (res%stick_resolution == resolution_unresolved) then
          d = maxloc(res%stick_ringing_ratio, 1)
          more = count(res%stick_ringing_ratio > 1.0_dp) - 1
          call push(w, 'the sticking spring of device '//trim(fmt_int(d))//' rings with '// &
                   trim(es(res%stick_ringing(d), 3))//' N against a margin of '//trim(es(res%stick_margin(d), 3))// &
-                  ' N to sliding, and dt1 = '//trim(es(res%dt1, 3))//' s puts its frequency '// &
-                  trim(fx(100*abs(res%stick_freq_error(d)), 2))//' % off, enough to dephase that ringing within '// &
-                  'a stick phase (stick_ringing_ratio = '//trim(fx(res%stick_ringing_ratio(d), 2))//' > 1): its '// &
-                  'stick-slip transitions may depend on the step; check with a larger n1 (halving dt1 '// &
-                  'quarters that error)'//trim(likewise(more, 'stick_ringing_ratio')))
+                  ' N, dephased by dt1 (stick_ringing_ratio = '//trim(fx(res%stick_ringing_ratio(d), 2))//' > 1'// &
+                  trim(likewise(more))//'): raise n1'//trim(see('stick-ringing')))
       end if
       if (res%band_resolution == resolution_unresolved) then
          d = maxloc(res%band_alternation, 1)
          more = count(res%band_alternation > 0.0_dp) - 1
          if (res%band_x(d) > 1.0_dp) then
-            s = 'raise n1 until dt1 < '//trim(es(res%dt1/res%band_x(d), 3))//' s (x < 1) or widen eps (exact '// &
-                'Coulomb friction, law = ''coulomb'' with technique = ''event_driven'', has no band)'
+            s = 'raise n1 until dt1 < '//trim(es(res%dt1/res%band_x(d), 3))//' s or widen eps'
          else
-            s = 'with x <= 1 another mode the step does not resolve drives it (a stiff spring, a hysteretic '// &
-                'device''s sticking spring: see mode_resolution and stick_resolution): raise n1'
+            s = 'another mode the step does not resolve drives it; raise n1'
          end if
-         call push(w, 'the force of device '//trim(fmt_int(d))//' alternates from step to step in its velocity '// &
-                  'band or at its edge, by +-'//trim(es(res%band_alternation(d), 3))//' N for '// &
-                  trim(es(res%band_alternation_time(d), 3))//' s in all (band_alternation_N, band_alternation_s): '// &
-                  'Newmark''s rule damps the band''s coupling only where x = (1 - gamma) dt1 (c_i / m_i + '// &
-                  'c_j / m_j) < 1 (c_n: the couplings P mu / eps of the velocity-law devices at its node n; '// &
-                  '(P mu / eps) dt1 / (2 m_r) for a device alone and average acceleration), and here x = '// &
-                  trim(es(res%band_x(d), 3))//'; the device''s force history and the absolute accelerations of its '// &
-                  'nodes carry the alternation (with average acceleration, its displacements do not): '//s// &
-                  trim(likewise(more, 'band_alternation_N')))
+         call push(w, 'the force of device '//trim(fmt_int(d))//' alternates step to step in its band '// &
+                  '(band_alternation_N = +-'//trim(es(res%band_alternation(d), 3))//' N, x = '// &
+                  trim(es(res%band_x(d), 3))//trim(likewise(more))//'): '//s//trim(see('band-alternation')))
       end if
       if (res%energy_balance == balance_digits) then
-         call push(w, 'the energy balance of the average acceleration rule closes at round-off, and this run''s '// &
-                  'residual is '//trim(es(abs(res%e_residual_ratio), 1))//' of the energy the structure held and '// &
-                  'received (|energy_residual_ratio| > '//trim(es(roundoff_ratio_limit, 1))//'): the integration '// &
-                  'lost digits to round-off, typically in a coupling far stiffer than dt1 resolves: a '// &
-                  'velocity-law band whose P mu / eps is huge for its masses (x = (P mu / eps) dt1 / (2 m_r) '// &
-                  '>> 1, m_r the reduced mass of its two nodes, leaves an alternating force in the band), or a '// &
-                  'very stiff spring; its forces and accelerations, and possibly its displacements, carry that '// &
-                  'error: widen eps or soften the coupling; a larger n1 helps only once it brings x below 1 '// &
-                  '(the alternating force can outlast this warning; band_resolution reports it)')
+         call push(w, 'the integration lost digits to round-off (|energy_residual_ratio| = '// &
+                  trim(es(abs(res%e_residual_ratio), 1))//' > '//trim(es(roundoff_ratio_limit, 1))// &
+                  '): a coupling too stiff for dt1; widen eps or soften it'//trim(see('energy-round-off')))
       else if (res%energy_balance /= balance_closed) then
          if (res%energy_balance == balance_dissipative) then
-            s = 'numerical damping (Newmark gamma > 1/2, Moreau-Jean theta > 1/2) the physics does not have; '// &
-                'the motion carries it: raise n1 (it shrinks with dt1) or use gamma = theta = 1/2'
+            s = 'numerical damping (gamma or theta > 1/2); raise n1 or use gamma = theta = 1/2'
          else
-            s = 'an energy error of the step (Newmark beta /= 1/4, or a step beyond its rule''s stability '// &
-                'limit) the physics does not have; the motion carries it: raise n1 or use beta = 1/4'
+            s = 'an energy error of the step (Newmark beta /= 1/4 or unstable); raise n1 or use beta = 1/4'
          end if
          call push(w, 'the integration '//trim(merge('dissipated', 'created   ', res%e_residual_ratio > 0.0_dp))// &
-                  ' '//trim(fx(100*abs(res%e_residual_ratio), 1))//' % of the energy the structure held and '// &
-                  'received (|energy_residual_ratio| > '//trim(fx(residual_ratio_limit, 2))//'): '//s)
+                  ' '//trim(fx(100*abs(res%e_residual_ratio), 1))//' % of the energy (|energy_residual_ratio| > '// &
+                  trim(fx(residual_ratio_limit, 2))//'): '//s//trim(see('energy-balance')))
       end if
    end subroutine run_warnings
 
@@ -157,25 +134,32 @@ contains
 
       select case (system)
       case (record_system_stuck)
-         s = 'the stuck system: no device slid'
+         s = 'stuck system'
       case (record_system_free)
-         s = 'the free system: a device slid'
+         s = 'free system'
       case (record_system_both)
-         s = 'the larger of the stuck and the free system: no device slid, one is velocity-law'
+         s = 'stuck and free'
       case default
-         s = 'the structure'
+         s = 'structure'
       end select
    end function record_system_text
 
-   !> " (n more device(s) likewise: summary key)", or nothing when n = 0.
-   pure function likewise(n, key) result(s)
+   !> ", n more device(s)" when n > 0, or nothing.
+   pure function likewise(n) result(s)
       integer, intent(in) :: n
-      character(len=*), intent(in) :: key
-      character(len=160) :: s
+      character(len=40) :: s
 
       s = ''
-      if (n > 0) s = ' ('//trim(fmt_int(n))//' more device(s) likewise: summary '//key//')'
+      if (n > 0) s = ', '//trim(fmt_int(n))//' more device(s)'
    end function likewise
+
+   !> The pointer to a warning's explanation: "; see docs/warnings.md#<anchor>".
+   pure function see(anchor) result(s)
+      character(len=*), intent(in) :: anchor
+      character(len=64) :: s
+
+      s = '; see docs/warnings.md#'//anchor
+   end function see
 
    !> x in scientific notation with d digits after the point (1.234E-03), left-adjusted; a
    !> three-digit exponent without its E (1.000+300), as Fortran writes it; NaN, Infinity.

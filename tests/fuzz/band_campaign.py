@@ -106,7 +106,7 @@ def run_deck(c: dict, n1: int, every: int, timeout: float) -> dict:
             "rc": 0,
             "s": {k: summary[k] for k in KEEP},
             "h": {n: data[:, i] for i, n in enumerate(names)},
-            "other_warning": any("alternates from step to step" not in w for w in warnings),
+            "other_warning": any("alternates step to step" not in w for w in warnings),
         }
     finally:
         shutil.rmtree(where, ignore_errors=True)
