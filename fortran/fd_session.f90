@@ -17,7 +17,7 @@
 !> another may call session_cancel (the solver stops within a poll, ~10 ms, with an error of
 !> stat_cancelled; a streamed file is removed) and session_progress (the time reached).
 module fd_session
-   use, intrinsic :: iso_c_binding, only: c_int, c_int64_t, c_intptr_t, c_ptr, c_loc, c_f_pointer
+   use, intrinsic :: iso_c_binding, only: c_int, c_int64_t, c_intptr_t, c_long_long, c_ptr, c_loc, c_f_pointer
    use fd_kinds, only: dp
    use fd_error, only: error_type, fatal_error, fmt_int
    use frictiondyn, only: run_config, result_type, read_deck, read_deck_string, run_config_solve, &
@@ -26,7 +26,7 @@ module fd_session
    use fd_run_control, only: progress_callback, control_reset
    use fd_history_stream, only: stream_close, stream_discard
    use fd_output, only: make_dir, temp_output_paths, remove_made_dirs
-   use fd_fileops, only: c_getpid
+   use fd_tempfiles, only: temp_tag, remove_stale_temps
    implicit none
    private
 
@@ -176,8 +176,7 @@ contains
       logical, intent(in), optional :: keep               !! hold the history in the session
                                                           !! (default: unless streamed)
       type(error_type), allocatable :: close_error
-      character(len=:), allocatable :: htmp, stmp
-      character(len=40) :: addr
+      character(len=:), allocatable :: htmp, stmp, hist, summ
 
       call need(s, session_read, 'solve', error)
       if (allocated(error)) return
@@ -195,11 +194,11 @@ contains
             s%state = state_failed
             return
          end if
-         if (.not. allocated(s%tag)) then
-            ! unique while the session lives: the process and the session's address
-            write (addr, '(i0,"-",z0)') c_getpid(), transfer(c_loc(s), 0_c_intptr_t)
-            s%tag = trim(addr)
-         end if
+         ! unique while the session lives: the process, its machine and the session's address
+         if (.not. allocated(s%tag)) call temp_tag(int(transfer(c_loc(s), 0_c_intptr_t), c_long_long), s%tag)
+         call output_paths(s%cfg%out, hist, summ)
+         call remove_stale_temps(hist)   ! those of killed writers of the name
+         call remove_stale_temps(summ)
          call temp_output_paths(s%cfg%out, s%tag, htmp, stmp)
          s%ctl%stream_path = htmp
       end if

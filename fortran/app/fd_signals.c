@@ -54,16 +54,3 @@ void fd_app_clear_temps(void)
 {
     n_temps = 0;
 }
-
-/* A tag for temporary names unique to this process on this cluster: host and pid. */
-void fd_app_tag(char *buf, int len)
-{
-    char host[256] = "host";
-    if (gethostname(host, sizeof host) != 0)
-        strcpy(host, "host");
-    host[sizeof host - 1] = '\0';
-    for (char *c = host; *c; c++)
-        if (*c == '/' || *c == '.')
-            *c = '_';
-    snprintf(buf, (size_t)len, "%s-%ld", host, (long)getpid());
-}

@@ -12,7 +12,7 @@
 !> progress line is shown on standard error.
 program frictiondyn_main
    use, intrinsic :: iso_fortran_env, only: error_unit, output_unit
-   use, intrinsic :: iso_c_binding, only: c_char, c_int, c_null_char
+   use, intrinsic :: iso_c_binding, only: c_char, c_int, c_long_long, c_null_char
    use fd_kinds, only: dp
    use frictiondyn, only: error_type, output_paths, temp_output_paths
    use fd_session, only: session_type, session_open, session_stream, session_solve, session_write, &
@@ -20,6 +20,7 @@ program frictiondyn_main
    use fd_progress_line, only: progress_wanted, progress_show, progress_clear
    use fd_version, only: frictiondyn_version
    use fd_warnings, only: warning_text, run_warnings
+   use fd_tempfiles, only: temp_tag
    implicit none
 
    interface
@@ -32,17 +33,11 @@ program frictiondyn_main
       end function register_temps
       subroutine clear_temps() bind(c, name='fd_app_clear_temps')
       end subroutine clear_temps
-      subroutine app_tag(buf, length) bind(c, name='fd_app_tag')
-         import :: c_char, c_int
-         character(kind=c_char), intent(out) :: buf(*)
-         integer(c_int), value :: length
-      end subroutine app_tag
    end interface
 
    type(session_type), target :: ses
    type(error_type), allocatable :: error
    character(len=:), allocatable :: deck, list, index_text, arg, hist, summ, htmp, stmp, tag
-   character(kind=c_char, len=300) :: tagbuf
    type(warning_text), allocatable :: warns(:)
    integer :: nargs, i, idx, ios
    interface
@@ -98,8 +93,7 @@ program frictiondyn_main
 
    ! the temporary outputs, registered for the signal handler before they exist: the history
    ! is written under its temporary name as the run goes, and committed with the summary
-   call app_tag(tagbuf, int(len(tagbuf), c_int))
-   tag = tagbuf(1:index(tagbuf, c_null_char) - 1)
+   call temp_tag(0_c_long_long, tag)
    call temp_output_paths(ses%cfg%out, tag, htmp, stmp)
    if (register_temps(htmp//c_null_char, stmp//c_null_char) /= 0) &
       call fail(deck//": output path too long: '"//htmp//"'")

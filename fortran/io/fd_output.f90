@@ -3,7 +3,7 @@
 !> name unique to the writer and the pair is committed under a lock (write_outputs); on
 !> any error no output file is left behind and earlier outputs of the name stay.
 module fd_output
-   use, intrinsic :: iso_c_binding, only: c_char, c_int, c_long, c_null_char
+   use, intrinsic :: iso_c_binding, only: c_char, c_int, c_long, c_long_long, c_null_char
    use fd_kinds, only: dp
    use fd_error, only: error_type, fatal_error, fmt_int, fmt_real
    use fd_model, only: model_type, output_type, law_name, technique_name
@@ -14,8 +14,9 @@ module fd_output
    use fd_history_stream, only: format_row, stream_value_width
    use fd_names, only: excitation_types, keyword_len
    use fd_matrices, only: modes_type, modes_flexible, modes_rigid, modes_unrestrained
-   use fd_fileops, only: c_lock_acquire, c_lock_release, c_unlink, c_rename, os_error, c_getpid, &
+   use fd_fileops, only: c_lock_acquire, c_lock_release, c_unlink, c_rename, os_error, &
                          c_file_create, c_file_write, c_file_close
+   use fd_tempfiles, only: temp_tag, remove_stale_temps
    implicit none
    private
 
@@ -73,15 +74,13 @@ contains
       hidden = path(1:slash)//'.'//path(slash + 1:)//suffix
    end subroutine hidden_name
 
-   !> A tag for temporary names: the process id and a random number (the names are also
-   !> created exclusively, so two writers never share one).
+   !> A tag for temporary names: the process, its machine and a random number (temp_tag; the
+   !> names are also created exclusively, so two writers never share one).
    subroutine default_tag(tag)
-      character(len=:), allocatable, intent(out) :: tag  !! e.g. '12345-3f9a0c1d'
-      character(len=32) :: buf
+      character(len=:), allocatable, intent(out) :: tag  !! e.g. '12345_node07_3f9a0c1d'
       real(dp) :: r
       call random_number(r)
-      write (buf, '(i0,"-",z8.8)') c_getpid(), int(r*2147483647.0_dp)
-      tag = trim(buf)
+      call temp_tag(int(r*2147483647.0_dp, c_long_long), tag)
    end subroutine default_tag
 
    !> Write the history (when out%history) and the summary of a run into out%dir (created
@@ -137,6 +136,8 @@ contains
 
       have = .false.
       if (present(streamed)) have = streamed .and. present(tag)
+      call remove_stale_temps(hist_path)   ! those of killed writers of the name
+      call remove_stale_temps(summ_path)
       do attempt = 1, 10
          if (present(tag)) then
             mytag = tag
