@@ -177,3 +177,18 @@ def small_fs(tmp_path):
         yield mnt
     finally:
         subprocess.run(["umount", "-l", str(mnt)], check=False)
+
+
+def chain(n: int, duration: float, *, name: str = "run", out: str = "out", n1: int = 2) -> dict:
+    """Deck groups of n masses (100 kg) in a chain of springs (4e4 N/m) under a harmonic
+    table motion (10 mm, 2 Hz), damped, every dt1 step in the history `out`/`name`."""
+    return {
+        "model": {"n_dof": n, "mass": [100.0] * n},
+        "springs": {"n_springs": n, "node_i": list(range(1, n + 1)), "node_j": list(range(n)),
+                    "k": [4.0e4] * n},
+        "damping": {"damping_type": "rayleigh", "rayleigh_a0": 0.2},
+        "excitation": {"excitation_type": "harmonic", "amplitude": 0.01, "frequency": 2.0,
+                       "dt_record": 0.01, "duration": duration},
+        "integration": {"n1": n1},
+        "output": {"name": name, "output_every": 1, "dir": out},
+    }

@@ -6,22 +6,11 @@ from __future__ import annotations
 import frictiondyn as fd
 import numpy as np
 import pytest
-from conftest import deck_text
+from conftest import chain, deck_text
 
 
 def oscillator(duration: float, out: str) -> dict:
-    """Ten masses in a chain under a harmonic table motion, every dt1 step in the history."""
-    n = 10
-    return {
-        "model": {"n_dof": n, "mass": [100.0] * n},
-        "springs": {"n_springs": n, "node_i": list(range(1, n + 1)), "node_j": list(range(n)),
-                    "k": [4.0e4] * n},
-        "damping": {"damping_type": "rayleigh", "rayleigh_a0": 0.2},
-        "excitation": {"excitation_type": "harmonic", "amplitude": 0.01, "frequency": 2.0,
-                       "dt_record": 0.01, "duration": duration},
-        "integration": {"n1": 2},
-        "output": {"name": "osc", "output_every": 1, "dir": out},
-    }
+    return chain(10, duration, name="osc", out=out)
 
 
 def test_to_npz_adds_the_suffix_and_reads_back(tmp_path):

@@ -14,25 +14,14 @@ from pathlib import Path
 
 import frictiondyn as fd
 import pytest
-from conftest import deck_text
+from conftest import chain, deck_text
 
 EXE = fd.executable()
 HOST = socket.gethostname().replace("/", "-").replace(".", "-").replace("_", "-")
 
 
-def chain(duration: float) -> dict:
-    """Twenty masses in a chain under a harmonic table motion, every dt1 step kept."""
-    n = 20
-    return {
-        "model": {"n_dof": n, "mass": [100.0] * n},
-        "springs": {"n_springs": n, "node_i": list(range(1, n + 1)), "node_j": list(range(n)),
-                    "k": [4.0e4] * n},
-        "damping": {"damping_type": "rayleigh", "rayleigh_a0": 0.2},
-        "excitation": {"excitation_type": "harmonic", "amplitude": 0.01, "frequency": 2.0,
-                       "dt_record": 0.01, "duration": duration},
-        "integration": {"n1": 10},
-        "output": {"name": "run", "output_every": 1, "dir": "out"},
-    }
+def chain20(duration: float) -> dict:
+    return chain(20, duration, n1=10)
 
 
 def hidden(out: Path) -> list[str]:
@@ -50,7 +39,7 @@ def wait_for_temp(proc: subprocess.Popen, out: Path) -> None:
 
 def test_a_killed_executables_temporaries_go_with_the_next_run_and_no_others(tmp_path):
     deck = tmp_path / "run.nml"
-    deck.write_text(deck_text(chain(3000.0)))
+    deck.write_text(deck_text(chain20(3000.0)))
     out = tmp_path / "out"
     p = subprocess.Popen([EXE, "run.nml"], cwd=tmp_path, stdout=subprocess.DEVNULL,
                          stderr=subprocess.DEVNULL)
@@ -68,7 +57,7 @@ def test_a_killed_executables_temporaries_go_with_the_next_run_and_no_others(tmp
     (out / f".run.summary.json.{p.pid}_{HOST}_1.tmp").mkdir()
     keep.append(f".run.summary.json.{p.pid}_{HOST}_1.tmp")
     (out / f".run.summary.json.{p.pid}_{HOST}_2.tmp").write_text("{")  # stale too
-    deck.write_text(deck_text(chain(0.5)))
+    deck.write_text(deck_text(chain20(0.5)))
     r = subprocess.run([EXE, "run.nml"], cwd=tmp_path, capture_output=True, text=True)
     assert r.returncode == 0, r.stderr
     assert hidden(out) == sorted(keep)
@@ -77,7 +66,7 @@ def test_a_killed_executables_temporaries_go_with_the_next_run_and_no_others(tmp
 
 def test_a_python_stream_ended_by_sigterm_is_cleaned_by_the_next_session(tmp_path):
     deck = tmp_path / "run.nml"
-    deck.write_text(deck_text(chain(3000.0)))
+    deck.write_text(deck_text(chain20(3000.0)))
     out = tmp_path / "out"
     code = f"""
 import frictiondyn as fd
@@ -91,7 +80,7 @@ with fd.Session({str(deck)!r}) as s:
     p.send_signal(signal.SIGTERM)
     assert p.wait(30) == -signal.SIGTERM
     assert len(hidden(out)) == 1  # Python's default SIGTERM ends the process at once
-    deck.write_text(deck_text(chain(0.5)))
+    deck.write_text(deck_text(chain20(0.5)))
     with fd.Session(deck) as s:
         s.stream(out)
         s.solve(history=False)
@@ -103,8 +92,8 @@ with fd.Session({str(deck)!r}) as s:
 def test_a_live_writers_temporary_is_never_taken(tmp_path):
     """A long run streams its history; a short run of the same name writes meanwhile: the
     long run's temporary survives, and the long run, stopped by SIGTERM, cleans up itself."""
-    (tmp_path / "long.nml").write_text(deck_text(chain(3000.0)))
-    (tmp_path / "short.nml").write_text(deck_text(chain(0.5)))
+    (tmp_path / "long.nml").write_text(deck_text(chain20(3000.0)))
+    (tmp_path / "short.nml").write_text(deck_text(chain20(0.5)))
     out = tmp_path / "out"
     p = subprocess.Popen([EXE, "long.nml"], cwd=tmp_path, stdout=subprocess.DEVNULL,
                          stderr=subprocess.DEVNULL)
