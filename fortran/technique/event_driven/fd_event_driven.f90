@@ -83,6 +83,11 @@ module fd_event_driven
       real(dp) :: last_accumulation = -huge(1.0_dp)       !! time of the last accumulation point
       real(dp) :: burst_t0 = -huge(1.0_dp)                !! first event of the current window
       integer :: burst_n = 0                              !! events since burst_t0 within the window
+      real(dp) :: t = 0.0_dp                              !! the current instant [s]
+      real(dp) :: t_end = 0.0_dp                          !! the end of the run [s]
+      real(dp) :: h = 0.0_dp                              !! dt1, the rows' step [s]
+      integer :: nrow = 0                                 !! the next history row
+      real(dp) :: s_row = 0.0_dp                          !! its time [s]
    end type ed_work
 
 contains
@@ -125,9 +130,9 @@ contains
       type(result_type), intent(out) :: res                !! histories and summary
       type(error_type), allocatable, intent(out) :: error  !! a phase decision failed, not finite, stop
       type(run_control), intent(inout), target, optional :: ctl !! the run's control (fd_run_control)
-      type(ed_work), target :: w
-      real(dp) :: h, t, t_end, s_row, sv
-      integer :: c0, c1, crate, d, stat, nrow, nqt, n, nd
+      type(ed_work) :: w
+      real(dp) :: sv
+      integer :: c0, c1, crate, d, stat, nqt, n, nd
       logical :: changed
 
       call system_clock(c0, crate)
@@ -149,7 +154,7 @@ contains
                           trim(fmt_int(nqt))//" output quantities")
          return
       end if
-      associate (st => w%st)
+      associate (st => w%st, t => w%t, h => w%h, t_end => w%t_end)
          call structure_matrices(model, st%k, st%c, res%period_stuck, res%xi_stuck, error)
          if (allocated(error)) return
          call observer_init(model, exc, opts, res, w%obs, error, ctl)
@@ -176,27 +181,27 @@ contains
          st%cur = 0
          call decide_phases(model, exc, t, st, changed, error)
          if (allocated(error)) then
-            call with_context(error)
+            call with_context(w, error)
             return
          end if
-         call check_subintervals(error)
+         call check_subintervals(w, error)
          if (allocated(error)) then
-            call with_context(error)
+            call with_context(w, error)
             return
          end if
          call observe_start(w%obs, st%mass, st%k, st%u, st%v, 0.0_dp, st%fn)
          ! the first row: the state at t = 0
          call ed_polynomials(model, exc, t, 0.0_dp, st)
-         call storey_polynomials()
-         call values_at(0.0_dp, w%yv)
+         call storey_polynomials(w, res)
+         call values_at(st, 0.0_dp, w%yv)
          w%env = abs(w%yv)
-         call write_row(t, 0.0_dp)
-         call update_global(0.0_dp, t)
-         nrow = 1
-         s_row = next_row_time(nrow)
-         call advance_run(error)
+         call write_row(w, exc, res, t, 0.0_dp)
+         call update_global(w, res, 0.0_dp, t)
+         w%nrow = 1
+         w%s_row = next_row_time(w, w%nrow)
+         call advance_run(w, model, exc, res, error)
          if (allocated(error)) then
-            call with_context(error)
+            call with_context(w, error)
             return
          end if
          call observe_end(w%obs, res, st%mass, st%k, st%u, st%v, 0.0_dp, w%w_fric, st%fn)
@@ -205,512 +210,545 @@ contains
       end associate
       call system_clock(c1)
       res%run_time = real(c1 - c0, dp)/real(max(crate, 1), dp)
-   contains
+   end subroutine run_event_driven
 
-      !> Time of history row nrow (dt1 step every*nrow, the last row at nsteps).
-      real(dp) function next_row_time(k) result(tr)
-         integer, intent(in) :: k
-         tr = min(k*w%obs%every, w%obs%nsteps)*h
-      end function next_row_time
+   !> Time of history row nrow (dt1 step every*nrow, the last row at nsteps).
+   real(dp) function next_row_time(w, k) result(tr)
+      type(ed_work), intent(in) :: w
+      integer, intent(in) :: k
+      tr = min(k*w%obs%every, w%obs%nsteps)*w%h
+   end function next_row_time
 
-      subroutine with_context(err)
-         type(error_type), intent(inout) :: err
-         if (err%stat == stat_cancelled) return   ! a cancel says so, as for the other techniques
-         if (index(err%message, "event-driven technique") == 0) &
-            err%message = "event-driven technique at t = "//trim(fmt_real(t))//" s: "//err%message
-      end subroutine with_context
+   subroutine with_context(w, err)
+      type(ed_work), intent(in) :: w
+      type(error_type), intent(inout) :: err
+      if (err%stat == stat_cancelled) return   ! a cancel says so, as for the other techniques
+      if (index(err%message, "event-driven technique") == 0) &
+         err%message = "event-driven technique at t = "//trim(fmt_real(w%t))//" s: "//err%message
+   end subroutine with_context
 
-      !> An error when the current phases' highest frequency needs more than max_subintervals
-      !> sub-intervals for the rest of the run (before their polynomials are built: at 1e30
-      !> rad/s their Taylor coefficients overflow).
-      subroutine check_subintervals(err)
-         type(error_type), allocatable, intent(out) :: err
+   !> An error when the current phases' highest frequency needs more than max_subintervals
+   !> sub-intervals for the rest of the run (before their polynomials are built: at 1e30
+   !> rad/s their Taylor coefficients overflow).
+   subroutine check_subintervals(w, err)
+      type(ed_work), intent(in) :: w
+      type(error_type), allocatable, intent(out) :: err
 
-         associate (delta => w%st%cache%slot(w%st%cur)%delta)
-            if (t_end - t > max_subintervals*delta) then
-               call fatal_error(err, "the structure's highest frequency with the current phases "// &
-                                "needs sub-intervals of "//trim(fmt_real(delta))// &
-                                " s: more than "//trim(fmt_real(max_subintervals))//" for the "// &
-                                trim(fmt_real(t_end - t))//" s left; check for a stiff spring on a "// &
-                                "small mass (the frequencies sqrt(k/m)), or use the velocity law")
-            end if
-         end associate
-      end subroutine check_subintervals
-
-      !> The loop over sub-intervals from t = 0 to t_end.
-      subroutine advance_run(err)
-         type(error_type), allocatable, intent(out) :: err
-         real(dp) :: span, tb, s_use, s_ev, thr, smin, tol, t_new
-         integer :: e, kk, halvings
-         logical :: fired, found, fresh, stop
-
-         associate (st => w%st)
-            fresh = .true.
-            do while (t < t_end)
-               tb = segment_end(exc, t, t_end)
-               call check_subintervals(err)
-               if (allocated(err)) return
-               span = min(st%cache%slot(st%cur)%delta, tb - t)
-               ! the polynomials, with remainders below the rounding level of the state and
-               ! of the table acceleration (which alone drives a pattern with no free coordinate)
-               do halvings = 0, 40
-                  call ed_polynomials(model, exc, t, span, st)
-                  if (st%rem <= 2.0_dp**(-50)*st%size .and. st%grem <= 2.0_dp**(-50)*st%gsize) exit
-                  span = 0.5_dp*span
-               end do
-               if (halvings > 40) then   ! no sub-interval bounds the series: no event is certain
-                  call fatal_error(err, "the exact technique at t = "//trim(fmt_real(t))//" s: the Taylor "// &
-                                   "series' remainder stays above the rounding level on sub-intervals down to "// &
-                                   trim(fmt_real(span))//" s, so events cannot be located; use moreau_jean "// &
-                                   "or the velocity law")
-                  return
-               end if
-               call storey_polynomials()
-               kk = st%order
-               smin = 8.0_dp*epsilon(1.0_dp)*(abs(t) + span)
-               tol = 2.0_dp*epsilon(1.0_dp)*(abs(t) + span)
-               if (fresh) then
-                  ! after a decision: a value below zero within the decision's tolerance is
-                  ! accepted; the band starts below it
-                  do e = 1, 2*st%nd
-                     st%offs(e) = 0.0_dp
-                     if (st%eon(e)) st%offs(e) = min(0.0_dp, st%ec(0, e))
-                  end do
-                  fresh = .false.
-               end if
-               ! the first crossing of any event function: g <= min(0, offs) - eta
-               s_use = span
-               fired = .false.
-               do e = 1, 2*st%nd
-                  if (.not. st%eon(e)) cycle
-                  thr = st%offs(e) - st%eta(e)
-                  st%pc1(0:kk) = st%ec(0:kk, e)
-                  st%pc1(0) = st%pc1(0) - thr - st%erem(e)
-                  if (st%pc1(0) <= 0.0_dp) then
-                     s_ev = 0.0_dp
-                     found = .true.
-                  else
-                     call first_crossing(st%pc1(0:kk), s_use, smin, tol, st%pw(0:kk, :), st%pw2(0:kk), s_ev, found)
-                  end if
-                  if (found .and. s_ev <= s_use) then
-                     s_use = s_ev
-                     fired = .true.
-                  end if
-               end do
-               ! rows, peaks and maxima between rows, energy, friction work over [0, s_use]
-               call observe_subinterval(s_use, err)
-               if (allocated(err)) return
-               if (fired) then
-                  t_new = t + s_use
-               else if (span == tb - t) then
-                  t_new = tb
-               else
-                  t_new = t + span
-               end if
-               call move_to(s_use)
-               t = t_new
-               if (fired) then
-                  call event_at(err)
-                  if (allocated(err)) return
-                  fresh = .true.
-               end if
-               ! cancel, progress, a failed history file: after every sub-interval
-               call observe_poll(w%obs, t, stop)
-               if (stop) then
-                  call observe_stop_error(w%obs, err)
-                  return
-               end if
-            end do
-         end associate
-      end subroutine advance_run
-
-      !> Move the state to s on the current sub-interval.
-      subroutine move_to(s)
-         real(dp), intent(in) :: s
-         integer :: i, gi
-         associate (st => w%st, pat => w%st%cache%slot(w%st%cur))
-            do gi = 1, pat%nq
-               st%q(gi) = poly_value(st%qc(gi, 0:st%order), s)
-               st%p(gi) = poly_value(st%pc(gi, 0:st%order), s)
-            end do
-            do i = 1, st%n
-               gi = pat%grp(i)
-               if (gi == 0) then
-                  st%u(i) = st%uc(i)
-                  st%v(i) = 0.0_dp
-               else
-                  st%u(i) = st%q(gi) + st%uc(i)
-                  st%v(i) = st%p(gi)
-               end if
-            end do
-         end associate
-      end subroutine move_to
-
-      !> The polynomials of the storeys' drifts and shears (drift1, V1, ..., Vb after the
-      !> state's quantities), order by order from those of u, v and F: they are linear in them.
-      subroutine storey_polynomials()
-         integer :: m, nb, ns, n1
-         associate (st => w%st)
-            nb = st%nbase
-            ns = res%eng%n_storeys
-            if (st%nquant == nb) return
-            n1 = 3*st%n
-            do m = 0, st%order
-               w%cu = st%yc(m, 1:n1:3)
-               w%cv = st%yc(m, 2:n1:3)
-               w%cf = st%yc(m, n1 + 2:n1 + 2*st%nd:2)
-               call storey_values(res%eng, w%cu, w%cv, w%cf, st%yc(m, nb + 1:nb + 2*ns - 1:2), &
-                                  st%yc(m, nb + 2:nb + 2*ns:2), st%yc(m, nb + 2*ns + 1))
-            end do
-         end associate
-      end subroutine storey_polynomials
-
-      !> Values of every quantity at s on the current sub-interval.
-      subroutine values_at(s, y)
-         real(dp), intent(in) :: s
-         real(dp), intent(out) :: y(:)
-         integer :: iq
-         do iq = 1, w%st%nquant
-            y(iq) = poly_value(w%st%yc(0:w%st%order, iq), s)
-         end do
-      end subroutine values_at
-
-      !> The history row at time tr (s on the current sub-interval), with the maxima since
-      !> the last row.
-      subroutine write_row(tr, s)
-         real(dp), intent(in) :: tr, s
-         real(dp) :: xg, vg, ag, dv
-         integer :: i, dd
-         associate (st => w%st)
-            call table_motion(exc, tr, xg, vg, ag)
-            do i = 1, st%n
-               w%uu(i) = w%yv(iq_u(i))
-               w%vv(i) = w%yv(iq_v(i))
-               w%aa(i) = w%yv(iq_a(i)) - ag
-            end do
-            do dd = 1, st%nd
-               w%ss(dd) = w%yv(iq_s(st%n, dd))
-               call poly_value_deriv(st%yc(0:st%order, iq_s(st%n, dd)), s, xg, dv)
-               w%sd(dd) = dv
-               w%ff(dd) = w%yv(iq_f(st%n, dd))
-            end do
-            ! the maxima of the history's columns (without storeys, not the base shear's)
-            call observe_sample(w%obs, res, tr, ag, w%uu, w%vv, w%aa, w%ss, w%sd, w%ff, st%phase, &
-                                w%env(1:merge(st%nquant, st%nbase, res%eng%n_storeys > 0)))
-            ! the storeys at the row: the values kept as residual ones at the last
-            call observe_storeys(res, tr, w%uu, w%vv, w%ss, w%ff)
-         end associate
-      end subroutine write_row
-
-      !> Peaks of the summary from the values yv at time tp.
-      subroutine update_global(s, tp)
-         real(dp), intent(in) :: s, tp
-         integer :: i, dd
-         if (s < 0.0_dp) return
-         do i = 1, w%st%n
-            call observe_peak_value(res, peak_of_u, i, abs(w%yv(iq_u(i))), tp)
-            call observe_peak_value(res, peak_of_v, i, abs(w%yv(iq_v(i))), tp)
-            call observe_peak_value(res, peak_of_aabs, i, abs(w%yv(iq_a(i))), tp)
-         end do
-         do dd = 1, w%st%nd
-            call observe_peak_value(res, peak_of_s, dd, abs(w%yv(iq_s(w%st%n, dd))), tp)
-            call observe_peak_value(res, peak_of_force, dd, abs(w%yv(iq_f(w%st%n, dd))), tp)
-         end do
-         do i = w%st%nbase + 1, w%st%nquant
-            call observe_peak_value(res, peak_of_storey, i - w%st%nbase, abs(w%yv(i)), tp)
-         end do
-      end subroutine update_global
-
-      !> Over [0, s_use] of the current sub-interval: the rows that fall in it, the exact
-      !> extrema (summary peaks, maxima between rows), the input and viscous work, and the
-      !> friction work.
-      subroutine observe_subinterval(s_use, err)
-         real(dp), intent(in) :: s_use
-         type(error_type), allocatable, intent(out) :: err
-         real(dp) :: smin, tol, x, y, sr
-         integer :: iq, kk, j
-         associate (st => w%st)
-            kk = st%order
-            smin = 8.0_dp*epsilon(1.0_dp)*(abs(t) + s_use)
-            tol = 2.0_dp*epsilon(1.0_dp)*(abs(t) + s_use)
-            ! the one-sided values at the start (after an event: the right limits)
-            call values_at(0.0_dp, w%yv)
-            do iq = 1, st%nquant
-               w%env(iq) = max(w%env(iq), abs(w%yv(iq)))
-            end do
-            call update_global(0.0_dp, t)
-            ! stationary points of every quantity in (0, s_use)
-            do iq = 1, st%nquant
-               w%nrt(iq) = 0
-               w%ip(iq) = 1
-               if (s_use > 0.0_dp) &
-                  call stationary_points(st%yc(0:kk, iq), s_use, smin, tol, st%pw(0:kk, :), st%pw2(0:kk), &
-                                         w%rts(:, iq), w%nrt(iq))
-            end do
-            ! rows inside (0, s_use], each with the maxima since the previous row
-            do while (nrow <= res%nout .and. s_row - t <= s_use)
-               sr = max(0.0_dp, s_row - t)
-               call absorb_until(sr)
-               call values_at(sr, w%yv)
-               if (.not. all(ieee_is_finite(w%yv))) then
-                  call fatal_error(err, "event-driven technique at t = "//trim(fmt_real(s_row))// &
-                                   " s: the solution is not finite (an overflow); check the masses, the "// &
-                                   "stiffnesses, the initial displacements u0 and velocities v0, and the table motion")
-                  return
-               end if
-               do iq = 1, st%nquant
-                  w%env(iq) = max(w%env(iq), abs(w%yv(iq)))
-               end do
-               call write_row(s_row, sr)
-               w%env = abs(w%yv)
-               nrow = nrow + 1
-               s_row = next_row_time(nrow)
-            end do
-            call absorb_until(s_use)
-            ! the end point (before an event: the left limits)
-            call values_at(s_use, w%yv)
-            do iq = 1, st%nquant
-               w%env(iq) = max(w%env(iq), abs(w%yv(iq)))
-            end do
-            call update_global(s_use, t + s_use)
-            call energy(s_use)
-            ! friction work: P mu |Delta s| over the slide
-            do j = 1, st%nd
-               if (.not. st%active(j) .or. st%phase(j) == phase_stick) cycle
-               x = poly_value(st%yc(0:kk, iq_s(st%n, j)), s_use)
-               y = st%yc(0, iq_s(st%n, j))
-               w%w_fric = w%w_fric + st%slip(j)*abs(x - y)
-            end do
-         end associate
-      end subroutine observe_subinterval
-
-      !> Take the stationary points up to s into the maxima (envelope and summary).
-      subroutine absorb_until(s)
-         real(dp), intent(in) :: s
-         integer :: iq, kk
-         real(dp) :: x, y
-         kk = w%st%order
-         do iq = 1, w%st%nquant
-            do while (w%ip(iq) <= w%nrt(iq))
-               x = w%rts(w%ip(iq), iq)
-               if (x > s) exit
-               y = abs(poly_value(w%st%yc(0:kk, iq), x))
-               w%env(iq) = max(w%env(iq), y)
-               call peak_one(iq, y, t + x)
-               w%ip(iq) = w%ip(iq) + 1
-            end do
-         end do
-      end subroutine absorb_until
-
-      !> One quantity's value into the summary's peak.
-      subroutine peak_one(iq, y, tp)
-         integer, intent(in) :: iq
-         real(dp), intent(in) :: y, tp
-         integer :: i, dd
-         if (iq > w%st%nbase) then
-            call observe_peak_value(res, peak_of_storey, iq - w%st%nbase, y, tp)
-         else if (iq <= 3*w%st%n) then
-            i = (iq + 2)/3
-            select case (iq - 3*(i - 1))
-            case (1)
-               call observe_peak_value(res, peak_of_u, i, y, tp)
-            case (2)
-               call observe_peak_value(res, peak_of_v, i, y, tp)
-            case default
-               call observe_peak_value(res, peak_of_aabs, i, y, tp)
-            end select
-         else
-            dd = (iq - 3*w%st%n + 1)/2
-            if (mod(iq - 3*w%st%n, 2) == 1) then
-               call observe_peak_value(res, peak_of_s, dd, y, tp)
-            else
-               call observe_peak_value(res, peak_of_force, dd, y, tp)
-            end if
+      associate (delta => w%st%cache%slot(w%st%cur)%delta, t => w%t, t_end => w%t_end)
+         if (t_end - t > max_subintervals*delta) then
+            call fatal_error(err, "the structure's highest frequency with the current phases "// &
+                             "needs sub-intervals of "//trim(fmt_real(delta))// &
+                             " s: more than "//trim(fmt_real(max_subintervals))//" for the "// &
+                             trim(fmt_real(t_end - t))//" s left; check for a stiff spring on a "// &
+                             "small mass (the frequencies sqrt(k/m)), or use the velocity law")
          end if
-      end subroutine peak_one
+      end associate
+   end subroutine check_subintervals
 
-      !> Input work -int ag mq'p and viscous work int p'Cq p over [0, s], exactly (the
-      !> polynomials' products integrated term by term).
-      subroutine energy(s)
-         real(dp), intent(in) :: s
-         integer :: j, m, kk, gi
-         real(dp) :: ein, evi, sp
-         associate (st => w%st, pat => w%st%cache%slot(w%st%cur))
-            if (pat%nq == 0 .or. s <= 0.0_dp) return
-            kk = st%order
-            do m = 0, kk
-               w%mp(m) = 0.0_dp
-               do gi = 1, pat%nq
-                  w%mp(m) = w%mp(m) + pat%mq(gi)*st%pc(gi, m)
-               end do
+   !> The loop over sub-intervals from t = 0 to t_end.
+   subroutine advance_run(w, model, exc, res, err)
+      type(ed_work), intent(inout) :: w
+      type(model_type), intent(in) :: model
+      type(excitation_type), intent(in) :: exc
+      type(result_type), intent(inout) :: res
+      type(error_type), allocatable, intent(out) :: err
+      real(dp) :: span, tb, s_use, s_ev, thr, smin, tol, t_new
+      integer :: e, kk, halvings
+      logical :: fired, found, fresh, stop
+
+      associate (st => w%st, t => w%t, t_end => w%t_end)
+         fresh = .true.
+         do while (t < t_end)
+            tb = segment_end(exc, t, t_end)
+            call check_subintervals(w, err)
+            if (allocated(err)) return
+            span = min(st%cache%slot(st%cur)%delta, tb - t)
+            ! the polynomials, with remainders below the rounding level of the state and
+            ! of the table acceleration (which alone drives a pattern with no free coordinate)
+            do halvings = 0, 40
+               call ed_polynomials(model, exc, t, span, st)
+               if (st%rem <= 2.0_dp**(-50)*st%size .and. st%grem <= 2.0_dp**(-50)*st%gsize) exit
+               span = 0.5_dp*span
             end do
-            w%ein(0:2*kk) = 0.0_dp
-            w%evi(0:2*kk) = 0.0_dp
-            ! p_j' Cq p_m = p_m' Cq p_j: the terms m > j count twice
-            do m = 0, kk
-               do j = 0, kk
-                  w%ein(j + m) = w%ein(j + m) + st%g(j)*w%mp(m)
+            if (halvings > 40) then   ! no sub-interval bounds the series: no event is certain
+               call fatal_error(err, "the exact technique at t = "//trim(fmt_real(t))//" s: the Taylor "// &
+                                "series' remainder stays above the rounding level on sub-intervals down to "// &
+                                trim(fmt_real(span))//" s, so events cannot be located; use moreau_jean "// &
+                                "or the velocity law")
+               return
+            end if
+            call storey_polynomials(w, res)
+            kk = st%order
+            smin = 8.0_dp*epsilon(1.0_dp)*(abs(t) + span)
+            tol = 2.0_dp*epsilon(1.0_dp)*(abs(t) + span)
+            if (fresh) then
+               ! after a decision: a value below zero within the decision's tolerance is
+               ! accepted; the band starts below it
+               do e = 1, 2*st%nd
+                  st%offs(e) = 0.0_dp
+                  if (st%eon(e)) st%offs(e) = min(0.0_dp, st%ec(0, e))
                end do
+               fresh = .false.
+            end if
+            ! the first crossing of any event function: g <= min(0, offs) - eta
+            s_use = span
+            fired = .false.
+            do e = 1, 2*st%nd
+               if (.not. st%eon(e)) cycle
+               thr = st%offs(e) - st%eta(e)
+               st%pc1(0:kk) = st%ec(0:kk, e)
+               st%pc1(0) = st%pc1(0) - thr - st%erem(e)
+               if (st%pc1(0) <= 0.0_dp) then
+                  s_ev = 0.0_dp
+                  found = .true.
+               else
+                  call first_crossing(st%pc1(0:kk), s_use, smin, tol, st%pw(0:kk, :), st%pw2(0:kk), s_ev, found)
+               end if
+               if (found .and. s_ev <= s_use) then
+                  s_use = s_ev
+                  fired = .true.
+               end if
+            end do
+            ! rows, peaks and maxima between rows, energy, friction work over [0, s_use]
+            call observe_subinterval(w, exc, res, s_use, err)
+            if (allocated(err)) return
+            if (fired) then
+               t_new = t + s_use
+            else if (span == tb - t) then
+               t_new = tb
+            else
+               t_new = t + span
+            end if
+            call move_to(w, s_use)
+            t = t_new
+            if (fired) then
+               call event_at(w, model, exc, res, err)
+               if (allocated(err)) return
+               fresh = .true.
+            end if
+            ! cancel, progress, a failed history file: after every sub-interval
+            call observe_poll(w%obs, t, stop)
+            if (stop) then
+               call observe_stop_error(w%obs, err)
+               return
+            end if
+         end do
+      end associate
+   end subroutine advance_run
+
+   !> Move the state to s on the current sub-interval.
+   subroutine move_to(w, s)
+      type(ed_work), intent(inout) :: w
+      real(dp), intent(in) :: s
+      integer :: i, gi
+      associate (st => w%st, pat => w%st%cache%slot(w%st%cur))
+         do gi = 1, pat%nq
+            st%q(gi) = poly_value(st%qc(gi, 0:st%order), s)
+            st%p(gi) = poly_value(st%pc(gi, 0:st%order), s)
+         end do
+         do i = 1, st%n
+            gi = pat%grp(i)
+            if (gi == 0) then
+               st%u(i) = st%uc(i)
+               st%v(i) = 0.0_dp
+            else
+               st%u(i) = st%q(gi) + st%uc(i)
+               st%v(i) = st%p(gi)
+            end if
+         end do
+      end associate
+   end subroutine move_to
+
+   !> The polynomials of the storeys' drifts and shears (drift1, V1, ..., Vb after the
+   !> state's quantities), order by order from those of u, v and F: they are linear in them.
+   subroutine storey_polynomials(w, res)
+      type(ed_work), intent(inout) :: w
+      type(result_type), intent(in) :: res
+      integer :: m, nb, ns, n1
+      associate (st => w%st)
+         nb = st%nbase
+         ns = res%eng%n_storeys
+         if (st%nquant == nb) return
+         n1 = 3*st%n
+         do m = 0, st%order
+            w%cu = st%yc(m, 1:n1:3)
+            w%cv = st%yc(m, 2:n1:3)
+            w%cf = st%yc(m, n1 + 2:n1 + 2*st%nd:2)
+            call storey_values(res%eng, w%cu, w%cv, w%cf, st%yc(m, nb + 1:nb + 2*ns - 1:2), &
+                               st%yc(m, nb + 2:nb + 2*ns:2), st%yc(m, nb + 2*ns + 1))
+         end do
+      end associate
+   end subroutine storey_polynomials
+
+   !> Values of every quantity at s on the current sub-interval.
+   subroutine values_at(st, s, y)
+      type(ed_state), intent(in) :: st
+      real(dp), intent(in) :: s
+      real(dp), intent(out) :: y(:)
+      integer :: iq
+      do iq = 1, st%nquant
+         y(iq) = poly_value(st%yc(0:st%order, iq), s)
+      end do
+   end subroutine values_at
+
+   !> The history row at time tr (s on the current sub-interval), with the maxima since
+   !> the last row.
+   subroutine write_row(w, exc, res, tr, s)
+      type(ed_work), intent(inout) :: w
+      type(excitation_type), intent(in) :: exc
+      type(result_type), intent(inout) :: res
+      real(dp), intent(in) :: tr, s
+      real(dp) :: xg, vg, ag, dv
+      integer :: i, dd
+      associate (st => w%st)
+         call table_motion(exc, tr, xg, vg, ag)
+         do i = 1, st%n
+            w%uu(i) = w%yv(iq_u(i))
+            w%vv(i) = w%yv(iq_v(i))
+            w%aa(i) = w%yv(iq_a(i)) - ag
+         end do
+         do dd = 1, st%nd
+            w%ss(dd) = w%yv(iq_s(st%n, dd))
+            call poly_value_deriv(st%yc(0:st%order, iq_s(st%n, dd)), s, xg, dv)
+            w%sd(dd) = dv
+            w%ff(dd) = w%yv(iq_f(st%n, dd))
+         end do
+         ! the maxima of the history's columns (without storeys, not the base shear's)
+         call observe_sample(w%obs, res, tr, ag, w%uu, w%vv, w%aa, w%ss, w%sd, w%ff, st%phase, &
+                             w%env(1:merge(st%nquant, st%nbase, res%eng%n_storeys > 0)))
+         ! the storeys at the row: the values kept as residual ones at the last
+         call observe_storeys(res, tr, w%uu, w%vv, w%ss, w%ff)
+      end associate
+   end subroutine write_row
+
+   !> Peaks of the summary from the values yv at time tp.
+   subroutine update_global(w, res, s, tp)
+      type(ed_work), intent(in) :: w
+      type(result_type), intent(inout) :: res
+      real(dp), intent(in) :: s, tp
+      integer :: i, dd
+      if (s < 0.0_dp) return
+      do i = 1, w%st%n
+         call observe_peak_value(res, peak_of_u, i, abs(w%yv(iq_u(i))), tp)
+         call observe_peak_value(res, peak_of_v, i, abs(w%yv(iq_v(i))), tp)
+         call observe_peak_value(res, peak_of_aabs, i, abs(w%yv(iq_a(i))), tp)
+      end do
+      do dd = 1, w%st%nd
+         call observe_peak_value(res, peak_of_s, dd, abs(w%yv(iq_s(w%st%n, dd))), tp)
+         call observe_peak_value(res, peak_of_force, dd, abs(w%yv(iq_f(w%st%n, dd))), tp)
+      end do
+      do i = w%st%nbase + 1, w%st%nquant
+         call observe_peak_value(res, peak_of_storey, i - w%st%nbase, abs(w%yv(i)), tp)
+      end do
+   end subroutine update_global
+
+   !> Over [0, s_use] of the current sub-interval: the rows that fall in it, the exact
+   !> extrema (summary peaks, maxima between rows), the input and viscous work, and the
+   !> friction work.
+   subroutine observe_subinterval(w, exc, res, s_use, err)
+      type(ed_work), intent(inout) :: w
+      type(excitation_type), intent(in) :: exc
+      type(result_type), intent(inout) :: res
+      real(dp), intent(in) :: s_use
+      type(error_type), allocatable, intent(out) :: err
+      real(dp) :: smin, tol, x, y, sr
+      integer :: iq, kk, j
+      associate (st => w%st, t => w%t, nrow => w%nrow, s_row => w%s_row)
+         kk = st%order
+         smin = 8.0_dp*epsilon(1.0_dp)*(abs(t) + s_use)
+         tol = 2.0_dp*epsilon(1.0_dp)*(abs(t) + s_use)
+         ! the one-sided values at the start (after an event: the right limits)
+         call values_at(st, 0.0_dp, w%yv)
+         do iq = 1, st%nquant
+            w%env(iq) = max(w%env(iq), abs(w%yv(iq)))
+         end do
+         call update_global(w, res, 0.0_dp, t)
+         ! stationary points of every quantity in (0, s_use)
+         do iq = 1, st%nquant
+            w%nrt(iq) = 0
+            w%ip(iq) = 1
+            if (s_use > 0.0_dp) &
+               call stationary_points(st%yc(0:kk, iq), s_use, smin, tol, st%pw(0:kk, :), st%pw2(0:kk), &
+                                      w%rts(:, iq), w%nrt(iq))
+         end do
+         ! rows inside (0, s_use], each with the maxima since the previous row
+         do while (nrow <= res%nout .and. s_row - t <= s_use)
+            sr = max(0.0_dp, s_row - t)
+            call absorb_until(w, res, sr)
+            call values_at(st, sr, w%yv)
+            if (.not. all(ieee_is_finite(w%yv))) then
+               call fatal_error(err, "event-driven technique at t = "//trim(fmt_real(s_row))// &
+                                " s: the solution is not finite (an overflow); check the masses, the "// &
+                                "stiffnesses, the initial displacements u0 and velocities v0, and the table motion")
+               return
+            end if
+            do iq = 1, st%nquant
+               w%env(iq) = max(w%env(iq), abs(w%yv(iq)))
+            end do
+            call write_row(w, exc, res, s_row, sr)
+            w%env = abs(w%yv)
+            nrow = nrow + 1
+            s_row = next_row_time(w, nrow)
+         end do
+         call absorb_until(w, res, s_use)
+         ! the end point (before an event: the left limits)
+         call values_at(st, s_use, w%yv)
+         do iq = 1, st%nquant
+            w%env(iq) = max(w%env(iq), abs(w%yv(iq)))
+         end do
+         call update_global(w, res, s_use, t + s_use)
+         call energy(w, res, s_use)
+         ! friction work: P mu |Delta s| over the slide
+         do j = 1, st%nd
+            if (.not. st%active(j) .or. st%phase(j) == phase_stick) cycle
+            x = poly_value(st%yc(0:kk, iq_s(st%n, j)), s_use)
+            y = st%yc(0, iq_s(st%n, j))
+            w%w_fric = w%w_fric + st%slip(j)*abs(x - y)
+         end do
+      end associate
+   end subroutine observe_subinterval
+
+   !> Take the stationary points up to s into the maxima (envelope and summary).
+   subroutine absorb_until(w, res, s)
+      type(ed_work), intent(inout) :: w
+      type(result_type), intent(inout) :: res
+      real(dp), intent(in) :: s
+      integer :: iq, kk
+      real(dp) :: x, y
+      kk = w%st%order
+      do iq = 1, w%st%nquant
+         do while (w%ip(iq) <= w%nrt(iq))
+            x = w%rts(w%ip(iq), iq)
+            if (x > s) exit
+            y = abs(poly_value(w%st%yc(0:kk, iq), x))
+            w%env(iq) = max(w%env(iq), y)
+            call peak_one(w, res, iq, y, w%t + x)
+            w%ip(iq) = w%ip(iq) + 1
+         end do
+      end do
+   end subroutine absorb_until
+
+   !> One quantity's value into the summary's peak.
+   subroutine peak_one(w, res, iq, y, tp)
+      type(ed_work), intent(in) :: w
+      type(result_type), intent(inout) :: res
+      integer, intent(in) :: iq
+      real(dp), intent(in) :: y, tp
+      integer :: i, dd
+      if (iq > w%st%nbase) then
+         call observe_peak_value(res, peak_of_storey, iq - w%st%nbase, y, tp)
+      else if (iq <= 3*w%st%n) then
+         i = (iq + 2)/3
+         select case (iq - 3*(i - 1))
+         case (1)
+            call observe_peak_value(res, peak_of_u, i, y, tp)
+         case (2)
+            call observe_peak_value(res, peak_of_v, i, y, tp)
+         case default
+            call observe_peak_value(res, peak_of_aabs, i, y, tp)
+         end select
+      else
+         dd = (iq - 3*w%st%n + 1)/2
+         if (mod(iq - 3*w%st%n, 2) == 1) then
+            call observe_peak_value(res, peak_of_s, dd, y, tp)
+         else
+            call observe_peak_value(res, peak_of_force, dd, y, tp)
+         end if
+      end if
+   end subroutine peak_one
+
+   !> Input work -int ag mq'p and viscous work int p'Cq p over [0, s], exactly (the
+   !> polynomials' products integrated term by term).
+   subroutine energy(w, res, s)
+      type(ed_work), intent(inout) :: w
+      type(result_type), intent(inout) :: res
+      real(dp), intent(in) :: s
+      integer :: j, m, kk, gi
+      real(dp) :: ein, evi, sp
+      associate (st => w%st, pat => w%st%cache%slot(w%st%cur))
+         if (pat%nq == 0 .or. s <= 0.0_dp) return
+         kk = st%order
+         do m = 0, kk
+            w%mp(m) = 0.0_dp
+            do gi = 1, pat%nq
+               w%mp(m) = w%mp(m) + pat%mq(gi)*st%pc(gi, m)
+            end do
+         end do
+         w%ein(0:2*kk) = 0.0_dp
+         w%evi(0:2*kk) = 0.0_dp
+         ! p_j' Cq p_m = p_m' Cq p_j: the terms m > j count twice
+         do m = 0, kk
+            do j = 0, kk
+               w%ein(j + m) = w%ein(j + m) + st%g(j)*w%mp(m)
+            end do
+            sp = 0.0_dp
+            do gi = 1, pat%nq
+               sp = sp + st%pc(gi, m)*st%cp(gi, m)
+            end do
+            w%evi(2*m) = w%evi(2*m) + sp
+            do j = 0, m - 1
                sp = 0.0_dp
                do gi = 1, pat%nq
-                  sp = sp + st%pc(gi, m)*st%cp(gi, m)
+                  sp = sp + st%pc(gi, j)*st%cp(gi, m)
                end do
-               w%evi(2*m) = w%evi(2*m) + sp
-               do j = 0, m - 1
-                  sp = 0.0_dp
-                  do gi = 1, pat%nq
-                     sp = sp + st%pc(gi, j)*st%cp(gi, m)
-                  end do
-                  w%evi(j + m) = w%evi(j + m) + 2.0_dp*sp
-               end do
+               w%evi(j + m) = w%evi(j + m) + 2.0_dp*sp
             end do
-            ein = 0.0_dp
-            evi = 0.0_dp
-            do m = 2*kk, 0, -1
-               ein = ein*s + w%ein(m)/(m + 1)
-               evi = evi*s + w%evi(m)/(m + 1)
-            end do
-            res%e_input = res%e_input - ein*s
-            res%e_input_gross = res%e_input_gross + abs(ein*s)
-            res%e_viscous = res%e_viscous + evi*s
-         end associate
-      end subroutine energy
+         end do
+         ein = 0.0_dp
+         evi = 0.0_dp
+         do m = 2*kk, 0, -1
+            ein = ein*s + w%ein(m)/(m + 1)
+            evi = evi*s + w%evi(m)/(m + 1)
+         end do
+         res%e_input = res%e_input - ein*s
+         res%e_input_gross = res%e_input_gross + abs(ein*s)
+         res%e_viscous = res%e_viscous + evi*s
+      end associate
+   end subroutine energy
 
-      !> An event at t: which devices are at it, the decision, and the accumulation guard.
-      subroutine event_at(err)
-         type(error_type), allocatable, intent(out) :: err
-         integer :: dd, e, oldest
-         real(dp) :: x, vs, thr
-         logical :: chg
-         associate (st => w%st)
-            ! the polynomials at the event instant (the old pattern, span 0): crossed
-            ! functions and sliders at zero velocity
-            call ed_polynomials(model, exc, t, 0.0_dp, st)
-            do dd = 1, st%nd
-               st%crossed(dd) = .false.
-               st%near(dd) = .false.
-               do e = 2*dd - 1, 2*dd
-                  if (.not. st%eon(e)) cycle
-                  thr = st%offs(e) - st%eta(e)
-                  if (st%ec(0, e) - st%erem(e) <= thr) st%crossed(dd) = .true.
-               end do
-               if (st%active(dd) .and. st%phase(dd) /= phase_stick) then
-                  x = device_relative(model, dd, st%v)
-                  vs = abs(st%v(model%dev(dd)%node_i))
-                  if (model%dev(dd)%node_j > 0) vs = vs + abs(st%v(model%dev(dd)%node_j))
-                  st%near(dd) = st%crossed(dd) .or. abs(x) <= max(rtol_decision*vs, 4.0_dp*st%eta(2*dd - 1))
-               end if
+   !> An event at t: which devices are at it, the decision, and the accumulation guard.
+   subroutine event_at(w, model, exc, res, err)
+      type(ed_work), intent(inout) :: w
+      type(model_type), intent(in) :: model
+      type(excitation_type), intent(in) :: exc
+      type(result_type), intent(inout) :: res
+      type(error_type), allocatable, intent(out) :: err
+      integer :: dd, e, oldest
+      real(dp) :: x, vs, thr
+      logical :: chg
+      associate (st => w%st, t => w%t)
+         ! the polynomials at the event instant (the old pattern, span 0): crossed
+         ! functions and sliders at zero velocity
+         call ed_polynomials(model, exc, t, 0.0_dp, st)
+         do dd = 1, st%nd
+            st%crossed(dd) = .false.
+            st%near(dd) = .false.
+            do e = 2*dd - 1, 2*dd
+               if (.not. st%eon(e)) cycle
+               thr = st%offs(e) - st%eta(e)
+               if (st%ec(0, e) - st%erem(e) <= thr) st%crossed(dd) = .true.
             end do
-            call decide_phases(model, exc, t, st, chg, err)
-            if (allocated(err)) return
-            ! no event loop without end: at most max_burst events within one window
-            if (t - w%burst_t0 <= accumulation_span*max(1.0_dp, abs(t))) then
-               w%burst_n = w%burst_n + 1
-               if (w%burst_n >= max_burst) then
-                  call stalled_events(err)
-                  return
-               end if
-            else
-               w%burst_t0 = t
-               w%burst_n = 1
-            end if
-            if (.not. chg) return
-            w%n_events = w%n_events + 1
-            call observe_transitions(res, st%oldph, st%phase)
-            call observe_event(res, t)
-            ! accumulation guard: ring_size phase changes within the window
-            w%ring_pos = mod(w%ring_pos, ring_size) + 1
-            w%ring(w%ring_pos) = t
-            oldest = mod(w%ring_pos, ring_size) + 1
-            if (t - w%ring(oldest) <= accumulation_span*max(1.0_dp, abs(t))) then
-               if (t - w%last_accumulation <= accumulation_span*max(1.0_dp, abs(t))) then
-                  call fatal_error(err, "event-driven technique at t = "//trim(fmt_real(t))//" s: events "// &
-                                   "accumulate again where sticking at the limit of the sequence should have "// &
-                                   "ended them; try technique = 'newmark' with law = 'velocity', or report the deck")
-                  return
-               end if
-               w%last_accumulation = t
-               call accumulation(err)
-               if (allocated(err)) return
-               w%ring = -huge(1.0_dp)
-            end if
-         end associate
-      end subroutine event_at
-
-      !> The error of max_burst events within one window: the time does not advance.
-      subroutine stalled_events(err)
-         type(error_type), allocatable, intent(out) :: err
-         integer :: dd, m
-         character(len=:), allocatable :: list
-         associate (st => w%st)
-            m = 0
-            do dd = 1, st%nd
-               if (.not. (st%crossed(dd) .or. st%near(dd))) cycle
-               m = m + 1
-               st%cand(m) = dd
-            end do
-            if (m > 0) then
-               call device_list(st%cand, m, list)
-               list = ", last at "//list
-            else
-               list = ""
-            end if
-            call fatal_error(err, "event-driven technique at t = "//trim(fmt_real(t))//" s: "// &
-                             trim(fmt_int(max_burst))//" events within "// &
-                             trim(fmt_real(t - w%burst_t0))//" s"//list//", the same instant decided again "// &
-                             "and again (the time does not advance); try technique = 'moreau_jean', or "// &
-                             "technique = 'newmark' with law = 'velocity', or report the deck")
-         end associate
-      end subroutine stalled_events
-
-      !> An accumulation of events (a Zeno sequence) at t: the devices at zero relative
-      !> velocity stick at the limit of the sequence, provided their forces hold.
-      subroutine accumulation(err)
-         type(error_type), allocatable, intent(out) :: err
-         integer :: dd, r, nbad
-         real(dp) :: x, vs, xg, vg, ag, f
-         character(len=:), allocatable :: list
-         associate (st => w%st)
-            st%oldph = st%phase
-            st%newph = st%phase
-            do dd = 1, st%nd
-               if (.not. st%active(dd) .or. st%phase(dd) == phase_stick) cycle
+            if (st%active(dd) .and. st%phase(dd) /= phase_stick) then
                x = device_relative(model, dd, st%v)
                vs = abs(st%v(model%dev(dd)%node_i))
                if (model%dev(dd)%node_j > 0) vs = vs + abs(st%v(model%dev(dd)%node_j))
-               if (abs(x) <= 1.0e-9_dp*max(vs, tiny(1.0_dp))) st%newph(dd) = phase_stick
-            end do
-            call cache_find(st%cache, model, st%mass, st%k, st%c, st%active, st%newph, st%slip, exc, [st%cur], &
-                            st%cur, err)
-            if (allocated(err)) return
-            call pattern_entry(st%cache%slot(st%cur), model, st%mass, st%k, st%newph, st%slip, st%u, st%v, &
-                               st%q, st%p, st%uc, st%b1, st%f0, st%fn)
-            st%phase = st%newph
-            call table_motion(exc, t, xg, vg, ag)
-            nbad = 0
-            associate (pat => st%cache%slot(st%cur))
-               do r = 1, pat%ns
-                  f = pat%fag(r)*ag + st%f0(r) + sum(pat%fq(r, 1:pat%nq)*st%q(1:pat%nq)) + &
-                      sum(pat%fp(r, 1:pat%nq)*st%p(1:pat%nq))
-                  if (abs(f) > st%slip(pat%ids(r))*(1.0_dp + 1.0e-6_dp)) then
-                     nbad = nbad + 1
-                     st%cand(nbad) = pat%ids(r)
-                  end if
-               end do
-            end associate
-            if (nbad > 0) then
-               call device_list(st%cand, nbad, list)
-               call fatal_error(err, "event-driven technique at t = "//trim(fmt_real(t))//" s: "// &
-                                trim(fmt_int(ring_size))//" phase changes within "// &
-                                trim(fmt_real(accumulation_span*max(1.0_dp, abs(t))))//" s, and sticking at their "// &
-                                "limit would need forces above P mu in "//list//"; try technique = "// &
-                                "'newmark' with law = 'velocity', or report the deck")
+               st%near(dd) = st%crossed(dd) .or. abs(x) <= max(rtol_decision*vs, 4.0_dp*st%eta(2*dd - 1))
+            end if
+         end do
+         call decide_phases(model, exc, t, st, chg, err)
+         if (allocated(err)) return
+         ! no event loop without end: at most max_burst events within one window
+         if (t - w%burst_t0 <= accumulation_span*max(1.0_dp, abs(t))) then
+            w%burst_n = w%burst_n + 1
+            if (w%burst_n >= max_burst) then
+               call stalled_events(w, err)
                return
             end if
-            call observe_transitions(res, st%oldph, st%phase)
-            call observe_accumulation(res, t)
+         else
+            w%burst_t0 = t
+            w%burst_n = 1
+         end if
+         if (.not. chg) return
+         w%n_events = w%n_events + 1
+         call observe_transitions(res, st%oldph, st%phase)
+         call observe_event(res, t)
+         ! accumulation guard: ring_size phase changes within the window
+         w%ring_pos = mod(w%ring_pos, ring_size) + 1
+         w%ring(w%ring_pos) = t
+         oldest = mod(w%ring_pos, ring_size) + 1
+         if (t - w%ring(oldest) <= accumulation_span*max(1.0_dp, abs(t))) then
+            if (t - w%last_accumulation <= accumulation_span*max(1.0_dp, abs(t))) then
+               call fatal_error(err, "event-driven technique at t = "//trim(fmt_real(t))//" s: events "// &
+                                "accumulate again where sticking at the limit of the sequence should have "// &
+                                "ended them; try technique = 'newmark' with law = 'velocity', or report the deck")
+               return
+            end if
+            w%last_accumulation = t
+            call accumulation(w, model, exc, res, err)
+            if (allocated(err)) return
+            w%ring = -huge(1.0_dp)
+         end if
+      end associate
+   end subroutine event_at
+
+   !> The error of max_burst events within one window: the time does not advance.
+   subroutine stalled_events(w, err)
+      type(ed_work), intent(inout) :: w
+      type(error_type), allocatable, intent(out) :: err
+      integer :: dd, m
+      character(len=:), allocatable :: list
+      associate (st => w%st, t => w%t)
+         m = 0
+         do dd = 1, st%nd
+            if (.not. (st%crossed(dd) .or. st%near(dd))) cycle
+            m = m + 1
+            st%cand(m) = dd
+         end do
+         if (m > 0) then
+            call device_list(st%cand, m, list)
+            list = ", last at "//list
+         else
+            list = ""
+         end if
+         call fatal_error(err, "event-driven technique at t = "//trim(fmt_real(t))//" s: "// &
+                          trim(fmt_int(max_burst))//" events within "// &
+                          trim(fmt_real(t - w%burst_t0))//" s"//list//", the same instant decided again "// &
+                          "and again (the time does not advance); try technique = 'moreau_jean', or "// &
+                          "technique = 'newmark' with law = 'velocity', or report the deck")
+      end associate
+   end subroutine stalled_events
+
+   !> An accumulation of events (a Zeno sequence) at t: the devices at zero relative
+   !> velocity stick at the limit of the sequence, provided their forces hold.
+   subroutine accumulation(w, model, exc, res, err)
+      type(ed_work), intent(inout) :: w
+      type(model_type), intent(in) :: model
+      type(excitation_type), intent(in) :: exc
+      type(result_type), intent(inout) :: res
+      type(error_type), allocatable, intent(out) :: err
+      integer :: dd, r, nbad
+      real(dp) :: x, vs, xg, vg, ag, f
+      character(len=:), allocatable :: list
+      associate (st => w%st, t => w%t)
+         st%oldph = st%phase
+         st%newph = st%phase
+         do dd = 1, st%nd
+            if (.not. st%active(dd) .or. st%phase(dd) == phase_stick) cycle
+            x = device_relative(model, dd, st%v)
+            vs = abs(st%v(model%dev(dd)%node_i))
+            if (model%dev(dd)%node_j > 0) vs = vs + abs(st%v(model%dev(dd)%node_j))
+            if (abs(x) <= 1.0e-9_dp*max(vs, tiny(1.0_dp))) st%newph(dd) = phase_stick
+         end do
+         call cache_find(st%cache, model, st%mass, st%k, st%c, st%active, st%newph, st%slip, exc, [st%cur], &
+                         st%cur, err)
+         if (allocated(err)) return
+         call pattern_entry(st%cache%slot(st%cur), model, st%mass, st%k, st%newph, st%slip, st%u, st%v, &
+                            st%q, st%p, st%uc, st%b1, st%f0, st%fn)
+         st%phase = st%newph
+         call table_motion(exc, t, xg, vg, ag)
+         nbad = 0
+         associate (pat => st%cache%slot(st%cur))
+            do r = 1, pat%ns
+               f = pat%fag(r)*ag + st%f0(r) + sum(pat%fq(r, 1:pat%nq)*st%q(1:pat%nq)) + &
+                   sum(pat%fp(r, 1:pat%nq)*st%p(1:pat%nq))
+               if (abs(f) > st%slip(pat%ids(r))*(1.0_dp + 1.0e-6_dp)) then
+                  nbad = nbad + 1
+                  st%cand(nbad) = pat%ids(r)
+               end if
+            end do
          end associate
-      end subroutine accumulation
-   end subroutine run_event_driven
+         if (nbad > 0) then
+            call device_list(st%cand, nbad, list)
+            call fatal_error(err, "event-driven technique at t = "//trim(fmt_real(t))//" s: "// &
+                             trim(fmt_int(ring_size))//" phase changes within "// &
+                             trim(fmt_real(accumulation_span*max(1.0_dp, abs(t))))//" s, and sticking at their "// &
+                             "limit would need forces above P mu in "//list//"; try technique = "// &
+                             "'newmark' with law = 'velocity', or report the deck")
+            return
+         end if
+         call observe_transitions(res, st%oldph, st%phase)
+         call observe_accumulation(res, t)
+      end associate
+   end subroutine accumulation
 
 end module fd_event_driven
