@@ -18,6 +18,7 @@ program tester
    use test_fd_technique, only: collect_technique
    use test_fd_root_finder, only: collect_root_finder
    use test_fd_phase_pattern, only: collect_phase_pattern
+   use test_fd_phase_decision, only: collect_phase_decision
    use test_fd_observer, only: collect_observer
    use test_fd_sha256, only: collect_sha256
    use test_fd_engineering, only: collect_engineering
@@ -58,6 +59,7 @@ program tester
    testsuites = [testsuites, new_testsuite("technique", collect_technique)]
    testsuites = [testsuites, new_testsuite("root_finder", collect_root_finder)]
    testsuites = [testsuites, new_testsuite("phase_pattern", collect_phase_pattern)]
+   testsuites = [testsuites, new_testsuite("phase_decision", collect_phase_decision)]
    testsuites = [testsuites, new_testsuite("observer", collect_observer)]
    testsuites = [testsuites, new_testsuite("sha256", collect_sha256)]
    testsuites = [testsuites, new_testsuite("engineering", collect_engineering)]
