@@ -29,7 +29,7 @@ from pathlib import Path
 
 import numpy as np
 
-from . import _core
+from . import _codes, _core
 
 __all__ = [
     "DeckError",
@@ -116,14 +116,14 @@ def summary_warnings(summary: dict) -> list[str]:
     return [str(w) for w in summary.get("warnings", [])]
 
 
-# the status codes of the extension (driver/frictiondyn/_core.f90)
+# the status codes of the extension (fortran/fd_session.f90's status_*, generated into _codes)
 _ERRORS = {
-    1: DeckError,
-    2: SolverError,
-    3: FrictiondynError,
-    4: OutputError,
-    5: OutOfMemoryError,
-    6: RunCancelled,
+    _codes.STATUS_INPUT: DeckError,
+    _codes.STATUS_SOLVER: SolverError,
+    _codes.STATUS_MISUSE: FrictiondynError,
+    _codes.STATUS_OUTPUT: OutputError,
+    _codes.STATUS_NO_MEMORY: OutOfMemoryError,
+    _codes.STATUS_CANCELLED: RunCancelled,
 }
 #: seconds between looks at a solve running in the worker thread (Ctrl-C, progress)
 _POLL = 0.05
@@ -218,10 +218,11 @@ def _summary_path(csv: str | os.PathLike) -> Path:
     return csv.with_name(stem + ".summary.json")
 
 
-# the texts a session gives (fortran/fd_session.f90)
-_HEADER, _SUMMARY, _OUTPUT_DIR, _OUTPUT_NAME, _HISTORY_PATH, _SUMMARY_PATH, _DECK, _ERROR = range(
-    1, 9
-)
+# the texts a session gives (fortran/fd_session.f90's text_*, generated into _codes)
+_HEADER, _SUMMARY = _codes.TEXT_HEADER, _codes.TEXT_SUMMARY
+_OUTPUT_DIR, _OUTPUT_NAME = _codes.TEXT_OUTPUT_DIR, _codes.TEXT_OUTPUT_NAME
+_HISTORY_PATH, _SUMMARY_PATH = _codes.TEXT_HISTORY_PATH, _codes.TEXT_SUMMARY_PATH
+_DECK, _ERROR = _codes.TEXT_DECK, _codes.TEXT_ERROR
 _PATHS = (_OUTPUT_DIR, _OUTPUT_NAME, _HISTORY_PATH, _SUMMARY_PATH, _DECK)
 
 
