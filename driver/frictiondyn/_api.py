@@ -859,7 +859,12 @@ class Result:
         """Write the history (header ``name[unit],...``, ``es24.16e3`` values) and the summary
         next to it (``<stem>.summary.json`` for ``<stem>.csv``, any case; ``<name>.summary.json``
         for any other name, as ``from_files`` looks for it) with the library's writer, exactly
-        as the executable does; each file goes to a temporary name renamed when complete."""
+        as the executable does; each file goes to a temporary name renamed when complete.
+
+        Why a new session: a Result holds none (it may come from arrays, from files or from a
+        session closed since), and only the library's writer gives the executable's bytes; so
+        the Result's header, summary and history are handed to a session made for this call
+        (which copies the history: the memory of one more history while it writes)."""
         path = Path(path)
         summary = _summary_path(path)
         with Session._adopt(self.data, self._header(), self.summary_json()) as session:
