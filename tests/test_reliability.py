@@ -1,4 +1,4 @@
-"""Issue 11, each fix with its regression test: nothing in a deck is skipped unread, strings
+"""Reliability, each rule with its regression test: nothing in a deck is skipped unread, strings
 are never cut, a directory or a binary file says so, the executable and the extension agree
 (NUL, non-ASCII text and paths), overflowing values are rejected up front naming group,
 variable and value, no result is non-finite, the work of a step refinement is bounded, and
@@ -535,8 +535,8 @@ def test_moreau_jean_out_of_memory_is_an_error_not_a_crash(tmp_path):
 def test_no_character_function_with_an_allocatable_result():
     """README's rule for the Fortran library: no function with a character(len=:),
     allocatable result. gfortran 12 keeps such a result's length in a static variable of
-    the caller, and runs side by side in threads then mix their texts up (stop 30's warning
-    texts did: test_many_concurrent_runs_of_the_same_files_are_identical failed once in CI).
+    the caller, and runs side by side in threads then mix their texts up (warning texts
+    did so: test_many_concurrent_runs_of_the_same_files_are_identical fails when they do).
     Every function's result declaration in fortran/ and the extension is read."""
     root = ROOT
     sources = sorted((root / "fortran").rglob("*.f90")) + sorted((root / "driver").rglob("*.f90"))
