@@ -1,9 +1,11 @@
-"""frictiondyn alone at scale (issue 13): cost and memory against the number of storeys, for
-both regularized laws; memory against the duration; reading a large deck; runs in threads;
-how fast Ctrl-C stops a run.
+"""frictiondyn alone at scale: cost and memory against the number of storeys, for both
+regularized laws; memory against the duration; reading a large deck; the set-up before the
+first step of 1e5 unconnected masses and of a 1e5-DOF chain; runs in threads; how fast Ctrl-C
+stops a run.
 
     .venv/bin/python bench/scale.py                        # all of it (about 30 min)
     .venv/bin/python bench/scale.py --sizes 10,100 --no-extras   # a quick look
+    .venv/bin/python bench/scale.py --sizes 10 --no-extras --setup 100000   # the set-up only
     .venv/bin/python bench/scale.py --sizes 10,100,1000 --no-extras --refinement nested
     .venv/bin/python bench/scale.py --out docs/performance       # what docs/performance.md shows
 
@@ -11,7 +13,12 @@ The building is bench/opensees_models.py's BuildingCase (a friction damper in ev
 20 s of synthetic ground motion at dt_r = 10 ms, dt1 = 1 ms), with the hysteretic law and
 with the velocity law (band eps = 1 mm/s). Each size runs in a process of its own (its peak
 resident memory, VmHWM, is measured there), keeping the roof's DOF and the first device in
-its history (the summary has every peak). Cost is CPU time of the run (the machine may be
+its history (the summary has every peak). The set-up case runs the executable on a deck of
+n masses, each on a spring and a friction device (hysteretic) to the table, with no
+connection between them, and on a chain of n masses (springs and devices between
+neighbours), for two dt1 steps: its time is reading the deck, the matrices, the ordering
+(reverse Cuthill-McKee, linear in DOFs + connections), the factorization and the modes,
+nearly all of it before the first step. Cost is CPU time of the run (the machine may be
 shared), per dt1 step and per Newmark step taken (dt1, dt2 and finer: the paper's step
 control redoes a dt1 step in which a device changes phase as n2 = 50 dt2 steps, so the
 number of Newmark steps per dt1 step grows with the number of devices until it saturates at
@@ -193,6 +200,52 @@ def deck_reading(work: Path, n: int) -> dict:
     return {"n": n, "bytes": size, "median_s": statistics.median(ts), "runs_s": ts}
 
 
+def setup_deck(work: Path, n: int, chain: bool) -> Path:
+    """n masses of 1000 kg on springs of 2e6 N/m and hysteretic friction devices: to the
+    table (unconnected), or each to the mass below (a chain); two dt1 steps of harmonic
+    table motion, no history file."""
+    below = [i - 1 for i in range(1, n + 1)] if chain else [0] * n
+    nodes = " ".join(str(i) for i in range(1, n + 1))
+    below_s = " ".join(str(b) for b in below)
+    text = (
+        f"&model\n n_dof = {n}\n mass = {n}*1000.0\n/\n"
+        f"&springs\n n_springs = {n}\n node_i = {nodes}\n node_j = {below_s}\n k = {n}*2.0e6\n/\n"
+        "&damping\n damping_type = 'rayleigh'\n rayleigh_a0 = 0.2\n rayleigh_a1 = 4.0e-4\n/\n"
+        f"&friction\n n_devices = {n}\n node_i = {nodes}\n node_j = {below_s}\n"
+        f" law = {n}*'hysteretic'\n p = {n}*1000.0\n mu = {n}*1.0\n f = {n}*5.0e-4\n/\n"
+        "&excitation\n excitation_type = 'harmonic'\n amplitude = 0.01\n frequency = 2.0\n"
+        " dt_record = 0.002\n duration = 0.002\n/\n"
+        "&integration\n n1 = 2\n/\n"
+        f"&output\n dir = '{work / 'out'}'\n name = 'setup'\n write_history = .false.\n/\n"
+    )
+    d = work / f"setup_{'chain' if chain else 'free'}_{n}"
+    d.mkdir(parents=True, exist_ok=True)
+    deck = d / "setup.nml"
+    deck.write_text(text)
+    return deck
+
+
+def setup_time(work: Path, n: int, exe: str) -> dict:
+    """Wall and CPU time of the executable on the set-up decks (two dt1 steps)."""
+    import resource
+
+    out: dict = {"n": n, "executable": exe}
+    for kind in ("free", "chain"):
+        deck = setup_deck(work, n, kind == "chain")
+        before = resource.getrusage(resource.RUSAGE_CHILDREN)
+        t0 = time.perf_counter()
+        p = subprocess.run([exe, str(deck)], capture_output=True, text=True, check=False)
+        wall = time.perf_counter() - t0
+        after = resource.getrusage(resource.RUSAGE_CHILDREN)
+        if p.returncode != 0:
+            raise RuntimeError(f"{exe} {deck}: {p.stderr.strip()[-500:]}")
+        cpu = after.ru_utime + after.ru_stime - before.ru_utime - before.ru_stime
+        out[kind] = {"wall_s": wall, "cpu_s": cpu}
+        print(f"set-up, {n} DOFs, {'a chain' if kind == 'chain' else 'unconnected masses'}: "
+              f"{cpu:.2f} s CPU, {wall:.2f} s wall (two dt1 steps; {exe})", flush=True)
+    return out
+
+
 def threads(work: Path, n: int) -> dict:
     """Two runs one after the other, then two at once in two threads: wall times."""
     import frictiondyn as fd
@@ -267,6 +320,9 @@ def main(argv=None) -> int:
         help="frictiondyn's refinement of a dt1 step with a phase change (docs/theory.md section 6)",
     )
     ap.add_argument("--memory-size", type=int, default=1000)
+    ap.add_argument("--setup", type=int, default=100000,
+                    help="DOFs of the set-up case (unconnected masses and a chain); 0: skip it")
+    ap.add_argument("--exe", default=None, help="the executable of the set-up case (default: the package's)")
     ap.add_argument("--no-extras", action="store_true", help="only the scaling")
     ap.add_argument("--out", type=Path, default=ROOT / "out" / "bench")
     ap.add_argument("--child", action="store_true", help=argparse.SUPPRESS)
@@ -283,6 +339,10 @@ def main(argv=None) -> int:
     with tempfile.TemporaryDirectory(prefix="fd_scale_") as tmp:
         work = Path(tmp)
         result["scaling"] = scaling(args, work)
+        if args.setup:
+            from frictiondyn import executable
+
+            result["setup"] = setup_time(work, args.setup, args.exe or str(executable()))
         if not args.no_extras:
             result["memory_vs_duration"] = memory_vs_duration(args, work)
             result["deck_reading"] = deck_reading(work, max(args.sizes))

@@ -43,7 +43,17 @@ module fd_session
    integer, parameter, public :: session_solved = 2  !! the result is there
    integer, parameter :: state_failed = 3  !! the solver failed: nothing more to get
 
-   ! the texts a session gives (session_text)
+   ! The status of an entry point of the C layer (driver/frictiondyn/_core.f90), one for each
+   ! kind of failure, and the texts a session gives (session_text). These lines are the one
+   ! source of the numbers: driver/gen_codes.py writes them into the Python package
+   ! (frictiondyn/_codes.py) when it is built.
+   integer, parameter, public :: status_ok = 0         !! success
+   integer, parameter, public :: status_input = 1      !! a bad deck or input
+   integer, parameter, public :: status_solver = 2     !! the solver failed
+   integer, parameter, public :: status_misuse = 3     !! wrong state, wrong buffer, no session
+   integer, parameter, public :: status_output = 4     !! an output file cannot be written
+   integer, parameter, public :: status_no_memory = 5  !! not enough memory (fd_error's stat_no_memory)
+   integer, parameter, public :: status_cancelled = 6  !! the solve was cancelled (session_cancel)
    integer, parameter :: text_header = 1        !! history header 'name[unit],...'
    integer, parameter :: text_summary = 2       !! summary JSON, as written to the summary file
    integer, parameter :: text_output_dir = 3    !! &output dir (or the directory set since)

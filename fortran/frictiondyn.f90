@@ -1,4 +1,6 @@
-!> Public API of the frictiondyn library: read a deck, run it, write its outputs.
+!> The library's layers in one module: the deck reader, the run of a configuration, the output
+!> writer and the types they share, for the session (fd_session, the library's public API: one
+!> deck read once, solved, queried and written) and the executable (fortran/app/main.f90).
 module frictiondyn
    use fd_kinds, only: dp
    use fd_error, only: error_type, fatal_error
@@ -16,7 +18,7 @@ module frictiondyn
 
    public :: dp, error_type, model_type, integration_type, device_type, excitation_type
    public :: result_type, run_config, output_type, run_control, select_history, stat_cancelled
-   public :: read_deck, read_deck_string, run_config_solve, run_deck, shape_of
+   public :: read_deck, read_deck_string, run_config_solve, shape_of
    public :: output_paths, temp_output_paths, summary_json, history_header
    public :: write_outputs, write_output_files
 
@@ -54,19 +56,5 @@ contains
       integer :: nsteps, every
       call history_shape(cfg%model, cfg%exc, cfg%opts, ncol, nout, nsteps, every, n_dof_kept, n_devices_kept)
    end subroutine shape_of
-
-   !> Read a deck, run it and write its outputs.
-   subroutine run_deck(path, cfg, res, error)
-      character(len=*), intent(in) :: path                !! deck file
-      type(run_config), intent(out) :: cfg                !! what the deck defines
-      type(result_type), intent(out) :: res               !! histories and summary
-      type(error_type), allocatable, intent(out) :: error !! bad deck, solver or output failure
-      call read_deck(path, cfg, error)
-      if (allocated(error)) return
-      call run_config_solve(cfg, res, error)
-      if (allocated(error)) return
-      call write_outputs(cfg%out, cfg%model, res, path, record=cfg%record, error=error)
-      if (allocated(error)) error%message = path//": "//error%message
-   end subroutine run_deck
 
 end module frictiondyn

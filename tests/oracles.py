@@ -3,7 +3,7 @@ the paper's published observation. They live here, in the tests, not in the inst
 package: a test must not take its expected values from the code it checks.
 
 Copied from driver/frictiondyn/validate.py (``linear_response``, ``den_hartog``) and
-driver/frictiondyn/paper.py (``PAPER_OBSERVATION``, there used to write the report); the
+driver/frictiondyn/paper.py (``PAPER_OBSERVATION``, which writes the report there); the
 copies are the tests' own and are not to be re-imported from the package. The validation
 studies (tools/validation/studies.py, not installed either) take ``linear_response`` and
 ``den_hartog`` from here.

@@ -60,7 +60,7 @@ CASES = [
     ("zero frequency", _set("excitation", "frequency", 0.0), ["&excitation", "frequency", "= 0 "]),
     ("negative duration", _set("excitation", "duration", -1.0), ["&excitation", "duration", "-1"]),
     ("unknown excitation", _set("excitation", "excitation_type", "sine"), ["&excitation", "sine"]),
-    # friction input (issue 4)
+    # friction input
     ("eps = 0", _set("friction", "eps", 0.0), ["&friction", "eps(1)", "= 0 "]),
     ("eps < 0", _set("friction", "eps", -1e-3), ["&friction", "eps(1)", "-0.001"]),
     ("eps1 = 0", _set("friction", "eps1", 0.0), ["&friction", "eps1(1)", "= 0 "]),

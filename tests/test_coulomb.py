@@ -1,4 +1,4 @@
-"""Issue 6: the exact (event-driven) Coulomb technique against closed forms."""
+"""The exact (event-driven) Coulomb technique against closed forms."""
 
 from __future__ import annotations
 
@@ -116,8 +116,8 @@ def test_block_stops_exactly(run):
 
 def test_block_stopping_on_the_step_grid_stops_once(run):
     """A block that comes to rest exactly at a step boundary, t = v0 / (mu g) = 250 dt1:
-    one event, then at rest (v = 0 exactly) at v0^2 / (2 mu g). (The root finder converging
-    to the end of a step used to leave the propagators of its last trial point in use: a
+    one event, then at rest (v = 0 exactly) at v0^2 / (2 mu g). (A root finder converging to
+    the end of a step that left the propagators of its last trial point in use would leave a
     residual velocity of 1e-15 m/s and a second, spurious event.)"""
     mu, m = 0.3, 2.0
     v0 = mu * G * 0.25

@@ -1,4 +1,4 @@
-"""What a design engineer reads from a run (issue 15): storey drifts and shears against the
+"""What a design engineer reads from a run: storey drifts and shears against the
 histories and equilibrium, modes against closed forms, Rayleigh damping from two modes,
 velocity-dependent friction against a hand-computed slide, the engineers' devices against
 their spelled-out decks, the summary's provenance, the Python conveniences, and the
@@ -346,7 +346,7 @@ def test_exponential_mu_reproduces_a_hand_computed_slide():
     mu is taken at the velocity at each step's end (the step iterates its sliding force to
     that velocity), so the error is Newmark's own, second order: measured 1.16e-7 s at
     dt1 = 1 ms, 2.91e-8 s at 0.5 ms (7.3e-9, 1.8e-9 at 0.25, 0.125 ms). mu taken at the
-    step's start, as before, gave 4.29e-4 s and 2.15e-4 s, first order."""
+    step's start would give 4.29e-4 s and 2.15e-4 s, first order."""
     v0, mu_max, mu_min, rate = 1.0, 0.12, 0.05, 4.0
     dev = fd.Device.exponential(1, 0, 100.0 * G, mu_max, mu_min, rate, eps=1e-4)
     errors = []

@@ -1,4 +1,4 @@
-"""Issue 10: the exact technique never misses an event, never stops at simultaneous events,
+"""The exact technique never misses an event, never stops at simultaneous events,
 and reports exact peaks.
 
 - Event location does not depend on the sampling step: dt1 from 0.25 ms to 50 ms on the
@@ -49,8 +49,8 @@ def velocity_groups(groups: dict, eps: float) -> dict:
 @pytest.mark.parametrize("test", [2, 4, 5])
 def test_events_do_not_depend_on_the_sampling_step(run, test):
     """dt1 = 0.25, 0.5, 1, 2.5, 5, 10, 25, 50 ms (dt_record 50 ms, n1 = 200..1): the same
-    event count and times (to 1e-9 s) as at 0.25 ms. (Before issue 10 the event check only
-    looked at the sign at each step's end: test 5 at dt1 = 10 ms found 29 of its 31.)
+    event count and times (to 1e-9 s) as at 0.25 ms. (An event check that looked only at
+    the sign at each step's end would find 29 of test 5's 31 at dt1 = 10 ms.)
     Measured: identical times at every dt1 (653 events on test 4, 31 on test 5, 8 on test 2).
     """
     reference = None
@@ -367,10 +367,10 @@ def test_stick_to_slip_on_the_table_closed_form(run, freq, ratio, xi):
     """A mass stuck to the table (the pattern has no free coordinate) starts to slide at
     t = arcsin(P mu / F0) / w, and its device's force never exceeds P mu: the first event
     to 1e-12 s (measured 1e-14), the peak force (summary and the history's maxima between
-    rows: every later stick-to-slip too) P mu to 1e-10 (measured 6e-12). Before, the table
-    acceleration's Taylor polynomial of such a pattern stopped at degree 5 whatever its
-    remainder (about 1e-3 F0, and the event fired at 4 times that): on the 2 Hz, P mu =
-    0.02 F0 case slip started at 1.923 ms instead of 1.592 ms with F = 1.21 P mu."""
+    rows: every later stick-to-slip too) P mu to 1e-10 (measured 6e-12). The table
+    acceleration's Taylor polynomial of such a pattern must not stop at degree 5 whatever its
+    remainder (about 1e-3 F0, and the event would fire at 4 times that): on the 2 Hz, P mu =
+    0.02 F0 case slip would start at 1.923 ms instead of 1.592 ms with F = 1.21 P mu."""
     w = 2.0 * math.pi * freq
     g = stuck_on_table(freq, ratio, xi)
     pmu = g["friction"]["p"]
@@ -424,7 +424,7 @@ def _index(q: str) -> int:
 def test_exact_steady_state_peak_of_test4(run):
     """Test 4's steady-state peak |aabs2| (last 10 cycles of 40 s) is 9.93062 m/s^2, the
     one-sided value at a stick/slip transition; rows every 0.25 ms sample it as 9.92559
-    (the value docs/validation.md reported before issue 10), rows every 5 ms as 9.8995.
+    (the sampled maximum), rows every 5 ms as 9.8995.
     Result.peak gives the exact value whatever the rows (to 1e-13); without the maxima
     between rows (Newmark) it is the sampled maximum."""
     from frictiondyn import paper
@@ -446,7 +446,7 @@ def test_an_error_names_the_deck_the_time_and_what_to_try(run):
     """A stiff spring on a small mass (k = 1e30 N/m on m = 1e-30 kg: 1e30 rad/s, each value
     within the deck's magnitude limits) would need about 1e30 sub-intervals for 1 s: the
     exact technique stops at once with an error naming the deck, the time, the sub-interval
-    and what to check, and leaves no output (before, the run did not end)."""
+    and what to check, and leaves no output (the run does not go on without end)."""
     g = {
         "model": {"n_dof": 1, "mass": [1.0e-30], "u0": [1.0e-3]},
         "springs": {"n_springs": 1, "node_i": [1], "node_j": [0], "k": [1.0e30]},
@@ -508,7 +508,7 @@ def closed_loop() -> dict:
 
 def test_closed_loop_of_devices_runs_to_the_end_and_matches_moreau_jean(tmp_path):
     """A closed loop of sticking devices whose share by the force map exceeds a limit: the
-    exact technique ends (before, at t = 0.055 s the LCP's share, on a limit, crossed it again
+    exact technique ends (at t = 0.055 s the LCP's share, on a limit, could cross it again
     2.6e-14 s later, the same decision again and again: a run without end) and agrees with
     Moreau-Jean at n1 = 400 (measured: peaks of u within 2.5e-6, friction work 2e-8), with
     every force within its limit. Run with a time limit, so that a hang fails the test."""

@@ -1,4 +1,4 @@
-"""Issue 4: both friction laws of the paper against analytic cases, linear limits, the
+"""Both friction laws of the paper against analytic cases, linear limits, the
 paper's Table 1 and Fig. 3, and several devices."""
 
 from __future__ import annotations
@@ -311,8 +311,8 @@ def test_stored_energy_is_the_springs_in_either_phase(run, duration):
     """The hysteretic law's spring holds F^2 / (2 k), k = P mu / f, sliding as well as
     sticking (eq. 3: it is released only when the force falls): energy_device_elastic_J is
     that at the end (the run starts with F = 0), and the friction work is the rest of the
-    device work. (Before stop 31 a device sliding at the end stored nothing, and its
-    spring's energy, here P mu f / 2, was booked as friction.)"""
+    device work: a device sliding at the end stores its spring's energy, here P mu f / 2,
+    which is not friction work."""
     g = paper_groups(4, "hysteretic")
     g["excitation"]["duration"] = duration
     g["output"] = {"output_every": 1}

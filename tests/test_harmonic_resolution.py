@@ -184,8 +184,8 @@ def test_a_sliding_block_its_rigid_body_mode(run):
     """A block on a friction interface has no stuck mode (the stuck system does not move) and
     one rigid-body free mode, whose damping ratio is undefined: its steady state under the
     sampled table motion is -1/Omega^2 against -1/w^2, Omega = (2 / dt) tan(w dt / 2), 53 % off
-    at 3.3 steps a period (a reviewer found it skipped as "resolved" while the peaks were 32 %
-    off); resolved at n1 = 64."""
+    at 3.3 steps a period (the peaks 32 % off: it must not be skipped as "resolved");
+    resolved at n1 = 64."""
     coarse = ok(run(BLOCK.replace("N1", "1"), name="coarse")).summary()
     fine = ok(run(BLOCK.replace("N1", "64"), name="fine")).summary()
     assert coarse["modes_free_status"] == "unrestrained"
@@ -211,8 +211,7 @@ def test_moreau_jean_is_judged_by_its_own_recursion():
     Moreau-Jean at dt1 = 0.2 s (5.6 steps a period): the step moves the linear steady state
     to the theta-method's resonance and the peak is several times the exact one (event-driven
     technique, which matches Den Hartog's steady state). The run says so (unresolved, warned);
-    at n1 = 64 it is resolved and the peak within 1 % of the exact one. Before stop 31 the
-    coarse run reported nothing."""
+    at n1 = 64 it is resolved and the peak within 1 % of the exact one."""
     exact = fd.run_text(MJ_SDOF.replace("TECH", "event_driven").replace("N1", "20")).summary
     with warnings.catch_warnings(record=True) as w:
         warnings.simplefilter("always")

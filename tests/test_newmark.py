@@ -1,4 +1,4 @@
-"""Issue 3: the linear Newmark machinery against closed forms."""
+"""The linear Newmark machinery against closed forms."""
 
 from __future__ import annotations
 
@@ -142,8 +142,8 @@ def test_paper_stuck_period_and_damping(tmp_path):
 def test_the_stuck_system_links_a_device_by_its_band(run, table, linked):
     """A stuck velocity-law device holds its masses by its band's coupling P mu(eps) / eps.
     A table that falls to 0 at speed still holds in the band: the stuck system is m1 + m2 on
-    k1 + k2, T = 2 pi sqrt((m1 + m2) / (k1 + k2)), as with the constant mu (before, the table's
-    last mu decided: 0 gave the bars apart). A table that is 0 in the band holds nothing: the
+    k1 + k2, T = 2 pi sqrt((m1 + m2) / (k1 + k2)), as with the constant mu (not the table's
+    last mu, whose 0 would give the bars apart). A table that is 0 in the band holds nothing: the
     bars apart, T = 2 pi sqrt(m1 / k1), the longer of the two."""
     text = (INPUTS / "test4_velocity.nml").read_text().replace("duration = 40.0", "duration = 0.1")
     text = text.replace("mu = 0.22", "mu_law = 'table'\n  mu_table_v = " + table)

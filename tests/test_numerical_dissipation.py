@@ -129,7 +129,7 @@ def test_a_run_that_blows_up_is_reported_not_stopped(run):
     the energy by a factor of about 1e51, still finite, so the run ends and warns. The ratio,
     the closed form's (newmark_energy), is written in scientific notation: a fixed format of
     that size overflowed its record and stopped the executable, and with it the Python
-    interpreter, before the summary was written (found by a review at stop 30)."""
+    interpreter, before the summary was written."""
     deck = oscillator(0.2, 100, 0.5, 1 / 6)
     r = ok(run(deck))
     s = r.summary()
@@ -239,10 +239,10 @@ def test_digits_lost_in_a_stiff_velocity_band(run):
 
 
 def test_digits_lost_where_the_peak_is_silently_wrong(run, tmp_path):
-    """The review's deck (P mu / eps = 1e9, x = 7.5e6) on 8 s of a synthetic record: the
+    """A deck of a stiff band (P mu / eps = 1e9, x = 7.5e6) on 8 s of a synthetic record: the
     mass's peak displacement is 8.9 % above the exact technique's, the record step check
-    says 3.35 % ("resolved") and the residual, 7.6e-3, was inside the old 0.05 limit. It is
-    now reported in the executable and in Python."""
+    says 3.35 % ("resolved") and the residual is 7.6e-3. The lost digits are reported, in
+    the executable and in Python."""
     import math
 
     from frictiondyn.synthetic import synthetic_record, write_at2

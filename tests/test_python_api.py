@@ -396,7 +396,7 @@ def test_damping_type_in_any_case_damps_as_the_lower_case_deck(given, lower):
 
 def test_write_deck_of_two_in_memory_records_keeps_each_its_own(tmp_path):
     """Two decks written into one directory, each with a Record of values: each deck runs
-    its own record (the second used to overwrite the first's record.txt)."""
+    its own record (the second does not overwrite the first's record.txt)."""
     t = np.arange(201) * 0.005
     a = quick(excitation=Record(0.005, values=2.0 * np.sin(2 * np.pi * t)))
     b = quick(excitation=Record(0.005, values=0.5 * np.sin(6 * np.pi * t)))

@@ -525,8 +525,7 @@ def test_moreau_jean_is_judged_by_its_own_recursion():
     by Moreau-Jean with theta = 1 at n1 = 2 (dt1 = 5 ms): the step alone moves the free
     system's peak linear response by more than 10 % (its own theta-method against the exact
     step), the run is unresolved and warned, and its top-storey slip is more than 20 % off
-    the exact technique's. At n1 = 10 the check is resolved. Before stop 31 Moreau-Jean's
-    record check was 'not applicable'."""
+    the exact technique's. At n1 = 10 the check is resolved."""
     deck = MJ_BUILDING.replace("RECORD", str(INPUTS / "synthetic_pga035.AT2"))
     exact = fd.run_text(deck.replace("TECH", "event_driven").replace("INTEGRATION", "")).summary
     with warnings.catch_warnings(record=True) as w:

@@ -1,7 +1,9 @@
 """Reference outputs of every bundled deck (inputs/*.nml), as dftd4's tester compares its
 reference energies: each deck is run by the installed executable and by the extension
 (``frictiondyn.run``), and the summary and a downsampled history are compared with
-tests/reference/<deck>.summary.json and <deck>.history.csv at the tolerances below.
+tests/reference/<deck>.summary.json and <deck>.history.csv at the tolerances below
+(kept, with the comparison, in tests/reference_check.py, which `meson test --suite reference`
+also runs on the executable of a Fortran-only build).
 The references are regenerated only by tools/update_reference.py, for an intended change of
 behaviour explained in its commit.
 
@@ -41,7 +43,6 @@ from __future__ import annotations
 
 import copy
 import json
-import math
 import subprocess
 from pathlib import Path
 
@@ -50,132 +51,18 @@ import numpy as np
 import pytest
 from conftest import INPUTS
 
-REFERENCE = Path(__file__).resolve().parent / "reference"
+# the rules of the comparison, shared with `meson test --suite reference` (tests/meson.build)
+from reference_check import REFERENCE, compare_history, compare_summary
+
 DECKS = sorted(p.stem for p in INPUTS.glob("*.nml"))
 
-RTOL = 1e-9  # floats of the summary (peaks, times, periods)
-ENERGY_ATOL = 1e-9  # energies, times energy_input_J
-HISTORY_RTOL = 1e-8  # history values, times the column's largest reference magnitude
-EXACT_COLUMNS = {"phase"}  # history columns compared exactly (by prefix)
-
-
-# counts that depend on round-off: (key, technique test, relative tolerance); see the docstring
-def _event_driven(ref: dict) -> bool:
-    return ref.get("technique") == "event_driven" or "coulomb" in ref.get("device_law", [])
-
-
-ROUNDOFF_COUNTS: dict = {}  # none at present (the event-driven technique's count became exact)
-# fractions of 1 with components that may be 0 (mode shapes scaled to a largest component
-# of 1, effective modal masses over the total): compared to RTOL absolutely
-ABSOLUTE_KEYS = (
-    "mode_shapes_",
-    "modal_mass_ratio_",
-    "energy_residual_ratio",
-    "harmonic_step_error",
-    "record_step_error",
-)
-
-
 # ------------------------------------------------------------------ comparison
-def _is_int(x) -> bool:
-    return isinstance(x, int) and not isinstance(x, bool)
-
-
-def _shape(x):
-    """The nesting and lengths of a JSON value (lists of lists: mode shapes, storey nodes)."""
-    return [_shape(y) for y in x] if isinstance(x, list) else None
-
-
-def _leaves(key: str, have, want):
-    """(where, have, want) for every number or text of a (nested) list, or the value."""
-    if not isinstance(want, list):
-        yield key, have, want
-        return
-    for i, (h, w) in enumerate(zip(have, want, strict=True)):
-        yield from _leaves(f"{key}[{i}]", h, w)
-
-
-def _flatten(summary: dict) -> dict:
-    """Nested objects (the record block) as dotted keys, compared by the same rules."""
-    flat = {}
-    for key, value in summary.items():
-        if isinstance(value, dict):
-            flat.update({f"{key}.{k}": v for k, v in value.items()})
-        else:
-            flat[key] = value
-    return flat
-
-
-def compare_summary(got: dict, ref: dict) -> list[str]:
-    """Mismatches of a run's summary against a reference summary (empty list: equal)."""
-    bad = []
-    scale = abs(ref.get("energy_input_J", 0.0))
-    got, ref = _flatten(got), _flatten(ref)
-    for key, want in ref.items():
-        if key not in got:
-            bad.append(f"{key}: missing from the run")
-            continue
-        have = got[key]
-        if key in ("deck", "record.file"):
-            if Path(have).name != Path(want).name:
-                bad.append(f"{key}: {have!r} != {want!r}")
-            continue
-        if _shape(want) != _shape(have):
-            bad.append(f"{key}: {have!r} != reference {want!r} (shape)")
-            continue
-        for where, h, w in _leaves(key, have, want):
-            if w is None or isinstance(w, (str, bool)):
-                ok = h == w
-            elif _is_int(w):
-                rule = ROUNDOFF_COUNTS.get(key)
-                if rule and rule[0](ref):
-                    ok = _is_int(h) and abs(h - w) <= rule[1] * abs(w)
-                else:
-                    ok = _is_int(h) and h == w
-            elif h is None or isinstance(h, (str, bool)):
-                ok = False
-            elif key.startswith(ABSOLUTE_KEYS):  # before energy_: the ratio is dimensionless
-                ok = math.isfinite(h) and abs(h - w) <= RTOL
-            elif key.startswith("energy_"):
-                ok = abs(h - w) <= ENERGY_ATOL * scale
-            else:
-                ok = math.isfinite(h) and abs(h - w) <= RTOL * abs(w)
-            if not ok:
-                bad.append(f"{where}: {h!r} != reference {w!r}")
-    return bad
-
-
 def read_reference_history(name: str) -> tuple[list[str], np.ndarray, np.ndarray]:
     """Column names, row indices and values of a reference history."""
     path = REFERENCE / f"{name}.history.csv"
     names = path.read_text().split("\n", 1)[0].split(",")
     table = np.loadtxt(path, delimiter=",", skiprows=1, ndmin=2)
     return names[1:], table[:, 0].astype(int), table[:, 1:]
-
-
-def compare_history(names: list[str], data: np.ndarray, ref_name: str) -> list[str]:
-    """Mismatches of a full history (columns `names`) against the reference rows."""
-    ref_names, rows, ref = read_reference_history(ref_name)
-    if rows[-1] >= len(data):
-        return [f"history has {len(data)} rows, the reference goes to row {rows[-1]}"]
-    bad = []
-    for j, col in enumerate(ref_names):
-        if col not in names:
-            bad.append(f"column {col}: missing from the run")
-            continue
-        have, want = data[rows, names.index(col)], ref[:, j]
-        if any(col.startswith(p) for p in EXACT_COLUMNS):
-            wrong = np.nonzero(have != want)[0]
-        else:
-            tol = HISTORY_RTOL * np.max(np.abs(want))
-            wrong = np.nonzero(~(np.abs(have - want) <= tol))[0]
-        if wrong.size:
-            k = wrong[np.argmax(np.abs(have[wrong] - want[wrong]))]
-            bad.append(
-                f"column {col}: {wrong.size} of {len(rows)} rows differ, worst row {rows[k]}: "
-                f"{float(have[k])!r} != reference {float(want[k])!r}"
-            )
-    return bad
 
 
 # ------------------------------------------------------------------ runs
@@ -313,3 +200,22 @@ def test_new_keys_and_counts_are_judged_as_documented():
     assert compare_summary(small, ref) == []
     large = {**ref, "energy_friction_J": ref["energy_friction_J"] + 1e-8 * e_in}
     assert compare_summary(large, ref) != []
+
+
+def test_the_meson_reference_check_judges_the_executable(tmp_path, capsys):
+    """tests/reference_check.py (run by `meson test --suite reference`) passes the executable
+    on a bundled deck, fails it on the same deck with the slip load changed by 1e-6, and
+    lists every bundled deck."""
+    import reference_check
+
+    exe = frictiondyn.executable()
+    deck = INPUTS / "test4_velocity.nml"
+    assert reference_check.main([exe, str(deck)]) == 0
+    changed = tmp_path / deck.name
+    text = deck.read_text()
+    assert "p = 61.81 " in text
+    changed.write_text(text.replace("p = 61.81 ", f"p = {61.81 * (1 + 1e-6)!r} "))
+    assert reference_check.main([exe, str(changed)]) == 1
+    assert "differs from tests/reference" in capsys.readouterr().err
+    reference_check.main(["--list", str(INPUTS)])
+    assert capsys.readouterr().out.split() == DECKS

@@ -1,4 +1,4 @@
-"""Plots for reports (issue 15): the default time window, thinning that keeps the peaks,
+"""Plots for reports: the default time window, thinning that keeps the peaks,
 units chosen by the user, names from the deck, the profiles over the height, titles,
 resolution and figures composed of panels."""
 

@@ -1,5 +1,5 @@
 """The structure-aware linear algebra, the streamed output, the history selection, progress
-and interrupt (issue 13). Correctness only: speed and memory are measured in
+and interrupt. Correctness only: speed and memory are measured in
 bench/compare_opensees.py and docs/performance.md, never here.
 
 - The banded path (reverse Cuthill-McKee, band Cholesky, rank-one updates as devices change
@@ -313,7 +313,7 @@ try:
 except KeyboardInterrupt:
     print("interrupted after", time.perf_counter() - t0)
 """
-    # five times: the session freed under a running solve crashed 2 runs in 6 (a race)
+    # five times: a session freed under a running solve would crash some runs (a race)
     for _ in range(5):
         proc = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True, timeout=120)
         assert proc.returncode == 0 and "interrupted after" in proc.stdout, (
@@ -344,8 +344,8 @@ print(fd.run(deck).data.shape[0])
 
 def test_a_progress_callback_that_raises_stops_the_run(tmp_path):
     """An exception from the progress callback is raised from solve, promptly (the run would
-    take minutes), after the solve has stopped: before, the session was freed under the
-    running solve and the process died (SIGSEGV)."""
+    take minutes), after the solve has stopped: the session is not freed under the running
+    solve (the process would die, SIGSEGV)."""
     code = f"""
 import time, frictiondyn as fd
 def progress(t, duration):
@@ -509,8 +509,8 @@ def test_storey_columns_are_kept_whatever_the_selection(technique):
 # ----------------------------------------------------------------- capacity, modes
 
 
-def test_a_deck_beyond_the_old_capacity_runs(tmp_path):
-    """12 000 storeys (the old limit was 10 000 DOFs): read, its stuck period computed by
+def test_a_deck_of_12000_storeys_runs(tmp_path):
+    """12 000 storeys: read, its stuck period computed by
     the subspace iteration (the free chain's closed form, dampers with P mu = 0), run."""
     n = 12000
     g = building(n=n, pmu=[0.0] * n, duration=0.01, output={"history_dofs": [n], "history_devices": 0})

@@ -7,6 +7,7 @@ from __future__ import annotations
 import json
 import threading
 import time
+from pathlib import Path
 
 import frictiondyn
 import numpy as np
@@ -142,3 +143,27 @@ def test_solve_releases_the_gil(tmp_path):
     # with the GIL held, the loop would stop for the whole solve (tenths of a second)
     assert elapsed > 0.05
     assert max(gaps) < 0.5 * elapsed, (max(gaps), elapsed)
+
+
+def test_status_codes_and_text_ids_have_one_source():
+    """The extension's status codes and text ids are fd_session.f90's status_* and text_*
+    parameters, generated into frictiondyn._codes: the Python side keeps no number of its
+    own. Every failure status has its exception, and each text id gives its text."""
+    import re
+
+    from conftest import ROOT
+    from frictiondyn import _api, _codes
+
+    source = (ROOT / "fortran" / "fd_session.f90").read_text()
+    fortran = {
+        name.upper(): int(value)
+        for name, value in re.findall(r"::\s*((?:status|text)_\w+)\s*=\s*(\d+)", source)
+    }
+    generated = {k: v for k, v in vars(_codes).items() if k.startswith(("STATUS_", "TEXT_"))}
+    assert generated == fortran and len(fortran) == 15
+    failures = {v for k, v in fortran.items() if k.startswith("STATUS_") and k != "STATUS_OK"}
+    assert set(_api._ERRORS) == failures
+    assert len(set(_api._ERRORS.values())) == len(failures)
+    with Session(INPUTS / "test4_velocity.nml") as s:
+        assert Path(s._text(_codes.TEXT_DECK)).name == "test4_velocity.nml"
+        assert s._text(_codes.TEXT_OUTPUT_NAME) == "test4_velocity"

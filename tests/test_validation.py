@@ -1,4 +1,4 @@
-"""Issue 6: the verification studies of docs/validation.md, asserted on reduced runs, at
+"""The verification studies of docs/validation.md, asserted on reduced runs, at
 tolerances stated here (measured values in the comments), not taken from the studies."""
 
 from __future__ import annotations

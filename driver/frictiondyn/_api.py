@@ -31,7 +31,7 @@ from pathlib import Path
 
 import numpy as np
 
-from . import _core
+from . import _codes, _core
 
 __all__ = [
     "DeckError",
@@ -131,14 +131,14 @@ def _user_stacklevel() -> int:
     return level
 
 
-# the status codes of the extension (driver/frictiondyn/_core.f90)
+# the status codes of the extension (fortran/fd_session.f90's status_*, generated into _codes)
 _ERRORS = {
-    1: DeckError,
-    2: SolverError,
-    3: FrictiondynError,
-    4: OutputError,
-    5: OutOfMemoryError,
-    6: RunCancelled,
+    _codes.STATUS_INPUT: DeckError,
+    _codes.STATUS_SOLVER: SolverError,
+    _codes.STATUS_MISUSE: FrictiondynError,
+    _codes.STATUS_OUTPUT: OutputError,
+    _codes.STATUS_NO_MEMORY: OutOfMemoryError,
+    _codes.STATUS_CANCELLED: RunCancelled,
 }
 #: seconds between looks at a solve running in the worker thread (Ctrl-C, progress)
 _POLL = 0.05
@@ -233,10 +233,11 @@ def _summary_path(csv: str | os.PathLike) -> Path:
     return csv.with_name(stem + ".summary.json")
 
 
-# the texts a session gives (fortran/fd_session.f90)
-_HEADER, _SUMMARY, _OUTPUT_DIR, _OUTPUT_NAME, _HISTORY_PATH, _SUMMARY_PATH, _DECK, _ERROR = range(
-    1, 9
-)
+# the texts a session gives (fortran/fd_session.f90's text_*, generated into _codes)
+_HEADER, _SUMMARY = _codes.TEXT_HEADER, _codes.TEXT_SUMMARY
+_OUTPUT_DIR, _OUTPUT_NAME = _codes.TEXT_OUTPUT_DIR, _codes.TEXT_OUTPUT_NAME
+_HISTORY_PATH, _SUMMARY_PATH = _codes.TEXT_HISTORY_PATH, _codes.TEXT_SUMMARY_PATH
+_DECK, _ERROR = _codes.TEXT_DECK, _codes.TEXT_ERROR
 _PATHS = (_OUTPUT_DIR, _OUTPUT_NAME, _HISTORY_PATH, _SUMMARY_PATH, _DECK)
 
 
@@ -873,7 +874,12 @@ class Result:
         """Write the history (header ``name[unit],...``, ``es24.16e3`` values) and the summary
         next to it (``<stem>.summary.json`` for ``<stem>.csv``, any case; ``<name>.summary.json``
         for any other name, as ``from_files`` looks for it) with the library's writer, exactly
-        as the executable does; each file goes to a temporary name renamed when complete."""
+        as the executable does; each file goes to a temporary name renamed when complete.
+
+        Why a new session: a Result holds none (it may come from arrays, from files or from a
+        session closed since), and only the library's writer gives the executable's bytes; so
+        the Result's header, summary and history are handed to a session made for this call
+        (which copies the history: the memory of one more history while it writes)."""
         path = Path(path)
         summary = _summary_path(path)
         with Session._adopt(self.data, self._header(), self.summary_json()) as session:

@@ -17,10 +17,10 @@
 !> an accented path) and lost what follows a NUL. (f2py's c_int8_t arrays do not compile:
 !> it declares them as an undefined C type, signed_char.)
 !>
-!> status: 0 success, 1 bad deck or input, 2 solver failure, 3 misuse (wrong state, wrong
-!> buffer, no session), 4 an output file cannot be written, 5 not enough memory (with the
-!> handle 0 when the session itself could not be allocated: then there is no message),
-!> 6 the solve was cancelled (fd_session_cancel).
+!> status: 0 or the kind of failure, fd_session's status_* (fortran/fd_session.f90: a bad deck
+!> or input, a solver failure, misuse, an output file that cannot be written, not enough
+!> memory (with the handle 0 when the session itself could not be allocated: then there is no
+!> message), a cancelled solve).
 !>
 !> Threads: fd_session_solve releases the GIL; while it runs, another thread may call
 !> fd_session_cancel and fd_session_progress on the same handle (and nothing else).
@@ -30,7 +30,8 @@
 !> (it holds the message) and must be closed too.
 subroutine fd_session_open(npath, path, ntext, text, from_text, handle, ncol, nout, status)
    use, intrinsic :: iso_c_binding, only: c_int, c_int64_t, c_short
-   use fd_session, only: session_type, session_new, session_open, session_open_text, session_shape
+   use fd_session, only: session_type, session_new, session_open, session_open_text, session_shape, &
+                         status_input, status_no_memory
    use frictiondyn, only: error_type
    implicit none
    integer(c_int), intent(in) :: npath           !! bytes of the path
@@ -52,7 +53,7 @@ subroutine fd_session_open(npath, path, ntext, text, from_text, handle, ncol, no
    ncol = 0; nout = 0
    call session_new(s, handle, stat)
    if (stat /= 0) then
-      status = 5
+      status = status_no_memory
       return
    end if
    call bytes_text(path, path_s, error)
@@ -65,7 +66,7 @@ subroutine fd_session_open(npath, path, ntext, text, from_text, handle, ncol, no
       call session_open(s, path_s, error)
    end if
    if (.not. allocated(error)) call session_shape(s, nc, no, history, error)
-   call keep_error(s, error, 1, status)
+   call keep_error(s, error, status_input, status)
    if (status /= 0) return
    ncol = int(nc, c_int); nout = int(no, c_int)
 contains
@@ -76,7 +77,7 @@ end subroutine fd_session_open
 !> the library's writer (fd_session_write_files).
 subroutine fd_session_adopt(ncol, nout, hist, nheader, header, nsummary, summary, handle, status)
    use, intrinsic :: iso_c_binding, only: c_int, c_int64_t, c_double, c_short
-   use fd_session, only: session_type, session_new, session_adopt
+   use fd_session, only: session_type, session_new, session_adopt, status_no_memory
    use frictiondyn, only: error_type
    implicit none
    integer(c_int), intent(in) :: ncol            !! columns
@@ -96,13 +97,13 @@ subroutine fd_session_adopt(ncol, nout, hist, nheader, header, nsummary, summary
 
    call session_new(s, handle, stat)
    if (stat /= 0) then
-      status = 5
+      status = status_no_memory
       return
    end if
    call bytes_text(header, header_s, error)
    if (.not. allocated(error)) call bytes_text(summary, summary_s, error)
    if (.not. allocated(error)) call session_adopt(s, hist, header_s, summary_s, error)
-   call keep_error(s, error, 5, status)
+   call keep_error(s, error, status_no_memory, status)
    if (status /= 0) return
 contains
    include 'fd_core_common.inc'
@@ -121,7 +122,7 @@ end subroutine fd_session_close
 !> Columns and samples of the session's history, and its &output write_history.
 subroutine fd_session_shape(handle, ncol, nout, history, status)
    use, intrinsic :: iso_c_binding, only: c_int, c_int64_t
-   use fd_session, only: session_type, session_from_handle, session_shape
+   use fd_session, only: session_type, session_from_handle, session_shape, status_misuse, status_ok
    use frictiondyn, only: error_type
    implicit none
    integer(c_int64_t), intent(in) :: handle      !! the session
@@ -136,10 +137,10 @@ subroutine fd_session_shape(handle, ncol, nout, history, status)
 
    ncol = 0; nout = 0; history = 0
    call session_from_handle(handle, s)
-   status = merge(0_c_int, 3_c_int, associated(s))
+   status = merge(int(status_ok, c_int), int(status_misuse, c_int), associated(s))
    if (status /= 0) return
    call session_shape(s, nc, no, hist, error)
-   call keep_error(s, error, 3, status)
+   call keep_error(s, error, status_misuse, status)
    if (status /= 0) return
    ncol = int(nc, c_int); nout = int(no, c_int)
    history = merge(1_c_int, 0_c_int, hist)
@@ -153,7 +154,8 @@ end subroutine fd_session_shape
 !> history in memory (the session streams it to its file, or only the summary is wanted).
 subroutine fd_session_solve(handle, mode, ncol, nout, hist, status)
    use, intrinsic :: iso_c_binding, only: c_int, c_int64_t, c_double
-   use fd_session, only: session_type, session_from_handle, session_solve, session_read
+   use fd_session, only: session_type, session_from_handle, session_solve, session_read, &
+                         status_cancelled, status_misuse, status_ok, status_solver
    use frictiondyn, only: error_type, stat_cancelled
    implicit none
    integer(c_int64_t), intent(in) :: handle      !! the session
@@ -168,9 +170,9 @@ subroutine fd_session_solve(handle, mode, ncol, nout, hist, status)
    integer :: code
 
    call session_from_handle(handle, s)
-   status = merge(0_c_int, 3_c_int, associated(s))
+   status = merge(int(status_ok, c_int), int(status_misuse, c_int), associated(s))
    if (status /= 0) return
-   code = merge(2, 3, s%state == session_read)  ! a failure of the solver, or misuse
+   code = merge(status_solver, status_misuse, s%state == session_read)  ! a failure of the solver, or misuse
    select case (mode)
    case (1)
       call session_solve(s, error, buffer=hist)
@@ -180,7 +182,7 @@ subroutine fd_session_solve(handle, mode, ncol, nout, hist, status)
       call session_solve(s, error, keep=.false.)
    end select
    if (allocated(error)) then
-      if (error%stat == stat_cancelled) code = 6
+      if (error%stat == stat_cancelled) code = status_cancelled
    end if
    call keep_error(s, error, code, status)
    if (status /= 0) return
@@ -191,7 +193,8 @@ end subroutine fd_session_solve
 !> Keep only some DOFs and devices (1-based, ascending) in the history; before solving.
 subroutine fd_session_select(handle, ndof, dofs, ndev, devices, ncol, status)
    use, intrinsic :: iso_c_binding, only: c_int, c_int64_t
-   use fd_session, only: session_type, session_from_handle, session_select, session_shape
+   use fd_session, only: session_type, session_from_handle, session_select, session_shape, &
+                         status_input, status_misuse, status_ok
    use frictiondyn, only: error_type
    implicit none
    integer(c_int64_t), intent(in) :: handle      !! the session
@@ -208,11 +211,11 @@ subroutine fd_session_select(handle, ndof, dofs, ndev, devices, ncol, status)
 
    ncol = 0
    call session_from_handle(handle, s)
-   status = merge(0_c_int, 3_c_int, associated(s))
+   status = merge(int(status_ok, c_int), int(status_misuse, c_int), associated(s))
    if (status /= 0) return
    call session_select(s, int(dofs), int(devices), error)
    if (.not. allocated(error)) call session_shape(s, nc, no, hist, error)
-   call keep_error(s, error, 1, status)
+   call keep_error(s, error, status_input, status)
    if (status /= 0) return
    ncol = int(nc, c_int)
 contains
@@ -222,7 +225,7 @@ end subroutine fd_session_select
 !> Numbers of DOFs and devices of the session's deck.
 subroutine fd_session_sizes(handle, n_dof, n_devices, status)
    use, intrinsic :: iso_c_binding, only: c_int, c_int64_t
-   use fd_session, only: session_type, session_from_handle, session_read
+   use fd_session, only: session_type, session_from_handle, session_read, status_misuse, status_ok
    use frictiondyn, only: error_type
    use fd_error, only: fatal_error
    implicit none
@@ -235,10 +238,10 @@ subroutine fd_session_sizes(handle, n_dof, n_devices, status)
 
    n_dof = 0; n_devices = 0
    call session_from_handle(handle, s)
-   status = merge(0_c_int, 3_c_int, associated(s))
+   status = merge(int(status_ok, c_int), int(status_misuse, c_int), associated(s))
    if (status /= 0) return
    if (.not. s%from_deck .or. s%state < session_read) call fatal_error(error, 'the session holds no deck')
-   call keep_error(s, error, 3, status)
+   call keep_error(s, error, status_misuse, status)
    if (status /= 0) return
    n_dof = int(s%cfg%model%n_dof, c_int)
    n_devices = int(s%cfg%model%n_devices, c_int)
@@ -251,7 +254,7 @@ end subroutine fd_session_sizes
 !> n_devices numbers (fd_session_sizes; at least 1 each); ndofs, ndevices of them are set.
 subroutine fd_session_selection(handle, n_dof, n_devices, dofs, ndofs, devices, ndevices, status)
    use, intrinsic :: iso_c_binding, only: c_int, c_int64_t
-   use fd_session, only: session_type, session_from_handle, session_read
+   use fd_session, only: session_type, session_from_handle, session_read, status_misuse, status_ok
    use frictiondyn, only: error_type
    use fd_error, only: fatal_error
    implicit none
@@ -269,7 +272,7 @@ subroutine fd_session_selection(handle, n_dof, n_devices, dofs, ndofs, devices, 
 
    dofs = 0; devices = 0; ndofs = 0; ndevices = 0
    call session_from_handle(handle, s)
-   status = merge(0_c_int, 3_c_int, associated(s))
+   status = merge(int(status_ok, c_int), int(status_misuse, c_int), associated(s))
    if (status /= 0) return
    if (.not. s%from_deck .or. s%state < session_read) call fatal_error(error, 'the session holds no deck')
    if (.not. allocated(error)) then
@@ -280,7 +283,7 @@ subroutine fd_session_selection(handle, n_dof, n_devices, dofs, ndofs, devices, 
       end if
       if (nd > n_dof .or. nv > n_devices) call fatal_error(error, 'selection buffer too small')
    end if
-   call keep_error(s, error, 3, status)
+   call keep_error(s, error, status_misuse, status)
    if (status /= 0) return
    if (s%ctl%select_all) then
       dofs(1:nd) = [(int(i, c_int), i=1, nd)]
@@ -297,7 +300,7 @@ end subroutine fd_session_selection
 !> Write the history to the deck's output file as the run goes (fd_session_write commits it).
 subroutine fd_session_stream(handle, status)
    use, intrinsic :: iso_c_binding, only: c_int, c_int64_t
-   use fd_session, only: session_type, session_from_handle, session_stream
+   use fd_session, only: session_type, session_from_handle, session_stream, status_misuse, status_ok
    use frictiondyn, only: error_type
    implicit none
    integer(c_int64_t), intent(in) :: handle      !! the session
@@ -306,10 +309,10 @@ subroutine fd_session_stream(handle, status)
    type(error_type), allocatable :: error
 
    call session_from_handle(handle, s)
-   status = merge(0_c_int, 3_c_int, associated(s))
+   status = merge(int(status_ok, c_int), int(status_misuse, c_int), associated(s))
    if (status /= 0) return
    call session_stream(s, error)
-   call keep_error(s, error, 3, status)
+   call keep_error(s, error, status_misuse, status)
    if (status /= 0) return
 contains
    include 'fd_core_common.inc'
@@ -351,7 +354,7 @@ end subroutine fd_session_progress
 !> Copy the history of a solved session into `hist` (its shape from fd_session_shape).
 subroutine fd_session_history(handle, ncol, nout, hist, status)
    use, intrinsic :: iso_c_binding, only: c_int, c_int64_t, c_double
-   use fd_session, only: session_type, session_from_handle, session_solved
+   use fd_session, only: session_type, session_from_handle, session_solved, status_misuse, status_ok
    use frictiondyn, only: error_type
    use fd_error, only: fatal_error
    implicit none
@@ -366,25 +369,26 @@ subroutine fd_session_history(handle, ncol, nout, hist, status)
 
    hist = 0.0_c_double
    call session_from_handle(handle, s)
-   status = merge(0_c_int, 3_c_int, associated(s))
+   status = merge(int(status_ok, c_int), int(status_misuse, c_int), associated(s))
    if (status /= 0) return
    if (s%state /= session_solved) then
       call fatal_error(error, 'cannot give the history: the session is not solved')
    else if (s%res%ncol /= ncol .or. s%res%nout /= nout) then
       call fatal_error(error, 'history buffer of the wrong shape')
    end if
-   call keep_error(s, error, 3, status)
+   call keep_error(s, error, status_misuse, status)
    if (status /= 0) return
    hist = real(s%res%hist, c_double)
 contains
    include 'fd_core_common.inc'
 end subroutine fd_session_history
 
-!> Length of one of the session's texts: 1 history header, 2 summary JSON, 3 &output dir,
-!> 4 &output name, 5 history CSV path, 6 summary path, 7 deck, 8 message of the last error.
+!> Length of one of the session's texts (which: fd_session's text_*, fortran/fd_session.f90:
+!> history header, summary JSON, &output dir and name, history and summary paths, deck,
+!> message of the last error).
 subroutine fd_session_text_length(handle, which, length, status)
    use, intrinsic :: iso_c_binding, only: c_int, c_int64_t
-   use fd_session, only: session_type, session_from_handle, session_text
+   use fd_session, only: session_type, session_from_handle, session_text, status_misuse, status_ok
    use frictiondyn, only: error_type
    implicit none
    integer(c_int64_t), intent(in) :: handle      !! the session
@@ -397,10 +401,10 @@ subroutine fd_session_text_length(handle, which, length, status)
 
    length = 0
    call session_from_handle(handle, s)
-   status = merge(0_c_int, 3_c_int, associated(s))
+   status = merge(int(status_ok, c_int), int(status_misuse, c_int), associated(s))
    if (status /= 0) return
    call session_text(s, int(which), str, error)
-   call keep_error(s, error, 3, status)
+   call keep_error(s, error, status_misuse, status)
    if (status /= 0) return
    length = int(len(str), c_int)
 contains
@@ -410,7 +414,7 @@ end subroutine fd_session_text_length
 !> One of the session's texts (see fd_session_text_length) into `buf` of exactly its length.
 subroutine fd_session_text(handle, which, length, buf, status)
    use, intrinsic :: iso_c_binding, only: c_int, c_int64_t, c_char
-   use fd_session, only: session_type, session_from_handle, session_text
+   use fd_session, only: session_type, session_from_handle, session_text, status_misuse, status_ok
    use frictiondyn, only: error_type
    use fd_error, only: fatal_error
    implicit none
@@ -426,12 +430,12 @@ subroutine fd_session_text(handle, which, length, buf, status)
 
    buf = ' '
    call session_from_handle(handle, s)
-   status = merge(0_c_int, 3_c_int, associated(s))
+   status = merge(int(status_ok, c_int), int(status_misuse, c_int), associated(s))
    if (status /= 0) return
    call session_text(s, int(which), str, error)
    if (.not. allocated(error) .and. len(str) /= length) &
       call fatal_error(error, 'text buffer of the wrong length')
-   call keep_error(s, error, 3, status)
+   call keep_error(s, error, status_misuse, status)
    if (status /= 0) return
    do i = 1, len(str)
       buf(i) = str(i:i)
@@ -443,7 +447,7 @@ end subroutine fd_session_text
 !> Write the outputs into `dir` instead of the deck's &output dir.
 subroutine fd_session_set_output_dir(handle, ndir, dir, status)
    use, intrinsic :: iso_c_binding, only: c_int, c_int64_t, c_short
-   use fd_session, only: session_type, session_from_handle, session_set_output_dir
+   use fd_session, only: session_type, session_from_handle, session_set_output_dir, status_misuse, status_ok
    use frictiondyn, only: error_type
    implicit none
    integer(c_int64_t), intent(in) :: handle      !! the session
@@ -455,11 +459,11 @@ subroutine fd_session_set_output_dir(handle, ndir, dir, status)
    character(len=:), allocatable :: dir_s
 
    call session_from_handle(handle, s)
-   status = merge(0_c_int, 3_c_int, associated(s))
+   status = merge(int(status_ok, c_int), int(status_misuse, c_int), associated(s))
    if (status /= 0) return
    call bytes_text(dir, dir_s, error)
    if (.not. allocated(error)) call session_set_output_dir(s, dir_s, error)
-   call keep_error(s, error, 3, status)
+   call keep_error(s, error, status_misuse, status)
    if (status /= 0) return
 contains
    include 'fd_core_common.inc'
@@ -470,7 +474,8 @@ end subroutine fd_session_set_output_dir
 !> (the caller's buffer of fd_session_solve), else the session's (or its streamed file).
 subroutine fd_session_write(handle, use_hist, ncol, nout, hist, status)
    use, intrinsic :: iso_c_binding, only: c_int, c_int64_t, c_double
-   use fd_session, only: session_type, session_from_handle, session_write, session_solved
+   use fd_session, only: session_type, session_from_handle, session_write, session_solved, &
+                         status_misuse, status_ok, status_output
    use frictiondyn, only: error_type
    implicit none
    integer(c_int64_t), intent(in) :: handle      !! the session
@@ -485,9 +490,9 @@ subroutine fd_session_write(handle, use_hist, ncol, nout, hist, status)
    integer :: code
 
    call session_from_handle(handle, s)
-   status = merge(0_c_int, 3_c_int, associated(s))
+   status = merge(int(status_ok, c_int), int(status_misuse, c_int), associated(s))
    if (status /= 0) return
-   code = merge(4, 3, s%state == session_solved)
+   code = merge(status_output, status_misuse, s%state == session_solved)
    if (use_hist /= 0) then
       call session_write(s, error, hist)
    else
@@ -503,7 +508,8 @@ end subroutine fd_session_write
 !> `hist_path` and the summary to `summ_path` with the library's writer.
 subroutine fd_session_write_files(handle, nhist, hist_path, nsumm, summ_path, history, use_hist, ncol, nout, hist, status)
    use, intrinsic :: iso_c_binding, only: c_int, c_int64_t, c_double, c_short
-   use fd_session, only: session_type, session_from_handle, session_write_files, session_solved
+   use fd_session, only: session_type, session_from_handle, session_write_files, session_solved, &
+                         status_misuse, status_ok, status_output
    use frictiondyn, only: error_type
    implicit none
    integer(c_int64_t), intent(in) :: handle      !! the session
@@ -524,9 +530,9 @@ subroutine fd_session_write_files(handle, nhist, hist_path, nsumm, summ_path, hi
    character(len=:), allocatable :: hist_s, summ_s
 
    call session_from_handle(handle, s)
-   status = merge(0_c_int, 3_c_int, associated(s))
+   status = merge(int(status_ok, c_int), int(status_misuse, c_int), associated(s))
    if (status /= 0) return
-   code = merge(4, 3, s%state == session_solved)
+   code = merge(status_output, status_misuse, s%state == session_solved)
    call bytes_text(hist_path, hist_s, error)
    if (.not. allocated(error)) call bytes_text(summ_path, summ_s, error)
    if (.not. allocated(error)) then

@@ -23,6 +23,7 @@ module fd_banded
    use, intrinsic :: ieee_arithmetic, only: ieee_is_finite
    use, intrinsic :: iso_fortran_env, only: int64
    use fd_kinds, only: dp
+   use fd_lapack, only: dpbtf2, dpbtrf, dpbtrs, dpotf2, dpotrf, dsbmv, dsymv, dsyrk, dtrsv
    use fd_error, only: error_type, fatal_error, fmt_int, fmt_real, stat_no_memory
    use fd_rcm, only: rcm_order, graph_bandwidth
    implicit none
@@ -108,76 +109,6 @@ module fd_banded
       real(dp), allocatable, private :: xv(:)         !! update vector, zero between calls
       real(dp), allocatable, private :: rdiag(:)      !! 1 / U(j, j) (the small dense solve)
    end type spd_system
-
-   interface
-      subroutine dpotrf(uplo, n, a, lda, info)
-         import :: dp
-         character(len=1), intent(in) :: uplo
-         integer, intent(in) :: n, lda
-         real(dp), intent(inout) :: a(lda, *)
-         integer, intent(out) :: info
-      end subroutine dpotrf
-      subroutine dpotf2(uplo, n, a, lda, info)
-         import :: dp
-         character(len=1), intent(in) :: uplo
-         integer, intent(in) :: n, lda
-         real(dp), intent(inout) :: a(lda, *)
-         integer, intent(out) :: info
-      end subroutine dpotf2
-      subroutine dpbtf2(uplo, n, kd, ab, ldab, info)
-         import :: dp
-         character(len=1), intent(in) :: uplo
-         integer, intent(in) :: n, kd, ldab
-         real(dp), intent(inout) :: ab(ldab, *)
-         integer, intent(out) :: info
-      end subroutine dpbtf2
-      subroutine dtrsv(uplo, trans, diag, n, a, lda, x, incx)
-         import :: dp
-         character(len=1), intent(in) :: uplo, trans, diag
-         integer, intent(in) :: n, lda, incx
-         real(dp), intent(in) :: a(lda, *)
-         real(dp), intent(inout) :: x(*)
-      end subroutine dtrsv
-      subroutine dpbtrf(uplo, n, kd, ab, ldab, info)
-         import :: dp
-         character(len=1), intent(in) :: uplo
-         integer, intent(in) :: n, kd, ldab
-         real(dp), intent(inout) :: ab(ldab, *)
-         integer, intent(out) :: info
-      end subroutine dpbtrf
-      subroutine dpbtrs(uplo, n, kd, nrhs, ab, ldab, b, ldb, info)
-         import :: dp
-         character(len=1), intent(in) :: uplo
-         integer, intent(in) :: n, kd, nrhs, ldab, ldb
-         real(dp), intent(in) :: ab(ldab, *)
-         real(dp), intent(inout) :: b(ldb, *)
-         integer, intent(out) :: info
-      end subroutine dpbtrs
-      subroutine dsyrk(uplo, trans, n, k, alpha, a, lda, beta, c, ldc)
-         import :: dp
-         character(len=1), intent(in) :: uplo, trans
-         integer, intent(in) :: n, k, lda, ldc
-         real(dp), intent(in) :: alpha, beta
-         real(dp), intent(in) :: a(lda, *)
-         real(dp), intent(inout) :: c(ldc, *)
-      end subroutine dsyrk
-      subroutine dsymv(uplo, n, alpha, a, lda, x, incx, beta, y, incy)
-         import :: dp
-         character(len=1), intent(in) :: uplo
-         integer, intent(in) :: n, lda, incx, incy
-         real(dp), intent(in) :: alpha, beta
-         real(dp), intent(in) :: a(lda, *), x(*)
-         real(dp), intent(inout) :: y(*)
-      end subroutine dsymv
-      subroutine dsbmv(uplo, n, k, alpha, a, lda, x, incx, beta, y, incy)
-         import :: dp
-         character(len=1), intent(in) :: uplo
-         integer, intent(in) :: n, k, lda, incx, incy
-         real(dp), intent(in) :: alpha, beta
-         real(dp), intent(in) :: a(lda, *), x(*)
-         real(dp), intent(inout) :: y(*)
-      end subroutine dsbmv
-   end interface
 
 contains
 

@@ -3,6 +3,7 @@
 !> and the generalized symmetric eigenproblem K phi = w^2 M phi.
 module fd_linalg
    use fd_kinds, only: dp
+   use fd_lapack, only: dgelss, dgemv, dgesv, dpotrf, dpotrs, dsbevx, dsyevr, dsygv, dsymv
    use fd_error, only: error_type, fatal_error, fmt_int, stat_no_memory
    use, intrinsic :: ieee_exceptions, only: ieee_set_halting_mode, ieee_get_halting_mode, ieee_support_halting, &
                                             ieee_set_flag, ieee_flag_type, ieee_invalid, ieee_divide_by_zero, &
@@ -12,82 +13,6 @@ module fd_linalg
 
    public :: cholesky_factor, cholesky_solve, sym_matvec, gen_matvec, generalized_eigen
    public :: lu_solve, least_squares, least_squares_work, lowest_eigen, lowest_eigen_band
-
-   interface
-      subroutine dpotrf(uplo, n, a, lda, info)
-         import :: dp
-         character(len=1), intent(in) :: uplo
-         integer, intent(in) :: n, lda
-         real(dp), intent(inout) :: a(lda, *)
-         integer, intent(out) :: info
-      end subroutine dpotrf
-      subroutine dpotrs(uplo, n, nrhs, a, lda, b, ldb, info)
-         import :: dp
-         character(len=1), intent(in) :: uplo
-         integer, intent(in) :: n, nrhs, lda, ldb
-         real(dp), intent(in) :: a(lda, *)
-         real(dp), intent(inout) :: b(ldb, *)
-         integer, intent(out) :: info
-      end subroutine dpotrs
-      subroutine dsymv(uplo, n, alpha, a, lda, x, incx, beta, y, incy)
-         import :: dp
-         character(len=1), intent(in) :: uplo
-         integer, intent(in) :: n, lda, incx, incy
-         real(dp), intent(in) :: alpha, beta
-         real(dp), intent(in) :: a(lda, *), x(*)
-         real(dp), intent(inout) :: y(*)
-      end subroutine dsymv
-      subroutine dgemv(trans, m, n, alpha, a, lda, x, incx, beta, y, incy)
-         import :: dp
-         character(len=1), intent(in) :: trans
-         integer, intent(in) :: m, n, lda, incx, incy
-         real(dp), intent(in) :: alpha, beta
-         real(dp), intent(in) :: a(lda, *), x(*)
-         real(dp), intent(inout) :: y(*)
-      end subroutine dgemv
-      subroutine dgesv(n, nrhs, a, lda, ipiv, b, ldb, info)
-         import :: dp
-         integer, intent(in) :: n, nrhs, lda, ldb
-         real(dp), intent(inout) :: a(lda, *), b(ldb, *)
-         integer, intent(out) :: ipiv(*), info
-      end subroutine dgesv
-      subroutine dgelss(m, n, nrhs, a, lda, b, ldb, s, rcond, rank, work, lwork, info)
-         import :: dp
-         integer, intent(in) :: m, n, nrhs, lda, ldb, lwork
-         real(dp), intent(inout) :: a(lda, *), b(ldb, *)
-         real(dp), intent(out) :: s(*), work(*)
-         real(dp), intent(in) :: rcond
-         integer, intent(out) :: rank, info
-      end subroutine dgelss
-      subroutine dsygv(itype, jobz, uplo, n, a, lda, b, ldb, w, work, lwork, info)
-         import :: dp
-         integer, intent(in) :: itype, n, lda, ldb, lwork
-         character(len=1), intent(in) :: jobz, uplo
-         real(dp), intent(inout) :: a(lda, *), b(ldb, *)
-         real(dp), intent(out) :: w(*), work(*)
-         integer, intent(out) :: info
-      end subroutine dsygv
-      subroutine dsyevr(jobz, range, uplo, n, a, lda, vl, vu, il, iu, abstol, m, w, z, ldz, isuppz, &
-                        work, lwork, iwork, liwork, info)
-         import :: dp
-         character(len=1), intent(in) :: jobz, range, uplo
-         integer, intent(in) :: n, lda, il, iu, ldz, lwork, liwork
-         real(dp), intent(inout) :: a(lda, *)
-         real(dp), intent(in) :: vl, vu, abstol
-         integer, intent(out) :: m, isuppz(*), iwork(*), info
-         real(dp), intent(out) :: w(*), z(ldz, *), work(*)
-      end subroutine dsyevr
-      subroutine dsbevx(jobz, range, uplo, n, kd, ab, ldab, q, ldq, vl, vu, il, iu, abstol, m, w, z, &
-                        ldz, work, iwork, ifail, info)
-         import :: dp
-         character(len=1), intent(in) :: jobz, range, uplo
-         integer, intent(in) :: n, kd, ldab, ldq, il, iu, ldz
-         real(dp), intent(inout) :: ab(ldab, *)
-         real(dp), intent(in) :: vl, vu, abstol
-         integer, intent(out) :: m, iwork(*), ifail(*), info
-         real(dp), intent(out) :: q(ldq, *), w(*), z(ldz, *), work(*)
-      end subroutine dsbevx
-   end interface
 
 contains
 

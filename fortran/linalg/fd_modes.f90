@@ -19,6 +19,7 @@
 !> has no cancellation: the eigenvalues come out to a few ulps of the projected problem.
 module fd_modes
    use fd_kinds, only: dp
+   use fd_lapack, only: dsterf
    use fd_error, only: error_type, fatal_error, fmt_int, fmt_real, stat_no_memory
    use fd_linalg, only: generalized_eigen
    use fd_banded, only: spd_system, spd_setup, spd_factor, spd_solve
@@ -45,16 +46,6 @@ module fd_modes
    !> Ritz value below which it stops.
    integer, parameter :: lanczos_max_steps = 120
    real(dp), parameter :: lanczos_tol = 1.0e-10_dp
-
-   interface
-      !> LAPACK: every eigenvalue of a symmetric tridiagonal matrix (ascending, in d).
-      pure subroutine dsterf(n, d, e, info)
-         import :: dp
-         integer, intent(in) :: n
-         real(dp), intent(inout) :: d(*), e(*)
-         integer, intent(out) :: info
-      end subroutine dsterf
-   end interface
 
 contains
 

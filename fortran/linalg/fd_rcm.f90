@@ -5,8 +5,13 @@
 !> Cuthill-McKee numbers the nodes by a breadth-first search from a pseudo-peripheral node
 !> (found by the George-Liu iteration), visiting the neighbours of each node by increasing
 !> degree; reversing that order (George) gives the same bandwidth and a smaller profile.
-!> Each connected component is ordered on its own. A chain, however numbered, comes back as
-!> a path: bandwidth 1.
+!> Each connected component is ordered on its own, seeded by an unnumbered node of least
+!> degree (then least number). A chain, however numbered, comes back as a path: bandwidth 1.
+!>
+!> The cost is linear in nodes + edges apart from the George-Liu iteration (one breadth-first
+!> search of a component per step, a few steps in practice): the adjacency lists are sorted
+!> by counting, and the seeds are taken in turn from the nodes bucketed by degree, so that
+!> 1e5 unconnected masses cost as little as a chain of 1e5.
 module fd_rcm
    implicit none
    private
@@ -21,28 +26,26 @@ contains
       integer, intent(in) :: edge_i(:)      !! first node of each edge (0 = table, ignored)
       integer, intent(in) :: edge_j(:)      !! second node of each edge (0 = table, ignored)
       integer, intent(out) :: perm(:)       !! new -> old, size n
-      integer, allocatable :: start(:), adj(:), deg(:), level(:), order(:)
+      integer, allocatable :: start(:), adj(:), deg(:), by_degree(:), level(:), order(:)
       logical, allocatable :: done(:)
-      integer :: nn, i, e, root, nlev, nlev2, first, last, last2, cand, head, tail, v, w, k
+      integer :: nn, e, root, nlev, nlev2, first, last, last2, cand, head, tail, v, w, k, next
 
       if (n == 0) return
-      call adjacency(n, edge_i, edge_j, start, adj, deg)
+      call adjacency(n, edge_i, edge_j, start, adj, deg, by_degree)
       allocate (level(n), order(n), done(n))
       level = -1
       done = .false.
       nn = 0
+      next = 1
       do
-         ! seed of the next component: an unnumbered node of least degree
-         root = 0
-         do i = 1, n
-            if (done(i)) cycle
-            if (root == 0) then
-               root = i
-            else if (deg(i) < deg(root)) then
-               root = i
-            end if
+         ! seed of the next component: an unnumbered node of least degree, then least number
+         ! (by_degree lists the nodes so; the nodes before next are all numbered)
+         do while (next <= n)
+            if (.not. done(by_degree(next))) exit
+            next = next + 1
          end do
-         if (root == 0) exit
+         if (next > n) exit
+         root = by_degree(next)
          ! George-Liu: move to a node of least degree in the last level while the
          ! eccentricity grows
          call levels(root, nn, start, adj, done, level, order, first, last, nlev)
@@ -129,13 +132,14 @@ contains
    end subroutine clear
 
    !> Adjacency lists (compressed, without self-loops and repeated edges), each sorted by
-   !> increasing degree, then node number.
-   pure subroutine adjacency(n, edge_i, edge_j, start, adj, deg)
+   !> increasing degree, then node number; by_degree lists the nodes in that order. Every
+   !> sort is a counting sort: linear in nodes + edges, whatever the degrees.
+   pure subroutine adjacency(n, edge_i, edge_j, start, adj, deg, by_degree)
       integer, intent(in) :: n
       integer, intent(in) :: edge_i(:), edge_j(:)
-      integer, allocatable, intent(out) :: start(:), adj(:), deg(:)
-      integer, allocatable :: fill(:), raw(:)
-      integer :: e, a, b, v, k, m, x, cnt
+      integer, allocatable, intent(out) :: start(:), adj(:), deg(:), by_degree(:)
+      integer, allocatable :: fill(:), raw(:), sorted(:), bucket(:)
+      integer :: e, a, b, v, k, m, x, cnt, prev
 
       allocate (start(n + 1), fill(n), deg(n))
       fill = 0
@@ -149,7 +153,7 @@ contains
       do v = 1, n
          start(v + 1) = start(v) + fill(v)
       end do
-      allocate (raw(start(n + 1) - 1))
+      allocate (raw(start(n + 1) - 1), sorted(start(n + 1) - 1))
       fill = start(1:n)
       do e = 1, size(edge_i)
          a = edge_i(e); b = edge_j(e)
@@ -159,54 +163,59 @@ contains
          raw(fill(b)) = a
          fill(b) = fill(b) + 1
       end do
-      ! drop repeated neighbours (sort each list by node number first)
+      ! each list by node number: the graph is symmetric, so listing x in the list of each of
+      ! its neighbours, x = 1, 2, ..., gives every list again (repeats included), sorted
+      fill = start(1:n)
+      do x = 1, n
+         do k = start(x), start(x + 1) - 1
+            v = raw(k)
+            sorted(fill(v)) = x
+            fill(v) = fill(v) + 1
+         end do
+      end do
+      ! drop repeated neighbours (adjacent once sorted)
       cnt = 0
       do v = 1, n
-         call insertion_sort(raw(start(v):start(v + 1) - 1))
          m = cnt
+         prev = 0
          do k = start(v), start(v + 1) - 1
-            if (k > start(v)) then
-               if (raw(k) == raw(k - 1)) cycle
-            end if
+            if (sorted(k) == prev) cycle
+            prev = sorted(k)
             m = m + 1
-            raw(m) = raw(k)
+            sorted(m) = prev
          end do
          start(v) = cnt + 1
          deg(v) = m - cnt
          cnt = m
       end do
       start(n + 1) = cnt + 1
-      adj = raw(1:cnt)
-      ! neighbours by increasing degree (stable: equal degrees keep node order)
+      ! the nodes by increasing degree, then node number (a stable counting sort)
+      allocate (bucket(0:maxval(deg) + 1), by_degree(n))
+      bucket = 0
       do v = 1, n
-         do k = start(v) + 1, start(v + 1) - 1
-            x = adj(k)
-            m = k - 1
-            do while (m >= start(v))
-               if (deg(adj(m)) <= deg(x)) exit
-               adj(m + 1) = adj(m)
-               m = m - 1
-            end do
-            adj(m + 1) = x
+         bucket(deg(v) + 1) = bucket(deg(v) + 1) + 1
+      end do
+      bucket(0) = 1
+      do k = 1, ubound(bucket, 1)
+         bucket(k) = bucket(k) + bucket(k - 1)
+      end do
+      do v = 1, n
+         by_degree(bucket(deg(v))) = v
+         bucket(deg(v)) = bucket(deg(v)) + 1
+      end do
+      ! each list by increasing degree, then node number: x in that order, listed in the
+      ! list of each of its neighbours
+      allocate (adj(cnt))
+      fill = start(1:n)
+      do m = 1, n
+         x = by_degree(m)
+         do k = start(x), start(x + 1) - 1
+            v = sorted(k)
+            adj(fill(v)) = x
+            fill(v) = fill(v) + 1
          end do
       end do
    end subroutine adjacency
-
-   pure subroutine insertion_sort(a)
-      integer, intent(inout) :: a(:)
-      integer :: k, m, x
-
-      do k = 2, size(a)
-         x = a(k)
-         m = k - 1
-         do while (m >= 1)
-            if (a(m) <= x) exit
-            a(m + 1) = a(m)
-            m = m - 1
-         end do
-         a(m + 1) = x
-      end do
-   end subroutine insertion_sort
 
    !> Half-bandwidth max |inv(a) - inv(b)| over the edges between two nodes (0 without any),
    !> where inv(old) is the new number of a node.

@@ -22,7 +22,7 @@ module fd_matrices
    public :: modes_dense_dofs, modes_kept, mode_damping, mode_participation
 
    !> Above this many DOFs the modes are found without an n x n matrix (natural_modes_sparse):
-   !> the dense matrices would make peak memory grow as n**2 (issue 13)
+   !> the dense matrices would make peak memory grow as n**2
    integer, parameter :: modes_dense_dofs = 200
 
    ! what the eigenproblem of a system found

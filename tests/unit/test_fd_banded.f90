@@ -38,6 +38,8 @@ contains
       testsuite = [ &
                   new_unittest("rcm chain bandwidth 1", test_rcm_chain), &
                   new_unittest("rcm frame band", test_rcm_frame), &
+                  new_unittest("rcm order equals the reference", test_rcm_reference), &
+                  new_unittest("rcm linear in nodes + edges", test_rcm_linear), &
                   new_unittest("banded solve equals dense", test_solve), &
                   new_unittest("matvecs equal dense", test_matvec), &
                   new_unittest("every device pattern n=10", test_patterns), &
@@ -999,5 +1001,280 @@ contains
          end if
       end do
    end subroutine test_small_kc
+
+
+   !> The ordering equals the plain quadratic implementation kept below (ref_rcm_order) on
+   !> random graphs: connected or not, with isolated nodes, repeated edges, self-loops and
+   !> edges to the table, and on randomly numbered chains and frames.
+   subroutine test_rcm_reference(error)
+      type(error_type), allocatable, intent(out) :: error
+      type(problem) :: pb
+      integer, allocatable :: ei(:), ej(:), perm(:), ref(:)
+      integer :: trial, n, ne, e
+
+      call seed(3)
+      do trial = 1, 300
+         n = 1 + mod(trial*7, 60)
+         ne = int(urand(0.0_dp, 2.5_dp*n))
+         allocate (ei(ne), ej(ne), perm(n), ref(n))
+         do e = 1, ne
+            ei(e) = min(n, int(urand(0.0_dp, n + 1.0_dp)))   ! 0 (the table) .. n
+            ej(e) = min(n, int(urand(0.0_dp, n + 1.0_dp)))
+            if (mod(e, 5) == 0 .and. e > 1) then               ! a repeated edge, reversed
+               ei(e) = ej(e - 1); ej(e) = ei(e - 1)
+            end if
+         end do
+         call rcm_order(n, ei, ej, perm)
+         call ref_rcm_order(n, ei, ej, ref)
+         call check(error, all(perm == ref), "trial "//trim(itoa(trial))//": n = "//trim(itoa(n))// &
+                    ", "//trim(itoa(ne))//" edges: the ordering differs from the reference")
+         if (allocated(error)) return
+         deallocate (ei, ej, perm, ref)
+      end do
+      do trial = 1, 6
+         if (trial <= 3) then
+            call chain(40*trial, pb, .true.)
+         else
+            call frame(trial, 3*trial, pb, .true.)
+         end if
+         ei = [pb%si, pb%di, pb%pi]
+         ej = [pb%sj, pb%dj, pb%pj]
+         allocate (perm(pb%n), ref(pb%n))
+         call rcm_order(pb%n, ei, ej, perm)
+         call ref_rcm_order(pb%n, ei, ej, ref)
+         call check(error, all(perm == ref), "structure "//trim(itoa(trial))//": the ordering differs")
+         if (allocated(error)) return
+         deallocate (perm, ref)
+      end do
+   end subroutine test_rcm_reference
+
+   !> 200 000 masses without a connection between them and a star of 100 000 leaves listed
+   !> from the last are ordered in well under a second (a quadratic ordering takes many seconds):
+   !> the free masses by number, reversed; the star as leaf 2, the hub, leaves 3, 4, ...,
+   !> reversed.
+   subroutine test_rcm_linear(error)
+      type(error_type), allocatable, intent(out) :: error
+      integer, parameter :: nfree = 200000, nleaf = 100000
+      integer, allocatable :: ei(:), ej(:), perm(:)
+      real :: t0, t1
+      integer :: i
+
+      allocate (ei(nfree), ej(nfree), perm(nfree))
+      ei = [(i, i=1, nfree)]
+      ej = 0                                   ! every mass on a spring to the table
+      call cpu_time(t0)
+      call rcm_order(nfree, ei, ej, perm)
+      call cpu_time(t1)
+      call check(error, all(perm == [(nfree + 1 - i, i=1, nfree)]), "free masses: not in reverse order")
+      if (allocated(error)) return
+      call check(error, t1 - t0 < 1.0, "ordering 200000 free masses took "//trim(rtoa(real(t1 - t0, dp)))//" s")
+      if (allocated(error)) return
+      deallocate (ei, ej, perm)
+      allocate (perm(nleaf + 1))
+      ei = [(1, i=1, nleaf)]
+      ej = [(nleaf + 2 - i, i=1, nleaf)]       ! leaves nleaf+1, nleaf, ..., 2
+      call cpu_time(t0)
+      call rcm_order(nleaf + 1, ei, ej, perm)
+      call cpu_time(t1)
+      call check(error, all(perm == [[(nleaf + 2 - i, i=1, nleaf - 1)], 1, 2]), "star: not leaf 2, hub, leaves 3..")
+      if (allocated(error)) return
+      call check(error, t1 - t0 < 1.0, "ordering a star of 100000 leaves took "//trim(rtoa(real(t1 - t0, dp)))//" s")
+   end subroutine test_rcm_linear
+
+   ! ---------------------------------------------------------------- reference ordering
+
+   !> The same ordering written plainly (a search of all nodes for the seed of each component,
+   !> insertion sorts of the adjacency lists: quadratic), the reference of test_rcm_reference.
+   pure subroutine ref_rcm_order(n, edge_i, edge_j, perm)
+      integer, intent(in) :: n              !! number of nodes (1..n)
+      integer, intent(in) :: edge_i(:)      !! first node of each edge (0 = table, ignored)
+      integer, intent(in) :: edge_j(:)      !! second node of each edge (0 = table, ignored)
+      integer, intent(out) :: perm(:)       !! new -> old, size n
+      integer, allocatable :: start(:), adj(:), deg(:), level(:), order(:)
+      logical, allocatable :: done(:)
+      integer :: nn, i, e, root, nlev, nlev2, first, last, last2, cand, head, tail, v, w, k
+
+      if (n == 0) return
+      call ref_adjacency(n, edge_i, edge_j, start, adj, deg)
+      allocate (level(n), order(n), done(n))
+      level = -1
+      done = .false.
+      nn = 0
+      do
+         ! seed of the next component: an unnumbered node of least degree
+         root = 0
+         do i = 1, n
+            if (done(i)) cycle
+            if (root == 0) then
+               root = i
+            else if (deg(i) < deg(root)) then
+               root = i
+            end if
+         end do
+         if (root == 0) exit
+         ! George-Liu: move to a node of least degree in the last level while the
+         ! eccentricity grows
+         call ref_levels(root, nn, start, adj, done, level, order, first, last, nlev)
+         do
+            cand = order(first)
+            do k = first, last
+               if (deg(order(k)) < deg(cand)) cand = order(k)
+            end do
+            call ref_clear(order(nn + 1:last), level)
+            call ref_levels(cand, nn, start, adj, done, level, order, first, last2, nlev2)
+            if (nlev2 > nlev) then
+               root = cand
+               nlev = nlev2
+               last = last2
+            else
+               call ref_clear(order(nn + 1:last2), level)
+               exit
+            end if
+         end do
+         call ref_clear(order(nn + 1:last), level)
+         ! Cuthill-McKee from root: neighbours by increasing degree (adj is sorted so)
+         head = nn + 1
+         tail = nn + 1
+         order(tail) = root
+         done(root) = .true.
+         do while (head <= tail)
+            v = order(head)
+            head = head + 1
+            do e = start(v), start(v + 1) - 1
+               w = adj(e)
+               if (done(w)) cycle
+               done(w) = .true.
+               tail = tail + 1
+               order(tail) = w
+            end do
+         end do
+         nn = tail
+      end do
+      do k = 1, n
+         perm(k) = order(n + 1 - k)
+      end do
+
+   end subroutine ref_rcm_order
+
+   !> Breadth-first level structure from r over the nodes not yet numbered, written to
+   !> order(nn+1:last); the last level is order(first:last), nlev the number of levels.
+   pure subroutine ref_levels(r, nn, start, adj, done, level, order, first, last, nlev)
+      integer, intent(in) :: r, nn
+      integer, intent(in) :: start(:), adj(:)
+      logical, intent(in) :: done(:)
+      integer, intent(inout) :: level(:), order(:)
+      integer, intent(out) :: first, last, nlev
+      integer :: h, x, y, q
+
+      last = nn + 1
+      order(last) = r
+      level(r) = 1
+      h = nn + 1
+      do while (h <= last)
+         x = order(h)
+         h = h + 1
+         do q = start(x), start(x + 1) - 1
+            y = adj(q)
+            if (level(y) >= 0 .or. done(y)) cycle
+            level(y) = level(x) + 1
+            last = last + 1
+            order(last) = y
+         end do
+      end do
+      nlev = level(order(last))
+      first = last
+      do while (first > nn + 1)
+         if (level(order(first - 1)) /= nlev) exit
+         first = first - 1
+      end do
+   end subroutine ref_levels
+
+   !> Reset the levels of the given nodes.
+   pure subroutine ref_clear(nodes, level)
+      integer, intent(in) :: nodes(:)
+      integer, intent(inout) :: level(:)
+
+      level(nodes) = -1
+   end subroutine ref_clear
+
+   !> Adjacency lists (compressed, without self-loops and repeated edges), each sorted by
+   !> increasing degree, then node number.
+   pure subroutine ref_adjacency(n, edge_i, edge_j, start, adj, deg)
+      integer, intent(in) :: n
+      integer, intent(in) :: edge_i(:), edge_j(:)
+      integer, allocatable, intent(out) :: start(:), adj(:), deg(:)
+      integer, allocatable :: fill(:), raw(:)
+      integer :: e, a, b, v, k, m, x, cnt
+
+      allocate (start(n + 1), fill(n), deg(n))
+      fill = 0
+      do e = 1, size(edge_i)
+         a = edge_i(e); b = edge_j(e)
+         if (a <= 0 .or. b <= 0 .or. a == b) cycle
+         fill(a) = fill(a) + 1
+         fill(b) = fill(b) + 1
+      end do
+      start(1) = 1
+      do v = 1, n
+         start(v + 1) = start(v) + fill(v)
+      end do
+      allocate (raw(start(n + 1) - 1))
+      fill = start(1:n)
+      do e = 1, size(edge_i)
+         a = edge_i(e); b = edge_j(e)
+         if (a <= 0 .or. b <= 0 .or. a == b) cycle
+         raw(fill(a)) = b
+         fill(a) = fill(a) + 1
+         raw(fill(b)) = a
+         fill(b) = fill(b) + 1
+      end do
+      ! drop repeated neighbours (sort each list by node number first)
+      cnt = 0
+      do v = 1, n
+         call ref_insertion_sort(raw(start(v):start(v + 1) - 1))
+         m = cnt
+         do k = start(v), start(v + 1) - 1
+            if (k > start(v)) then
+               if (raw(k) == raw(k - 1)) cycle
+            end if
+            m = m + 1
+            raw(m) = raw(k)
+         end do
+         start(v) = cnt + 1
+         deg(v) = m - cnt
+         cnt = m
+      end do
+      start(n + 1) = cnt + 1
+      adj = raw(1:cnt)
+      ! neighbours by increasing degree (stable: equal degrees keep node order)
+      do v = 1, n
+         do k = start(v) + 1, start(v + 1) - 1
+            x = adj(k)
+            m = k - 1
+            do while (m >= start(v))
+               if (deg(adj(m)) <= deg(x)) exit
+               adj(m + 1) = adj(m)
+               m = m - 1
+            end do
+            adj(m + 1) = x
+         end do
+      end do
+   end subroutine ref_adjacency
+
+   pure subroutine ref_insertion_sort(a)
+      integer, intent(inout) :: a(:)
+      integer :: k, m, x
+
+      do k = 2, size(a)
+         x = a(k)
+         m = k - 1
+         do while (m >= 1)
+            if (a(m) <= x) exit
+            a(m + 1) = a(m)
+            m = m - 1
+         end do
+         a(m + 1) = x
+      end do
+   end subroutine ref_insertion_sort
 
 end module test_fd_banded

@@ -1073,8 +1073,8 @@ contains
 
    !> A box LCP whose q is subnormal (a record of 2e-309 m/s^2 under a block of limits
    !> +-1): the solution is z = -q/M inside the box, zero to round-off at the bounds' scale,
-   !> and is solved; the residual is measured at the scale of the bounds (before, zs/ws
-   !> overflowed and the answer z = 0 counted as a residual of 1, "not solved").
+   !> and is solved; the residual is measured at the scale of the bounds (scaled by zs/ws it
+   !> would overflow, and the answer z = 0 count as a residual of 1, "not solved").
    subroutine test_box_subnormal(error)
       type(error_type), allocatable, intent(out) :: error
       type(lcp_work) :: work

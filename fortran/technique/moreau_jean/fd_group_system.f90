@@ -12,6 +12,7 @@
 !> set-up, never made for a chain.
 module fd_group_system
    use fd_kinds, only: dp
+   use fd_lapack, only: dpbtrf, dpbtrs, dpttrf, dpttrs, dsbgvx
    use fd_error, only: error_type, fatal_error, fmt_int, fmt_real, stat_no_memory
    implicit none
    private
@@ -36,47 +37,6 @@ module fd_group_system
       real(dp), allocatable :: ab(:)            !! band storage, (kb + 1) x nr, upper
       real(dp), allocatable :: dd(:), de(:)     !! tridiagonal factor (D, L's subdiagonal)
    end type group_system
-
-   interface
-      subroutine dpttrf(n, d, e, info)
-         import :: dp
-         integer, intent(in) :: n
-         real(dp), intent(inout) :: d(*), e(*)
-         integer, intent(out) :: info
-      end subroutine dpttrf
-      subroutine dpttrs(n, nrhs, d, e, b, ldb, info)
-         import :: dp
-         integer, intent(in) :: n, nrhs, ldb
-         real(dp), intent(in) :: d(*), e(*)
-         real(dp), intent(inout) :: b(ldb, *)
-         integer, intent(out) :: info
-      end subroutine dpttrs
-      subroutine dpbtrf(uplo, n, kd, ab, ldab, info)
-         import :: dp
-         character(len=1), intent(in) :: uplo
-         integer, intent(in) :: n, kd, ldab
-         real(dp), intent(inout) :: ab(ldab, *)
-         integer, intent(out) :: info
-      end subroutine dpbtrf
-      subroutine dpbtrs(uplo, n, kd, nrhs, ab, ldab, b, ldb, info)
-         import :: dp
-         character(len=1), intent(in) :: uplo
-         integer, intent(in) :: n, kd, nrhs, ldab, ldb
-         real(dp), intent(in) :: ab(ldab, *)
-         real(dp), intent(inout) :: b(ldb, *)
-         integer, intent(out) :: info
-      end subroutine dpbtrs
-      subroutine dsbgvx(jobz, range, uplo, n, ka, kb, ab, ldab, bb, ldbb, q, ldq, vl, vu, il, iu, &
-                        abstol, m, w, z, ldz, work, iwork, ifail, info)
-         import :: dp
-         character(len=1), intent(in) :: jobz, range, uplo
-         integer, intent(in) :: n, ka, kb, ldab, ldbb, ldq, il, iu, ldz
-         real(dp), intent(inout) :: ab(ldab, *), bb(ldbb, *)
-         real(dp), intent(out) :: q(ldq, *), z(ldz, *), w(*), work(*)
-         real(dp), intent(in) :: vl, vu, abstol
-         integer, intent(out) :: m, iwork(*), ifail(*), info
-      end subroutine dsbgvx
-   end interface
 
 contains
 

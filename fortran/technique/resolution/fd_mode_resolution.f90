@@ -6,7 +6,7 @@
 !> gives 2 atan(omega dt / 2) / dt: 27 % too long at omega dt = 2, and never above pi / dt)
 !> and no numerical damping. A friction transition excites every mode near its device, so
 !> the absolute accelerations then carry a spurious response of those modes (6 times the
-!> resolved peak at 10 000 storeys and dt1 = 1 ms, issue 14): the summary says so, and the
+!> resolved peak at 10 000 storeys and dt1 = 1 ms): the summary says so, and the
 !> executable and the command line print a warning. It is a report, not an error: drifts
 !> and shears are dominated by the low modes, which the step resolves.
 !>

@@ -1,0 +1,169 @@
+!> Interfaces of the LAPACK and BLAS routines the library calls, in one place (the reference
+!> LAPACK argument lists; Debian's liblapack-dev and libblas-dev provide them).
+module fd_lapack
+   use fd_kinds, only: dp
+   implicit none
+   private
+
+   public :: dgelss, dgemv, dgesv, dpbtf2, dpbtrf, dpbtrs, dpotf2, dpotrf, dpotrs, dpttrf, dpttrs, &
+             dsbevx, dsbgvx, dsbmv, dsterf, dsyevr, dsygv, dsymv, dsyrk, dtrsv
+
+   interface
+      subroutine dgelss(m, n, nrhs, a, lda, b, ldb, s, rcond, rank, work, lwork, info)
+         import :: dp
+         integer, intent(in) :: m, n, nrhs, lda, ldb, lwork
+         real(dp), intent(inout) :: a(lda, *), b(ldb, *)
+         real(dp), intent(out) :: s(*), work(*)
+         real(dp), intent(in) :: rcond
+         integer, intent(out) :: rank, info
+      end subroutine dgelss
+      subroutine dgemv(trans, m, n, alpha, a, lda, x, incx, beta, y, incy)
+         import :: dp
+         character(len=1), intent(in) :: trans
+         integer, intent(in) :: m, n, lda, incx, incy
+         real(dp), intent(in) :: alpha, beta
+         real(dp), intent(in) :: a(lda, *), x(*)
+         real(dp), intent(inout) :: y(*)
+      end subroutine dgemv
+      subroutine dgesv(n, nrhs, a, lda, ipiv, b, ldb, info)
+         import :: dp
+         integer, intent(in) :: n, nrhs, lda, ldb
+         real(dp), intent(inout) :: a(lda, *), b(ldb, *)
+         integer, intent(out) :: ipiv(*), info
+      end subroutine dgesv
+      subroutine dpbtf2(uplo, n, kd, ab, ldab, info)
+         import :: dp
+         character(len=1), intent(in) :: uplo
+         integer, intent(in) :: n, kd, ldab
+         real(dp), intent(inout) :: ab(ldab, *)
+         integer, intent(out) :: info
+      end subroutine dpbtf2
+      subroutine dpbtrf(uplo, n, kd, ab, ldab, info)
+         import :: dp
+         character(len=1), intent(in) :: uplo
+         integer, intent(in) :: n, kd, ldab
+         real(dp), intent(inout) :: ab(ldab, *)
+         integer, intent(out) :: info
+      end subroutine dpbtrf
+      subroutine dpbtrs(uplo, n, kd, nrhs, ab, ldab, b, ldb, info)
+         import :: dp
+         character(len=1), intent(in) :: uplo
+         integer, intent(in) :: n, kd, nrhs, ldab, ldb
+         real(dp), intent(in) :: ab(ldab, *)
+         real(dp), intent(inout) :: b(ldb, *)
+         integer, intent(out) :: info
+      end subroutine dpbtrs
+      subroutine dpotf2(uplo, n, a, lda, info)
+         import :: dp
+         character(len=1), intent(in) :: uplo
+         integer, intent(in) :: n, lda
+         real(dp), intent(inout) :: a(lda, *)
+         integer, intent(out) :: info
+      end subroutine dpotf2
+      subroutine dpotrf(uplo, n, a, lda, info)
+         import :: dp
+         character(len=1), intent(in) :: uplo
+         integer, intent(in) :: n, lda
+         real(dp), intent(inout) :: a(lda, *)
+         integer, intent(out) :: info
+      end subroutine dpotrf
+      subroutine dpotrs(uplo, n, nrhs, a, lda, b, ldb, info)
+         import :: dp
+         character(len=1), intent(in) :: uplo
+         integer, intent(in) :: n, nrhs, lda, ldb
+         real(dp), intent(in) :: a(lda, *)
+         real(dp), intent(inout) :: b(ldb, *)
+         integer, intent(out) :: info
+      end subroutine dpotrs
+      subroutine dpttrf(n, d, e, info)
+         import :: dp
+         integer, intent(in) :: n
+         real(dp), intent(inout) :: d(*), e(*)
+         integer, intent(out) :: info
+      end subroutine dpttrf
+      subroutine dpttrs(n, nrhs, d, e, b, ldb, info)
+         import :: dp
+         integer, intent(in) :: n, nrhs, ldb
+         real(dp), intent(in) :: d(*), e(*)
+         real(dp), intent(inout) :: b(ldb, *)
+         integer, intent(out) :: info
+      end subroutine dpttrs
+      subroutine dsbevx(jobz, range, uplo, n, kd, ab, ldab, q, ldq, vl, vu, il, iu, abstol, m, w, z, &
+                        ldz, work, iwork, ifail, info)
+         import :: dp
+         character(len=1), intent(in) :: jobz, range, uplo
+         integer, intent(in) :: n, kd, ldab, ldq, il, iu, ldz
+         real(dp), intent(inout) :: ab(ldab, *)
+         real(dp), intent(in) :: vl, vu, abstol
+         integer, intent(out) :: m, iwork(*), ifail(*), info
+         real(dp), intent(out) :: q(ldq, *), w(*), z(ldz, *), work(*)
+      end subroutine dsbevx
+      subroutine dsbgvx(jobz, range, uplo, n, ka, kb, ab, ldab, bb, ldbb, q, ldq, vl, vu, il, iu, &
+                        abstol, m, w, z, ldz, work, iwork, ifail, info)
+         import :: dp
+         character(len=1), intent(in) :: jobz, range, uplo
+         integer, intent(in) :: n, ka, kb, ldab, ldbb, ldq, il, iu, ldz
+         real(dp), intent(inout) :: ab(ldab, *), bb(ldbb, *)
+         real(dp), intent(out) :: q(ldq, *), z(ldz, *), w(*), work(*)
+         real(dp), intent(in) :: vl, vu, abstol
+         integer, intent(out) :: m, iwork(*), ifail(*), info
+      end subroutine dsbgvx
+      subroutine dsbmv(uplo, n, k, alpha, a, lda, x, incx, beta, y, incy)
+         import :: dp
+         character(len=1), intent(in) :: uplo
+         integer, intent(in) :: n, k, lda, incx, incy
+         real(dp), intent(in) :: alpha, beta
+         real(dp), intent(in) :: a(lda, *), x(*)
+         real(dp), intent(inout) :: y(*)
+      end subroutine dsbmv
+      !> LAPACK: every eigenvalue of a symmetric tridiagonal matrix (ascending, in d).
+      pure subroutine dsterf(n, d, e, info)
+         import :: dp
+         integer, intent(in) :: n
+         real(dp), intent(inout) :: d(*), e(*)
+         integer, intent(out) :: info
+      end subroutine dsterf
+      subroutine dsyevr(jobz, range, uplo, n, a, lda, vl, vu, il, iu, abstol, m, w, z, ldz, isuppz, &
+                        work, lwork, iwork, liwork, info)
+         import :: dp
+         character(len=1), intent(in) :: jobz, range, uplo
+         integer, intent(in) :: n, lda, il, iu, ldz, lwork, liwork
+         real(dp), intent(inout) :: a(lda, *)
+         real(dp), intent(in) :: vl, vu, abstol
+         integer, intent(out) :: m, isuppz(*), iwork(*), info
+         real(dp), intent(out) :: w(*), z(ldz, *), work(*)
+      end subroutine dsyevr
+      subroutine dsygv(itype, jobz, uplo, n, a, lda, b, ldb, w, work, lwork, info)
+         import :: dp
+         integer, intent(in) :: itype, n, lda, ldb, lwork
+         character(len=1), intent(in) :: jobz, uplo
+         real(dp), intent(inout) :: a(lda, *), b(ldb, *)
+         real(dp), intent(out) :: w(*), work(*)
+         integer, intent(out) :: info
+      end subroutine dsygv
+      subroutine dsymv(uplo, n, alpha, a, lda, x, incx, beta, y, incy)
+         import :: dp
+         character(len=1), intent(in) :: uplo
+         integer, intent(in) :: n, lda, incx, incy
+         real(dp), intent(in) :: alpha, beta
+         real(dp), intent(in) :: a(lda, *), x(*)
+         real(dp), intent(inout) :: y(*)
+      end subroutine dsymv
+      subroutine dsyrk(uplo, trans, n, k, alpha, a, lda, beta, c, ldc)
+         import :: dp
+         character(len=1), intent(in) :: uplo, trans
+         integer, intent(in) :: n, k, lda, ldc
+         real(dp), intent(in) :: alpha, beta
+         real(dp), intent(in) :: a(lda, *)
+         real(dp), intent(inout) :: c(ldc, *)
+      end subroutine dsyrk
+      subroutine dtrsv(uplo, trans, diag, n, a, lda, x, incx)
+         import :: dp
+         character(len=1), intent(in) :: uplo, trans, diag
+         integer, intent(in) :: n, lda, incx
+         real(dp), intent(in) :: a(lda, *)
+         real(dp), intent(inout) :: x(*)
+      end subroutine dtrsv
+   end interface
+
+end module fd_lapack
