@@ -710,3 +710,35 @@ def test_plot_of_a_wrong_column_names_the_close_ones(tmp_path):
     p = subprocess.run([*SWEEP, "plot", str(out), "friction.mu", "peak_s_m[1]", "--by", "zzz"],
                        capture_output=True, text=True)
     assert p.returncode == 1 and "'zzz' is not a column" in p.stderr
+
+
+def _fuzz(module: str):
+    sys.path.insert(0, str(Path(__file__).resolve().parent / "fuzz"))
+    try:
+        return __import__(module)
+    finally:
+        sys.path.pop(0)
+
+
+def test_a_short_sweep_spec_fuzz_campaign_has_no_failure():
+    """tests/fuzz/sweep_spec.py, 60 mutated specs (seed 2024): every case a clean one-line
+    SweepError with nothing written, or a correct sweep whose job script, run by bash, runs
+    the executable once in the sweep directory and nothing else. The long campaign is run by
+    hand: python tests/fuzz/sweep_spec.py --count 5000 --seed 1."""
+    fz = _fuzz("sweep_spec")
+    rep = fz.report(fz.campaign(60, 2024), 2024)
+    assert rep["runs"] == 60
+    assert rep["sweeps"] >= 5 and rep["clean errors"] >= 30, rep
+    assert not any(rep[k] for k in fz.FAILURES), rep["failures"][:5]
+
+
+def test_a_short_collect_fuzz_campaign_has_no_failure():
+    """tests/fuzz/collect_damage.py, 80 damaged folders (seed 2024): no traceback; a
+    damaged manifest one line; otherwise the table of every run, each run not done named,
+    and a done row only with its own run's values. The long campaign is run by hand:
+    python tests/fuzz/collect_damage.py --count 5000 --seed 1."""
+    fz = _fuzz("collect_damage")
+    rep = fz.report(fz.campaign(80, 2024), 2024)
+    assert rep["runs"] == 80
+    assert rep["tables"] >= 40 and rep["clean errors"] >= 5, rep
+    assert not any(rep[k] for k in fz.FAILURES), rep["failures"][:5]

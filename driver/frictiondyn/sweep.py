@@ -29,6 +29,7 @@ the run's deck (``run_deck``) and its SHA-256, and its summary (arrays as ``key[
 from __future__ import annotations
 
 import argparse
+import contextlib
 import csv
 import datetime
 import difflib
@@ -372,9 +373,9 @@ def load_spec(path: str | os.PathLike) -> dict:
     if "base" not in spec and "deck" not in spec.get("cross", {}) and "deck" not in zipped:
         raise SweepError(f"{path}: give a base deck (base = 'deck.nml') or vary 'deck'")
     spec.setdefault("name", path.stem)
-    if not _NAME.fullmatch(spec["name"]):
+    if not _NAME.fullmatch(spec["name"]) or len(spec["name"]) > 100:
         raise SweepError(f"{path}: name = {json.dumps(spec['name'])}: letters, digits, '_', "
-                         "'-', '.' only, not first '.' or '-'")
+                         "'-', '.' only, not first '.' or '-', at most 100")
     return spec
 
 
@@ -531,11 +532,14 @@ def expand(
         for key, value in first.items():
             if key != "deck" and "." in key:
                 _set(probe, key, value, f"{where}: with base deck {base_path}")
+    made = [p for p in [*reversed(sdir.parents), sdir] if not p.exists()]
     try:
-        (sdir / "decks").mkdir(parents=True, exist_ok=True)
-        (sdir / "runs").mkdir(exist_ok=True)
-        (sdir / "logs").mkdir(exist_ok=True)
+        for p in [*made, sdir / "decks", sdir / "runs", sdir / "logs"]:
+            p.mkdir(exist_ok=True)
     except OSError as exc:
+        for p in reversed(made):  # nothing left of a directory that could not be made
+            with contextlib.suppress(OSError):
+                p.rmdir()
         raise SweepError(f"{where}: cannot make the sweep directory {sdir}: {exc.strerror}") from None
     lock = SweepLock(sdir, str(spec_path))
     try:
@@ -828,6 +832,32 @@ def _sbatch_arg(value: str, option: str) -> str:
     return value
 
 
+def check_slurm_values(
+    directory: Path,
+    exe: str,
+    time_limit: str | None = None,
+    partition: str | None = None,
+    extra: Sequence[str] = (),
+    job_name: str | None = None,
+) -> None:
+    """The values a job script names can be written in it: SweepError otherwise."""
+    sdir = str(directory)
+    for what, value in (("the sweep directory", sdir), ("the executable's path",
+                                                        os.path.abspath(exe))):
+        if _CONTROL.search(value):  # a newline would end an #SBATCH line (or a command)
+            raise SweepError(f"{what} {json.dumps(value)} holds a newline or another control "
+                             "character: a job script cannot name it; give another")
+    _sbatch_arg(sdir, "--chdir")
+    for value, option in ((time_limit, "--time"), (partition, "--partition"),
+                          (job_name, "--job-name")):
+        if value:
+            _sbatch_arg(value, option)
+    for x in extra:
+        if _CONTROL.search(x):
+            raise SweepError(f"--sbatch {json.dumps(x)}: a newline or another control "
+                             "character cannot be written in an #SBATCH line")
+
+
 def slurm_script(
     sweep: Sweep,
     indices: Sequence[int] | None = None,
@@ -843,6 +873,7 @@ def slurm_script(
     the sweep directory (no Python needed on the compute node). ``indices`` default to the
     pending runs. Returns the script's path."""
     exe = os.path.abspath(exe or executable())
+    check_slurm_values(sweep.directory, exe, time_limit, partition, extra, job_name)
     if indices is None:
         indices = [r.index for r in sweep.pending()]
     if not indices:
@@ -855,10 +886,6 @@ def slurm_script(
         raise SweepError(f"{sweep.directory}: array indices outside the sweep's runs")
     width = len(sweep.runs[0].id) - 1
     sdir = str(sweep.directory)
-    for what, value in (("the sweep directory", sdir), ("the executable's path", exe)):
-        if _CONTROL.search(value):  # a newline would end an #SBATCH line (or a command)
-            raise SweepError(f"{what} {json.dumps(value)} holds a newline or another control "
-                             "character: a job script cannot name it; give another")
     lines = [
         "#!/bin/bash",
         f"#SBATCH --job-name={_sbatch_arg(job_name or 'fd-' + sweep.name, '--job-name')}",
@@ -873,11 +900,7 @@ def slurm_script(
         lines.append(f"#SBATCH --time={_sbatch_arg(time_limit, '--time')}")
     if partition:
         lines.append(f"#SBATCH --partition={_sbatch_arg(partition, '--partition')}")
-    for x in extra:
-        if _CONTROL.search(x):
-            raise SweepError(f"--sbatch {json.dumps(x)}: a newline or another control "
-                             "character cannot be written in an #SBATCH line")
-        lines.append(f"#SBATCH {x}")
+    lines += [f"#SBATCH {x}" for x in extra]
     lines += [
         f"# frictiondyn sweep '{sweep.name}': {len(indices)} of {len(sweep.runs)} runs.",
         "# Each task runs the standalone executable on its own deck (decks.txt, 0-based);",
@@ -1076,7 +1099,10 @@ def collect(sweep: Sweep, write: bool = True) -> Collected:
         w.writeheader()
         for row in rows:
             w.writerow({k: _csv_value(v) for k, v in row.items()})
-        _write_atomic(table, buf.getvalue())
+        try:
+            _write_atomic(table, buf.getvalue())
+        except OSError as exc:
+            raise SweepError(f"{table}: cannot write the table: {exc.strerror}") from None
         note = _write_parquet(table)
         if note:
             notes.append(note)
@@ -1297,6 +1323,10 @@ def main(argv: Sequence[str]) -> int:
         raise SweepError(f"--max-runs {a.max_runs}: a whole number from 1 is needed")
     if a.jobs is not None and not 1 <= a.jobs <= MAX_JOBS:
         raise SweepError(f"-j {a.jobs}: a whole number from 1 to {MAX_JOBS} is needed")
+    if a.slurm:  # what the job script must name, checked before anything is written
+        spec_path = Path(a.spec).resolve()
+        sdir = sweep_directory(load_spec(spec_path), spec_path, a.out)
+        check_slurm_values(sdir, a.exe or executable(), a.time_limit, a.partition, a.sbatch)
     with expand(a.spec, a.out, a.max_runs) as sweep:
         pending = sweep.pending()
         print(f"sweep '{sweep.name}': {len(sweep.runs)} runs in {sweep.directory} "
