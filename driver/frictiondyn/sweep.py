@@ -19,11 +19,14 @@ A key is "group.variable", "group.variable(i)" (one element), a label without a 
 "deck" (the base deck itself varies). Expanding a spec writes, under the sweep directory,
 ``decks/<id>.nml`` (one deck per run, outputs to ``runs/<id>.csv`` and
 ``runs/<id>.summary.json``), ``decks.txt`` (the list the executable's ``--list`` reads) and
-``manifest.json`` (runs, parameters, deck hashes). A run is complete when its summary
-exists; complete runs are skipped, so an interrupted sweep resumes where it stopped. A run
+``manifest.json`` (runs, parameters, deck and record hashes). A run is complete when its
+summary exists and is its own (its deck's and record's SHA-256 and its version those of the
+manifest); complete runs are skipped, so an interrupted sweep resumes where it stopped, and
+a summary that is not the run's own is reported damaged and the run is run again. A run
 that fails leaves ``runs/<id>.error.txt`` with the executable's message and does not stop
 the others. ``results.csv`` collects every run's parameters, status, the frictiondyn version,
-the run's deck (``run_deck``) and its SHA-256, and its summary (arrays as ``key[i]``, i from 1).
+the run's deck (``run_deck``) and its SHA-256, and its summary (arrays as ``key[i]``, i from 1;
+a null as NaN). One sweep at a time expands into a directory or runs in it (``SweepLock``).
 """
 
 from __future__ import annotations
