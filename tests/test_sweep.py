@@ -5,7 +5,9 @@ script."""
 
 from __future__ import annotations
 
+import contextlib
 import csv
+import io
 import json
 import os
 import re
@@ -326,6 +328,17 @@ def test_results_csv_columns(tmp_path):
 
 
 # ------------------------------------------------------------------ runs tied to their decks
+def _cli(*args):
+    """python -m frictiondyn sweep ARGS in this process (faster than a new interpreter):
+    CompletedProcess-like (returncode, stdout, stderr)."""
+    from frictiondyn.cli import main as cli_main
+
+    out, err = io.StringIO(), io.StringIO()
+    with contextlib.redirect_stdout(out), contextlib.redirect_stderr(err):
+        code = cli_main(["sweep", *map(str, args)])
+    return subprocess.CompletedProcess(args, code, out.getvalue(), err.getvalue())
+
+
 def _tiny_sweep(tmp_path, mus=(0.1, 0.2, 0.3, 0.6), extra=""):
     (tmp_path / "base.nml").write_text(deck_text(tiny()))
     spec = tmp_path / "s.toml"
@@ -352,7 +365,7 @@ def test_a_summary_of_another_run_is_damaged_and_runs_again(tmp_path):
     own = json.loads((out / "runs" / "r0000.summary.json").read_text())
     other = (out / "runs" / "r0003.summary.json").read_bytes()
     (out / "runs" / "r0000.summary.json").write_bytes(other)
-    c = subprocess.run([*SWEEP, "collect", str(out)], capture_output=True, text=True)
+    c = _cli("collect", str(out))
     assert c.returncode == 1, c.stdout
     assert "3 of 4 runs complete, 0 failed, 0 missing, 1 damaged" in c.stdout
     assert "damaged: r0000 (index 0): its summary is of another deck" in c.stdout
@@ -370,7 +383,7 @@ def test_a_summary_of_another_run_is_damaged_and_runs_again(tmp_path):
     s1 = out / "runs" / "r0001.summary.json"
     s1.write_text(s1.read_text().replace(f'"frictiondyn_version": "{frictiondyn.__version__}"',
                                          '"frictiondyn_version": "0.0.1"'))
-    c = subprocess.run([*SWEEP, "collect", str(out)], capture_output=True, text=True)
+    c = _cli("collect", str(out))
     assert "damaged: r0001 (index 1): its summary is of frictiondyn \"0.0.1\"" in c.stdout
 
 
@@ -396,7 +409,7 @@ def test_a_summary_of_another_record_is_damaged(tmp_path):
     summ = json.loads(s0.read_text())
     assert summ["record"]["sha256"] == manifest["runs"][0]["record_sha256"]
     s0.write_text(s0.read_text().replace(summ["record"]["sha256"], "0" * 64))
-    c = subprocess.run([*SWEEP, "collect", str(out)], capture_output=True, text=True)
+    c = _cli("collect", str(out))
     assert "damaged: r0000 (index 0): its summary is of another record" in c.stdout
 
 
@@ -588,6 +601,7 @@ sys.exit(main(sys.argv[1:]))
         ("name = '..'\n", ['name = "..": letters, digits']),
         ("name = 'a/b'\n", ['name = "a/b"']),
         ("directory = 5\n", ["directory = 5: a non-empty string"]),
+        (f"directory = '{'x' * 300}'\n", ["the sweep directory", "File name too long"]),
         ("jobs = 'x'\n", ['jobs = "x": a whole number from 1 to 1024']),
         ("jobs = 0\n", ["jobs = 0: a whole number"]),
         ("write_history = 'no'\n", ['write_history = "no": true or false is needed']),
@@ -615,8 +629,9 @@ def test_a_spec_value_of_the_wrong_kind_is_one_line_naming_the_key(tmp_path, tex
     written, never a traceback."""
     (tmp_path / "b.nml").write_text(deck_text(tiny()))
     (tmp_path / "s.toml").write_text("base = 'b.nml'\n" + text)
-    r = subprocess.run([*SWEEP, str(tmp_path / "s.toml"), "--out", str(tmp_path / "o"),
-                        "--slurm"], capture_output=True, text=True, cwd=tmp_path)
+    out = [] if text.startswith("directory") else ["--out", str(tmp_path / "o")]
+    r = subprocess.run([*SWEEP, str(tmp_path / "s.toml"), *out, "--slurm"],
+                       capture_output=True, text=True, cwd=tmp_path)
     assert r.returncode == 1
     assert r.stderr.startswith(f"frictiondyn: error: {tmp_path / 's.toml'}: "), r.stderr
     assert len(r.stderr.splitlines()) == 1, r.stderr
@@ -651,7 +666,7 @@ def test_collect_reports_damaged_runs_and_writes_what_it_can_read(tmp_path):
     (runs / "r0004.summary.json").mkdir()
     (runs / "r0005.summary.json").unlink()
     (runs / "r0005.error.txt").write_bytes(b"frictiondyn: error: \xff\xfe bad\n")
-    c = subprocess.run([*SWEEP, "collect", str(out)], capture_output=True, text=True)
+    c = _cli("collect", str(out))
     assert c.returncode == 1 and "Traceback" not in c.stderr, c.stderr
     assert "0 of 6 runs complete, 1 failed, 0 missing, 5 damaged" in c.stdout
     for rid, why in [("r0000", "is a JSON array, not an object"), ("r0001", "is a JSON number"),
@@ -664,7 +679,7 @@ def test_collect_reports_damaged_runs_and_writes_what_it_can_read(tmp_path):
     assert [r["friction.mu"] for r in rows] == ["0.1", "0.15", "0.2", "0.25", "0.3", "0.35"]
     for bad in (b"[]", b"\xff{}", b'{"name": "s", "runs": 5}', b'{"name": "s\\n", "runs": []}'):
         (out / "manifest.json").write_bytes(bad)
-        c = subprocess.run([*SWEEP, "collect", str(out)], capture_output=True, text=True)
+        c = _cli("collect", str(out))
         assert c.returncode == 1 and c.stdout == "", c.stdout
         assert c.stderr.startswith(f"frictiondyn: error: {out / 'manifest.json'} is damaged")
         assert len(c.stderr.splitlines()) == 1
@@ -681,34 +696,30 @@ def test_a_null_of_a_summary_is_nan_in_the_table_and_left_out_of_plots(tmp_path)
         summ["period_stuck_s"] = None
         summ["peak_u_m"] = [None]
         p.write_text(json.dumps(summ))
-    c = subprocess.run([*SWEEP, "collect", str(out)], capture_output=True, text=True)
+    c = _cli("collect", str(out))
     assert c.returncode == 0, c.stdout + c.stderr
     rows = _rows(out)
     assert [r["period_stuck_s"] for r in rows][1:3] == ["NaN", "NaN"]
     assert [r["peak_u_m[1]"] for r in rows][1:3] == ["NaN", "NaN"]
     assert float(rows[0]["peak_u_m[1]"]) > float(rows[3]["peak_u_m[1]"]) > 0
-    p = subprocess.run([*SWEEP, "plot", str(out), "friction.mu", "peak_u_m[1]"],
-                       capture_output=True, text=True)
+    p = _cli("plot", out, "friction.mu", "peak_u_m[1]")
     assert p.returncode == 0, p.stderr
     assert Path(p.stdout.split("plot: ")[1].strip()).read_bytes()[:4] == b"\x89PNG"
     for rid in ("r0000", "r0003"):
         s = out / "runs" / f"{rid}.summary.json"
         s.write_text(s.read_text().replace('"period_stuck_s": ', '"period_stuck_s": null, "x": '))
-    subprocess.run([*SWEEP, "collect", str(out)], check=True, capture_output=True)
-    p = subprocess.run([*SWEEP, "plot", str(out), "friction.mu", "period_stuck_s"],
-                       capture_output=True, text=True)
+    _cli("collect", out)
+    p = _cli("plot", str(out), "friction.mu", "period_stuck_s")
     assert p.returncode == 1 and "no complete run has numbers for both" in p.stderr, p.stderr
 
 
 def test_plot_of_a_wrong_column_names_the_close_ones(tmp_path):
     spec, out = _tiny_sweep(tmp_path, mus=(0.1, 0.2))
-    p = subprocess.run([*SWEEP, "plot", str(out), "friction.mu", "peak_s_m[1"],
-                       capture_output=True, text=True)
+    p = _cli("plot", str(out), "friction.mu", "peak_s_m[1")
     assert p.returncode == 1
     assert "'peak_s_m[1' is not a column of results.csv; close matches: peak_s_m[1]" in p.stderr
     assert len(p.stderr) < 300 and "energy_input_J" not in p.stderr
-    p = subprocess.run([*SWEEP, "plot", str(out), "friction.mu", "peak_s_m[1]", "--by", "zzz"],
-                       capture_output=True, text=True)
+    p = _cli("plot", out, "friction.mu", "peak_s_m[1]", "--by", "zzz")
     assert p.returncode == 1 and "'zzz' is not a column" in p.stderr
 
 

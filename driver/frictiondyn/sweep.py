@@ -491,7 +491,13 @@ def sweep_directory(spec: dict, spec_path: Path, directory: str | os.PathLike | 
     if _CONTROL.search(str(sdir)):
         raise SweepError(f"{spec_path}: the sweep directory {json.dumps(str(sdir))} holds a "
                          "newline or another control character: give another (--out)")
-    if sdir.exists() and not sdir.is_dir():
+    try:
+        st = os.stat(sdir)
+    except FileNotFoundError:
+        return sdir
+    except OSError as exc:  # a name too long, a file on the way, no permission
+        raise SweepError(f"{spec_path}: the sweep directory {sdir}: {exc.strerror}") from None
+    if not stat.S_ISDIR(st.st_mode):
         raise SweepError(f"{spec_path}: the sweep directory {sdir} is not a directory")
     return sdir
 
@@ -535,7 +541,7 @@ def expand(
         for key, value in first.items():
             if key != "deck" and "." in key:
                 _set(probe, key, value, f"{where}: with base deck {base_path}")
-    made = [p for p in [*reversed(sdir.parents), sdir] if not p.exists()]
+    made = [p for p in [*reversed(sdir.parents), sdir] if not os.path.lexists(p)]
     try:
         for p in [*made, sdir / "decks", sdir / "runs", sdir / "logs"]:
             p.mkdir(exist_ok=True)

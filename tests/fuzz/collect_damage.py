@@ -245,8 +245,14 @@ def damage(rng: random.Random, sdir: Path, state: dict) -> str:
         elif how == "bytes":
             m.write_bytes(b"\xff" + data)
         else:
-            man = json.loads(data)
-            entry = man["runs"][i]
+            try:
+                man = json.loads(data)
+                entry = man["runs"][i]
+                assert isinstance(entry, dict)
+            except Exception:  # noqa: BLE001 - damaged already
+                m.write_bytes(data[:len(data) // 2])
+                state["manifest"] = True
+                return "manifest: cut"
             if how == "run type":
                 man["runs"][i] = rng.choice([5, None, "r0000", []])
             elif how == "run id":
