@@ -493,10 +493,7 @@ def test_the_job_script_runs_nothing_a_directory_name_smuggles_in(tmp_path, name
     assert t.returncode == 0, t.stderr
     assert json.loads((out / "runs" / "r0001.summary.json").read_text())["n_dof"] == 1
     assert not (out / "runs" / "r0000.summary.json").exists()
-    assert not [p for p in tmp_path.rglob("*") if "INJECTED" in p.name and not p.is_dir()
-                and p.parent.name != p.name]
-    assert not list(tmp_path.rglob("INJECTED*")) or all(
-        p.is_dir() or HOSTILE[name] in str(p.parent) for p in tmp_path.rglob("INJECTED*"))
+    assert not list(tmp_path.rglob("INJECTED*"))  # no name of the test starts so
     assert not (tmp_path / "STUB_CALLED").exists()
     # and as sbatch reads the #SBATCH lines: its splitting and quoting
     opts = dict(_sbatch_options(text))

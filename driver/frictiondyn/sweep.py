@@ -207,6 +207,7 @@ class SweepLock:
     lock (process, host, since, spec), for the message of a sweep refused."""
 
     def __init__(self, directory: Path, spec: str = ""):
+        self.fd: int | None = None
         self.path = Path(directory) / LOCK_NAME
         flags = os.O_RDWR | os.O_CREAT | os.O_NOFOLLOW | os.O_NONBLOCK | os.O_CLOEXEC
         try:
@@ -240,12 +241,15 @@ class SweepLock:
         except BaseException:
             os.close(fd)
             raise
-        self.fd: int | None = fd
+        self.fd = fd
 
     def release(self) -> None:
         if self.fd is not None:
             os.close(self.fd)  # closing the only descriptor releases the flock
             self.fd = None
+
+    def __del__(self) -> None:  # a safety net: a sweep dropped without close()
+        self.release()
 
 
 # ------------------------------------------------------------------------------------ spec
