@@ -137,6 +137,13 @@ def damage(rng: random.Random, sdir: Path, state: dict) -> str:
         else:
             path.unlink(missing_ok=True)
 
+    def put(path: Path, data: bytes) -> None:
+        """Write the file itself: a link planted before is replaced, never written through
+        (that would change the other run's summary behind the oracle's back)."""
+        if path.is_symlink():
+            path.unlink()
+        path.write_bytes(data)
+
     def text(path: Path) -> bytes | None:
         try:
             return path.read_bytes()
@@ -145,7 +152,7 @@ def damage(rng: random.Random, sdir: Path, state: dict) -> str:
 
     if kind == "truncate" and (data := text(s_i)) is not None:
         at = rng.randrange(len(data))
-        s_i.write_bytes(data[:at])
+        put(s_i, data[:at])
         state["touched"].add(i)
         return f"{rid(i)} summary cut at byte {at}"
     if kind == "swap":
@@ -153,12 +160,12 @@ def damage(rng: random.Random, sdir: Path, state: dict) -> str:
         for path, data in ((s_i, b), (s_j, a)):
             clear(path)
             if data is not None:
-                path.write_bytes(data)
+                put(path, data)
         state["touched"] |= {i, j}
         return f"summaries of {rid(i)} and {rid(j)} swapped"
     if kind == "copy" and (data := text(s_j)) is not None:
         clear(s_i)
-        s_i.write_bytes(data)
+        put(s_i, data)
         state["touched"].add(i)
         return f"summary of {rid(j)} copied over {rid(i)}'s"
     if kind == "link":
@@ -168,12 +175,12 @@ def damage(rng: random.Random, sdir: Path, state: dict) -> str:
         return f"summary of {rid(i)} a link to {rid(j)}'s"
     if kind == "other json":
         clear(s_i)
-        s_i.write_text(rng.choice(["[1, 2]", "123", '"x"', "null", "true", "{}", "[]", ""]))
+        put(s_i, (rng.choice(["[1, 2]", "123", '"x"', "null", "true", "{}", "[]", ""])).encode())
         state["touched"].add(i)
         return f"{rid(i)} summary {s_i.read_text()!r}"
     if kind == "not utf-8" and (data := text(s_i)) is not None:
         at = rng.randrange(len(data) + 1)
-        s_i.write_bytes(data[:at] + b"\xff\xfe\xc3" + data[at:])
+        put(s_i, data[:at] + b"\xff\xfe\xc3" + data[at:])
         state["touched"].add(i)
         return f"{rid(i)} summary with bytes not UTF-8 at {at}"
     if kind == "directory":
@@ -183,11 +190,11 @@ def damage(rng: random.Random, sdir: Path, state: dict) -> str:
         return f"{rid(i)} summary a directory"
     if kind == "deep":
         clear(s_i)
-        s_i.write_text("[" * 100000 + "]" * 100000)
+        put(s_i, ("[" * 100000 + "]" * 100000).encode())
         state["touched"].add(i)
         return f"{rid(i)} summary nested 1e5 deep"
     if kind == "nan" and (data := text(s_i)) is not None:
-        s_i.write_bytes(data.replace(b'"samples": ', b'"samples": NaN, "was": ', 1))
+        put(s_i, data.replace(b'"samples": ', b'"samples": NaN, "was": ', 1))
         state["touched"].add(i)
         return f"{rid(i)} summary with NaN"
     if kind in ("key type", "null", "value type"):
@@ -212,7 +219,7 @@ def damage(rng: random.Random, sdir: Path, state: dict) -> str:
                                     1e308, -0.0, "\u00e9"])
             state["values"].setdefault(i, set()).add(key)
             what = f"{rid(i)} summary {key} = {summ[key]!r}"
-        s_i.write_text(json.dumps(summ))
+        put(s_i, (json.dumps(summ)).encode())
         return what
     if kind == "delete":
         clear(s_i)
@@ -232,7 +239,7 @@ def damage(rng: random.Random, sdir: Path, state: dict) -> str:
         data = text(e_j)
         clear(e_i)
         if data is not None:
-            e_i.write_bytes(data)
+            put(e_i, data)
         return f"error.txt of {rid(j)} copied to {rid(i)}"
     if kind == "manifest":
         m = sdir / "manifest.json"
