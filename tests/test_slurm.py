@@ -233,3 +233,24 @@ def test_job_array_gives_the_local_results(cluster, tmp_path):
     _same(local, remote, 5)
     rows = (remote / "results.csv").read_text().splitlines()
     assert len(rows) == 6 and all(",done," in x for x in rows[1:])
+
+
+def test_a_job_array_in_a_folder_named_to_inject_commands(cluster, tmp_path):
+    """A sweep directory whose name holds a quote, $(...), backticks, '#', '%' and blanks:
+    sbatch reads the #SBATCH lines as written (the directory, the log file pattern), the
+    tasks run every deck in that directory, and nothing the name asks for runs."""
+    env, _ = cluster
+    spec = tmp_path / "two.toml"
+    spec.write_text(f'name = "two"\nbase = "{INPUTS}/building5_friction.nml"\n'
+                    '[zip]\n"excitation.duration" = [2.0, 3.0]\n')
+    out = tmp_path / "it's 100% a $(touch INJECTED_1) `touch INJECTED_2` # sweep"
+    r = subprocess.run([*SWEEP, str(spec), "--out", str(out), "--slurm", "--submit"], env=env,
+                       capture_output=True, text=True)
+    assert r.returncode == 0, r.stderr
+    job = _job_id(r.stdout)
+    _wait_job(env, job)
+    c = subprocess.run([*SWEEP, "collect", str(out)], env=env, capture_output=True, text=True)
+    assert c.returncode == 0 and "2 of 2 runs complete" in c.stdout, c.stdout + c.stderr
+    assert sorted(p.name for p in (out / "logs").glob("*.out")) == [f"{job}_0.out", f"{job}_1.out"]
+    assert not list(tmp_path.rglob("INJECTED*"))
+    assert not list(Path("/").glob("INJECTED*")) and not list(Path.home().glob("INJECTED*"))

@@ -19,25 +19,36 @@ A key is "group.variable", "group.variable(i)" (one element), a label without a 
 "deck" (the base deck itself varies). Expanding a spec writes, under the sweep directory,
 ``decks/<id>.nml`` (one deck per run, outputs to ``runs/<id>.csv`` and
 ``runs/<id>.summary.json``), ``decks.txt`` (the list the executable's ``--list`` reads) and
-``manifest.json`` (runs, parameters, deck hashes). A run is complete when its summary
-exists; complete runs are skipped, so an interrupted sweep resumes where it stopped. A run
+``manifest.json`` (runs, parameters, deck and record hashes). A run is complete when its
+summary exists and is its own (its deck's and record's SHA-256 and its version those of the
+manifest); complete runs are skipped, so an interrupted sweep resumes where it stopped, and
+a summary that is not the run's own is reported damaged and the run is run again. A run
 that fails leaves ``runs/<id>.error.txt`` with the executable's message and does not stop
 the others. ``results.csv`` collects every run's parameters, status, the frictiondyn version,
-the run's deck (``run_deck``) and its SHA-256, and its summary (arrays as ``key[i]``, i from 1).
+the run's deck (``run_deck``) and its SHA-256, and its summary (arrays as ``key[i]``, i from 1;
+a null as NaN). One sweep at a time expands into a directory or runs in it (``SweepLock``).
 """
 
 from __future__ import annotations
 
 import argparse
+import contextlib
 import csv
+import datetime
+import difflib
+import errno
+import fcntl
 import hashlib
 import io
 import itertools
 import json
+import math
 import os
 import re
 import shlex
 import signal
+import socket
+import stat
 import subprocess
 import sys
 import threading
@@ -72,7 +83,47 @@ __all__ = [
     "slurm_script",
 ]
 
-_KEY = re.compile(r"^(?:(?P<group>[A-Za-z_]\w*)\.)?(?P<var>[A-Za-z_]\w*)(?:\((?P<idx>\d+)\))?$")
+_KEY = re.compile(
+    r"^(?:(?P<group>[A-Za-z_]\w*)\.)?(?P<var>[A-Za-z_]\w*)(?:\((?P<idx>\d{1,9})\))?$", re.ASCII
+)
+
+#: The groups of a deck and their variables: the namelist statements of the deck reader
+#: (fortran/io/fd_deck.f90; tests/test_sweep.py checks that the two agree). A sweep key that
+#: names anything else stops the sweep before it writes anything.
+DECK_VARIABLES: dict[str, tuple[str, ...]] = {
+    "model": ("n_dof", "mass", "u0", "v0", "label"),
+    "springs": ("n_springs", "node_i", "node_j", "k"),
+    "damping": ("damping_type", "xi", "period", "rayleigh_a0", "rayleigh_a1", "mode_i",
+                "mode_j", "mode_system"),
+    "friction": ("n_devices", "node_i", "node_j", "law", "p", "mu", "eps", "eps1", "f",
+                 "mu_law", "mu_max", "mu_min", "mu_rate", "mu_table_v", "mu_table_mu", "label"),
+    "braces": ("n_braces", "node_i", "node_j", "slip_load", "stiffness", "eps1", "label"),
+    "isolators": ("n_isolators", "node_i", "node_j", "law", "weight", "mu", "radius", "eps",
+                  "eps1", "f", "mu_law", "mu_max", "mu_min", "mu_rate", "mu_table_v",
+                  "mu_table_mu", "label"),
+    "storeys": ("n_storeys", "node_i", "node_j", "spring", "height", "label"),
+    "excitation": ("excitation_type", "amplitude", "frequency", "ramp_cycles", "duration",
+                   "dt_record", "record_file", "record_kind", "record_scale", "record_format",
+                   "record_units"),
+    "integration": ("technique", "beta", "gamma", "n1", "n2", "n", "check_correctness",
+                    "dt_min", "theta", "linear_system", "refinement"),
+    "output": ("dir", "name", "output_every", "write_history", "history_dofs",
+               "history_devices", "n_modes"),
+}
+
+#: Runs a spec may make unless --max-runs (``expand(max_runs=...)``) allows more: the runs
+#: are counted before any is expanded, so a spec crossing into 1e12 runs is refused at once.
+MAX_RUNS = 100_000
+#: Parallel runs of a local sweep at most (``jobs``, ``-j``).
+MAX_JOBS = 1024
+#: Columns of results.csv before the parameters; a label may not take one of these names.
+FIXED_COLUMNS = ("run", "status", "message", "run_deck", "deck_sha256", "frictiondyn_version",
+                 "warnings", "warning_text")
+_CONTROL = re.compile(r"[\x00-\x1f\x7f]")
+_NAME = re.compile(r"[A-Za-z0-9_][A-Za-z0-9_.-]*", re.ASCII)
+_SHA256 = re.compile(r"[0-9a-f]{64}", re.ASCII)
+_RUN_ID = re.compile(r"r[0-9]{4,9}", re.ASCII)
+LOCK_NAME = ".sweep.lock"
 
 
 class SweepError(ValueError):
@@ -88,6 +139,7 @@ class Run:
     params: dict[str, Any]  #: parameter -> value (the varied ones)
     deck: str  #: deck path relative to the sweep directory
     deck_sha256: str = ""
+    record_sha256: str = ""  #: SHA-256 of the record file the deck names ("" when none)
 
     @property
     def summary(self) -> str:
@@ -104,36 +156,188 @@ class Run:
 
 @dataclass
 class Sweep:
-    """An expanded sweep: its directory, runs and parameters."""
+    """An expanded sweep: its directory, runs and parameters. A sweep made by ``expand``
+    holds the lock of its directory until ``close()`` (or the end of a ``with`` block, or of
+    the process): no other sweep can be expanded into it or run in it meanwhile."""
 
     name: str
     directory: Path
     parameters: list[str]
     runs: list[Run] = field(default_factory=list)
     zipped: list[str] = field(default_factory=list)  #: the parameters of [zip]
+    version: str = __version__  #: the frictiondyn version the runs are for
+    spec_sha256: str = ""
+    jobs: int | None = None  #: the spec's ``jobs``
+    lock: SweepLock | None = field(default=None, repr=False)
+
+    def state(self, run: Run) -> tuple[str, dict | None, str]:
+        """("done", summary, "") when the run's summary is its own and whole; ("damaged",
+        None, why) when a summary is there but is not (unreadable, of another deck, record or
+        version); ("absent", None, "") when there is none."""
+        return _summary_state(self, run)
 
     def complete(self, run: Run) -> bool:
-        """The run's summary exists and is a complete JSON object."""
-        return _read_summary(self.directory / run.summary) is not None
+        """The run's summary exists, is a whole JSON object and is of this run's deck,
+        record and version."""
+        return self.state(run)[0] == "done"
 
     def pending(self) -> list[Run]:
         return [r for r in self.runs if not self.complete(r)]
 
+    def close(self) -> None:
+        """Release the directory's lock (if this object holds it)."""
+        if self.lock is not None:
+            self.lock.release()
+            self.lock = None
+
+    def __enter__(self) -> Sweep:
+        return self
+
+    def __exit__(self, *exc: object) -> None:
+        self.close()
+
+
+# ------------------------------------------------------------------------------------ lock
+class SweepLock:
+    """An exclusive ``flock`` on ``DIR/.sweep.lock``, taken without waiting: one sweep at a
+    time expands into a directory or runs in it. The lock file is opened with O_NOFOLLOW and
+    must be a regular file with one link: a planted symbolic link, hard link, FIFO or
+    directory is refused, never followed or written. The file stays (removing a lock file
+    races with its next taker); the lock dies with its process. The file holds who has the
+    lock (process, host, since, spec), for the message of a sweep refused."""
+
+    def __init__(self, directory: Path, spec: str = ""):
+        self.fd: int | None = None
+        self.path = Path(directory) / LOCK_NAME
+        flags = os.O_RDWR | os.O_CREAT | os.O_NOFOLLOW | os.O_NONBLOCK | os.O_CLOEXEC
+        try:
+            fd = os.open(self.path, flags, 0o644)
+        except OSError as exc:
+            if exc.errno == errno.ELOOP:
+                raise SweepError(f"{self.path} is a symbolic link: a sweep does not follow it; "
+                                 "remove it") from None
+            raise SweepError(f"cannot open the lock {self.path}: {exc.strerror}") from None
+        try:
+            st = os.fstat(fd)
+            if not stat.S_ISREG(st.st_mode) or st.st_nlink != 1:
+                raise SweepError(f"{self.path} is not a regular file of one link: a sweep does "
+                                 "not use it; remove it")
+            try:
+                fcntl.flock(fd, fcntl.LOCK_EX | fcntl.LOCK_NB)
+            except BlockingIOError:
+                holder = " ".join(os.pread(fd, 400, 0).decode("utf-8", "replace").split())
+                raise SweepError(
+                    f"{self.path.parent} is in use by another sweep ({holder or 'starting'}); "
+                    "wait for it to end, or give another directory (--out)"
+                ) from None
+            except OSError as exc:
+                raise SweepError(f"cannot lock {self.path}: {exc.strerror}") from None
+            when = datetime.datetime.now(datetime.timezone.utc).strftime("%Y-%m-%dT%H:%M:%SZ")
+            info = f"pid {os.getpid()} on {socket.gethostname()} since {when}"
+            if spec:
+                info += f", spec {spec}"
+            os.ftruncate(fd, 0)
+            os.pwrite(fd, (" ".join(info.split()) + "\n").encode("utf-8", "replace"), 0)
+        except BaseException:
+            os.close(fd)
+            raise
+        self.fd = fd
+
+    def release(self) -> None:
+        if self.fd is not None:
+            os.close(self.fd)  # closing the only descriptor releases the flock
+            self.fd = None
+
+    def __del__(self) -> None:  # a safety net: a sweep dropped without close()
+        self.release()
+
 
 # ------------------------------------------------------------------------------------ spec
+def _kind(v: Any) -> str:
+    return type(v).__name__.replace("str", "string").replace("int", "integer")
+
+
+def _check_value(v: Any, where: str, deck_value: bool) -> None:
+    """A spec value: a string, number, boolean or a list of them (nested lists too)."""
+    if isinstance(v, list):
+        for x in v:
+            _check_value(x, where, deck_value)
+        return
+    if isinstance(v, float) and not math.isfinite(v):
+        raise SweepError(f"{where}: {v!r} is not a finite number")
+    if not isinstance(v, (str, int, float, bool)):
+        raise SweepError(f"{where}: a {_kind(v)} ({_short(v)}) is not a value of a sweep: "
+                         "give strings, numbers, booleans or lists of them")
+    if deck_value and isinstance(v, str) and _CONTROL.search(v):
+        raise SweepError(f"{where}: {json.dumps(v)}: a string of a deck may not hold a newline "
+                         "or another control character")
+
+
+def _close(word: str, choices) -> str:
+    near = difflib.get_close_matches(word, list(choices), n=3, cutoff=0.6)
+    return f"; did you mean {' or '.join(repr(n) for n in near)}?" if near else ""
+
+
+def _check_key(key: str, where: str) -> None:
+    """A key naming a group must name a group and variable of the deck reader."""
+    m = _KEY.match(key)
+    assert m is not None
+    if m["group"] is None:
+        return
+    group, var = m["group"].lower(), m["var"].lower()
+    if group not in DECK_VARIABLES:
+        raise SweepError(f"{where}: no group &{group} in a deck{_close(group, DECK_VARIABLES)}"
+                         f" (the groups: {', '.join(DECK_VARIABLES)})")
+    if var not in DECK_VARIABLES[group]:
+        raise SweepError(f"{where}: &{group} has no variable {var!r}"
+                         f"{_close(var, DECK_VARIABLES[group])} (its variables: "
+                         f"{', '.join(DECK_VARIABLES[group])})")
+    if group == "output" and var in ("dir", "name"):
+        raise SweepError(f"{where}: the sweep sets &output dir and name itself "
+                         "(runs/<id>); vary something else")
+
+
 def load_spec(path: str | os.PathLike) -> dict:
-    """Read and check a sweep spec (TOML); the keys are described in the module doc."""
+    """Read and check a sweep spec (TOML); the keys are described in the module doc. Every
+    error is a SweepError of one line naming the spec and the key."""
     path = Path(path)
     try:
-        spec = tomllib.loads(path.read_text())
+        data = path.read_bytes()
     except FileNotFoundError:
         raise SweepError(f"{path}: no such spec file") from None
+    except OSError as exc:
+        raise SweepError(f"{path}: cannot read the spec: {exc.strerror}") from None
+    try:
+        spec = tomllib.loads(data.decode("utf-8"))
+    except UnicodeDecodeError as exc:
+        raise SweepError(f"{path}: not UTF-8 text (byte {exc.start})") from None
     except tomllib.TOMLDecodeError as exc:
         raise SweepError(f"{path}: not valid TOML: {exc}") from None
+    except RecursionError:
+        raise SweepError(f"{path}: not valid TOML: nested too deeply") from None
     known = {"name", "base", "cross", "zip", "write_history", "jobs", "directory"}
     unknown = set(spec) - known
     if unknown:
-        raise SweepError(f"{path}: unknown key(s) {sorted(unknown)}; known: {sorted(known)}")
+        raise SweepError(f"{path}: unknown key(s) {sorted(unknown)}"
+                         f"{_close(sorted(unknown)[0], known)} (known: {sorted(known)})")
+    spec["_sha256"] = _sha256(data)
+    for key in ("name", "base", "directory"):
+        if key in spec:
+            v = spec[key]
+            if not isinstance(v, str) or not v:
+                raise SweepError(f"{path}: {key} = {_short(v)}: a non-empty string is needed")
+            if _CONTROL.search(v):
+                raise SweepError(f"{path}: {key} = {json.dumps(v)}: a newline or another "
+                                 "control character is not allowed")
+    if "write_history" in spec and not isinstance(spec["write_history"], bool):
+        raise SweepError(f"{path}: write_history = {_short(spec['write_history'])}: "
+                         "true or false is needed")
+    if "jobs" in spec:
+        j = spec["jobs"]
+        if isinstance(j, bool) or not isinstance(j, int) or not 1 <= j <= MAX_JOBS:
+            raise SweepError(f"{path}: jobs = {_short(j)}: a whole number from 1 to {MAX_JOBS} "
+                             "is needed")
+    seen: dict[tuple[str, str], str] = {}
     for table in ("cross", "zip"):
         if not isinstance(spec.get(table, {}), dict):
             raise SweepError(f"{path}: [{table}] must be a table of parameter = [values]")
@@ -145,6 +349,27 @@ def load_spec(path: str | os.PathLike) -> dict:
                 )
             if not isinstance(values, list) or not values:
                 raise SweepError(f"{path}: [{table}] {key} must be a non-empty list of values")
+            m = _KEY.match(key)
+            where = f"{path}: [{table}] {key}"
+            _check_key(key, where)
+            for v in values:
+                _check_value(v, where, deck_value=m["group"] is not None)
+            if key == "deck" and not all(isinstance(v, str) and v for v in values):
+                raise SweepError(f"{where}: every value must be the path of a deck (a string)")
+            if m["group"] is None and key != "deck" and key in FIXED_COLUMNS:
+                raise SweepError(f"{where}: a label may not be named like a column of the "
+                                 f"table ({', '.join(FIXED_COLUMNS)})")
+            if m["group"] is not None:  # one variable (or element) set by one key only
+                gv = (m["group"].lower(), m["var"].lower())
+                other = seen.get(gv)
+                if other is not None and (m["idx"] is None or _KEY.match(other)["idx"] is None
+                                          or int(_KEY.match(other)["idx"]) == int(m["idx"])):
+                    raise SweepError(f"{where}: sets what {other!r} sets; give each variable "
+                                     "or element once")
+                if other is None or m["idx"] is None:
+                    seen[gv] = key
+            if (key.lower() == "output.write_history" and "write_history" in spec):
+                raise SweepError(f"{where}: write_history is given too; give one of the two")
     zipped = spec.get("zip", {})
     lengths = {k: len(v) for k, v in zipped.items()}
     if len(set(lengths.values())) > 1:
@@ -155,9 +380,18 @@ def load_spec(path: str | os.PathLike) -> dict:
     if "base" not in spec and "deck" not in spec.get("cross", {}) and "deck" not in zipped:
         raise SweepError(f"{path}: give a base deck (base = 'deck.nml') or vary 'deck'")
     spec.setdefault("name", path.stem)
-    if not re.fullmatch(r"[\w.-]+", spec["name"]):
-        raise SweepError(f"{path}: name = {spec['name']!r}: letters, digits, '_', '-', '.' only")
+    if not _NAME.fullmatch(spec["name"]) or len(spec["name"]) > 100:
+        raise SweepError(f"{path}: name = {json.dumps(spec['name'])}: letters, digits, '_', "
+                         "'-', '.' only, not first '.' or '-', at most 100")
     return spec
+
+
+def count_runs(spec: dict) -> int:
+    """The runs a checked spec makes: the product of the [cross] lists' lengths, times the
+    length of the [zip] lists (counted, not expanded)."""
+    n = math.prod(len(v) for v in spec.get("cross", {}).values())
+    zipped = spec.get("zip", {})
+    return n * (len(next(iter(zipped.values()))) if zipped else 1)
 
 
 def _combinations(spec: dict) -> tuple[list[str], list[dict[str, Any]]]:
@@ -219,40 +453,128 @@ def _deck_text(nml: f90nml.Namelist, header: str) -> str:
     return header + write_namelist(nml)
 
 
-def expand(spec_path: str | os.PathLike, directory: str | os.PathLike | None = None) -> Sweep:
+def _read_base(base: str, base_dir: Path, where: str) -> tuple[Path, f90nml.Namelist]:
+    base_path = (base_dir / base).resolve()
+    try:  # the deck's bytes as the library reads them (a Latin-1 comment is no error)
+        text = base_path.read_bytes().decode("utf-8", "surrogateescape")
+    except FileNotFoundError:
+        raise SweepError(f"{where}: base deck {base_path} does not exist") from None
+    except OSError as exc:
+        raise SweepError(f"{where}: cannot read the base deck {base_path}: {exc.strerror}") from None
+    try:
+        return base_path, read_namelist(text, base_path)
+    except FrictiondynError as exc:
+        raise SweepError(f"{where}: base deck: {exc}") from None
+
+
+def _record_sha256(nml: f90nml.Namelist, decks: Path, cache: dict[str, str]) -> str:
+    """SHA-256 of the record file a run's deck names (relative to decks/), "" when it names
+    none or it cannot be read (the run then fails and says why)."""
+    exc_group = nml.get("excitation") or {}
+    rec = exc_group.get("record_file")
+    kind = str(exc_group.get("excitation_type", "")).strip().lower()
+    if not isinstance(rec, str) or not rec.strip() or kind not in ("record", ""):
+        return ""
+    path = str(decks / rec.strip())
+    if path not in cache:
+        h = hashlib.sha256()
+        try:
+            with open(path, "rb") as fh:
+                for block in iter(lambda: fh.read(1 << 20), b""):
+                    h.update(block)
+            cache[path] = h.hexdigest()
+        except OSError:
+            cache[path] = ""
+    return cache[path]
+
+
+def sweep_directory(spec: dict, spec_path: Path, directory: str | os.PathLike | None) -> Path:
+    """The sweep directory of a checked spec: ``directory`` (--out), else the spec's
+    ``directory``, else ``sweeps/<name>`` in the working directory."""
+    sdir = Path(directory or spec.get("directory") or Path("sweeps") / spec["name"]).resolve()
+    if _CONTROL.search(str(sdir)):
+        raise SweepError(f"{spec_path}: the sweep directory {json.dumps(str(sdir))} holds a "
+                         "newline or another control character: give another (--out)")
+    try:
+        st = os.stat(sdir)
+    except FileNotFoundError:
+        return sdir
+    except OSError as exc:  # a name too long, a file on the way, no permission
+        raise SweepError(f"{spec_path}: the sweep directory {sdir}: {exc.strerror}") from None
+    if not stat.S_ISDIR(st.st_mode):
+        raise SweepError(f"{spec_path}: the sweep directory {sdir} is not a directory")
+    return sdir
+
+
+def expand(
+    spec_path: str | os.PathLike,
+    directory: str | os.PathLike | None = None,
+    max_runs: int = MAX_RUNS,
+) -> Sweep:
     """Write one deck per run, decks.txt and manifest.json under the sweep directory
     (default: spec ``directory``, else ``sweeps/<name>`` in the working directory). A run
-    whose deck changed since an earlier expansion loses its old outputs."""
+    whose deck changed since an earlier expansion loses its old outputs.
+
+    Everything that can be wrong with the spec (its keys and values, the count of runs
+    against ``max_runs``, the base decks, an element a base deck does not give) is found
+    before anything is written. The returned sweep holds the directory's lock
+    (``SweepLock``): ``close()`` it, or use it in a ``with`` block."""
     spec_path = Path(spec_path).resolve()
     spec = load_spec(spec_path)
     where = str(spec_path)
     base_dir = spec_path.parent
     name = spec["name"]
-    sdir = Path(directory or spec.get("directory") or Path("sweeps") / name).resolve()
-    (sdir / "decks").mkdir(parents=True, exist_ok=True)
-    (sdir / "runs").mkdir(exist_ok=True)
-    (sdir / "logs").mkdir(exist_ok=True)
+    n = count_runs(spec)
+    if n > max_runs:
+        sizes = [f"{len(v):,}" for v in spec.get("cross", {}).values()]
+        if spec.get("zip"):
+            sizes.append(f"{len(next(iter(spec['zip'].values()))):,} zipped")
+        raise SweepError(f"{where}: the spec makes {n:,} runs ({' x '.join(sizes)}), more than "
+                         f"the limit of {max_runs:,}; raise it with --max-runs if you mean it")
+    sdir = sweep_directory(spec, spec_path, directory)
     keys, rows = _combinations(spec)
-    width = max(4, len(str(len(rows) - 1)))
-    sweep = Sweep(name=name, directory=sdir, parameters=keys, zipped=list(spec.get("zip", {})))
-    bases: dict[str, f90nml.Namelist] = {}
-    for index, params in enumerate(rows):
+    # every base deck read, and every key set in each, before anything is written
+    bases: dict[str, tuple[Path, f90nml.Namelist]] = {}
+    for params in rows:
         base = params.get("deck", spec.get("base"))
-        if not isinstance(base, str):
-            raise SweepError(f"{where}: deck = {base!r} is not a path")
-        base_path = (base_dir / base).resolve()
         if base not in bases:
-            try:  # the deck's bytes as the library reads them (a Latin-1 comment is no error)
-                text = base_path.read_bytes().decode("utf-8", "surrogateescape")
-            except FileNotFoundError:
-                raise SweepError(f"{where}: base deck {base_path} does not exist") from None
-            except OSError as exc:
-                raise SweepError(f"{where}: cannot read the base deck {base_path}: {exc}") from None
-            try:
-                bases[base] = read_namelist(text, base_path)
-            except FrictiondynError as exc:
-                raise SweepError(f"{where}: base deck: {exc}") from None
-        nml = copy_namelist(bases[base])
+            bases[base] = _read_base(base, base_dir, where)
+    first = rows[0]
+    for base_path, nml in bases.values():
+        probe = copy_namelist(nml)
+        for key, value in first.items():
+            if key != "deck" and "." in key:
+                _set(probe, key, value, f"{where}: with base deck {base_path}")
+    made = [p for p in [*reversed(sdir.parents), sdir] if not os.path.lexists(p)]
+    try:
+        for p in [*made, sdir / "decks", sdir / "runs", sdir / "logs"]:
+            p.mkdir(exist_ok=True)
+    except OSError as exc:
+        for p in reversed(made):  # nothing left of a directory that could not be made
+            with contextlib.suppress(OSError):
+                p.rmdir()
+        raise SweepError(f"{where}: cannot make the sweep directory {sdir}: {exc.strerror}") from None
+    lock = SweepLock(sdir, str(spec_path))
+    try:
+        sweep = _write_runs(spec, spec_path, sdir, keys, rows, bases)
+    except BaseException:
+        lock.release()
+        raise
+    sweep.lock = lock
+    return sweep
+
+
+def _write_runs(spec, spec_path, sdir, keys, rows, bases) -> Sweep:
+    where = str(spec_path)
+    base_dir = spec_path.parent
+    name = spec["name"]
+    width = max(4, len(str(len(rows) - 1)))
+    sweep = Sweep(name=name, directory=sdir, parameters=keys, zipped=list(spec.get("zip", {})),
+                  spec_sha256=spec["_sha256"], jobs=spec.get("jobs"))
+    records: dict[str, str] = {}
+    for index, params in enumerate(rows):
+        base_path, base_nml = bases[params.get("deck", spec.get("base"))]
+        nml = copy_namelist(base_nml)
         # a relative record file is relative to the deck that names it
         exc_group = nml.get("excitation", {})
         rec = exc_group.get("record_file") if exc_group else None
@@ -274,17 +596,21 @@ def expand(spec_path: str | os.PathLike, directory: str | os.PathLike | None = N
         nml["output"]["dir"] = "runs"
         nml["output"]["name"] = rid
         if "write_history" in spec:
-            nml["output"]["write_history"] = bool(spec["write_history"])
+            nml["output"]["write_history"] = spec["write_history"]
         shown = ", ".join(f"{k} = {_short(v)}" for k, v in params.items())
         text = _deck_text(nml, f"! frictiondyn sweep '{name}', run {rid}: {shown}\n")
         deck = sdir / "decks" / f"{rid}.nml"
         data = text.encode("utf-8", "surrogateescape")
-        old = deck.read_bytes() if deck.exists() else None
+        try:
+            old = deck.read_bytes()
+        except OSError:
+            old = None
         if old != data:
             for stale in (f"runs/{rid}.summary.json", f"runs/{rid}.csv", f"runs/{rid}.error.txt"):
                 (sdir / stale).unlink(missing_ok=True)
             _write_atomic(deck, data)
-        run = Run(index, rid, params, f"decks/{rid}.nml", _sha256(data))
+        run = Run(index, rid, params, f"decks/{rid}.nml", _sha256(data),
+                  _record_sha256(nml, sdir / "decks", records))
         sweep.runs.append(run)
     # decks of a larger earlier expansion are no longer part of the sweep
     wanted = {r.deck for r in sweep.runs}
@@ -297,12 +623,13 @@ def expand(spec_path: str | os.PathLike, directory: str | os.PathLike | None = N
     manifest = {
         "name": name,
         "spec": str(spec_path),
+        "spec_sha256": spec["_sha256"],
         "frictiondyn_version": __version__,
         "parameters": keys,
         "zip": sweep.zipped,
         "runs": [
             {"index": r.index, "id": r.id, "deck": r.deck, "deck_sha256": r.deck_sha256,
-             "params": r.params}
+             "record_sha256": r.record_sha256, "params": r.params}
             for r in sweep.runs
         ],
     }
@@ -311,20 +638,96 @@ def expand(spec_path: str | os.PathLike, directory: str | os.PathLike | None = N
 
 
 def _short(v: Any) -> str:
-    text = json.dumps(v)
+    text = json.dumps(v, default=str)
     return text if len(text) <= 60 else text[:57] + "..."
 
 
+def _damaged_manifest(sdir: Path, why: str) -> SweepError:
+    return SweepError(f"{sdir / 'manifest.json'} is damaged ({why}): expand the spec again "
+                      "(python -m frictiondyn sweep SPEC --expand-only)")
+
+
 def load(directory: str | os.PathLike) -> Sweep:
-    """The sweep expanded in a directory (from its manifest.json)."""
+    """The sweep expanded in a directory (from its manifest.json, every field checked: a
+    damaged manifest is a SweepError naming what is wrong)."""
     sdir = Path(directory).resolve()
     try:
-        m = json.loads((sdir / "manifest.json").read_text())
+        data = (sdir / "manifest.json").read_bytes()
     except FileNotFoundError:
         raise SweepError(f"{sdir}: no manifest.json (not a sweep directory)") from None
-    runs = [Run(r["index"], r["id"], r["params"], r["deck"], r["deck_sha256"]) for r in m["runs"]]
-    return Sweep(name=m["name"], directory=sdir, parameters=m["parameters"], runs=runs,
-                 zipped=m.get("zip", []))
+    except OSError as exc:
+        raise SweepError(f"{sdir / 'manifest.json'}: cannot read it: {exc.strerror}") from None
+    try:
+        m = json.loads(data.decode("utf-8"), parse_constant=_no_constant)
+    except UnicodeDecodeError as exc:
+        raise _damaged_manifest(sdir, f"not UTF-8 text at byte {exc.start}") from None
+    except ValueError as exc:
+        raise _damaged_manifest(sdir, f"not valid JSON: {exc}") from None
+    except RecursionError:
+        raise _damaged_manifest(sdir, "not valid JSON: nested too deeply") from None
+
+    def want(obj, key, kind, what):
+        v = obj.get(key) if isinstance(obj, dict) else None
+        if not isinstance(v, kind) or isinstance(v, bool):
+            raise _damaged_manifest(sdir, f"{what} is {_short(v)}, not a {kind.__name__}")
+        return v
+
+    if not isinstance(m, dict):
+        raise _damaged_manifest(sdir, f"a JSON {type(m).__name__}, not an object")
+    name = want(m, "name", str, "name")
+    if not _NAME.fullmatch(name):
+        raise _damaged_manifest(sdir, f"name {json.dumps(name)}")
+    params = want(m, "parameters", list, "parameters")
+    zipped = m.get("zip", [])
+    if not all(isinstance(p, str) for p in params) or not isinstance(zipped, list) or not all(
+            isinstance(p, str) for p in zipped):
+        raise _damaged_manifest(sdir, "parameters or zip not lists of names")
+    version = m.get("frictiondyn_version", "")
+    if not isinstance(version, str):
+        raise _damaged_manifest(sdir, f"frictiondyn_version is {_short(version)}")
+    runs = []
+    ids = set()
+    for i, r in enumerate(want(m, "runs", list, "runs")):
+        what = f"runs[{i}]"
+        if not isinstance(r, dict):
+            raise _damaged_manifest(sdir, f"{what} is {_short(r)}")
+        rid = want(r, "id", str, f"{what}.id")
+        index = want(r, "index", int, f"{what}.index")
+        deck = want(r, "deck", str, f"{what}.deck")
+        sha = want(r, "deck_sha256", str, f"{what}.deck_sha256")
+        rec = r.get("record_sha256", "")
+        p = want(r, "params", dict, f"{what}.params")
+        if (index != i or not _RUN_ID.fullmatch(rid) or rid in ids or deck != f"decks/{rid}.nml"
+                or not _SHA256.fullmatch(sha) or not isinstance(rec, str)
+                or (rec and not _SHA256.fullmatch(rec))
+                or (runs and len(rid) != len(runs[0].id))):
+            raise _damaged_manifest(sdir, f"{what} = {_short(r)}")
+        ids.add(rid)
+        runs.append(Run(index, rid, p, deck, sha, rec))
+    if not runs:
+        raise _damaged_manifest(sdir, "no runs")
+    spec_sha = m.get("spec_sha256", "")
+    return Sweep(name=name, directory=sdir, parameters=params, runs=runs, zipped=zipped,
+                 version=version, spec_sha256=spec_sha if isinstance(spec_sha, str) else "")
+
+
+def _no_constant(name: str):
+    raise ValueError(f"{name}, which frictiondyn never writes")
+
+
+def load_locked(directory: str | os.PathLike) -> Sweep:
+    """``load`` with the directory's lock held (refused while another sweep holds it)."""
+    sdir = Path(directory).resolve()
+    if not (sdir / "manifest.json").exists():
+        return load(sdir)  # its error
+    lock = SweepLock(sdir)
+    try:
+        sweep = load(sdir)
+    except BaseException:
+        lock.release()
+        raise
+    sweep.lock = lock
+    return sweep
 
 
 # ------------------------------------------------------------------------------- running
@@ -343,7 +746,16 @@ def run_local(
     stop the sweep: running executables get SIGTERM (they remove their temporary files)
     and what completed stays complete. Returns counts: done, failed, skipped."""
     exe = exe or executable()
-    jobs = max(1, jobs or os.cpu_count() or 1)
+    if jobs is not None and (isinstance(jobs, bool) or not 1 <= jobs <= MAX_JOBS):
+        raise SweepError(f"jobs = {jobs}: a whole number from 1 to {MAX_JOBS} is needed")
+    jobs = jobs or os.cpu_count() or 1
+    if sweep.lock is None:  # a sweep loaded from its directory: lock it while it runs
+        with load_locked(sweep.directory) as locked:
+            if [(r.id, r.deck_sha256) for r in locked.runs] != [
+                    (r.id, r.deck_sha256) for r in sweep.runs]:
+                raise SweepError(f"{sweep.directory}: expanded again since it was loaded; "
+                                 "load it again")
+            return run_local(locked, jobs, exe, progress)
     pending = sweep.pending()
     counts = {"skipped": len(sweep.runs) - len(pending), "done": 0, "failed": 0}
     procs: set[subprocess.Popen] = set()
@@ -419,6 +831,46 @@ def array_ranges(indices: Sequence[int]) -> str:
     return ",".join(out)
 
 
+def _sbatch_arg(value: str, option: str) -> str:
+    """A value as one argument of an #SBATCH line. Such a line is a comment to the shell,
+    read by sbatch alone, which splits it at blanks and takes '#' for the start of a
+    comment unless quoted: a value holding those is written in double quotes. A newline or
+    another control character (it would end the line: what follows would be a command) and
+    a double quote or backslash (sbatch's quoting cannot hold them plainly) are refused."""
+    if _CONTROL.search(value) or '"' in value or "\\" in value:
+        raise SweepError(f"{option} {json.dumps(value)}: a newline, control character, '\"' or "
+                         "'\\' cannot be written in an #SBATCH line; give another")
+    if not value or re.search(r"[\s#']", value):
+        return f'"{value}"'
+    return value
+
+
+def check_slurm_values(
+    directory: Path,
+    exe: str,
+    time_limit: str | None = None,
+    partition: str | None = None,
+    extra: Sequence[str] = (),
+    job_name: str | None = None,
+) -> None:
+    """The values a job script names can be written in it: SweepError otherwise."""
+    sdir = str(directory)
+    for what, value in (("the sweep directory", sdir), ("the executable's path",
+                                                        os.path.abspath(exe))):
+        if _CONTROL.search(value):  # a newline would end an #SBATCH line (or a command)
+            raise SweepError(f"{what} {json.dumps(value)} holds a newline or another control "
+                             "character: a job script cannot name it; give another")
+    _sbatch_arg(sdir, "--chdir")
+    for value, option in ((time_limit, "--time"), (partition, "--partition"),
+                          (job_name, "--job-name")):
+        if value:
+            _sbatch_arg(value, option)
+    for x in extra:
+        if _CONTROL.search(x):
+            raise SweepError(f"--sbatch {json.dumps(x)}: a newline or another control "
+                             "character cannot be written in an #SBATCH line")
+
+
 def slurm_script(
     sweep: Sweep,
     indices: Sequence[int] | None = None,
@@ -434,24 +886,33 @@ def slurm_script(
     the sweep directory (no Python needed on the compute node). ``indices`` default to the
     pending runs. Returns the script's path."""
     exe = os.path.abspath(exe or executable())
+    check_slurm_values(sweep.directory, exe, time_limit, partition, extra, job_name)
     if indices is None:
         indices = [r.index for r in sweep.pending()]
     if not indices:
         raise SweepError(f"{sweep.directory}: every run is complete; nothing to submit")
+    if not all(_RUN_ID.fullmatch(r.id) for r in sweep.runs) or not _NAME.fullmatch(sweep.name):
+        raise SweepError(f"{sweep.directory}: run ids or sweep name not as a sweep writes them")
+    if isinstance(max_parallel, bool) or not isinstance(max_parallel, int) or max_parallel < 1:
+        raise SweepError(f"--max-parallel {max_parallel}: a whole number from 1 is needed")
+    if not set(indices) <= {r.index for r in sweep.runs}:
+        raise SweepError(f"{sweep.directory}: array indices outside the sweep's runs")
     width = len(sweep.runs[0].id) - 1
+    sdir = str(sweep.directory)
     lines = [
         "#!/bin/bash",
-        f"#SBATCH --job-name={job_name or 'fd-' + sweep.name}",
-        f"#SBATCH --array={array_ranges(indices)}%{max(1, int(max_parallel))}",
+        f"#SBATCH --job-name={_sbatch_arg(job_name or 'fd-' + sweep.name, '--job-name')}",
+        f"#SBATCH --array={array_ranges(indices)}%{max_parallel}",
         "#SBATCH --ntasks=1",
         "#SBATCH --cpus-per-task=1",
-        f"#SBATCH --chdir={sweep.directory}",
-        f"#SBATCH --output={sweep.directory}/logs/%A_%a.out",
+        f"#SBATCH --chdir={_sbatch_arg(sdir, '--chdir')}",
+        # a file name pattern: '%' of the directory itself doubled
+        f"#SBATCH --output={_sbatch_arg(sdir.replace('%', '%%') + '/logs/%A_%a.out', '--output')}",
     ]
     if time_limit:
-        lines.append(f"#SBATCH --time={time_limit}")
+        lines.append(f"#SBATCH --time={_sbatch_arg(time_limit, '--time')}")
     if partition:
-        lines.append(f"#SBATCH --partition={partition}")
+        lines.append(f"#SBATCH --partition={_sbatch_arg(partition, '--partition')}")
     lines += [f"#SBATCH {x}" for x in extra]
     lines += [
         f"# frictiondyn sweep '{sweep.name}': {len(indices)} of {len(sweep.runs)} runs.",
@@ -490,10 +951,72 @@ def submit(script: Path) -> str:
 
 # ------------------------------------------------------------------------------- results
 def _read_summary(path: Path) -> dict | None:
+    """The summary at ``path`` as a dict, None when absent or unreadable."""
     try:
-        return json.loads(path.read_text())
-    except (FileNotFoundError, ValueError):
+        summ = _load_summary(path)
+    except (FileNotFoundError, _Damaged):
         return None
+    return summ
+
+
+class _Damaged(Exception):
+    """A summary that is there but cannot be this run's (the message says why)."""
+
+
+def _load_summary(path: Path) -> dict:
+    try:
+        data = path.read_bytes()
+    except FileNotFoundError:
+        raise
+    except OSError as exc:
+        raise _Damaged(f"its summary cannot be read: {exc.strerror}") from None
+    try:
+        summ = json.loads(data.decode("utf-8"), parse_constant=_no_constant)
+    except UnicodeDecodeError as exc:
+        raise _Damaged(f"its summary is not UTF-8 text (byte {exc.start})") from None
+    except ValueError as exc:
+        raise _Damaged(f"its summary is not valid JSON ({exc})") from None
+    except RecursionError:
+        raise _Damaged("its summary is not valid JSON (nested too deeply)") from None
+    if not isinstance(summ, dict):
+        raise _Damaged(f"its summary is a JSON {_json_kind(summ)}, not an object")
+    for key in ("frictiondyn_version", "deck_sha256"):
+        if not isinstance(summ.get(key), str):
+            raise _Damaged(f"its summary's {key} is {_short(summ.get(key))}, not a string")
+    w = summ.get("warnings", [])
+    if not isinstance(w, list) or not all(isinstance(x, str) for x in w):
+        raise _Damaged(f"its summary's warnings are {_short(w)}, not a list of strings")
+    rec = summ.get("record")
+    if rec is not None and not (isinstance(rec, dict) and isinstance(rec.get("sha256", ""), str)):
+        raise _Damaged(f"its summary's record is {_short(rec)}")
+    return summ
+
+
+def _json_kind(v: Any) -> str:
+    return {list: "array", str: "string", int: "number", float: "number", bool: "boolean",
+            type(None): "null"}.get(type(v), type(v).__name__)
+
+
+def _summary_state(sweep: Sweep, run: Run) -> tuple[str, dict | None, str]:
+    try:
+        summ = _load_summary(sweep.directory / run.summary)
+    except FileNotFoundError:
+        return "absent", None, ""
+    except _Damaged as exc:
+        return "damaged", None, str(exc)
+    if summ["deck_sha256"] != run.deck_sha256:
+        return "damaged", None, (f"its summary is of another deck (deck_sha256 "
+                                 f"{summ['deck_sha256'][:12]}..., the run's deck "
+                                 f"{run.deck_sha256[:12]}...)")
+    rec = (summ.get("record") or {}).get("sha256", "")
+    if run.record_sha256 and rec and rec != run.record_sha256:
+        return "damaged", None, (f"its summary is of another record (sha256 {rec[:12]}..., "
+                                 f"the record expanded {run.record_sha256[:12]}...)")
+    if sweep.version and summ["frictiondyn_version"] != sweep.version:
+        return "damaged", None, (f"its summary is of frictiondyn "
+                                 f"{_short(summ['frictiondyn_version'])}, the sweep's "
+                                 f"{sweep.version}")
+    return "done", summ, ""
 
 
 def _flatten(prefix: str, value: Any, out: dict[str, Any]) -> None:
@@ -502,7 +1025,7 @@ def _flatten(prefix: str, value: Any, out: dict[str, Any]) -> None:
             _flatten(f"{prefix}.{k}" if prefix else k, v, out)
     elif isinstance(value, list):
         for i, v in enumerate(value, 1):
-            out[f"{prefix}[{i}]"] = v
+            out[f"{prefix}[{i}]"] = json.dumps(v) if isinstance(v, (list, dict)) else v
     else:
         out[prefix] = value
 
@@ -515,36 +1038,57 @@ class Collected:
     failed: list[Run]
     missing: list[Run]
     table: Path
+    damaged: list[Run] = field(default_factory=list)  #: a summary there but not the run's
+    notes: list[str] = field(default_factory=list)  #: what could not be written, and why
+
+
+def _read_error(path: Path) -> str | None:
+    """A failed run's message (None when the run left none), at most 64 KiB of it."""
+    try:
+        with open(path, "rb") as fh:
+            data = fh.read(1 << 16)
+    except FileNotFoundError:
+        return None
+    except OSError as exc:
+        return f"(its error.txt cannot be read: {exc.strerror})"
+    return " ".join(data.decode("utf-8", "replace").split())
 
 
 def collect(sweep: Sweep, write: bool = True) -> Collected:
     """Gather every run's status and summary into ``results.csv`` (and ``results.parquet``
-    when pyarrow is installed); report failed runs (with their message) and missing ones."""
-    rows, failed, missing = [], [], []
+    when pyarrow is installed); report failed runs (with their message), missing ones and
+    damaged ones (a summary there that is not the run's own and whole: unreadable, of the
+    wrong type, of another deck, record or version). A row holds a summary's values only
+    when its run is done; a null of a summary (an undefined quantity) is written NaN."""
+    rows, failed, missing, damaged = [], [], [], []
+    reserved = set(FIXED_COLUMNS) | set(sweep.parameters)
     for run in sweep.runs:
-        summ = _read_summary(sweep.directory / run.summary)
+        state, summ, why = _summary_state(sweep, run)
         row: dict[str, Any] = {"run": run.id}
-        if summ is not None:
+        error = None if state == "done" else _read_error(sweep.directory / run.error)
+        if state == "done":
             row["status"], row["message"] = "done", ""
-        elif (sweep.directory / run.error).exists():
-            text = (sweep.directory / run.error).read_text().strip()
-            row["status"] = "failed"
-            row["message"] = " ".join(text.split())
+        elif error is not None:
+            row["status"], row["message"] = "failed", error
             failed.append(run)
+        elif state == "damaged":
+            row["status"], row["message"] = "damaged", why
+            damaged.append(run)
         else:
             row["status"], row["message"] = "missing", ""
             missing.append(run)
         for k in sweep.parameters:
             v = run.params.get(k)
-            row[k] = json.dumps(v) if isinstance(v, list) else v
+            row[k] = json.dumps(v) if isinstance(v, (list, dict)) else v
         row["run_deck"] = run.deck
         row["deck_sha256"] = run.deck_sha256
-        row["frictiondyn_version"] = (summ or {}).get("frictiondyn_version", "")
+        row["frictiondyn_version"] = summ["frictiondyn_version"] if summ else ""
         if summ is not None:
             flat: dict[str, Any] = {}
-            skip = ("deck", "frictiondyn_version", "warnings")
+            skip = ("deck", "frictiondyn_version", "warnings", "deck_sha256")
             _flatten("", {k: v for k, v in summ.items() if k not in skip}, flat)
-            row.update(flat)
+            # a summary key named like a parameter or a fixed column keeps apart
+            row.update({(f"summary.{k}" if k in reserved else k): v for k, v in flat.items()})
             # the run's warnings (fd_warnings): how many, and their texts in one cell (empty
             # cells for a summary of an older build, which does not say)
             if "warnings" in summ:
@@ -554,21 +1098,33 @@ def collect(sweep: Sweep, write: bool = True) -> Collected:
                 row["warnings"] = row["warning_text"] = ""
         rows.append(row)
     table = sweep.directory / "results.csv"
+    notes: list[str] = []
     if write:
         columns: list[str] = []
+        seen: set[str] = set()
         for row in rows:
-            columns += [c for c in row if c not in columns]
+            for c in row:
+                if c not in seen:
+                    seen.add(c)
+                    columns.append(c)
         buf = io.StringIO()
         w = csv.DictWriter(buf, fieldnames=columns, lineterminator="\n")
         w.writeheader()
         for row in rows:
             w.writerow({k: _csv_value(v) for k, v in row.items()})
-        _write_atomic(table, buf.getvalue())
-        _write_parquet(table)
-    return Collected(rows, failed, missing, table)
+        try:
+            _write_atomic(table, buf.getvalue())
+        except OSError as exc:
+            raise SweepError(f"{table}: cannot write the table: {exc.strerror}") from None
+        note = _write_parquet(table)
+        if note:
+            notes.append(note)
+    return Collected(rows, failed, missing, table, damaged, notes)
 
 
 def _csv_value(v: Any) -> Any:
+    if v is None:  # a summary's null: a quantity the run does not define
+        return "NaN"
     if isinstance(v, float):
         return repr(v)
     if isinstance(v, bool):
@@ -576,7 +1132,9 @@ def _csv_value(v: Any) -> Any:
     return v
 
 
-def _write_parquet(table: Path) -> Path | None:
+def _write_parquet(table: Path) -> str | None:
+    """results.parquet beside the table when pyarrow is installed; a note when it cannot be
+    written (then no older results.parquet stays beside the new table)."""
     try:
         import pyarrow.csv as pacsv
         import pyarrow.parquet as pq
@@ -584,22 +1142,42 @@ def _write_parquet(table: Path) -> Path | None:
         return None
     out = table.with_suffix(".parquet")
     tmp = out.with_name(f".{out.name}.{os.getpid()}.tmp")
-    pq.write_table(pacsv.read_csv(table), tmp)
-    os.replace(tmp, out)
-    return out
+    try:
+        pq.write_table(pacsv.read_csv(table), tmp)
+        os.replace(tmp, out)
+    except Exception as exc:  # noqa: BLE001 - pyarrow raises several kinds
+        tmp.unlink(missing_ok=True)
+        out.unlink(missing_ok=True)
+        return f"{out.name} not written: {' '.join(str(exc).split())[:200]}"
+    return None
 
 
 def read_results(directory: str | os.PathLike) -> list[dict[str, str]]:
     """The rows of a sweep's results.csv, as strings."""
-    with open(Path(directory) / "results.csv", newline="") as fh:
-        return list(csv.DictReader(fh))
-
-
-def _number(text: str) -> float | None:
+    path = Path(directory) / "results.csv"
     try:
-        return float(text)
+        with open(path, newline="", encoding="utf-8", errors="replace") as fh:
+            return list(csv.DictReader(fh))
+    except FileNotFoundError:
+        raise SweepError(f"{path}: no such file (run 'sweep collect' first)") from None
+    except (OSError, csv.Error) as exc:
+        raise SweepError(f"{path}: cannot be read: {exc}") from None
+
+
+def _number(text: str | None) -> float | None:
+    """The number of a cell; None for text, an empty cell and NaN (an undefined value)."""
+    try:
+        v = float(text)  # type: ignore[arg-type]
     except (TypeError, ValueError):
         return None
+    return v if math.isfinite(v) else None
+
+
+def _no_column(col: str, columns: list[str]) -> SweepError:
+    near = difflib.get_close_matches(col, columns, n=5, cutoff=0.5)
+    hint = (f"close matches: {', '.join(near)}" if near else
+            "no close match (the header of results.csv lists them)")
+    return SweepError(f"{col!r} is not a column of results.csv; {hint}")
 
 
 def plot(
@@ -612,27 +1190,33 @@ def plot(
     """One summary quantity (``y``, a results.csv column such as ``peak_u_m[5]``) against
     one parameter (``x``), one line per value of ``by`` (default: the other varied
     parameters, together, less those zipped with ``x``, which vary with it). Writes a PNG
-    (default ``<dir>/<y>_vs_<x>.png``)."""
+    (default ``<dir>/<y>_vs_<x>.png``). A point whose x or y is not a number (NaN: a
+    quantity the run does not define) is left out."""
     from matplotlib.backends.backend_agg import FigureCanvasAgg
     from matplotlib.figure import Figure
 
     sweep = load(directory)
-    rows = [r for r in read_results(directory) if r["status"] == "done"]
+    rows = [r for r in read_results(directory) if r.get("status") == "done"]
     if not rows:
         raise SweepError(f"{directory}: no complete run to plot (run 'sweep collect' first)")
-    for col in (x, y):
+    columns = list(rows[0].keys())
+    for col in (x, y) + ((by,) if by else ()):
         if col not in rows[0]:
-            raise SweepError(f"{col!r} is not a column of results.csv; columns: "
-                             + ", ".join(rows[0].keys()))
+            raise _no_column(col, columns)
     along = sweep.zipped if x in sweep.zipped else [x]
-    others = [by] if by else [p for p in sweep.parameters if p not in along]
+    others = [by] if by else [p for p in sweep.parameters if p not in along and p in rows[0]]
     groups: dict[str, list[tuple[float, float]]] = {}
+    skipped = 0
     for r in rows:
         xv, yv = _number(r[x]), _number(r[y])
         if xv is None or yv is None:
+            skipped += 1
             continue
         label = ", ".join(f"{k} = {r.get(k, '')}" for k in others)
         groups.setdefault(label, []).append((xv, yv))
+    if not groups:
+        raise SweepError(f"{directory}: no complete run has numbers for both {x!r} and {y!r} "
+                         f"({skipped} left out: text or NaN, a quantity the run does not define)")
     fig = Figure(figsize=(7, 4.5))
     FigureCanvasAgg(fig)
     ax = fig.add_subplot()
@@ -641,7 +1225,10 @@ def plot(
         ax.plot([p[0] for p in pts], [p[1] for p in pts], marker="o", label=label or None)
     ax.set_xlabel(x)
     ax.set_ylabel(y)
-    ax.set_title(f"sweep '{sweep.name}'")
+    title = f"sweep '{sweep.name}'"
+    if skipped:
+        title += f" ({skipped} run(s) left out: {y} or {x} not a number)"
+    ax.set_title(title, fontsize="medium")
     ax.grid(True, alpha=0.3)
     if len(groups) > 1 or next(iter(groups), ""):
         ax.legend(fontsize="small")
@@ -674,6 +1261,8 @@ def _run_parser() -> argparse.ArgumentParser:
     p.add_argument("--exe", help="the frictiondyn executable (default: the installed one)")
     p.add_argument("--quiet", action="store_true", help="no progress bar")
     p.add_argument("--expand-only", action="store_true", help="write the decks, run nothing")
+    p.add_argument("--max-runs", type=int, default=MAX_RUNS, metavar="N",
+                   help=f"refuse a spec that makes more than N runs (default {MAX_RUNS:,})")
     g = p.add_argument_group("Slurm")
     g.add_argument("--slurm", action="store_true",
                    help="write a job-array script (sweep.sbatch) instead of running here")
@@ -690,12 +1279,16 @@ def _run_parser() -> argparse.ArgumentParser:
 def _report(c: Collected, sweep: Sweep) -> None:
     done = sum(1 for r in c.rows if r["status"] == "done")
     print(f"sweep '{sweep.name}': {done} of {len(sweep.runs)} runs complete, "
-          f"{len(c.failed)} failed, {len(c.missing)} missing")
+          f"{len(c.failed)} failed, {len(c.missing)} missing, {len(c.damaged)} damaged")
+    message = {r["run"]: r["message"] for r in c.rows}
     for run in c.failed:
-        msg = next(r["message"] for r in c.rows if r["run"] == run.id)
-        print(f"  failed: {run.id} (index {run.index}): {msg}")
+        print(f"  failed: {run.id} (index {run.index}): {message[run.id]}")
+    for run in c.damaged:
+        print(f"  damaged: {run.id} (index {run.index}): {message[run.id]}; it runs again")
     if c.missing:
         print(f"  missing: {array_ranges([r.index for r in c.missing])} (indices)")
+    for note in c.notes:
+        print(f"  note: {note}")
     print(f"table: {c.table}")
 
 
@@ -704,27 +1297,28 @@ def main(argv: Sequence[str]) -> int:
     if argv and argv[0] == "collect":
         p = argparse.ArgumentParser(prog="python -m frictiondyn sweep collect",
                                     description="Gather the results of a sweep; report "
-                                    "failed and missing runs; resubmit them.")
+                                    "failed, missing and damaged runs; resubmit them.")
         p.add_argument("directory")
         p.add_argument("--resubmit", action="store_true",
-                       help="write resubmit.sbatch for the failed and missing runs and sbatch it")
+                       help="write resubmit.sbatch for the failed, missing and damaged runs "
+                       "and sbatch it")
         p.add_argument("--max-parallel", type=int, default=32, metavar="M")
         p.add_argument("--exe")
         a = p.parse_args(argv[1:])
-        sweep = load(a.directory)
-        c = collect(sweep)
-        _report(c, sweep)
-        if a.resubmit:
-            todo = sorted(r.index for r in c.failed + c.missing)
-            if not todo:
-                print("nothing to resubmit")
-                return 0
-            for run in c.failed:
-                (sweep.directory / run.error).unlink(missing_ok=True)
-            script = slurm_script(sweep, todo, a.max_parallel, a.exe, name="resubmit.sbatch")
-            print(f"script: {script}")
-            print(f"submitted: job {submit(script)} ({len(todo)} tasks)")
-        return 0 if not (c.failed or c.missing) else 1
+        with (load_locked if a.resubmit else load)(a.directory) as sweep:
+            c = collect(sweep)
+            _report(c, sweep)
+            if a.resubmit:
+                todo = sorted(r.index for r in c.failed + c.missing + c.damaged)
+                if not todo:
+                    print("nothing to resubmit")
+                    return 0
+                script = slurm_script(sweep, todo, a.max_parallel, a.exe, name="resubmit.sbatch")
+                for run in c.failed:
+                    (sweep.directory / run.error).unlink(missing_ok=True)
+                print(f"script: {script}")
+                print(f"submitted: job {submit(script)} ({len(todo)} tasks)")
+        return 0 if not (c.failed or c.missing or c.damaged) else 1
     if argv and argv[0] == "plot":
         p = argparse.ArgumentParser(prog="python -m frictiondyn sweep plot",
                                     description="Plot one results.csv column against one "
@@ -738,29 +1332,36 @@ def main(argv: Sequence[str]) -> int:
         print(f"plot: {plot(a.directory, a.x, a.y, a.by, a.out)}")
         return 0
     a = _run_parser().parse_args(argv)
-    sweep = expand(a.spec, a.out)
-    pending = sweep.pending()
-    print(f"sweep '{sweep.name}': {len(sweep.runs)} runs in {sweep.directory} "
-          f"({len(sweep.runs) - len(pending)} already complete)")
-    if a.expand_only:
-        return 0
-    if a.slurm:
-        if not pending:
-            print("every run is complete")
+    if a.max_runs < 1:
+        raise SweepError(f"--max-runs {a.max_runs}: a whole number from 1 is needed")
+    if a.jobs is not None and not 1 <= a.jobs <= MAX_JOBS:
+        raise SweepError(f"-j {a.jobs}: a whole number from 1 to {MAX_JOBS} is needed")
+    if a.slurm:  # what the job script must name, checked before anything is written
+        spec_path = Path(a.spec).resolve()
+        sdir = sweep_directory(load_spec(spec_path), spec_path, a.out)
+        check_slurm_values(sdir, a.exe or executable(), a.time_limit, a.partition, a.sbatch)
+    with expand(a.spec, a.out, a.max_runs) as sweep:
+        pending = sweep.pending()
+        print(f"sweep '{sweep.name}': {len(sweep.runs)} runs in {sweep.directory} "
+              f"({len(sweep.runs) - len(pending)} already complete)")
+        if a.expand_only:
             return 0
-        script = slurm_script(sweep, None, a.max_parallel, a.exe, time_limit=a.time_limit,
-                              partition=a.partition, extra=a.sbatch)
-        print(f"script: {script}")
-        if a.submit:
-            print(f"submitted: job {submit(script)} ({len(pending)} tasks); then: "
-                  f"python -m frictiondyn sweep collect {sweep.directory}")
-        return 0
-    spec = load_spec(a.spec)
-    t0 = time.perf_counter()
-    counts = run_local(sweep, a.jobs or spec.get("jobs"), a.exe, progress=not a.quiet)
-    print(f"ran {counts['done'] + counts['failed']} run(s) in {time.perf_counter() - t0:.1f} s: "
-          f"{counts['done']} done, {counts['failed']} failed, {counts['skipped']} skipped "
-          "(complete before)")
-    c = collect(sweep)
-    _report(c, sweep)
-    return 0 if not c.failed else 1
+        if a.slurm:
+            if not pending:
+                print("every run is complete")
+                return 0
+            script = slurm_script(sweep, None, a.max_parallel, a.exe, time_limit=a.time_limit,
+                                  partition=a.partition, extra=a.sbatch)
+            print(f"script: {script}")
+            if a.submit:
+                print(f"submitted: job {submit(script)} ({len(pending)} tasks); then: "
+                      f"python -m frictiondyn sweep collect {shlex.quote(str(sweep.directory))}")
+            return 0
+        t0 = time.perf_counter()
+        counts = run_local(sweep, a.jobs or sweep.jobs, a.exe, progress=not a.quiet)
+        print(f"ran {counts['done'] + counts['failed']} run(s) in {time.perf_counter() - t0:.1f} s: "
+              f"{counts['done']} done, {counts['failed']} failed, {counts['skipped']} skipped "
+              "(complete before)")
+        c = collect(sweep)
+        _report(c, sweep)
+        return 0 if not (c.failed or c.missing or c.damaged) else 1
