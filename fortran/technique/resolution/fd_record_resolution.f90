@@ -26,7 +26,8 @@
 !> applicable: a harmonic (fd_harmonic_resolution) or no table motion, no mode of the judged
 !> system to estimate (n_modes = 0, or only the modes left out below), or the event-driven
 !> technique (no step). The Moreau-Jean technique is judged by its own recursion
-!> (theta_step_map), its Coulomb devices as hysteretic ones (no slide: the stuck system). Only the summary's modes are seen (the lowest n_modes): omega_max dt1
+!> (theta_step_map), its Coulomb devices as hysteretic ones (no slide: the stuck system).
+!> Only the summary's modes are seen (the lowest n_modes): omega_max dt1
 !> (fd_mode_resolution) covers the highest. Rigid-body modes are left out (their drift,
 !> unbounded without a0, has no step error to speak of and would swamp the others' peaks),
 !> and so are summary modes beyond omega dt1 = 2 or Newmark's stability limit
@@ -51,6 +52,21 @@ module fd_record_resolution
    !> relative change of a DOF's combined peak linear response above which the step does not
    !> resolve the record
    real(dp), parameter :: record_error_limit = 0.05_dp
+
+   !> One pass of the modes of both systems through the record: each mode a row.
+   type :: mode_pass
+      real(dp), allocatable :: ex(:, :)     !! the exact step maps (8 coefficients a row)
+      real(dp), allocatable :: nx(:, :)     !! the run's step maps (12 coefficients a row)
+      real(dp), allocatable :: z(:, :)      !! the exact (q, q') and the run's (q, q', q'' or load)
+      real(dp), allocatable :: q0(:)        !! q at the start
+      real(dp), allocatable :: ext(:, :)    !! largest and smallest q, exact and by the step
+      logical, allocatable :: kept(:)       !! the mode is estimated
+      real(dp), allocatable :: off(:)       !! per DOF, the system's equilibrium
+      real(dp), allocatable :: ku0(:)       !! K u0, the springs' alone
+      real(dp) :: h = 0.0_dp                !! dt1 [s]
+      real(dp) :: limit = 2.0_dp            !! the largest wn dt1 estimated
+      real(dp) :: p0 = 0.0_dp               !! the load at the start (-ag(0))
+   end type mode_pass
 
 contains
 
@@ -149,11 +165,9 @@ contains
       real(dp), intent(in) :: theta                       !! Moreau-Jean's theta
       type(result_type), intent(inout) :: res             !! the result of the run
       type(error_type), allocatable, intent(out) :: error !! not enough memory
-      real(dp), allocatable :: off(:), ku0(:), ex(:, :), nx(:, :), z(:, :), q0(:), ext(:, :)
-      real(dp) :: h, p0, p1, q, v, limit
-      integer :: n, stat, nm, ns, m, step, judged
-      logical :: ok, slid, some
-      logical, allocatable :: kept(:)
+      type(mode_pass) :: ps
+      integer :: n, stat, nm, ns, m, judged
+      logical :: ok, some
 
       n = model%n_dof
       res%record_resolution = resolution_none
@@ -164,25 +178,7 @@ contains
       if (res%technique /= technique_newmark .and. res%technique /= technique_moreau_jean) return
       if (res%eng%excitation /= excitation_record) return
       if (res%dt1 <= 0.0_dp .or. .not. (exc%duration > 0.0_dp)) return
-      ! the system the run was in, which the verdict judges: the stuck one when no device slid
-      ! and every device is hysteretic (a sticking spring: the run is then that linear
-      ! system); the free one when a device slid (from the start or by a transition: the
-      ! stuck system's modes, run through the whole record, overstate the error of short
-      ! stick phases; on 51 613 fuzz decks, judging it there too added 411 flags, 99 of them
-      ! wrong runs); both, the larger, when no device slid and one is a velocity-law device
-      ! (within its band a dashpot P mu / eps, neither a rigid link nor absent)
-      slid = res%started_sliding .or. any(res%stick_to_slip > 0) .or. any(res%slip_to_stick > 0) &
-             .or. any(res%reversals > 0)
-      if (model%n_devices == 0) then
-         judged = record_system_structure
-      else if (slid) then
-         judged = record_system_free
-      else if (all(model%dev(1:model%n_devices)%law == law_hysteretic .or. &
-                   model%dev(1:model%n_devices)%law == law_coulomb)) then
-         judged = record_system_stuck
-      else
-         judged = record_system_both
-      end if
+      judged = judged_system(model, res)
       ns = modes_kept(res%eng%stuck)
       nm = ns
       ! without devices the free system is the stuck one
@@ -191,69 +187,46 @@ contains
       ! the maps by mode, one row of 8 (exact) and of 12 (Newmark) coefficients per mode: the
       ! pass below runs across the modes, each coefficient contiguous; ext: each mode's
       ! largest and smallest q, exact and by Newmark; kept: the mode is estimated
-      allocate (off(n), ku0(n), ex(nm, 8), nx(nm, 12), z(nm, 5), q0(nm), ext(nm, 4), kept(nm), &
-                stat=stat)
+      allocate (ps%off(n), ps%ku0(n), ps%ex(nm, 8), ps%nx(nm, 12), ps%z(nm, 5), ps%q0(nm), ps%ext(nm, 4), &
+                ps%kept(nm), stat=stat)
       if (stat /= 0) then
          call fatal_error(error, "the step against the record: not enough memory for "// &
                           trim(fmt_int(n))//" DOFs", stat_no_memory)
          return
       end if
-      h = res%dt1
+      ps%h = res%dt1
       ! the largest wn dt1 the check integrates: mode_resolution's limit 2, and Newmark's
       ! stability limit 1 / sqrt(gamma / 2 - beta) when it is conditionally stable
-      limit = 2.0_dp
+      ps%limit = 2.0_dp
       if (res%technique == technique_newmark .and. beta < 0.5_dp*gamma) &
-         limit = min(limit, 1.0_dp/sqrt(0.5_dp*gamma - beta))
-      call springs_times(model, model%u0, ku0)
+         ps%limit = min(ps%limit, 1.0_dp/sqrt(0.5_dp*gamma - beta))
+      call springs_times(model, model%u0, ps%ku0)
       ! every mode q'' + c q' + wn^2 q = -g ag (g its participation) from the run's initial
       ! conditions, through the run's dt1 steps (fd_result's count) at the accelerations the
       ! run saw; z: the exact (q, q') and Newmark's (q, q', q'')
-      z = 0.0_dp
-      p0 = -table_acceleration(exc, 0.0_dp)
+      ps%z = 0.0_dp
+      ps%p0 = -table_acceleration(exc, 0.0_dp)
       do m = 1, nm
          if (m <= ns) then
-            call mode_start(res%eng%stuck, m, m)
+            call mode_start(ps, model, res, beta, gamma, theta, res%eng%stuck, m, m)
          else
-            call mode_start(res%eng%free, m - ns, m)
+            call mode_start(ps, model, res, beta, gamma, theta, res%eng%free, m - ns, m)
          end if
       end do
       ! no mode of the judged system to estimate: not applicable (without devices the free
       ! system's modes are the stuck one's)
       select case (judged)
       case (record_system_free)
-         some = any(kept(ns + 1:nm))
+         some = any(ps%kept(ns + 1:nm))
       case (record_system_both)
-         some = any(kept)
+         some = any(ps%kept)
       case default
-         some = any(kept(1:ns))
+         some = any(ps%kept(1:ns))
       end select
       if (.not. some) return
-      q0 = z(:, 1)
-      ext(:, 1) = q0
-      ext(:, 2) = q0
-      ext(:, 3) = q0
-      ext(:, 4) = q0
-      do step = 1, max(1, nint(exc%duration/h))
-         p1 = -table_acceleration(exc, step*h)
-         !GCC$ ivdep
-         do m = 1, nm
-            q = ex(m, 1)*z(m, 1) + ex(m, 2)*z(m, 2) + ex(m, 5)*p0 + ex(m, 7)*p1
-            z(m, 2) = ex(m, 3)*z(m, 1) + ex(m, 4)*z(m, 2) + ex(m, 6)*p0 + ex(m, 8)*p1
-            z(m, 1) = q
-            ext(m, 1) = max(ext(m, 1), q)
-            ext(m, 2) = min(ext(m, 2), q)
-            q = nx(m, 1)*z(m, 3) + nx(m, 2)*z(m, 4) + nx(m, 3)*z(m, 5) + nx(m, 10)*p1
-            v = nx(m, 4)*z(m, 3) + nx(m, 5)*z(m, 4) + nx(m, 6)*z(m, 5) + nx(m, 11)*p1
-            z(m, 5) = nx(m, 7)*z(m, 3) + nx(m, 8)*z(m, 4) + nx(m, 9)*z(m, 5) + nx(m, 12)*p1
-            z(m, 4) = v
-            z(m, 3) = q
-            ext(m, 3) = max(ext(m, 3), q)
-            ext(m, 4) = min(ext(m, 4), q)
-         end do
-         p0 = p1
-      end do
-      ok = combine(res%eng%stuck, 0, res%record_error_stuck)
-      if (ok .and. nm > ns) ok = combine(res%eng%free, ns, res%record_error_free)
+      call run_pass(ps, exc)
+      ok = combine(ps, model%u0(1:n), res%eng%stuck, 0, res%record_error_stuck)
+      if (ok .and. nm > ns) ok = combine(ps, model%u0(1:n), res%eng%free, ns, res%record_error_free)
       res%record_system = judged
       if (.not. ok) then
          res%record_error = 1.0_dp
@@ -273,69 +246,143 @@ contains
       end select
       res%record_resolution = resolution_resolved
       if (any(res%record_error > record_error_limit)) res%record_resolution = resolution_unresolved
+   end subroutine record_resolution
 
-   contains
+   !> The system the run was in, which the verdict judges: the stuck one when no device slid
+   !> and every device is hysteretic (a sticking spring: the run is then that linear
+   !> system); the free one when a device slid (from the start or by a transition: the
+   !> stuck system's modes, run through the whole record, overstate the error of short
+   !> stick phases; on 51 613 fuzz decks, judging it there too added 411 flags, 99 of them
+   !> wrong runs); both, the larger, when no device slid and one is a velocity-law device
+   !> (within its band a dashpot P mu / eps, neither a rigid link nor absent); the
+   !> structure itself without devices.
+   pure integer function judged_system(model, res) result(judged)
+      type(model_type), intent(in) :: model     !! the model
+      type(result_type), intent(in) :: res      !! the run's transitions
+      logical :: slid
 
-      !> Mode k of the system as row m of the pass: its maps (exact_step_map's phi by rows, g0,
-      !> g1; newmark_step_map's nm by rows, np), with the load scaled by its participation,
-      !> and its start. The initial conditions' modal coordinates are taken about the system's
-      !> equilibrium with its devices stuck where they start (their rest lengths the initial
-      !> ones; none for the free system): q(0) = phi' K u0 / (wn^2 phi' M phi), with K the
-      !> springs' alone, and q'(0) = phi' M v0 / phi' M phi. Left out (kept false, a zero
-      !> row): a rigid-body mode (its drift, unbounded without a0, has no step
-      !> error to speak of and would swamp the other modes' peaks), and a mode the step cannot
-      !> integrate (beyond omega dt1 = 2, which mode_resolution reports, or unstable).
-      subroutine mode_start(modes, k, m)
-         type(modes_type), intent(in) :: modes
-         integer, intent(in) :: k, m
-         real(dp) :: phi(2, 2), g0(2), g1(2), nmap(3, 3), np(3), g, mk, wn, c
+      slid = res%started_sliding .or. any(res%stick_to_slip > 0) .or. any(res%slip_to_stick > 0) &
+             .or. any(res%reversals > 0)
+      if (model%n_devices == 0) then
+         judged = record_system_structure
+      else if (slid) then
+         judged = record_system_free
+      else if (all(model%dev(1:model%n_devices)%law == law_hysteretic .or. &
+                   model%dev(1:model%n_devices)%law == law_coulomb)) then
+         judged = record_system_stuck
+      else
+         judged = record_system_both
+      end if
+   end function judged_system
 
-         ex(m, :) = 0.0_dp
-         nx(m, :) = 0.0_dp
-         wn = sqrt(max(modes%omega2(k), 0.0_dp))
-         c = mode_damping(modes, k, res%eng%a0)
-         kept(m) = wn > 0.0_dp .and. wn*h < limit
-         if (.not. kept(m)) return
-         g = mode_participation(modes, k, model%mass(1:n))
-         call exact_step_map(wn, c, h, phi, g0, g1)
-         ex(m, :) = [phi(1, 1), phi(1, 2), phi(2, 1), phi(2, 2), g*g0(1), g*g0(2), g*g1(1), g*g1(2)]
-         if (res%technique == technique_moreau_jean) then
-            call theta_step_map(wn, c, h, theta, nmap, np)
-         else
-            call newmark_step_map(wn, c, h, beta, gamma, nmap, np)
-         end if
-         nx(m, :) = [nmap(1, :), nmap(2, :), nmap(3, :), g*np]
-         mk = sum(model%mass(1:n)*modes%shape(:, k)**2)
-         z(m, 1) = sum(modes%shape(:, k)*ku0)/(wn*wn*mk)
-         z(m, 2) = sum(modes%shape(:, k)*model%mass(1:n)*model%v0(1:n))/mk
-         z(m, 3:4) = z(m, 1:2)
-         if (res%technique == technique_moreau_jean) then
-            z(m, 5) = g*p0                                ! the step's starting load
-         else
-            z(m, 5) = g*p0 - c*z(m, 2) - wn*wn*z(m, 1)    ! the acceleration
-         end if
-      end subroutine mode_start
+   !> Mode k of the system as row m of the pass: its maps (exact_step_map's phi by rows, g0,
+   !> g1; newmark_step_map's nm by rows, np), with the load scaled by its participation,
+   !> and its start. The initial conditions' modal coordinates are taken about the system's
+   !> equilibrium with its devices stuck where they start (their rest lengths the initial
+   !> ones; none for the free system): q(0) = phi' K u0 / (wn^2 phi' M phi), with K the
+   !> springs' alone, and q'(0) = phi' M v0 / phi' M phi. Left out (kept false, a zero
+   !> row): a rigid-body mode (its drift, unbounded without a0, has no step
+   !> error to speak of and would swamp the other modes' peaks), and a mode the step cannot
+   !> integrate (beyond omega dt1 = 2, which mode_resolution reports, or unstable).
+   pure subroutine mode_start(ps, model, res, beta, gamma, theta, modes, k, m)
+      type(mode_pass), intent(inout) :: ps      !! the pass (h, limit, ku0, p0 set)
+      type(model_type), intent(in) :: model     !! the model (masses, v0)
+      type(result_type), intent(in) :: res      !! the technique, the damping (res%eng%a0)
+      real(dp), intent(in) :: beta, gamma       !! Newmark's parameters
+      real(dp), intent(in) :: theta             !! Moreau-Jean's theta
+      type(modes_type), intent(in) :: modes     !! the system's modes
+      integer, intent(in) :: k, m               !! the mode, its row
+      real(dp) :: phi(2, 2), g0(2), g1(2), nmap(3, 3), np(3), g, mk, wn, c
+      integer :: n
 
-      !> The system's modes (from position first + 1 in the pass) combined DOF by DOF into err.
-      !> The run's displacement is u = off + sum_k phi_k q_k, off = u0 - sum_k phi_k q_k(0)
-      !> the system's equilibrium (and the part of u0 in the modes left out). With one mode
-      !> estimated, a DOF's peak is max |off + phi q| over the mode's largest and smallest q,
-      !> exact and by Newmark, and err the change of that peak against it (exact). With several,
-      !> the peak is estimated as |off| + the square root of the sum of squares of the modes'
-      !> peaks |phi q|, and err is that of the peaks' changes against it. .false. when not
-      !> finite.
-      logical function combine(modes, first, err) result(finite)
-         type(modes_type), intent(in) :: modes
-         integer, intent(in) :: first
-         real(dp), intent(inout) :: err(:)
-         real(dp) :: big, pe, pn, peak(n), change(n)
-         integer :: k, i, m
+      n = model%n_dof
+      ps%ex(m, :) = 0.0_dp
+      ps%nx(m, :) = 0.0_dp
+      wn = sqrt(max(modes%omega2(k), 0.0_dp))
+      c = mode_damping(modes, k, res%eng%a0)
+      ps%kept(m) = wn > 0.0_dp .and. wn*ps%h < ps%limit
+      if (.not. ps%kept(m)) return
+      g = mode_participation(modes, k, model%mass(1:n))
+      call exact_step_map(wn, c, ps%h, phi, g0, g1)
+      ps%ex(m, :) = [phi(1, 1), phi(1, 2), phi(2, 1), phi(2, 2), g*g0(1), g*g0(2), g*g1(1), g*g1(2)]
+      if (res%technique == technique_moreau_jean) then
+         call theta_step_map(wn, c, ps%h, theta, nmap, np)
+      else
+         call newmark_step_map(wn, c, ps%h, beta, gamma, nmap, np)
+      end if
+      ps%nx(m, :) = [nmap(1, :), nmap(2, :), nmap(3, :), g*np]
+      mk = sum(model%mass(1:n)*modes%shape(:, k)**2)
+      ps%z(m, 1) = sum(modes%shape(:, k)*ps%ku0)/(wn*wn*mk)
+      ps%z(m, 2) = sum(modes%shape(:, k)*model%mass(1:n)*model%v0(1:n))/mk
+      ps%z(m, 3:4) = ps%z(m, 1:2)
+      if (res%technique == technique_moreau_jean) then
+         ps%z(m, 5) = g*ps%p0                                   ! the step's starting load
+      else
+         ps%z(m, 5) = g*ps%p0 - c*ps%z(m, 2) - wn*wn*ps%z(m, 1)    ! the acceleration
+      end if
+   end subroutine mode_start
 
-         finite = .true.
-         if (modes_kept(modes) == 0) return
-         off = model%u0(1:n)
+   !> The pass through the record: every mode exactly and by the step's recursion, step by
+   !> step at the accelerations the run saw, keeping each mode's largest and smallest q.
+   subroutine run_pass(ps, exc)
+      type(mode_pass), intent(inout) :: ps      !! the pass, its modes started
+      type(excitation_type), intent(in) :: exc  !! the table motion
+      real(dp) :: p0, p1, q, v
+      integer :: m, step
+
+      ps%q0 = ps%z(:, 1)
+      ps%ext(:, 1) = ps%q0
+      ps%ext(:, 2) = ps%q0
+      ps%ext(:, 3) = ps%q0
+      ps%ext(:, 4) = ps%q0
+      p0 = ps%p0
+      associate (ex => ps%ex, nx => ps%nx, z => ps%z, ext => ps%ext)
+         do step = 1, max(1, nint(exc%duration/ps%h))
+            p1 = -table_acceleration(exc, step*ps%h)
+            !GCC$ ivdep
+            do m = 1, size(z, 1)
+               q = ex(m, 1)*z(m, 1) + ex(m, 2)*z(m, 2) + ex(m, 5)*p0 + ex(m, 7)*p1
+               z(m, 2) = ex(m, 3)*z(m, 1) + ex(m, 4)*z(m, 2) + ex(m, 6)*p0 + ex(m, 8)*p1
+               z(m, 1) = q
+               ext(m, 1) = max(ext(m, 1), q)
+               ext(m, 2) = min(ext(m, 2), q)
+               q = nx(m, 1)*z(m, 3) + nx(m, 2)*z(m, 4) + nx(m, 3)*z(m, 5) + nx(m, 10)*p1
+               v = nx(m, 4)*z(m, 3) + nx(m, 5)*z(m, 4) + nx(m, 6)*z(m, 5) + nx(m, 11)*p1
+               z(m, 5) = nx(m, 7)*z(m, 3) + nx(m, 8)*z(m, 4) + nx(m, 9)*z(m, 5) + nx(m, 12)*p1
+               z(m, 4) = v
+               z(m, 3) = q
+               ext(m, 3) = max(ext(m, 3), q)
+               ext(m, 4) = min(ext(m, 4), q)
+            end do
+            p0 = p1
+         end do
+      end associate
+   end subroutine run_pass
+
+   !> The system's modes (from position first + 1 in the pass) combined DOF by DOF into err.
+   !> The run's displacement is u = off + sum_k phi_k q_k, off = u0 - sum_k phi_k q_k(0)
+   !> the system's equilibrium (and the part of u0 in the modes left out). With one mode
+   !> estimated, a DOF's peak is max |off + phi q| over the mode's largest and smallest q,
+   !> exact and by Newmark, and err the change of that peak against it (exact). With several,
+   !> the peak is estimated as |off| + the square root of the sum of squares of the modes'
+   !> peaks |phi q|, and err is that of the peaks' changes against it. .false. when not
+   !> finite.
+   logical function combine(ps, u0, modes, first, err) result(finite)
+      type(mode_pass), intent(inout) :: ps      !! the pass, run (off is set here)
+      real(dp), intent(in) :: u0(:)             !! the initial displacements
+      type(modes_type), intent(in) :: modes     !! the system's modes
+      integer, intent(in) :: first              !! the row before its first mode
+      real(dp), intent(inout) :: err(:)         !! per DOF, the larger kept
+      real(dp) :: big, pe, pn, peak(size(u0)), change(size(u0))
+      integer :: k, i, m, n
+
+      finite = .true.
+      if (modes_kept(modes) == 0) return
+      n = size(u0)
+      associate (off => ps%off, ext => ps%ext, kept => ps%kept)
+         off = u0
          do k = 1, modes%n
-            off = off - modes%shape(:, k)*q0(first + k)
+            off = off - modes%shape(:, k)*ps%q0(first + k)
          end do
          peak = 0.0_dp
          change = 0.0_dp
@@ -362,17 +409,17 @@ contains
             peak = abs(off) + sqrt(peak)
             change = sqrt(change)
          end if
-         ! tested without an ordered comparison, which a NaN would trap in the checked build:
-         ! an estimate that failed is not a "resolved"
-         finite = all(ieee_is_finite(peak)) .and. all(ieee_is_finite(change))
-         if (.not. finite) return
-         big = maxval(peak)
-         if (.not. (big > 0.0_dp)) return
-         do i = 1, n
-            if (peak(i) >= 0.01_dp*big) err(i) = max(err(i), change(i)/peak(i))
-         end do
-      end function combine
-   end subroutine record_resolution
+      end associate
+      ! tested without an ordered comparison, which a NaN would trap in the checked build:
+      ! an estimate that failed is not a "resolved"
+      finite = all(ieee_is_finite(peak)) .and. all(ieee_is_finite(change))
+      if (.not. finite) return
+      big = maxval(peak)
+      if (.not. (big > 0.0_dp)) return
+      do i = 1, n
+         if (peak(i) >= 0.01_dp*big) err(i) = max(err(i), change(i)/peak(i))
+      end do
+   end function combine
 
    !> ku = K u, K the springs' stiffness (node 0 the table, at rest).
    pure subroutine springs_times(model, u, ku)
