@@ -686,3 +686,17 @@ def test_the_history_size_is_the_files(tmp_path):
     csv = tmp_path / "out" / "under.csv"
     header = csv.read_bytes().split(b"\n", 1)[0]
     assert csv.stat().st_size == 3495 * 12 * 25 + len(header) + 1 <= 1048576 + len(header) + 1
+
+
+def test_an_analysis_whose_history_is_beyond_the_limit_raises_a_deck_error():
+    """The Python model goes through the library's reader: the same check, before any run."""
+    import dataclasses
+
+    from frictiondyn import Output
+    from frictiondyn.paper import paper_analysis
+
+    a = paper_analysis(4, "velocity")
+    a = dataclasses.replace(a, excitation=dataclasses.replace(a.excitation, duration=2.0e5),
+                            output=Output(output_every=1))
+    with pytest.raises(DeckError, match=r"group &output: the history would take .* GiB"):
+        a.run()
