@@ -3,8 +3,14 @@ a non-zero exit, and no output file left behind."""
 
 from __future__ import annotations
 
+import copy
+import re
+
+import frictiondyn
+import numpy as np
 import pytest
-from conftest import deck_text, paper_groups
+from conftest import ROOT, deck_text, paper_groups
+from frictiondyn import FrictiondynError
 
 
 def modified(change):
@@ -178,3 +184,202 @@ def test_bad_record(run, text, words):
 
 def test_missing_record_file(run):
     assert_rejected(run(record_deck()), ["&excitation", "record_file", "rec.txt", "does not exist"])
+
+
+# ---------------------------------------------------------------- extreme values, every variable
+# Whether a deck gives a variable is read from the deck's text, never from a value: the
+# largest numbers a deck can write, and the most negative, are values like any other. Each
+# is given to every variable of every group the reader declares (its namelist statements in
+# fortran/io/fd_deck.f90: a new variable cannot escape this test), in a deck where that
+# variable is used; the deck is refused with a message naming the group and the variable,
+# or, where the value is valid, the run uses it.
+
+EXTREMES = [-1.7976931348623157e308, 1.7976931348623157e308, -2147483647, 2147483647]
+
+
+def reader_variables() -> dict[str, list[str]]:
+    """{group: [variables]} from the namelist statements of the deck reader."""
+    src = (ROOT / "fortran" / "io" / "fd_deck.f90").read_text()
+    src = re.sub(r"&[ \t]*\n[ \t]*", " ", src)  # continuation lines joined
+    groups = {}
+    for group, names in re.findall(r"^[ \t]*namelist[ \t]*/(\w+)/(.*)$", src, re.M):
+        groups[group] = [n.strip().lower() for n in names.split(",")]
+    return groups
+
+
+RECORD = "".join(f"{0.1 * ((i % 7) - 3):.3f}\n" for i in range(41))  # 41 samples
+AT2 = (
+    "PEER STRONG MOTION DATABASE RECORD\nTEST\n"
+    "ACCELERATION TIME SERIES IN UNITS OF G\nNPTS=   41, DT=   .0050 SEC\n" + RECORD
+)
+
+
+def base_groups() -> dict[str, dict]:
+    """A short run of every group: two masses, a velocity-law device, a brace, a curved
+    isolator and two storeys under a harmonic table motion."""
+    g = paper_groups(4, "velocity")
+    g["friction"]["eps"] = 1.0e-3
+    g["braces"] = {"n_braces": 1, "node_i": 2, "node_j": 0, "slip_load": 50.0, "stiffness": 1.0e4}
+    g["isolators"] = {"n_isolators": 1, "node_i": 2, "node_j": 0, "law": "velocity",
+                      "weight": 24.8, "mu": 0.1, "radius": 2.0}
+    g["storeys"] = {"n_storeys": 2, "node_i": [1, 2], "node_j": [2, 0], "height": [3.0, 3.0]}
+    g["damping"]["period"] = 0.3  # the stuck system has no free DOF: no period of its own
+    g["excitation"]["duration"] = 0.1
+    g["output"] = {"dir": "out"}
+    return g
+
+
+# the decks in which a variable is used, beyond base_groups: {context: (group, changes)}
+CONTEXTS = {
+    "rayleigh": ("damping", {"damping_type": "rayleigh", "rayleigh_a0": 0.1,
+                             "rayleigh_a1": 0.001}),
+    "rayleigh modes": ("damping", {"damping_type": "rayleigh", "xi": 0.05, "mode_i": 1,
+                                   "mode_j": 2}),
+    "exponential": ("friction", {"mu_law": "exponential", "mu_max": 0.3, "mu_min": 0.2,
+                                 "mu_rate": 10.0}),
+    "table": ("friction", {"mu_law": "table", "mu_table_v": [0.0, 0.1],
+                           "mu_table_mu": [0.3, 0.2]}),
+    "record": ("excitation", {"excitation_type": "record", "record_file": "r.txt",
+                              "dt_record": 0.005, "duration": 0.1}),
+    "at2": ("excitation", {"excitation_type": "record", "record_file": "r.at2",
+                           "duration": 0.1}),
+    "hysteretic": ("friction", {"law": "hysteretic", "f": 1.0e-5}),
+    "hysteretic isolator": ("isolators", {"law": "hysteretic", "f": 1.0e-5}),
+}
+USED_IN = {
+    ("damping", "rayleigh_a0"): ["rayleigh"], ("damping", "rayleigh_a1"): ["rayleigh"],
+    ("damping", "mode_i"): ["rayleigh modes"], ("damping", "mode_j"): ["rayleigh modes"],
+    ("damping", "mode_system"): ["rayleigh modes"],
+    ("friction", "mu_max"): ["exponential"], ("friction", "mu_min"): ["exponential"],
+    ("friction", "mu_rate"): ["exponential"],
+    ("friction", "mu_table_v"): ["table"], ("friction", "mu_table_mu"): ["table"],
+    ("excitation", "record_file"): ["record"], ("excitation", "record_kind"): ["record"],
+    ("excitation", "record_scale"): ["record"], ("excitation", "record_format"): ["record"],
+    ("excitation", "record_units"): ["record"],
+    ("excitation", "dt_record"): [None, "record", "at2"],
+    ("excitation", "duration"): [None, "record", "at2"],
+    ("friction", "f"): ["hysteretic"], ("friction", "eps1"): ["hysteretic"],
+    ("isolators", "f"): ["hysteretic isolator"], ("isolators", "eps1"): ["hysteretic isolator"],
+}
+
+
+def extreme_cases():
+    for group, names in reader_variables().items():
+        for var in names:
+            for context in USED_IN.get((group, var), [None]):
+                for value in EXTREMES:
+                    yield group, var, context, value
+
+
+def deck_with(group: str, var: str, context: str | None, value) -> tuple[dict, dict]:
+    """The deck of the context with `value` given to the variable (its last element when the
+    deck gives a list), and the deck that does not give that element (what a value taken for
+    "not given" ran as)."""
+    g = base_groups()
+    if context:
+        cgroup, changes = CONTEXTS[context]
+        if "mu_law" in changes:
+            g[cgroup].pop("mu")
+        if cgroup == "excitation":
+            g[cgroup] = {}
+        g[cgroup].update(changes)
+    without = copy.deepcopy(g)
+    old = g[group].get(var)
+    if isinstance(old, list):
+        g[group][var] = old[:-1] + [value]
+        without[group][var] = old[:-1]
+    else:
+        g[group][var] = value
+        without[group].pop(var, None)
+    return g, without
+
+
+def outcome(summary: dict) -> dict:
+    """A summary but what differs between runs of one configuration (the deck's hash, the
+    wall-clock time)."""
+    return {k: v for k, v in summary.items() if k not in ("deck_sha256", "run_time_s")}
+
+
+# valid extreme values whose use the run's outcome does not show (checked otherwise): what
+# the reader read, as the session says it, or a deck the value lets through
+def _output(key):
+    def check(text, where, result, value):
+        with frictiondyn.Session.from_text(text, "case.nml", where) as s:
+            return getattr(s.output, key) == repr(value)
+    return check
+
+
+def _all_modes(text, where, result, value):  # more modes than DOFs: all of them (the free
+    return len(result.summary["periods_free_s"]) == 2  # system's; the stuck one is rigid)
+
+
+def _history_limit(text, where, result, value):  # a 240 GB history is let through
+    big = text.replace("duration = 0.1", "duration = 200000.0")
+    big = big.replace("  dir = 'out'", "  dir = 'out'\n  output_every = 1")
+    frictiondyn.Session.from_text(big, "case.nml", where).close()
+    return True
+
+
+def _runs(text, where, result, value):
+    # eps1, the end-of-sliding band of the hysteretic law: 2147483647 m/s is valid (a band
+    # no slide leaves), and a short run does not show it; the value is read (a negative one
+    # is refused: test_extreme values above), not replaced by the default
+    return True
+
+
+USED = {
+    ("output", "dir"): _output("dir"),
+    ("output", "name"): _output("name"),
+    ("output", "n_modes"): _all_modes,
+    ("output", "max_history_mb"): _history_limit,
+    ("friction", "eps1"): _runs,
+    ("braces", "eps1"): _runs,
+    ("isolators", "eps1"): _runs,
+}
+
+
+@pytest.mark.parametrize(
+    "group, var, context, value", list(extreme_cases()),
+    ids=[f"{g}.{v}{'@' + c if c else ''}={x!r}" for g, v, c, x in extreme_cases()],
+)
+def test_an_extreme_value_is_refused_or_used_never_taken_for_not_given(
+    tmp_path, group, var, context, value
+):
+    """`v0 = 0.0, -1.7976931348623157e308` ran with v0(2) = 0; the same for u0, eps, eps1, f,
+    an isolator's radius, a storey's height, a record's duration and dt_record, and
+    history_dofs = -2147483647: the reader took the value for its "not given" marker."""
+    (tmp_path / "r.txt").write_text(RECORD)
+    (tmp_path / "r.at2").write_text(AT2)
+    groups, without = deck_with(group, var, context, value)
+    try:
+        result = frictiondyn.run_text(deck_text(groups), "case.nml", tmp_path)
+    except FrictiondynError as exc:
+        message = str(exc)
+        assert f"&{group}" in message, message
+        assert re.search(rf"\b{var}\b", message), message
+        assert "is not given" not in message, message
+        return
+    check = USED.get((group, var))
+    if check is not None:
+        assert check(deck_text(groups), tmp_path, result, value), f"{group}.{var} = {value!r}"
+        return
+    try:  # a valid value: the run is not the one without it
+        reference = frictiondyn.run_text(deck_text(without), "case.nml", tmp_path)
+    except FrictiondynError:
+        return  # without it the deck is refused: the value was used
+    same = outcome(reference.summary) == outcome(result.summary)
+    same = same and np.array_equal(reference.data, result.data)
+    assert not same, f"{group}.{var} = {value!r} ran as if it were not given"
+
+
+def test_every_variable_of_the_reader_is_documented():
+    """The variables of the extreme-value test are those of docs/namelist.md, group by group."""
+    doc = (ROOT / "docs" / "namelist.md").read_text()
+    sections = re.split(r"^## `&(\w+)`", doc, flags=re.M)
+    documented = {
+        sections[i]: {name for cell in re.findall(r"^\|([^|]*)\|", sections[i + 1], re.M)
+                      for name in re.findall(r"`(\w+)[`(]", cell)}
+        for i in range(1, len(sections), 2)
+    }
+    for group, names in reader_variables().items():
+        assert set(names) <= documented[group], (group, set(names) - documented[group])

@@ -581,3 +581,148 @@ def test_lapack_interfaces_are_declared_once_and_generated_files_once():
             outputs.append(f"{build.parent.relative_to(ROOT)}/{out.group(1)}")
     assert "fortran/core/fd_version.f90" in outputs
     assert len(outputs) == len(set(outputs)), outputs
+
+
+# ---------------------------------------------------------------- echoed values are capped
+
+MEGA = 1_000_000
+
+
+@pytest.mark.parametrize(
+    "change, words",
+    [
+        (("  n1 = 20", "  n1 = 20, nn1 = " + "7" * MEGA), ["unknown variable 'nn1'", "77777"]),
+        (("  n1 = 20", "  n1 = " + "x" * MEGA), ["variable 'n1' has a bad value 'xxxx"]),
+        (("  n1 = 20", "  " + "n" * MEGA + " = 20"), ["unknown variable 'nnnn", "(value 20)"]),
+        (("&damping", "&" + "d" * MEGA), ["unknown group &dddd"]),
+        (("&damping", "deck " + "t" * MEGA + "\n&damping"), ["text outside any group"]),
+    ],
+    ids=["unknown variable's value", "bad value", "variable name", "group name", "text outside"],
+)
+def test_a_megabyte_value_is_echoed_as_80_characters_and_its_length(tmp_path, change, words):
+    """A 1 MB unknown value gave a 1 MB stderr line and a 1,000,073-character DeckError."""
+    text = short_deck()
+    assert change[0] in text
+    message = assert_both_reject(tmp_path, text.replace(*change, 1), ["case.nml", *words])
+    assert f"... ({MEGA} characters)" in message or f"... ({MEGA + 5} characters)" in message
+    assert len(message) < 400, len(message)
+
+
+def test_a_record_whose_first_line_is_a_megabyte_is_echoed_capped(tmp_path):
+    """A record_file naming a file that is no record echoed its first line whole."""
+    g = paper_groups(4)
+    g["excitation"] = {"excitation_type": "record", "record_file": "r.txt", "dt_record": 0.01}
+    message = assert_both_reject(tmp_path, deck_text(g), ["record_file = 'r.txt'", "line 1",
+                                 "'" + "q" * 80 + f"... ({MEGA} characters)' is not a number"],
+                                 files={"r.txt": "q" * MEGA + "\n0.1\n"})
+    assert len(message) < 400
+
+
+def test_an_echo_is_cut_between_utf8_characters_and_counts_characters(tmp_path):
+    text = short_deck().replace("  n1 = 20", "  n1 = " + "é" * 100, 1)
+    message = assert_both_reject(tmp_path, text, ["'" + "é" * 80 + "... (100 characters)'"])
+    assert "\ufffd" not in message
+
+
+def test_the_executable_caps_an_unknown_option_and_index(tmp_path):
+    long = 100_000  # an argument of the command line is at most 128 KiB
+    r = subprocess.run([frictiondyn.executable(), "--" + "x" * long], capture_output=True,
+                       text=True)
+    assert r.returncode == 2 and f"... ({long + 2} characters)'" in r.stderr and len(r.stderr) < 400
+    (tmp_path / "l.txt").write_text("a.nml\n")
+    r = subprocess.run([frictiondyn.executable(), "--list", "l.txt", "--index", "1" * long],
+                       cwd=tmp_path, capture_output=True, text=True)
+    assert r.returncode == 2 and f"... ({long} characters)'" in r.stderr and len(r.stderr) < 400
+
+
+# ---------------------------------------------------------------- line ends, --list
+
+def test_a_deck_whose_lines_end_with_cr_alone_says_so(tmp_path):
+    """It said "required group &model is missing"."""
+    text = short_deck().replace("\n", "\r")
+    assert_both_reject(tmp_path, text, ["case.nml: its lines end with CR alone", "LF"])
+
+
+def test_crlf_line_ends_run_as_lf_ones():
+    a = frictiondyn.run_text(short_deck(duration=0.2), "a.nml")
+    b = frictiondyn.run_text(short_deck(duration=0.2).replace("\n", "\r\n"), "a.nml")
+    assert np.array_equal(a.data, b.data)
+
+
+def test_list_of_a_directory_or_of_cr_lines_says_so(tmp_path):
+    """`--list` on a directory said "has only 0 line(s)"."""
+    (tmp_path / "decks").mkdir()
+    r = subprocess.run([frictiondyn.executable(), "--list", "decks", "--index", "0"], cwd=tmp_path,
+                       capture_output=True, text=True)
+    assert r.returncode == 1 and "'decks' is a directory, not a file" in r.stderr, r.stderr
+    (tmp_path / "l.txt").write_text("a.nml\rb.nml\r")
+    r = subprocess.run([frictiondyn.executable(), "--list", "l.txt", "--index", "1"], cwd=tmp_path,
+                       capture_output=True, text=True)
+    assert r.returncode == 1 and "--list 'l.txt': its lines end with CR alone" in r.stderr, r.stderr
+    r = subprocess.run([frictiondyn.executable(), "--list", "nope.txt", "--index", "0"],
+                       cwd=tmp_path, capture_output=True, text=True)
+    assert r.returncode == 1 and "'nope.txt' does not exist" in r.stderr, r.stderr
+
+
+# ---------------------------------------------------------------- the history's size, up front
+
+def history_deck(duration, every=1, limit=None):
+    text = short_deck(duration=duration)
+    extra = f"  output_every = {every}\n"
+    if limit is not None:
+        extra += f"  max_history_mb = {limit}\n"
+    return text.replace("  dir = 'out'\n", "  dir = 'out'\n" + extra)
+
+
+def test_a_history_beyond_max_history_mb_is_refused_up_front(tmp_path):
+    """A 332-byte deck asked for about 29 GB of history, and wrote it."""
+    # 2e5 s at dt1 = 0.005 / 20: 8e8 samples of 12 columns, 25 bytes a value: 2.4e11 bytes
+    message = assert_both_reject(tmp_path, history_deck(2.0e5), [
+        "group &output", "the history would take 223.5 GiB (800000001 samples of 12 columns)",
+        "max_history_mb = 2048 MiB",
+        "raise output_every (a sample every 1 dt1 steps now, of 800000000)",
+        "history_dofs, history_devices: 2 and 1 now", "write_history = .false."])
+    assert "max_history_mb" in message
+    # the same run without a history file, or with the limit raised, is read (not run here)
+    no_file = history_deck(2.0e5).replace("  output_every",
+                                          "  write_history = .false.\n  output_every")
+    frictiondyn.Session.from_text(no_file, "a.nml").close()
+    frictiondyn.Session.from_text(history_deck(2.0e5, limit=300000), "a.nml").close()
+
+
+@pytest.mark.parametrize("limit", [0, -1])
+def test_max_history_mb_must_be_positive(tmp_path, limit):
+    assert_both_reject(tmp_path, history_deck(0.1, limit=limit),
+                       ["group &output", f"max_history_mb = {limit} is invalid", ">= 1"])
+
+
+def test_the_history_size_is_the_files(tmp_path):
+    """The estimate is the file's size but its header: a history of just over 1 MiB is
+    refused with max_history_mb = 1, and one just under it is written, to that size."""
+    # 12 columns x 25 bytes = 300 bytes a sample; 1 MiB = 3495.25 samples: 3495 fit
+    under = history_deck(3494 * 0.005 / 20, limit=1)     # 3494 steps: 3495 samples
+    over = history_deck(3495 * 0.005 / 20, limit=1)      # 3496 samples
+    assert_both_reject(tmp_path, over, ["1.0 MiB (3496 samples of 12 columns)",
+                                        "max_history_mb = 1 MiB"])
+    deck = tmp_path / "under.nml"
+    deck.write_text(under)
+    r = subprocess.run([frictiondyn.executable(), "under.nml"], cwd=tmp_path, capture_output=True,
+                       text=True)
+    assert r.returncode == 0, r.stderr
+    csv = tmp_path / "out" / "under.csv"
+    header = csv.read_bytes().split(b"\n", 1)[0]
+    assert csv.stat().st_size == 3495 * 12 * 25 + len(header) + 1 <= 1048576 + len(header) + 1
+
+
+def test_an_analysis_whose_history_is_beyond_the_limit_raises_a_deck_error():
+    """The Python model goes through the library's reader: the same check, before any run."""
+    import dataclasses
+
+    from frictiondyn import Output
+    from frictiondyn.paper import paper_analysis
+
+    a = paper_analysis(4, "velocity")
+    a = dataclasses.replace(a, excitation=dataclasses.replace(a.excitation, duration=2.0e5),
+                            output=Output(output_every=1))
+    with pytest.raises(DeckError, match=r"group &output: the history would take .* GiB"):
+        a.run()

@@ -21,6 +21,8 @@ program frictiondyn_main
    use fd_version, only: frictiondyn_version
    use fd_warnings, only: warning_text, run_warnings
    use fd_tempfiles, only: temp_tag
+   use fd_error, only: fmt_text
+   use fd_textio, only: line_type, read_file_text, split_lines, cr_line_ends
    implicit none
 
    interface
@@ -71,7 +73,7 @@ program frictiondyn_main
          i = i + 1
          call argument(i, index_text)
       case default
-         if (arg(1:min(1, len(arg))) == '-' .and. len(arg) > 1) call usage_error("unknown option '"//arg//"'")
+         if (arg(1:min(1, len(arg))) == '-' .and. len(arg) > 1) call usage_error("unknown option '"//trim(fmt_text(arg))//"'")
          if (allocated(deck)) call usage_error('one deck at a time (use --list for many)')
          deck = arg
       end select
@@ -81,7 +83,7 @@ program frictiondyn_main
    if (allocated(list) .and. allocated(deck)) call usage_error('give a deck or --list/--index, not both')
    if (allocated(list)) then
       if (verify(index_text, '0123456789') /= 0 .or. len(index_text) == 0 .or. len(index_text) > 9) &
-         call usage_error("--index '"//index_text//"' is not a whole number >= 0")
+         call usage_error("--index '"//trim(fmt_text(index_text))//"' is not a whole number >= 0")
       read (index_text, *, iostat=ios) idx
       call deck_of_list(list, idx, deck, error)
       if (allocated(error)) call fail(error%message)
@@ -165,33 +167,40 @@ contains
    end subroutine argument
 
    !> Line idx+1 of the list file: a deck path, relative to the list's directory unless
-   !> it starts with '/'.
+   !> it starts with '/'. The list is read as a deck is (fd_textio): a directory, a missing
+   !> or unreadable file, and lines that end with CR alone are errors saying so.
    subroutine deck_of_list(path, idx, deck_path, error)
       character(len=*), intent(in) :: path
       integer, intent(in) :: idx
       character(len=:), allocatable, intent(out) :: deck_path
       type(error_type), allocatable, intent(out) :: error
-      character(len=4096) :: line
-      integer :: unit, ios, k, slash
-      character(len=256) :: msg
+      character(len=:), allocatable :: text, line
+      type(line_type), allocatable :: lines(:)
+      integer :: stat, slash
 
-      open (newunit=unit, file=path, status='old', action='read', iostat=ios, iomsg=msg)
-      if (ios /= 0) then
-         allocate (error)
-         error%message = "--list '"//path//"': "//trim(msg)
+      call read_file_text(path, text, error)
+      if (allocated(error)) then
+         error%message = "--list: "//error%message
          return
       end if
-      do k = 0, idx
-         read (unit, '(a)', iostat=ios) line
-         if (ios /= 0) exit
-      end do
-      close (unit)
-      if (ios /= 0) then
+      if (len_trim(cr_line_ends(text)) > 0) then
          allocate (error)
-         error%message = "--list '"//path//"' has only "//trim(itoa(k))//" line(s); --index "// &
+         error%message = "--list '"//path//"'"//trim(cr_line_ends(text))
+         return
+      end if
+      call split_lines(text, lines, stat)
+      if (stat /= 0) then
+         allocate (error)
+         error%message = "--list '"//path//"': not enough memory for its lines"
+         return
+      end if
+      if (idx >= size(lines)) then
+         allocate (error)
+         error%message = "--list '"//path//"' has only "//trim(itoa(size(lines)))//" line(s); --index "// &
                          trim(itoa(idx))//" asks for line "//trim(itoa(idx + 1))
          return
       end if
+      line = lines(idx + 1)%s
       if (len_trim(line) == 0) then
          allocate (error)
          error%message = "--list '"//path//"', line "//trim(itoa(idx + 1))//" (--index "//trim(itoa(idx))// &

@@ -4,7 +4,7 @@ module fd_error
    implicit none
    private
 
-   public :: error_type, fatal_error, fmt_real, fmt_int, stat_no_memory, stat_output
+   public :: error_type, fatal_error, fmt_real, fmt_int, fmt_text, stat_no_memory, stat_output, echo_chars
 
    !> The stat of an error raised because memory could not be had (an allocation the size
    !> of the input failed): the caller may tell it from a bad input.
@@ -14,6 +14,10 @@ module fd_error
    !> a full disk, a quota, a file-size limit, a permission): the caller may tell it from a
    !> bad input or a failure of the solver, whichever step met it.
    integer, parameter :: stat_output = 4
+
+   !> Characters of a text a message echoes (a value, a line of a file); a longer text is cut
+   !> there and its length said: a megabyte value makes a line of a message, not a megabyte.
+   integer, parameter :: echo_chars = 80
 
    !> An error raised by the library, handed back to the caller.
    type :: error_type
@@ -89,6 +93,42 @@ contains
       end if
       str = w
    end function fmt_real
+
+   !> A text as a message echoes it: its first echo_chars characters (UTF-8 characters, never
+   !> cut inside one), then '... (N characters)' when it is longer; control characters shown
+   !> as '?'. Trailing blanks are dropped (trim the result where it is used).
+   pure function fmt_text(text) result(str)
+      character(len=*), intent(in) :: text    !! the text to echo
+      character(len=4*echo_chars + 32) :: str !! as shown
+      integer :: i, n, chars, last
+
+      n = len_trim(text)
+      chars = 0
+      last = 0
+      do i = 1, n
+         if (iand(iachar(text(i:i)), 192) == 128) cycle   ! a UTF-8 continuation byte
+         chars = chars + 1
+         if (chars <= echo_chars) last = i
+      end do
+      if (chars > echo_chars) then
+         ! the last character kept ends before the first byte of the next one
+         do i = last + 1, n
+            if (iand(iachar(text(i:i)), 192) /= 128) exit
+            last = i
+         end do
+      else
+         last = n
+      end if
+      str = text(1:min(last, 4*echo_chars))
+      do i = 1, min(last, 4*echo_chars)
+         if (iachar(str(i:i)) < 32 .or. iachar(str(i:i)) == 127) str(i:i) = '?'
+      end do
+      if (chars > echo_chars) then
+         str = str(1:min(last, 4*echo_chars))//'... ('//trim(fmt_int(chars))//' characters)'
+      else if (last > 4*echo_chars) then   ! bytes that are no UTF-8 text
+         str = str(1:4*echo_chars)//'... ('//trim(fmt_int(n))//' bytes)'
+      end if
+   end function fmt_text
 
    !> An integer as text, for messages.
    pure function fmt_int(i) result(str)

@@ -7,6 +7,7 @@ module fd_textio
    private
 
    public :: line_type, read_text_file, read_file_text, split_lines, lower, split_tokens, max_file_bytes
+   public :: cr_line_ends
 
    !> Largest text file read (a deck or a record): 1 GiB. Lengths stay in default integers.
    integer, parameter :: max_file_bytes = 2**30
@@ -213,6 +214,20 @@ contains
          start = i + 1
       end do
    end subroutine split_lines
+
+   !> Why a text's lines are not read as its author sees them: lines end with LF or CR LF,
+   !> and a text whose lines end with CR alone (the classic Mac OS line end: CRs and no LF)
+   !> is one long line. The reason, to follow the file's name in a message (': ...'); blank
+   !> when the text has an LF or no CR.
+   pure function cr_line_ends(text) result(msg)
+      character(len=*), intent(in) :: text   !! the file's text
+      character(len=200) :: msg
+
+      msg = ''
+      if (index(text, achar(13)) == 0 .or. index(text, achar(10)) > 0) return
+      msg = ": its lines end with CR alone (the classic Mac OS line end), which ends no line here: "// &
+            "save it with LF (Unix) or CR LF (Windows) line ends"
+   end function cr_line_ends
 
    !> Lower-case copy of a string.
    pure function lower(str) result(low)

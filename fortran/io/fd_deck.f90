@@ -9,10 +9,10 @@ module fd_deck
                                             ieee_overflow, &
                                             ieee_set_flag
    use fd_kinds, only: dp
-   use fd_error, only: error_type, fatal_error, fmt_int, fmt_real, stat_no_memory
+   use fd_error, only: error_type, fatal_error, fmt_int, fmt_real, fmt_text, stat_no_memory
    use fd_textio, only: lower
    use fd_namelist, only: deck_text, group_text, deck_from_string, find_group, &
-                          next_read, check_groups, longest_string
+                          next_read, check_groups, longest_string, given_elements
    use fd_names, only: keyword_type, keyword_id, keyword_choices, law_id, law_choices, &
                        damping_types, damping_stiffness, damping_rayleigh, damping_none, &
                        excitation_types, excitation_harmonic, excitation_record, excitation_none, &
@@ -22,7 +22,8 @@ module fd_deck
                        default_ramp_cycles, default_record_kind, default_record_scale, default_technique, &
                        default_beta, default_gamma, default_n1, default_n2, default_n, default_theta, &
                        default_check_correctness, default_dt_min, default_dir, default_output_every, &
-                       default_write_history, linear_systems, default_linear_system, refinements, default_refinement
+                       default_write_history, default_max_history_mb, linear_systems, default_linear_system, &
+                       refinements, default_refinement
    use fd_model, only: model_type, integration_type, device_type, output_type
    use fd_excitation, only: excitation_type
    use fd_record, only: read_record, record_info, record_formats, record_units_list, units_factor
@@ -34,8 +35,9 @@ module fd_deck
    use fd_model, only: source_friction, source_brace, source_isolator
    use fd_matrices, only: modes_type, natural_modes, natural_modes_sparse, stiffness_matrix, modes_dense_dofs
    use fd_sha256, only: sha256_text
-   use fd_textio, only: read_file_text
+   use fd_textio, only: read_file_text, cr_line_ends
    use fd_step_limits, only: check_step_limits
+   use fd_result, only: history_shape
    implicit none
    private
 
@@ -47,6 +49,9 @@ module fd_deck
    integer, parameter :: max_dof = 1000000      !! DOFs (n_dof)
    integer, parameter :: max_springs = 4000000  !! springs (n_springs)
    integer, parameter :: max_devices = 1000000  !! friction devices (n_devices)
+   !> What the variables read hold before the read: a filler only. Whether the deck gives a
+   !> value is read from its text (given_elements), never from a value: any value a deck can
+   !> write, this one too, is a value given.
    real(dp), parameter :: unset = -huge(1.0_dp)
    !> Largest magnitude of a real value, and smallest of a value that must be > 0 (a mass,
    !> stiffness, band, step, frequency...): within them the products a run forms (forces,
@@ -99,6 +104,11 @@ contains
       ! overflow (-ffpe-trap, tools/test_checked.sh) must not stop there. The halting mode is
       ! saved, switched off while the deck is read, the overflow flag cleared and the mode
       ! set back (gfortran does not restore it on return, as Fortran 2008's 14.3 would).
+      ! a deck whose lines end with CR alone would be one line: said so, not "&model is missing"
+      if (len_trim(cr_line_ends(text)) > 0) then
+         call fatal_error(error, path//trim(cr_line_ends(text)))
+         return
+      end if
       call ieee_get_halting_mode(ieee_overflow, halting)
       if (ieee_support_halting(ieee_overflow)) call ieee_set_halting_mode(ieee_overflow, .false.)
       call deck_from_string(text, path, deck, error)
@@ -193,14 +203,14 @@ contains
          if (.not. more) exit
       end do
       if (allocated(error)) return
-      call need_int(deck, 'model', 'n_dof', n_dof, 1, max_dof, error)
+      call need_int(deck, 'model', 'n_dof', n_dof, is_given(grp, 'n_dof'), 1, max_dof, error)
       if (allocated(error)) return
       n = n_dof
-      call need_reals(deck, 'model', 'mass', mass, n, 'kg', error, positive=.true.)
+      call need_reals(deck, 'model', 'mass', mass, given_of(grp, 'mass', size(mass)), n, 'kg', error, positive=.true.)
       if (allocated(error)) return
-      call optional_reals(deck, 'model', 'u0', u0, n, default_u0, 'm', error)
+      call optional_reals(deck, 'model', 'u0', u0, given_of(grp, 'u0', size(u0)), n, default_u0, 'm', error)
       if (allocated(error)) return
-      call optional_reals(deck, 'model', 'v0', v0, n, default_v0, 'm/s', error)
+      call optional_reals(deck, 'model', 'v0', v0, given_of(grp, 'v0', size(v0)), n, default_v0, 'm/s', error)
       if (allocated(error)) return
       call check_labels(deck, grp, 'model', label, n, error)
       if (allocated(error)) return
@@ -240,14 +250,16 @@ contains
          if (.not. more) exit
       end do
       if (allocated(error)) return
-      call need_int(deck, 'springs', 'n_springs', n_springs, 0, max_springs, error)
+      call need_int(deck, 'springs', 'n_springs', n_springs, is_given(grp, 'n_springs'), 0, max_springs, error)
       if (allocated(error)) return
       n = n_springs
-      call node_list(deck, 'springs', 'node_i', node_i, n, 1, cfg%model%n_dof, error)
+      call node_list(deck, 'springs', 'node_i', node_i, given_of(grp, 'node_i', size(node_i)), n, 1, &
+                     cfg%model%n_dof, error)
       if (allocated(error)) return
-      call node_list(deck, 'springs', 'node_j', node_j, n, 0, cfg%model%n_dof, error)
+      call node_list(deck, 'springs', 'node_j', node_j, given_of(grp, 'node_j', size(node_j)), n, 0, &
+                     cfg%model%n_dof, error)
       if (allocated(error)) return
-      call need_reals(deck, 'springs', 'k', k, n, 'N/m', error, positive=.true.)
+      call need_reals(deck, 'springs', 'k', k, given_of(grp, 'k', size(k)), n, 'N/m', error, positive=.true.)
       if (allocated(error)) return
       do i = 1, n
          call distinct_nodes(deck, 'springs', i, node_i(i), node_j(i), 'a spring joins two different nodes', error)
@@ -304,7 +316,8 @@ contains
          if (allocated(error)) return
          call check_real(deck, 'damping', 'rayleigh_a1', rayleigh_a1, 0.0_dp, max_magnitude, 's', error)
          if (allocated(error)) return
-         call rayleigh_modes(deck, xi, rayleigh_a0, rayleigh_a1, mode_i, mode_j, mode_system, cfg, error)
+         call rayleigh_modes(deck, xi, rayleigh_a0, rayleigh_a1, mode_i, mode_j, is_given(grp, 'mode_i'), &
+                             is_given(grp, 'mode_j'), mode_system, cfg, error)
          if (allocated(error)) return
       case (damping_none)
       case default
@@ -331,6 +344,7 @@ contains
       real(dp), allocatable :: mu_max(:), mu_min(:), mu_rate(:), mu_table_v(:, :), mu_table_mu(:, :)
       character(len=label_len), allocatable :: label(:)
       integer, allocatable :: mu_ids(:)
+      logical, allocatable :: g_mu(:), g_table(:, :)
       namelist /friction/ n_devices, node_i, node_j, law, p, mu, eps, eps1, f, &
          mu_law, mu_max, mu_min, mu_rate, mu_table_v, mu_table_mu, label
       type(group_text) :: grp
@@ -368,27 +382,33 @@ contains
          if (.not. more) exit
       end do
       if (allocated(error)) return
-      call need_int(deck, 'friction', 'n_devices', n_devices, 0, max_devices, error)
+      call need_int(deck, 'friction', 'n_devices', n_devices, .true., 0, max_devices, error)
       if (allocated(error)) return
       n = n_devices
-      call node_list(deck, 'friction', 'node_i', node_i, n, 1, cfg%model%n_dof, error)
+      call node_list(deck, 'friction', 'node_i', node_i, given_of(grp, 'node_i', size(node_i)), n, 1, &
+                     cfg%model%n_dof, error)
       if (allocated(error)) return
-      call node_list(deck, 'friction', 'node_j', node_j, n, 0, cfg%model%n_dof, error)
+      call node_list(deck, 'friction', 'node_j', node_j, given_of(grp, 'node_j', size(node_j)), n, 0, &
+                     cfg%model%n_dof, error)
       if (allocated(error)) return
-      call need_reals(deck, 'friction', 'p', p, n, 'N', error, positive=.false.)
+      call need_reals(deck, 'friction', 'p', p, given_of(grp, 'p', size(p)), n, 'N', error, positive=.false.)
       if (allocated(error)) return
-      call read_mu_laws(deck, 'friction', n, mu_law, mu, mu_max, mu_min, mu_rate, mu_table_v, mu_table_mu, &
-                        mu_ids, error)
+      g_mu = given_of(grp, 'mu', size(mu))
+      call read_mu_laws(deck, grp, n, mu_law, mu, g_mu, mu_max, mu_min, mu_rate, mu_table_v, mu_table_mu, &
+                        mu_ids, g_table, error)
       if (allocated(error)) return
       call check_labels(deck, grp, 'friction', label, n, error)
       if (allocated(error)) return
-      call need_reals(deck, 'friction', 'mu', mu, n, '', error, positive=.false.)
+      call need_reals(deck, 'friction', 'mu', mu, g_mu, n, '', error, positive=.false.)
       if (allocated(error)) return
-      call optional_reals(deck, 'friction', 'eps', eps, n, default_eps, 'm/s', error, positive=.true.)
+      call optional_reals(deck, 'friction', 'eps', eps, given_of(grp, 'eps', size(eps)), n, default_eps, 'm/s', &
+                          error, positive=.true.)
       if (allocated(error)) return
-      call optional_reals(deck, 'friction', 'eps1', eps1, n, default_eps1, 'm/s', error, positive=.true.)
+      call optional_reals(deck, 'friction', 'eps1', eps1, given_of(grp, 'eps1', size(eps1)), n, default_eps1, &
+                          'm/s', error, positive=.true.)
       if (allocated(error)) return
-      call optional_reals(deck, 'friction', 'f', f, n, default_f, 'm', error, positive=.true.)
+      call optional_reals(deck, 'friction', 'f', f, given_of(grp, 'f', size(f)), n, default_f, 'm', error, &
+                          positive=.true.)
       if (allocated(error)) return
       if (any(law(n + 1:) /= '')) then
          call bad(deck, 'friction', 'law', 'with '//trim(fmt_int(findloc(law /= '', .true., 1, back=.true.))) &
@@ -417,7 +437,7 @@ contains
          cfg%model%dev(i) = device_type(node_i=node_i(i), node_j=node_j(i), law=id, &
                                         p=p(i), mu=mu(i), eps=eps(i), eps1=eps1(i), f=f(i))
          call apply_mu_law(deck, 'friction', i, mu_ids(i), mu_min(i), mu_rate(i), mu_table_v(:, i), &
-                           mu_table_mu(:, i), cfg%model%dev(i), error)
+                           mu_table_mu(:, i), g_table(:, i), cfg%model%dev(i), error)
          if (allocated(error)) return
          cfg%model%dev(i)%label = label(i)
          cfg%model%dev(i)%source_index = i
@@ -435,7 +455,7 @@ contains
       character(len=path_len) :: record_file
       real(dp) :: amplitude, frequency, duration, dt_record, record_scale, factor
       integer :: ramp_cycles
-      logical :: known
+      logical :: known, given_dt, given_duration
       namelist /excitation/ excitation_type, amplitude, frequency, ramp_cycles, duration, dt_record, &
          record_file, record_kind, record_scale, record_format, record_units
       type(group_text) :: grp
@@ -464,22 +484,25 @@ contains
       end do
       if (allocated(error)) return
       ! a record whose file gives DT (AT2) may leave dt_record out
-      if (.not. (keyword_id(excitation_types, excitation_type) == excitation_record .and. dt_record == unset)) then
-         call need_real(deck, 'excitation', 'dt_record', dt_record, 's', error)
+      given_dt = is_given(grp, 'dt_record')
+      given_duration = is_given(grp, 'duration')
+      if (.not. (keyword_id(excitation_types, excitation_type) == excitation_record .and. .not. given_dt)) then
+         call need_real(deck, 'excitation', 'dt_record', dt_record, given_dt, 's', error)
          if (allocated(error)) return
       end if
       cfg%exc%dt_record = dt_record
       cfg%exc%kind = keyword_id(excitation_types, excitation_type)
       select case (cfg%exc%kind)
       case (excitation_harmonic)
-         call need_real(deck, 'excitation', 'amplitude', amplitude, 'm', error, positive=.false.)
+         call need_real(deck, 'excitation', 'amplitude', amplitude, is_given(grp, 'amplitude'), 'm', error, &
+                        positive=.false.)
          if (allocated(error)) return
-         call need_real(deck, 'excitation', 'frequency', frequency, 'Hz', error)
+         call need_real(deck, 'excitation', 'frequency', frequency, is_given(grp, 'frequency'), 'Hz', error)
          if (allocated(error)) return
          if (ramp_cycles < 0) then
             call bad(deck, 'excitation', 'ramp_cycles', trim(fmt_int(ramp_cycles)), '>= 0', error); return
          end if
-         call need_real(deck, 'excitation', 'duration', duration, 's', error)
+         call need_real(deck, 'excitation', 'duration', duration, given_duration, 's', error)
          if (allocated(error)) return
          cfg%exc%amplitude = amplitude
          cfg%exc%frequency = frequency
@@ -512,10 +535,10 @@ contains
          end if
          call relative_to(deck%path, trim(record_file), path)
          call read_record(path, trim(record_format), kind_id == record_displacement, &
-                          trim(record_units), record_scale, merge(dt_record, 0.0_dp, dt_record /= unset), &
+                          trim(record_units), record_scale, merge(dt_record, 0.0_dp, given_dt), &
                           cfg%exc%acc, cfg%record, error)
          if (allocated(error)) then
-            error%message = deck%path//", group &excitation, record_file = '"//trim(record_file)//"': "// &
+            error%message = deck%path//", group &excitation, record_file = '"//trim(fmt_text(record_file))//"': "// &
                             error%message
             return
          end if
@@ -525,17 +548,18 @@ contains
          call check_magnitude(deck, 'excitation', "dt_record (the record file's DT)", dt_record, 's', .true., error)
          if (allocated(error)) return
          if (.not. (cfg%record%peak_acc <= max_magnitude)) then
-            call bad(deck, 'excitation', 'record_file', "'"//trim(record_file)//"'", 'a record whose table '// &
+            call bad(deck, 'excitation', 'record_file', "'"//trim(fmt_text(record_file))//"'", 'a record whose table '// &
                      'acceleration (after record_units and record_scale = '//trim(fmt_real(record_scale))// &
                      ') stays within '//trim(fmt_real(max_magnitude))//' m/s2 in magnitude; it reaches '// &
                      trim(fmt_real(cfg%record%peak_acc))//' m/s2', error)
             return
          end if
-         if (duration == unset) duration = (size(cfg%exc%acc) - 1)*dt_record
-         call need_real(deck, 'excitation', 'duration', duration, 's', error)
+         if (.not. given_duration) duration = (size(cfg%exc%acc) - 1)*dt_record
+         given_duration = .true.
+         call need_real(deck, 'excitation', 'duration', duration, given_duration, 's', error)
          if (allocated(error)) return
       case (excitation_none)
-         call need_real(deck, 'excitation', 'duration', duration, 's', error)
+         call need_real(deck, 'excitation', 'duration', duration, given_duration, 's', error)
          if (allocated(error)) return
       case default
          call keyword_choices(excitation_types, choices)
@@ -610,7 +634,8 @@ contains
       if (cfg%exc%duration/(cfg%exc%dt_record/n1) > 2.0e9_dp) then
          call bad(deck, 'integration', 'n1', trim(fmt_int(n1)), 'such that duration / (dt_record / n1) = '// &
                   trim(fmt_real(cfg%exc%duration/(cfg%exc%dt_record/n1)))//' steps stays below 2e9 (duration = '// &
-                  trim(fmt_real(cfg%exc%duration))//' s)', error)
+                  trim(fmt_real(cfg%exc%duration))//' s and dt_record = '//trim(fmt_real(cfg%exc%dt_record))// &
+                  ' s of &excitation)', error)
          return
       end if
       cfg%opts%technique = technique_id
@@ -632,10 +657,11 @@ contains
       type(run_config), intent(inout) :: cfg
       type(error_type), allocatable, intent(out) :: error
       character(len=path_len) :: dir, name
-      integer :: output_every, n_modes
+      integer :: output_every, n_modes, max_history_mb
       logical :: write_history
       integer, allocatable :: history_dofs(:), history_devices(:)
-      namelist /output/ dir, name, output_every, write_history, history_dofs, history_devices, n_modes
+      namelist /output/ dir, name, output_every, write_history, history_dofs, history_devices, n_modes, &
+         max_history_mb
       type(group_text) :: grp
       character(len=512) :: msg
       integer :: ios
@@ -649,6 +675,7 @@ contains
       end if
       history_dofs = unset_int; history_devices = unset_int
       n_modes = default_n_modes
+      max_history_mb = default_max_history_mb
       call stem(deck%path, name)
       call find_group(deck, 'output', grp, found, error)
       if (allocated(error)) return
@@ -667,16 +694,17 @@ contains
          call bad(deck, 'output', 'dir', "''", 'a directory path', error); return
       end if
       if (len_trim(name) == 0 .or. index(trim(name), '/') > 0) then
-         call bad(deck, 'output', 'name', "'"//trim(name)//"'", 'a file name without directory', error); return
+         call bad(deck, 'output', 'name', "'"//trim(fmt_text(name))//"'", 'a file name without directory', error); return
       end if
       if (output_every < 0) then
          call bad(deck, 'output', 'output_every', trim(fmt_int(output_every)), '>= 0 (0 = at the record step)', error)
          return
       end if
-      call history_list(deck, 'history_dofs', history_dofs, cfg%model%n_dof, cfg%out%history_dofs, error)
+      call history_list(deck, 'history_dofs', history_dofs, given_of(grp, 'history_dofs', size(history_dofs)), &
+                        cfg%model%n_dof, cfg%out%history_dofs, error)
       if (allocated(error)) return
-      call history_list(deck, 'history_devices', history_devices, cfg%model%n_devices, cfg%out%history_devices, &
-                        error)
+      call history_list(deck, 'history_devices', history_devices, given_of(grp, 'history_devices', &
+                        size(history_devices)), cfg%model%n_devices, cfg%out%history_devices, error)
       if (allocated(error)) return
       cfg%out%dir = trim(dir)
       cfg%out%name = trim(name)
@@ -687,21 +715,66 @@ contains
          return
       end if
       cfg%opts%n_modes = n_modes
+      if (max_history_mb < 1) then
+         call bad(deck, 'output', 'max_history_mb', trim(fmt_int(max_history_mb)), '>= 1 (MiB)', error)
+         return
+      end if
+      if (write_history) call check_history_size(deck, cfg, max_history_mb, error)
    end subroutine read_output_group
+
+   !> The history file a run writes must stay within max_history_mb MiB: its size is known
+   !> before the run (samples and columns, 25 bytes a value); a larger one is refused with
+   !> the settings that shrink it.
+   subroutine check_history_size(deck, cfg, max_history_mb, error)
+      type(deck_text), intent(in) :: deck
+      type(run_config), intent(in) :: cfg
+      integer, intent(in) :: max_history_mb               !! the limit, MiB
+      type(error_type), allocatable, intent(out) :: error
+      integer :: ncol, nout, nsteps, every, nk, ndk
+      real(dp) :: bytes
+      character(len=:), allocatable :: keep
+
+      nk = cfg%model%n_dof
+      ndk = cfg%model%n_devices
+      if (allocated(cfg%out%history_dofs)) nk = size(cfg%out%history_dofs)
+      if (allocated(cfg%out%history_devices)) ndk = size(cfg%out%history_devices)
+      call history_shape(cfg%model, cfg%exc, cfg%opts, ncol, nout, nsteps, every, nk, ndk)
+      bytes = 25.0_dp*real(ncol, dp)*real(nout, dp)
+      if (bytes <= real(max_history_mb, dp)*1048576.0_dp) return
+      keep = ''
+      if (nk + ndk > 0) keep = ', keep fewer DOFs and devices (history_dofs, history_devices: '// &
+                               trim(fmt_int(nk))//' and '//trim(fmt_int(ndk))//' now)'
+      call fatal_error(error, deck%path//", group &output: the history would take "//trim(size_text(bytes))//" ("// &
+                       trim(fmt_int(nout))//" samples of "//trim(fmt_int(ncol))//" columns), more than "// &
+                       "max_history_mb = "//trim(fmt_int(max_history_mb))//" MiB: raise output_every (a sample "// &
+                       "every "//trim(fmt_int(every))//" dt1 steps now, of "//trim(fmt_int(nsteps))//")"//keep// &
+                       ", set write_history = .false., or raise max_history_mb")
+   contains
+      pure function size_text(b) result(str)
+         real(dp), intent(in) :: b
+         character(len=32) :: str
+         if (b >= 1024.0_dp**3) then
+            write (str, '(f0.1,a)') b/1024.0_dp**3, ' GiB'
+         else
+            write (str, '(f0.1,a)') b/1024.0_dp**2, ' MiB'
+         end if
+      end function size_text
+   end subroutine check_history_size
 
    !> A list of DOFs or devices for the history: not given, all (list not allocated); a single
    !> 0, none; else numbers in 1..n, increasing, without repeats.
-   subroutine history_list(deck, var, x, n, list, error)
+   subroutine history_list(deck, var, x, given, n, list, error)
       type(deck_text), intent(in) :: deck
       character(len=*), intent(in) :: var
       integer, intent(in) :: x(:), n
+      logical, intent(in) :: given(:)                     !! the elements the deck gives
       integer, allocatable, intent(inout) :: list(:)
       type(error_type), allocatable, intent(out) :: error
       integer :: m, i
 
-      m = count(x /= unset_int)
+      m = count(given)
       if (m == 0) return
-      if (any(x(m + 1:) /= unset_int)) then
+      if (any(given(m + 1:))) then
          call bad(deck, 'output', var, 'with a gap', 'a list of consecutive values', error); return
       end if
       if (m == 1 .and. x(1) == 0) then
@@ -761,18 +834,23 @@ contains
          if (.not. more) exit
       end do
       if (allocated(error)) return
-      call need_int(deck, 'braces', 'n_braces', n_braces, 0, max_devices - cfg%model%n_devices, error)
+      call need_int(deck, 'braces', 'n_braces', n_braces, .true., 0, max_devices - cfg%model%n_devices, error)
       if (allocated(error)) return
       n = n_braces
-      call node_list(deck, 'braces', 'node_i', node_i, n, 1, cfg%model%n_dof, error)
+      call node_list(deck, 'braces', 'node_i', node_i, given_of(grp, 'node_i', size(node_i)), n, 1, &
+                     cfg%model%n_dof, error)
       if (allocated(error)) return
-      call node_list(deck, 'braces', 'node_j', node_j, n, 0, cfg%model%n_dof, error)
+      call node_list(deck, 'braces', 'node_j', node_j, given_of(grp, 'node_j', size(node_j)), n, 0, &
+                     cfg%model%n_dof, error)
       if (allocated(error)) return
-      call need_reals(deck, 'braces', 'slip_load', slip_load, n, 'N', error, positive=.true.)
+      call need_reals(deck, 'braces', 'slip_load', slip_load, given_of(grp, 'slip_load', size(slip_load)), n, 'N', &
+                      error, positive=.true.)
       if (allocated(error)) return
-      call need_reals(deck, 'braces', 'stiffness', stiffness, n, 'N/m', error, positive=.true.)
+      call need_reals(deck, 'braces', 'stiffness', stiffness, given_of(grp, 'stiffness', size(stiffness)), n, &
+                      'N/m', error, positive=.true.)
       if (allocated(error)) return
-      call optional_reals(deck, 'braces', 'eps1', eps1, n, default_eps1, 'm/s', error, positive=.true.)
+      call optional_reals(deck, 'braces', 'eps1', eps1, given_of(grp, 'eps1', size(eps1)), n, default_eps1, 'm/s', &
+                          error, positive=.true.)
       if (allocated(error)) return
       call check_labels(deck, grp, 'braces', label, n, error)
       if (allocated(error)) return
@@ -813,6 +891,7 @@ contains
       real(dp), allocatable :: mu_max(:), mu_min(:), mu_rate(:), mu_table_v(:, :), mu_table_mu(:, :)
       character(len=label_len), allocatable :: label(:)
       integer, allocatable :: mu_ids(:)
+      logical, allocatable :: g_mu(:), g_table(:, :)
       namelist /isolators/ n_isolators, node_i, node_j, law, weight, mu, radius, eps, eps1, f, &
          mu_law, mu_max, mu_min, mu_rate, mu_table_v, mu_table_mu, label
       type(group_text) :: grp
@@ -845,27 +924,36 @@ contains
          if (.not. more) exit
       end do
       if (allocated(error)) return
-      call need_int(deck, 'isolators', 'n_isolators', n_isolators, 0, max_devices - cfg%model%n_devices, error)
+      call need_int(deck, 'isolators', 'n_isolators', n_isolators, .true., 0, max_devices - cfg%model%n_devices, &
+                    error)
       if (allocated(error)) return
       n = n_isolators
-      call node_list(deck, 'isolators', 'node_i', node_i, n, 1, cfg%model%n_dof, error)
+      call node_list(deck, 'isolators', 'node_i', node_i, given_of(grp, 'node_i', size(node_i)), n, 1, &
+                     cfg%model%n_dof, error)
       if (allocated(error)) return
-      call node_list(deck, 'isolators', 'node_j', node_j, n, 0, cfg%model%n_dof, error)
+      call node_list(deck, 'isolators', 'node_j', node_j, given_of(grp, 'node_j', size(node_j)), n, 0, &
+                     cfg%model%n_dof, error)
       if (allocated(error)) return
-      call need_reals(deck, 'isolators', 'weight', weight, n, 'N', error, positive=.true.)
+      call need_reals(deck, 'isolators', 'weight', weight, given_of(grp, 'weight', size(weight)), n, 'N', error, &
+                      positive=.true.)
       if (allocated(error)) return
-      call read_mu_laws(deck, 'isolators', n, mu_law, mu, mu_max, mu_min, mu_rate, mu_table_v, mu_table_mu, &
-                        mu_ids, error)
+      g_mu = given_of(grp, 'mu', size(mu))
+      call read_mu_laws(deck, grp, n, mu_law, mu, g_mu, mu_max, mu_min, mu_rate, mu_table_v, mu_table_mu, &
+                        mu_ids, g_table, error)
       if (allocated(error)) return
-      call need_reals(deck, 'isolators', 'mu', mu, n, '', error, positive=.false.)
+      call need_reals(deck, 'isolators', 'mu', mu, g_mu, n, '', error, positive=.false.)
       if (allocated(error)) return
-      call optional_reals(deck, 'isolators', 'radius', radius, n, default_radius, 'm', error)
+      call optional_reals(deck, 'isolators', 'radius', radius, given_of(grp, 'radius', size(radius)), n, &
+                          default_radius, 'm', error)
       if (allocated(error)) return
-      call optional_reals(deck, 'isolators', 'eps', eps, n, default_eps, 'm/s', error, positive=.true.)
+      call optional_reals(deck, 'isolators', 'eps', eps, given_of(grp, 'eps', size(eps)), n, default_eps, 'm/s', &
+                          error, positive=.true.)
       if (allocated(error)) return
-      call optional_reals(deck, 'isolators', 'eps1', eps1, n, default_eps1, 'm/s', error, positive=.true.)
+      call optional_reals(deck, 'isolators', 'eps1', eps1, given_of(grp, 'eps1', size(eps1)), n, default_eps1, &
+                          'm/s', error, positive=.true.)
       if (allocated(error)) return
-      call optional_reals(deck, 'isolators', 'f', f, n, default_f, 'm', error, positive=.true.)
+      call optional_reals(deck, 'isolators', 'f', f, given_of(grp, 'f', size(f)), n, default_f, 'm', error, &
+                          positive=.true.)
       if (allocated(error)) return
       call check_labels(deck, grp, 'isolators', label, n, error)
       if (allocated(error)) return
@@ -902,7 +990,7 @@ contains
          dev(i) = device_type(node_i=node_i(i), node_j=node_j(i), law=id, p=weight(i), mu=mu(i), &
                               eps=eps(i), eps1=eps1(i), f=f(i))
          call apply_mu_law(deck, 'isolators', i, mu_ids(i), mu_min(i), mu_rate(i), mu_table_v(:, i), &
-                           mu_table_mu(:, i), dev(i), error)
+                           mu_table_mu(:, i), g_table(:, i), dev(i), error)
          if (allocated(error)) return
          dev(i)%label = label(i)
          if (len_trim(label(i)) == 0) dev(i)%label = 'isolator '//trim(fmt_int(i))
@@ -938,6 +1026,7 @@ contains
       integer, allocatable :: node_i(:), node_j(:), spring(:)
       real(dp), allocatable :: height(:)
       character(len=label_len), allocatable :: label(:)
+      logical, allocatable :: g_i(:), g_j(:), g_spring(:)
       namelist /storeys/ n_storeys, node_i, node_j, spring, height, label
       type(group_text) :: grp
       character(len=512) :: msg
@@ -966,13 +1055,16 @@ contains
          if (.not. more) exit
       end do
       if (allocated(error)) return
-      call need_int(deck, 'storeys', 'n_storeys', n_storeys, 0, max_dof, error)
+      call need_int(deck, 'storeys', 'n_storeys', n_storeys, .true., 0, max_dof, error)
       if (allocated(error)) return
       n = n_storeys
+      g_i = given_of(grp, 'node_i', size(node_i))
+      g_j = given_of(grp, 'node_j', size(node_j))
+      g_spring = given_of(grp, 'spring', size(spring))
       do i = 1, n
          idx = '('//trim(fmt_int(i))//')'
-         if (spring(i) /= unset_int) then
-            if (node_i(i) /= unset_int .or. node_j(i) /= unset_int) then
+         if (g_spring(i)) then
+            if (g_i(i) .or. g_j(i)) then
                call bad(deck, 'storeys', 'spring'//idx, trim(fmt_int(spring(i))), 'given alone: storey '// &
                         trim(fmt_int(i))//' is a spring or a pair of nodes (node_i'//idx//', node_j'//idx// &
                         '), not both', error)
@@ -985,19 +1077,21 @@ contains
             end if
             node_i(i) = cfg%model%spring_i(spring(i))
             node_j(i) = cfg%model%spring_j(spring(i))
+            g_i(i) = .true.; g_j(i) = .true.
          end if
       end do
-      last = findloc(spring /= unset_int, .true., 1, back=.true.)
+      last = findloc(g_spring, .true., 1, back=.true.)
       if (last > n) then
          call bad(deck, 'storeys', 'spring('//trim(fmt_int(last))//')', trim(fmt_int(spring(last))), &
                   'absent: only '//trim(fmt_int(n))//' value(s) are expected', error)
          return
       end if
-      call node_list(deck, 'storeys', 'node_i', node_i, n, 1, cfg%model%n_dof, error)
+      call node_list(deck, 'storeys', 'node_i', node_i, g_i, n, 1, cfg%model%n_dof, error)
       if (allocated(error)) return
-      call node_list(deck, 'storeys', 'node_j', node_j, n, 0, cfg%model%n_dof, error)
+      call node_list(deck, 'storeys', 'node_j', node_j, g_j, n, 0, cfg%model%n_dof, error)
       if (allocated(error)) return
-      call optional_reals(deck, 'storeys', 'height', height, n, default_storey_height, 'm', error)
+      call optional_reals(deck, 'storeys', 'height', height, given_of(grp, 'height', size(height)), n, &
+                          default_storey_height, 'm', error)
       if (allocated(error)) return
       call check_labels(deck, grp, 'storeys', label, n, error)
       if (allocated(error)) return
@@ -1041,19 +1135,30 @@ contains
    !> ('constant' by default), and for 'exponential' mu_max, mu_min, mu_rate, for 'table' the
    !> points (mu_table_v(k, i), mu_table_mu(k, i)). For those two, mu is not given: it is set
    !> here to mu_max, or to the table's last value (what a slide at high speed meets).
-   subroutine read_mu_laws(deck, group, n, mu_law, mu, mu_max, mu_min, mu_rate, tab_v, tab_mu, ids, error)
+   subroutine read_mu_laws(deck, grp, n, mu_law, mu, g_mu, mu_max, mu_min, mu_rate, tab_v, tab_mu, ids, g_table, &
+                           error)
       type(deck_text), intent(in) :: deck
-      character(len=*), intent(in) :: group
+      type(group_text), intent(in) :: grp      !! the group read (what it gives)
       integer, intent(in) :: n
       character(len=name_len), intent(in) :: mu_law(:)
       real(dp), intent(inout) :: mu(:)
+      logical, intent(inout) :: g_mu(:)        !! the elements of mu given (or set here)
       real(dp), intent(inout) :: mu_max(:), mu_min(:), mu_rate(:)
       real(dp), intent(in) :: tab_v(:, :), tab_mu(:, :)
       integer, allocatable, intent(out) :: ids(:)
+      logical, allocatable, intent(out) :: g_table(:, :)   !! the points of the tables given
       type(error_type), allocatable, intent(out) :: error
-      character(len=:), allocatable :: idx, choices, law_of
+      character(len=:), allocatable :: idx, choices, law_of, group
+      logical, allocatable :: g_max(:), g_min(:), g_rate(:), g_tv(:, :), g_tm(:, :)
       integer :: i, k, np, last
 
+      group = grp%name
+      g_max = given_of(grp, 'mu_max', size(mu_max))
+      g_min = given_of(grp, 'mu_min', size(mu_min))
+      g_rate = given_of(grp, 'mu_rate', size(mu_rate))
+      g_tv = reshape(given_of(grp, 'mu_table_v', size(tab_v), shape(tab_v)), shape(tab_v))
+      g_tm = reshape(given_of(grp, 'mu_table_mu', size(tab_mu), shape(tab_mu)), shape(tab_mu))
+      g_table = g_tv .or. g_tm
       allocate (ids(n))
       last = findloc(mu_law /= '', .true., 1, back=.true.)
       if (last > n) then
@@ -1064,17 +1169,17 @@ contains
       do k = 1, 3
          select case (k)
          case (1)
-            call no_extra(deck, group, 'mu_max', mu_max, n, error)
+            call no_extra(deck, group, 'mu_max', mu_max, g_max, n, error)
          case (2)
-            call no_extra(deck, group, 'mu_min', mu_min, n, error)
+            call no_extra(deck, group, 'mu_min', mu_min, g_min, n, error)
          case (3)
-            call no_extra(deck, group, 'mu_rate', mu_rate, n, error)
+            call no_extra(deck, group, 'mu_rate', mu_rate, g_rate, n, error)
          end select
          if (allocated(error)) return
       end do
       do i = n + 1, size(tab_v, 2)
-         if (any(tab_v(:, i) /= unset) .or. any(tab_mu(:, i) /= unset)) then
-            call bad(deck, group, 'mu_table_v(:, '//trim(fmt_int(i))//')', '(given)', &
+         if (any(g_table(:, i))) then
+            call bad(deck, group, trim(table_var(i))//'(:, '//trim(fmt_int(i))//')', '(given)', &
                      'absent: only '//trim(fmt_int(n))//' item(s) are expected', error)
             return
          end if
@@ -1091,47 +1196,48 @@ contains
          law_of = "mu_law"//idx//" = '"//trim(mu_laws(ids(i))%name)//"'"
          ! what the chosen form does not use must not be given (a forgotten mu_law)
          if (ids(i) /= mu_exponential) then
-            if (mu_max(i) /= unset) then
+            if (g_max(i)) then
                call bad(deck, group, 'mu_max'//idx, trim(fmt_real(mu_max(i))), "absent with "//law_of// &
                         " (set mu_law"//idx//" = 'exponential' to use it)", error); return
             end if
-            if (mu_min(i) /= unset) then
+            if (g_min(i)) then
                call bad(deck, group, 'mu_min'//idx, trim(fmt_real(mu_min(i))), "absent with "//law_of// &
                         " (set mu_law"//idx//" = 'exponential' to use it)", error); return
             end if
-            if (mu_rate(i) /= unset) then
+            if (g_rate(i)) then
                call bad(deck, group, 'mu_rate'//idx, trim(fmt_real(mu_rate(i))), "absent with "//law_of// &
                         " (set mu_law"//idx//" = 'exponential' to use it)", error); return
             end if
          end if
          if (ids(i) /= mu_table) then
-            if (any(tab_v(:, i) /= unset) .or. any(tab_mu(:, i) /= unset)) then
-               call bad(deck, group, 'mu_table_v(:, '//trim(fmt_int(i))//')', '(given)', "absent with "//law_of// &
+            if (any(g_table(:, i))) then
+               call bad(deck, group, trim(table_var(i))//'(:, '//trim(fmt_int(i))//')', '(given)', "absent with "//law_of// &
                         " (set mu_law"//idx//" = 'table' to use it)", error); return
             end if
          end if
          if (ids(i) == mu_constant) cycle
-         if (mu(i) /= unset) then
+         if (g_mu(i)) then
             call bad(deck, group, 'mu'//idx, trim(fmt_real(mu(i))), "absent with "//law_of//": mu(v) is given by "// &
                      trim(mu_laws(ids(i))%note), error)
             return
          end if
          select case (ids(i))
          case (mu_exponential)
-            call need_real(deck, group, 'mu_max'//idx, mu_max(i), '', error, positive=.false.)
+            call need_real(deck, group, 'mu_max'//idx, mu_max(i), g_max(i), '', error, positive=.false.)
             if (allocated(error)) return
-            call need_real(deck, group, 'mu_min'//idx, mu_min(i), '', error, positive=.false.)
+            call need_real(deck, group, 'mu_min'//idx, mu_min(i), g_min(i), '', error, positive=.false.)
             if (allocated(error)) return
-            call need_real(deck, group, 'mu_rate'//idx, mu_rate(i), 's/m', error, positive=.true.)
+            call need_real(deck, group, 'mu_rate'//idx, mu_rate(i), g_rate(i), 's/m', error, positive=.true.)
             if (allocated(error)) return
             mu(i) = mu_max(i)
+            g_mu(i) = .true.
          case (mu_table)
             np = 0
             do k = 1, size(tab_v, 1)
-               if (tab_v(k, i) == unset .and. tab_mu(k, i) == unset) exit
+               if (.not. g_table(k, i)) exit
                np = k
             end do
-            if (any(tab_v(np + 1:, i) /= unset) .or. any(tab_mu(np + 1:, i) /= unset)) then
+            if (any(g_table(np + 1:, i))) then
                call bad(deck, group, 'mu_table_v(:, '//trim(fmt_int(i))//')', '(with a gap)', &
                         'points 1, 2, ... without a gap', error)
                return
@@ -1143,9 +1249,9 @@ contains
             end if
             do k = 1, np
                idx = '('//trim(fmt_int(k))//', '//trim(fmt_int(i))//')'
-               call need_real(deck, group, 'mu_table_v'//idx, tab_v(k, i), 'm/s', error, positive=.false.)
+               call need_real(deck, group, 'mu_table_v'//idx, tab_v(k, i), g_tv(k, i), 'm/s', error, positive=.false.)
                if (allocated(error)) return
-               call need_real(deck, group, 'mu_table_mu'//idx, tab_mu(k, i), '', error, positive=.false.)
+               call need_real(deck, group, 'mu_table_mu'//idx, tab_mu(k, i), g_tm(k, i), '', error, positive=.false.)
                if (allocated(error)) return
             end do
             do k = 2, np
@@ -1157,17 +1263,26 @@ contains
                end if
             end do
             mu(i) = tab_mu(np, i)
+            g_mu(i) = .true.
          end select
       end do
+   contains
+      !> The table variable given for item i, as a message names it.
+      pure function table_var(i) result(name)
+         integer, intent(in) :: i
+         character(len=11) :: name
+         name = merge('mu_table_v ', 'mu_table_mu', any(g_tv(:, i)))
+      end function table_var
    end subroutine read_mu_laws
 
    !> Set a device's mu(v) from the checked inputs (read_mu_laws); an error when the form
    !> is not constant and the device's law is not the velocity law.
-   subroutine apply_mu_law(deck, group, i, id, mu_min, mu_rate, tab_v, tab_mu, dev, error)
+   subroutine apply_mu_law(deck, group, i, id, mu_min, mu_rate, tab_v, tab_mu, g_table, dev, error)
       type(deck_text), intent(in) :: deck
       character(len=*), intent(in) :: group
       integer, intent(in) :: i, id
       real(dp), intent(in) :: mu_min, mu_rate, tab_v(:), tab_mu(:)
+      logical, intent(in) :: g_table(:)        !! the points given (1 to the table's last)
       type(device_type), intent(inout) :: dev
       type(error_type), allocatable, intent(out) :: error
       integer :: k
@@ -1187,7 +1302,7 @@ contains
       case (mu_table)
          dev%n_mu_points = 0
          do k = 1, size(tab_v)
-            if (tab_v(k) == unset) exit
+            if (.not. g_table(k)) exit
             dev%n_mu_points = k
             dev%mu_v(k) = tab_v(k)
             dev%mu_at(k) = tab_mu(k)
@@ -1233,10 +1348,11 @@ contains
    !> 'rayleigh' damping as the ratio xi at two natural modes (mode_i, mode_j of the stuck or
    !> the free system) instead of a0, a1: checked here, resolved by resolve_rayleigh once the
    !> devices are known.
-   subroutine rayleigh_modes(deck, xi, a0, a1, mode_i, mode_j, mode_system, cfg, error)
+   subroutine rayleigh_modes(deck, xi, a0, a1, mode_i, mode_j, given_i, given_j, mode_system, cfg, error)
       type(deck_text), intent(in) :: deck
       real(dp), intent(in) :: xi, a0, a1
       integer, intent(in) :: mode_i, mode_j
+      logical, intent(in) :: given_i, given_j     !! the deck gives mode_i, mode_j
       character(len=*), intent(in) :: mode_system
       type(run_config), intent(inout) :: cfg
       type(error_type), allocatable, intent(out) :: error
@@ -1244,7 +1360,7 @@ contains
 
       cfg%model%mode_i = 0
       cfg%model%mode_j = 0
-      if (mode_i == unset_int .and. mode_j == unset_int) then
+      if (.not. given_i .and. .not. given_j) then
          ! xi with 'rayleigh' is a ratio at two modes: without them it would be left unused
          ! and the structure damped by a0, a1 alone (undamped when they are not given)
          if (xi /= default_xi) call bad(deck, 'damping', 'xi', trim(fmt_real(xi)), "absent with 'rayleigh' "// &
@@ -1252,8 +1368,8 @@ contains
                                         "two modes); or give rayleigh_a0 and rayleigh_a1 alone", error)
          return
       end if
-      if (mode_i == unset_int .or. mode_j == unset_int) then
-         call fatal_error(error, deck%path//", group &damping: "//trim(merge('mode_i', 'mode_j', mode_i == unset_int))// &
+      if (.not. given_i .or. .not. given_j) then
+         call fatal_error(error, deck%path//", group &damping: "//trim(merge('mode_i', 'mode_j', .not. given_i))// &
                           " is not given: 'rayleigh' damping from modes needs xi, mode_i and mode_j")
          return
       end if
@@ -1480,28 +1596,56 @@ contains
                        trim(fmt_int(cap))//" characters long")
    end subroutine check_length
 
-   subroutine need_int(deck, group, var, x, lo, hi, error)
+   !> The value a group's variable has after its read, when the group's text gives one; "not
+   !> given" is read from the text (given_elements), never from a value.
+   pure logical function is_given(grp, var)
+      type(group_text), intent(in) :: grp
+      character(len=*), intent(in) :: var     !! a scalar variable, lower case
+      logical :: g(1)
+      call given_elements(grp, var, [1], g)
+      is_given = g(1)
+   end function is_given
+
+   !> The elements of an array variable (n of them, of shape `extents` when not 1-D) that the
+   !> group's text gives, in array element order.
+   pure function given_of(grp, var, n, extents) result(g)
+      type(group_text), intent(in) :: grp
+      character(len=*), intent(in) :: var     !! the variable, lower case
+      integer, intent(in) :: n                !! its size
+      integer, intent(in), optional :: extents(:) !! its shape (default [n])
+      logical, allocatable :: g(:)
+      allocate (g(n))
+      if (present(extents)) then
+         call given_elements(grp, var, extents, g)
+      else
+         call given_elements(grp, var, [n], g)
+      end if
+   end function given_of
+
+   subroutine need_int(deck, group, var, x, given, lo, hi, error)
       type(deck_text), intent(in) :: deck
       character(len=*), intent(in) :: group, var
       integer, intent(in) :: x, lo, hi
+      logical, intent(in) :: given                        !! the deck gives x
       type(error_type), allocatable, intent(out) :: error
-      if (x == unset_int) then
+      if (.not. given) then
          call fatal_error(error, deck%path//", group &"//group//": "//var//" is not given"); return
       end if
       if (x < lo .or. x > hi) &
          call bad(deck, group, var, trim(fmt_int(x)), 'in '//trim(fmt_int(lo))//'..'//trim(fmt_int(hi)), error)
    end subroutine need_int
 
-   subroutine need_real(deck, group, var, x, unit, error, positive)
+   subroutine need_real(deck, group, var, x, given, unit, error, positive)
       type(deck_text), intent(in) :: deck
       character(len=*), intent(in) :: group, var, unit
       real(dp), intent(in) :: x
+      logical, intent(in) :: given                        !! the deck gives x
       type(error_type), allocatable, intent(out) :: error
       logical, intent(in), optional :: positive
       logical :: pos
       pos = .true.
       if (present(positive)) pos = positive
-      if (x == unset) then
+      if (.not. given) then
          call fatal_error(error, deck%path//", group &"//group//": "//var//" is not given"); return
       end if
       if (.not. ieee_is_finite(x)) then
@@ -1559,26 +1703,28 @@ contains
    end subroutine check_real
 
    !> n values must be given, finite and > 0 (or >= 0); no more than n.
-   subroutine need_reals(deck, group, var, x, n, unit, error, positive)
+   subroutine need_reals(deck, group, var, x, given, n, unit, error, positive)
       type(deck_text), intent(in) :: deck
       character(len=*), intent(in) :: group, var, unit
       real(dp), intent(in) :: x(:)
+      logical, intent(in) :: given(:)                     !! the elements the deck gives
       integer, intent(in) :: n
       type(error_type), allocatable, intent(out) :: error
       logical, intent(in) :: positive
       integer :: i
       do i = 1, n
-         call need_real(deck, group, var//'('//trim(fmt_int(i))//')', x(i), unit, error, positive)
+         call need_real(deck, group, var//'('//trim(fmt_int(i))//')', x(i), given(i), unit, error, positive)
          if (allocated(error)) return
       end do
-      call no_extra(deck, group, var, x, n, error)
+      call no_extra(deck, group, var, x, given, n, error)
    end subroutine need_reals
 
    !> Values not given take a default; given ones must be finite (and > 0 if positive).
-   subroutine optional_reals(deck, group, var, x, n, default, unit, error, positive)
+   subroutine optional_reals(deck, group, var, x, given, n, default, unit, error, positive)
       type(deck_text), intent(in) :: deck
       character(len=*), intent(in) :: group, var, unit
       real(dp), intent(inout) :: x(:)
+      logical, intent(in) :: given(:)                     !! the elements the deck gives
       integer, intent(in) :: n
       real(dp), intent(in) :: default
       type(error_type), allocatable, intent(out) :: error
@@ -1588,7 +1734,7 @@ contains
       pos = .false.
       if (present(positive)) pos = positive
       do i = 1, n
-         if (x(i) == unset) x(i) = default
+         if (.not. given(i)) x(i) = default
          if (.not. ieee_is_finite(x(i))) then
             call bad(deck, group, var//'('//trim(fmt_int(i))//')', trim(fmt_real(x(i))), 'a finite number', error); return
          end if
@@ -1598,29 +1744,31 @@ contains
          call check_magnitude(deck, group, var//'('//trim(fmt_int(i))//')', x(i), unit, pos, error)
          if (allocated(error)) return
       end do
-      call no_extra(deck, group, var, x, n, error)
+      call no_extra(deck, group, var, x, given, n, error)
    end subroutine optional_reals
 
-   subroutine no_extra(deck, group, var, x, n, error)
+   subroutine no_extra(deck, group, var, x, given, n, error)
       type(deck_text), intent(in) :: deck
       character(len=*), intent(in) :: group, var
       real(dp), intent(in) :: x(:)
+      logical, intent(in) :: given(:)                     !! the elements the deck gives
       integer, intent(in) :: n
       type(error_type), allocatable, intent(out) :: error
       integer :: last
-      last = findloc(x /= unset, .true., 1, back=.true.)
+      last = findloc(given, .true., 1, back=.true.)
       if (last > n) call bad(deck, group, var//'('//trim(fmt_int(last))//')', trim(fmt_real(x(last))), &
                              'absent: only '//trim(fmt_int(n))//' value(s) are expected', error)
    end subroutine no_extra
 
-   subroutine node_list(deck, group, var, x, n, lo, hi, error)
+   subroutine node_list(deck, group, var, x, given, n, lo, hi, error)
       type(deck_text), intent(in) :: deck
       character(len=*), intent(in) :: group, var
       integer, intent(in) :: x(:), n, lo, hi
+      logical, intent(in) :: given(:)                     !! the elements the deck gives
       type(error_type), allocatable, intent(out) :: error
       integer :: i, last
       do i = 1, n
-         if (x(i) == unset_int) then
+         if (.not. given(i)) then
             call fatal_error(error, deck%path//", group &"//group//": "//var//'('//trim(fmt_int(i))//") is not given")
             return
          end if
@@ -1630,7 +1778,7 @@ contains
             return
          end if
       end do
-      last = findloc(x /= unset_int, .true., 1, back=.true.)
+      last = findloc(given, .true., 1, back=.true.)
       if (last > n) call bad(deck, group, var//'('//trim(fmt_int(last))//')', trim(fmt_int(x(last))), &
                              'absent: only '//trim(fmt_int(n))//' value(s) are expected', error)
    end subroutine node_list

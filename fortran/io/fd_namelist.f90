@@ -5,13 +5,13 @@
 !> read where it is declared), in a loop with next_read: on failure the group is re-read
 !> one assignment at a time (group_item) to find the variable and value at fault.
 module fd_namelist
-   use fd_error, only: error_type, fatal_error, fmt_int, stat_no_memory
+   use fd_error, only: error_type, fatal_error, fmt_int, fmt_text, stat_no_memory, echo_chars
    use fd_textio, only: line_type, read_text_file, split_lines, lower
    implicit none
    private
 
    public :: deck_text, group_text, load_deck, deck_from_string, find_group, group_item, group_read_error, next_read
-   public :: check_groups, group_opened, scan_deck, group_span, longest_string
+   public :: check_groups, group_opened, scan_deck, group_span, longest_string, given_elements
 
    character(len=*), parameter :: blanks = ' '//achar(9)  !! what separates words on a line
 
@@ -221,7 +221,12 @@ contains
                   end if
                end if
                cur = group_span()
-               cur%name = lower(line(b + 1:min(e - 1, b + len(cur%name))))
+               if (e - 1 - b > len(cur%name)) then   ! longer than any group's name
+                  where = deck%path//", line "//trim(fmt_int(i))   ! formatted only for a message
+                  call fatal_error(error, where//": unknown group "//line(b:b)//trim(shown(line(b + 1:e - 1))))
+                  return
+               end if
+               cur%name = lower(line(b + 1:e - 1))
                cur%first_line = i
                cur%first_col = b
                cur%name_end = e - 1
@@ -344,25 +349,13 @@ contains
                        "; between groups only blank lines and comments ('!') are allowed")
    end subroutine outside_text
 
-   !> Deck text as shown in a message: at most 60 characters (cut on a UTF-8 character
-   !> boundary), control characters shown as '?', trailing blanks dropped.
+   !> Deck text as shown in a message (fd_error's fmt_text): at most 80 characters (cut on a
+   !> UTF-8 character boundary, the length said), control characters shown as '?', trailing
+   !> blanks dropped.
    pure function shown(text) result(out)
       character(len=*), intent(in) :: text
-      character(len=64) :: out
-      integer :: n, i
-
-      n = min(len_trim(text), 60)
-      if (n < len_trim(text)) then
-         ! do not cut a multi-byte character: back off over continuation bytes (10xxxxxx)
-         do while (n > 1 .and. iand(iachar(text(n + 1:n + 1)), 192) == 128)
-            n = n - 1
-         end do
-      end if
-      out = text(1:n)
-      do i = 1, n
-         if (iachar(out(i:i)) < 32 .or. iachar(out(i:i)) == 127) out(i:i) = '?'
-      end do
-      if (n < len_trim(text)) out(n + 1:) = '...'
+      character(len=4*echo_chars + 32) :: out
+      out = fmt_text(text)
    end function shown
 
    pure logical function is_name_char(c)
@@ -754,6 +747,199 @@ contains
       end do
    end subroutine longest_string
 
+   !> Which elements of a variable the group's assignments give a value, read from the
+   !> group's text as the namelist reader assigns them, so that "not given" is never a value:
+   !> 'x = v1, v2' gives x's elements from the first on, in array element order (first
+   !> subscript fastest); 'x(i) = v1, v2' from element i on (each subscript running from its
+   !> value to its upper bound, as gfortran continues); 'x(l:u:s) = ...' the section's
+   !> elements in its order (a subscript without ':' in a section fixed). A null value (an
+   !> empty place between commas, 'r*' alone) gives none, but takes its element; 'r*c' gives
+   !> r. Subscripts that are not whole numbers, of another rank or out of the bounds give
+   !> nothing here (the namelist read rejects them).
+   pure subroutine given_elements(grp, var, extents, given)
+      type(group_text), intent(in) :: grp       !! the group
+      character(len=*), intent(in) :: var       !! variable name, lower case
+      integer, intent(in) :: extents(:)         !! its extents (lower bounds 1); [1] for a scalar
+      logical, intent(out) :: given(:)          !! size product(extents), array element order
+      character(len=:), allocatable :: name, sub
+      integer :: i, k, d, rank, paren, eq, t0, st, r, ios, c0, nsub
+      integer :: lo(size(extents)), hi(size(extents)), step(size(extents)), at(size(extents))
+      logical :: scalar(size(extents))
+      character(len=1) :: quote
+      logical :: in_value, after_comma, more, ok, null
+
+      given = .false.
+      if (.not. allocated(grp%items)) return
+      rank = size(extents)
+      do i = 1, size(grp%items)
+         call item_variable(grp%items(i)%s, name)
+         paren = index(name, '(')
+         if (paren == 0) then
+            if (name /= var) cycle
+            lo = 1; hi = extents; step = 1
+         else
+            if (name(1:paren - 1) /= var) cycle
+            k = index(name(paren:), ')')
+            if (k == 0) cycle
+            sub = name(paren + 1:paren + k - 2)
+            if (count_char(sub, ',') + 1 /= rank) cycle
+            ok = .true.
+            c0 = 1
+            do d = 1, rank
+               nsub = index(sub(c0:), ',')
+               if (nsub == 0) then
+                  nsub = len(sub) + 1
+               else
+                  nsub = c0 + nsub - 1
+               end if
+               call section(sub(c0:nsub - 1), extents(d), lo(d), hi(d), step(d), ok)
+               if (.not. ok) exit
+               scalar(d) = index(sub(c0:nsub - 1), ':') == 0
+               c0 = nsub + 1
+            end do
+            if (.not. ok) cycle
+            ! in a section a subscript without ':' stays fixed; an element alone is continued
+            if (.not. all(scalar)) where (scalar) hi = lo
+         end if
+         if (any(lo < 1 .or. lo > extents)) cycle
+         at = lo
+         more = all((hi - lo)*step >= 0)
+         ! the values, one at a time (as value_count reads them), each taking the next element
+         associate (item => grp%items(i)%s)
+            eq = index(item, '=')
+            quote = ' '
+            in_value = .false.
+            after_comma = .true.
+            t0 = 0
+            do k = eq + 1, len(item) + 1
+               if (.not. more) exit
+               if (k <= len(item)) then
+                  if (quote /= ' ') then
+                     if (item(k:k) == quote) quote = ' '
+                     cycle
+                  end if
+                  if (item(k:k) == '"' .or. item(k:k) == "'") then
+                     quote = item(k:k)
+                     if (.not. in_value) then
+                        in_value = .true.; t0 = k
+                     end if
+                     cycle
+                  end if
+                  if (item(k:k) /= ',' .and. item(k:k) /= ' ' .and. item(k:k) /= achar(9)) then
+                     if (.not. in_value) then
+                        in_value = .true.; t0 = k
+                     end if
+                     cycle
+                  end if
+               end if
+               if (in_value) then   ! a value ends: 'r*c' gives r, 'r*' is r null values
+                  r = 1
+                  null = .false.
+                  st = index(item(t0:k - 1), '*')
+                  if (st > 1 .and. item(t0:t0) /= '"' .and. item(t0:t0) /= "'") then
+                     if (verify(item(t0:t0 + st - 2), '0123456789') == 0 .and. st <= 10) then
+                        read (item(t0:t0 + st - 2), *, iostat=ios) r
+                        if (ios /= 0) r = 1
+                        null = t0 + st - 1 == k - 1
+                     end if
+                  end if
+                  call take(r, null, lo, hi, step, extents, at, more, given)
+                  in_value = .false.
+                  after_comma = .false.
+               end if
+               if (k <= len(item)) then
+                  if (item(k:k) == ',') then
+                     ! an empty place: a null value
+                     if (after_comma .and. k < len(item)) call take(1, .true., lo, hi, step, extents, at, more, given)
+                     after_comma = .true.
+                  end if
+               end if
+            end do
+         end associate
+      end do
+   contains
+      !> The next r elements: given, unless the values are null.
+      pure subroutine take(r, null, lo, hi, step, extents, at, more, given)
+         integer, intent(in) :: r
+         logical, intent(in) :: null
+         integer, intent(in) :: lo(:), hi(:), step(:), extents(:)
+         integer, intent(inout) :: at(:)      !! the element the next value takes
+         logical, intent(inout) :: more       !! elements are left
+         logical, intent(inout) :: given(:)
+         integer :: m, e, dd, rank
+         rank = size(extents)
+         do m = 1, r
+            if (.not. more) return
+            if (.not. null .and. all(at >= 1 .and. at <= extents)) then
+               e = 0
+               do dd = rank, 1, -1
+                  e = e*extents(dd) + (at(dd) - 1)
+               end do
+               given(e + 1) = .true.
+            end if
+            ! the next element: the first subscript fastest
+            more = .false.
+            do dd = 1, rank
+               if ((hi(dd) - (at(dd) + step(dd)))*step(dd) >= 0) then
+                  at(dd) = at(dd) + step(dd)
+                  more = .true.
+                  exit
+               end if
+               at(dd) = lo(dd)
+            end do
+         end do
+      end subroutine take
+
+      !> One subscript: 'i' (from i to the upper bound) or a triplet 'l:u:s'.
+      pure subroutine section(t, ext, l, u, s, ok)
+         character(len=*), intent(in) :: t
+         integer, intent(in) :: ext
+         integer, intent(out) :: l, u, s
+         logical, intent(out) :: ok
+         integer :: c1, c2
+         l = 1; u = ext; s = 1
+         c1 = index(t, ':')
+         if (c1 == 0) then
+            call whole(t, l, ok)
+            return
+         end if
+         c2 = index(t(c1 + 1:), ':')
+         if (c2 > 0) c2 = c1 + c2
+         ok = .true.
+         if (c1 > 1) call whole(t(1:c1 - 1), l, ok)
+         if (.not. ok) return
+         if (c2 == 0) then
+            if (c1 < len(t)) call whole(t(c1 + 1:), u, ok)
+            return
+         end if
+         if (c2 > c1 + 1) call whole(t(c1 + 1:c2 - 1), u, ok)
+         if (.not. ok) return
+         call whole(t(c2 + 1:), s, ok)
+         if (ok) ok = s /= 0
+         if (ok .and. s < 0) then   ! omitted bounds run the other way
+            if (c1 == 1) l = ext
+            if (c2 == c1 + 1) u = 1
+         end if
+      end subroutine section
+
+      pure subroutine whole(t, v, ok)
+         character(len=*), intent(in) :: t
+         integer, intent(out) :: v
+         logical, intent(out) :: ok
+         integer :: k0, ios2
+         v = 0
+         k0 = 1
+         if (len(t) > 0) then
+            if (t(1:1) == '+' .or. t(1:1) == '-') k0 = 2
+         end if
+         ok = len(t) >= k0 .and. len(t) <= 9
+         if (ok) ok = verify(t(k0:), '0123456789') == 0
+         if (.not. ok) return
+         read (t, *, iostat=ios2) v
+         ok = ios2 == 0
+      end subroutine whole
+   end subroutine given_elements
+
    !> The variable an assignment sets, lower case, blanks removed: 'mass', 'mass(2)'.
    pure subroutine item_variable(item, var)
       character(len=*), intent(in) :: item
@@ -1013,7 +1199,7 @@ contains
       character(len=*), intent(in) :: msg                 !! the namelist reader's message
       type(error_type), allocatable, intent(out) :: error !! the error
       character(len=:), allocatable :: item, var, val
-      integer :: eq
+      integer :: eq, k
 
       if (bad < 1 .or. bad > size(grp%items)) then
          call fatal_error(error, deck%path//", group &"//grp%name//" (line "//trim(fmt_int(grp%first_line))// &
@@ -1024,13 +1210,16 @@ contains
       eq = index(item, '=')
       var = trim(adjustl(item(1:max(eq - 1, 0))))
       val = trim(adjustl(item(eq + 1:)))
-      if (index(msg, 'Cannot match namelist object name '//lower(var)) > 0 .or. &
-          index(msg, 'Cannot match namelist object name '//var) > 0) then
+      ! (the reader's message holds the name, cut to its length: its start is compared)
+      k = min(len(var), 64)
+      if (index(msg, 'Cannot match namelist object name '//lower(var(1:k))) > 0 .or. &
+          index(msg, 'Cannot match namelist object name '//var(1:k)) > 0) then
          call fatal_error(error, deck%path//", group &"//grp%name//", line "//trim(fmt_int(grp%item_line(bad)))// &
-                          ": unknown variable '"//var//"' (value "//val//")")
+                          ": unknown variable '"//trim(fmt_text(var))//"' (value "//trim(fmt_text(val))//")")
       else
          call fatal_error(error, deck%path//", group &"//grp%name//", line "//trim(fmt_int(grp%item_line(bad)))// &
-                          ": variable '"//var//"' has a bad value '"//val//"' ("//trim(msg)//")")
+                          ": variable '"//trim(fmt_text(var))//"' has a bad value '"//trim(fmt_text(val))//"' ("// &
+                          trim(fmt_text(msg))//")")
       end if
    end subroutine group_read_error
 

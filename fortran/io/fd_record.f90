@@ -9,7 +9,7 @@ module fd_record
    use, intrinsic :: ieee_arithmetic, only: ieee_is_finite, ieee_is_nan
    use, intrinsic :: iso_c_binding, only: c_char, c_double, c_ptr, c_null_ptr, c_null_char
    use fd_kinds, only: dp
-   use fd_error, only: error_type, fatal_error, fmt_int, fmt_real, stat_no_memory
+   use fd_error, only: error_type, fatal_error, fmt_int, fmt_real, fmt_text, stat_no_memory
    use fd_textio, only: read_file_text, lower
    use fd_sha256, only: sha256_text
    implicit none
@@ -659,7 +659,7 @@ contains
       type(error_type), allocatable, intent(out) :: error
       character(len=:), allocatable :: where, tok
       where = "record file '"//path//"', line "//trim(fmt_int(line))
-      tok = s(lo:hi)
+      tok = trim(fmt_text(s(lo:hi)))
       select case (stat)
       case (num_nan)
          call fatal_error(error, where//": '"//tok//"' is NaN: not finite; expected a finite number")

@@ -30,7 +30,7 @@ module fd_names
    public :: default_technique, default_beta, default_gamma, default_n1, default_n2, default_n
    public :: default_check_correctness, default_dt_min, default_theta, default_linear_system
    public :: default_refinement
-   public :: default_dir, default_output_every, default_write_history
+   public :: default_dir, default_output_every, default_write_history, default_max_history_mb
    public :: default_mu_law, default_mode_system, default_n_modes, default_radius, default_storey_height
    public :: label_len, max_mu_points
 
@@ -166,6 +166,7 @@ module fd_names
    character(len=*), parameter :: default_dir = 'out'    !! output directory
    integer, parameter :: default_output_every = 0        !! 0 = every dt_record
    logical, parameter :: default_write_history = .true.
+   integer, parameter :: default_max_history_mb = 2048   !! largest history file a run writes [MiB]
    integer, parameter :: default_n_modes = 10            !! modes reported per system
 
 contains

@@ -7,7 +7,8 @@ module test_fd_namelist
    use fd_kinds, only: dp
    use fd_error, only: fd_error_type => error_type
    use fd_namelist, only: deck_text, group_text, deck_from_string, load_deck, find_group, group_item, &
-                          group_read_error, check_groups, group_opened, longest_string, next_read
+                          group_read_error, check_groups, group_opened, longest_string, next_read, &
+                          given_elements
    implicit none
    private
 
@@ -60,7 +61,9 @@ contains
                   new_unittest("a comment after a separator is no value", test_comment_no_value), &
                   new_unittest("a text not closed on its line", test_open_text), &
                   new_unittest("a UTF-8 byte order mark before the first line", test_bom), &
-                  new_unittest("the longest string of a variable", test_longest) &
+                  new_unittest("the longest string of a variable", test_longest), &
+                  new_unittest("the elements given, as the namelist reader assigns them", test_given), &
+                  new_unittest("a value equal to any marker is given", test_given_extremes) &
                   ]
    end subroutine collect_namelist
 
@@ -599,6 +602,75 @@ contains
       call longest_string(grp, 'law', length, line)
       call check(error, length, 9, "it's    x: a doubled quote is one character")
    end subroutine test_longest
+
+   !> given_elements against gfortran's own reader: each group is read twice, its arrays set
+   !> to two different values first; an element the read left at both is not given. Every
+   !> form the reader takes: lists, an element and the values after it, sections with strides
+   !> (negative too), null values (empty places, 'r*'), repeat counts, 2-D arrays.
+   subroutine test_given(error)
+      type(error_type), allocatable, intent(out) :: error
+      character(len=40), parameter :: cases(*) = [character(len=40) :: &
+         'a = 1, 2', 'a = 1 2 3', 'a(2) = 1, 2, 3', 'a(2:5) = 1', 'a = , 2', 'a = 2*, 3', &
+         'a = 1 2*, 4', 'a = 1,,3', 'a = 1, 2,', 'a(2:6:2) = 7, 8', 'a(5:2:-1) = 7, 8', &
+         'a(1:6:2) = 1, 2, 3', 'a(:3) = 9', 'a(4:) = 1 2 3', 'a(6:1:-2) = , 5', 'a = 3*1.0, 2*, 5', &
+         'a(1) = 1, a(3) = 3', 'a = 1.0 , , 4', 'A(2) = 5', &
+         'b(2,:) = 7, 8', 'b(:,2) = 7, 8, 9', 'b = 7, 8, 9, 10', 'b(2,2) = 7, 8, 9', &
+         'b(:, 3) = 1 2', 'b(2, :) = , 4', 'b = 4*0.5', 'b(3:1:-1, 2) = 1, , 3', 'a = 1, b(1,1) = 2', &
+         'b(2:3, 2:3) = 1, 2, 3, 4', 'b(1, 2:3) = 1*, 5']
+      type(deck_text) :: deck
+      type(group_text) :: grp
+      type(fd_error_type), allocatable :: err
+      real(dp) :: a(6), b(3, 3), a1(6), b1(3, 3)
+      logical :: found, ga(6), gb(9)
+      integer :: i, ios
+      namelist /g/ a, b
+
+      do i = 1, size(cases)
+         call deck_from_string('&g'//nl//'  '//trim(cases(i))//nl//'/'//nl, 't.nml', deck)
+         call find_group(deck, 'g', grp, found, err)
+         call check(error, found .and. .not. allocated(err), trim(cases(i))//': found')
+         if (allocated(error)) return
+         a = -7777.0_dp; b = -7777.0_dp
+         read (grp%lines, nml=g, iostat=ios)
+         ! values after an element alone ('a(2) = 1, 2, 3') are gfortran's extension, refused
+         ! under -std=f2008: nothing is then read
+         if (ios /= 0 .and. (cases(i) == 'a(2) = 1, 2, 3' .or. cases(i) == 'b(2,2) = 7, 8, 9')) cycle
+         call check(error, ios, 0, trim(cases(i))//': read')
+         if (allocated(error)) return
+         a1 = a; b1 = b
+         a = -8888.0_dp; b = -8888.0_dp
+         read (grp%lines, nml=g, iostat=ios)
+         call given_elements(grp, 'a', [6], ga)
+         call given_elements(grp, 'b', [3, 3], gb)
+         call check(error, all(ga .eqv. .not. (a1 == -7777.0_dp .and. a == -8888.0_dp)), trim(cases(i))//': a')
+         if (allocated(error)) return
+         call check(error, all(gb .eqv. .not. reshape(b1 == -7777.0_dp .and. b == -8888.0_dp, [9])), &
+                    trim(cases(i))//': b')
+         if (allocated(error)) return
+      end do
+      ! a scalar, and a variable of the same prefix
+      call deck_from_string('&g'//nl//'  ab = 1, a = 2'//nl//'/'//nl, 't.nml', deck)
+      call find_group(deck, 'g', grp, found, err)
+      call given_elements(grp, 'ab', [1], ga(1:1))
+      call given_elements(grp, 'b', [1], ga(2:2))
+      call check(error, ga(1) .and. .not. ga(2), "'ab' given, 'b' not")
+   end subroutine test_given
+
+   !> A value that is the largest (or most negative) number is given like any other.
+   subroutine test_given_extremes(error)
+      type(error_type), allocatable, intent(out) :: error
+      type(deck_text) :: deck
+      type(group_text) :: grp
+      type(fd_error_type), allocatable :: err
+      logical :: found, gv(3), gn(1)
+
+      call deck_from_string('&model'//nl//'  n_dof = -2147483647, v0 = 0.0, -1.7976931348623157e308'//nl// &
+                            '/'//nl, 't.nml', deck)
+      call find_group(deck, 'model', grp, found, err)
+      call given_elements(grp, 'v0', [3], gv)
+      call given_elements(grp, 'n_dof', [1], gn)
+      call check(error, gn(1) .and. all(gv .eqv. [.true., .true., .false.]), 'n_dof and v0(1:2) given')
+   end subroutine test_given_extremes
 
    !> check_groups on a deck gives an error containing `text`.
    subroutine expect_error(deck_string, text, error)

@@ -1,10 +1,11 @@
 !> Unit tests of the text-file reader (fd_textio): a file of several read buffers (the
 !> buffer grows geometrically), line ends (LF, CRLF, none at the end), a missing file, a
-!> directory, a file with a NUL character.
+!> directory, a file with a NUL character; lines that end with CR alone; a text as a message
+!> echoes it (fmt_text).
 module test_fd_textio
    use testdrive, only: new_unittest, unittest_type, error_type, check, test_failed
-   use fd_error, only: fd_error_type => error_type, fmt_int
-   use fd_textio, only: line_type, read_text_file
+   use fd_error, only: fd_error_type => error_type, fmt_int, fmt_text
+   use fd_textio, only: line_type, read_text_file, cr_line_ends
    implicit none
    private
 
@@ -20,7 +21,9 @@ contains
                   new_unittest("missing file", test_missing), &
                   new_unittest("a directory", test_directory), &
                   new_unittest("a NUL character", test_nul), &
-                  new_unittest("an empty file", test_empty) &
+                  new_unittest("an empty file", test_empty), &
+                  new_unittest("lines that end with CR alone", test_lone_cr), &
+                  new_unittest("an echoed text: 80 characters and its length", test_echo) &
                   ]
    end subroutine collect_textio
 
@@ -117,5 +120,41 @@ contains
       if (allocated(error)) return
       call check(error, size(lines), 0)
    end subroutine test_empty
+
+   !> A text whose lines end with CR alone (CRs, no LF) is said to be one; LF and CR LF line
+   !> ends are not.
+   subroutine test_lone_cr(error)
+      type(error_type), allocatable, intent(out) :: error
+      character(len=*), parameter :: cr = achar(13), lf = achar(10)
+
+      call check(error, index(cr_line_ends('a'//cr//'b'//cr), ': its lines end with CR alone') == 1, &
+                 'CR-only line ends')
+      if (allocated(error)) return
+      call check(error, len_trim(cr_line_ends('a'//cr//lf//'b'//lf)), 0, 'CR LF and LF: nothing to say')
+      if (allocated(error)) return
+      call check(error, len_trim(cr_line_ends('a b')), 0, 'one line without an end: nothing to say')
+   end subroutine test_lone_cr
+
+   !> fmt_text: a text of at most 80 characters as it is (control characters as '?'); a
+   !> longer one cut after 80 characters, never inside a UTF-8 character, and its length said.
+   subroutine test_echo(error)
+      type(error_type), allocatable, intent(out) :: error
+      character(len=*), parameter :: e_acute = achar(195)//achar(169)
+
+      call check(error, trim(fmt_text('abc'//achar(9)//'d')), 'abc?d')
+      if (allocated(error)) return
+      call check(error, trim(fmt_text(repeat('x', 80))), repeat('x', 80))
+      if (allocated(error)) return
+      call check(error, trim(fmt_text(repeat('x', 81))), repeat('x', 80)//'... (81 characters)')
+      if (allocated(error)) return
+      call check(error, trim(fmt_text(repeat('y', 1000000))), repeat('y', 80)//'... (1000000 characters)')
+      if (allocated(error)) return
+      call check(error, trim(fmt_text(repeat(e_acute, 100))), repeat(e_acute, 80)//'... (100 characters)')
+      if (allocated(error)) return
+      call check(error, trim(fmt_text('x'//repeat(e_acute, 80))), 'x'//repeat(e_acute, 79)//'... (81 characters)')
+      if (allocated(error)) return
+      call check(error, trim(fmt_text(repeat(achar(128), 400))), repeat(achar(128), 320)//'... (400 bytes)', &
+                 'bytes that are no UTF-8 text')
+   end subroutine test_echo
 
 end module test_fd_textio
