@@ -7,6 +7,7 @@ from __future__ import annotations
 
 import json
 import os
+import re
 import signal
 import subprocess
 import time
@@ -198,3 +199,99 @@ def test_summary_names_the_version(run):
     summ = json.loads((r.workdir / "out" / "same.summary.json").read_text())
     assert summ["frictiondyn_version"] == frictiondyn.__version__
     assert np.isfinite(summ["energy_residual_J"])
+
+
+def test_planted_lock_symlink_is_not_followed(tmp_path):
+    """The commit lock out/.<name>.lock planted as a symbolic link (to a file that does not
+    exist, as an attacker would point it anywhere): the writer neither follows it nor creates
+    its target; the run fails with a message naming the lock, and leaves no output and no
+    temporary file (the planted link alone stays)."""
+    deck = tmp_path / "same.nml"
+    deck.write_text(deck_text(oscillator(1, 0.2)))
+    out = tmp_path / "out"
+    out.mkdir()
+    target = tmp_path / "elsewhere" / "victim"
+    target.parent.mkdir()
+    (out / ".same.lock").symlink_to(target)
+    r = subprocess.run([EXE, str(deck)], cwd=tmp_path, capture_output=True, text=True)
+    assert r.returncode == 1, r.stdout
+    assert "same.nml: cannot lock 'out/.same.lock': it is a symbolic link" in r.stderr
+    assert not target.exists() and list(target.parent.iterdir()) == []
+    assert sorted(p.name for p in out.iterdir()) == [".same.lock"]
+    assert (out / ".same.lock").is_symlink()
+
+
+def test_file_size_limit_is_a_clean_write_error(tmp_path):
+    """Under a file-size limit (`ulimit -f`, 64 KiB) a history of about 250 KB cannot be
+    written: the executable is not killed by SIGXFSZ (status 153) but ends with the usual
+    error (status 1) naming the file and the reason, and leaves no file behind."""
+    deck = tmp_path / "big.nml"
+    deck.write_text(deck_text(oscillator(1, 20.0, name="big")))
+    r = subprocess.run(["bash", "-c", f'ulimit -f 64; exec "{EXE}" big.nml'], cwd=tmp_path,
+                       capture_output=True, text=True)
+    assert r.returncode == 1, (r.returncode, r.stderr[-500:])
+    assert "frictiondyn: error:" in r.stderr
+    assert re.search(r"cannot write 'out/\.big\.csv\.[^']*\.tmp': File too large",
+                     r.stderr), r.stderr
+    assert "Backtrace" not in r.stderr and "signal" not in r.stderr
+    out = tmp_path / "out"
+    assert not out.exists() or list(out.iterdir()) == []
+
+
+def test_output_directory_that_cannot_be_made_gives_the_system_reason(tmp_path):
+    """A new output directory under a regular file: the error names the directory and
+    gives the system's reason."""
+    (tmp_path / "plain").write_text("a file, not a directory\n")
+    g = oscillator(1, 0.2)
+    g["output"]["dir"] = "plain/out"
+    (tmp_path / "d.nml").write_text(deck_text(g))
+    r = subprocess.run([EXE, "d.nml"], cwd=tmp_path, capture_output=True, text=True)
+    assert r.returncode == 1
+    assert ("&output: cannot create the output directory dir = 'plain/out': Not a directory"
+            in r.stderr), r.stderr
+
+
+def test_read_only_file_system_output_directory_gives_the_system_reason(tmp_path):
+    """A new output directory on a read-only file system (a tmpfs mounted read-only): the
+    error gives the system's reason, "Read-only file system"."""
+    if os.geteuid() != 0:
+        pytest.skip("mounting a tmpfs needs root (CI runs as root)")
+    mnt = tmp_path / "ro"
+    mnt.mkdir()
+    m = subprocess.run(["mount", "-t", "tmpfs", "-o", "ro,size=16k", "tmpfs", str(mnt)],
+                       capture_output=True, text=True)
+    if m.returncode != 0:
+        pytest.skip(f"cannot mount a tmpfs here: {m.stderr.strip()}")
+    try:
+        g = oscillator(1, 0.2)
+        g["output"]["dir"] = f"{mnt}/new/out"
+        (tmp_path / "d.nml").write_text(deck_text(g))
+        r = subprocess.run([EXE, "d.nml"], cwd=tmp_path, capture_output=True, text=True)
+    finally:
+        subprocess.run(["umount", "-l", str(mnt)], check=False)
+    assert r.returncode == 1
+    assert f"cannot create the output directory dir = '{mnt}/new/out': Read-only file system" in r.stderr
+
+
+def test_latin1_path_and_label_give_a_valid_utf8_summary(tmp_path):
+    """A deck in a directory whose name has Latin-1 bytes ('d\\xe9j\\xe0'), with a Latin-1
+    label ('caf\\xe9') and a tab in another: the summary is valid UTF-8 JSON (strict), each
+    such byte the character of its Latin-1 reading, and Result.from_files reads it."""
+    work = os.path.join(os.fsencode(tmp_path), b"d\xe9j\xe0")
+    os.mkdir(work)
+    g = oscillator(2, 0.2, name="lat")
+    deck = deck_text(g).encode().replace(
+        b"  mass = 100.0, 100.0\n", b"  mass = 100.0, 100.0\n  label = 'caf\xe9', 'a\tb'\n")
+    with open(os.path.join(work, b"lat.nml"), "wb") as fh:
+        fh.write(deck)
+    r = subprocess.run([os.fsencode(EXE), os.path.join(work, b"lat.nml")], cwd=work,
+                       capture_output=True)
+    assert r.returncode == 0, r.stderr
+    out = os.path.join(work, b"out")
+    raw = open(os.path.join(out, b"lat.summary.json"), "rb").read()
+    summ = json.loads(raw.decode("utf-8", errors="strict"), strict=True)
+    assert summ["deck"] == os.path.join(work, b"lat.nml").decode("latin-1")
+    assert summ["dof_labels"] == ["café", "a\tb"]
+    res = frictiondyn.Result.from_files(os.fsdecode(os.path.join(out, b"lat.csv")))
+    assert res.dof_labels == ["café", "a\tb"]
+    assert res.summary == summ

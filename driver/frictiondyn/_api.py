@@ -682,7 +682,7 @@ class Result:
         ``h.summary.json``, ``h.dat`` -> ``h.dat.summary.json``) and raises
         FileNotFoundError when it is missing; False reads none (``summary`` is then {})."""
         csv = Path(csv)
-        with csv.open() as fh:
+        with csv.open(encoding="utf-8") as fh:
             header = fh.readline().strip()
         data = np.loadtxt(csv, delimiter=",", skiprows=1, ndmin=2)
         if summary is False:
@@ -694,7 +694,7 @@ class Result:
                     f"{csv}: no summary {summary.name} next to it (pass summary=False to read "
                     "the history alone, or the summary's path)"
                 )
-        text = Path(summary).read_text().removesuffix("\n")
+        text = Path(summary).read_text(encoding="utf-8").removesuffix("\n")
         return cls.from_arrays(header, data, text)
 
     @classmethod

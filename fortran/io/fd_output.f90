@@ -15,7 +15,7 @@ module fd_output
    use fd_names, only: excitation_types, keyword_len
    use fd_matrices, only: modes_type, modes_flexible, modes_rigid, modes_unrestrained
    use fd_fileops, only: c_lock_acquire, c_lock_release, c_unlink, c_rename, os_error, c_getpid, &
-                         c_file_create, c_file_write, c_file_close
+                         c_file_create, c_file_write, c_file_close, c_mkdir, lock_not_file
    implicit none
    private
 
@@ -28,12 +28,6 @@ module fd_output
          character(kind=c_char), intent(in) :: path(*)
          integer(c_int) :: stat
       end function c_rmdir
-      function c_mkdir(path, mode) bind(c, name='mkdir') result(stat)
-         import :: c_char, c_int
-         character(kind=c_char), intent(in) :: path(*)
-         integer(c_int), value :: mode
-         integer(c_int) :: stat
-      end function c_mkdir
    end interface
 
    integer(c_int), parameter :: enoent = 2, eexist = 17
@@ -170,7 +164,12 @@ contains
       end if
       call hidden_name(stem, '.lock', lock)
       err = c_lock_acquire(lock//c_null_char, fd)
-      if (err /= 0) then
+      if (err == lock_not_file) then
+         call discard()
+         call fatal_error(error, "cannot lock '"//lock//"': it is a symbolic link or not a regular file "// &
+                          "(a lock file is never followed; remove it)")
+         return
+      else if (err /= 0) then
          call discard()
          call os_error(error, "cannot lock '"//lock//"'", err)
          return
@@ -216,22 +215,31 @@ contains
       character(len=*), intent(in) :: dir
       type(error_type), allocatable, intent(out) :: error
       character(len=:), allocatable, intent(out), optional :: made
-      integer :: stat, i
+      integer :: i
+      integer(c_int) :: err, first
       logical :: exists
 
+      first = 0
       do i = 2, len(dir) + 1
          if (i <= len(dir)) then
             if (dir(i:i) /= '/') cycle
          end if
          inquire (file=dir(1:i - 1)//'/.', exist=exists)
          if (exists) cycle
-         stat = c_mkdir(dir(1:i - 1)//c_null_char, int(o'755', c_int))
-         if (stat == 0 .and. present(made)) then
+         err = c_mkdir(dir(1:i - 1)//c_null_char)
+         if (err == 0 .and. present(made)) then
             if (.not. allocated(made)) made = dir(1:i - 1)
+         else if (err /= 0 .and. err /= eexist .and. first == 0) then
+            first = err
          end if
       end do
       inquire (file=dir//'/.', exist=exists)
-      if (.not. exists) call fatal_error(error, "&output: cannot create the output directory dir = '"//dir//"'")
+      if (exists) return
+      if (first /= 0) then
+         call os_error(error, "&output: cannot create the output directory dir = '"//dir//"'", first)
+      else
+         call fatal_error(error, "&output: cannot create the output directory dir = '"//dir//"'")
+      end if
    end subroutine make_dir
 
    !> Remove the directories make_dir created for `dir` (`made` the outermost), innermost
@@ -670,20 +678,77 @@ contains
       str = adjustl(row(1:stream_value_width - 1))
    end function json_real
 
+   !> A text as the content of a JSON string: '"' and '\' escaped, control characters as
+   !> \u00XX, well-formed UTF-8 sequences kept, and any other byte (Latin-1 text, a stray
+   !> byte of a path) written as the character of its Latin-1 reading (\u00XX): the summary is
+   !> valid UTF-8 JSON whatever the bytes of a path, a label or a record title.
    pure subroutine json_escape(s, r)
-      character(len=*), intent(in) :: s
-      character(len=:), allocatable, intent(out) :: r
-      integer :: i
-      r = ''
-      do i = 1, len(s)
+      character(len=*), intent(in) :: s                 !! bytes
+      character(len=:), allocatable, intent(out) :: r   !! the escaped text
+      character(len=16), parameter :: hex = '0123456789abcdef'
+      character(len=:), allocatable :: buf
+      integer :: i, pos, c, n, k, lo, hi
+
+      allocate (character(len=6*len(s)) :: buf)
+      pos = 0
+      i = 1
+      do while (i <= len(s))
+         c = iachar(s(i:i))
          if (s(i:i) == '"' .or. s(i:i) == '\') then
-            r = r//'\'//s(i:i)
-         else if (iachar(s(i:i)) < 32) then
-            r = r//' '
-         else
-            r = r//s(i:i)
+            buf(pos + 1:pos + 2) = '\'//s(i:i)
+            pos = pos + 2
+            i = i + 1
+            cycle
+         else if (c >= 32 .and. c < 128) then
+            buf(pos + 1:pos + 1) = s(i:i)
+            pos = pos + 1
+            i = i + 1
+            cycle
          end if
+         ! the continuation bytes a well-formed UTF-8 sequence led by c has (0: none), and the
+         ! range of its second byte (no overlong form, no surrogate, nothing above U+10FFFF)
+         n = 0
+         lo = 128
+         hi = 191
+         select case (c)
+         case (194:223)
+            n = 1
+         case (224)
+            n = 2
+            lo = 160
+         case (225:236, 238:239)
+            n = 2
+         case (237)
+            n = 2
+            hi = 159
+         case (240)
+            n = 3
+            lo = 144
+         case (241:243)
+            n = 3
+         case (244)
+            n = 3
+            hi = 143
+         end select
+         if (n > 0 .and. i + n <= len(s)) then
+            if (iachar(s(i + 1:i + 1)) >= lo .and. iachar(s(i + 1:i + 1)) <= hi) then
+               do k = 2, n
+                  if (iachar(s(i + k:i + k)) < 128 .or. iachar(s(i + k:i + k)) > 191) exit
+               end do
+               if (k > n) then
+                  buf(pos + 1:pos + n + 1) = s(i:i + n)
+                  pos = pos + n + 1
+                  i = i + n + 1
+                  cycle
+               end if
+            end if
+         end if
+         ! a control character, or a byte that starts no well-formed sequence: \u00XX
+         buf(pos + 1:pos + 6) = '\u00'//hex(c/16 + 1:c/16 + 1)//hex(mod(c, 16) + 1:mod(c, 16) + 1)
+         pos = pos + 6
+         i = i + 1
       end do
+      r = buf(1:pos)
    end subroutine json_escape
 
 end module fd_output
