@@ -295,3 +295,90 @@ def test_latin1_path_and_label_give_a_valid_utf8_summary(tmp_path):
     res = frictiondyn.Result.from_files(os.fsdecode(os.path.join(out, b"lat.csv")))
     assert res.dof_labels == ["café", "a\tb"]
     assert res.summary == summ
+
+
+def _undefined():
+    import sys
+    sys.path.insert(0, str(Path(__file__).resolve().parent / "fuzz"))
+    import undefined  # the one list of keys that can be null: docs/namelist.md
+    return undefined
+
+
+def test_undefined_summary_values_are_null_never_0(tmp_path):
+    """Values a run does not define are JSON null, only in the keys docs/namelist.md lists
+    ("Undefined values"), and the executable prints "not defined (why)":
+    - a braced mass (a velocity-law device and a spring to the table, a storey without a
+      height): the stuck system is rigid, so period_stuck_s and xi_stuck are null (the
+      executable printed 'stuck period .000000 s'), and so are the drift ratios;
+    - the event-driven technique: omega_max_rad_s, omega_max_dt1 (no step dt1);
+    - a flat slider at rest with no table motion: the free system's rigid-body mode (period
+      and damping ratio), excitation_frequency_Hz, energy_residual_ratio (no energy passed),
+      the times of peaks that never occurred."""
+    und = _undefined()
+    keys = und.undefined_keys()
+    braced = oscillator(1, 0.5, name="braced")
+    braced["friction"] = {"n_devices": 1, "node_i": 1, "node_j": 0, "law": "velocity",
+                          "p": 1000.0, "mu": 0.3, "eps": 1e-3}
+    braced["damping"] = {"damping_type": "none"}
+    braced["storeys"] = {"n_storeys": 1, "node_i": 1, "node_j": 0}
+    event = {**oscillator(1, 0.5, name="event")}
+    event["friction"] = {"n_devices": 1, "node_i": 1, "node_j": 0, "law": "coulomb",
+                         "p": 100.0, "mu": 0.3}
+    event["integration"] = {"technique": "event_driven", "n1": 2}
+    slider = {
+        "model": {"n_dof": 1, "mass": [2.0]},
+        "springs": {"n_springs": 0},
+        "damping": {"damping_type": "none"},
+        "friction": {"n_devices": 1, "node_i": 1, "node_j": 0, "law": "velocity",
+                     "p": 19.62, "mu": 0.3, "eps": 1e-3},
+        "excitation": {"excitation_type": "none", "dt_record": 0.01, "duration": 0.2},
+        "output": {"name": "slider"},
+    }
+    summ = {}
+    for g in (braced, event, slider):
+        name = g["output"]["name"]
+        (tmp_path / f"{name}.nml").write_text(deck_text(g))
+        r = subprocess.run([EXE, f"{name}.nml"], cwd=tmp_path, capture_output=True, text=True)
+        assert r.returncode == 0, r.stderr
+        summ[name] = json.loads((tmp_path / "out" / f"{name}.summary.json").read_text())
+        assert und.null_keys(summ[name]) <= keys, und.null_keys(summ[name]) - keys
+        assert keys <= set(summ[name]), keys - set(summ[name])  # the list names real keys
+        if name == "braced":
+            assert ("stuck period not defined (with every device a rigid link the structure has "
+                    "no free DOF or a rigid-body mode)") in r.stdout
+    b, e, s = summ["braced"], summ["event"], summ["slider"]
+    assert b["period_stuck_s"] is None and b["xi_stuck"] is None
+    assert b["storey_height_m"] == [0.0]
+    assert b["peak_drift_ratio"] == [None] and b["residual_drift_ratio"] == [None]
+    assert b["peak_drift_m"][0] > 0 and b["omega_max_rad_s"] > 0
+    assert e["omega_max_rad_s"] is None and e["omega_max_dt1"] is None
+    assert e["mode_resolution"] == "not applicable"
+    assert s["modes_free_status"] == "unrestrained"
+    assert s["periods_free_s"] == [None] and s["modal_xi_free"] == [None]
+    assert s["excitation_frequency_Hz"] is None and s["energy_residual_ratio"] is None
+    assert s["peak_u_m"] == [0.0] and s["peak_u_time_s"] == [None]
+    assert s["peak_aabs_time_s"] == [None] and s["mu_unconverged_s"] is None
+
+
+def test_python_reads_undefined_values_as_none_and_nan(tmp_path):
+    """Python's Result holds an undefined summary value as None (as json.loads reads null),
+    in the run's Result and in Result.from_files alike; modes() gives inf for a rigid-body
+    mode's period and nan for its damping ratio."""
+    g = {
+        "model": {"n_dof": 1, "mass": [2.0]},
+        "springs": {"n_springs": 0},
+        "damping": {"damping_type": "none"},
+        "friction": {"n_devices": 1, "node_i": 1, "node_j": 0, "law": "velocity",
+                     "p": 19.62, "mu": 0.3, "eps": 1e-3},
+        "excitation": {"excitation_type": "none", "dt_record": 0.01, "duration": 0.2},
+        "output": {"name": "slider"},
+    }
+    (tmp_path / "slider.nml").write_text(deck_text(g))
+    res = frictiondyn.run(tmp_path / "slider.nml")
+    assert res.summary["period_stuck_s"] is None and res.summary["periods_free_s"] == [None]
+    modes = res.modes("free")
+    assert modes.status == "unrestrained"
+    assert np.isinf(modes.periods[0]) and np.isnan(modes.xi[0]) and modes.frequencies[0] == 0.0
+    res.to_csv(tmp_path / "h.csv")
+    back = frictiondyn.Result.from_files(tmp_path / "h.csv")
+    assert back.summary == res.summary and back.summary["excitation_frequency_Hz"] is None

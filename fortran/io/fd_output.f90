@@ -10,6 +10,7 @@ module fd_output
    use fd_result, only: result_type, resolution_names, energy_balance_names, record_system_names
    use fd_record, only: record_info
    use fd_warnings, only: warning_text, run_warnings
+   use fd_undefined, only: undefined_why
    use fd_version, only: frictiondyn_version
    use fd_history_stream, only: format_row, stream_value_width
    use fd_names, only: excitation_types, keyword_len
@@ -410,13 +411,13 @@ contains
       call kv('stick_resolution', '"'//trim(resolution_names(res%stick_resolution))//'"')
       call kr('band_x', res%band_x)
       call kr('band_alternation_N', res%band_alternation)
-      call kr('band_alternation_s', res%band_alternation_time)
+      call kr('band_alternation_s', res%band_alternation_time, res%band_alternation /= 0.0_dp)
       call kv('band_resolution', '"'//trim(resolution_names(res%band_resolution))//'"')
       call kr('peak_u_m', res%peak_u)
-      call kr('peak_u_time_s', res%peak_u_time)
+      call kr('peak_u_time_s', res%peak_u_time, res%peak_u /= 0.0_dp)
       call kr('peak_v_mps', res%peak_v)
       call kr('peak_aabs_mps2', res%peak_aabs)
-      call kr('peak_aabs_time_s', res%peak_aabs_time)
+      call kr('peak_aabs_time_s', res%peak_aabs_time, res%peak_aabs /= 0.0_dp)
       call kr('peak_s_m', res%peak_s)
       call kr('peak_force_N', res%peak_force)
       call ki('stick_to_slip', res%stick_to_slip)
@@ -518,16 +519,17 @@ contains
             call put('],'//nl)
             call kr('storey_height_m', eng%height)
             call kr('peak_drift_m', eng%peak_drift)
-            call kr('peak_drift_time_s', eng%peak_drift_time)
+            call kr('peak_drift_time_s', eng%peak_drift_time, eng%peak_drift /= 0.0_dp)
             call kr('residual_drift_m', eng%drift)
+            ! a ratio without a storey height is undefined (null), not 0
             allocate (ratio(eng%n_storeys))
             ratio = 0.0_dp
             where (eng%height > 0.0_dp) ratio = eng%peak_drift/eng%height
-            call kr('peak_drift_ratio', ratio)
+            call kr('peak_drift_ratio', ratio, eng%height > 0.0_dp)
             where (eng%height > 0.0_dp) ratio = eng%drift/eng%height
-            call kr('residual_drift_ratio', ratio)
+            call kr('residual_drift_ratio', ratio, eng%height > 0.0_dp)
             call kr('peak_storey_shear_N', eng%peak_shear(1:))
-            call kr('peak_storey_shear_time_s', eng%peak_shear_time(1:))
+            call kr('peak_storey_shear_time_s', eng%peak_shear_time(1:), eng%peak_shear(1:) /= 0.0_dp)
             call kr('residual_storey_shear_N', eng%shear(1:))
          end associate
       end subroutine engineering_keys
@@ -551,8 +553,8 @@ contains
             call kr('modal_xi_'//name, [real(dp) ::])
             return
          end select
-         ! a rigid-body mode (w = 0): period and damping ratio 0 (its period is infinite)
-         call kr('periods_'//name//'_s', merge(m%period, 0.0_dp, m%omega2 > 0.0_dp))
+         ! a rigid-body mode (w = 0): period (infinite) and damping ratio undefined (null)
+         call kr('periods_'//name//'_s', merge(m%period, 0.0_dp, m%omega2 > 0.0_dp), m%omega2 > 0.0_dp)
          call put('  "mode_shapes_'//name//'": [')
          do j = 1, m%n
             call put_reals(m%shape(:, j))
@@ -560,7 +562,7 @@ contains
          end do
          call put('],'//nl)
          call kr('modal_mass_ratio_'//name, m%mass_ratio)
-         call kr('modal_xi_'//name, merge(m%xi, 0.0_dp, m%omega2 > 0.0_dp))
+         call kr('modal_xi_'//name, merge(m%xi, 0.0_dp, m%omega2 > 0.0_dp), m%omega2 > 0.0_dp)
       end subroutine modes_keys
       !> The run's warnings (fd_warnings), one string each.
       subroutine warnings_key()
@@ -600,26 +602,40 @@ contains
          integer, intent(in) :: n
          call kv(key, trim(fmt_int(n)))
       end subroutine kint
-      !> A real number (null when not finite, json_real).
+      !> A real number: null when the key is undefined for this result (fd_undefined).
       subroutine kreal(key, x)
          character(len=*), intent(in) :: key
          real(dp), intent(in) :: x
-         call kv(key, trim(json_real(x)))
+         if (len_trim(undefined_why(res, key)) > 0) then
+            call kv(key, 'null')
+         else
+            call kv(key, trim(json_real(x)))
+         end if
       end subroutine kreal
-      subroutine kr(key, x)
+      !> A list of reals; with `defined`, null for each item not defined.
+      subroutine kr(key, x, defined)
          character(len=*), intent(in) :: key
          real(dp), intent(in) :: x(:)
+         logical, intent(in), optional :: defined(:)
          call put('  "'//key//'": ')
-         call put_reals(x)
+         call put_reals(x, defined)
          call put(','//nl)
       end subroutine kr
       !> '[x1, x2, ...]' appended number by number (put: linear in the length).
-      subroutine put_reals(x)
+      subroutine put_reals(x, defined)
          real(dp), intent(in) :: x(:)
+         logical, intent(in), optional :: defined(:)
          integer :: k
+         logical :: def
          call put('[')
          do k = 1, size(x)
-            call put(trim(json_real(x(k))))
+            def = .true.
+            if (present(defined)) def = defined(k)
+            if (def) then
+               call put(trim(json_real(x(k))))
+            else
+               call put('null')
+            end if
             if (k < size(x)) call put(', ')
          end do
          call put(']')
