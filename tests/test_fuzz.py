@@ -26,3 +26,17 @@ def test_a_short_fuzz_campaign_has_no_failure(tmp_path):
     # the campaign exercises both outcomes (measured: about a quarter run, most are refused)
     assert rep["successes"] > COUNT // 10 and rep["clean errors"] > COUNT // 2
     assert not any(counts.values()), (counts, rep["failures"][:5])
+
+
+def test_a_short_at2_header_campaign_has_no_failure(tmp_path):
+    """The AT2 fuzzer (tests/fuzz/at2_fuzz.py; a long campaign by request: --count 5000):
+    60 mutated PEER records (tabs and duplicate keys in line 4, values after DT, NPTS off by
+    one, numbers cut inside, values moved out of their fixed-width fields, tabs between
+    them, CRLF, units), each read with exactly its values or refused naming the record
+    file, the line and the rule it breaks."""
+    import at2_fuzz
+    import frictiondyn
+
+    rep = at2_fuzz.campaign(60, 2024, frictiondyn.executable(), tmp_path)
+    assert rep["failures"] == []
+    assert rep["accepted"] >= 10 and rep["refused"] >= 20  # measured: 20 read, 40 refused

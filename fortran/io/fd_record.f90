@@ -324,7 +324,8 @@ contains
          if (width < 0) then
             width = field_width(text(lo:hi))
             first = line
-         else if (width > 0) then
+         end if
+         if (width > 0) then
             ! a value that does not fill its field: cut short (a truncated file), shifted or glued
             call misplaced_field(text(lo:hi), width, bad_lo, bad_hi)
             if (scan(text(lo:hi), achar(9)//',') > 0) then
@@ -816,15 +817,19 @@ contains
    end subroutine parse_real
 
    !> The width of the fixed-width fields of a record line (an AT2 body line as PEER writes
-   !> them, FORTRAN's 5E15.7 and the like): w when the line holds at least two values and the
-   !> j-th ends at column j w (w: where the first ends), every field blank-padded on the left;
-   !> 0 when it does not (values separated freely, a tab or a comma among them).
+   !> them, FORTRAN's 5E15.7 and the like): w when the line holds at least two values of which
+   !> the j-th ends at column j w (w: where the first ends), every field blank-padded on the
+   !> left (the first value too: a line that starts with a value sets no fields), all of
+   !> them but perhaps the last (a line cut inside its last value still shows its fields:
+   !> misplaced_field finds that value); 0 when it does not (values separated freely, a tab
+   !> or a comma among them).
    pure integer function field_width(s) result(w)
       character(len=*), intent(in) :: s   !! the line
       integer :: i, j, k
 
       w = 0
-      if (scan(s, achar(9)//',') > 0) return
+      if (len(s) == 0 .or. scan(s, achar(9)//',') > 0) return
+      if (s(1:1) /= ' ') return
       k = 0
       i = 1
       do
@@ -842,7 +847,8 @@ contains
          if (k == 1) then
             w = j
          else if (j /= k*w) then
-            w = 0
+            ! misplaced: only the last value may be, after two in their fields
+            if (k < 3 .or. verify(s(j + 1:), ' '//achar(13)) /= 0) w = 0
             return
          end if
          i = j + 1

@@ -146,6 +146,14 @@ contains
       if (allocated(error)) return
       call check(error, field_width('0.1 -0.25 0.003'), 0, 'free format')
       if (allocated(error)) return
+      call check(error, field_width('-0.12345 0.12345'), 0, 'free format, evenly spaced by chance')
+      if (allocated(error)) return
+      call check(error, field_width('  1.0000000E-01  2.0000000E-01  3.0000000'), 15, 'the last value cut')
+      if (allocated(error)) return
+      call check(error, field_width('  1.0000000E-01  2.0000000E-01  3.0000000  4.0'), 0, 'an inner value off')
+      if (allocated(error)) return
+      call check(error, field_width('  1.0000000E-01  2.0000000'), 0, 'two values, the second off')
+      if (allocated(error)) return
       call check(error, field_width('  1.0000000E-01'), 0, 'one value: no layout')
       if (allocated(error)) return
       call check(error, field_width('  1.0E-01,  2.0E-01'), 0, 'a comma: no layout')
