@@ -171,8 +171,8 @@ def test_peaks_of_a_linear_run_are_the_rows_peaks():
         k = int(np.argmax(np.abs(r[f"drift{st}"])))
         assert s["peak_drift_m"][st - 1] == abs(r[f"drift{st}"][k])
         assert s["peak_drift_time_s"][st - 1] == pytest.approx(r.time[k], rel=1e-12)
-    # no height given: 0 (the summary holds no null), and so the drift ratio
-    assert s["peak_drift_ratio"] == [0.0] * 3 and s["storey_height_m"] == [0.0] * 3
+    # no height given: 0, and the drift ratio undefined (null: docs/namelist.md)
+    assert s["peak_drift_ratio"] == [None] * 3 and s["storey_height_m"] == [0.0] * 3
     assert s["peak_base_shear_N"] == np.abs(r["Vb"]).max()
     # with a0 M damping the base shear is the inertia forces less the a0 M v forces
     m = np.full(3, M_FLOOR)
@@ -223,7 +223,7 @@ def test_a_rigid_stuck_system_is_reported_rigid_not_as_zero_seconds():
     a = chain(2, devices=[fd.Device(i, 0, p=1e6, mu=0.5, law="velocity") for i in (1, 2)])
     s = a.run().summary
     assert s["modes_stuck_status"] == "rigid" and s["periods_stuck_s"] == []
-    assert s["period_stuck_s"] == 0.0 and s["xi_stuck"] == 0.0  # 0: none (no null)
+    assert s["period_stuck_s"] is None and s["xi_stuck"] is None  # undefined: null, not 0
     assert s["modes_free_status"] == "flexible" and len(s["periods_free_s"]) == 2
     # a flat slider with nothing to the table: the free system has a rigid-body mode
     b = fd.Analysis(
@@ -233,8 +233,8 @@ def test_a_rigid_stuck_system_is_reported_rigid_not_as_zero_seconds():
         excitation=fd.FreeVibration(0.01, 0.1),
     )
     rb = b.run()
-    # the summary: 0 for the rigid-body mode's period and damping ratio (no null)
-    assert rb.summary["periods_free_s"][0] == 0.0 and rb.summary["modal_xi_free"][0] == 0.0
+    # the summary: null for the rigid-body mode's period and damping ratio (undefined)
+    assert rb.summary["periods_free_s"][0] is None and rb.summary["modal_xi_free"][0] is None
     modes = rb.modes("free")
     assert modes.status == "unrestrained" and modes.periods[0] == np.inf
     assert modes.mass_ratios[0] == pytest.approx(1.0, rel=1e-12) and np.isnan(modes.xi[0])
@@ -249,7 +249,7 @@ def test_hysteretic_devices_are_their_sticking_springs_in_the_stuck_modes():
     for j in range(n):
         w, _ = chain_mode(n, j + 1)
         assert s["periods_stuck_s"][j] == pytest.approx(2 * np.pi / w / np.sqrt(2), rel=1e-12)
-    assert s["period_stuck_s"] == 0.0  # every device a rigid link to the table: rigid, none
+    assert s["period_stuck_s"] is None  # every device a rigid link to the table: rigid, none
 
 
 # --- Rayleigh damping from modes -------------------------------------------------------
@@ -504,7 +504,7 @@ def test_the_summary_names_the_version_the_deck_and_the_record_with_their_hashes
     assert s["deck_sha256"] == hashlib.sha256(deck.read_bytes()).hexdigest()
     assert s["record"]["file"] == "synthetic_pga035.AT2"  # as the deck gives it
     assert s["record"]["sha256"] == hashlib.sha256(record.read_bytes()).hexdigest()
-    assert s["excitation_type"] == "record" and s["excitation_frequency_Hz"] == 0.0
+    assert s["excitation_type"] == "record" and s["excitation_frequency_Hz"] is None
     # a deck given as text: the hash of the text; the same text written to a file: the same
     a = chain(2)
     text = a.deck_text()

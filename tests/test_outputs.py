@@ -6,6 +6,8 @@ SIGINT); the executable's command line (--list/--index, --version, --help)."""
 from __future__ import annotations
 
 import json
+import os
+import re
 import signal
 import subprocess
 import time
@@ -180,3 +182,186 @@ def test_summary_names_the_version(run):
     summ = json.loads((r.workdir / "out" / "same.summary.json").read_text())
     assert summ["frictiondyn_version"] == frictiondyn.__version__
     assert np.isfinite(summ["energy_residual_J"])
+
+
+def test_planted_lock_symlink_is_not_followed(tmp_path):
+    """The commit lock out/.<name>.lock planted as a symbolic link (to a file that does not
+    exist, as an attacker would point it anywhere): the writer neither follows it nor creates
+    its target; the run fails with a message naming the lock, and leaves no output and no
+    temporary file (the planted link alone stays)."""
+    deck = tmp_path / "same.nml"
+    deck.write_text(deck_text(oscillator(1, 0.2)))
+    out = tmp_path / "out"
+    out.mkdir()
+    target = tmp_path / "elsewhere" / "victim"
+    target.parent.mkdir()
+    (out / ".same.lock").symlink_to(target)
+    r = subprocess.run([EXE, str(deck)], cwd=tmp_path, capture_output=True, text=True)
+    assert r.returncode == 1, r.stdout
+    assert "same.nml: cannot lock 'out/.same.lock': it is a symbolic link" in r.stderr
+    assert not target.exists() and list(target.parent.iterdir()) == []
+    assert sorted(p.name for p in out.iterdir()) == [".same.lock"]
+    assert (out / ".same.lock").is_symlink()
+
+
+def test_file_size_limit_is_a_clean_write_error(tmp_path):
+    """Under a file-size limit (`ulimit -f`, 64 KiB) a history of about 250 KB cannot be
+    written: the executable is not killed by SIGXFSZ (status 153) but ends with the usual
+    error (status 1) naming the file and the reason, and leaves no file behind."""
+    deck = tmp_path / "big.nml"
+    deck.write_text(deck_text(oscillator(1, 20.0, name="big")))
+    r = subprocess.run(["bash", "-c", f'ulimit -f 64; exec "{EXE}" big.nml'], cwd=tmp_path,
+                       capture_output=True, text=True)
+    assert r.returncode == 1, (r.returncode, r.stderr[-500:])
+    assert "frictiondyn: error:" in r.stderr
+    assert re.search(r"cannot write 'out/\.big\.csv\.[^']*\.tmp': File too large",
+                     r.stderr), r.stderr
+    assert "Backtrace" not in r.stderr and "signal" not in r.stderr
+    out = tmp_path / "out"
+    assert not out.exists() or list(out.iterdir()) == []
+
+
+def test_output_directory_that_cannot_be_made_gives_the_system_reason(tmp_path):
+    """A new output directory under a regular file: the error names the directory and
+    gives the system's reason."""
+    (tmp_path / "plain").write_text("a file, not a directory\n")
+    g = oscillator(1, 0.2)
+    g["output"]["dir"] = "plain/out"
+    (tmp_path / "d.nml").write_text(deck_text(g))
+    r = subprocess.run([EXE, "d.nml"], cwd=tmp_path, capture_output=True, text=True)
+    assert r.returncode == 1
+    assert ("&output: cannot create the output directory dir = 'plain/out': Not a directory"
+            in r.stderr), r.stderr
+
+
+def test_read_only_file_system_output_directory_gives_the_system_reason(tmp_path):
+    """A new output directory on a read-only file system (a tmpfs mounted read-only): the
+    error gives the system's reason, "Read-only file system"."""
+    if os.geteuid() != 0:
+        pytest.skip("mounting a tmpfs needs root (CI runs as root)")
+    mnt = tmp_path / "ro"
+    mnt.mkdir()
+    m = subprocess.run(["mount", "-t", "tmpfs", "-o", "ro,size=16k", "tmpfs", str(mnt)],
+                       capture_output=True, text=True)
+    if m.returncode != 0:
+        pytest.skip(f"cannot mount a tmpfs here: {m.stderr.strip()}")
+    try:
+        g = oscillator(1, 0.2)
+        g["output"]["dir"] = f"{mnt}/new/out"
+        (tmp_path / "d.nml").write_text(deck_text(g))
+        r = subprocess.run([EXE, "d.nml"], cwd=tmp_path, capture_output=True, text=True)
+    finally:
+        subprocess.run(["umount", "-l", str(mnt)], check=False)
+    assert r.returncode == 1
+    assert f"cannot create the output directory dir = '{mnt}/new/out': Read-only file system" in r.stderr
+
+
+def test_latin1_path_and_label_give_a_valid_utf8_summary(tmp_path):
+    """A deck in a directory whose name has Latin-1 bytes ('d\\xe9j\\xe0'), with a Latin-1
+    label ('caf\\xe9') and a tab in another: the summary is valid UTF-8 JSON (strict), each
+    such byte the character of its Latin-1 reading, and Result.from_files reads it."""
+    work = os.path.join(os.fsencode(tmp_path), b"d\xe9j\xe0")
+    os.mkdir(work)
+    g = oscillator(2, 0.2, name="lat")
+    deck = deck_text(g).encode().replace(
+        b"  mass = 100.0, 100.0\n", b"  mass = 100.0, 100.0\n  label = 'caf\xe9', 'a\tb'\n")
+    with open(os.path.join(work, b"lat.nml"), "wb") as fh:
+        fh.write(deck)
+    r = subprocess.run([os.fsencode(EXE), os.path.join(work, b"lat.nml")], cwd=work,
+                       capture_output=True)
+    assert r.returncode == 0, r.stderr
+    out = os.path.join(work, b"out")
+    raw = open(os.path.join(out, b"lat.summary.json"), "rb").read()
+    summ = json.loads(raw.decode("utf-8", errors="strict"), strict=True)
+    assert summ["deck"] == os.path.join(work, b"lat.nml").decode("latin-1")
+    assert summ["dof_labels"] == ["café", "a\tb"]
+    res = frictiondyn.Result.from_files(os.fsdecode(os.path.join(out, b"lat.csv")))
+    assert res.dof_labels == ["café", "a\tb"]
+    assert res.summary == summ
+
+
+def _undefined():
+    import sys
+    sys.path.insert(0, str(Path(__file__).resolve().parent / "fuzz"))
+    import undefined  # the one list of keys that can be null: docs/namelist.md
+    return undefined
+
+
+def test_undefined_summary_values_are_null_never_0(tmp_path):
+    """Values a run does not define are JSON null, only in the keys docs/namelist.md lists
+    ("Undefined values"), and the executable prints "not defined (why)":
+    - a braced mass (a velocity-law device and a spring to the table, a storey without a
+      height): the stuck system is rigid, so period_stuck_s and xi_stuck are null (the
+      executable printed 'stuck period .000000 s'), and so are the drift ratios;
+    - the event-driven technique: omega_max_rad_s, omega_max_dt1 (no step dt1);
+    - a flat slider at rest with no table motion: the free system's rigid-body mode (period
+      and damping ratio), excitation_frequency_Hz, energy_residual_ratio (no energy passed),
+      the times of peaks that never occurred."""
+    und = _undefined()
+    keys = und.undefined_keys()
+    braced = oscillator(1, 0.5, name="braced")
+    braced["friction"] = {"n_devices": 1, "node_i": 1, "node_j": 0, "law": "velocity",
+                          "p": 1000.0, "mu": 0.3, "eps": 1e-3}
+    braced["damping"] = {"damping_type": "none"}
+    braced["storeys"] = {"n_storeys": 1, "node_i": 1, "node_j": 0}
+    event = {**oscillator(1, 0.5, name="event")}
+    event["friction"] = {"n_devices": 1, "node_i": 1, "node_j": 0, "law": "coulomb",
+                         "p": 100.0, "mu": 0.3}
+    event["integration"] = {"technique": "event_driven", "n1": 2}
+    slider = {
+        "model": {"n_dof": 1, "mass": [2.0]},
+        "springs": {"n_springs": 0},
+        "damping": {"damping_type": "none"},
+        "friction": {"n_devices": 1, "node_i": 1, "node_j": 0, "law": "velocity",
+                     "p": 19.62, "mu": 0.3, "eps": 1e-3},
+        "excitation": {"excitation_type": "none", "dt_record": 0.01, "duration": 0.2},
+        "output": {"name": "slider"},
+    }
+    summ = {}
+    for g in (braced, event, slider):
+        name = g["output"]["name"]
+        (tmp_path / f"{name}.nml").write_text(deck_text(g))
+        r = subprocess.run([EXE, f"{name}.nml"], cwd=tmp_path, capture_output=True, text=True)
+        assert r.returncode == 0, r.stderr
+        summ[name] = json.loads((tmp_path / "out" / f"{name}.summary.json").read_text())
+        assert und.null_keys(summ[name]) <= keys, und.null_keys(summ[name]) - keys
+        assert keys <= set(summ[name]), keys - set(summ[name])  # the list names real keys
+        if name == "braced":
+            assert ("stuck period not defined (with every device a rigid link the structure has "
+                    "no free DOF or a rigid-body mode)") in r.stdout
+    b, e, s = summ["braced"], summ["event"], summ["slider"]
+    assert b["period_stuck_s"] is None and b["xi_stuck"] is None
+    assert b["storey_height_m"] == [0.0]
+    assert b["peak_drift_ratio"] == [None] and b["residual_drift_ratio"] == [None]
+    assert b["peak_drift_m"][0] > 0 and b["omega_max_rad_s"] > 0
+    assert e["omega_max_rad_s"] is None and e["omega_max_dt1"] is None
+    assert e["mode_resolution"] == "not applicable"
+    assert s["modes_free_status"] == "unrestrained"
+    assert s["periods_free_s"] == [None] and s["modal_xi_free"] == [None]
+    assert s["excitation_frequency_Hz"] is None and s["energy_residual_ratio"] is None
+    assert s["peak_u_m"] == [0.0] and s["peak_u_time_s"] == [None]
+    assert s["peak_aabs_time_s"] == [None] and s["mu_unconverged_s"] is None
+
+
+def test_python_reads_undefined_values_as_none_and_nan(tmp_path):
+    """Python's Result holds an undefined summary value as None (as json.loads reads null),
+    in the run's Result and in Result.from_files alike; modes() gives inf for a rigid-body
+    mode's period and nan for its damping ratio."""
+    g = {
+        "model": {"n_dof": 1, "mass": [2.0]},
+        "springs": {"n_springs": 0},
+        "damping": {"damping_type": "none"},
+        "friction": {"n_devices": 1, "node_i": 1, "node_j": 0, "law": "velocity",
+                     "p": 19.62, "mu": 0.3, "eps": 1e-3},
+        "excitation": {"excitation_type": "none", "dt_record": 0.01, "duration": 0.2},
+        "output": {"name": "slider"},
+    }
+    (tmp_path / "slider.nml").write_text(deck_text(g))
+    res = frictiondyn.run(tmp_path / "slider.nml")
+    assert res.summary["period_stuck_s"] is None and res.summary["periods_free_s"] == [None]
+    modes = res.modes("free")
+    assert modes.status == "unrestrained"
+    assert np.isinf(modes.periods[0]) and np.isnan(modes.xi[0]) and modes.frequencies[0] == 0.0
+    res.to_csv(tmp_path / "h.csv")
+    back = frictiondyn.Result.from_files(tmp_path / "h.csv")
+    assert back.summary == res.summary and back.summary["excitation_frequency_Hz"] is None

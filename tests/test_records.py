@@ -191,7 +191,47 @@ AT2_BAD = [
      ["line 3", "units of 'ft/s2'", "convert the record"]),
     ("three header lines", "H1\nH2\nACCELERATION TIME SERIES IN UNITS OF G\n",
      ["ends at line 3", "four header lines"]),
+    ("NPTS twice", at2_text([0.1] * 6).replace("NPTS=  6,", "NPTS=  6, NPTS=  7,"),
+     ["line 4", "NPTS is given twice", "once each"]),
+    ("DT twice", at2_text([0.1] * 6, spelling="old").replace("NPTS, DT", "NPTS, DT, DT"),
+     ["line 4", "DT is given twice"]),
+    ("a value after the header", at2_text([0.1] * 6).replace(" SEC\n", " SEC  1.0000000E-01\n", 1),
+     ["line 4", "'1.0000000E-01' after NPTS and DT", "the values start on line 5"]),
+    ("a third number (old spelling)", at2_text([0.1] * 6, spelling="old").replace("NPTS, DT", "NPTS, DT  7"),
+     ["line 4", "'7' after NPTS and DT"]),
+    # a file cut inside its last number: 1.4126416E-01 read as 1.4126416 would be 10x too large
+    ("last number cut before its exponent", at2_text([0.1] * 5 + [0.14126416]).rstrip("\n")[:-4],
+     ["line 6", "value '1.4126416' ends at column 11", "fixed-width fields of 15 characters",
+      "values of line 5"]),
+    ("last number cut inside its exponent", at2_text([0.1] * 5 + [0.14126416]).rstrip("\n")[:-1],
+     ["line 6", "value '1.4126416E-0' ends at column 14", "fixed-width fields of 15"]),
+    ("a tab among fixed-width fields", at2_text([0.1] * 7).replace("\n  1.0000000E-01  1.0000000E-01\n",
+                                                                  "\n  1.0000000E-01\t1.0000000E-01\n"),
+     ["line 6", "a tab or a comma", "fixed-width fields of 15"]),
 ]
+
+
+def test_at2_line_4_with_tabs_reads_as_with_blanks(run):
+    """Tabs between the words of line 4 ('NPTS=<tab>501,<tab>DT=<tab>.0100 SEC') separate
+    them as blanks do: the same record, the same run."""
+    a = list(acc_g())
+    plain = ok(run(oscillator(record_excitation("rec.AT2")), files={"rec.AT2": at2_text(a)}))
+    text = at2_text(a).replace("NPTS=  501, DT=   .0100 SEC", "NPTS=\t501,\tDT=\t.0100\tSEC")
+    assert "\t" in text
+    tabs = ok(run(oscillator(record_excitation("rec.AT2")), files={"rec.AT2": text}))
+    assert np.array_equal(tabs.history().data, plain.history().data)
+    assert tabs.summary()["record"]["samples"] == 501
+
+
+def test_at2_free_format_body_is_not_held_to_fields(run):
+    """A body whose values are separated freely (widths vary, as a script writes them) is
+    read as it is: the fixed-width rule applies only to a file whose first body line has
+    the fields."""
+    head = at2_text([0.1] * 6).splitlines()[:4]
+    body = ["0.1 -0.25 0.003", "1e-2 -0.5", "0.125"]
+    r = ok(run(oscillator(record_excitation("rec.AT2")), files={"rec.AT2": "\n".join(head + body)}))
+    assert r.history()["ag"][:6] == pytest.approx(np.array([0.1, -0.25, 0.003, 0.01, -0.5, 0.125]) * G,
+                                                  rel=1e-15)
 
 
 @pytest.mark.parametrize("text, words", [c[1:] for c in AT2_BAD], ids=[c[0] for c in AT2_BAD])

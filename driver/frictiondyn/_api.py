@@ -649,8 +649,8 @@ class Modes:
 
 
 def _floats(values) -> np.ndarray:
-    """A JSON list as a float array."""
-    return np.array([float(v) for v in values], dtype=float)
+    """A JSON list as a float array: null (an undefined value, docs/namelist.md) is nan."""
+    return np.array([np.nan if v is None else float(v) for v in values], dtype=float)
 
 
 @dataclass
@@ -660,7 +660,8 @@ class Result:
     ``result["u1"]`` is a column by name (see ``names``, ``units``); ``time`` is ``t``;
     ``dof(i)`` and ``device(d)`` group the series of one DOF or device (1-based);
     ``summary`` is the run's summary (peaks, transitions, steps, correctness violations,
-    energy) as a dict; ``peak(name, t_range)`` the peak of a series (exact for the exact
+    energy) as a dict, an undefined value (JSON null: docs/namelist.md, "Undefined values")
+    as None, whole or as an item of a list; ``peak(name, t_range)`` the peak of a series (exact for the exact
     technique, whose peaks include the extrema between rows and the one-sided values at
     events).
     """
@@ -698,7 +699,7 @@ class Result:
         ``h.summary.json``, ``h.dat`` -> ``h.dat.summary.json``) and raises
         FileNotFoundError when it is missing; False reads none (``summary`` is then {})."""
         csv = Path(csv)
-        with csv.open() as fh:
+        with csv.open(encoding="utf-8") as fh:
             header = fh.readline().strip()
         data = np.loadtxt(csv, delimiter=",", skiprows=1, ndmin=2)
         if summary is False:
@@ -710,7 +711,7 @@ class Result:
                     f"{csv}: no summary {summary.name} next to it (pass summary=False to read "
                     "the history alone, or the summary's path)"
                 )
-        text = Path(summary).read_text().removesuffix("\n")
+        text = Path(summary).read_text(encoding="utf-8").removesuffix("\n")
         return cls.from_arrays(header, data, text)
 
     @classmethod
@@ -824,7 +825,8 @@ class Result:
         if f"modes_{system}_status" not in s:
             raise KeyError("the summary has no modes (written by an older frictiondyn)")
         periods = _floats(s[f"periods_{system}_s"])
-        rigid = periods == 0.0  # a rigid-body mode: the summary gives period and xi 0
+        # a rigid-body mode: the summary's period and xi are null (0 in older summaries)
+        rigid = np.isnan(periods) | (periods == 0.0)
         periods[rigid] = np.inf
         shapes = np.array(s[f"mode_shapes_{system}"], dtype=float).reshape(len(periods), self.n_dof)
         return Modes(
@@ -932,5 +934,6 @@ def read_history(path: str | os.PathLike, summary: str | os.PathLike | None | bo
 
 
 def read_summary(path: str | os.PathLike) -> dict:
-    """The executable's summary JSON."""
-    return json.loads(Path(path).read_text())
+    """The executable's summary JSON (UTF-8; an undefined value, JSON null, is None:
+    docs/namelist.md, "Undefined values")."""
+    return json.loads(Path(path).read_text(encoding="utf-8"))

@@ -2,7 +2,9 @@
  * files being written are process-global state, kept here. On SIGINT, SIGTERM, SIGHUP or
  * SIGXCPU (Slurm's time limit sends SIGTERM) the registered temporary files are removed and
  * the signal is raised again with its default action, so the exit status tells the shell
- * (and Slurm) how the run ended. */
+ * (and Slurm) how the run ended. SIGXFSZ (a file-size limit, `ulimit -f`, reached) is
+ * ignored: the write then fails with EFBIG and the run ends with the writer's usual
+ * "cannot write" error, its temporary files removed, instead of being killed. */
 #define _GNU_SOURCE
 #include <signal.h>
 #include <stdio.h>
@@ -34,6 +36,7 @@ void fd_app_install_signal_handlers(void)
     sa.sa_flags = SA_RESTART;
     for (size_t i = 0; i < sizeof sigs / sizeof sigs[0]; i++)
         sigaction(sigs[i], &sa, NULL);
+    signal(SIGXFSZ, SIG_IGN);
 }
 
 /* Register the temporary files a signal must remove ("" for none). Returns 1 when a path

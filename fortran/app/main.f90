@@ -23,6 +23,7 @@ program frictiondyn_main
    use fd_tempfiles, only: temp_tag
    use fd_error, only: fmt_text
    use fd_textio, only: line_type, read_file_text, split_lines, cr_line_ends
+   use fd_undefined, only: undefined_why
    implicit none
 
    interface
@@ -120,8 +121,15 @@ program frictiondyn_main
    end do
    deallocate (warns)
    write (output_unit, '(a)') 'frictiondyn: '//deck
-   write (output_unit, '(a,f0.6,a,i0,a,i0,a,i0,a,i0)') '  stuck period ', res%period_stuck, ' s; steps dt1 ', &
-      res%steps_dt1, ', nested ', res%steps_nested, ', dt2 ', res%steps_dt2, ', finer ', res%steps_finer
+   ! an undefined value is said to be so (fd_undefined), never printed as 0
+   if (len_trim(undefined_why(res, 'period_stuck_s')) > 0) then
+      write (output_unit, '(a,i0,a,i0,a,i0,a,i0)') '  stuck period not defined ('// &
+         trim(undefined_why(res, 'period_stuck_s'))//'); steps dt1 ', &
+         res%steps_dt1, ', nested ', res%steps_nested, ', dt2 ', res%steps_dt2, ', finer ', res%steps_finer
+   else
+      write (output_unit, '(a,f0.6,a,i0,a,i0,a,i0,a,i0)') '  stuck period ', res%period_stuck, ' s; steps dt1 ', &
+         res%steps_dt1, ', nested ', res%steps_nested, ', dt2 ', res%steps_dt2, ', finer ', res%steps_finer
+   end if
    if (res%steps_implicit + res%implicit_fallbacks > 0) &
       write (output_unit, '(a,i0,a,i0,a,i0,a)') '  implicit phases: ', res%steps_implicit, ' dt1 steps settled (', &
       res%implicit_redos, ' trials redone), ', res%implicit_fallbacks, ' refined as the paper''s'

@@ -10,17 +10,32 @@
 #include <sys/stat.h>
 #include <unistd.h>
 
+/* fd_lock_acquire: the lock path is not a regular file (a symbolic link, a directory, ...). */
+#define FD_LOCK_NOT_FILE (-1)
+
 /* Take an exclusive lock on the file `path` (created if missing); on success *fd holds the
- * descriptor to pass to fd_lock_release and 0 is returned, else errno. A lock file is
- * removed on release; a waiter that got the lock on a file removed meanwhile retries on
+ * descriptor to pass to fd_lock_release and 0 is returned, else errno, or FD_LOCK_NOT_FILE
+ * when `path` is a symbolic link or anything but a regular file (a link planted there
+ * would make the writer create or lock a file elsewhere: it is never followed). A lock file
+ * is removed on release; a waiter that got the lock on a file removed meanwhile retries on
  * the new one, so two processes never both hold "the" lock. */
 int fd_lock_acquire(const char *path, int *fd)
 {
     for (;;) {
         struct stat held, now;
-        int f = open(path, O_RDWR | O_CREAT | O_CLOEXEC, 0644);
-        if (f < 0)
-            return errno;
+        int f = open(path, O_RDWR | O_CREAT | O_CLOEXEC | O_NOFOLLOW | O_NONBLOCK, 0644);
+        if (f < 0) {
+            int e = errno;
+            struct stat ls;
+            if (e == ELOOP || e == EISDIR || e == ENXIO ||
+                (lstat(path, &ls) == 0 && !S_ISREG(ls.st_mode)))
+                return FD_LOCK_NOT_FILE;
+            return e;
+        }
+        if (fstat(f, &held) != 0 || !S_ISREG(held.st_mode)) {
+            close(f);
+            return FD_LOCK_NOT_FILE;
+        }
         while (flock(f, LOCK_EX) != 0) {
             if (errno != EINTR) {
                 int e = errno;
@@ -28,8 +43,7 @@ int fd_lock_acquire(const char *path, int *fd)
                 return e;
             }
         }
-        if (fstat(f, &held) == 0 && stat(path, &now) == 0 && held.st_ino == now.st_ino &&
-            held.st_dev == now.st_dev) {
+        if (lstat(path, &now) == 0 && held.st_ino == now.st_ino && held.st_dev == now.st_dev) {
             *fd = f;
             return 0;
         }
@@ -43,6 +57,12 @@ int fd_lock_release(const char *path, int fd)
     int e = unlink(path) == 0 ? 0 : errno;
     close(fd);
     return e;
+}
+
+/* mkdir(path, 0755): 0, or errno (EEXIST included). */
+int fd_mkdir(const char *path)
+{
+    return mkdir(path, 0755) == 0 ? 0 : errno;
 }
 
 /* unlink(path): 0, or errno (ENOENT included). */

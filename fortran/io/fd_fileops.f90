@@ -9,7 +9,10 @@ module fd_fileops
    private
 
    public :: c_lock_acquire, c_lock_release, c_unlink, c_rename, c_errno_text, c_getpid
-   public :: c_file_create, c_file_write, c_file_close, os_error
+   public :: c_file_create, c_file_write, c_file_close, os_error, c_mkdir
+
+   !> c_lock_acquire: the lock's path is a symbolic link or not a regular file (never followed).
+   integer(c_int), parameter, public :: lock_not_file = -1
 
    interface
       !> Take the lock file `path` (created, held while fd is open).
@@ -26,6 +29,12 @@ module fd_fileops
          integer(c_int), value :: fd
          integer(c_int) :: err
       end function c_lock_release
+      !> Create a directory (mode 0755 less the umask): 0 or errno.
+      function c_mkdir(path) bind(c, name='fd_mkdir') result(err)
+         import :: c_char, c_int
+         character(kind=c_char), intent(in) :: path(*)
+         integer(c_int) :: err
+      end function c_mkdir
       !> Remove a file.
       function c_unlink(path) bind(c, name='fd_unlink') result(err)
          import :: c_char, c_int

@@ -10,12 +10,13 @@ module fd_output
    use fd_result, only: result_type, resolution_names, energy_balance_names, record_system_names
    use fd_record, only: record_info
    use fd_warnings, only: warning_text, run_warnings
+   use fd_undefined, only: undefined_why
    use fd_version, only: frictiondyn_version
    use fd_history_stream, only: format_row, stream_value_width
    use fd_names, only: excitation_types, keyword_len
    use fd_matrices, only: modes_type, modes_flexible, modes_rigid, modes_unrestrained
    use fd_fileops, only: c_lock_acquire, c_lock_release, c_unlink, c_rename, os_error, &
-                         c_file_create, c_file_write, c_file_close
+                         c_file_create, c_file_write, c_file_close, c_mkdir, lock_not_file
    use fd_tempfiles, only: temp_tag, remove_stale_temps
    implicit none
    private
@@ -29,12 +30,6 @@ module fd_output
          character(kind=c_char), intent(in) :: path(*)
          integer(c_int) :: stat
       end function c_rmdir
-      function c_mkdir(path, mode) bind(c, name='mkdir') result(stat)
-         import :: c_char, c_int
-         character(kind=c_char), intent(in) :: path(*)
-         integer(c_int), value :: mode
-         integer(c_int) :: stat
-      end function c_mkdir
    end interface
 
    integer(c_int), parameter :: enoent = 2, eexist = 17
@@ -171,7 +166,12 @@ contains
       end if
       call hidden_name(stem, '.lock', lock)
       err = c_lock_acquire(lock//c_null_char, fd)
-      if (err /= 0) then
+      if (err == lock_not_file) then
+         call discard()
+         call fatal_error(error, "cannot lock '"//lock//"': it is a symbolic link or not a regular file "// &
+                          "(a lock file is never followed; remove it)")
+         return
+      else if (err /= 0) then
          call discard()
          call os_error(error, "cannot lock '"//lock//"'", err)
          return
@@ -217,22 +217,31 @@ contains
       character(len=*), intent(in) :: dir
       type(error_type), allocatable, intent(out) :: error
       character(len=:), allocatable, intent(out), optional :: made
-      integer :: stat, i
+      integer :: i
+      integer(c_int) :: err, first
       logical :: exists
 
+      first = 0
       do i = 2, len(dir) + 1
          if (i <= len(dir)) then
             if (dir(i:i) /= '/') cycle
          end if
          inquire (file=dir(1:i - 1)//'/.', exist=exists)
          if (exists) cycle
-         stat = c_mkdir(dir(1:i - 1)//c_null_char, int(o'755', c_int))
-         if (stat == 0 .and. present(made)) then
+         err = c_mkdir(dir(1:i - 1)//c_null_char)
+         if (err == 0 .and. present(made)) then
             if (.not. allocated(made)) made = dir(1:i - 1)
+         else if (err /= 0 .and. err /= eexist .and. first == 0) then
+            first = err
          end if
       end do
       inquire (file=dir//'/.', exist=exists)
-      if (.not. exists) call fatal_error(error, "&output: cannot create the output directory dir = '"//dir//"'")
+      if (exists) return
+      if (first /= 0) then
+         call os_error(error, "&output: cannot create the output directory dir = '"//dir//"'", first)
+      else
+         call fatal_error(error, "&output: cannot create the output directory dir = '"//dir//"'")
+      end if
    end subroutine make_dir
 
    !> Remove the directories make_dir created for `dir` (`made` the outermost), innermost
@@ -403,13 +412,13 @@ contains
       call kv('stick_resolution', '"'//trim(resolution_names(res%stick_resolution))//'"')
       call kr('band_x', res%band_x)
       call kr('band_alternation_N', res%band_alternation)
-      call kr('band_alternation_s', res%band_alternation_time)
+      call kr('band_alternation_s', res%band_alternation_time, res%band_alternation /= 0.0_dp)
       call kv('band_resolution', '"'//trim(resolution_names(res%band_resolution))//'"')
       call kr('peak_u_m', res%peak_u)
-      call kr('peak_u_time_s', res%peak_u_time)
+      call kr('peak_u_time_s', res%peak_u_time, res%peak_u /= 0.0_dp)
       call kr('peak_v_mps', res%peak_v)
       call kr('peak_aabs_mps2', res%peak_aabs)
-      call kr('peak_aabs_time_s', res%peak_aabs_time)
+      call kr('peak_aabs_time_s', res%peak_aabs_time, res%peak_aabs /= 0.0_dp)
       call kr('peak_s_m', res%peak_s)
       call kr('peak_force_N', res%peak_force)
       call ki('stick_to_slip', res%stick_to_slip)
@@ -511,16 +520,17 @@ contains
             call put('],'//nl)
             call kr('storey_height_m', eng%height)
             call kr('peak_drift_m', eng%peak_drift)
-            call kr('peak_drift_time_s', eng%peak_drift_time)
+            call kr('peak_drift_time_s', eng%peak_drift_time, eng%peak_drift /= 0.0_dp)
             call kr('residual_drift_m', eng%drift)
+            ! a ratio without a storey height is undefined (null), not 0
             allocate (ratio(eng%n_storeys))
             ratio = 0.0_dp
             where (eng%height > 0.0_dp) ratio = eng%peak_drift/eng%height
-            call kr('peak_drift_ratio', ratio)
+            call kr('peak_drift_ratio', ratio, eng%height > 0.0_dp)
             where (eng%height > 0.0_dp) ratio = eng%drift/eng%height
-            call kr('residual_drift_ratio', ratio)
+            call kr('residual_drift_ratio', ratio, eng%height > 0.0_dp)
             call kr('peak_storey_shear_N', eng%peak_shear(1:))
-            call kr('peak_storey_shear_time_s', eng%peak_shear_time(1:))
+            call kr('peak_storey_shear_time_s', eng%peak_shear_time(1:), eng%peak_shear(1:) /= 0.0_dp)
             call kr('residual_storey_shear_N', eng%shear(1:))
          end associate
       end subroutine engineering_keys
@@ -544,8 +554,8 @@ contains
             call kr('modal_xi_'//name, [real(dp) ::])
             return
          end select
-         ! a rigid-body mode (w = 0): period and damping ratio 0 (its period is infinite)
-         call kr('periods_'//name//'_s', merge(m%period, 0.0_dp, m%omega2 > 0.0_dp))
+         ! a rigid-body mode (w = 0): period (infinite) and damping ratio undefined (null)
+         call kr('periods_'//name//'_s', merge(m%period, 0.0_dp, m%omega2 > 0.0_dp), m%omega2 > 0.0_dp)
          call put('  "mode_shapes_'//name//'": [')
          do j = 1, m%n
             call put_reals(m%shape(:, j))
@@ -553,7 +563,7 @@ contains
          end do
          call put('],'//nl)
          call kr('modal_mass_ratio_'//name, m%mass_ratio)
-         call kr('modal_xi_'//name, merge(m%xi, 0.0_dp, m%omega2 > 0.0_dp))
+         call kr('modal_xi_'//name, merge(m%xi, 0.0_dp, m%omega2 > 0.0_dp), m%omega2 > 0.0_dp)
       end subroutine modes_keys
       !> The run's warnings (fd_warnings), one string each.
       subroutine warnings_key()
@@ -593,26 +603,40 @@ contains
          integer, intent(in) :: n
          call kv(key, trim(fmt_int(n)))
       end subroutine kint
-      !> A real number (null when not finite, json_real).
+      !> A real number: null when the key is undefined for this result (fd_undefined).
       subroutine kreal(key, x)
          character(len=*), intent(in) :: key
          real(dp), intent(in) :: x
-         call kv(key, trim(json_real(x)))
+         if (len_trim(undefined_why(res, key)) > 0) then
+            call kv(key, 'null')
+         else
+            call kv(key, trim(json_real(x)))
+         end if
       end subroutine kreal
-      subroutine kr(key, x)
+      !> A list of reals; with `defined`, null for each item not defined.
+      subroutine kr(key, x, defined)
          character(len=*), intent(in) :: key
          real(dp), intent(in) :: x(:)
+         logical, intent(in), optional :: defined(:)
          call put('  "'//key//'": ')
-         call put_reals(x)
+         call put_reals(x, defined)
          call put(','//nl)
       end subroutine kr
       !> '[x1, x2, ...]' appended number by number (put: linear in the length).
-      subroutine put_reals(x)
+      subroutine put_reals(x, defined)
          real(dp), intent(in) :: x(:)
+         logical, intent(in), optional :: defined(:)
          integer :: k
+         logical :: def
          call put('[')
          do k = 1, size(x)
-            call put(trim(json_real(x(k))))
+            def = .true.
+            if (present(defined)) def = defined(k)
+            if (def) then
+               call put(trim(json_real(x(k))))
+            else
+               call put('null')
+            end if
             if (k < size(x)) call put(', ')
          end do
          call put(']')
@@ -671,20 +695,77 @@ contains
       str = adjustl(row(1:stream_value_width - 1))
    end function json_real
 
+   !> A text as the content of a JSON string: '"' and '\' escaped, control characters as
+   !> \u00XX, well-formed UTF-8 sequences kept, and any other byte (Latin-1 text, a stray
+   !> byte of a path) written as the character of its Latin-1 reading (\u00XX): the summary is
+   !> valid UTF-8 JSON whatever the bytes of a path, a label or a record title.
    pure subroutine json_escape(s, r)
-      character(len=*), intent(in) :: s
-      character(len=:), allocatable, intent(out) :: r
-      integer :: i
-      r = ''
-      do i = 1, len(s)
+      character(len=*), intent(in) :: s                 !! bytes
+      character(len=:), allocatable, intent(out) :: r   !! the escaped text
+      character(len=16), parameter :: hex = '0123456789abcdef'
+      character(len=:), allocatable :: buf
+      integer :: i, pos, c, n, k, lo, hi
+
+      allocate (character(len=6*len(s)) :: buf)
+      pos = 0
+      i = 1
+      do while (i <= len(s))
+         c = iachar(s(i:i))
          if (s(i:i) == '"' .or. s(i:i) == '\') then
-            r = r//'\'//s(i:i)
-         else if (iachar(s(i:i)) < 32) then
-            r = r//' '
-         else
-            r = r//s(i:i)
+            buf(pos + 1:pos + 2) = '\'//s(i:i)
+            pos = pos + 2
+            i = i + 1
+            cycle
+         else if (c >= 32 .and. c < 128) then
+            buf(pos + 1:pos + 1) = s(i:i)
+            pos = pos + 1
+            i = i + 1
+            cycle
          end if
+         ! the continuation bytes a well-formed UTF-8 sequence led by c has (0: none), and the
+         ! range of its second byte (no overlong form, no surrogate, nothing above U+10FFFF)
+         n = 0
+         lo = 128
+         hi = 191
+         select case (c)
+         case (194:223)
+            n = 1
+         case (224)
+            n = 2
+            lo = 160
+         case (225:236, 238:239)
+            n = 2
+         case (237)
+            n = 2
+            hi = 159
+         case (240)
+            n = 3
+            lo = 144
+         case (241:243)
+            n = 3
+         case (244)
+            n = 3
+            hi = 143
+         end select
+         if (n > 0 .and. i + n <= len(s)) then
+            if (iachar(s(i + 1:i + 1)) >= lo .and. iachar(s(i + 1:i + 1)) <= hi) then
+               do k = 2, n
+                  if (iachar(s(i + k:i + k)) < 128 .or. iachar(s(i + k:i + k)) > 191) exit
+               end do
+               if (k > n) then
+                  buf(pos + 1:pos + n + 1) = s(i:i + n)
+                  pos = pos + n + 1
+                  i = i + n + 1
+                  cycle
+               end if
+            end if
+         end if
+         ! a control character, or a byte that starts no well-formed sequence: \u00XX
+         buf(pos + 1:pos + 6) = '\u00'//hex(c/16 + 1:c/16 + 1)//hex(mod(c, 16) + 1:mod(c, 16) + 1)
+         pos = pos + 6
+         i = i + 1
       end do
+      r = buf(1:pos)
    end subroutine json_escape
 
 end module fd_output

@@ -16,6 +16,7 @@ module fd_record
    private
 
    public :: record_info, read_record, parse_real, units_factor, standard_gravity
+   public :: npts_dt, field_width, misplaced_field
    public :: record_formats, record_units_list
 
    real(dp), parameter :: standard_gravity = 9.80665_dp  !! g [m/s2] (CGPM 1901)
@@ -219,7 +220,7 @@ contains
       real(dp), allocatable, intent(out) :: val(:)
       type(record_info), intent(inout) :: info
       type(error_type), allocatable, intent(out) :: error
-      integer :: next, lo, hi, line, npts, n, stat, bad_lo, bad_hi, k
+      integer :: next, lo, hi, line, npts, n, stat, bad_lo, bad_hi, k, width, first
       integer :: hlo(4), hhi(4)
       real(dp) :: dt, f_declared, f_given
       character(len=:), allocatable :: h3, declared, where
@@ -303,6 +304,7 @@ contains
       end if
       n = 0
       line = 4
+      width = -1   ! the fixed-width fields of the body, from its first line (0: none)
       do while (next <= len(text))
          call next_line(text, next, lo, hi)
          line = line + 1
@@ -318,6 +320,27 @@ contains
          if (stat /= num_ok) then
             call value_error(path, line, text(lo:hi), stat, bad_lo, bad_hi, npts, error)
             return
+         end if
+         if (width < 0) then
+            width = field_width(text(lo:hi))
+            first = line
+         end if
+         if (width > 0) then
+            ! a value that does not fill its field: cut short (a truncated file), shifted or glued
+            call misplaced_field(text(lo:hi), width, bad_lo, bad_hi)
+            if (scan(text(lo:hi), achar(9)//',') > 0) then
+               call fatal_error(error, "record file '"//path//"', line "//trim(fmt_int(line))// &
+                                ": a tab or a comma between values, but the values of line "//trim(fmt_int(first))// &
+                                " are in fixed-width fields of "//trim(fmt_int(width))//" characters (blank-padded)")
+               return
+            else if (bad_lo > 0) then
+               call fatal_error(error, "record file '"//path//"', line "//trim(fmt_int(line))//": value '"// &
+                                text(lo + bad_lo - 1:lo + bad_hi - 1)//"' ends at column "//trim(fmt_int(bad_hi))// &
+                                ", not at the end of a field: the values of line "//trim(fmt_int(first))// &
+                                " are in fixed-width fields of "//trim(fmt_int(width))// &
+                                " characters (a number cut short, or out of its field)")
+               return
+            end if
          end if
       end do
       if (n < npts) then
@@ -401,6 +424,8 @@ contains
 
    !> NPTS and DT of AT2 line 4, in the spellings of the PEER files:
    !> "NPTS=  5590, DT=   .0050 SEC", "5590   0.0050   NPTS, DT", "NPTS, DT: 5590 0.0050 SEC".
+   !> Tabs are blanks; NPTS and DT are named once each; the line holds nothing else (their
+   !> values, the unit SEC after DT): a value after them is refused, not ignored.
    subroutine npts_dt(path, line, npts, dt, error)
       character(len=*), intent(in) :: path, line
       integer, intent(out) :: npts
@@ -409,10 +434,13 @@ contains
       character(len=:), allocatable :: up, where, expect, tok(:)
       character(len=64) :: num(2), unit
       integer :: k, nnum, stat, ios
-      logical :: keyed
+      logical :: keyed, used(2)
 
       npts = 0; dt = 0.0_dp
       up = upper(line)
+      do k = 1, len(up)   ! a tab separates words as a blank does
+         if (up(k:k) == achar(9)) up(k:k) = ' '
+      end do
       where = "record file '"//path//"', line 4"
       expect = "expected NPTS and DT, e.g. 'NPTS=  5590, DT=   .0050 SEC' or '5590   .0050   NPTS, DT'"
       if (index(up, 'NPTS') == 0) then
@@ -423,6 +451,14 @@ contains
          call fatal_error(error, where//": DT is missing; "//expect//", found '"//trim(line)//"'")
          return
       end if
+      call words(up, tok)
+      do k = 1, 2
+         if (count(tok == merge('NPTS', 'DT  ', k == 1)) > 1) then
+            call fatal_error(error, where//": "//trim(merge('NPTS', 'DT  ', k == 1))//" is given twice ('"// &
+                             trim(line)//"'); line 4 gives NPTS and DT once each")
+            return
+         end if
+      end do
       keyed = index(up, '=') > 0
       num = ''
       if (keyed) then
@@ -439,8 +475,23 @@ contains
                return
             end if
          end select
+         ! nothing but NPTS, DT, their values and DT's unit (a missing value is told below)
+         used = num == ''
+         do k = 1, merge(size(tok), 0, all(num /= ''))
+            select case (trim(tok(k)))
+            case ('NPTS', 'DT', 'SEC', 'SECS', 'S', 'SECOND', 'SECONDS')
+               cycle
+            end select
+            if (.not. used(1) .and. tok(k) == num(1)) then
+               used(1) = .true.
+            else if (.not. used(2) .and. tok(k) == num(2)) then
+               used(2) = .true.
+            else
+               call extra_word(tok(k))
+               return
+            end if
+         end do
       else
-         call words(up, tok)
          nnum = 0
          do k = 1, size(tok)
             select case (trim(tok(k)))
@@ -448,10 +499,15 @@ contains
                cycle
             end select
             nnum = nnum + 1
-            if (nnum <= 2) num(nnum) = tok(k)
+            if (nnum <= 2) then
+               num(nnum) = tok(k)
+            else
+               call extra_word(tok(k))
+               return
+            end if
          end do
       end if
-      if (num(1) == '' .or. nnum > 2) then
+      if (num(1) == '') then
          call fatal_error(error, where//": cannot find the value of NPTS; "//expect//", found '"//trim(line)//"'")
          return
       end if
@@ -477,6 +533,12 @@ contains
          call fatal_error(error, where//": DT = "//trim(num(2))//" s must be > 0")
       end if
    contains
+      !> The error of a word line 4 does not hold (a value after the header, a stray word).
+      subroutine extra_word(w)
+         character(len=*), intent(in) :: w
+         call fatal_error(error, where//": '"//trim(w)//"' after NPTS and DT ('"//trim(line)// &
+                          "'); line 4 holds NPTS, DT and their values only, the values start on line 5")
+      end subroutine extra_word
       !> The word after "KEY=" (KEY as a whole word), '' when absent; after: the word that
       !> follows it.
       pure subroutine keyed_value(s, key, v, after)
@@ -753,6 +815,78 @@ contains
          stat = num_ok
       end if
    end subroutine parse_real
+
+   !> The width of the fixed-width fields of a record line (an AT2 body line as PEER writes
+   !> them, FORTRAN's 5E15.7 and the like): w when the line holds at least two values of which
+   !> the j-th ends at column j w (w: where the first ends), every field blank-padded on the
+   !> left (the first value too: a line that starts with a value sets no fields), all of
+   !> them but perhaps the last (a line cut inside its last value still shows its fields:
+   !> misplaced_field finds that value); 0 when it does not (values separated freely, a tab
+   !> or a comma among them).
+   pure integer function field_width(s) result(w)
+      character(len=*), intent(in) :: s   !! the line
+      integer :: i, j, k
+
+      w = 0
+      if (len(s) == 0 .or. scan(s, achar(9)//',') > 0) return
+      if (s(1:1) /= ' ') return
+      k = 0
+      i = 1
+      do
+         do while (i <= len(s))
+            if (s(i:i) /= ' ' .and. s(i:i) /= achar(13)) exit
+            i = i + 1
+         end do
+         if (i > len(s)) exit
+         j = i
+         do while (j < len(s))
+            if (s(j + 1:j + 1) == ' ' .or. s(j + 1:j + 1) == achar(13)) exit
+            j = j + 1
+         end do
+         k = k + 1
+         if (k == 1) then
+            w = j
+         else if (j /= k*w) then
+            ! misplaced: only the last value may be, after two in their fields
+            if (k < 3 .or. verify(s(j + 1:), ' '//achar(13)) /= 0) w = 0
+            return
+         end if
+         i = j + 1
+      end do
+      if (k < 2) w = 0
+   end function field_width
+
+   !> The first value of a line that does not end at the end of a field of `width` columns
+   !> (or starts in the field before its own): its columns lo:hi; lo = 0 when every value
+   !> fills its field as field_width found them (a shorter last line included).
+   pure subroutine misplaced_field(s, width, lo, hi)
+      character(len=*), intent(in) :: s     !! the line
+      integer, intent(in) :: width          !! the fields' width (> 0)
+      integer, intent(out) :: lo, hi        !! the misplaced value, or 0, 0
+      integer :: i, j
+
+      lo = 0
+      hi = 0
+      i = 1
+      do
+         do while (i <= len(s))
+            if (s(i:i) /= ' ' .and. s(i:i) /= achar(13)) exit
+            i = i + 1
+         end do
+         if (i > len(s)) return
+         j = i
+         do while (j < len(s))
+            if (s(j + 1:j + 1) == ' ' .or. s(j + 1:j + 1) == achar(13)) exit
+            j = j + 1
+         end do
+         if (mod(j, width) /= 0 .or. i <= j - width) then
+            lo = i
+            hi = j
+            return
+         end if
+         i = j + 1
+      end do
+   end subroutine misplaced_field
 
    ! ------------------------------------------------------------------ text helpers
    !> The line starting at next: text(lo:hi), without its newline or carriage return;

@@ -508,6 +508,7 @@ contains
       ! the residual against the energy that passed through the structure: what it held at
       ! the start and what the table put in or took out, step by step
       scale = obs%e_kin0 + obs%e_str0 + abs(obs%e_dev0) + res%e_input_gross
+      res%e_through = max(scale, 0.0_dp)
       res%e_residual_ratio = 0.0_dp
       if (scale > 0.0_dp) res%e_residual_ratio = res%e_residual/scale
       if (associated(obs%ctl)) obs%ctl%time = obs%ctl%duration   ! the run is complete

@@ -150,7 +150,8 @@ module fd_result
       real(dp) :: e_device = 0.0_dp    !! elastic energy stored in sticking devices at the end
       real(dp) :: e_residual = 0.0_dp  !! input - (kinetic + strain + viscous + friction + device)
       real(dp) :: e_input_gross = 0.0_dp !! sum over the steps of |input work of the step|
-      real(dp) :: e_residual_ratio = 0.0_dp !! e_residual / (initial energy + e_input_gross)
+      real(dp) :: e_residual_ratio = 0.0_dp !! e_residual / e_through (0 when e_through is 0)
+      real(dp) :: e_through = 0.0_dp   !! initial energy + e_input_gross (0: the ratio is undefined)
       integer :: energy_balance = balance_closed !! e_residual_ratio's verdict (energy_balance_of)
       real(dp) :: run_time = 0.0_dp    !! wall-clock time of the integration [s]
       ! names, modes, storey drifts and shears, residual values (fd_engineering)

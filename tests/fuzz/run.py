@@ -11,7 +11,8 @@ Session(deck).solve(), result(), write(), and run_text of the same text). Each r
 in time (--timeout, times $FRICTIONDYN_TIME_SCALE: time_scale) and in memory (--mem, an
 address-space limit), and its outcome classified:
 
-- success: both ran, wrote the same files (byte for byte, but for run_time_s), no null;
+- success: both ran, wrote the same files (byte for byte, but for run_time_s), valid JSON
+  summaries with no null but in the keys that can be undefined (docs/namelist.md);
 - clean error: both refused with the same message, naming the deck file (or the record file,
   or a group or variable), leaving no file behind; the Python exception a FrictiondynError;
 - long by request: a valid deck (the reader accepts it) that asks for at least LONG_STEPS
@@ -21,9 +22,10 @@ address-space limit), and its outcome classified:
 and every other outcome is a failure, counted by kind: crash (the executable killed by a
 signal, an exit status other than 0 and 1, a gfortran runtime message), interpreter death,
 wrong exception type, hang, partial output left, anonymous message, disagreement (executable
-against Python, or the file against run_text), null in a summary. The report gives the
-counts, the failures by what the case mutated (deck, record, path) and, for each failure, the
-case to reproduce it (`--case I` runs case I alone and keeps its directory).
+against Python, or the file against run_text), null in a summary where no value can be
+undefined (or a summary that is not JSON). The report gives the counts, the failures by
+what the case mutated (deck, record, path) and, for each failure, the case to reproduce it
+(`--case I` runs case I alone and keeps its directory).
 """
 
 from __future__ import annotations
@@ -45,6 +47,11 @@ from pathlib import Path
 
 sys.path.insert(0, str(Path(__file__).resolve().parent))
 import mutate  # noqa: E402
+from undefined import null_keys, undefined_keys  # noqa: E402
+
+
+def _no_constant(name: str) -> None:
+    raise ValueError(f"{name} is not JSON")
 
 FAILURES = [
     "crash",
@@ -323,8 +330,15 @@ def classify(case, exe_dir, py_dir, proc, answer, status, death, inputs) -> Outc
                     continue
                 ta, tb = a.read_bytes(), b.read_bytes()
                 if rel.endswith(".json"):
-                    if b"null" in ta or b"NaN" in ta or b"Infinity" in ta:
-                        o.fail("null in a summary", rel)
+                    # null only where a value can be undefined (docs/namelist.md, "Undefined
+                    # values"); NaN and Infinity are not JSON at all
+                    try:
+                        bad = null_keys(json.loads(ta, parse_constant=_no_constant))
+                        bad -= undefined_keys()
+                    except ValueError as e:
+                        bad = {f"invalid JSON: {e}"}
+                    if bad:
+                        o.fail("null in a summary", f"{rel}: {', '.join(sorted(bad))}")
                     ta = without_run_time(ta.decode("utf-8", "replace")).encode()
                     tb = without_run_time(tb.decode("utf-8", "replace")).encode()
                 if ta != tb:

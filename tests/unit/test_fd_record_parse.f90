@@ -4,7 +4,8 @@
 module test_fd_record_parse
    use testdrive, only: new_unittest, unittest_type, error_type, check
    use fd_kinds, only: dp
-   use fd_record, only: parse_real, units_factor, standard_gravity
+   use fd_record, only: parse_real, units_factor, standard_gravity, npts_dt, field_width, misplaced_field
+   use fd_error, only: fd_error_type => error_type
    implicit none
    private
 
@@ -19,7 +20,9 @@ contains
                   new_unittest("numbers read exactly", test_numbers), &
                   new_unittest("list-directed tokens rejected", test_rejected), &
                   new_unittest("NaN and infinity", test_nonfinite), &
-                  new_unittest("units", test_units) &
+                  new_unittest("units", test_units), &
+                  new_unittest("AT2 line 4: tabs, duplicates, extra words", test_line4), &
+                  new_unittest("AT2 body: fixed-width fields", test_fields) &
                   ]
    end subroutine collect_record_parse
 
@@ -97,5 +100,75 @@ contains
       call units_factor('m', .false., f, ok)
       call check(error, .not. ok, 'm is not an acceleration unit')
    end subroutine test_units
+
+   !> Line 4 of an AT2 file: the PEER spellings read, tabs as blanks; a key given twice and
+   !> a word after NPTS and DT refused, naming the rule.
+   subroutine test_line4(error)
+      type(error_type), allocatable, intent(out) :: error
+      character(len=48), parameter :: good(5) = [character(len=48) :: 'NPTS=  5590, DT=   .0050 SEC', &
+                                                 '  5590   .0050   NPTS, DT', 'NPTS, DT: 5590 .0050 SEC', &
+                                                 'NPTS='//achar(9)//'5590,'//achar(9)//'DT='//achar(9)//'.0050 SEC', &
+                                                 'npts= 5590 dt= .0050']
+      character(len=48), parameter :: bad(4) = [character(len=48) :: 'NPTS= 5590, NPTS= 5591, DT= .0050 SEC', &
+                                                'NPTS= 5590, DT= .0050, DT= .0060', &
+                                                'NPTS= 5590, DT= .0050 SEC  .1412E-01', '5590 .0050 NPTS, DT 3']
+      character(len=40), parameter :: rule(4) = [character(len=40) :: 'NPTS is given twice', 'DT is given twice', &
+                                                 "'.1412E-01' after NPTS and DT", "'3' after NPTS and DT"]
+      type(fd_error_type), allocatable :: err
+      integer :: i, npts
+      real(dp) :: dt
+      do i = 1, size(good)
+         call npts_dt('r.AT2', trim(good(i)), npts, dt, err)
+         call check(error, .not. allocated(err), 'read: '//trim(good(i)))
+         if (allocated(error)) return
+         call check(error, npts == 5590 .and. dt == 0.005_dp, 'values of: '//trim(good(i)))
+         if (allocated(error)) return
+      end do
+      do i = 1, size(bad)
+         call npts_dt('r.AT2', trim(bad(i)), npts, dt, err)
+         call check(error, allocated(err), 'refused: '//trim(bad(i)))
+         if (allocated(error)) return
+         call check(error, index(err%message, "'r.AT2', line 4: "//trim(rule(i))) > 0, err%message)
+         if (allocated(error)) return
+      end do
+   end subroutine test_line4
+
+   !> The fields of a PEER body line (5E15.7, 5E14.7 without the leading zero), none in a
+   !> free-format line; a value cut short, or spilling over its field, found.
+   subroutine test_fields(error)
+      type(error_type), allocatable, intent(out) :: error
+      character(len=*), parameter :: e15 = '  1.0000000E-01 -2.0000000E-01  3.0000000E-01'
+      character(len=*), parameter :: e14 = '  .1187585E-02 -.1181436E-02  .1177437E-02'
+      integer :: lo, hi
+      call check(error, field_width(e15), 15, 'E15.7')
+      if (allocated(error)) return
+      call check(error, field_width(e14//'   '//achar(13)), 14, 'E14.7, trailing blanks and CR')
+      if (allocated(error)) return
+      call check(error, field_width('0.1 -0.25 0.003'), 0, 'free format')
+      if (allocated(error)) return
+      call check(error, field_width('-0.12345 0.12345'), 0, 'free format, evenly spaced by chance')
+      if (allocated(error)) return
+      call check(error, field_width('  1.0000000E-01  2.0000000E-01  3.0000000'), 15, 'the last value cut')
+      if (allocated(error)) return
+      call check(error, field_width('  1.0000000E-01  2.0000000E-01  3.0000000  4.0'), 0, 'an inner value off')
+      if (allocated(error)) return
+      call check(error, field_width('  1.0000000E-01  2.0000000'), 0, 'two values, the second off')
+      if (allocated(error)) return
+      call check(error, field_width('  1.0000000E-01'), 0, 'one value: no layout')
+      if (allocated(error)) return
+      call check(error, field_width('  1.0E-01,  2.0E-01'), 0, 'a comma: no layout')
+      if (allocated(error)) return
+      call misplaced_field(e15(1:30), 15, lo, hi)
+      call check(error, lo == 0 .and. hi == 0, 'a shorter last line is fine')
+      if (allocated(error)) return
+      call misplaced_field('  1.0000000E-01  1.4126416', 15, lo, hi)
+      call check(error, lo == 18 .and. hi == 26, 'a number cut before its exponent')
+      if (allocated(error)) return
+      call misplaced_field('  1.0000000E-01  1.4126416E-0', 15, lo, hi)
+      call check(error, lo == 18 .and. hi == 29, 'a number cut inside its exponent')
+      if (allocated(error)) return
+      call misplaced_field('  1.0000000E-0112.0000000E-01', 15, lo, hi)
+      call check(error, lo == 3 .and. hi == 29, 'two numbers glued')
+   end subroutine test_fields
 
 end module test_fd_record_parse
