@@ -179,9 +179,10 @@ def small_fs(tmp_path):
         subprocess.run(["umount", "-l", str(mnt)], check=False)
 
 
-def chain(n: int, duration: float, *, name: str = "run", out: str = "out", n1: int = 2) -> dict:
+def chain(n: int, duration: float, *, name: str = "run", out: str = "out", n1: int = 2,
+          every: int = 1) -> dict:
     """Deck groups of n masses (100 kg) in a chain of springs (4e4 N/m) under a harmonic
-    table motion (10 mm, 2 Hz), damped, every dt1 step in the history `out`/`name`."""
+    table motion (10 mm, 2 Hz), damped, every `every` dt1 steps in the history `out`/`name`."""
     return {
         "model": {"n_dof": n, "mass": [100.0] * n},
         "springs": {"n_springs": n, "node_i": list(range(1, n + 1)), "node_j": list(range(n)),
@@ -190,5 +191,5 @@ def chain(n: int, duration: float, *, name: str = "run", out: str = "out", n1: i
         "excitation": {"excitation_type": "harmonic", "amplitude": 0.01, "frequency": 2.0,
                        "dt_record": 0.01, "duration": duration},
         "integration": {"n1": n1},
-        "output": {"name": name, "output_every": 1, "dir": out},
+        "output": {"name": name, "output_every": every, "dir": out},
     }

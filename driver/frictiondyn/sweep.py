@@ -108,7 +108,7 @@ DECK_VARIABLES: dict[str, tuple[str, ...]] = {
     "integration": ("technique", "beta", "gamma", "n1", "n2", "n", "check_correctness",
                     "dt_min", "theta", "linear_system", "refinement"),
     "output": ("dir", "name", "output_every", "write_history", "history_dofs",
-               "history_devices", "n_modes"),
+               "history_devices", "n_modes", "max_history_mb"),
 }
 
 #: Runs a spec may make unless --max-runs (``expand(max_runs=...)``) allows more: the runs
