@@ -622,6 +622,32 @@ def test_a_record_whose_first_line_is_a_megabyte_is_echoed_capped(tmp_path):
     assert len(message) < 400
 
 
+@pytest.mark.parametrize(
+    "line3, line4, words",
+    [
+        ("ACCELERATION TIME SERIES IN UNITS OF G", "NPTS=  3, DT=  .0100 SEC " + "w" * MEGA,
+         ["line 4", "after NPTS and DT"]),
+        ("ACCELERATION TIME SERIES IN UNITS OF G", "NPTS=  3, NPTS= 3, DT=  .0100 SEC " + "w" * MEGA,
+         ["line 4", "NPTS is given twice"]),
+        ("ACCELERATION TIME SERIES IN UNITS OF G", "NPTS=  3, DT=  .0100 " + "M" * MEGA,
+         ["line 4", "DT is followed by"]),
+        ("ACCELERATION TIME SERIES IN UNITS OF " + "F" * MEGA, "NPTS=  3, DT=  .0100 SEC",
+         ["line 3", "the header declares units of"]),
+        ("ACCELERATION TIME SERIES IN UNITS OF G", "DT=  .0100 SEC " + "x" * MEGA,
+         ["line 4", "NPTS is missing"]),
+    ],
+)
+def test_an_at2_header_line_of_a_megabyte_is_echoed_capped(tmp_path, line3, line4, words):
+    """The AT2 header's messages quote the line they refuse: 80 characters and its length."""
+    g = paper_groups(4)
+    g["excitation"] = {"excitation_type": "record", "record_file": "r.AT2", "record_format": "at2"}
+    at2 = "\n".join(["PEER NGA STRONG MOTION DATABASE RECORD", "TEST", line3, line4,
+                     "  .1000000E-01  .2000000E-01  .1000000E-01"]) + "\n"
+    message = assert_both_reject(tmp_path, deck_text(g), ["record file", *words, "characters)"],
+                                 files={"r.AT2": at2})
+    assert len(message) < 600, len(message)
+
+
 def test_an_echo_is_cut_between_utf8_characters_and_counts_characters(tmp_path):
     text = short_deck().replace("  n1 = 20", "  n1 = " + "é" * 100, 1)
     message = assert_both_reject(tmp_path, text, ["'" + "é" * 80 + "... (100 characters)'"])

@@ -263,8 +263,8 @@ contains
          ! that contradicted a unit not known here would go unnoticed)
          call units_factor(declared, is_displacement, f_declared, ok_declared)
          if (.not. ok_declared) then
-            call fatal_error(error, where//": the header declares units of '"//declared//"' ('"// &
-                             trim(text(hlo(3):hhi(3)))//"'), which are not units of a"// &
+            call fatal_error(error, where//": the header declares units of '"//trim(fmt_text(declared))//"' ('"// &
+                             trim(fmt_text(text(hlo(3):hhi(3))))//"'), which are not units of a"// &
                              trim(merge(' displacement ', 'n acceleration', is_displacement))// &
                              " record known here ("//record_units_list//"): convert the record")
             return
@@ -273,7 +273,8 @@ contains
          if (len(units) > 0) then
             call units_factor(units, is_displacement, f_given, ok)
             if (.not. ok .or. f_given /= f_declared) then
-               call fatal_error(error, where//": the header declares units of '"//declared//"' but record_units = '"// &
+               call fatal_error(error, where//": the header declares units of '"//trim(fmt_text(declared))// &
+                                "' but record_units = '"// &
                                 units//"'")
                return
             end if
@@ -444,18 +445,18 @@ contains
       where = "record file '"//path//"', line 4"
       expect = "expected NPTS and DT, e.g. 'NPTS=  5590, DT=   .0050 SEC' or '5590   .0050   NPTS, DT'"
       if (index(up, 'NPTS') == 0) then
-         call fatal_error(error, where//": NPTS is missing; "//expect//", found '"//trim(line)//"'")
+         call fatal_error(error, where//": NPTS is missing; "//expect//", found '"//trim(fmt_text(line))//"'")
          return
       end if
       if (index(up, 'DT') == 0) then
-         call fatal_error(error, where//": DT is missing; "//expect//", found '"//trim(line)//"'")
+         call fatal_error(error, where//": DT is missing; "//expect//", found '"//trim(fmt_text(line))//"'")
          return
       end if
       call words(up, tok)
       do k = 1, 2
          if (count(tok == merge('NPTS', 'DT  ', k == 1)) > 1) then
             call fatal_error(error, where//": "//trim(merge('NPTS', 'DT  ', k == 1))//" is given twice ('"// &
-                             trim(line)//"'); line 4 gives NPTS and DT once each")
+                             trim(fmt_text(line))//"'); line 4 gives NPTS and DT once each")
             return
          end if
       end do
@@ -470,8 +471,8 @@ contains
          case ('', 'SEC', 'SECS', 'S', 'SECOND', 'SECONDS')
          case default
             if (unit(1:4) /= 'NPTS') then
-               call fatal_error(error, where//": DT is followed by '"//trim(unit)//"'; DT is read in seconds "// &
-                                "(SEC), give it so ('"//trim(line)//"')")
+               call fatal_error(error, where//": DT is followed by '"//trim(fmt_text(unit))//"'; DT is read in seconds "// &
+                                "(SEC), give it so ('"//trim(fmt_text(line))//"')")
                return
             end if
          end select
@@ -508,11 +509,11 @@ contains
          end do
       end if
       if (num(1) == '') then
-         call fatal_error(error, where//": cannot find the value of NPTS; "//expect//", found '"//trim(line)//"'")
+         call fatal_error(error, where//": cannot find the value of NPTS; "//expect//", found '"//trim(fmt_text(line))//"'")
          return
       end if
       if (num(2) == '') then
-         call fatal_error(error, where//": DT has no value; "//expect//", found '"//trim(line)//"'")
+         call fatal_error(error, where//": DT has no value; "//expect//", found '"//trim(fmt_text(line))//"'")
          return
       end if
       if (verify(trim(num(1)), '0123456789') /= 0) then
@@ -536,7 +537,7 @@ contains
       !> The error of a word line 4 does not hold (a value after the header, a stray word).
       subroutine extra_word(w)
          character(len=*), intent(in) :: w
-         call fatal_error(error, where//": '"//trim(w)//"' after NPTS and DT ('"//trim(line)// &
+         call fatal_error(error, where//": '"//trim(fmt_text(w))//"' after NPTS and DT ('"//trim(fmt_text(line))// &
                           "'); line 4 holds NPTS, DT and their values only, the values start on line 5")
       end subroutine extra_word
       !> The word after "KEY=" (KEY as a whole word), '' when absent; after: the word that
