@@ -2,6 +2,7 @@
 
 from __future__ import annotations
 
+import contextlib
 import os
 import subprocess
 import sys
@@ -162,14 +163,14 @@ def steady_amplitude(t: np.ndarray, x: np.ndarray, freq: float, cycles: int) -> 
     return float(np.hypot(*coef))
 
 
-@pytest.fixture
-def small_fs(tmp_path):
-    """A 160 KiB tmpfs (mounted as root); unmounted afterwards."""
+@contextlib.contextmanager
+def tmpfs(mnt: Path, options: str):
+    """A tmpfs mounted at mnt (created) with the mount options given, unmounted afterwards;
+    the test is skipped where it cannot be mounted (mounting needs root: CI runs as root)."""
     if os.geteuid() != 0:
         pytest.skip("mounting a tmpfs needs root (CI runs as root)")
-    mnt = tmp_path / "fs"
     mnt.mkdir()
-    r = subprocess.run(["mount", "-t", "tmpfs", "-o", "size=160k", "tmpfs", str(mnt)],
+    r = subprocess.run(["mount", "-t", "tmpfs", "-o", options, "tmpfs", str(mnt)],
                        capture_output=True, text=True)
     if r.returncode != 0:
         pytest.skip(f"cannot mount a tmpfs here: {r.stderr.strip()}")
@@ -177,6 +178,13 @@ def small_fs(tmp_path):
         yield mnt
     finally:
         subprocess.run(["umount", "-l", str(mnt)], check=False)
+
+
+@pytest.fixture
+def small_fs(tmp_path):
+    """A 160 KiB tmpfs, to fill."""
+    with tmpfs(tmp_path / "fs", "size=160k") as mnt:
+        yield mnt
 
 
 def chain(n: int, duration: float, *, name: str = "run", out: str = "out", n1: int = 2,

@@ -16,7 +16,7 @@ from pathlib import Path
 import frictiondyn
 import numpy as np
 import pytest
-from conftest import deck_text
+from conftest import deck_text, tmpfs
 
 EXE = frictiondyn.executable()
 
@@ -34,6 +34,20 @@ def oscillator(n_dof: int, duration: float, name: str = "same", every: int = 1) 
         "output": {"name": name, "output_every": every},
     }
 
+
+
+def free_slider() -> dict:
+    """A 2 kg block on a velocity-law device to the table, no spring, no table motion: a
+    rigid-body mode (no period), no forcing frequency, nothing to balance."""
+    return {
+        "model": {"n_dof": 1, "mass": [2.0]},
+        "springs": {"n_springs": 0},
+        "damping": {"damping_type": "none"},
+        "friction": {"n_devices": 1, "node_i": 1, "node_j": 0, "law": "velocity",
+                     "p": 19.62, "mu": 0.3, "eps": 1e-3},
+        "excitation": {"excitation_type": "none", "dt_record": 0.01, "duration": 0.2},
+        "output": {"name": "slider"},
+    }
 
 def pair_is_consistent(outdir: Path, name: str = "same") -> tuple[int, int]:
     """The CSV and the summary of `name` come from one run: the CSV's columns and rows are
@@ -237,21 +251,11 @@ def test_output_directory_that_cannot_be_made_gives_the_system_reason(tmp_path):
 def test_read_only_file_system_output_directory_gives_the_system_reason(tmp_path):
     """A new output directory on a read-only file system (a tmpfs mounted read-only): the
     error gives the system's reason, "Read-only file system"."""
-    if os.geteuid() != 0:
-        pytest.skip("mounting a tmpfs needs root (CI runs as root)")
-    mnt = tmp_path / "ro"
-    mnt.mkdir()
-    m = subprocess.run(["mount", "-t", "tmpfs", "-o", "ro,size=16k", "tmpfs", str(mnt)],
-                       capture_output=True, text=True)
-    if m.returncode != 0:
-        pytest.skip(f"cannot mount a tmpfs here: {m.stderr.strip()}")
-    try:
+    with tmpfs(tmp_path / "ro", "ro,size=16k") as mnt:
         g = oscillator(1, 0.2)
         g["output"]["dir"] = f"{mnt}/new/out"
         (tmp_path / "d.nml").write_text(deck_text(g))
         r = subprocess.run([EXE, "d.nml"], cwd=tmp_path, capture_output=True, text=True)
-    finally:
-        subprocess.run(["umount", "-l", str(mnt)], check=False)
     assert r.returncode == 1
     assert f"cannot create the output directory dir = '{mnt}/new/out': Read-only file system" in r.stderr
 
@@ -308,15 +312,7 @@ def test_undefined_summary_values_are_null_never_0(tmp_path):
     event["friction"] = {"n_devices": 1, "node_i": 1, "node_j": 0, "law": "coulomb",
                          "p": 100.0, "mu": 0.3}
     event["integration"] = {"technique": "event_driven", "n1": 2}
-    slider = {
-        "model": {"n_dof": 1, "mass": [2.0]},
-        "springs": {"n_springs": 0},
-        "damping": {"damping_type": "none"},
-        "friction": {"n_devices": 1, "node_i": 1, "node_j": 0, "law": "velocity",
-                     "p": 19.62, "mu": 0.3, "eps": 1e-3},
-        "excitation": {"excitation_type": "none", "dt_record": 0.01, "duration": 0.2},
-        "output": {"name": "slider"},
-    }
+    slider = free_slider()
     summ = {}
     for g in (braced, event, slider):
         name = g["output"]["name"]
@@ -347,15 +343,7 @@ def test_python_reads_undefined_values_as_none_and_nan(tmp_path):
     """Python's Result holds an undefined summary value as None (as json.loads reads null),
     in the run's Result and in Result.from_files alike; modes() gives inf for a rigid-body
     mode's period and nan for its damping ratio."""
-    g = {
-        "model": {"n_dof": 1, "mass": [2.0]},
-        "springs": {"n_springs": 0},
-        "damping": {"damping_type": "none"},
-        "friction": {"n_devices": 1, "node_i": 1, "node_j": 0, "law": "velocity",
-                     "p": 19.62, "mu": 0.3, "eps": 1e-3},
-        "excitation": {"excitation_type": "none", "dt_record": 0.01, "duration": 0.2},
-        "output": {"name": "slider"},
-    }
+    g = free_slider()
     (tmp_path / "slider.nml").write_text(deck_text(g))
     res = frictiondyn.run(tmp_path / "slider.nml")
     assert res.summary["period_stuck_s"] is None and res.summary["periods_free_s"] == [None]

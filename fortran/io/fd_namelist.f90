@@ -675,22 +675,6 @@ contains
          end if
       end subroutine triplet
 
-      pure subroutine int_of(t, v, ok)
-         character(len=*), intent(in) :: t
-         integer, intent(out) :: v
-         logical, intent(out) :: ok
-         integer :: ios, k0
-         v = 0
-         k0 = 1
-         if (len(t) > 0) then
-            if (t(1:1) == '+' .or. t(1:1) == '-') k0 = 2
-         end if
-         ok = len(t) >= k0 .and. len(t) <= 9
-         if (ok) ok = verify(t(k0:), '0123456789') == 0
-         if (.not. ok) return
-         read (t, *, iostat=ios) v
-         ok = ios == 0
-      end subroutine int_of
    end function dims_overlap
 
    !> The longest string an assignment of variable `var` (or of its elements, 'var(i)') gives
@@ -900,21 +884,21 @@ contains
          l = 1; u = ext; s = 1
          c1 = index(t, ':')
          if (c1 == 0) then
-            call whole(t, l, ok)
+            call int_of(t, l, ok)
             return
          end if
          c2 = index(t(c1 + 1:), ':')
          if (c2 > 0) c2 = c1 + c2
          ok = .true.
-         if (c1 > 1) call whole(t(1:c1 - 1), l, ok)
+         if (c1 > 1) call int_of(t(1:c1 - 1), l, ok)
          if (.not. ok) return
          if (c2 == 0) then
-            if (c1 < len(t)) call whole(t(c1 + 1:), u, ok)
+            if (c1 < len(t)) call int_of(t(c1 + 1:), u, ok)
             return
          end if
-         if (c2 > c1 + 1) call whole(t(c1 + 1:c2 - 1), u, ok)
+         if (c2 > c1 + 1) call int_of(t(c1 + 1:c2 - 1), u, ok)
          if (.not. ok) return
-         call whole(t(c2 + 1:), s, ok)
+         call int_of(t(c2 + 1:), s, ok)
          if (ok) ok = s /= 0
          if (ok .and. s < 0) then   ! omitted bounds run the other way
             if (c1 == 1) l = ext
@@ -922,23 +906,26 @@ contains
          end if
       end subroutine section
 
-      pure subroutine whole(t, v, ok)
-         character(len=*), intent(in) :: t
-         integer, intent(out) :: v
-         logical, intent(out) :: ok
-         integer :: k0, ios2
-         v = 0
-         k0 = 1
-         if (len(t) > 0) then
-            if (t(1:1) == '+' .or. t(1:1) == '-') k0 = 2
-         end if
-         ok = len(t) >= k0 .and. len(t) <= 9
-         if (ok) ok = verify(t(k0:), '0123456789') == 0
-         if (.not. ok) return
-         read (t, *, iostat=ios2) v
-         ok = ios2 == 0
-      end subroutine whole
    end subroutine given_elements
+
+   !> The integer a subscript's text gives (an optional sign and at most 9 digits); ok false
+   !> for anything else.
+   pure subroutine int_of(t, v, ok)
+      character(len=*), intent(in) :: t   !! the text
+      integer, intent(out) :: v           !! its value (0 when not ok)
+      logical, intent(out) :: ok          !! the text is such an integer
+      integer :: ios, k0
+      v = 0
+      k0 = 1
+      if (len(t) > 0) then
+         if (t(1:1) == '+' .or. t(1:1) == '-') k0 = 2
+      end if
+      ok = len(t) >= k0 .and. len(t) <= 9
+      if (ok) ok = verify(t(k0:), '0123456789') == 0
+      if (.not. ok) return
+      read (t, *, iostat=ios) v
+      ok = ios == 0
+   end subroutine int_of
 
    !> The variable an assignment sets, lower case, blanks removed: 'mass', 'mass(2)'.
    pure subroutine item_variable(item, var)
