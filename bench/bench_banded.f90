@@ -16,6 +16,7 @@ program bench_banded
    use, intrinsic :: iso_fortran_env, only: output_unit, int64
    use fd_kinds, only: dp
    use fd_error, only: error_type
+   use fd_kinematics, only: pair_terms
    use fd_banded, only: spd_system, spd_setup, spd_factor, spd_update_device, spd_update_devices, &
                         spd_solve, spd_k_matvec, spd_c_matvec, spd_bandwidth, spd_dense, spd_banded, &
                         spd_auto, spd_choose, spd_rank_one, spd_refactor, spd_is_dense, spd_size
@@ -89,7 +90,7 @@ contains
       integer :: d
 
       call structure(n, nx, mass, si, sj, sk, di, dj)
-      call spd_setup(sys, mass, si, sj, sk, di, dj, error, a0=0.3_dp, a1=2.0e-3_dp, path=path, &
+      call pair_setup(sys, mass, si, sj, sk, di, dj, error, a0=0.3_dp, a1=2.0e-3_dp, path=path, &
                      method=method)
       if (allocated(error)) error stop 1
       allocate (kd(size(di)))
@@ -273,7 +274,7 @@ contains
             kd(::2) = 3.0e9_dp
             t = huge(1.0_dp)
             do path = spd_dense, spd_banded
-               call spd_setup(sys, mass, si, sj, sk, di, dj, error, a0=0.3_dp, a1=2.0e-3_dp, path=path)
+               call pair_setup(sys, mass, si, sj, sk, di, dj, error, a0=0.3_dp, a1=2.0e-3_dp, path=path)
                if (allocated(error)) error stop 6
                if (path == spd_banded) kb = spd_bandwidth(sys)
                do k = 1, 4
@@ -407,5 +408,20 @@ contains
          end do
       end do
    end subroutine alloc_run
+
+   !> spd_setup for devices between two nodes (di, dj; 0 = the table).
+   subroutine pair_setup(sys, mass, si, sj, sk, di, dj, error, a0, a1, path, method)
+      type(spd_system), intent(out) :: sys
+      real(dp), intent(in) :: mass(:), sk(:)
+      integer, intent(in) :: si(:), sj(:), di(:), dj(:)
+      type(error_type), allocatable, intent(out) :: error
+      real(dp), intent(in), optional :: a0, a1
+      integer, intent(in), optional :: path, method
+      integer :: ptr(size(di) + 1), dof(2*size(di))
+      real(dp) :: coef(2*size(di))
+
+      call pair_terms(di, dj, ptr, dof, coef)
+      call spd_setup(sys, mass, si, sj, sk, ptr, dof, coef, error, a0=a0, a1=a1, path=path, method=method)
+   end subroutine pair_setup
 
 end program bench_banded

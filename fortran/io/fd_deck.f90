@@ -25,6 +25,7 @@ module fd_deck
                        default_write_history, default_max_history_mb, linear_systems, default_linear_system, &
                        refinements, default_refinement
    use fd_model, only: model_type, integration_type, device_type, output_type
+   use fd_kinematics, only: set_pair_directions
    use fd_excitation, only: excitation_type
    use fd_record, only: read_record, record_info, record_formats, record_units_list, units_factor
    use fd_technique, only: check_technique
@@ -123,6 +124,7 @@ contains
       type(deck_text), intent(inout) :: deck   !! (check_groups keeps its groups' places)
       type(run_config), intent(inout) :: cfg
       type(error_type), allocatable, intent(out) :: error
+      integer :: stat
 
       cfg%deck_path = deck%path
       call check_groups(deck, [character(len=12) :: 'model', 'springs', 'damping', 'friction', &
@@ -144,6 +146,12 @@ contains
       if (allocated(error)) return
       call read_storeys_group(deck, cfg, error)
       if (allocated(error)) return
+      ! each device's direction from its two nodes (fd_kinematics)
+      call set_pair_directions(cfg%model, stat)
+      if (stat /= 0) then
+         call no_memory(deck, 'friction', cfg%model%n_devices, 'device directions', error)
+         return
+      end if
       call read_excitation_group(deck, cfg, error)
       if (allocated(error)) return
       call read_integration_group(deck, cfg, error)

@@ -1,7 +1,10 @@
 !> The effective stiffness of a structure with friction devices, stored and factored the way
 !> its graph allows, and kept factored as devices change phase:
 !>
-!>   K^ = K + c1 C + c0 M + sum_d kd_d b_d b_d',   b_d = e_i - e_j (e_i for a device on the table)
+!>   K^ = K + c1 C + c0 M + sum_d kd_d b_d b_d'
+!>
+!> with b_d device d's direction over the DOFs (a few terms: e_i - e_j for a device between
+!> two nodes, e_i for one on the table).
 !>
 !> K (springs) and C (a0 M + a1 K + dashpots) are stored once, in a reverse Cuthill-McKee
 !> ordering of the graph of springs, dashpots and devices, as symmetric band matrices
@@ -97,7 +100,12 @@ module fd_banded
       real(dp), private :: span = huge(1.0_dp)        !! running mean of columns per update
       integer, allocatable, private :: perm(:)        !! new -> old DOF
       integer, allocatable, private :: inv(:)         !! old -> new DOF
-      integer, allocatable, private :: dlo(:), dhi(:) !! device columns (new), dlo < dhi or dhi = 0
+      integer, allocatable, private :: dlo(:), dhi(:) !! first and last column of each device (new
+                                                      !! order); dhi = 0 for a one-term device
+      integer, allocatable, private :: dptr(:)        !! start of each device's terms
+      integer, allocatable, private :: dcol(:)        !! column of each term (new order)
+      real(dp), allocatable, private :: dval(:)       !! coefficient of each term, signed so that
+                                                      !! the one in column dlo is positive
       integer, allocatable, private :: dorder(:)      !! devices by decreasing last column
       real(dp), allocatable, private :: mass(:)       !! masses (new order)
       real(dp), allocatable, private :: kmat(:)       !! K, upper triangle, storage layout
@@ -114,15 +122,16 @@ contains
 
    !> Set up the system: graph, ordering, storage, K and C. Allocates everything the
    !> other procedures use; the factor is made by spd_factor.
-   subroutine spd_setup(sys, mass, spring_i, spring_j, spring_k, dev_i, dev_j, error, &
+   subroutine spd_setup(sys, mass, spring_i, spring_j, spring_k, dev_ptr, dev_dof, dev_coef, error, &
                         a0, a1, dashpot_i, dashpot_j, dashpot_c, path, budget, method)
       type(spd_system), intent(out) :: sys       !! the system
       real(dp), intent(in) :: mass(:)            !! masses [kg], one per DOF (n = size)
       integer, intent(in) :: spring_i(:)         !! first node of each spring (0..n, 0 = table)
       integer, intent(in) :: spring_j(:)         !! second node of each spring (0..n)
       real(dp), intent(in) :: spring_k(:)        !! spring stiffness [N/m], >= 0
-      integer, intent(in) :: dev_i(:)            !! first node of each device (0..n)
-      integer, intent(in) :: dev_j(:)            !! second node of each device (0..n)
+      integer, intent(in) :: dev_ptr(:)          !! start of each device's terms (devices + 1)
+      integer, intent(in) :: dev_dof(:)          !! DOF of each term (1..n)
+      real(dp), intent(in) :: dev_coef(:)        !! coefficient of each term (finite, not 0)
       type(error_type), allocatable, intent(out) :: error !! invalid input
       real(dp), intent(in), optional :: a0       !! C = a0 M + ... [1/s], default 0
       real(dp), intent(in), optional :: a1       !! C = ... + a1 K + ... [s], default 0
@@ -135,11 +144,11 @@ contains
       integer, allocatable :: ei(:), ej(:), di(:), dj(:)
       real(dp), allocatable :: dc(:)
       real(dp) :: ca0, ca1
-      integer :: n, ns, nd, nc, ne, i, d, a, b, kbw, mode, stat
+      integer :: n, ns, nd, nc, ne, i, d, a, kbw, mode, stat
 
       n = size(mass)
       ns = size(spring_i)
-      nd = size(dev_i)
+      nd = size(dev_ptr) - 1
       ca0 = 0.0_dp
       ca1 = 0.0_dp
       if (present(a0)) ca0 = a0
@@ -173,17 +182,13 @@ contains
          call fatal_error(error, "spd_setup: spring_i, spring_j and spring_k differ in size")
          return
       end if
-      if (size(dev_j) /= nd) then
-         call fatal_error(error, "spd_setup: dev_i and dev_j differ in size")
-         return
-      end if
+      call check_devices(dev_ptr, dev_dof, dev_coef, n, error)
+      if (allocated(error)) return
       if (size(dj) /= nc .or. size(dc) /= nc) then
          call fatal_error(error, "spd_setup: dashpot_i, dashpot_j and dashpot_c differ in size")
          return
       end if
       call check_links("spring", spring_i, spring_j, spring_k, n, error)
-      if (allocated(error)) return
-      call check_links("device", dev_i, dev_j, [(0.0_dp, i=1, nd)], n, error)
       if (allocated(error)) return
       call check_links("dashpot", di, dj, dc, n, error)
       if (allocated(error)) return
@@ -216,17 +221,39 @@ contains
          sys%budget = budget
       end if
 
-      ! the graph: springs, devices and dashpots between two DOFs
-      ne = ns + nd + nc
+      ! the graph: springs and dashpots between two DOFs, each device a star from its first
+      ! term (its edge to the table, node 0, when it has one term)
+      ne = ns + (dev_ptr(nd + 1) - 1) + nc
       allocate (ei(ne), ej(ne))
-      ei = [spring_i, dev_i, di]
-      ej = [spring_j, dev_j, dj]
+      ne = ns
+      ei(1:ns) = spring_i
+      ej(1:ns) = spring_j
+      do d = 1, nd
+         ne = ne + 1
+         ei(ne) = dev_dof(dev_ptr(d))
+         ej(ne) = 0
+         if (dev_ptr(d + 1) - dev_ptr(d) > 1) ej(ne) = dev_dof(dev_ptr(d) + 1)
+         do i = dev_ptr(d) + 2, dev_ptr(d + 1) - 1
+            ne = ne + 1
+            ei(ne) = dev_dof(dev_ptr(d))
+            ej(ne) = dev_dof(i)
+         end do
+      end do
+      ei(ne + 1:ne + nc) = di
+      ej(ne + 1:ne + nc) = dj
+      ne = ne + nc
       allocate (sys%perm(n), sys%inv(n))
-      call rcm_order(n, ei, ej, sys%perm)
+      call rcm_order(n, ei(1:ne), ej(1:ne), sys%perm)
       do i = 1, n
          sys%inv(sys%perm(i)) = i
       end do
-      kbw = graph_bandwidth(ei, ej, sys%inv)
+      kbw = graph_bandwidth(ei(1:ne), ej(1:ne), sys%inv)
+      ! a device of three or more terms spans more than its star's edges
+      do d = 1, nd
+         if (dev_ptr(d + 1) - dev_ptr(d) < 3) cycle
+         kbw = max(kbw, maxval(sys%inv(dev_dof(dev_ptr(d):dev_ptr(d + 1) - 1))) - &
+                   minval(sys%inv(dev_dof(dev_ptr(d):dev_ptr(d + 1) - 1))))
+      end do
       if (mode == spd_auto) then
          ! dense where it is faster: a few DOFs (a band nearly as wide as the matrix is no
          ! slower than dense storage: bench/banded.sh wide)
@@ -259,7 +286,8 @@ contains
       end if
       allocate (sys%mass(n), sys%kmat(sys%ld*n), sys%cmat(sys%ld*n), sys%fac(sys%ld*n), sys%kd(nd), &
                 sys%errcol(n), sys%w1(n), sys%w2(n), sys%xv(n), sys%rdiag(n), sys%dlo(nd), sys%dhi(nd), &
-                sys%dorder(nd), stat=stat)
+                sys%dorder(nd), sys%dptr(nd + 1), sys%dcol(dev_ptr(nd + 1) - 1), &
+                sys%dval(dev_ptr(nd + 1) - 1), stat=stat)
       if (stat /= 0) then
          call fatal_error(error, "not enough memory for the effective stiffness of "//trim(fmt_int(n))// &
                           " DOFs of half-bandwidth "//trim(fmt_int(sys%kb))//" (3 x "// &
@@ -291,21 +319,7 @@ contains
       do i = 1, nc
          call add_link(sys, sys%cmat, di(i), dj(i), dc(i))
       end do
-      do d = 1, nd
-         a = 0
-         b = 0
-         if (dev_i(d) > 0) a = sys%inv(dev_i(d))
-         if (dev_j(d) > 0) b = sys%inv(dev_j(d))
-         if (a == 0) then
-            a = b
-            b = 0
-         end if
-         if (b > 0 .and. b < a) then
-            i = a; a = b; b = i
-         end if
-         sys%dlo(d) = a
-         sys%dhi(d) = b
-      end do
+      call order_devices(sys, dev_ptr, dev_dof, dev_coef)
       call sort_devices(sys)
    end subroutine spd_setup
 
@@ -318,7 +332,8 @@ contains
       integer :: stat
 
       allocate (dst%perm(size(src%perm)), dst%inv(size(src%inv)), dst%dlo(size(src%dlo)), &
-                dst%dhi(size(src%dhi)), dst%dorder(size(src%dorder)), dst%mass(size(src%mass)), &
+                dst%dhi(size(src%dhi)), dst%dorder(size(src%dorder)), dst%dptr(size(src%dptr)), &
+                dst%dcol(size(src%dcol)), dst%dval(size(src%dval)), dst%mass(size(src%mass)), &
                 dst%kmat(size(src%kmat)), dst%cmat(size(src%cmat)), dst%fac(size(src%fac)), &
                 dst%kd(size(src%kd)), dst%errcol(size(src%errcol)), dst%w1(size(src%w1)), &
                 dst%w2(size(src%w2)), dst%xv(size(src%xv)), dst%rdiag(size(src%rdiag)), stat=stat)
@@ -330,6 +345,84 @@ contains
       end if
       dst = src   ! every array already has its shape: nothing is allocated here
    end subroutine spd_copy
+
+   !> Check the devices' terms: each device has one or more, on distinct DOFs in 1..n, with
+   !> finite coefficients other than 0.
+   subroutine check_devices(ptr, dof, coef, n, error)
+      integer, intent(in) :: ptr(:), dof(:)
+      real(dp), intent(in) :: coef(:)
+      integer, intent(in) :: n
+      type(error_type), allocatable, intent(out) :: error
+      integer :: d, k, l
+
+      if (size(ptr) < 1) then
+         call fatal_error(error, "spd_setup: dev_ptr must have the number of devices + 1 entries")
+         return
+      end if
+      if (ptr(1) /= 1 .or. ptr(size(ptr)) - 1 > min(size(dof), size(coef))) then
+         call fatal_error(error, "spd_setup: dev_ptr does not index dev_dof and dev_coef (from 1 to "// &
+                          trim(fmt_int(ptr(size(ptr)) - 1))//" terms)")
+         return
+      end if
+      do d = 1, size(ptr) - 1
+         if (ptr(d + 1) <= ptr(d)) then
+            call fatal_error(error, "spd_setup: device "//trim(fmt_int(d))//" has no term")
+            return
+         end if
+         do k = ptr(d), ptr(d + 1) - 1
+            if (dof(k) < 1 .or. dof(k) > n) then
+               call fatal_error(error, "spd_setup: device "//trim(fmt_int(d))//" has a term at DOF "// &
+                                trim(fmt_int(dof(k)))//", outside 1.."//trim(fmt_int(n)))
+               return
+            end if
+            if (.not. (coef(k) /= 0.0_dp .and. ieee_is_finite(coef(k)))) then
+               call fatal_error(error, "spd_setup: device "//trim(fmt_int(d))//" has the coefficient "// &
+                                trim(fmt_real(coef(k)))//" at DOF "//trim(fmt_int(dof(k)))// &
+                                ", which must be finite and not 0")
+               return
+            end if
+            do l = ptr(d), k - 1
+               if (dof(l) == dof(k)) then
+                  call fatal_error(error, "spd_setup: device "//trim(fmt_int(d))//" has two terms at DOF "// &
+                                   trim(fmt_int(dof(k))))
+                  return
+               end if
+            end do
+         end do
+      end do
+   end subroutine check_devices
+
+   !> The devices' terms in the new order, their first and last columns, and the signs that
+   !> make each device's term in its first column positive (b b' does not change).
+   subroutine order_devices(sys, ptr, dof, coef)
+      type(spd_system), intent(inout) :: sys
+      integer, intent(in) :: ptr(:), dof(:)
+      real(dp), intent(in) :: coef(:)
+      integer :: d, k, lo, hi, c
+      real(dp) :: sgn
+
+      sys%dptr = ptr(1:sys%nd + 1)
+      do d = 1, sys%nd
+         lo = sys%n + 1
+         hi = 0
+         sgn = 1.0_dp
+         do k = ptr(d), ptr(d + 1) - 1
+            c = sys%inv(dof(k))
+            sys%dcol(k) = c
+            if (c < lo) then
+               lo = c
+               sgn = sign(1.0_dp, coef(k))
+            end if
+            hi = max(hi, c)
+         end do
+         do k = ptr(d), ptr(d + 1) - 1
+            sys%dval(k) = sgn*coef(k)
+         end do
+         sys%dlo(d) = lo
+         sys%dhi(d) = hi
+         if (hi == lo) sys%dhi(d) = 0
+      end do
+   end subroutine order_devices
 
    !> Check the nodes and coefficients of a list of two-node elements.
    subroutine check_links(what, ni, nj, coef, n, error)
@@ -503,7 +596,7 @@ contains
       type(spd_system), intent(inout) :: sys
       integer, intent(in) :: p
       type(error_type), allocatable, intent(out) :: error
-      integer :: i, j, l, k, m, d, a, b, n, kb, info
+      integer :: i, j, l, k, m, d, n, kb, info, r, q
       real(dp) :: s, e
 
       n = sys%n
@@ -518,17 +611,21 @@ contains
             k = idx(sys, j, j)
             fac(k) = fac(k) + sys%c0*sys%mass(j)
          end do
+         ! kd b b', in the columns from p on
          do m = 1, sys%nd
             d = sys%dorder(m)
-            a = sys%dlo(d)
-            b = sys%dhi(d)
-            if (max(a, b) < p) exit
+            if (max(sys%dlo(d), sys%dhi(d)) < p) exit
             if (sys%kd(d) == 0.0_dp) cycle
-            if (a >= p) fac(idx(sys, a, a)) = fac(idx(sys, a, a)) + sys%kd(d)
-            if (b > 0) then
-               fac(idx(sys, b, b)) = fac(idx(sys, b, b)) + sys%kd(d)
-               if (a >= p) fac(idx(sys, a, b)) = fac(idx(sys, a, b)) - sys%kd(d)
-            end if
+            do r = sys%dptr(d), sys%dptr(d + 1) - 1
+               i = sys%dcol(r)
+               if (i < p) cycle
+               do q = sys%dptr(d), sys%dptr(d + 1) - 1
+                  j = sys%dcol(q)
+                  if (j < i) cycle
+                  k = idx(sys, i, j)
+                  fac(k) = fac(k) + sys%kd(d)*sys%dval(r)*sys%dval(q)
+               end do
+            end do
          end do
          do j = p, n
             sys%w2(j) = fac(idx(sys, j, j))
@@ -685,7 +782,7 @@ contains
 
       delta = kd - sys%kd(d)
       sys%kd(d) = kd
-      call rank_one(sys, sys%dlo(d), sys%dhi(d), delta, status)
+      call rank_one(sys, d, delta, status)
       ok = status == 0
       select case (status)
       case (0)
@@ -701,7 +798,7 @@ contains
       end select
    end subroutine modify
 
-   !> U' U + delta v v' -> U' U, v = e_a - e_b (e_a when b = 0), a < b: hyperbolic
+   !> U' U + delta v v' -> U' U, v = b_d (columns dlo to dhi, positive in dlo): hyperbolic
    !> (delta < 0) or circular (delta > 0) rotations in the mixed form, column a to n,
    !> touching the band only. The rotations stop early once the rest of the update vector
    !> is negligible: when every remaining entry x_j satisfies |x_j| <= tau U_jj, the
@@ -712,13 +809,13 @@ contains
    !> alone loses more than the budget); 2 abandoned, the accumulated error estimate would
    !> exceed the budget. An abandoned modification leaves the factor partly modified and
    !> marked not factored.
-   subroutine rank_one(sys, a, b, delta, status)
+   subroutine rank_one(sys, d, delta, status)
       type(spd_system), intent(inout) :: sys
-      integer, intent(in) :: a, b
+      integer, intent(in) :: d
       real(dp), intent(in) :: delta
       integer, intent(out) :: status
       real(dp) :: x, xk, ukk, s, ratio, c, ci, e, u
-      integer :: k, j, jmax, last, kk, ij, n, kb, sj
+      integer :: k, j, jmax, last, kk, ij, n, kb, sj, a
       logical :: up
 
       status = 0
@@ -728,9 +825,11 @@ contains
       up = delta > 0.0_dp
       x = sqrt(abs(delta))
       associate (fac => sys%fac, xv => sys%xv, errcol => sys%errcol)
-         xv(a) = x
-         if (b > 0) xv(b) = -x
-         last = max(a, b)
+         do k = sys%dptr(d), sys%dptr(d + 1) - 1
+            xv(sys%dcol(k)) = x*sys%dval(k)
+         end do
+         a = sys%dlo(d)
+         last = max(a, sys%dhi(d))
          k = a
          do while (k <= last)
             xk = xv(k)

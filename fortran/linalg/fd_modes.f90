@@ -134,6 +134,7 @@ contains
       real(dp) :: delta, change, norm
       integer :: n, nq, it, i, j, e, a, b, pass, stat
       integer :: none(0)
+      real(dp) :: no_coef(0)
       real(dp) :: nokd(0)
       logical :: done
 
@@ -153,7 +154,7 @@ contains
          return
       end if
       delta = 1.0e-10_dp*scale
-      call spd_setup(sys, mass, ei, ej, ek, none, none, error)
+      call spd_setup(sys, mass, ei, ej, ek, [1], none, no_coef, error)
       if (allocated(error)) return
       call spd_factor(sys, delta, 0.0_dp, nokd, error)
       if (allocated(error)) return

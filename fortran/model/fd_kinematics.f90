@@ -1,32 +1,87 @@
-!> Kinematics of the friction devices, for every technique: device d between node_i and
-!> node_j has the direction b_d = e_i - e_j (node 0, the table, dropped), its relative
-!> displacement is s_d = b_d' u = u(node_i) - u(node_j), and its force F_d enters the
-!> equations of motion as b_d F_d.
+!> Kinematics of the friction devices: the one place that knows a device's geometry. Device
+!> d has a direction b_d over the DOFs (sparse: a few terms, kept in the model as dev_ptr,
+!> dev_dof, dev_coef); its relative displacement is s_d = b_d' u and its force F_d enters the
+!> equations of motion as b_d F_d. A device between two nodes has b_d = e_i - e_j (node 0,
+!> the table, dropped). Every technique and check reaches a device's motion through the
+!> routines here; those that group nodes joined by stuck devices (the exact technique's
+!> phase patterns, Moreau-Jean's sticking groups, the stuck system's modes) ask device_pair
+!> for the two nodes, and refuse a model whose devices are not all between two nodes.
 module fd_kinematics
    use fd_kinds, only: dp
    use fd_model, only: model_type
    implicit none
    private
 
-   public :: device_kinematics, device_relative, add_device
+   public :: set_pair_directions, pair_terms, directions_set
+   public :: device_kinematics, device_relative, device_abs_relative, add_device
+   public :: add_device_abs, add_device_outer, pair_nodes, device_nodes, devices_are_pairs, moved_mass
+   public :: device_inverse_mass_relative, device_abs_inverse_mass_relative, device_coupling
 
 contains
 
-   !> Relative displacement and velocity of every device.
+   !> The directions of devices between two nodes: b_d = e_i - e_j (e_i when node_j = 0)
+   !> from each device's node_i and node_j. stat /= 0: not enough memory.
+   pure subroutine set_pair_directions(model, stat)
+      type(model_type), intent(inout) :: model  !! the model; its devices' nodes are read
+      integer, intent(out) :: stat              !! 0, or the allocation's status
+
+      integer :: nd
+
+      nd = model%n_devices
+      if (allocated(model%dev_ptr)) deallocate (model%dev_ptr)
+      if (allocated(model%dev_dof)) deallocate (model%dev_dof)
+      if (allocated(model%dev_coef)) deallocate (model%dev_coef)
+      allocate (model%dev_ptr(nd + 1), model%dev_dof(2*nd), model%dev_coef(2*nd), stat=stat)
+      if (stat /= 0) return
+      call pair_terms(model%dev(1:nd)%node_i, model%dev(1:nd)%node_j, model%dev_ptr, model%dev_dof, &
+                      model%dev_coef)
+   end subroutine set_pair_directions
+
+   !> The compressed directions of two-node elements: e_i - e_j, e_i when j = 0 (and -e_j
+   !> when i = 0). ptr has size(ni) + 1 entries, dof and coef at least 2 size(ni).
+   pure subroutine pair_terms(ni, nj, ptr, dof, coef)
+      integer, intent(in) :: ni(:)            !! first node of each element (0..n)
+      integer, intent(in) :: nj(:)            !! second node (0..n)
+      integer, intent(out) :: ptr(:)          !! start of each element's terms
+      integer, intent(out) :: dof(:)          !! DOF of each term
+      real(dp), intent(out) :: coef(:)        !! coefficient of each term
+      integer :: e, k
+
+      k = 1
+      do e = 1, size(ni)
+         ptr(e) = k
+         if (ni(e) > 0) then
+            dof(k) = ni(e); coef(k) = 1.0_dp; k = k + 1
+         end if
+         if (nj(e) > 0) then
+            dof(k) = nj(e); coef(k) = -1.0_dp; k = k + 1
+         end if
+      end do
+      ptr(size(ni) + 1) = k
+      dof(k:) = 0
+      coef(k:) = 0.0_dp
+   end subroutine pair_terms
+
+   !> Whether the model's directions are set for all its devices.
+   pure logical function directions_set(model) result(set)
+      type(model_type), intent(in) :: model  !! the model
+
+      set = allocated(model%dev_ptr)
+      if (set) set = size(model%dev_ptr) == model%n_devices + 1
+   end function directions_set
+
+   !> Relative displacement and velocity of every device, s = b' u and s' = b' v.
    pure subroutine device_kinematics(model, u, v, s, sd)
       type(model_type), intent(in) :: model   !! the model
       real(dp), intent(in) :: u(:)            !! displacements of the DOFs [m]
       real(dp), intent(in) :: v(:)            !! velocities of the DOFs [m/s]
       real(dp), intent(out) :: s(:)           !! relative displacement of each device [m]
       real(dp), intent(out) :: sd(:)          !! relative velocity of each device [m/s]
-      integer :: d, i, j
+      integer :: d
 
       do d = 1, model%n_devices
-         i = model%dev(d)%node_i; j = model%dev(d)%node_j
-         s(d) = u(i); sd(d) = v(i)
-         if (j > 0) then
-            s(d) = s(d) - u(j); sd(d) = sd(d) - v(j)
-         end if
+         s(d) = device_relative(model, d, u)
+         sd(d) = device_relative(model, d, v)
       end do
    end subroutine device_kinematics
 
@@ -35,10 +90,34 @@ contains
       type(model_type), intent(in) :: model   !! the model
       integer, intent(in) :: d                !! device
       real(dp), intent(in) :: y(:)            !! displacements, velocities, ... of the DOFs
+      integer :: k, k0
 
-      rel = y(model%dev(d)%node_i)
-      if (model%dev(d)%node_j > 0) rel = rel - y(model%dev(d)%node_j)
+      ! the sum starts from the first term, not from 0, so that e_i' y is y_i to its sign
+      k0 = model%dev_ptr(d)
+      rel = 0.0_dp
+      if (model%dev_ptr(d + 1) == k0) return
+      rel = model%dev_coef(k0)*y(model%dev_dof(k0))
+      do k = k0 + 1, model%dev_ptr(d + 1) - 1
+         rel = rel + model%dev_coef(k)*y(model%dev_dof(k))
+      end do
    end function device_relative
+
+   !> |b_d|' |y| (coefficients and values by their magnitude): the scale of b_d' y, against
+   !> which its rounding is judged.
+   pure real(dp) function device_abs_relative(model, d, y) result(rel)
+      type(model_type), intent(in) :: model   !! the model
+      integer, intent(in) :: d                !! device
+      real(dp), intent(in) :: y(:)            !! values over the DOFs
+      integer :: k, k0
+
+      k0 = model%dev_ptr(d)
+      rel = 0.0_dp
+      if (model%dev_ptr(d + 1) == k0) return
+      rel = abs(model%dev_coef(k0))*abs(y(model%dev_dof(k0)))
+      do k = k0 + 1, model%dev_ptr(d + 1) - 1
+         rel = rel + abs(model%dev_coef(k))*abs(y(model%dev_dof(k)))
+      end do
+   end function device_abs_relative
 
    !> y = y + alpha b_d.
    pure subroutine add_device(model, d, alpha, y)
@@ -46,9 +125,172 @@ contains
       integer, intent(in) :: d                !! device
       real(dp), intent(in) :: alpha           !! factor of b_d
       real(dp), intent(inout) :: y(:)         !! vector over the DOFs
+      integer :: k
 
-      y(model%dev(d)%node_i) = y(model%dev(d)%node_i) + alpha
-      if (model%dev(d)%node_j > 0) y(model%dev(d)%node_j) = y(model%dev(d)%node_j) - alpha
+      do k = model%dev_ptr(d), model%dev_ptr(d + 1) - 1
+         y(model%dev_dof(k)) = y(model%dev_dof(k)) + alpha*model%dev_coef(k)
+      end do
    end subroutine add_device
+
+   !> b_d' M^-1 y for the lumped masses M: the relative acceleration across device d that
+   !> forces y produce.
+   pure real(dp) function device_inverse_mass_relative(model, d, y) result(rel)
+      type(model_type), intent(in) :: model   !! the model
+      integer, intent(in) :: d                !! device
+      real(dp), intent(in) :: y(:)            !! forces on the DOFs [N]
+      integer :: k, k0, i
+
+      k0 = model%dev_ptr(d)
+      rel = 0.0_dp
+      if (model%dev_ptr(d + 1) == k0) return
+      i = model%dev_dof(k0)
+      rel = model%dev_coef(k0)*(y(i)/model%mass(i))
+      do k = k0 + 1, model%dev_ptr(d + 1) - 1
+         i = model%dev_dof(k)
+         rel = rel + model%dev_coef(k)*(y(i)/model%mass(i))
+      end do
+   end function device_inverse_mass_relative
+
+   !> |b_d|' M^-1 (scale y) (coefficients by their magnitude): a bound on b_d' M^-1 y's
+   !> rounding when y holds magnitudes of forces, or the velocity change across the device
+   !> that positive coefficients y make in a time scale.
+   pure real(dp) function device_abs_inverse_mass_relative(model, d, y, scale) result(rel)
+      type(model_type), intent(in) :: model   !! the model
+      integer, intent(in) :: d                !! device
+      real(dp), intent(in) :: y(:)            !! magnitudes on the DOFs [N, or N s/m]
+      real(dp), intent(in), optional :: scale !! factor of y (default 1) [-, or s]
+      real(dp) :: f
+      integer :: k, k0, i
+
+      k0 = model%dev_ptr(d)
+      rel = 0.0_dp
+      if (model%dev_ptr(d + 1) == k0) return
+      f = 1.0_dp
+      if (present(scale)) f = scale
+      i = model%dev_dof(k0)
+      rel = abs(model%dev_coef(k0))*(f*y(i)/model%mass(i))
+      do k = k0 + 1, model%dev_ptr(d + 1) - 1
+         i = model%dev_dof(k)
+         rel = rel + abs(model%dev_coef(k))*(f*y(i)/model%mass(i))
+      end do
+   end function device_abs_inverse_mass_relative
+
+   !> y = y + alpha |b_d| (coefficients by their magnitude).
+   pure subroutine add_device_abs(model, d, alpha, y)
+      type(model_type), intent(in) :: model   !! the model
+      integer, intent(in) :: d                !! device
+      real(dp), intent(in) :: alpha           !! factor of |b_d|
+      real(dp), intent(inout) :: y(:)         !! vector over the DOFs
+      integer :: k
+
+      do k = model%dev_ptr(d), model%dev_ptr(d + 1) - 1
+         y(model%dev_dof(k)) = y(model%dev_dof(k)) + alpha*abs(model%dev_coef(k))
+      end do
+   end subroutine add_device_abs
+
+   !> b_a' M^-1 b_b: how a force across device b accelerates device a's relative motion.
+   pure real(dp) function device_coupling(model, a, b) result(c)
+      type(model_type), intent(in) :: model   !! the model
+      integer, intent(in) :: a, b             !! devices
+      integer :: k, l
+
+      c = 0.0_dp
+      do k = model%dev_ptr(a), model%dev_ptr(a + 1) - 1
+         do l = model%dev_ptr(b), model%dev_ptr(b + 1) - 1
+            if (model%dev_dof(k) == model%dev_dof(l)) &
+               c = c + model%dev_coef(k)*model%dev_coef(l)/model%mass(model%dev_dof(k))
+         end do
+      end do
+   end function device_coupling
+
+   !> a = a + alpha b_d b_d' (a dense matrix over the DOFs).
+   pure subroutine add_device_outer(model, d, alpha, a)
+      type(model_type), intent(in) :: model   !! the model
+      integer, intent(in) :: d                !! device
+      real(dp), intent(in) :: alpha           !! factor
+      real(dp), intent(inout) :: a(:, :)      !! matrix over the DOFs
+      integer :: k, l
+
+      do k = model%dev_ptr(d), model%dev_ptr(d + 1) - 1
+         do l = model%dev_ptr(d), model%dev_ptr(d + 1) - 1
+            a(model%dev_dof(k), model%dev_dof(l)) = a(model%dev_dof(k), model%dev_dof(l)) + &
+                                                    alpha*model%dev_coef(k)*model%dev_coef(l)
+         end do
+      end do
+   end subroutine add_device_outer
+
+   !> The mass device d moves against its other end, 1 / (b' M^-1 b): m_i to the table,
+   !> m_i m_j / (m_i + m_j) between two DOFs (the step limits' band floor, the mode of its
+   !> sticking spring).
+   pure real(dp) function moved_mass(model, d) result(m)
+      type(model_type), intent(in) :: model  !! the model
+      integer, intent(in) :: d               !! the device
+      integer :: i, j
+
+      call pair_nodes(model, d, i, j)
+      if (i > 0) then
+         m = model%mass(i)
+         if (j > 0) m = model%mass(i)*model%mass(j)/(model%mass(i) + model%mass(j))
+      else
+         m = 1.0_dp/device_coupling(model, d, d)
+      end if
+   end function moved_mass
+
+   !> The nodes of device d if it joins two (b_d = e_i - e_j, or e_i to the table): i
+   !> (1..n_dof) and j (0..n_dof, 0 = the table); i = j = 0 if it does not.
+   pure subroutine pair_nodes(model, d, i, j)
+      type(model_type), intent(in) :: model  !! the model
+      integer, intent(in) :: d               !! the device
+      integer, intent(out) :: i, j           !! its nodes
+      integer :: k0, nt
+
+      i = 0; j = 0
+      k0 = model%dev_ptr(d)
+      nt = model%dev_ptr(d + 1) - k0
+      if (nt == 1) then
+         if (model%dev_coef(k0) == 1.0_dp) i = model%dev_dof(k0)
+      else if (nt == 2) then
+         if (model%dev_coef(k0) == 1.0_dp .and. model%dev_coef(k0 + 1) == -1.0_dp) then
+            i = model%dev_dof(k0); j = model%dev_dof(k0 + 1)
+         end if
+      end if
+   end subroutine pair_nodes
+
+   !> The two nodes of every device (node_j = 0: the table), for the techniques and checks
+   !> that treat devices as links between nodes; first = 0 when all devices join two nodes,
+   !> else the first that does not (its nodes and those after it are 0).
+   pure subroutine device_nodes(model, ni, nj, first)
+      type(model_type), intent(in) :: model  !! the model
+      integer, intent(out) :: ni(:)          !! first node of each device (1..n_dof)
+      integer, intent(out) :: nj(:)          !! second node (0..n_dof)
+      integer, intent(out) :: first          !! 0, or the first device not between two nodes
+      integer :: d
+
+      ni = 0
+      nj = 0
+      first = 0
+      do d = 1, model%n_devices
+         call pair_nodes(model, d, ni(d), nj(d))
+         if (ni(d) == 0) then
+            first = d
+            return
+         end if
+      end do
+   end subroutine device_nodes
+
+   !> Whether every device of the model joins two nodes.
+   pure logical function devices_are_pairs(model) result(pairs)
+      type(model_type), intent(in) :: model  !! the model
+      integer :: d, i, j
+
+      pairs = .true.
+      do d = 1, model%n_devices
+         call pair_nodes(model, d, i, j)
+         if (i == 0) then
+            pairs = .false.
+            return
+         end if
+      end do
+   end function devices_are_pairs
 
 end module fd_kinematics

@@ -12,6 +12,7 @@ module fd_matrices
    use fd_linalg, only: generalized_eigen, lowest_eigen, lowest_eigen_band
    use fd_rcm, only: rcm_order
    use fd_modes, only: lowest_modes
+   use fd_kinematics, only: add_device_outer, pair_nodes
    implicit none
    private
 
@@ -312,12 +313,14 @@ contains
       integer, intent(out) :: grp(:)          !! group of each DOF, 0 = with the table
       integer, intent(out) :: nq              !! number of moving groups
       integer :: root(0:model%n_dof), col(0:model%n_dof)
-      integer :: d, i, a, b
+      integer :: d, i, a, b, ni, nj
 
       root = [(i, i=0, model%n_dof)]
       do d = 1, model%n_devices
          if (.not. linked(d)) cycle
-         a = find(root, model%dev(d)%node_i); b = find(root, model%dev(d)%node_j)
+         call pair_nodes(model, d, ni, nj)
+         if (ni == 0) cycle
+         a = find(root, ni); b = find(root, nj)
          if (a /= b) root(max(a, b)) = min(a, b)
       end do
       col = 0
@@ -367,13 +370,7 @@ contains
       do d = 1, model%n_devices
          kd = sticking_stiffness(model%dev(d))
          if (system == system_stuck .and. kd > 0.0_dp) then
-            ni = model%dev(d)%node_i; nj = model%dev(d)%node_j
-            ks(ni, ni) = ks(ni, ni) + kd
-            if (nj > 0) then
-               ks(nj, nj) = ks(nj, nj) + kd
-               ks(ni, nj) = ks(ni, nj) - kd
-               ks(nj, ni) = ks(nj, ni) - kd
-            end if
+            call add_device_outer(model, d, kd, ks)
          end if
       end do
       ! Kq = T' K T, Cq = T' C T, Mq = T' M T by summing over the groups (T is 0/1: O(n^2))
@@ -449,7 +446,7 @@ contains
       logical, allocatable :: grounded(:)
       real(dp), allocatable :: mq(:), ek(:), lam(:), z(:, :), ebig(:), zcz(:)
       real(dp) :: kd, big, sigma, scale, w, kz
-      integer :: n, nq, ne, ns, nd, i, j, a, b, s, d, m, stat
+      integer :: n, nq, ne, ns, nd, i, j, a, b, s, d, m, stat, ni, nj
       logical :: shifted
 
       n = model%n_dof
@@ -475,7 +472,14 @@ contains
       if (system == system_stuck) then
          do d = 1, nd
             kd = sticking_stiffness(model%dev(d))
-            if (kd > 0.0_dp) call add_element(grp, model%dev(d)%node_i, model%dev(d)%node_j, kd, ea, eb, ek, ne)
+            if (kd <= 0.0_dp) cycle
+            call pair_nodes(model, d, ni, nj)
+            if (ni == 0) then
+               call fatal_error(error, "the sparse modes of the stuck system take devices between two nodes; "// &
+                                "device "//trim(fmt_int(d))//" is not")
+               return
+            end if
+            call add_element(grp, ni, nj, kd, ea, eb, ek, ne)
          end do
       end if
       ! a bound of the largest eigenvalue of Mq^-1 Kq (Gershgorin), and the groups held to

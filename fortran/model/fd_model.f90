@@ -24,18 +24,20 @@ module fd_model
    public :: mu_constant, mu_exponential, mu_table, label_len, max_mu_points
    public :: system_stuck, system_free
    public :: source_friction, source_brace, source_isolator
-   public :: sticking_stiffness, moved_mass, largest_mu, sliding_mu, holds_when_stuck
+   public :: sticking_stiffness, largest_mu, sliding_mu, holds_when_stuck
 
    ! where a device (or spring) of the model comes from in the deck
    integer, parameter :: source_friction = 0  !! &friction (or &springs)
    integer, parameter :: source_brace = 1     !! &braces (a friction damper in series with a brace)
    integer, parameter :: source_isolator = 2  !! &isolators (a sliding isolator)
 
-   !> One friction device between node_i and node_j (node 0 = the table).
-   !> Its relative displacement is s = u(node_i) - u(node_j); its force F acts
-   !> as +F on node_i's equation of motion and -F on node_j's (eq. 5).
+   !> One friction device. Its geometry is its direction b over the DOFs, kept in the model
+   !> (dev_ptr, dev_dof, dev_coef) and reached only through fd_kinematics: its relative
+   !> displacement is s = b' u and its force F enters the equations of motion as b F (eq. 5).
+   !> A device between two nodes has b = e_i - e_j (e_i on the table), made from node_i
+   !> and node_j by fd_kinematics' set_pair_directions.
    type :: device_type
-      integer :: node_i = 0        !! first node (1..n_dof)
+      integer :: node_i = 0        !! first node (1..n_dof) of a device between two nodes
       integer :: node_j = 0        !! second node (0..n_dof, 0 = table)
       integer :: law = law_velocity !! friction law id
       real(dp) :: p = 0.0_dp       !! normal force P [N]
@@ -73,6 +75,11 @@ module fd_model
       real(dp) :: rayleigh_a1 = default_rayleigh_a1 !! Rayleigh stiffness factor [s]
       integer :: n_devices = 0                !! number of friction devices
       type(device_type), allocatable :: dev(:) !! the friction devices
+      ! the devices' directions b_d, compressed by device: b_d has the coefficient dev_coef(k)
+      ! at DOF dev_dof(k) for k = dev_ptr(d) .. dev_ptr(d + 1) - 1 (fd_kinematics reads them)
+      integer, allocatable :: dev_ptr(:)      !! start of each device's terms (n_devices + 1)
+      integer, allocatable :: dev_dof(:)      !! DOF of each term (1..n_dof)
+      real(dp), allocatable :: dev_coef(:)    !! coefficient of each term [-]
       ! 'rayleigh' damping given as xi at two natural modes (resolved into a0, a1 when read)
       integer :: mode_i = 0                   !! first mode (0: a0, a1 given)
       integer :: mode_j = 0                   !! second mode
@@ -183,17 +190,5 @@ contains
       if (dev%mu_law == mu_table) mu = maxval(dev%mu_at(1:dev%n_mu_points))
       if (dev%mu_law == mu_exponential) mu = max(dev%mu, dev%mu_min)
    end function largest_mu
-
-   !> The mass device d moves against its other end: m_i to the table, m_i m_j / (m_i + m_j)
-   !> between two DOFs (the step limits' band floor, the mode of its sticking spring).
-   pure real(dp) function moved_mass(model, d) result(m)
-      type(model_type), intent(in) :: model  !! the model
-      integer, intent(in) :: d               !! the device
-
-      associate (i => model%dev(d)%node_i, j => model%dev(d)%node_j)
-         m = model%mass(i)
-         if (j > 0) m = model%mass(i)*model%mass(j)/(model%mass(i) + model%mass(j))
-      end associate
-   end function moved_mass
 
 end module fd_model

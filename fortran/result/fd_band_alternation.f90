@@ -43,6 +43,7 @@ module fd_band_alternation
    use fd_kinds, only: dp
    use fd_error, only: error_type, fatal_error, fmt_int, stat_no_memory
    use fd_model, only: model_type, device_type, sliding_mu, holds_when_stuck
+   use fd_kinematics, only: add_device_abs, device_abs_inverse_mass_relative
    use fd_names, only: law_velocity
    use fd_device_state, only: device_state, phase_stick
    use fd_result, only: result_type, resolution_none, resolution_resolved, resolution_unresolved
@@ -100,7 +101,7 @@ contains
 
       res%band_resolution = resolution_none
       al%n = count(watched(model%dev(1:model%n_devices)))
-      allocate (al%w(al%n), c(0:model%n_dof), stat=stat)
+      allocate (al%w(al%n), c(model%n_dof), stat=stat)
       if (stat /= 0) then
          call fatal_error(error, "not enough memory for the bands of "//trim(fmt_int(al%n))// &
                           " velocity-law devices", stat_no_memory)
@@ -114,16 +115,12 @@ contains
             q = q + 1
             pmu = dev%p*sliding_mu(dev, dev%eps)
             al%w(q) = band_watch(dev=d, floor4=4.0_dp*alternation_floor*pmu)
-            c(dev%node_i) = c(dev%node_i) + pmu/dev%eps
-            c(dev%node_j) = c(dev%node_j) + pmu/dev%eps
+            call add_device_abs(model, d, pmu/dev%eps, c)
          end associate
       end do
       scale = max(0.0_dp, 1.0_dp - gamma)*dt1
       do q = 1, al%n
-         associate (i => model%dev(al%w(q)%dev)%node_i, j => model%dev(al%w(q)%dev)%node_j)
-            res%band_x(al%w(q)%dev) = scale*c(i)/model%mass(i)
-            if (j > 0) res%band_x(al%w(q)%dev) = res%band_x(al%w(q)%dev) + scale*c(j)/model%mass(j)
-         end associate
+         res%band_x(al%w(q)%dev) = device_abs_inverse_mass_relative(model, al%w(q)%dev, c, scale)
       end do
       if (al%n > 0) res%band_resolution = resolution_resolved
    end subroutine alternation_init

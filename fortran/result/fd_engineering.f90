@@ -16,6 +16,7 @@ module fd_engineering
    use fd_error, only: error_type, fatal_error, fmt_int, stat_no_memory
    use fd_model, only: model_type, integration_type, label_len, system_stuck, system_free, &
                        damping_stiffness, damping_rayleigh
+   use fd_kinematics, only: pair_nodes
    use fd_excitation, only: excitation_type, excitation_harmonic
    use fd_matrices, only: modes_type, natural_modes, natural_modes_sparse, stiffness_matrix, damping_matrix, &
                           stiffness_damping_factor, modes_dense_dofs
@@ -181,7 +182,9 @@ contains
             if (on_cut(cut, model%spring_i(e), model%spring_j(e)) /= 0.0_dp) nsp = nsp + 1
          end do
          do e = 1, model%n_devices
-            if (on_cut(cut, model%dev(e)%node_i, model%dev(e)%node_j) /= 0.0_dp) ndv = ndv + 1
+            call pair_nodes(model, e, a, b)
+            if (a == 0) cycle
+            if (on_cut(cut, a, b) /= 0.0_dp) ndv = ndv + 1
          end do
       end do
       allocate (eng%sp_i(nsp), eng%sp_j(nsp), eng%sp_k(nsp), eng%dv_id(ndv), eng%dv_sign(ndv), stat=stat)
@@ -198,7 +201,9 @@ contains
             eng%sp_i(nsp) = a; eng%sp_j(nsp) = b; eng%sp_k(nsp) = sgn*model%spring_k(e)
          end do
          do e = 1, model%n_devices
-            sgn = on_cut(cut, model%dev(e)%node_i, model%dev(e)%node_j)
+            call pair_nodes(model, e, a, b)
+            if (a == 0) cycle
+            sgn = on_cut(cut, a, b)
             if (sgn == 0.0_dp) cycle
             ndv = ndv + 1
             eng%dv_id(ndv) = e; eng%dv_sign(ndv) = sgn

@@ -35,7 +35,8 @@
 module fd_stick_ringing
    use fd_kinds, only: dp
    use fd_error, only: error_type, fatal_error, fmt_int, stat_no_memory
-   use fd_model, only: model_type, sticking_stiffness, moved_mass
+   use fd_model, only: model_type, sticking_stiffness
+   use fd_kinematics, only: moved_mass, device_nodes
    use fd_names, only: law_velocity
    use fd_device_state, only: device_state, phase_stick
    use fd_result, only: result_type, resolution_none, resolution_resolved, resolution_unresolved
@@ -118,7 +119,7 @@ contains
       integer, allocatable :: sp_first(:), sp_list(:), vd_first(:), vd_list(:), di(:), dj(:)
       logical, allocatable :: velocity(:)
       real(dp) :: k, ai, aj, c, x, wt, zn
-      integer :: nd, ns, d, q, i, j, nb, stat
+      integer :: nd, ns, d, q, i, j, nb, stat, first
       logical :: osc
 
       nd = model%n_devices
@@ -127,8 +128,7 @@ contains
       rg%n = count(sticking_stiffness(model%dev(1:nd)) > 0.0_dp)
       allocate (di(nd), dj(nd), velocity(nd), stat=stat)
       if (stat == 0) then
-         di = model%dev(1:nd)%node_i
-         dj = model%dev(1:nd)%node_j
+         call device_nodes(model, di, dj, first)
          velocity = model%dev(1:nd)%law == law_velocity
          call incidence(model%n_dof, model%spring_i(1:ns), model%spring_j(1:ns), [(.true., i=1, ns)], &
                         sp_first, sp_list, stat)

@@ -35,7 +35,7 @@ module fd_newmark
    use fd_excitation, only: excitation_type, table_motion, table_acceleration, grid_motion, grid_init, &
                             grid_acceleration
    use fd_matrices, only: structure_damping
-   use fd_kinematics, only: device_kinematics, add_device
+   use fd_kinematics, only: device_kinematics, device_relative, add_device
    use fd_banded, only: spd_system, spd_setup, spd_factor, spd_update_devices, spd_solve, spd_k_matvec, &
                         spd_c_matvec, spd_kc_matvec, spd_auto, spd_dense, spd_banded, spd_is_dense, spd_bandwidth, &
                         spd_copy
@@ -81,7 +81,6 @@ module fd_newmark
       integer :: version = 0                          !! counts the accepted phase changes
       real(dp), allocatable :: u(:), v(:), a(:), u1(:), v1(:), a1(:), rhs(:), tmp(:)
       real(dp), allocatable :: s(:), sd(:), s1(:), sd1(:), f(:), kd(:)
-      integer, allocatable :: di(:), dj(:)            !! device nodes (dj = 0: the table)
       type(device_state), allocatable :: st(:), st1(:)
       type(device_state), allocatable :: st0(:)       !! states at the start ('implicit' refinement)
       integer, allocatable :: phase0(:), phase1(:)    !! phases of st, st1 for the observer
@@ -281,17 +280,8 @@ contains
       case default
          path = spd_auto
       end select
-      ! the devices' nodes as arrays of their own before the set-up (a component of an array of
-      ! derived type passed as an argument is copied to a temporary at the call)
-      allocate (w%di(nd), w%dj(nd), stat=stat)
-      if (stat /= 0) then
-         call fatal_error(error, "not enough memory for the nodes of n_devices = "//trim(fmt_int(nd))//" devices", &
-                          stat_no_memory)
-         return
-      end if
-      w%di = model%dev%node_i
-      w%dj = model%dev%node_j
-      call spd_setup(base, model%mass, model%spring_i, model%spring_j, model%spring_k, w%di, w%dj, error, &
+      call spd_setup(base, model%mass, model%spring_i, model%spring_j, model%spring_k, model%dev_ptr, model%dev_dof, &
+                     model%dev_coef, error, &
                      a0=a0, a1=a1, path=path)
       if (allocated(error)) return
       res%storage = merge(1, 2, spd_is_dense(base))
@@ -400,12 +390,12 @@ contains
       if (w%nf > 0) call start_forces(model%dev, w)
       call predict(w%n, h, w%lev(lv)%g1h, w%lev(lv)%b2h2, ag1, w%mass, w%u, w%v, w%a, w%tmp, w%u1, w%rhs)
       call spd_kc_matvec(w%lev(lv)%sys, w%u1, w%tmp, w%rhs, -1.0_dp)
-      call device_loads(w%n, w%nd, w%di, w%dj, w%st, w%u1, w%tmp, w%lev(lv)%c0, w%rhs)
+      call device_loads(model, w%st, w%u1, w%tmp, w%lev(lv)%c0, w%rhs)
       call spd_solve(w%lev(lv)%sys, w%rhs, error)
       if (allocated(error)) return
-      call correct(w%n, w%nd, w%lev(lv)%bh2, w%lev(lv)%gh, w%di, w%dj, w%rhs, w%tmp, w%a1, w%u1, w%v1, &
-                   w%s1, w%sd1)
-      if (w%nf > 0) call follow_forces(model%dev, lv, w, error)
+      call correct(w%n, w%lev(lv)%bh2, w%lev(lv)%gh, w%rhs, w%tmp, w%a1, w%u1, w%v1)
+      call device_kinematics(model, w%u1, w%v1, w%s1, w%sd1)
+      if (w%nf > 0) call follow_forces(model, lv, w, error)
    end subroutine try_step
 
    !> A speed-dependent mu at the velocity at the step's end (implicit, as a Newton-Raphson
@@ -420,8 +410,8 @@ contains
    !> back to the forces it started with (mu at the velocity at the step's start,
    !> start_forces) and w%follow_failed is set: the step is then refined, and counted if it
    !> is accepted so.
-   subroutine follow_forces(dev, lv, w, error)
-      type(device_type), intent(in) :: dev(:)
+   subroutine follow_forces(model, lv, w, error)
+      type(model_type), intent(in) :: model
       integer, intent(in) :: lv
       type(workspace), intent(inout), target :: w
       type(error_type), allocatable, intent(out) :: error
@@ -431,7 +421,7 @@ contains
       w%follow_failed = .false.
       last = huge(1.0_dp)
       do it = 0, max_follow
-         call friction_follow(w%nf, w%fl, dev, w%sd1, w%st, w%df)
+         call friction_follow(w%nf, w%fl, model%dev, w%sd1, w%st, w%df)
          misfit = 0.0_dp
          do q = 1, w%nf
             if (abs(w%df(q)) > follow_tol*w%cap(q)) misfit = max(misfit, abs(w%df(q))/w%cap(q))
@@ -442,14 +432,14 @@ contains
          if (it == max_follow .or. .not. misfit < last) exit
          if (it > 0 .and. misfit*(misfit/last)**(max_follow - it) > follow_tol) exit
          last = misfit
-         call move_forces(lv, w, error)
+         call move_forces(model, lv, w, error)
          if (allocated(error)) return
       end do
       ! back to the trial with the forces it started with, mu at the step's start (start_forces)
       w%follow_failed = .true.
       w%follow_misfit = misfit
-      call friction_follow(w%nf, w%fl, dev, w%sd, w%st, w%df)
-      call move_forces(lv, w, error)
+      call friction_follow(w%nf, w%fl, model%dev, w%sd, w%st, w%df)
+      call move_forces(model, lv, w, error)
    end subroutine follow_forces
 
    !> The followed devices' f0 at the relative velocities at the step's start (w%sd): the
@@ -467,7 +457,8 @@ contains
 
    !> The trial state with the followed devices' f0 changed by w%df: the change of the load
    !> along each b_d solved with the step's factor, the state moved by the solution.
-   subroutine move_forces(lv, w, error)
+   subroutine move_forces(model, lv, w, error)
+      type(model_type), intent(in) :: model
       integer, intent(in) :: lv
       type(workspace), intent(inout), target :: w
       type(error_type), allocatable, intent(out) :: error
@@ -479,8 +470,7 @@ contains
       do q = 1, w%nf
          d = w%fl(q)
          w%st(d)%f0 = w%st(d)%f0 + w%df(q)
-         w%rhs(w%di(d)) = w%rhs(w%di(d)) - w%lev(lv)%c0*w%df(q)
-         if (w%dj(d) > 0) w%rhs(w%dj(d)) = w%rhs(w%dj(d)) + w%lev(lv)%c0*w%df(q)
+         call add_device(model, d, -(w%lev(lv)%c0*w%df(q)), w%rhs)
       end do
       call spd_solve(w%lev(lv)%sys, w%rhs, error)
       if (allocated(error)) return
@@ -490,7 +480,7 @@ contains
          w%u1(i) = w%u1(i) + w%lev(lv)%bh2*w%rhs(i)
          w%v1(i) = w%v1(i) + w%lev(lv)%gh*w%rhs(i)
       end do
-      call relative_motion(w%n, w%nd, w%di, w%dj, w%u1, w%v1, w%s1, w%sd1)
+      call device_kinematics(model, w%u1, w%v1, w%s1, w%sd1)
    end subroutine move_forces
 
    !> Predictors v~ = v + (1 - gamma) h a (in vt), u~ = u + h v + (1/2 - beta) h^2 a (in ut),
@@ -512,39 +502,29 @@ contains
 
    !> The devices' forces at the predictors, F = ks s~ + cs s'~ + f0, subtracted from rhs
    !> along b_d; then rhs scaled by c0 (K^ = c0 (M + gamma h C_t + beta h^2 K_t)).
-   pure subroutine device_loads(n, nd, di, dj, st, ut, vt, c0, rhs)
-      integer, intent(in) :: n, nd
-      integer, intent(in) :: di(nd), dj(nd)
-      type(device_state), intent(in) :: st(nd)
-      real(dp), intent(in) :: ut(n), vt(n), c0
-      real(dp), intent(inout) :: rhs(n)
+   pure subroutine device_loads(model, st, ut, vt, c0, rhs)
+      type(model_type), intent(in) :: model
+      type(device_state), intent(in) :: st(:)
+      real(dp), intent(in) :: ut(:), vt(:), c0
+      real(dp), intent(inout) :: rhs(:)
       real(dp) :: f
-      integer :: d, i, j
+      integer :: d, i
 
-      do d = 1, nd
-         i = di(d)
-         j = dj(d)
-         if (j > 0) then
-            f = st(d)%ks*(ut(i) - ut(j)) + st(d)%cs*(vt(i) - vt(j)) + st(d)%f0
-            rhs(j) = rhs(j) + f
-         else
-            f = st(d)%ks*ut(i) + st(d)%cs*vt(i) + st(d)%f0
-         end if
-         rhs(i) = rhs(i) - f
+      do d = 1, model%n_devices
+         f = st(d)%ks*device_relative(model, d, ut) + st(d)%cs*device_relative(model, d, vt) + st(d)%f0
+         call add_device(model, d, -f, rhs)
       end do
-      do i = 1, n
+      do i = 1, size(rhs)
          rhs(i) = c0*rhs(i)
       end do
    end subroutine device_loads
 
-   !> The trial state from a1 (in rhs): u1 = u~ + beta h^2 a1, v1 = v~ + gamma h a1, and the
-   !> devices' relative displacement and velocity.
-   pure subroutine correct(n, nd, bh2, gh, di, dj, a1s, vt, a1, u1, v1, s1, sd1)
-      integer, intent(in) :: n, nd
+   !> The trial state from a1 (in rhs): u1 = u~ + beta h^2 a1, v1 = v~ + gamma h a1.
+   pure subroutine correct(n, bh2, gh, a1s, vt, a1, u1, v1)
+      integer, intent(in) :: n
       real(dp), intent(in) :: bh2, gh
-      integer, intent(in) :: di(nd), dj(nd)
       real(dp), intent(in) :: a1s(n), vt(n)
-      real(dp), intent(out) :: a1(n), v1(n), s1(nd), sd1(nd)
+      real(dp), intent(out) :: a1(n), v1(n)
       real(dp), intent(inout) :: u1(n)
       integer :: i
 
@@ -554,29 +534,7 @@ contains
          u1(i) = u1(i) + bh2*a1s(i)
          v1(i) = vt(i) + gh*a1s(i)
       end do
-      call relative_motion(n, nd, di, dj, u1, v1, s1, sd1)
    end subroutine correct
-
-   !> The devices' relative displacements and velocities, s = u_i - u_j, s' = v_i - v_j.
-   pure subroutine relative_motion(n, nd, di, dj, u1, v1, s1, sd1)
-      integer, intent(in) :: n, nd
-      integer, intent(in) :: di(nd), dj(nd)
-      real(dp), intent(in) :: u1(n), v1(n)
-      real(dp), intent(out) :: s1(nd), sd1(nd)
-      integer :: d, i, j
-
-      do d = 1, nd
-         i = di(d)
-         j = dj(d)
-         if (j > 0) then
-            s1(d) = u1(i) - u1(j)
-            sd1(d) = v1(i) - v1(j)
-         else
-            s1(d) = u1(i)
-            sd1(d) = v1(i)
-         end if
-      end do
-   end subroutine relative_motion
 
    !> The factored effective stiffness of level lv for the current phases: factored the
    !> first time the level is used, updated (never refactored from scratch) when the

@@ -14,7 +14,8 @@ module fd_step_limits
    use fd_kinds, only: dp
    use fd_error, only: error_type, fatal_error, fmt_int, fmt_real
    use fd_names, only: law_velocity, law_hysteretic
-   use fd_model, only: model_type, integration_type, sticking_stiffness, moved_mass, largest_mu, sliding_mu
+   use fd_model, only: model_type, integration_type, sticking_stiffness, largest_mu, sliding_mu
+   use fd_kinematics, only: moved_mass, pair_nodes
    use fd_excitation, only: excitation_type
    implicit none
    private
@@ -150,7 +151,9 @@ contains
          return
       end if
       do d = 1, model%n_devices
-         i = model%dev(d)%node_i; j = model%dev(d)%node_j
+         ! a device between two DOFs (one on the table adds to a diagonal alone)
+         call pair_nodes(model, d, i, j)
+         if (i == 0) cycle
          if (j <= 0) cycle
          select case (model%dev(d)%law)
          case (law_velocity)

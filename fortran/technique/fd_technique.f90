@@ -11,6 +11,7 @@ module fd_technique
    use fd_names, only: technique_newmark, technique_event_driven, technique_moreau_jean, techniques, &
                        keyword_choices
    use fd_model, only: model_type, integration_type
+   use fd_kinematics, only: devices_are_pairs
    use fd_excitation, only: excitation_type
    use fd_result, only: result_type, energy_balance_of
    use fd_run_control, only: run_control
@@ -35,6 +36,12 @@ contains
       type(integration_type), intent(in) :: opts    !! the technique and its settings
       type(error_type), allocatable, intent(out) :: error !! what cannot be integrated
 
+      ! the modes of the stuck system, the storeys and the groups of the exact techniques take
+      ! each device as a link between two nodes (fd_kinematics)
+      if (.not. devices_are_pairs(model)) then
+         call fatal_error(error, "a device that is not between two nodes is integrated by no technique")
+         return
+      end if
       select case (opts%technique)
       case (technique_newmark)
          call newmark_check(model, exc, error)

@@ -10,6 +10,7 @@ module test_fd_banded
    use fd_error, only: lib_error => error_type
    use fd_linalg, only: cholesky_factor, cholesky_solve, sym_matvec
    use fd_rcm, only: rcm_order, graph_bandwidth
+   use fd_kinematics, only: pair_terms
    use fd_banded, only: spd_system, spd_setup, spd_factor, spd_update_device, spd_update_devices, &
                         spd_solve, spd_k_matvec, spd_c_matvec, spd_bandwidth, spd_is_dense, &
                         spd_error_estimate, spd_auto, spd_dense, spd_banded, spd_dense_max_n, &
@@ -50,7 +51,8 @@ contains
                   new_unittest("storage chosen by size", test_auto_path), &
                   new_unittest("bad input named", test_errors), &
                   new_unittest("narrow band factor is dpbtf2's", test_band_potf2), &
-                  new_unittest("small K^ products in dsymv's order", test_small_kc) &
+                  new_unittest("small K^ products in dsymv's order", test_small_kc), &
+                  new_unittest("devices along general directions", test_general_devices) &
                   ]
    end subroutine collect_banded
 
@@ -195,7 +197,7 @@ contains
       type(error_type), allocatable, intent(out) :: error
       type(lib_error), allocatable :: err
 
-      call spd_setup(sys, pb%mass, pb%si, pb%sj, pb%sk, pb%di, pb%dj, err, a0=pb%a0, a1=pb%a1, &
+      call pair_setup(sys, pb%mass, pb%si, pb%sj, pb%sk, pb%di, pb%dj, err, a0=pb%a0, a1=pb%a1, &
                      dashpot_i=pb%pi, dashpot_j=pb%pj, dashpot_c=pb%pc, path=path, method=method, &
                      budget=budget)
       call pass(err, error)
@@ -797,25 +799,25 @@ contains
       call seed(10)
       call chain(6, pb, .false.)
       pb%mass(3) = 0.0_dp
-      call spd_setup(sys, pb%mass, pb%si, pb%sj, pb%sk, pb%di, pb%dj, err)
+      call pair_setup(sys, pb%mass, pb%si, pb%sj, pb%sk, pb%di, pb%dj, err)
       call expect(err, "mass(3)", error)
       if (allocated(error)) return
       pb%mass(3) = 1.0_dp
       pb%sj(2) = 7
-      call spd_setup(sys, pb%mass, pb%si, pb%sj, pb%sk, pb%di, pb%dj, err)
+      call pair_setup(sys, pb%mass, pb%si, pb%sj, pb%sk, pb%di, pb%dj, err)
       call expect(err, "spring 2 joins nodes 2 and 7, outside 0..6", error)
       if (allocated(error)) return
       pb%sj(2) = 1
       pb%sk(4) = -1.0_dp
-      call spd_setup(sys, pb%mass, pb%si, pb%sj, pb%sk, pb%di, pb%dj, err)
+      call pair_setup(sys, pb%mass, pb%si, pb%sj, pb%sk, pb%di, pb%dj, err)
       call expect(err, "spring 4 has the coefficient -1.0", error)
       if (allocated(error)) return
       pb%sk(4) = 1.0e3_dp
-      call spd_setup(sys, pb%mass, pb%si, pb%sj, pb%sk, pb%di, pb%dj, err, path=5)
+      call pair_setup(sys, pb%mass, pb%si, pb%sj, pb%sk, pb%di, pb%dj, err, path=5)
       call expect(err, "path = 5", error)
       if (allocated(error)) return
       do path = spd_dense, spd_banded
-         call spd_setup(sys, pb%mass, pb%si, pb%sj, pb%sk, pb%di, pb%dj, err, path=path)
+         call pair_setup(sys, pb%mass, pb%si, pb%sj, pb%sk, pb%di, pb%dj, err, path=path)
          call pass(err, error)
          if (allocated(error)) return
          x = [1.0_dp, 2.0_dp, 3.0_dp, 4.0_dp, 5.0_dp, 6.0_dp]
@@ -842,7 +844,7 @@ contains
       pb%sj(1) = 2
       pb%si(1) = 1
       pb%sj(2) = 3
-      call spd_setup(sys, pb%mass, pb%si, pb%sj, pb%sk, pb%di(2:), pb%dj(2:), err, path=spd_banded)
+      call pair_setup(sys, pb%mass, pb%si, pb%sj, pb%sk, pb%di(2:), pb%dj(2:), err, path=spd_banded)
       call pass(err, error)
       if (allocated(error)) return
       call spd_factor(sys, 0.0_dp, 0.0_dp, [(0.0_dp, path=1, 5)], err)
@@ -1276,5 +1278,114 @@ contains
          a(m + 1) = x
       end do
    end subroutine ref_insertion_sort
+
+   !> Devices along general directions (three or four terms, coefficients other than 1, a
+   !> term on the table side dropped): the factor of K^ = K + c1 C + c0 M + sum kd b b' solves
+   !> as the dense Cholesky of the same matrix assembled by hand, after the set-up and after
+   !> rank-one updates and downdates of each device, on both storages.
+   subroutine test_general_devices(error)
+      type(error_type), allocatable, intent(out) :: error
+      integer, parameter :: n = 12, nd = 3
+      integer, parameter :: ptr(nd + 1) = [1, 4, 8, 11]
+      integer, parameter :: dof(10) = [2, 5, 9, 1, 3, 4, 12, 7, 11, 8]
+      real(dp), parameter :: coef(10) = [0.8_dp, -0.6_dp, 0.25_dp, 1.0_dp, -0.5_dp, 0.3_dp, -1.2_dp, &
+                                         0.7_dp, 0.7_dp, -1.0_dp]
+      real(dp), parameter :: a0 = 0.3_dp, a1 = 2.0e-3_dp
+      type(spd_system) :: sys
+      type(lib_error), allocatable :: err
+      real(dp) :: mass(n), sk(n), kmat(n, n), a(n, n), x(n), y(n), kd(nd), diff
+      real(dp), allocatable :: b(:)
+      integer :: si(n), sj(n), i, k, l, d, path, step, info
+
+      call seed(17)
+      kmat = 0.0_dp
+      do i = 1, n
+         mass(i) = urand(1.0_dp, 2.0_dp)
+         si(i) = i; sj(i) = i - 1; sk(i) = urand(1.0e3_dp, 2.0e3_dp)
+         kmat(i, i) = kmat(i, i) + sk(i)
+      end do
+      do i = 2, n
+         kmat(i - 1, i - 1) = kmat(i - 1, i - 1) + sk(i)
+         kmat(i, i - 1) = kmat(i, i - 1) - sk(i)
+         kmat(i - 1, i) = kmat(i - 1, i) - sk(i)
+      end do
+      call random_vector(n, b)
+      kd = [4.0e3_dp, 0.0_dp, 2.5e4_dp]
+      do path = spd_dense, spd_banded
+         call spd_setup(sys, mass, si, sj, sk, ptr, dof, coef, err, a0=a0, a1=a1, path=path)
+         call pass(err, error)
+         if (allocated(error)) return
+         if (path == spd_banded) then
+            ! the band covers each device's span: device 2 joins DOFs 1 and 12
+            call check(error, spd_bandwidth(sys) >= 1, "bandwidth")
+            if (allocated(error)) return
+         end if
+         call spd_factor(sys, c0, c1, kd, err)
+         call pass(err, error)
+         if (allocated(error)) return
+         do step = 0, 3
+            if (step == 1) kd(2) = 9.0e3_dp
+            if (step == 2) kd(3) = 1.0e2_dp
+            if (step == 3) kd(1) = 0.0_dp
+            if (step > 0) then
+               call spd_update_devices(sys, kd, err)
+               call pass(err, error)
+               if (allocated(error)) return
+            end if
+            ! the same matrix by hand
+            a = (1.0_dp + c1*a1)*kmat
+            do i = 1, n
+               a(i, i) = a(i, i) + (c0 + c1*a0)*mass(i)
+            end do
+            do d = 1, nd
+               do k = ptr(d), ptr(d + 1) - 1
+                  do l = ptr(d), ptr(d + 1) - 1
+                     a(dof(k), dof(l)) = a(dof(k), dof(l)) + kd(d)*coef(k)*coef(l)
+                  end do
+               end do
+            end do
+            call cholesky_factor(a, info)
+            call check(error, info == 0, "dense factor")
+            if (allocated(error)) return
+            y = b
+            call cholesky_solve(a, y)
+            x = b
+            call spd_solve(sys, x, err)
+            call pass(err, error)
+            if (allocated(error)) return
+            diff = maxval(abs(x - y))/maxval(abs(y))
+            call check(error, diff <= 1.0e-12_dp, "path "//trim(itoa(path))//", step "//trim(itoa(step))// &
+                       ": solve differs from the dense Cholesky by "//trim(rtoa(diff)))
+            if (allocated(error)) return
+         end do
+      end do
+      ! a term outside the DOFs, a zero coefficient, a DOF twice: named
+      call spd_setup(sys, mass, si, sj, sk, [1, 3], [2, 13], [1.0_dp, -1.0_dp], err)
+      call expect(err, "device 1 has a term at DOF 13, outside 1..12", error)
+      if (allocated(error)) return
+      call spd_setup(sys, mass, si, sj, sk, [1, 3], [2, 3], [1.0_dp, 0.0_dp], err)
+      call expect(err, "device 1 has the coefficient 0 at DOF 3", error)
+      if (allocated(error)) return
+      call spd_setup(sys, mass, si, sj, sk, [1, 2, 4], [2, 3, 3], [1.0_dp, 1.0_dp, -1.0_dp], err)
+      call expect(err, "device 2 has two terms at DOF 3", error)
+   end subroutine test_general_devices
+
+   !> spd_setup for devices between two nodes (di, dj; 0 = the table).
+   subroutine pair_setup(sys, mass, si, sj, sk, di, dj, error, a0, a1, dashpot_i, dashpot_j, dashpot_c, &
+                         path, budget, method)
+      type(spd_system), intent(out) :: sys
+      real(dp), intent(in) :: mass(:), sk(:)
+      integer, intent(in) :: si(:), sj(:), di(:), dj(:)
+      type(lib_error), allocatable, intent(out) :: error
+      real(dp), intent(in), optional :: a0, a1, budget
+      integer, intent(in), optional :: dashpot_i(:), dashpot_j(:), path, method
+      real(dp), intent(in), optional :: dashpot_c(:)
+      integer :: ptr(size(di) + 1), dof(2*size(di))
+      real(dp) :: coef(2*size(di))
+
+      call pair_terms(di, dj, ptr, dof, coef)
+      call spd_setup(sys, mass, si, sj, sk, ptr, dof, coef, error, a0=a0, a1=a1, dashpot_i=dashpot_i, &
+                     dashpot_j=dashpot_j, dashpot_c=dashpot_c, path=path, budget=budget, method=method)
+   end subroutine pair_setup
 
 end module test_fd_banded

@@ -13,7 +13,7 @@ module test_fd_engineering
    use fd_matrices, only: modes_type, natural_modes, stiffness_matrix, damping_matrix, modes_flexible, &
                           modes_rigid, modes_unrestrained, natural_modes_sparse
    use fd_engineering, only: engineering_type, engineering_init, storey_values, observe_engineering
-   use test_fd_helpers, only: check_close
+   use test_fd_helpers, only: check_close, pairs_of
    implicit none
    private
 
@@ -65,6 +65,7 @@ contains
          model%dev(d)%mu = 1.0_dp
          model%dev(d)%f = 1.0e5_dp/k
       end do
+      call pairs_of(model)
    end subroutine chain
 
    !> The modes of a model (no damping).
@@ -258,6 +259,7 @@ contains
       model%dev(1)%node_i = 2; model%dev(1)%node_j = 1
       model%dev(2)%node_i = 1; model%dev(2)%node_j = 2
       model%dev(3)%node_i = 1; model%dev(3)%node_j = 0
+      call pairs_of(model)
       model%damping = damping_rayleigh
       a1 = 1.0e-3_dp
       model%rayleigh_a0 = 0.5_dp

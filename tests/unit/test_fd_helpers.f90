@@ -7,10 +7,12 @@ module test_fd_helpers
    use, intrinsic :: iso_fortran_env, only: output_unit
    use testdrive, only: error_type, test_failed
    use fd_kinds, only: dp
+   use fd_model, only: model_type
+   use fd_kinematics, only: set_pair_directions
    implicit none
    private
 
-   public :: check_close, check_matrix
+   public :: check_close, check_matrix, pairs_of
 
 contains
 
@@ -71,5 +73,14 @@ contains
       call get_environment_variable('FD_UNIT_REPORT', length=length)
       if (length > 0) write (output_unit, '(es9.2,a,es9.2,2a)') err, ' (tol', tol, ') ', what
    end subroutine report
+
+   !> The directions of a test model's devices from their nodes (as the deck reader sets them).
+   subroutine pairs_of(model)
+      type(model_type), intent(inout) :: model  !! a model whose devices have node_i and node_j
+      integer :: stat
+
+      call set_pair_directions(model, stat)
+      if (stat /= 0) error stop "pairs_of: not enough memory"
+   end subroutine pairs_of
 
 end module test_fd_helpers

@@ -6,7 +6,7 @@ module test_fd_matrices
    use fd_error, only: fd_error_type => error_type
    use fd_model, only: model_type, damping_stiffness, damping_rayleigh, law_velocity
    use fd_matrices, only: link_groups, stiffness_matrix, damping_matrix, stuck_first_mode, structure_matrices
-   use test_fd_helpers, only: check_close, check_matrix
+   use test_fd_helpers, only: check_close, check_matrix, pairs_of
    implicit none
    private
 
@@ -58,6 +58,7 @@ contains
          model%dev(d)%p = 10.0_dp
          model%dev(d)%mu = 0.2_dp
       end do
+      call pairs_of(model)
    end subroutine make_model
 
    !> The paper's model: m1 on k1 and m2 on k2 to the table, one device between them.

@@ -3,6 +3,7 @@
 !> correctness violations, and the closing of the energy balance.
 module test_fd_observer
    use testdrive, only: new_unittest, unittest_type, error_type, check, test_failed
+   use test_fd_helpers, only: pairs_of
    use fd_kinds, only: dp
    use fd_error, only: fd_error_type => error_type
    use fd_model, only: model_type, device_type, integration_type, law_velocity
@@ -49,6 +50,7 @@ contains
       model%mass = [2.0_dp, 1.0_dp]
       model%n_devices = 1
       model%dev = [device_type(node_i=1, node_j=2, law=law_velocity, p=10.0_dp, mu=0.2_dp)]
+      call pairs_of(model)
       exc%kind = excitation_none
       exc%dt_record = 0.01_dp
       exc%duration = 0.0123_dp
@@ -256,6 +258,7 @@ contains
       model%mass = [2.0_dp, 1.0_dp]
       model%n_devices = 1
       model%dev = [device_type(node_i=1, node_j=2, law=law_velocity, p=10.0_dp, mu=0.2_dp)]
+      call pairs_of(model)
       exc%kind = excitation_none
       exc%dt_record = 0.01_dp
       exc%duration = 0.0123_dp
@@ -303,6 +306,7 @@ contains
       model%n_devices = 2
       model%dev = [device_type(node_i=1, node_j=0, law=law_velocity, p=1.0_dp, mu=0.1_dp), &
                    device_type(node_i=3, node_j=2, law=law_velocity, p=1.0_dp, mu=0.1_dp)]
+      call pairs_of(model)
       exc%kind = excitation_none
       exc%dt_record = 0.01_dp
       exc%duration = 0.01_dp

@@ -14,7 +14,7 @@ module test_fd_phase_decision
    use fd_device_state, only: phase_stick
    use fd_ed_state, only: ed_state, ed_setup
    use fd_phase_decision, only: decide_phases
-   use test_fd_helpers, only: check_close
+   use test_fd_helpers, only: check_close, pairs_of
    implicit none
    private
 
@@ -84,6 +84,7 @@ contains
       do d = 1, size(slip)
          model%dev(d) = device_type(node_i=1, node_j=0, law=law_coulomb, p=slip(d), mu=1.0_dp)
       end do
+      call pairs_of(model)
    end subroutine block_model
 
    !> Decide at t; the phases and the sticking devices' forces (0 for a sliding one).

@@ -15,7 +15,7 @@ module test_fd_phase_pattern
    use fd_phase_pattern, only: pattern_type, pattern_cache, cache_init, cache_find, build_pattern, &
                                pattern_entry, pattern_taylor, remainder_bound, kmax
    use fd_taylor, only: poly_value
-   use test_fd_helpers, only: check_close
+   use test_fd_helpers, only: check_close, pairs_of
    implicit none
    private
 
@@ -65,6 +65,7 @@ contains
       do d = 1, size(ni)
          model%dev(d) = device_type(node_i=ni(d), node_j=nj(d), law=law_coulomb, p=slip(d), mu=1.0_dp)
       end do
+      call pairs_of(model)
    end subroutine make_model
 
    !> Build the pattern of the phases, enter it at (u, v) and expand it about t.

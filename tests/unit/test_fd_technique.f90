@@ -4,6 +4,7 @@
 !> without force or an unforced structure.
 module test_fd_technique
    use testdrive, only: new_unittest, unittest_type, error_type, check, test_failed
+   use test_fd_helpers, only: pairs_of
    use fd_kinds, only: dp
    use fd_error, only: fd_error_type => error_type
    use fd_model, only: model_type, device_type, integration_type, law_velocity, law_hysteretic, law_coulomb, &
@@ -30,7 +31,8 @@ contains
                   new_unittest("moreau_jean: coulomb only, theta in range", test_moreau_jean), &
                   new_unittest("unknown technique", test_unknown_technique), &
                   new_unittest("unknown excitation", test_unknown_excitation), &
-                  new_unittest("friction dispatch: a law it lacks", test_friction_dispatch) &
+                  new_unittest("friction dispatch: a law it lacks", test_friction_dispatch), &
+                  new_unittest("a device not between two nodes is refused", test_general_device) &
                   ]
    end subroutine collect_technique
 
@@ -51,6 +53,7 @@ contains
       model%n_devices = 2
       model%dev = [device_type(node_i=1, node_j=0, law=law1, p=10.0_dp, mu=0.2_dp), &
                    device_type(node_i=2, node_j=1, law=law2, p=5.0_dp, mu=0.2_dp)]
+      call pairs_of(model)
       exc%kind = excitation_harmonic
       exc%amplitude = 0.01_dp
       exc%frequency = 2.0_dp
@@ -95,6 +98,7 @@ contains
       ! no devices: both techniques integrate the linear structure
       model%n_devices = 0
       model%dev = model%dev(1:0)
+      call pairs_of(model)
       call check_technique(model, exc, opts, err)
       call check(error, .not. allocated(err), "no devices under event_driven")
    end subroutine test_valid
@@ -229,5 +233,26 @@ contains
       call friction_init(model%dev, [0.0_dp, 0.0_dp], [0.0_dp, 0.0_dp], st, err)
       call expect(err, [character(len=40) :: "device 1", "id 77"], error)
    end subroutine test_friction_dispatch
+
+   !> Every technique refuses a device along a general direction (the stuck system's modes,
+   !> the storeys and the exact techniques' groups take devices as links between two nodes).
+   subroutine test_general_device(error)
+      type(error_type), allocatable, intent(out) :: error
+      type(model_type) :: model
+      type(excitation_type) :: exc
+      type(integration_type) :: opts
+      type(fd_error_type), allocatable :: err
+      integer, parameter :: techniques(3) = [technique_newmark, technique_event_driven, technique_moreau_jean]
+      integer :: t
+
+      call setup(law_velocity, law_velocity, model, exc)
+      model%dev_coef(1) = 0.6_dp
+      do t = 1, 3
+         opts%technique = techniques(t)
+         call check_technique(model, exc, opts, err)
+         call expect(err, [character(len=40) :: "not between two nodes"], error)
+         if (allocated(error)) return
+      end do
+   end subroutine test_general_device
 
 end module test_fd_technique

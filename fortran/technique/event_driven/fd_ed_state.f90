@@ -12,6 +12,7 @@ module fd_ed_state
    use fd_kinds, only: dp
    use fd_error, only: error_type, fatal_error, fmt_int
    use fd_model, only: model_type
+   use fd_kinematics, only: pair_nodes
    use fd_excitation, only: excitation_type, table_taylor
    use fd_device_state, only: phase_stick
    use fd_lcp, only: lcp_work, lcp_init
@@ -196,8 +197,7 @@ contains
          end do
          ! per device: s, F, and the event functions
          do d = 1, st%nd
-            ni = model%dev(d)%node_i
-            nj = model%dev(d)%node_j
+            call pair_nodes(model, d, ni, nj)
             st%yc(0:kk, iq_s(st%n, d)) = st%yc(0:kk, iq_u(ni))
             gi = pat%grp(ni)
             gj = 0

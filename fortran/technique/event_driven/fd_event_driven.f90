@@ -35,7 +35,7 @@ module fd_event_driven
    use fd_model, only: model_type, integration_type
    use fd_excitation, only: excitation_type, table_motion, segment_end, forcing_form, forcing_unknown
    use fd_matrices, only: structure_matrices
-   use fd_kinematics, only: device_relative
+   use fd_kinematics, only: device_relative, device_abs_relative
    use fd_device_state, only: phase_stick
    use fd_result, only: result_type
    use fd_observer, only: observer_type, observer_init, observe_start, observe_sample, observe_transitions, &
@@ -630,8 +630,7 @@ contains
             end do
             if (st%active(dd) .and. st%phase(dd) /= phase_stick) then
                x = device_relative(model, dd, st%v)
-               vs = abs(st%v(model%dev(dd)%node_i))
-               if (model%dev(dd)%node_j > 0) vs = vs + abs(st%v(model%dev(dd)%node_j))
+               vs = device_abs_relative(model, dd, st%v)
                st%near(dd) = st%crossed(dd) .or. abs(x) <= max(rtol_decision*vs, 4.0_dp*st%eta(2*dd - 1))
             end if
          end do
@@ -715,8 +714,7 @@ contains
          do dd = 1, st%nd
             if (.not. st%active(dd) .or. st%phase(dd) == phase_stick) cycle
             x = device_relative(model, dd, st%v)
-            vs = abs(st%v(model%dev(dd)%node_i))
-            if (model%dev(dd)%node_j > 0) vs = vs + abs(st%v(model%dev(dd)%node_j))
+            vs = device_abs_relative(model, dd, st%v)
             if (abs(x) <= 1.0e-9_dp*max(vs, tiny(1.0_dp))) st%newph(dd) = phase_stick
          end do
          call cache_find(st%cache, model, st%mass, st%k, st%c, st%active, st%newph, st%slip, exc, [st%cur], &

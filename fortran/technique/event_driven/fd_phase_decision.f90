@@ -46,7 +46,8 @@ module fd_phase_decision
    use fd_error, only: error_type, fatal_error, fmt_int, fmt_real
    use fd_model, only: model_type
    use fd_excitation, only: excitation_type, table_motion, table_taylor
-   use fd_kinematics, only: device_relative, add_device
+   use fd_kinematics, only: device_relative, add_device, add_device_abs, pair_nodes, device_coupling, &
+                            device_inverse_mass_relative, device_abs_inverse_mass_relative
    use fd_device_state, only: phase_stick
    use fd_lcp, only: box_lcp_solve, lcp_solve, lcp_info, lcp_solved, lcp_status_text
    use fd_phase_pattern, only: cache_find, pattern_entry, pattern_taylor
@@ -159,8 +160,7 @@ contains
       do d = 1, st%nd
          if (.not. st%active(d) .or. st%phase(d) == phase_stick .or. st%near(d)) cycle
          call add_device(model, d, -st%phase(d)*st%slip(d), st%pe)
-         st%pa(model%dev(d)%node_i) = st%pa(model%dev(d)%node_i) + st%slip(d)
-         if (model%dev(d)%node_j > 0) st%pa(model%dev(d)%node_j) = st%pa(model%dev(d)%node_j) + st%slip(d)
+         call add_device_abs(model, d, st%slip(d), st%pa)
       end do
       if (.not. all(ieee_is_finite(st%pe))) then
          call fatal_error(error, "event-driven technique at t = "//trim(fmt_real(dc%t))//" s: the forces on "// &
@@ -169,10 +169,10 @@ contains
          return
       end if
       do a = 1, nc
-         st%lq(a) = -rel_over_mass(model, st%cand(a), st%pe, st%mass)
-         st%lqa(a) = abs_over_mass(model, st%cand(a), st%pa, st%mass)
+         st%lq(a) = -device_inverse_mass_relative(model, st%cand(a), st%pe)
+         st%lqa(a) = device_abs_inverse_mass_relative(model, st%cand(a), st%pa)
          do b = 1, nc
-            st%wm(a, b) = delassus(model, st%cand(a), st%cand(b), st%mass)
+            st%wm(a, b) = device_coupling(model, st%cand(a), st%cand(b))
          end do
          st%lo(a) = -st%slip(st%cand(a))
          st%hi(a) = st%slip(st%cand(a))
@@ -234,7 +234,7 @@ contains
       type(error_type), allocatable, intent(out) :: error !! an LCP unsolved
       type(lcp_info) :: info
       real(dp) :: sc
-      integer :: a, b, d, i, lev, gi, gj, kk
+      integer :: a, b, d, i, lev, gi, gj, kk, ni, nj
 
       do lev = 1, max_level
          if (dc%ndg == 0) exit
@@ -250,9 +250,10 @@ contains
             call abs_taylor(st, dc%slot1, lev + 2)
             do a = 1, dc%ndg
                d = st%cand(a)
-               gi = pat%grp(model%dev(d)%node_i)
+               call pair_nodes(model, d, ni, nj)
+               gi = pat%grp(ni)
                gj = 0
-               if (model%dev(d)%node_j > 0) gj = pat%grp(model%dev(d)%node_j)
+               if (nj > 0) gj = pat%grp(nj)
                st%lq(a) = 0.0_dp
                st%lqa(a) = 0.0_dp
                if (gi > 0) then
@@ -383,9 +384,9 @@ contains
             call add_device(model, pat%ids(aa), st%lqa(aa), st%pe)
          end do
          do aa = 1, ns
-            st%lq(aa) = -rel_over_mass(model, pat%ids(aa), st%pe, st%mass)
+            st%lq(aa) = -device_inverse_mass_relative(model, pat%ids(aa), st%pe)
             do bb = 1, ns
-               st%wm(aa, bb) = delassus(model, pat%ids(aa), pat%ids(bb), st%mass)
+               st%wm(aa, bb) = device_coupling(model, pat%ids(aa), pat%ids(bb))
             end do
          end do
          lam_lo = 0.0_dp
@@ -516,53 +517,22 @@ contains
       end associate
    end subroutine abs_taylor
 
-   !> b_d' M^-1 y.
-   pure real(dp) function rel_over_mass(model, d, y, mass) result(x)
-      type(model_type), intent(in) :: model
-      integer, intent(in) :: d
-      real(dp), intent(in) :: y(:), mass(:)
-      x = y(model%dev(d)%node_i)/mass(model%dev(d)%node_i)
-      if (model%dev(d)%node_j > 0) x = x - y(model%dev(d)%node_j)/mass(model%dev(d)%node_j)
-   end function rel_over_mass
-
-   !> |b_d|' M^-1 y.
-   pure real(dp) function abs_over_mass(model, d, y, mass) result(x)
-      type(model_type), intent(in) :: model
-      integer, intent(in) :: d
-      real(dp), intent(in) :: y(:), mass(:)
-      x = y(model%dev(d)%node_i)/mass(model%dev(d)%node_i)
-      if (model%dev(d)%node_j > 0) x = x + y(model%dev(d)%node_j)/mass(model%dev(d)%node_j)
-   end function abs_over_mass
-
-   !> b_a' M^-1 b_b.
-   pure real(dp) function delassus(model, a, b, mass) result(x)
-      type(model_type), intent(in) :: model
-      integer, intent(in) :: a, b
-      real(dp), intent(in) :: mass(:)
-      integer :: ia, ja, ib, jb
-      ia = model%dev(a)%node_i; ja = model%dev(a)%node_j
-      ib = model%dev(b)%node_i; jb = model%dev(b)%node_j
-      x = 0.0_dp
-      if (ia == ib) x = x + 1.0_dp/mass(ia)
-      if (ja > 0 .and. ja == jb) x = x + 1.0_dp/mass(ja)
-      if (jb > 0 .and. ia == jb) x = x - 1.0_dp/mass(ia)
-      if (ja > 0 .and. ja == ib) x = x - 1.0_dp/mass(ja)
-   end function delassus
-
    !> b_a' T Mq^-1 T' b_b in a pattern with groups grp and group masses mq.
    pure real(dp) function group_delassus(model, a, b, grp, mq) result(x)
       type(model_type), intent(in) :: model
       integer, intent(in) :: a, b
       integer, intent(in) :: grp(:)
       real(dp), intent(in) :: mq(:)
-      integer :: ga(2), gb(2), i, j
+      integer :: ga(2), gb(2), i, j, ni, nj
       real(dp), parameter :: sg(2) = [1.0_dp, -1.0_dp]
       ga = 0
       gb = 0
-      ga(1) = grp(model%dev(a)%node_i)
-      if (model%dev(a)%node_j > 0) ga(2) = grp(model%dev(a)%node_j)
-      gb(1) = grp(model%dev(b)%node_i)
-      if (model%dev(b)%node_j > 0) gb(2) = grp(model%dev(b)%node_j)
+      call pair_nodes(model, a, ni, nj)
+      ga(1) = grp(ni)
+      if (nj > 0) ga(2) = grp(nj)
+      call pair_nodes(model, b, ni, nj)
+      gb(1) = grp(ni)
+      if (nj > 0) gb(2) = grp(nj)
       x = 0.0_dp
       do i = 1, 2
          if (ga(i) == 0) cycle

@@ -26,7 +26,7 @@ module fd_moreau_jean
                        technique_newmark, damping_stiffness, damping_rayleigh
    use fd_model, only: model_type, integration_type
    use fd_excitation, only: excitation_type, table_motion
-   use fd_kinematics, only: device_kinematics
+   use fd_kinematics, only: device_kinematics, device_nodes
    use fd_result, only: result_type
    use fd_observer, only: observer_type, observer_init, sample_due, observe_peaks, observe_sample, &
                           observe_transitions, observe_start_energies, observe_end_energies, &
@@ -266,7 +266,7 @@ contains
       type(error_type), allocatable, intent(out) :: error
       type(error_type), allocatable :: eig_error
       real(dp) :: period, t_damp, om
-      integer :: n, nd, stat
+      integer :: n, nd, stat, first
       integer, allocatable :: dev_i(:), dev_j(:)
       real(dp), allocatable :: pmu(:)
 
@@ -281,8 +281,12 @@ contains
          call no_memory(error, n)
          return
       end if
-      dev_i = model%dev%node_i
-      dev_j = model%dev%node_j
+      call device_nodes(model, dev_i, dev_j, first)
+      if (first /= 0) then
+         call fatal_error(error, "the Moreau-Jean technique integrates devices between two nodes; device "// &
+                          trim(fmt_int(first))//" is not")
+         return
+      end if
       pmu = model%dev%p*model%dev%mu
       call solver_setup(w%p, model%mass, model%spring_i, model%spring_j, model%spring_k, dev_i, dev_j, pmu, error)
       if (allocated(error)) return

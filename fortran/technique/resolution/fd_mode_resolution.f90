@@ -20,6 +20,7 @@ module fd_mode_resolution
    use fd_error, only: error_type, fatal_error, fmt_int, stat_no_memory
    use fd_names, only: technique_newmark, technique_moreau_jean
    use fd_model, only: model_type, sticking_stiffness
+   use fd_kinematics, only: pair_nodes
    use fd_modes, only: highest_eigenvalue
    use fd_result, only: result_type, resolution_none, resolution_resolved, resolution_unresolved
    implicit none
@@ -65,8 +66,7 @@ contains
             kd = sticking_stiffness(model%dev(d))
             if (kd <= 0.0_dp) cycle
             ne = ne + 1
-            ei(ne) = model%dev(d)%node_i
-            ej(ne) = model%dev(d)%node_j
+            call pair_nodes(model, d, ei(ne), ej(ne))
             ek(ne) = kd
          end do
       end if
