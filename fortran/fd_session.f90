@@ -27,12 +27,14 @@ module fd_session
    use fd_history_stream, only: stream_close, stream_discard
    use fd_output, only: make_dir, temp_output_paths, remove_made_dirs
    use fd_tempfiles, only: temp_tag, remove_stale_temps
+   use fd_excitation, only: excitation_record
+   use fd_spectrum, only: response_spectrum
    implicit none
    private
 
    public :: session_type, session_open, session_open_text, session_adopt, session_solve
    public :: session_shape, session_text, session_set_output_dir, session_write, session_write_files
-   public :: session_new, session_from_handle, session_free
+   public :: session_new, session_from_handle, session_free, session_spectrum
    public :: session_select, session_stream, session_cancel, session_progress, session_set_progress
    public :: text_header, text_summary, text_output_dir, text_output_name, text_history_path, &
              text_summary_path, text_deck, text_error
@@ -286,6 +288,35 @@ contains
       s%ctl%on_progress => callback
       s%ctl%progress_interval = interval
    end subroutine session_set_progress
+
+   !> The elastic response spectrum of the deck's recorded table motion (as read: units,
+   !> scale; over the analysed duration): fd_spectrum's peaks for each period.
+   subroutine session_spectrum(s, periods, xi, sd, psv, psa, sa, error)
+      type(session_type), intent(in) :: s                 !! an open session
+      real(dp), intent(in) :: periods(:)                  !! periods [s], >= 0
+      real(dp), intent(in) :: xi                          !! damping ratio, 0 <= xi < 1
+      real(dp), intent(out) :: sd(:)                      !! peak relative displacement [m]
+      real(dp), intent(out) :: psv(:)                     !! pseudo-velocity [m/s]
+      real(dp), intent(out) :: psa(:)                     !! pseudo-acceleration [m/s2]
+      real(dp), intent(out) :: sa(:)                      !! peak absolute acceleration [m/s2]
+      type(error_type), allocatable, intent(out) :: error !! no record, bad input
+      integer :: n
+
+      sd = 0.0_dp; psv = 0.0_dp; psa = 0.0_dp; sa = 0.0_dp
+      if (s%state /= session_read .and. s%state /= session_solved .and. s%state /= state_failed) then
+         call fatal_error(error, 'the session holds no deck')
+         return
+      end if
+      associate (exc => s%cfg%exc)
+         if (exc%kind /= excitation_record) then
+            call fatal_error(error, "group &excitation: the response spectrum is of a recorded motion; "// &
+                             "this deck's table motion is not a record")
+            return
+         end if
+         n = min(size(exc%acc), nint(exc%duration/exc%dt_record) + 1)
+         call response_spectrum(exc%acc(1:n), exc%dt_record, periods, xi, sd, psv, psa, sa, error)
+      end associate
+   end subroutine session_spectrum
 
    !> Columns and samples of the history (that the run will produce, or has produced).
    subroutine session_shape(s, ncol, nout, history, error)

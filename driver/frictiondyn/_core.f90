@@ -547,3 +547,33 @@ subroutine fd_session_write_files(handle, nhist, hist_path, nsumm, summ_path, hi
 contains
    include 'fd_core_common.inc'
 end subroutine fd_session_write_files
+
+!> The elastic response spectrum of the session's recorded table motion (see session_spectrum).
+subroutine fd_session_spectrum(handle, nper, periods, xi, sd, psv, psa, sa, status)
+   use, intrinsic :: iso_c_binding, only: c_int, c_int64_t, c_double
+   use fd_session, only: session_type, session_from_handle, session_spectrum, status_input, status_misuse, &
+                         status_ok
+   use frictiondyn, only: error_type
+   implicit none
+   integer(c_int64_t), intent(in) :: handle      !! the session
+   integer(c_int), intent(in) :: nper            !! number of periods
+   real(c_double), intent(in) :: periods(nper)   !! periods [s]
+   real(c_double), intent(in) :: xi              !! damping ratio
+   real(c_double), intent(out) :: sd(nper)       !! peak relative displacement [m]
+   real(c_double), intent(out) :: psv(nper)      !! pseudo-velocity [m/s]
+   real(c_double), intent(out) :: psa(nper)      !! pseudo-acceleration [m/s2]
+   real(c_double), intent(out) :: sa(nper)       !! peak absolute acceleration [m/s2]
+   integer(c_int), intent(out) :: status         !! 0 or an error code
+   !f2py threadsafe
+   type(session_type), pointer :: s
+   type(error_type), allocatable :: error
+
+   sd = 0; psv = 0; psa = 0; sa = 0
+   call session_from_handle(handle, s)
+   status = merge(int(status_ok, c_int), int(status_misuse, c_int), associated(s))
+   if (status /= 0) return
+   call session_spectrum(s, periods, xi, sd, psv, psa, sa, error)
+   call keep_error(s, error, status_input, status)
+contains
+   include 'fd_core_common.inc'
+end subroutine fd_session_spectrum

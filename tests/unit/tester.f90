@@ -30,6 +30,7 @@ program tester
    use test_fd_stick_groups, only: collect_stick_groups
    use test_fd_kinematics, only: collect_kinematics
    use test_fd_matrix_market, only: collect_matrix_market
+   use test_fd_spectrum, only: collect_spectrum
    use test_fd_group_system, only: collect_group_system
    use test_fd_impulse_solver, only: collect_impulse_solver
    use test_fd_step_limits, only: collect_step_limits
@@ -74,6 +75,7 @@ program tester
    testsuites = [testsuites, new_testsuite("stick_groups", collect_stick_groups)]
    testsuites = [testsuites, new_testsuite("kinematics", collect_kinematics)]
    testsuites = [testsuites, new_testsuite("matrix_market", collect_matrix_market)]
+   testsuites = [testsuites, new_testsuite("spectrum", collect_spectrum)]
    testsuites = [testsuites, new_testsuite("group_system", collect_group_system)]
    testsuites = [testsuites, new_testsuite("impulse_solver", collect_impulse_solver)]
    testsuites = [testsuites, new_testsuite("step_limits", collect_step_limits)]

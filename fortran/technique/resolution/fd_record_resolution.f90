@@ -44,6 +44,7 @@ module fd_record_resolution
    use fd_result, only: result_type, resolution_none, resolution_resolved, resolution_unresolved, &
                         record_system_none, record_system_structure, record_system_stuck, &
                         record_system_free, record_system_both
+   use fd_spectrum, only: exact_step_map
    implicit none
    private
 
@@ -69,49 +70,6 @@ module fd_record_resolution
    end type mode_pass
 
 contains
-
-   !> The exact step of a mode q'' + c q' + wn^2 q = p(t) with p linear in the step:
-   !> (q, q')(h) = phi (q, q')(0) + g0 p(0) + g1 p(h). From exp(A h) of the state with the
-   !> load's value and slope appended, A = [0 1 0 0; -wn^2 -c 1 0; 0 0 0 1; 0 0 0 0], by
-   !> scaling and squaring of its Taylor series (any wn >= 0 and c >= 0: rigid-body,
-   !> underdamped and overdamped modes alike).
-   pure subroutine exact_step_map(wn, c, h, phi, g0, g1)
-      real(dp), intent(in) :: wn        !! natural circular frequency [rad/s]
-      real(dp), intent(in) :: c         !! damping per unit modal mass [1/s]
-      real(dp), intent(in) :: h         !! step [s]
-      real(dp), intent(out) :: phi(2, 2) !! the free response's map
-      real(dp), intent(out) :: g0(2), g1(2) !! the response to p(0) and to p(h)
-      real(dp) :: a(4, 4), e(4, 4), term(4, 4), nrm
-      integer :: s, k
-
-      a = 0.0_dp
-      a(1, 2) = h
-      a(2, 1) = -wn*wn*h
-      a(2, 2) = -c*h
-      a(2, 3) = h
-      a(3, 4) = 1.0_dp            ! the slope appended as (p(h) - p(0)): its rate 1/h times h
-      nrm = maxval(sum(abs(a), dim=1))
-      s = 0
-      if (nrm > 0.5_dp) s = ceiling(log(nrm/0.5_dp)/log(2.0_dp))
-      a = a/2.0_dp**s
-      ! Taylor series to 20 terms of a matrix of norm <= 1/2: truncation below 1e-25
-      e = 0.0_dp
-      do k = 1, 4
-         e(k, k) = 1.0_dp
-      end do
-      term = e
-      do k = 1, 20
-         term = matmul(term, a)/real(k, dp)
-         e = e + term
-      end do
-      do k = 1, s
-         e = matmul(e, e)
-      end do
-      phi = e(1:2, 1:2)
-      ! (q, q')(h) = phi z0 + e(1:2, 3) p(0) + e(1:2, 4) (p(h) - p(0))
-      g0 = e(1:2, 3) - e(1:2, 4)
-      g1 = e(1:2, 4)
-   end subroutine exact_step_map
 
    !> Newmark's step (beta, gamma, acceleration form as fd_newmark's try_step) of the same mode
    !> as a map: (q, q', q'')(h) = nm (q, q', q'')(0) + np p(h).
