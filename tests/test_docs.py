@@ -1,0 +1,156 @@
+"""The documentation as a reader meets it: every link and anchor resolves, every "docs/X.md
+section N" names a section that exists, every topic has a heading, and the docs speak of the
+product as it is, not of how it was made."""
+
+from __future__ import annotations
+
+import re
+from pathlib import Path
+
+import pytest
+
+ROOT = Path(__file__).resolve().parent.parent
+DOCS = sorted((ROOT / "docs").glob("*.md"))
+PAGES = [ROOT / "README.md", *DOCS]
+
+
+def _prose(text: str) -> list[tuple[int, str]]:
+    """(line number, line) of the lines outside fenced code blocks."""
+    out, fence = [], False
+    for n, line in enumerate(text.splitlines(), 1):
+        if line.lstrip().startswith("```"):
+            fence = not fence
+            continue
+        if not fence:
+            out.append((n, line))
+    return out
+
+
+def _slug(heading: str) -> str:
+    """GitHub's anchor of a heading: lower case, punctuation dropped, spaces to hyphens."""
+    return re.sub(r"[^\w\- ]", "", heading.strip().lower()).replace(" ", "-")
+
+
+def _headings(page: Path) -> list[tuple[int, int, str]]:
+    """(line number, level, text) of every heading of a page."""
+    return [(n, len(m.group(1)), m.group(2)) for n, line in _prose(page.read_text())
+            if (m := re.match(r"^(#{1,6}) (.+?)\s*$", line))]
+
+
+def _anchors(page: Path) -> set[str]:
+    seen: dict[str, int] = {}
+    out = set()
+    for _, _, text in _headings(page):
+        s = _slug(text)
+        out.add(s if s not in seen else f"{s}-{seen[s]}")
+        seen[s] = seen.get(s, 0) + 1
+    return out
+
+
+def _links(page: Path) -> list[tuple[int, str]]:
+    """(line number, target) of every relative Markdown link of a page."""
+    out = []
+    for n, line in _prose(page.read_text()):
+        for target in re.findall(r"\]\(([^)\s]+)\)", line):
+            if not re.match(r"[a-z][a-z0-9+.-]*:", target):  # http:, https:, mailto:
+                out.append((n, target))
+    return out
+
+
+def _section_numbers(page: Path) -> set[str]:
+    """The numbers of a page's numbered headings: '6', '6.2', ..."""
+    return {m.group(1) for _, _, text in _headings(page) if (m := re.match(r"(\d+(?:\.\d+)*)\.? ", text))}
+
+
+def test_the_link_check_sees_links_and_anchors():
+    """The checker itself: it finds this page's links and GitHub's anchors of odd headings."""
+    assert _slug("6. Step control (`technique = 'newmark'`, `fd_newmark.f90`)") == (
+        "6-step-control-technique--newmark-fd_newmarkf90")
+    assert _slug("Does dt1 resolve a record?") == "does-dt1-resolve-a-record"
+    assert len([t for p in PAGES for _, t in _links(p)]) > 50
+    assert "65-mode-resolution-does-dt1-resolve-the-highest-modes" in _anchors(ROOT / "docs/theory.md")
+
+
+@pytest.mark.parametrize("page", PAGES, ids=lambda p: p.name)
+def test_every_relative_link_and_anchor_resolves(page):
+    bad = []
+    for n, target in _links(page):
+        path, _, anchor = target.partition("#")
+        dest = (page.parent / path).resolve() if path else page
+        if not dest.exists():
+            bad.append(f"{page.name}:{n}: {target}: no such file")
+        elif anchor and dest.suffix == ".md" and anchor not in _anchors(dest):
+            bad.append(f"{page.name}:{n}: {target}: no such heading")
+    assert not bad, "\n".join(bad)
+
+
+# "docs/theory.md section 6", "docs/theory.md, section 5.4", "docs/theory.md 5.4",
+# "docs/studies.md, 3.2", "docs/theory.md, sections 6 and 12", "docs/validation.md, 6.4"
+REF = re.compile(r"docs/(\w+)\.md(?:'s)?,? (?:sections? )?(\d+(?:\.\d+)*)((?:(?:, | and )\d+(?:\.\d+)*)*)")
+SOURCES = ["README.md", "docs", "fortran", "driver", "tests", "tools", "bench", "inputs"]
+
+
+def _files_that_cite_docs():
+    for entry in SOURCES:
+        base = ROOT / entry
+        for f in [base] if base.is_file() else sorted(base.rglob("*")):
+            if f.is_file() and f.suffix in {".md", ".py", ".f90", ".F90", ".c", ".sh", ".nml", ".build"}:
+                yield f
+
+
+def test_every_numbered_section_a_file_cites_exists():
+    """A comment, message, test or page that says "docs/theory.md section 6.7" points at a
+    section that is there (renumbering a page breaks this test, not the reader)."""
+    numbers = {p.stem: _section_numbers(p) for p in DOCS}
+    bad, seen = [], 0
+    for f in _files_that_cite_docs():
+        text = re.sub(r"\s*\n\s*(?:!>?|#|//|\*)?\s*", " ", f.read_text(errors="replace"))
+        for m in REF.finditer(text):
+            page = m.group(1)
+            if page not in numbers:
+                continue
+            for num in [m.group(2), *re.findall(r"\d+(?:\.\d+)*", m.group(3))]:
+                seen += 1
+                if num not in numbers[page]:
+                    bad.append(f"{f.relative_to(ROOT)}: docs/{page}.md section {num}")
+    assert seen > 50
+    assert not bad, "\n".join(bad)
+
+
+@pytest.mark.parametrize("page", [p for p in PAGES if p.name != "architecture.md"], ids=lambda p: p.name)
+def test_no_section_runs_long_without_a_heading(page):
+    """Every topic has a heading: no more than 80 lines of a page without one."""
+    lines = page.read_text().splitlines()
+    starts = [n for n, _, _ in _headings(page)] + [len(lines) + 1]
+    longest = max(b - a for a, b in zip([1, *starts], starts))
+    assert longest <= 80
+
+
+@pytest.mark.parametrize("page", PAGES, ids=lambda p: p.name)
+def test_the_docs_speak_of_the_product_not_of_its_making(page):
+    text = page.read_text()
+    for pattern in [r"\bstops? \d+\b", r"\bissues? \d+\b", r"\bsince the last change\b",
+                    r"\bprevious stop\b", r"\bthis version\b"]:
+        assert not re.search(pattern, text, re.I), (page.name, pattern)
+
+
+def _cells(page: Path) -> list[tuple[int, str]]:
+    """(line number, text) of every table cell of a page ('\\|' is a pipe inside a cell)."""
+    return [(n, cell.strip()) for n, line in _prose(page.read_text()) if line.startswith("|")
+            for cell in re.split(r"(?<!\\)\|", line)[1:-1]]
+
+
+def test_the_namelist_tables_hold_short_cells():
+    """A variable's row is its meaning, unit, default and range; the long explanations are the
+    notes below the table, which the row links."""
+    page = ROOT / "docs/namelist.md"
+    long = [(n, len(c)) for n, c in _cells(page) if len(c) > 300]
+    assert not long
+    notes = {a for a in _anchors(page) if a.startswith("note-")}
+    linked = {t[1:] for _, t in _links(page) if t.startswith("#note-")}
+    assert len(notes) >= 20 and notes == linked
+
+
+@pytest.mark.parametrize("page", PAGES, ids=lambda p: p.name)
+def test_no_table_cell_is_a_page_of_its_own(page):
+    assert max((len(c) for _, c in _cells(page)), default=0) <= 1000
