@@ -4,6 +4,7 @@ product as it is, not of how it was made."""
 
 from __future__ import annotations
 
+import json
 import re
 from pathlib import Path
 
@@ -99,7 +100,7 @@ def _files_that_cite_docs():
 
 
 def test_every_numbered_section_a_file_cites_exists():
-    """A comment, message, test or page that says "docs/theory.md section 6.7" points at a
+    """A comment, message, test or page that cites "docs/<page>.md section N" points at a
     section that is there (renumbering a page breaks this test, not the reader)."""
     numbers = {p.stem: _section_numbers(p) for p in DOCS}
     bad, seen = [], 0
@@ -154,3 +155,56 @@ def test_the_namelist_tables_hold_short_cells():
 @pytest.mark.parametrize("page", PAGES, ids=lambda p: p.name)
 def test_no_table_cell_is_a_page_of_its_own(page):
     assert max((len(c) for _, c in _cells(page)), default=0) <= 1000
+
+
+# --- the README a new user reads ------------------------------------------------------------
+
+def _blocks(page: Path, lang: str) -> list[str]:
+    return re.findall(rf"^```{lang}\n(.*?)^```", page.read_text(), re.M | re.S)
+
+
+def test_the_readme_reads_in_two_minutes():
+    text = (ROOT / "README.md").read_text()
+    first = re.search(r"^# frictiondyn\n\n(.+?\.)(?:\s|$)", text, re.S).group(1)
+    assert len(first.split()) <= 20, first
+    assert len(re.sub(r"```.*?```", "", text, flags=re.S).split()) <= 600
+
+
+def test_the_readmes_quick_start_is_what_ci_runs():
+    """The two quick-start commands are the set-up-and-run script (its default deck the one
+    the README names) and the test script that .ci/run runs."""
+    (quick, *_) = _blocks(ROOT / "README.md", "sh")
+    assert [line.split()[0] for line in quick.splitlines()] == ["tools/run.sh", "tools/test.sh"]
+    assert "inputs/test4_velocity.nml" in quick
+    assert "deck=${1:-inputs/test4_velocity.nml}" in (ROOT / "tools/run.sh").read_text()
+    assert re.search(r"^bash tools/test\.sh\b", (ROOT / ".ci/run").read_text(), re.M)
+    assert "bash tools/setup.sh" in (ROOT / "tools/test.sh").read_text()
+
+
+def test_the_readmes_deck_runs_and_slides():
+    """The example deck (at most 10 lines) runs as printed: the table's peak acceleration,
+    (2 pi 2 Hz)^2 x 10 mm = 1.58 m/s2, is above mu g = 0.98 m/s2, so the mass slides."""
+    import frictiondyn as fd
+
+    (deck,) = _blocks(ROOT / "README.md", "fortran")
+    assert len(deck.splitlines()) <= 10
+    s = fd.run_text(deck, name="slider.nml").summary
+    assert s["stick_to_slip"][0] > 0 and s["warnings"] == []
+    assert s["correctness_violations"] == 0
+
+
+def test_the_readmes_python_example_prints_what_it_says(tmp_path, monkeypatch, capsys):
+    """The five lines run as printed, and each print gives what its comment shows."""
+    (code,) = _blocks(ROOT / "README.md", "python")
+    assert len(code.splitlines()) <= 5
+    (tmp_path / "inputs").symlink_to(ROOT / "inputs")
+    monkeypatch.chdir(tmp_path)
+    exec(compile(code, "README.md", "exec"), {})
+    printed = capsys.readouterr().out.splitlines()
+    said = [re.sub(r"\s*m/s2$", "", line.split("#", 1)[1].strip())
+            for line in code.splitlines() if line.startswith("print(")]
+    assert len(printed) == len(said) == 2
+    for out, comment in zip(printed, said):
+        assert re.fullmatch(re.escape(comment).replace(r"\.\.\.", r"\d*"), out), (out, comment)
+    assert (tmp_path / "test4_velocity.csv").stat().st_size > 0
+
