@@ -208,3 +208,97 @@ def test_the_readmes_python_example_prints_what_it_says(tmp_path, monkeypatch, c
         assert re.fullmatch(re.escape(comment).replace(r"\.\.\.", r"\d*"), out), (out, comment)
     assert (tmp_path / "test4_velocity.csv").stat().st_size > 0
 
+
+# --- figures the docs quote that the code produces ------------------------------------------
+
+def _ref(deck: str) -> dict:
+    return json.loads((ROOT / "tests/reference" / f"{deck}.summary.json").read_text())
+
+
+def _flat(page: str) -> str:
+    return re.sub(r"\s+", " ", (ROOT / page).read_text())
+
+
+def _quoted(page: str, *figures: str):
+    text = _flat(page)
+    missing = [f for f in figures if f not in text]
+    assert not missing, (page, missing)
+
+
+def test_the_counts_the_docs_quote():
+    """Unit suites, bundled decks and their references, deck groups and variables."""
+    build = (ROOT / "tests/unit/meson.build").read_text()
+    suites = re.findall(r"^\s+'(\w+)',$", build.split("unit_suites = [")[1].split("]")[0], re.M)
+    decks = sorted(p.stem for p in (ROOT / "inputs").glob("*.nml"))
+    references = sorted(p.name.removesuffix(".summary.json")
+                        for p in (ROOT / "tests/reference").glob("*.summary.json"))
+    assert decks == references
+    _quoted("README.md", f"the {len(suites)} Fortran unit suites, the {len(decks)} bundled decks")
+    src = re.sub(r"&[ \t]*\n[ \t]*&?", " ", (ROOT / "fortran/io/fd_deck.f90").read_text())
+    groups = {m[1]: m[2].split(",") for m in re.finditer(r"namelist\s*/(\w+)/([^\n!]*)", src, re.I)}
+    _quoted("docs/namelist.md", f"A deck has {len(groups)} groups of "
+            f"{sum(len(v) for v in groups.values())} variables in all")
+
+
+def test_the_paper_figures_the_theory_and_studies_quote():
+    """Counts and values of the bundled decks that theory.md, studies.md and python.md quote,
+    against the reference outputs (regenerating those makes this test say what moved)."""
+    v4, h4, c4 = _ref("test4_velocity"), _ref("test4_hysteretic"), _ref("test4_coulomb")
+    v3, h3, fps = _ref("test3_velocity"), _ref("test3_hysteretic"), _ref("isolated_fps")
+
+    def n(x: int) -> str:  # 41524 -> "41 524"
+        return f"{x:,}".replace(",", " ")
+
+    _quoted("docs/theory.md",
+            f"T = 2 pi sqrt(8.831 / 3979) = {v4['period_stuck_s']:.5f} s",
+            f"factors twice in 40 s (dt1 and dt2) and updates {v4['factor_updates']} times (each of its "
+            f"{v4['stick_to_slip'][0] + v4['slip_to_stick'][0]} phase changes",
+            f"on test 4 the hysteretic law counts {h4['stick_to_slip'][0]} stick-to-slip transitions in "
+            f"40 s, the velocity law {v4['stick_to_slip'][0]}; on test 3, {h3['stick_to_slip'][0]} "
+            f"against {v3['stick_to_slip'][0]}",
+            f"takes {n(fps['mu_passes'])} passes for its {n(fps['steps_dt1'] + fps['steps_dt2'])} steps",
+            f"the transitions equal the exact technique's "
+            f"({c4['stick_to_slip'][0] + c4['slip_to_stick'][0]} in 40 s)",
+            f"{abs(c4['energy_residual_J']):.0e} J of {c4['energy_input_J']:.0f} J on test 4")
+    assert v4["factorizations"] == 2
+    _quoted("docs/studies.md",
+            f"against {h4['stick_to_slip'][0]} stops",
+            f"against {_ref('building5_friction')['stick_to_slip']}",
+            f"{n(h4['steps_dt2'])} dt2 steps become",
+            f"the same {h4['stick_to_slip'][0]} transitions",
+            f"{c4['events']} events, {c4['factorizations']} patterns")
+    peaks = v4["peak_aabs_mps2"]
+    cut4 = [f"{int(x * 1e4) / 1e4:.4f}..." for x in peaks]  # printed to 4 places, then "..."
+    _quoted("docs/python.md", f"[{cut4[0]}, {cut4[1]}] m/s2",
+            f"[{v4['stick_to_slip'][0]}] {v4['correctness_violations']}")
+
+
+def test_the_worked_examples_quote_their_reference_outputs():
+    """docs/examples.md: the numbers 'the scripts print (and tests/reference/ holds)'."""
+    bare, damped, fps = _ref("building5_bare"), _ref("building5_dampers"), _ref("isolated_fps")
+    g = 9.81
+
+    def periods(p):
+        return ", ".join(f"{x:.3f}" for x in p)
+
+    rows = [f"| {s + 1} | {100 * b:.3f} % | {100 * d:.3f} % | {1000 * r:.3f} mm |".replace("| -0.", "| -0.")
+            for s, (b, d, r) in enumerate(zip(bare["peak_drift_ratio"], damped["peak_drift_ratio"],
+                                              damped["residual_drift_m"]))]
+    cut = [1 - d / b for b, d in zip(bare["peak_drift_ratio"], damped["peak_drift_ratio"])]
+    _quoted("docs/examples.md",
+            f"the bare frame {periods(bare['periods_free_s'])} s",
+            f"with the dampers stuck (braces elastic) {periods(damped['periods_stuck_s'])} s",
+            f"`damping_a0_per_s` = {damped['damping_a0_per_s']:.4f} 1/s",
+            f"`damping_a1_s` = {damped['damping_a1_s'] * 1e4:.2f}e-4 s",
+            *rows,
+            f"by {100 * min(cut):.0f} to {100 * max(cut):.0f} %",
+            f"from {bare['peak_aabs_mps2'][-1] / g:.3f} g to {damped['peak_aabs_mps2'][-1] / g:.3f} g",
+            f"from {bare['peak_base_shear_N'] / 1e3:.0f} kN to {damped['peak_base_shear_N'] / 1e3:.0f} kN",
+            f"they dissipate {100 * damped['energy_friction_J'] / damped['energy_input_J']:.0f} %",
+            f"the frame on a fixed base, {periods(fps['periods_stuck_s'])} s",
+            f"the isolation mode {fps['periods_free_s'][0]:.3f} s",
+            f"the frame's {periods(fps['periods_free_s'][1:])} s",
+            " / ".join(f"{100 * r:.3f}" for r in fps["peak_drift_ratio"][1:]) + " %",
+            f"| {fps['peak_aabs_mps2'][-1] / g:.3f} g |",
+            f"| {1000 * fps['peak_s_m'][0]:.1f} mm |",
+            f"residual of {1000 * abs(fps['residual_s_m'][0]):.1f} mm")
