@@ -1,7 +1,7 @@
 #!/usr/bin/env python3
 """Band campaign: does a run report the velocity-law band forces its step leaves alternating?
 
-    python tests/fuzz/band_campaign.py --first 1 --last 5000     # docs/theory.md's figures (~3 min)
+    python tests/fuzz/band_campaign.py --first 1 --last 5000     # docs/studies.md's figures (~3 min)
     python tests/fuzz/band_campaign.py --report                  # the tables of --out again
 
 Every seed of tests/fuzz/physics.py in the range with a velocity-law device (P mu(eps) > 0)

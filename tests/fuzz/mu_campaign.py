@@ -1,7 +1,7 @@
 #!/usr/bin/env python3
 """Speed-dependent mu campaign: how far is a run from the same deck at a much finer step?
 
-    python tests/fuzz/mu_campaign.py --first 1 --last 3000        # docs/theory.md 5.4 (~2 min)
+    python tests/fuzz/mu_campaign.py --first 1 --last 3000        # docs/studies.md 1.2 (~2 min)
     python tests/fuzz/mu_campaign.py --exe old/frictiondyn --out old.jsonl   # another build
 
 Every seed of tests/fuzz/physics.py in the range with a velocity-law device whose mu depends

@@ -1,7 +1,7 @@
 #!/usr/bin/env python3
 """Step campaign: does a run's own report say when its step is too coarse for a record?
 
-    python tests/fuzz/step_campaign.py --first 1 --last 200000    # docs/theory.md's figures (~25 min)
+    python tests/fuzz/step_campaign.py --first 1 --last 200000    # docs/studies.md's figures (~25 min)
     python tests/fuzz/step_campaign.py --first 1 --last 5000      # a short one (~40 s)
 
 Every seed of tests/fuzz/physics.py in the range whose table motion is a record is run by the
