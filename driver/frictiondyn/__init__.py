@@ -26,6 +26,7 @@ from ._api import (
 )
 from ._exe import ExecutableRun, RunFailed, executable, run_executable
 from ._version import __version__
+from .spectrum import Spectrum, response_spectrum
 from .model import (
     Analysis,
     Damping,
@@ -64,6 +65,7 @@ __all__ = [
     "Session",
     "SlidingIsolator",
     "SolverError",
+    "Spectrum",
     "Spring",
     "Storey",
     "__version__",
@@ -71,6 +73,7 @@ __all__ = [
     "newmark_steps",
     "read_history",
     "read_summary",
+    "response_spectrum",
     "run",
     "run_executable",
     "run_text",

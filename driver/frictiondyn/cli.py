@@ -330,6 +330,36 @@ def cmd_paper(args: argparse.Namespace) -> int:
     return 0
 
 
+def cmd_spectrum(args: argparse.Namespace) -> int:
+    import numpy as np
+
+    from .spectrum import G, default_periods, plot_spectra, response_spectrum
+
+    periods = default_periods()
+    if args.periods is not None:
+        t0, t1, n = args.periods
+        if not (0 < t0 < t1) or int(n) < 2:
+            raise ValueError("--periods T0 T1 N needs 0 < T0 < T1 and N >= 2")
+        periods = np.concatenate([[0.0], np.logspace(np.log10(t0), np.log10(t1), int(n))])
+    out = Path(args.out)
+    out.mkdir(parents=True, exist_ok=True)
+    spectra = []
+    for source in args.sources:
+        s = response_spectrum(source, periods=periods, xi=args.xi, format=args.format,
+                              units=args.record_units, scale=args.scale, dt=args.dt, kind=args.kind)
+        spectra.append(s)
+        csv_path = s.to_csv(out / (Path(source).stem + ".spectrum.csv"))
+        k = int(np.argmax(s.psa))
+        print(f"{source}: PGA {s.psa[0] / G:.4g} g; PSA peaks at {s.psa[k] / G:.4g} g, "
+              f"T = {s.periods[k]:.4g} s (xi = {s.xi:g})")
+        print(f"  spectrum: {csv_path}")
+    if args.plot:
+        png = plot_spectra(spectra, out / (args.name + ".png"), dpi=args.dpi or 150)
+        print(f"  plot: {png}")
+    return 0
+
+
+
 def build_parser() -> argparse.ArgumentParser:
     parser = argparse.ArgumentParser(
         prog="python -m frictiondyn",
@@ -402,6 +432,24 @@ def build_parser() -> argparse.ArgumentParser:
     p.add_argument("outdir", help="directory for the PNGs and report.md")
     p.add_argument("--quiet", action="store_true", help="no progress bar")
     p.set_defaults(func=cmd_paper)
+
+    p = sub.add_parser(
+        "spectrum", help="elastic response spectra of records (or of decks' table motions)"
+    )
+    p.add_argument("sources", nargs="+", metavar="RECORD", help="record file (.AT2, ...) or deck .nml")
+    p.add_argument("--xi", type=float, default=0.05, help="damping ratio (default 0.05)")
+    p.add_argument("--periods", nargs=3, type=float, metavar=("T0", "T1", "N"),
+                   help="N periods from T0 to T1 [s], log-spaced, and T = 0 (default 0.01..10 s, 120)")
+    p.add_argument("--format", default="auto", help="record_format: auto, at2, values, time_value")
+    p.add_argument("--record-units", metavar="UNITS", help="record_units (default: the file's, or m/s2)")
+    p.add_argument("--scale", type=float, default=1.0, help="record_scale (default 1)")
+    p.add_argument("--dt", type=float, help="dt_record [s] (required but for AT2)")
+    p.add_argument("--kind", default="acceleration", help="record_kind: acceleration or displacement")
+    p.add_argument("--out", metavar="DIR", default=".", help="where the CSVs and the plot go (default: .)")
+    p.add_argument("--plot", action="store_true", help="also plot PSA [g] against T")
+    p.add_argument("--name", default="spectrum", help="base name of the plot (default: spectrum)")
+    p.add_argument("--dpi", **dpi)
+    p.set_defaults(func=cmd_spectrum)
 
     from .sweep import add_parser as add_sweep_parser
 
