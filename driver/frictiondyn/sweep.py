@@ -16,7 +16,20 @@ A spec (TOML) names a base deck and the namelist variables that vary (docs/batch
     "friction.p" = [[0.0, 0.0], [1.0e4, 5.0e3]]
 
 A key is "group.variable", "group.variable(i)" (one element), a label without a group, or
-"deck" (the base deck itself varies). Expanding a spec writes, under the sweep directory,
+"deck" (the base deck itself varies). A ``[records]`` table crosses everything with a suite
+of records, each scaled to a target intensity (docs/batch.md, "Record suites"):
+
+    [records]
+    files = ["records/*.AT2"]         # globs, relative to the spec's directory
+    scale_to = "sa"                   # "pga", or "sa": the 5 %-damped PSA at `period`
+    period = 1.2                      # s (for "sa")
+    intensities = [0.2, 0.4, 0.8]     # g
+
+Each run then has the labels ``record`` (the file's name) and ``intensity_g`` and the deck
+variables ``excitation.record_file`` and ``excitation.record_scale`` (the factor that brings
+the record, read with the base deck's record settings, to the intensity); ``collect`` also
+writes ``intensity.csv``: per intensity (and other parameters) the median and the 16th and
+84th percentiles over the records of every numeric column. Expanding a spec writes, under the sweep directory,
 ``decks/<id>.nml`` (one deck per run, outputs to ``runs/<id>.csv`` and
 ``runs/<id>.summary.json``), ``decks.txt`` (the list the executable's ``--list`` reads) and
 ``manifest.json`` (runs, parameters, deck and record hashes). A run is complete when its
@@ -168,6 +181,7 @@ class Sweep:
     version: str = __version__  #: the frictiondyn version the runs are for
     spec_sha256: str = ""
     jobs: int | None = None  #: the spec's ``jobs``
+    records: dict | None = None  #: the spec's [records] (a record suite), if any
     lock: SweepLock | None = field(default=None, repr=False)
 
     def state(self, run: Run) -> tuple[str, dict | None, str]:
@@ -315,7 +329,7 @@ def load_spec(path: str | os.PathLike) -> dict:
         raise SweepError(f"{path}: not valid TOML: {exc}") from None
     except RecursionError:
         raise SweepError(f"{path}: not valid TOML: nested too deeply") from None
-    known = {"name", "base", "cross", "zip", "write_history", "jobs", "directory"}
+    known = {"name", "base", "cross", "zip", "records", "write_history", "jobs", "directory"}
     unknown = set(spec) - known
     if unknown:
         raise SweepError(f"{path}: unknown key(s) {sorted(unknown)}"
@@ -379,6 +393,8 @@ def load_spec(path: str | os.PathLike) -> dict:
         raise SweepError(f"{path}: {sorted(both)} in both [cross] and [zip]")
     if "base" not in spec and "deck" not in spec.get("cross", {}) and "deck" not in zipped:
         raise SweepError(f"{path}: give a base deck (base = 'deck.nml') or vary 'deck'")
+    if "records" in spec:
+        _check_records(spec, path, seen)
     spec.setdefault("name", path.stem)
     if not _NAME.fullmatch(spec["name"]) or len(spec["name"]) > 100:
         raise SweepError(f"{path}: name = {json.dumps(spec['name'])}: letters, digits, '_', "
@@ -391,19 +407,114 @@ def count_runs(spec: dict) -> int:
     length of the [zip] lists (counted, not expanded)."""
     n = math.prod(len(v) for v in spec.get("cross", {}).values())
     zipped = spec.get("zip", {})
+    if "records" in spec:
+        n *= len(spec["records"]["_files"]) * len(spec["records"]["intensities"])
     return n * (len(next(iter(zipped.values()))) if zipped else 1)
 
 
-def _combinations(spec: dict) -> tuple[list[str], list[dict[str, Any]]]:
+def _combinations(spec: dict, suite: list[dict[str, Any]] | None = None
+                  ) -> tuple[list[str], list[dict[str, Any]]]:
     cross = spec.get("cross", {})
     zipped = spec.get("zip", {})
-    keys = list(cross) + list(zipped)
+    keys = list(cross) + list(zipped) + (list(suite[0]) if suite else [])
     zrows = [dict(zip(zipped, vals)) for vals in zip(*zipped.values())] if zipped else [{}]
     rows = []
     for combo in itertools.product(*cross.values()) if cross else [()]:
         for z in zrows:
-            rows.append({**dict(zip(cross, combo)), **z})
+            for r in suite or [{}]:
+                rows.append({**dict(zip(cross, combo)), **z, **r})
     return keys, rows
+
+
+#: The labels and deck variables a record suite sets in each run.
+SUITE_KEYS = ("record", "intensity_g", "excitation.record_file", "excitation.record_scale")
+
+
+def _check_records(spec: dict, path: Path, seen: dict) -> None:
+    """Check a spec's [records] table and list its files (spec["records"]["_files"])."""
+    rec = spec["records"]
+    where = f"{path}: [records]"
+    if not isinstance(rec, dict):
+        raise SweepError(f"{where} must be a table (files, scale_to, period, intensities)")
+    known = {"files", "scale_to", "period", "damping", "intensities"}
+    unknown = set(rec) - known
+    if unknown:
+        raise SweepError(f"{where}: unknown key(s) {sorted(unknown)} (known: {sorted(known)})")
+    files = rec.get("files")
+    if not isinstance(files, list) or not files or not all(isinstance(f, str) and f for f in files):
+        raise SweepError(f"{where} files = {_short(files)}: a non-empty list of paths or globs")
+    found: list[Path] = []
+    for pattern in files:
+        matches = sorted(path.parent.glob(pattern)) if not Path(pattern).is_absolute() else (
+            sorted(Path("/").glob(pattern.lstrip("/"))))
+        matches = [m for m in matches if m.is_file()]
+        if not matches:
+            raise SweepError(f"{where} files: {pattern!r} names no file (relative to {path.parent})")
+        found += [m.resolve() for m in matches]
+    if len(set(found)) != len(found):
+        raise SweepError(f"{where} files: a record is named twice")
+    names = [f.name for f in found]
+    if len(set(names)) != len(names):
+        raise SweepError(f"{where} files: two records have the same file name; rename one")
+    scale_to = rec.get("scale_to", "pga")
+    if scale_to not in ("pga", "sa"):
+        raise SweepError(f"{where} scale_to = {_short(scale_to)}: 'pga' or 'sa'")
+    if scale_to == "sa":
+        t = rec.get("period")
+        if isinstance(t, bool) or not isinstance(t, (int, float)) or not (0 < t < math.inf):
+            raise SweepError(f"{where} period = {_short(t)}: scale_to = 'sa' needs the period [s], > 0")
+    elif "period" in rec:
+        raise SweepError(f"{where} period: only with scale_to = 'sa'")
+    xi = rec.get("damping", 0.05)
+    if isinstance(xi, bool) or not isinstance(xi, (int, float)) or not 0 <= xi < 1:
+        raise SweepError(f"{where} damping = {_short(xi)}: 0 <= damping < 1")
+    levels = rec.get("intensities")
+    if (not isinstance(levels, list) or not levels or any(
+            isinstance(v, bool) or not isinstance(v, (int, float)) or not 0 < v < math.inf
+            for v in levels)):
+        raise SweepError(f"{where} intensities = {_short(levels)}: a non-empty list of numbers > 0 [g]")
+    for table in ("cross", "zip"):
+        for key in spec.get(table, {}):
+            if key.lower() in ("record", "intensity_g", "deck") or key.lower() in (
+                    "excitation.record_file", "excitation.record_scale"):
+                raise SweepError(f"{path}: [{table}] {key}: [records] sets it; give it once")
+    if "base" not in spec:
+        raise SweepError(f"{where}: a record suite needs a base deck (base = 'deck.nml')")
+    rec["_files"] = found
+    rec["scale_to"] = scale_to
+    rec["damping"] = float(xi)
+
+
+def _suite_rows(spec: dict, spec_dir: Path, nml: f90nml.Namelist, where: str) -> list[dict]:
+    """One row per record and intensity: the record's file and the scale that brings it,
+    read with the base deck's record settings, to the intensity."""
+    from .spectrum import G, response_spectrum
+
+    rec = spec["records"]
+    exc = nml.get("excitation") or {}
+    settings = {
+        "format": str(exc.get("record_format", "auto")),
+        "units": exc.get("record_units"),
+        "kind": str(exc.get("record_kind", "acceleration")),
+        "dt": exc.get("dt_record"),
+    }
+    t = float(rec.get("period", 0.0))
+    rows = []
+    for f in rec["_files"]:
+        try:
+            s = response_spectrum(f, periods=[0.0, t] if t > 0 else [0.0], xi=rec["damping"],
+                                  **settings)
+        except FrictiondynError as exc:
+            raise SweepError(f"{where} [records]: {exc}") from None
+        measured = float(s.psa[-1])  # the PGA at T = 0, else PSA(T)
+        if not measured > 0:
+            raise SweepError(f"{where} [records]: {f.name} has no motion to scale (its "
+                             f"{'PGA' if t == 0 else f'PSA at {t} s'} is 0)")
+        for level in rec["intensities"]:
+            rows.append({"record": f.name, "intensity_g": level,
+                         "excitation.record_file": os.path.relpath(f, spec_dir),
+                         "excitation.record_scale": float(level) * G / measured})
+    return rows
 
 
 def _set(nml: f90nml.Namelist, key: str, value: Any, where: str) -> None:
@@ -532,7 +643,11 @@ def expand(
         raise SweepError(f"{where}: the spec makes {n:,} runs ({' x '.join(sizes)}), more than "
                          f"the limit of {max_runs:,}; raise it with --max-runs if you mean it")
     sdir = sweep_directory(spec, spec_path, directory)
-    keys, rows = _combinations(spec)
+    suite = None
+    if "records" in spec:  # each record's scale, from the base deck's record settings
+        base_path, nml = _read_base(spec["base"], base_dir, where)
+        suite = _suite_rows(spec, base_dir, nml, where)
+    keys, rows = _combinations(spec, suite)
     # every base deck read, and every key set in each, before anything is written
     bases: dict[str, tuple[Path, f90nml.Namelist]] = {}
     for params in rows:
@@ -570,7 +685,9 @@ def _write_runs(spec, spec_path, sdir, keys, rows, bases) -> Sweep:
     name = spec["name"]
     width = max(4, len(str(len(rows) - 1)))
     sweep = Sweep(name=name, directory=sdir, parameters=keys, zipped=list(spec.get("zip", {})),
-                  spec_sha256=spec["_sha256"], jobs=spec.get("jobs"))
+                  spec_sha256=spec["_sha256"], jobs=spec.get("jobs"),
+                  records={k: v for k, v in spec["records"].items() if not k.startswith("_")}
+                  if "records" in spec else None)
     records: dict[str, str] = {}
     for index, params in enumerate(rows):
         base_path, base_nml = bases[params.get("deck", spec.get("base"))]
@@ -627,6 +744,7 @@ def _write_runs(spec, spec_path, sdir, keys, rows, bases) -> Sweep:
         "frictiondyn_version": __version__,
         "parameters": keys,
         "zip": sweep.zipped,
+        "records": sweep.records,
         "runs": [
             {"index": r.index, "id": r.id, "deck": r.deck, "deck_sha256": r.deck_sha256,
              "record_sha256": r.record_sha256, "params": r.params}
@@ -707,8 +825,13 @@ def load(directory: str | os.PathLike) -> Sweep:
     if not runs:
         raise _damaged_manifest(sdir, "no runs")
     spec_sha = m.get("spec_sha256", "")
+    records = m.get("records")
+    if records is not None and (not isinstance(records, dict) or not all(
+            k in params for k in SUITE_KEYS)):
+        raise _damaged_manifest(sdir, f"records is {_short(records)}")
     return Sweep(name=name, directory=sdir, parameters=params, runs=runs, zipped=zipped,
-                 version=version, spec_sha256=spec_sha if isinstance(spec_sha, str) else "")
+                 version=version, spec_sha256=spec_sha if isinstance(spec_sha, str) else "",
+                 records=records)
 
 
 def _no_constant(name: str):
@@ -1119,7 +1242,61 @@ def collect(sweep: Sweep, write: bool = True) -> Collected:
         note = _write_parquet(table)
         if note:
             notes.append(note)
+        if sweep.records is not None:
+            _write_intensity_table(sweep, rows)
     return Collected(rows, failed, missing, table, damaged, notes)
+
+
+def intensity_statistics(sweep: Sweep, rows: list[dict[str, Any]]) -> list[dict[str, Any]]:
+    """Per intensity (and every other parameter's value), over the records whose runs are
+    done: their count, and the median and the 16th and 84th percentiles (linear
+    interpolation, numpy's default) of every numeric summary column."""
+    import numpy as np
+
+    others = [k for k in sweep.parameters if k not in SUITE_KEYS]
+    groups: dict[tuple, list[dict[str, Any]]] = {}
+    for row in rows:
+        if row["status"] != "done":
+            continue
+        key = tuple(json.dumps(row.get(k)) for k in others) + (row["intensity_g"],)
+        groups.setdefault(key, []).append(row)
+    skip = set(FIXED_COLUMNS) | set(sweep.parameters)
+    out = []
+    for key, members in groups.items():
+        stats: dict[str, Any] = {k: members[0].get(k) for k in others}
+        stats["intensity_g"] = key[-1]
+        stats["records"] = len(members)
+        columns = [c for c in members[0] if c not in skip]
+        for c in columns:
+            vals = [m.get(c) for m in members]
+            if not all(isinstance(v, (int, float)) and not isinstance(v, bool) and v is not None
+                       for v in vals):
+                continue
+            x = np.asarray(vals, dtype=float)
+            if not np.all(np.isfinite(x)):
+                continue
+            stats[f"{c}.median"] = float(np.median(x))
+            stats[f"{c}.p16"] = float(np.percentile(x, 16))
+            stats[f"{c}.p84"] = float(np.percentile(x, 84))
+        out.append(stats)
+    return out
+
+
+def _write_intensity_table(sweep: Sweep, rows: list[dict[str, Any]]) -> None:
+    stats = intensity_statistics(sweep, rows)
+    columns: list[str] = []
+    for row in stats:
+        columns += [c for c in row if c not in columns]
+    buf = io.StringIO()
+    w = csv.DictWriter(buf, fieldnames=columns, lineterminator="\n")
+    w.writeheader()
+    for row in stats:
+        w.writerow({k: _csv_value(v) for k, v in row.items()})
+    path = sweep.directory / "intensity.csv"
+    try:
+        _write_atomic(path, buf.getvalue())
+    except OSError as exc:
+        raise SweepError(f"{path}: cannot write the table: {exc.strerror}") from None
 
 
 def _csv_value(v: Any) -> Any:
