@@ -25,7 +25,11 @@ of records, each scaled to a target intensity (docs/batch.md, "Record suites"):
     period = 1.2                      # s (for "sa")
     intensities = [0.2, 0.4, 0.8]     # g
 
-Each run then has the labels ``record`` (the file's name) and ``intensity_g`` and the deck
+A ``[labels]`` table names the values of a [cross] or [zip] key (``"braces.stiffness" =
+["1x", "2x", "4x"]``, one name a value): the table's column of the key then holds the name
+(the value in ``<key> [value]``), and so do the decks' headers and the legends of ``plot``.
+
+Each run of a record suite then has the labels ``record`` (the file's name) and ``intensity_g`` and the deck
 variables ``excitation.record_file`` and ``excitation.record_scale`` (the factor that brings
 the record, read with the base deck's record settings, to the intensity); ``collect`` also
 writes ``intensity.csv``: per intensity (and other parameters) the median and the 16th and
@@ -182,6 +186,7 @@ class Sweep:
     spec_sha256: str = ""
     jobs: int | None = None  #: the spec's ``jobs``
     records: dict | None = None  #: the spec's [records] (a record suite), if any
+    labels: dict | None = None  #: key -> {"values": [...], "names": [...]} ([labels])
     lock: SweepLock | None = field(default=None, repr=False)
 
     def state(self, run: Run) -> tuple[str, dict | None, str]:
@@ -329,7 +334,8 @@ def load_spec(path: str | os.PathLike) -> dict:
         raise SweepError(f"{path}: not valid TOML: {exc}") from None
     except RecursionError:
         raise SweepError(f"{path}: not valid TOML: nested too deeply") from None
-    known = {"name", "base", "cross", "zip", "records", "write_history", "jobs", "directory"}
+    known = {"name", "base", "cross", "zip", "records", "labels", "write_history", "jobs",
+             "directory"}
     unknown = set(spec) - known
     if unknown:
         raise SweepError(f"{path}: unknown key(s) {sorted(unknown)}"
@@ -395,6 +401,8 @@ def load_spec(path: str | os.PathLike) -> dict:
         raise SweepError(f"{path}: give a base deck (base = 'deck.nml') or vary 'deck'")
     if "records" in spec:
         _check_records(spec, path, seen)
+    if "labels" in spec:
+        _check_labels(spec, path)
     spec.setdefault("name", path.stem)
     if not _NAME.fullmatch(spec["name"]) or len(spec["name"]) > 100:
         raise SweepError(f"{path}: name = {json.dumps(spec['name'])}: letters, digits, '_', "
@@ -424,6 +432,41 @@ def _combinations(spec: dict, suite: list[dict[str, Any]] | None = None
             for r in suite or [{}]:
                 rows.append({**dict(zip(cross, combo)), **z, **r})
     return keys, rows
+
+
+def _check_labels(spec: dict, path: Path) -> None:
+    """[labels]: for a key of [cross] or [zip], one name (a non-empty string, distinct) for
+    each of its values, which must be distinct too."""
+    labels = spec["labels"]
+    if not isinstance(labels, dict):
+        raise SweepError(f"{path}: [labels] must be a table of key = [names]")
+    varied = {**spec.get("cross", {}), **spec.get("zip", {})}
+    for key, names in labels.items():
+        where = f"{path}: [labels] {key}"
+        if key not in varied:
+            raise SweepError(f"{where}: not a key of [cross] or [zip]"
+                             f"{_close(key, list(varied))}")
+        values = varied[key]
+        if (not isinstance(names, list) or len(names) != len(values)
+                or not all(isinstance(n, str) and n.strip() and not _CONTROL.search(n) for n in names)):
+            raise SweepError(f"{where}: one name (a non-empty string on one line) for each of its "
+                             f"{len(values)} values")
+        if len(set(names)) != len(names):
+            raise SweepError(f"{where}: a name given twice")
+        shown = [json.dumps(v, sort_keys=True) for v in values]
+        if len(set(shown)) != len(shown):
+            raise SweepError(f"{where}: the key's values repeat, so a name would be ambiguous")
+
+
+def _label_of(labels: dict | None, key: str, value: Any) -> Any:
+    """The name [labels] gives the value of a key (the value itself without one)."""
+    if not labels or key not in labels:
+        return None
+    shown = json.dumps(value, sort_keys=True)
+    for v, name in zip(labels[key]["values"], labels[key]["names"]):
+        if json.dumps(v, sort_keys=True) == shown:
+            return name
+    return None
 
 
 #: The labels and deck variables a record suite sets in each run.
@@ -687,7 +730,8 @@ def _write_runs(spec, spec_path, sdir, keys, rows, bases) -> Sweep:
     sweep = Sweep(name=name, directory=sdir, parameters=keys, zipped=list(spec.get("zip", {})),
                   spec_sha256=spec["_sha256"], jobs=spec.get("jobs"),
                   records={k: v for k, v in spec["records"].items() if not k.startswith("_")}
-                  if "records" in spec else None)
+                  if "records" in spec else None,
+                  labels=_spec_labels(spec))
     records: dict[str, str] = {}
     for index, params in enumerate(rows):
         base_path, base_nml = bases[params.get("deck", spec.get("base"))]
@@ -714,7 +758,8 @@ def _write_runs(spec, spec_path, sdir, keys, rows, bases) -> Sweep:
         nml["output"]["name"] = rid
         if "write_history" in spec:
             nml["output"]["write_history"] = spec["write_history"]
-        shown = ", ".join(f"{k} = {_short(v)}" for k, v in params.items())
+        shown = ", ".join(f"{k} = {_short(_label_of(sweep.labels, k, v) or v)}"
+                          for k, v in params.items())
         text = _deck_text(nml, f"! frictiondyn sweep '{name}', run {rid}: {shown}\n")
         deck = sdir / "decks" / f"{rid}.nml"
         data = text.encode("utf-8", "surrogateescape")
@@ -745,6 +790,7 @@ def _write_runs(spec, spec_path, sdir, keys, rows, bases) -> Sweep:
         "parameters": keys,
         "zip": sweep.zipped,
         "records": sweep.records,
+        "labels": sweep.labels,
         "runs": [
             {"index": r.index, "id": r.id, "deck": r.deck, "deck_sha256": r.deck_sha256,
              "record_sha256": r.record_sha256, "params": r.params}
@@ -753,6 +799,13 @@ def _write_runs(spec, spec_path, sdir, keys, rows, bases) -> Sweep:
     }
     _write_atomic(sdir / "manifest.json", json.dumps(manifest, indent=1) + "\n")
     return sweep
+
+
+def _spec_labels(spec: dict) -> dict | None:
+    if "labels" not in spec:
+        return None
+    varied = {**spec.get("cross", {}), **spec.get("zip", {})}
+    return {k: {"values": varied[k], "names": names} for k, names in spec["labels"].items()}
 
 
 def _short(v: Any) -> str:
@@ -829,9 +882,14 @@ def load(directory: str | os.PathLike) -> Sweep:
     if records is not None and (not isinstance(records, dict) or not all(
             k in params for k in SUITE_KEYS)):
         raise _damaged_manifest(sdir, f"records is {_short(records)}")
+    labels = m.get("labels")
+    if labels is not None and (not isinstance(labels, dict) or not all(
+            k in params and isinstance(v, dict) and isinstance(v.get("values"), list)
+            and isinstance(v.get("names"), list) for k, v in labels.items())):
+        raise _damaged_manifest(sdir, f"labels is {_short(labels)}")
     return Sweep(name=name, directory=sdir, parameters=params, runs=runs, zipped=zipped,
                  version=version, spec_sha256=spec_sha if isinstance(spec_sha, str) else "",
-                 records=records)
+                 records=records, labels=labels)
 
 
 def _no_constant(name: str):
@@ -1184,7 +1242,8 @@ def collect(sweep: Sweep, write: bool = True) -> Collected:
     wrong type, of another deck, record or version). A row holds a summary's values only
     when its run is done; a null of a summary (an undefined quantity) is written NaN."""
     rows, failed, missing, damaged = [], [], [], []
-    reserved = set(FIXED_COLUMNS) | set(sweep.parameters)
+    reserved = set(FIXED_COLUMNS) | set(sweep.parameters) | {
+        f"{k} [value]" for k in (sweep.labels or {})}
     for run in sweep.runs:
         state, summ, why = _summary_state(sweep, run)
         row: dict[str, Any] = {"run": run.id}
@@ -1202,7 +1261,13 @@ def collect(sweep: Sweep, write: bool = True) -> Collected:
             missing.append(run)
         for k in sweep.parameters:
             v = run.params.get(k)
-            row[k] = json.dumps(v) if isinstance(v, (list, dict)) else v
+            name = _label_of(sweep.labels, k, v)
+            shown = json.dumps(v) if isinstance(v, (list, dict)) else v
+            if name is None:
+                row[k] = shown
+            else:  # the name in the key's column, the value beside it
+                row[k] = name
+                row[f"{k} [value]"] = shown
         row["run_deck"] = run.deck
         row["deck_sha256"] = run.deck_sha256
         row["frictiondyn_version"] = summ["frictiondyn_version"] if summ else ""
@@ -1260,7 +1325,7 @@ def intensity_statistics(sweep: Sweep, rows: list[dict[str, Any]]) -> list[dict[
             continue
         key = tuple(json.dumps(row.get(k)) for k in others) + (row["intensity_g"],)
         groups.setdefault(key, []).append(row)
-    skip = set(FIXED_COLUMNS) | set(sweep.parameters)
+    skip = set(FIXED_COLUMNS) | set(sweep.parameters) | {f"{k} [value]" for k in (sweep.labels or {})}
     out = []
     for key, members in groups.items():
         stats: dict[str, Any] = {k: members[0].get(k) for k in others}
