@@ -25,6 +25,14 @@ of records, each scaled to a target intensity (docs/batch.md, "Record suites"):
     period = 1.2                      # s (for "sa")
     intensities = [0.2, 0.4, 0.8]     # g
 
+A ``[derived]`` table computes deck variables (or labels) in each run from an expression
+over the run's parameters and quantities of the base deck (docs/batch.md, "Derived values"):
+
+    [cross]
+    alpha = [0.02, 0.05]              # a label
+    [derived]
+    "friction.p" = "alpha * device_weight_above / friction.mu"
+
 A ``[labels]`` table names the values of a [cross] or [zip] key (``"braces.stiffness" =
 ["1x", "2x", "4x"]``, one name a value): the table's column of the key then holds the name
 (the value in ``<key> [value]``), and so do the decks' headers and the legends of ``plot``.
@@ -334,8 +342,8 @@ def load_spec(path: str | os.PathLike) -> dict:
         raise SweepError(f"{path}: not valid TOML: {exc}") from None
     except RecursionError:
         raise SweepError(f"{path}: not valid TOML: nested too deeply") from None
-    known = {"name", "base", "cross", "zip", "records", "labels", "write_history", "jobs",
-             "directory"}
+    known = {"name", "base", "cross", "zip", "records", "labels", "derived", "write_history",
+             "jobs", "directory"}
     unknown = set(spec) - known
     if unknown:
         raise SweepError(f"{path}: unknown key(s) {sorted(unknown)}"
@@ -403,6 +411,8 @@ def load_spec(path: str | os.PathLike) -> dict:
         _check_records(spec, path, seen)
     if "labels" in spec:
         _check_labels(spec, path)
+    if "derived" in spec:
+        _check_derived(spec, path, seen)
     spec.setdefault("name", path.stem)
     if not _NAME.fullmatch(spec["name"]) or len(spec["name"]) > 100:
         raise SweepError(f"{path}: name = {json.dumps(spec['name'])}: letters, digits, '_', "
@@ -432,6 +442,225 @@ def _combinations(spec: dict, suite: list[dict[str, Any]] | None = None
             for r in suite or [{}]:
                 rows.append({**dict(zip(cross, combo)), **z, **r})
     return keys, rows
+
+
+def _check_derived(spec: dict, path: Path, seen: dict) -> None:
+    """[derived]: key = "expression", each key a deck variable (or a label) no other table
+    sets, each expression one the evaluator reads (checked again with values at expansion)."""
+    derived = spec["derived"]
+    if not isinstance(derived, dict) or not derived:
+        raise SweepError(f"{path}: [derived] must be a table of key = \"expression\"")
+    varied = {**spec.get("cross", {}), **spec.get("zip", {})}
+    for key, expr in derived.items():
+        where = f"{path}: [derived] {key}"
+        m = _KEY.match(key)
+        if m is None or key == "deck":
+            raise SweepError(f"{where}: not 'group.variable', 'group.variable(i)' or a label")
+        _check_key(key, where)
+        if key in varied or key in SUITE_KEYS:
+            raise SweepError(f"{where}: [cross], [zip] or [records] sets it too; give it once")
+        if m["group"] is not None:
+            gv = (m["group"].lower(), m["var"].lower())
+            if gv in seen:
+                raise SweepError(f"{where}: sets what {seen[gv]!r} sets; give each variable once")
+            seen[gv] = key
+        elif key in FIXED_COLUMNS:
+            raise SweepError(f"{where}: a label may not be named like a column of the table")
+        if not isinstance(expr, str) or not expr.strip() or len(expr) > 1000:
+            raise SweepError(f"{where}: the expression must be a non-empty string (at most 1000 "
+                             "characters)")
+        try:
+            _parse_expression(expr)
+        except SweepError as exc:
+            raise SweepError(f"{where} = {json.dumps(expr)}: {exc}") from None
+
+
+#: Functions an expression of [derived] may call.
+_FUNCTIONS = {"sqrt": "sqrt", "abs": "abs", "min": "min", "max": "max", "sum": "sum",
+              "exp": "exp", "log": "log", "sin": "sin", "cos": "cos", "tan": "tan",
+              "cumsum": "cumsum", "reverse": "reverse"}
+
+
+def _parse_expression(expr: str):
+    """The expression's syntax tree, when it uses only numbers, names, group.variable,
+    + - * / ** (and unary -), parentheses and the functions of _FUNCTIONS."""
+    import ast
+
+    try:
+        tree = ast.parse(expr.strip(), mode="eval")
+    except SyntaxError as exc:
+        raise SweepError(f"not an expression ({exc.msg})") from None
+    allowed_ops = (ast.Add, ast.Sub, ast.Mult, ast.Div, ast.Pow, ast.USub, ast.UAdd)
+    for node in ast.walk(tree):
+        if isinstance(node, (ast.Expression, ast.BinOp, ast.UnaryOp, ast.Load)) or isinstance(
+                node, allowed_ops):
+            continue
+        if isinstance(node, ast.Constant) and isinstance(node.value, (int, float)) and not isinstance(
+                node.value, bool):
+            continue
+        if isinstance(node, ast.Name):
+            continue
+        if isinstance(node, ast.Attribute) and isinstance(node.value, ast.Name):
+            continue
+        if isinstance(node, ast.Call) and isinstance(node.func, ast.Name) and not node.keywords \
+                and node.func.id in _FUNCTIONS:
+            continue
+        what = type(node).__name__
+        if isinstance(node, ast.Call):
+            what = "a call of something other than " + ", ".join(sorted(_FUNCTIONS))
+        raise SweepError(f"{what} is not allowed (numbers, names, group.variable, + - * / **, "
+                         f"parentheses and {', '.join(sorted(_FUNCTIONS))})")
+    return tree
+
+
+def _evaluate(tree, names: dict[str, Any], where: str):
+    """The value of a parsed expression (a float or a numpy array) with ``names``: a name or
+    'group.variable' to a number or a list of numbers."""
+    import ast
+
+    import numpy as np
+
+    def value(node):
+        if isinstance(node, ast.Expression):
+            return value(node.body)
+        if isinstance(node, ast.Constant):
+            return float(node.value)
+        if isinstance(node, (ast.Name, ast.Attribute)):
+            name = node.id if isinstance(node, ast.Name) else f"{node.value.id}.{node.attr}"
+            if name.lower() not in names:
+                raise SweepError(f"{where}: {name!r} is not a parameter of the run or a quantity "
+                                 f"of the base deck{_close(name.lower(), list(names))}")
+            v = names[name.lower()]
+            try:
+                return np.asarray(v, dtype=float) if isinstance(v, list) else float(v)
+            except (TypeError, ValueError):
+                raise SweepError(f"{where}: {name} = {_short(v)} is not a number or a list of "
+                                 "numbers") from None
+        if isinstance(node, ast.UnaryOp):
+            x = value(node.operand)
+            return -x if isinstance(node.op, ast.USub) else x
+        if isinstance(node, ast.BinOp):
+            a, b = value(node.left), value(node.right)
+            if np.ndim(a) and np.ndim(b) and np.shape(a) != np.shape(b):
+                raise SweepError(f"{where}: lists of {np.size(a)} and {np.size(b)} values combined")
+            op = type(node.op)
+            with np.errstate(all="ignore"):
+                return {ast.Add: np.add, ast.Sub: np.subtract, ast.Mult: np.multiply,
+                        ast.Div: np.divide, ast.Pow: np.power}[op](a, b)
+        if isinstance(node, ast.Call):
+            args = [value(a) for a in node.args]
+            f = node.func.id
+            if f in ("min", "max") and len(args) == 2:
+                return (np.minimum if f == "min" else np.maximum)(*args)
+            if len(args) != 1:
+                raise SweepError(f"{where}: {f}() takes one argument (min and max one or two)")
+            x = args[0]
+            if f in ("min", "max", "sum"):
+                return float({"min": np.min, "max": np.max, "sum": np.sum}[f](x))
+            if f == "cumsum":
+                return np.cumsum(x)
+            if f == "reverse":
+                return np.asarray(x)[::-1] if np.ndim(x) else x
+            with np.errstate(all="ignore"):
+                return getattr(np, f)(x)
+        raise SweepError(f"{where}: cannot evaluate {type(node).__name__}")
+
+    out = value(tree)
+    if not np.all(np.isfinite(out)):
+        raise SweepError(f"{where}: the value is not finite ({_short(np.asarray(out).tolist())})")
+    return out
+
+
+def _base_quantities(nml: f90nml.Namelist) -> dict[str, Any]:
+    """The quantities of a base deck an expression of [derived] may use (lower case), besides
+    its variables as group.variable: g, mass, weight (m g per DOF), total_mass,
+    total_weight, and with the elements' graph, weight_above (per storey of &storeys: the
+    weight of the DOFs on its upper node's side once the elements joining its two nodes are
+    cut), device_weight_above (the same per device of &friction), storey_height."""
+    import numpy as np
+
+    from .spectrum import G
+
+    q: dict[str, Any] = {"g": G}
+    for group, variables in nml.items():
+        for var, v in variables.items():
+            if isinstance(v, (int, float, list)) and not isinstance(v, bool):
+                q[f"{group.lower()}.{var.lower()}"] = v
+    model = nml.get("model") or {}
+    mass = model.get("mass")
+    n = int(model.get("n_dof", 0) or 0)
+    if mass is None or n < 1:
+        return q
+    mass = [float(x) for x in (mass if isinstance(mass, list) else [mass])][:n]
+    m = np.array(mass + [0.0] * (n - len(mass)))
+    q.update(mass=m.tolist(), weight=(G * m).tolist(), total_mass=float(m.sum()),
+             total_weight=float(G * m.sum()))
+    edges: list[tuple[int, int]] = []
+    for group in ("springs", "friction", "braces", "isolators"):
+        g = nml.get(group) or {}
+        ni, nj = g.get("node_i"), g.get("node_j")
+        if ni is None or nj is None:
+            continue
+        ni = ni if isinstance(ni, list) else [ni]
+        nj = nj if isinstance(nj, list) else [nj]
+        edges += [(int(a), int(b)) for a, b in zip(ni, nj) if a is not None and b is not None]
+
+    def above(i: int, j: int) -> float:
+        """Weight of the DOFs joined to node i once every element between i and j is cut."""
+        adj: dict[int, set[int]] = {}
+        for a, b in edges:
+            if {a, b} == {i, j}:
+                continue
+            adj.setdefault(a, set()).add(b)
+            adj.setdefault(b, set()).add(a)
+        seen, todo = {i}, [i]
+        while todo:
+            k = todo.pop()
+            for nb in adj.get(k, ()):
+                if nb not in seen:
+                    seen.add(nb)
+                    todo.append(nb)
+        if 0 in seen:  # still joined to the table: not a cut
+            return float("nan")
+        return float(G * sum(m[k - 1] for k in seen if 1 <= k <= n))
+
+    st = nml.get("storeys") or {}
+    if st.get("node_i") is not None and st.get("node_j") is not None:
+        si = st["node_i"] if isinstance(st["node_i"], list) else [st["node_i"]]
+        sj = st["node_j"] if isinstance(st["node_j"], list) else [st["node_j"]]
+        q["weight_above"] = [above(int(a), int(b)) for a, b in zip(si, sj)]
+        h = st.get("height")
+        if h is not None:
+            q["storey_height"] = [float(x) for x in (h if isinstance(h, list) else [h])]
+    fr = nml.get("friction") or {}
+    if fr.get("node_i") is not None and fr.get("node_j") is not None:
+        fi = fr["node_i"] if isinstance(fr["node_i"], list) else [fr["node_i"]]
+        fj = fr["node_j"] if isinstance(fr["node_j"], list) else [fr["node_j"]]
+        q["device_weight_above"] = [above(int(a), int(b)) for a, b in zip(fi, fj)]
+    return q
+
+
+def _derive(spec: dict, rows: list[dict[str, Any]], base_dir: Path, where: str) -> list[str]:
+    """Each run's [derived] values (from its parameters and its base deck's quantities),
+    added to its parameters; returns the derived keys."""
+    import numpy as np
+
+    quantities: dict[str, dict[str, Any]] = {}
+    trees = {k: _parse_expression(e) for k, e in spec["derived"].items()}
+    for row in rows:
+        base = row.get("deck", spec.get("base"))
+        if base not in quantities:
+            quantities[base] = _base_quantities(_read_base(base, base_dir, where)[1])
+        names = dict(quantities[base])
+        names.update({k.lower(): v for k, v in row.items() if k != "deck"})
+        for key, tree in trees.items():
+            v = _evaluate(tree, names, f"{where}: [derived] {key} = {json.dumps(spec['derived'][key])}")
+            v = [float(x) for x in np.ravel(v)] if np.ndim(v) else float(v)
+            if isinstance(v, list) and any(math.isnan(x) for x in v):
+                raise SweepError(f"{where}: [derived] {key}: not a number at some element")
+            row[key] = v
+            names[key.lower()] = v
+    return list(trees)
 
 
 def _check_labels(spec: dict, path: Path) -> None:
@@ -691,6 +920,8 @@ def expand(
         base_path, nml = _read_base(spec["base"], base_dir, where)
         suite = _suite_rows(spec, base_dir, nml, where)
     keys, rows = _combinations(spec, suite)
+    if "derived" in spec:  # each run's derived values, from its parameters and the base deck
+        keys += _derive(spec, rows, base_dir, where)
     # every base deck read, and every key set in each, before anything is written
     bases: dict[str, tuple[Path, f90nml.Namelist]] = {}
     for params in rows:

@@ -1,0 +1,69 @@
+"""Derived sweep values ([derived]): a deck variable computed in each run from the run's
+parameters and the base deck's quantities, without Python's eval of the spec's text."""
+
+from __future__ import annotations
+
+import csv
+import json
+import subprocess
+import sys
+
+import numpy as np
+import pytest
+from conftest import INPUTS
+
+from frictiondyn import sweep as sw
+from frictiondyn.spectrum import G
+
+SWEEP = [sys.executable, "-m", "frictiondyn", "sweep"]
+MASS = np.array([300.0e3, 300.0e3, 300.0e3, 300.0e3, 250.0e3])  # building5_friction.nml
+
+
+def spec(tmp_path, body: str):
+    s = tmp_path / "s.toml"
+    s.write_text(f'base = "{INPUTS}/building5_friction.nml"\nwrite_history = false\n' + body)
+    return s
+
+
+def test_slip_load_is_alpha_times_the_weight_above(tmp_path):
+    """The slip load of each storey's damper, P mu = alpha W_above: the deck's P is
+    alpha W_above / mu, W_above the weight of the floors above the damper's storey."""
+    s = spec(tmp_path, '[cross]\nalpha = [0.02, 0.05]\n"friction.mu" = [[0.3, 0.3, 0.3, 0.3, 0.3]]\n'
+                       '[derived]\n"friction.p" = "alpha * device_weight_above / friction.mu"\n'
+                       'slip_total = "sum(friction.p * friction.mu)"\n'
+                       '"excitation.duration" = "2.0"\n')
+    out = tmp_path / "o"
+    r = subprocess.run([*SWEEP, str(s), "--out", str(out), "--quiet"], capture_output=True, text=True)
+    assert r.returncode == 0, r.stderr
+    with open(out / "results.csv", newline="") as fh:
+        rows = list(csv.DictReader(fh))
+    above = G * np.cumsum(MASS[::-1])[::-1]  # storey i carries floors i..5
+    for row in rows:
+        alpha = float(row["alpha"])
+        p = np.array(json.loads(row["friction.p"]))
+        np.testing.assert_allclose(p * 0.3, alpha * above, rtol=1e-14)
+        assert float(row["slip_total"]) == pytest.approx(alpha * above.sum(), rel=1e-14)
+        # the run used them: the first storey's damper never carries more than its slip load
+        assert float(row["peak_force_N[1]"]) <= alpha * above[0] * (1 + 1e-9)
+    deck = (out / "decks" / "r0001.nml").read_text()
+    assert "duration = 2.0" in deck
+
+
+@pytest.mark.parametrize("derived, words", [
+    ('"friction.p" = "__import__(\'os\').system(\'true\')"', "not allowed"),
+    ('"friction.p" = "alpha.__class__"', "not a parameter"),
+    ('"friction.p" = "open(\'x\')"', "not allowed"),
+    ('"friction.p" = "alpha * nosuch"', "'nosuch' is not a parameter"),
+    ('"friction.p" = "mass[1]"', "not allowed"),
+    ('"friction.p" = "alpha / 0.0"', "not finite"),
+    ('"friction.p" = "mass + [1, 2]"', "not allowed"),
+    ('"friction.p" = "alpha * mass + springs.k[0:2]"', "not allowed"),
+    ('alpha = "1.0"', "give it once"),
+    ('"friction.nosuch" = "1.0"', "no variable"),
+])
+def test_bad_expressions(tmp_path, derived, words):
+    s = spec(tmp_path, f'[cross]\nalpha = [0.02]\n[derived]\n{derived}\n')
+    with pytest.raises(sw.SweepError) as err:
+        sw.expand(s, tmp_path / "o")
+    assert words in str(err.value)
+    assert not (tmp_path / "o").exists()
