@@ -9,8 +9,10 @@ default (docs/namelist.md), and Python restates none of them.
 
 from __future__ import annotations
 
+import contextlib
 import io
 import os
+import re
 import tempfile
 from collections.abc import Callable, Sequence
 from dataclasses import dataclass, field
@@ -258,15 +260,18 @@ class Record:
     values that are written to a file for the run: by ``write_deck`` to ``file`` (relative
     to the deck's directory), or when ``file`` is None to ``<deck stem>.record.txt`` next to
     the deck; by ``run`` to a temporary directory (the base name of ``file``, or
-    ``<stem of run's name>.record.txt``). kind, scale, duration: None takes the reader's default (acceleration,
-    1, the whole record)."""
+    ``<stem of run's name>.record.txt``). dt_record, kind, scale, duration, format, units:
+    None takes the reader's default (an AT2 file's DT, acceleration, 1, the whole record,
+    'auto', the file's or SI units; dt_record is required but for an AT2 file)."""
 
-    dt_record: float
+    dt_record: float | None = None
     file: str | os.PathLike | None = None
     values: np.ndarray | None = None
     kind: str | None = None
     scale: float | None = None
     duration: float | None = None
+    format: str | None = None
+    units: str | None = None
 
     def group(
         self, directory: Path | None, cwd: Path | None = None, record_name: str | None = None
@@ -286,8 +291,10 @@ class Record:
         elif cwd is not None and not os.path.isabs(file):
             file = os.fspath(Path(cwd) / file)
         g: dict = {"excitation_type": "record", "record_file": file}
-        _put(g, record_kind=self.kind, record_scale=self.scale)
-        g["dt_record"] = float(self.dt_record)
+        _put(g, record_kind=self.kind, record_scale=self.scale, record_format=self.format,
+             record_units=self.units)
+        if self.dt_record is not None:
+            g["dt_record"] = float(self.dt_record)
         _put(g, duration=self.duration)
         return g
 
@@ -362,6 +369,8 @@ class Output:
     history_dofs: list[int] | None = None
     history_devices: list[int] | None = None
     n_modes: int | None = None
+    #: largest history the run may keep in memory or write [MB]; None: the reader's default
+    max_history_mb: float | None = None
 
     def group(self) -> dict:
         g: dict = {}
@@ -372,6 +381,7 @@ class Output:
             output_every=_opt_int(self.output_every, "output_every"),
             write_history=self.write_history,
             n_modes=_opt_int(self.n_modes, "n_modes"),
+            max_history_mb=self.max_history_mb,
         )
         for key in ("history_dofs", "history_devices"):
             value = getattr(self, key)
@@ -488,6 +498,63 @@ def _friction_values(group: dict, items: list) -> None:
                 + [None] * (n - len(x.mu_table or []))
                 for x in items
             ]
+
+
+#: Where each deck group's variables live in an Analysis: the attribute (a list of items
+#: when the group has an index) and the deck variable's field name where they differ.
+_GROUP_FIELDS: dict[str, tuple[str, bool, dict[str, str]]] = {
+    "model": ("", False, {"mass": "masses", "u0": "u0", "v0": "v0", "label": "labels",
+                          "n_dof": "masses"}),
+    "springs": ("springs", True, {}),
+    "damping": ("damping", False, {"damping_type": "type"}),
+    "friction": ("devices", True, {"mu_table_v": "mu_table", "mu_table_mu": "mu_table"}),
+    "braces": ("braces", True, {}),
+    "isolators": ("isolators", True, {"mu_table_v": "mu_table", "mu_table_mu": "mu_table"}),
+    "storeys": ("storeys", True, {}),
+    "excitation": ("excitation", False, {"record_file": "file", "record_kind": "kind",
+                                         "record_scale": "scale", "record_format": "format",
+                                         "record_units": "units"}),
+    "integration": ("integration", False, {}),
+    "output": ("output", False, {}),
+}
+_DECK_PLACE = re.compile(
+    r"group &(?P<group>[a-z_]+): (?P<var>[a-z_0-9]+)(?:\((?P<i>\d+|:)(?:, *(?P<j>\d+))?\))?"
+)
+
+
+def python_place(message: str) -> str | None:
+    """The Analysis attribute a deck message's "group &g: var(i)" names (devices[1].p for
+    &friction p(2)); None when the message names none."""
+    m = _DECK_PLACE.search(message)
+    if m is None or m["group"] not in _GROUP_FIELDS:
+        return None
+    attr, indexed, names = _GROUP_FIELDS[m["group"]]
+    var = names.get(m["var"], m["var"])
+    index = m["j"] or (m["i"] if m["i"] != ":" else None)  # mu_table_v(:, i): item i
+    if attr == "":  # &model: the Analysis's own lists
+        return f"{var}[{int(index) - 1}]" if index else var
+    if indexed and index and m["var"] not in ("n_springs", "n_devices", "n_braces", "n_isolators",
+                                              "n_storeys"):
+        return f"{attr}[{int(index) - 1}].{var}"
+    if indexed:
+        return attr
+    return f"{attr}.{var}"
+
+
+@contextlib.contextmanager
+def _named_errors(name: str, base_dir: str | os.PathLike):
+    """A DeckError of the generated deck says which attribute of the Analysis is wrong,
+    and names the Analysis instead of the deck file the caller never wrote."""
+    try:
+        yield
+    except DeckError as exc:
+        text = str(exc)
+        deck = os.path.join(os.fspath(base_dir), name)
+        text = text.replace(deck + ", ", "Analysis: ", 1)
+        place = python_place(text)
+        if place is not None:
+            text = f"Analysis.{place}: " + text.replace("Analysis: ", "", 1)
+        raise DeckError(text) from None
 
 
 @dataclass
@@ -635,7 +702,8 @@ class Analysis:
         kw = {"dofs": dofs, "devices": devices, "progress": progress}
         cwd = Path.cwd()
         if not isinstance(self.excitation, Record) or self.excitation.values is None:
-            return run_text(self.deck_text(None, cwd), name=name, base_dir=".", **kw)
+            with _named_errors(name, "."):
+                return run_text(self.deck_text(None, cwd), name=name, base_dir=".", **kw)
         file = self.excitation.file
         # only inside the temporary directory: a file given with a directory (absolute or
         # not) is never written to
@@ -645,4 +713,5 @@ class Analysis:
         with tempfile.TemporaryDirectory() as tmp:
             directory = Path(tmp)
             text = self.deck_text(directory, cwd, record_name)
-            return run_text(text, name=name, base_dir=directory, **kw)
+            with _named_errors(name, directory):
+                return run_text(text, name=name, base_dir=directory, **kw)
