@@ -715,6 +715,25 @@ class Result:
         return cls.from_arrays(header, data, text)
 
     @classmethod
+    def from_parquet(cls, path: str | os.PathLike) -> Result:
+        """A Result from a Parquet file written by to_parquet (needs pyarrow:
+        ``pip install frictiondyn[parquet]``)."""
+        pq = _pyarrow_parquet()
+        table = pq.read_table(path)
+        meta = table.schema.metadata or {}
+        try:
+            units = json.loads(meta[b"frictiondyn.units"].decode("utf-8"))
+            text = meta[b"frictiondyn.summary"].decode("utf-8")
+        except KeyError:
+            raise FrictiondynError(f"{path}: not a history written by Result.to_parquet "
+                                   "(no frictiondyn metadata)") from None
+        names = list(table.column_names)
+        data = np.column_stack([table.column(n).to_numpy() for n in names]) if names else \
+            np.zeros((table.num_rows, 0))
+        return cls(names, units, np.asarray(data, dtype=np.float64), json.loads(text),
+                   summary_text=text)
+
+    @classmethod
     def from_npz(cls, path: str | os.PathLike) -> Result:
         """A Result from a .npz written by to_npz."""
         with np.load(path, allow_pickle=False) as z:
@@ -896,6 +915,32 @@ class Result:
             session._write_files(None, path, None)
         return path
 
+    def to_parquet(self, path: str | os.PathLike) -> Path:
+        """Write the history to a Parquet file (a column a quantity, float64; the units and the
+        summary JSON in the schema's metadata, ``frictiondyn.units`` and
+        ``frictiondyn.summary``), atomically as to_npz; needs pyarrow
+        (``pip install frictiondyn[parquet]``). Raises OutputError when it cannot be written."""
+        pq = _pyarrow_parquet()
+        import pyarrow as pa
+
+        path = Path(path)
+        table = pa.table({n: np.ascontiguousarray(self.data[:, k]) for k, n in enumerate(self.names)})
+        table = table.replace_schema_metadata({
+            "frictiondyn.units": json.dumps({n: self.units[n] for n in self.names}),
+            "frictiondyn.summary": self.summary_json(),
+        })
+        tmp = path.with_name(f".{path.name}.{os.getpid()}.{threading.get_ident()}.tmp")
+        try:
+            pq.write_table(table, tmp)
+            os.replace(tmp, path)
+        except BaseException as e:
+            with contextlib.suppress(OSError):
+                tmp.unlink(missing_ok=True)
+            if isinstance(e, OSError):
+                raise OutputError(f"cannot write '{path}': {e.strerror or e}") from None
+            raise
+        return path
+
     def to_npz(self, path: str | os.PathLike) -> Path:
         """Write names, units, data and the summary (as JSON) to a .npz file (``.npz`` is
         added to a name without it, as numpy does) and return its path. The file is written
@@ -925,6 +970,14 @@ class Result:
                 raise OutputError(f"cannot write '{path}': {e.strerror or e}") from None
             raise
         return path
+
+
+def _pyarrow_parquet():
+    try:
+        import pyarrow.parquet as pq
+    except ImportError:
+        raise ImportError("Parquet needs pyarrow: pip install frictiondyn[parquet]") from None
+    return pq
 
 
 def read_history(path: str | os.PathLike, summary: str | os.PathLike | None | bool = None) -> Result:

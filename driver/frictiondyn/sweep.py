@@ -1473,6 +1473,7 @@ def collect(sweep: Sweep, write: bool = True) -> Collected:
     wrong type, of another deck, record or version). A row holds a summary's values only
     when its run is done; a null of a summary (an undefined quantity) is written NaN."""
     rows, failed, missing, damaged = [], [], [], []
+    summaries: list[tuple[dict[str, Any], dict]] = []  # (row, summary) of the done runs
     reserved = set(FIXED_COLUMNS) | set(sweep.parameters) | {
         f"{k} [value]" for k in (sweep.labels or {})}
     for run in sweep.runs:
@@ -1515,6 +1516,7 @@ def collect(sweep: Sweep, write: bool = True) -> Collected:
                 row["warning_text"] = " | ".join(summ["warnings"])
             else:
                 row["warnings"] = row["warning_text"] = ""
+            summaries.append((row, summ))
         rows.append(row)
     table = sweep.directory / "results.csv"
     notes: list[str] = []
@@ -1540,7 +1542,69 @@ def collect(sweep: Sweep, write: bool = True) -> Collected:
             notes.append(note)
         if sweep.records is not None:
             _write_intensity_table(sweep, rows)
+        for entity in LONG_TABLES:
+            note = _write_long_table(sweep, summaries, entity)
+            if note:
+                notes.append(note)
     return Collected(rows, failed, missing, table, damaged, notes)
+
+
+#: The long tables of collect: one row per run and storey, device or DOF, with the summary
+#: keys that hold one value each (their names as in the summary) and the labels' key.
+LONG_TABLES: dict[str, tuple[str, tuple[str, ...]]] = {
+    "storey": ("storey_labels", ("storey_height_m", "peak_drift_m", "peak_drift_time_s",
+                                 "residual_drift_m", "peak_drift_ratio", "residual_drift_ratio",
+                                 "peak_storey_shear_N", "peak_storey_shear_time_s",
+                                 "residual_storey_shear_N")),
+    "device": ("device_labels", ("device_law", "peak_s_m", "peak_force_N", "residual_s_m",
+                                 "stick_to_slip", "slip_to_stick", "slip_reversals")),
+    "dof": ("dof_labels", ("peak_u_m", "peak_u_time_s", "peak_v_mps", "peak_aabs_mps2",
+                           "peak_aabs_time_s")),
+}
+
+
+def long_rows(sweep: Sweep, summaries: list[tuple[dict[str, Any], dict]], entity: str
+              ) -> list[dict[str, Any]]:
+    """One row per done run and storey (device, DOF): the run, its parameters as in
+    results.csv, the item's number (from 1) and label, and the summary's value of each
+    of the entity's keys for that item (a key the summary lacks is left out)."""
+    labels_key, keys = LONG_TABLES[entity]
+    params = [c for c in (summaries[0][0] if summaries else {})
+              if c in sweep.parameters or c.endswith(" [value]")]
+    out = []
+    for row, summ in summaries:
+        labels = summ.get(labels_key) or []
+        for i, label in enumerate(labels):
+            r: dict[str, Any] = {"run": row["run"], **{k: row.get(k) for k in params},
+                                 entity: i + 1, f"{entity}_label": label}
+            for k in keys:
+                v = summ.get(k)
+                if isinstance(v, list) and len(v) == len(labels):
+                    r[k] = v[i]
+            out.append(r)
+    return out
+
+
+def _write_long_table(sweep: Sweep, summaries, entity: str) -> str | None:
+    rows = long_rows(sweep, summaries, entity)
+    path = sweep.directory / f"results_{entity}s.csv"
+    if not rows:
+        path.unlink(missing_ok=True)
+        path.with_suffix(".parquet").unlink(missing_ok=True)
+        return None
+    columns: list[str] = []
+    for row in rows:
+        columns += [c for c in row if c not in columns]
+    buf = io.StringIO()
+    w = csv.DictWriter(buf, fieldnames=columns, lineterminator="\n")
+    w.writeheader()
+    for row in rows:
+        w.writerow({k: _csv_value(v) for k, v in row.items()})
+    try:
+        _write_atomic(path, buf.getvalue())
+    except OSError as exc:
+        raise SweepError(f"{path}: cannot write the table: {exc.strerror}") from None
+    return _write_parquet(path)
 
 
 def intensity_statistics(sweep: Sweep, rows: list[dict[str, Any]]) -> list[dict[str, Any]]:
@@ -1606,8 +1670,9 @@ def _csv_value(v: Any) -> Any:
 
 
 def _write_parquet(table: Path) -> str | None:
-    """results.parquet beside the table when pyarrow is installed; a note when it cannot be
-    written (then no older results.parquet stays beside the new table)."""
+    """A Parquet copy beside the table (results.parquet beside results.csv) when pyarrow is
+    installed; a note when it cannot be written (then no older copy stays beside the new
+    table)."""
     try:
         import pyarrow.csv as pacsv
         import pyarrow.parquet as pq
