@@ -145,7 +145,7 @@ def announced(stdout: str, key: str) -> list[str]:
 @pytest.mark.parametrize("name", ["test4_velocity", "fig3_coarse"])
 def test_cli_run_writes_what_the_executable_writes(name, tmp_path):
     shutil.copy(INPUTS / f"{name}.nml", tmp_path / f"{name}.nml")
-    r = cli("run", f"{name}.nml", "--plot", cwd=tmp_path)
+    r = cli("run", f"{name}.nml", "--plot", "--plots", "all", cwd=tmp_path)
     assert r.returncode == 0, r.stderr
     assert announced(r.stdout, "history") == [f"out/{name}.csv"]
     assert announced(r.stdout, "summary") == [f"out/{name}.summary.json"]
@@ -182,7 +182,7 @@ def test_cli_run_out_dir_and_plot_and_compare(tmp_path):
         assert announced(r.stdout, "history") == [f"res/{law}.csv"]
         assert not (tmp_path / "out").exists()
     # plot a CSV and an .npz
-    r = cli("plot", "res/velocity.csv", cwd=tmp_path)
+    r = cli("plot", "res/velocity.csv", "--plots", "all", cwd=tmp_path)
     assert r.returncode == 0, r.stderr
     pngs = announced(r.stdout, "plot")
     assert "res/velocity_aabs1.png" in pngs and len(pngs) == 5
@@ -191,7 +191,7 @@ def test_cli_run_out_dir_and_plot_and_compare(tmp_path):
     r = cli("plot", "hys.npz", "--out", "figs", "--t-range", "2", "3", cwd=tmp_path)
     assert r.returncode == 0, r.stderr
     pngs = announced(r.stdout, "plot")
-    assert pngs[0] == "figs/hys_aabs1.png" and all(is_png(tmp_path / p) for p in pngs)
+    assert pngs[0] == "figs/hys_aabs2.png" and all(is_png(tmp_path / p) for p in pngs)  # the roof
     # compare the two laws: the plots and the printed peaks (the summaries' values)
     r = cli(
         "compare", "res/hysteretic.csv", "hys.npz", "velocity.nml", "--out", "cmp", cwd=tmp_path
@@ -267,3 +267,31 @@ def test_cli_paper_reproduces_table1_and_writes_the_figures(tmp_path):
     # Fig. 4: the two laws' steady-state peaks agree within 3 % (measured 0.34 % and 1.74 %)
     diffs = re.findall(r"\| (?:upper|lower) \(m\d\) \| [\d.]+ \| [\d.]+ \| ([+-][\d.]+) %", report)
     assert len(diffs) == 2 and all(abs(float(d)) < 3 for d in diffs)
+
+
+def test_the_default_plots_are_the_key_ones(tmp_path):
+    """run --plot writes the key set: the roof's acceleration, the hysteresis of the device
+    whose peak force is largest, and with storeys the profiles and the base shear; --plots
+    chooses kinds; an unknown kind is a usage error naming the kinds."""
+    shutil.copy(INPUTS / "building5_friction.nml", tmp_path)
+    shutil.copy(INPUTS / "synthetic_pga035.AT2", tmp_path)
+    deck = (tmp_path / "building5_friction.nml").read_text()
+    (tmp_path / "building5_friction.nml").write_text(deck.replace(
+        "&excitation", "&storeys\n  n_storeys = 5, node_i = 1, 2, 3, 4, 5, node_j = 0, 1, 2, 3, 4\n/\n"
+        "&excitation\n  duration = 3.0"))
+    r = cli("run", "building5_friction.nml", "--plot", "--dpi", "60", cwd=tmp_path)
+    assert r.returncode == 0, r.stderr
+    summ = json.loads((tmp_path / "out/building5_friction.summary.json").read_text())
+    top = 1 + max(range(5), key=lambda d: summ["peak_force_N"][d])
+    assert announced(r.stdout, "plot") == [
+        "out/building5_friction_aabs5.png", f"out/building5_friction_hysteresis{top}.png",
+        "out/building5_friction_drift_profile.png",
+        "out/building5_friction_acceleration_profile.png",
+        "out/building5_friction_base_shear.png"]
+    r = cli("plot", "out/building5_friction.csv", "--plots", "phase,storey_loop", "--dpi", "60",
+            cwd=tmp_path)
+    assert r.returncode == 0, r.stderr
+    pngs = announced(r.stdout, "plot")
+    assert len(pngs) == 5 + 5 and pngs[0].endswith("_phase1.png")
+    r = cli("plot", "out/building5_friction.csv", "--plots", "orbit", cwd=tmp_path)
+    assert r.returncode == 1 and "not a plot kind (orbit)" in r.stderr

@@ -75,3 +75,25 @@ def test_history_to_parquet_and_back(tmp_path):
     pq.write_table(pa.table({"x": [1.0]}), plain)
     with pytest.raises(fd.FrictiondynError, match="not a history"):
         fd.Result.from_parquet(plain)
+
+
+def test_envelope_over_the_storeys(tmp_path):
+    """Envelopes of a sweep with storeys: per run, and per value of a parameter (the median
+    and the percentile band); an unknown parameter named."""
+    spec = tmp_path / "s.toml"
+    spec.write_text(f'base = "{INPUTS}/isolated_fps.nml"\nwrite_history = false\n[cross]\n'
+                    '"excitation.duration" = [2.0, 3.0]\n"isolators.mu_max" = [0.05, 0.08]\n')
+    out = tmp_path / "o"
+    r = subprocess.run([*SWEEP, str(spec), "--out", str(out), "--quiet"], capture_output=True,
+                       text=True)
+    assert r.returncode == 0, r.stderr
+    r = subprocess.run([*SWEEP, "envelope", str(out), "--dpi", "60"], capture_output=True, text=True)
+    assert r.returncode == 0, r.stderr
+    assert (out / "envelope_drift_ratio.png").stat().st_size > 3000
+    r = subprocess.run([*SWEEP, "envelope", str(out), "--quantity", "shear", "--units", "kN",
+                        "--by", "isolators.mu_max", "--out", str(tmp_path / "v.png"), "--dpi", "60"],
+                       capture_output=True, text=True)
+    assert r.returncode == 0, r.stderr
+    assert (tmp_path / "v.png").stat().st_size > 3000
+    with pytest.raises(sw.SweepError, match="nosuch"):
+        sw.envelope(out, by="nosuch")

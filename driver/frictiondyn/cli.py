@@ -157,6 +157,9 @@ class _ProgressBar:
 
 def cmd_run(args: argparse.Namespace) -> int:
     trange = _trange(args.t_range)
+    from .plots import plot_kinds
+
+    kinds = plot_kinds(args.plots)
     bar = _ProgressBar(sys.stderr.isatty() and not args.quiet)
     with Session(args.deck) as session:  # the deck is read once; the library writes
         # the history goes to its file as the run goes (memory does not grow with the
@@ -184,6 +187,7 @@ def cmd_run(args: argparse.Namespace) -> int:
             t_range=trange,
             units=args.units,
             dpi=args.dpi,
+            kinds=kinds,
         ):
             print(f"  plot: {p}")
     return 0
@@ -194,11 +198,13 @@ def cmd_plot(args: argparse.Namespace) -> int:
 
     path = Path(args.result)
     trange = _trange(args.t_range)
+    kinds = plots.plot_kinds(args.plots)
     result = load_result(path)
     directory = Path(args.out) if args.out else path.parent
     directory.mkdir(parents=True, exist_ok=True)
     for p in plots.plot_all(
-        result, directory, _stem(path), t_range=trange, units=args.units, dpi=args.dpi
+        result, directory, _stem(path), t_range=trange, units=args.units, dpi=args.dpi,
+        kinds=kinds,
     ):
         print(f"plot: {p}")
     return 0
@@ -380,13 +386,21 @@ def build_parser() -> argparse.ArgumentParser:
         "help": "units of the plots, e.g. mm,kN,g (length m/cm/mm, force N/kN/MN, "
         "acceleration m/s2/cm/s2/g, velocity m/s/cm/s/mm/s; default SI)",
     }
-    dpi = {"type": int, "default": None, "help": "resolution of the PNGs (default 150)"}
+    dpi = {"type": int, "default": None, "help": "resolution of the PNGs (default 150; 300 for a report)"}
+    which = {
+        "metavar": "SET",
+        "help": "which PNGs: 'key' (default: the roof's acceleration, the hysteresis of the most "
+        "loaded device, with storeys the drift and acceleration profiles and the base shear), "
+        "'all', or kinds separated by commas: aabs, sdot, hysteresis, phase, drift_profile, "
+        "acceleration_profile, storey_loop, base_shear",
+    }
     p = sub.add_parser("run", help="run a deck; write its history CSV and summary JSON")
     p.add_argument("deck", help="namelist deck (.nml)")
     p.add_argument(
         "--out", metavar="DIR", help="output directory (default: the deck's &output dir)"
     )
     p.add_argument("--plot", action="store_true", help="also write PNGs next to the outputs")
+    p.add_argument("--plots", **which)
     p.add_argument("--t-range", **trange)
     p.add_argument("--quiet", action="store_true", help="no progress bar")
     p.add_argument("--units", **units)
@@ -396,6 +410,7 @@ def build_parser() -> argparse.ArgumentParser:
     p = sub.add_parser("plot", help="PNGs of a result (.csv or .npz)")
     p.add_argument("result", help="history CSV (with its .summary.json), or .npz")
     p.add_argument("--out", metavar="DIR", help="where the PNGs go (default: next to RESULT)")
+    p.add_argument("--plots", **which)
     p.add_argument("--t-range", **trange)
     p.add_argument("--units", **units)
     p.add_argument("--dpi", **dpi)

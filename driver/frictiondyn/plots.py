@@ -692,6 +692,28 @@ def plot_compare(
     return _finish(fig, path, dpi)
 
 
+#: What plot_all can write, in its order; KEY_PLOTS is the default set.
+PLOT_KINDS = ("aabs", "sdot", "hysteresis", "phase", "drift_profile", "acceleration_profile",
+              "storey_loop", "base_shear")
+KEY_PLOTS = "key"
+
+
+def plot_kinds(text: str | None) -> tuple[str, ...] | str:
+    """``"key"`` (the default: the roof's acceleration, the hysteresis of the device with the
+    largest force, and with storeys the drift and acceleration profiles and the base shear),
+    ``"all"`` (every kind), or kinds separated by commas; an unknown kind is a ValueError."""
+    if text is None or text == KEY_PLOTS:
+        return KEY_PLOTS
+    if text == "all":
+        return PLOT_KINDS
+    kinds = tuple(k.strip() for k in text.split(",") if k.strip())
+    bad = [k for k in kinds if k not in PLOT_KINDS]
+    if bad or not kinds:
+        raise ValueError(f"--plots {text!r}: not a plot kind ({', '.join(bad) or 'none given'}); "
+                         f"'key', 'all' or some of {', '.join(PLOT_KINDS)}")
+    return kinds
+
+
 def plot_all(
     result: Result,
     directory: str | os.PathLike,
@@ -701,38 +723,52 @@ def plot_all(
     max_items: int = 10,
     units: Units | str | None = None,
     dpi: int | None = None,
+    kinds: Sequence[str] | str = PLOT_KINDS,
 ) -> list[Path]:
-    """Write the standard PNGs of one result into ``directory``: ``<stem>_aabs<i>.png`` per
-    DOF, ``<stem>_sdot<d>.png``, ``<stem>_hysteresis<d>.png`` and ``<stem>_phase<d>.png`` per
-    device (the first ``max_items`` DOFs and devices), and with storeys
-    ``<stem>_drift_profile.png``, ``<stem>_acceleration_profile.png`` and
-    ``<stem>_storey_loop<s>.png``. Returns the paths written."""
+    """Write PNGs of one result into ``directory`` and return their paths. ``kinds`` (from
+    PLOT_KINDS, or "key"): ``<stem>_aabs<i>.png`` per DOF, ``<stem>_sdot<d>.png``,
+    ``<stem>_hysteresis<d>.png`` and ``<stem>_phase<d>.png`` per device (the first
+    ``max_items`` DOFs and devices), and with storeys ``<stem>_drift_profile.png``,
+    ``<stem>_acceleration_profile.png``, ``<stem>_storey_loop<s>.png`` and
+    ``<stem>_base_shear.png``. "key" is the last DOF's acceleration, the hysteresis of the
+    device whose peak force is largest, and with storeys the two profiles and the base
+    shear."""
     directory = Path(directory)
     written: list[Path] = []
     kw = {"t_range": t_range, "units": units, "dpi": dpi}
-    for i in range(1, min(result.n_dof, max_items) + 1):
-        p = directory / f"{stem}_aabs{i}.png"
-        plot_acceleration(result, i, p, **kw)
-        written.append(p)
-    for d in range(1, min(result.n_devices, max_items) + 1):
-        for kind, func in (
-            ("sdot", plot_relative_velocity),
-            ("hysteresis", plot_hysteresis),
-            ("phase", plot_phase),
-        ):
-            p = directory / f"{stem}_{kind}{d}.png"
-            opts = {"t_range": t_range, "dpi": dpi} if func is plot_phase else kw
-            func(result, d, p, **opts)
+    dofs = range(1, min(result.n_dof, max_items) + 1)
+    devices = range(1, min(result.n_devices, max_items) + 1)
+    chosen: dict[str, range | list[int]] = {k: (dofs if k == "aabs" else devices) for k in PLOT_KINDS}
+    if kinds == KEY_PLOTS:
+        kinds = ("aabs", "hysteresis", "drift_profile", "acceleration_profile", "base_shear")
+        chosen["aabs"] = [result.n_dof] if result.n_dof else []
+        forces = result.summary.get("peak_force_N") or []
+        chosen["hysteresis"] = [1 + int(np.argmax(forces))] if len(forces) else []
+    storeys = bool(result.n_storeys) and "drift1" in result
+    funcs = {"aabs": plot_acceleration, "sdot": plot_relative_velocity,
+             "hysteresis": plot_hysteresis, "phase": plot_phase}
+    for kind in ("aabs", "sdot", "hysteresis", "phase"):
+        if kind not in kinds:
+            continue
+        for k in chosen[kind]:
+            p = directory / f"{stem}_{kind}{k}.png"
+            opts = {"t_range": t_range, "dpi": dpi} if kind == "phase" else kw
+            funcs[kind](result, k, p, **opts)
             written.append(p)
-    if result.n_storeys and "drift1" in result:
-        p = directory / f"{stem}_drift_profile.png"
-        plot_drift_profile(result, p, units=units, dpi=dpi)
-        written.append(p)
-        p = directory / f"{stem}_acceleration_profile.png"
-        plot_acceleration_profile(result, p, units=units, dpi=dpi)
-        written.append(p)
-        for s in range(1, min(result.n_storeys, max_items) + 1):
-            p = directory / f"{stem}_storey_loop{s}.png"
-            plot_storey_loop(result, s, p, **kw)
+    if storeys:
+        for kind, func in (("drift_profile", plot_drift_profile),
+                           ("acceleration_profile", plot_acceleration_profile)):
+            if kind in kinds:
+                p = directory / f"{stem}_{kind}.png"
+                func(result, p, units=units, dpi=dpi)
+                written.append(p)
+        if "storey_loop" in kinds:
+            for s_ in range(1, min(result.n_storeys, max_items) + 1):
+                p = directory / f"{stem}_storey_loop{s_}.png"
+                plot_storey_loop(result, s_, p, **kw)
+                written.append(p)
+        if "base_shear" in kinds and "Vb" in result:
+            p = directory / f"{stem}_base_shear.png"
+            plot_base_shear(result, p, **kw)
             written.append(p)
     return written

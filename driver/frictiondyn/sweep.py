@@ -1776,6 +1776,97 @@ def plot(
     return path
 
 
+#: The storey quantities of ``envelope``: the long table's column, the axis label and
+#: how a value is shown (its unit kind for --units, or a factor to %).
+ENVELOPE_QUANTITIES = {
+    "drift_ratio": ("peak_drift_ratio", "peak drift ratio [%]", "percent"),
+    "drift": ("peak_drift_m", "peak drift", "length"),
+    "shear": ("peak_storey_shear_N", "peak storey shear", "force"),
+    "residual_drift_ratio": ("residual_drift_ratio", "residual drift ratio [%]", "percent"),
+}
+
+
+def envelope(
+    directory: str | os.PathLike,
+    quantity: str = "drift_ratio",
+    by: str | None = None,
+    out: str | os.PathLike | None = None,
+    units: str | None = None,
+    dpi: int = 150,
+) -> Path:
+    """Envelopes over the storeys (results_storeys.csv of ``collect``): a storey quantity
+    (``ENVELOPE_QUANTITIES``: the peak drift ratio in %, the peak drift, the peak storey
+    shear, the residual drift ratio) against the storey, one curve per run, or with ``by``
+    per value of that parameter the median over its runs with the band of their 16th and
+    84th percentiles (a record suite's envelopes per intensity: ``by='intensity_g'``).
+    Writes a PNG (default ``<dir>/envelope_<quantity>.png``)."""
+    import numpy as np
+    from matplotlib.backends.backend_agg import FigureCanvasAgg
+    from matplotlib.figure import Figure
+
+    from .plots import _FACTORS, Units
+
+    if quantity not in ENVELOPE_QUANTITIES:
+        raise SweepError(f"envelope quantity {quantity!r}: one of {', '.join(ENVELOPE_QUANTITIES)}")
+    column, axis, kind = ENVELOPE_QUANTITIES[quantity]
+    sweep = load(directory)
+    path = Path(directory) / "results_storeys.csv"
+    try:
+        with open(path, newline="", encoding="utf-8") as fh:
+            rows = list(csv.DictReader(fh))
+    except FileNotFoundError:
+        raise SweepError(f"{path}: no such file (the sweep has no storeys, or run 'sweep "
+                         "collect' first)") from None
+    if not rows:
+        raise SweepError(f"{path}: no storey of a complete run")
+    if by is not None and by not in rows[0]:
+        raise _no_column(by, [c for c in rows[0] if c in sweep.parameters])
+    if kind == "percent":
+        factor, unit = 100.0, ""
+    else:
+        u = Units.parse(units)
+        name = getattr(u, kind)
+        factor, unit = _FACTORS[kind][name], f" [{name}]"
+    n = max(int(r["storey"]) for r in rows)
+    labels = {int(r["storey"]): r["storey_label"] for r in rows}
+    series: dict[str, dict[int, list[float]]] = {}
+    for r in rows:
+        v = _number(r.get(column))
+        if v is None:
+            continue
+        if by is None:
+            key = r["run"] + ": " + ", ".join(f"{k} = {r[k]}" for k in sweep.parameters
+                                               if k in r and k not in SUITE_KEYS[2:])
+        else:
+            key = f"{by} = {r[by]}"
+        series.setdefault(key, {}).setdefault(int(r["storey"]), []).append(factor * v)
+    if not series:
+        raise SweepError(f"{path}: no run has a number for {column} (a storey without a height "
+                         "has no drift ratio)")
+    fig = Figure(figsize=(6, 1.6 + 0.45 * n))
+    FigureCanvasAgg(fig)
+    ax = fig.add_subplot()
+    for key, per in series.items():
+        levels = sorted(per)
+        med = [float(np.median(per[s])) for s in levels]
+        line, = ax.plot(med, levels, marker="o", label=key)
+        if by is not None and any(len(per[s]) > 1 for s in levels):
+            ax.fill_betweenx(levels, [float(np.percentile(per[s], 16)) for s in levels],
+                             [float(np.percentile(per[s], 84)) for s in levels],
+                             color=line.get_color(), alpha=0.2)
+    ax.set_yticks(range(1, n + 1), [labels.get(s, str(s)) for s in range(1, n + 1)])
+    ax.set_xlabel(axis + unit)
+    ax.set_ylabel("storey")
+    what = "median and 16th-84th percentiles" if by else "each run"
+    ax.set_title(f"sweep '{sweep.name}': {axis.split(' [')[0]}, {what}", fontsize="medium")
+    ax.set_xlim(left=0)
+    ax.grid(True, alpha=0.3)
+    ax.legend(fontsize="small")
+    target = Path(out) if out else Path(directory) / f"envelope_{quantity}.png"
+    fig.savefig(target, dpi=dpi, bbox_inches="tight")
+    return target
+
+
 # -------------------------------------------------------------------------- command line
 def add_parser(sub: argparse._SubParsersAction) -> None:
     """Register ``sweep`` on the command line of ``python -m frictiondyn``."""
@@ -1783,7 +1874,7 @@ def add_parser(sub: argparse._SubParsersAction) -> None:
         "sweep",
         help="parameter sweeps: run locally or as a Slurm job array; collect; plot",
         description="sweep SPEC.toml [options] | sweep collect DIR [--resubmit] | "
-        "sweep plot DIR X Y (docs/batch.md)",
+        "sweep plot DIR X Y | sweep envelope DIR (docs/batch.md)",
         add_help=False,
     )
     p.add_argument("args", nargs=argparse.REMAINDER)
@@ -1868,6 +1959,19 @@ def main(argv: Sequence[str]) -> int:
         p.add_argument("--out", metavar="PNG")
         a = p.parse_args(argv[1:])
         print(f"plot: {plot(a.directory, a.x, a.y, a.by, a.out)}")
+        return 0
+    if argv and argv[0] == "envelope":
+        p = argparse.ArgumentParser(prog="python -m frictiondyn sweep envelope",
+                                    description="Envelopes over the storeys, one curve per run "
+                                    "or per value of a parameter (docs/batch.md).")
+        p.add_argument("directory")
+        p.add_argument("--quantity", default="drift_ratio", choices=list(ENVELOPE_QUANTITIES))
+        p.add_argument("--by", help="median and 16th-84th percentile band per value of this parameter")
+        p.add_argument("--units", help="units of drift and shear, e.g. mm,kN (default SI)")
+        p.add_argument("--dpi", type=int, default=150, help="resolution (default 150; 300 for a report)")
+        p.add_argument("--out", metavar="PNG")
+        a = p.parse_args(argv[1:])
+        print(f"plot: {envelope(a.directory, a.quantity, a.by, a.out, a.units, a.dpi)}")
         return 0
     a = _run_parser().parse_args(argv)
     if a.max_runs < 1:
