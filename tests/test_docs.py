@@ -302,3 +302,10 @@ def test_the_worked_examples_quote_their_reference_outputs():
             f"| {fps['peak_aabs_mps2'][-1] / g:.3f} g |",
             f"| {1000 * fps['peak_s_m'][0]:.1f} mm |",
             f"residual of {1000 * abs(fps['residual_s_m'][0]):.1f} mm")
+
+
+def test_the_single_node_slurm_conf_shown_is_the_tested_one():
+    """docs/batch.md shows tools/slurm/single-node.conf.in whole, the file the Slurm test
+    runs."""
+    conf = (ROOT / "tools" / "slurm" / "single-node.conf.in").read_text()
+    assert "```\n" + conf + "```" in (ROOT / "docs" / "batch.md").read_text()

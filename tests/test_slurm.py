@@ -26,6 +26,8 @@ from conftest import INPUTS
 SWEEP = [sys.executable, "-m", "frictiondyn", "sweep"]
 DAEMONS = ("munged", "slurmctld", "slurmd", "sbatch", "squeue", "sinfo")
 
+ROOT = Path(__file__).resolve().parents[1]
+
 
 def _unavailable(reason: str):
     if os.environ.get("CI"):
@@ -79,38 +81,13 @@ def cluster():
     for d in ("state", "spool"):
         (base / d).mkdir()
     conf = base / "slurm.conf"
-    conf.write_text(
-        "\n".join(
-            [
-                "ClusterName=fdtest",
-                f"SlurmctldHost={host}",
-                "SlurmUser=root",
-                "SlurmdUser=root",
-                "AuthType=auth/munge",
-                f"AuthInfo=socket={sock}",
-                f"StateSaveLocation={base}/state",
-                f"SlurmdSpoolDir={base}/spool",
-                f"SlurmctldPidFile={base}/slurmctld.pid",
-                f"SlurmdPidFile={base}/slurmd.pid",
-                f"SlurmctldPort={_free_port()}",
-                f"SlurmdPort={_free_port()}",
-                f"SlurmctldLogFile={base}/slurmctld.log",
-                f"SlurmdLogFile={base}/slurmd.log",
-                "ProctrackType=proctrack/linuxproc",
-                "TaskPlugin=task/none",
-                "SelectType=select/cons_tres",
-                "SelectTypeParameters=CR_Core",
-                "ReturnToService=2",
-                "MpiDefault=none",
-                "JobCompType=jobcomp/none",
-                "AccountingStorageType=accounting_storage/none",
-                "SchedulerParameters=sched_interval=1",
-                f"NodeName={host} CPUs={os.cpu_count()} RealMemory=1000 State=UNKNOWN",
-                f"PartitionName=fd Nodes={host} Default=YES MaxTime=INFINITE State=UP",
-            ]
-        )
-        + "\n"
-    )
+    template = (ROOT / "tools" / "slurm" / "single-node.conf.in").read_text()
+    for mark, value in (("@HOST@", host), ("@DIR@", str(base)), ("@MUNGE_SOCKET@", str(sock)),
+                       ("@SLURMCTLD_PORT@", str(_free_port())),
+                       ("@SLURMD_PORT@", str(_free_port())), ("@CPUS@", str(os.cpu_count()))):
+        template = template.replace(mark, value)
+    assert not any("@" in line for line in template.splitlines() if not line.startswith("#"))
+    conf.write_text(template)
     env = {**os.environ, "SLURM_CONF": str(conf)}
     procs: list[subprocess.Popen] = []
     try:
