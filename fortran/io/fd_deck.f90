@@ -29,10 +29,11 @@ module fd_deck
    use fd_record, only: read_record, record_info, record_formats, record_units_list, units_factor
    use fd_technique, only: check_technique
    use fd_names, only: label_len, max_mu_points, mu_laws, mu_constant, mu_exponential, mu_table, mode_systems, &
-                       system_stuck, law_velocity, law_hysteretic, technique_event_driven, technique_newmark, &
+                       system_stuck, law_hysteretic, technique_newmark, &
                        default_mu_law, default_mode_system, default_n_modes, default_radius, &
                        default_storey_height, law_name
    use fd_model, only: source_friction, source_brace, source_isolator
+   use fd_friction, only: law_mu_of_speed
    use fd_matrices, only: modes_type, natural_modes, natural_modes_sparse, stiffness_matrix, modes_dense_dofs
    use fd_sha256, only: sha256_text
    use fd_textio, only: read_file_text, cr_line_ends
@@ -1289,7 +1290,7 @@ contains
 
       dev%mu_law = id
       if (id == mu_constant) return
-      if (dev%law /= law_velocity) then
+      if (.not. law_mu_of_speed(dev%law)) then
          call bad(deck, group, 'mu_law('//trim(fmt_int(i))//')', "'"//trim(mu_laws(id)%name)//"'", &
                   "'constant' with law("//trim(fmt_int(i))//") = '"//trim(law_name(dev%law))//"': "// &
                   "velocity-dependent friction is available for the velocity law only (docs/theory.md, 5.4)", error)

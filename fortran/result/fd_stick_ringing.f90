@@ -35,8 +35,8 @@
 module fd_stick_ringing
    use fd_kinds, only: dp
    use fd_error, only: error_type, fatal_error, fmt_int, stat_no_memory
-   use fd_model, only: model_type, sticking_stiffness, moved_mass
-   use fd_names, only: law_velocity
+   use fd_model, only: model_type, moved_mass
+   use fd_friction, only: sticking_stiffness, law_stuck, stuck_dashpot
    use fd_device_state, only: device_state, phase_stick
    use fd_result, only: result_type, resolution_none, resolution_resolved, resolution_unresolved
    implicit none
@@ -129,7 +129,7 @@ contains
       if (stat == 0) then
          di = model%dev(1:nd)%node_i
          dj = model%dev(1:nd)%node_j
-         velocity = model%dev(1:nd)%law == law_velocity
+         velocity = law_stuck(model%dev(1:nd)%law) == stuck_dashpot
          call incidence(model%n_dof, model%spring_i(1:ns), model%spring_j(1:ns), [(.true., i=1, ns)], &
                         sp_first, sp_list, stat)
       end if

@@ -19,7 +19,8 @@ module fd_mode_resolution
    use fd_kinds, only: dp
    use fd_error, only: error_type, fatal_error, fmt_int, stat_no_memory
    use fd_names, only: technique_newmark, technique_moreau_jean
-   use fd_model, only: model_type, sticking_stiffness
+   use fd_model, only: model_type
+   use fd_friction, only: sticking_stiffness
    use fd_modes, only: highest_eigenvalue
    use fd_result, only: result_type, resolution_none, resolution_resolved, resolution_unresolved
    implicit none

@@ -37,9 +37,10 @@ module fd_record_resolution
    use, intrinsic :: ieee_arithmetic, only: ieee_is_finite
    use fd_kinds, only: dp
    use fd_error, only: error_type, fatal_error, fmt_int, stat_no_memory
-   use fd_names, only: technique_newmark, technique_moreau_jean, excitation_record, law_coulomb
+   use fd_names, only: technique_newmark, technique_moreau_jean, excitation_record
    use fd_matrices, only: modes_type, modes_kept, mode_damping, mode_participation
-   use fd_model, only: model_type, law_hysteretic
+   use fd_model, only: model_type
+   use fd_friction, only: law_stuck, stuck_dashpot
    use fd_excitation, only: excitation_type, table_acceleration
    use fd_result, only: result_type, resolution_none, resolution_resolved, resolution_unresolved, &
                         record_system_none, record_system_structure, record_system_stuck, &
@@ -267,8 +268,7 @@ contains
          judged = record_system_structure
       else if (slid) then
          judged = record_system_free
-      else if (all(model%dev(1:model%n_devices)%law == law_hysteretic .or. &
-                   model%dev(1:model%n_devices)%law == law_coulomb)) then
+      else if (all(law_stuck(model%dev(1:model%n_devices)%law) /= stuck_dashpot)) then
          judged = record_system_stuck
       else
          judged = record_system_both
