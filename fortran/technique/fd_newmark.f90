@@ -28,7 +28,7 @@ module fd_newmark
    use, intrinsic :: ieee_arithmetic, only: ieee_is_finite
    use fd_kinds, only: dp
    use fd_error, only: error_type, fatal_error, fmt_real, fmt_int, stat_no_memory
-   use fd_names, only: laws, law_name, law_choices, excitation_types, technique_name, technique_newmark, &
+   use fd_names, only: technique_integrates, law_name, law_choices, excitation_types, technique_name, technique_newmark, &
                        technique_event_driven, technique_moreau_jean, linear_system_dense, linear_system_banded, &
                        refinement_nested, refinement_implicit
    use fd_model, only: model_type, integration_type, device_type
@@ -118,9 +118,7 @@ contains
 
       do d = 1, model%n_devices
          law = model%dev(d)%law
-         if (law >= 1 .and. law <= size(laws)) then
-            if (laws(law)%regularized) cycle
-         end if
+         if (technique_integrates(technique_newmark, law)) cycle
          idx = 'law('//trim(fmt_int(d))//')'
          call law_choices(allowed, regularized=.true.)
          call fatal_error(error, "group &friction: "//idx//" = '"//trim(law_name(law))//"' is invalid with "// &
