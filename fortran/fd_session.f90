@@ -3,7 +3,8 @@
 !> so that the deck and its record are read exactly once per run and every buffer the caller
 !> needs is sized here, from the deck and the result, never guessed.
 !>
-!> Life cycle: session_open (or session_open_text) reads and validates the deck; session_solve
+!> Life cycle: session_open (or session_open_text) reads and validates the deck, and asks its
+!> technique whether it can integrate the model (fd_technique's check_technique); session_solve
 !> runs it; session_text, session_shape and the result's history give what it produced;
 !> session_write writes the outputs with the library's writer. session_adopt makes a solved
 !> session from a history and texts given by the caller, to write them with the same writer.
@@ -27,6 +28,7 @@ module fd_session
    use fd_history_stream, only: stream_close, stream_discard
    use fd_output, only: make_dir, temp_output_paths, remove_made_dirs
    use fd_tempfiles, only: temp_tag, remove_stale_temps
+   use fd_technique, only: check_technique
    implicit none
    private
 
@@ -128,6 +130,8 @@ contains
       call reset(s)
       call read_deck(path, s%cfg, error)
       if (allocated(error)) return
+      call technique_check(s, error)
+      if (allocated(error)) return
       call deck_selection(s, error)
       if (allocated(error)) return
       s%state = session_read
@@ -143,6 +147,8 @@ contains
       type(error_type), allocatable, intent(out) :: error !! bad deck or record
       call reset(s)
       call read_deck_string(text, path, s%cfg, error)
+      if (allocated(error)) return
+      call technique_check(s, error)
       if (allocated(error)) return
       call deck_selection(s, error)
       if (allocated(error)) return
@@ -449,6 +455,16 @@ contains
       end if
       call select_history(s%ctl, dofs, devices, s%cfg%model%n_dof, s%cfg%model%n_devices, error)
    end subroutine deck_selection
+
+   !> Whether the technique of the deck just read can integrate its model and table motion
+   !> (fd_technique's check_technique): an error, prefixed with the deck as the reader's are,
+   !> for what it cannot.
+   subroutine technique_check(s, error)
+      type(session_type), intent(in) :: s
+      type(error_type), allocatable, intent(out) :: error
+      call check_technique(s%cfg%model, s%cfg%exc, s%cfg%opts, error)
+      if (allocated(error)) error%message = s%cfg%deck_path//", "//error%message
+   end subroutine technique_check
 
    subroutine reset(s)
       type(session_type), intent(inout) :: s
