@@ -9,8 +9,8 @@
 module fd_friction
    use fd_kinds, only: dp
    use fd_error, only: error_type, fatal_error, fmt_int
-   use fd_model, only: device_type, law_velocity, law_hysteretic, law_coulomb, law_name, mu_constant, &
-                       device_parameter
+   use fd_names, only: law_velocity, law_hysteretic, law_coulomb, law_name
+   use fd_model, only: device_type, mu_constant, device_parameter
    use fd_device_state, only: device_state, job_init, job_update, job_correct, law_traits_type, &
                               stuck_none, stuck_rigid, stuck_spring, stuck_dashpot
    use fd_friction_velocity, only: velocity_law, velocity_update, velocity_correct, velocity_settle, velocity_follow, &

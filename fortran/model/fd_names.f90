@@ -5,8 +5,8 @@
 !> docs/namelist.md documents each of them.
 !>
 !> The id of a keyword is its position in its table. Adding a friction law is one row in
-!> `laws` with its id below it, one module in fortran/friction and one case in
-!> fd_friction's dispatch.
+!> `laws` with its id below it (public), one module in fortran/friction and one case in each
+!> `select case` of fd_friction.
 module fd_names
    use fd_kinds, only: dp
    use fd_textio, only: lower
