@@ -238,8 +238,8 @@ contains
    !> and friction_correct do device by device, in one loop that calls each law's routines
    !> directly (the time step's per-device cost in a large structure; explicit shapes, since
    !> building array descriptors at every call cost more than a two-mass model's laws). A
-   !> device whose law has no case here keeps its state (friction_init rejected it before the
-   !> first step).
+   !> law with no case of its own here goes through `dispatch` (a law unknown there too keeps
+   !> its state: friction_init rejected it before the first step).
    subroutine friction_step(nd, dev, n, s1, sd1, sd, st, st1, changed, ok, any_changed, any_bad)
       integer, intent(in) :: nd                 !! devices
       type(device_type), intent(in) :: dev(nd)  !! devices
@@ -267,13 +267,32 @@ contains
             call velocity_update(dev(d), s1(d), sd1(d), st1(d), changed(d))
             ok(d) = velocity_correct(dev(d), n, st(d), sd(d), sd1(d))
          case default
-            changed(d) = .false.
-            ok(d) = .true.
+            call step_by_dispatch(dev(d), n, s1(d), sd1(d), sd(d), st(d), st1(d), changed(d), ok(d))
          end select
          any_changed = any_changed .or. changed(d)
          any_bad = any_bad .or. .not. ok(d)
       end do
    end subroutine friction_step
+
+   !> friction_step for one device of a law without a case of its own there: the update and
+   !> the correctness condition through `dispatch`.
+   elemental subroutine step_by_dispatch(dev, n, s1, sd1, sd, st, st1, changed, ok)
+      type(device_type), intent(in) :: dev      !! device parameters
+      real(dp), intent(in) :: n                 !! n > 1 of the correctness condition
+      real(dp), intent(in) :: s1                !! relative displacement at the step's end [m]
+      real(dp), intent(in) :: sd1               !! relative velocity at the step's end [m/s]
+      real(dp), intent(in) :: sd                !! relative velocity at its start [m/s]
+      type(device_state), intent(in) :: st      !! state during the step
+      type(device_state), intent(inout) :: st1  !! state for the next step
+      logical, intent(out) :: changed           !! the phase changed
+      logical, intent(out) :: ok                !! the step satisfies the condition
+      type(device_state) :: st_copy
+      logical :: known, unused
+
+      call dispatch(job_update, dev, n, s1, sd1, sd, st1, changed, ok, known)
+      st_copy = st
+      call dispatch(job_correct, dev, n, s1, sd1, sd, st_copy, unused, ok, known)
+   end subroutine step_by_dispatch
 
    !> `refinement = 'implicit'`: the state of every device in which to take a step that ends
    !> in the phases of st1 (the law's update at the end of the last trial, where the relative
