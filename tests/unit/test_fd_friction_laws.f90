@@ -11,6 +11,7 @@ module test_fd_friction_laws
    use testdrive, only: new_unittest, unittest_type, error_type, check
    use fd_kinds, only: dp
    use fd_model, only: device_type, law_velocity, law_hysteretic, law_coulomb, mu_table
+   use fd_names, only: laws
    use fd_device_state, only: device_state, phase_stick, phase_slip_pos
    use fd_friction, only: law_traits_type, law_traits, law_stuck, stuck_none, stuck_rigid, stuck_spring, &
                           stuck_dashpot, law_band_name, law_coupling_name, law_checks_correctness, &
@@ -103,7 +104,7 @@ contains
       type(device_type) :: dev
       integer :: law
 
-      do law = 0, 4, 4
+      do law = 0, size(laws) + 1, size(laws) + 1
          call check(error, law_stuck(law) == stuck_none .and. law_band_name(law) == '' .and. &
                     .not. law_checks_correctness(law) .and. .not. law_stores_energy(law), 'no traits')
          if (allocated(error)) return
