@@ -25,8 +25,7 @@ module fd_friction
    public :: follows_velocity, friction_follow, friction_energy
    ! what a law says of itself (law_traits) and of a device of it
    public :: law_traits_type, law_traits, stuck_none, stuck_rigid, stuck_spring, stuck_dashpot
-   public :: law_stuck, law_band_name, law_coupling_name, law_checks_correctness, law_checks_stick_ringing
-   public :: law_checks_band_alternation, law_stores_energy, law_mu_of_speed
+   public :: law_stuck, law_band_name, law_coupling_name, law_checks_band_alternation, law_mu_of_speed
    public :: sticking_stiffness, sticking_damping, holds_when_stuck, links_when_stuck, friction_capacity, law_band
 
 contains
@@ -81,24 +80,6 @@ contains
       end associate
    end function law_coupling_name
 
-   !> Whether Newmark checks the law's correctness condition (eqs. 9, 12).
-   elemental logical function law_checks_correctness(law) result(checks)
-      integer, intent(in) :: law             !! law id
-
-      associate (t => law_traits(law))
-         checks = t%checks_correctness
-      end associate
-   end function law_checks_correctness
-
-   !> Whether the law's sticking spring may ring (fd_stick_ringing).
-   elemental logical function law_checks_stick_ringing(law) result(checks)
-      integer, intent(in) :: law             !! law id
-
-      associate (t => law_traits(law))
-         checks = t%checks_stick_ringing
-      end associate
-   end function law_checks_stick_ringing
-
    !> Whether the law's band force may alternate from step to step (fd_band_alternation).
    elemental logical function law_checks_band_alternation(law) result(checks)
       integer, intent(in) :: law             !! law id
@@ -107,15 +88,6 @@ contains
          checks = t%checks_band_alternation
       end associate
    end function law_checks_band_alternation
-
-   !> Whether a device of the law stores elastic energy (friction_energy).
-   elemental logical function law_stores_energy(law) result(stores)
-      integer, intent(in) :: law             !! law id
-
-      associate (t => law_traits(law))
-         stores = t%stores_energy
-      end associate
-   end function law_stores_energy
 
    !> Whether the law's mu may depend on the sliding speed (mu_law other than 'constant').
    elemental logical function law_mu_of_speed(law) result(speed)
@@ -329,9 +301,9 @@ contains
       end do
    end subroutine friction_settle
 
-   !> Elastic energy a device stores at relative displacement s in its state [J] (the laws that
-   !> law_stores_energy: the hysteretic law's spring; the velocity law stores none: its band is
-   !> a dashpot).
+   !> Elastic energy a device stores at relative displacement s in its state [J] (a law whose
+   !> traits say stores_energy: the hysteretic law's spring; the velocity law stores none: its
+   !> band is a dashpot).
    elemental real(dp) function friction_energy(dev, st, s) result(e)
       type(device_type), intent(in) :: dev      !! device parameters
       type(device_state), intent(in) :: st      !! its state

@@ -14,8 +14,7 @@ module test_fd_friction_laws
    use fd_names, only: laws
    use fd_device_state, only: device_state, phase_stick, phase_slip_pos
    use fd_friction, only: law_traits_type, law_traits, law_stuck, stuck_none, stuck_rigid, stuck_spring, &
-                          stuck_dashpot, law_band_name, law_coupling_name, law_checks_correctness, &
-                          law_checks_stick_ringing, law_checks_band_alternation, law_stores_energy, &
+                          stuck_dashpot, law_band_name, law_coupling_name, law_checks_band_alternation, &
                           law_mu_of_speed, sticking_stiffness, sticking_damping, holds_when_stuck, &
                           links_when_stuck, friction_capacity, law_band, friction_energy, follows_velocity
    implicit none
@@ -64,49 +63,58 @@ contains
       call check(error, law_band_name(law_velocity) == 'eps' .and. law_coupling_name(law_velocity) == 'eps', &
                  'band and coupling set by eps')
       if (allocated(error)) return
-      call check(error, law_checks_correctness(law_velocity) .and. law_checks_band_alternation(law_velocity) .and. &
-                 .not. law_checks_stick_ringing(law_velocity), 'eq. 9 and band alternation, no ringing')
+      call check(error, t%checks_correctness .and. t%checks_band_alternation .and. &
+                 law_checks_band_alternation(law_velocity) .and. .not. t%checks_stick_ringing, &
+                 'eq. 9 and band alternation, no ringing')
       if (allocated(error)) return
-      call check(error, .not. law_stores_energy(law_velocity) .and. law_mu_of_speed(law_velocity), &
+      call check(error, .not. t%stores_energy .and. law_mu_of_speed(law_velocity), &
                  'no stored energy; mu may depend on the speed')
    end subroutine test_velocity_traits
 
    subroutine test_hysteretic_traits(error)
       type(error_type), allocatable, intent(out) :: error
+      type(law_traits_type) :: t
+
+      t = law_traits(law_hysteretic)
 
       call check(error, law_stuck(law_hysteretic) == stuck_spring, 'a sticking hysteretic device is a spring (eq. 3)')
       if (allocated(error)) return
       call check(error, law_band_name(law_hysteretic) == 'eps1' .and. law_coupling_name(law_hysteretic) == 'f', &
                  'band eps1, spring set by f')
       if (allocated(error)) return
-      call check(error, law_checks_correctness(law_hysteretic) .and. law_checks_stick_ringing(law_hysteretic) .and. &
+      call check(error, t%checks_correctness .and. t%checks_stick_ringing .and. &
                  .not. law_checks_band_alternation(law_hysteretic), 'eq. 12 and stick ringing, no band alternation')
       if (allocated(error)) return
-      call check(error, law_stores_energy(law_hysteretic) .and. .not. law_mu_of_speed(law_hysteretic), &
+      call check(error, t%stores_energy .and. .not. law_mu_of_speed(law_hysteretic), &
                  'its spring stores energy; constant mu')
    end subroutine test_hysteretic_traits
 
    subroutine test_coulomb_traits(error)
       type(error_type), allocatable, intent(out) :: error
+      type(law_traits_type) :: t
+
+      t = law_traits(law_coulomb)
 
       call check(error, law_stuck(law_coulomb) == stuck_rigid, 'a sticking Coulomb device is a rigid link')
       if (allocated(error)) return
       call check(error, law_band_name(law_coulomb) == '' .and. law_coupling_name(law_coulomb) == '', &
                  'no band, no coupling variable')
       if (allocated(error)) return
-      call check(error, .not. (law_checks_correctness(law_coulomb) .or. law_checks_stick_ringing(law_coulomb) .or. &
-                               law_checks_band_alternation(law_coulomb) .or. law_stores_energy(law_coulomb) .or. &
+      call check(error, .not. (t%checks_correctness .or. t%checks_stick_ringing .or. &
+                               law_checks_band_alternation(law_coulomb) .or. t%stores_energy .or. &
                                law_mu_of_speed(law_coulomb)), 'no check, no energy, constant mu')
    end subroutine test_coulomb_traits
 
    subroutine test_unknown_law(error)
       type(error_type), allocatable, intent(out) :: error
       type(device_type) :: dev
+      type(law_traits_type) :: t
       integer :: law
 
       do law = 0, size(laws) + 1, size(laws) + 1
+         t = law_traits(law)
          call check(error, law_stuck(law) == stuck_none .and. law_band_name(law) == '' .and. &
-                    .not. law_checks_correctness(law) .and. .not. law_stores_energy(law), 'no traits')
+                    .not. t%checks_correctness .and. .not. t%stores_energy, 'no traits')
          if (allocated(error)) return
          dev = device(law)
          call check(error, .not. holds_when_stuck(dev) .and. .not. links_when_stuck(dev) .and. &
