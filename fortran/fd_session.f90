@@ -129,13 +129,7 @@ contains
       type(error_type), allocatable, intent(out) :: error !! bad or missing deck or record
       call reset(s)
       call read_deck(path, s%cfg, error)
-      if (allocated(error)) return
-      call technique_check(s, error)
-      if (allocated(error)) return
-      call deck_selection(s, error)
-      if (allocated(error)) return
-      s%state = session_read
-      s%from_deck = .true.
+      if (.not. allocated(error)) call opened(s, error)
    end subroutine session_open
 
    !> Read and validate a deck given as text into a fresh session; `path` names it in messages
@@ -147,13 +141,7 @@ contains
       type(error_type), allocatable, intent(out) :: error !! bad deck or record
       call reset(s)
       call read_deck_string(text, path, s%cfg, error)
-      if (allocated(error)) return
-      call technique_check(s, error)
-      if (allocated(error)) return
-      call deck_selection(s, error)
-      if (allocated(error)) return
-      s%state = session_read
-      s%from_deck = .true.
+      if (.not. allocated(error)) call opened(s, error)
    end subroutine session_open_text
 
    !> A solved session holding a history and texts given by the caller (no deck): what
@@ -456,15 +444,22 @@ contains
       call select_history(s%ctl, dofs, devices, s%cfg%model%n_dof, s%cfg%model%n_devices, error)
    end subroutine deck_selection
 
-   !> Whether the technique of the deck just read can integrate its model and table motion
-   !> (fd_technique's check_technique): an error, prefixed with the deck as the reader's are,
-   !> for what it cannot.
-   subroutine technique_check(s, error)
-      type(session_type), intent(in) :: s
+   !> A deck just read: ask its technique whether it can integrate the model and the table
+   !> motion (fd_technique's check_technique; an error prefixed with the deck as the reader's
+   !> are), take the deck's history selection, and hold the deck.
+   subroutine opened(s, error)
+      type(session_type), intent(inout) :: s
       type(error_type), allocatable, intent(out) :: error
       call check_technique(s%cfg%model, s%cfg%exc, s%cfg%opts, error)
-      if (allocated(error)) error%message = s%cfg%deck_path//", "//error%message
-   end subroutine technique_check
+      if (allocated(error)) then
+         error%message = s%cfg%deck_path//", "//error%message
+         return
+      end if
+      call deck_selection(s, error)
+      if (allocated(error)) return
+      s%state = session_read
+      s%from_deck = .true.
+   end subroutine opened
 
    subroutine reset(s)
       type(session_type), intent(inout) :: s
