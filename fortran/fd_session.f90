@@ -3,7 +3,8 @@
 !> so that the deck and its record are read exactly once per run and every buffer the caller
 !> needs is sized here, from the deck and the result, never guessed.
 !>
-!> Life cycle: session_open (or session_open_text) reads and validates the deck; session_solve
+!> Life cycle: session_open (or session_open_text) reads and validates the deck, and asks its
+!> technique whether it can integrate the model (fd_technique's check_technique); session_solve
 !> runs it; session_text, session_shape and the result's history give what it produced;
 !> session_write writes the outputs with the library's writer. session_adopt makes a solved
 !> session from a history and texts given by the caller, to write them with the same writer.
@@ -29,6 +30,7 @@ module fd_session
    use fd_tempfiles, only: temp_tag, remove_stale_temps
    use fd_excitation, only: excitation_record
    use fd_spectrum, only: response_spectrum
+   use fd_technique, only: check_technique
    implicit none
    private
 
@@ -129,11 +131,7 @@ contains
       type(error_type), allocatable, intent(out) :: error !! bad or missing deck or record
       call reset(s)
       call read_deck(path, s%cfg, error)
-      if (allocated(error)) return
-      call deck_selection(s, error)
-      if (allocated(error)) return
-      s%state = session_read
-      s%from_deck = .true.
+      if (.not. allocated(error)) call opened(s, error)
    end subroutine session_open
 
    !> Read and validate a deck given as text into a fresh session; `path` names it in messages
@@ -145,11 +143,7 @@ contains
       type(error_type), allocatable, intent(out) :: error !! bad deck or record
       call reset(s)
       call read_deck_string(text, path, s%cfg, error)
-      if (allocated(error)) return
-      call deck_selection(s, error)
-      if (allocated(error)) return
-      s%state = session_read
-      s%from_deck = .true.
+      if (.not. allocated(error)) call opened(s, error)
    end subroutine session_open_text
 
    !> A solved session holding a history and texts given by the caller (no deck): what
@@ -480,6 +474,23 @@ contains
       end if
       call select_history(s%ctl, dofs, devices, s%cfg%model%n_dof, s%cfg%model%n_devices, error)
    end subroutine deck_selection
+
+   !> A deck just read: ask its technique whether it can integrate the model and the table
+   !> motion (fd_technique's check_technique; an error prefixed with the deck as the reader's
+   !> are), take the deck's history selection, and hold the deck.
+   subroutine opened(s, error)
+      type(session_type), intent(inout) :: s
+      type(error_type), allocatable, intent(out) :: error
+      call check_technique(s%cfg%model, s%cfg%exc, s%cfg%opts, error)
+      if (allocated(error)) then
+         error%message = s%cfg%deck_path//", "//error%message
+         return
+      end if
+      call deck_selection(s, error)
+      if (allocated(error)) return
+      s%state = session_read
+      s%from_deck = .true.
+   end subroutine opened
 
    subroutine reset(s)
       type(session_type), intent(inout) :: s

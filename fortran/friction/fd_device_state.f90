@@ -9,6 +9,7 @@ module fd_device_state
 
    public :: device_state, phase_stick, phase_slip_pos, phase_slip_neg, device_force
    public :: job_init, job_update, job_correct
+   public :: law_traits_type, stuck_none, stuck_rigid, stuck_spring, stuck_dashpot
 
    integer, parameter :: phase_stick = 0     !! sticking (adherence)
    integer, parameter :: phase_slip_pos = 1  !! sliding with positive relative velocity
@@ -18,6 +19,25 @@ module fd_device_state
    integer, parameter :: job_init = 1        !! phase and coefficients at t = 0
    integer, parameter :: job_update = 2      !! phase for the next step
    integer, parameter :: job_correct = 3     !! correctness condition of a step
+
+   ! how a sticking device joins the stuck system (a law's traits)
+   integer, parameter :: stuck_none = 0      !! not at all (a law without a case)
+   integer, parameter :: stuck_rigid = 1     !! a rigid link (exact Coulomb)
+   integer, parameter :: stuck_spring = 2    !! a spring, its sticking stiffness (hysteretic)
+   integer, parameter :: stuck_dashpot = 3   !! a dashpot, its band's coupling (velocity)
+
+   !> What a friction law says of itself, whatever its device's parameters: each law module
+   !> answers one (`<law>_traits`), fd_friction's law_traits gives a law's.
+   type :: law_traits_type
+      integer :: stuck = stuck_none                !! how it joins the stuck system (stuck_*)
+      character(len=4) :: band_name = ''           !! the &friction variable of its band ('' none)
+      character(len=4) :: coupling_name = ''       !! the variable that sets its sticking coupling
+      logical :: checks_correctness = .false.      !! Newmark checks its correctness condition
+      logical :: checks_stick_ringing = .false.    !! its sticking spring may ring (fd_stick_ringing)
+      logical :: checks_band_alternation = .false. !! its band may alternate (fd_band_alternation)
+      logical :: stores_energy = .false.           !! it stores elastic energy (friction_energy)
+      logical :: mu_of_speed = .false.             !! mu may depend on the sliding speed (mu_law)
+   end type law_traits_type
 
    !> Phase and force coefficients of one device.
    type :: device_state

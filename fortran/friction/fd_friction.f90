@@ -1,23 +1,182 @@
-!> Dispatch over the regularized friction laws (those Newmark integrates). Each law is one
-!> module with one entry, `<law>_law(job, ...)`, that does the job asked (init, update,
-!> correct); adding a law is that module, its row in fd_names' law table and one case in
-!> `dispatch` below. A law with no case here is an error at the start of a run, never a
-!> device without force.
+!> The one place that branches on the friction law. Each law is one module that says what it
+!> is (`<law>_traits`: how it sticks, its band, the checks that apply, the energy it stores) and
+!> gives its elemental kernels (init, update, correct, settle; its sticking stiffness or
+!> damping, whether it holds when stuck, its capacity, its energy); every routine here is one
+!> `select case` over the laws that calls them (as OpenSees's FrictionModel interface).
+!> Adding a law is that module, its row in fd_names' law table and one case in each
+!> `select case` below. A regularized law with no case here is an error at the start of a
+!> Newmark run (friction_init), never a device without force.
 module fd_friction
    use fd_kinds, only: dp
    use fd_error, only: error_type, fatal_error, fmt_int
-   use fd_model, only: device_type, law_velocity, law_hysteretic, law_name, mu_constant
-   use fd_device_state, only: device_state, job_init, job_update, job_correct
-   use fd_friction_velocity, only: velocity_law, velocity_update, velocity_correct, velocity_settle, velocity_follow
+   use fd_names, only: law_velocity, law_hysteretic, law_coulomb, law_name
+   use fd_model, only: device_type, mu_constant, device_parameter
+   use fd_device_state, only: device_state, job_init, job_update, job_correct, law_traits_type, &
+                              stuck_none, stuck_rigid, stuck_spring, stuck_dashpot
+   use fd_friction_velocity, only: velocity_law, velocity_update, velocity_correct, velocity_settle, velocity_follow, &
+                                   velocity_traits, velocity_damping, velocity_holds, velocity_capacity
    use fd_friction_hysteretic, only: hysteretic_law, hysteretic_update, hysteretic_correct, hysteretic_settle, &
-                                     hysteretic_energy
+                                     hysteretic_energy, hysteretic_traits, hysteretic_stiffness, hysteretic_holds
+   use fd_friction_coulomb, only: coulomb_traits, coulomb_holds
    implicit none
    private
 
    public :: friction_init, friction_update, friction_correct, friction_step, friction_settle
    public :: follows_velocity, friction_follow, friction_energy
+   ! what a law says of itself (law_traits) and of a device of it
+   public :: law_traits_type, law_traits, stuck_none, stuck_rigid, stuck_spring, stuck_dashpot
+   public :: law_stuck, law_band_name, law_coupling_name, law_checks_band_alternation, law_mu_of_speed
+   public :: sticking_stiffness, sticking_damping, holds_when_stuck, links_when_stuck, friction_capacity, law_band
 
 contains
+
+   ! ---------------------------------------------------------------- what a law is
+
+   !> The traits of a law (the default record, all .false., for an id without a case).
+   elemental function law_traits(law) result(traits)
+      integer, intent(in) :: law             !! law id (fd_names)
+      type(law_traits_type) :: traits        !! what it says of itself
+
+      select case (law)
+      case (law_velocity)
+         traits = velocity_traits()
+      case (law_hysteretic)
+         traits = hysteretic_traits()
+      case (law_coulomb)
+         traits = coulomb_traits()
+      case default
+         traits = law_traits_type()
+      end select
+   end function law_traits
+
+   !> How a sticking device of the law joins the stuck system: stuck_rigid, stuck_spring,
+   !> stuck_dashpot (stuck_none for an id without a case).
+   elemental integer function law_stuck(law) result(stuck)
+      integer, intent(in) :: law             !! law id
+
+      associate (t => law_traits(law))
+         stuck = t%stuck
+      end associate
+   end function law_stuck
+
+   !> The &friction variable of the law's band ('eps', 'eps1'; blank for a law without one).
+   elemental function law_band_name(law) result(name)
+      integer, intent(in) :: law             !! law id
+      character(len=4) :: name               !! the variable's name, left-adjusted
+
+      associate (t => law_traits(law))
+         name = t%band_name
+      end associate
+   end function law_band_name
+
+   !> The &friction variable that sets the law's sticking coupling ('eps' for the band's
+   !> dashpot, 'f' for the hysteretic spring; blank for a law without one).
+   elemental function law_coupling_name(law) result(name)
+      integer, intent(in) :: law             !! law id
+      character(len=4) :: name               !! the variable's name, left-adjusted
+
+      associate (t => law_traits(law))
+         name = t%coupling_name
+      end associate
+   end function law_coupling_name
+
+   !> Whether the law's band force may alternate from step to step (fd_band_alternation).
+   elemental logical function law_checks_band_alternation(law) result(checks)
+      integer, intent(in) :: law             !! law id
+
+      associate (t => law_traits(law))
+         checks = t%checks_band_alternation
+      end associate
+   end function law_checks_band_alternation
+
+   !> Whether the law's mu may depend on the sliding speed (mu_law other than 'constant').
+   elemental logical function law_mu_of_speed(law) result(speed)
+      integer, intent(in) :: law             !! law id
+
+      associate (t => law_traits(law))
+         speed = t%mu_of_speed
+      end associate
+   end function law_mu_of_speed
+
+   ! ---------------------------------------------------------------- what a device of it is
+
+   !> The sticking spring of a device [N/m]: k = P mu / f of a hysteretic device with P mu > 0
+   !> (eq. 3); 0 for the others (a velocity-law device sticks through a dashpot, a Coulomb one
+   !> rigidly). The stuck system's modes and stiffness, the step limits, the step checks and
+   !> the stick ringing take it from here.
+   elemental real(dp) function sticking_stiffness(dev) result(k)
+      type(device_type), intent(in) :: dev   !! the device
+
+      select case (dev%law)
+      case (law_hysteretic)
+         k = hysteretic_stiffness(dev)
+      case default
+         k = 0.0_dp
+      end select
+   end function sticking_stiffness
+
+   !> The sticking dashpot of a device [N s/m]: the velocity law's band coupling
+   !> P mu(eps) / eps (eq. 6); 0 for the others.
+   elemental real(dp) function sticking_damping(dev) result(c)
+      type(device_type), intent(in) :: dev   !! the device
+
+      select case (dev%law)
+      case (law_velocity)
+         c = velocity_damping(dev)
+      case default
+         c = 0.0_dp
+      end select
+   end function sticking_damping
+
+   !> Whether a device holds its nodes together while it sticks (a link of the stuck system,
+   !> or its spring): each law says (a velocity-law device through P mu(eps) > 0, the others
+   !> with P mu > 0); .false. for a law without a case.
+   elemental logical function holds_when_stuck(dev) result(holds)
+      type(device_type), intent(in) :: dev   !! the device
+
+      select case (dev%law)
+      case (law_velocity)
+         holds = velocity_holds(dev)
+      case (law_hysteretic)
+         holds = hysteretic_holds(dev)
+      case (law_coulomb)
+         holds = coulomb_holds(dev)
+      case default
+         holds = .false.
+      end select
+   end function holds_when_stuck
+
+   !> Whether a sticking device is a rigid link of the stuck system's groups: it holds, and
+   !> not through a spring (which the stuck stiffness carries instead).
+   elemental logical function links_when_stuck(dev) result(links)
+      type(device_type), intent(in) :: dev   !! the device
+
+      links = holds_when_stuck(dev)
+      if (links) links = law_stuck(dev%law) /= stuck_spring
+   end function links_when_stuck
+
+   !> The friction capacity of a device, P times the largest mu at any sliding speed [N]: a
+   !> device with none never slips.
+   elemental real(dp) function friction_capacity(dev) result(cap)
+      type(device_type), intent(in) :: dev   !! the device
+
+      select case (dev%law)
+      case (law_velocity)
+         cap = velocity_capacity(dev)
+      case default
+         cap = dev%p*dev%mu
+      end select
+   end function friction_capacity
+
+   !> The band of a device [m/s]: the value of its law's band variable (law_band_name: eps of
+   !> the velocity law, eps1 of the hysteretic law); 0 for a law without one.
+   elemental real(dp) function law_band(dev) result(band)
+      type(device_type), intent(in) :: dev   !! the device
+
+      band = device_parameter(dev, law_band_name(dev%law))
+   end function law_band
+
+   ! ---------------------------------------------------------------- the time step
 
    !> The one dispatch over the laws: do `job` for device dev with its law.
    elemental subroutine dispatch(job, dev, n, s, sdot, sdot_old, st, changed, ok, known)
@@ -51,8 +210,8 @@ contains
    !> and friction_correct do device by device, in one loop that calls each law's routines
    !> directly (the time step's per-device cost in a large structure; explicit shapes, since
    !> building array descriptors at every call cost more than a two-mass model's laws). A
-   !> device whose law has no case here keeps its state (friction_init rejected it before the
-   !> first step).
+   !> law with no case of its own here goes through `dispatch` (a law unknown there too keeps
+   !> its state: friction_init rejected it before the first step).
    subroutine friction_step(nd, dev, n, s1, sd1, sd, st, st1, changed, ok, any_changed, any_bad)
       integer, intent(in) :: nd                 !! devices
       type(device_type), intent(in) :: dev(nd)  !! devices
@@ -80,13 +239,32 @@ contains
             call velocity_update(dev(d), s1(d), sd1(d), st1(d), changed(d))
             ok(d) = velocity_correct(dev(d), n, st(d), sd(d), sd1(d))
          case default
-            changed(d) = .false.
-            ok(d) = .true.
+            call step_by_dispatch(dev(d), n, s1(d), sd1(d), sd(d), st(d), st1(d), changed(d), ok(d))
          end select
          any_changed = any_changed .or. changed(d)
          any_bad = any_bad .or. .not. ok(d)
       end do
    end subroutine friction_step
+
+   !> friction_step for one device of a law without a case of its own there: the update and
+   !> the correctness condition through `dispatch`.
+   elemental subroutine step_by_dispatch(dev, n, s1, sd1, sd, st, st1, changed, ok)
+      type(device_type), intent(in) :: dev      !! device parameters
+      real(dp), intent(in) :: n                 !! n > 1 of the correctness condition
+      real(dp), intent(in) :: s1                !! relative displacement at the step's end [m]
+      real(dp), intent(in) :: sd1               !! relative velocity at the step's end [m/s]
+      real(dp), intent(in) :: sd                !! relative velocity at its start [m/s]
+      type(device_state), intent(in) :: st      !! state during the step
+      type(device_state), intent(inout) :: st1  !! state for the next step
+      logical, intent(out) :: changed           !! the phase changed
+      logical, intent(out) :: ok                !! the step satisfies the condition
+      type(device_state) :: st_copy
+      logical :: known, unused
+
+      call dispatch(job_update, dev, n, s1, sd1, sd, st1, changed, ok, known)
+      st_copy = st
+      call dispatch(job_correct, dev, n, s1, sd1, sd, st_copy, unused, ok, known)
+   end subroutine step_by_dispatch
 
    !> `refinement = 'implicit'`: the state of every device in which to take a step that ends
    !> in the phases of st1 (the law's update at the end of the last trial, where the relative
@@ -123,8 +301,9 @@ contains
       end do
    end subroutine friction_settle
 
-   !> Elastic energy a device stores at relative displacement s in its state (the hysteretic
-   !> law's spring; the velocity law stores none: its band is a dashpot).
+   !> Elastic energy a device stores at relative displacement s in its state [J] (a law whose
+   !> traits say stores_energy: the hysteretic law's spring; the velocity law stores none: its
+   !> band is a dashpot).
    elemental real(dp) function friction_energy(dev, st, s) result(e)
       type(device_type), intent(in) :: dev      !! device parameters
       type(device_state), intent(in) :: st      !! its state
@@ -138,18 +317,14 @@ contains
       end select
    end function friction_energy
 
-   !> Whether a device's sliding force depends on the velocity within a step (a velocity-law
-   !> device with a speed-dependent mu): the time-step loop iterates such forces to the
-   !> velocity at the step's end (friction_follow).
+   !> Whether a device's sliding force depends on the velocity within a step (a device of a law
+   !> whose mu may depend on the sliding speed, law_mu_of_speed, with a mu_law that does): the
+   !> time-step loop iterates such forces to the velocity at the step's end (friction_follow).
    elemental logical function follows_velocity(dev) result(follows)
       type(device_type), intent(in) :: dev      !! device parameters
 
-      select case (dev%law)
-      case (law_velocity)
-         follows = dev%mu_law /= mu_constant
-      case default
-         follows = .false.
-      end select
+      follows = law_mu_of_speed(dev%law)
+      if (follows) follows = dev%mu_law /= mu_constant
    end function follows_velocity
 
    !> For the devices fl(1:nf) (those follows_velocity picks), the change df of their constant

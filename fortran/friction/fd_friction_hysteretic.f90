@@ -14,16 +14,42 @@
 !> within one step reverses. docs/theory.md section 5.2.
 module fd_friction_hysteretic
    use fd_kinds, only: dp
-   use fd_model, only: device_type, sticking_stiffness
+   use fd_model, only: device_type
    use fd_device_state, only: device_state, phase_stick, phase_slip_pos, phase_slip_neg, &
-                              job_init, job_update, job_correct
+                              job_init, job_update, job_correct, law_traits_type, stuck_spring
    implicit none
    private
 
    public :: hysteretic_law, hysteretic_init, hysteretic_update, hysteretic_correct, hysteretic_settle
-   public :: hysteretic_energy
+   public :: hysteretic_energy, hysteretic_traits, hysteretic_stiffness, hysteretic_holds
 
 contains
+
+   !> What the hysteretic law says of itself: while it sticks, a spring k = P mu / f (eq. 3, set
+   !> by f) that may ring; its slides end in the band |sdot| < eps1; Newmark checks eq. 12 in
+   !> its armed slides; its spring stores elastic energy.
+   pure function hysteretic_traits() result(traits)
+      type(law_traits_type) :: traits   !! the hysteretic law's traits
+
+      traits = law_traits_type(stuck=stuck_spring, band_name='eps1', coupling_name='f', checks_correctness=.true., &
+                               checks_stick_ringing=.true., stores_energy=.true.)
+   end function hysteretic_traits
+
+   !> The sticking spring k = P mu / f (eq. 3) [N/m]; 0 for a device with P mu = 0 (no
+   !> friction capacity, no force).
+   elemental real(dp) function hysteretic_stiffness(dev) result(k)
+      type(device_type), intent(in) :: dev     !! device parameters
+
+      k = 0.0_dp
+      if (dev%p*dev%mu > 0.0_dp) k = dev%p*dev%mu/dev%f
+   end function hysteretic_stiffness
+
+   !> Whether a sticking device holds its nodes together (through its spring): P mu > 0.
+   elemental logical function hysteretic_holds(dev) result(holds)
+      type(device_type), intent(in) :: dev     !! device parameters
+
+      holds = dev%p*dev%mu > 0.0_dp
+   end function hysteretic_holds
 
    !> Elastic energy stored in the device's spring: F^2 / (2 k) with k = P mu / f, in either
    !> phase (eq. 3: sliding, the spring holds P mu; it is released only when the force falls).
@@ -34,7 +60,7 @@ contains
       real(dp) :: k, force
 
       e = 0.0_dp
-      k = sticking_stiffness(dev)
+      k = hysteretic_stiffness(dev)
       if (k <= 0.0_dp) return
       force = st%ks*s + st%f0          ! no damping in the law: the spring's force
       e = 0.5_dp*force*force/k
@@ -98,7 +124,7 @@ contains
       if (slip == 0.0_dp) then
          ! no friction capacity: F = 0 (k = 0), never slips
       else if (st%phase == phase_stick) then
-         force = st%ks*(s - st%centre)                           ! st%ks: sticking_stiffness
+         force = st%ks*(s - st%centre)                           ! st%ks: hysteretic_stiffness
          if (abs(force) >= slip) then
             st%phase = merge(phase_slip_pos, phase_slip_neg, force > 0.0_dp)
             st%armed = abs(sdot) >= dev%eps1
@@ -192,7 +218,7 @@ contains
 
       st%cs = 0.0_dp
       if (st%phase == phase_stick) then
-         k = sticking_stiffness(dev)
+         k = hysteretic_stiffness(dev)
          st%ks = k
          st%f0 = -k*st%centre
       else

@@ -11,15 +11,60 @@
 !> band the coupling is P mu(eps) / eps, continuous with the sliding force at |sdot| = eps.
 module fd_friction_velocity
    use fd_kinds, only: dp
-   use fd_model, only: device_type, mu_constant, largest_mu, sliding_mu
+   use fd_model, only: device_type, mu_constant, mu_exponential, mu_table, sliding_mu
    use fd_device_state, only: device_state, phase_stick, phase_slip_pos, phase_slip_neg, &
-                              job_init, job_update, job_correct
+                              job_init, job_update, job_correct, law_traits_type, stuck_dashpot
    implicit none
    private
 
    public :: velocity_law, velocity_init, velocity_update, velocity_correct, velocity_settle, velocity_follow
+   public :: velocity_traits, velocity_damping, velocity_holds, velocity_capacity, largest_mu
 
 contains
+
+   !> What the velocity law says of itself: while it sticks, a dashpot (its band's coupling
+   !> P mu(eps) / eps, set by eps) in the band |sdot| < eps; Newmark checks eq. 9 in its slides;
+   !> its band's force may alternate from step to step; it stores no energy; mu may depend on
+   !> the sliding speed.
+   pure function velocity_traits() result(traits)
+      type(law_traits_type) :: traits   !! the velocity law's traits
+
+      traits = law_traits_type(stuck=stuck_dashpot, band_name='eps', coupling_name='eps', checks_correctness=.true., &
+                               checks_band_alternation=.true., mu_of_speed=.true.)
+   end function velocity_traits
+
+   !> The band's coupling P mu(eps) / eps [N s/m]: the dashpot of a sticking device (eq. 6).
+   elemental real(dp) function velocity_damping(dev) result(c)
+      type(device_type), intent(in) :: dev   !! device parameters
+
+      c = dev%p*sliding_mu(dev, dev%eps)/dev%eps
+   end function velocity_damping
+
+   !> Whether a sticking device holds its nodes together: through its band's coupling, so
+   !> P mu(eps) > 0 (a speed-dependent mu that is 0 in the band holds nothing).
+   elemental logical function velocity_holds(dev) result(holds)
+      type(device_type), intent(in) :: dev   !! device parameters
+
+      holds = dev%p*sliding_mu(dev, dev%eps) > 0.0_dp
+   end function velocity_holds
+
+   !> The friction capacity P mu_max [N], mu_max the largest mu at any sliding speed.
+   elemental real(dp) function velocity_capacity(dev) result(cap)
+      type(device_type), intent(in) :: dev   !! device parameters
+
+      cap = dev%p*largest_mu(dev)
+   end function velocity_capacity
+
+   !> The largest friction coefficient of a device at any sliding speed: mu itself (constant
+   !> law; exponential, where it is mu_max; the larger of it and mu_min), or the table's largest
+   !> value. P times it is the device's friction capacity: a device with none never slips.
+   elemental real(dp) function largest_mu(dev) result(mu)
+      type(device_type), intent(in) :: dev   !! device parameters
+
+      mu = dev%mu
+      if (dev%mu_law == mu_table) mu = maxval(dev%mu_at(1:dev%n_mu_points))
+      if (dev%mu_law == mu_exponential) mu = max(dev%mu, dev%mu_min)
+   end function largest_mu
 
    !> The law's entry for the dispatch (fd_friction): init, update or correct, by job.
    elemental subroutine velocity_law(job, dev, n, s, sdot, sdot_old, st, changed, ok)

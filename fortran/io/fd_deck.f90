@@ -1,6 +1,7 @@
 !> The deck reader: one namelist deck is one run. Groups &model, &springs, &damping and
 !> &excitation are required; &friction, &integration and &output are optional. Every value
-!> is validated after reading, and the model against the technique chosen; messages name
+!> is validated after reading (what the technique chosen can integrate is the technique's to
+!> say: fd_technique's check_technique, which the session asks after reading); messages name
 !> the file, the group, the variable and the value. Keywords, their lists in messages and
 !> every default come from fd_names. docs/namelist.md documents every variable.
 module fd_deck
@@ -28,16 +29,15 @@ module fd_deck
    use fd_kinematics, only: set_pair_directions
    use fd_excitation, only: excitation_type
    use fd_record, only: read_record, record_info, record_formats, record_units_list, units_factor
-   use fd_technique, only: check_technique
    use fd_names, only: label_len, max_mu_points, mu_laws, mu_constant, mu_exponential, mu_table, mode_systems, &
-                       system_stuck, law_velocity, law_hysteretic, technique_event_driven, technique_newmark, &
+                       system_stuck, law_hysteretic, &
                        default_mu_law, default_mode_system, default_n_modes, default_radius, &
                        default_storey_height, law_name
    use fd_model, only: source_friction, source_brace, source_isolator
+   use fd_friction, only: law_mu_of_speed
    use fd_matrices, only: modes_type, natural_modes, natural_modes_sparse, stiffness_matrix, modes_dense_dofs
    use fd_sha256, only: sha256_text
    use fd_textio, only: read_file_text, cr_line_ends
-   use fd_step_limits, only: check_step_limits
    use fd_result, only: history_shape
    implicit none
    private
@@ -158,20 +158,9 @@ contains
       if (allocated(error)) return
       call read_output_group(deck, cfg, error)
       if (allocated(error)) return
-      ! 'rayleigh' damping from xi at two modes; shorthands the technique cannot integrate
+      ! 'rayleigh' damping from xi at two modes (what the technique can integrate is asked by
+      ! the session, fd_technique's check_technique)
       call resolve_rayleigh(deck, cfg, error)
-      if (allocated(error)) return
-      call check_shorthands(deck, cfg, error)
-      if (allocated(error)) return
-      ! what the technique cannot integrate (a law, a table motion)
-      call check_technique(cfg%model, cfg%exc, cfg%opts, error)
-      if (allocated(error)) then
-         error%message = deck%path//", "//error%message
-         return
-      end if
-      ! Newmark's steps: bounded work, digits left in the effective stiffness
-      if (cfg%opts%technique == technique_newmark) call check_step_limits(cfg%model, cfg%exc, cfg%opts, error)
-      if (allocated(error)) error%message = deck%path//", "//error%message
    end subroutine read_groups
 
    ! ---------------------------------------------------------------- &model
@@ -1297,7 +1286,7 @@ contains
 
       dev%mu_law = id
       if (id == mu_constant) return
-      if (dev%law /= law_velocity) then
+      if (.not. law_mu_of_speed(dev%law)) then
          call bad(deck, group, 'mu_law('//trim(fmt_int(i))//')', "'"//trim(mu_laws(id)%name)//"'", &
                   "'constant' with law("//trim(fmt_int(i))//") = '"//trim(law_name(dev%law))//"': "// &
                   "velocity-dependent friction is available for the velocity law only (docs/theory.md, 5.4)", error)
@@ -1462,26 +1451,6 @@ contains
       if (.not. allocated(error)) call check_magnitude(deck, 'damping', 'rayleigh_a1 (from xi, mode_i, mode_j)', &
                                                        cfg%model%rayleigh_a1, 's', .false., error)
    end subroutine resolve_rayleigh
-
-   !> What the technique cannot do with the shorthands: braces are hysteretic devices, which
-   !> only Newmark integrates (the exact Coulomb techniques' devices are rigid while stuck).
-   subroutine check_shorthands(deck, cfg, error)
-      type(deck_text), intent(in) :: deck
-      type(run_config), intent(inout) :: cfg
-      type(error_type), allocatable, intent(out) :: error
-      integer :: d
-
-      if (cfg%opts%technique == technique_newmark) return
-      do d = 1, cfg%model%n_devices
-         if (cfg%model%dev(d)%source /= source_brace) cycle
-         call fatal_error(error, deck%path//", group &braces: brace "//trim(fmt_int(cfg%model%dev(d)%source_index))// &
-                          " cannot be integrated with technique = '"//trim(technique_name(cfg%opts%technique))// &
-                          "' of &integration: a brace's elastic stiffness in series with the damper is the "// &
-                          "sticking stiffness of the hysteretic law, which only technique = 'newmark' integrates "// &
-                          "(the exact Coulomb techniques' devices are rigid while stuck); set technique = 'newmark'")
-         return
-      end do
-   end subroutine check_shorthands
 
    ! ---------------------------------------------------------------- helpers
    !> Size of a group's arrays, from the count the group declares (`count_var`, read from its

@@ -6,9 +6,9 @@ module fd_matrices
    use, intrinsic :: ieee_arithmetic, only: ieee_value, ieee_positive_inf, ieee_quiet_nan
    use fd_kinds, only: dp
    use fd_error, only: error_type, fatal_error, fmt_real, fmt_int, stat_no_memory
-   use fd_model, only: model_type, damping_none, damping_stiffness, damping_rayleigh, law_hysteretic, sticking_stiffness, &
-                       holds_when_stuck, &
+   use fd_model, only: model_type, damping_none, damping_stiffness, damping_rayleigh, &
                        system_stuck, system_free
+   use fd_friction, only: sticking_stiffness, holds_when_stuck, links_when_stuck
    use fd_linalg, only: generalized_eigen, lowest_eigen, lowest_eigen_band
    use fd_rcm, only: rcm_order
    use fd_modes, only: lowest_modes
@@ -701,8 +701,7 @@ contains
       allocate (grp(model%n_dof), linked(model%n_devices), stat=stat)
       if (stat /= 0) return
       do d = 1, model%n_devices
-         linked(d) = system == system_stuck .and. holds_when_stuck(model%dev(d)) .and. &
-                     model%dev(d)%law /= law_hysteretic
+         linked(d) = system == system_stuck .and. links_when_stuck(model%dev(d))
       end do
       call link_groups(model, linked, grp, modes%nq)
       if (modes%nq > 0) return

@@ -24,7 +24,7 @@ module fd_model
    public :: mu_constant, mu_exponential, mu_table, label_len, max_mu_points
    public :: system_stuck, system_free
    public :: source_friction, source_brace, source_isolator
-   public :: sticking_stiffness, largest_mu, sliding_mu, holds_when_stuck
+   public :: sliding_mu, device_parameter
 
    ! where a device (or spring) of the model comes from in the deck
    integer, parameter :: source_friction = 0  !! &friction (or &springs)
@@ -124,18 +124,6 @@ module fd_model
 
 contains
 
-   !> The sticking spring of a device, k = P mu / f (eq. 3): a hysteretic device with P mu > 0;
-   !> 0 for the others (a velocity-law device sticks through damping, a Coulomb one rigidly).
-   !> The hysteretic law (at a change of phase; between changes it reads k from the device's
-   !> state), the stuck system's modes, the step limits and the step-resolution report take
-   !> it from here.
-   elemental real(dp) function sticking_stiffness(dev) result(k)
-      type(device_type), intent(in) :: dev  !! the device
-
-      k = 0.0_dp
-      if (dev%law == law_hysteretic .and. dev%p*dev%mu > 0.0_dp) k = dev%p*dev%mu/dev%f
-   end function sticking_stiffness
-
    !> Friction coefficient at the sliding speed |v|: mu itself (constant), the exponential
    !> mu_max - (mu_max - mu_min) exp(-rate |v|) with mu_max = mu, or linear between the table's
    !> points (constant before the first and after the last).
@@ -167,28 +155,27 @@ contains
       end select
    end function sliding_mu
 
-   !> Whether a device holds its nodes together while it sticks (a link of the stuck system):
-   !> a velocity-law device through its band's coupling P mu(eps) / eps, so P mu(eps) > 0 (a
-   !> speed-dependent mu that is 0 in the band holds nothing); any other with P mu > 0.
-   elemental logical function holds_when_stuck(dev) result(holds)
-      type(device_type), intent(in) :: dev   !! device parameters
+   !> The value of a device's real &friction variable by its name ('p', 'mu', 'eps', 'eps1',
+   !> 'f'); 0 for a blank or another name (a friction law names its band and its sticking
+   !> coupling by the variable that sets them, fd_friction).
+   elemental real(dp) function device_parameter(dev, name) result(value)
+      type(device_type), intent(in) :: dev        !! the device
+      character(len=*), intent(in) :: name        !! the variable, lower case
 
-      if (dev%law == law_velocity) then
-         holds = dev%p*sliding_mu(dev, dev%eps) > 0.0_dp
-      else
-         holds = dev%p*dev%mu > 0.0_dp
-      end if
-   end function holds_when_stuck
-
-   !> The largest friction coefficient of a device at any sliding speed: mu itself (constant
-   !> law; exponential, where it is mu_max; the larger of it and mu_min), or the table's largest
-   !> value. P times it is the device's friction capacity: a device with none never slips.
-   elemental real(dp) function largest_mu(dev) result(mu)
-      type(device_type), intent(in) :: dev   !! device parameters
-
-      mu = dev%mu
-      if (dev%mu_law == mu_table) mu = maxval(dev%mu_at(1:dev%n_mu_points))
-      if (dev%mu_law == mu_exponential) mu = max(dev%mu, dev%mu_min)
-   end function largest_mu
+      select case (name)
+      case ('p')
+         value = dev%p
+      case ('mu')
+         value = dev%mu
+      case ('eps')
+         value = dev%eps
+      case ('eps1')
+         value = dev%eps1
+      case ('f')
+         value = dev%f
+      case default
+         value = 0.0_dp
+      end select
+   end function device_parameter
 
 end module fd_model

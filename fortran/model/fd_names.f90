@@ -5,8 +5,8 @@
 !> docs/namelist.md documents each of them.
 !>
 !> The id of a keyword is its position in its table. Adding a friction law is one row in
-!> `laws` with its id below it, one module in fortran/friction and one case in
-!> fd_friction's dispatch.
+!> `laws` with its id below it (public), one module in fortran/friction and one case in each
+!> `select case` of fd_friction.
 module fd_names
    use fd_kinds, only: dp
    use fd_textio, only: lower
@@ -16,6 +16,8 @@ module fd_names
    public :: keyword_type, law_type, keyword_len
    public :: laws, law_velocity, law_hysteretic, law_coulomb
    public :: techniques, technique_newmark, technique_event_driven, technique_moreau_jean
+   public :: technique_traits_type, technique_traits, technique_step_rule, technique_integrates
+   public :: rule_none, rule_newmark, rule_theta
    public :: damping_types, damping_stiffness, damping_rayleigh, damping_none
    public :: excitation_types, excitation_harmonic, excitation_record, excitation_none
    public :: record_kinds, record_acceleration, record_displacement
@@ -68,6 +70,30 @@ module fd_names
    integer, parameter :: technique_newmark = 1      !! Newmark with the paper's step control
    integer, parameter :: technique_event_driven = 2 !! exact event-driven Coulomb technique
    integer, parameter :: technique_moreau_jean = 3  !! Moreau-Jean time stepping, exact Coulomb impulses
+
+   ! the rule of a technique's steps dt1, which the step checks (fd_*_resolution) analyse
+   integer, parameter :: rule_none = 0      !! no step dt1 (event by event)
+   integer, parameter :: rule_newmark = 1   !! Newmark's beta, gamma
+   integer, parameter :: rule_theta = 2     !! the theta-method (Moreau-Jean)
+
+   !> What a technique says of itself, whatever the deck's settings: the laws it integrates,
+   !> the rule of its steps, whether it refines a step, what its history rows hold. The
+   !> technique's answer to technique_traits (one row of technique_table, by id): a constant
+   !> of the names table, so that every layer may ask it (the result's history shape is
+   !> sized before any technique runs). docs/architecture.md, "Where to add".
+   type :: technique_traits_type
+      logical :: regularized_laws = .false.  !! integrates the regularized laws (laws%regularized)
+      logical :: set_valued_laws = .false.   !! integrates the set-valued law (exact Coulomb)
+      integer :: step_rule = rule_none       !! the rule of its steps dt1 (rule_*)
+      logical :: refines_steps = .false.     !! refines a step dt1 (dt2, dt_min: fd_step_limits)
+      logical :: envelope = .false.          !! its history rows carry the maxima since the last row
+   end type technique_traits_type
+
+   !> Each technique's traits, by id (the order of `techniques`).
+   type(technique_traits_type), parameter :: technique_table(*) = [ &
+      technique_traits_type(regularized_laws=.true., step_rule=rule_newmark, refines_steps=.true.), & ! newmark
+      technique_traits_type(set_valued_laws=.true., envelope=.true.), &                               ! event_driven
+      technique_traits_type(set_valued_laws=.true., step_rule=rule_theta)]                            ! moreau_jean
 
    ! ------------------------------------------------------------------ damping types
    type(keyword_type), parameter :: damping_types(*) = [ &
@@ -236,6 +262,42 @@ contains
       name = 'unknown'
       if (law >= 1 .and. law <= size(laws)) name = laws(law)%name
    end function law_name
+
+   !> The traits of a technique (the default record, nothing integrated and no step, for an
+   !> id not in the table).
+   pure function technique_traits(technique) result(traits)
+      integer, intent(in) :: technique          !! technique id
+      type(technique_traits_type) :: traits     !! what it says of itself
+
+      traits = technique_traits_type()
+      if (technique >= 1 .and. technique <= size(technique_table)) traits = technique_table(technique)
+   end function technique_traits
+
+   !> The rule of a technique's steps dt1 (rule_none for a technique that takes none).
+   pure integer function technique_step_rule(technique) result(rule)
+      integer, intent(in) :: technique          !! technique id
+      type(technique_traits_type) :: traits
+
+      traits = technique_traits(technique)
+      rule = traits%step_rule
+   end function technique_step_rule
+
+   !> Whether a technique integrates a law: the regularized laws, or the set-valued one
+   !> (laws%regularized); .false. for an id not in either table.
+   pure logical function technique_integrates(technique, law) result(integrates)
+      integer, intent(in) :: technique          !! technique id
+      integer, intent(in) :: law                !! law id
+      type(technique_traits_type) :: traits
+
+      integrates = .false.
+      if (law < 1 .or. law > size(laws)) return
+      traits = technique_traits(technique)
+      if (laws(law)%regularized) then
+         integrates = traits%regularized_laws
+      else
+         integrates = traits%set_valued_laws
+      end if
+   end function technique_integrates
 
    !> Name of a technique, as written in decks ('unknown' for an id not in the table).
    pure function technique_name(technique) result(name)

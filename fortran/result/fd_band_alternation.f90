@@ -42,9 +42,9 @@
 module fd_band_alternation
    use fd_kinds, only: dp
    use fd_error, only: error_type, fatal_error, fmt_int, stat_no_memory
-   use fd_model, only: model_type, device_type, sliding_mu, holds_when_stuck
+   use fd_model, only: model_type, device_type, sliding_mu
    use fd_kinematics, only: add_device_abs, device_abs_inverse_mass_relative
-   use fd_names, only: law_velocity
+   use fd_friction, only: holds_when_stuck, law_checks_band_alternation
    use fd_device_state, only: device_state, phase_stick
    use fd_result, only: result_type, resolution_none, resolution_resolved, resolution_unresolved
    implicit none
@@ -130,7 +130,7 @@ contains
    elemental logical function watched(dev)
       type(device_type), intent(in) :: dev
 
-      watched = dev%law == law_velocity .and. holds_when_stuck(dev)
+      watched = law_checks_band_alternation(dev%law) .and. holds_when_stuck(dev)
    end function watched
 
    !> An accepted step of length h: the watched devices' forces at its end (f, in the phases

@@ -4,7 +4,8 @@ module fd_result
    use fd_kinds, only: dp
    use, intrinsic :: ieee_arithmetic, only: ieee_is_finite
    use fd_error, only: error_type, fatal_error, fmt_int, fmt_real, stat_no_memory
-   use fd_model, only: model_type, integration_type, technique_event_driven
+   use fd_model, only: model_type, integration_type
+   use fd_names, only: technique_traits_type, technique_traits
    use fd_excitation, only: excitation_type
    use fd_engineering, only: engineering_type, engineering_columns
    use fd_matrices, only: modes_type
@@ -189,11 +190,13 @@ contains
 
    !> Whether a run of these settings writes, after the state columns, the maxima of |u|,
    !> |v|, |aabs| per DOF, |s|, |F| per device and |drift|, |V| per storey and |Vb| since the
-   !> previous row (the exact technique, whose solution between rows is known).
+   !> previous row (a technique whose solution between rows is known: its traits' envelope).
    pure logical function has_envelope(opts)
       type(integration_type), intent(in) :: opts    !! integration settings
+      type(technique_traits_type) :: traits
 
-      has_envelope = opts%technique == technique_event_driven
+      traits = technique_traits(opts%technique)
+      has_envelope = traits%envelope
    end function has_envelope
 
    !> Size of the history a run writes: columns t, ag, (u, v, aabs) per DOF and

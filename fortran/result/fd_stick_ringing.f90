@@ -35,9 +35,9 @@
 module fd_stick_ringing
    use fd_kinds, only: dp
    use fd_error, only: error_type, fatal_error, fmt_int, stat_no_memory
-   use fd_model, only: model_type, sticking_stiffness
+   use fd_model, only: model_type
    use fd_kinematics, only: moved_mass, device_nodes
-   use fd_names, only: law_velocity
+   use fd_friction, only: sticking_stiffness, law_stuck, stuck_dashpot
    use fd_device_state, only: device_state, phase_stick
    use fd_result, only: result_type, resolution_none, resolution_resolved, resolution_unresolved
    implicit none
@@ -129,7 +129,7 @@ contains
       allocate (di(nd), dj(nd), velocity(nd), stat=stat)
       if (stat == 0) then
          call device_nodes(model, di, dj, first)
-         velocity = model%dev(1:nd)%law == law_velocity
+         velocity = law_stuck(model%dev(1:nd)%law) == stuck_dashpot
          call incidence(model%n_dof, model%spring_i(1:ns), model%spring_j(1:ns), [(.true., i=1, ns)], &
                         sp_first, sp_list, stat)
       end if

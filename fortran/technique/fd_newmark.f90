@@ -28,10 +28,10 @@ module fd_newmark
    use, intrinsic :: ieee_arithmetic, only: ieee_is_finite
    use fd_kinds, only: dp
    use fd_error, only: error_type, fatal_error, fmt_real, fmt_int, stat_no_memory
-   use fd_names, only: laws, law_name, law_choices, excitation_types, technique_name, technique_newmark, &
+   use fd_names, only: technique_integrates, law_name, law_choices, excitation_types, technique_name, technique_newmark, &
                        technique_event_driven, technique_moreau_jean, linear_system_dense, linear_system_banded, &
                        refinement_nested, refinement_implicit
-   use fd_model, only: model_type, integration_type, device_type, largest_mu
+   use fd_model, only: model_type, integration_type, device_type
    use fd_excitation, only: excitation_type, table_motion, table_acceleration, grid_motion, grid_init, &
                             grid_acceleration
    use fd_matrices, only: structure_damping
@@ -41,7 +41,7 @@ module fd_newmark
                         spd_copy
    use fd_device_state, only: device_state, device_force, phase_stick
    use fd_friction, only: friction_init, friction_step, friction_settle, follows_velocity, friction_follow, &
-                          friction_energy
+                          friction_energy, friction_capacity
    use fd_result, only: result_type
    use fd_run_control, only: run_control
    use fd_observer, only: observer_type, observer_init, sample_due, observe_start_energies, observe_peaks, &
@@ -117,9 +117,7 @@ contains
 
       do d = 1, model%n_devices
          law = model%dev(d)%law
-         if (law >= 1 .and. law <= size(laws)) then
-            if (laws(law)%regularized) cycle
-         end if
+         if (technique_integrates(technique_newmark, law)) cycle
          idx = 'law('//trim(fmt_int(d))//')'
          call law_choices(allowed, regularized=.true.)
          call fatal_error(error, "group &friction: "//idx//" = '"//trim(law_name(law))//"' is invalid with "// &
@@ -333,7 +331,7 @@ contains
          return
       end if
       w%fl = pack([(l, l=1, nd)], follows_velocity(model%dev))
-      w%cap = model%dev(w%fl)%p*largest_mu(model%dev(w%fl))
+      w%cap = friction_capacity(model%dev(w%fl))
    end subroutine setup
 
    !> Acceleration in equilibrium with the current phases: M a = p - C v - K u - sum b F

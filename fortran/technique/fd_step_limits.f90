@@ -13,8 +13,9 @@
 module fd_step_limits
    use fd_kinds, only: dp
    use fd_error, only: error_type, fatal_error, fmt_int, fmt_real
-   use fd_names, only: law_velocity, law_hysteretic
-   use fd_model, only: model_type, integration_type, sticking_stiffness, largest_mu, sliding_mu
+   use fd_model, only: model_type, integration_type, device_parameter
+   use fd_friction, only: sticking_stiffness, sticking_damping, friction_capacity, law_band, law_band_name, &
+                          law_coupling_name
    use fd_kinematics, only: moved_mass, pair_nodes
    use fd_excitation, only: excitation_type
    implicit none
@@ -96,19 +97,12 @@ contains
    end function finest_step
 
    !> The band of device d's law: eps (velocity law), eps1 (hysteretic law), 0 for a law
-   !> without one.
+   !> without one (fd_friction's law_band).
    pure real(dp) function band_of(model, d) result(band)
       type(model_type), intent(in) :: model  !! the model
       integer, intent(in) :: d               !! the device
 
-      select case (model%dev(d)%law)
-      case (law_velocity)
-         band = model%dev(d)%eps
-      case (law_hysteretic)
-         band = model%dev(d)%eps1
-      case default
-         band = 0.0_dp
-      end select
+      band = law_band(model%dev(d))
    end function band_of
 
    !> P mu dt_min / m: the velocity change device d's friction force makes in the step dt_min
@@ -119,7 +113,7 @@ contains
       integer, intent(in) :: d               !! the device
       real(dp), intent(in) :: dt_min         !! the finest step [s]
 
-      floor = model%dev(d)%p*largest_mu(model%dev(d))*dt_min/moved_mass(model, d)
+      floor = friction_capacity(model%dev(d))*dt_min/moved_mass(model, d)
    end function band_floor
 
    !> The limits checked when the deck is read: the work of a refinement, the digits of the
@@ -155,27 +149,16 @@ contains
          call pair_nodes(model, d, i, j)
          if (i == 0) cycle
          if (j <= 0) cycle
-         select case (model%dev(d)%law)
-         case (law_velocity)
-            ! the band's coupling P mu(eps) / eps (a speed-dependent mu at eps)
-            associate (dev => model%dev(d))
-               kd = opts%gamma/(opts%beta*dt1)*(dev%p*sliding_mu(dev, dev%eps)/dev%eps)
-            end associate
-         case (law_hysteretic)
-            kd = sticking_stiffness(model%dev(d))
-         case default
-            cycle
-         end select
+         ! the sticking spring, or the sticking dashpot in the effective stiffness (the band's
+         ! coupling P mu(eps) / eps, a speed-dependent mu at eps); a law has one or neither
+         kd = sticking_stiffness(model%dev(d)) + opts%gamma/(opts%beta*dt1)*sticking_damping(model%dev(d))
          ratio = kd*opts%beta*dt1**2/(model%mass(i) + model%mass(j))
          if (ratio > max_stiffness_ratio) then
             ! the variable named only here: fmt_real's shortest round trip costs about
             ! 4e5 instructions, 0.1 s a 1000 devices when it was built for every device
             idx = '('//trim(fmt_int(d))//')'
-            if (model%dev(d)%law == law_velocity) then
-               var = 'eps'//idx//' = '//trim(fmt_real(model%dev(d)%eps))
-            else
-               var = 'f'//idx//' = '//trim(fmt_real(model%dev(d)%f))
-            end if
+            var = trim(law_coupling_name(model%dev(d)%law))
+            var = var//idx//' = '//trim(fmt_real(device_parameter(model%dev(d), var)))
             call fatal_error(error, "group &friction: "//var//" is invalid: the sticking stiffness of device "// &
                              trim(fmt_int(d))//", "//trim(fmt_real(kd))//" N/m in the effective stiffness at dt1 = "// &
                              trim(fmt_real(dt1))//" s, must stay within "//trim(fmt_real(max_stiffness_ratio))// &
@@ -215,8 +198,7 @@ contains
       band = band_of(model, d)
       floor = band_floor(model, d, dt_min)
       if (.not. band < floor) return
-      var = merge('eps ', 'eps1', model%dev(d)%law == law_velocity)
-      var = trim(var)//'('//trim(fmt_int(d))//')'
+      var = trim(law_band_name(model%dev(d)%law))//'('//trim(fmt_int(d))//')'
       call fatal_error(error, "group &friction: "//var//" = "//trim(fmt_real(band))//" is invalid: device "// &
                        trim(fmt_int(d))//" slides and violates the correctness condition at t = "//trim(fmt_real(t))// &
                        " s even in the finest step dt_min = "//trim(fmt_real(dt_min))//" s, and its band is narrower "// &

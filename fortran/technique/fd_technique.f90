@@ -1,16 +1,22 @@
 !> The one dispatch over the time-integration techniques (`technique` of &integration):
 !> 'newmark' (regularized friction laws, the paper's step control), 'event_driven'
 !> (exact Coulomb friction, event by event) and 'moreau_jean' (Coulomb friction by
-!> nonsmooth time stepping, at building scale). Each technique says what it cannot integrate (a law, a table
-!> motion) with an error naming the group, the variable, the value and what to set;
-!> adding a technique is its module, its row in fd_names' technique table and one case in
-!> each routine here.
+!> nonsmooth time stepping, at building scale). Each technique says what it cannot integrate
+!> (a law, a table motion) with an error naming the group, the variable, the value and what
+!> to set (check_technique, which the session asks after reading a deck), and what it is:
+!> its traits (technique_traits: the laws it integrates, the rule of its steps, whether it
+!> refines them, what its history rows hold), which code outside technique/ asks instead of
+!> the technique's id. The traits are constants of fd_names' technique table, so that the
+!> result layer, below this one, can ask them too. Adding a technique is its module, its rows
+!> in fd_names' technique tables (name and traits) and one case in each routine here.
 module fd_technique
    use fd_kinds, only: dp
    use fd_error, only: error_type, fatal_error, fmt_int
    use fd_names, only: technique_newmark, technique_event_driven, technique_moreau_jean, techniques, &
-                       keyword_choices
-   use fd_model, only: model_type, integration_type
+                       keyword_choices, technique_name, technique_traits_type, technique_traits, &
+                       technique_integrates, technique_step_rule, rule_newmark, rule_theta
+   use fd_model, only: model_type, integration_type, source_brace
+   use fd_step_limits, only: check_step_limits
    use fd_kinematics, only: devices_are_pairs
    use fd_excitation, only: excitation_type
    use fd_result, only: result_type, energy_balance_of
@@ -25,16 +31,21 @@ module fd_technique
    private
 
    public :: check_technique, run_technique
+   public :: technique_traits_type, technique_traits, technique_integrates, technique_step_rule
 
 contains
 
    !> An error for anything of the model or the table motion the chosen technique cannot
-   !> integrate (messages start with "group &...": the deck reader prefixes the deck).
+   !> integrate: a brace (a shorthand of the deck) whose law it does not integrate, what the
+   !> technique itself refuses, and for a technique that refines its steps the limits of that
+   !> refinement (fd_step_limits). Messages start with "group &...": the session prefixes the
+   !> deck.
    subroutine check_technique(model, exc, opts, error)
       type(model_type), intent(in) :: model         !! the model
       type(excitation_type), intent(in) :: exc      !! the table motion
       type(integration_type), intent(in) :: opts    !! the technique and its settings
       type(error_type), allocatable, intent(out) :: error !! what cannot be integrated
+      type(technique_traits_type) :: traits
 
       ! the modes of the stuck system, the storeys and the groups of the exact techniques take
       ! each device as a link between two nodes (fd_kinematics)
@@ -42,6 +53,8 @@ contains
          call fatal_error(error, "a device that is not between two nodes is integrated by no technique")
          return
       end if
+      call check_braces(model, opts%technique, error)
+      if (allocated(error)) return
       select case (opts%technique)
       case (technique_newmark)
          call newmark_check(model, exc, error)
@@ -52,7 +65,32 @@ contains
       case default
          call unknown_technique(opts%technique, error)
       end select
+      if (allocated(error)) return
+      ! the refinement's steps: bounded work, digits left in the effective stiffness
+      traits = technique_traits(opts%technique)
+      if (traits%refines_steps) call check_step_limits(model, exc, opts, error)
    end subroutine check_technique
+
+   !> The braces of the deck are hysteretic devices: an error naming &braces for a technique
+   !> that does not integrate their law (the exact Coulomb techniques' devices are rigid while
+   !> stuck).
+   subroutine check_braces(model, technique, error)
+      type(model_type), intent(in) :: model         !! the model
+      integer, intent(in) :: technique             !! the technique
+      type(error_type), allocatable, intent(out) :: error !! a brace it cannot integrate
+      integer :: d
+
+      do d = 1, model%n_devices
+         if (model%dev(d)%source /= source_brace) cycle
+         if (technique_integrates(technique, model%dev(d)%law)) cycle
+         call fatal_error(error, "group &braces: brace "//trim(fmt_int(model%dev(d)%source_index))// &
+                          " cannot be integrated with technique = '"//trim(technique_name(technique))// &
+                          "' of &integration: a brace's elastic stiffness in series with the damper is the "// &
+                          "sticking stiffness of the hysteretic law, which only technique = 'newmark' integrates "// &
+                          "(the exact Coulomb techniques' devices are rigid while stuck); set technique = 'newmark'")
+         return
+      end do
+   end subroutine check_braces
 
    !> Run the technique the settings choose (with the caller's control of the run, if any:
    !> history columns and destinations, stop requests, progress).
@@ -78,11 +116,13 @@ contains
       ! the energy balance's verdict; a residual is the method's numerical damping when the
       ! method damps, and round-off when its accounting is exact (average acceleration) (set
       ! after the run: each technique's res is intent(out))
-      res%energy_balance = energy_balance_of(res%e_residual_ratio, &
-                                             (opts%technique == technique_newmark .and. opts%gamma > 0.5_dp) .or. &
-                                             (opts%technique == technique_moreau_jean .and. opts%theta > 0.5_dp), &
-                                             opts%technique == technique_newmark .and. opts%beta == 0.25_dp .and. &
-                                             opts%gamma == 0.5_dp)
+      associate (rule => technique_step_rule(opts%technique))
+         res%energy_balance = energy_balance_of(res%e_residual_ratio, &
+                                                (rule == rule_newmark .and. opts%gamma > 0.5_dp) .or. &
+                                                (rule == rule_theta .and. opts%theta > 0.5_dp), &
+                                                rule == rule_newmark .and. opts%beta == 0.25_dp .and. &
+                                                opts%gamma == 0.5_dp)
+      end associate
       ! whether the step resolves the highest modes: one report for every stepping technique
       if (.not. allocated(error)) call mode_resolution(model, res, error)
       ! and the table's motion: a harmonic's frequency, a record's spectrum

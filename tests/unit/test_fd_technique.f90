@@ -8,12 +8,15 @@ module test_fd_technique
    use fd_kinds, only: dp
    use fd_error, only: fd_error_type => error_type
    use fd_model, only: model_type, device_type, integration_type, law_velocity, law_hysteretic, law_coulomb, &
-                       technique_newmark, technique_event_driven, technique_moreau_jean
+                       technique_newmark, technique_event_driven, technique_moreau_jean, source_brace
+   use fd_names, only: techniques, laws, rule_none, rule_newmark, rule_theta
    use fd_excitation, only: excitation_type, excitation_harmonic
    use fd_result, only: result_type
    use fd_device_state, only: device_state, phase_stick
    use fd_friction, only: friction_init
-   use fd_technique, only: check_technique, run_technique
+   use fd_technique, only: check_technique, run_technique, technique_traits_type, technique_traits, &
+                           technique_integrates, technique_step_rule
+   use fd_step_limits, only: max_refinement
    implicit none
    private
 
@@ -32,7 +35,11 @@ contains
                   new_unittest("unknown technique", test_unknown_technique), &
                   new_unittest("unknown excitation", test_unknown_excitation), &
                   new_unittest("friction dispatch: a law it lacks", test_friction_dispatch), &
-                  new_unittest("a device not between two nodes is refused", test_general_device) &
+                  new_unittest("a device not between two nodes is refused", test_general_device), &
+                  new_unittest("traits of each technique", test_traits), &
+                  new_unittest("the laws each technique integrates", test_integrates), &
+                  new_unittest("a brace under an exact Coulomb technique", test_braces), &
+                  new_unittest("newmark: the refinement's limits", test_refinement_limits) &
                   ]
    end subroutine collect_technique
 
@@ -234,6 +241,103 @@ contains
       call expect(err, [character(len=40) :: "device 1", "id 77"], error)
    end subroutine test_friction_dispatch
 
+   !> Each technique's traits as documented (fd_names, fd_technique): Newmark integrates the
+   !> regularized laws with its own step rule and refines its steps; the exact technique
+   !> integrates Coulomb's law with no step and rows that carry the maxima since the last
+   !> one; Moreau-Jean integrates Coulomb's law with the theta-method. An id without a row
+   !> integrates nothing and takes no step; every technique of the names table has a row.
+   subroutine test_traits(error)
+      type(error_type), allocatable, intent(out) :: error
+      type(technique_traits_type) :: t
+      integer :: k
+
+      t = technique_traits(technique_newmark)
+      call check(error, t%regularized_laws .and. .not. t%set_valued_laws .and. t%step_rule == rule_newmark .and. &
+                 t%refines_steps .and. .not. t%envelope, "newmark")
+      if (allocated(error)) return
+      t = technique_traits(technique_event_driven)
+      call check(error, .not. t%regularized_laws .and. t%set_valued_laws .and. t%step_rule == rule_none .and. &
+                 .not. t%refines_steps .and. t%envelope, "event_driven")
+      if (allocated(error)) return
+      t = technique_traits(technique_moreau_jean)
+      call check(error, .not. t%regularized_laws .and. t%set_valued_laws .and. t%step_rule == rule_theta .and. &
+                 .not. t%refines_steps .and. .not. t%envelope, "moreau_jean")
+      if (allocated(error)) return
+      do k = 0, size(techniques) + 1, size(techniques) + 1
+         t = technique_traits(k)
+         call check(error, .not. (t%regularized_laws .or. t%set_valued_laws .or. t%refines_steps .or. t%envelope) &
+                    .and. technique_step_rule(k) == rule_none, "an id without a row has no traits")
+         if (allocated(error)) return
+      end do
+      do k = 1, size(techniques)
+         t = technique_traits(k)
+         call check(error, t%regularized_laws .or. t%set_valued_laws, &
+                    "technique '"//trim(techniques(k)%name)//"' has traits (integrates a law)")
+         if (allocated(error)) return
+      end do
+   end subroutine test_traits
+
+   subroutine test_integrates(error)
+      type(error_type), allocatable, intent(out) :: error
+
+      call check(error, technique_integrates(technique_newmark, law_velocity) .and. &
+                 technique_integrates(technique_newmark, law_hysteretic) .and. &
+                 .not. technique_integrates(technique_newmark, law_coulomb), "newmark: the regularized laws")
+      if (allocated(error)) return
+      call check(error, technique_integrates(technique_event_driven, law_coulomb) .and. &
+                 .not. technique_integrates(technique_event_driven, law_velocity) .and. &
+                 .not. technique_integrates(technique_event_driven, law_hysteretic), "event_driven: coulomb")
+      if (allocated(error)) return
+      call check(error, technique_integrates(technique_moreau_jean, law_coulomb) .and. &
+                 .not. technique_integrates(technique_moreau_jean, law_velocity), "moreau_jean: coulomb")
+      if (allocated(error)) return
+      call check(error, .not. technique_integrates(technique_newmark, 0) .and. &
+                 .not. technique_integrates(technique_newmark, size(laws) + 1) .and. &
+                 .not. technique_integrates(99, law_velocity), "no unknown law, no unknown technique")
+   end subroutine test_integrates
+
+   !> A brace (a hysteretic device of &braces) is refused by name under a technique that does
+   !> not integrate its law, before the technique's own check of the law; Newmark takes it.
+   subroutine test_braces(error)
+      type(error_type), allocatable, intent(out) :: error
+      type(model_type) :: model
+      type(excitation_type) :: exc
+      type(integration_type) :: opts
+      type(fd_error_type), allocatable :: err
+
+      call setup(law_coulomb, law_hysteretic, model, exc)
+      model%dev(2)%source = source_brace
+      model%dev(2)%source_index = 1
+      opts%technique = technique_event_driven
+      call check_technique(model, exc, opts, err)
+      call expect(err, [character(len=40) :: "group &braces: brace 1", "technique = 'event_driven'", &
+                        "set technique = 'newmark'"], error)
+      if (allocated(error)) return
+      opts%technique = technique_moreau_jean
+      call check_technique(model, exc, opts, err)
+      call expect(err, [character(len=40) :: "group &braces: brace 1", "technique = 'moreau_jean'"], error)
+      if (allocated(error)) return
+      model%dev(1)%law = law_velocity
+      opts%technique = technique_newmark
+      call check_technique(model, exc, opts, err)
+      call check(error, .not. allocated(err), "a brace under newmark")
+   end subroutine test_braces
+
+   !> The technique that refines its steps checks the refinement's limits (fd_step_limits).
+   subroutine test_refinement_limits(error)
+      type(error_type), allocatable, intent(out) :: error
+      type(model_type) :: model
+      type(excitation_type) :: exc
+      type(integration_type) :: opts
+      type(fd_error_type), allocatable :: err
+
+      call setup(law_velocity, law_hysteretic, model, exc)
+      opts%technique = technique_newmark
+      opts%n2 = max_refinement + 1
+      call check_technique(model, exc, opts, err)
+      call expect(err, [character(len=40) :: "group &integration: n2 = ", "at most"], error)
+   end subroutine test_refinement_limits
+
    !> Every technique refuses a device along a general direction (the stuck system's modes,
    !> the storeys and the exact techniques' groups take devices as links between two nodes).
    subroutine test_general_device(error)
@@ -242,13 +346,14 @@ contains
       type(excitation_type) :: exc
       type(integration_type) :: opts
       type(fd_error_type), allocatable :: err
-      integer, parameter :: techniques(3) = [technique_newmark, technique_event_driven, technique_moreau_jean]
+      integer, parameter :: all_techniques(3) = [technique_newmark, technique_event_driven, &
+                                                 technique_moreau_jean]
       integer :: t
 
       call setup(law_velocity, law_velocity, model, exc)
       model%dev_coef(1) = 0.6_dp
       do t = 1, 3
-         opts%technique = techniques(t)
+         opts%technique = all_techniques(t)
          call check_technique(model, exc, opts, err)
          call expect(err, [character(len=40) :: "not between two nodes"], error)
          if (allocated(error)) return

@@ -31,7 +31,7 @@ module fd_event_driven
    use fd_kinds, only: dp
    use fd_error, only: error_type, fatal_error, fmt_real, fmt_int
    use fd_names, only: law_coulomb, law_name, excitation_types, technique_name, technique_event_driven, &
-                       technique_newmark
+                       technique_newmark, technique_integrates
    use fd_model, only: model_type, integration_type
    use fd_excitation, only: excitation_type, table_motion, segment_end, forcing_form, forcing_unknown
    use fd_matrices, only: structure_matrices
@@ -104,7 +104,7 @@ contains
 
       tech = "technique = '"//trim(technique_name(technique_event_driven))//"'"
       do d = 1, model%n_devices
-         if (model%dev(d)%law == law_coulomb) cycle
+         if (technique_integrates(technique_event_driven, model%dev(d)%law)) cycle
          idx = 'law('//trim(fmt_int(d))//')'
          call fatal_error(error, "group &friction: "//idx//" = '"//trim(law_name(model%dev(d)%law))// &
                           "' is invalid with "//tech//" of &integration: the exact event-driven technique "// &

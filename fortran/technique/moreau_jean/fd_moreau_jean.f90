@@ -23,7 +23,7 @@ module fd_moreau_jean
    use fd_kinds, only: dp
    use fd_error, only: error_type, fatal_error, fmt_real, fmt_int, stat_no_memory
    use fd_names, only: law_coulomb, law_name, excitation_types, technique_name, technique_moreau_jean, &
-                       technique_newmark, damping_stiffness, damping_rayleigh
+                       technique_newmark, damping_stiffness, damping_rayleigh, technique_integrates
    use fd_model, only: model_type, integration_type
    use fd_excitation, only: excitation_type, table_motion
    use fd_kinematics, only: device_kinematics, device_nodes
@@ -74,7 +74,7 @@ contains
 
       tech = "technique = '"//trim(technique_name(technique_moreau_jean))//"'"
       do d = 1, model%n_devices
-         if (model%dev(d)%law == law_coulomb) cycle
+         if (technique_integrates(technique_moreau_jean, model%dev(d)%law)) cycle
          idx = 'law('//trim(fmt_int(d))//')'
          call fatal_error(error, "group &friction: "//idx//" = '"//trim(law_name(model%dev(d)%law))// &
                           "' is invalid with "//tech//" of &integration: the Moreau-Jean technique "// &

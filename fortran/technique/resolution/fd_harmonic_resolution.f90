@@ -22,7 +22,7 @@ module fd_harmonic_resolution
    use, intrinsic :: ieee_arithmetic, only: ieee_is_finite
    use fd_kinds, only: dp
    use fd_error, only: error_type, fatal_error, fmt_int, stat_no_memory
-   use fd_names, only: technique_newmark, technique_moreau_jean, excitation_harmonic
+   use fd_names, only: technique_step_rule, rule_none, rule_theta, excitation_harmonic
    use fd_matrices, only: modes_type, modes_kept, mode_damping, mode_participation
    use fd_model, only: model_type
    use fd_result, only: result_type, resolution_none, resolution_resolved, resolution_unresolved
@@ -105,7 +105,7 @@ contains
       n = model%n_dof
       res%harmonic_resolution = resolution_none
       res%harmonic_error = 0.0_dp               ! allocated with the summary (init_result)
-      if (res%technique /= technique_newmark .and. res%technique /= technique_moreau_jean) return
+      if (technique_step_rule(res%technique) == rule_none) return
       if (res%eng%excitation /= excitation_harmonic) return
       if (res%dt1 <= 0.0_dp .or. .not. (res%eng%frequency > 0.0_dp)) return
       allocate (ue(n), ud(n), stat=stat)
@@ -141,7 +141,7 @@ contains
             wn = sqrt(max(modes%omega2(k), 0.0_dp))
             c = mode_damping(modes, k, res%eng%a0)
             gamma_k = mode_participation(modes, k, model%mass(1:n))
-            if (res%technique == technique_moreau_jean) then
+            if (technique_step_rule(res%technique) == rule_theta) then
                call theta_response(w, wn, c, res%dt1, theta, hd, ok_k)
             else
                call newmark_response(w, wn, c, res%dt1, beta, gamma, hd, ok_k)

@@ -10,16 +10,17 @@
 !> executable and the command line print a warning. It is a report, not an error: drifts
 !> and shears are dominated by the low modes, which the step resolves.
 !>
-!> The system integrated at dt1: the springs, and for Newmark the hysteretic devices'
-!> sticking springs P mu / f (the stiffest phase); velocity-law devices add damping, not
+!> The system integrated at dt1: the springs, and the devices' sticking springs (the
+!> hysteretic law's P mu / f, the stiffest phase); velocity-law devices add damping, not
 !> stiffness, and rigid (Coulomb) links only lower the highest frequency (a constraint
 !> cannot raise the largest eigenvalue), so neither enters. The event-driven technique has no
 !> step: not applicable.
 module fd_mode_resolution
    use fd_kinds, only: dp
    use fd_error, only: error_type, fatal_error, fmt_int, stat_no_memory
-   use fd_names, only: technique_newmark, technique_moreau_jean
-   use fd_model, only: model_type, sticking_stiffness
+   use fd_names, only: technique_step_rule, rule_none
+   use fd_model, only: model_type
+   use fd_friction, only: sticking_stiffness
    use fd_kinematics, only: pair_nodes
    use fd_modes, only: highest_eigenvalue
    use fd_result, only: result_type, resolution_none, resolution_resolved, resolution_unresolved
@@ -47,7 +48,7 @@ contains
 
       res%mode_resolution = resolution_none
       res%omega_max = 0.0_dp
-      if (res%technique /= technique_newmark .and. res%technique /= technique_moreau_jean) return
+      if (technique_step_rule(res%technique) == rule_none) return
       if (res%dt1 <= 0.0_dp .or. model%n_dof == 0) return
       ns = model%n_springs
       nd = model%n_devices
@@ -61,15 +62,14 @@ contains
       ej(1:ns) = model%spring_j(1:ns)
       ek(1:ns) = model%spring_k(1:ns)
       ne = ns
-      if (res%technique == technique_newmark) then
-         do d = 1, nd
-            kd = sticking_stiffness(model%dev(d))
-            if (kd <= 0.0_dp) cycle
-            ne = ne + 1
-            call pair_nodes(model, d, ei(ne), ej(ne))
-            ek(ne) = kd
-         end do
-      end if
+      ! the sticking springs (the Coulomb devices of the theta-method's steps have none)
+      do d = 1, nd
+         kd = sticking_stiffness(model%dev(d))
+         if (kd <= 0.0_dp) cycle
+         ne = ne + 1
+         call pair_nodes(model, d, ei(ne), ej(ne))
+         ek(ne) = kd
+      end do
       call highest_eigenvalue(model%mass, ei(1:ne), ej(1:ne), ek(1:ne), lam, bound, error)
       if (allocated(error)) then
          error%message = "the highest natural frequency: "//error%message

@@ -37,9 +37,10 @@ module fd_record_resolution
    use, intrinsic :: ieee_arithmetic, only: ieee_is_finite
    use fd_kinds, only: dp
    use fd_error, only: error_type, fatal_error, fmt_int, stat_no_memory
-   use fd_names, only: technique_newmark, technique_moreau_jean, excitation_record, law_coulomb
+   use fd_names, only: technique_step_rule, rule_none, rule_newmark, rule_theta, excitation_record
    use fd_matrices, only: modes_type, modes_kept, mode_damping, mode_participation
-   use fd_model, only: model_type, law_hysteretic
+   use fd_model, only: model_type
+   use fd_friction, only: law_stuck, stuck_dashpot
    use fd_excitation, only: excitation_type, table_acceleration
    use fd_result, only: result_type, resolution_none, resolution_resolved, resolution_unresolved, &
                         record_system_none, record_system_structure, record_system_stuck, &
@@ -133,7 +134,7 @@ contains
       res%record_error = 0.0_dp               ! allocated with the summary (init_result)
       res%record_error_stuck = 0.0_dp
       res%record_error_free = 0.0_dp
-      if (res%technique /= technique_newmark .and. res%technique /= technique_moreau_jean) return
+      if (technique_step_rule(res%technique) == rule_none) return
       if (res%eng%excitation /= excitation_record) return
       if (res%dt1 <= 0.0_dp .or. .not. (exc%duration > 0.0_dp)) return
       judged = judged_system(model, res)
@@ -156,7 +157,7 @@ contains
       ! the largest wn dt1 the check integrates: mode_resolution's limit 2, and Newmark's
       ! stability limit 1 / sqrt(gamma / 2 - beta) when it is conditionally stable
       ps%limit = 2.0_dp
-      if (res%technique == technique_newmark .and. beta < 0.5_dp*gamma) &
+      if (technique_step_rule(res%technique) == rule_newmark .and. beta < 0.5_dp*gamma) &
          ps%limit = min(ps%limit, 1.0_dp/sqrt(0.5_dp*gamma - beta))
       call springs_times(model, model%u0, ps%ku0)
       ! every mode q'' + c q' + wn^2 q = -g ag (g its participation) from the run's initial
@@ -225,8 +226,7 @@ contains
          judged = record_system_structure
       else if (slid) then
          judged = record_system_free
-      else if (all(model%dev(1:model%n_devices)%law == law_hysteretic .or. &
-                   model%dev(1:model%n_devices)%law == law_coulomb)) then
+      else if (all(law_stuck(model%dev(1:model%n_devices)%law) /= stuck_dashpot)) then
          judged = record_system_stuck
       else
          judged = record_system_both
@@ -263,7 +263,7 @@ contains
       g = mode_participation(modes, k, model%mass(1:n))
       call exact_step_map(wn, c, ps%h, phi, g0, g1)
       ps%ex(m, :) = [phi(1, 1), phi(1, 2), phi(2, 1), phi(2, 2), g*g0(1), g*g0(2), g*g1(1), g*g1(2)]
-      if (res%technique == technique_moreau_jean) then
+      if (technique_step_rule(res%technique) == rule_theta) then
          call theta_step_map(wn, c, ps%h, theta, nmap, np)
       else
          call newmark_step_map(wn, c, ps%h, beta, gamma, nmap, np)
@@ -273,7 +273,7 @@ contains
       ps%z(m, 1) = sum(modes%shape(:, k)*ps%ku0)/(wn*wn*mk)
       ps%z(m, 2) = sum(modes%shape(:, k)*model%mass(1:n)*model%v0(1:n))/mk
       ps%z(m, 3:4) = ps%z(m, 1:2)
-      if (res%technique == technique_moreau_jean) then
+      if (technique_step_rule(res%technique) == rule_theta) then
          ps%z(m, 5) = g*ps%p0                                   ! the step's starting load
       else
          ps%z(m, 5) = g*ps%p0 - c*ps%z(m, 2) - wn*wn*ps%z(m, 1)    ! the acceleration
