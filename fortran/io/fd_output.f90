@@ -16,6 +16,8 @@ module fd_output
    use fd_names, only: excitation_types, keyword_len
    use fd_matrices, only: modes_type, modes_flexible, modes_rigid, modes_unrestrained
    use fd_engineering, only: engineering_type
+   use fd_statistics, only: newmark_stats, event_driven_stats, moreau_jean_stats, summary_counts, &
+                            newmark_counts, event_driven_counts, moreau_jean_counts
    use fd_fileops, only: c_lock_acquire, c_lock_release, c_unlink, c_rename, os_error, &
                          c_file_create, c_file_write, c_file_close, c_mkdir, lock_not_file
    use fd_tempfiles, only: temp_tag, remove_stale_temps
@@ -507,34 +509,81 @@ contains
       call ki(jt, 'slip_reversals', res%reversals)
    end subroutine peaks_part
 
-   !> What the technique did: its steps, factorizations, linear system, events, patterns.
+   !> What the technique did: the part of the technique that ran (its own statistics, under
+   !> the summary's counter keys; fd_statistics).
    subroutine statistics_part(jt, res)
       type(json_text), intent(inout) :: jt     !! the summary
       type(result_type), intent(in) :: res     !! the result
 
-      call kint(jt, 'steps_dt1', res%steps_dt1)
-      call kint(jt, 'steps_nested', res%steps_nested)
-      call kint(jt, 'steps_implicit', res%steps_implicit)
-      call kint(jt, 'implicit_redos', res%implicit_redos)
-      call kint(jt, 'implicit_fallbacks', res%implicit_fallbacks)
-      call kint(jt, 'steps_dt2', res%steps_dt2)
-      call kint(jt, 'steps_finer', res%steps_finer)
-      call kint(jt, 'factorizations', res%factorizations)
-      call kint(jt, 'factor_updates', res%factor_updates)
-      call kint(jt, 'partial_factorizations', res%partial_factorizations)
-      call kv(jt, 'linear_system', '"'//trim(storage_name(res%storage))//'"')
-      call kint(jt, 'half_bandwidth', res%bandwidth)
-      call kint(jt, 'events', res%events)
-      if (res%exact_peaks) then
-         ! the exact technique: peaks are the exact extrema; its event times, accumulations
-         call kv(jt, 'peaks_exact', 'true')
-         call kr(jt, 'event_times_s', res%event_time(1:res%n_event_times))
-         call kint(jt, 'accumulation_points', res%accumulations)
-         call kr(jt, 'accumulation_times_s', res%accumulation_time(1:res%n_accumulation_times))
+      if (res%newmark%ran) then
+         call newmark_part(jt, res%newmark)
+      else if (res%exact%ran) then
+         call event_driven_part(jt, res%exact)
+      else
+         call moreau_jean_part(jt, res%moreau_jean)
       end if
-      call kint(jt, 'patterns_solved', res%patterns)
-      call kint(jt, 'lcp_fallbacks', res%lcp_fallbacks)
    end subroutine statistics_part
+
+   !> Newmark's steps of each size, refinements, factorizations and linear system.
+   subroutine newmark_part(jt, st)
+      type(json_text), intent(inout) :: jt        !! the summary
+      type(newmark_stats), intent(in) :: st       !! Newmark's statistics
+
+      call counts_part(jt, newmark_counts(st))
+      call patterns_part(jt, newmark_counts(st))
+   end subroutine newmark_part
+
+   !> The exact technique's intervals, matrix exponentials and events; its peaks are the
+   !> exact extrema; its event times and accumulation points.
+   subroutine event_driven_part(jt, st)
+      type(json_text), intent(inout) :: jt          !! the summary
+      type(event_driven_stats), intent(in) :: st    !! the exact technique's statistics
+
+      call counts_part(jt, event_driven_counts(st))
+      call kv(jt, 'peaks_exact', 'true')
+      call kr(jt, 'event_times_s', st%event_time(1:st%n_event_times))
+      call kint(jt, 'accumulation_points', st%accumulations)
+      call kr(jt, 'accumulation_times_s', st%accumulation_time(1:st%n_accumulation_times))
+      call patterns_part(jt, event_driven_counts(st))
+   end subroutine event_driven_part
+
+   !> Moreau-Jean's steps, factorizations, patterns and Lemke fallbacks.
+   subroutine moreau_jean_part(jt, st)
+      type(json_text), intent(inout) :: jt         !! the summary
+      type(moreau_jean_stats), intent(in) :: st    !! Moreau-Jean's statistics
+
+      call counts_part(jt, moreau_jean_counts(st))
+      call patterns_part(jt, moreau_jean_counts(st))
+   end subroutine moreau_jean_part
+
+   !> The summary's counter keys of every technique, from steps_dt1 to events.
+   subroutine counts_part(jt, c)
+      type(json_text), intent(inout) :: jt     !! the summary
+      type(summary_counts), intent(in) :: c    !! a technique's counters under these keys
+
+      call kint(jt, 'steps_dt1', c%steps_dt1)
+      call kint(jt, 'steps_nested', c%steps_nested)
+      call kint(jt, 'steps_implicit', c%steps_implicit)
+      call kint(jt, 'implicit_redos', c%implicit_redos)
+      call kint(jt, 'implicit_fallbacks', c%implicit_fallbacks)
+      call kint(jt, 'steps_dt2', c%steps_dt2)
+      call kint(jt, 'steps_finer', c%steps_finer)
+      call kint(jt, 'factorizations', c%factorizations)
+      call kint(jt, 'factor_updates', c%factor_updates)
+      call kint(jt, 'partial_factorizations', c%partial_factorizations)
+      call kv(jt, 'linear_system', '"'//trim(storage_name(c%storage))//'"')
+      call kint(jt, 'half_bandwidth', c%bandwidth)
+      call kint(jt, 'events', c%events)
+   end subroutine counts_part
+
+   !> The summary's last counter keys of every technique: patterns_solved, lcp_fallbacks.
+   subroutine patterns_part(jt, c)
+      type(json_text), intent(inout) :: jt     !! the summary
+      type(summary_counts), intent(in) :: c    !! a technique's counters under these keys
+
+      call kint(jt, 'patterns_solved', c%patterns)
+      call kint(jt, 'lcp_fallbacks', c%lcp_fallbacks)
+   end subroutine patterns_part
 
    !> The linear system's storage in words: 1 dense, 2 banded, else none.
    pure function storage_name(storage) result(name)
@@ -566,7 +615,7 @@ contains
       type(json_text), intent(inout) :: jt     !! the summary
       type(result_type), intent(in) :: res     !! the result
 
-      call kint(jt, 'mu_passes', res%mu_passes)
+      call kint(jt, 'mu_passes', res%newmark%mu_passes)
       call kint(jt, 'mu_unconverged_steps', res%mu_unconverged)
       call kreal(jt, res, 'mu_unconverged_s', res%mu_unconverged_time)
       call kreal(jt, res, 'mu_unconverged_misfit', res%mu_misfit)

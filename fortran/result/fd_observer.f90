@@ -17,7 +17,7 @@ module fd_observer
    use fd_error, only: error_type, fatal_error, fmt_real
    use fd_model, only: model_type, integration_type
    use fd_excitation, only: excitation_type
-   use fd_result, only: result_type, init_result, max_violation_times, max_event_times
+   use fd_result, only: result_type, init_result, max_violation_times
    use fd_linalg, only: sym_matvec
    use fd_run_control, only: run_control, cancel_requested, stat_cancelled
    use fd_history_stream, only: stream_open, stream_row, stream_failed, stream_close
@@ -29,7 +29,7 @@ module fd_observer
    public :: observer_type, observer_init, sample_due, observe_start, observe_peaks, observe_sample
    public :: observe_transitions, observe_violations, observe_end, strain_energy
    public :: observe_start_energies, observe_end_energies, observe_poll, observe_stop_error
-   public :: observe_peak_value, observe_event, observe_accumulation
+   public :: observe_peak_value
    public :: peak_of_u, peak_of_v, peak_of_aabs, peak_of_s, peak_of_force, peak_of_storey
    public :: observe_storeys
 
@@ -243,27 +243,6 @@ contains
 
       call observe_engineering(res%eng, t, size(u), size(s), u, v, s, force)
    end subroutine observe_storeys
-
-   !> An event at time t (phases changed): its time is kept (the first max_event_times).
-   pure subroutine observe_event(res, t)
-      type(result_type), intent(inout) :: res  !! the result
-      real(dp), intent(in) :: t                !! time of the event [s]
-
-      if (res%n_event_times >= max_event_times) return
-      res%n_event_times = res%n_event_times + 1
-      res%event_time(res%n_event_times) = t
-   end subroutine observe_event
-
-   !> An accumulation point of events (a Zeno sequence) at time t, ended by sticking.
-   pure subroutine observe_accumulation(res, t)
-      type(result_type), intent(inout) :: res  !! the result
-      real(dp), intent(in) :: t                !! its time [s]
-
-      res%accumulations = res%accumulations + 1
-      if (res%n_accumulation_times >= max_violation_times) return
-      res%n_accumulation_times = res%n_accumulation_times + 1
-      res%accumulation_time(res%n_accumulation_times) = t
-   end subroutine observe_accumulation
 
    !> The next row of the history: t, ag, (u, v, aabs) per kept DOF, (s, s', F, phase) per
    !> kept device, then (a history with those columns, has_envelope) the maxima since the

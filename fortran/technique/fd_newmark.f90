@@ -156,6 +156,7 @@ contains
       if (allocated(error)) return
       dt1 = exc%dt_record/opts%n1
       dt2 = dt1/opts%n2
+      res%newmark%ran = .true.
       res%dt1 = dt1
       res%dt2 = dt2
       res%dt_min = opts%dt_min
@@ -194,7 +195,7 @@ contains
          call judge(model, opts, w, any_changed, any_bad)
          if (w%nd == 0 .or. .not. (any_changed .or. (any_bad .and. opts%check))) then
             call accept(model, exc, t0 + dt1, w, res, any_changed, .false.)
-            res%steps_dt1 = res%steps_dt1 + 1
+            res%newmark%steps_dt1 = res%newmark%steps_dt1 + 1
          else if (opts%refinement == refinement_implicit .and. any_changed) then
             ! redone in the phases it ends in; refined as the paper's when they do not settle
             call settle_phases(model, exc, opts, t0, w, res, settled, error)
@@ -206,7 +207,7 @@ contains
          else if (opts%n2 == 1 .and. .not. (any_bad .and. opts%check)) then
             ! redone as one step of dt2 = dt1 from the same state and phases: the trial itself
             call accept(model, exc, t0 + dt1, w, res, any_changed, any_bad)
-            res%steps_dt2 = res%steps_dt2 + 1
+            res%newmark%steps_dt2 = res%newmark%steps_dt2 + 1
          else
             call advance_nested(model, exc, opts, t0, 0, w, res, error)
             if (allocated(error)) return
@@ -229,15 +230,15 @@ contains
       w%phase0 = w%st%phase
       call ringing_finish(w%ring, w%phase0, res)
       call alternation_finish(res)
-      res%mu_passes = w%follow_passes
+      res%newmark%mu_passes = w%follow_passes
       call observe_end_energies(w%obs, res, 0.5_dp*sum(w%mass*w%v**2), strain_energy(model, w%u), &
                                 device_energy(model, w%st, w%s), &
                               w%w_device)
       do l = 1, size(w%lev)
          associate (stats => w%lev(l)%sys%stats)
-            res%factorizations = res%factorizations + stats%factorizations
-            res%partial_factorizations = res%partial_factorizations + stats%partial
-            res%factor_updates = res%factor_updates + stats%updates + stats%downdates
+            res%newmark%factorizations = res%newmark%factorizations + stats%factorizations
+            res%newmark%partial_factorizations = res%newmark%partial_factorizations + stats%partial
+            res%newmark%factor_updates = res%newmark%factor_updates + stats%updates + stats%downdates
          end associate
       end do
       call system_clock(c1)
@@ -294,8 +295,8 @@ contains
       call spd_setup(base, model%mass, model%spring_i, model%spring_j, model%spring_k, w%di, w%dj, error, &
                      a0=a0, a1=a1, path=path)
       if (allocated(error)) return
-      res%storage = merge(1, 2, spd_is_dense(base))
-      res%bandwidth = spd_bandwidth(base)
+      res%newmark%storage = merge(1, 2, spd_is_dense(base))
+      res%newmark%bandwidth = spd_bandwidth(base)
       w%lmax = lmax
       ! the levels of the refinement: the paper's is one, dt1 to dt2 = dt1 / n2
       w%nested = 0
@@ -660,7 +661,7 @@ contains
             if (allocated(error)) return
          else
             call accept(model, exc, tj + h, w, res, any_changed, any_bad)
-            res%steps_nested = res%steps_nested + 1
+            res%newmark%steps_nested = res%newmark%steps_nested + 1
             call observe_poll(w%obs, tj + h, stop)
             if (stop) then
                call observe_stop_error(w%obs, error)
@@ -709,9 +710,9 @@ contains
          end if
          call accept(model, exc, tl + h, w, res, any_changed, any_bad)
          if (level == 0) then
-            res%steps_dt2 = res%steps_dt2 + 1
+            res%newmark%steps_dt2 = res%newmark%steps_dt2 + 1
          else
-            res%steps_finer = res%steps_finer + 1
+            res%newmark%steps_finer = res%newmark%steps_finer + 1
          end if
          call observe_poll(w%obs, tl + h, stop)
          if (stop) then
@@ -769,7 +770,7 @@ contains
             redone = .true.
             call try_step(model, exc, t, 1, w, error)
             if (allocated(error)) return
-            res%implicit_redos = res%implicit_redos + 1
+            res%newmark%implicit_redos = res%newmark%implicit_redos + 1
             ! the phases this trial ends in, judged from the start
             call friction_step(w%nd, model%dev, opts%n_corr, w%s1, w%sd1, w%sd, w%st0, w%st1, w%changed, w%ok, &
                                any_changed, any_bad)
@@ -791,14 +792,14 @@ contains
          w%phase1 = w%st%phase
          call observe_transitions(res, w%phase0, w%phase1)
          call accept(model, exc, t + w%lev(1)%h, w, res, any_changed, any_bad)
-         res%steps_implicit = res%steps_implicit + 1
+         res%newmark%steps_implicit = res%newmark%steps_implicit + 1
          settled = .true.
          return
       end do
       ! the start's states again; a factor that a redone trial updated follows them back
       w%st = w%st0
       if (redone) w%version = w%version + 1
-      res%implicit_fallbacks = res%implicit_fallbacks + 1
+      res%newmark%implicit_fallbacks = res%newmark%implicit_fallbacks + 1
    end subroutine settle_phases
 
    !> Every device's phase in st is phase.

@@ -38,8 +38,9 @@ module fd_event_driven
    use fd_kinematics, only: device_relative
    use fd_device_state, only: phase_stick
    use fd_result, only: result_type
+   use fd_statistics, only: count_event, count_accumulation
    use fd_observer, only: observer_type, observer_init, observe_start, observe_sample, observe_transitions, &
-                          observe_end, observe_peak_value, observe_event, observe_accumulation, &
+                          observe_end, observe_peak_value, &
                           peak_of_u, peak_of_v, peak_of_aabs, peak_of_s, peak_of_force, peak_of_storey, &
                           observe_poll, observe_stop_error, observe_storeys
    use fd_run_control, only: run_control, stat_cancelled
@@ -77,7 +78,6 @@ module fd_event_driven
       real(dp), allocatable :: mp(:)                      !! mq' p coefficients (0:kmax)
       real(dp), allocatable :: ein(:), evi(:)             !! power coefficients (0:2 kmax)
       real(dp) :: w_fric = 0.0_dp                         !! friction work [J]
-      integer :: n_events = 0                             !! event instants at which phases changed
       real(dp) :: ring(ring_size) = -huge(1.0_dp)         !! times of the last events
       integer :: ring_pos = 0
       real(dp) :: last_accumulation = -huge(1.0_dp)       !! time of the last accumulation point
@@ -164,7 +164,8 @@ contains
          res%dt2 = 0.0_dp
          res%dt_min = 0.0_dp
          t_end = w%obs%nsteps*h
-         res%steps_dt1 = w%obs%nsteps
+         res%exact%ran = .true.
+         res%exact%intervals = w%obs%nsteps
 
          ! the initial phases: a device moving at t = 0 slides its way, the others are
          ! candidates for sticking, decided by the complementarity problems
@@ -205,8 +206,7 @@ contains
             return
          end if
          call observe_end(w%obs, res, st%mass, st%k, st%u, st%v, 0.0_dp, w%w_fric, st%fn)
-         res%factorizations = st%cache%builds
-         res%events = w%n_events
+         res%exact%exponentials = st%cache%builds
       end associate
       call system_clock(c1)
       res%run_time = real(c1 - c0, dp)/real(max(crate, 1), dp)
@@ -649,9 +649,8 @@ contains
             w%burst_n = 1
          end if
          if (.not. chg) return
-         w%n_events = w%n_events + 1
          call observe_transitions(res, st%oldph, st%phase)
-         call observe_event(res, t)
+         call count_event(res%exact, t)
          ! accumulation guard: ring_size phase changes within the window
          w%ring_pos = mod(w%ring_pos, ring_size) + 1
          w%ring(w%ring_pos) = t
@@ -747,7 +746,7 @@ contains
             return
          end if
          call observe_transitions(res, st%oldph, st%phase)
-         call observe_accumulation(res, t)
+         call count_accumulation(res%exact, t)
       end associate
    end subroutine accumulation
 

@@ -151,6 +151,7 @@ contains
       if (allocated(error)) return
       th = opts%theta
       h = exc%dt_record/opts%n1
+      res%moreau_jean%ran = .true.
       res%dt1 = h
       res%dt2 = 0.0_dp
       res%dt_min = 0.0_dp
@@ -234,7 +235,7 @@ contains
          call count_transitions(w, res, .false.)
          w%phase0 = w%phase1
          call observe_peaks(res, t1, size(w%u), size(w%s), w%u, w%v, w%acc, ag1, w%s, w%force)
-         res%steps_dt1 = res%steps_dt1 + 1
+         res%moreau_jean%steps = res%moreau_jean%steps + 1
          if (sample_due(w%obs, k)) then
             if (.not. all(ieee_is_finite(w%u)) .or. .not. all(ieee_is_finite(w%acc))) then
                call fatal_error(error, "moreau_jean: the solution is not finite at t = "//trim(fmt_real(t1))//" s")
@@ -251,9 +252,9 @@ contains
       call count_transitions(w, res, .true.)
       call energies(w, e_kin, e_str)
       call observe_end_energies(w%obs, res, e_kin, e_str, 0.0_dp, w%w_fric)
-      res%factorizations = w%p%gs%factorizations
-      res%patterns = w%p%patterns
-      res%lcp_fallbacks = w%p%fallbacks
+      res%moreau_jean%factorizations = w%p%gs%factorizations
+      res%moreau_jean%patterns = w%p%patterns
+      res%moreau_jean%lcp_fallbacks = w%p%fallbacks
       call system_clock(c1)
       res%run_time = real(c1 - c0, dp)/real(max(crate, 1), dp)
    end subroutine run_moreau_jean
