@@ -1,8 +1,12 @@
-!> The observer of a run, one for every technique: it sets up the result, keeps the peaks
-!> over every accepted state, samples the history, counts phase transitions and
-!> correctness violations, and closes the energy balance. A technique hands it the state
-!> (time, table acceleration, u, v, relative acceleration, and per device s, s', F and
-!> phase); a new output quantity is a change here (and in the writer), not in the loops.
+!> The observer of a run, one for every technique, and the only writer of the result's
+!> histories, peaks and energies: it sets up the result, keeps the peaks over every accepted
+!> state, samples the history, counts phase transitions and correctness violations, and
+!> closes the energy balance. A technique hands it the state (observe_peaks, observe_sample:
+!> time, table acceleration, u, v, relative acceleration, and per device s, s', F and phase),
+!> the work of each step (observe_work), and, when it knows its solution between steps, the
+!> exact extrema (observe_extrema, observe_extremum); the stuck system's period it computed is
+!> an argument of observer_init. A new output quantity is a change here (and in the writer),
+!> not in the loops.
 !>
 !> A run's control (fd_run_control), when the technique is given one, says which history
 !> columns are kept and where their rows go (the result, the caller's buffer, a file written
@@ -29,16 +33,8 @@ module fd_observer
    public :: observer_type, observer_init, sample_due, observe_start, observe_peaks, observe_sample
    public :: observe_transitions, observe_violations, observe_end, strain_energy
    public :: observe_start_energies, observe_end_energies, observe_poll, observe_stop_error
-   public :: observe_peak_value
-   public :: peak_of_u, peak_of_v, peak_of_aabs, peak_of_s, peak_of_force, peak_of_storey
+   public :: observe_extrema, observe_extremum, observe_work
    public :: observe_storeys
-
-   integer, parameter :: peak_of_u = 1      !! |u| of a DOF
-   integer, parameter :: peak_of_v = 2      !! |v| of a DOF
-   integer, parameter :: peak_of_aabs = 3   !! |absolute acceleration| of a DOF
-   integer, parameter :: peak_of_s = 4      !! |s| of a device
-   integer, parameter :: peak_of_force = 5  !! |F| of a device
-   integer, parameter :: peak_of_storey = 6 !! |drift|, |V| of a storey, |Vb|: the history's order
 
    !> Wall-clock time aimed at between two polls that look at the clock [s].
    real(dp), parameter :: poll_target = 0.01_dp
@@ -72,10 +68,12 @@ contains
    !> observer: the number of dt1 steps and the sampling interval. With a control: the
    !> history's columns and destinations it selects, and its history file opened (created
    !> under its temporary name, the header written).
-   subroutine observer_init(model, exc, opts, res, obs, error, ctl)
+   subroutine observer_init(model, exc, opts, period_stuck, res, obs, error, ctl)
       type(model_type), intent(in) :: model         !! the model run
       type(excitation_type), intent(in) :: exc      !! the table motion
       type(integration_type), intent(in) :: opts    !! integration settings
+      real(dp), intent(in) :: period_stuck          !! first period of the stuck system, as the
+                                                    !! technique computed it [s] (0: none)
       type(result_type), intent(inout) :: res       !! the result to set up
       type(observer_type), intent(out) :: obs       !! the observer
       type(error_type), allocatable, intent(out) :: error !! not enough memory, history file
@@ -98,8 +96,8 @@ contains
       call init_result(model, exc, opts, res, obs%nsteps, obs%every, error, obs%dofs, obs%devices, obs%to_result)
       if (allocated(error)) return
       res%technique = opts%technique
-      ! names, modes and storeys (res%period_stuck: set by the technique before)
-      call engineering_init(model, exc, opts, res%period_stuck, res%eng, error)
+      ! names, modes and storeys
+      call engineering_init(model, exc, opts, period_stuck, res%eng, error)
       if (allocated(error)) return
       allocate (obs%row(res%ncol))
       obs%row = 0.0_dp
@@ -204,34 +202,68 @@ contains
       call observe_engineering(res%eng, t, n, nd, u, v, s, force)
    end subroutine observe_peaks
 
-   !> One value into a peak of the summary (a technique that knows its solution between
-   !> steps passes the exact extrema, with their times): quantity peak_of_*, DOF or device i.
-   pure subroutine observe_peak_value(res, quantity, i, value, t)
+   !> The exact extrema of a technique that knows its solution between steps: |y(q)| of every
+   !> output quantity q at time t into the summary's peaks (observe_extremum's order).
+   pure subroutine observe_extrema(res, y, t)
       type(result_type), intent(inout) :: res  !! the result
-      integer, intent(in) :: quantity          !! peak_of_u, _v, _aabs, _s, _force, _storey
-      integer, intent(in) :: i                 !! DOF, device, or storey quantity (drift1, V1, ..., Vb)
+      real(dp), intent(in) :: y(:)             !! the quantities' values, in observe_extremum's order
+      real(dp), intent(in) :: t                !! their time [s]
+      integer :: q
+
+      do q = 1, size(y)
+         call observe_extremum(res, q, abs(y(q)), t)
+      end do
+   end subroutine observe_extrema
+
+   !> One exact extremum |value| at time t of output quantity q, numbered as the history's
+   !> envelope columns of every DOF and device: |u|, |v|, |aabs| of DOF i are q = 3 i - 2,
+   !> 3 i - 1, 3 i; |s|, |F| of device d are q = 3 n + 2 d - 1, 3 n + 2 d; then the storeys'
+   !> |drift1|, |V1|, ..., |Vb| (fd_engineering's order).
+   pure subroutine observe_extremum(res, q, value, t)
+      type(result_type), intent(inout) :: res  !! the result
+      integer, intent(in) :: q                 !! the quantity
       real(dp), intent(in) :: value            !! |value|
       real(dp), intent(in) :: t                !! its time [s]
+      integer :: i, n3
 
-      select case (quantity)
-      case (peak_of_u)
-         if (value > res%peak_u(i)) then
-            res%peak_u(i) = value; res%peak_u_time(i) = t
+      n3 = 3*res%n_dof
+      if (q > n3 + 2*res%n_devices) then
+         call observe_storey_peak(res%eng, q - n3 - 2*res%n_devices, value, t)
+      else if (q <= n3) then
+         i = (q + 2)/3
+         select case (q - 3*(i - 1))
+         case (1)
+            if (value > res%peak_u(i)) then
+               res%peak_u(i) = value; res%peak_u_time(i) = t
+            end if
+         case (2)
+            res%peak_v(i) = max(res%peak_v(i), value)
+         case default
+            if (value > res%peak_aabs(i)) then
+               res%peak_aabs(i) = value; res%peak_aabs_time(i) = t
+            end if
+         end select
+      else
+         i = (q - n3 + 1)/2
+         if (mod(q - n3, 2) == 1) then
+            res%peak_s(i) = max(res%peak_s(i), value)
+         else
+            res%peak_force(i) = max(res%peak_force(i), value)
          end if
-      case (peak_of_v)
-         res%peak_v(i) = max(res%peak_v(i), value)
-      case (peak_of_aabs)
-         if (value > res%peak_aabs(i)) then
-            res%peak_aabs(i) = value; res%peak_aabs_time(i) = t
-         end if
-      case (peak_of_s)
-         res%peak_s(i) = max(res%peak_s(i), value)
-      case (peak_of_force)
-         res%peak_force(i) = max(res%peak_force(i), value)
-      case (peak_of_storey)
-         call observe_storey_peak(res%eng, i, value, t)
-      end select
-   end subroutine observe_peak_value
+      end if
+   end subroutine observe_extremum
+
+   !> The work of a step (or part of one): the table's inertia loads' work `input` and the
+   !> viscous dissipation `viscous` [J] into the energy balance (observe_end closes it).
+   pure subroutine observe_work(res, input, viscous)
+      type(result_type), intent(inout) :: res  !! the result
+      real(dp), intent(in) :: input            !! work of the table's inertia loads [J]
+      real(dp), intent(in) :: viscous          !! viscous dissipation [J]
+
+      res%e_input = res%e_input + input
+      res%e_input_gross = res%e_input_gross + abs(input)
+      res%e_viscous = res%e_viscous + viscous
+   end subroutine observe_work
 
    !> The storeys at a state the technique reports besides observe_peaks (a row of the exact
    !> technique): drifts, shears, their peaks, and the values kept as the residual ones.
@@ -450,7 +482,7 @@ contains
    !> Close the energy balance at the end of the run: kinetic, strain and device elastic
    !> energy (end minus start), friction dissipation (device work minus stored energy) and
    !> the residual input - (kinetic + strain + viscous + friction + device elastic). The
-   !> technique has accumulated the input and viscous work in res.
+   !> technique has handed the input and viscous work of its steps to observe_work.
    subroutine observe_end(obs, res, mass, k, u, v, e_device, w_device, tmp)
       type(observer_type), intent(inout) :: obs !! the observer
       type(result_type), intent(inout) :: res  !! the result

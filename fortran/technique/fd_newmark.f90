@@ -46,7 +46,7 @@ module fd_newmark
    use fd_run_control, only: run_control
    use fd_observer, only: observer_type, observer_init, sample_due, observe_start_energies, observe_peaks, &
                           observe_sample, observe_transitions, observe_violations, observe_end_energies, &
-                          observe_poll, observe_stop_error
+                          observe_poll, observe_stop_error, observe_work
    use fd_step_limits, only: halving_levels, unresolved_band, max_nested, nested_splits, max_settle, max_follow, &
                              follow_tol
    use fd_stick_ringing, only: ringing_type, ringing_init, ringing_changed, ringing_finish, stat_time, stat_sd2, &
@@ -163,7 +163,7 @@ contains
       if (res%dt_min <= 0.0_dp) res%dt_min = dt2/2.0_dp**10
       call setup(model, opts, dt1, dt2, halving_levels(dt2, res%dt_min), w, res, error)
       if (allocated(error)) return
-      call observer_init(model, exc, opts, res, w%obs, error, ctl)
+      call observer_init(model, exc, opts, res%period_stuck, res, w%obs, error, ctl)
       if (allocated(error)) return
       call grid_init(exc, dt1, w%grid)
 
@@ -833,9 +833,7 @@ contains
       ! energy of the step, forces at both ends in the step's phases; the state moves on
       call step_energy(w%n, w%mass, w%u, w%v, w%a, w%u1, w%v1, w%a1, w%tmp, w%rhs, ein)
       ein = 0.5_dp*(w%ag + w%ag1)*ein
-      res%e_input = res%e_input - ein
-      res%e_input_gross = res%e_input_gross + abs(ein)
-      res%e_viscous = res%e_viscous + 0.5_dp*viscous_work(model, w%a0, w%a1c, w%n, w%mass, w%tmp, w%rhs)
+      call observe_work(res, -ein, 0.5_dp*viscous_work(model, w%a0, w%a1c, w%n, w%mass, w%tmp, w%rhs))
       w%ag = w%ag1
       ! violations of the correctness condition left in an accepted step
       if (any_bad) call observe_violations(res, t1, w%ok)

@@ -12,7 +12,8 @@ module test_fd_observer
    use fd_names, only: technique_event_driven
    use, intrinsic :: ieee_arithmetic, only: ieee_value, ieee_quiet_nan, ieee_positive_inf
    use fd_observer, only: observer_type, observer_init, sample_due, observe_start, observe_peaks, &
-                          observe_sample, observe_transitions, observe_violations, observe_end
+                          observe_sample, observe_transitions, observe_violations, observe_end, &
+                          observe_extrema, observe_extremum, observe_work
    implicit none
    private
 
@@ -31,7 +32,9 @@ contains
                   new_unittest("energy balance of a free oscillator", test_energy), &
                   new_unittest("a non-finite result named", test_non_finite), &
                   new_unittest("a non-finite row outside the result noted", test_non_finite_buffer), &
-                  new_unittest("maxima between rows of the kept DOFs and devices", test_selected_envelope) &
+                  new_unittest("maxima between rows of the kept DOFs and devices", test_selected_envelope), &
+                  new_unittest("exact extrema in the envelope's order", test_extrema), &
+                  new_unittest("the work of the steps into the balance", test_work) &
                   ]
    end subroutine collect_observer
 
@@ -53,7 +56,7 @@ contains
       exc%dt_record = 0.01_dp
       exc%duration = 0.0123_dp
       opts%n1 = 20
-      call observer_init(model, exc, opts, res, obs, err)
+      call observer_init(model, exc, opts, res%period_stuck, res, obs, err)
       if (allocated(err)) call test_failed(error, err%message)
    end subroutine setup
 
@@ -262,7 +265,7 @@ contains
       opts%n1 = 20
       ctl%buffer => buf
       ctl%keep = .false.
-      call observer_init(model, exc, opts, res, obs, err, ctl)
+      call observer_init(model, exc, opts, res%period_stuck, res, obs, err, ctl)
       if (allocated(err)) call test_failed(error, err%message)
       if (allocated(error)) return
       call check(error, size(res%hist, 2) == 0 .and. res%nout == 3, 'no rows in the result')
@@ -311,7 +314,7 @@ contains
       call select_history(ctl, [3], [2], 3, 2, err)
       if (allocated(err)) call test_failed(error, err%message)
       if (allocated(error)) return
-      call observer_init(model, exc, opts, res, obs, err, ctl)
+      call observer_init(model, exc, opts, res%period_stuck, res, obs, err, ctl)
       if (allocated(err)) call test_failed(error, err%message)
       if (allocated(error)) return
       call check(error, res%ncol == 2 + 3 + 4 + 3 + 2, 'columns: t, ag, 3 of DOF 3, 4 of device 2, 3 + 2 maxima')
@@ -326,5 +329,39 @@ contains
       call check(error, all(res%hist(10:14, 1) == [7.0_dp, 8.0_dp, 9.0_dp, 12.0_dp, 13.0_dp]), &
                  'the maxima of DOF 3 and device 2')
    end subroutine test_selected_envelope
+
+   !> Two DOFs and one device: the quantities |u1|, |v1|, |aabs1|, |u2|, |v2|, |aabs2|, |s1|,
+   !> |F1| go to their peaks (with the times of u and aabs); a smaller value leaves a peak.
+   subroutine test_extrema(error)
+      type(error_type), allocatable, intent(out) :: error
+      type(model_type) :: model
+      type(result_type) :: res
+      type(observer_type) :: obs
+
+      call setup(model, res, obs, error)
+      if (allocated(error)) return
+      call observe_extrema(res, [0.1_dp, -0.2_dp, 0.3_dp, -0.4_dp, 0.5_dp, -0.6_dp, 0.7_dp, -80.0_dp], 0.25_dp)
+      call check(error, all(res%peak_u == [0.1_dp, 0.4_dp]) .and. all(res%peak_v == [0.2_dp, 0.5_dp]) .and. &
+                 all(res%peak_aabs == [0.3_dp, 0.6_dp]) .and. all(res%peak_u_time == 0.25_dp) .and. &
+                 all(res%peak_aabs_time == 0.25_dp), 'the DOFs')
+      if (allocated(error)) return
+      call check(error, res%peak_s(1) == 0.7_dp .and. res%peak_force(1) == 80.0_dp, 'the device')
+      if (allocated(error)) return
+      call observe_extremum(res, 4, 0.3_dp, 0.5_dp)
+      call observe_extremum(res, 7, 0.9_dp, 0.5_dp)
+      call check(error, res%peak_u(2) == 0.4_dp .and. res%peak_u_time(2) == 0.25_dp .and. res%peak_s(1) == 0.9_dp, &
+                 'a smaller |u2| leaves its peak, a larger |s1| replaces it')
+   end subroutine test_extrema
+
+   !> Input work -2 J then +1 J, viscous 0.5 J each: input -1 J, gross 3 J, viscous 1 J.
+   subroutine test_work(error)
+      type(error_type), allocatable, intent(out) :: error
+      type(result_type) :: res
+
+      call observe_work(res, -2.0_dp, 0.5_dp)
+      call observe_work(res, 1.0_dp, 0.5_dp)
+      call check(error, res%e_input == -1.0_dp .and. res%e_input_gross == 3.0_dp .and. res%e_viscous == 1.0_dp, &
+                 'the balance')
+   end subroutine test_work
 
 end module test_fd_observer

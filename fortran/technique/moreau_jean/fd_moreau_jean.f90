@@ -30,7 +30,7 @@ module fd_moreau_jean
    use fd_result, only: result_type
    use fd_observer, only: observer_type, observer_init, sample_due, observe_peaks, observe_sample, &
                           observe_transitions, observe_start_energies, observe_end_energies, &
-                         observe_poll, observe_stop_error
+                         observe_poll, observe_stop_error, observe_work
    use fd_run_control, only: run_control
    use fd_stick_groups, only: groups_build, edge_relative
    use fd_group_system, only: gs_k_matvec, gs_k_absmatvec, gs_lowest_eigenvalue
@@ -147,7 +147,7 @@ contains
       if (allocated(error)) return
       call setup(model, w, res, error)
       if (allocated(error)) return
-      call observer_init(model, exc, opts, res, w%obs, error, ctl)
+      call observer_init(model, exc, opts, res%period_stuck, res, w%obs, error, ctl)
       if (allocated(error)) return
       th = opts%theta
       h = exc%dt_record/opts%n1
@@ -207,10 +207,8 @@ contains
          ! energy of the step: input, viscous and friction work over du = h v_theta
          w%du = w%u1 - w%u
          ein = agt*sum(model%mass*w%du)
-         res%e_input = res%e_input - ein
-         res%e_input_gross = res%e_input_gross + abs(ein)
          call gs_k_matvec(w%p%gs, w%du, w%kx, 1.0_dp, 0.0_dp)
-         res%e_viscous = res%e_viscous + (w%a0*sum(model%mass*w%du**2) + w%a1*dot_product(w%du, w%kx))/h
+         call observe_work(res, -ein, (w%a0*sum(model%mass*w%du**2) + w%a1*dot_product(w%du, w%kx))/h)
          do e = 1, w%ne
             w%w_fric = w%w_fric + w%p%lam(e)*edge_relative(w%p%es, e, w%du)/h
          end do
