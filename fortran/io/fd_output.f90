@@ -7,7 +7,7 @@ module fd_output
    use fd_kinds, only: dp
    use fd_error, only: error_type, fatal_error, fmt_int, fmt_real
    use fd_model, only: model_type, output_type, law_name, technique_name
-   use fd_result, only: result_type, resolution_names, energy_balance_names, record_system_names
+   use fd_result, only: result_type, resolution_names, energy_balance_names, record_system_names, history_header
    use fd_record, only: record_info
    use fd_warnings, only: warning_text, run_warnings
    use fd_undefined, only: undefined_why
@@ -861,29 +861,6 @@ contains
       end do
       call put(jt, '],'//nl)
    end subroutine ki
-
-   !> The header line of the history: name[unit] of each column, comma separated.
-   pure subroutine history_header(res, line)
-      type(result_type), intent(in) :: res                 !! the result
-      character(len=:), allocatable, intent(out) :: line   !! the header
-      integer :: j, pos, n
-
-      n = 0
-      do j = 1, res%ncol
-         n = n + len_trim(res%names(j)) + len_trim(res%units(j)) + 3
-      end do
-      allocate (character(len=max(n - 1, 0)) :: line)
-      pos = 0
-      do j = 1, res%ncol
-         n = len_trim(res%names(j)) + len_trim(res%units(j)) + 2
-         line(pos + 1:pos + n) = trim(res%names(j))//'['//trim(res%units(j))//']'
-         pos = pos + n
-         if (j < res%ncol) then
-            line(pos + 1:pos + 1) = ','
-            pos = pos + 1
-         end if
-      end do
-   end subroutine history_header
 
    !> A real as JSON: 17 significant digits (null when not finite), left-adjusted.
    pure function json_real(x) result(str)

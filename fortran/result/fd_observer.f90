@@ -24,8 +24,7 @@ module fd_observer
    use fd_result, only: result_type, init_result, max_violation_times
    use fd_linalg, only: sym_matvec
    use fd_run_control, only: run_control, cancel_requested, stat_cancelled
-   use fd_history_stream, only: stream_open, stream_row, stream_failed, stream_close
-   use fd_output, only: history_header
+   use fd_result, only: history_header
    use fd_engineering, only: engineering_init, observe_engineering, storey_values, observe_storey_peak
    implicit none
    private
@@ -66,8 +65,8 @@ contains
 
    !> Set up the result of a run (history, per-DOF and per-device summary) and the
    !> observer: the number of dt1 steps and the sampling interval. With a control: the
-   !> history's columns and destinations it selects, and its history file opened (created
-   !> under its temporary name, the header written).
+   !> history's columns and destinations it selects, and its row sink begun (for the history
+   !> file: created under its temporary name, the header written).
    subroutine observer_init(model, exc, opts, period_stuck, res, obs, error, ctl)
       type(model_type), intent(in) :: model         !! the model run
       type(excitation_type), intent(in) :: exc      !! the table motion
@@ -111,9 +110,9 @@ contains
             return
          end if
       end if
-      if (allocated(ctl%stream_path)) then
+      if (allocated(ctl%sink)) then
          call history_header(res, header)
-         call stream_open(ctl%stream, ctl%stream_path, header, res%ncol, error)
+         call ctl%sink%begin(header, res%ncol, error)
          if (allocated(error)) return
       end if
       call system_clock(obs%last_poll, obs%rate)
@@ -279,8 +278,8 @@ contains
    !> The next row of the history: t, ag, (u, v, aabs) per kept DOF, (s, s', F, phase) per
    !> kept device, then (a history with those columns, has_envelope) the maxima since the
    !> previous row `env` of the kept DOFs and devices; into the result, the control's buffer
-   !> and its history file as selected. The first value not finite of a row that goes only to
-   !> the buffer or the file is noted in the control (run_config_solve makes it an error; the
+   !> and its row sink as selected. The first value not finite of a row that goes only to
+   !> the buffer or the sink is noted in the control (run_config_solve makes it an error; the
    !> result's rows are checked at the end). Allocates nothing.
    subroutine observe_sample(obs, res, t, ag, u, v, acc, s, sd, force, phase, env)
       type(observer_type), intent(inout) :: obs !! the observer
@@ -368,7 +367,7 @@ contains
          end if
          if (associated(obs%ctl)) then
             if (associated(obs%ctl%buffer)) obs%ctl%buffer(:, obs%rows) = row
-            if (allocated(obs%ctl%stream_path)) call stream_row(obs%ctl%stream, row)
+            if (allocated(obs%ctl%sink)) call obs%ctl%sink%put(row)
          end if
       end associate
    end subroutine observe_sample
@@ -376,7 +375,7 @@ contains
    !> Called by a technique after every accepted step. Mostly a counter; every ~10 ms of
    !> wall clock (the interval adapts to the cost of a step) it publishes the time reached,
    !> calls the progress callback when its interval has passed, and says whether the run must
-   !> stop: a stop was requested, or the history file could not be written.
+   !> stop: a stop was requested, or the row sink (the history file) could not be written.
    subroutine observe_poll(obs, t, halt)
       type(observer_type), intent(inout) :: obs !! the observer
       real(dp), intent(in) :: t                !! time reached [s]
@@ -403,8 +402,8 @@ contains
       obs%countdown = obs%poll_every
       obs%ctl%time = t
       if (cancel_requested(obs%ctl%cancel)) halt = .true.
-      if (allocated(obs%ctl%stream_path)) then
-         if (stream_failed(obs%ctl%stream)) halt = .true.
+      if (allocated(obs%ctl%sink)) then
+         if (obs%ctl%sink%failed()) halt = .true.
       end if
       if (halt) then
          obs%stopped = .true.
@@ -420,16 +419,16 @@ contains
    end subroutine observe_poll
 
    !> The error a technique returns when observe_poll said stop: the run was cancelled
-   !> (error%stat = stat_cancelled), or the history file could not be written.
+   !> (error%stat = stat_cancelled), or the row sink (the history file) could not be written.
    subroutine observe_stop_error(obs, error)
       type(observer_type), intent(inout) :: obs          !! the observer
       type(error_type), allocatable, intent(out) :: error !! why the run stopped
       type(error_type), allocatable :: write_error
 
       if (associated(obs%ctl)) then
-         if (allocated(obs%ctl%stream_path)) then
-            if (stream_failed(obs%ctl%stream)) then
-               call stream_close(obs%ctl%stream, write_error)
+         if (allocated(obs%ctl%sink)) then
+            if (obs%ctl%sink%failed()) then
+               call obs%ctl%sink%finish(write_error)
                call move_alloc(write_error, error)
                return
             end if

@@ -13,7 +13,7 @@ module fd_result
    private
 
    public :: result_type, max_violation_times, column_name_len, init_result, history_shape, check_finite
-   public :: nonfinite_history_error
+   public :: nonfinite_history_error, history_header
    public :: max_event_times, has_envelope
    public :: resolution_none, resolution_resolved, resolution_unresolved, resolution_names
    public :: residual_ratio_limit, roundoff_ratio_limit, energy_balance_of, energy_balance_names
@@ -321,6 +321,29 @@ contains
       res%names(c + 1) = prefix//'Vb'; res%units(c + 1) = 'N'
       c = c + 1
    end subroutine storey_columns
+
+   !> The header line of the history: name[unit] of each column, comma separated.
+   pure subroutine history_header(res, line)
+      type(result_type), intent(in) :: res                 !! the result
+      character(len=:), allocatable, intent(out) :: line   !! the header
+      integer :: j, pos, n
+
+      n = 0
+      do j = 1, res%ncol
+         n = n + len_trim(res%names(j)) + len_trim(res%units(j)) + 3
+      end do
+      allocate (character(len=max(n - 1, 0)) :: line)
+      pos = 0
+      do j = 1, res%ncol
+         n = len_trim(res%names(j)) + len_trim(res%units(j)) + 2
+         line(pos + 1:pos + n) = trim(res%names(j))//'['//trim(res%units(j))//']'
+         pos = pos + n
+         if (j < res%ncol) then
+            line(pos + 1:pos + 1) = ','
+            pos = pos + 1
+         end if
+      end do
+   end subroutine history_header
 
    !> Every number of a result must be finite: an error names the first quantity that is not
    !> (its summary key, or its history column and time), never a null in a summary.
