@@ -378,9 +378,10 @@ contains
       call run_part(jt, deck_path, record)
       call model_part(jt, model, res)
       call mode_part(jt, res)
-      call harmonic_part(jt, res)
+      call harmonic_part(jt, res%harmonic_error, res%harmonic_resolution)
       call record_step_part(jt, res)
-      call stick_part(jt, res)
+      call stick_part(jt, res%stick_freq_error, res%stick_ringing_ratio, res%stick_ringing, res%stick_margin, &
+                      res%stick_resolution)
       call band_part(jt, res)
       call peaks_part(jt, res)
       call statistics_part(jt, res)
@@ -448,13 +449,15 @@ contains
       call kv(jt, 'mode_resolution', '"'//trim(resolution_names(res%mode_resolution))//'"')
    end subroutine mode_part
 
-   !> Whether dt1 resolves a harmonic table motion (fd_harmonic_resolution).
-   subroutine harmonic_part(jt, res)
+   !> Whether dt1 resolves a harmonic table motion (fd_harmonic_resolution): the step's error
+   !> per DOF and the verdict.
+   subroutine harmonic_part(jt, step_error, resolution)
       type(json_text), intent(inout) :: jt     !! the summary
-      type(result_type), intent(in) :: res     !! the result
+      real(dp), intent(in) :: step_error(:)    !! per DOF: the step's error in the steady state
+      integer, intent(in) :: resolution        !! resolution_*
 
-      call kr(jt, 'harmonic_step_error', res%harmonic_error)
-      call kv(jt, 'harmonic_resolution', '"'//trim(resolution_names(res%harmonic_resolution))//'"')
+      call kr(jt, 'harmonic_step_error', step_error)
+      call kv(jt, 'harmonic_resolution', '"'//trim(resolution_names(resolution))//'"')
    end subroutine harmonic_part
 
    !> Whether dt1 resolves a recorded table motion (fd_record_resolution).
@@ -469,16 +472,21 @@ contains
       call kv(jt, 'record_step_system', '"'//trim(record_system_names(res%record_system))//'"')
    end subroutine record_step_part
 
-   !> Whether dt1 resolves the sticking springs' ringing (fd_stick_ringing).
-   subroutine stick_part(jt, res)
+   !> Whether dt1 resolves the sticking springs' ringing (fd_stick_ringing): per device the
+   !> frequency error, the ringing ratio, amplitude and margin, then the verdict.
+   subroutine stick_part(jt, freq_error, ratio, ringing, margin, resolution)
       type(json_text), intent(inout) :: jt     !! the summary
-      type(result_type), intent(in) :: res     !! the result
+      real(dp), intent(in) :: freq_error(:)    !! 1 - omega~/omega of each sticking spring's mode
+      real(dp), intent(in) :: ratio(:)         !! largest ringing / margin of a dephased stick phase
+      real(dp), intent(in) :: ringing(:)       !! that phase's ringing amplitude [N]
+      real(dp), intent(in) :: margin(:)        !! that phase's margin [N]
+      integer, intent(in) :: resolution        !! resolution_*
 
-      call kr(jt, 'stick_frequency_error', res%stick_freq_error)
-      call kr(jt, 'stick_ringing_ratio', res%stick_ringing_ratio)
-      call kr(jt, 'stick_ringing_N', res%stick_ringing)
-      call kr(jt, 'stick_margin_N', res%stick_margin)
-      call kv(jt, 'stick_resolution', '"'//trim(resolution_names(res%stick_resolution))//'"')
+      call kr(jt, 'stick_frequency_error', freq_error)
+      call kr(jt, 'stick_ringing_ratio', ratio)
+      call kr(jt, 'stick_ringing_N', ringing)
+      call kr(jt, 'stick_margin_N', margin)
+      call kv(jt, 'stick_resolution', '"'//trim(resolution_names(resolution))//'"')
    end subroutine stick_part
 
    !> Whether the step damps the velocity-law bands (fd_band_alternation).

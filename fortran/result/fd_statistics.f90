@@ -74,18 +74,11 @@ contains
       type(newmark_stats), intent(in) :: st   !! Newmark's statistics
       type(summary_counts) :: c               !! the summary's counters
 
-      c%steps_dt1 = st%steps_dt1
-      c%steps_nested = st%steps_nested
-      c%steps_implicit = st%steps_implicit
-      c%implicit_redos = st%implicit_redos
-      c%implicit_fallbacks = st%implicit_fallbacks
-      c%steps_dt2 = st%steps_dt2
-      c%steps_finer = st%steps_finer
-      c%factorizations = st%factorizations
-      c%factor_updates = st%factor_updates
-      c%partial_factorizations = st%partial_factorizations
-      c%storage = st%storage
-      c%bandwidth = st%bandwidth
+      c = summary_counts(steps_dt1=st%steps_dt1, steps_nested=st%steps_nested, steps_implicit=st%steps_implicit, &
+                         implicit_redos=st%implicit_redos, implicit_fallbacks=st%implicit_fallbacks, &
+                         steps_dt2=st%steps_dt2, steps_finer=st%steps_finer, factorizations=st%factorizations, &
+                         factor_updates=st%factor_updates, partial_factorizations=st%partial_factorizations, &
+                         storage=st%storage, bandwidth=st%bandwidth)
    end function newmark_counts
 
    !> The exact technique's counters under the summary's keys: its sampling intervals as

@@ -128,21 +128,39 @@ contains
                   trim(see('mode-resolution'))
    end subroutine mode_check
 
+   !> The head of a check judged by its largest value per DOF or device (harmonic, record,
+   !> stick ringing, band alternation): its key, its verdict from `resolution`, and (when it
+   !> applies) the figures `what` (the DOF or device of the largest value, d; 0 when the check
+   !> does not apply) and that value under the name `name`.
+   pure subroutine largest_check(c, key, resolution, values, what, name, d)
+      type(check_type), intent(out) :: c                 !! the check
+      character(len=*), intent(in) :: key                !! its key
+      integer, intent(in) :: resolution                  !! resolution_*
+      real(dp), allocatable, intent(in) :: values(:)     !! per DOF or device (not allocated: none)
+      character(len=*), intent(in) :: what               !! 'dof' or 'device'
+      character(len=*), intent(in) :: name               !! the values' summary key
+      integer, intent(out) :: d                          !! the DOF or device of the largest value
+
+      d = 0
+      c%key = key
+      c%verdict = resolution_verdict(resolution)
+      if (c%verdict == verdict_not_applicable .or. .not. allocated(values)) return
+      if (size(values) == 0) return
+      d = maxloc(values, 1)
+      call add_figure(c, what, real(d, dp))
+      call add_figure(c, name, values(d))
+   end subroutine largest_check
+
    !> Whether dt1 resolves a harmonic table motion's steady state (fd_harmonic_resolution).
    pure subroutine harmonic_check(res, c)
       type(result_type), intent(in) :: res   !! the result
       type(check_type), intent(out) :: c     !! the check
       integer :: d
 
-      c%key = 'harmonic_resolution'
-      c%verdict = resolution_verdict(res%harmonic_resolution)
-      if (c%verdict == verdict_not_applicable .or. .not. allocated(res%harmonic_error)) return
-      if (size(res%harmonic_error) == 0) return
-      d = maxloc(res%harmonic_error, 1)
-      call add_figure(c, 'dt1_s', res%dt1)
-      call add_figure(c, 'dof', real(d, dp))
-      call add_figure(c, 'harmonic_step_error', res%harmonic_error(d))
-      if (c%verdict /= verdict_warns) return
+      call largest_check(c, 'harmonic_resolution', res%harmonic_resolution, res%harmonic_error, 'dof', &
+                         'harmonic_step_error', d)
+      if (d > 0) call add_figure(c, 'dt1_s', res%dt1)
+      if (c%verdict /= verdict_warns .or. d == 0) return
       c%warning = 'dt1 = '//trim(es(res%dt1, 3))//' s takes '//trim(fx(1.0_dp/(res%eng%frequency*res%dt1), 2))// &
                   ' steps a table period: the step alone moves the linear steady-state amplitude of DOF '// &
                   trim(fmt_int(d))//' by '//trim(fx(100*res%harmonic_error(d), 1))//' % (harmonic_step_error > '// &
@@ -155,15 +173,10 @@ contains
       type(check_type), intent(out) :: c     !! the check
       integer :: d
 
-      c%key = 'record_resolution'
-      c%verdict = resolution_verdict(res%record_resolution)
-      if (c%verdict == verdict_not_applicable .or. .not. allocated(res%record_error)) return
-      if (size(res%record_error) == 0) return
-      d = maxloc(res%record_error, 1)
-      call add_figure(c, 'dt1_s', res%dt1)
-      call add_figure(c, 'dof', real(d, dp))
-      call add_figure(c, 'record_step_error', res%record_error(d))
-      if (c%verdict /= verdict_warns) return
+      call largest_check(c, 'record_resolution', res%record_resolution, res%record_error, 'dof', &
+                         'record_step_error', d)
+      if (d > 0) call add_figure(c, 'dt1_s', res%dt1)
+      if (c%verdict /= verdict_warns .or. d == 0) return
       c%warning = 'dt1 = '//trim(es(res%dt1, 3))//' s does not resolve the record: the step alone moves the peak '// &
                   'linear response of DOF '//trim(fmt_int(d))//' by '//trim(fx(100*res%record_error(d), 1))// &
                   ' % (record_step_error > 0.05, '//trim(record_system_text(res%record_system))//'); raise n1'// &
@@ -176,15 +189,10 @@ contains
       type(check_type), intent(out) :: c     !! the check
       integer :: d, more
 
-      c%key = 'stick_resolution'
-      c%verdict = resolution_verdict(res%stick_resolution)
-      if (c%verdict == verdict_not_applicable .or. .not. allocated(res%stick_ringing_ratio)) return
-      if (size(res%stick_ringing_ratio) == 0) return
-      d = maxloc(res%stick_ringing_ratio, 1)
+      call largest_check(c, 'stick_resolution', res%stick_resolution, res%stick_ringing_ratio, 'device', &
+                         'stick_ringing_ratio', d)
+      if (c%verdict /= verdict_warns .or. d == 0) return
       more = count(res%stick_ringing_ratio > 1.0_dp) - 1
-      call add_figure(c, 'device', real(d, dp))
-      call add_figure(c, 'stick_ringing_ratio', res%stick_ringing_ratio(d))
-      if (c%verdict /= verdict_warns) return
       call add_figure(c, 'stick_ringing_N', res%stick_ringing(d))
       call add_figure(c, 'stick_margin_N', res%stick_margin(d))
       call add_figure(c, 'more_devices', real(more, dp))
@@ -201,15 +209,10 @@ contains
       character(len=:), allocatable :: s
       integer :: d, more
 
-      c%key = 'band_resolution'
-      c%verdict = resolution_verdict(res%band_resolution)
-      if (c%verdict == verdict_not_applicable .or. .not. allocated(res%band_alternation)) return
-      if (size(res%band_alternation) == 0) return
-      d = maxloc(res%band_alternation, 1)
+      call largest_check(c, 'band_resolution', res%band_resolution, res%band_alternation, 'device', &
+                         'band_alternation_N', d)
+      if (c%verdict /= verdict_warns .or. d == 0) return
       more = count(res%band_alternation > 0.0_dp) - 1
-      call add_figure(c, 'device', real(d, dp))
-      call add_figure(c, 'band_alternation_N', res%band_alternation(d))
-      if (c%verdict /= verdict_warns) return
       call add_figure(c, 'band_x', res%band_x(d))
       call add_figure(c, 'more_devices', real(more, dp))
       if (res%band_x(d) > 1.0_dp) then
