@@ -25,7 +25,7 @@ module fd_session
                           shape_of, summary_json, history_header, output_paths, write_outputs, &
                           write_output_files, run_control, select_history
    use fd_run_control, only: progress_callback, control_reset
-   use fd_history_stream, only: stream_close, stream_discard
+   use fd_history_stream, only: history_file_sink
    use fd_output, only: make_dir, temp_output_paths, remove_made_dirs
    use fd_tempfiles, only: temp_tag, remove_stale_temps
    use fd_excitation, only: excitation_record
@@ -193,7 +193,7 @@ contains
          s%ctl%buffer => buffer
          s%ctl%keep = .false.
       end if
-      if (allocated(s%ctl%stream_path)) deallocate (s%ctl%stream_path)
+      if (allocated(s%ctl%sink)) deallocate (s%ctl%sink)
       if (s%stream .and. s%cfg%out%history) then
          call make_dir(s%cfg%out%dir, error, s%made_dir)
          if (allocated(error)) then
@@ -206,7 +206,7 @@ contains
          call remove_stale_temps(hist)   ! those of killed writers of the name
          call remove_stale_temps(summ)
          call temp_output_paths(s%cfg%out, s%tag, htmp, stmp)
-         s%ctl%stream_path = htmp
+         call history_file_sink(htmp, s%ctl%sink)
       end if
       call run_config_solve(s%cfg, s%res, error, s%ctl)
       nullify (s%ctl%buffer)
@@ -216,15 +216,15 @@ contains
          error%message = s%cfg%deck_path//": "//error%message   ! as the executable says it
          return
       end if
-      if (allocated(s%ctl%stream_path)) then
-         call stream_close(s%ctl%stream, close_error)
+      if (allocated(s%ctl%sink)) then
+         call s%ctl%sink%finish(close_error)
          if (allocated(close_error)) then
             call discard_stream(s)
             call move_alloc(close_error, error)
             s%state = state_failed
             return
          end if
-         s%stream_tmp = s%ctl%stream_path
+         s%stream_tmp = htmp
       end if
       s%have_history = s%ctl%keep
       call history_header(s%res, s%header)
@@ -416,7 +416,7 @@ contains
          ! the history is complete under its temporary name: commit it with the summary
          call write_output_files(hist, summ, s%cfg%out%history, s%header, none, s%summary, error, &
                                  tag=s%tag, streamed=.true.)
-         if (allocated(s%ctl%stream%path)) deallocate (s%ctl%stream%path)
+         if (allocated(s%ctl%sink)) deallocate (s%ctl%sink)   ! committed: not to be discarded
          deallocate (s%stream_tmp)
          if (allocated(error) .and. allocated(s%made_dir)) call remove_made_dirs(s%cfg%out%dir, s%made_dir)
          if (allocated(s%made_dir)) deallocate (s%made_dir)
@@ -503,7 +503,10 @@ contains
    !> they are left empty: a run that failed or was cancelled leaves nothing behind.
    subroutine discard_stream(s)
       type(session_type), intent(inout) :: s
-      call stream_discard(s%ctl%stream)
+      if (allocated(s%ctl%sink)) then
+         call s%ctl%sink%discard()
+         deallocate (s%ctl%sink)
+      end if
       if (allocated(s%made_dir)) then
          call remove_made_dirs(s%cfg%out%dir, s%made_dir)
          deallocate (s%made_dir)

@@ -24,6 +24,7 @@ program frictiondyn_main
    use fd_error, only: fmt_text
    use fd_textio, only: line_type, read_file_text, split_lines, cr_line_ends
    use fd_undefined, only: undefined_why
+   use fd_statistics, only: technique_counts
    implicit none
 
    interface
@@ -113,7 +114,8 @@ program frictiondyn_main
    call clear_temps()
    if (allocated(error)) call fail(error%message)
 
-   associate (res => ses%res, cfg => ses%cfg)
+   associate (res => ses%res, cfg => ses%cfg, &
+              n => technique_counts(ses%res%newmark, ses%res%exact, ses%res%moreau_jean))
    ! the warnings the result calls for (fd_warnings: the summary holds the same texts)
    call run_warnings(res, warns)
    do i = 1, size(warns)
@@ -125,14 +127,14 @@ program frictiondyn_main
    if (len_trim(undefined_why(res, 'period_stuck_s')) > 0) then
       write (output_unit, '(a,i0,a,i0,a,i0,a,i0)') '  stuck period not defined ('// &
          trim(undefined_why(res, 'period_stuck_s'))//'); steps dt1 ', &
-         res%steps_dt1, ', nested ', res%steps_nested, ', dt2 ', res%steps_dt2, ', finer ', res%steps_finer
+         n%steps_dt1, ', nested ', n%steps_nested, ', dt2 ', n%steps_dt2, ', finer ', n%steps_finer
    else
       write (output_unit, '(a,f0.6,a,i0,a,i0,a,i0,a,i0)') '  stuck period ', res%period_stuck, ' s; steps dt1 ', &
-         res%steps_dt1, ', nested ', res%steps_nested, ', dt2 ', res%steps_dt2, ', finer ', res%steps_finer
+         n%steps_dt1, ', nested ', n%steps_nested, ', dt2 ', n%steps_dt2, ', finer ', n%steps_finer
    end if
-   if (res%steps_implicit + res%implicit_fallbacks > 0) &
-      write (output_unit, '(a,i0,a,i0,a,i0,a)') '  implicit phases: ', res%steps_implicit, ' dt1 steps settled (', &
-      res%implicit_redos, ' trials redone), ', res%implicit_fallbacks, ' refined as the paper''s'
+   if (n%steps_implicit + n%implicit_fallbacks > 0) &
+      write (output_unit, '(a,i0,a,i0,a,i0,a)') '  implicit phases: ', n%steps_implicit, ' dt1 steps settled (', &
+      n%implicit_redos, ' trials redone), ', n%implicit_fallbacks, ' refined as the paper''s'
    if (allocated(cfg%record%path)) then
       write (output_unit, '(a,i0,a,es12.5,a)') '  record '//cfg%record%path//' ('//trim(cfg%record%format)// &
          trim(merge(', detected', '          ', cfg%record%detected))//', '//trim(cfg%record%units)//'): ', &

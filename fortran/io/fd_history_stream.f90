@@ -12,25 +12,34 @@ module fd_history_stream
    use fd_kinds, only: dp
    use fd_error, only: error_type, fatal_error
    use fd_fileops, only: c_file_create, c_file_write, c_file_close, c_unlink, c_rename, os_error
+   use fd_row_sink, only: row_sink
    implicit none
    private
 
    public :: history_stream, stream_open, stream_row, stream_close, stream_discard, stream_commit
-   public :: stream_failed, stream_is_open, format_row
+   public :: stream_failed, stream_is_open, format_row, history_file_sink
 
    !> Bytes a value takes in a row: 24 characters and a comma (or the newline).
    integer, parameter, public :: stream_value_width = 25
    !> Size of the output buffer [bytes] (at least one row).
    integer, parameter :: buffer_bytes = 1048576
 
-   !> One history file being written.
-   type :: history_stream
+   !> One history file being written; as the observer's row sink (fd_row_sink, made by
+   !> history_file_sink) it creates `dest` when begun.
+   type, extends(row_sink) :: history_stream
       integer(c_int) :: fd = -1                      !! file descriptor (-1: not open)
       character(len=:), allocatable :: path          !! the (temporary) file written
       character(kind=c_char, len=:), allocatable :: buf !! output buffer
       integer :: pos = 0                             !! bytes used in buf
       integer :: ncol = 0                            !! values a row
       integer(c_int) :: err = 0                      !! errno of a failed write (0: none)
+      character(len=:), allocatable :: dest          !! the file the sink creates when begun
+   contains
+      procedure :: begin => sink_begin
+      procedure :: put => sink_put
+      procedure :: failed => sink_failed
+      procedure :: finish => sink_finish
+      procedure :: discard => sink_discard
    end type history_stream
 
    interface
@@ -176,5 +185,64 @@ contains
       end if
       deallocate (st%path)
    end subroutine stream_commit
+
+   !> A row sink that writes the history file `path` (created when the run begins it, under
+   !> the name the caller chose: a temporary one, committed by write_output_files).
+   subroutine history_file_sink(path, sink)
+      character(len=*), intent(in) :: path                   !! the file to create
+      class(row_sink), allocatable, intent(out) :: sink      !! the sink
+
+      allocate (history_stream :: sink)
+      select type (sink)
+      type is (history_stream)
+         sink%dest = path
+      end select
+   end subroutine history_file_sink
+
+   !> The sink begun: its file created (stream_open), the header written.
+   subroutine sink_begin(sink, header, ncol, error)
+      class(history_stream), intent(inout) :: sink        !! the sink
+      character(len=*), intent(in) :: header              !! header line, without newline
+      integer, intent(in) :: ncol                         !! values a row
+      type(error_type), allocatable, intent(out) :: error !! cannot create or write
+      character(len=:), allocatable :: dest
+
+      if (.not. allocated(sink%dest)) then
+         call fatal_error(error, "the history sink names no file")
+         return
+      end if
+      dest = sink%dest
+      call stream_open(sink, dest, header, ncol, error)
+   end subroutine sink_begin
+
+   !> One row (stream_row).
+   subroutine sink_put(sink, row)
+      class(history_stream), intent(inout) :: sink  !! the sink
+      real(dp), intent(in) :: row(:)                !! the row's values
+
+      call stream_row(sink, row)
+   end subroutine sink_put
+
+   !> Whether a write has failed (stream_failed).
+   logical function sink_failed(sink)
+      class(history_stream), intent(in) :: sink     !! the sink
+
+      sink_failed = stream_failed(sink)
+   end function sink_failed
+
+   !> Flush, close (stream_close); on failure the file is removed and the error names it.
+   subroutine sink_finish(sink, error)
+      class(history_stream), intent(inout) :: sink        !! the sink
+      type(error_type), allocatable, intent(out) :: error !! the file could not be written
+
+      call stream_close(sink, error)
+   end subroutine sink_finish
+
+   !> Close if open and remove the file (stream_discard).
+   subroutine sink_discard(sink)
+      class(history_stream), intent(inout) :: sink  !! the sink
+
+      call stream_discard(sink)
+   end subroutine sink_discard
 
 end module fd_history_stream

@@ -7,7 +7,7 @@ module fd_output
    use fd_kinds, only: dp
    use fd_error, only: error_type, fatal_error, fmt_int, fmt_real
    use fd_model, only: model_type, output_type, law_name, technique_name
-   use fd_result, only: result_type, resolution_names, energy_balance_names, record_system_names
+   use fd_result, only: result_type, resolution_names, energy_balance_names, record_system_names, history_header
    use fd_record, only: record_info
    use fd_warnings, only: warning_text, run_warnings
    use fd_undefined, only: undefined_why
@@ -15,6 +15,9 @@ module fd_output
    use fd_history_stream, only: format_row, stream_value_width
    use fd_names, only: excitation_types, keyword_len
    use fd_matrices, only: modes_type, modes_flexible, modes_rigid, modes_unrestrained
+   use fd_engineering, only: engineering_type
+   use fd_statistics, only: newmark_stats, event_driven_stats, moreau_jean_stats, summary_counts, &
+                            newmark_counts, event_driven_counts, moreau_jean_counts
    use fd_fileops, only: c_lock_acquire, c_lock_release, c_unlink, c_rename, os_error, &
                          c_file_create, c_file_write, c_file_close, c_mkdir, lock_not_file
    use fd_tempfiles, only: temp_tag, remove_stale_temps
@@ -33,6 +36,13 @@ module fd_output
    end interface
 
    integer(c_int), parameter :: enoent = 2, eexist = 17
+   character(len=1), parameter :: nl = achar(10)   !! the summary's line end
+
+   !> The summary's text as it grows (put appends, doubling the capacity when full).
+   type :: json_text
+      character(len=:), allocatable :: buf   !! capacity
+      integer :: pos = 0                     !! characters used
+   end type json_text
 
 contains
 
@@ -315,7 +325,6 @@ contains
       integer(c_int) :: fd
       integer :: i, pos, width, rows_per_chunk
       character(len=:), allocatable :: fmt, buf
-      character(len=1), parameter :: nl = achar(10)
 
       call create_new(path, fd, error)
       if (allocated(error)) return
@@ -352,330 +361,514 @@ contains
       call finish(fd, path, error)
    end subroutine write_summary
 
-   !> The summary of a run as a JSON object (keys documented in docs/namelist.md).
+   !> The summary of a run as a JSON object (keys documented in docs/namelist.md): its parts in
+   !> order, each written by its own routine (the run and its model, each check of the step,
+   !> the peaks and phase changes, the technique's statistics, the checks of the run, the
+   !> energy balance, the engineering outputs, the warnings).
    subroutine summary_json(model, res, deck_path, js, record)
       type(model_type), intent(in) :: model                !! the model run
       type(result_type), intent(in) :: res                 !! its result
       character(len=*), intent(in) :: deck_path            !! deck named in the summary
       character(len=:), allocatable, intent(out) :: js     !! the JSON text
       type(record_info), intent(in), optional :: record    !! the record read, if any
-      character(len=1), parameter :: nl = achar(10)
-      character(len=:), allocatable :: esc, buf
-      integer :: pos
-      integer :: d
+      type(json_text) :: jt
 
-      call json_escape(deck_path, esc)
-      pos = 0
-      allocate (character(len=4096 + 64*(res%n_dof + res%n_devices)*8) :: buf)
-      call put('{'//nl)
-      call put('  "deck": "'//esc//'",'//nl)
-      call put('  "frictiondyn_version": "'//frictiondyn_version//'",'//nl)
-      if (present(record)) then
-         if (allocated(record%path)) then
-            call put('  "record": {')
-            call json_escape(record%path, esc)
-            call put('"file": "'//esc//'", "format": "'//trim(record%format)//'", "format_detected": '// &
-                 trim(merge('true ', 'false', record%detected))//', "units": "'//trim(record%units)// &
-                 '", "samples": '//trim(fmt_int(record%npts))//', "dt_s": '//trim(json_real(record%dt))// &
-                 ', "scale": '//trim(json_real(record%scale))//', "peak_acc_mps2": '// &
-                 trim(json_real(record%peak_acc))//', "sha256": "'//trim(record%sha256)//'"')
-            if (allocated(record%title)) then
-               call json_escape(record%title, esc)
-               call put(', "title": "'//esc//'"')
-            end if
-            call put('},'//nl)
-         end if
-      end if
-      call kint('n_dof', res%n_dof)
-      call kint('n_devices', res%n_devices)
-      call kv('technique', '"'//trim(technique_name(res%technique))//'"')
-      call ks('device_law', [character(len=keyword_len) :: (law_name(model%dev(d)%law), d=1, model%n_devices)])
-      call kreal('period_stuck_s', res%period_stuck)
-      call kreal('xi_stuck', res%xi_stuck)
-      call kreal('dt1_s', res%dt1)
-      call kreal('dt2_s', res%dt2)
-      call kreal('dt_min_s', res%dt_min)
-      call kreal('omega_max_rad_s', res%omega_max)
-      call kreal('omega_max_dt1', res%omega_max*res%dt1)
-      call kv('mode_resolution', '"'//trim(resolution_names(res%mode_resolution))//'"')
-      call kr('harmonic_step_error', res%harmonic_error)
-      call kv('harmonic_resolution', '"'//trim(resolution_names(res%harmonic_resolution))//'"')
-      call kr('record_step_error', res%record_error)
-      call kr('record_step_error_stuck', res%record_error_stuck)
-      call kr('record_step_error_free', res%record_error_free)
-      call kv('record_resolution', '"'//trim(resolution_names(res%record_resolution))//'"')
-      call kv('record_step_system', '"'//trim(record_system_names(res%record_system))//'"')
-      call kr('stick_frequency_error', res%stick_freq_error)
-      call kr('stick_ringing_ratio', res%stick_ringing_ratio)
-      call kr('stick_ringing_N', res%stick_ringing)
-      call kr('stick_margin_N', res%stick_margin)
-      call kv('stick_resolution', '"'//trim(resolution_names(res%stick_resolution))//'"')
-      call kr('band_x', res%band_x)
-      call kr('band_alternation_N', res%band_alternation)
-      call kr('band_alternation_s', res%band_alternation_time, res%band_alternation /= 0.0_dp)
-      call kv('band_resolution', '"'//trim(resolution_names(res%band_resolution))//'"')
-      call kr('peak_u_m', res%peak_u)
-      call kr('peak_u_time_s', res%peak_u_time, res%peak_u /= 0.0_dp)
-      call kr('peak_v_mps', res%peak_v)
-      call kr('peak_aabs_mps2', res%peak_aabs)
-      call kr('peak_aabs_time_s', res%peak_aabs_time, res%peak_aabs /= 0.0_dp)
-      call kr('peak_s_m', res%peak_s)
-      call kr('peak_force_N', res%peak_force)
-      call ki('stick_to_slip', res%stick_to_slip)
-      call ki('slip_to_stick', res%slip_to_stick)
-      call ki('slip_reversals', res%reversals)
-      call kint('steps_dt1', res%steps_dt1)
-      call kint('steps_nested', res%steps_nested)
-      call kint('steps_implicit', res%steps_implicit)
-      call kint('implicit_redos', res%implicit_redos)
-      call kint('implicit_fallbacks', res%implicit_fallbacks)
-      call kint('steps_dt2', res%steps_dt2)
-      call kint('steps_finer', res%steps_finer)
-      call kint('factorizations', res%factorizations)
-      call kint('factor_updates', res%factor_updates)
-      call kint('partial_factorizations', res%partial_factorizations)
-      select case (res%storage)
-      case (1)
-         call kv('linear_system', '"dense"')
-      case (2)
-         call kv('linear_system', '"banded"')
-      case default
-         call kv('linear_system', '"none"')
-      end select
-      call kint('half_bandwidth', res%bandwidth)
-      call kint('events', res%events)
-      if (res%exact_peaks) then
-         ! the exact technique: peaks are the exact extrema; its event times, accumulations
-         call kv('peaks_exact', 'true')
-         call kr('event_times_s', res%event_time(1:res%n_event_times))
-         call kint('accumulation_points', res%accumulations)
-         call kr('accumulation_times_s', res%accumulation_time(1:res%n_accumulation_times))
-      end if
-      call kint('patterns_solved', res%patterns)
-      call kint('lcp_fallbacks', res%lcp_fallbacks)
-      call kint('correctness_violations', res%violations)
-      call kr('violation_times_s', res%violation_time(1:res%n_violation_times))
-      call ki('violation_devices', res%violation_device(1:res%n_violation_times))
-      call kint('mu_passes', res%mu_passes)
-      call kint('mu_unconverged_steps', res%mu_unconverged)
-      call kreal('mu_unconverged_s', res%mu_unconverged_time)
-      call kreal('mu_unconverged_misfit', res%mu_misfit)
-      call kreal('energy_input_J', res%e_input)
-      call kreal('energy_kinetic_J', res%e_kinetic)
-      call kreal('energy_strain_J', res%e_strain)
-      call kreal('energy_viscous_J', res%e_viscous)
-      call kreal('energy_friction_J', res%e_friction)
-      call kreal('energy_device_elastic_J', res%e_device)
-      call kreal('energy_residual_J', res%e_residual)
-      call kreal('energy_residual_ratio', res%e_residual_ratio)
-      call kv('energy_balance', '"'//trim(energy_balance_names(res%energy_balance))//'"')
-      call engineering_keys()
-      call kint('samples', res%nout)
-      call warnings_key()
-      call put('  "run_time_s": '//trim(json_real(res%run_time))//nl//'}')
-      js = buf(1:pos)
-   contains
-      !> Append to the text (capacity doubled when full: linear in the length, not quadratic).
-      subroutine put(text)
-         character(len=*), intent(in) :: text
-         character(len=:), allocatable :: bigger
-         if (pos + len(text) > len(buf)) then
-            allocate (character(len=2*(pos + len(text))) :: bigger)
-            bigger(1:pos) = buf(1:pos)
-            call move_alloc(bigger, buf)
-         end if
-         buf(pos + 1:pos + len(text)) = text
-         pos = pos + len(text)
-      end subroutine put
-      !> What produced the run, the names, the modes, the storeys (fd_engineering).
-      subroutine engineering_keys()
-         integer :: i
-         real(dp), allocatable :: ratio(:)
-         call kv('deck_sha256', '"'//trim(model%deck_sha256)//'"')
-         associate (eng => res%eng)
-            if (eng%excitation >= 1 .and. eng%excitation <= size(excitation_types)) then
-               call kv('excitation_type', '"'//trim(excitation_types(eng%excitation)%name)//'"')
-            else
-               call kv('excitation_type', '"unknown"')
-            end if
-            call kreal('excitation_frequency_Hz', eng%frequency)
-            call kreal('duration_s', eng%duration)
-            call ks('dof_labels', eng%dof_label)
-            call ks('device_labels', eng%device_label)
-            call kreal('damping_a0_per_s', eng%a0)
-            call kreal('damping_a1_s', eng%a1)
-            call modes_keys('stuck', eng%stuck)
-            call modes_keys('free', eng%free)
-            call kr('residual_s_m', eng%residual_s)
-            call kreal('peak_base_shear_N', eng%peak_shear(0))
-            call kreal('peak_base_shear_time_s', eng%peak_shear_time(0))
-            call kreal('residual_base_shear_N', eng%shear(0))
-            call kint('n_storeys', eng%n_storeys)
-            call ks('storey_labels', eng%storey_label)
-            call put('  "storey_nodes": [')
-            do i = 1, eng%n_storeys
-               call put('['//trim(fmt_int(eng%storey_i(i)))//', '//trim(fmt_int(eng%storey_j(i)))//']')
-               if (i < eng%n_storeys) call put(', ')
-            end do
-            call put('],'//nl)
-            call kr('storey_height_m', eng%height)
-            call kr('peak_drift_m', eng%peak_drift)
-            call kr('peak_drift_time_s', eng%peak_drift_time, eng%peak_drift /= 0.0_dp)
-            call kr('residual_drift_m', eng%drift)
-            ! a ratio without a storey height is undefined (null), not 0
-            allocate (ratio(eng%n_storeys))
-            ratio = 0.0_dp
-            where (eng%height > 0.0_dp) ratio = eng%peak_drift/eng%height
-            call kr('peak_drift_ratio', ratio, eng%height > 0.0_dp)
-            where (eng%height > 0.0_dp) ratio = eng%drift/eng%height
-            call kr('residual_drift_ratio', ratio, eng%height > 0.0_dp)
-            call kr('peak_storey_shear_N', eng%peak_shear(1:))
-            call kr('peak_storey_shear_time_s', eng%peak_shear_time(1:), eng%peak_shear(1:) /= 0.0_dp)
-            call kr('residual_storey_shear_N', eng%shear(1:))
-         end associate
-      end subroutine engineering_keys
-      !> The modes of one system: status, periods (0: a rigid-body mode), shapes, mass ratios, damping.
-      subroutine modes_keys(name, m)
-         character(len=*), intent(in) :: name
-         type(modes_type), intent(in) :: m
-         integer :: j
-         select case (m%status)
-         case (modes_flexible)
-            call kv('modes_'//name//'_status', '"flexible"')
-         case (modes_rigid)
-            call kv('modes_'//name//'_status', '"rigid"')
-         case (modes_unrestrained)
-            call kv('modes_'//name//'_status', '"unrestrained"')
-         case default
-            call kv('modes_'//name//'_status', '"not computed"')
-            call kr('periods_'//name//'_s', [real(dp) ::])
-            call put('  "mode_shapes_'//name//'": [],'//nl)
-            call kr('modal_mass_ratio_'//name, [real(dp) ::])
-            call kr('modal_xi_'//name, [real(dp) ::])
-            return
-         end select
-         ! a rigid-body mode (w = 0): period (infinite) and damping ratio undefined (null)
-         call kr('periods_'//name//'_s', merge(m%period, 0.0_dp, m%omega2 > 0.0_dp), m%omega2 > 0.0_dp)
-         call put('  "mode_shapes_'//name//'": [')
-         do j = 1, m%n
-            call put_reals(m%shape(:, j))
-            if (j < m%n) call put(', ')
-         end do
-         call put('],'//nl)
-         call kr('modal_mass_ratio_'//name, m%mass_ratio)
-         call kr('modal_xi_'//name, merge(m%xi, 0.0_dp, m%omega2 > 0.0_dp), m%omega2 > 0.0_dp)
-      end subroutine modes_keys
-      !> The run's warnings (fd_warnings), one string each.
-      subroutine warnings_key()
-         type(warning_text), allocatable :: w(:)
-         character(len=:), allocatable :: e
-         integer :: k
-         call run_warnings(res, w)
-         call put('  "warnings": [')
-         do k = 1, size(w)
-            call json_escape(w(k)%text, e)
-            call put(nl//'    "'//e//'"')
-            if (k < size(w)) call put(',')
-         end do
-         call put('],'//nl)
-      end subroutine warnings_key
-      !> Strings.
-      subroutine ks(key, x)
-         character(len=*), intent(in) :: key
-         character(len=*), intent(in) :: x(:)
-         integer :: k
-         character(len=:), allocatable :: e
-         call put('  "'//key//'": [')
-         do k = 1, size(x)
-            call json_escape(trim(x(k)), e)
-            call put('"'//e//'"')
-            if (k < size(x)) call put(', ')
-         end do
-         call put('],'//nl)
-      end subroutine ks
-      subroutine kv(key, val)
-         character(len=*), intent(in) :: key, val
-         call put('  "'//key//'": '//val//','//nl)
-      end subroutine kv
-      !> An integer.
-      subroutine kint(key, n)
-         character(len=*), intent(in) :: key
-         integer, intent(in) :: n
-         call kv(key, trim(fmt_int(n)))
-      end subroutine kint
-      !> A real number: null when the key is undefined for this result (fd_undefined).
-      subroutine kreal(key, x)
-         character(len=*), intent(in) :: key
-         real(dp), intent(in) :: x
-         if (len_trim(undefined_why(res, key)) > 0) then
-            call kv(key, 'null')
-         else
-            call kv(key, trim(json_real(x)))
-         end if
-      end subroutine kreal
-      !> A list of reals; with `defined`, null for each item not defined.
-      subroutine kr(key, x, defined)
-         character(len=*), intent(in) :: key
-         real(dp), intent(in) :: x(:)
-         logical, intent(in), optional :: defined(:)
-         call put('  "'//key//'": ')
-         call put_reals(x, defined)
-         call put(','//nl)
-      end subroutine kr
-      !> '[x1, x2, ...]' appended number by number (put: linear in the length).
-      subroutine put_reals(x, defined)
-         real(dp), intent(in) :: x(:)
-         logical, intent(in), optional :: defined(:)
-         integer :: k
-         logical :: def
-         call put('[')
-         do k = 1, size(x)
-            def = .true.
-            if (present(defined)) def = defined(k)
-            if (def) then
-               call put(trim(json_real(x(k))))
-            else
-               call put('null')
-            end if
-            if (k < size(x)) call put(', ')
-         end do
-         call put(']')
-      end subroutine put_reals
-      subroutine ki(key, x)
-         character(len=*), intent(in) :: key
-         integer, intent(in) :: x(:)
-         integer :: k
-         call put('  "'//key//'": [')
-         do k = 1, size(x)
-            call put(trim(fmt_int(x(k))))
-            if (k < size(x)) call put(', ')
-         end do
-         call put('],'//nl)
-      end subroutine ki
+      allocate (character(len=4096 + 64*(res%n_dof + res%n_devices)*8) :: jt%buf)
+      call put(jt, '{'//nl)
+      call run_part(jt, deck_path, record)
+      call model_part(jt, model, res)
+      call mode_part(jt, res)
+      call harmonic_part(jt, res%harmonic_error, res%harmonic_resolution)
+      call record_step_part(jt, res)
+      call stick_part(jt, res%stick_freq_error, res%stick_ringing_ratio, res%stick_ringing, res%stick_margin, &
+                      res%stick_resolution)
+      call band_part(jt, res)
+      call peaks_part(jt, res)
+      call statistics_part(jt, res)
+      call correctness_part(jt, res)
+      call mu_part(jt, res)
+      call energy_part(jt, res)
+      call engineering_part(jt, model, res)
+      call kint(jt, 'samples', res%nout)
+      call warnings_part(jt, res)
+      call put(jt, '  "run_time_s": '//trim(json_real(res%run_time))//nl//'}')
+      js = jt%buf(1:jt%pos)
    end subroutine summary_json
 
-   !> The header line of the history: name[unit] of each column, comma separated.
-   pure subroutine history_header(res, line)
-      type(result_type), intent(in) :: res                 !! the result
-      character(len=:), allocatable, intent(out) :: line   !! the header
-      integer :: j, pos, n
+   !> The deck, the program's version and the record read (if any).
+   subroutine run_part(jt, deck_path, record)
+      type(json_text), intent(inout) :: jt                 !! the summary
+      character(len=*), intent(in) :: deck_path            !! deck named in the summary
+      type(record_info), intent(in), optional :: record    !! the record read, if any
+      character(len=:), allocatable :: esc
 
-      n = 0
-      do j = 1, res%ncol
-         n = n + len_trim(res%names(j)) + len_trim(res%units(j)) + 3
-      end do
-      allocate (character(len=max(n - 1, 0)) :: line)
-      pos = 0
-      do j = 1, res%ncol
-         n = len_trim(res%names(j)) + len_trim(res%units(j)) + 2
-         line(pos + 1:pos + n) = trim(res%names(j))//'['//trim(res%units(j))//']'
-         pos = pos + n
-         if (j < res%ncol) then
-            line(pos + 1:pos + 1) = ','
-            pos = pos + 1
+      call json_escape(deck_path, esc)
+      call put(jt, '  "deck": "'//esc//'",'//nl)
+      call put(jt, '  "frictiondyn_version": "'//frictiondyn_version//'",'//nl)
+      if (.not. present(record)) return
+      if (.not. allocated(record%path)) return
+      call put(jt, '  "record": {')
+      call json_escape(record%path, esc)
+      call put(jt, '"file": "'//esc//'", "format": "'//trim(record%format)//'", "format_detected": '// &
+               trim(merge('true ', 'false', record%detected))//', "units": "'//trim(record%units)// &
+               '", "samples": '//trim(fmt_int(record%npts))//', "dt_s": '//trim(json_real(record%dt))// &
+               ', "scale": '//trim(json_real(record%scale))//', "peak_acc_mps2": '// &
+               trim(json_real(record%peak_acc))//', "sha256": "'//trim(record%sha256)//'"')
+      if (allocated(record%title)) then
+         call json_escape(record%title, esc)
+         call put(jt, ', "title": "'//esc//'"')
+      end if
+      call put(jt, '},'//nl)
+   end subroutine run_part
+
+   !> The model's size, technique and laws, the stuck system's first mode and the steps.
+   subroutine model_part(jt, model, res)
+      type(json_text), intent(inout) :: jt     !! the summary
+      type(model_type), intent(in) :: model    !! the model run
+      type(result_type), intent(in) :: res     !! its result
+      integer :: d
+
+      call kint(jt, 'n_dof', res%n_dof)
+      call kint(jt, 'n_devices', res%n_devices)
+      call kv(jt, 'technique', '"'//trim(technique_name(res%technique))//'"')
+      call ks(jt, 'device_law', [character(len=keyword_len) :: (law_name(model%dev(d)%law), d=1, model%n_devices)])
+      call kreal(jt, res, 'period_stuck_s', res%period_stuck)
+      call kreal(jt, res, 'xi_stuck', res%xi_stuck)
+      call kreal(jt, res, 'dt1_s', res%dt1)
+      call kreal(jt, res, 'dt2_s', res%dt2)
+      call kreal(jt, res, 'dt_min_s', res%dt_min)
+   end subroutine model_part
+
+   !> Whether dt1 resolves the highest modes (fd_mode_resolution).
+   subroutine mode_part(jt, res)
+      type(json_text), intent(inout) :: jt     !! the summary
+      type(result_type), intent(in) :: res     !! the result
+
+      call kreal(jt, res, 'omega_max_rad_s', res%omega_max)
+      call kreal(jt, res, 'omega_max_dt1', res%omega_max*res%dt1)
+      call kv(jt, 'mode_resolution', '"'//trim(resolution_names(res%mode_resolution))//'"')
+   end subroutine mode_part
+
+   !> Whether dt1 resolves a harmonic table motion (fd_harmonic_resolution): the step's error
+   !> per DOF and the verdict.
+   subroutine harmonic_part(jt, step_error, resolution)
+      type(json_text), intent(inout) :: jt     !! the summary
+      real(dp), intent(in) :: step_error(:)    !! per DOF: the step's error in the steady state
+      integer, intent(in) :: resolution        !! resolution_*
+
+      call kr(jt, 'harmonic_step_error', step_error)
+      call kv(jt, 'harmonic_resolution', '"'//trim(resolution_names(resolution))//'"')
+   end subroutine harmonic_part
+
+   !> Whether dt1 resolves a recorded table motion (fd_record_resolution).
+   subroutine record_step_part(jt, res)
+      type(json_text), intent(inout) :: jt     !! the summary
+      type(result_type), intent(in) :: res     !! the result
+
+      call kr(jt, 'record_step_error', res%record_error)
+      call kr(jt, 'record_step_error_stuck', res%record_error_stuck)
+      call kr(jt, 'record_step_error_free', res%record_error_free)
+      call kv(jt, 'record_resolution', '"'//trim(resolution_names(res%record_resolution))//'"')
+      call kv(jt, 'record_step_system', '"'//trim(record_system_names(res%record_system))//'"')
+   end subroutine record_step_part
+
+   !> Whether dt1 resolves the sticking springs' ringing (fd_stick_ringing): per device the
+   !> frequency error, the ringing ratio, amplitude and margin, then the verdict.
+   subroutine stick_part(jt, freq_error, ratio, ringing, margin, resolution)
+      type(json_text), intent(inout) :: jt     !! the summary
+      real(dp), intent(in) :: freq_error(:)    !! 1 - omega~/omega of each sticking spring's mode
+      real(dp), intent(in) :: ratio(:)         !! largest ringing / margin of a dephased stick phase
+      real(dp), intent(in) :: ringing(:)       !! that phase's ringing amplitude [N]
+      real(dp), intent(in) :: margin(:)        !! that phase's margin [N]
+      integer, intent(in) :: resolution        !! resolution_*
+
+      call kr(jt, 'stick_frequency_error', freq_error)
+      call kr(jt, 'stick_ringing_ratio', ratio)
+      call kr(jt, 'stick_ringing_N', ringing)
+      call kr(jt, 'stick_margin_N', margin)
+      call kv(jt, 'stick_resolution', '"'//trim(resolution_names(resolution))//'"')
+   end subroutine stick_part
+
+   !> Whether the step damps the velocity-law bands (fd_band_alternation).
+   subroutine band_part(jt, res)
+      type(json_text), intent(inout) :: jt     !! the summary
+      type(result_type), intent(in) :: res     !! the result
+
+      call kr(jt, 'band_x', res%band_x)
+      call kr(jt, 'band_alternation_N', res%band_alternation)
+      call kr(jt, 'band_alternation_s', res%band_alternation_time, res%band_alternation /= 0.0_dp)
+      call kv(jt, 'band_resolution', '"'//trim(resolution_names(res%band_resolution))//'"')
+   end subroutine band_part
+
+   !> The peaks per DOF and device, with their times, and the devices' phase changes.
+   subroutine peaks_part(jt, res)
+      type(json_text), intent(inout) :: jt     !! the summary
+      type(result_type), intent(in) :: res     !! the result
+
+      call kr(jt, 'peak_u_m', res%peak_u)
+      call kr(jt, 'peak_u_time_s', res%peak_u_time, res%peak_u /= 0.0_dp)
+      call kr(jt, 'peak_v_mps', res%peak_v)
+      call kr(jt, 'peak_aabs_mps2', res%peak_aabs)
+      call kr(jt, 'peak_aabs_time_s', res%peak_aabs_time, res%peak_aabs /= 0.0_dp)
+      call kr(jt, 'peak_s_m', res%peak_s)
+      call kr(jt, 'peak_force_N', res%peak_force)
+      call ki(jt, 'stick_to_slip', res%stick_to_slip)
+      call ki(jt, 'slip_to_stick', res%slip_to_stick)
+      call ki(jt, 'slip_reversals', res%reversals)
+   end subroutine peaks_part
+
+   !> What the technique did: the part of the technique that ran (its own statistics, under
+   !> the summary's counter keys; fd_statistics).
+   subroutine statistics_part(jt, res)
+      type(json_text), intent(inout) :: jt     !! the summary
+      type(result_type), intent(in) :: res     !! the result
+
+      if (res%newmark%ran) then
+         call newmark_part(jt, res%newmark)
+      else if (res%exact%ran) then
+         call event_driven_part(jt, res%exact)
+      else
+         call moreau_jean_part(jt, res%moreau_jean)
+      end if
+   end subroutine statistics_part
+
+   !> Newmark's steps of each size, refinements, factorizations and linear system.
+   subroutine newmark_part(jt, st)
+      type(json_text), intent(inout) :: jt        !! the summary
+      type(newmark_stats), intent(in) :: st       !! Newmark's statistics
+
+      call counts_part(jt, newmark_counts(st))
+      call patterns_part(jt, newmark_counts(st))
+   end subroutine newmark_part
+
+   !> The exact technique's intervals, matrix exponentials and events; its peaks are the
+   !> exact extrema; its event times and accumulation points.
+   subroutine event_driven_part(jt, st)
+      type(json_text), intent(inout) :: jt          !! the summary
+      type(event_driven_stats), intent(in) :: st    !! the exact technique's statistics
+
+      call counts_part(jt, event_driven_counts(st))
+      call kv(jt, 'peaks_exact', 'true')
+      call kr(jt, 'event_times_s', st%event_time(1:st%n_event_times))
+      call kint(jt, 'accumulation_points', st%accumulations)
+      call kr(jt, 'accumulation_times_s', st%accumulation_time(1:st%n_accumulation_times))
+      call patterns_part(jt, event_driven_counts(st))
+   end subroutine event_driven_part
+
+   !> Moreau-Jean's steps, factorizations, patterns and Lemke fallbacks.
+   subroutine moreau_jean_part(jt, st)
+      type(json_text), intent(inout) :: jt         !! the summary
+      type(moreau_jean_stats), intent(in) :: st    !! Moreau-Jean's statistics
+
+      call counts_part(jt, moreau_jean_counts(st))
+      call patterns_part(jt, moreau_jean_counts(st))
+   end subroutine moreau_jean_part
+
+   !> The summary's counter keys of every technique, from steps_dt1 to events.
+   subroutine counts_part(jt, c)
+      type(json_text), intent(inout) :: jt     !! the summary
+      type(summary_counts), intent(in) :: c    !! a technique's counters under these keys
+
+      call kint(jt, 'steps_dt1', c%steps_dt1)
+      call kint(jt, 'steps_nested', c%steps_nested)
+      call kint(jt, 'steps_implicit', c%steps_implicit)
+      call kint(jt, 'implicit_redos', c%implicit_redos)
+      call kint(jt, 'implicit_fallbacks', c%implicit_fallbacks)
+      call kint(jt, 'steps_dt2', c%steps_dt2)
+      call kint(jt, 'steps_finer', c%steps_finer)
+      call kint(jt, 'factorizations', c%factorizations)
+      call kint(jt, 'factor_updates', c%factor_updates)
+      call kint(jt, 'partial_factorizations', c%partial_factorizations)
+      call kv(jt, 'linear_system', '"'//trim(storage_name(c%storage))//'"')
+      call kint(jt, 'half_bandwidth', c%bandwidth)
+      call kint(jt, 'events', c%events)
+   end subroutine counts_part
+
+   !> The summary's last counter keys of every technique: patterns_solved, lcp_fallbacks.
+   subroutine patterns_part(jt, c)
+      type(json_text), intent(inout) :: jt     !! the summary
+      type(summary_counts), intent(in) :: c    !! a technique's counters under these keys
+
+      call kint(jt, 'patterns_solved', c%patterns)
+      call kint(jt, 'lcp_fallbacks', c%lcp_fallbacks)
+   end subroutine patterns_part
+
+   !> The linear system's storage in words: 1 dense, 2 banded, else none.
+   pure function storage_name(storage) result(name)
+      integer, intent(in) :: storage   !! result_type's storage
+      character(len=8) :: name         !! its name in the summary
+
+      select case (storage)
+      case (1)
+         name = 'dense'
+      case (2)
+         name = 'banded'
+      case default
+         name = 'none'
+      end select
+   end function storage_name
+
+   !> The correctness condition's violations (eqs. 9, 12): count, first times and devices.
+   subroutine correctness_part(jt, res)
+      type(json_text), intent(inout) :: jt     !! the summary
+      type(result_type), intent(in) :: res     !! the result
+
+      call kint(jt, 'correctness_violations', res%violations)
+      call kr(jt, 'violation_times_s', res%violation_time(1:res%n_violation_times))
+      call ki(jt, 'violation_devices', res%violation_device(1:res%n_violation_times))
+   end subroutine correctness_part
+
+   !> A speed-dependent mu: the fixed point's passes and the steps left unconverged.
+   subroutine mu_part(jt, res)
+      type(json_text), intent(inout) :: jt     !! the summary
+      type(result_type), intent(in) :: res     !! the result
+
+      call kint(jt, 'mu_passes', res%newmark%mu_passes)
+      call kint(jt, 'mu_unconverged_steps', res%mu_unconverged)
+      call kreal(jt, res, 'mu_unconverged_s', res%mu_unconverged_time)
+      call kreal(jt, res, 'mu_unconverged_misfit', res%mu_misfit)
+   end subroutine mu_part
+
+   !> The energy balance and its verdict.
+   subroutine energy_part(jt, res)
+      type(json_text), intent(inout) :: jt     !! the summary
+      type(result_type), intent(in) :: res     !! the result
+
+      call kreal(jt, res, 'energy_input_J', res%e_input)
+      call kreal(jt, res, 'energy_kinetic_J', res%e_kinetic)
+      call kreal(jt, res, 'energy_strain_J', res%e_strain)
+      call kreal(jt, res, 'energy_viscous_J', res%e_viscous)
+      call kreal(jt, res, 'energy_friction_J', res%e_friction)
+      call kreal(jt, res, 'energy_device_elastic_J', res%e_device)
+      call kreal(jt, res, 'energy_residual_J', res%e_residual)
+      call kreal(jt, res, 'energy_residual_ratio', res%e_residual_ratio)
+      call kv(jt, 'energy_balance', '"'//trim(energy_balance_names(res%energy_balance))//'"')
+   end subroutine energy_part
+
+   !> What produced the run, the table motion, the labels, the damping, the modes, the
+   !> residual deformations and the storeys (fd_engineering).
+   subroutine engineering_part(jt, model, res)
+      type(json_text), intent(inout) :: jt     !! the summary
+      type(model_type), intent(in) :: model    !! the model run
+      type(result_type), intent(in) :: res     !! the result
+
+      call kv(jt, 'deck_sha256', '"'//trim(model%deck_sha256)//'"')
+      associate (eng => res%eng)
+         if (eng%excitation >= 1 .and. eng%excitation <= size(excitation_types)) then
+            call kv(jt, 'excitation_type', '"'//trim(excitation_types(eng%excitation)%name)//'"')
+         else
+            call kv(jt, 'excitation_type', '"unknown"')
          end if
+         call kreal(jt, res, 'excitation_frequency_Hz', eng%frequency)
+         call kreal(jt, res, 'duration_s', eng%duration)
+         call ks(jt, 'dof_labels', eng%dof_label)
+         call ks(jt, 'device_labels', eng%device_label)
+         call kreal(jt, res, 'damping_a0_per_s', eng%a0)
+         call kreal(jt, res, 'damping_a1_s', eng%a1)
+         call modes_part(jt, 'stuck', eng%stuck)
+         call modes_part(jt, 'free', eng%free)
+         call kr(jt, 'residual_s_m', eng%residual_s)
+         call kreal(jt, res, 'peak_base_shear_N', eng%peak_shear(0))
+         call kreal(jt, res, 'peak_base_shear_time_s', eng%peak_shear_time(0))
+         call kreal(jt, res, 'residual_base_shear_N', eng%shear(0))
+      end associate
+      call storeys_part(jt, res%eng)
+   end subroutine engineering_part
+
+   !> The storeys: labels, nodes, heights, drifts (and their ratios) and shears.
+   subroutine storeys_part(jt, eng)
+      type(json_text), intent(inout) :: jt        !! the summary
+      type(engineering_type), intent(in) :: eng   !! the engineering outputs
+      real(dp), allocatable :: ratio(:)
+      integer :: i
+
+      call kint(jt, 'n_storeys', eng%n_storeys)
+      call ks(jt, 'storey_labels', eng%storey_label)
+      call put(jt, '  "storey_nodes": [')
+      do i = 1, eng%n_storeys
+         call put(jt, '['//trim(fmt_int(eng%storey_i(i)))//', '//trim(fmt_int(eng%storey_j(i)))//']')
+         if (i < eng%n_storeys) call put(jt, ', ')
       end do
-   end subroutine history_header
+      call put(jt, '],'//nl)
+      call kr(jt, 'storey_height_m', eng%height)
+      call kr(jt, 'peak_drift_m', eng%peak_drift)
+      call kr(jt, 'peak_drift_time_s', eng%peak_drift_time, eng%peak_drift /= 0.0_dp)
+      call kr(jt, 'residual_drift_m', eng%drift)
+      ! a ratio without a storey height is undefined (null), not 0
+      allocate (ratio(eng%n_storeys))
+      ratio = 0.0_dp
+      where (eng%height > 0.0_dp) ratio = eng%peak_drift/eng%height
+      call kr(jt, 'peak_drift_ratio', ratio, eng%height > 0.0_dp)
+      where (eng%height > 0.0_dp) ratio = eng%drift/eng%height
+      call kr(jt, 'residual_drift_ratio', ratio, eng%height > 0.0_dp)
+      call kr(jt, 'peak_storey_shear_N', eng%peak_shear(1:))
+      call kr(jt, 'peak_storey_shear_time_s', eng%peak_shear_time(1:), eng%peak_shear(1:) /= 0.0_dp)
+      call kr(jt, 'residual_storey_shear_N', eng%shear(1:))
+   end subroutine storeys_part
+
+   !> The modes of one system: status, periods (0: a rigid-body mode), shapes, mass ratios, damping.
+   subroutine modes_part(jt, name, m)
+      type(json_text), intent(inout) :: jt     !! the summary
+      character(len=*), intent(in) :: name     !! 'stuck' or 'free'
+      type(modes_type), intent(in) :: m        !! its modes
+      integer :: j
+
+      select case (m%status)
+      case (modes_flexible)
+         call kv(jt, 'modes_'//name//'_status', '"flexible"')
+      case (modes_rigid)
+         call kv(jt, 'modes_'//name//'_status', '"rigid"')
+      case (modes_unrestrained)
+         call kv(jt, 'modes_'//name//'_status', '"unrestrained"')
+      case default
+         call kv(jt, 'modes_'//name//'_status', '"not computed"')
+         call kr(jt, 'periods_'//name//'_s', [real(dp) ::])
+         call put(jt, '  "mode_shapes_'//name//'": [],'//nl)
+         call kr(jt, 'modal_mass_ratio_'//name, [real(dp) ::])
+         call kr(jt, 'modal_xi_'//name, [real(dp) ::])
+         return
+      end select
+      ! a rigid-body mode (w = 0): period (infinite) and damping ratio undefined (null)
+      call kr(jt, 'periods_'//name//'_s', merge(m%period, 0.0_dp, m%omega2 > 0.0_dp), m%omega2 > 0.0_dp)
+      call put(jt, '  "mode_shapes_'//name//'": [')
+      do j = 1, m%n
+         call put_reals(jt, m%shape(:, j))
+         if (j < m%n) call put(jt, ', ')
+      end do
+      call put(jt, '],'//nl)
+      call kr(jt, 'modal_mass_ratio_'//name, m%mass_ratio)
+      call kr(jt, 'modal_xi_'//name, merge(m%xi, 0.0_dp, m%omega2 > 0.0_dp), m%omega2 > 0.0_dp)
+   end subroutine modes_part
+
+   !> The run's warnings (fd_warnings), one string each.
+   subroutine warnings_part(jt, res)
+      type(json_text), intent(inout) :: jt     !! the summary
+      type(result_type), intent(in) :: res     !! the result
+      type(warning_text), allocatable :: w(:)
+      character(len=:), allocatable :: e
+      integer :: k
+
+      call run_warnings(res, w)
+      call put(jt, '  "warnings": [')
+      do k = 1, size(w)
+         call json_escape(w(k)%text, e)
+         call put(jt, nl//'    "'//e//'"')
+         if (k < size(w)) call put(jt, ',')
+      end do
+      call put(jt, '],'//nl)
+   end subroutine warnings_part
+
+   !> Append to the text (capacity doubled when full: linear in the length, not quadratic).
+   subroutine put(jt, text)
+      type(json_text), intent(inout) :: jt     !! the text
+      character(len=*), intent(in) :: text     !! what to append
+      character(len=:), allocatable :: bigger
+
+      if (jt%pos + len(text) > len(jt%buf)) then
+         allocate (character(len=2*(jt%pos + len(text))) :: bigger)
+         bigger(1:jt%pos) = jt%buf(1:jt%pos)
+         call move_alloc(bigger, jt%buf)
+      end if
+      jt%buf(jt%pos + 1:jt%pos + len(text)) = text
+      jt%pos = jt%pos + len(text)
+   end subroutine put
+
+   !> A key and its JSON value, as a line of the object.
+   subroutine kv(jt, key, val)
+      type(json_text), intent(inout) :: jt     !! the text
+      character(len=*), intent(in) :: key, val !! the key and its value's text
+
+      call put(jt, '  "'//key//'": '//val//','//nl)
+   end subroutine kv
+
+   !> A list of strings.
+   subroutine ks(jt, key, x)
+      type(json_text), intent(inout) :: jt     !! the text
+      character(len=*), intent(in) :: key     !! the key
+      character(len=*), intent(in) :: x(:)    !! the strings (trimmed)
+      character(len=:), allocatable :: e
+      integer :: k
+
+      call put(jt, '  "'//key//'": [')
+      do k = 1, size(x)
+         call json_escape(trim(x(k)), e)
+         call put(jt, '"'//e//'"')
+         if (k < size(x)) call put(jt, ', ')
+      end do
+      call put(jt, '],'//nl)
+   end subroutine ks
+
+   !> An integer.
+   subroutine kint(jt, key, n)
+      type(json_text), intent(inout) :: jt     !! the text
+      character(len=*), intent(in) :: key     !! the key
+      integer, intent(in) :: n                !! the value
+
+      call kv(jt, key, trim(fmt_int(n)))
+   end subroutine kint
+
+   !> A real number: null when the key is undefined for this result (fd_undefined).
+   subroutine kreal(jt, res, key, x)
+      type(json_text), intent(inout) :: jt     !! the text
+      type(result_type), intent(in) :: res     !! the result (whether the key is defined)
+      character(len=*), intent(in) :: key     !! the key
+      real(dp), intent(in) :: x               !! the value
+
+      if (len_trim(undefined_why(res, key)) > 0) then
+         call kv(jt, key, 'null')
+      else
+         call kv(jt, key, trim(json_real(x)))
+      end if
+   end subroutine kreal
+
+   !> A list of reals; with `defined`, null for each item not defined.
+   subroutine kr(jt, key, x, defined)
+      type(json_text), intent(inout) :: jt     !! the text
+      character(len=*), intent(in) :: key     !! the key
+      real(dp), intent(in) :: x(:)            !! the values
+      logical, intent(in), optional :: defined(:) !! which are defined
+
+      call put(jt, '  "'//key//'": ')
+      call put_reals(jt, x, defined)
+      call put(jt, ','//nl)
+   end subroutine kr
+
+   !> '[x1, x2, ...]' appended number by number (put: linear in the length).
+   subroutine put_reals(jt, x, defined)
+      type(json_text), intent(inout) :: jt     !! the text
+      real(dp), intent(in) :: x(:)            !! the values
+      logical, intent(in), optional :: defined(:) !! which are defined
+      logical :: def
+      integer :: k
+
+      call put(jt, '[')
+      do k = 1, size(x)
+         def = .true.
+         if (present(defined)) def = defined(k)
+         if (def) then
+            call put(jt, trim(json_real(x(k))))
+         else
+            call put(jt, 'null')
+         end if
+         if (k < size(x)) call put(jt, ', ')
+      end do
+      call put(jt, ']')
+   end subroutine put_reals
+
+   !> A list of integers.
+   subroutine ki(jt, key, x)
+      type(json_text), intent(inout) :: jt     !! the text
+      character(len=*), intent(in) :: key     !! the key
+      integer, intent(in) :: x(:)             !! the values
+      integer :: k
+
+      call put(jt, '  "'//key//'": [')
+      do k = 1, size(x)
+         call put(jt, trim(fmt_int(x(k))))
+         if (k < size(x)) call put(jt, ', ')
+      end do
+      call put(jt, '],'//nl)
+   end subroutine ki
 
    !> A real as JSON: 17 significant digits (null when not finite), left-adjusted.
    pure function json_real(x) result(str)

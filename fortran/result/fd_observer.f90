@@ -1,8 +1,12 @@
-!> The observer of a run, one for every technique: it sets up the result, keeps the peaks
-!> over every accepted state, samples the history, counts phase transitions and
-!> correctness violations, and closes the energy balance. A technique hands it the state
-!> (time, table acceleration, u, v, relative acceleration, and per device s, s', F and
-!> phase); a new output quantity is a change here (and in the writer), not in the loops.
+!> The observer of a run, one for every technique, and the only writer of the result's
+!> histories, peaks and energies: it sets up the result, keeps the peaks over every accepted
+!> state, samples the history, counts phase transitions and correctness violations, and
+!> closes the energy balance. A technique hands it the state (observe_peaks, observe_sample:
+!> time, table acceleration, u, v, relative acceleration, and per device s, s', F and phase),
+!> the work of each step (observe_work), and, when it knows its solution between steps, the
+!> exact extrema (observe_extrema, observe_extremum); the stuck system's period it computed is
+!> an argument of observer_init. A new output quantity is a change here (and in the writer),
+!> not in the loops.
 !>
 !> A run's control (fd_run_control), when the technique is given one, says which history
 !> columns are kept and where their rows go (the result, the caller's buffer, a file written
@@ -17,11 +21,10 @@ module fd_observer
    use fd_error, only: error_type, fatal_error, fmt_real
    use fd_model, only: model_type, integration_type
    use fd_excitation, only: excitation_type
-   use fd_result, only: result_type, init_result, max_violation_times, max_event_times
+   use fd_result, only: result_type, init_result, max_violation_times
    use fd_linalg, only: sym_matvec
    use fd_run_control, only: run_control, cancel_requested, stat_cancelled
-   use fd_history_stream, only: stream_open, stream_row, stream_failed, stream_close
-   use fd_output, only: history_header
+   use fd_result, only: history_header
    use fd_engineering, only: engineering_init, observe_engineering, storey_values, observe_storey_peak
    implicit none
    private
@@ -29,16 +32,8 @@ module fd_observer
    public :: observer_type, observer_init, sample_due, observe_start, observe_peaks, observe_sample
    public :: observe_transitions, observe_violations, observe_end, strain_energy
    public :: observe_start_energies, observe_end_energies, observe_poll, observe_stop_error
-   public :: observe_peak_value, observe_event, observe_accumulation
-   public :: peak_of_u, peak_of_v, peak_of_aabs, peak_of_s, peak_of_force, peak_of_storey
+   public :: observe_extrema, observe_extremum, observe_work
    public :: observe_storeys
-
-   integer, parameter :: peak_of_u = 1      !! |u| of a DOF
-   integer, parameter :: peak_of_v = 2      !! |v| of a DOF
-   integer, parameter :: peak_of_aabs = 3   !! |absolute acceleration| of a DOF
-   integer, parameter :: peak_of_s = 4      !! |s| of a device
-   integer, parameter :: peak_of_force = 5  !! |F| of a device
-   integer, parameter :: peak_of_storey = 6 !! |drift|, |V| of a storey, |Vb|: the history's order
 
    !> Wall-clock time aimed at between two polls that look at the clock [s].
    real(dp), parameter :: poll_target = 0.01_dp
@@ -70,12 +65,14 @@ contains
 
    !> Set up the result of a run (history, per-DOF and per-device summary) and the
    !> observer: the number of dt1 steps and the sampling interval. With a control: the
-   !> history's columns and destinations it selects, and its history file opened (created
-   !> under its temporary name, the header written).
-   subroutine observer_init(model, exc, opts, res, obs, error, ctl)
+   !> history's columns and destinations it selects, and its row sink begun (for the history
+   !> file: created under its temporary name, the header written).
+   subroutine observer_init(model, exc, opts, period_stuck, res, obs, error, ctl)
       type(model_type), intent(in) :: model         !! the model run
       type(excitation_type), intent(in) :: exc      !! the table motion
       type(integration_type), intent(in) :: opts    !! integration settings
+      real(dp), intent(in) :: period_stuck          !! first period of the stuck system, as the
+                                                    !! technique computed it [s] (0: none)
       type(result_type), intent(inout) :: res       !! the result to set up
       type(observer_type), intent(out) :: obs       !! the observer
       type(error_type), allocatable, intent(out) :: error !! not enough memory, history file
@@ -98,8 +95,8 @@ contains
       call init_result(model, exc, opts, res, obs%nsteps, obs%every, error, obs%dofs, obs%devices, obs%to_result)
       if (allocated(error)) return
       res%technique = opts%technique
-      ! names, modes and storeys (res%period_stuck: set by the technique before)
-      call engineering_init(model, exc, opts, res%period_stuck, res%eng, error)
+      ! names, modes and storeys
+      call engineering_init(model, exc, opts, period_stuck, res%eng, error)
       if (allocated(error)) return
       allocate (obs%row(res%ncol))
       obs%row = 0.0_dp
@@ -113,9 +110,9 @@ contains
             return
          end if
       end if
-      if (allocated(ctl%stream_path)) then
+      if (allocated(ctl%sink)) then
          call history_header(res, header)
-         call stream_open(ctl%stream, ctl%stream_path, header, res%ncol, error)
+         call ctl%sink%begin(header, res%ncol, error)
          if (allocated(error)) return
       end if
       call system_clock(obs%last_poll, obs%rate)
@@ -204,34 +201,68 @@ contains
       call observe_engineering(res%eng, t, n, nd, u, v, s, force)
    end subroutine observe_peaks
 
-   !> One value into a peak of the summary (a technique that knows its solution between
-   !> steps passes the exact extrema, with their times): quantity peak_of_*, DOF or device i.
-   pure subroutine observe_peak_value(res, quantity, i, value, t)
+   !> The exact extrema of a technique that knows its solution between steps: |y(q)| of every
+   !> output quantity q at time t into the summary's peaks (observe_extremum's order).
+   pure subroutine observe_extrema(res, y, t)
       type(result_type), intent(inout) :: res  !! the result
-      integer, intent(in) :: quantity          !! peak_of_u, _v, _aabs, _s, _force, _storey
-      integer, intent(in) :: i                 !! DOF, device, or storey quantity (drift1, V1, ..., Vb)
+      real(dp), intent(in) :: y(:)             !! the quantities' values, in observe_extremum's order
+      real(dp), intent(in) :: t                !! their time [s]
+      integer :: q
+
+      do q = 1, size(y)
+         call observe_extremum(res, q, abs(y(q)), t)
+      end do
+   end subroutine observe_extrema
+
+   !> One exact extremum |value| at time t of output quantity q, numbered as the history's
+   !> envelope columns of every DOF and device: |u|, |v|, |aabs| of DOF i are q = 3 i - 2,
+   !> 3 i - 1, 3 i; |s|, |F| of device d are q = 3 n + 2 d - 1, 3 n + 2 d; then the storeys'
+   !> |drift1|, |V1|, ..., |Vb| (fd_engineering's order).
+   pure subroutine observe_extremum(res, q, value, t)
+      type(result_type), intent(inout) :: res  !! the result
+      integer, intent(in) :: q                 !! the quantity
       real(dp), intent(in) :: value            !! |value|
       real(dp), intent(in) :: t                !! its time [s]
+      integer :: i, n3
 
-      select case (quantity)
-      case (peak_of_u)
-         if (value > res%peak_u(i)) then
-            res%peak_u(i) = value; res%peak_u_time(i) = t
+      n3 = 3*res%n_dof
+      if (q > n3 + 2*res%n_devices) then
+         call observe_storey_peak(res%eng, q - n3 - 2*res%n_devices, value, t)
+      else if (q <= n3) then
+         i = (q + 2)/3
+         select case (q - 3*(i - 1))
+         case (1)
+            if (value > res%peak_u(i)) then
+               res%peak_u(i) = value; res%peak_u_time(i) = t
+            end if
+         case (2)
+            res%peak_v(i) = max(res%peak_v(i), value)
+         case default
+            if (value > res%peak_aabs(i)) then
+               res%peak_aabs(i) = value; res%peak_aabs_time(i) = t
+            end if
+         end select
+      else
+         i = (q - n3 + 1)/2
+         if (mod(q - n3, 2) == 1) then
+            res%peak_s(i) = max(res%peak_s(i), value)
+         else
+            res%peak_force(i) = max(res%peak_force(i), value)
          end if
-      case (peak_of_v)
-         res%peak_v(i) = max(res%peak_v(i), value)
-      case (peak_of_aabs)
-         if (value > res%peak_aabs(i)) then
-            res%peak_aabs(i) = value; res%peak_aabs_time(i) = t
-         end if
-      case (peak_of_s)
-         res%peak_s(i) = max(res%peak_s(i), value)
-      case (peak_of_force)
-         res%peak_force(i) = max(res%peak_force(i), value)
-      case (peak_of_storey)
-         call observe_storey_peak(res%eng, i, value, t)
-      end select
-   end subroutine observe_peak_value
+      end if
+   end subroutine observe_extremum
+
+   !> The work of a step (or part of one): the table's inertia loads' work `input` and the
+   !> viscous dissipation `viscous` [J] into the energy balance (observe_end closes it).
+   pure subroutine observe_work(res, input, viscous)
+      type(result_type), intent(inout) :: res  !! the result
+      real(dp), intent(in) :: input            !! work of the table's inertia loads [J]
+      real(dp), intent(in) :: viscous          !! viscous dissipation [J]
+
+      res%e_input = res%e_input + input
+      res%e_input_gross = res%e_input_gross + abs(input)
+      res%e_viscous = res%e_viscous + viscous
+   end subroutine observe_work
 
    !> The storeys at a state the technique reports besides observe_peaks (a row of the exact
    !> technique): drifts, shears, their peaks, and the values kept as the residual ones.
@@ -244,32 +275,11 @@ contains
       call observe_engineering(res%eng, t, size(u), size(s), u, v, s, force)
    end subroutine observe_storeys
 
-   !> An event at time t (phases changed): its time is kept (the first max_event_times).
-   pure subroutine observe_event(res, t)
-      type(result_type), intent(inout) :: res  !! the result
-      real(dp), intent(in) :: t                !! time of the event [s]
-
-      if (res%n_event_times >= max_event_times) return
-      res%n_event_times = res%n_event_times + 1
-      res%event_time(res%n_event_times) = t
-   end subroutine observe_event
-
-   !> An accumulation point of events (a Zeno sequence) at time t, ended by sticking.
-   pure subroutine observe_accumulation(res, t)
-      type(result_type), intent(inout) :: res  !! the result
-      real(dp), intent(in) :: t                !! its time [s]
-
-      res%accumulations = res%accumulations + 1
-      if (res%n_accumulation_times >= max_violation_times) return
-      res%n_accumulation_times = res%n_accumulation_times + 1
-      res%accumulation_time(res%n_accumulation_times) = t
-   end subroutine observe_accumulation
-
    !> The next row of the history: t, ag, (u, v, aabs) per kept DOF, (s, s', F, phase) per
    !> kept device, then (a history with those columns, has_envelope) the maxima since the
    !> previous row `env` of the kept DOFs and devices; into the result, the control's buffer
-   !> and its history file as selected. The first value not finite of a row that goes only to
-   !> the buffer or the file is noted in the control (run_config_solve makes it an error; the
+   !> and its row sink as selected. The first value not finite of a row that goes only to
+   !> the buffer or the sink is noted in the control (run_config_solve makes it an error; the
    !> result's rows are checked at the end). Allocates nothing.
    subroutine observe_sample(obs, res, t, ag, u, v, acc, s, sd, force, phase, env)
       type(observer_type), intent(inout) :: obs !! the observer
@@ -357,7 +367,7 @@ contains
          end if
          if (associated(obs%ctl)) then
             if (associated(obs%ctl%buffer)) obs%ctl%buffer(:, obs%rows) = row
-            if (allocated(obs%ctl%stream_path)) call stream_row(obs%ctl%stream, row)
+            if (allocated(obs%ctl%sink)) call obs%ctl%sink%put(row)
          end if
       end associate
    end subroutine observe_sample
@@ -365,7 +375,7 @@ contains
    !> Called by a technique after every accepted step. Mostly a counter; every ~10 ms of
    !> wall clock (the interval adapts to the cost of a step) it publishes the time reached,
    !> calls the progress callback when its interval has passed, and says whether the run must
-   !> stop: a stop was requested, or the history file could not be written.
+   !> stop: a stop was requested, or the row sink (the history file) could not be written.
    subroutine observe_poll(obs, t, halt)
       type(observer_type), intent(inout) :: obs !! the observer
       real(dp), intent(in) :: t                !! time reached [s]
@@ -392,8 +402,8 @@ contains
       obs%countdown = obs%poll_every
       obs%ctl%time = t
       if (cancel_requested(obs%ctl%cancel)) halt = .true.
-      if (allocated(obs%ctl%stream_path)) then
-         if (stream_failed(obs%ctl%stream)) halt = .true.
+      if (allocated(obs%ctl%sink)) then
+         if (obs%ctl%sink%failed()) halt = .true.
       end if
       if (halt) then
          obs%stopped = .true.
@@ -409,16 +419,16 @@ contains
    end subroutine observe_poll
 
    !> The error a technique returns when observe_poll said stop: the run was cancelled
-   !> (error%stat = stat_cancelled), or the history file could not be written.
+   !> (error%stat = stat_cancelled), or the row sink (the history file) could not be written.
    subroutine observe_stop_error(obs, error)
       type(observer_type), intent(inout) :: obs          !! the observer
       type(error_type), allocatable, intent(out) :: error !! why the run stopped
       type(error_type), allocatable :: write_error
 
       if (associated(obs%ctl)) then
-         if (allocated(obs%ctl%stream_path)) then
-            if (stream_failed(obs%ctl%stream)) then
-               call stream_close(obs%ctl%stream, write_error)
+         if (allocated(obs%ctl%sink)) then
+            if (obs%ctl%sink%failed()) then
+               call obs%ctl%sink%finish(write_error)
                call move_alloc(write_error, error)
                return
             end if
@@ -471,7 +481,7 @@ contains
    !> Close the energy balance at the end of the run: kinetic, strain and device elastic
    !> energy (end minus start), friction dissipation (device work minus stored energy) and
    !> the residual input - (kinetic + strain + viscous + friction + device elastic). The
-   !> technique has accumulated the input and viscous work in res.
+   !> technique has handed the input and viscous work of its steps to observe_work.
    subroutine observe_end(obs, res, mass, k, u, v, e_device, w_device, tmp)
       type(observer_type), intent(inout) :: obs !! the observer
       type(result_type), intent(inout) :: res  !! the result

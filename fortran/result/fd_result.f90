@@ -9,11 +9,12 @@ module fd_result
    use fd_excitation, only: excitation_type
    use fd_engineering, only: engineering_type, engineering_columns
    use fd_matrices, only: modes_type
+   use fd_statistics, only: newmark_stats, event_driven_stats, moreau_jean_stats, max_event_times
    implicit none
    private
 
    public :: result_type, max_violation_times, column_name_len, init_result, history_shape, check_finite
-   public :: nonfinite_history_error
+   public :: nonfinite_history_error, history_header
    public :: max_event_times, has_envelope
    public :: resolution_none, resolution_resolved, resolution_unresolved, resolution_names
    public :: residual_ratio_limit, roundoff_ratio_limit, energy_balance_of, energy_balance_names
@@ -22,7 +23,6 @@ module fd_result
              record_system_both, record_system_names
 
    integer, parameter :: max_violation_times = 10 !! first violation times kept
-   integer, parameter :: max_event_times = 1000   !! first event times kept (exact technique)
    ! whether dt1 resolves the highest natural modes (fd_mode_resolution)
    integer, parameter :: resolution_none = 1        !! not applicable: no step (event-driven)
    integer, parameter :: resolution_resolved = 2    !! omega_max dt1 <= 2
@@ -107,38 +107,18 @@ module fd_result
       real(dp), allocatable :: band_alternation(:)    !! largest step-to-step alternation of the
                                                       !! band's force counted [N]
       real(dp), allocatable :: band_alternation_time(:) !! time of the steps counted [s]
-      ! steps
-      integer :: steps_dt1 = 0         !! steps taken with dt1
-      integer :: steps_dt2 = 0         !! steps taken with dt2
-      integer :: steps_nested = 0      !! steps of the sizes between dt1 and dt2 (refinement 'nested')
-      integer :: steps_implicit = 0    !! dt1 steps taken in the phases they end in (refinement 'implicit')
-      integer :: implicit_redos = 0    !! trial steps redone to settle the phases (refinement 'implicit')
-      integer :: implicit_fallbacks = 0 !! dt1 steps whose phases did not settle, refined as 'step'
-      integer :: steps_finer = 0       !! steps taken with dt2/2, dt2/4, ...
-      integer :: factorizations = 0    !! factorizations of the effective stiffness
-                                       !! (exact technique: matrix exponentials)
-      integer :: factor_updates = 0    !! rank-one updates and downdates of the factor (phase changes)
-      integer :: partial_factorizations = 0 !! refactorizations from the first changed column on
-      integer :: storage = 0           !! effective stiffness stored 1 dense, 2 banded (0: none)
-      integer :: bandwidth = 0         !! its half-bandwidth in the solver's ordering
-      integer :: events = 0            !! events located (exact technique): instants at which
-                                       !! phases changed
-      integer :: n_event_times = 0     !! entries used in event_time
-      real(dp) :: event_time(max_event_times) = 0.0_dp !! times of the first events [s]
-      integer :: accumulations = 0     !! accumulation points of events (Zeno), handled
-      integer :: n_accumulation_times = 0 !! entries used in accumulation_time
-      real(dp) :: accumulation_time(max_violation_times) = 0.0_dp !! their first times [s]
-      logical :: exact_peaks = .false. !! peaks are the exact extrema (exact technique)
+      ! what the technique did: each technique counts in its own type (fd_statistics), the
+      ! others stay 0
+      type(newmark_stats) :: newmark            !! Newmark's steps, refinements, factorizations
+      type(event_driven_stats) :: exact         !! the exact technique's intervals, events
+      type(moreau_jean_stats) :: moreau_jean    !! Moreau-Jean's steps, patterns, fallbacks
       integer :: env_col = 0           !! first column of the maxima between rows (0: none)
-      integer :: patterns = 0          !! stick-slip patterns solved in one-step problems (Moreau-Jean)
-      integer :: lcp_fallbacks = 0     !! one-step problems that needed Lemke's fallback (Moreau-Jean)
       ! correctness condition, eqs. 9 and 12
       integer :: violations = 0        !! steps accepted that violate it
       integer :: n_violation_times = 0 !! entries used in violation_time
       real(dp) :: violation_time(max_violation_times) = 0.0_dp  !! end times of the first ones [s]
       integer :: violation_device(max_violation_times) = 0      !! their devices
       ! a speed-dependent mu, taken at the velocity at each step's end (Newmark)
-      integer :: mu_passes = 0         !! solves of the fixed point on the sliding forces
       integer :: mu_unconverged = 0    !! steps accepted with those forces unconverged
       real(dp) :: mu_unconverged_time = 0.0_dp !! end of the first one [s]
       real(dp) :: mu_misfit = 0.0_dp   !! the largest change their last pass asked for, |df| / (P mu_largest) [-]
@@ -285,7 +265,6 @@ contains
       if (engineering_columns(model) > 0) call storey_columns(res, c, '', model%n_storeys)
       if (has_envelope(opts)) then
          res%env_col = c + 1
-         res%exact_peaks = .true.
          call add_columns(res, c, 'peak_', kd, dof_names, dof_units)
          call add_columns(res, c, 'peak_', kv, [character(len=1) :: 's', 'F'], [character(len=1) :: 'm', 'N'])
          if (engineering_columns(model) > 0) call storey_columns(res, c, 'peak_', model%n_storeys)
@@ -345,6 +324,29 @@ contains
       res%names(c + 1) = prefix//'Vb'; res%units(c + 1) = 'N'
       c = c + 1
    end subroutine storey_columns
+
+   !> The header line of the history: name[unit] of each column, comma separated.
+   pure subroutine history_header(res, line)
+      type(result_type), intent(in) :: res                 !! the result
+      character(len=:), allocatable, intent(out) :: line   !! the header
+      integer :: j, pos, n
+
+      n = 0
+      do j = 1, res%ncol
+         n = n + len_trim(res%names(j)) + len_trim(res%units(j)) + 3
+      end do
+      allocate (character(len=max(n - 1, 0)) :: line)
+      pos = 0
+      do j = 1, res%ncol
+         n = len_trim(res%names(j)) + len_trim(res%units(j)) + 2
+         line(pos + 1:pos + n) = trim(res%names(j))//'['//trim(res%units(j))//']'
+         pos = pos + n
+         if (j < res%ncol) then
+            line(pos + 1:pos + 1) = ','
+            pos = pos + 1
+         end if
+      end do
+   end subroutine history_header
 
    !> Every number of a result must be finite: an error names the first quantity that is not
    !> (its summary key, or its history column and time), never a null in a summary.

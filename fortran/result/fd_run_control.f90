@@ -1,6 +1,6 @@
 !> What the caller of a run controls while it goes, for every technique (the observer
 !> applies it): which history columns are kept and where their rows go (the result's
-!> history, a buffer the caller owns, a file written as the run goes), a request to stop
+!> history, a buffer the caller owns, a row sink such as a file written as the run goes), a request to stop
 !> (set from another thread, polled by the solver), and the progress the run reports (the
 !> time reached, read from another thread; a callback at a set interval of wall-clock time).
 !> A run without a control keeps every column in the result's history, as before.
@@ -12,7 +12,7 @@
 module fd_run_control
    use fd_kinds, only: dp
    use fd_error, only: error_type, fatal_error, fmt_int
-   use fd_history_stream, only: history_stream
+   use fd_row_sink, only: row_sink
    implicit none
    private
 
@@ -41,8 +41,8 @@ module fd_run_control
       ! where the rows go
       logical :: keep = .true.                        !! into the result's history (memory)
       real(dp), pointer :: buffer(:, :) => null()     !! into the caller's (ncol, nout) buffer
-      character(len=:), allocatable :: stream_path    !! into this file, written as the run goes
-      type(history_stream) :: stream                  !! that file, once opened by the observer
+      class(row_sink), allocatable :: sink            !! into this sink as the run goes (the caller's:
+                                                      !! the history file of fd_history_stream)
       ! stop and progress
       integer :: cancel = 0                           !! set non-zero (another thread) to stop
       real(dp) :: time = 0.0_dp                       !! time reached [s] (written by the run)

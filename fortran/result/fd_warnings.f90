@@ -1,126 +1,255 @@
-!> The warnings a run's result calls for, worded once: the executable prints each on standard
-!> error after "frictiondyn: warning: ", the summary holds them (key `warnings`), and Python
-!> issues them as FrictiondynWarning from the summary. A warning says that the run finished
-!> but that its answer needs care: correctness violations left in accepted steps (eqs. 9,
-!> 12), steps whose speed-dependent mu did not converge, a step dt1 that does not resolve
-!> the highest modes, a harmonic table motion's steady state or a record's peak linear
-!> response, a sticking spring's ringing that the step dephases, a velocity-law band's force
-!> left alternating, and an energy balance that misses (more than 5 %, or beyond round-off
-!> with the average acceleration rule). Each is one line: what happened, with the figures of
-!> the summary key it names, what to change, and the section of docs/warnings.md that
-!> explains it.
+!> The checks of a run's result, each as a check record (fd_check), and the warnings they
+!> call for, worded once: the executable prints each on standard error after "frictiondyn:
+!> warning: ", the summary holds them (key `warnings`), and Python issues them as
+!> FrictiondynWarning from the summary. A warning says that the run finished but that its
+!> answer needs care: correctness violations left in accepted steps (eqs. 9, 12), steps
+!> whose speed-dependent mu did not converge, a step dt1 that does not resolve the highest
+!> modes, a harmonic table motion's steady state or a record's peak linear response, a
+!> sticking spring's ringing that the step dephases, a velocity-law band's force left
+!> alternating, and an energy balance that misses (more than 5 %, or beyond round-off with
+!> the average acceleration rule). Each is one line: what happened, with the figures of the
+!> summary key it names, what to change, and the section of docs/warnings.md that explains
+!> it. The warnings are a filter over the checks (check_warnings): a new check is one
+!> routine here and one line of run_checks.
 module fd_warnings
    use fd_kinds, only: dp
    use fd_error, only: fmt_int
-   use fd_result, only: result_type, resolution_unresolved, residual_ratio_limit, roundoff_ratio_limit, &
-                        balance_closed, balance_digits, balance_dissipative, record_system_stuck, &
-                        record_system_free, record_system_both
+   use fd_result, only: result_type, resolution_none, resolution_unresolved, residual_ratio_limit, &
+                        roundoff_ratio_limit, balance_closed, balance_digits, balance_dissipative, &
+                        record_system_stuck, record_system_free, record_system_both
+   use fd_check, only: check_type, warning_text, add_figure, check_warnings, verdict_not_applicable, &
+                       verdict_passed, verdict_warns
    implicit none
    private
 
-   public :: warning_text, run_warnings
+   public :: warning_text, run_warnings, run_checks, n_checks
 
-   !> One warning's text, without the executable's "frictiondyn: warning: ".
-   type :: warning_text
-      character(len=:), allocatable :: text
-   end type warning_text
+   !> The checks of a run, in the order of their warnings.
+   integer, parameter :: n_checks = 8
 
 contains
 
-   !> Every warning the result calls for, in the order above (none: an empty array).
+   !> Every warning the result calls for, in the order of the checks (none: an empty array).
    pure subroutine run_warnings(res, w)
       type(result_type), intent(in) :: res                 !! the run's result
       type(warning_text), allocatable, intent(out) :: w(:) !! its warnings
-      character(len=:), allocatable :: s
-      integer :: d, k, more
+      type(check_type) :: checks(n_checks)
 
-      allocate (w(0))
-      if (res%violations > 0) then
-         s = trim(fmt_int(res%violations))//' step(s) violate the correctness condition (eqs. 9, 12), first at t ='
-         do k = 1, min(3, res%n_violation_times)   ! the first three; the summary keeps more
-            s = s//' '//trim(fx(res%violation_time(k), 6))
-            if (k < min(3, res%n_violation_times)) s = s//','
-         end do
-         if (res%n_violation_times > 3) s = s//', ...'
-         call push(w, s//' s (correctness_violations): lower dt_min or widen eps, eps1'//trim(see('correctness')))
-      end if
-      if (res%mu_unconverged > 0) then
-         call push(w, trim(fmt_int(res%mu_unconverged))//' step(s) could not take a speed-dependent mu at their '// &
+      call run_checks(res, checks)
+      call check_warnings(checks, w)
+   end subroutine run_warnings
+
+   !> The checks of a result, each filled from the verdicts and figures the run left in it:
+   !> the correctness condition, a speed-dependent mu, the highest modes, a harmonic table
+   !> motion, a record, the sticking springs' ringing, the velocity-law bands, the energy
+   !> balance.
+   pure subroutine run_checks(res, checks)
+      type(result_type), intent(in) :: res                 !! the run's result
+      type(check_type), intent(out) :: checks(n_checks)    !! its checks
+
+      call correctness_check(res, checks(1))
+      call mu_check(res, checks(2))
+      call mode_check(res, checks(3))
+      call harmonic_check(res, checks(4))
+      call record_check(res, checks(5))
+      call stick_check(res, checks(6))
+      call band_check(res, checks(7))
+      call energy_check(res, checks(8))
+   end subroutine run_checks
+
+   !> The verdict of a resolution check (resolution_*): not applicable, passed or warns.
+   pure integer function resolution_verdict(resolution) result(verdict)
+      integer, intent(in) :: resolution   !! resolution_none, _resolved or _unresolved
+
+      select case (resolution)
+      case (resolution_none)
+         verdict = verdict_not_applicable
+      case (resolution_unresolved)
+         verdict = verdict_warns
+      case default
+         verdict = verdict_passed
+      end select
+   end function resolution_verdict
+
+   !> The correctness condition (eqs. 9, 12): steps accepted that violate it.
+   pure subroutine correctness_check(res, c)
+      type(result_type), intent(in) :: res   !! the result
+      type(check_type), intent(out) :: c     !! the check
+      character(len=:), allocatable :: s
+      integer :: k
+
+      c%key = 'correctness_violations'
+      c%verdict = merge(verdict_warns, verdict_passed, res%violations > 0)
+      call add_figure(c, 'correctness_violations', real(res%violations, dp))
+      do k = 1, min(3, res%n_violation_times)   ! the first three; the summary keeps more
+         call add_figure(c, 'violation_times_s('//trim(fmt_int(k))//')', res%violation_time(k))
+      end do
+      if (c%verdict /= verdict_warns) return
+      s = trim(fmt_int(res%violations))//' step(s) violate the correctness condition (eqs. 9, 12), first at t ='
+      do k = 1, min(3, res%n_violation_times)
+         s = s//' '//trim(fx(res%violation_time(k), 6))
+         if (k < min(3, res%n_violation_times)) s = s//','
+      end do
+      if (res%n_violation_times > 3) s = s//', ...'
+      c%warning = s//' s (correctness_violations): lower dt_min or widen eps, eps1'//trim(see('correctness'))
+   end subroutine correctness_check
+
+   !> A speed-dependent mu: steps accepted with their sliding forces unconverged.
+   pure subroutine mu_check(res, c)
+      type(result_type), intent(in) :: res   !! the result
+      type(check_type), intent(out) :: c     !! the check
+
+      c%key = 'mu_unconverged_steps'
+      c%verdict = merge(verdict_warns, verdict_passed, res%mu_unconverged > 0)
+      call add_figure(c, 'mu_unconverged_steps', real(res%mu_unconverged, dp))
+      if (c%verdict /= verdict_warns) return
+      call add_figure(c, 'mu_unconverged_s', res%mu_unconverged_time)
+      call add_figure(c, 'mu_unconverged_misfit', res%mu_misfit)
+      c%warning = trim(fmt_int(res%mu_unconverged))//' step(s) could not take a speed-dependent mu at their '// &
                   'end velocity, first at t = '//trim(es(res%mu_unconverged_time, 3))//' s (mu_unconverged_'// &
                   'steps, last change '//trim(es(res%mu_misfit, 3))//' of P mu): raise n1 or lower dt_min'// &
-                  trim(see('mu-unconverged')))
-      end if
-      if (res%mode_resolution == resolution_unresolved) then
-         call push(w, 'dt1 = '//trim(es(res%dt1, 3))//' s does not resolve the highest modes (shortest period '// &
+                  trim(see('mu-unconverged'))
+   end subroutine mu_check
+
+   !> Whether dt1 resolves the highest modes (fd_mode_resolution).
+   pure subroutine mode_check(res, c)
+      type(result_type), intent(in) :: res   !! the result
+      type(check_type), intent(out) :: c     !! the check
+
+      c%key = 'mode_resolution'
+      c%verdict = resolution_verdict(res%mode_resolution)
+      if (c%verdict == verdict_not_applicable) return
+      call add_figure(c, 'dt1_s', res%dt1)
+      call add_figure(c, 'omega_max_dt1', res%omega_max*res%dt1)
+      if (c%verdict /= verdict_warns) return
+      c%warning = 'dt1 = '//trim(es(res%dt1, 3))//' s does not resolve the highest modes (shortest period '// &
                   trim(es(2*acos(-1.0_dp)/res%omega_max, 3))//' s, omega_max_dt1 = '// &
                   trim(fx(res%omega_max*res%dt1, 2))//' > 2): peak accelerations may be off; raise n1'// &
-                  trim(see('mode-resolution')))
-      end if
-      if (res%harmonic_resolution == resolution_unresolved) then
-         d = maxloc(res%harmonic_error, 1)
-         call push(w, 'dt1 = '//trim(es(res%dt1, 3))//' s takes '//trim(fx(1.0_dp/(res%eng%frequency*res%dt1), 2))// &
+                  trim(see('mode-resolution'))
+   end subroutine mode_check
+
+   !> The head of a check judged by its largest value per DOF or device (harmonic, record,
+   !> stick ringing, band alternation): its key, its verdict from `resolution`, and (when it
+   !> applies) the figures `what` (the DOF or device of the largest value, d; 0 when the check
+   !> does not apply) and that value under the name `name`.
+   pure subroutine largest_check(c, key, resolution, values, what, name, d)
+      type(check_type), intent(out) :: c                 !! the check
+      character(len=*), intent(in) :: key                !! its key
+      integer, intent(in) :: resolution                  !! resolution_*
+      real(dp), allocatable, intent(in) :: values(:)     !! per DOF or device (not allocated: none)
+      character(len=*), intent(in) :: what               !! 'dof' or 'device'
+      character(len=*), intent(in) :: name               !! the values' summary key
+      integer, intent(out) :: d                          !! the DOF or device of the largest value
+
+      d = 0
+      c%key = key
+      c%verdict = resolution_verdict(resolution)
+      if (c%verdict == verdict_not_applicable .or. .not. allocated(values)) return
+      if (size(values) == 0) return
+      d = maxloc(values, 1)
+      call add_figure(c, what, real(d, dp))
+      call add_figure(c, name, values(d))
+   end subroutine largest_check
+
+   !> Whether dt1 resolves a harmonic table motion's steady state (fd_harmonic_resolution).
+   pure subroutine harmonic_check(res, c)
+      type(result_type), intent(in) :: res   !! the result
+      type(check_type), intent(out) :: c     !! the check
+      integer :: d
+
+      call largest_check(c, 'harmonic_resolution', res%harmonic_resolution, res%harmonic_error, 'dof', &
+                         'harmonic_step_error', d)
+      if (d > 0) call add_figure(c, 'dt1_s', res%dt1)
+      if (c%verdict /= verdict_warns .or. d == 0) return
+      c%warning = 'dt1 = '//trim(es(res%dt1, 3))//' s takes '//trim(fx(1.0_dp/(res%eng%frequency*res%dt1), 2))// &
                   ' steps a table period: the step alone moves the linear steady-state amplitude of DOF '// &
-                  trim(fmt_int(d))//' by '//trim(fx(100*res%harmonic_error(d), 1))//' % (harmonic_step_error > 0.05); '// &
-                  'raise n1'//trim(see('harmonic-resolution')))
-      end if
-      if (res%record_resolution == resolution_unresolved) then
-         d = maxloc(res%record_error, 1)
-         call push(w, 'dt1 = '//trim(es(res%dt1, 3))//' s does not resolve the record: the step alone moves the peak '// &
+                  trim(fmt_int(d))//' by '//trim(fx(100*res%harmonic_error(d), 1))//' % (harmonic_step_error > '// &
+                  '0.05); raise n1'//trim(see('harmonic-resolution'))
+   end subroutine harmonic_check
+
+   !> Whether dt1 resolves a record's peak linear response (fd_record_resolution).
+   pure subroutine record_check(res, c)
+      type(result_type), intent(in) :: res   !! the result
+      type(check_type), intent(out) :: c     !! the check
+      integer :: d
+
+      call largest_check(c, 'record_resolution', res%record_resolution, res%record_error, 'dof', &
+                         'record_step_error', d)
+      if (d > 0) call add_figure(c, 'dt1_s', res%dt1)
+      if (c%verdict /= verdict_warns .or. d == 0) return
+      c%warning = 'dt1 = '//trim(es(res%dt1, 3))//' s does not resolve the record: the step alone moves the peak '// &
                   'linear response of DOF '//trim(fmt_int(d))//' by '//trim(fx(100*res%record_error(d), 1))// &
                   ' % (record_step_error > 0.05, '//trim(record_system_text(res%record_system))//'); raise n1'// &
-                  trim(see('record-resolution')))
-      end if
-      if (res%stick_resolution == resolution_unresolved) then
-         d = maxloc(res%stick_ringing_ratio, 1)
-         more = count(res%stick_ringing_ratio > 1.0_dp) - 1
-         call push(w, 'the sticking spring of device '//trim(fmt_int(d))//' rings with '// &
+                  trim(see('record-resolution'))
+   end subroutine record_check
+
+   !> Whether dt1 resolves the sticking springs' ringing (fd_stick_ringing).
+   pure subroutine stick_check(res, c)
+      type(result_type), intent(in) :: res   !! the result
+      type(check_type), intent(out) :: c     !! the check
+      integer :: d, more
+
+      call largest_check(c, 'stick_resolution', res%stick_resolution, res%stick_ringing_ratio, 'device', &
+                         'stick_ringing_ratio', d)
+      if (c%verdict /= verdict_warns .or. d == 0) return
+      more = count(res%stick_ringing_ratio > 1.0_dp) - 1
+      call add_figure(c, 'stick_ringing_N', res%stick_ringing(d))
+      call add_figure(c, 'stick_margin_N', res%stick_margin(d))
+      call add_figure(c, 'more_devices', real(more, dp))
+      c%warning = 'the sticking spring of device '//trim(fmt_int(d))//' rings with '// &
                   trim(es(res%stick_ringing(d), 3))//' N against a margin of '//trim(es(res%stick_margin(d), 3))// &
                   ' N, dephased by dt1 (stick_ringing_ratio = '//trim(fx(res%stick_ringing_ratio(d), 2))//' > 1'// &
-                  trim(likewise(more))//'): raise n1'//trim(see('stick-ringing')))
+                  trim(likewise(more))//'): raise n1'//trim(see('stick-ringing'))
+   end subroutine stick_check
+
+   !> Whether the step damps the velocity-law bands (fd_band_alternation).
+   pure subroutine band_check(res, c)
+      type(result_type), intent(in) :: res   !! the result
+      type(check_type), intent(out) :: c     !! the check
+      character(len=:), allocatable :: s
+      integer :: d, more
+
+      call largest_check(c, 'band_resolution', res%band_resolution, res%band_alternation, 'device', &
+                         'band_alternation_N', d)
+      if (c%verdict /= verdict_warns .or. d == 0) return
+      more = count(res%band_alternation > 0.0_dp) - 1
+      call add_figure(c, 'band_x', res%band_x(d))
+      call add_figure(c, 'more_devices', real(more, dp))
+      if (res%band_x(d) > 1.0_dp) then
+         s = 'raise n1 until dt1 < '//trim(es(res%dt1/res%band_x(d), 3))//' s or widen eps'
+      else
+         s = 'another mode the step does not resolve drives it; raise n1'
       end if
-      if (res%band_resolution == resolution_unresolved) then
-         d = maxloc(res%band_alternation, 1)
-         more = count(res%band_alternation > 0.0_dp) - 1
-         if (res%band_x(d) > 1.0_dp) then
-            s = 'raise n1 until dt1 < '//trim(es(res%dt1/res%band_x(d), 3))//' s or widen eps'
-         else
-            s = 'another mode the step does not resolve drives it; raise n1'
-         end if
-         call push(w, 'the force of device '//trim(fmt_int(d))//' alternates step to step in its band '// &
+      c%warning = 'the force of device '//trim(fmt_int(d))//' alternates step to step in its band '// &
                   '(band_alternation_N = +-'//trim(es(res%band_alternation(d), 3))//' N, x = '// &
-                  trim(es(res%band_x(d), 3))//trim(likewise(more))//'): '//s//trim(see('band-alternation')))
-      end if
+                  trim(es(res%band_x(d), 3))//trim(likewise(more))//'): '//s//trim(see('band-alternation'))
+   end subroutine band_check
+
+   !> Whether the energy balance closes (energy_balance_of): round-off beyond
+   !> roundoff_ratio_limit, or a residual beyond residual_ratio_limit, warns.
+   pure subroutine energy_check(res, c)
+      type(result_type), intent(in) :: res   !! the result
+      type(check_type), intent(out) :: c     !! the check
+      character(len=:), allocatable :: s
+
+      c%key = 'energy_balance'
+      c%verdict = merge(verdict_passed, verdict_warns, res%energy_balance == balance_closed)
+      call add_figure(c, 'energy_residual_ratio', res%e_residual_ratio)
       if (res%energy_balance == balance_digits) then
-         call push(w, 'the integration lost digits to round-off (|energy_residual_ratio| = '// &
-                  trim(es(abs(res%e_residual_ratio), 1))//' > '//trim(es(roundoff_ratio_limit, 1))// &
-                  '): a coupling too stiff for dt1; widen eps or soften it'//trim(see('energy-round-off')))
+         c%warning = 'the integration lost digits to round-off (|energy_residual_ratio| = '// &
+                     trim(es(abs(res%e_residual_ratio), 1))//' > '//trim(es(roundoff_ratio_limit, 1))// &
+                     '): a coupling too stiff for dt1; widen eps or soften it'//trim(see('energy-round-off'))
       else if (res%energy_balance /= balance_closed) then
          if (res%energy_balance == balance_dissipative) then
             s = 'numerical damping (gamma or theta > 1/2); raise n1 or use gamma = theta = 1/2'
          else
             s = 'an energy error of the step (Newmark beta /= 1/4 or unstable); raise n1 or use beta = 1/4'
          end if
-         call push(w, 'the integration '//trim(merge('dissipated', 'created   ', res%e_residual_ratio > 0.0_dp))// &
-                  ' '//trim(fx(100*abs(res%e_residual_ratio), 1))//' % of the energy (|energy_residual_ratio| > '// &
-                  trim(fx(residual_ratio_limit, 2))//'): '//s//trim(see('energy-balance')))
+         c%warning = 'the integration '//trim(merge('dissipated', 'created   ', res%e_residual_ratio > 0.0_dp))// &
+                     ' '//trim(fx(100*abs(res%e_residual_ratio), 1))//' % of the energy (|energy_residual_ratio| > '// &
+                     trim(fx(residual_ratio_limit, 2))//'): '//s//trim(see('energy-balance'))
       end if
-   end subroutine run_warnings
-
-   !> One more warning. (The texts move to the longer array: gfortran 12's w = [w, x] on a
-   !> type with an allocatable component leaks the old array, which LeakSanitizer reports.)
-   pure subroutine push(w, text)
-      type(warning_text), allocatable, intent(inout) :: w(:)
-      character(len=*), intent(in) :: text
-      type(warning_text), allocatable :: longer(:)
-      integer :: k
-
-      allocate (longer(size(w) + 1))
-      do k = 1, size(w)
-         call move_alloc(w(k)%text, longer(k)%text)
-      end do
-      longer(size(w) + 1)%text = text
-      call move_alloc(longer, w)
-   end subroutine push
+   end subroutine energy_check
 
    ! The helpers below return fixed-length text, trimmed where it is used: a function with a
    ! character(len=:), allocatable result keeps its length in a static variable of the caller

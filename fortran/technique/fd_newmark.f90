@@ -46,7 +46,7 @@ module fd_newmark
    use fd_run_control, only: run_control
    use fd_observer, only: observer_type, observer_init, sample_due, observe_start_energies, observe_peaks, &
                           observe_sample, observe_transitions, observe_violations, observe_end_energies, &
-                          observe_poll, observe_stop_error
+                          observe_poll, observe_stop_error, observe_work
    use fd_step_limits, only: halving_levels, unresolved_band, max_nested, nested_splits, max_settle, max_follow, &
                              follow_tol
    use fd_stick_ringing, only: ringing_type, ringing_init, ringing_changed, ringing_finish, stat_time, stat_sd2, &
@@ -153,13 +153,14 @@ contains
       if (allocated(error)) return
       dt1 = exc%dt_record/opts%n1
       dt2 = dt1/opts%n2
+      res%newmark%ran = .true.
       res%dt1 = dt1
       res%dt2 = dt2
       res%dt_min = opts%dt_min
       if (res%dt_min <= 0.0_dp) res%dt_min = dt2/2.0_dp**10
       call setup(model, opts, dt1, dt2, halving_levels(dt2, res%dt_min), w, res, error)
       if (allocated(error)) return
-      call observer_init(model, exc, opts, res, w%obs, error, ctl)
+      call observer_init(model, exc, opts, res%period_stuck, res, w%obs, error, ctl)
       if (allocated(error)) return
       call grid_init(exc, dt1, w%grid)
 
@@ -191,7 +192,7 @@ contains
          call judge(model, opts, w, any_changed, any_bad)
          if (w%nd == 0 .or. .not. (any_changed .or. (any_bad .and. opts%check))) then
             call accept(model, exc, t0 + dt1, w, res, any_changed, .false.)
-            res%steps_dt1 = res%steps_dt1 + 1
+            res%newmark%steps_dt1 = res%newmark%steps_dt1 + 1
          else if (opts%refinement == refinement_implicit .and. any_changed) then
             ! redone in the phases it ends in; refined as the paper's when they do not settle
             call settle_phases(model, exc, opts, t0, w, res, settled, error)
@@ -203,7 +204,7 @@ contains
          else if (opts%n2 == 1 .and. .not. (any_bad .and. opts%check)) then
             ! redone as one step of dt2 = dt1 from the same state and phases: the trial itself
             call accept(model, exc, t0 + dt1, w, res, any_changed, any_bad)
-            res%steps_dt2 = res%steps_dt2 + 1
+            res%newmark%steps_dt2 = res%newmark%steps_dt2 + 1
          else
             call advance_nested(model, exc, opts, t0, 0, w, res, error)
             if (allocated(error)) return
@@ -226,15 +227,15 @@ contains
       w%phase0 = w%st%phase
       call ringing_finish(w%ring, w%phase0, res)
       call alternation_finish(res)
-      res%mu_passes = w%follow_passes
+      res%newmark%mu_passes = w%follow_passes
       call observe_end_energies(w%obs, res, 0.5_dp*sum(w%mass*w%v**2), strain_energy(model, w%u), &
                                 device_energy(model, w%st, w%s), &
                               w%w_device)
       do l = 1, size(w%lev)
          associate (stats => w%lev(l)%sys%stats)
-            res%factorizations = res%factorizations + stats%factorizations
-            res%partial_factorizations = res%partial_factorizations + stats%partial
-            res%factor_updates = res%factor_updates + stats%updates + stats%downdates
+            res%newmark%factorizations = res%newmark%factorizations + stats%factorizations
+            res%newmark%partial_factorizations = res%newmark%partial_factorizations + stats%partial
+            res%newmark%factor_updates = res%newmark%factor_updates + stats%updates + stats%downdates
          end associate
       end do
       call system_clock(c1)
@@ -282,8 +283,8 @@ contains
                      model%dev_coef, error, &
                      a0=a0, a1=a1, path=path)
       if (allocated(error)) return
-      res%storage = merge(1, 2, spd_is_dense(base))
-      res%bandwidth = spd_bandwidth(base)
+      res%newmark%storage = merge(1, 2, spd_is_dense(base))
+      res%newmark%bandwidth = spd_bandwidth(base)
       w%lmax = lmax
       ! the levels of the refinement: the paper's is one, dt1 to dt2 = dt1 / n2
       w%nested = 0
@@ -616,7 +617,7 @@ contains
             if (allocated(error)) return
          else
             call accept(model, exc, tj + h, w, res, any_changed, any_bad)
-            res%steps_nested = res%steps_nested + 1
+            res%newmark%steps_nested = res%newmark%steps_nested + 1
             call observe_poll(w%obs, tj + h, stop)
             if (stop) then
                call observe_stop_error(w%obs, error)
@@ -665,9 +666,9 @@ contains
          end if
          call accept(model, exc, tl + h, w, res, any_changed, any_bad)
          if (level == 0) then
-            res%steps_dt2 = res%steps_dt2 + 1
+            res%newmark%steps_dt2 = res%newmark%steps_dt2 + 1
          else
-            res%steps_finer = res%steps_finer + 1
+            res%newmark%steps_finer = res%newmark%steps_finer + 1
          end if
          call observe_poll(w%obs, tl + h, stop)
          if (stop) then
@@ -725,7 +726,7 @@ contains
             redone = .true.
             call try_step(model, exc, t, 1, w, error)
             if (allocated(error)) return
-            res%implicit_redos = res%implicit_redos + 1
+            res%newmark%implicit_redos = res%newmark%implicit_redos + 1
             ! the phases this trial ends in, judged from the start
             call friction_step(w%nd, model%dev, opts%n_corr, w%s1, w%sd1, w%sd, w%st0, w%st1, w%changed, w%ok, &
                                any_changed, any_bad)
@@ -747,14 +748,14 @@ contains
          w%phase1 = w%st%phase
          call observe_transitions(res, w%phase0, w%phase1)
          call accept(model, exc, t + w%lev(1)%h, w, res, any_changed, any_bad)
-         res%steps_implicit = res%steps_implicit + 1
+         res%newmark%steps_implicit = res%newmark%steps_implicit + 1
          settled = .true.
          return
       end do
       ! the start's states again; a factor that a redone trial updated follows them back
       w%st = w%st0
       if (redone) w%version = w%version + 1
-      res%implicit_fallbacks = res%implicit_fallbacks + 1
+      res%newmark%implicit_fallbacks = res%newmark%implicit_fallbacks + 1
    end subroutine settle_phases
 
    !> Every device's phase in st is phase.
@@ -788,9 +789,7 @@ contains
       ! energy of the step, forces at both ends in the step's phases; the state moves on
       call step_energy(w%n, w%mass, w%u, w%v, w%a, w%u1, w%v1, w%a1, w%tmp, w%rhs, ein)
       ein = 0.5_dp*(w%ag + w%ag1)*ein
-      res%e_input = res%e_input - ein
-      res%e_input_gross = res%e_input_gross + abs(ein)
-      res%e_viscous = res%e_viscous + 0.5_dp*viscous_work(model, w%a0, w%a1c, w%n, w%mass, w%tmp, w%rhs)
+      call observe_work(res, -ein, 0.5_dp*viscous_work(model, w%a0, w%a1c, w%n, w%mass, w%tmp, w%rhs))
       w%ag = w%ag1
       ! violations of the correctness condition left in an accepted step
       if (any_bad) call observe_violations(res, t1, w%ok)

@@ -10,14 +10,31 @@ module test_fd_observer
    use fd_excitation, only: excitation_type, excitation_none
    use fd_result, only: result_type, max_violation_times, check_finite, nonfinite_history_error
    use fd_run_control, only: run_control, select_history
+   use fd_row_sink, only: row_sink
    use fd_names, only: technique_event_driven
    use, intrinsic :: ieee_arithmetic, only: ieee_value, ieee_quiet_nan, ieee_positive_inf
    use fd_observer, only: observer_type, observer_init, sample_due, observe_start, observe_peaks, &
-                          observe_sample, observe_transitions, observe_violations, observe_end
+                          observe_sample, observe_transitions, observe_violations, observe_end, &
+                          observe_extrema, observe_extremum, observe_work, observe_poll, observe_stop_error
    implicit none
    private
 
    public :: collect_observer
+
+   !> A row sink in memory: the header, the rows put and a failure to report.
+   type, extends(row_sink) :: memory_sink
+      character(len=:), allocatable :: header
+      integer :: rows = 0
+      real(dp) :: last(10) = 0.0_dp
+      logical :: broken = .false.
+      logical :: finished = .false.
+   contains
+      procedure :: begin => memory_begin
+      procedure :: put => memory_put
+      procedure :: failed => memory_failed
+      procedure :: finish => memory_finish
+      procedure :: discard => memory_discard
+   end type memory_sink
 
 contains
 
@@ -32,7 +49,10 @@ contains
                   new_unittest("energy balance of a free oscillator", test_energy), &
                   new_unittest("a non-finite result named", test_non_finite), &
                   new_unittest("a non-finite row outside the result noted", test_non_finite_buffer), &
-                  new_unittest("maxima between rows of the kept DOFs and devices", test_selected_envelope) &
+                  new_unittest("maxima between rows of the kept DOFs and devices", test_selected_envelope), &
+                  new_unittest("exact extrema in the envelope's order", test_extrema), &
+                  new_unittest("the work of the steps into the balance", test_work), &
+                  new_unittest("rows into the control's row sink; its failure stops the run", test_sink) &
                   ]
    end subroutine collect_observer
 
@@ -55,7 +75,7 @@ contains
       exc%dt_record = 0.01_dp
       exc%duration = 0.0123_dp
       opts%n1 = 20
-      call observer_init(model, exc, opts, res, obs, err)
+      call observer_init(model, exc, opts, res%period_stuck, res, obs, err)
       if (allocated(err)) call test_failed(error, err%message)
    end subroutine setup
 
@@ -265,7 +285,7 @@ contains
       opts%n1 = 20
       ctl%buffer => buf
       ctl%keep = .false.
-      call observer_init(model, exc, opts, res, obs, err, ctl)
+      call observer_init(model, exc, opts, res%period_stuck, res, obs, err, ctl)
       if (allocated(err)) call test_failed(error, err%message)
       if (allocated(error)) return
       call check(error, size(res%hist, 2) == 0 .and. res%nout == 3, 'no rows in the result')
@@ -315,7 +335,7 @@ contains
       call select_history(ctl, [3], [2], 3, 2, err)
       if (allocated(err)) call test_failed(error, err%message)
       if (allocated(error)) return
-      call observer_init(model, exc, opts, res, obs, err, ctl)
+      call observer_init(model, exc, opts, res%period_stuck, res, obs, err, ctl)
       if (allocated(err)) call test_failed(error, err%message)
       if (allocated(error)) return
       call check(error, res%ncol == 2 + 3 + 4 + 3 + 2, 'columns: t, ag, 3 of DOF 3, 4 of device 2, 3 + 2 maxima')
@@ -330,5 +350,128 @@ contains
       call check(error, all(res%hist(10:14, 1) == [7.0_dp, 8.0_dp, 9.0_dp, 12.0_dp, 13.0_dp]), &
                  'the maxima of DOF 3 and device 2')
    end subroutine test_selected_envelope
+
+   !> Two DOFs and one device: the quantities |u1|, |v1|, |aabs1|, |u2|, |v2|, |aabs2|, |s1|,
+   !> |F1| go to their peaks (with the times of u and aabs); a smaller value leaves a peak.
+   subroutine test_extrema(error)
+      type(error_type), allocatable, intent(out) :: error
+      type(model_type) :: model
+      type(result_type) :: res
+      type(observer_type) :: obs
+
+      call setup(model, res, obs, error)
+      if (allocated(error)) return
+      call observe_extrema(res, [0.1_dp, -0.2_dp, 0.3_dp, -0.4_dp, 0.5_dp, -0.6_dp, 0.7_dp, -80.0_dp], 0.25_dp)
+      call check(error, all(res%peak_u == [0.1_dp, 0.4_dp]) .and. all(res%peak_v == [0.2_dp, 0.5_dp]) .and. &
+                 all(res%peak_aabs == [0.3_dp, 0.6_dp]) .and. all(res%peak_u_time == 0.25_dp) .and. &
+                 all(res%peak_aabs_time == 0.25_dp), 'the DOFs')
+      if (allocated(error)) return
+      call check(error, res%peak_s(1) == 0.7_dp .and. res%peak_force(1) == 80.0_dp, 'the device')
+      if (allocated(error)) return
+      call observe_extremum(res, 4, 0.3_dp, 0.5_dp)
+      call observe_extremum(res, 7, 0.9_dp, 0.5_dp)
+      call check(error, res%peak_u(2) == 0.4_dp .and. res%peak_u_time(2) == 0.25_dp .and. res%peak_s(1) == 0.9_dp, &
+                 'a smaller |u2| leaves its peak, a larger |s1| replaces it')
+   end subroutine test_extrema
+
+   !> Input work -2 J then +1 J, viscous 0.5 J each: input -1 J, gross 3 J, viscous 1 J.
+   subroutine test_work(error)
+      type(error_type), allocatable, intent(out) :: error
+      type(result_type) :: res
+
+      call observe_work(res, -2.0_dp, 0.5_dp)
+      call observe_work(res, 1.0_dp, 0.5_dp)
+      call check(error, res%e_input == -1.0_dp .and. res%e_input_gross == 3.0_dp .and. res%e_viscous == 1.0_dp, &
+                 'the balance')
+   end subroutine test_work
+
+   !> A run whose control holds a row sink: begun with the history's header, each row put
+   !> into it (none into the result); a failed write makes the next look at the clock say
+   !> stop, and the stop error is the sink's own.
+   subroutine test_sink(error)
+      type(error_type), allocatable, intent(out) :: error
+      type(model_type) :: model
+      type(result_type) :: res
+      type(observer_type) :: obs
+      type(excitation_type) :: exc
+      type(integration_type) :: opts
+      type(run_control), target :: ctl
+      type(fd_error_type), allocatable :: err
+      logical :: halt
+      integer :: k
+
+      model%n_dof = 2
+      model%mass = [2.0_dp, 1.0_dp]
+      model%n_devices = 1
+      model%dev = [device_type(node_i=1, node_j=2, law=law_velocity, p=10.0_dp, mu=0.2_dp)]
+      exc%kind = excitation_none
+      exc%dt_record = 0.01_dp
+      exc%duration = 0.0123_dp
+      opts%n1 = 20
+      ctl%keep = .false.
+      allocate (memory_sink :: ctl%sink)
+      call observer_init(model, exc, opts, res%period_stuck, res, obs, err, ctl)
+      if (allocated(err)) call test_failed(error, err%message)
+      if (allocated(error)) return
+      call observe_sample(obs, res, 0.0_dp, -0.5_dp, [1.0_dp, 2.0_dp], [3.0_dp, 4.0_dp], [0.0_dp, 0.0_dp], &
+                          [5.0_dp], [6.0_dp], [7.0_dp], [1])
+      select type (sink => ctl%sink)
+      type is (memory_sink)
+         call check(error, sink%header, 't[s],ag[m/s2],u1[m],v1[m/s],aabs1[m/s2],u2[m],v2[m/s],aabs2[m/s2],'// &
+                    's1[m],sdot1[m/s],F1[N],phase1[-]')
+         if (allocated(error)) return
+         call check(error, sink%rows == 1 .and. sink%last(3) == 1.0_dp .and. sink%last(10) == 6.0_dp .and. &
+                    size(res%hist, 2) == 0, 'the row in the sink, none in the result')
+         if (allocated(error)) return
+         sink%broken = .true.
+      end select
+      halt = .false.
+      do k = 1, 2100000
+         call observe_poll(obs, 0.001_dp*k, halt)
+         if (halt) exit
+      end do
+      call check(error, halt, 'a failed sink stops the run')
+      if (allocated(error)) return
+      call observe_stop_error(obs, err)
+      call check(error, allocated(err), 'the stop error')
+      if (allocated(error)) return
+      call check(error, err%message, 'memory sink: broken')
+   end subroutine test_sink
+
+   subroutine memory_begin(sink, header, ncol, error)
+      class(memory_sink), intent(inout) :: sink
+      character(len=*), intent(in) :: header
+      integer, intent(in) :: ncol
+      type(fd_error_type), allocatable, intent(out) :: error
+      sink%header = header
+      if (ncol /= 12) allocate (error)
+   end subroutine memory_begin
+
+   subroutine memory_put(sink, row)
+      class(memory_sink), intent(inout) :: sink
+      real(dp), intent(in) :: row(:)
+      sink%rows = sink%rows + 1
+      sink%last(1:min(10, size(row))) = row(1:min(10, size(row)))
+   end subroutine memory_put
+
+   logical function memory_failed(sink)
+      class(memory_sink), intent(in) :: sink
+      memory_failed = sink%broken
+   end function memory_failed
+
+   subroutine memory_finish(sink, error)
+      class(memory_sink), intent(inout) :: sink
+      type(fd_error_type), allocatable, intent(out) :: error
+      sink%finished = .true.
+      if (sink%broken) then
+         allocate (error)
+         error%message = 'memory sink: broken'
+      end if
+   end subroutine memory_finish
+
+   subroutine memory_discard(sink)
+      class(memory_sink), intent(inout) :: sink
+      sink%rows = 0
+   end subroutine memory_discard
 
 end module test_fd_observer

@@ -162,7 +162,7 @@ contains
       call run_technique(model, exc, opts, res, err)
       call check(error, .not. allocated(err), "coulomb under moreau_jean runs")
       if (allocated(error)) return
-      call check(error, res%technique == technique_moreau_jean .and. res%steps_dt1 == 100, "its steps")
+      call check(error, res%technique == technique_moreau_jean .and. res%moreau_jean%steps == 100, "its steps")
       if (allocated(error)) return
       call setup(law_coulomb, law_hysteretic, model, exc)
       call check_technique(model, exc, opts, err)

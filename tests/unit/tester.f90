@@ -41,6 +41,8 @@ program tester
    use test_fd_record_resolution, only: collect_record_resolution
    use test_fd_warnings, only: collect_warnings
    use test_fd_undefined, only: collect_undefined
+   use test_fd_check, only: collect_check
+   use test_fd_statistics, only: collect_statistics
    implicit none
    integer :: stat, is
    character(len=:), allocatable :: suite_name, test_name
@@ -87,6 +89,8 @@ program tester
    testsuites = [testsuites, new_testsuite("record_resolution", collect_record_resolution)]
    testsuites = [testsuites, new_testsuite("warnings", collect_warnings)]
    testsuites = [testsuites, new_testsuite("undefined", collect_undefined)]
+   testsuites = [testsuites, new_testsuite("check", collect_check)]
+   testsuites = [testsuites, new_testsuite("statistics", collect_statistics)]
 
    call get_argument(1, suite_name)
    call get_argument(2, test_name)

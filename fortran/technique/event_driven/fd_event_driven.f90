@@ -38,9 +38,9 @@ module fd_event_driven
    use fd_kinematics, only: device_relative, device_abs_relative
    use fd_device_state, only: phase_stick
    use fd_result, only: result_type
+   use fd_statistics, only: count_event, count_accumulation
    use fd_observer, only: observer_type, observer_init, observe_start, observe_sample, observe_transitions, &
-                          observe_end, observe_peak_value, observe_event, observe_accumulation, &
-                          peak_of_u, peak_of_v, peak_of_aabs, peak_of_s, peak_of_force, peak_of_storey, &
+                          observe_end, observe_extrema, observe_extremum, observe_work, &
                           observe_poll, observe_stop_error, observe_storeys
    use fd_run_control, only: run_control, stat_cancelled
    use fd_engineering, only: storey_values, engineering_columns
@@ -77,7 +77,6 @@ module fd_event_driven
       real(dp), allocatable :: mp(:)                      !! mq' p coefficients (0:kmax)
       real(dp), allocatable :: ein(:), evi(:)             !! power coefficients (0:2 kmax)
       real(dp) :: w_fric = 0.0_dp                         !! friction work [J]
-      integer :: n_events = 0                             !! event instants at which phases changed
       real(dp) :: ring(ring_size) = -huge(1.0_dp)         !! times of the last events
       integer :: ring_pos = 0
       real(dp) :: last_accumulation = -huge(1.0_dp)       !! time of the last accumulation point
@@ -157,14 +156,15 @@ contains
       associate (st => w%st, t => w%t, h => w%h, t_end => w%t_end)
          call structure_matrices(model, st%k, st%c, res%period_stuck, res%xi_stuck, error)
          if (allocated(error)) return
-         call observer_init(model, exc, opts, res, w%obs, error, ctl)
+         call observer_init(model, exc, opts, res%period_stuck, res, w%obs, error, ctl)
          if (allocated(error)) return
          h = exc%dt_record/opts%n1
          res%dt1 = h
          res%dt2 = 0.0_dp
          res%dt_min = 0.0_dp
          t_end = w%obs%nsteps*h
-         res%steps_dt1 = w%obs%nsteps
+         res%exact%ran = .true.
+         res%exact%intervals = w%obs%nsteps
 
          ! the initial phases: a device moving at t = 0 slides its way, the others are
          ! candidates for sticking, decided by the complementarity problems
@@ -205,8 +205,7 @@ contains
             return
          end if
          call observe_end(w%obs, res, st%mass, st%k, st%u, st%v, 0.0_dp, w%w_fric, st%fn)
-         res%factorizations = st%cache%builds
-         res%events = w%n_events
+         res%exact%exponentials = st%cache%builds
       end associate
       call system_clock(c1)
       res%run_time = real(c1 - c0, dp)/real(max(crate, 1), dp)
@@ -426,20 +425,8 @@ contains
       type(ed_work), intent(in) :: w
       type(result_type), intent(inout) :: res
       real(dp), intent(in) :: s, tp
-      integer :: i, dd
       if (s < 0.0_dp) return
-      do i = 1, w%st%n
-         call observe_peak_value(res, peak_of_u, i, abs(w%yv(iq_u(i))), tp)
-         call observe_peak_value(res, peak_of_v, i, abs(w%yv(iq_v(i))), tp)
-         call observe_peak_value(res, peak_of_aabs, i, abs(w%yv(iq_a(i))), tp)
-      end do
-      do dd = 1, w%st%nd
-         call observe_peak_value(res, peak_of_s, dd, abs(w%yv(iq_s(w%st%n, dd))), tp)
-         call observe_peak_value(res, peak_of_force, dd, abs(w%yv(iq_f(w%st%n, dd))), tp)
-      end do
-      do i = w%st%nbase + 1, w%st%nquant
-         call observe_peak_value(res, peak_of_storey, i - w%st%nbase, abs(w%yv(i)), tp)
-      end do
+      call observe_extrema(res, w%yv(1:w%st%nquant), tp)
    end subroutine update_global
 
    !> Over [0, s_use] of the current sub-interval: the rows that fall in it, the exact
@@ -522,40 +509,11 @@ contains
             if (x > s) exit
             y = abs(poly_value(w%st%yc(0:kk, iq), x))
             w%env(iq) = max(w%env(iq), y)
-            call peak_one(w, res, iq, y, w%t + x)
+            call observe_extremum(res, iq, y, w%t + x)
             w%ip(iq) = w%ip(iq) + 1
          end do
       end do
    end subroutine absorb_until
-
-   !> One quantity's value into the summary's peak.
-   subroutine peak_one(w, res, iq, y, tp)
-      type(ed_work), intent(in) :: w
-      type(result_type), intent(inout) :: res
-      integer, intent(in) :: iq
-      real(dp), intent(in) :: y, tp
-      integer :: i, dd
-      if (iq > w%st%nbase) then
-         call observe_peak_value(res, peak_of_storey, iq - w%st%nbase, y, tp)
-      else if (iq <= 3*w%st%n) then
-         i = (iq + 2)/3
-         select case (iq - 3*(i - 1))
-         case (1)
-            call observe_peak_value(res, peak_of_u, i, y, tp)
-         case (2)
-            call observe_peak_value(res, peak_of_v, i, y, tp)
-         case default
-            call observe_peak_value(res, peak_of_aabs, i, y, tp)
-         end select
-      else
-         dd = (iq - 3*w%st%n + 1)/2
-         if (mod(iq - 3*w%st%n, 2) == 1) then
-            call observe_peak_value(res, peak_of_s, dd, y, tp)
-         else
-            call observe_peak_value(res, peak_of_force, dd, y, tp)
-         end if
-      end if
-   end subroutine peak_one
 
    !> Input work -int ag mq'p and viscous work int p'Cq p over [0, s], exactly (the
    !> polynomials' products integrated term by term).
@@ -600,9 +558,7 @@ contains
             ein = ein*s + w%ein(m)/(m + 1)
             evi = evi*s + w%evi(m)/(m + 1)
          end do
-         res%e_input = res%e_input - ein*s
-         res%e_input_gross = res%e_input_gross + abs(ein*s)
-         res%e_viscous = res%e_viscous + evi*s
+         call observe_work(res, -ein*s, evi*s)
       end associate
    end subroutine energy
 
@@ -648,9 +604,8 @@ contains
             w%burst_n = 1
          end if
          if (.not. chg) return
-         w%n_events = w%n_events + 1
          call observe_transitions(res, st%oldph, st%phase)
-         call observe_event(res, t)
+         call count_event(res%exact, t)
          ! accumulation guard: ring_size phase changes within the window
          w%ring_pos = mod(w%ring_pos, ring_size) + 1
          w%ring(w%ring_pos) = t
@@ -745,7 +700,7 @@ contains
             return
          end if
          call observe_transitions(res, st%oldph, st%phase)
-         call observe_accumulation(res, t)
+         call count_accumulation(res%exact, t)
       end associate
    end subroutine accumulation
 

@@ -30,7 +30,7 @@ module fd_moreau_jean
    use fd_result, only: result_type
    use fd_observer, only: observer_type, observer_init, sample_due, observe_peaks, observe_sample, &
                           observe_transitions, observe_start_energies, observe_end_energies, &
-                         observe_poll, observe_stop_error
+                         observe_poll, observe_stop_error, observe_work
    use fd_run_control, only: run_control
    use fd_stick_groups, only: groups_build, edge_relative
    use fd_group_system, only: gs_k_matvec, gs_k_absmatvec, gs_lowest_eigenvalue
@@ -147,10 +147,11 @@ contains
       if (allocated(error)) return
       call setup(model, w, res, error)
       if (allocated(error)) return
-      call observer_init(model, exc, opts, res, w%obs, error, ctl)
+      call observer_init(model, exc, opts, res%period_stuck, res, w%obs, error, ctl)
       if (allocated(error)) return
       th = opts%theta
       h = exc%dt_record/opts%n1
+      res%moreau_jean%ran = .true.
       res%dt1 = h
       res%dt2 = 0.0_dp
       res%dt_min = 0.0_dp
@@ -206,10 +207,8 @@ contains
          ! energy of the step: input, viscous and friction work over du = h v_theta
          w%du = w%u1 - w%u
          ein = agt*sum(model%mass*w%du)
-         res%e_input = res%e_input - ein
-         res%e_input_gross = res%e_input_gross + abs(ein)
          call gs_k_matvec(w%p%gs, w%du, w%kx, 1.0_dp, 0.0_dp)
-         res%e_viscous = res%e_viscous + (w%a0*sum(model%mass*w%du**2) + w%a1*dot_product(w%du, w%kx))/h
+         call observe_work(res, -ein, (w%a0*sum(model%mass*w%du**2) + w%a1*dot_product(w%du, w%kx))/h)
          do e = 1, w%ne
             w%w_fric = w%w_fric + w%p%lam(e)*edge_relative(w%p%es, e, w%du)/h
          end do
@@ -234,7 +233,7 @@ contains
          call count_transitions(w, res, .false.)
          w%phase0 = w%phase1
          call observe_peaks(res, t1, size(w%u), size(w%s), w%u, w%v, w%acc, ag1, w%s, w%force)
-         res%steps_dt1 = res%steps_dt1 + 1
+         res%moreau_jean%steps = res%moreau_jean%steps + 1
          if (sample_due(w%obs, k)) then
             if (.not. all(ieee_is_finite(w%u)) .or. .not. all(ieee_is_finite(w%acc))) then
                call fatal_error(error, "moreau_jean: the solution is not finite at t = "//trim(fmt_real(t1))//" s")
@@ -251,9 +250,9 @@ contains
       call count_transitions(w, res, .true.)
       call energies(w, e_kin, e_str)
       call observe_end_energies(w%obs, res, e_kin, e_str, 0.0_dp, w%w_fric)
-      res%factorizations = w%p%gs%factorizations
-      res%patterns = w%p%patterns
-      res%lcp_fallbacks = w%p%fallbacks
+      res%moreau_jean%factorizations = w%p%gs%factorizations
+      res%moreau_jean%patterns = w%p%patterns
+      res%moreau_jean%lcp_fallbacks = w%p%fallbacks
       call system_clock(c1)
       res%run_time = real(c1 - c0, dp)/real(max(crate, 1), dp)
    end subroutine run_moreau_jean
