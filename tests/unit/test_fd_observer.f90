@@ -404,6 +404,7 @@ contains
       model%mass = [2.0_dp, 1.0_dp]
       model%n_devices = 1
       model%dev = [device_type(node_i=1, node_j=2, law=law_velocity, p=10.0_dp, mu=0.2_dp)]
+      call pairs_of(model)
       exc%kind = excitation_none
       exc%dt_record = 0.01_dp
       exc%duration = 0.0123_dp
