@@ -37,6 +37,7 @@ program tester
    use test_fd_record_resolution, only: collect_record_resolution
    use test_fd_warnings, only: collect_warnings
    use test_fd_undefined, only: collect_undefined
+   use test_fd_event_driven, only: collect_event_driven
    implicit none
    integer :: stat, is
    character(len=:), allocatable :: suite_name, test_name
@@ -79,6 +80,7 @@ program tester
    testsuites = [testsuites, new_testsuite("record_resolution", collect_record_resolution)]
    testsuites = [testsuites, new_testsuite("warnings", collect_warnings)]
    testsuites = [testsuites, new_testsuite("undefined", collect_undefined)]
+   testsuites = [testsuites, new_testsuite("event_driven", collect_event_driven)]
 
    call get_argument(1, suite_name)
    call get_argument(2, test_name)
