@@ -3,18 +3,19 @@
 !> its closed form; the work integrated over a sub-interval of a damped oscillator on a
 !> moving table against the change of its mechanical energy; the row times; the routing of
 !> each output quantity to its summary peak; the stationary points taken into the maxima up
-!> to a given point only; the error context and the sub-interval budget.
+!> to a given point only; the error context and the sub-interval budget; and, through the
+!> whole loop, the event of a sliding block that stops, at its closed-form instant.
 module test_fd_event_driven
    use testdrive, only: new_unittest, unittest_type, error_type, check, test_failed
    use fd_kinds, only: dp
    use fd_error, only: fd_error_type => error_type, fmt_real, fatal_error
-   use fd_model, only: model_type
+   use fd_model, only: model_type, device_type, integration_type, law_coulomb
    use fd_excitation, only: excitation_type, excitation_harmonic
    use fd_result, only: result_type
    use fd_run_control, only: stat_cancelled
    use fd_ed_state, only: ed_setup, ed_polynomials, iq_u, iq_v, iq_a
    use fd_phase_decision, only: decide_phases
-   use fd_event_driven, only: ed_work, next_row_time, with_context, check_subintervals, move_to, values_at, &
+   use fd_event_driven, only: run_event_driven, ed_work, next_row_time, with_context, check_subintervals, move_to, values_at, &
                               update_global, absorb_until, peak_one, energy
    use test_fd_helpers, only: check_close
    implicit none
@@ -41,7 +42,8 @@ contains
                   new_unittest("summary peaks from values at a point", test_update_global), &
                   new_unittest("stationary points are taken up to s only", test_absorb_until), &
                   new_unittest("an error says the technique and t once", test_with_context), &
-                  new_unittest("more than 1e9 sub-intervals left is an error", test_subinterval_budget) &
+                  new_unittest("more than 1e9 sub-intervals left is an error", test_subinterval_budget), &
+                  new_unittest("a sliding block stops at m v0 / (P mu)", test_event_location) &
                   ]
    end subroutine collect_event_driven
 
@@ -298,6 +300,47 @@ contains
       call check(error, index(err%message, "needs sub-intervals of "//trim(fmt_real(delta))//" s") > 0, &
                  err%message)
    end subroutine test_subinterval_budget
+
+   !> A block of mass 2 kg on a table at rest, sliding at v0 = 0.3 m/s against a Coulomb
+   !> device of P mu = 2 N (no spring): it decelerates at 1 m/s2 and stops at t* = m v0 /
+   !> (P mu) = 0.3 s, after u = v0 t* / 2 = 0.045 m, then sticks: one event, at t*, located
+   !> by the loop (advance_run, event_at) where the velocity falls below minus its rounding
+   !> level (a few 1e-14 s after t*).
+   subroutine test_event_location(error)
+      type(error_type), allocatable, intent(out) :: error
+      type(model_type) :: model
+      type(excitation_type) :: exc
+      type(integration_type) :: opts
+      type(result_type) :: res
+      type(fd_error_type), allocatable :: err
+
+      model%n_dof = 1
+      model%mass = [2.0_dp]
+      model%u0 = [0.0_dp]
+      model%v0 = [0.3_dp]
+      model%n_springs = 0
+      allocate (model%spring_i(0), model%spring_j(0), model%spring_k(0))
+      model%n_devices = 1
+      model%dev = [device_type(node_i=1, node_j=0, law=law_coulomb, p=10.0_dp, mu=0.2_dp)]
+      exc%kind = excitation_harmonic
+      exc%amplitude = 0.0_dp
+      exc%frequency = 2.0_dp
+      exc%dt_record = 0.007_dp
+      exc%duration = 0.5_dp
+      opts%n1 = 3
+      call run_event_driven(model, exc, opts, res, err)
+      if (allocated(err)) then
+         call test_failed(error, err%message)
+         return
+      end if
+      call check(error, res%events, 1, "one event")
+      if (allocated(error)) return
+      call check_close(error, res%event_time(1), 0.3_dp, 2e-13_dp, "at m v0 / (P mu)")   ! measured 5.3e-14
+      if (allocated(error)) return
+      call check_close(error, res%peak_u(1), 0.045_dp, 4.0_dp*epsilon(1.0_dp), "u = v0 t* / 2")
+      if (allocated(error)) return
+      call check_close(error, res%peak_u_time(1), 0.3_dp, 2e-13_dp, "reached when it stops")
+   end subroutine test_event_location
 
    !> The work of two DOFs and one device (8 quantities, no storeys) and its summary peaks.
    subroutine two_dofs(w, res)
