@@ -638,32 +638,18 @@ contains
          character(len=*), intent(in) :: d
          integer, intent(out) :: lo, hi, st
          logical, intent(out) :: ok
-         integer :: c1, c2, f, l
+         integer :: f
+         logical :: lo_given, hi_given
          lo = -big; hi = big; st = 1
-         c1 = index(d, ':')
-         if (c1 == 0) then
+         if (index(d, ':') == 0) then
             call int_of(d, lo, ok)
             hi = lo
             return
          end if
-         c2 = index(d(c1 + 1:), ':')
-         if (c2 > 0) c2 = c1 + c2
-         ok = .true.
-         if (c1 > 1) call int_of(d(1:c1 - 1), lo, ok)
+         call triplet_parts(d, lo, hi, st, lo_given, hi_given, ok)
          if (.not. ok) return
-         l = len(d)
-         if (c2 > 0) l = c2 - 1
-         if (l > c1) call int_of(d(c1 + 1:l), hi, ok)
-         if (.not. ok) return
-         if (c2 > 0) then
-            call int_of(d(c2 + 1:), st, ok)
-            if (.not. ok .or. st == 0) then
-               ok = .false.
-               return
-            end if
-         end if
          if (st < 0) then   ! l:u:-s runs down from l to u: the same set as last..l, ascending
-            if (c1 == 1 .or. l == c1) then
+            if (.not. (lo_given .and. hi_given)) then
                ok = .false.   ! an omitted bound with a negative stride: compared as text
                return
             end if
@@ -810,31 +796,43 @@ contains
       integer, intent(in) :: ext
       integer, intent(out) :: l, u, s
       logical, intent(out) :: ok
-      integer :: c1, c2
+      logical :: l_given, u_given
       l = 1; u = ext; s = 1
-      c1 = index(t, ':')
-      if (c1 == 0) then
+      if (index(t, ':') == 0) then
          call int_of(t, l, ok)
          return
       end if
-      c2 = index(t(c1 + 1:), ':')
-      if (c2 > 0) c2 = c1 + c2
-      ok = .true.
-      if (c1 > 1) call int_of(t(1:c1 - 1), l, ok)
-      if (.not. ok) return
-      if (c2 == 0) then
-         if (c1 < len(t)) call int_of(t(c1 + 1:), u, ok)
-         return
-      end if
-      if (c2 > c1 + 1) call int_of(t(c1 + 1:c2 - 1), u, ok)
-      if (.not. ok) return
-      call int_of(t(c2 + 1:), s, ok)
-      if (ok) ok = s /= 0
+      call triplet_parts(t, l, u, s, l_given, u_given, ok)
       if (ok .and. s < 0) then   ! omitted bounds run the other way
-         if (c1 == 1) l = ext
-         if (c2 == c1 + 1) u = 1
+         if (.not. l_given) l = ext
+         if (.not. u_given) u = 1
       end if
    end subroutine subscript_section
+
+   !> The parts of a subscript triplet 'l:u:s' (t holds a ':'): l, u and s where given, each
+   !> left as it is where omitted, and whether l and u are given; ok false when a part
+   !> given is not a whole number (int_of) or s is 0.
+   pure subroutine triplet_parts(t, l, u, s, l_given, u_given, ok)
+      character(len=*), intent(in) :: t         !! the subscript
+      integer, intent(inout) :: l, u, s         !! its bounds and stride; the defaults on entry
+      logical, intent(out) :: l_given, u_given  !! l and u are given
+      logical, intent(out) :: ok                !! every part given is a whole number, s /= 0
+      integer :: c1, c2, last
+      c1 = index(t, ':')
+      c2 = index(t(c1 + 1:), ':')
+      if (c2 > 0) c2 = c1 + c2
+      last = len(t)
+      if (c2 > 0) last = c2 - 1
+      l_given = c1 > 1
+      u_given = last > c1
+      ok = .true.
+      if (l_given) call int_of(t(1:c1 - 1), l, ok)
+      if (ok .and. u_given) call int_of(t(c1 + 1:last), u, ok)
+      if (ok .and. c2 > 0) then
+         call int_of(t(c2 + 1:), s, ok)
+         if (ok) ok = s /= 0
+      end if
+   end subroutine triplet_parts
 
    !> Mark given the elements an assignment's values take, from lo on through the section
    !> (first subscript fastest): the values one at a time (next_value), each taking the next

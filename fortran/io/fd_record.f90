@@ -883,16 +883,8 @@ contains
       k = 0
       i = 1
       do
-         do while (i <= len(s))
-            if (s(i:i) /= ' ' .and. s(i:i) /= achar(13)) exit
-            i = i + 1
-         end do
+         call next_field(s, i, j)
          if (i > len(s)) exit
-         j = i
-         do while (j < len(s))
-            if (s(j + 1:j + 1) == ' ' .or. s(j + 1:j + 1) == achar(13)) exit
-            j = j + 1
-         end do
          k = k + 1
          if (k == 1) then
             w = j
@@ -919,16 +911,8 @@ contains
       hi = 0
       i = 1
       do
-         do while (i <= len(s))
-            if (s(i:i) /= ' ' .and. s(i:i) /= achar(13)) exit
-            i = i + 1
-         end do
+         call next_field(s, i, j)
          if (i > len(s)) return
-         j = i
-         do while (j < len(s))
-            if (s(j + 1:j + 1) == ' ' .or. s(j + 1:j + 1) == achar(13)) exit
-            j = j + 1
-         end do
          if (mod(j, width) /= 0 .or. i <= j - width) then
             lo = i
             hi = j
@@ -937,6 +921,23 @@ contains
          i = j + 1
       end do
    end subroutine misplaced_field
+
+   !> The next value of a line from column i on: its columns i:j (blanks and carriage
+   !> returns skipped); i > len(s) when there is none.
+   pure subroutine next_field(s, i, j)
+      character(len=*), intent(in) :: s     !! the line
+      integer, intent(inout) :: i           !! where to look from; the value's first column
+      integer, intent(out) :: j             !! its last column
+      do while (i <= len(s))
+         if (s(i:i) /= ' ' .and. s(i:i) /= achar(13)) exit
+         i = i + 1
+      end do
+      j = i
+      do while (j < len(s))
+         if (s(j + 1:j + 1) == ' ' .or. s(j + 1:j + 1) == achar(13)) exit
+         j = j + 1
+      end do
+   end subroutine next_field
 
    ! ------------------------------------------------------------------ text helpers
    !> The line starting at next: text(lo:hi), without its newline or carriage return;
