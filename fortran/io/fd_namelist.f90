@@ -638,32 +638,18 @@ contains
          character(len=*), intent(in) :: d
          integer, intent(out) :: lo, hi, st
          logical, intent(out) :: ok
-         integer :: c1, c2, f, l
+         integer :: f
+         logical :: lo_given, hi_given
          lo = -big; hi = big; st = 1
-         c1 = index(d, ':')
-         if (c1 == 0) then
+         if (index(d, ':') == 0) then
             call int_of(d, lo, ok)
             hi = lo
             return
          end if
-         c2 = index(d(c1 + 1:), ':')
-         if (c2 > 0) c2 = c1 + c2
-         ok = .true.
-         if (c1 > 1) call int_of(d(1:c1 - 1), lo, ok)
+         call triplet_parts(d, lo, hi, st, lo_given, hi_given, ok)
          if (.not. ok) return
-         l = len(d)
-         if (c2 > 0) l = c2 - 1
-         if (l > c1) call int_of(d(c1 + 1:l), hi, ok)
-         if (.not. ok) return
-         if (c2 > 0) then
-            call int_of(d(c2 + 1:), st, ok)
-            if (.not. ok .or. st == 0) then
-               ok = .false.
-               return
-            end if
-         end if
          if (st < 0) then   ! l:u:-s runs down from l to u: the same set as last..l, ascending
-            if (c1 == 1 .or. l == c1) then
+            if (.not. (lo_given .and. hi_given)) then
                ok = .false.   ! an omitted bound with a negative stride: compared as text
                return
             end if
@@ -745,168 +731,161 @@ contains
       character(len=*), intent(in) :: var       !! variable name, lower case
       integer, intent(in) :: extents(:)         !! its extents (lower bounds 1); [1] for a scalar
       logical, intent(out) :: given(:)          !! size product(extents), array element order
-      character(len=:), allocatable :: name, sub
-      integer :: i, k, d, rank, paren, eq, t0, st, r, ios, c0, nsub
-      integer :: lo(size(extents)), hi(size(extents)), step(size(extents)), at(size(extents))
-      logical :: scalar(size(extents))
-      character(len=1) :: quote
-      logical :: in_value, after_comma, more, ok, null
+      character(len=:), allocatable :: name
+      integer :: i
+      integer :: lo(size(extents)), hi(size(extents)), step(size(extents))
+      logical :: ok
 
       given = .false.
       if (.not. allocated(grp%items)) return
-      rank = size(extents)
       do i = 1, size(grp%items)
          call item_variable(grp%items(i)%s, name)
-         paren = index(name, '(')
-         if (paren == 0) then
-            if (name /= var) cycle
-            lo = 1; hi = extents; step = 1
-         else
-            if (name(1:paren - 1) /= var) cycle
-            k = index(name(paren:), ')')
-            if (k == 0) cycle
-            sub = name(paren + 1:paren + k - 2)
-            if (count_char(sub, ',') + 1 /= rank) cycle
-            ok = .true.
-            c0 = 1
-            do d = 1, rank
-               nsub = index(sub(c0:), ',')
-               if (nsub == 0) then
-                  nsub = len(sub) + 1
-               else
-                  nsub = c0 + nsub - 1
-               end if
-               call section(sub(c0:nsub - 1), extents(d), lo(d), hi(d), step(d), ok)
-               if (.not. ok) exit
-               scalar(d) = index(sub(c0:nsub - 1), ':') == 0
-               c0 = nsub + 1
-            end do
-            if (.not. ok) cycle
-            ! in a section a subscript without ':' stays fixed; an element alone is continued
-            if (.not. all(scalar)) where (scalar) hi = lo
-         end if
-         if (any(lo < 1 .or. lo > extents)) cycle
-         at = lo
-         more = all((hi - lo)*step >= 0)
-         ! the values, one at a time (as value_count reads them), each taking the next element
-         associate (item => grp%items(i)%s)
-            eq = index(item, '=')
-            quote = ' '
-            in_value = .false.
-            after_comma = .true.
-            t0 = 0
-            do k = eq + 1, len(item) + 1
-               if (.not. more) exit
-               if (k <= len(item)) then
-                  if (quote /= ' ') then
-                     if (item(k:k) == quote) quote = ' '
-                     cycle
-                  end if
-                  if (item(k:k) == '"' .or. item(k:k) == "'") then
-                     quote = item(k:k)
-                     if (.not. in_value) then
-                        in_value = .true.; t0 = k
-                     end if
-                     cycle
-                  end if
-                  if (item(k:k) /= ',' .and. item(k:k) /= ' ' .and. item(k:k) /= achar(9)) then
-                     if (.not. in_value) then
-                        in_value = .true.; t0 = k
-                     end if
-                     cycle
-                  end if
-               end if
-               if (in_value) then   ! a value ends: 'r*c' gives r, 'r*' is r null values
-                  r = 1
-                  null = .false.
-                  st = index(item(t0:k - 1), '*')
-                  if (st > 1 .and. item(t0:t0) /= '"' .and. item(t0:t0) /= "'") then
-                     if (verify(item(t0:t0 + st - 2), '0123456789') == 0 .and. st <= 10) then
-                        read (item(t0:t0 + st - 2), *, iostat=ios) r
-                        if (ios /= 0) r = 1
-                        null = t0 + st - 1 == k - 1
-                     end if
-                  end if
-                  call take(r, null, lo, hi, step, extents, at, more, given)
-                  in_value = .false.
-                  after_comma = .false.
-               end if
-               if (k <= len(item)) then
-                  if (item(k:k) == ',') then
-                     ! an empty place: a null value
-                     if (after_comma .and. k < len(item)) call take(1, .true., lo, hi, step, extents, at, more, given)
-                     after_comma = .true.
-                  end if
-               end if
-            end do
-         end associate
+         call assigned_section(name, var, extents, lo, hi, step, ok)
+         if (ok) call take_values(grp%items(i)%s, lo, hi, step, extents, given)
       end do
-   contains
-      !> The next r elements: given, unless the values are null.
-      pure subroutine take(r, null, lo, hi, step, extents, at, more, given)
-         integer, intent(in) :: r
-         logical, intent(in) :: null
-         integer, intent(in) :: lo(:), hi(:), step(:), extents(:)
-         integer, intent(inout) :: at(:)      !! the element the next value takes
-         logical, intent(inout) :: more       !! elements are left
-         logical, intent(inout) :: given(:)
-         integer :: m, e, dd, rank
-         rank = size(extents)
-         do m = 1, r
-            if (.not. more) return
-            if (.not. null .and. all(at >= 1 .and. at <= extents)) then
-               e = 0
-               do dd = rank, 1, -1
-                  e = e*extents(dd) + (at(dd) - 1)
-               end do
-               given(e + 1) = .true.
-            end if
-            ! the next element: the first subscript fastest
-            more = .false.
-            do dd = 1, rank
-               if ((hi(dd) - (at(dd) + step(dd)))*step(dd) >= 0) then
-                  at(dd) = at(dd) + step(dd)
-                  more = .true.
-                  exit
-               end if
-               at(dd) = lo(dd)
-            end do
-         end do
-      end subroutine take
+   end subroutine given_elements
 
-      !> One subscript: 'i' (from i to the upper bound) or a triplet 'l:u:s'.
-      pure subroutine section(t, ext, l, u, s, ok)
-         character(len=*), intent(in) :: t
-         integer, intent(in) :: ext
-         integer, intent(out) :: l, u, s
-         logical, intent(out) :: ok
-         integer :: c1, c2
-         l = 1; u = ext; s = 1
-         c1 = index(t, ':')
-         if (c1 == 0) then
-            call int_of(t, l, ok)
-            return
-         end if
-         c2 = index(t(c1 + 1:), ':')
-         if (c2 > 0) c2 = c1 + c2
-         ok = .true.
-         if (c1 > 1) call int_of(t(1:c1 - 1), l, ok)
-         if (.not. ok) return
-         if (c2 == 0) then
-            if (c1 < len(t)) call int_of(t(c1 + 1:), u, ok)
-            return
-         end if
-         if (c2 > c1 + 1) call int_of(t(c1 + 1:c2 - 1), u, ok)
-         if (.not. ok) return
+   !> The elements an assignment to `name` ('x', 'x(i, j)', 'x(l:u:s, j)') starts from and
+   !> runs over, for variable `var` of these extents: each subscript from lo to hi by step
+   !> (an element alone continues to the upper bounds; in a section a subscript without ':'
+   !> stays fixed). ok false when the name is another variable's, or its subscripts are not
+   !> whole numbers, of another rank, or start out of the bounds.
+   pure subroutine assigned_section(name, var, extents, lo, hi, step, ok)
+      character(len=*), intent(in) :: name      !! the assignment's variable, lower case, no blanks
+      character(len=*), intent(in) :: var       !! variable name, lower case
+      integer, intent(in) :: extents(:)         !! its extents (lower bounds 1); [1] for a scalar
+      integer, intent(out) :: lo(:), hi(:), step(:)
+      logical, intent(out) :: ok
+      character(len=:), allocatable :: sub
+      integer :: d, k, paren, c0, nsub
+      logical :: scalar(size(extents))
+
+      ok = .false.
+      paren = index(name, '(')
+      if (paren == 0) then
+         if (name /= var) return
+         lo = 1; hi = extents; step = 1
+      else
+         if (name(1:paren - 1) /= var) return
+         k = index(name(paren:), ')')
+         if (k == 0) return
+         sub = name(paren + 1:paren + k - 2)
+         if (count_char(sub, ',') + 1 /= size(extents)) return
+         c0 = 1
+         do d = 1, size(extents)
+            nsub = index(sub(c0:), ',')
+            if (nsub == 0) then
+               nsub = len(sub) + 1
+            else
+               nsub = c0 + nsub - 1
+            end if
+            call subscript_section(sub(c0:nsub - 1), extents(d), lo(d), hi(d), step(d), ok)
+            if (.not. ok) return
+            scalar(d) = index(sub(c0:nsub - 1), ':') == 0
+            c0 = nsub + 1
+         end do
+         ! in a section a subscript without ':' stays fixed; an element alone is continued
+         if (.not. all(scalar)) where (scalar) hi = lo
+      end if
+      ok = .not. any(lo < 1 .or. lo > extents)
+   end subroutine assigned_section
+
+   !> One subscript: 'i' (from i to the upper bound ext) or a triplet 'l:u:s'.
+   pure subroutine subscript_section(t, ext, l, u, s, ok)
+      character(len=*), intent(in) :: t
+      integer, intent(in) :: ext
+      integer, intent(out) :: l, u, s
+      logical, intent(out) :: ok
+      logical :: l_given, u_given
+      l = 1; u = ext; s = 1
+      if (index(t, ':') == 0) then
+         call int_of(t, l, ok)
+         return
+      end if
+      call triplet_parts(t, l, u, s, l_given, u_given, ok)
+      if (ok .and. s < 0) then   ! omitted bounds run the other way
+         if (.not. l_given) l = ext
+         if (.not. u_given) u = 1
+      end if
+   end subroutine subscript_section
+
+   !> The parts of a subscript triplet 'l:u:s' (t holds a ':'): l, u and s where given, each
+   !> left as it is where omitted, and whether l and u are given; ok false when a part
+   !> given is not a whole number (int_of) or s is 0.
+   pure subroutine triplet_parts(t, l, u, s, l_given, u_given, ok)
+      character(len=*), intent(in) :: t         !! the subscript
+      integer, intent(inout) :: l, u, s         !! its bounds and stride; the defaults on entry
+      logical, intent(out) :: l_given, u_given  !! l and u are given
+      logical, intent(out) :: ok                !! every part given is a whole number, s /= 0
+      integer :: c1, c2, last
+      c1 = index(t, ':')
+      c2 = index(t(c1 + 1:), ':')
+      if (c2 > 0) c2 = c1 + c2
+      last = len(t)
+      if (c2 > 0) last = c2 - 1
+      l_given = c1 > 1
+      u_given = last > c1
+      ok = .true.
+      if (l_given) call int_of(t(1:c1 - 1), l, ok)
+      if (ok .and. u_given) call int_of(t(c1 + 1:last), u, ok)
+      if (ok .and. c2 > 0) then
          call int_of(t(c2 + 1:), s, ok)
          if (ok) ok = s /= 0
-         if (ok .and. s < 0) then   ! omitted bounds run the other way
-            if (c1 == 1) l = ext
-            if (c2 == c1 + 1) u = 1
-         end if
-      end subroutine section
+      end if
+   end subroutine triplet_parts
 
-   end subroutine given_elements
+   !> Mark given the elements an assignment's values take, from lo on through the section
+   !> (first subscript fastest): the values one at a time (next_value), each taking the next
+   !> element; a null value takes its element without giving it.
+   pure subroutine take_values(item, lo, hi, step, extents, given)
+      character(len=*), intent(in) :: item      !! the assignment 'x(...) = v1, v2 ...'
+      integer, intent(in) :: lo(:), hi(:), step(:), extents(:)
+      logical, intent(inout) :: given(:)        !! size product(extents), array element order
+      integer :: at(size(extents)), k, r
+      logical :: more, after_comma, null, found
+
+      at = lo
+      more = all((hi - lo)*step >= 0)
+      k = index(item, '=') + 1
+      after_comma = .true.
+      do while (more)
+         call next_value(item, k, after_comma, r, null, found)
+         if (.not. found) exit
+         call take_elements(r, null, lo, hi, step, extents, at, more, given)
+      end do
+   end subroutine take_values
+
+   !> The next r elements of a section: given, unless the values are null.
+   pure subroutine take_elements(r, null, lo, hi, step, extents, at, more, given)
+      integer, intent(in) :: r
+      logical, intent(in) :: null
+      integer, intent(in) :: lo(:), hi(:), step(:), extents(:)
+      integer, intent(inout) :: at(:)      !! the element the next value takes
+      logical, intent(inout) :: more       !! elements are left
+      logical, intent(inout) :: given(:)
+      integer :: m, e, dd, rank
+      rank = size(extents)
+      do m = 1, r
+         if (.not. more) return
+         if (.not. null .and. all(at >= 1 .and. at <= extents)) then
+            e = 0
+            do dd = rank, 1, -1
+               e = e*extents(dd) + (at(dd) - 1)
+            end do
+            given(e + 1) = .true.
+         end if
+         ! the next element: the first subscript fastest
+         more = .false.
+         do dd = 1, rank
+            if ((hi(dd) - (at(dd) + step(dd)))*step(dd) >= 0) then
+               at(dd) = at(dd) + step(dd)
+               more = .true.
+               exit
+            end if
+            at(dd) = lo(dd)
+         end do
+      end do
+   end subroutine take_elements
 
    !> The integer a subscript's text gives (an optional sign and at most 9 digits); ok false
    !> for anything else.
@@ -997,58 +976,84 @@ contains
    !> two commas counts 1 (texts in quotes are one value).
    pure integer function value_count(item) result(nv)
       character(len=*), intent(in) :: item
-      integer :: i, eq, t0, st, r, ios
-      character(len=1) :: quote
-      logical :: in_value, after_comma
+      integer :: k, r
+      logical :: after_comma, null, found
 
       nv = 0
-      eq = index(item, '=')
-      if (eq == 0) return
+      if (index(item, '=') == 0) return
+      k = index(item, '=') + 1
+      after_comma = .true.
+      do
+         call next_value(item, k, after_comma, r, null, found)
+         if (.not. found) exit
+         nv = nv + r
+      end do
+   end function value_count
+
+   !> The next value of an assignment's list 'var = v1, v2 ...', as a namelist reader reads
+   !> them (separated by commas or blanks, a text in quotes one value), scanning on from
+   !> column k: r values ('r*c' is r values, 'r*' r null values, an empty place between two
+   !> commas one null value, anything else one value). found false when the list is done.
+   pure subroutine next_value(item, k, after_comma, r, null, found)
+      character(len=*), intent(in) :: item      !! the assignment
+      integer, intent(inout) :: k               !! where to scan on; the column after '=' at first
+      logical, intent(inout) :: after_comma     !! the last separator was a comma; true at first
+      integer, intent(out) :: r                 !! how many values
+      logical, intent(out) :: null              !! they are null values
+      logical, intent(out) :: found             !! a value was found
+      integer :: t0, st, ios
+      character(len=1) :: quote
+      logical :: in_value
+
+      r = 1
+      null = .false.
+      found = .false.
       quote = ' '
       in_value = .false.
-      after_comma = .true.
       t0 = 0
-      do i = eq + 1, len(item) + 1
-         if (i <= len(item)) then
+      do while (k <= len(item) + 1)
+         if (k <= len(item)) then
             if (quote /= ' ') then
-               if (item(i:i) == quote) quote = ' '
+               if (item(k:k) == quote) quote = ' '
+               k = k + 1
                cycle
             end if
-            if (item(i:i) == '"' .or. item(i:i) == "'") then
-               quote = item(i:i)
+            if (item(k:k) /= ',' .and. item(k:k) /= ' ' .and. item(k:k) /= achar(9)) then
+               if (item(k:k) == '"' .or. item(k:k) == "'") quote = item(k:k)
                if (.not. in_value) then
-                  in_value = .true.; t0 = i
+                  in_value = .true.; t0 = k
                end if
-               cycle
-            end if
-            if (item(i:i) /= ',' .and. item(i:i) /= ' ' .and. item(i:i) /= achar(9)) then
-               if (.not. in_value) then
-                  in_value = .true.; t0 = i
-               end if
+               k = k + 1
                cycle
             end if
          end if
-         if (in_value) then   ! a value ends: 'r*...' counts r
-            r = 1
-            st = index(item(t0:i - 1), '*')
-            if (st > 1) then
-               if (verify(item(t0:t0 + st - 2), '0123456789') == 0 .and. st <= 10) then
+         if (in_value) then   ! a value ends before column k: 'r*c' gives r, 'r*' is r null values
+            st = index(item(t0:k - 1), '*')
+            if (st > 1 .and. st <= 10) then
+               if (verify(item(t0:t0 + st - 2), '0123456789') == 0) then
                   read (item(t0:t0 + st - 2), *, iostat=ios) r
                   if (ios /= 0) r = 1
+                  null = t0 + st - 1 == k - 1
                end if
             end if
-            nv = nv + r
-            in_value = .false.
             after_comma = .false.
+            found = .true.
+            return   ! k stays on the separator
          end if
-         if (i <= len(item)) then
-            if (item(i:i) == ',') then
-               if (after_comma) nv = nv + 1   ! an empty place: a null value
+         if (k <= len(item)) then
+            if (item(k:k) == ',') then
+               if (after_comma) then   ! an empty place: a null value
+                  null = .true.
+                  found = .true.
+                  k = k + 1
+                  return
+               end if
                after_comma = .true.
             end if
          end if
+         k = k + 1
       end do
-   end function value_count
+   end subroutine next_value
 
    !> Split a group body at the start of each 'name =' or 'name(index) ='.
    pure subroutine split_items(body, line_of, items, item_line, stat)

@@ -433,9 +433,8 @@ contains
       real(dp), intent(out) :: dt
       type(error_type), allocatable, intent(out) :: error
       character(len=:), allocatable :: up, where, expect, tok(:)
-      character(len=64) :: num(2), unit
-      integer :: k, nnum, stat, ios
-      logical :: keyed, used(2)
+      character(len=64) :: num(2)
+      integer :: k
 
       npts = 0; dt = 0.0_dp
       up = upper(line)
@@ -444,6 +443,25 @@ contains
       end do
       where = "record file '"//path//"', line 4"
       expect = "expected NPTS and DT, e.g. 'NPTS=  5590, DT=   .0050 SEC' or '5590   .0050   NPTS, DT'"
+      call words(up, tok)
+      call check_npts_dt_named(where, expect, line, up, tok, error)
+      if (allocated(error)) return
+      if (index(up, '=') > 0) then
+         call keyed_npts_dt(where, line, up, tok, num, error)
+      else
+         call bare_npts_dt(where, line, tok, num, error)
+      end if
+      if (allocated(error)) return
+      call npts_dt_values(where, expect, line, num, npts, dt, error)
+   end subroutine npts_dt
+
+   !> Line 4 (upper case `up`, its words `tok`) names NPTS and DT, each once.
+   subroutine check_npts_dt_named(where, expect, line, up, tok, error)
+      character(len=*), intent(in) :: where, expect   !! the place, the forms expected
+      character(len=*), intent(in) :: line, up        !! line 4, in upper case
+      character(len=*), intent(in) :: tok(:)          !! its words
+      type(error_type), allocatable, intent(out) :: error
+      integer :: k
       if (index(up, 'NPTS') == 0) then
          call fatal_error(error, where//": NPTS is missing; "//expect//", found '"//trim(fmt_text(line))//"'")
          return
@@ -452,7 +470,6 @@ contains
          call fatal_error(error, where//": DT is missing; "//expect//", found '"//trim(fmt_text(line))//"'")
          return
       end if
-      call words(up, tok)
       do k = 1, 2
          if (count(tok == merge('NPTS', 'DT  ', k == 1)) > 1) then
             call fatal_error(error, where//": "//trim(merge('NPTS', 'DT  ', k == 1))//" is given twice ('"// &
@@ -460,54 +477,84 @@ contains
             return
          end if
       end do
-      keyed = index(up, '=') > 0
+   end subroutine check_npts_dt_named
+
+   !> The texts of NPTS's and DT's values in the keyed form ('NPTS= 5590, DT= .0050 SEC'),
+   !> '' for one not found; DT in another unit than seconds, or a word that is neither a key,
+   !> a value nor the unit, is an error.
+   subroutine keyed_npts_dt(where, line, up, tok, num, error)
+      character(len=*), intent(in) :: where, line, up  !! the place, line 4, in upper case
+      character(len=*), intent(in) :: tok(:)           !! its words
+      character(len=*), intent(out) :: num(2)          !! NPTS's and DT's values
+      type(error_type), allocatable, intent(out) :: error
+      character(len=64) :: unit
+      logical :: used(2)
+      integer :: k
       num = ''
-      if (keyed) then
-         call keyed_value(up, 'NPTS', num(1))
-         call keyed_value(up, 'DT', num(2), unit)
-         nnum = count(num /= '')
-         ! DT is read in seconds: another unit after it ('DT= 5 MSEC') is refused
-         select case (trim(unit))
-         case ('', 'SEC', 'SECS', 'S', 'SECOND', 'SECONDS')
-         case default
-            if (unit(1:4) /= 'NPTS') then
-               call fatal_error(error, where//": DT is followed by '"//trim(fmt_text(unit))//"'; DT is read in seconds "// &
-                                "(SEC), give it so ('"//trim(fmt_text(line))//"')")
-               return
-            end if
+      call keyed_value(up, 'NPTS', num(1))
+      call keyed_value(up, 'DT', num(2), unit)
+      ! DT is read in seconds: another unit after it ('DT= 5 MSEC') is refused
+      select case (trim(unit))
+      case ('', 'SEC', 'SECS', 'S', 'SECOND', 'SECONDS')
+      case default
+         if (unit(1:4) /= 'NPTS') then
+            call fatal_error(error, where//": DT is followed by '"//trim(fmt_text(unit))//"'; DT is read in seconds "// &
+                             "(SEC), give it so ('"//trim(fmt_text(line))//"')")
+            return
+         end if
+      end select
+      ! nothing but NPTS, DT, their values and DT's unit (a missing value is told later)
+      used = num == ''
+      do k = 1, merge(size(tok), 0, all(num /= ''))
+         select case (trim(tok(k)))
+         case ('NPTS', 'DT', 'SEC', 'SECS', 'S', 'SECOND', 'SECONDS')
+            cycle
          end select
-         ! nothing but NPTS, DT, their values and DT's unit (a missing value is told below)
-         used = num == ''
-         do k = 1, merge(size(tok), 0, all(num /= ''))
-            select case (trim(tok(k)))
-            case ('NPTS', 'DT', 'SEC', 'SECS', 'S', 'SECOND', 'SECONDS')
-               cycle
-            end select
-            if (.not. used(1) .and. tok(k) == num(1)) then
-               used(1) = .true.
-            else if (.not. used(2) .and. tok(k) == num(2)) then
-               used(2) = .true.
-            else
-               call extra_word(tok(k))
-               return
-            end if
-         end do
-      else
-         nnum = 0
-         do k = 1, size(tok)
-            select case (trim(tok(k)))
-            case ('NPTS', 'DT', 'SEC', 'SECS', 'S')
-               cycle
-            end select
-            nnum = nnum + 1
-            if (nnum <= 2) then
-               num(nnum) = tok(k)
-            else
-               call extra_word(tok(k))
-               return
-            end if
-         end do
-      end if
+         if (.not. used(1) .and. tok(k) == num(1)) then
+            used(1) = .true.
+         else if (.not. used(2) .and. tok(k) == num(2)) then
+            used(2) = .true.
+         else
+            call extra_word_error(where, line, tok(k), error)
+            return
+         end if
+      end do
+   end subroutine keyed_npts_dt
+
+   !> The texts of NPTS's and DT's values in the form without '=' ('5590   .0050   NPTS, DT'):
+   !> the first two words that are not NPTS, DT or SEC, '' for one missing; a third is an error.
+   subroutine bare_npts_dt(where, line, tok, num, error)
+      character(len=*), intent(in) :: where, line      !! the place, line 4
+      character(len=*), intent(in) :: tok(:)           !! its words, in upper case
+      character(len=*), intent(out) :: num(2)          !! NPTS's and DT's values
+      type(error_type), allocatable, intent(out) :: error
+      integer :: k, nnum
+      num = ''
+      nnum = 0
+      do k = 1, size(tok)
+         select case (trim(tok(k)))
+         case ('NPTS', 'DT', 'SEC', 'SECS', 'S')
+            cycle
+         end select
+         nnum = nnum + 1
+         if (nnum <= 2) then
+            num(nnum) = tok(k)
+         else
+            call extra_word_error(where, line, tok(k), error)
+            return
+         end if
+      end do
+   end subroutine bare_npts_dt
+
+   !> NPTS and DT from their values' texts: NPTS a whole number >= 1, DT a finite number > 0.
+   subroutine npts_dt_values(where, expect, line, num, npts, dt, error)
+      character(len=*), intent(in) :: where, expect, line  !! the place, the forms expected, line 4
+      character(len=*), intent(in) :: num(2)               !! NPTS's and DT's values ('' missing)
+      integer, intent(out) :: npts
+      real(dp), intent(out) :: dt
+      type(error_type), allocatable, intent(out) :: error
+      integer :: stat, ios
+      npts = 0; dt = 0.0_dp
       if (num(1) == '') then
          call fatal_error(error, where//": cannot find the value of NPTS; "//expect//", found '"//trim(fmt_text(line))//"'")
          return
@@ -533,53 +580,55 @@ contains
       if (dt <= 0.0_dp) then
          call fatal_error(error, where//": DT = "//trim(num(2))//" s must be > 0")
       end if
-   contains
-      !> The error of a word line 4 does not hold (a value after the header, a stray word).
-      subroutine extra_word(w)
-         character(len=*), intent(in) :: w
-         call fatal_error(error, where//": '"//trim(fmt_text(w))//"' after NPTS and DT ('"//trim(fmt_text(line))// &
-                          "'); line 4 holds NPTS, DT and their values only, the values start on line 5")
-      end subroutine extra_word
-      !> The word after "KEY=" (KEY as a whole word), '' when absent; after: the word that
-      !> follows it.
-      pure subroutine keyed_value(s, key, v, after)
-         character(len=*), intent(in) :: s, key
-         character(len=*), intent(out) :: v
-         character(len=*), intent(out), optional :: after
-         character(len=len(s)) :: rest
-         integer :: p, q, e, e2
-         v = ''
-         if (present(after)) after = ''
-         p = 0
-         do
-            q = index(s(p + 1:), key)
-            if (q == 0) return
-            p = p + q
-            if (p > 1) then
-               if (index('ABCDEFGHIJKLMNOPQRSTUVWXYZ', s(p - 1:p - 1)) > 0) cycle
-            end if
-            e = verify(s(p + len(key):), ' ')
-            if (e == 0) return
-            e = p + len(key) - 1 + e
-            if (s(e:e) /= '=') cycle
-            rest = adjustl(s(e + 1:))
-            e = scan(rest, ' ,;'//achar(9)//achar(13))
-            v = rest
-            if (e > 0) v = rest(1:e - 1)
-            if (v == 'SEC' .or. v == 'NPTS' .or. v == 'DT') then
-               v = ''
-               return
-            end if
-            if (present(after) .and. e > 0) then
-               rest = adjustl(rest(e + 1:))
-               e2 = scan(rest, ' ,;'//achar(9)//achar(13))
-               if (e2 > 0) rest = rest(1:e2 - 1)
-               after = rest
-            end if
+   end subroutine npts_dt_values
+
+   !> The error of a word line 4 does not hold (a value after the header, a stray word).
+   subroutine extra_word_error(where, line, w, error)
+      character(len=*), intent(in) :: where, line, w   !! the place, line 4, the word
+      type(error_type), allocatable, intent(out) :: error
+      call fatal_error(error, where//": '"//trim(fmt_text(w))//"' after NPTS and DT ('"//trim(fmt_text(line))// &
+                       "'); line 4 holds NPTS, DT and their values only, the values start on line 5")
+   end subroutine extra_word_error
+
+   !> The word after "KEY=" (KEY as a whole word) in upper-case text s, '' when absent;
+   !> after: the word that follows it.
+   pure subroutine keyed_value(s, key, v, after)
+      character(len=*), intent(in) :: s, key
+      character(len=*), intent(out) :: v
+      character(len=*), intent(out), optional :: after
+      character(len=len(s)) :: rest
+      integer :: p, q, e, e2
+      v = ''
+      if (present(after)) after = ''
+      p = 0
+      do
+         q = index(s(p + 1:), key)
+         if (q == 0) return
+         p = p + q
+         if (p > 1) then
+            if (index('ABCDEFGHIJKLMNOPQRSTUVWXYZ', s(p - 1:p - 1)) > 0) cycle
+         end if
+         e = verify(s(p + len(key):), ' ')
+         if (e == 0) return
+         e = p + len(key) - 1 + e
+         if (s(e:e) /= '=') cycle
+         rest = adjustl(s(e + 1:))
+         e = scan(rest, ' ,;'//achar(9)//achar(13))
+         v = rest
+         if (e > 0) v = rest(1:e - 1)
+         if (v == 'SEC' .or. v == 'NPTS' .or. v == 'DT') then
+            v = ''
             return
-         end do
-      end subroutine keyed_value
-   end subroutine npts_dt
+         end if
+         if (present(after) .and. e > 0) then
+            rest = adjustl(rest(e + 1:))
+            e2 = scan(rest, ' ,;'//achar(9)//achar(13))
+            if (e2 > 0) rest = rest(1:e2 - 1)
+            after = rest
+         end if
+         return
+      end do
+   end subroutine keyed_value
 
    !> One value a line ('values') or time and value ('time_value'); blank lines and lines
    !> starting with '#' or '!' are skipped.
@@ -834,16 +883,8 @@ contains
       k = 0
       i = 1
       do
-         do while (i <= len(s))
-            if (s(i:i) /= ' ' .and. s(i:i) /= achar(13)) exit
-            i = i + 1
-         end do
+         call next_field(s, i, j)
          if (i > len(s)) exit
-         j = i
-         do while (j < len(s))
-            if (s(j + 1:j + 1) == ' ' .or. s(j + 1:j + 1) == achar(13)) exit
-            j = j + 1
-         end do
          k = k + 1
          if (k == 1) then
             w = j
@@ -870,16 +911,8 @@ contains
       hi = 0
       i = 1
       do
-         do while (i <= len(s))
-            if (s(i:i) /= ' ' .and. s(i:i) /= achar(13)) exit
-            i = i + 1
-         end do
+         call next_field(s, i, j)
          if (i > len(s)) return
-         j = i
-         do while (j < len(s))
-            if (s(j + 1:j + 1) == ' ' .or. s(j + 1:j + 1) == achar(13)) exit
-            j = j + 1
-         end do
          if (mod(j, width) /= 0 .or. i <= j - width) then
             lo = i
             hi = j
@@ -888,6 +921,23 @@ contains
          i = j + 1
       end do
    end subroutine misplaced_field
+
+   !> The next value of a line from column i on: its columns i:j (blanks and carriage
+   !> returns skipped); i > len(s) when there is none.
+   pure subroutine next_field(s, i, j)
+      character(len=*), intent(in) :: s     !! the line
+      integer, intent(inout) :: i           !! where to look from; the value's first column
+      integer, intent(out) :: j             !! its last column
+      do while (i <= len(s))
+         if (s(i:i) /= ' ' .and. s(i:i) /= achar(13)) exit
+         i = i + 1
+      end do
+      j = i
+      do while (j < len(s))
+         if (s(j + 1:j + 1) == ' ' .or. s(j + 1:j + 1) == achar(13)) exit
+         j = j + 1
+      end do
+   end subroutine next_field
 
    ! ------------------------------------------------------------------ text helpers
    !> The line starting at next: text(lo:hi), without its newline or carriage return;

@@ -165,14 +165,7 @@ contains
       end do
       ! each list by node number: the graph is symmetric, so listing x in the list of each of
       ! its neighbours, x = 1, 2, ..., gives every list again (repeats included), sorted
-      fill = start(1:n)
-      do x = 1, n
-         do k = start(x), start(x + 1) - 1
-            v = raw(k)
-            sorted(fill(v)) = x
-            fill(v) = fill(v) + 1
-         end do
-      end do
+      call list_in_order(n, start, [(x, x=1, n)], raw, sorted, fill)
       ! drop repeated neighbours (adjacent once sorted)
       cnt = 0
       do v = 1, n
@@ -206,16 +199,30 @@ contains
       ! each list by increasing degree, then node number: x in that order, listed in the
       ! list of each of its neighbours
       allocate (adj(cnt))
+      call list_in_order(n, start, by_degree, sorted, adj, fill)
+   end subroutine adjacency
+
+   !> The adjacency lists `from` listed again into `to` (the same layout, start) with each
+   !> list in the order of the nodes in `order`: every node x, in that order, is appended to
+   !> the list of each of its neighbours (the graph is symmetric).
+   pure subroutine list_in_order(n, start, order, from, to, fill)
+      integer, intent(in) :: n
+      integer, intent(in) :: start(:)            !! list x is from(start(x):start(x + 1) - 1)
+      integer, intent(in) :: order(:)            !! the nodes 1..n in the lists' order
+      integer, intent(in) :: from(:)             !! the lists
+      integer, intent(inout) :: to(:)            !! the lists in that order
+      integer, intent(inout) :: fill(:)          !! work (n)
+      integer :: m, x, k, v
       fill = start(1:n)
       do m = 1, n
-         x = by_degree(m)
+         x = order(m)
          do k = start(x), start(x + 1) - 1
-            v = sorted(k)
-            adj(fill(v)) = x
+            v = from(k)
+            to(fill(v)) = x
             fill(v) = fill(v) + 1
          end do
       end do
-   end subroutine adjacency
+   end subroutine list_in_order
 
    !> Half-bandwidth max |inv(a) - inv(b)| over the edges between two nodes (0 without any),
    !> where inv(old) is the new number of a node.
