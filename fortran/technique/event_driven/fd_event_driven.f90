@@ -53,7 +53,7 @@ module fd_event_driven
 
    public :: run_event_driven, event_driven_check
    public :: ed_work, next_row_time, with_context, check_subintervals, move_to, values_at, update_global, &
-             absorb_until, peak_one, energy   ! the loop's steps, for their unit suite
+             absorb_until, energy   ! the loop's steps, for their unit suite
 
    integer, parameter :: ring_size = 64          !! events in the accumulation window
    !> Most sub-intervals a run may need (about an hour of integration): a pattern whose
