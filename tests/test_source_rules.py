@@ -23,10 +23,7 @@ MAX_LINES = 150
 
 # Routines that are being split in another branch: expected over the limit until it is
 # merged. Each entry is "path: routine"; empty this list when the split is in.
-BEING_SPLIT = {
-    "fortran/io/fd_output.f90: summary_json",
-    "fortran/linalg/fd_banded.f90: spd_setup",
-}
+BEING_SPLIT: set[str] = set()
 
 
 @dataclass(frozen=True)
@@ -216,6 +213,8 @@ def test_every_fortran_source_parses_balanced():
     for f in _sources():
         found = _routines_of(f)
         text = f.read_text(errors="replace").lower()
+        # a derived type's own `contains` (its type-bound procedures) holds no routine
+        text = re.sub(r"^\s*type\b(?!\s*\().*?^\s*end\s*type\b", "", text, flags=re.M | re.S)
         if re.search(r"^\s*contains\s*$", text, re.M):
             assert found, f"{f.relative_to(ROOT)}: no routine found after 'contains'"
         total += len(found)

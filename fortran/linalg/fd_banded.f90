@@ -141,13 +141,12 @@ contains
       integer, intent(in), optional :: path      !! spd_auto (default), spd_dense or spd_banded
       real(dp), intent(in), optional :: budget   !! allowed estimated update error, default 1e-12
       integer, intent(in), optional :: method    !! spd_choose (default), spd_rank_one, spd_refactor
-      integer, allocatable :: ei(:), ej(:), di(:), dj(:)
+      integer, allocatable :: di(:), dj(:)
       real(dp), allocatable :: dc(:)
       real(dp) :: ca0, ca1
-      integer :: n, ns, nd, nc, ne, i, d, a, kbw, mode, stat
+      integer :: n, nd, i, kbw, mode, stat
 
       n = size(mass)
-      ns = size(spring_i)
       nd = size(dev_ptr) - 1
       ca0 = 0.0_dp
       ca1 = 0.0_dp
@@ -165,46 +164,9 @@ contains
       else
          allocate (di(0), dj(0), dc(0))
       end if
-      nc = size(di)
-
-      if (n < 1) then
-         call fatal_error(error, "spd_setup: the structure has no DOF (size(mass) = 0)")
-         return
-      end if
-      do i = 1, n
-         if (.not. (mass(i) > 0.0_dp .and. ieee_is_finite(mass(i)))) then
-            call fatal_error(error, "spd_setup: mass("//trim(fmt_int(i))//") = "//trim(fmt_real(mass(i)))// &
-                             " must be finite and > 0")
-            return
-         end if
-      end do
-      if (size(spring_j) /= ns .or. size(spring_k) /= ns) then
-         call fatal_error(error, "spd_setup: spring_i, spring_j and spring_k differ in size")
-         return
-      end if
-      call check_devices(dev_ptr, dev_dof, dev_coef, n, error)
+      call check_setup(mass, spring_i, spring_j, spring_k, dev_ptr, dev_dof, dev_coef, di, dj, dc, ca0, ca1, &
+                       mode, error)
       if (allocated(error)) return
-      if (size(dj) /= nc .or. size(dc) /= nc) then
-         call fatal_error(error, "spd_setup: dashpot_i, dashpot_j and dashpot_c differ in size")
-         return
-      end if
-      call check_links("spring", spring_i, spring_j, spring_k, n, error)
-      if (allocated(error)) return
-      call check_links("dashpot", di, dj, dc, n, error)
-      if (allocated(error)) return
-      if (.not. (ca0 >= 0.0_dp .and. ieee_is_finite(ca0))) then
-         call fatal_error(error, "spd_setup: a0 = "//trim(fmt_real(ca0))//" must be finite and >= 0")
-         return
-      end if
-      if (.not. (ca1 >= 0.0_dp .and. ieee_is_finite(ca1))) then
-         call fatal_error(error, "spd_setup: a1 = "//trim(fmt_real(ca1))//" must be finite and >= 0")
-         return
-      end if
-      if (mode /= spd_auto .and. mode /= spd_dense .and. mode /= spd_banded) then
-         call fatal_error(error, "spd_setup: path = "//trim(fmt_int(mode))//" is not spd_auto, spd_dense &
-                          &or spd_banded")
-         return
-      end if
       if (present(method)) then
          if (method /= spd_choose .and. method /= spd_rank_one .and. method /= spd_refactor) then
             call fatal_error(error, "spd_setup: method = "//trim(fmt_int(method))//" is not spd_choose, &
@@ -221,39 +183,7 @@ contains
          sys%budget = budget
       end if
 
-      ! the graph: springs and dashpots between two DOFs, each device a star from its first
-      ! term (its edge to the table, node 0, when it has one term)
-      ne = ns + (dev_ptr(nd + 1) - 1) + nc
-      allocate (ei(ne), ej(ne))
-      ne = ns
-      ei(1:ns) = spring_i
-      ej(1:ns) = spring_j
-      do d = 1, nd
-         ne = ne + 1
-         ei(ne) = dev_dof(dev_ptr(d))
-         ej(ne) = 0
-         if (dev_ptr(d + 1) - dev_ptr(d) > 1) ej(ne) = dev_dof(dev_ptr(d) + 1)
-         do i = dev_ptr(d) + 2, dev_ptr(d + 1) - 1
-            ne = ne + 1
-            ei(ne) = dev_dof(dev_ptr(d))
-            ej(ne) = dev_dof(i)
-         end do
-      end do
-      ei(ne + 1:ne + nc) = di
-      ej(ne + 1:ne + nc) = dj
-      ne = ne + nc
-      allocate (sys%perm(n), sys%inv(n))
-      call rcm_order(n, ei(1:ne), ej(1:ne), sys%perm)
-      do i = 1, n
-         sys%inv(sys%perm(i)) = i
-      end do
-      kbw = graph_bandwidth(ei(1:ne), ej(1:ne), sys%inv)
-      ! a device of three or more terms spans more than its star's edges
-      do d = 1, nd
-         if (dev_ptr(d + 1) - dev_ptr(d) < 3) cycle
-         kbw = max(kbw, maxval(sys%inv(dev_dof(dev_ptr(d):dev_ptr(d + 1) - 1))) - &
-                   minval(sys%inv(dev_dof(dev_ptr(d):dev_ptr(d + 1) - 1))))
-      end do
+      call order_graph(sys, n, spring_i, spring_j, dev_ptr, dev_dof, di, dj, kbw)
       if (mode == spd_auto) then
          ! dense where it is faster: a few DOFs (a band nearly as wide as the matrix is no
          ! slower than dense storage: bench/banded.sh wide)
@@ -294,6 +224,117 @@ contains
                           trim(fmt_real(8.0_dp*real(sys%ld, dp)*n/2.0_dp**20))//" MiB)", stat_no_memory)
          return
       end if
+      call assemble(sys, mass, spring_i, spring_j, spring_k, di, dj, dc, ca0, ca1)
+      call order_devices(sys, dev_ptr, dev_dof, dev_coef)
+      call sort_devices(sys)
+   end subroutine spd_setup
+
+   !> The input of spd_setup checked: masses, springs, devices, dashpots, C's factors, path.
+   subroutine check_setup(mass, spring_i, spring_j, spring_k, dev_ptr, dev_dof, dev_coef, di, dj, dc, ca0, ca1, &
+                          mode, error)
+      real(dp), intent(in) :: mass(:), spring_k(:), dev_coef(:), dc(:), ca0, ca1
+      integer, intent(in) :: spring_i(:), spring_j(:), dev_ptr(:), dev_dof(:), di(:), dj(:), mode
+      type(error_type), allocatable, intent(out) :: error
+      integer :: n, ns, nc, i
+
+      n = size(mass)
+      ns = size(spring_i)
+      nc = size(di)
+      if (n < 1) then
+         call fatal_error(error, "spd_setup: the structure has no DOF (size(mass) = 0)")
+         return
+      end if
+      do i = 1, n
+         if (.not. (mass(i) > 0.0_dp .and. ieee_is_finite(mass(i)))) then
+            call fatal_error(error, "spd_setup: mass("//trim(fmt_int(i))//") = "//trim(fmt_real(mass(i)))// &
+                             " must be finite and > 0")
+            return
+         end if
+      end do
+      if (size(spring_j) /= ns .or. size(spring_k) /= ns) then
+         call fatal_error(error, "spd_setup: spring_i, spring_j and spring_k differ in size")
+         return
+      end if
+      call check_devices(dev_ptr, dev_dof, dev_coef, n, error)
+      if (allocated(error)) return
+      if (size(dj) /= nc .or. size(dc) /= nc) then
+         call fatal_error(error, "spd_setup: dashpot_i, dashpot_j and dashpot_c differ in size")
+         return
+      end if
+      call check_links("spring", spring_i, spring_j, spring_k, n, error)
+      if (allocated(error)) return
+      call check_links("dashpot", di, dj, dc, n, error)
+      if (allocated(error)) return
+      if (.not. (ca0 >= 0.0_dp .and. ieee_is_finite(ca0))) then
+         call fatal_error(error, "spd_setup: a0 = "//trim(fmt_real(ca0))//" must be finite and >= 0")
+         return
+      end if
+      if (.not. (ca1 >= 0.0_dp .and. ieee_is_finite(ca1))) then
+         call fatal_error(error, "spd_setup: a1 = "//trim(fmt_real(ca1))//" must be finite and >= 0")
+         return
+      end if
+      if (mode /= spd_auto .and. mode /= spd_dense .and. mode /= spd_banded) then
+         call fatal_error(error, "spd_setup: path = "//trim(fmt_int(mode))//" is not spd_auto, spd_dense &
+                          &or spd_banded")
+         return
+      end if
+   end subroutine check_setup
+
+   !> The graph of springs, devices and dashpots, its reverse Cuthill-McKee order (perm,
+   !> inv) and the half-bandwidth kbw in that order.
+   subroutine order_graph(sys, n, spring_i, spring_j, dev_ptr, dev_dof, di, dj, kbw)
+      type(spd_system), intent(inout) :: sys
+      integer, intent(in) :: n, spring_i(:), spring_j(:), dev_ptr(:), dev_dof(:), di(:), dj(:)
+      integer, intent(out) :: kbw
+      integer, allocatable :: ei(:), ej(:)
+      integer :: ns, nd, nc, ne, d, i
+
+      ns = size(spring_i)
+      nd = size(dev_ptr) - 1
+      nc = size(di)
+      ! the graph: springs and dashpots between two DOFs, each device a star from its first
+      ! term (its edge to the table, node 0, when it has one term)
+      ne = ns + (dev_ptr(nd + 1) - 1) + nc
+      allocate (ei(ne), ej(ne))
+      ne = ns
+      ei(1:ns) = spring_i
+      ej(1:ns) = spring_j
+      do d = 1, nd
+         ne = ne + 1
+         ei(ne) = dev_dof(dev_ptr(d))
+         ej(ne) = 0
+         if (dev_ptr(d + 1) - dev_ptr(d) > 1) ej(ne) = dev_dof(dev_ptr(d) + 1)
+         do i = dev_ptr(d) + 2, dev_ptr(d + 1) - 1
+            ne = ne + 1
+            ei(ne) = dev_dof(dev_ptr(d))
+            ej(ne) = dev_dof(i)
+         end do
+      end do
+      ei(ne + 1:ne + nc) = di
+      ej(ne + 1:ne + nc) = dj
+      ne = ne + nc
+      allocate (sys%perm(n), sys%inv(n))
+      call rcm_order(n, ei(1:ne), ej(1:ne), sys%perm)
+      do i = 1, n
+         sys%inv(sys%perm(i)) = i
+      end do
+      kbw = graph_bandwidth(ei(1:ne), ej(1:ne), sys%inv)
+      ! a device of three or more terms spans more than its star's edges
+      do d = 1, nd
+         if (dev_ptr(d + 1) - dev_ptr(d) < 3) cycle
+         kbw = max(kbw, maxval(sys%inv(dev_dof(dev_ptr(d):dev_ptr(d + 1) - 1))) - &
+                   minval(sys%inv(dev_dof(dev_ptr(d):dev_ptr(d + 1) - 1))))
+      end do
+   end subroutine order_graph
+
+   !> K (springs) and C = a0 M + a1 K + dashpots in the storage, the rest zeroed.
+   subroutine assemble(sys, mass, spring_i, spring_j, spring_k, di, dj, dc, ca0, ca1)
+      type(spd_system), intent(inout) :: sys
+      real(dp), intent(in) :: mass(:), spring_k(:), dc(:), ca0, ca1
+      integer, intent(in) :: spring_i(:), spring_j(:), di(:), dj(:)
+      integer :: i, a, n
+
+      n = sys%n
       sys%rdiag = 0.0_dp
       sys%mass = mass(sys%perm)
       sys%kmat = 0.0_dp
@@ -304,24 +345,22 @@ contains
       sys%w1 = 0.0_dp
       sys%w2 = 0.0_dp
       sys%xv = 0.0_dp
-      do i = 1, ns
+      do i = 1, size(spring_i)
          call add_link(sys, sys%kmat, spring_i(i), spring_j(i), spring_k(i))
       end do
       ! C = a0 M + a1 K + dashpots
       sys%a0 = ca0
       sys%a1 = ca1
-      sys%rayleigh_c = nc == 0
+      sys%rayleigh_c = size(di) == 0
       sys%cmat = ca1*sys%kmat
       do i = 1, n
          a = idx(sys, i, i)
          sys%cmat(a) = sys%cmat(a) + ca0*sys%mass(i)
       end do
-      do i = 1, nc
+      do i = 1, size(di)
          call add_link(sys, sys%cmat, di(i), dj(i), dc(i))
       end do
-      call order_devices(sys, dev_ptr, dev_dof, dev_coef)
-      call sort_devices(sys)
-   end subroutine spd_setup
+   end subroutine assemble
 
    !> A copy of a system set up by spd_setup (another step size starts from it): memory that
    !> cannot be had is an error, not a stop of the runtime in an assignment.
