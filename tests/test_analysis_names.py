@@ -62,3 +62,15 @@ def test_record_of_an_at2_file_needs_no_dt(tmp_path):
     # format and units reach the reader: cm/s2 values a hundredth of m/s2
     b = frame(excitation=fd.Record(file=plain, dt_record=0.01, format="values", units="cm/s2"))
     assert b.run().summary["record"]["peak_acc_mps2"] == pytest.approx(0.001, rel=1e-12)
+
+
+def test_warnings_name_the_analysis_at_the_callers_line():
+    """A run's warning names the Analysis, not the deck it generates, and points at the
+    line that called run()."""
+    a = frame(integration=fd.Integration(n1=1, n2=2),
+              excitation=fd.Harmonic(amplitude=0.05, frequency=8.0, dt_record=0.02, duration=1.0))
+    with pytest.warns(fd.FrictiondynWarning) as caught:
+        a.run()
+    assert caught and all(str(w.message).startswith("Analysis: ") for w in caught), \
+        [str(w.message) for w in caught]
+    assert all(w.filename == __file__ for w in caught)

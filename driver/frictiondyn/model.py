@@ -9,11 +9,11 @@ default (docs/namelist.md), and Python restates none of them.
 
 from __future__ import annotations
 
-import contextlib
 import io
 import os
 import re
 import tempfile
+import warnings
 from collections.abc import Callable, Sequence
 from dataclasses import dataclass, field
 from pathlib import Path
@@ -21,7 +21,7 @@ from pathlib import Path
 import f90nml
 import numpy as np
 
-from ._api import DeckError, Result, run_text
+from ._api import DeckError, FrictiondynWarning, Result, _user_stacklevel, run_text
 
 __all__ = [
     "Analysis",
@@ -541,20 +541,29 @@ def python_place(message: str) -> str | None:
     return f"{attr}.{var}"
 
 
-@contextlib.contextmanager
-def _named_errors(name: str, base_dir: str | os.PathLike):
-    """A DeckError of the generated deck says which attribute of the Analysis is wrong,
-    and names the Analysis instead of the deck file the caller never wrote."""
+def _run_named(name: str, base_dir: str | os.PathLike, run: Callable[[], Result]) -> Result:
+    """run() of a generated deck: a DeckError says which attribute of the Analysis is
+    wrong, and errors and warnings name the Analysis instead of the deck file the caller
+    never wrote (warnings re-issued at the caller's line)."""
+    deck = os.path.join(os.fspath(base_dir), name)
     try:
-        yield
+        with warnings.catch_warnings(record=True) as caught:
+            warnings.simplefilter("always", FrictiondynWarning)
+            result = run()
     except DeckError as exc:
-        text = str(exc)
-        deck = os.path.join(os.fspath(base_dir), name)
-        text = text.replace(deck + ", ", "Analysis: ", 1)
+        text = str(exc).replace(deck + ", ", "Analysis: ", 1)
         place = python_place(text)
         if place is not None:
             text = f"Analysis.{place}: " + text.replace("Analysis: ", "", 1)
         raise DeckError(text) from None
+    level = _user_stacklevel()
+    for w in caught:
+        if issubclass(w.category, FrictiondynWarning):
+            text = str(w.message).replace(deck + ": ", "Analysis: ", 1)
+            warnings.warn(text, w.category, stacklevel=level)
+        else:
+            warnings.warn_explicit(w.message, w.category, w.filename, w.lineno)
+    return result
 
 
 @dataclass
@@ -702,8 +711,8 @@ class Analysis:
         kw = {"dofs": dofs, "devices": devices, "progress": progress}
         cwd = Path.cwd()
         if not isinstance(self.excitation, Record) or self.excitation.values is None:
-            with _named_errors(name, "."):
-                return run_text(self.deck_text(None, cwd), name=name, base_dir=".", **kw)
+            text = self.deck_text(None, cwd)
+            return _run_named(name, ".", lambda: run_text(text, name=name, base_dir=".", **kw))
         file = self.excitation.file
         # only inside the temporary directory: a file given with a directory (absolute or
         # not) is never written to
@@ -713,5 +722,5 @@ class Analysis:
         with tempfile.TemporaryDirectory() as tmp:
             directory = Path(tmp)
             text = self.deck_text(directory, cwd, record_name)
-            with _named_errors(name, directory):
-                return run_text(text, name=name, base_dir=directory, **kw)
+            return _run_named(name, directory,
+                              lambda: run_text(text, name=name, base_dir=directory, **kw))
