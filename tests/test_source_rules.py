@@ -323,3 +323,14 @@ def test_the_guard_names_file_routine_and_length(tmp_path):
                    f"subroutine long(x)\n{body}\n\nend subroutine long\nend module\n")
     assert [(r.name, r.length) for r in routines(src.read_text())] == [("ok", 150), ("long", 151)]
     assert over_the_limit(tmp_path) == {"fortran/io/fd_long.f90: long": 151}
+
+
+def test_each_module_is_in_the_file_of_its_name():
+    """`use fd_x` names its file: every module of fortran/ is in fd_x.f90, in the folder of
+    its layer (docs/architecture.md), and no two files share a name."""
+    seen: dict[str, Path] = {}
+    for f in _sources():
+        assert f.name not in seen, (f, seen.get(f.name))
+        seen[f.name] = f
+        for m in re.finditer(r"^\s*module\s+(\w+)\s*$", f.read_text(errors="replace"), re.M | re.I):
+            assert m.group(1).lower() + ".f90" == f.name.lower(), (f, m.group(1))

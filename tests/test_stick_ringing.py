@@ -1,5 +1,5 @@
 """Whether dt1 resolves the ringing of the hysteretic devices' sticking springs
-(fortran/result/fd_stick_ringing.f90): the frequency error it reports against the closed forms
+(fortran/technique/resolution/fd_stick_ringing.f90): the frequency error it reports against the closed forms
 of Newmark's rules, and the warning against what the step really does to the stick-slip
 decisions: a deck whose device slides 81 times at n1 = 24 and never at any n1 >= 48 is
 reported, one at n1 = 96 (the same decisions as n1 = 192) is not, and neither are the
