@@ -13,7 +13,8 @@ module fd_kinematics
    private
 
    public :: set_pair_directions, pair_terms, directions_set
-   public :: device_kinematics, device_relative, device_abs_relative, add_device
+   public :: device_kinematics, device_relative, device_abs_relative, add_device, add_device_forces
+   public :: relative_kernel, force_kernel
    public :: add_device_abs, add_device_outer, pair_nodes, device_nodes, devices_are_pairs, moved_mass
    public :: device_inverse_mass_relative, device_abs_inverse_mass_relative, device_coupling
 
@@ -73,17 +74,63 @@ contains
    !> Relative displacement and velocity of every device, s = b' u and s' = b' v.
    pure subroutine device_kinematics(model, u, v, s, sd)
       type(model_type), intent(in) :: model   !! the model
-      real(dp), intent(in) :: u(:)            !! displacements of the DOFs [m]
-      real(dp), intent(in) :: v(:)            !! velocities of the DOFs [m/s]
-      real(dp), intent(out) :: s(:)           !! relative displacement of each device [m]
-      real(dp), intent(out) :: sd(:)          !! relative velocity of each device [m/s]
-      integer :: d
+      real(dp), intent(in), contiguous :: u(:)   !! displacements of the DOFs [m]
+      real(dp), intent(in), contiguous :: v(:)   !! velocities of the DOFs [m/s]
+      real(dp), intent(out), contiguous :: s(:)  !! relative displacement of each device [m]
+      real(dp), intent(out), contiguous :: sd(:) !! relative velocity of each device [m/s]
 
-      do d = 1, model%n_devices
-         s(d) = device_relative(model, d, u)
-         sd(d) = device_relative(model, d, v)
-      end do
+      call relative_kernel(model%n_devices, model%dev_ptr, model%dev_dof, model%dev_coef, u, v, s, sd)
    end subroutine device_kinematics
+
+   !> y = y + sum_d f_d b_d: the devices' forces f on the DOFs.
+   pure subroutine add_device_forces(model, f, y)
+      type(model_type), intent(in) :: model   !! the model
+      real(dp), intent(in), contiguous :: f(:)   !! force of each device [N]
+      real(dp), intent(inout), contiguous :: y(:) !! vector over the DOFs
+
+      call force_kernel(model%n_devices, model%dev_ptr, model%dev_dof, model%dev_coef, f, y)
+   end subroutine add_device_forces
+
+   !> device_kinematics' loop on plain arrays: a time-step loop's hot path passes the model's
+   !> dev_ptr, dev_dof and dev_coef itself (no array descriptor is made per call, which for a
+   !> model of one device costs as much as the sums); each sum starts from the first term.
+   pure subroutine relative_kernel(nd, ptr, dof, coef, u, v, s, sd)
+      integer, intent(in) :: nd, ptr(nd + 1), dof(*)
+      real(dp), intent(in) :: coef(*), u(*), v(*)
+      real(dp), intent(out) :: s(nd), sd(nd)
+      real(dp) :: a, b
+      integer :: d, k, k0
+
+      do d = 1, nd
+         k0 = ptr(d)
+         a = 0.0_dp
+         b = 0.0_dp
+         if (ptr(d + 1) > k0) then
+            a = coef(k0)*u(dof(k0))
+            b = coef(k0)*v(dof(k0))
+         end if
+         do k = k0 + 1, ptr(d + 1) - 1
+            a = a + coef(k)*u(dof(k))
+            b = b + coef(k)*v(dof(k))
+         end do
+         s(d) = a
+         sd(d) = b
+      end do
+   end subroutine relative_kernel
+
+   !> add_device_forces' loop on plain arrays.
+   pure subroutine force_kernel(nd, ptr, dof, coef, f, y)
+      integer, intent(in) :: nd, ptr(nd + 1), dof(*)
+      real(dp), intent(in) :: coef(*), f(nd)
+      real(dp), intent(inout) :: y(*)
+      integer :: d, k
+
+      do d = 1, nd
+         do k = ptr(d), ptr(d + 1) - 1
+            y(dof(k)) = y(dof(k)) + f(d)*coef(k)
+         end do
+      end do
+   end subroutine force_kernel
 
    !> b_d' y: the relative value across device d of a vector over the DOFs.
    pure real(dp) function device_relative(model, d, y) result(rel)

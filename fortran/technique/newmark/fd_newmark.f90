@@ -35,7 +35,7 @@ module fd_newmark
    use fd_excitation, only: excitation_type, table_motion, table_acceleration, grid_motion, grid_init, &
                             grid_acceleration
    use fd_matrices, only: structure_damping
-   use fd_kinematics, only: device_kinematics, device_relative, add_device
+   use fd_kinematics, only: device_kinematics, add_device, relative_kernel, force_kernel
    use fd_banded, only: spd_system, spd_setup, spd_factor, spd_update_devices, spd_solve, spd_k_matvec, &
                         spd_c_matvec, spd_kc_matvec, spd_auto, spd_dense, spd_banded, spd_is_dense, spd_bandwidth, &
                         spd_copy
@@ -81,6 +81,7 @@ module fd_newmark
       integer :: version = 0                          !! counts the accepted phase changes
       real(dp), allocatable :: u(:), v(:), a(:), u1(:), v1(:), a1(:), rhs(:), tmp(:)
       real(dp), allocatable :: s(:), sd(:), s1(:), sd1(:), f(:), kd(:)
+      real(dp), allocatable :: fw(:)                  !! work: the devices' loads of a trial
       type(device_state), allocatable :: st(:), st1(:)
       type(device_state), allocatable :: st0(:)       !! states at the start ('implicit' refinement)
       integer, allocatable :: phase0(:), phase1(:)    !! phases of st, st1 for the observer
@@ -317,7 +318,7 @@ contains
          if (allocated(error)) return
       end do
       allocate (w%u(n), w%v(n), w%a(n), w%u1(n), w%v1(n), w%a1(n), w%rhs(n), w%tmp(n), &
-                w%s(nd), w%sd(nd), w%s1(nd), w%sd1(nd), w%f(nd), w%kd(nd), w%st(nd), w%st1(nd), w%st0(nd), &
+                w%s(nd), w%sd(nd), w%s1(nd), w%sd1(nd), w%f(nd), w%fw(nd), w%kd(nd), w%st(nd), w%st1(nd), w%st0(nd), &
                 w%phase0(nd), w%phase1(nd), w%phase_end(nd), w%changed(nd), w%ok(nd), stat=stat)
       if (stat /= 0) then
          call fatal_error(error, "not enough memory for the state of n_dof = "//trim(fmt_int(n))//" DOFs", &
@@ -389,11 +390,11 @@ contains
       if (w%nf > 0) call start_forces(model%dev, w)
       call predict(w%n, h, w%lev(lv)%g1h, w%lev(lv)%b2h2, ag1, w%mass, w%u, w%v, w%a, w%tmp, w%u1, w%rhs)
       call spd_kc_matvec(w%lev(lv)%sys, w%u1, w%tmp, w%rhs, -1.0_dp)
-      call device_loads(model, w%st, w%u1, w%tmp, w%lev(lv)%c0, w%rhs)
+      call device_loads(model, w%n, w%nd, w%st, w%u1, w%tmp, w%lev(lv)%c0, w%rhs, w%s1, w%sd1, w%fw)
       call spd_solve(w%lev(lv)%sys, w%rhs, error)
       if (allocated(error)) return
       call correct(w%n, w%lev(lv)%bh2, w%lev(lv)%gh, w%rhs, w%tmp, w%a1, w%u1, w%v1)
-      call device_kinematics(model, w%u1, w%v1, w%s1, w%sd1)
+      call relative_kernel(w%nd, model%dev_ptr, model%dev_dof, model%dev_coef, w%u1, w%v1, w%s1, w%sd1)
       if (w%nf > 0) call follow_forces(model, lv, w, error)
    end subroutine try_step
 
@@ -501,19 +502,21 @@ contains
 
    !> The devices' forces at the predictors, F = ks s~ + cs s'~ + f0, subtracted from rhs
    !> along b_d; then rhs scaled by c0 (K^ = c0 (M + gamma h C_t + beta h^2 K_t)).
-   pure subroutine device_loads(model, st, ut, vt, c0, rhs)
+   pure subroutine device_loads(model, n, nd, st, ut, vt, c0, rhs, s, sd, f)
       type(model_type), intent(in) :: model
-      type(device_state), intent(in) :: st(:)
-      real(dp), intent(in) :: ut(:), vt(:), c0
-      real(dp), intent(inout) :: rhs(:)
-      real(dp) :: f
+      integer, intent(in) :: n, nd
+      type(device_state), intent(in) :: st(nd)
+      real(dp), intent(in) :: ut(n), vt(n), c0
+      real(dp), intent(inout) :: rhs(n)
+      real(dp), intent(out) :: s(nd), sd(nd), f(nd)   !! work: s~, s'~ and -F of each device
       integer :: d, i
 
-      do d = 1, model%n_devices
-         f = st(d)%ks*device_relative(model, d, ut) + st(d)%cs*device_relative(model, d, vt) + st(d)%f0
-         call add_device(model, d, -f, rhs)
+      call relative_kernel(nd, model%dev_ptr, model%dev_dof, model%dev_coef, ut, vt, s, sd)
+      do d = 1, nd
+         f(d) = -(st(d)%ks*s(d) + st(d)%cs*sd(d) + st(d)%f0)
       end do
-      do i = 1, size(rhs)
+      call force_kernel(nd, model%dev_ptr, model%dev_dof, model%dev_coef, f, rhs)
+      do i = 1, n
          rhs(i) = c0*rhs(i)
       end do
    end subroutine device_loads
