@@ -929,17 +929,7 @@ class Result:
             "frictiondyn.units": json.dumps({n: self.units[n] for n in self.names}),
             "frictiondyn.summary": self.summary_json(),
         })
-        tmp = path.with_name(f".{path.name}.{os.getpid()}.{threading.get_ident()}.tmp")
-        try:
-            pq.write_table(table, tmp)
-            os.replace(tmp, path)
-        except BaseException as e:
-            with contextlib.suppress(OSError):
-                tmp.unlink(missing_ok=True)
-            if isinstance(e, OSError):
-                raise OutputError(f"cannot write '{path}': {e.strerror or e}") from None
-            raise
-        return path
+        return _write_replacing(path, lambda tmp: pq.write_table(table, tmp))
 
     def to_npz(self, path: str | os.PathLike) -> Path:
         """Write names, units, data and the summary (as JSON) to a .npz file (``.npz`` is
@@ -950,8 +940,8 @@ class Result:
         path = Path(path)
         if path.suffix != ".npz":
             path = path.with_name(path.name + ".npz")
-        tmp = path.with_name(f".{path.name}.{os.getpid()}.{threading.get_ident()}.tmp")
-        try:
+
+        def write(tmp: Path) -> None:
             with open(tmp, "xb") as f:
                 np.savez(
                     f,
@@ -962,14 +952,25 @@ class Result:
                 )
                 f.flush()
                 os.fsync(f.fileno())
-            os.replace(tmp, path)
-        except BaseException as e:
-            with contextlib.suppress(OSError):
-                tmp.unlink(missing_ok=True)
-            if isinstance(e, OSError):
-                raise OutputError(f"cannot write '{path}': {e.strerror or e}") from None
-            raise
-        return path
+
+        return _write_replacing(path, write)
+
+
+def _write_replacing(path: Path, write: Callable[[Path], object]) -> Path:
+    """write(tmp) to a temporary name beside path, then renamed over it: an earlier file of
+    the name is replaced whole or not at all; OutputError (the file and the system's reason)
+    when it cannot be written, and nothing left then."""
+    tmp = path.with_name(f".{path.name}.{os.getpid()}.{threading.get_ident()}.tmp")
+    try:
+        write(tmp)
+        os.replace(tmp, path)
+    except BaseException as e:
+        with contextlib.suppress(OSError):
+            tmp.unlink(missing_ok=True)
+        if isinstance(e, OSError):
+            raise OutputError(f"cannot write '{path}': {e.strerror or e}") from None
+        raise
+    return path
 
 
 def _pyarrow_parquet():

@@ -1521,22 +1521,7 @@ def collect(sweep: Sweep, write: bool = True) -> Collected:
     table = sweep.directory / "results.csv"
     notes: list[str] = []
     if write:
-        columns: list[str] = []
-        seen: set[str] = set()
-        for row in rows:
-            for c in row:
-                if c not in seen:
-                    seen.add(c)
-                    columns.append(c)
-        buf = io.StringIO()
-        w = csv.DictWriter(buf, fieldnames=columns, lineterminator="\n")
-        w.writeheader()
-        for row in rows:
-            w.writerow({k: _csv_value(v) for k, v in row.items()})
-        try:
-            _write_atomic(table, buf.getvalue())
-        except OSError as exc:
-            raise SweepError(f"{table}: cannot write the table: {exc.strerror}") from None
+        _write_table(table, rows)
         note = _write_parquet(table)
         if note:
             notes.append(note)
@@ -1592,9 +1577,20 @@ def _write_long_table(sweep: Sweep, summaries, entity: str) -> str | None:
         path.unlink(missing_ok=True)
         path.with_suffix(".parquet").unlink(missing_ok=True)
         return None
+    _write_table(path, rows)
+    return _write_parquet(path)
+
+
+def _write_table(path: Path, rows: list[dict[str, Any]]) -> None:
+    """A CSV of rows (the columns in the order they first appear; a missing value empty, a
+    null NaN), written whole under a temporary name and renamed."""
     columns: list[str] = []
+    seen: set[str] = set()
     for row in rows:
-        columns += [c for c in row if c not in columns]
+        for c in row:
+            if c not in seen:
+                seen.add(c)
+                columns.append(c)
     buf = io.StringIO()
     w = csv.DictWriter(buf, fieldnames=columns, lineterminator="\n")
     w.writeheader()
@@ -1604,7 +1600,6 @@ def _write_long_table(sweep: Sweep, summaries, entity: str) -> str | None:
         _write_atomic(path, buf.getvalue())
     except OSError as exc:
         raise SweepError(f"{path}: cannot write the table: {exc.strerror}") from None
-    return _write_parquet(path)
 
 
 def intensity_statistics(sweep: Sweep, rows: list[dict[str, Any]]) -> list[dict[str, Any]]:
@@ -1643,20 +1638,7 @@ def intensity_statistics(sweep: Sweep, rows: list[dict[str, Any]]) -> list[dict[
 
 
 def _write_intensity_table(sweep: Sweep, rows: list[dict[str, Any]]) -> None:
-    stats = intensity_statistics(sweep, rows)
-    columns: list[str] = []
-    for row in stats:
-        columns += [c for c in row if c not in columns]
-    buf = io.StringIO()
-    w = csv.DictWriter(buf, fieldnames=columns, lineterminator="\n")
-    w.writeheader()
-    for row in stats:
-        w.writerow({k: _csv_value(v) for k, v in row.items()})
-    path = sweep.directory / "intensity.csv"
-    try:
-        _write_atomic(path, buf.getvalue())
-    except OSError as exc:
-        raise SweepError(f"{path}: cannot write the table: {exc.strerror}") from None
+    _write_table(sweep.directory / "intensity.csv", intensity_statistics(sweep, rows))
 
 
 def _csv_value(v: Any) -> Any:
