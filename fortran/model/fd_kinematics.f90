@@ -14,7 +14,7 @@ module fd_kinematics
 
    public :: set_pair_directions, pair_terms, directions_set
    public :: device_kinematics, device_relative, device_abs_relative, add_device, add_device_forces
-   public :: relative_kernel, force_kernel
+   public :: relative_motion, device_forces
    public :: add_device_abs, add_device_outer, pair_nodes, device_nodes, devices_are_pairs, moved_mass
    public :: device_inverse_mass_relative, device_abs_inverse_mass_relative, device_coupling
 
@@ -36,6 +36,11 @@ contains
       if (stat /= 0) return
       call pair_terms(model%dev(1:nd)%node_i, model%dev(1:nd)%node_j, model%dev_ptr, model%dev_dof, &
                       model%dev_coef)
+      if (allocated(model%dev_nodes)) deallocate (model%dev_nodes)
+      allocate (model%dev_nodes(2, nd), stat=stat)
+      if (stat /= 0) return
+      model%dev_nodes(1, :) = model%dev(1:nd)%node_i
+      model%dev_nodes(2, :) = model%dev(1:nd)%node_j
    end subroutine set_pair_directions
 
    !> The compressed directions of two-node elements: e_i - e_j, e_i when j = 0 (and -e_j
@@ -91,9 +96,54 @@ contains
       call force_kernel(model%n_devices, model%dev_ptr, model%dev_dof, model%dev_coef, f, y)
    end subroutine add_device_forces
 
-   !> device_kinematics' loop on plain arrays: a time-step loop's hot path passes the model's
-   !> dev_ptr, dev_dof and dev_coef itself (no array descriptor is made per call, which for a
-   !> model of one device costs as much as the sums); each sum starts from the first term.
+   !> s = b' u and s' = b' v of every device, for a time-step loop: explicit shapes (no
+   !> array descriptor is made per call, which for a model of one device costs as much as
+   !> the sums), and devices between two nodes by their nodes, as differences.
+   pure subroutine relative_motion(model, n, nd, u, v, s, sd)
+      type(model_type), intent(in) :: model   !! the model
+      integer, intent(in) :: n, nd            !! DOFs and devices
+      real(dp), intent(in) :: u(n), v(n)      !! displacements [m] and velocities [m/s]
+      real(dp), intent(out) :: s(nd), sd(nd)  !! relative displacements and velocities
+      integer :: d, i, j
+
+      if (.not. allocated(model%dev_nodes)) then
+         call relative_kernel(nd, model%dev_ptr, model%dev_dof, model%dev_coef, u, v, s, sd)
+         return
+      end if
+      do d = 1, nd
+         i = model%dev_nodes(1, d)
+         j = model%dev_nodes(2, d)
+         if (j > 0) then
+            s(d) = u(i) - u(j)
+            sd(d) = v(i) - v(j)
+         else
+            s(d) = u(i)
+            sd(d) = v(i)
+         end if
+      end do
+   end subroutine relative_motion
+
+   !> y = y + sum_d f_d b_d, for a time-step loop (as relative_motion).
+   pure subroutine device_forces(model, n, nd, f, y)
+      type(model_type), intent(in) :: model   !! the model
+      integer, intent(in) :: n, nd            !! DOFs and devices
+      real(dp), intent(in) :: f(nd)           !! force of each device [N]
+      real(dp), intent(inout) :: y(n)         !! vector over the DOFs
+      integer :: d, i, j
+
+      if (.not. allocated(model%dev_nodes)) then
+         call force_kernel(nd, model%dev_ptr, model%dev_dof, model%dev_coef, f, y)
+         return
+      end if
+      do d = 1, nd
+         i = model%dev_nodes(1, d)
+         j = model%dev_nodes(2, d)
+         y(i) = y(i) + f(d)
+         if (j > 0) y(j) = y(j) - f(d)
+      end do
+   end subroutine device_forces
+
+   !> device_kinematics' loop on plain arrays; each sum starts from the first term.
    pure subroutine relative_kernel(nd, ptr, dof, coef, u, v, s, sd)
       integer, intent(in) :: nd, ptr(nd + 1), dof(*)
       real(dp), intent(in) :: coef(*), u(*), v(*)

@@ -80,6 +80,9 @@ module fd_model
       integer, allocatable :: dev_ptr(:)      !! start of each device's terms (n_devices + 1)
       integer, allocatable :: dev_dof(:)      !! DOF of each term (1..n_dof)
       real(dp), allocatable :: dev_coef(:)    !! coefficient of each term [-]
+      ! when every device joins two nodes, those nodes (node_i, node_j; 0 = the table) by
+      ! device: the time-step loops' fast path (fd_kinematics); not allocated otherwise
+      integer, allocatable :: dev_nodes(:, :) !! (2, n_devices)
       ! 'rayleigh' damping given as xi at two natural modes (resolved into a0, a1 when read)
       integer :: mode_i = 0                   !! first mode (0: a0, a1 given)
       integer :: mode_j = 0                   !! second mode

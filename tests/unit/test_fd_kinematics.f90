@@ -8,7 +8,7 @@ module test_fd_kinematics
    use fd_model, only: model_type, device_type
    use fd_kinematics, only: set_pair_directions, device_kinematics, device_relative, add_device, &
                             add_device_outer, moved_mass, device_coupling, device_inverse_mass_relative, &
-                            pair_nodes, devices_are_pairs, device_nodes
+                            pair_nodes, devices_are_pairs, device_nodes, relative_motion, device_forces
    implicit none
    private
 
@@ -21,7 +21,8 @@ contains
 
       testsuite = [ &
                   new_unittest("directions of devices between two nodes", test_pairs), &
-                  new_unittest("general directions against dense products", test_general) &
+                  new_unittest("general directions against dense products", test_general), &
+                  new_unittest("the time-step loops' kernels, pairs and general", test_loop_kernels) &
                   ]
    end subroutine collect_kinematics
 
@@ -128,5 +129,48 @@ contains
       call device_nodes(model, ni, nj, first)
       call check(error, first == 1 .and. .not. devices_are_pairs(model), "the first general device named")
    end subroutine test_general
+
+   !> relative_motion and device_forces (the time-step loops' kernels) equal device_relative
+   !> and add_device, by the nodes of a model of pairs and by the terms of a general one.
+   subroutine test_loop_kernels(error)
+      type(error_type), allocatable, intent(out) :: error
+      type(model_type) :: model
+      real(dp) :: u(4), v(4), y(4), z(4)
+      real(dp), allocatable :: s(:), sd(:), f(:)
+      integer :: d, pass
+
+      u = [0.1_dp, 0.4_dp, -0.2_dp, 0.7_dp]
+      v = [1.0_dp, -2.0_dp, 0.5_dp, 0.25_dp]
+      do pass = 1, 2
+         if (pass == 1) then
+            call pair_model(model)
+            call check(error, allocated(model%dev_nodes), "a model of pairs has its nodes")
+         else
+            model%n_dof = 4
+            model%mass = [2.0e4_dp, 2.0e4_dp, 3.0e5_dp, 1.0e3_dp]
+            model%n_devices = 2
+            if (allocated(model%dev_nodes)) deallocate (model%dev_nodes)
+            model%dev_ptr = [1, 4, 6]
+            model%dev_dof = [1, 2, 3, 4, 1]
+            model%dev_coef = [0.6_dp, 0.8_dp, 2.5_dp, 1.0_dp, -1.0_dp]
+         end if
+         if (allocated(error)) return
+         allocate (s(model%n_devices), sd(model%n_devices), f(model%n_devices))
+         call relative_motion(model, model%n_dof, model%n_devices, u(1:model%n_dof), v(1:model%n_dof), s, sd)
+         f = [(1.5_dp*d, d=1, model%n_devices)]
+         y = 0.25_dp
+         z = 0.25_dp
+         call device_forces(model, model%n_dof, model%n_devices, f, y(1:model%n_dof))
+         do d = 1, model%n_devices
+            call check(error, s(d) == device_relative(model, d, u(1:model%n_dof)) .and. &
+                       sd(d) == device_relative(model, d, v(1:model%n_dof)), "s, s' as device_relative")
+            if (allocated(error)) return
+            call add_device(model, d, f(d), z(1:model%n_dof))
+         end do
+         call check(error, all(y == z), "forces as add_device")
+         if (allocated(error)) return
+         deallocate (s, sd, f)
+      end do
+   end subroutine test_loop_kernels
 
 end module test_fd_kinematics

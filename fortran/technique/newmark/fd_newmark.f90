@@ -35,7 +35,7 @@ module fd_newmark
    use fd_excitation, only: excitation_type, table_motion, table_acceleration, grid_motion, grid_init, &
                             grid_acceleration
    use fd_matrices, only: structure_damping
-   use fd_kinematics, only: device_kinematics, add_device, relative_kernel, force_kernel
+   use fd_kinematics, only: device_kinematics, add_device, relative_motion, device_forces
    use fd_banded, only: spd_system, spd_setup, spd_factor, spd_update_devices, spd_solve, spd_k_matvec, &
                         spd_c_matvec, spd_kc_matvec, spd_auto, spd_dense, spd_banded, spd_is_dense, spd_bandwidth, &
                         spd_copy
@@ -394,7 +394,7 @@ contains
       call spd_solve(w%lev(lv)%sys, w%rhs, error)
       if (allocated(error)) return
       call correct(w%n, w%lev(lv)%bh2, w%lev(lv)%gh, w%rhs, w%tmp, w%a1, w%u1, w%v1)
-      call relative_kernel(w%nd, model%dev_ptr, model%dev_dof, model%dev_coef, w%u1, w%v1, w%s1, w%sd1)
+      call relative_motion(model, w%n, w%nd, w%u1, w%v1, w%s1, w%sd1)
       if (w%nf > 0) call follow_forces(model, lv, w, error)
    end subroutine try_step
 
@@ -511,11 +511,11 @@ contains
       real(dp), intent(out) :: s(nd), sd(nd), f(nd)   !! work: s~, s'~ and -F of each device
       integer :: d, i
 
-      call relative_kernel(nd, model%dev_ptr, model%dev_dof, model%dev_coef, ut, vt, s, sd)
+      call relative_motion(model, n, nd, ut, vt, s, sd)
       do d = 1, nd
          f(d) = -(st(d)%ks*s(d) + st(d)%cs*sd(d) + st(d)%f0)
       end do
-      call force_kernel(nd, model%dev_ptr, model%dev_dof, model%dev_coef, f, rhs)
+      call device_forces(model, n, nd, f, rhs)
       do i = 1, n
          rhs(i) = c0*rhs(i)
       end do
