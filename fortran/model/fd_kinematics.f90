@@ -26,21 +26,24 @@ contains
       type(model_type), intent(inout) :: model  !! the model; its devices' nodes are read
       integer, intent(out) :: stat              !! 0, or the allocation's status
 
-      integer :: nd
+      integer :: nd, d
 
       nd = model%n_devices
       if (allocated(model%dev_ptr)) deallocate (model%dev_ptr)
       if (allocated(model%dev_dof)) deallocate (model%dev_dof)
       if (allocated(model%dev_coef)) deallocate (model%dev_coef)
-      allocate (model%dev_ptr(nd + 1), model%dev_dof(2*nd), model%dev_coef(2*nd), stat=stat)
-      if (stat /= 0) return
-      call pair_terms(model%dev(1:nd)%node_i, model%dev(1:nd)%node_j, model%dev_ptr, model%dev_dof, &
-                      model%dev_coef)
       if (allocated(model%dev_nodes)) deallocate (model%dev_nodes)
-      allocate (model%dev_nodes(2, nd), stat=stat)
+      allocate (model%dev_ptr(nd + 1), model%dev_dof(2*nd), model%dev_coef(2*nd), model%dev_nodes(2, nd), &
+                stat=stat)
       if (stat /= 0) return
-      model%dev_nodes(1, :) = model%dev(1:nd)%node_i
-      model%dev_nodes(2, :) = model%dev(1:nd)%node_j
+      ! the nodes copied by device first: a component of an array of derived type passed as
+      ! an argument would be copied to a temporary at the call
+      do d = 1, nd
+         model%dev_nodes(1, d) = model%dev(d)%node_i
+         model%dev_nodes(2, d) = model%dev(d)%node_j
+      end do
+      call pair_terms(model%dev_nodes(1, :), model%dev_nodes(2, :), model%dev_ptr, model%dev_dof, &
+                      model%dev_coef)
    end subroutine set_pair_directions
 
    !> The compressed directions of two-node elements: e_i - e_j, e_i when j = 0 (and -e_j
