@@ -12,8 +12,8 @@ module fd_kinematics
    implicit none
    private
 
-   public :: set_pair_directions, pair_terms, directions_set
-   public :: device_kinematics, device_relative, device_abs_relative, add_device, add_device_forces
+   public :: set_pair_directions, pair_terms
+   public :: device_kinematics, device_relative, device_abs_relative, add_device
    public :: relative_motion, device_forces
    public :: add_device_abs, add_device_outer, pair_nodes, device_nodes, devices_are_pairs, moved_mass
    public :: device_inverse_mass_relative, device_abs_inverse_mass_relative, device_coupling
@@ -71,14 +71,6 @@ contains
       coef(k:) = 0.0_dp
    end subroutine pair_terms
 
-   !> Whether the model's directions are set for all its devices.
-   pure logical function directions_set(model) result(set)
-      type(model_type), intent(in) :: model  !! the model
-
-      set = allocated(model%dev_ptr)
-      if (set) set = size(model%dev_ptr) == model%n_devices + 1
-   end function directions_set
-
    !> Relative displacement and velocity of every device, s = b' u and s' = b' v.
    pure subroutine device_kinematics(model, u, v, s, sd)
       type(model_type), intent(in) :: model   !! the model
@@ -89,15 +81,6 @@ contains
 
       call relative_kernel(model%n_devices, model%dev_ptr, model%dev_dof, model%dev_coef, u, v, s, sd)
    end subroutine device_kinematics
-
-   !> y = y + sum_d f_d b_d: the devices' forces f on the DOFs.
-   pure subroutine add_device_forces(model, f, y)
-      type(model_type), intent(in) :: model   !! the model
-      real(dp), intent(in), contiguous :: f(:)   !! force of each device [N]
-      real(dp), intent(inout), contiguous :: y(:) !! vector over the DOFs
-
-      call force_kernel(model%n_devices, model%dev_ptr, model%dev_dof, model%dev_coef, f, y)
-   end subroutine add_device_forces
 
    !> s = b' u and s' = b' v of every device, for a time-step loop: explicit shapes (no
    !> array descriptor is made per call, which for a model of one device costs as much as
@@ -171,7 +154,7 @@ contains
       end do
    end subroutine relative_kernel
 
-   !> add_device_forces' loop on plain arrays.
+   !> device_forces' loop over the terms, on plain arrays.
    pure subroutine force_kernel(nd, ptr, dof, coef, f, y)
       integer, intent(in) :: nd, ptr(nd + 1), dof(*)
       real(dp), intent(in) :: coef(*), f(nd)
