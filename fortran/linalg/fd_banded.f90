@@ -123,7 +123,7 @@ contains
    !> Set up the system: graph, ordering, storage, K and C. Allocates everything the
    !> other procedures use; the factor is made by spd_factor.
    subroutine spd_setup(sys, mass, spring_i, spring_j, spring_k, dev_ptr, dev_dof, dev_coef, error, &
-                        a0, a1, dashpot_i, dashpot_j, dashpot_c, path, budget, method)
+                        a0, a1, dashpot_i, dashpot_j, dashpot_c, path, budget, method, kx_i, kx_j, kx_v)
       type(spd_system), intent(out) :: sys       !! the system
       real(dp), intent(in) :: mass(:)            !! masses [kg], one per DOF (n = size)
       integer, intent(in) :: spring_i(:)         !! first node of each spring (0..n, 0 = table)
@@ -141,8 +141,11 @@ contains
       integer, intent(in), optional :: path      !! spd_auto (default), spd_dense or spd_banded
       real(dp), intent(in), optional :: budget   !! allowed estimated update error, default 1e-12
       integer, intent(in), optional :: method    !! spd_choose (default), spd_rank_one, spd_refactor
-      integer, allocatable :: di(:), dj(:)
-      real(dp), allocatable :: dc(:)
+      integer, intent(in), optional :: kx_i(:)   !! more stiffness K_x: row of each entry (1..n)
+      integer, intent(in), optional :: kx_j(:)   !! its column (kx_i <= kx_j)
+      real(dp), intent(in), optional :: kx_v(:)  !! its value
+      integer, allocatable :: di(:), dj(:), xi(:), xj(:), gi(:), gj(:)
+      real(dp), allocatable :: dc(:), xv(:)
       real(dp) :: ca0, ca1
       integer :: n, nd, i, kbw, mode, stat
 
@@ -164,6 +167,18 @@ contains
       else
          allocate (di(0), dj(0), dc(0))
       end if
+      if (present(kx_i) .and. present(kx_j) .and. present(kx_v)) then
+         xi = kx_i
+         xj = kx_j
+         xv = kx_v
+      else if (present(kx_i) .or. present(kx_j) .or. present(kx_v)) then
+         call fatal_error(error, "spd_setup: kx_i, kx_j and kx_v go together")
+         return
+      else
+         allocate (xi(0), xj(0), xv(0))
+      end if
+      call check_entries(xi, xj, xv, n, error)
+      if (allocated(error)) return
       call check_setup(mass, spring_i, spring_j, spring_k, dev_ptr, dev_dof, dev_coef, di, dj, dc, ca0, ca1, &
                        mode, error)
       if (allocated(error)) return
@@ -183,7 +198,10 @@ contains
          sys%budget = budget
       end if
 
-      call order_graph(sys, n, spring_i, spring_j, dev_ptr, dev_dof, di, dj, kbw)
+      ! the graph's edges: the springs and the entries of K_x off the diagonal
+      gi = [spring_i, pack(xi, xi /= xj)]
+      gj = [spring_j, pack(xj, xi /= xj)]
+      call order_graph(sys, n, gi, gj, dev_ptr, dev_dof, di, dj, kbw)
       if (mode == spd_auto) then
          ! dense where it is faster: a few DOFs (a band nearly as wide as the matrix is no
          ! slower than dense storage: bench/banded.sh wide)
@@ -224,7 +242,7 @@ contains
                           trim(fmt_real(8.0_dp*real(sys%ld, dp)*n/2.0_dp**20))//" MiB)", stat_no_memory)
          return
       end if
-      call assemble(sys, mass, spring_i, spring_j, spring_k, di, dj, dc, ca0, ca1)
+      call assemble(sys, mass, spring_i, spring_j, spring_k, di, dj, dc, ca0, ca1, xi, xj, xv)
       call order_devices(sys, dev_ptr, dev_dof, dev_coef)
       call sort_devices(sys)
    end subroutine spd_setup
@@ -328,11 +346,11 @@ contains
    end subroutine order_graph
 
    !> K (springs) and C = a0 M + a1 K + dashpots in the storage, the rest zeroed.
-   subroutine assemble(sys, mass, spring_i, spring_j, spring_k, di, dj, dc, ca0, ca1)
+   subroutine assemble(sys, mass, spring_i, spring_j, spring_k, di, dj, dc, ca0, ca1, xi, xj, xv)
       type(spd_system), intent(inout) :: sys
-      real(dp), intent(in) :: mass(:), spring_k(:), dc(:), ca0, ca1
-      integer, intent(in) :: spring_i(:), spring_j(:), di(:), dj(:)
-      integer :: i, a, n
+      real(dp), intent(in) :: mass(:), spring_k(:), dc(:), ca0, ca1, xv(:)
+      integer, intent(in) :: spring_i(:), spring_j(:), di(:), dj(:), xi(:), xj(:)
+      integer :: i, a, b, n
 
       n = sys%n
       sys%rdiag = 0.0_dp
@@ -347,6 +365,11 @@ contains
       sys%xv = 0.0_dp
       do i = 1, size(spring_i)
          call add_link(sys, sys%kmat, spring_i(i), spring_j(i), spring_k(i))
+      end do
+      do i = 1, size(xi)
+         a = min(sys%inv(xi(i)), sys%inv(xj(i)))
+         b = max(sys%inv(xi(i)), sys%inv(xj(i)))
+         sys%kmat(idx(sys, a, b)) = sys%kmat(idx(sys, a, b)) + xv(i)
       end do
       ! C = a0 M + a1 K + dashpots
       sys%a0 = ca0
@@ -384,6 +407,31 @@ contains
       end if
       dst = src   ! every array already has its shape: nothing is allocated here
    end subroutine spd_copy
+
+   !> Check the entries of K_x: rows and columns in 1..n with row <= column, finite values.
+   subroutine check_entries(xi, xj, xv, n, error)
+      integer, intent(in) :: xi(:), xj(:), n
+      real(dp), intent(in) :: xv(:)
+      type(error_type), allocatable, intent(out) :: error
+      integer :: e
+
+      if (size(xj) /= size(xi) .or. size(xv) /= size(xi)) then
+         call fatal_error(error, "spd_setup: kx_i, kx_j and kx_v differ in size")
+         return
+      end if
+      do e = 1, size(xi)
+         if (xi(e) < 1 .or. xj(e) > n .or. xi(e) > xj(e)) then
+            call fatal_error(error, "spd_setup: entry "//trim(fmt_int(e))//" of K_x is at ("// &
+                             trim(fmt_int(xi(e)))//", "//trim(fmt_int(xj(e)))//"), not 1 <= i <= j <= "// &
+                             trim(fmt_int(n)))
+            return
+         end if
+         if (.not. ieee_is_finite(xv(e))) then
+            call fatal_error(error, "spd_setup: entry "//trim(fmt_int(e))//" of K_x is "//trim(fmt_real(xv(e))))
+            return
+         end if
+      end do
+   end subroutine check_entries
 
    !> Check the devices' terms: each device has one or more, on distinct DOFs in 1..n, with
    !> finite coefficients other than 0.

@@ -12,7 +12,8 @@ module fd_matrices
    use fd_linalg, only: generalized_eigen, lowest_eigen, lowest_eigen_band
    use fd_rcm, only: rcm_order
    use fd_modes, only: lowest_modes
-   use fd_kinematics, only: add_device_outer, pair_nodes
+   use fd_kinematics, only: add_device_outer, pair_nodes, devices_are_pairs
+   use fd_stiffness, only: add_general_dense, general_form, influence_of
    implicit none
    private
 
@@ -101,6 +102,7 @@ contains
             k(j, i) = k(j, i) - ks
          end if
       end do
+      call add_general_dense(model, k)
    end subroutine stiffness_matrix
 
    !> The nev lowest natural modes of the structure with the devices flagged in `linked` made
@@ -127,6 +129,11 @@ contains
       omega2 = 0.0_dp
       phi = 0.0_dp
       n = model%n_dof
+      if (model%n_kx > 0 .or. .not. devices_are_pairs(model)) then
+         ! stiffness beyond springs, or devices that are no links between two nodes: dense
+         call dense_system_modes(model, linked, nev, omega2, phi, nq, error)
+         return
+      end if
       allocate (grp(n), stat=stat)
       if (stat /= 0) then
          nq = -1
@@ -239,6 +246,7 @@ contains
          i = model%spring_i(s); j = model%spring_j(s)
          pkp = pkp + model%spring_k(s)*(node_value(i) - node_value(j))**2
       end do
+      if (model%n_kx > 0) pkp = pkp + general_form(model, phi, phi)
       pmp = sum(model%mass*phi**2)
       xi = (a0*pmp + a1*pkp)/(2.0_dp*(2.0_dp*pi/period)*pmp)
    contains
@@ -304,6 +312,197 @@ contains
       end if
    end subroutine damping_period
 
+   !> system_modes of a general model (stiffness K_x, or devices with any direction b_d): the
+   !> devices in `linked` are the constraints b_d' u = 0, and the modes those of the dense
+   !> (K, M) on their null space (constrained_modes).
+   subroutine dense_system_modes(model, linked, nev, omega2, phi, nq, error)
+      type(model_type), intent(in) :: model          !! the model
+      logical, intent(in) :: linked(:)               !! devices acting as rigid links
+      integer, intent(in) :: nev                     !! modes wanted
+      real(dp), intent(out) :: omega2(:)             !! w^2 [1/s^2], size nev (0 beyond nq)
+      real(dp), intent(out) :: phi(:, :)             !! M-normalized mode shapes, n_dof x nev
+      integer, intent(out) :: nq                     !! free DOFs of the constrained system
+      type(error_type), allocatable, intent(out) :: error !! no free DOF, rigid-body mode
+      real(dp), allocatable :: k(:, :), lam(:), z(:, :)
+      real(dp) :: big
+      integer :: n, m, j, stat
+
+      n = model%n_dof
+      allocate (k(n, n), lam(n), z(n, n), stat=stat)
+      if (stat /= 0) then
+         nq = -1
+         call fatal_error(error, "not enough memory for the eigenproblem of "//trim(fmt_int(n))//" DOFs", &
+                          stat_no_memory)
+         return
+      end if
+      call stiffness_matrix(model, k)
+      big = 0.0_dp
+      do j = 1, n
+         big = max(big, sum(abs(k(:, j)))/model%mass(j))
+      end do
+      call constrained_modes(model, k, linked, lam, z, nq, error)
+      if (allocated(error)) return
+      if (nq == 0) then
+         call fatal_error(error, "the system has no free DOF: every mass is locked to the table by rigid links")
+         return
+      end if
+      m = min(nev, nq)
+      if (lam(1) <= 1.0e-12_dp*big) then
+         call fatal_error(error, "the system has a rigid-body mode (first eigenvalue "// &
+                          trim(fmt_real(lam(1)))//"): a mass or group of masses has no spring to the table")
+         return
+      end if
+      omega2(1:m) = lam(1:m)
+      phi(:, 1:m) = z(:, 1:m)
+   end subroutine dense_system_modes
+
+   !> The modes of K u = w^2 M u under the constraints b_d' u = 0 of the devices in `linked`:
+   !> Z an orthonormal basis of their null space (the eigenvectors of B B' whose eigenvalue
+   !> is below 1e-12 of the largest, B = [b_d]), then (Z' K Z) y = w^2 (Z' M Z) y and
+   !> phi = Z y, so that phi' M phi = 1. lam and the first nq columns of phi are set, nq the
+   !> dimension of the null space (lam ascending).
+   subroutine constrained_modes(model, k, linked, lam, phi, nq, error)
+      type(model_type), intent(in) :: model          !! the model (masses, directions)
+      real(dp), intent(in) :: k(:, :)                !! stiffness over the DOFs
+      logical, intent(in) :: linked(:)               !! the devices that constrain
+      real(dp), intent(out) :: lam(:)                !! w^2, ascending (n_dof)
+      real(dp), intent(out) :: phi(:, :)             !! shapes (n_dof, n_dof), M-normalized
+      integer, intent(out) :: nq                     !! free DOFs
+      type(error_type), allocatable, intent(out) :: error !! LAPACK failure, no memory
+      real(dp), allocatable :: bb(:, :), eye(:, :), ev(:), vec(:, :), z(:, :), kq(:, :), mq(:, :), y(:, :)
+      real(dp), allocatable :: col(:)
+      integer :: n, d, i, j, stat
+
+      n = model%n_dof
+      lam = 0.0_dp
+      phi = 0.0_dp
+      allocate (bb(n, n), eye(n, n), ev(n), vec(n, n), col(n), stat=stat)
+      if (stat /= 0) then
+         nq = -1
+         call fatal_error(error, "not enough memory for the eigenproblem of "//trim(fmt_int(n))//" DOFs", &
+                          stat_no_memory)
+         return
+      end if
+      bb = 0.0_dp
+      eye = 0.0_dp
+      do i = 1, n
+         eye(i, i) = 1.0_dp
+      end do
+      do d = 1, model%n_devices
+         if (linked(d)) call add_device_outer(model, d, 1.0_dp, bb)
+      end do
+      if (any(bb /= 0.0_dp)) then
+         call generalized_eigen(bb, eye, ev, vec, error)
+         if (allocated(error)) return
+         nq = count(ev <= 1.0e-12_dp*maxval(abs(ev)))
+         z = vec(:, 1:nq)
+      else
+         nq = n
+         z = eye
+      end if
+      if (nq == 0) return
+      allocate (kq(nq, nq), mq(nq, nq), y(nq, nq), stat=stat)
+      if (stat /= 0) then
+         call fatal_error(error, "not enough memory for the eigenproblem of "//trim(fmt_int(nq))//" DOFs", &
+                          stat_no_memory)
+         return
+      end if
+      kq = matmul(transpose(z), matmul(k, z))
+      do j = 1, nq
+         col = model%mass*z(:, j)
+         do i = 1, nq
+            mq(i, j) = dot_product(z(:, i), col)
+         end do
+      end do
+      kq = 0.5_dp*(kq + transpose(kq))
+      mq = 0.5_dp*(mq + transpose(mq))
+      call generalized_eigen(kq, mq, lam(1:nq), y, error)
+      if (allocated(error)) return
+      phi(:, 1:nq) = matmul(z, y)
+   end subroutine constrained_modes
+
+   !> natural_modes of a model whose devices are not all links between two nodes: the stuck
+   !> system's linking devices as constraints and its hysteretic devices' sticking springs
+   !> in K (constrained_modes); the same outputs as natural_modes.
+   subroutine constrained_natural_modes(model, k, c, system, nmax, modes, error)
+      type(model_type), intent(in) :: model          !! the model
+      real(dp), intent(in) :: k(:, :)                !! stiffness over the DOFs (springs, K_x)
+      real(dp), intent(in) :: c(:, :)                !! viscous damping
+      integer, intent(in) :: system                  !! system_stuck or system_free
+      integer, intent(in) :: nmax                    !! modes to keep at most
+      type(modes_type), intent(inout) :: modes       !! the modes
+      type(error_type), allocatable, intent(out) :: error !! LAPACK failure
+      real(dp), allocatable :: ks(:, :), lam(:), z(:, :), zcz(:)
+      logical, allocatable :: linked(:)
+      integer, allocatable :: grp(:)
+      real(dp) :: kd, big
+      integer :: n, d, j, stat
+
+      n = model%n_dof
+      allocate (ks(n, n), lam(n), z(n, n), linked(model%n_devices), grp(n), stat=stat)
+      if (stat /= 0) then
+         call fatal_error(error, "not enough memory for the natural modes of "//trim(fmt_int(n))//" DOFs", &
+                          stat_no_memory)
+         return
+      end if
+      ks = k
+      do d = 1, model%n_devices
+         linked(d) = system == system_stuck .and. links_when_stuck(model%dev(d))
+         kd = sticking_stiffness(model%dev(d))
+         if (system == system_stuck .and. kd > 0.0_dp) call add_device_outer(model, d, kd, ks)
+      end do
+      call constrained_modes(model, ks, linked, lam, z, modes%nq, error)
+      if (allocated(error)) return
+      if (modes%nq == 0) then
+         modes%status = modes_rigid
+         allocate (modes%omega2(0), modes%period(0), modes%shape(n, 0), modes%mass_ratio(0), modes%xi(0))
+         return
+      end if
+      big = 0.0_dp
+      do j = 1, n
+         big = max(big, sum(abs(ks(:, j)))/model%mass(j))
+      end do
+      modes%n = min(max(nmax, 0), modes%nq)
+      allocate (zcz(modes%n))
+      do j = 1, modes%n
+         zcz(j) = dot_product(z(:, j), matmul(c, z(:, j)))
+      end do
+      modes%status = modes_flexible
+      if (lam(1) <= 1.0e-12_dp*big) modes%status = modes_unrestrained
+      grp = [(j, j=1, n)]
+      call store_modes(grp, model%mass, lam, z, lam(1:modes%n) <= 1.0e-12_dp*big, zcz, modes, stat, &
+                       model%influence)
+      if (stat /= 0) call fatal_error(error, "not enough memory for the natural modes of "//trim(fmt_int(n))// &
+                                      " DOFs", stat_no_memory)
+   end subroutine constrained_natural_modes
+
+   !> natural_modes_sparse of a general model: the dense matrices K and C = a0 M + a1 K, then
+   !> natural_modes (memory n_dof**2).
+   subroutine dense_natural_modes(model, a0, a1, system, nmax, modes, error)
+      type(model_type), intent(in) :: model          !! the model
+      real(dp), intent(in) :: a0, a1                 !! C = a0 M + a1 K
+      integer, intent(in) :: system                  !! system_stuck or system_free
+      integer, intent(in) :: nmax                    !! modes to keep at most
+      type(modes_type), intent(out) :: modes         !! the modes
+      type(error_type), allocatable, intent(out) :: error !! solver failure, no memory
+      real(dp), allocatable :: k(:, :), c(:, :)
+      integer :: n, i, stat
+
+      n = model%n_dof
+      allocate (k(n, n), c(n, n), stat=stat)
+      if (stat /= 0) then
+         call fatal_error(error, "not enough memory for the natural modes of "//trim(fmt_int(n))// &
+                          " DOFs (two dense matrices)", stat_no_memory)
+         return
+      end if
+      call stiffness_matrix(model, k)
+      c = a1*k
+      do i = 1, n
+         c(i, i) = c(i, i) + a0*model%mass(i)
+      end do
+      call natural_modes(model, k, c, system, nmax, modes, error)
+   end subroutine dense_natural_modes
+
    !> Groups of DOFs joined by rigid links (the devices flagged in `linked`), by union-find
    !> over the nodes 0..n_dof: grp(i) = 1..nq for a group that moves, 0 for a DOF linked
    !> (directly or through others) to the table.
@@ -359,6 +558,10 @@ contains
 
       n = model%n_dof
       modes%system = system
+      if (.not. devices_are_pairs(model)) then
+         call constrained_natural_modes(model, k, c, system, nmax, modes, error)
+         return
+      end if
       call system_groups(model, system, grp, modes, stat)
       if (stat == 0) allocate (ks(n, n), stat=stat)
       if (stat /= 0) then
@@ -418,7 +621,7 @@ contains
       do j = 1, modes%n
          zcz(j) = dot_product(z(:, j), matmul(cq, z(:, j)))
       end do
-      call store_modes(grp, model%mass, lam, z, lam(1:modes%n) <= 1.0e-12_dp*big, zcz, modes, stat)
+      call store_modes(grp, model%mass, lam, z, lam(1:modes%n) <= 1.0e-12_dp*big, zcz, modes, stat, model%influence)
       if (stat /= 0) call no_memory(n)
    contains
       subroutine no_memory(size)
@@ -453,6 +656,11 @@ contains
       ns = model%n_springs
       nd = model%n_devices
       modes%system = system
+      if (model%n_kx > 0 .or. .not. devices_are_pairs(model)) then
+         ! stiffness beyond springs, or devices that are no links between two nodes: dense
+         call dense_natural_modes(model, a0, a1, system, nmax, modes, error)
+         return
+      end if
       call system_groups(model, system, grp, modes, stat)
       if (stat == 0) allocate (ea(ns + nd + n), eb(ns + nd + n), ek(ns + nd + n), stat=stat)
       if (stat /= 0) then
@@ -533,7 +741,8 @@ contains
          end do
          zcz(j) = a0 + a1*kz
       end do
-      call store_modes(grp, model%mass, lam, z, lam(1:modes%n) <= 1.0e-9_dp*big .and. shifted, zcz, modes, stat)
+      call store_modes(grp, model%mass, lam, z, lam(1:modes%n) <= 1.0e-9_dp*big .and. shifted, zcz, modes, stat, &
+                       model%influence)
       if (stat /= 0) call no_memory(n)
    contains
       !> Component j of z at a node (0 on the table and in its group).
@@ -714,7 +923,7 @@ contains
    !> that its component of largest magnitude is +1, its effective mass ratio; a rigid-body
    !> mode (rigid) has w = 0, an infinite period and no damping ratio, the others
    !> w = sqrt(lam) and xi = zcz / (2 w), zcz = z' Cq z.
-   subroutine store_modes(grp, mass, lam, z, rigid, zcz, modes, stat)
+   subroutine store_modes(grp, mass, lam, z, rigid, zcz, modes, stat, influence)
       integer, intent(in) :: grp(:)                  !! group of each DOF, 0 = with the table
       real(dp), intent(in) :: mass(:)                !! masses of the DOFs
       real(dp), intent(in) :: lam(:)                 !! eigenvalues w^2, increasing
@@ -723,7 +932,8 @@ contains
       real(dp), intent(in) :: zcz(:)                 !! (modes%n) z' Cq z
       type(modes_type), intent(inout) :: modes       !! n set; its arrays
       integer, intent(out) :: stat                   !! 0, or not enough memory
-      real(dp), allocatable :: phi(:)
+      real(dp), intent(in), optional :: influence(:) !! r, the table motion's direction (default 1)
+      real(dp), allocatable :: phi(:), mr(:)
       real(dp) :: w, l, mtot
       integer :: n, i, j, imax
 
@@ -731,7 +941,13 @@ contains
       allocate (modes%omega2(modes%n), modes%period(modes%n), modes%shape(n, modes%n), &
                 modes%mass_ratio(modes%n), modes%xi(modes%n), phi(n), stat=stat)
       if (stat /= 0) return
+      ! the effective mass along r: (phi' M r)^2 / (phi' M phi), of the total r' M r
+      mr = mass
       mtot = sum(mass)
+      if (present(influence)) then
+         mr = mass*influence
+         mtot = sum(mr*influence)
+      end if
       do j = 1, modes%n
          do i = 1, n
             phi(i) = 0.0_dp
@@ -740,7 +956,7 @@ contains
          imax = maxloc(abs(phi), 1)
          phi = phi/phi(imax)
          modes%shape(:, j) = phi
-         l = sum(mass*phi)
+         l = sum(mr*phi)
          modes%mass_ratio(j) = l*l/sum(mass*phi**2)/mtot
          if (rigid(j)) then
             modes%omega2(j) = 0.0_dp

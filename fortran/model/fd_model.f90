@@ -83,6 +83,15 @@ module fd_model
       ! when every device joins two nodes, those nodes (node_i, node_j; 0 = the table) by
       ! device: the time-step loops' fast path (fd_kinematics); not allocated otherwise
       integer, allocatable :: dev_nodes(:, :) !! (2, n_devices)
+      ! the stiffness that is no spring between two nodes (rigid floors' frames): K_x,
+      ! symmetric, by its entries on and above the diagonal (fd_stiffness reads them)
+      integer :: n_kx = 0                     !! entries of K_x
+      integer, allocatable :: kx_i(:)         !! row of each entry (1..n_dof)
+      integer, allocatable :: kx_j(:)         !! column (kx_i <= kx_j)
+      real(dp), allocatable :: kx_v(:)        !! value [N/m, N, or N m]
+      ! the table motion's direction over the DOFs, r: the load is -M r a_g (not allocated:
+      ! r = 1, every DOF a translation along the table's motion)
+      real(dp), allocatable :: influence(:)   !! (n_dof) [-]
       ! 'rayleigh' damping given as xi at two natural modes (resolved into a0, a1 when read)
       integer :: mode_i = 0                   !! first mode (0: a0, a1 given)
       integer :: mode_j = 0                   !! second mode

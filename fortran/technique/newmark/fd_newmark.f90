@@ -36,6 +36,7 @@ module fd_newmark
                             grid_acceleration
    use fd_matrices, only: structure_damping
    use fd_kinematics, only: device_kinematics, add_device, relative_motion, device_forces
+   use fd_stiffness, only: general_form, influence_of
    use fd_banded, only: spd_system, spd_setup, spd_factor, spd_update_devices, spd_solve, spd_k_matvec, &
                         spd_c_matvec, spd_kc_matvec, spd_auto, spd_dense, spd_banded, spd_is_dense, spd_bandwidth, &
                         spd_copy
@@ -74,6 +75,7 @@ module fd_newmark
       integer :: lmax = 0                             !! halvings below dt2
       real(dp) :: a0 = 0.0_dp, a1c = 0.0_dp           !! C = a0 M + a1c K
       real(dp), allocatable :: mass(:)
+      real(dp), allocatable :: mr(:)          !! M r: the load of a unit table acceleration
       type(level_type), allocatable :: lev(:)         !! 1: dt1, 2: dt2, 2 + l: dt2 / 2**l,
                                                       !! lmax + 2 + k: level k of nested refinement
       integer :: nested = 1                           !! levels of the refinement (the paper's: 1)
@@ -261,13 +263,16 @@ contains
       nd = model%n_devices
       w%n = n
       w%nd = nd
-      allocate (w%mass(n), stat=stat)
+      allocate (w%mass(n), w%mr(n), stat=stat)
       if (stat /= 0) then
          call fatal_error(error, "not enough memory for the masses of n_dof = "//trim(fmt_int(n))//" DOFs", &
                           stat_no_memory)
          return
       end if
       w%mass = model%mass
+      do l = 1, n
+         w%mr(l) = model%mass(l)*influence_of(model, l)
+      end do
       call structure_damping(model, a0, a1, res%period_stuck, res%xi_stuck, error)
       if (allocated(error)) return
       w%a0 = a0
@@ -282,7 +287,7 @@ contains
       end select
       call spd_setup(base, model%mass, model%spring_i, model%spring_j, model%spring_k, model%dev_ptr, model%dev_dof, &
                      model%dev_coef, error, &
-                     a0=a0, a1=a1, path=path)
+                     a0=a0, a1=a1, path=path, kx_i=model%kx_i, kx_j=model%kx_j, kx_v=model%kx_v)
       if (allocated(error)) return
       res%newmark%storage = merge(1, 2, spd_is_dense(base))
       res%newmark%bandwidth = spd_bandwidth(base)
@@ -347,7 +352,7 @@ contains
       integer :: d
 
       call table_motion(exc, t, xg, vg, w%ag)
-      w%rhs = -w%mass*w%ag
+      w%rhs = -w%mr*w%ag
       call spd_c_matvec(w%lev(1)%sys, w%v, w%rhs, -1.0_dp, 1.0_dp)
       call spd_k_matvec(w%lev(1)%sys, w%u, w%rhs, -1.0_dp, 1.0_dp)
       do d = 1, w%nd
@@ -388,7 +393,7 @@ contains
       ! a speed-dependent mu's sliding forces start from the velocity at the step's start,
       ! whatever an earlier trial of the step left in them (follow_forces takes them on)
       if (w%nf > 0) call start_forces(model%dev, w)
-      call predict(w%n, h, w%lev(lv)%g1h, w%lev(lv)%b2h2, ag1, w%mass, w%u, w%v, w%a, w%tmp, w%u1, w%rhs)
+      call predict(w%n, h, w%lev(lv)%g1h, w%lev(lv)%b2h2, ag1, w%mr, w%u, w%v, w%a, w%tmp, w%u1, w%rhs)
       call spd_kc_matvec(w%lev(lv)%sys, w%u1, w%tmp, w%rhs, -1.0_dp)
       call device_loads(model, w%n, w%nd, w%st, w%u1, w%tmp, w%lev(lv)%c0, w%rhs, w%s1, w%sd1, w%fw)
       call spd_solve(w%lev(lv)%sys, w%rhs, error)
@@ -484,11 +489,12 @@ contains
    end subroutine move_forces
 
    !> Predictors v~ = v + (1 - gamma) h a (in vt), u~ = u + h v + (1/2 - beta) h^2 a (in ut),
-   !> and the table's inertia load -M ag1 (in rhs).
+   !> and the table's inertia load -M r ag1 (in rhs).
    pure subroutine predict(n, h, g1h, b2h2, ag1, mass, u, v, a, vt, ut, rhs)
       integer, intent(in) :: n
       real(dp), intent(in) :: h, g1h, b2h2, ag1
-      real(dp), intent(in) :: mass(n), u(n), v(n), a(n)
+      real(dp), intent(in) :: mass(n)   !! M r, the load of a unit table acceleration
+      real(dp), intent(in) :: u(n), v(n), a(n)
       real(dp), intent(out) :: vt(n), ut(n), rhs(n)
       integer :: i
 
@@ -790,7 +796,7 @@ contains
       logical :: changed_k, any_force
 
       ! energy of the step, forces at both ends in the step's phases; the state moves on
-      call step_energy(w%n, w%mass, w%u, w%v, w%a, w%u1, w%v1, w%a1, w%tmp, w%rhs, ein)
+      call step_energy(w%n, w%mr, w%u, w%v, w%a, w%u1, w%v1, w%a1, w%tmp, w%rhs, ein)
       ein = 0.5_dp*(w%ag + w%ag1)*ein
       call observe_work(res, -ein, 0.5_dp*viscous_work(model, w%a0, w%a1c, w%n, w%mass, w%tmp, w%rhs))
       w%ag = w%ag1
@@ -826,10 +832,11 @@ contains
    end subroutine accept
 
    !> The state moves to the trial state; du = u1 - u (in du), v + v1 (in vsum) and
-   !> sum_i m_i du_i (the input work's factor) of the step.
+   !> sum_i m_i r_i du_i (the input work's factor) of the step.
    pure subroutine step_energy(n, mass, u, v, a, u1, v1, a1, du, vsum, ein)
       integer, intent(in) :: n
-      real(dp), intent(in) :: mass(n), u1(n), v1(n), a1(n)
+      real(dp), intent(in) :: mass(n)   !! M r
+      real(dp), intent(in) :: u1(n), v1(n), a1(n)
       real(dp), intent(inout) :: u(n), v(n), a(n)
       real(dp), intent(out) :: du(n), vsum(n), ein
       integer :: i
@@ -845,7 +852,7 @@ contains
       end do
    end subroutine step_energy
 
-   !> (v + v1)' C du of a step, C = a0 M + a1 K, K from the springs (no matrix product).
+   !> (v + v1)' C du of a step, C = a0 M + a1 K, K from the springs and K_x (no matrix product).
    pure real(dp) function viscous_work(model, a0, a1, n, mass, du, vsum) result(e)
       type(model_type), intent(in) :: model
       real(dp), intent(in) :: a0, a1
@@ -876,6 +883,7 @@ contains
             end if
             ek = ek + model%spring_k(s)*x*y
          end do
+         if (model%n_kx > 0) ek = ek + general_form(model, du, vsum)
          e = e + a1*ek
       end if
    end function viscous_work
@@ -932,7 +940,8 @@ contains
       end do
    end subroutine phase_statistics
 
-   !> Strain energy of the springs, 1/2 u' K u = sum_s k_s (u_i - u_j)^2 / 2 (no cancellation).
+   !> Strain energy of the structure, 1/2 u' K u: the springs' sum_s k_s (u_i - u_j)^2 / 2 (no
+   !> cancellation) and K_x's.
    pure real(dp) function strain_energy(model, u) result(e)
       type(model_type), intent(in) :: model
       real(dp), intent(in) :: u(:)
@@ -946,6 +955,7 @@ contains
          if (model%spring_j(s) > 0) x = x - u(model%spring_j(s))
          e = e + model%spring_k(s)*x*x
       end do
+      if (model%n_kx > 0) e = e + general_form(model, u, u)
       e = 0.5_dp*e
    end function strain_energy
 
