@@ -257,6 +257,8 @@ USED_IN = {
     ("excitation", "record_scale"): ["record"], ("excitation", "record_format"): ["record"],
     ("excitation", "record_units"): ["record"],
     ("excitation", "dt_record"): [None, "record", "at2"],
+    ("floors", "inertia"): ["floor inertia"], ("floor_braces", "eps"): ["floor velocity"],
+    ("floor_braces", "law"): [None, "floor velocity"],
     ("excitation", "duration"): [None, "record", "at2"],
     ("friction", "f"): ["hysteretic"], ("friction", "eps1"): ["hysteretic"],
     ("isolators", "f"): ["hysteretic isolator"], ("isolators", "eps1"): ["hysteretic isolator"],
@@ -271,12 +273,40 @@ def extreme_cases():
                     yield group, var, context, value
 
 
+FLOOR_GROUPS = ("floors", "frames", "floor_braces")
+
+
+def floor_groups() -> dict[str, dict]:
+    """A short run of a building of rigid floors: two floors, two frames a storey, one brace
+    with a friction damper a storey, under a harmonic table motion along 30 degrees."""
+    return {
+        "floors": {"n_floors": 2, "mass": [2.0e5, 2.0e5], "plan_x": [20.0, 20.0], "plan_y": [12.0, 12.0],
+                   "cm_x": [0.0, 0.5], "cm_y": [0.0, 0.0], "height": [3.0, 3.0], "excitation_angle": 30.0},
+        "frames": {"n_frames": 4, "storey": [1, 1, 2, 2], "angle": [0.0, 90.0, 0.0, 90.0],
+                   "x": [0.0, 5.0, 0.0, 5.0], "y": [3.0, 0.0, 3.0, 0.0], "k": [2.0e8, 2.0e8, 1.0e8, 1.0e8]},
+        "damping": {"damping_type": "rayleigh", "rayleigh_a0": 0.1, "rayleigh_a1": 0.001},
+        "floor_braces": {"n_braces": 2, "storey": [1, 2], "angle": [45.0, 45.0], "x": [-4.0, -4.0],
+                         "y": [2.0, 2.0], "slip_load": [1.0e5, 5.0e4], "stiffness": [1.0e8, 1.0e8],
+                         "eps1": [1.0e-3, 1.0e-3], "label": ["b1", "b2"]},
+        "excitation": {"excitation_type": "harmonic", "amplitude": 0.01, "frequency": 2.0,
+                       "dt_record": 0.005, "duration": 0.1},
+        "output": {"dir": "out"},
+    }
+
+
 def deck_with(group: str, var: str, context: str | None, value) -> tuple[dict, dict]:
     """The deck of the context with `value` given to the variable (its last element when the
     deck gives a list), and the deck that does not give that element (what a value taken for
     "not given" ran as)."""
-    g = base_groups()
-    if context:
+    g = floor_groups() if group in FLOOR_GROUPS else base_groups()
+    if context == "floor inertia":
+        g["floors"].pop("plan_x")
+        g["floors"].pop("plan_y")
+        g["floors"]["inertia"] = [1.0e7, 1.0e7]
+    elif context == "floor velocity":
+        g["floor_braces"].pop("stiffness")
+        g["floor_braces"].update(law=["velocity", "velocity"], eps=[1.0e-3, 1.0e-3])
+    elif context:
         cgroup, changes = CONTEXTS[context]
         if "mu_law" in changes:
             g[cgroup].pop("mu")
@@ -335,6 +365,7 @@ USED = {
     ("friction", "eps1"): _runs,
     ("braces", "eps1"): _runs,
     ("isolators", "eps1"): _runs,
+    ("floor_braces", "eps1"): _runs,
 }
 
 

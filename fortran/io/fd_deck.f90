@@ -26,14 +26,16 @@ module fd_deck
                        default_write_history, default_max_history_mb, linear_systems, default_linear_system, &
                        refinements, default_refinement
    use fd_model, only: model_type, integration_type, device_type, output_type
-   use fd_kinematics, only: set_pair_directions
+   use fd_kinematics, only: set_pair_directions, append_device
    use fd_excitation, only: excitation_type
    use fd_record, only: read_record, record_info, record_formats, record_units_list, units_factor
    use fd_names, only: label_len, max_mu_points, mu_laws, mu_constant, mu_exponential, mu_table, mode_systems, &
                        system_stuck, law_hysteretic, &
                        default_mu_law, default_mode_system, default_n_modes, default_radius, &
                        default_storey_height, law_name
-   use fd_model, only: source_friction, source_brace, source_isolator
+   use fd_model, only: source_friction, source_brace, source_isolator, source_floor_brace
+   use fd_floors, only: floor_dof, plan_direction, floor_inertia, max_plan_terms
+   use fd_stiffness, only: add_general_entry
    use fd_friction, only: law_mu_of_speed
    use fd_matrices, only: modes_type, natural_modes, natural_modes_sparse, stiffness_matrix, modes_dense_dofs
    use fd_sha256, only: sha256_text
@@ -50,6 +52,7 @@ module fd_deck
    integer, parameter :: max_dof = 1000000      !! DOFs (n_dof)
    integer, parameter :: max_springs = 4000000  !! springs (n_springs)
    integer, parameter :: max_devices = 1000000  !! friction devices (n_devices)
+   integer, parameter :: max_floors = max_dof/3 !! rigid floors (n_floors), three DOFs each
    !> What the variables read hold before the read: a filler only. Whether the deck gives a
    !> value is read from its text (given_elements), never from a value: any value a deck can
    !> write, this one too, is a value given.
@@ -125,13 +128,23 @@ contains
       type(run_config), intent(inout) :: cfg
       type(error_type), allocatable, intent(out) :: error
       integer :: stat
+      logical :: floors
 
       cfg%deck_path = deck%path
       call check_groups(deck, [character(len=12) :: 'model', 'springs', 'damping', 'friction', &
-                               'braces', 'isolators', 'storeys', &
+                               'braces', 'isolators', 'storeys', 'floors', 'frames', 'floor_braces', &
                                'excitation', 'integration', 'output'], error)
       if (allocated(error)) return
-      call read_model_group(deck, cfg, error)
+      ! the DOFs: a building of rigid floors (&floors, &frames), or masses (&model, &springs)
+      call read_floors_group(deck, cfg, floors, error)
+      if (allocated(error)) return
+      call one_model(deck, floors, error)
+      if (allocated(error)) return
+      if (floors) then
+         call read_frames_group(deck, cfg, error)
+      else
+         call read_model_group(deck, cfg, error)
+      end if
       if (allocated(error)) return
       call read_springs_group(deck, cfg, error)
       if (allocated(error)) return
@@ -144,7 +157,7 @@ contains
       if (allocated(error)) return
       call read_isolators_group(deck, cfg, error)
       if (allocated(error)) return
-      call read_storeys_group(deck, cfg, error)
+      if (.not. floors) call read_storeys_group(deck, cfg, error)
       if (allocated(error)) return
       ! each device's direction from its two nodes (fd_kinematics)
       call set_pair_directions(cfg%model, stat)
@@ -152,6 +165,9 @@ contains
          call no_memory(deck, 'friction', cfg%model%n_devices, 'device directions', error)
          return
       end if
+      ! the braces at plan positions of rigid floors: devices of any direction
+      if (floors) call read_floor_braces_group(deck, cfg, error)
+      if (allocated(error)) return
       call read_excitation_group(deck, cfg, error)
       if (allocated(error)) return
       call read_integration_group(deck, cfg, error)
@@ -162,6 +178,36 @@ contains
       ! the session, fd_technique's check_technique)
       call resolve_rayleigh(deck, cfg, error)
    end subroutine read_groups
+
+   !> The model is one of two kinds: masses (&model) or rigid floors (&floors, &frames,
+   !> &floor_braces); the groups of the other kind are refused, and &storeys with floors.
+   subroutine one_model(deck, floors, error)
+      type(deck_text), intent(in) :: deck
+      logical, intent(in) :: floors                       !! &floors is given
+      type(error_type), allocatable, intent(out) :: error
+      type(group_text) :: grp
+      character(len=12), parameter :: names(4) = [character(len=12) :: 'model', 'storeys', 'frames', &
+                                                  'floor_braces']
+      character(len=12) :: name
+      logical :: found
+      integer :: k
+
+      do k = 1, 4
+         name = names(k)
+         if ((k <= 2) .neqv. floors) cycle
+         call find_group(deck, trim(name), grp, found, error)
+         if (allocated(error)) return
+         if (.not. found) cycle
+         if (floors) then
+            call fatal_error(error, deck%path//": group &"//trim(name)//" is not for a building of &floors: "// &
+                             "its DOFs and storeys are the floors'")
+         else
+            call fatal_error(error, deck%path//": group &"//trim(name)//" is for a building of rigid floors: "// &
+                             "give &floors (or leave it out)")
+         end if
+         return
+      end do
+   end subroutine one_model
 
    ! ---------------------------------------------------------------- &model
    subroutine read_model_group(deck, cfg, error)
@@ -230,10 +276,22 @@ contains
       type(group_text) :: grp
       character(len=512) :: msg
       integer :: ios, i, n
-      logical :: more
+      logical :: more, found
 
       n_springs = unset_int
-      call required_group(deck, 'springs', grp, error)
+      if (cfg%model%n_floors > 0) then
+         ! a building of rigid floors: springs between its DOFs are optional
+         call find_group(deck, 'springs', grp, found, error)
+         if (allocated(error)) return
+         if (.not. found) then
+            cfg%model%n_springs = 0
+            allocate (cfg%model%spring_i(0), cfg%model%spring_j(0), cfg%model%spring_k(0), &
+                      cfg%model%spring_source(0))
+            return
+         end if
+      else
+         call required_group(deck, 'springs', grp, error)
+      end if
       if (allocated(error)) return
       i = array_capacity(grp, 'n_springs', max_springs)
       allocate (node_i(i), node_j(i), k(i), stat=ios)
@@ -793,6 +851,316 @@ contains
       end do
       list = x(1:m)
    end subroutine history_list
+   ! ---------------------------------------------------------------- &floors
+   !> A building of rigid floors (fd_floors): floor f has the DOFs ux, uy, rz at its centre
+   !> of mass, its mass and rotational inertia (given, or from its plan dimensions). The
+   !> table motion acts along excitation_angle in plan (the influence vector r).
+   subroutine read_floors_group(deck, cfg, found, error)
+      type(deck_text), intent(in) :: deck
+      type(run_config), intent(inout) :: cfg
+      logical, intent(out) :: found
+      type(error_type), allocatable, intent(out) :: error
+      integer :: n_floors
+      real(dp), allocatable :: mass(:), inertia(:), plan_x(:), plan_y(:), cm_x(:), cm_y(:), height(:)
+      real(dp) :: excitation_angle, c, s
+      character(len=label_len), allocatable :: label(:)
+      namelist /floors/ n_floors, mass, inertia, plan_x, plan_y, cm_x, cm_y, height, label, excitation_angle
+      type(group_text) :: grp
+      character(len=512) :: msg
+      character(len=:), allocatable :: idx
+      logical, allocatable :: g_in(:), g_px(:), g_py(:)
+      integer :: ios, i, n, f
+      logical :: more
+
+      n_floors = unset_int
+      excitation_angle = 0.0_dp
+      call find_group(deck, 'floors', grp, found, error)
+      if (allocated(error) .or. .not. found) return
+      i = array_capacity(grp, 'n_floors', max_floors)
+      allocate (mass(i), inertia(i), plan_x(i), plan_y(i), cm_x(i), cm_y(i), height(i), label(i), stat=ios)
+      if (ios /= 0) then
+         call no_memory(deck, 'floors', i, 'floors', error); return
+      end if
+      mass = unset; inertia = unset; plan_x = unset; plan_y = unset; cm_x = unset; cm_y = unset; height = unset
+      label = ''
+      call check_length(deck, grp, 'label', label_len - 1, error)
+      if (allocated(error)) return
+      do
+         read (grp%lines, nml=floors, iostat=ios, iomsg=msg)
+         call next_read(deck, grp, ios, msg, more, error)
+         if (.not. more) exit
+      end do
+      if (allocated(error)) return
+      call need_int(deck, 'floors', 'n_floors', n_floors, is_given(grp, 'n_floors'), 1, max_floors, error)
+      if (allocated(error)) return
+      n = n_floors
+      call need_reals(deck, 'floors', 'mass', mass, given_of(grp, 'mass', size(mass)), n, 'kg', error, positive=.true.)
+      if (allocated(error)) return
+      call optional_reals(deck, 'floors', 'cm_x', cm_x, given_of(grp, 'cm_x', size(cm_x)), n, 0.0_dp, 'm', error)
+      if (allocated(error)) return
+      call optional_reals(deck, 'floors', 'cm_y', cm_y, given_of(grp, 'cm_y', size(cm_y)), n, 0.0_dp, 'm', error)
+      if (allocated(error)) return
+      call optional_reals(deck, 'floors', 'height', height, given_of(grp, 'height', size(height)), n, &
+                          default_storey_height, 'm', error)
+      if (allocated(error)) return
+      g_in = given_of(grp, 'inertia', size(inertia))
+      g_px = given_of(grp, 'plan_x', size(plan_x))
+      g_py = given_of(grp, 'plan_y', size(plan_y))
+      do f = 1, n
+         idx = '('//trim(fmt_int(f))//')'
+         if (g_in(f) .eqv. (g_px(f) .or. g_py(f))) then
+            call bad(deck, 'floors', 'inertia'//idx, merge('given      ', '(not given)', g_in(f)), &
+                     'given alone, or replaced by plan_x'//idx//' and plan_y'//idx//' (a uniform rectangle)', error)
+            return
+         end if
+         if (g_px(f) .neqv. g_py(f)) then
+            call bad(deck, 'floors', merge('plan_y', 'plan_x', g_px(f))//idx, '(not given)', &
+                     'given with '//merge('plan_x', 'plan_y', g_px(f))//idx, error)
+            return
+         end if
+         if (.not. g_in(f)) then
+            call need_real(deck, 'floors', 'plan_x'//idx, plan_x(f), .true., 'm', error, positive=.true.)
+            if (allocated(error)) return
+            call need_real(deck, 'floors', 'plan_y'//idx, plan_y(f), .true., 'm', error, positive=.true.)
+            if (allocated(error)) return
+            inertia(f) = floor_inertia(mass(f), plan_x(f), plan_y(f))
+         else
+            call need_real(deck, 'floors', 'inertia'//idx, inertia(f), .true., 'kg m2', error, positive=.true.)
+            if (allocated(error)) return
+         end if
+         if (height(f) < 0.0_dp) then
+            call bad(deck, 'floors', 'height'//idx, trim(fmt_real(height(f))), '>= 0 m (0 = not given)', error)
+            return
+         end if
+      end do
+      call check_real(deck, 'floors', 'excitation_angle', excitation_angle, -360.0_dp, 360.0_dp, 'deg', error)
+      if (allocated(error)) return
+      call check_labels(deck, grp, 'floors', label, n, error)
+      if (allocated(error)) return
+      cfg%model%n_dof = 3*n
+      allocate (cfg%model%mass(3*n), cfg%model%u0(3*n), cfg%model%v0(3*n), cfg%model%dof_label(3*n), &
+                cfg%model%influence(3*n), cfg%model%floor_x(n), cfg%model%floor_y(n), &
+                cfg%model%floor_height(n))
+      cfg%model%u0 = 0.0_dp
+      cfg%model%v0 = 0.0_dp
+      c = cos(excitation_angle*acos(-1.0_dp)/180.0_dp)
+      s = sin(excitation_angle*acos(-1.0_dp)/180.0_dp)
+      if (modulo(excitation_angle, 90.0_dp) == 0.0_dp) then
+         c = real(nint(c), dp); s = real(nint(s), dp)
+      end if
+      do f = 1, n
+         if (len_trim(label(f)) == 0) label(f) = 'floor '//trim(fmt_int(f))
+         cfg%model%mass(floor_dof(f, [1, 2, 3])) = [mass(f), mass(f), inertia(f)]
+         cfg%model%influence(floor_dof(f, [1, 2, 3])) = [c, s, 0.0_dp]
+         cfg%model%dof_label(floor_dof(f, 1)) = trim(label(f))//' ux'
+         cfg%model%dof_label(floor_dof(f, 2)) = trim(label(f))//' uy'
+         cfg%model%dof_label(floor_dof(f, 3)) = trim(label(f))//' rz'
+         cfg%model%floor_x(f) = cm_x(f)
+         cfg%model%floor_y(f) = cm_y(f)
+      end do
+      cfg%model%n_floors = n
+      cfg%model%floor_height = height(1:n)
+      ! storeys: s along x (2s - 1) and along y (2s), between the floors' centres of mass
+      cfg%model%n_storeys = 2*n
+      allocate (cfg%model%storey_i(2*n), cfg%model%storey_j(2*n), cfg%model%storey_height(2*n), &
+                cfg%model%storey_label(2*n), cfg%model%xs_storey(0), cfg%model%xs_dof(0), cfg%model%xs_coef(0), &
+                cfg%model%xd_storey(0), cfg%model%xd_dev(0), cfg%model%xd_coef(0))
+      do f = 1, n
+         do i = 1, 2
+            cfg%model%storey_i(2*f - 2 + i) = floor_dof(f, i)
+            cfg%model%storey_j(2*f - 2 + i) = merge(floor_dof(f - 1, i), 0, f > 1)
+            cfg%model%storey_height(2*f - 2 + i) = height(f)
+            cfg%model%storey_label(2*f - 2 + i) = 'storey '//trim(fmt_int(f))//' '//merge('x', 'y', i == 1)
+         end do
+      end do
+   end subroutine read_floors_group
+
+   ! ---------------------------------------------------------------- &frames
+   !> The lateral elements of a building of rigid floors: frame or wall e of storey s
+   !> (between floor s and floor s - 1, 0 the ground) a shear spring k along angle in plan
+   !> through the point (x, y), added to K as k b b' (fd_floors' plan_direction).
+   subroutine read_frames_group(deck, cfg, error)
+      type(deck_text), intent(in) :: deck
+      type(run_config), intent(inout) :: cfg
+      type(error_type), allocatable, intent(out) :: error
+      integer :: n_frames
+      integer, allocatable :: storey(:)
+      real(dp), allocatable :: angle(:), x(:), y(:), k(:)
+      namelist /frames/ n_frames, storey, angle, x, y, k
+      type(group_text) :: grp
+      character(len=512) :: msg
+      integer :: dof(max_plan_terms), ios, i, n, nt, m
+      real(dp) :: coef(max_plan_terms), w
+      real(dp), parameter :: pi = acos(-1.0_dp)
+      logical :: found, more
+
+      n_frames = unset_int
+      call find_group(deck, 'frames', grp, found, error)
+      if (allocated(error)) return
+      if (.not. found) then
+         call fatal_error(error, deck%path//": group &frames is missing: a building of &floors needs its frames")
+         return
+      end if
+      i = array_capacity(grp, 'n_frames', max_springs)
+      allocate (storey(i), angle(i), x(i), y(i), k(i), stat=ios)
+      if (ios /= 0) then
+         call no_memory(deck, 'frames', i, 'frames', error); return
+      end if
+      storey = unset_int; angle = unset; x = unset; y = unset; k = unset
+      do
+         read (grp%lines, nml=frames, iostat=ios, iomsg=msg)
+         call next_read(deck, grp, ios, msg, more, error)
+         if (.not. more) exit
+      end do
+      if (allocated(error)) return
+      call need_int(deck, 'frames', 'n_frames', n_frames, is_given(grp, 'n_frames'), 1, max_springs, error)
+      if (allocated(error)) return
+      n = n_frames
+      call plan_elements(deck, 'frames', grp, cfg, n, storey, angle, x, y, error)
+      if (allocated(error)) return
+      call need_reals(deck, 'frames', 'k', k, given_of(grp, 'k', size(k)), n, 'N/m', error, positive=.true.)
+      if (allocated(error)) return
+      allocate (cfg%model%kx_i(0), cfg%model%kx_j(0), cfg%model%kx_v(0))
+      cfg%model%n_kx = 0
+      do i = 1, n
+         call plan_direction(storey(i), angle(i), x(i), y(i), cfg%model%floor_x, cfg%model%floor_y, &
+                             dof, coef, nt)
+         call add_general_entry(cfg%model, dof(1:nt), coef(1:nt), k(i))
+         ! its force k b' u along x and y in the shear of its storey
+         do m = 1, 2
+            w = k(i)*merge(cos(angle(i)*pi/180.0_dp), sin(angle(i)*pi/180.0_dp), m == 1)
+            if (modulo(angle(i), 90.0_dp) == 0.0_dp) w = k(i)*real(nint(w/k(i)), dp)
+            if (w == 0.0_dp) cycle
+            cfg%model%xs_storey = [cfg%model%xs_storey, spread(2*storey(i) - 2 + m, 1, nt)]
+            cfg%model%xs_dof = [cfg%model%xs_dof, dof(1:nt)]
+            cfg%model%xs_coef = [cfg%model%xs_coef, w*coef(1:nt)]
+         end do
+      end do
+   end subroutine read_frames_group
+
+   !> The plan position of the elements of a group of a building of rigid floors: storey
+   !> (1..n_floors), angle [deg], and a point (x, y) of the element's line [m].
+   subroutine plan_elements(deck, group, grp, cfg, n, storey, angle, x, y, error)
+      type(deck_text), intent(in) :: deck
+      character(len=*), intent(in) :: group
+      type(group_text), intent(in) :: grp
+      type(run_config), intent(in) :: cfg
+      integer, intent(in) :: n
+      integer, intent(in) :: storey(:)
+      real(dp), intent(inout) :: angle(:), x(:), y(:)
+      type(error_type), allocatable, intent(out) :: error
+
+      call node_list(deck, group, 'storey', storey, given_of(grp, 'storey', size(storey)), n, 1, &
+                     cfg%model%n_floors, error)
+      if (allocated(error)) return
+      call signed_reals(deck, group, 'angle', angle, given_of(grp, 'angle', size(angle)), n, 'deg', error)
+      if (allocated(error)) return
+      call signed_reals(deck, group, 'x', x, given_of(grp, 'x', size(x)), n, 'm', error)
+      if (allocated(error)) return
+      call signed_reals(deck, group, 'y', y, given_of(grp, 'y', size(y)), n, 'm', error)
+   end subroutine plan_elements
+
+   ! ---------------------------------------------------------------- &floor_braces
+   !> Braces with a friction damper at plan positions of a building of rigid floors: brace
+   !> b of storey s along angle through (x, y), a device of direction b (fd_floors) that
+   !> slips at slip_load. law = 'hysteretic' (default): the damper in series with a brace of
+   !> the given stiffness (f = slip_load / stiffness, as &braces); 'velocity' or 'coulomb':
+   !> a rigid brace (P mu = slip_load, the velocity law's band eps).
+   subroutine read_floor_braces_group(deck, cfg, error)
+      type(deck_text), intent(in) :: deck
+      type(run_config), intent(inout) :: cfg
+      type(error_type), allocatable, intent(out) :: error
+      integer :: n_braces
+      integer, allocatable :: storey(:)
+      real(dp), allocatable :: angle(:), x(:), y(:), slip_load(:), stiffness(:), eps1(:), eps(:)
+      character(len=label_len), allocatable :: label(:)
+      character(len=name_len), allocatable :: law(:)
+      namelist /floor_braces/ n_braces, storey, angle, x, y, slip_load, stiffness, eps1, eps, law, label
+      type(group_text) :: grp
+      type(device_type) :: dev
+      character(len=512) :: msg
+      character(len=:), allocatable :: idx
+      logical, allocatable :: g_k(:)
+      integer :: dof(max_plan_terms), ios, i, n, nt, id, m
+      real(dp) :: coef(max_plan_terms), w
+      real(dp), parameter :: pi = acos(-1.0_dp)
+      logical :: found, more
+
+      n_braces = 0
+      call find_group(deck, 'floor_braces', grp, found, error)
+      if (allocated(error) .or. .not. found) return
+      i = array_capacity(grp, 'n_braces', max_devices)
+      allocate (storey(i), angle(i), x(i), y(i), slip_load(i), stiffness(i), eps1(i), eps(i), label(i), law(i), &
+                stat=ios)
+      if (ios /= 0) then
+         call no_memory(deck, 'floor_braces', i, 'braces', error); return
+      end if
+      storey = unset_int; angle = unset; x = unset; y = unset; slip_load = unset; stiffness = unset
+      eps1 = unset; eps = unset; label = ''; law = 'hysteretic'
+      call check_length(deck, grp, 'label', label_len - 1, error)
+      if (allocated(error)) return
+      do
+         read (grp%lines, nml=floor_braces, iostat=ios, iomsg=msg)
+         call next_read(deck, grp, ios, msg, more, error)
+         if (.not. more) exit
+      end do
+      if (allocated(error)) return
+      call need_int(deck, 'floor_braces', 'n_braces', n_braces, .true., 0, max_devices - cfg%model%n_devices, error)
+      if (allocated(error)) return
+      n = n_braces
+      call plan_elements(deck, 'floor_braces', grp, cfg, n, storey, angle, x, y, error)
+      if (allocated(error)) return
+      call need_reals(deck, 'floor_braces', 'slip_load', slip_load, given_of(grp, 'slip_load', size(slip_load)), n, &
+                      'N', error, positive=.true.)
+      if (allocated(error)) return
+      call optional_reals(deck, 'floor_braces', 'eps1', eps1, given_of(grp, 'eps1', size(eps1)), n, default_eps1, &
+                          'm/s', error, positive=.true.)
+      if (allocated(error)) return
+      call optional_reals(deck, 'floor_braces', 'eps', eps, given_of(grp, 'eps', size(eps)), n, default_eps, &
+                          'm/s', error, positive=.true.)
+      if (allocated(error)) return
+      call check_labels(deck, grp, 'floor_braces', label, n, error)
+      if (allocated(error)) return
+      g_k = given_of(grp, 'stiffness', size(stiffness))
+      do i = 1, n
+         idx = '('//trim(fmt_int(i))//')'
+         call device_law(deck, 'floor_braces', i, law(i), id, error)
+         if (allocated(error)) return
+         if (id == law_hysteretic) then
+            call need_real(deck, 'floor_braces', 'stiffness'//idx, stiffness(i), g_k(i), 'N/m', error, positive=.true.)
+            if (allocated(error)) return
+            call check_magnitude(deck, 'floor_braces', 'slip_load'//idx//' / stiffness'//idx, &
+                                 slip_load(i)/stiffness(i), 'm', .true., error)
+            if (allocated(error)) return
+            dev = device_type(law=law_hysteretic, p=slip_load(i), mu=1.0_dp, eps1=eps1(i), f=slip_load(i)/stiffness(i))
+         else
+            if (g_k(i)) then
+               call bad(deck, 'floor_braces', 'stiffness'//idx, trim(fmt_real(stiffness(i))), &
+                        "not given: law"//idx//" = '"//trim(law(i))//"' has a rigid brace (law 'hysteretic' "// &
+                        "takes the brace's stiffness)", error)
+               return
+            end if
+            dev = device_type(law=id, p=slip_load(i), mu=1.0_dp, eps=eps(i), eps1=eps1(i))
+         end if
+         dev%label = label(i)
+         if (len_trim(label(i)) == 0) dev%label = 'floor brace '//trim(fmt_int(i))
+         dev%source = source_floor_brace
+         dev%source_index = i
+         call plan_direction(storey(i), angle(i), x(i), y(i), cfg%model%floor_x, cfg%model%floor_y, &
+                             dof, coef, nt)
+         call append_device(cfg%model, dev, dof(1:nt), coef(1:nt), ios)
+         ! its force along x and y in the shear of its storey
+         do m = 1, 2
+            w = merge(cos(angle(i)*pi/180.0_dp), sin(angle(i)*pi/180.0_dp), m == 1)
+            if (modulo(angle(i), 90.0_dp) == 0.0_dp) w = real(nint(w), dp)
+            if (w == 0.0_dp) cycle
+            cfg%model%xd_storey = [cfg%model%xd_storey, 2*storey(i) - 2 + m]
+            cfg%model%xd_dev = [cfg%model%xd_dev, cfg%model%n_devices]
+            cfg%model%xd_coef = [cfg%model%xd_coef, w]
+         end do
+      end do
+   end subroutine read_floor_braces_group
+
    ! ---------------------------------------------------------------- &braces
    !> Friction dampers in series with an elastic brace (Pall type), a shorthand: brace b
    !> becomes a hysteretic device with P mu = slip_load (p = slip_load, mu = 1) and
@@ -1695,6 +2063,30 @@ contains
       end do
       call no_extra(deck, group, var, x, given, n, error)
    end subroutine need_reals
+
+   !> Values that must be given, finite and of either sign (a plan coordinate, an angle).
+   subroutine signed_reals(deck, group, var, x, given, n, unit, error)
+      type(deck_text), intent(in) :: deck
+      character(len=*), intent(in) :: group, var, unit
+      real(dp), intent(in) :: x(:)
+      logical, intent(in) :: given(:)                     !! the elements the deck gives
+      integer, intent(in) :: n
+      type(error_type), allocatable, intent(out) :: error
+      character(len=:), allocatable :: name
+      integer :: i
+      do i = 1, n
+         name = var//'('//trim(fmt_int(i))//')'
+         if (.not. given(i)) then
+            call fatal_error(error, deck%path//", group &"//group//": "//name//" is not given"); return
+         end if
+         if (.not. ieee_is_finite(x(i))) then
+            call bad(deck, group, name, trim(fmt_real(x(i))), 'a finite number', error); return
+         end if
+         call check_magnitude(deck, group, name, abs(x(i)), unit, .false., error)
+         if (allocated(error)) return
+      end do
+      call no_extra(deck, group, var, x, given, n, error)
+   end subroutine signed_reals
 
    !> Values not given take a default; given ones must be finite (and > 0 if positive).
    subroutine optional_reals(deck, group, var, x, given, n, default, unit, error, positive)

@@ -8,11 +8,11 @@
 !> for the two nodes, and refuse a model whose devices are not all between two nodes.
 module fd_kinematics
    use fd_kinds, only: dp
-   use fd_model, only: model_type
+   use fd_model, only: model_type, device_type
    implicit none
    private
 
-   public :: set_pair_directions, pair_terms
+   public :: set_pair_directions, pair_terms, append_device
    public :: device_kinematics, device_relative, device_abs_relative, add_device
    public :: relative_motion, device_forces
    public :: add_device_abs, add_device_outer, pair_nodes, device_nodes, devices_are_pairs, moved_mass
@@ -45,6 +45,28 @@ contains
       call pair_terms(model%dev_nodes(1, :), model%dev_nodes(2, :), model%dev_ptr, model%dev_dof, &
                       model%dev_coef)
    end subroutine set_pair_directions
+
+   !> Device `dev` appended to the model with the direction b of terms (dof, coef), after
+   !> the devices whose directions are set (set_pair_directions first). The model's devices
+   !> are then no longer all pairs when b is not one. stat /= 0: not enough memory.
+   pure subroutine append_device(model, dev, dof, coef, stat)
+      type(model_type), intent(inout) :: model  !! the model
+      type(device_type), intent(in) :: dev      !! the device (node_i = node_j = 0)
+      integer, intent(in) :: dof(:)             !! DOFs of b's terms (distinct, 1..n_dof)
+      real(dp), intent(in) :: coef(:)           !! their coefficients (not 0)
+      integer, intent(out) :: stat              !! 0, or the allocation's status
+      integer :: nd, nt
+
+      nd = model%n_devices
+      nt = model%dev_ptr(nd + 1) - 1
+      model%dev = [model%dev(1:nd), dev]
+      model%dev_dof = [model%dev_dof(1:nt), dof]
+      model%dev_coef = [model%dev_coef(1:nt), coef]
+      model%dev_ptr = [model%dev_ptr(1:nd + 1), nt + size(dof) + 1]
+      model%n_devices = nd + 1
+      if (allocated(model%dev_nodes)) deallocate (model%dev_nodes)
+      stat = 0
+   end subroutine append_device
 
    !> The compressed directions of two-node elements: e_i - e_j, e_i when j = 0 (and -e_j
    !> when i = 0). ptr has size(ni) + 1 entries, dof and coef at least 2 size(ni).

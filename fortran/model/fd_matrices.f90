@@ -75,14 +75,19 @@ contains
       end if
    end function mode_damping
 
-   !> Participation of mode k in a motion of the table (every DOF along it):
-   !> phi' M 1 / phi' M phi.
-   pure real(dp) function mode_participation(modes, k, mass) result(g)
+   !> Participation of mode k in a motion of the table along r (default: every DOF along
+   !> it, r = 1): phi' M r / phi' M phi.
+   pure real(dp) function mode_participation(modes, k, mass, influence) result(g)
       type(modes_type), intent(in) :: modes !! the system's modes
       integer, intent(in) :: k              !! the mode
       real(dp), intent(in) :: mass(:)       !! the DOFs' masses [kg]
+      real(dp), intent(in), optional :: influence(:) !! r [-]
 
-      g = sum(mass*modes%shape(:, k))/sum(mass*modes%shape(:, k)**2)
+      if (present(influence)) then
+         g = sum(mass*influence*modes%shape(:, k))/sum(mass*modes%shape(:, k)**2)
+      else
+         g = sum(mass*modes%shape(:, k))/sum(mass*modes%shape(:, k)**2)
+      end if
    end function mode_participation
 
    !> Stiffness matrix of the springs (relative coordinates; node 0 is the table).

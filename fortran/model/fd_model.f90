@@ -23,13 +23,14 @@ module fd_model
    public :: technique_newmark, technique_event_driven, technique_moreau_jean, technique_name
    public :: mu_constant, mu_exponential, mu_table, label_len, max_mu_points
    public :: system_stuck, system_free
-   public :: source_friction, source_brace, source_isolator
+   public :: source_friction, source_brace, source_isolator, source_floor_brace
    public :: sliding_mu, device_parameter
 
    ! where a device (or spring) of the model comes from in the deck
    integer, parameter :: source_friction = 0  !! &friction (or &springs)
    integer, parameter :: source_brace = 1     !! &braces (a friction damper in series with a brace)
    integer, parameter :: source_isolator = 2  !! &isolators (a sliding isolator)
+   integer, parameter :: source_floor_brace = 3 !! &floor_braces (a brace at a plan position of rigid floors)
 
    !> One friction device. Its geometry is its direction b over the DOFs, kept in the model
    !> (dev_ptr, dev_dof, dev_coef) and reached only through fd_kinematics: its relative
@@ -92,6 +93,21 @@ module fd_model
       ! the table motion's direction over the DOFs, r: the load is -M r a_g (not allocated:
       ! r = 1, every DOF a translation along the table's motion)
       real(dp), allocatable :: influence(:)   !! (n_dof) [-]
+      ! a building of rigid floors (fd_floors): floor f has the DOFs 3f - 2 (ux), 3f - 1 (uy)
+      ! and 3f (rz) at its centre of mass
+      integer :: n_floors = 0                 !! floors (0: a model of masses, &model)
+      real(dp), allocatable :: floor_x(:)     !! centre of mass of each floor in plan, x [m]
+      real(dp), allocatable :: floor_y(:)     !! and y [m]
+      real(dp), allocatable :: floor_height(:) !! height of the storey below each floor [m]; 0 = not given
+      ! the forces of a storey that are no springs or devices between its two nodes (the
+      ! frames and braces of rigid floors): its shear adds sum coef (u + a1 v)(dof) over the
+      ! entries (xs_*) of the storey, and sum coef F(dev) over the entries (xd_*)
+      integer, allocatable :: xs_storey(:)    !! storey of each stiffness entry
+      integer, allocatable :: xs_dof(:)       !! its DOF
+      real(dp), allocatable :: xs_coef(:)     !! its coefficient [N/m, or N]
+      integer, allocatable :: xd_storey(:)    !! storey of each device entry
+      integer, allocatable :: xd_dev(:)       !! its device
+      real(dp), allocatable :: xd_coef(:)     !! its coefficient [-]
       ! 'rayleigh' damping given as xi at two natural modes (resolved into a0, a1 when read)
       integer :: mode_i = 0                   !! first mode (0: a0, a1 given)
       integer :: mode_j = 0                   !! second mode

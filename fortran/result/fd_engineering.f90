@@ -16,7 +16,8 @@ module fd_engineering
    use fd_error, only: error_type, fatal_error, fmt_int, stat_no_memory
    use fd_model, only: model_type, integration_type, label_len, system_stuck, system_free, &
                        damping_stiffness, damping_rayleigh
-   use fd_kinematics, only: pair_nodes
+   use fd_kinematics, only: pair_nodes, devices_are_pairs, device_relative
+   use fd_stiffness, only: add_general_times, influence_of
    use fd_excitation, only: excitation_type, excitation_harmonic
    use fd_matrices, only: modes_type, natural_modes, natural_modes_sparse, stiffness_matrix, damping_matrix, &
                           stiffness_damping_factor, modes_dense_dofs
@@ -53,6 +54,17 @@ module fd_engineering
       integer, allocatable :: dv_first(:)       !! (0:n_storeys+1): devices of cut c
       integer, allocatable :: dv_id(:)          !! device indices
       real(dp), allocatable :: dv_sign(:)       !! +1 or -1 along the cut
+      ! a general model (stiffness K_x, devices of any direction): the base shear along the
+      ! table motion r is r' (K u + a1 K v) + sum_d (b_d' r) F_d, the forces every element
+      ! passes to the table (an element inside the structure passes none: b' r = 0)
+      logical :: general = .false.              !! the base shear from kr and br
+      real(dp), allocatable :: kr(:)            !! (n_dof) K r [N/m]
+      real(dp), allocatable :: br(:)            !! (n_devices) b_d' r [-]
+      real(dp), allocatable :: r(:)             !! (n_dof) r, when the model gives one [-]
+      ! the storey forces that are no element between the storey's two nodes (rigid floors'
+      ! frames and braces), by storey: xs_first(c):xs_first(c+1)-1 and xd_first likewise
+      integer, allocatable :: xs_first(:), xs_dof(:), xd_first(:), xd_dev(:)
+      real(dp), allocatable :: xs_coef(:), xd_coef(:)
       ! values at the last state observed (the residual values at the end of the run)
       real(dp), allocatable :: drift(:)         !! (n_storeys) drift [m]
       real(dp), allocatable :: shear(:)         !! (0:n_storeys) shear, 0 = base [N]
@@ -142,7 +154,15 @@ contains
             if (len_trim(model%storey_label(s)) > 0) eng%storey_label(s) = model%storey_label(s)
          end if
       end do
+      if (allocated(model%influence)) eng%r = model%influence
+      if (model%n_kx > 0 .or. .not. devices_are_pairs(model)) then
+         call general_base(model, eng, stat)
+         if (stat /= 0) then
+            call no_memory('the base shear'); return
+         end if
+      end if
       call storey_elements(model, eng, stat)
+      if (stat == 0 .and. allocated(model%xs_storey)) call storey_extras(model, eng, stat)
       if (stat /= 0) then
          call no_memory('the elements of the storeys'); return
       end if
@@ -227,6 +247,37 @@ contains
       end function on_cut
    end subroutine storey_elements
 
+   !> The base of a general model: K r and b_d' r (r the table motion's direction).
+   subroutine general_base(model, eng, stat)
+      type(model_type), intent(in) :: model
+      type(engineering_type), intent(inout) :: eng
+      integer, intent(out) :: stat                 !! not 0: not enough memory
+      real(dp), allocatable :: r(:)
+      real(dp) :: x
+      integer :: i, j, s, d
+
+      allocate (r(model%n_dof), eng%kr(model%n_dof), eng%br(model%n_devices), stat=stat)
+      if (stat /= 0) return
+      do i = 1, model%n_dof
+         r(i) = influence_of(model, i)
+      end do
+      eng%kr = 0.0_dp
+      do s = 1, model%n_springs
+         i = model%spring_i(s); j = model%spring_j(s)
+         x = 0.0_dp
+         if (i > 0) x = r(i)
+         if (j > 0) x = x - r(j)
+         x = model%spring_k(s)*x
+         if (i > 0) eng%kr(i) = eng%kr(i) + x
+         if (j > 0) eng%kr(j) = eng%kr(j) - x
+      end do
+      call add_general_times(model, r, eng%kr)
+      do d = 1, model%n_devices
+         eng%br(d) = device_relative(model, d, r)
+      end do
+      eng%general = .true.
+   end subroutine general_base
+
    !> Drift and shear of every storey, and the base shear, at one state.
    pure subroutine storey_values(eng, u, v, force, drift, shear, base)
       type(engineering_type), intent(in) :: eng  !! the set-up outputs
@@ -271,6 +322,15 @@ contains
       integer :: e, i, j
 
       f = 0.0_dp
+      if (cut == 0 .and. eng%general) then
+         do i = 1, size(u)
+            f = f + eng%kr(i)*(u(i) + eng%a1*v(i))
+         end do
+         do e = 1, size(force)
+            f = f + eng%br(e)*force(e)
+         end do
+         return
+      end if
       do e = eng%sp_first(cut), eng%sp_first(cut + 1) - 1
          i = eng%sp_i(e)
          j = eng%sp_j(e)
@@ -289,7 +349,48 @@ contains
       do e = eng%dv_first(cut), eng%dv_first(cut + 1) - 1
          f = f + eng%dv_sign(e)*force(eng%dv_id(e))
       end do
+      if (.not. allocated(eng%xs_first) .or. cut == 0) return
+      do e = eng%xs_first(cut), eng%xs_first(cut + 1) - 1
+         f = f + eng%xs_coef(e)*(u(eng%xs_dof(e)) + eng%a1*v(eng%xs_dof(e)))
+      end do
+      do e = eng%xd_first(cut), eng%xd_first(cut + 1) - 1
+         f = f + eng%xd_coef(e)*force(eng%xd_dev(e))
+      end do
    end function cut_force
+
+   !> The model's storey forces beyond its storeys' elements (xs_*, xd_*), by storey.
+   subroutine storey_extras(model, eng, stat)
+      type(model_type), intent(in) :: model
+      type(engineering_type), intent(inout) :: eng
+      integer, intent(out) :: stat                 !! not 0: not enough memory
+      integer :: ns, c, e, k
+
+      ns = eng%n_storeys
+      allocate (eng%xs_first(ns + 1), eng%xd_first(ns + 1), eng%xs_dof(size(model%xs_dof)), &
+                eng%xs_coef(size(model%xs_dof)), eng%xd_dev(size(model%xd_dev)), eng%xd_coef(size(model%xd_dev)), &
+                stat=stat)
+      if (stat /= 0) return
+      k = 0
+      do c = 1, ns
+         eng%xs_first(c) = k + 1
+         do e = 1, size(model%xs_storey)
+            if (model%xs_storey(e) /= c) cycle
+            k = k + 1
+            eng%xs_dof(k) = model%xs_dof(e); eng%xs_coef(k) = model%xs_coef(e)
+         end do
+      end do
+      eng%xs_first(ns + 1) = k + 1
+      k = 0
+      do c = 1, ns
+         eng%xd_first(c) = k + 1
+         do e = 1, size(model%xd_storey)
+            if (model%xd_storey(e) /= c) cycle
+            k = k + 1
+            eng%xd_dev(k) = model%xd_dev(e); eng%xd_coef(k) = model%xd_coef(e)
+         end do
+      end do
+      eng%xd_first(ns + 1) = k + 1
+   end subroutine storey_extras
 
    !> One accepted state: drifts and shears, their peaks, and the values kept as the
    !> residual ones (those of the last state observed). Runs at every accepted step: the

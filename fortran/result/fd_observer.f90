@@ -181,15 +181,21 @@ contains
       real(dp), intent(in) :: force(nd)        !! device forces [N]
       real(dp) :: x
       integer :: i
+      real(dp) :: ri
+      logical :: has_r
 
       ! (explicit shapes: this runs at every accepted step, and a call that builds array
       ! descriptors costs more than a two-mass model's peaks)
+      has_r = allocated(res%eng%r)
       do i = 1, n
          if (abs(u(i)) > res%peak_u(i)) then
             res%peak_u(i) = abs(u(i)); res%peak_u_time(i) = t
          end if
          res%peak_v(i) = max(res%peak_v(i), abs(v(i)))
-         x = abs(acc(i) + ag)
+         ! the absolute acceleration: the table's along the DOF's direction r_i added
+         ri = 1.0_dp
+         if (has_r) ri = res%eng%r(i)
+         x = abs(acc(i) + ri*ag)
          if (x > res%peak_aabs(i)) then
             res%peak_aabs(i) = x; res%peak_aabs_time(i) = t
          end if
@@ -306,7 +312,7 @@ contains
          c = 2
          if (obs%all_columns) then
             do i = 1, size(u)
-               row(c + 1) = u(i); row(c + 2) = v(i); row(c + 3) = acc(i) + ag
+               row(c + 1) = u(i); row(c + 2) = v(i); row(c + 3) = acc(i) + table_along(i)
                c = c + 3
             end do
             do i = 1, size(s)
@@ -316,7 +322,7 @@ contains
          else
             do j = 1, size(obs%dofs)
                i = obs%dofs(j)
-               row(c + 1) = u(i); row(c + 2) = v(i); row(c + 3) = acc(i) + ag
+               row(c + 1) = u(i); row(c + 2) = v(i); row(c + 3) = acc(i) + table_along(i)
                c = c + 3
             end do
             do j = 1, size(obs%devices)
@@ -370,6 +376,13 @@ contains
             if (allocated(obs%ctl%sink)) call obs%ctl%sink%put(row)
          end if
       end associate
+   contains
+      !> The table's acceleration along DOF i (r_i ag; ag when the model gives no r).
+      pure real(dp) function table_along(i) result(x)
+         integer, intent(in) :: i
+         x = ag
+         if (allocated(res%eng%r)) x = res%eng%r(i)*ag
+      end function table_along
    end subroutine observe_sample
 
    !> Called by a technique after every accepted step. Mostly a counter; every ~10 ms of

@@ -47,10 +47,18 @@ contains
       type(error_type), allocatable, intent(out) :: error !! what cannot be integrated
       type(technique_traits_type) :: traits
 
-      ! the modes of the stuck system, the storeys and the groups of the exact techniques take
-      ! each device as a link between two nodes (fd_kinematics)
-      if (.not. devices_are_pairs(model)) then
-         call fatal_error(error, "a device that is not between two nodes is integrated by no technique")
+      ! the exact techniques' phase patterns and sticking groups take each device as a link
+      ! between two nodes (fd_kinematics); Newmark takes any direction
+      if (opts%technique /= technique_newmark .and. .not. devices_are_pairs(model)) then
+         call fatal_error(error, "group &integration: technique = '"//trim(technique_name(opts%technique))// &
+                          "' takes devices between two nodes (&friction, &braces, &isolators): a brace at a "// &
+                          "plan position of rigid floors (&floor_braces) is integrated by technique = 'newmark'")
+         return
+      end if
+      if (opts%technique /= technique_newmark .and. model%n_kx > 0) then
+         call fatal_error(error, "group &integration: technique = '"//trim(technique_name(opts%technique))// &
+                          "' takes a structure of springs between two nodes: a building of rigid floors "// &
+                          "(&floors, &frames) is integrated by technique = 'newmark'")
          return
       end if
       call check_braces(model, opts%technique, error)

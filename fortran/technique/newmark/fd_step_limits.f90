@@ -147,12 +147,16 @@ contains
       do d = 1, model%n_devices
          ! a device between two DOFs (one on the table adds to a diagonal alone)
          call pair_nodes(model, d, i, j)
-         if (i == 0) cycle
-         if (j <= 0) cycle
+         if (i > 0 .and. j <= 0) cycle
          ! the sticking spring, or the sticking dashpot in the effective stiffness (the band's
          ! coupling P mu(eps) / eps, a speed-dependent mu at eps); a law has one or neither
          kd = sticking_stiffness(model%dev(d)) + opts%gamma/(opts%beta*dt1)*sticking_damping(model%dev(d))
-         ratio = kd*opts%beta*dt1**2/(model%mass(i) + model%mass(j))
+         if (i > 0) then
+            ratio = kd*opts%beta*dt1**2/(model%mass(i) + model%mass(j))
+         else
+            ! a device of any direction: against the mass it moves, 1 / (b' M^-1 b)
+            ratio = kd*opts%beta*dt1**2/moved_mass(model, d)
+         end if
          if (ratio > max_stiffness_ratio) then
             ! the variable named only here: fmt_real's shortest round trip costs about
             ! 4e5 instructions, 0.1 s a 1000 devices when it was built for every device

@@ -140,7 +140,7 @@ contains
          do k = 1, modes%n
             wn = sqrt(max(modes%omega2(k), 0.0_dp))
             c = mode_damping(modes, k, res%eng%a0)
-            gamma_k = mode_participation(modes, k, model%mass(1:n))
+            gamma_k = mode_participation(modes, k, model%mass(1:n), model%influence)
             if (technique_step_rule(res%technique) == rule_theta) then
                call theta_response(w, wn, c, res%dt1, theta, hd, ok_k)
             else

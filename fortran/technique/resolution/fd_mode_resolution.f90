@@ -21,7 +21,9 @@ module fd_mode_resolution
    use fd_names, only: technique_step_rule, rule_none
    use fd_model, only: model_type
    use fd_friction, only: sticking_stiffness
-   use fd_kinematics, only: pair_nodes
+   use fd_kinematics, only: pair_nodes, devices_are_pairs, add_device_outer
+   use fd_matrices, only: stiffness_matrix
+   use fd_linalg, only: generalized_eigen
    use fd_modes, only: highest_eigenvalue
    use fd_result, only: result_type, resolution_none, resolution_resolved, resolution_unresolved
    implicit none
@@ -50,6 +52,15 @@ contains
       res%omega_max = 0.0_dp
       if (technique_step_rule(res%technique) == rule_none) return
       if (res%dt1 <= 0.0_dp .or. model%n_dof == 0) return
+      if (model%n_kx > 0 .or. .not. devices_are_pairs(model)) then
+         ! stiffness beyond springs, or devices of any direction: the dense eigenproblem
+         call dense_highest(model, lam, error)
+         if (allocated(error)) return
+         res%omega_max = sqrt(max(lam, 0.0_dp))
+         res%mode_resolution = merge(resolution_unresolved, resolution_resolved, &
+                                     res%omega_max*res%dt1 > resolution_limit)
+         return
+      end if
       ns = model%n_springs
       nd = model%n_devices
       allocate (ei(ns + nd), ej(ns + nd), ek(ns + nd), stat=stat)
@@ -82,5 +93,40 @@ contains
          res%mode_resolution = resolution_resolved
       end if
    end subroutine mode_resolution
+
+   !> The largest eigenvalue w^2 of (K + the sticking springs' k_d b_d b_d', M) of a general
+   !> model, from the dense generalized eigenproblem.
+   subroutine dense_highest(model, lam, error)
+      type(model_type), intent(in) :: model               !! the model
+      real(dp), intent(out) :: lam                        !! largest w^2 [1/s2]
+      type(error_type), allocatable, intent(out) :: error !! no memory, solver failure
+      real(dp), allocatable :: k(:, :), m(:, :), w(:), z(:, :)
+      real(dp) :: kd
+      integer :: n, d, i, stat
+
+      n = model%n_dof
+      lam = 0.0_dp
+      allocate (k(n, n), m(n, n), w(n), z(n, n), stat=stat)
+      if (stat /= 0) then
+         call fatal_error(error, "the highest natural frequency: not enough memory for "//trim(fmt_int(n))// &
+                          " DOFs (dense matrices)", stat_no_memory)
+         return
+      end if
+      call stiffness_matrix(model, k)
+      do d = 1, model%n_devices
+         kd = sticking_stiffness(model%dev(d))
+         if (kd > 0.0_dp) call add_device_outer(model, d, kd, k)
+      end do
+      m = 0.0_dp
+      do i = 1, n
+         m(i, i) = model%mass(i)
+      end do
+      call generalized_eigen(k, m, w, z, error)
+      if (allocated(error)) then
+         error%message = "the highest natural frequency: "//error%message
+         return
+      end if
+      lam = w(n)
+   end subroutine dense_highest
 
 end module fd_mode_resolution

@@ -38,6 +38,7 @@ module fd_record_resolution
    use fd_kinds, only: dp
    use fd_error, only: error_type, fatal_error, fmt_int, stat_no_memory
    use fd_names, only: technique_step_rule, rule_none, rule_newmark, rule_theta, excitation_record
+   use fd_stiffness, only: add_general_times
    use fd_matrices, only: modes_type, modes_kept, mode_damping, mode_participation
    use fd_model, only: model_type
    use fd_friction, only: law_stuck, stuck_dashpot
@@ -260,7 +261,7 @@ contains
       c = mode_damping(modes, k, res%eng%a0)
       ps%kept(m) = wn > 0.0_dp .and. wn*ps%h < ps%limit
       if (.not. ps%kept(m)) return
-      g = mode_participation(modes, k, model%mass(1:n))
+      g = mode_participation(modes, k, model%mass(1:n), model%influence)
       call exact_step_map(wn, c, ps%h, phi, g0, g1)
       ps%ex(m, :) = [phi(1, 1), phi(1, 2), phi(2, 1), phi(2, 2), g*g0(1), g*g0(2), g*g1(1), g*g1(2)]
       if (technique_step_rule(res%technique) == rule_theta) then
@@ -379,7 +380,7 @@ contains
       end do
    end function combine
 
-   !> ku = K u, K the springs' stiffness (node 0 the table, at rest).
+   !> ku = K u, K the structure's stiffness: the springs (node 0 the table, at rest) and K_x.
    pure subroutine springs_times(model, u, ku)
       type(model_type), intent(in) :: model
       real(dp), intent(in) :: u(:)
@@ -397,6 +398,7 @@ contains
          if (i > 0) ku(i) = ku(i) + x
          if (j > 0) ku(j) = ku(j) - x
       end do
+      call add_general_times(model, u, ku)
    end subroutine springs_times
 
 end module fd_record_resolution

@@ -36,7 +36,8 @@ module fd_stick_ringing
    use fd_kinds, only: dp
    use fd_error, only: error_type, fatal_error, fmt_int, stat_no_memory
    use fd_model, only: model_type
-   use fd_kinematics, only: moved_mass, device_nodes
+   use fd_kinematics, only: moved_mass, device_nodes, devices_are_pairs, add_device, device_relative
+   use fd_stiffness, only: general_form
    use fd_friction, only: sticking_stiffness, law_stuck, stuck_dashpot
    use fd_device_state, only: device_state, phase_stick
    use fd_result, only: result_type, resolution_none, resolution_resolved, resolution_unresolved
@@ -122,6 +123,10 @@ contains
       integer :: nd, ns, d, q, i, j, nb, stat, first
       logical :: osc
 
+      if (model%n_kx > 0 .or. .not. devices_are_pairs(model)) then
+         call general_ringing_init(model, dt1, beta, gamma, a0, a1, rg, res, error)
+         return
+      end if
       nd = model%n_devices
       ns = model%n_springs
       res%stick_resolution = resolution_none
@@ -239,6 +244,94 @@ contains
          end do
       end subroutine spring_damping
    end subroutine ringing_init
+
+   !> ringing_init for a general model (stiffness K_x, devices of any direction): the mode of
+   !> device d's sticking spring is phi = m_r M^-1 b_d (b_d' phi = 1, m_r = 1 / (b_d' M^-1 b_d));
+   !> its damping a0 m_r + a1 phi' K phi, its band devices the velocity-law devices e with
+   !> b_e' phi /= 0 (shape (b_e' phi)^2). O(n_devices (n_dof + n_devices)).
+   subroutine general_ringing_init(model, dt1, beta, gamma, a0, a1, rg, res, error)
+      type(model_type), intent(in) :: model         !! the model
+      real(dp), intent(in) :: dt1                   !! main step [s]
+      real(dp), intent(in) :: beta, gamma           !! Newmark's parameters
+      real(dp), intent(in) :: a0, a1                !! C = a0 M + a1 K
+      type(ringing_type), intent(out) :: rg         !! the devices watched
+      type(result_type), intent(inout) :: res       !! stick_freq_error, stick_resolution set
+      type(error_type), allocatable, intent(out) :: error !! not enough memory
+      real(dp), allocatable :: phi(:)
+      logical, allocatable :: velocity(:)
+      real(dp) :: k, c, x, wt, zn, y, ek
+      integer :: nd, d, e, q, nb, sp, pass, stat
+      logical :: osc
+
+      nd = model%n_devices
+      res%stick_resolution = resolution_none
+      rg%n = count(sticking_stiffness(model%dev(1:nd)) > 0.0_dp)
+      allocate (phi(model%n_dof), velocity(nd), rg%dev(rg%n), rg%k(rg%n), rg%omega(rg%n), rg%pmu(rg%n), &
+                rg%drift(rg%n), rg%c_fixed(rg%n), rg%mr(rg%n), rg%first(rg%n + 1), rg%c_start(rg%n), &
+                rg%stats(4, nd), stat=stat)
+      if (stat /= 0) then
+         call fatal_error(error, "not enough memory for the sticking springs of "//trim(fmt_int(rg%n))// &
+                          " devices", stat_no_memory)
+         return
+      end if
+      rg%stats = 0.0_dp
+      rg%c_start = 0.0_dp
+      velocity = law_stuck(model%dev(1:nd)%law) == stuck_dashpot
+      ! two passes: count the band devices, then list them
+      do pass = 1, 2
+         q = 0
+         nb = 0
+         do d = 1, nd
+            k = sticking_stiffness(model%dev(d))
+            if (.not. (k > 0.0_dp)) cycle
+            q = q + 1
+            phi = 0.0_dp
+            call add_device(model, d, 1.0_dp, phi)
+            phi = moved_mass(model, d)*phi/model%mass
+            if (pass == 2) rg%first(q) = nb + 1
+            do e = 1, nd
+               if (.not. velocity(e)) cycle
+               y = device_relative(model, e, phi)
+               if (y == 0.0_dp) cycle
+               nb = nb + 1
+               if (pass == 2) then
+                  rg%band_dev(nb) = e
+                  rg%band_shape(nb) = y*y
+               end if
+            end do
+            if (pass == 1) cycle
+            rg%dev(q) = d
+            rg%k(q) = k
+            rg%mr(q) = moved_mass(model, d)
+            ek = general_form(model, phi, phi)
+            do sp = 1, model%n_springs
+               y = 0.0_dp
+               if (model%spring_i(sp) > 0) y = phi(model%spring_i(sp))
+               if (model%spring_j(sp) > 0) y = y - phi(model%spring_j(sp))
+               ek = ek + model%spring_k(sp)*y*y
+            end do
+            c = a0*rg%mr(q) + a1*ek
+            rg%omega(q) = sqrt(k/rg%mr(q))
+            rg%pmu(q) = model%dev(d)%p*model%dev(d)%mu
+            x = rg%omega(q)*dt1
+            call newmark_frequency(x, beta, gamma, wt, zn, osc)
+            res%stick_freq_error(d) = 1.0_dp
+            if (osc) res%stick_freq_error(d) = 1.0_dp - wt/x
+            rg%drift(q) = abs(res%stick_freq_error(d))*rg%omega(q)
+            rg%c_fixed(q) = c + 2.0_dp*rg%mr(q)*rg%omega(q)*zn
+         end do
+         if (pass == 1) then
+            allocate (rg%band_dev(nb), rg%band_shape(nb), stat=stat)
+            if (stat /= 0) then
+               call fatal_error(error, "not enough memory for the sticking springs of "//trim(fmt_int(rg%n))// &
+                                " devices", stat_no_memory)
+               return
+            end if
+         end if
+      end do
+      rg%first(rg%n + 1) = nb + 1
+      if (rg%n > 0) res%stick_resolution = resolution_resolved
+   end subroutine general_ringing_init
 
    !> The elements at each node 1..n (node 0, the table, left out) of those with use: the
    !> elements at node m are list(first(m) : first(m + 1) - 1); one entry when both ends

@@ -1,0 +1,169 @@
+"""Buildings of rigid floors (&floors, &frames, &floor_braces): three DOFs a floor (ux, uy,
+rz at its centre of mass), frames and braces at plan positions, the table motion along a
+plan direction."""
+
+import numpy as np
+import pytest
+
+from conftest import ok
+
+HARMONIC = {"excitation_type": "harmonic", "amplitude": 0.02, "frequency": 2.5, "dt_record": 0.01,
+            "duration": 3.0}
+K = [400.0e6, 320.0e6, 200.0e6]          # storey stiffness along x (and y) [N/m]
+SLIP = [600.0e3, 400.0e3, 200.0e3]       # storey slip load [N]
+KB = 300.0e6                             # brace stiffness [N/m]
+DAMPING = {"damping_type": "rayleigh", "rayleigh_a0": 0.3, "rayleigh_a1": 8.0e-4}
+
+
+def planar():
+    return {
+        "model": {"n_dof": 3, "mass": [3.0e5] * 3},
+        "springs": {"n_springs": 3, "node_i": [1, 2, 3], "node_j": [0, 1, 2], "k": K},
+        "damping": DAMPING,
+        "braces": {"n_braces": 3, "node_i": [1, 2, 3], "node_j": [0, 1, 2], "slip_load": SLIP,
+                   "stiffness": [KB] * 3},
+        "storeys": {"n_storeys": 3, "node_i": [1, 2, 3], "node_j": [0, 1, 2], "height": [3.0] * 3},
+        "excitation": HARMONIC,
+        "integration": {"n1": 20, "n2": 50},
+    }
+
+
+def symmetric(angle=0.0):
+    """The planar building as rigid floors 20 m x 12 m: along x two frames at y = -6, 6 with
+    half the storey's stiffness each and two braces beside them; along y two frames at
+    x = -10, 10. Doubly symmetric: the centre of stiffness is the centre of mass."""
+    storey = [s for s in (1, 2, 3) for _ in range(4)]
+    return {
+        "floors": {"n_floors": 3, "mass": [3.0e5] * 3, "plan_x": [20.0] * 3, "plan_y": [12.0] * 3,
+                   "height": [3.0] * 3, "excitation_angle": angle},
+        "frames": {"n_frames": 12, "storey": storey, "angle": [0.0, 0.0, 90.0, 90.0] * 3,
+                   "x": [0.0, 0.0, -10.0, 10.0] * 3, "y": [-6.0, 6.0, 0.0, 0.0] * 3,
+                   "k": [k / 2 for k in K for _ in range(4)]},
+        "damping": DAMPING,
+        "floor_braces": {"n_braces": 6, "storey": [1, 1, 2, 2, 3, 3], "angle": [0.0] * 6, "x": [0.0] * 6,
+                         "y": [-6.0, 6.0] * 3, "slip_load": [s / 2 for s in SLIP for _ in range(2)],
+                         "stiffness": [KB / 2] * 6},
+        "excitation": HARMONIC,
+        "integration": {"n1": 20, "n2": 50},
+    }
+
+
+def test_symmetric_building_along_x_is_the_planar_one(run):
+    """Excited along x, a doubly symmetric building of rigid floors does not turn and does
+    not move along y, and its x motion is the planar shear building's (1e-12)."""
+    p = ok(run(planar(), name="planar"))
+    f = ok(run(symmetric(), name="floors"))
+    hp, hf = p.history(), f.history()
+    sp, sf = p.summary(), f.summary()
+    up = np.array([hp[f"u{i}"] for i in (1, 2, 3)])
+    ux = np.array([hf[f"u{3 * i - 2}"] for i in (1, 2, 3)])
+    scale = np.abs(up).max()
+    assert scale > 1e-3
+    assert np.abs(ux - up).max() <= 1e-12 * scale
+    for c in (2, 3):  # uy and rz of every floor
+        assert np.abs(np.array([hf[f"u{3 * i - 3 + c}"] for i in (1, 2, 3)])).max() <= 1e-12 * scale
+    # the braces slip: a nonlinear run, and the same peaks of force and base shear
+    assert max(sp["peak_force_N"]) >= 0.999 * SLIP[0]
+    fx = np.array(sf["peak_force_N"]).reshape(3, 2).sum(axis=1)
+    assert np.allclose(fx, sp["peak_force_N"], rtol=1e-12)
+    assert sf["peak_base_shear_N"] == pytest.approx(sp["peak_base_shear_N"], rel=1e-12)
+    # storeys: s along x and along y; the x ones are the planar storeys
+    assert sf["storey_labels"] == [f"storey {s} {d}" for s in (1, 2, 3) for d in "xy"]
+    for key in ("peak_drift_m", "peak_storey_shear_N", "peak_drift_ratio"):
+        got = np.array(sf[key], dtype=float).reshape(3, 2)
+        assert np.allclose(got[:, 0], sp[key], rtol=1e-12, atol=0), key
+        assert np.abs(got[:, 1]).max() <= 1e-12 * np.abs(got[:, 0]).max(), key
+    aabs = np.array(sf["peak_aabs_mps2"]).reshape(3, 3)
+    assert np.allclose(aabs[:, 0], sp["peak_aabs_mps2"], rtol=1e-12)
+    assert np.abs(aabs[:, 1:]).max() <= 1e-9 * aabs[:, 0].max()
+
+
+def test_symmetric_building_along_y_moves_along_y(run):
+    """The same building excited along y (excitation_angle = 90): no x motion, no rotation;
+    the y frames are stiffer than the x ones, so the motion differs from the x run."""
+    f = ok(run(symmetric(angle=90.0), name="floors"))
+    h = f.history()
+    uy = np.array([h[f"u{3 * i - 1}"] for i in (1, 2, 3)])
+    assert np.abs(uy).max() > 1e-4
+    for c in (1, 3):
+        assert np.abs(np.array([h[f"u{3 * i - 3 + c}"] for i in (1, 2, 3)])).max() <= 1e-12 * np.abs(uy).max()
+
+
+def eccentric():
+    """One rigid floor 20 m x 12 m, frames off the centre of mass: x frames at y = -6 (k)
+    and y = 6 (3k), y frames at x = -10 and 10; no devices, no damping."""
+    return {
+        "floors": {"n_floors": 1, "mass": [2.0e5], "plan_x": [20.0], "plan_y": [12.0],
+                   "excitation_angle": 30.0},
+        "frames": {"n_frames": 4, "storey": [1] * 4, "angle": [0.0, 0.0, 90.0, 90.0],
+                   "x": [0.0, 0.0, -10.0, 10.0], "y": [-6.0, 6.0, 0.0, 0.0],
+                   "k": [50.0e6, 150.0e6, 100.0e6, 100.0e6]},
+        "damping": {"damping_type": "none"},
+        "excitation": {"excitation_type": "harmonic", "amplitude": 0.01, "frequency": 1.3,
+                       "dt_record": 0.002, "duration": 2.0},
+        "integration": {"n1": 20},
+    }
+
+
+def test_eccentric_floor_equals_modal_closed_form(run):
+    """An eccentric floor (coupled x and torsion) under a harmonic table motion at 30 deg from
+    rest: the modal closed form of (K, M), q_k = -G_k A (sin W t - (W / w_k) sin w_k t) /
+    (w_k^2 - W^2), with K from the frames' directions written out independently here."""
+    r = ok(run(eccentric(), name="ecc"))
+    h = r.history()
+    m, lx, ly = 2.0e5, 20.0, 12.0
+    M = np.diag([m, m, m * (lx**2 + ly**2) / 12])
+    K = np.zeros((3, 3))
+    # b = (cos a, sin a, -cos a (y - 0) + sin a (x - 0)) for each frame
+    for a, x, y, k in [(0, 0, -6, 50e6), (0, 0, 6, 150e6), (90, -10, 0, 100e6), (90, 10, 0, 100e6)]:
+        c, s = np.cos(np.radians(a)), np.sin(np.radians(a))
+        c, s = round(c, 15), round(s, 15)
+        b = np.array([c, s, -c * y + s * x])
+        K += k * np.outer(b, b)
+    w2, phi = np.linalg.eigh(np.linalg.solve(np.sqrt(M), np.linalg.solve(np.sqrt(M), K).T))
+    phi = np.linalg.solve(np.sqrt(M), phi)
+    w = np.sqrt(w2)
+    rr = np.array([np.cos(np.radians(30)), np.sin(np.radians(30)), 0.0])
+    W = 2 * np.pi * 1.3
+    A = -0.01 * W**2  # the table acceleration a_g = A sin W t
+    t = np.asarray(h["t"])
+    u = np.zeros((3, t.size))
+    for k in range(3):
+        g = phi[:, k] @ M @ rr  # phi' M phi = 1
+        q = -g * A * (np.sin(W * t) - W / w[k] * np.sin(w[k] * t)) / (w2[k] - W**2)
+        u += np.outer(phi[:, k], q)
+    got = np.array([h[f"u{i}"] for i in (1, 2, 3)])
+    # Newmark's phase error over the run: (w dt)^2 / 12 per radian, at most 2e-4 here
+    dt = 0.002 / 20
+    bound = (w.max() * dt) ** 2 / 12 * w.max() * t[-1]
+    assert bound < 2e-3
+    for i in range(3):
+        assert np.abs(got[i] - u[i]).max() <= 2 * bound * np.abs(u[i]).max()
+    assert np.abs(u[2]).max() > 1e-5  # it turns
+
+
+@pytest.mark.parametrize("technique", ["event_driven", "moreau_jean"])
+def test_exact_techniques_refuse_rigid_floors(run, technique):
+    deck = symmetric()
+    deck["floor_braces"]["law"] = ["coulomb"] * 6
+    del deck["floor_braces"]["stiffness"]
+    deck["integration"] = {"technique": technique}
+    r = run(deck)
+    assert r.returncode != 0
+    assert "technique = 'newmark'" in r.stderr
+
+
+@pytest.mark.parametrize("change, words", [
+    (lambda d: d.update(model={"n_dof": 1, "mass": [1.0]}), "group &model is not for a building of &floors"),
+    (lambda d: d["frames"].update(storey=[4] + [1] * 11), "storey(1) = 4"),
+    (lambda d: d["floors"].update(inertia=[1.0e6] * 3), "inertia(1)"),
+    (lambda d: d["floor_braces"].update(law=["velocity"] * 6), "stiffness(1)"),
+    (lambda d: d.pop("frames"), "group &frames is missing"),
+])
+def test_bad_floors_input(run, change, words):
+    deck = symmetric()
+    change(deck)
+    r = run(deck)
+    assert r.returncode != 0
+    assert words in r.stderr, r.stderr
+    assert not (r.outdir).exists() or not any(r.outdir.iterdir())
