@@ -167,3 +167,45 @@ def test_bad_floors_input(run, change, words):
     assert r.returncode != 0
     assert words in r.stderr, r.stderr
     assert not (r.outdir).exists() or not any(r.outdir.iterdir())
+
+
+def one_storey(p_delta=True, m=2.0e5, k=5.0e6, h=3.0):
+    """One floor 20 m x 12 m on four frames: along x at y = -6 and 6, along y at x = -10, 10."""
+    return {
+        "floors": {"n_floors": 1, "mass": [m], "plan_x": [20.0], "plan_y": [12.0], "height": [h],
+                   "p_delta": p_delta},
+        "frames": {"n_frames": 4, "storey": [1] * 4, "angle": [0.0, 0.0, 90.0, 90.0],
+                   "x": [0.0, 0.0, -10.0, 10.0], "y": [-6.0, 6.0, 0.0, 0.0], "k": [k, 1.5 * k, 2 * k, 2 * k]},
+        "damping": {"damping_type": "none"},
+        "excitation": {"excitation_type": "harmonic", "amplitude": 0.001, "frequency": 1.0,
+                       "dt_record": 0.01, "duration": 0.05},
+        "output": {"dir": "out", "n_modes": 3},
+    }
+
+
+def test_p_delta_lowers_each_period_by_the_weight_over_the_height(run):
+    """P-Delta of one storey: w^2 = (k - m g / h) / m along x and y, and
+    (k_theta - g J / h) / J in torsion, the closed forms of a symmetric storey (here the x
+    frames are unequal: x and torsion couple, so the check is on the 3 x 3 problem)."""
+    m, k, h, g = 2.0e5, 5.0e6, 3.0, 9.80665
+    s = ok(run(one_storey(m=m, k=k, h=h))).summary()
+    s0 = ok(run(one_storey(False, m=m, k=k, h=h))).summary()
+    J = m * (20.0**2 + 12.0**2) / 12
+    K = np.zeros((3, 3))
+    for a, x, y, ke in [(0, 0, -6, k), (0, 0, 6, 1.5 * k), (90, -10, 0, 2 * k), (90, 10, 0, 2 * k)]:
+        c, sn = (1.0, 0.0) if a == 0 else (0.0, 1.0)
+        b = np.array([c, sn, sn * x - c * y])
+        K += ke * np.outer(b, b)
+    M = np.diag([m, m, J])
+    Kg = -np.diag([m * g / h, m * g / h, g * J / h])
+    for summary, kk in ((s0, K), (s, K + Kg)):
+        w2 = np.sort(np.linalg.eigvals(np.linalg.solve(M, kk)).real)
+        assert np.allclose(summary["periods_free_s"], 2 * np.pi / np.sqrt(w2), rtol=1e-10)
+    assert all(a > b for a, b in zip(s["periods_free_s"], s0["periods_free_s"]))
+
+
+def test_p_delta_refuses_a_building_that_buckles(run):
+    # m g / h = 6.5e6 N/m > the y frames' 2 x 2 k = 4e6 N/m
+    r = run(one_storey(m=2.0e6, k=1.0e6, h=3.0))
+    assert r.returncode != 0
+    assert "p_delta" in r.stderr and "buckling" in r.stderr

@@ -128,7 +128,7 @@ DECK_VARIABLES: dict[str, tuple[str, ...]] = {
                   "mu_table_mu", "label"),
     "storeys": ("n_storeys", "node_i", "node_j", "spring", "height", "label"),
     "floors": ("n_floors", "mass", "inertia", "plan_x", "plan_y", "cm_x", "cm_y", "height",
-               "label", "excitation_angle"),
+               "label", "excitation_angle", "p_delta"),
     "frames": ("n_frames", "storey", "angle", "x", "y", "k"),
     "floor_braces": ("n_braces", "storey", "angle", "x", "y", "slip_load", "stiffness", "eps1",
                      "eps", "law", "label"),

@@ -36,6 +36,7 @@ module fd_deck
    use fd_model, only: source_friction, source_brace, source_isolator, source_floor_brace
    use fd_floors, only: floor_dof, plan_direction, floor_inertia, max_plan_terms
    use fd_stiffness, only: add_general_entry
+   use fd_linalg, only: cholesky_factor
    use fd_friction, only: law_mu_of_speed
    use fd_matrices, only: modes_type, natural_modes, natural_modes_sparse, stiffness_matrix, modes_dense_dofs
    use fd_sha256, only: sha256_text
@@ -147,6 +148,8 @@ contains
       end if
       if (allocated(error)) return
       call read_springs_group(deck, cfg, error)
+      if (allocated(error)) return
+      if (cfg%model%p_delta) call add_p_delta(deck, cfg, error)
       if (allocated(error)) return
       call read_damping_group(deck, cfg, error)
       if (allocated(error)) return
@@ -863,8 +866,10 @@ contains
       integer :: n_floors
       real(dp), allocatable :: mass(:), inertia(:), plan_x(:), plan_y(:), cm_x(:), cm_y(:), height(:)
       real(dp) :: excitation_angle, c, s
+      logical :: p_delta
       character(len=label_len), allocatable :: label(:)
-      namelist /floors/ n_floors, mass, inertia, plan_x, plan_y, cm_x, cm_y, height, label, excitation_angle
+      namelist /floors/ n_floors, mass, inertia, plan_x, plan_y, cm_x, cm_y, height, label, excitation_angle, &
+         p_delta
       type(group_text) :: grp
       character(len=512) :: msg
       character(len=:), allocatable :: idx
@@ -874,6 +879,7 @@ contains
 
       n_floors = unset_int
       excitation_angle = 0.0_dp
+      p_delta = .false.
       call find_group(deck, 'floors', grp, found, error)
       if (allocated(error) .or. .not. found) return
       i = array_capacity(grp, 'n_floors', max_floors)
@@ -958,8 +964,16 @@ contains
          cfg%model%floor_x(f) = cm_x(f)
          cfg%model%floor_y(f) = cm_y(f)
       end do
+      if (p_delta .and. any(height(1:n) <= 0.0_dp)) then
+         f = findloc(height(1:n) <= 0.0_dp, .true., 1)
+         call bad(deck, 'floors', 'height('//trim(fmt_int(f))//')', trim(fmt_real(height(f))), &
+                  '> 0 m with p_delta = .true. (the geometric stiffness is the weight above over the height)', error)
+         return
+      end if
       cfg%model%n_floors = n
       cfg%model%floor_height = height(1:n)
+      cfg%model%floor_inertia = inertia(1:n)
+      cfg%model%p_delta = p_delta
       ! storeys: s along x (2s - 1) and along y (2s), between the floors' centres of mass
       cfg%model%n_storeys = 2*n
       allocate (cfg%model%storey_i(2*n), cfg%model%storey_j(2*n), cfg%model%storey_height(2*n), &
@@ -1059,6 +1073,53 @@ contains
       if (allocated(error)) return
       call signed_reals(deck, group, 'y', y, given_of(grp, 'y', size(y)), n, 'm', error)
    end subroutine plan_elements
+
+   !> P-Delta of a building of rigid floors: the constant geometric stiffness of the gravity
+   !> loads. Storey s carries the weight m_j g of every floor j >= s at that floor's centre of
+   !> mass Q_j: -(m_j g / h_s) (b_x b_x' + b_y b_y') with b_x, b_y the storey's deformation at
+   !> Q_j along x and y, and -(g J_j / h_s) (rz_s - rz_{s-1})^2 for the floor's mass spread
+   !> about Q_j (rotational inertia J_j). Linear: the loads and the geometry do not change. The
+   !> building must stay stable: the stiffness with P-Delta positive definite.
+   subroutine add_p_delta(deck, cfg, error)
+      type(deck_text), intent(in) :: deck
+      type(run_config), intent(inout) :: cfg
+      type(error_type), allocatable, intent(out) :: error
+      real(dp), parameter :: g = 9.80665_dp
+      real(dp) :: coef(max_plan_terms), h
+      real(dp), allocatable :: k(:, :)
+      integer :: dof(max_plan_terms), nt, s, j, nf, info, stat
+
+      nf = cfg%model%n_floors
+      do s = 1, nf
+         h = cfg%model%floor_height(s)
+         do j = s, nf
+            call plan_direction(s, 0.0_dp, cfg%model%floor_x(j), cfg%model%floor_y(j), cfg%model%floor_x, &
+                                cfg%model%floor_y, dof, coef, nt)
+            call add_general_entry(cfg%model, dof(1:nt), coef(1:nt), -cfg%model%mass(floor_dof(j, 1))*g/h)
+            call plan_direction(s, 90.0_dp, cfg%model%floor_x(j), cfg%model%floor_y(j), cfg%model%floor_x, &
+                                cfg%model%floor_y, dof, coef, nt)
+            call add_general_entry(cfg%model, dof(1:nt), coef(1:nt), -cfg%model%mass(floor_dof(j, 1))*g/h)
+            if (s > 1) then
+               call add_general_entry(cfg%model, [floor_dof(s, 3), floor_dof(s - 1, 3)], [1.0_dp, -1.0_dp], &
+                                      -g*cfg%model%floor_inertia(j)/h)
+            else
+               call add_general_entry(cfg%model, [floor_dof(s, 3)], [1.0_dp], -g*cfg%model%floor_inertia(j)/h)
+            end if
+         end do
+      end do
+      ! stable: K (the frames with P-Delta) positive definite
+      allocate (k(3*nf, 3*nf), stat=stat)
+      if (stat /= 0) then
+         call no_memory(deck, 'floors', 3*nf, 'DOFs (the stability check of p_delta)', error); return
+      end if
+      call stiffness_matrix(cfg%model, k)
+      call cholesky_factor(k, info)
+      if (info /= 0) then
+         call bad(deck, 'floors', 'p_delta', '.true.', 'for a building stable under its gravity loads: '// &
+                  'its frames with P-Delta are not positive definite (buckling); stiffen the frames or '// &
+                  'check mass and height', error)
+      end if
+   end subroutine add_p_delta
 
    ! ---------------------------------------------------------------- &floor_braces
    !> Braces with a friction damper at plan positions of a building of rigid floors: brace

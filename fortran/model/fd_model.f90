@@ -99,6 +99,8 @@ module fd_model
       real(dp), allocatable :: floor_x(:)     !! centre of mass of each floor in plan, x [m]
       real(dp), allocatable :: floor_y(:)     !! and y [m]
       real(dp), allocatable :: floor_height(:) !! height of the storey below each floor [m]; 0 = not given
+      real(dp), allocatable :: floor_inertia(:) !! rotational inertia of each floor [kg m2]
+      logical :: p_delta = .false.            !! the gravity loads' geometric stiffness is in K_x
       ! the forces of a storey that are no springs or devices between its two nodes (the
       ! frames and braces of rigid floors): its shear adds sum coef (u + a1 v)(dof) over the
       ! entries (xs_*) of the storey, and sum coef F(dev) over the entries (xd_*)
