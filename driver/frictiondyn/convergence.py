@@ -89,7 +89,8 @@ SAFETY_RICHARDSON, SAFETY_DIFFERENCE = 1.25, 3.0
 
 @dataclass
 class Estimate:
-    """An a-posteriori estimate of a quantity's step error from its values at the levels.
+    """An a-posteriori estimate of a quantity's error from its values at levels of one
+    refined parameter: the step (n1), or a regularized law's eps or f.
 
     ``method``: ``"richardson"`` (the order measured from the last three levels is
     consistent: the limit is extrapolated and each level's error is its distance to it, times
@@ -114,7 +115,8 @@ class Estimate:
 
 
 def estimate_error(values: Sequence[float], factor: int = 2, scale: float = 0.0) -> Estimate:
-    """The step error of ``values``, a quantity at steps h, h/factor, h/factor**2, ...
+    """The error of ``values``, a quantity at a parameter (the step, eps, f) h, h/factor,
+    h/factor**2, ...
 
     From the last three levels: the changes d1 = q1 - q0, d2 = q2 - q1 (q2 finest) give the
     order p = log(d1 / d2) / log(factor) when they have one sign and shrink; when p lies in
