@@ -219,7 +219,7 @@ def test_estimate_error_on_known_series():
     assert estimate_error([1.0, 1.1, 1.15, 1.3], 2, 1.0).method == "difference"
     alternating = estimate_error([1.0, 1.1, 1.05], 2, 1.0)
     assert alternating.method == "difference" and "alternate" in alternating.reason
-    assert alternating.errors == pytest.approx([SAFETY_DIFFERENCE * 0.05, SAFETY_DIFFERENCE * 0.05, SAFETY_DIFFERENCE * 0.05])
+    assert alternating.errors == pytest.approx([SAFETY_DIFFERENCE * 0.05] * 3)
     assert "do not shrink" in estimate_error([1.0, 1.1, 1.3], 2, 1.0).reason
     assert "outside" in estimate_error([1.0, 1.1, 1.1001], 2, 1.0).reason  # order 10
     assert "two levels" in estimate_error([1.0, 1.1], 2, 1.0).reason
@@ -344,3 +344,19 @@ def test_the_hysteretic_laws_acceleration_error_does_not_vanish_with_the_step(tm
     assert row["law"]["method"] == "difference" and row["estimated_error"] == pytest.approx(a1.error)
     alone = step_convergence(deck, law=False)
     assert "the step's errors alone" in str(alone)
+
+
+def test_a_failed_law_level_is_named(monkeypatch):
+    """A law level that cannot run (here a deck whose refined f is made invalid) stops the
+    study with the library's message, the level it came from and how to leave such levels
+    out."""
+    import frictiondyn.convergence as conv
+
+    real = conv._law_text
+    monkeypatch.setattr(conv, "_law_text", lambda text, f: real(text, f).replace("    f = ", "    f = -", 1))
+    with pytest.raises(fd.DeckError) as info:
+        step_convergence(INPUTS / "test4_hysteretic.nml")
+    text = str(info.value)
+    assert "group &friction: f(1) = -5.0E-6 is invalid: must be > 0 m" in text, text
+    assert text.endswith("(in the step convergence study, the level n1 = 80 with eps and f / 2; "
+                         "--no-law (law=False) leaves the law levels out)"), text

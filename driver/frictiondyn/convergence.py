@@ -582,7 +582,8 @@ def step_convergence(
                 raise
         summaries = [json.loads(s._text(_SUMMARY)) for s in sessions]
     except FrictiondynError as exc:  # say which level
-        raise type(exc)(f"{exc} (in the step convergence study, the level {level})") from None
+        hint = "; --no-law (law=False) leaves the law levels out" if "eps and f" in level else ""
+        raise type(exc)(f"{exc} (in the step convergence study, the level {level}{hint})") from None
     finally:
         for s in sessions:
             s.close()
