@@ -9,9 +9,11 @@
   from ``Result.to_npz``), next to it or in ``--out``.
 - ``compare A B [...]``: overlay two or more results (CSV, .npz, or decks, which are run)
   and print the differences of their peaks.
-- ``converge DECK [--factor F] [--levels L] [--rtol R] [--json FILE]``: a time-step
-  convergence study: the deck at n1, F·n1, ... side by side; prints what moves; exit status 3
-  when the answer depends on the step (``frictiondyn.convergence``).
+- ``converge DECK [--factor F] [--levels L] [--rtol R] [--no-law] [--json FILE]``: a
+  time-step convergence study: the deck at n1, F·n1, F²·n1 side by side (and a regularized
+  law's eps or f refined); prints what moves and each kind of quantity's estimated error with
+  its method; exit status 3 when a change or an estimated error exceeds the tolerance
+  (``frictiondyn.convergence``).
 - ``paper OUTDIR``: the paper's Table 1 classification and Figs. 2, 3a, 3b, 4a, 4b.
 - ``sweep SPEC.toml`` / ``sweep collect DIR`` / ``sweep plot DIR X Y``: parameter sweeps,
   locally or as a Slurm job array (``frictiondyn.sweep``, docs/batch.md).
@@ -296,7 +298,8 @@ def cmd_converge(args: argparse.Namespace) -> int:
     if target is not None and not target.parent.is_dir():  # before the study, not after it
         raise CliError(f"--json {target}: its directory {target.parent} does not exist")
     report = step_convergence(
-        args.deck, factor=args.factor, levels=args.levels, rtol=args.rtol, threads=args.threads
+        args.deck, factor=args.factor, levels=args.levels, rtol=args.rtol, threads=args.threads,
+        law=not args.no_law,
     )
     print(report)
     if target is not None:
@@ -431,10 +434,17 @@ def build_parser() -> argparse.ArgumentParser:
     )
     p.add_argument("deck", help="namelist deck (.nml)")
     p.add_argument("--factor", type=int, default=2, help="n1 grows by this each level (default 2)")
-    p.add_argument("--levels", type=int, default=1, help="finer runs (default 1: n1 and factor n1)")
+    p.add_argument(
+        "--levels", type=int, default=2,
+        help="finer runs (default 2: n1, factor n1 and factor^2 n1, from which the order is measured)",
+    )
     p.add_argument(
         "--rtol", type=float, default=0.01,
         help="largest change allowed between levels, relative (default 0.01)",
+    )
+    p.add_argument(
+        "--no-law", action="store_true",
+        help="do not refine a regularized law's eps or f (estimate the step's error alone)",
     )
     p.add_argument("--json", metavar="FILE", help="also write the whole comparison as JSON")
     p.add_argument(

@@ -13,6 +13,15 @@ step), and compares what a design check reads from the summary: the peaks of eve
 device and storey, the residual drifts and slips, the energy dissipated by friction, and the
 stick-slip counts. ``python -m frictiondyn converge DECK`` prints it (exit status 3 when the
 answer moves). docs/python.md documents both.
+
+With three levels or more (the default: n1, 2 n1, 4 n1) it also estimates the error of the
+quantities a design reads (peak displacements, drifts, absolute accelerations, device forces
+and the friction energy) a posteriori: the order of convergence measured from the last three
+levels and Richardson extrapolation where that order is consistent, a plain difference,
+flagged as such and no claim of convergence, where it is not (``Estimate``). Under a
+regularized law the step levels converge to the law's solution, not to Coulomb's: law levels
+(the finest step with eps, or f and eps1, divided) estimate the law's error too
+(docs/theory.md, section 16).
 """
 
 from __future__ import annotations
@@ -32,7 +41,7 @@ from ._nml import copy_namelist, read_namelist, write_namelist
 
 DEFAULT_N1 = 20  # n1 when a deck does not give it (fortran/model/fd_names.f90, default_n1)
 
-__all__ = ["ConvergenceReport", "Quantity", "step_convergence"]
+__all__ = ["ConvergenceReport", "Estimate", "Quantity", "estimate_error", "step_convergence"]
 
 #: (summary key, what, unit, item kind, peak key): a quantity is judged relative to its own
 #: size, but not below FLOOR times the largest of its kind (a DOF that hardly moves is judged
@@ -58,6 +67,93 @@ _COUNTS = (
 )
 #: a quantity smaller than FLOOR times the largest of its group is judged against that
 FLOOR = 0.01
+#: the quantities whose error is estimated: what a design reads from a run
+ESTIMATED = ("peak_u_m", "peak_drift_m", "peak_aabs_mps2", "peak_force_N", "energy_friction_J")
+#: a measured order is consistent in [ORDER_MIN, ORDER_MAX]: the techniques converge at order 1
+#: to 2 (Newmark's across the events the correctness condition locates, Moreau-Jean's first
+#: order, second where the events are velocity zeros), a resonant amplitude, quadratic in
+#: Newmark's frequency error, at up to 4, a regularized law's peaks in eps or f at about 1;
+#: a ratio of changes outside this range is not the asymptotic behaviour of an error
+ORDER_MIN, ORDER_MAX = 0.5, 4.0
+#: changes between levels below UNCHANGED times the quantity's scale are round-off: the
+#: quantity does not depend on the step
+UNCHANGED = 1e-9
+#: a plain difference from three levels stands for the error only when every change stays
+#: below NOISE times the tolerance
+NOISE = 0.1
+#: safety factors on the distance to the limit (Roache's grid convergence index: 1.25 with a
+#: measured, consistent order, 3 without one), so that an estimate is a bound more often than
+#: not: the extrapolated limit is a best guess, and the order at finer steps may differ
+SAFETY_RICHARDSON, SAFETY_DIFFERENCE = 1.25, 3.0
+
+
+@dataclass
+class Estimate:
+    """An a-posteriori estimate of a quantity's error from its values at levels of one
+    refined parameter: the step (n1), or a regularized law's eps or f.
+
+    ``method``: ``"richardson"`` (the order measured from the last three levels is
+    consistent: the limit is extrapolated and each level's error is its distance to it, times
+    SAFETY_RICHARDSON), ``"difference"`` (no consistent order: each level's error is its
+    distance to the finest level's value, the finest level's the last change, times
+    SAFETY_DIFFERENCE; a plain difference, not a bound, and from three levels no claim of
+    convergence unless every change is noise, ``_claims``) or ``"unchanged"`` (the levels
+    agree to round-off).
+    ``reason`` says why a difference was used."""
+
+    method: str
+    errors: list[float]  #: estimated absolute error of each level's value
+    order: float | None = None  #: measured order (from the last three levels)
+    extrapolated: float | None = None  #: Richardson's limit
+    reason: str = ""
+    changes: list[float] = field(default_factory=list)  #: |change| between consecutive levels
+
+    @property
+    def error(self) -> float:
+        """The estimated error of the deck's own level (the first)."""
+        return self.errors[0]
+
+
+def estimate_error(values: Sequence[float], factor: int = 2, scale: float = 0.0) -> Estimate:
+    """The error of ``values``, a quantity at a parameter (the step, eps, f) h, h/factor,
+    h/factor**2, ...
+
+    From the last three levels: the changes d1 = q1 - q0, d2 = q2 - q1 (q2 finest) give the
+    order p = log(d1 / d2) / log(factor) when they have one sign and shrink; when p lies in
+    [ORDER_MIN, ORDER_MAX] (and, with four levels or more, every earlier triple's order too)
+    the limit is q2 + d2 / (factor**p - 1) (Richardson). Otherwise a plain difference, with
+    the reason. Changes below UNCHANGED * ``scale`` are round-off. ``Estimate`` says how each
+    level's error follows."""
+    q = [float(v) for v in values]
+    if len(q) < 2:
+        raise ValueError("an error estimate needs two levels or more")
+    d = [b - a for a, b in zip(q, q[1:])]
+    changes = [abs(x) for x in d]
+    if max(changes) <= UNCHANGED * scale:
+        return Estimate("unchanged", [max(changes)] * len(q), changes=changes)
+
+    def plain(reason: str) -> Estimate:
+        last, fs = q[-1], SAFETY_DIFFERENCE
+        return Estimate("difference", [fs * abs(v - last) for v in q[:-1]] + [fs * changes[-1]],
+                        reason=reason, changes=changes)
+
+    if len(q) < 3:
+        return plain("two levels: no order can be measured")
+    orders = []
+    for d1, d2 in zip(d, d[1:]):
+        if d1 * d2 <= 0 or d2 == 0:
+            return plain("the changes between levels alternate in sign" if d1 * d2 < 0
+                         else "a change between levels is zero")
+        if abs(d2) >= abs(d1):
+            return plain("the changes between levels do not shrink as the step does")
+        orders.append(math.log(d1 / d2) / math.log(factor))
+    p = orders[-1]
+    bad = [x for x in orders if not ORDER_MIN <= x <= ORDER_MAX]
+    if bad:
+        return plain(f"measured order {bad[0]:.2g} outside [{ORDER_MIN:g}, {ORDER_MAX:g}]")
+    limit = q[-1] + d[-1] / (factor**p - 1)
+    return Estimate("richardson", [SAFETY_RICHARDSON * abs(v - limit) for v in q], order=p,
+                    extrapolated=limit, changes=changes)
 
 
 @dataclass
@@ -71,7 +167,25 @@ class Quantity:
     values: list[float]  #: at n1, factor·n1, ...
     scale: float  #: a change is judged relative to this (0 for a count)
     tolerance: float  #: the largest change allowed between consecutive levels
-    agrees: bool
+    agrees: bool  #: the changes and the estimated error within the tolerance
+    estimate: Estimate | None = None  #: its step error (the quantities of ESTIMATED)
+    #: the error of a regularized law's eps or f, from the law levels (at the finest step)
+    law_estimate: Estimate | None = None
+
+    @property
+    def error(self) -> float | None:
+        """The estimated error of the deck's own level: the step's plus the law's."""
+        if self.estimate is None:
+            return None
+        return self.estimate.error + (self.law_estimate.error if self.law_estimate else 0.0)
+
+    @property
+    def relative_error(self) -> float | None:
+        """The estimated error of the deck's own level over the quantity's scale."""
+        error = self.error
+        if error is None:
+            return None
+        return error / self.scale if self.scale > 0 else (math.inf if error else 0.0)
 
     @property
     def change(self) -> float:
@@ -93,6 +207,10 @@ class ConvergenceReport:
     summaries: list[dict]
     warnings: list[list[str]]
     quantities: list[Quantity] = field(default_factory=list)
+    #: the law levels (the finest step, eps and f divided by factor, factor**2, ...), if any
+    law_summaries: list[dict] = field(default_factory=list)
+    factor: int = 2
+    law_warnings: list[list[str]] = field(default_factory=list)
 
     @property
     def converged(self) -> bool:
@@ -116,16 +234,30 @@ class ConvergenceReport:
             "deck": self.deck,
             "n1": self.n1,
             "rtol": self.rtol,
+            "factor": self.factor,
+            "law_levels": len(self.law_summaries),
             "converged": self.converged,
             "warnings": self.warnings,
             "quantities": [
                 {
                     "key": q.key, "item": q.item, "unit": q.unit, "values": q.values,
                     "scale": q.scale, "tolerance": q.tolerance, "agrees": q.agrees,
+                    **_estimate_dict(q),
                 }
                 for q in self.quantities
             ],
         }
+
+    def estimated(self) -> list[Quantity]:
+        """For each kind of quantity whose error is estimated, the one with the largest
+        estimated relative error (a plain difference from three levels or more first)."""
+        out: dict[str, Quantity] = {}
+        for q in self.quantities:
+            if q.estimate is None:
+                continue
+            if q.key not in out or _rank(q) > _rank(out[q.key]):
+                out[q.key] = q
+        return list(out.values())
 
     def __str__(self) -> str:
         levels = ", ".join(str(n) for n in self.n1)
@@ -134,6 +266,9 @@ class ConvergenceReport:
         for n, w in zip(self.n1, self.warnings):
             for text in w:
                 lines.append(f"  n1 = {n}: warning: {text}")
+        for k, w in enumerate(self.law_warnings, start=1):
+            for text in w:
+                lines.append(f"  n1 = {self.n1[-1]}, eps and f / {self.factor**k}: warning: {text}")
         lines.append(
             f"  the quantity of each kind that moves most (tolerance {100 * self.rtol:g} % of the "
             "quantity, or of the largest of its kind; counts max(2, 10 %)):"
@@ -142,8 +277,23 @@ class ConvergenceReport:
             name = f"{q.what} {q.item}".strip()
             vals = " -> ".join(f"{v:.6g}" for v in q.values)
             unit = f" {q.unit}" if q.unit else ""
-            mark = "agrees" if q.agrees else "MOVES"
+            mark = "agrees" if q.agrees else ("MOVES" if q.change > 1 else "ESTIMATED ERROR ABOVE IT")
             lines.append(f"    {name}: {vals}{unit}  {mark}")
+        estimated = self.estimated()
+        if estimated:
+            lines.append(f"  estimated error of the results at n1 = {self.n1[0]} (the largest of each kind):")
+            for q in estimated:
+                lines.append("    " + _estimate_line(q))
+            if self.law_summaries:
+                lines.append(
+                    "  step: the deck's n1 against n1 refined; law: eps and f refined at the finest step "
+                    "(the law's error does not vanish with the step; docs/theory.md, section 16)"
+                )
+            elif any(x in ("velocity", "hysteretic") for x in self.summaries[0].get("device_law", [])):
+                lines.append(
+                    "  these are the step's errors alone: the error of a regularized law (eps, f) does not "
+                    "vanish with the step and is not included (docs/theory.md, section 16)"
+                )
         moved = self.moved
         if not moved:
             lines.append(
@@ -151,12 +301,74 @@ class ConvergenceReport:
                 f"tolerance; the results at n1 = {self.n1[0]} do not depend on the step at that tolerance"
             )
         else:
+            erratic = [q for q in moved if q.estimate is not None and not _claims(q.estimate, q.tolerance)]
+            law = [q for q in moved if _law_bound(q)]
             lines.append(
                 f"  NOT converged: {len(moved)} quantit{'y moves' if len(moved) == 1 else 'ies move'} "
-                f"by more than the tolerance; the results at n1 = {self.n1[0]} depend on the step "
-                "(raise n1 and check again)"
+                f"by more than the tolerance or {'has' if len(moved) == 1 else 'have'} an estimated "
+                "error above it"
+                + ("" if len(law) == len(moved) else
+                   f"; the results at n1 = {self.n1[0]} depend on the step (raise n1 and check again)")
             )
+            if erratic:
+                lines.append(
+                    f"  {len(erratic)} of them do not converge with the step at a measurable order (a plain "
+                    "difference, not an error bound): their error may not vanish with the step"
+                )
+            if law:
+                lines.append(
+                    f"  {len(law)} of them carry the law's error (eps or f) more than the step's: a smaller "
+                    "eps or f, or the exact technique, not a finer step, reduces it"
+                )
         return "\n".join(lines)
+
+
+def _law_bound(q: Quantity) -> bool:
+    """Whether the law's error governs a quantity's estimate."""
+    e, law = q.estimate, q.law_estimate
+    if e is None or law is None:
+        return False
+    return law.error >= e.error or not _claims(law, q.tolerance)
+
+
+def _rank(q: Quantity) -> tuple[int, float]:
+    flagged = any(e is not None and not _claims(e, q.tolerance) for e in (q.estimate, q.law_estimate))
+    return (int(flagged), q.relative_error or 0.0)
+
+
+def _estimate_part(e: Estimate) -> dict:
+    return {"method": e.method, "order": e.order, "extrapolated": e.extrapolated,
+            "error": e.error, "errors": e.errors, "reason": e.reason}
+
+
+def _estimate_dict(q: Quantity) -> dict:
+    if q.estimate is None:
+        return {}
+    return {
+        "estimated_error": q.error, "relative_error": q.relative_error,
+        "step": _estimate_part(q.estimate),
+        "law": None if q.law_estimate is None else _estimate_part(q.law_estimate),
+    }
+
+
+def _describe(e: Estimate, what: str, unit: str) -> str:
+    if e.method == "richardson":
+        return (f"{what} {e.error:.3g} by Richardson at the measured order {e.order:.2f} "
+                f"(limit {e.extrapolated:.6g}{unit})")
+    if e.method == "unchanged":
+        return f"{what} {e.error:.3g}, unchanged between levels (round-off)"
+    return f"{what} {e.error:.3g}, a plain difference ({e.reason})"
+
+
+def _estimate_line(q: Quantity) -> str:
+    assert q.estimate is not None
+    name = f"{q.what} {q.item}".strip()
+    unit = f" {q.unit}" if q.unit else ""
+    head = f"{name}: {q.values[0]:.6g}{unit} +- {q.error:.3g} ({100 * (q.relative_error or 0.0):.3g} %): "
+    parts = [_describe(q.estimate, "step", unit)]
+    if q.law_estimate is not None:
+        parts.append(_describe(q.law_estimate, "law", unit))
+    return head + "; ".join(parts)
 
 
 def _deck(deck: str | os.PathLike) -> tuple[f90nml.Namelist, Path]:
@@ -185,6 +397,40 @@ def _level_text(nml: f90nml.Namelist, factor: int) -> str:
     return write_namelist(out)
 
 
+#: the numerical parameter of each regularized law, refined by the law levels: the velocity
+#: law's band eps; the hysteretic law's sticking displacement f with its end-of-slide band
+#: eps1 (docs/namelist.md defaults)
+_LAW_PARAMETERS = {"velocity": (("eps", 1.0e-3),), "hysteretic": (("f", 1.0e-5), ("eps1", 1.0e-3))}
+#: the groups whose devices' eps and f are numerical (a brace's f is its stiffness: physical)
+_LAW_GROUPS = (("friction", "n_devices"), ("isolators", "n_isolators"))
+
+
+def _law_text(text: str, factor: int) -> str | None:
+    """The deck (a level's text) with the numerical parameter of every regularized device of
+    ``&friction`` and ``&isolators`` divided by ``factor``; None when it has none."""
+    out = f90nml.reads(text)
+    changed = False
+    for name, count in _LAW_GROUPS:
+        group = out.get(name)
+        if group is None or not int(group.get(count) or 0):
+            continue
+        n = int(group[count])
+        laws = group.get("law")
+        laws = laws if isinstance(laws, list) else [laws]
+        laws = [str(x).strip().lower() if x is not None else "" for x in laws] + [""] * n
+        for var, default in {v for law in laws[:n] for v in _LAW_PARAMETERS.get(law, ())}:
+            given = group.get(var)
+            given = given if isinstance(given, list) else [given]
+            given = list(given) + [None] * (n - len(given))
+            values = [default if v is None else float(v) for v in given[:n]]
+            for i in range(n):
+                if any(var == v for v, _ in _LAW_PARAMETERS.get(laws[i], ())):
+                    values[i] /= factor
+                    changed = True
+            group[var] = values
+    return write_namelist(out) if changed else None
+
+
 def _items(kind: str, summary: dict, n: int) -> list[str]:
     if not kind:
         return [""]
@@ -196,11 +442,26 @@ def _items(kind: str, summary: dict, n: int) -> list[str]:
     return [labels[i] if labels and i < len(labels) and labels[i] else f"{kind} {i + 1}" for i in range(n)]
 
 
-def _compare(summaries: list[dict], rtol: float) -> list[Quantity]:
+def _claims(estimate: Estimate, tol: float) -> bool:
+    """Whether an estimate may stand for the error: Richardson's, or no change beyond
+    round-off; a plain difference from three levels or more only when every change stays
+    below NOISE times ``tol`` (the scatter of sampled peaks and located events). Otherwise its
+    changes do not shrink at an order and nothing says that the error vanishes with the
+    step: no convergence is claimed. (Two levels give no order: their change is judged
+    against the tolerance as it is.)"""
+    if estimate.method != "difference" or len(estimate.errors) < 3:
+        return True
+    return max(estimate.changes) <= NOISE * tol
+
+
+def _compare(
+    summaries: list[dict], rtol: float, factor: int = 2, law_summaries: Sequence[dict] = ()
+) -> list[Quantity]:
     out = []
     for key, what, unit, kind, peak_key in _GROUPS:
         if any(key not in s for s in summaries):
             continue
+        law_rows = [s[key] if isinstance(s[key], list) else [s[key]] for s in law_summaries]
         if key == "energy_friction_J" and not summaries[0].get("n_devices"):
             continue  # no device: nothing to compare (the per-device lists are empty)
         rows = [s[key] if isinstance(s[key], list) else [s[key]] for s in summaries]
@@ -218,7 +479,16 @@ def _compare(summaries: list[dict], rtol: float) -> list[Quantity]:
                 size = max(size, max(abs(float(p[i])) for p in peaks))
             tol = rtol * size
             agrees = all(abs(b - a) <= tol for a, b in zip(values, values[1:]))
-            out.append(Quantity(key, what, item, unit, values, size, tol, agrees))
+            estimate = law = None
+            if key in ESTIMATED:
+                estimate = estimate_error(values, factor, size)
+                if law_rows:
+                    law = estimate_error([values[-1]] + [float(r[i]) for r in law_rows], factor, size)
+                error = estimate.error + (law.error if law else 0.0)
+                if len(values) >= 3:  # from two levels, the change is all there is to judge
+                    agrees = agrees and error <= tol and _claims(estimate, tol) and (
+                        law is None or _claims(law, tol))
+            out.append(Quantity(key, what, item, unit, values, size, tol, agrees, estimate, law))
     for key, what in _COUNTS:
         if any(key not in s for s in summaries):
             continue
@@ -242,9 +512,10 @@ def _cpus() -> int:
 def step_convergence(
     deck: str | os.PathLike,
     factor: int = 2,
-    levels: int = 1,
+    levels: int = 2,
     rtol: float = 0.01,
     threads: int | None = None,
+    law: bool = True,
 ) -> ConvergenceReport:
     """Run ``deck`` at its n1 and at n1·factor**k, k = 1..levels, and compare the results.
 
@@ -252,10 +523,15 @@ def step_convergence(
     quantity (and not below ``FLOOR`` times the largest of its kind, so that a DOF that
     hardly moves is judged against the structure's motion); a residual drift or slip is
     judged against the largest peak drift or slip, the friction energy against the energy
-    input; a stick-slip count may move by max(2, 10 %). ``threads``: runs side by side
-    (default: as many as there are levels, at most the CPUs this process may use). Raises
-    DeckError for a bad deck, or for the event-driven technique (exact: its n1 only samples
-    the history).
+    input; a stick-slip count may move by max(2, 10 %). The quantities of ``ESTIMATED`` also
+    get an estimate of their error (``Estimate``): from the step levels, and with ``law``
+    (the default), for the devices of ``&friction`` and ``&isolators`` under a regularized
+    law, from law levels: the finest step with their eps (velocity law) or f and eps1
+    (hysteretic law) divided by factor**k, k = 1..levels; such a quantity agrees when its
+    estimated error (the step's plus the law's) is within the tolerance and its estimates
+    may stand for the error (``_claims``). ``threads``: runs side by side (default: as many
+    as there are runs, at most the CPUs this process may use). Raises DeckError for a bad
+    deck, or for the event-driven technique (exact: its n1 only samples the history).
     """
     if isinstance(factor, bool) or not isinstance(factor, int) or factor < 2:
         raise ValueError(f"factor = {factor!r}: must be an integer >= 2")
@@ -274,11 +550,16 @@ def step_convergence(
     factors = [factor**k for k in range(levels + 1)]
     texts = [_level_text(nml, f) for f in factors]
     n1 = [int(f90nml.reads(t)["integration"]["n1"]) for t in texts]
+    names = [f"n1 = {n}" for n in n1]
+    law_texts = [_law_text(texts[-1], f) for f in factors[1:]] if law else []
+    if law_texts and law_texts[0] is not None:
+        texts += law_texts
+        names += [f"n1 = {n1[-1]} with eps and f / {f}" for f in factors[1:]]
     workers = max(1, threads or min(len(texts), _cpus()))
     sessions: list[Session] = []
-    level = n1[0]
+    level = names[0]
     try:
-        for text, level in zip(texts, n1):
+        for text, level in zip(texts, names):
             sessions.append(Session.from_text(text, path.name, path.parent))
             sessions[-1].select([], [])  # the summary has every peak; no history is kept
         with ThreadPoolExecutor(max_workers=workers) as pool:
@@ -286,10 +567,10 @@ def step_convergence(
             try:
                 # a failed level stops the others at once
                 wait(futures, return_when=FIRST_EXCEPTION)
-                for f, level in zip(futures, n1):
+                for f, level in zip(futures, names):
                     if f.done() and f.exception() is not None:
                         f.result()  # raises it
-                for f, level in zip(futures, n1):
+                for f, level in zip(futures, names):
                     f.result()
             except BaseException:  # Ctrl-C or a failed level: stop the others, then raise
                 for f in futures:
@@ -301,13 +582,16 @@ def step_convergence(
                 raise
         summaries = [json.loads(s._text(_SUMMARY)) for s in sessions]
     except FrictiondynError as exc:  # say which level
-        raise type(exc)(f"{exc} (in the step convergence study, the level n1 = {level})") from None
+        hint = "; --no-law (law=False) leaves the law levels out" if "eps and f" in level else ""
+        raise type(exc)(f"{exc} (in the step convergence study, the level {level}{hint})") from None
     finally:
         for s in sessions:
             s.close()
+    steps, laws = summaries[: len(n1)], summaries[len(n1):]
     report = ConvergenceReport(
-        deck=str(path), n1=n1, rtol=float(rtol), summaries=summaries,
-        warnings=[summary_warnings(s) for s in summaries],
+        deck=str(path), n1=n1, rtol=float(rtol), summaries=steps,
+        warnings=[summary_warnings(s) for s in steps], law_summaries=laws,
+        law_warnings=[summary_warnings(s) for s in laws], factor=factor,
     )
-    report.quantities = _compare(summaries, rtol)
+    report.quantities = _compare(steps, rtol, factor, laws)
     return report
