@@ -209,3 +209,76 @@ def test_p_delta_refuses_a_building_that_buckles(run):
     r = run(one_storey(m=2.0e6, k=1.0e6, h=3.0))
     assert r.returncode != 0
     assert "p_delta" in r.stderr and "buckling" in r.stderr
+
+
+Y_MOTION = {"excitation_type": "harmonic", "amplitude": 0.015, "frequency": 3.1, "dt_record": 0.01,
+            "duration": 3.0}
+
+
+def test_two_components_of_a_symmetric_building_are_its_two_one_component_runs(run):
+    """&excitation along x and &excitation2 along y: the doubly symmetric building does not
+    turn and its braces act along x only, so its x motion is the x-only run's (1e-12). Its y
+    motion is the run along y alone (excitation_angle = 90) with the second motion, but
+    integrated with the steps the x braces' transitions refine (the refinement is global):
+    equal to within Newmark's own error of the y modes, (w dt1)^2 / 12 per radian."""
+    both = symmetric()
+    both["excitation2"] = Y_MOTION
+    xy = ok(run(both, name="xy")).history()
+    x = ok(run(symmetric(), name="x")).history()
+    only_y = symmetric(angle=90.0)
+    only_y["excitation"] = Y_MOTION
+    ry = ok(run(only_y, name="y"))
+    y = ry.history()
+    w = 2 * np.pi / min(p for p in ry.summary()["periods_free_s"] if p)
+    t_end, dt1 = 3.0, 0.01 / 20
+    newmark = (w * dt1) ** 2 / 12 * w * t_end
+    for f in (1, 2, 3):
+        for c, ref, tol in ((1, x, 1e-12), (2, y, newmark)):
+            got, want = np.asarray(xy[f"u{3 * f - 3 + c}"]), np.asarray(ref[f"u{3 * f - 3 + c}"])
+            assert np.abs(want).max() > 1e-5
+            assert np.abs(got - want).max() <= tol * np.abs(want).max()
+        rz = np.asarray(xy[f"u{3 * f}"])
+        assert np.abs(rz).max() <= 1e-12 * np.abs(np.asarray(x[f"u{3 * f - 2}"])).max()
+
+
+def test_two_components_of_an_eccentric_floor_equal_the_modal_closed_form(run):
+    """Two harmonic components at 30 and 120 degrees on the eccentric floor: the sum of
+    each component's modal closed form."""
+    deck = eccentric()
+    deck["excitation2"] = {"excitation_type": "harmonic", "amplitude": 0.006, "frequency": 2.1,
+                           "dt_record": 0.002, "duration": 2.0}
+    h = ok(run(deck, name="ecc2")).history()
+    m, lx, ly = 2.0e5, 20.0, 12.0
+    M = np.diag([m, m, m * (lx**2 + ly**2) / 12])
+    K = np.zeros((3, 3))
+    for c, s, x, y, k in [(1, 0, 0, -6, 50e6), (1, 0, 0, 6, 150e6), (0, 1, -10, 0, 100e6), (0, 1, 10, 0, 100e6)]:
+        b = np.array([c, s, -c * y + s * x])
+        K += k * np.outer(b, b)
+    w2, phi = np.linalg.eigh(np.linalg.solve(np.sqrt(M), np.linalg.solve(np.sqrt(M), K).T))
+    phi = np.linalg.solve(np.sqrt(M), phi)
+    w = np.sqrt(w2)
+    t = np.asarray(h["t"])
+    u = np.zeros((3, t.size))
+    for angle, amp, freq in ((30.0, 0.01, 1.3), (120.0, 0.006, 2.1)):
+        rr = np.array([np.cos(np.radians(angle)), np.sin(np.radians(angle)), 0.0])
+        W = 2 * np.pi * freq
+        A = -amp * W**2
+        for k in range(3):
+            g = phi[:, k] @ M @ rr
+            u += np.outer(phi[:, k], -g * A * (np.sin(W * t) - W / w[k] * np.sin(w[k] * t)) / (w2[k] - W**2))
+    got = np.array([h[f"u{i}"] for i in (1, 2, 3)])
+    dt = 0.002 / 20
+    bound = (w.max() * dt) ** 2 / 12 * w.max() * t[-1]
+    for i in range(3):
+        assert np.abs(got[i] - u[i]).max() <= 2 * bound * np.abs(u[i]).max()
+
+
+def test_a_second_component_needs_rigid_floors_and_the_same_step(run):
+    deck = planar()
+    deck["excitation2"] = Y_MOTION
+    r = run(deck)
+    assert r.returncode != 0 and "&excitation2" in r.stderr and "&floors" in r.stderr
+    deck = symmetric()
+    deck["excitation2"] = dict(Y_MOTION, dt_record=0.02)
+    r = run(deck)
+    assert r.returncode != 0 and "dt_record" in r.stderr and "&excitation2" in r.stderr

@@ -650,6 +650,8 @@ def test_deck_variables_are_the_deck_readers(tmp_path):
     src = re.sub(r"&[ \t]*\n[ \t]*&?", " ", src)
     found = {m[1].lower(): tuple(v.strip().lower() for v in m[2].split(","))
              for m in re.finditer(r"namelist\s*/(\w+)/([^\n!]*)", src, re.I)}
+    # &excitation2, the second horizontal component, is read with &excitation's statement
+    found["excitation2"] = found["excitation"]
     assert found == {g: tuple(v) for g, v in sw.DECK_VARIABLES.items()}
 
 

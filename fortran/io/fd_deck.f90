@@ -74,6 +74,8 @@ module fd_deck
       type(integration_type) :: opts              !! integration settings
       type(output_type) :: out                    !! output settings
       type(record_info) :: record                 !! the record read (excitation_type = 'record')
+      type(excitation_type) :: exc2               !! the second horizontal component (kind none: not given)
+      type(record_info) :: record2                !! its record
    end type run_config
 
 contains
@@ -134,7 +136,7 @@ contains
       cfg%deck_path = deck%path
       call check_groups(deck, [character(len=12) :: 'model', 'springs', 'damping', 'friction', &
                                'braces', 'isolators', 'storeys', 'floors', 'frames', 'floor_braces', &
-                               'excitation', 'integration', 'output'], error)
+                               'excitation', 'excitation2', 'integration', 'output'], error)
       if (allocated(error)) return
       ! the DOFs: a building of rigid floors (&floors, &frames), or masses (&model, &springs)
       call read_floors_group(deck, cfg, floors, error)
@@ -508,6 +510,42 @@ contains
       type(deck_text), intent(in) :: deck
       type(run_config), intent(inout) :: cfg
       type(error_type), allocatable, intent(out) :: error
+      real(dp) :: a
+      integer :: f
+      logical :: found
+
+      call read_component(deck, 'excitation', .true., cfg%exc, cfg%record, found, error)
+      if (allocated(error)) return
+      ! a second horizontal component: perpendicular to the first, for rigid floors
+      call read_component(deck, 'excitation2', .false., cfg%exc2, cfg%record2, found, error)
+      if (allocated(error) .or. .not. found) return
+      if (cfg%model%n_floors == 0) then
+         call fatal_error(error, deck%path//": group &excitation2 is the second horizontal component of a "// &
+                          "building of rigid floors (&floors): a model of &model has one direction")
+         return
+      end if
+      if (cfg%exc2%dt_record /= cfg%exc%dt_record) then
+         call bad(deck, 'excitation2', 'dt_record', trim(fmt_real(cfg%exc2%dt_record)), "equal to &excitation's "// &
+                  trim(fmt_real(cfg%exc%dt_record))//' s (the two components share the step dt1 = dt_record / n1)', &
+                  error)
+         return
+      end if
+      ! r2 = (-sin a, cos a, 0): along excitation_angle + 90 degrees
+      allocate (cfg%model%influence2(cfg%model%n_dof))
+      do f = 1, cfg%model%n_floors
+         a = cfg%model%influence(floor_dof(f, 1))
+         cfg%model%influence2(floor_dof(f, [1, 2, 3])) = [-cfg%model%influence(floor_dof(f, 2)), a, 0.0_dp]
+      end do
+   end subroutine read_excitation_group
+
+   subroutine read_component(deck, gname, required, exc, record, found, error)
+      type(deck_text), intent(in) :: deck
+      character(len=*), intent(in) :: gname               !! the group: 'excitation' or 'excitation2'
+      logical, intent(in) :: required                     !! the deck must give it
+      type(excitation_type), intent(inout) :: exc         !! the component read
+      type(record_info), intent(inout) :: record          !! its record, if one
+      logical, intent(out) :: found                       !! the deck gives the group
+      type(error_type), allocatable, intent(out) :: error
       character(len=name_len) :: excitation_type, record_kind, record_format, record_units
       integer :: kind_id
       character(len=path_len) :: record_file
@@ -527,8 +565,19 @@ contains
       record_scale = default_record_scale
       ramp_cycles = default_ramp_cycles
       record_format = 'auto'; record_units = ''
-      call required_group(deck, 'excitation', grp, error)
+      if (required) then
+         call required_group(deck, gname, grp, error)
+         found = .true.
+      else
+         call find_group(deck, gname, grp, found, error)
+         if (.not. found) return
+      end if
       if (allocated(error)) return
+      ! the namelist read takes the group by the name of its namelist statement
+      if (gname /= 'excitation') then
+         ios = index(lower(grp%lines(1)), '&'//gname)
+         grp%lines(1)(ios:ios + len(gname)) = '&excitation'//repeat(' ', len(gname) - len('excitation'))
+      end if
       call check_length(deck, grp, 'excitation_type', name_len, error)
       if (.not. allocated(error)) call check_length(deck, grp, 'record_kind', name_len, error)
       if (.not. allocated(error)) call check_length(deck, grp, 'record_format', name_len, error)
@@ -545,48 +594,48 @@ contains
       given_dt = is_given(grp, 'dt_record')
       given_duration = is_given(grp, 'duration')
       if (.not. (keyword_id(excitation_types, excitation_type) == excitation_record .and. .not. given_dt)) then
-         call need_real(deck, 'excitation', 'dt_record', dt_record, given_dt, 's', error)
+         call need_real(deck, gname, 'dt_record', dt_record, given_dt, 's', error)
          if (allocated(error)) return
       end if
-      cfg%exc%dt_record = dt_record
-      cfg%exc%kind = keyword_id(excitation_types, excitation_type)
-      select case (cfg%exc%kind)
+      exc%dt_record = dt_record
+      exc%kind = keyword_id(excitation_types, excitation_type)
+      select case (exc%kind)
       case (excitation_harmonic)
-         call need_real(deck, 'excitation', 'amplitude', amplitude, is_given(grp, 'amplitude'), 'm', error, &
+         call need_real(deck, gname, 'amplitude', amplitude, is_given(grp, 'amplitude'), 'm', error, &
                         positive=.false.)
          if (allocated(error)) return
-         call need_real(deck, 'excitation', 'frequency', frequency, is_given(grp, 'frequency'), 'Hz', error)
+         call need_real(deck, gname, 'frequency', frequency, is_given(grp, 'frequency'), 'Hz', error)
          if (allocated(error)) return
          if (ramp_cycles < 0) then
-            call bad(deck, 'excitation', 'ramp_cycles', trim(fmt_int(ramp_cycles)), '>= 0', error); return
+            call bad(deck, gname, 'ramp_cycles', trim(fmt_int(ramp_cycles)), '>= 0', error); return
          end if
-         call need_real(deck, 'excitation', 'duration', duration, given_duration, 's', error)
+         call need_real(deck, gname, 'duration', duration, given_duration, 's', error)
          if (allocated(error)) return
-         cfg%exc%amplitude = amplitude
-         cfg%exc%frequency = frequency
-         cfg%exc%ramp_cycles = ramp_cycles
+         exc%amplitude = amplitude
+         exc%frequency = frequency
+         exc%ramp_cycles = ramp_cycles
       case (excitation_record)
          if (len_trim(record_file) == 0) then
-            call bad(deck, 'excitation', 'record_file', "''", 'the path of the record file', error); return
+            call bad(deck, gname, 'record_file', "''", 'the path of the record file', error); return
          end if
          if (.not. ieee_is_finite(record_scale) .or. record_scale == 0.0_dp) then
-            call bad(deck, 'excitation', 'record_scale', trim(fmt_real(record_scale)), 'finite and non-zero', error)
+            call bad(deck, gname, 'record_scale', trim(fmt_real(record_scale)), 'finite and non-zero', error)
             return
          end if
-         call check_magnitude(deck, 'excitation', 'record_scale', record_scale, '', .true., error)
+         call check_magnitude(deck, gname, 'record_scale', record_scale, '', .true., error)
          if (allocated(error)) return
-         call keyword_value(deck, 'excitation', 'record_kind', record_kinds, record_kind, kind_id, error)
+         call keyword_value(deck, gname, 'record_kind', record_kinds, record_kind, kind_id, error)
          if (allocated(error)) return
          select case (lower(trim(record_format)))
          case ('auto', 'at2', 'values', 'time_value')
          case default
-            call bad(deck, 'excitation', 'record_format', "'"//trim(record_format)//"'", 'one of '//record_formats, error)
+            call bad(deck, gname, 'record_format', "'"//trim(record_format)//"'", 'one of '//record_formats, error)
             return
          end select
          if (len_trim(record_units) > 0) then
             call units_factor(lower(trim(record_units)), kind_id == record_displacement, factor, known)
             if (.not. known) then
-               call bad(deck, 'excitation', 'record_units', "'"//trim(record_units)//"'", 'one of '// &
+               call bad(deck, gname, 'record_units', "'"//trim(record_units)//"'", 'one of '// &
                         record_units_list//", matching record_kind = '"//trim(record_kind)//"'", error)
                return
             end if
@@ -594,38 +643,38 @@ contains
          call relative_to(deck%path, trim(record_file), path)
          call read_record(path, trim(record_format), kind_id == record_displacement, &
                           trim(record_units), record_scale, merge(dt_record, 0.0_dp, given_dt), &
-                          cfg%exc%acc, cfg%record, error)
+                          exc%acc, record, error)
          if (allocated(error)) then
-            error%message = deck%path//", group &excitation, record_file = '"//trim(fmt_text(record_file))//"': "// &
+            error%message = deck%path//", group &"//gname//", record_file = '"//trim(fmt_text(record_file))//"': "// &
                             error%message
             return
          end if
-         cfg%record%path = trim(record_file)   ! as the deck gives it (like the summary's "deck")
-         dt_record = cfg%record%dt
-         cfg%exc%dt_record = dt_record
-         call check_magnitude(deck, 'excitation', "dt_record (the record file's DT)", dt_record, 's', .true., error)
+         record%path = trim(record_file)   ! as the deck gives it (like the summary's "deck")
+         dt_record = record%dt
+         exc%dt_record = dt_record
+         call check_magnitude(deck, gname, "dt_record (the record file's DT)", dt_record, 's', .true., error)
          if (allocated(error)) return
-         if (.not. (cfg%record%peak_acc <= max_magnitude)) then
-            call bad(deck, 'excitation', 'record_file', "'"//trim(fmt_text(record_file))//"'", 'a record whose table '// &
+         if (.not. (record%peak_acc <= max_magnitude)) then
+            call bad(deck, gname, 'record_file', "'"//trim(fmt_text(record_file))//"'", 'a record whose table '// &
                      'acceleration (after record_units and record_scale = '//trim(fmt_real(record_scale))// &
                      ') stays within '//trim(fmt_real(max_magnitude))//' m/s2 in magnitude; it reaches '// &
-                     trim(fmt_real(cfg%record%peak_acc))//' m/s2', error)
+                     trim(fmt_real(record%peak_acc))//' m/s2', error)
             return
          end if
-         if (.not. given_duration) duration = (size(cfg%exc%acc) - 1)*dt_record
+         if (.not. given_duration) duration = (size(exc%acc) - 1)*dt_record
          given_duration = .true.
-         call need_real(deck, 'excitation', 'duration', duration, given_duration, 's', error)
+         call need_real(deck, gname, 'duration', duration, given_duration, 's', error)
          if (allocated(error)) return
       case (excitation_none)
-         call need_real(deck, 'excitation', 'duration', duration, given_duration, 's', error)
+         call need_real(deck, gname, 'duration', duration, given_duration, 's', error)
          if (allocated(error)) return
       case default
          call keyword_choices(excitation_types, choices)
-         call bad(deck, 'excitation', 'excitation_type', "'"//trim(excitation_type)//"'", 'one of '//choices, error)
+         call bad(deck, gname, 'excitation_type', "'"//trim(excitation_type)//"'", 'one of '//choices, error)
          return
       end select
-      cfg%exc%duration = duration
-   end subroutine read_excitation_group
+      exc%duration = duration
+   end subroutine read_component
 
    ! ---------------------------------------------------------------- &integration
    subroutine read_integration_group(deck, cfg, error)

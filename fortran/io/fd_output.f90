@@ -365,17 +365,18 @@ contains
    !> order, each written by its own routine (the run and its model, each check of the step,
    !> the peaks and phase changes, the technique's statistics, the checks of the run, the
    !> energy balance, the engineering outputs, the warnings).
-   subroutine summary_json(model, res, deck_path, js, record)
+   subroutine summary_json(model, res, deck_path, js, record, record2)
       type(model_type), intent(in) :: model                !! the model run
       type(result_type), intent(in) :: res                 !! its result
       character(len=*), intent(in) :: deck_path            !! deck named in the summary
       character(len=:), allocatable, intent(out) :: js     !! the JSON text
       type(record_info), intent(in), optional :: record    !! the record read, if any
+      type(record_info), intent(in), optional :: record2   !! the second component's record, if any
       type(json_text) :: jt
 
       allocate (character(len=4096 + 64*(res%n_dof + res%n_devices)*8) :: jt%buf)
       call put(jt, '{'//nl)
-      call run_part(jt, deck_path, record)
+      call run_part(jt, deck_path, record, record2)
       call model_part(jt, model, res)
       call mode_part(jt, res)
       call harmonic_part(jt, res%harmonic_error, res%harmonic_resolution)
@@ -395,19 +396,30 @@ contains
       js = jt%buf(1:jt%pos)
    end subroutine summary_json
 
-   !> The deck, the program's version and the record read (if any).
-   subroutine run_part(jt, deck_path, record)
+   !> The deck, the program's version and the records read (if any).
+   subroutine run_part(jt, deck_path, record, record2)
       type(json_text), intent(inout) :: jt                 !! the summary
       character(len=*), intent(in) :: deck_path            !! deck named in the summary
       type(record_info), intent(in), optional :: record    !! the record read, if any
+      type(record_info), intent(in), optional :: record2   !! the second component's, if any
       character(len=:), allocatable :: esc
 
       call json_escape(deck_path, esc)
       call put(jt, '  "deck": "'//esc//'",'//nl)
       call put(jt, '  "frictiondyn_version": "'//frictiondyn_version//'",'//nl)
-      if (.not. present(record)) return
+      if (present(record)) call record_item(jt, 'record', record)
+      if (present(record2)) call record_item(jt, 'record2', record2)
+   end subroutine run_part
+
+   !> A record read: its file, format, units, samples, step, scale, peak and hash.
+   subroutine record_item(jt, key, record)
+      type(json_text), intent(inout) :: jt                 !! the summary
+      character(len=*), intent(in) :: key                  !! its key
+      type(record_info), intent(in) :: record              !! the record
+      character(len=:), allocatable :: esc
+
       if (.not. allocated(record%path)) return
-      call put(jt, '  "record": {')
+      call put(jt, '  "'//key//'": {')
       call json_escape(record%path, esc)
       call put(jt, '"file": "'//esc//'", "format": "'//trim(record%format)//'", "format_detected": '// &
                trim(merge('true ', 'false', record%detected))//', "units": "'//trim(record%units)// &
@@ -419,7 +431,7 @@ contains
          call put(jt, ', "title": "'//esc//'"')
       end if
       call put(jt, '},'//nl)
-   end subroutine run_part
+   end subroutine record_item
 
    !> The model's size, technique and laws, the stuck system's first mode and the steps.
    subroutine model_part(jt, model, res)

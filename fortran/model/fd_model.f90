@@ -93,6 +93,7 @@ module fd_model
       ! the table motion's direction over the DOFs, r: the load is -M r a_g (not allocated:
       ! r = 1, every DOF a translation along the table's motion)
       real(dp), allocatable :: influence(:)   !! (n_dof) [-]
+      real(dp), allocatable :: influence2(:)  !! (n_dof) r2 of the second component, if any [-]
       ! a building of rigid floors (fd_floors): floor f has the DOFs 3f - 2 (ux), 3f - 1 (uy)
       ! and 3f (rz) at its centre of mass
       integer :: n_floors = 0                 !! floors (0: a model of masses, &model)

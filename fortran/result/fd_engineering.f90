@@ -61,6 +61,7 @@ module fd_engineering
       real(dp), allocatable :: kr(:)            !! (n_dof) K r [N/m]
       real(dp), allocatable :: br(:)            !! (n_devices) b_d' r [-]
       real(dp), allocatable :: r(:)             !! (n_dof) r, when the model gives one [-]
+      real(dp), allocatable :: r2(:)            !! (n_dof) r2 of a second component, if any [-]
       ! the storey forces that are no element between the storey's two nodes (rigid floors'
       ! frames and braces), by storey: xs_first(c):xs_first(c+1)-1 and xd_first likewise
       integer, allocatable :: xs_first(:), xs_dof(:), xd_first(:), xd_dev(:)
@@ -155,6 +156,7 @@ contains
          end if
       end do
       if (allocated(model%influence)) eng%r = model%influence
+      if (allocated(model%influence2)) eng%r2 = model%influence2
       if (model%n_kx > 0 .or. .not. devices_are_pairs(model)) then
          call general_base(model, eng, stat)
          if (stat /= 0) then

@@ -168,7 +168,7 @@ contains
 
    !> Peaks over the accepted states: |u| (and its time), |v|, |absolute acceleration| (and
    !> its time) per DOF, |s| and |F| per device.
-   pure subroutine observe_peaks(res, t, n, nd, u, v, acc, ag, s, force)
+   pure subroutine observe_peaks(res, t, n, nd, u, v, acc, ag, s, force, ag2)
       type(result_type), intent(inout) :: res  !! the result
       real(dp), intent(in) :: t                !! time [s]
       integer, intent(in) :: n                 !! DOFs
@@ -177,6 +177,7 @@ contains
       real(dp), intent(in) :: v(n)             !! relative velocities [m/s]
       real(dp), intent(in) :: acc(n)           !! relative accelerations [m/s2]
       real(dp), intent(in) :: ag               !! table acceleration [m/s2]
+      real(dp), intent(in), optional :: ag2    !! a second component's table acceleration [m/s2]
       real(dp), intent(in) :: s(nd)            !! device relative displacements [m]
       real(dp), intent(in) :: force(nd)        !! device forces [N]
       real(dp) :: x
@@ -195,7 +196,9 @@ contains
          ! the absolute acceleration: the table's along the DOF's direction r_i added
          ri = 1.0_dp
          if (has_r) ri = res%eng%r(i)
-         x = abs(acc(i) + ri*ag)
+         x = acc(i) + ri*ag
+         if (present(ag2) .and. allocated(res%eng%r2)) x = x + res%eng%r2(i)*ag2
+         x = abs(x)
          if (x > res%peak_aabs(i)) then
             res%peak_aabs(i) = x; res%peak_aabs_time(i) = t
          end if
@@ -287,11 +290,12 @@ contains
    !> and its row sink as selected. The first value not finite of a row that goes only to
    !> the buffer or the sink is noted in the control (run_config_solve makes it an error; the
    !> result's rows are checked at the end). Allocates nothing.
-   subroutine observe_sample(obs, res, t, ag, u, v, acc, s, sd, force, phase, env)
+   subroutine observe_sample(obs, res, t, ag, u, v, acc, s, sd, force, phase, env, ag2)
       type(observer_type), intent(inout) :: obs !! the observer
       type(result_type), intent(inout) :: res  !! the result
       real(dp), intent(in) :: t                !! time [s]
       real(dp), intent(in) :: ag               !! table acceleration [m/s2]
+      real(dp), intent(in), optional :: ag2    !! a second component's table acceleration [m/s2]
       real(dp), intent(in) :: u(:)             !! relative displacements [m]
       real(dp), intent(in) :: v(:)             !! relative velocities [m/s]
       real(dp), intent(in) :: acc(:)           !! relative accelerations [m/s2]
@@ -377,11 +381,13 @@ contains
          end if
       end associate
    contains
-      !> The table's acceleration along DOF i (r_i ag; ag when the model gives no r).
+      !> The table's acceleration along DOF i (r_i ag, ag when the model gives no r, and r2_i ag2
+      !> of a second component).
       pure real(dp) function table_along(i) result(x)
          integer, intent(in) :: i
          x = ag
          if (allocated(res%eng%r)) x = res%eng%r(i)*ag
+         if (present(ag2) .and. allocated(res%eng%r2)) x = x + res%eng%r2(i)*ag2
       end function table_along
    end subroutine observe_sample
 

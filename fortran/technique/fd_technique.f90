@@ -102,7 +102,7 @@ contains
 
    !> Run the technique the settings choose (with the caller's control of the run, if any:
    !> history columns and destinations, stop requests, progress).
-   subroutine run_technique(model, exc, opts, res, error, ctl)
+   subroutine run_technique(model, exc, opts, res, error, ctl, exc2)
       type(model_type), intent(in) :: model         !! validated model
       type(excitation_type), intent(in) :: exc      !! validated table motion
       type(integration_type), intent(in) :: opts    !! validated settings
@@ -110,10 +110,12 @@ contains
       type(error_type), allocatable, intent(out) :: error !! what the technique cannot do, or
                                                           !! its failure
       type(run_control), intent(inout), target, optional :: ctl !! the run's control
+      type(excitation_type), intent(in), optional :: exc2 !! a second horizontal component
+                                                          !! (along the model's influence2)
 
       select case (opts%technique)
       case (technique_newmark)
-         call run_newmark(model, exc, opts, res, error, ctl)
+         call run_newmark(model, exc, opts, res, error, ctl, exc2)
       case (technique_event_driven)
          call run_event_driven(model, exc, opts, res, error, ctl)
       case (technique_moreau_jean)

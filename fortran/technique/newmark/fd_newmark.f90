@@ -32,6 +32,7 @@ module fd_newmark
                        technique_event_driven, technique_moreau_jean, linear_system_dense, linear_system_banded, &
                        refinement_nested, refinement_implicit
    use fd_model, only: model_type, integration_type, device_type
+   use fd_names, only: excitation_none
    use fd_excitation, only: excitation_type, table_motion, table_acceleration, grid_motion, grid_init, &
                             grid_acceleration
    use fd_matrices, only: structure_damping
@@ -97,6 +98,12 @@ module fd_newmark
       real(dp) :: follow_misfit = 0.0_dp              !! then its last pass's largest |df| / cap
       integer :: follow_passes = 0                    !! solves the fixed point took in all
       real(dp) :: ag = 0.0_dp, ag1 = 0.0_dp
+      ! a second horizontal component: its table acceleration now and at the trial state, and
+      ! the load M r2 of a unit of it (two = .false.: none)
+      logical :: two = .false.
+      type(excitation_type) :: exc2
+      real(dp) :: ag2 = 0.0_dp, ag21 = 0.0_dp
+      real(dp), allocatable :: mr2(:)
       real(dp) :: w_device = 0.0_dp                   !! work of the device forces [J]
       real(dp) :: t = 0.0_dp                          !! time of the accepted state [s]
       integer :: k = 0                                !! the dt1 step being taken, from k - 1 to k
@@ -139,13 +146,15 @@ contains
 
    !> Integrate a model under a table motion and fill the result. With a control: the
    !> history columns and destinations it selects, stop requests and progress reports.
-   subroutine run_newmark(model, exc, opts, res, error, ctl)
+   subroutine run_newmark(model, exc, opts, res, error, ctl, exc2)
       type(model_type), intent(in) :: model         !! validated model
       type(excitation_type), intent(in) :: exc      !! validated table motion
       type(integration_type), intent(in) :: opts    !! validated settings
       type(result_type), intent(out) :: res         !! histories and summary
       type(error_type), allocatable, intent(out) :: error !! singular system, divergence, stop
       type(run_control), intent(inout), target, optional :: ctl !! the run's control
+      type(excitation_type), intent(in), optional :: exc2 !! a second horizontal component, along
+                                                          !! the model's influence2 (kind none: none)
       type(workspace) :: w
       real(dp) :: dt1, dt2, t0
       integer :: k, c0, c1, crate, l
@@ -163,6 +172,18 @@ contains
       if (res%dt_min <= 0.0_dp) res%dt_min = dt2/2.0_dp**10
       call setup(model, opts, dt1, dt2, halving_levels(dt2, res%dt_min), w, res, error)
       if (allocated(error)) return
+      if (present(exc2)) then
+         if (exc2%kind /= excitation_none) then
+            if (.not. allocated(model%influence2)) then
+               call fatal_error(error, "a second horizontal component needs the model's direction of it "// &
+                                "(a building of rigid floors, &floors)")
+               return
+            end if
+            w%two = .true.
+            w%exc2 = exc2
+            w%mr2 = model%mass*model%influence2
+         end if
+      end if
       call observer_init(model, exc, opts, res%period_stuck, res, w%obs, error, ctl)
       if (allocated(error)) return
       call grid_init(exc, dt1, w%grid)
@@ -184,8 +205,8 @@ contains
                                   device_energy(model, w%st, w%s))
       w%phase0 = w%st%phase
       res%started_sliding = any(w%phase0 /= phase_stick)
-      call observe_sample(w%obs, res, 0.0_dp, w%ag, w%u, w%v, w%a, w%s, w%sd, w%f, w%phase0)
-      call observe_peaks(res, 0.0_dp, w%n, w%nd, w%u, w%v, w%a, w%ag, w%s, w%f)
+      call observe_sample(w%obs, res, 0.0_dp, w%ag, w%u, w%v, w%a, w%s, w%sd, w%f, w%phase0, ag2=w%ag2)
+      call observe_peaks(res, 0.0_dp, w%n, w%nd, w%u, w%v, w%a, w%ag, w%s, w%f, w%ag2)
 
       do k = 1, w%obs%nsteps
          t0 = (k - 1)*dt1
@@ -219,7 +240,7 @@ contains
                return
             end if
             w%phase0 = w%st%phase
-            call observe_sample(w%obs, res, k*dt1, w%ag, w%u, w%v, w%a, w%s, w%sd, w%f, w%phase0)
+            call observe_sample(w%obs, res, k*dt1, w%ag, w%u, w%v, w%a, w%s, w%sd, w%f, w%phase0, ag2=w%ag2)
          end if
          call observe_poll(w%obs, k*dt1, stop)
          if (stop) then
@@ -353,6 +374,10 @@ contains
 
       call table_motion(exc, t, xg, vg, w%ag)
       w%rhs = -w%mr*w%ag
+      if (w%two) then
+         call table_motion(w%exc2, t, xg, vg, w%ag2)
+         w%rhs = w%rhs - w%mr2*w%ag2
+      end if
       call spd_c_matvec(w%lev(1)%sys, w%v, w%rhs, -1.0_dp, 1.0_dp)
       call spd_k_matvec(w%lev(1)%sys, w%u, w%rhs, -1.0_dp, 1.0_dp)
       do d = 1, w%nd
@@ -394,6 +419,10 @@ contains
       ! whatever an earlier trial of the step left in them (follow_forces takes them on)
       if (w%nf > 0) call start_forces(model%dev, w)
       call predict(w%n, h, w%lev(lv)%g1h, w%lev(lv)%b2h2, ag1, w%mr, w%u, w%v, w%a, w%tmp, w%u1, w%rhs)
+      if (w%two) then
+         w%ag21 = table_acceleration(w%exc2, t + h)
+         w%rhs = w%rhs - w%mr2*w%ag21
+      end if
       call spd_kc_matvec(w%lev(lv)%sys, w%u1, w%tmp, w%rhs, -1.0_dp)
       call device_loads(model, w%n, w%nd, w%st, w%u1, w%tmp, w%lev(lv)%c0, w%rhs, w%s1, w%sd1, w%fw)
       call spd_solve(w%lev(lv)%sys, w%rhs, error)
@@ -798,6 +827,10 @@ contains
       ! energy of the step, forces at both ends in the step's phases; the state moves on
       call step_energy(w%n, w%mr, w%u, w%v, w%a, w%u1, w%v1, w%a1, w%tmp, w%rhs, ein)
       ein = 0.5_dp*(w%ag + w%ag1)*ein
+      if (w%two) then
+         ein = ein + 0.5_dp*(w%ag2 + w%ag21)*dot_product(w%mr2, w%tmp)
+         w%ag2 = w%ag21
+      end if
       call observe_work(res, -ein, 0.5_dp*viscous_work(model, w%a0, w%a1c, w%n, w%mass, w%tmp, w%rhs))
       w%ag = w%ag1
       ! violations of the correctness condition left in an accepted step
@@ -828,7 +861,7 @@ contains
       w%t = t1
       if (changed_k) w%version = w%version + 1
       if (any_changed .or. any_force) call consistent_acceleration(model, exc, t1, w)
-      call observe_peaks(res, t1, w%n, w%nd, w%u, w%v, w%a, w%ag, w%s, w%f)
+      call observe_peaks(res, t1, w%n, w%nd, w%u, w%v, w%a, w%ag, w%s, w%f, w%ag2)
    end subroutine accept
 
    !> The state moves to the trial state; du = u1 - u (in du), v + v1 (in vsum) and
