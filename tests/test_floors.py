@@ -282,3 +282,23 @@ def test_a_second_component_needs_rigid_floors_and_the_same_step(run):
     deck["excitation2"] = dict(Y_MOTION, dt_record=0.02)
     r = run(deck)
     assert r.returncode != 0 and "dt_record" in r.stderr and "&excitation2" in r.stderr
+
+
+def test_profiles_of_rigid_floors_draw_x_and_y_apart(run, tmp_path):
+    """The drift and acceleration profiles of a building of rigid floors: one curve along x
+    and one along y, each through its own storeys (their values the summary's)."""
+    from frictiondyn import plots
+
+    r = ok(run(symmetric(), name="floors"))
+    res = r.history()
+    fig = plots.plot_drift_profile(res, tmp_path / "drift.png")
+    lines = [ln for ln in fig.axes[0].get_lines() if ln.get_label() in ("x", "y")]
+    assert sorted(ln.get_label() for ln in lines) == ["x", "y"]
+    ratio = np.array(r.summary()["peak_drift_ratio"], dtype=float).reshape(3, 2) * 100
+    for ln, col in zip(sorted(lines, key=lambda ln: ln.get_label()), (0, 1)):
+        assert np.allclose(ln.get_xdata()[::2], ratio[:, col], rtol=1e-12)
+        assert np.allclose(ln.get_ydata(), [0, 3, 3, 6, 6, 9])
+    fig = plots.plot_acceleration_profile(res, tmp_path / "acc.png")
+    aabs = np.array(r.summary()["peak_aabs_mps2"]).reshape(3, 3)
+    got = {ln.get_label(): ln.get_xdata() for ln in fig.axes[0].get_lines()}
+    assert np.allclose(got["x"], aabs[:, 0]) and np.allclose(got["y"], aabs[:, 1])

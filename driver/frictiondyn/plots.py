@@ -545,6 +545,30 @@ def _storey_levels(r: Result) -> tuple[np.ndarray, bool]:
     return np.column_stack([np.arange(n), np.arange(1, n + 1)]).astype(float), False
 
 
+def _storey_chains(r: Result) -> list[list[int]]:
+    """The storeys (0-based) as stacks from the table: each stack the storeys one above the
+    other, bottom first (a building of rigid floors has one along x and one along y). A
+    storey in no stack from the table is a stack of its own."""
+    nodes = [tuple(n) for n in (r.summary.get("storey_nodes") or [])]
+    above = {}
+    for k, (i, j) in enumerate(nodes):
+        above.setdefault(j, []).append(k)
+    chains, seen = [], set()
+    for k in above.get(0, []):
+        chain = [k]
+        while len(above.get(nodes[chain[-1]][0], [])) == 1:
+            chain.append(above[nodes[chain[-1]][0]][0])
+        chains.append(chain)
+        seen.update(chain)
+    return chains + [[k] for k in range(len(nodes)) if k not in seen] if chains else [list(range(len(nodes)))]
+
+
+def _chain_name(r: Result, chain: list[int]) -> str:
+    """The direction a stack of storeys shares ('x' of 'storey 1 x', ...), '' if none."""
+    words = {lab.split()[-1] for lab in (r.storey_labels[k] for k in chain) if len(lab.split()) > 1}
+    return words.pop() if len(words) == 1 and len(chain) > 1 and next(iter(words), "") in ("x", "y") else ""
+
+
 def _floor_levels(r: Result) -> tuple[np.ndarray, bool]:
     """Level of each DOF: its height when the storeys give it, else its number."""
     levels, metres = _storey_levels(r)
@@ -586,29 +610,34 @@ def plot_drift_profile(
             raise ValueError(f"{name}: drift ratios need every storey's height")
         scale = 100.0 if use_ratio else u.factor("m")
         levels, metres = _storey_levels(r)
-        color = f"C{k}"
-        for kind, style in (("peak", "-"), ("residual", "--")):
-            if kind == "residual" and not residual:
-                continue
-            values = np.abs(np.array(s[f"{kind}_{key}"], dtype=float)) * scale
-            xs = np.repeat(values, 2)
-            ys = levels.reshape(-1)
-            lab = name if kind == "peak" else f"{name}, residual"
-            ax.plot(xs, ys, style, color=color, linewidth=1.2, label=lab)
-            ax.plot(values, levels.mean(axis=1), "o", color=color, markersize=3.5)
+        chains = _storey_chains(r)
+        for c, chain in enumerate(chains):
+            color = f"C{k * len(chains) + c}"
+            direction = _chain_name(r, chain)
+            for kind, style in (("peak", "-"), ("residual", "--")):
+                if kind == "residual" and not residual:
+                    continue
+                values = np.abs(np.array(s[f"{kind}_{key}"], dtype=float)[chain]) * scale
+                xs = np.repeat(values, 2)
+                ys = levels[chain].reshape(-1)
+                lab = name if not direction else f"{name}, {direction}" if len(rs) > 1 else direction
+                lab = lab if kind == "peak" else f"{lab}, residual"
+                ax.plot(xs, ys, style, color=color, linewidth=1.2, label=lab)
+                ax.plot(values, levels[chain].mean(axis=1), "o", color=color, markersize=3.5)
     r0 = rs[0]
     levels, metres = _storey_levels(r0)
     if metres:
         ax.set_ylabel("height [m]")
     else:
-        ax.set_yticks(levels.mean(axis=1), r0.storey_labels)
+        chain = _storey_chains(r0)[0]
+        ax.set_yticks(levels[chain].mean(axis=1), [r0.storey_labels[k] for k in chain])
         ax.set_ylabel("storey")
     ax.set_ylim(bottom=0.0)
     ax.set_xlim(0.0, 1.08 * max(ln.get_xdata().max() for ln in ax.get_lines()))
     use_ratio = ratio if ratio is not None else all(h > 0 for h in r0.summary["storey_height_m"])
     ax.set_xlabel("drift ratio [%]" if use_ratio else f"drift [{u.name('m')}]")
     ax.grid(True, linewidth=0.3)
-    if len(rs) > 1 or residual:
+    if len(rs) > 1 or residual or len(_storey_chains(r0)) > 1:
         ax.legend(fontsize="small", loc="best")
     _title(ax, title, "peak inter-storey drift")
     return _finish(fig, path, dpi)
@@ -633,23 +662,38 @@ def plot_acceleration_profile(
     u = Units.parse(units)
     f = u.factor("m/s2")
     for r, name in zip(rs, names, strict=True):
-        levels, metres = _floor_levels(r)
         peaks = np.array(r.summary["peak_aabs_mps2"], dtype=float) * f
+        chains = _storey_chains(r) if r.n_storeys else []
+        if len(chains) > 1:
+            # one curve per stack of storeys (rigid floors: along x and along y), the DOFs at
+            # their tops; no table point (the history's ag is the first component alone)
+            slevels, _ = _storey_levels(r)
+            nodes = r.summary["storey_nodes"]
+            for chain in chains:
+                direction = _chain_name(r, chain)
+                dofs = [nodes[k][0] - 1 for k in chain]
+                ys = slevels[chain, 1]
+                xs = peaks[dofs]
+                ax.plot(xs, ys, "-o", linewidth=1.2, markersize=3.5,
+                        label=f"{name}, {direction}" if len(rs) > 1 else direction or name)
+            continue
+        levels, metres = _floor_levels(r)
         order = np.argsort(levels, kind="stable")
         ys = np.concatenate([[0.0], levels[order]])
         xs = np.concatenate([[float(np.max(np.abs(r["ag"]))) * f], peaks[order]])
         ax.plot(xs, ys, "-o", linewidth=1.2, markersize=3.5, label=name)
     r0 = rs[0]
     levels, metres = _floor_levels(r0)
-    if metres:
+    stacks = r0.n_storeys and len(_storey_chains(r0)) > 1
+    if metres or (stacks and _storey_levels(r0)[1]):
         ax.set_ylabel("height [m]")
-    else:
+    elif not stacks:
         ax.set_yticks(np.concatenate([[0.0], levels]), ["table", *r0.dof_labels])
         ax.set_ylabel("level")
     ax.set_xlim(0.0, 1.08 * max(ln.get_xdata().max() for ln in ax.get_lines()))
     ax.set_xlabel(f"peak absolute acceleration [{u.name('m/s2')}]")
     ax.grid(True, linewidth=0.3)
-    if len(rs) > 1:
+    if len(rs) > 1 or stacks:
         ax.legend(fontsize="small")
     _title(ax, title, "peak floor acceleration")
     return _finish(fig, path, dpi)
