@@ -156,11 +156,14 @@ def test_large_model_low_rank_and_linear_in_size():
     assert r.summary["modal_xi_stuck"] == pytest.approx([0.05] * 3, abs=1e-8)
     times = {}
     for n in (1000, 4000):
-        t0 = time.perf_counter()
-        chain_analysis(n, 2.0, modes_kept=10).run()
-        t1 = time.perf_counter()
-        chain_analysis(n, 0.02, modes_kept=10).run()
-        times[n] = (t1 - t0) - (time.perf_counter() - t1)  # the steps, set-up removed
+        best = []
+        for _ in range(2):  # the better of two: the machine may be shared
+            t0 = time.perf_counter()
+            chain_analysis(n, 2.0, modes_kept=10).run()
+            t1 = time.perf_counter()
+            chain_analysis(n, 0.02, modes_kept=10).run()
+            best.append((t1 - t0) - (time.perf_counter() - t1))  # 400 steps, set-up removed
+        times[n] = min(best)
     assert times[4000] / times[1000] < 8.0
 
 
