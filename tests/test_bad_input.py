@@ -54,8 +54,8 @@ CASES = [
     ("too many masses", _set("model", "mass", [1.0, 2.0, 3.0]), ["&model", "mass(3)", "3.0"]),
     (
         "unknown damping",
-        _set("damping", "damping_type", "modal"),
-        ["&damping", "damping_type", "modal"],
+        _set("damping", "damping_type", "caughey"),
+        ["&damping", "damping_type", "caughey"],
     ),
     ("xi >= 1", _set("damping", "xi", 1.5), ["&damping", "xi", "1.5"]),
     (

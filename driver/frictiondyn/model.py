@@ -185,12 +185,14 @@ class Storey:
 @dataclass
 class Damping:
     """Viscous damping: 'stiffness' (C = psi K, psi = T xi / pi; T computed when the period
-    is not given), 'rayleigh' (C = a0 M + a1 K) or 'none'. Values left at None take the
+    is not given), 'rayleigh' (C = a0 M + a1 K), 'modal' (the ratio xi, or one ratio per
+    mode, in each kept mode of the stuck system) or 'none'. Values left at None take the
     reader's defaults. The type and every value given are written as they are: the reader
-    takes the type in any case, and ignores a value the type does not use."""
+    takes the type in any case, and ignores a value the type does not use ('modal' refuses
+    them)."""
 
     type: str = "none"
-    xi: float | None = None
+    xi: float | Sequence[float] | None = None
     period: float | None = None
     rayleigh_a0: float | None = None
     rayleigh_a1: float | None = None
@@ -202,6 +204,14 @@ class Damping:
     mode_i: int | None = None
     mode_j: int | None = None
     mode_system: str | None = None
+    modal_modes: int | None = None
+
+    @classmethod
+    def modal(cls, xi: float | Sequence[float], modes: int | None = None) -> Damping:
+        """Modal damping: the ratio xi in each of the lowest `modes` modes of the stuck
+        system (default: every mode, at most 50), or one ratio per mode (a sequence: as
+        many modes as ratios). The modes above those kept have none."""
+        return cls("modal", xi=xi, modal_modes=modes)
 
     @classmethod
     def rayleigh(cls, a0: float, a1: float) -> Damping:
@@ -217,15 +227,19 @@ class Damping:
 
     def group(self) -> dict:
         g: dict = {"damping_type": _value(self.type)}
+        xi = self.xi
+        if xi is not None and not isinstance(xi, (str, bytes)) and np.ndim(xi) == 1:
+            xi = [_value(x) for x in xi]
         _put(
             g,
-            xi=self.xi,
+            xi=xi,
             period=self.period,
             rayleigh_a0=self.rayleigh_a0,
             rayleigh_a1=self.rayleigh_a1,
             mode_i=_opt_int(self.mode_i, "mode_i"),
             mode_j=_opt_int(self.mode_j, "mode_j"),
             mode_system=self.mode_system,
+            modal_modes=_opt_int(self.modal_modes, "modal_modes"),
         )
         return g
 

@@ -119,7 +119,7 @@ DECK_VARIABLES: dict[str, tuple[str, ...]] = {
     "model": ("n_dof", "mass", "u0", "v0", "label"),
     "springs": ("n_springs", "node_i", "node_j", "k"),
     "damping": ("damping_type", "xi", "period", "rayleigh_a0", "rayleigh_a1", "mode_i",
-                "mode_j", "mode_system"),
+                "mode_j", "mode_system", "modal_modes"),
     "friction": ("n_devices", "node_i", "node_j", "law", "p", "mu", "eps", "eps1", "f",
                  "mu_law", "mu_max", "mu_min", "mu_rate", "mu_table_v", "mu_table_mu", "label"),
     "braces": ("n_braces", "node_i", "node_j", "slip_load", "stiffness", "eps1", "label"),

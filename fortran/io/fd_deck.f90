@@ -15,7 +15,7 @@ module fd_deck
    use fd_namelist, only: deck_text, group_text, deck_from_string, find_group, &
                           next_read, check_groups, longest_string, given_elements
    use fd_names, only: keyword_type, keyword_id, keyword_choices, law_id, law_choices, &
-                       damping_types, damping_stiffness, damping_rayleigh, damping_none, &
+                       damping_types, damping_stiffness, damping_rayleigh, damping_none, damping_modal, &
                        excitation_types, excitation_harmonic, excitation_record, excitation_none, &
                        record_kinds, record_displacement, techniques, technique_name, &
                        default_u0, default_v0, default_xi, default_period, default_rayleigh_a0, &
@@ -31,7 +31,7 @@ module fd_deck
    use fd_record, only: read_record, record_info, record_formats, record_units_list, units_factor
    use fd_names, only: label_len, max_mu_points, mu_laws, mu_constant, mu_exponential, mu_table, mode_systems, &
                        system_stuck, law_hysteretic, &
-                       default_mu_law, default_mode_system, default_n_modes, default_radius, &
+                       default_mu_law, default_mode_system, default_n_modes, default_radius, default_modal_modes, &
                        default_storey_height, law_name
    use fd_model, only: source_friction, source_brace, source_isolator, source_floor_brace
    use fd_floors, only: floor_dof, plan_direction, floor_inertia, max_plan_terms
@@ -39,6 +39,7 @@ module fd_deck
    use fd_linalg, only: cholesky_factor
    use fd_friction, only: law_mu_of_speed
    use fd_matrices, only: modes_type, natural_modes, natural_modes_sparse, stiffness_matrix, modes_dense_dofs
+   use fd_modal_damping, only: modal_damping_basis
    use fd_sha256, only: sha256_text
    use fd_textio, only: read_file_text, cr_line_ends
    use fd_result, only: history_shape
@@ -182,6 +183,12 @@ contains
       ! 'rayleigh' damping from xi at two modes (what the technique can integrate is asked by
       ! the session, fd_technique's check_technique)
       call resolve_rayleigh(deck, cfg, error)
+      if (allocated(error)) return
+      ! 'modal' damping: the kept modes of the stuck system, once the devices are known
+      if (cfg%model%damping == damping_modal) then
+         call modal_damping_basis(cfg%model, error)
+         if (allocated(error)) error%message = deck%path//", group &damping: "//error%message
+      end if
    end subroutine read_groups
 
    !> The model is one of two kinds: masses (&model) or rigid floors (&floors, &frames,
@@ -339,20 +346,26 @@ contains
       type(run_config), intent(inout) :: cfg
       type(error_type), allocatable, intent(out) :: error
       character(len=name_len) :: damping_type
-      real(dp) :: xi, period, rayleigh_a0, rayleigh_a1
-      integer :: mode_i, mode_j
+      real(dp) :: period, rayleigh_a0, rayleigh_a1
+      real(dp), allocatable :: xi(:)
+      integer :: mode_i, mode_j, modal_modes
       character(len=name_len) :: mode_system
-      namelist /damping/ damping_type, xi, period, rayleigh_a0, rayleigh_a1, mode_i, mode_j, mode_system
+      namelist /damping/ damping_type, xi, period, rayleigh_a0, rayleigh_a1, mode_i, mode_j, mode_system, modal_modes
       type(group_text) :: grp
       character(len=512) :: msg
       character(len=:), allocatable :: choices
-      integer :: ios
+      logical, allocatable :: given(:)
+      integer :: ios, nx
       logical :: more
 
       damping_type = ''
+      ! xi: one ratio, or ('modal') one per mode: at most one a DOF (and a few more, which
+      ! the checks below report)
+      allocate (xi(2*cfg%model%n_dof + 16))
       xi = default_xi; period = default_period
       rayleigh_a0 = default_rayleigh_a0; rayleigh_a1 = default_rayleigh_a1
       mode_i = unset_int; mode_j = unset_int; mode_system = mode_systems(default_mode_system)%name
+      modal_modes = default_modal_modes
       call required_group(deck, 'damping', grp, error)
       if (allocated(error)) return
       call check_length(deck, grp, 'damping_type', name_len, error)
@@ -364,10 +377,29 @@ contains
          if (.not. more) exit
       end do
       if (allocated(error)) return
+      given = given_of(grp, 'xi', size(xi))
+      nx = count(given)
+      if (nx > 0 .and. .not. all(given(1:nx))) then
+         call fatal_error(error, deck%path//", group &damping: xi is given as elements that do not start at "// &
+                          "xi(1) or have gaps: give xi = x1, x2, ... in order")
+         return
+      end if
       cfg%model%damping = keyword_id(damping_types, damping_type)
+      if (cfg%model%damping /= damping_modal) then
+         if (nx > 1) then
+            call bad(deck, 'damping', 'xi', trim(fmt_int(nx))//' values', "one value unless damping_type = "// &
+                     "'modal' (a ratio per mode)", error)
+            return
+         end if
+         if (is_given(grp, 'modal_modes')) then
+            call bad(deck, 'damping', 'modal_modes', trim(fmt_int(modal_modes)), "absent unless damping_type = "// &
+                     "'modal'", error)
+            return
+         end if
+      end if
       select case (cfg%model%damping)
       case (damping_stiffness)
-         call check_real(deck, 'damping', 'xi', xi, 0.0_dp, 1.0_dp, '', error, open_hi=.true.)
+         call check_real(deck, 'damping', 'xi', xi(1), 0.0_dp, 1.0_dp, '', error, open_hi=.true.)
          if (allocated(error)) return
          call check_real(deck, 'damping', 'period', period, 0.0_dp, max_magnitude, 's', error)
          if (allocated(error)) return
@@ -376,8 +408,11 @@ contains
          if (allocated(error)) return
          call check_real(deck, 'damping', 'rayleigh_a1', rayleigh_a1, 0.0_dp, max_magnitude, 's', error)
          if (allocated(error)) return
-         call rayleigh_modes(deck, xi, rayleigh_a0, rayleigh_a1, mode_i, mode_j, is_given(grp, 'mode_i'), &
+         call rayleigh_modes(deck, xi(1), rayleigh_a0, rayleigh_a1, mode_i, mode_j, is_given(grp, 'mode_i'), &
                              is_given(grp, 'mode_j'), mode_system, cfg, error)
+         if (allocated(error)) return
+      case (damping_modal)
+         call modal_ratios(deck, grp, xi(1:nx), modal_modes, cfg, error)
          if (allocated(error)) return
       case (damping_none)
       case default
@@ -385,11 +420,58 @@ contains
          call bad(deck, 'damping', 'damping_type', "'"//trim(damping_type)//"'", 'one of '//choices, error)
          return
       end select
-      cfg%model%xi = xi
+      cfg%model%xi = xi(1)
       cfg%model%period = period
       cfg%model%rayleigh_a0 = rayleigh_a0
       cfg%model%rayleigh_a1 = rayleigh_a1
    end subroutine read_damping_group
+
+   !> 'modal' damping: xi (one ratio for every kept mode, or one per kept mode, each in
+   !> [0, 1)) and modal_modes (>= 1 when given); the variables of the other damping types
+   !> are refused rather than left unused. The modes are found once the devices are known
+   !> (fd_modal_damping, from read_groups).
+   subroutine modal_ratios(deck, grp, xi, modal_modes, cfg, error)
+      type(deck_text), intent(in) :: deck
+      type(group_text), intent(in) :: grp
+      real(dp), intent(in) :: xi(:)                 !! the ratios given
+      integer, intent(in) :: modal_modes
+      type(run_config), intent(inout) :: cfg
+      type(error_type), allocatable, intent(out) :: error
+      character(len=12), parameter :: others(*) = [character(len=12) :: 'period', 'rayleigh_a0', 'rayleigh_a1', &
+                                                   'mode_i', 'mode_j', 'mode_system']
+      integer :: i
+
+      if (size(xi) == 0) then
+         call fatal_error(error, deck%path//", group &damping: xi is not given: 'modal' damping needs the damping "// &
+                          "ratio of the modes (one for every kept mode, or one per mode)")
+         return
+      end if
+      do i = 1, size(others)
+         if (is_given(grp, trim(others(i)))) then
+            call fatal_error(error, deck%path//", group &damping: "//trim(others(i))//" is given: it must be "// &
+                             "absent with 'modal' damping (xi and modal_modes set it)")
+            return
+         end if
+      end do
+      do i = 1, size(xi)
+         if (size(xi) == 1) then
+            call check_real(deck, 'damping', 'xi', xi(i), 0.0_dp, 1.0_dp, '', error, open_hi=.true.)
+         else
+            call check_real(deck, 'damping', 'xi('//trim(fmt_int(i))//')', xi(i), 0.0_dp, 1.0_dp, '', error, &
+                            open_hi=.true.)
+         end if
+         if (allocated(error)) return
+      end do
+      if (is_given(grp, 'modal_modes')) then
+         if (modal_modes < 1 .or. modal_modes > cfg%model%n_dof) then
+            call bad(deck, 'damping', 'modal_modes', trim(fmt_int(modal_modes)), 'in 1..'// &
+                     trim(fmt_int(cfg%model%n_dof))//' (n_dof)', error)
+            return
+         end if
+      end if
+      cfg%model%modal_xi = xi
+      cfg%model%modal_modes = modal_modes
+   end subroutine modal_ratios
 
    ! ---------------------------------------------------------------- &friction
    subroutine read_friction_group(deck, cfg, error)

@@ -6,7 +6,7 @@ module fd_matrices
    use, intrinsic :: ieee_arithmetic, only: ieee_value, ieee_positive_inf, ieee_quiet_nan
    use fd_kinds, only: dp
    use fd_error, only: error_type, fatal_error, fmt_real, fmt_int, stat_no_memory
-   use fd_model, only: model_type, damping_none, damping_stiffness, damping_rayleigh, &
+   use fd_model, only: model_type, damping_none, damping_stiffness, damping_rayleigh, damping_modal, &
                        system_stuck, system_free
    use fd_friction, only: sticking_stiffness, holds_when_stuck, links_when_stuck
    use fd_linalg, only: generalized_eigen, lowest_eigen, lowest_eigen_band
@@ -254,6 +254,9 @@ contains
       if (model%n_kx > 0) pkp = pkp + general_form(model, phi, phi)
       pmp = sum(model%mass*phi**2)
       xi = (a0*pmp + a1*pkp)/(2.0_dp*(2.0_dp*pi/period)*pmp)
+      ! 'modal' damping's low-rank term: phi' U diag(d) U' phi
+      if (allocated(model%modal_d)) xi = xi + sum(model%modal_d*matmul(phi, model%modal_u)**2)/ &
+                                         (2.0_dp*(2.0_dp*pi/period)*pmp)
    contains
       pure real(dp) function node_value(node)
          integer, intent(in) :: node
@@ -745,6 +748,16 @@ contains
             kz = kz + model%spring_k(s)*w*w
          end do
          zcz(j) = a0 + a1*kz
+         ! 'modal' damping's low-rank term: z' U diag(d) U' z
+         if (allocated(model%modal_d)) then
+            do d = 1, size(model%modal_d)
+               kz = 0.0_dp
+               do i = 1, n
+                  kz = kz + model%modal_u(i, d)*node_z(i, j)
+               end do
+               zcz(j) = zcz(j) + model%modal_d(d)*kz*kz
+            end do
+         end if
       end do
       call store_modes(grp, model%mass, lam, z, lam(1:modes%n) <= 1.0e-9_dp*big .and. shifted, zcz, modes, stat, &
                        model%influence)
@@ -852,7 +865,7 @@ contains
       real(dp), intent(in) :: k(:, :)       !! springs' stiffness
       real(dp), intent(in) :: period        !! stuck first period T [s] (for damping_stiffness)
       real(dp), intent(out) :: c(:, :)      !! C [N s/m]
-      integer :: i
+      integer :: i, j
 
       select case (model%damping)
       case (damping_stiffness)
@@ -861,6 +874,14 @@ contains
          c = model%rayleigh_a1*k
          do i = 1, model%n_dof
             c(i, i) = c(i, i) + model%rayleigh_a0*model%mass(i)
+         end do
+      case (damping_modal)
+         ! U diag(d) U' (a dense C only for the small models that use one)
+         c = 0.0_dp
+         do i = 1, size(model%modal_d)
+            do j = 1, model%n_dof
+               c(:, j) = c(:, j) + (model%modal_d(i)*model%modal_u(j, i))*model%modal_u(:, i)
+            end do
          end do
       case default
          c = 0.0_dp

@@ -4,7 +4,7 @@
 !> damping types and techniques, and every default, come from fd_names (re-exported here).
 module fd_model
    use fd_kinds, only: dp
-   use fd_names, only: damping_none, damping_stiffness, damping_rayleigh, &
+   use fd_names, only: damping_none, damping_stiffness, damping_rayleigh, damping_modal, &
                        law_velocity, law_hysteretic, law_coulomb, law_name, &
                        technique_newmark, technique_event_driven, technique_moreau_jean, technique_name, &
                        default_eps, default_eps1, default_f, default_xi, default_period, &
@@ -18,7 +18,7 @@ module fd_model
    private
 
    public :: model_type, device_type, integration_type, output_type
-   public :: damping_none, damping_stiffness, damping_rayleigh
+   public :: damping_none, damping_stiffness, damping_rayleigh, damping_modal
    public :: law_velocity, law_hysteretic, law_coulomb, law_name
    public :: technique_newmark, technique_event_driven, technique_moreau_jean, technique_name
    public :: mu_constant, mu_exponential, mu_table, label_len, max_mu_points
@@ -115,6 +115,12 @@ module fd_model
       integer :: mode_i = 0                   !! first mode (0: a0, a1 given)
       integer :: mode_j = 0                   !! second mode
       integer :: mode_system = default_mode_system !! modes of the stuck or the free system
+      ! 'modal' damping: C = U diag(modal_d) U', U = M Phi over the kept modes of the stuck
+      ! system (fd_modal_damping, when the deck is read); no n x n matrix
+      real(dp), allocatable :: modal_xi(:)    !! the ratios given: one for every kept mode, or one each [-]
+      integer :: modal_modes = 0              !! modes kept (0 = the default)
+      real(dp), allocatable :: modal_u(:, :)  !! (n_dof, kept) M phi_k [kg]
+      real(dp), allocatable :: modal_d(:)     !! (kept) 2 xi_k w_k / (phi_k' M phi_k) [1/(kg s)]
       ! names and storeys, for the engineering outputs
       character(len=label_len), allocatable :: dof_label(:)    !! name of each DOF ('floor 3')
       integer :: n_storeys = 0                !! storeys (drift, shear) named by the deck

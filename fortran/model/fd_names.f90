@@ -18,7 +18,8 @@ module fd_names
    public :: techniques, technique_newmark, technique_event_driven, technique_moreau_jean
    public :: technique_traits_type, technique_traits, technique_step_rule, technique_integrates
    public :: rule_none, rule_newmark, rule_theta
-   public :: damping_types, damping_stiffness, damping_rayleigh, damping_none
+   public :: damping_types, damping_stiffness, damping_rayleigh, damping_none, damping_modal
+   public :: default_modal_modes, max_default_modal_modes
    public :: excitation_types, excitation_harmonic, excitation_record, excitation_none
    public :: record_kinds, record_acceleration, record_displacement
    public :: linear_systems, linear_system_auto, linear_system_dense, linear_system_banded
@@ -99,10 +100,12 @@ module fd_names
    type(keyword_type), parameter :: damping_types(*) = [ &
                                     keyword_type('stiffness', 'C = psi K, the paper'), &
                                     keyword_type('rayleigh', 'C = a0 M + a1 K'), &
-                                    keyword_type('none', '')]
+                                    keyword_type('none', ''), &
+                                    keyword_type('modal', 'xi per mode of the stuck system')]
    integer, parameter :: damping_stiffness = 1 !! C = psi K, psi = T xi / pi (the paper)
    integer, parameter :: damping_rayleigh = 2  !! C = a0 M + a1 K
    integer, parameter :: damping_none = 3      !! no viscous damping
+   integer, parameter :: damping_modal = 4     !! C = M Phi diag(2 xi w / m) Phi' M over the kept modes
 
    ! ------------------------------------------------------------------ excitation types
    type(keyword_type), parameter :: excitation_types(*) = [ &
@@ -170,6 +173,9 @@ module fd_names
    real(dp), parameter :: default_radius = 0.0_dp        !! isolator radius, 0 = flat [m]
    ! &damping ('rayleigh' from xi at two modes)
    integer, parameter :: default_mode_system = system_stuck
+   ! &damping ('modal')
+   integer, parameter :: default_modal_modes = 0         !! 0 = every mode of the stuck system, at most:
+   integer, parameter :: max_default_modal_modes = 20    !! the modes 'modal' damping keeps by default
    ! &storeys
    real(dp), parameter :: default_storey_height = 0.0_dp !! 0 = not given [m]
    ! &excitation

@@ -15,7 +15,7 @@ module fd_technique
    use fd_names, only: technique_newmark, technique_event_driven, technique_moreau_jean, techniques, &
                        keyword_choices, technique_name, technique_traits_type, technique_traits, &
                        technique_integrates, technique_step_rule, rule_newmark, rule_theta
-   use fd_model, only: model_type, integration_type, source_brace
+   use fd_model, only: model_type, integration_type, source_brace, damping_modal
    use fd_step_limits, only: check_step_limits
    use fd_kinematics, only: devices_are_pairs
    use fd_excitation, only: excitation_type
@@ -67,9 +67,11 @@ contains
       case (technique_newmark)
          call newmark_check(model, exc, error)
       case (technique_event_driven)
-         call event_driven_check(model, exc, error)
+         call modal_damping_check(model, opts%technique, error)
+         if (.not. allocated(error)) call event_driven_check(model, exc, error)
       case (technique_moreau_jean)
-         call moreau_jean_check(model, exc, opts, error)
+         call modal_damping_check(model, opts%technique, error)
+         if (.not. allocated(error)) call moreau_jean_check(model, exc, opts, error)
       case default
          call unknown_technique(opts%technique, error)
       end select
@@ -78,6 +80,19 @@ contains
       traits = technique_traits(opts%technique)
       if (traits%refines_steps) call check_step_limits(model, exc, opts, error)
    end subroutine check_technique
+
+   !> 'modal' damping (a low-rank C, fd_modal_damping) is integrated by Newmark alone: an
+   !> error for the techniques that take C = a0 M + a1 K only.
+   subroutine modal_damping_check(model, technique, error)
+      type(model_type), intent(in) :: model         !! the model
+      integer, intent(in) :: technique              !! the technique chosen
+      type(error_type), allocatable, intent(out) :: error !! 'modal' damping with it
+
+      if (model%damping /= damping_modal) return
+      call fatal_error(error, "group &damping: damping_type = 'modal' is invalid with technique = '"// &
+                       trim(technique_name(technique))//"': it is integrated by technique 'newmark' only; "// &
+                       "give 'rayleigh' (xi at mode_i, mode_j), 'stiffness' or 'none'")
+   end subroutine modal_damping_check
 
    !> The braces of the deck are hysteretic devices: an error naming &braces for a technique
    !> that does not integrate their law (the exact Coulomb techniques' devices are rigid while

@@ -42,7 +42,8 @@ contains
       character(len=:), allocatable :: text
 
       call keyword_choices(damping_types, text)
-      call check(error, text, "'stiffness' (C = psi K, the paper), 'rayleigh' (C = a0 M + a1 K), 'none'")
+      call check(error, text, "'stiffness' (C = psi K, the paper), 'rayleigh' (C = a0 M + a1 K), 'none', "// &
+                 "'modal' (xi per mode of the stuck system)")
       if (allocated(error)) return
       call keyword_choices(excitation_types, text)
       call check(error, text, "'harmonic', 'record', 'none'")

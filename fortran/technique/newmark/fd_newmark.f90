@@ -36,6 +36,8 @@ module fd_newmark
    use fd_excitation, only: excitation_type, table_motion, table_acceleration, grid_motion, grid_init, &
                             grid_acceleration
    use fd_matrices, only: structure_damping
+   use fd_woodbury, only: woodbury_type, woodbury_setup, woodbury_factor, woodbury_correct, lowrank_matvec, &
+                          lowrank_form
    use fd_kinematics, only: device_kinematics, add_device, relative_motion, device_forces
    use fd_stiffness, only: general_form, influence_of
    use fd_banded, only: spd_system, spd_setup, spd_factor, spd_update_devices, spd_solve, spd_k_matvec, &
@@ -67,6 +69,7 @@ module fd_newmark
       real(dp) :: bh2 = 0.0_dp, b2h2 = 0.0_dp          !! beta h^2, (1/2 - beta) h^2
       type(spd_system) :: sys              !! its factored K^
       logical :: factored = .false.        !! factored once (then only updated)
+      type(woodbury_type) :: wb            !! 'modal' damping's low-rank c1 C in K^ (fd_woodbury)
       integer :: version = -1              !! the pattern of device stiffnesses it holds
    end type level_type
 
@@ -342,6 +345,8 @@ contains
          w%lev(l)%bh2 = b*h*h; w%lev(l)%b2h2 = (0.5_dp - b)*h*h
          call spd_copy(base, w%lev(l)%sys, error)
          if (allocated(error)) return
+         if (allocated(model%modal_d)) call woodbury_setup(w%lev(l)%wb, model%modal_u, model%modal_d, w%lev(l)%c1, error)
+         if (allocated(error)) return
       end do
       allocate (w%u(n), w%v(n), w%a(n), w%u1(n), w%v1(n), w%a1(n), w%rhs(n), w%tmp(n), &
                 w%s(nd), w%sd(nd), w%s1(nd), w%sd1(nd), w%f(nd), w%fw(nd), w%kd(nd), w%st(nd), w%st1(nd), w%st0(nd), &
@@ -379,6 +384,7 @@ contains
          w%rhs = w%rhs - w%mr2*w%ag2
       end if
       call spd_c_matvec(w%lev(1)%sys, w%v, w%rhs, -1.0_dp, 1.0_dp)
+      if (allocated(model%modal_d)) call lowrank_matvec(model%modal_u, model%modal_d, w%v, w%rhs, -1.0_dp)
       call spd_k_matvec(w%lev(1)%sys, w%u, w%rhs, -1.0_dp, 1.0_dp)
       do d = 1, w%nd
          call add_device(model, d, -w%f(d), w%rhs)
@@ -404,7 +410,7 @@ contains
       real(dp) :: h, ag1
 
       if (.not. (w%lev(lv)%factored .and. w%lev(lv)%version == w%version)) then
-         call factor_for(lv, w, error)
+         call factor_for(model, lv, w, error)
          if (allocated(error)) return
       end if
       h = w%lev(lv)%h
@@ -424,9 +430,11 @@ contains
          w%rhs = w%rhs - w%mr2*w%ag21
       end if
       call spd_kc_matvec(w%lev(lv)%sys, w%u1, w%tmp, w%rhs, -1.0_dp)
+      if (w%lev(lv)%wb%r > 0) call lowrank_matvec(model%modal_u, model%modal_d, w%tmp, w%rhs, -1.0_dp)
       call device_loads(model, w%n, w%nd, w%st, w%u1, w%tmp, w%lev(lv)%c0, w%rhs, w%s1, w%sd1, w%fw)
       call spd_solve(w%lev(lv)%sys, w%rhs, error)
       if (allocated(error)) return
+      if (w%lev(lv)%wb%r > 0) call woodbury_correct(w%lev(lv)%wb, model%modal_u, w%rhs)
       call correct(w%n, w%lev(lv)%bh2, w%lev(lv)%gh, w%rhs, w%tmp, w%a1, w%u1, w%v1)
       call relative_motion(model, w%n, w%nd, w%u1, w%v1, w%s1, w%sd1)
       if (w%nf > 0) call follow_forces(model, lv, w, error)
@@ -508,6 +516,7 @@ contains
       end do
       call spd_solve(w%lev(lv)%sys, w%rhs, error)
       if (allocated(error)) return
+      if (w%lev(lv)%wb%r > 0) call woodbury_correct(w%lev(lv)%wb, model%modal_u, w%rhs)
       w%follow_passes = w%follow_passes + 1
       do i = 1, w%n
          w%a1(i) = w%a1(i) + w%rhs(i)
@@ -575,8 +584,10 @@ contains
 
    !> The factored effective stiffness of level lv for the current phases: factored the
    !> first time the level is used, updated (never refactored from scratch) when the
-   !> devices' stiffnesses have changed since it was last used.
-   subroutine factor_for(lv, w, error)
+   !> devices' stiffnesses have changed since it was last used; with 'modal' damping, the
+   !> Woodbury factors of its low-rank term follow the factor.
+   subroutine factor_for(model, lv, w, error)
+      type(model_type), intent(in) :: model
       integer, intent(in) :: lv
       type(workspace), intent(inout), target :: w
       type(error_type), allocatable, intent(out) :: error
@@ -593,6 +604,7 @@ contains
          else
             call spd_update_devices(lev%sys, w%kd, error)
          end if
+         if (.not. allocated(error) .and. lev%wb%r > 0) call woodbury_factor(lev%wb, model%modal_u, lev%sys, error)
          if (allocated(error)) then
             error%message = "the step "//trim(fmt_real(lev%h))//" s: "//error%message
             return
@@ -885,7 +897,8 @@ contains
       end do
    end subroutine step_energy
 
-   !> (v + v1)' C du of a step, C = a0 M + a1 K, K from the springs and K_x (no matrix product).
+   !> (v + v1)' C du of a step, C = a0 M + a1 K, K from the springs and K_x (no matrix product),
+   !> and 'modal' damping's low-rank term.
    pure real(dp) function viscous_work(model, a0, a1, n, mass, du, vsum) result(e)
       type(model_type), intent(in) :: model
       real(dp), intent(in) :: a0, a1
@@ -919,6 +932,7 @@ contains
          if (model%n_kx > 0) ek = ek + general_form(model, du, vsum)
          e = e + a1*ek
       end if
+      if (allocated(model%modal_d)) e = e + lowrank_form(model%modal_u, model%modal_d, vsum, du)
    end function viscous_work
 
    !> Work of the device forces over the step (trapezoid, the step's phases); the devices move
