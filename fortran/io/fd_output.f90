@@ -500,7 +500,8 @@ contains
       call kv(jt, 'band_resolution', '"'//trim(resolution_names(res%band_resolution))//'"')
    end subroutine band_part
 
-   !> The peaks per DOF and device, with their times, and the devices' phase changes.
+   !> The peaks per DOF and device, with their times, the devices' phase changes, and each
+   !> device's slip excursions, dissipated energy and slip travel.
    subroutine peaks_part(jt, res)
       type(json_text), intent(inout) :: jt     !! the summary
       type(result_type), intent(in) :: res     !! the result
@@ -515,6 +516,9 @@ contains
       call ki(jt, 'stick_to_slip', res%stick_to_slip)
       call ki(jt, 'slip_to_stick', res%slip_to_stick)
       call ki(jt, 'slip_reversals', res%reversals)
+      call ki(jt, 'slip_excursions', res%slip_excursions)
+      call kr(jt, 'dissipated_energy_J', res%dissipated)
+      call kr(jt, 'slip_travel_m', res%slip_travel)
    end subroutine peaks_part
 
    !> What the technique did: the part of the technique that ran (its own statistics, under
