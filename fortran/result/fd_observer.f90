@@ -23,7 +23,7 @@ module fd_observer
    use fd_kinds, only: dp
    use fd_error, only: error_type, fatal_error, fmt_real
    use fd_model, only: model_type, integration_type
-   use fd_excitation, only: excitation_type
+   use fd_excitation, only: excitation_type, excitation_record
    use fd_result, only: result_type, init_result, max_violation_times
    use fd_linalg, only: sym_matvec
    use fd_run_control, only: run_control, cancel_requested, stat_cancelled
@@ -104,6 +104,9 @@ contains
       call init_result(model, exc, opts, res, obs%nsteps, obs%every, error, obs%dofs, obs%devices, obs%to_result)
       if (allocated(error)) return
       res%technique = opts%technique
+      if (exc%kind == excitation_record .and. allocated(exc%acc)) then
+         if (size(exc%acc) > 0) res%record_pga = maxval(abs(exc%acc))
+      end if
       ! names, modes and storeys
       call engineering_init(model, exc, opts, period_stuck, res%eng, error)
       if (allocated(error)) return

@@ -141,6 +141,8 @@ module fd_result
       real(dp) :: e_through = 0.0_dp   !! initial energy + e_input_gross (0: the ratio is undefined)
       integer :: energy_balance = balance_closed !! e_residual_ratio's verdict (energy_balance_of)
       real(dp) :: run_time = 0.0_dp    !! wall-clock time of the integration [s]
+      real(dp) :: record_pga = 0.0_dp  !! a record's max |table acceleration| fed to the run [m/s2]
+                                       !! (0: no record)
       ! names, modes, storey drifts and shears, residual values (fd_engineering)
       type(engineering_type) :: eng    !! the engineering outputs
    end type result_type
