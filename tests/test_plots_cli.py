@@ -295,3 +295,40 @@ def test_the_default_plots_are_the_key_ones(tmp_path):
     assert len(pngs) == 5 + 5 and pngs[0].endswith("_phase1.png")
     r = cli("plot", "out/building5_friction.csv", "--plots", "orbit", cwd=tmp_path)
     assert r.returncode == 1 and "not a plot kind (orbit)" in r.stderr
+
+
+def _num(x: float) -> str:
+    """The executable's screen format: four significant digits, fixed from 0.01 to 1e5."""
+    if x == 0.0:
+        return "0"
+    if 0.01 <= abs(x) < 1e5:
+        return f"{x:.{max(0, 3 - int(np.floor(np.log10(abs(x)))))}f}"
+    return f"{x:.3E}"
+
+
+def test_the_executables_screen_summary_shows_periods_drifts_and_shears(tmp_path):
+    """inputs/building5_dampers.nml (storeys with heights) for 1 s: the screen shows the first
+    three periods of the stuck and the free system, each storey's peak drift with its drift
+    ratio and its peak shear, the peak base shear and its time, and each device's dissipated
+    energy and slip travel: the summary's values, and never a period printed as .000000."""
+    text = (INPUTS / "building5_dampers.nml").read_text()
+    text = text.replace("record_file = 'synthetic_pga035.AT2'", f"record_file = '{INPUTS / 'synthetic_pga035.AT2'}'")
+    text = text.replace("duration = 30.0", "duration = 1.0")
+    (tmp_path / "b.nml").write_text(text)
+    exe = frictiondyn.run_executable("b.nml", cwd=tmp_path)
+    s = exe.summary()
+    out = subprocess.run([frictiondyn.executable(), "b.nml"], cwd=tmp_path, capture_output=True,
+                         text=True, check=True).stdout
+    stuck = ", ".join(_num(t) for t in s["periods_stuck_s"][:3])
+    free = ", ".join(_num(t) for t in s["periods_free_s"][:3])
+    assert f"  periods: stuck {stuck} s; free {free} s\n" in out
+    assert stuck.startswith("0.4478") and free.startswith("0.6332")
+    for i in range(5):
+        drift, ratio, shear = s["peak_drift_m"][i], s["peak_drift_ratio"][i], s["peak_storey_shear_N"][i]
+        assert (f"  storey {i + 1}: peak drift {_num(drift)} m ({_num(100 * ratio)} %), "
+                f"peak shear {_num(shear)} N\n") in out
+        e, travel = s["dissipated_energy_J"][i], s["slip_travel_m"][i]
+        assert f", dissipated {_num(e)} J, slip travel {_num(travel)} m\n" in out
+    assert (f"  base shear: peak {_num(s['peak_base_shear_N'])} N at t = "
+            f"{_num(s['peak_base_shear_time_s'])} s\n") in out
+    assert "stuck period not defined" in out and ".000000" not in out

@@ -9,6 +9,7 @@ from __future__ import annotations
 
 from ._api import (
     DeckError,
+    DeviceResults,
     FrictiondynError,
     FrictiondynWarning,
     Modes,
@@ -47,6 +48,7 @@ __all__ = [
     "Damping",
     "DeckError",
     "Device",
+    "DeviceResults",
     "ExecutableRun",
     "FreeVibration",
     "FrictionBrace",

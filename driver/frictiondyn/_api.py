@@ -35,6 +35,7 @@ from . import _codes, _core
 
 __all__ = [
     "DeckError",
+    "DeviceResults",
     "FrictiondynError",
     "FrictiondynWarning",
     "Modes",
@@ -654,6 +655,40 @@ def _floats(values) -> np.ndarray:
 
 
 @dataclass
+class DeviceResults:
+    """What each friction device did over a run, one entry per device (docs/python.md).
+
+    ``labels`` the devices' labels; ``dissipated_energy`` [J] the work of its friction force
+    over its relative motion less the elastic energy it stores (end minus start: the entries
+    sum to the summary's ``energy_friction_J``); ``slip_travel`` [m] the integral of |ds|
+    while it slides; ``slip_excursions`` its slides (stick-to-slip transitions, and one for a
+    slide at t = 0); ``peak_force`` [N] max |F|; ``residual_slip`` [m] its relative
+    displacement s at the end."""
+
+    labels: list[str]
+    dissipated_energy: np.ndarray
+    slip_travel: np.ndarray
+    slip_excursions: np.ndarray
+    peak_force: np.ndarray
+    residual_slip: np.ndarray
+
+    def __len__(self) -> int:
+        return len(self.labels)
+
+    def rows(self) -> list[dict]:
+        """One dict per device: its number (from 1), label and values under the summary's keys."""
+        return [
+            {"device": d + 1, "device_label": self.labels[d],
+             "dissipated_energy_J": float(self.dissipated_energy[d]),
+             "slip_travel_m": float(self.slip_travel[d]),
+             "slip_excursions": int(self.slip_excursions[d]),
+             "peak_force_N": float(self.peak_force[d]),
+             "residual_s_m": float(self.residual_slip[d])}
+            for d in range(len(self.labels))
+        ]
+
+
+@dataclass
 class Result:
     """Time histories and summary of one run.
 
@@ -835,6 +870,22 @@ class Result:
     def base_shear(self) -> np.ndarray:
         """Base shear over time (column Vb, decks with &storeys)."""
         return self["Vb"]
+
+    def device_results(self) -> DeviceResults:
+        """Per device: dissipated energy, slip travel, slip excursions, peak force and
+        residual slip, from the summary (keys ``dissipated_energy_J``, ``slip_travel_m``,
+        ``slip_excursions``, ``peak_force_N``, ``residual_s_m``)."""
+        s = self.summary
+        if "dissipated_energy_J" not in s:
+            raise KeyError("the summary has no per-device energies (written by an older frictiondyn)")
+        return DeviceResults(
+            self.device_labels,
+            _floats(s["dissipated_energy_J"]),
+            _floats(s["slip_travel_m"]),
+            np.array(s["slip_excursions"], dtype=int),
+            _floats(s["peak_force_N"]),
+            _floats(s["residual_s_m"]),
+        )
 
     def modes(self, system: str = "stuck") -> Modes:
         """The natural modes of the 'stuck' or the 'free' system from the summary."""

@@ -1550,7 +1550,8 @@ LONG_TABLES: dict[str, tuple[str, tuple[str, ...]]] = {
                                  "peak_storey_shear_N", "peak_storey_shear_time_s",
                                  "residual_storey_shear_N")),
     "device": ("device_labels", ("device_law", "peak_s_m", "peak_force_N", "residual_s_m",
-                                 "stick_to_slip", "slip_to_stick", "slip_reversals")),
+                                 "stick_to_slip", "slip_to_stick", "slip_reversals",
+                                 "slip_excursions", "dissipated_energy_J", "slip_travel_m")),
     "dof": ("dof_labels", ("peak_u_m", "peak_u_time_s", "peak_v_mps", "peak_aabs_mps2",
                            "peak_aabs_time_s")),
 }

@@ -25,6 +25,8 @@ program frictiondyn_main
    use fd_textio, only: line_type, read_file_text, split_lines, cr_line_ends
    use fd_undefined, only: undefined_why
    use fd_statistics, only: technique_counts
+   use fd_result, only: result_type
+   use fd_matrices, only: modes_type, modes_flexible, modes_rigid, modes_unrestrained
    implicit none
 
    interface
@@ -129,9 +131,10 @@ program frictiondyn_main
          trim(undefined_why(res, 'period_stuck_s'))//'); steps dt1 ', &
          n%steps_dt1, ', nested ', n%steps_nested, ', dt2 ', n%steps_dt2, ', finer ', n%steps_finer
    else
-      write (output_unit, '(a,f0.6,a,i0,a,i0,a,i0,a,i0)') '  stuck period ', res%period_stuck, ' s; steps dt1 ', &
+      write (output_unit, '(a,i0,a,i0,a,i0,a,i0)') '  stuck period '//trim(num(res%period_stuck))//' s; steps dt1 ', &
          n%steps_dt1, ', nested ', n%steps_nested, ', dt2 ', n%steps_dt2, ', finer ', n%steps_finer
    end if
+   call print_periods(res)
    if (n%steps_implicit + n%implicit_fallbacks > 0) &
       write (output_unit, '(a,i0,a,i0,a,i0,a)') '  implicit phases: ', n%steps_implicit, ' dt1 steps settled (', &
       n%implicit_redos, ' trials redone), ', n%implicit_fallbacks, ' refined as the paper''s'
@@ -141,13 +144,15 @@ program frictiondyn_main
          cfg%record%npts, ' samples, dt ', cfg%record%dt, ' s'
    end if
    do i = 1, res%n_devices
-      write (output_unit, '(a,i0,a,i0,a,i0)') '  device ', i, ': stick->slip ', res%stick_to_slip(i), &
-         ', slip->stick ', res%slip_to_stick(i)
+      write (output_unit, '(a,i0,a,i0,a,i0,a)') '  device ', i, ': stick->slip ', res%stick_to_slip(i), &
+         ', slip->stick ', res%slip_to_stick(i), ', dissipated '//trim(num(res%dissipated(i)))//' J, slip travel '// &
+         trim(num(res%slip_travel(i)))//' m'
    end do
    do i = 1, res%n_dof
       write (output_unit, '(a,i0,a,es12.5,a,es12.5,a)') '  dof ', i, ': peak |u| ', res%peak_u(i), &
          ' m, peak |a_abs| ', res%peak_aabs(i), ' m/s2'
    end do
+   call print_storeys(res)
    write (output_unit, '(a,i0)') '  correctness violations: ', res%violations
    call output_paths(cfg%out, hist, summ)
    if (cfg%out%history) write (output_unit, '(a)') '  history: '//hist
@@ -223,6 +228,95 @@ contains
          deck_path = path(1:slash)//deck_path
       end if
    end subroutine deck_of_list
+
+   !> The first periods (at most three) of the stuck and the free system, on one line:
+   !> "periods: stuck 0.2961, 0.007235 s; free 0.4790, 0.1857 s" (inf: a rigid-body mode;
+   !> none: every mass held to the table); nothing when no modes were computed.
+   subroutine print_periods(res)
+      type(result_type), intent(in) :: res
+      character(len=:), allocatable :: line
+
+      line = ''
+      call add_periods(line, 'stuck', res%eng%stuck)
+      call add_periods(line, 'free', res%eng%free)
+      if (len(line) > 0) write (output_unit, '(a)') '  periods:'//line
+   end subroutine print_periods
+
+   !> One system's part of print_periods' line.
+   subroutine add_periods(line, name, m)
+      character(len=:), allocatable, intent(inout) :: line
+      character(len=*), intent(in) :: name
+      type(modes_type), intent(in) :: m
+      integer :: k
+
+      if (m%status /= modes_flexible .and. m%status /= modes_rigid .and. m%status /= modes_unrestrained) return
+      if (len(line) > 0) line = line//';'
+      line = line//' '//name
+      if (m%status == modes_rigid .or. m%n == 0) then
+         line = line//' none (every mass held to the table)'
+         return
+      end if
+      do k = 1, min(3, m%n)
+         if (m%omega2(k) > 0.0_dp) then
+            line = line//' '//trim(num(m%period(k)))
+         else
+            line = line//' inf'
+         end if
+         if (k < min(3, m%n)) line = line//','
+      end do
+      line = line//' s'
+   end subroutine add_periods
+
+   !> Per storey its peak drift (and drift ratio, when its height is given) and peak shear,
+   !> then the peak base shear and its time.
+   subroutine print_storeys(res)
+      type(result_type), intent(in) :: res
+      character(len=32) :: ratio
+      integer :: i
+
+      associate (eng => res%eng)
+         do i = 1, eng%n_storeys
+            ratio = ''
+            if (eng%height(i) > 0.0_dp) ratio = ' ('//trim(num(100.0_dp*eng%peak_drift(i)/eng%height(i)))//' %)'
+            write (output_unit, '(a)') '  '//trim(eng%storey_label(i))//': peak drift '//trim(num(eng%peak_drift(i)))// &
+               ' m'//trim(ratio)//', peak shear '//trim(num(eng%peak_shear(i)))//' N'
+         end do
+         if (.not. allocated(eng%peak_shear)) return
+         if (eng%peak_shear(0) > 0.0_dp) then
+            write (output_unit, '(a)') '  base shear: peak '//trim(num(eng%peak_shear(0)))//' N at t = '// &
+               trim(num(eng%peak_shear_time(0)))//' s'
+         else
+            write (output_unit, '(a)') '  base shear: peak 0 N'
+         end if
+      end associate
+   end subroutine print_storeys
+
+   !> x with four significant digits: fixed from 0.01 to 1e5 (0.2960, 20.00, 1234), else
+   !> scientific (7.235E-03, 1.234E+06); 0 as 0.
+   pure function num(x) result(s)
+      use, intrinsic :: ieee_arithmetic, only: ieee_is_finite
+      real(dp), intent(in) :: x
+      character(len=24) :: s
+      character(len=16) :: fmt
+      integer :: d, ios
+
+      if (x == 0.0_dp) then
+         s = '0'
+         return
+      end if
+      if (ieee_is_finite(x) .and. abs(x) >= 0.01_dp .and. abs(x) < 1.0e5_dp) then
+         d = max(0, 3 - floor(log10(abs(x))))
+         write (fmt, '(a,i0,a)') '(f24.', d, ')'
+      else
+         fmt = '(es24.3)'
+      end if
+      write (s, fmt, iostat=ios) x
+      if (ios /= 0) s = '?'
+      s = adjustl(s)
+      if (s(len_trim(s):len_trim(s)) == '.') s(len_trim(s):len_trim(s)) = ' '
+      if (s(1:1) == '.') s = '0'//s
+      if (s(1:2) == '-.') s = '-0'//s(2:)
+   end function num
 
    pure function itoa(k) result(s)
       integer, intent(in) :: k

@@ -9,7 +9,8 @@ module fd_output
    use fd_model, only: model_type, output_type, law_name, technique_name
    use fd_result, only: result_type, resolution_names, energy_balance_names, record_system_names, history_header
    use fd_record, only: record_info
-   use fd_warnings, only: warning_text, run_warnings
+   use fd_warnings, only: warning_text, run_warnings, run_checks, n_checks
+   use fd_check, only: check_type, verdict_names
    use fd_undefined, only: undefined_why
    use fd_version, only: frictiondyn_version
    use fd_history_stream, only: format_row, stream_value_width
@@ -389,6 +390,7 @@ contains
       call correctness_part(jt, res)
       call mu_part(jt, res)
       call energy_part(jt, res)
+      call plausibility_part(jt, res)
       call engineering_part(jt, model, res)
       call kint(jt, 'samples', res%nout)
       call warnings_part(jt, res)
@@ -512,7 +514,8 @@ contains
       call kv(jt, 'band_resolution', '"'//trim(resolution_names(res%band_resolution))//'"')
    end subroutine band_part
 
-   !> The peaks per DOF and device, with their times, and the devices' phase changes.
+   !> The peaks per DOF and device, with their times, the devices' phase changes, and each
+   !> device's slip excursions, dissipated energy and slip travel.
    subroutine peaks_part(jt, res)
       type(json_text), intent(inout) :: jt     !! the summary
       type(result_type), intent(in) :: res     !! the result
@@ -527,6 +530,9 @@ contains
       call ki(jt, 'stick_to_slip', res%stick_to_slip)
       call ki(jt, 'slip_to_stick', res%slip_to_stick)
       call ki(jt, 'slip_reversals', res%reversals)
+      call ki(jt, 'slip_excursions', res%slip_excursions)
+      call kr(jt, 'dissipated_energy_J', res%dissipated)
+      call kr(jt, 'slip_travel_m', res%slip_travel)
    end subroutine peaks_part
 
    !> What the technique did: the part of the technique that ran (its own statistics, under
@@ -656,6 +662,21 @@ contains
       call kreal(jt, res, 'energy_residual_ratio', res%e_residual_ratio)
       call kv(jt, 'energy_balance', '"'//trim(energy_balance_names(res%energy_balance))//'"')
    end subroutine energy_part
+
+   !> Whether the first period and a record's peak acceleration lie where structures and
+   !> earthquakes have theirs (fd_warnings' period and record checks): their verdicts.
+   subroutine plausibility_part(jt, res)
+      type(json_text), intent(inout) :: jt     !! the summary
+      type(result_type), intent(in) :: res     !! the result
+      type(check_type) :: checks(n_checks)
+      integer :: k
+
+      call run_checks(res, checks)
+      do k = 1, n_checks
+         if (checks(k)%key /= 'period_plausibility' .and. checks(k)%key /= 'record_plausibility') cycle
+         call kv(jt, trim(checks(k)%key), '"'//trim(verdict_names(checks(k)%verdict))//'"')
+      end do
+   end subroutine plausibility_part
 
    !> What produced the run, the table motion, the labels, the damping, the modes, the
    !> residual deformations and the storeys (fd_engineering).

@@ -3,7 +3,10 @@
 !> state, samples the history, counts phase transitions and correctness violations, and
 !> closes the energy balance. A technique hands it the state (observe_peaks, observe_sample:
 !> time, table acceleration, u, v, relative acceleration, and per device s, s', F and phase),
-!> the work of each step (observe_work), and, when it knows its solution between steps, the
+!> the work of each step (observe_work) and of each device's force with the device's slip
+!> travel (observe_device_motion, or added into the observer's device_work and slip_travel
+!> in the technique's own loop over the devices), and, when it knows its solution between
+!> steps, the
 !> exact extrema (observe_extrema, observe_extremum); the stuck system's period it computed is
 !> an argument of observer_init. A new output quantity is a change here (and in the writer),
 !> not in the loops.
@@ -20,7 +23,7 @@ module fd_observer
    use fd_kinds, only: dp
    use fd_error, only: error_type, fatal_error, fmt_real
    use fd_model, only: model_type, integration_type
-   use fd_excitation, only: excitation_type
+   use fd_excitation, only: excitation_type, excitation_record
    use fd_result, only: result_type, init_result, max_violation_times
    use fd_linalg, only: sym_matvec
    use fd_run_control, only: run_control, cancel_requested, stat_cancelled
@@ -32,7 +35,7 @@ module fd_observer
    public :: observer_type, observer_init, sample_due, observe_start, observe_peaks, observe_sample
    public :: observe_transitions, observe_violations, observe_end, strain_energy
    public :: observe_start_energies, observe_end_energies, observe_poll, observe_stop_error
-   public :: observe_extrema, observe_extremum, observe_work
+   public :: observe_extrema, observe_extremum, observe_work, observe_device_motion
    public :: observe_storeys
 
    !> Wall-clock time aimed at between two polls that look at the clock [s].
@@ -46,6 +49,12 @@ module fd_observer
       real(dp) :: e_kin0 = 0.0_dp    !! kinetic energy at the start [J]
       real(dp) :: e_str0 = 0.0_dp    !! strain energy at the start [J]
       real(dp) :: e_dev0 = 0.0_dp    !! elastic energy stored in devices at the start [J]
+      real(dp), allocatable :: e_dev0_each(:) !! the same, per device [J]
+      !> per device, the work of its force over its relative motion [J] and its slip travel (the
+      !> integral of |ds| while it slides) [m] so far: added by observe_device_motion, or by the
+      !> technique's own loop over the devices where a call a step would cost a share of the
+      !> step (Newmark's device_step: 2-3 % of a step of the paper's model, callgrind)
+      real(dp), allocatable :: device_work(:), slip_travel(:)
       type(run_control), pointer :: ctl => null() !! the run's control, if any
       integer, allocatable :: dofs(:)     !! DOFs in the history
       integer, allocatable :: devices(:)  !! devices in the history
@@ -95,11 +104,18 @@ contains
       call init_result(model, exc, opts, res, obs%nsteps, obs%every, error, obs%dofs, obs%devices, obs%to_result)
       if (allocated(error)) return
       res%technique = opts%technique
+      if (exc%kind == excitation_record .and. allocated(exc%acc)) then
+         if (size(exc%acc) > 0) res%record_pga = maxval(abs(exc%acc))
+      end if
       ! names, modes and storeys
       call engineering_init(model, exc, opts, period_stuck, res%eng, error)
       if (allocated(error)) return
-      allocate (obs%row(res%ncol))
+      allocate (obs%row(res%ncol), obs%e_dev0_each(model%n_devices), obs%device_work(model%n_devices), &
+                obs%slip_travel(model%n_devices))
       obs%row = 0.0_dp
+      obs%e_dev0_each = 0.0_dp
+      obs%device_work = 0.0_dp
+      obs%slip_travel = 0.0_dp
       if (.not. associated(obs%ctl)) return
       ctl%duration = obs%nsteps*(exc%dt_record/opts%n1)
       ctl%time = 0.0_dp
@@ -154,16 +170,18 @@ contains
    end subroutine observe_start
 
    !> Energies of the initial state, given by a technique that computes them itself (without
-   !> a dense stiffness matrix).
-   pure subroutine observe_start_energies(obs, e_kin, e_str, e_device)
+   !> a dense stiffness matrix); with devices that store energy, each one's share.
+   pure subroutine observe_start_energies(obs, e_kin, e_str, e_device, e_each)
       type(observer_type), intent(inout) :: obs !! the observer
       real(dp), intent(in) :: e_kin        !! kinetic energy at t = 0 [J]
       real(dp), intent(in) :: e_str        !! springs' strain energy at t = 0 [J]
       real(dp), intent(in) :: e_device     !! elastic energy stored in devices at t = 0 [J]
+      real(dp), intent(in), optional :: e_each(:) !! the same per device (default 0) [J]
 
       obs%e_kin0 = e_kin
       obs%e_str0 = e_str
       obs%e_dev0 = e_device
+      if (present(e_each)) obs%e_dev0_each = e_each
    end subroutine observe_start_energies
 
    !> Peaks over the accepted states: |u| (and its time), |v|, |absolute acceleration| (and
@@ -273,6 +291,18 @@ contains
       res%e_viscous = res%e_viscous + viscous
    end subroutine observe_work
 
+   !> The work of device d's force over a step (or part of one) [J] and its slip travel in it
+   !> (|ds| while it slid) [m] into the device's totals.
+   pure subroutine observe_device_motion(obs, d, work, travel)
+      type(observer_type), intent(inout) :: obs !! the observer
+      integer, intent(in) :: d                 !! the device
+      real(dp), intent(in) :: work             !! work of its force [J]
+      real(dp), intent(in) :: travel           !! its slip travel [m]
+
+      obs%device_work(d) = obs%device_work(d) + work
+      obs%slip_travel(d) = obs%slip_travel(d) + travel
+   end subroutine observe_device_motion
+
    !> The storeys at a state the technique reports besides observe_peaks (a row of the exact
    !> technique): drifts, shears, their peaks, and the values kept as the residual ones.
    pure subroutine observe_storeys(res, t, u, v, s, force)
@@ -310,6 +340,12 @@ contains
 
       obs%rows = obs%rows + 1
       if (obs%rows > res%nout) return
+      ! the first row is the state at t = 0: a device sliding in it begins a slip excursion
+      if (obs%rows == 1 .and. allocated(res%slip_excursions)) then
+         do i = 1, min(size(phase), size(res%slip_excursions))
+            if (phase(i) /= 0) res%slip_excursions(i) = res%slip_excursions(i) + 1
+         end do
+      end if
       associate (row => obs%row)
          row(1) = t
          row(2) = ag
@@ -457,8 +493,8 @@ contains
                        stat=stat_cancelled)
    end subroutine observe_stop_error
 
-   !> Count the phase changes of the devices: stick to slip, slip to stick, and slip
-   !> reversals (slip + to slip - and back without sticking).
+   !> Count the phase changes of the devices: stick to slip (each begins a slip excursion),
+   !> slip to stick, and slip reversals (slip + to slip - and back without sticking).
    pure subroutine observe_transitions(res, old, new)
       type(result_type), intent(inout) :: res  !! the result
       integer, intent(in) :: old(:)            !! phases before (0 stick, +-1 slip)
@@ -470,6 +506,7 @@ contains
          if (old(d) == new(d)) cycle
          if (old(d) == 0) then
             res%stick_to_slip(d) = res%stick_to_slip(d) + 1
+            res%slip_excursions(d) = res%slip_excursions(d) + 1
          else if (new(d) == 0) then
             res%slip_to_stick(d) = res%slip_to_stick(d) + 1
          else
@@ -500,7 +537,9 @@ contains
    !> Close the energy balance at the end of the run: kinetic, strain and device elastic
    !> energy (end minus start), friction dissipation (device work minus stored energy) and
    !> the residual input - (kinetic + strain + viscous + friction + device elastic). The
-   !> technique has handed the input and viscous work of its steps to observe_work.
+   !> technique has handed the input and viscous work of its steps to observe_work, and the
+   !> work and slip travel of each device to observe_device_motion (or into device_work and
+   !> slip_travel).
    subroutine observe_end(obs, res, mass, k, u, v, e_device, w_device, tmp)
       type(observer_type), intent(inout) :: obs !! the observer
       type(result_type), intent(inout) :: res  !! the result
@@ -518,20 +557,33 @@ contains
    end subroutine observe_end
 
    !> Close the energy balance from the end energies a technique computed itself (see
-   !> observe_end).
-   subroutine observe_end_energies(obs, res, e_kin, e_str, e_device, w_device)
+   !> observe_end); with devices that store energy, each one's share at the end. Each
+   !> device's dissipation is its work minus the elastic energy it stores (end minus start):
+   !> they sum to energy_friction_J to round-off.
+   subroutine observe_end_energies(obs, res, e_kin, e_str, e_device, w_device, e_each)
       type(observer_type), intent(in) :: obs   !! the observer
       type(result_type), intent(inout) :: res  !! the result
       real(dp), intent(in) :: e_kin            !! kinetic energy at the end [J]
       real(dp), intent(in) :: e_str            !! springs' strain energy at the end [J]
       real(dp), intent(in) :: e_device         !! elastic energy stored in devices at the end [J]
       real(dp), intent(in) :: w_device         !! work of the device forces over the run [J]
+      real(dp), intent(in), optional :: e_each(:) !! elastic energy of each device at the end
+                                                  !! (default 0) [J]
       real(dp) :: scale
+      integer :: d
 
       res%e_kinetic = e_kin - obs%e_kin0
       res%e_strain = e_str - obs%e_str0
       res%e_device = e_device - obs%e_dev0
       res%e_friction = w_device - res%e_device
+      if (allocated(res%dissipated) .and. allocated(obs%device_work)) then
+         res%slip_travel = obs%slip_travel
+         do d = 1, size(res%dissipated)
+            res%dissipated(d) = obs%device_work(d)
+            if (present(e_each)) res%dissipated(d) = res%dissipated(d) - e_each(d)
+            if (allocated(obs%e_dev0_each)) res%dissipated(d) = res%dissipated(d) + obs%e_dev0_each(d)
+         end do
+      end if
       res%e_residual = res%e_input - (res%e_kinetic + res%e_strain + res%e_viscous + &
                                       res%e_friction + res%e_device)
       ! the residual against the energy that passed through the structure: what it held at

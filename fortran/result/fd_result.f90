@@ -94,6 +94,12 @@ module fd_result
       integer, allocatable :: stick_to_slip(:)  !! stick-to-slip transitions
       integer, allocatable :: slip_to_stick(:)  !! slip-to-stick transitions
       integer, allocatable :: reversals(:)      !! slip+ to slip- and back, without sticking
+      integer, allocatable :: slip_excursions(:) !! slides: stick-to-slip transitions, and one for a
+                                                 !! device sliding at t = 0
+      real(dp), allocatable :: dissipated(:)    !! its friction dissipation: the work of its force
+                                                !! over its relative motion minus the elastic energy
+                                                !! it stores (end minus start) [J]
+      real(dp), allocatable :: slip_travel(:)   !! integral of |ds| while it slides [m]
       real(dp), allocatable :: harmonic_error(:)      !! per DOF: the step's error in the linear steady state
       real(dp), allocatable :: record_error(:)        !! per DOF: the step's error in the linear peak response
                                                       !! of the system the run was in
@@ -135,6 +141,8 @@ module fd_result
       real(dp) :: e_through = 0.0_dp   !! initial energy + e_input_gross (0: the ratio is undefined)
       integer :: energy_balance = balance_closed !! e_residual_ratio's verdict (energy_balance_of)
       real(dp) :: run_time = 0.0_dp    !! wall-clock time of the integration [s]
+      real(dp) :: record_pga = 0.0_dp  !! a record's max |table acceleration| fed to the run [m/s2]
+                                       !! (0: no record)
       ! names, modes, storey drifts and shears, residual values (fd_engineering)
       type(engineering_type) :: eng    !! the engineering outputs
    end type result_type
@@ -271,7 +279,8 @@ contains
       end if
       allocate (res%peak_u(n), res%peak_u_time(n), res%peak_v(n), res%peak_aabs(n), &
                 res%peak_aabs_time(n), res%peak_s(nd), res%peak_force(nd), res%stick_to_slip(nd), &
-                res%slip_to_stick(nd), res%reversals(nd), res%harmonic_error(n), res%record_error(n), &
+                res%slip_to_stick(nd), res%reversals(nd), res%slip_excursions(nd), res%dissipated(nd), &
+                res%slip_travel(nd), res%harmonic_error(n), res%record_error(n), &
                 res%record_error_stuck(n), res%record_error_free(n), &
                 res%stick_freq_error(nd), res%stick_ringing_ratio(nd), res%stick_ringing(nd), &
                 res%stick_margin(nd), res%band_x(nd), res%band_alternation(nd), &
@@ -284,7 +293,8 @@ contains
       res%peak_u = 0.0_dp; res%peak_u_time = 0.0_dp; res%peak_v = 0.0_dp
       res%peak_aabs = 0.0_dp; res%peak_aabs_time = 0.0_dp
       res%peak_s = 0.0_dp; res%peak_force = 0.0_dp
-      res%stick_to_slip = 0; res%slip_to_stick = 0; res%reversals = 0
+      res%stick_to_slip = 0; res%slip_to_stick = 0; res%reversals = 0; res%slip_excursions = 0
+      res%dissipated = 0.0_dp; res%slip_travel = 0.0_dp
       res%harmonic_error = 0.0_dp; res%record_error = 0.0_dp
       res%record_error_stuck = 0.0_dp; res%record_error_free = 0.0_dp
       res%stick_freq_error = 0.0_dp; res%stick_ringing_ratio = 0.0_dp
@@ -370,6 +380,8 @@ contains
       if (allocated(res%peak_aabs)) call vector('peak_aabs_mps2', res%peak_aabs)
       if (allocated(res%peak_s)) call vector('peak_s_m', res%peak_s)
       if (allocated(res%peak_force)) call vector('peak_force_N', res%peak_force)
+      if (allocated(res%dissipated)) call vector('dissipated_energy_J', res%dissipated)
+      if (allocated(res%slip_travel)) call vector('slip_travel_m', res%slip_travel)
       call engineering()
       if (allocated(error) .or. .not. allocated(res%hist)) return
       do j = 1, min(res%nout, size(res%hist, 2))

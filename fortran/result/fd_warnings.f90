@@ -6,8 +6,10 @@
 !> whose speed-dependent mu did not converge, a step dt1 that does not resolve the highest
 !> modes, a harmonic table motion's steady state or a record's peak linear response, a
 !> sticking spring's ringing that the step dephases, a velocity-law band's force left
-!> alternating, and an energy balance that misses (more than 5 %, or beyond round-off with
-!> the average acceleration rule). Each is one line: what happened, with the figures of the
+!> alternating, an energy balance that misses (more than 5 %, or beyond round-off with
+!> the average acceleration rule), and a model or record outside what structures and
+!> earthquakes have (a first period beyond 0.01-10 s, a record's peak acceleration beyond
+!> 0.005-3 g: most likely a unit typed wrong). Each is one line: what happened, with the figures of the
 !> summary key it names, what to change, and the section of docs/warnings.md that explains
 !> it. The warnings are a filter over the checks (check_warnings): a new check is one
 !> routine here and one line of run_checks.
@@ -23,9 +25,17 @@ module fd_warnings
    private
 
    public :: warning_text, run_warnings, run_checks, n_checks
+   public :: period_shortest, period_longest, pga_smallest, pga_largest, standard_gravity
 
    !> The checks of a run, in the order of their warnings.
-   integer, parameter :: n_checks = 8
+   integer, parameter :: n_checks = 10
+
+   ! what structures and earthquakes have: a first period, a record's peak acceleration
+   real(dp), parameter :: period_shortest = 0.01_dp   !! below: implausible [s]
+   real(dp), parameter :: period_longest = 10.0_dp    !! above: implausible [s]
+   real(dp), parameter :: pga_smallest = 0.005_dp     !! below: implausible [g]
+   real(dp), parameter :: pga_largest = 3.0_dp        !! above: implausible [g]
+   real(dp), parameter :: standard_gravity = 9.80665_dp !! g [m/s2]
 
 contains
 
@@ -42,7 +52,7 @@ contains
    !> The checks of a result, each filled from the verdicts and figures the run left in it:
    !> the correctness condition, a speed-dependent mu, the highest modes, a harmonic table
    !> motion, a record, the sticking springs' ringing, the velocity-law bands, the energy
-   !> balance.
+   !> balance, the first period's and the record's peak acceleration's plausibility.
    pure subroutine run_checks(res, checks)
       type(result_type), intent(in) :: res                 !! the run's result
       type(check_type), intent(out) :: checks(n_checks)    !! its checks
@@ -55,6 +65,8 @@ contains
       call stick_check(res, checks(6))
       call band_check(res, checks(7))
       call energy_check(res, checks(8))
+      call period_check(res, checks(9))
+      call record_range_check(res, checks(10))
    end subroutine run_checks
 
    !> The verdict of a resolution check (resolution_*): not applicable, passed or warns.
@@ -250,6 +262,87 @@ contains
                      trim(fx(residual_ratio_limit, 2))//'): '//s//trim(see('energy-balance'))
       end if
    end subroutine energy_check
+
+   !> The structure's first period T1 [s] and its summary key: the stuck system's
+   !> (period_stuck_s) or, where it has none (every mass held to the table through its
+   !> devices), the free system's first finite one (periods_free_s); 0 and blank when neither.
+   pure subroutine first_period(res, t1, key)
+      type(result_type), intent(in) :: res   !! the result
+      real(dp), intent(out) :: t1            !! T1 [s] (0: none)
+      character(len=*), intent(out) :: key   !! its summary key
+      integer :: k
+
+      t1 = 0.0_dp
+      key = ''
+      if (res%period_stuck > 0.0_dp) then
+         t1 = res%period_stuck
+         key = 'period_stuck_s'
+         return
+      end if
+      if (.not. allocated(res%eng%free%omega2)) return
+      do k = 1, min(res%eng%free%n, size(res%eng%free%omega2))
+         if (.not. (res%eng%free%omega2(k) > 0.0_dp)) cycle
+         t1 = res%eng%free%period(k)
+         key = 'periods_free_s('//trim(fmt_int(k))//')'
+         return
+      end do
+   end subroutine first_period
+
+   !> Whether the first period lies where structures have theirs, 0.01 s to 10 s: beyond, a
+   !> unit typed wrong is the likely cause (a stiffness in kN/m typed as N/m makes T1 31.6
+   !> times too long, masses in t typed as kg 31.6 times too short).
+   pure subroutine period_check(res, c)
+      type(result_type), intent(in) :: res   !! the result
+      type(check_type), intent(out) :: c     !! the check
+      character(len=24) :: key
+      real(dp) :: t1
+
+      c%key = 'period_plausibility'
+      call first_period(res, t1, key)
+      if (.not. (t1 > 0.0_dp)) return
+      call add_figure(c, trim(key), t1)
+      c%verdict = verdict_passed
+      if (t1 > period_longest) then
+         c%verdict = verdict_warns
+         c%warning = 'the first period T1 = '//trim(fx(t1, 1))//' s ('//trim(key)//') is beyond 10 s, '// &
+                     'longer than structures have: a stiffness in kN/m typed as N/m?'//trim(see('implausible-period'))
+      else if (t1 < period_shortest) then
+         c%verdict = verdict_warns
+         c%warning = 'the first period T1 = '//trim(es(t1, 2))//' s ('//trim(key)//') is below 0.01 s, '// &
+                     'shorter than structures have: masses in t typed as kg, or a stiffness in N/mm typed as N/m?'// &
+                     trim(see('implausible-period'))
+      end if
+   end subroutine period_check
+
+   !> Whether a record's peak table acceleration lies where earthquakes have theirs, 0.005 g
+   !> to 3 g: beyond, a record read in the wrong units is the likely cause (cm/s2 read as g
+   !> or m/s2 makes it 981 or 100 times too large; g or m/s2 read as cm/s2 that much too
+   !> small). Not applicable without a record, or to a record of zeros (free vibration).
+   pure subroutine record_range_check(res, c)
+      type(result_type), intent(in) :: res   !! the result
+      type(check_type), intent(out) :: c     !! the check
+      real(dp) :: pga
+
+      c%key = 'record_plausibility'
+      if (.not. (res%record_pga > 0.0_dp)) return
+      pga = res%record_pga/standard_gravity
+      call add_figure(c, 'record.peak_acc_mps2', res%record_pga)
+      call add_figure(c, 'pga_g', pga)
+      c%verdict = verdict_passed
+      if (pga > pga_largest) then
+         c%verdict = verdict_warns
+         c%warning = 'the record peaks at '//trim(fx(pga, 1))//' g (record.peak_acc_mps2 = '// &
+                     trim(es(res%record_pga, 3))//'), beyond 3 g, more than '// &
+                     'earthquakes have: a record in cm/s2 read as g or m/s2? set record_units'// &
+                     trim(see('implausible-record'))
+      else if (pga < pga_smallest) then
+         c%verdict = verdict_warns
+         c%warning = 'the record peaks at '//trim(es(pga, 2))//' g (record.peak_acc_mps2 = '// &
+                     trim(es(res%record_pga, 3))//'), below 0.005 g, less than '// &
+                     'earthquakes have: a record in g or m/s2 read as cm/s2? set record_units, record_scale'// &
+                     trim(see('implausible-record'))
+      end if
+   end subroutine record_range_check
 
    ! The helpers below return fixed-length text, trimmed where it is used: a function with a
    ! character(len=:), allocatable result keeps its length in a static variable of the caller

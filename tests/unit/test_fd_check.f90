@@ -175,6 +175,8 @@ contains
       res%band_alternation = [1.0_dp]
       res%band_x = [2.0_dp]
       res%energy_balance = balance_digits
+      res%period_stuck = 30.0_dp
+      res%record_pga = 1000.0_dp
       call run_checks(res, c)
       call run_warnings(res, w)
       call check(error, size(w), n_checks)

@@ -15,7 +15,8 @@ module test_fd_observer
    use, intrinsic :: ieee_arithmetic, only: ieee_value, ieee_quiet_nan, ieee_positive_inf
    use fd_observer, only: observer_type, observer_init, sample_due, observe_start, observe_peaks, &
                           observe_sample, observe_transitions, observe_violations, observe_end, &
-                          observe_extrema, observe_extremum, observe_work, observe_poll, observe_stop_error
+                          observe_extrema, observe_extremum, observe_work, observe_poll, observe_stop_error, &
+                          observe_device_motion, observe_start_energies, observe_end_energies
    implicit none
    private
 
@@ -52,6 +53,7 @@ contains
                   new_unittest("maxima between rows of the kept DOFs and devices", test_selected_envelope), &
                   new_unittest("exact extrema in the envelope's order", test_extrema), &
                   new_unittest("the work of the steps into the balance", test_work), &
+                  new_unittest("each device's work, dissipation and slip travel", test_device_work), &
                   new_unittest("rows into the control's row sink; its failure stops the run", test_sink) &
                   ]
    end subroutine collect_observer
@@ -104,6 +106,9 @@ contains
       end do
       call check(error, obs%rows == 4, "rows counted")
       if (allocated(error)) return
+      ! the device slides in the first row (t = 0): a slip excursion, the later rows none
+      call check(error, res%slip_excursions(1) == 1 .and. res%stick_to_slip(1) == 0, "a slide at t = 0")
+      if (allocated(error)) return
       ! t, ag, (u, v, aabs = a + ag) per DOF, (s, s', F, phase) per device
       call check(error, all(res%hist(:, 2) == [0.02_dp, -1.0_dp, 2.0_dp, 6.0_dp, 9.0_dp, 4.0_dp, 8.0_dp, &
                                                11.0_dp, 14.0_dp, 16.0_dp, 18.0_dp, -1.0_dp]), &
@@ -152,6 +157,9 @@ contains
       ! stick->slip at 0->1 and 0->-1; slip->stick at 1->0 and -1->0; reversals -1->1, 1->-1
       call check(error, res%stick_to_slip(1) == 2 .and. res%slip_to_stick(1) == 2 .and. res%reversals(1) == 2, &
                  "transition counts")
+      if (allocated(error)) return
+      ! two slides (a reversal continues one)
+      call check(error, res%slip_excursions(1), 2)
    end subroutine test_transitions
 
    subroutine test_violations(error)
@@ -384,6 +392,65 @@ contains
       call check(error, res%e_input == -1.0_dp .and. res%e_input_gross == 3.0_dp .and. res%e_viscous == 1.0_dp, &
                  'the balance')
    end subroutine test_work
+
+   !> Two devices: device 1 sticks (elastic work 0.3 J, stored at the end) then slides 0.02 m
+   !> at 50 N (1 J); device 2 slides 0.01 m at 20 N, 0.03 m at 20 N (0.8 J) and back 0.005 m
+   !> (0.1 J). Each one's dissipation is its work less the elastic energy it stored (0.05 J
+   !> at the start, 0.25 J at the end, device 1), its travel only what it slid; the devices'
+   !> dissipations sum to energy_friction_J.
+   subroutine test_device_work(error)
+      type(error_type), allocatable, intent(out) :: error
+      type(model_type) :: model
+      type(result_type) :: res
+      type(observer_type) :: obs
+
+      call setup(model, res, obs, error)
+      if (allocated(error)) return
+      model%n_devices = 2
+      model%dev = [model%dev(1), model%dev(1)]
+      call pairs_of(model)
+      call reinit(model, res, obs, error)
+      if (allocated(error)) return
+      call observe_start_energies(obs, 0.0_dp, 0.0_dp, 0.05_dp, [0.05_dp, 0.0_dp])
+      ! a technique's own loop adds to the observer's totals (Newmark), or it calls
+      ! observe_device_motion
+      obs%device_work = obs%device_work + [0.3_dp, 0.2_dp]
+      obs%slip_travel = obs%slip_travel + [0.0_dp, 0.01_dp]
+      call observe_device_motion(obs, 1, 1.0_dp, 0.02_dp)
+      call observe_device_motion(obs, 2, 0.6_dp, 0.03_dp)
+      call observe_device_motion(obs, 2, 0.1_dp, 0.005_dp)
+      call observe_end_energies(obs, res, 0.0_dp, 0.0_dp, 0.25_dp, 2.2_dp, [0.25_dp, 0.0_dp])
+      call check(error, obs%device_work(1), 1.3_dp, thr=1.0e-15_dp)
+      if (allocated(error)) return
+      call check(error, obs%device_work(2), 0.9_dp, thr=1.0e-15_dp)
+      if (allocated(error)) return
+      call check(error, res%dissipated(1), 1.1_dp, thr=1.0e-15_dp)
+      if (allocated(error)) return
+      call check(error, res%dissipated(2), 0.9_dp, thr=1.0e-15_dp)
+      if (allocated(error)) return
+      call check(error, sum(res%dissipated), res%e_friction, thr=1.0e-15_dp)
+      if (allocated(error)) return
+      call check(error, res%slip_travel(1), 0.02_dp, thr=1.0e-17_dp)
+      if (allocated(error)) return
+      call check(error, res%slip_travel(2), 0.045_dp, thr=1.0e-17_dp)
+   contains
+      subroutine reinit(model, res, obs, error)
+         type(model_type), intent(in) :: model
+         type(result_type), intent(out) :: res
+         type(observer_type), intent(out) :: obs
+         type(error_type), allocatable, intent(out) :: error
+         type(excitation_type) :: exc
+         type(integration_type) :: opts
+         type(fd_error_type), allocatable :: err
+
+         exc%kind = excitation_none
+         exc%dt_record = 0.01_dp
+         exc%duration = 0.0123_dp
+         opts%n1 = 20
+         call observer_init(model, exc, opts, res%period_stuck, res, obs, err)
+         if (allocated(err)) call test_failed(error, err%message)
+      end subroutine reinit
+   end subroutine test_device_work
 
    !> A run whose control holds a row sink: begun with the history's header, each row put
    !> into it (none into the result); a failed write makes the next look at the clock say

@@ -24,6 +24,8 @@ contains
                   new_unittest("the band: the device, its figures, the others", test_band), &
                   new_unittest("the energy balance: dissipated or created", test_energy), &
                   new_unittest("a run that blew up: figures of 1e40", test_huge), &
+                  new_unittest("a first period beyond 0.01-10 s: the unit typed wrong", test_period), &
+                  new_unittest("a record's peak beyond 0.005-3 g: the units read wrong", test_record_peak), &
                   new_unittest("every warning: one line, short, its explanation named", test_one_line) &
                   ]
    end subroutine collect_warnings
@@ -122,6 +124,79 @@ contains
       call check(error, index(w(2)%text, 'the integration created 1.0E+42 % of the energy') == 1, w(2)%text)
    end subroutine test_huge
 
+   !> The stuck system's first period of 31.6 s (a storey stiffness in kN/m typed as N/m: 1000
+   !> times too soft) and of 3.2 ms warn, naming the unit; 0.3 s passes; without a stuck period
+   !> (every mass held to the table through its devices) the free system's first finite
+   !> period is judged (here after a rigid-body mode); with neither the check does not apply.
+   subroutine test_period(error)
+      type(error_type), allocatable, intent(out) :: error
+      type(result_type) :: res
+      type(warning_text), allocatable :: w(:)
+
+      res%period_stuck = 31.6_dp
+      call run_warnings(res, w)
+      call check(error, size(w), 1)
+      if (allocated(error)) return
+      call check(error, w(1)%text, 'the first period T1 = 31.6 s (period_stuck_s) is beyond 10 s, longer than '// &
+                 'structures have: a stiffness in kN/m typed as N/m?; see docs/warnings.md#implausible-period')
+      if (allocated(error)) return
+      res%period_stuck = 3.2e-3_dp
+      call run_warnings(res, w)
+      call check(error, size(w), 1)
+      if (allocated(error)) return
+      call check(error, w(1)%text, 'the first period T1 = 3.20E-03 s (period_stuck_s) is below 0.01 s, shorter '// &
+                 'than structures have: masses in t typed as kg, or a stiffness in N/mm typed as N/m?; '// &
+                 'see docs/warnings.md#implausible-period')
+      if (allocated(error)) return
+      res%period_stuck = 0.3_dp
+      call run_warnings(res, w)
+      call check(error, size(w), 0)
+      if (allocated(error)) return
+      res%period_stuck = 0.0_dp
+      call run_warnings(res, w)
+      call check(error, size(w), 0)
+      if (allocated(error)) return
+      res%eng%free%n = 2
+      res%eng%free%omega2 = [0.0_dp, 0.16_dp]
+      res%eng%free%period = [huge(1.0_dp), 2.0_dp*acos(-1.0_dp)/0.4_dp]
+      call run_warnings(res, w)
+      call check(error, size(w), 1)
+      if (allocated(error)) return
+      call check(error, index(w(1)%text, 'T1 = 15.7 s (periods_free_s(2)) is beyond 10 s') > 0, w(1)%text)
+   end subroutine test_period
+
+   !> A record of 0.35 g passes; one in cm/s2 read as g (343 g) and one in g read as cm/s2
+   !> (3.6e-4 g) warn, naming the units; a record of zeros (free vibration) is not judged.
+   subroutine test_record_peak(error)
+      type(error_type), allocatable, intent(out) :: error
+      type(result_type) :: res
+      type(warning_text), allocatable :: w(:)
+
+      res%record_pga = 0.35_dp*9.80665_dp
+      call run_warnings(res, w)
+      call check(error, size(w), 0)
+      if (allocated(error)) return
+      res%record_pga = 0.35_dp*9.80665_dp*100.0_dp*9.80665_dp
+      call run_warnings(res, w)
+      call check(error, size(w), 1)
+      if (allocated(error)) return
+      call check(error, w(1)%text, 'the record peaks at 343.2 g (record.peak_acc_mps2 = 3.366E+03), beyond 3 g, '// &
+                 'more than earthquakes have: a record in cm/s2 read as g or m/s2? set record_units; '// &
+                 'see docs/warnings.md#implausible-record')
+      if (allocated(error)) return
+      res%record_pga = 0.35_dp*0.01_dp
+      call run_warnings(res, w)
+      call check(error, size(w), 1)
+      if (allocated(error)) return
+      call check(error, w(1)%text, 'the record peaks at 3.57E-04 g (record.peak_acc_mps2 = 3.500E-03), below '// &
+                 '0.005 g, less than earthquakes have: a record in g or m/s2 read as cm/s2? set record_units, '// &
+                 'record_scale; see docs/warnings.md#implausible-record')
+      if (allocated(error)) return
+      res%record_pga = 0.0_dp
+      call run_warnings(res, w)
+      call check(error, size(w), 0)
+   end subroutine test_record_peak
+
    !> Every warning at once, with figures of their widest formats: each is one line of at most
    !> 220 characters (the executable adds its prefix) that names its section of
    !> docs/warnings.md.
@@ -157,8 +232,10 @@ contains
       res%band_x = [1.234e3_dp, 1.0_dp, 1.0_dp]
       res%energy_balance = balance_digits
       res%e_residual_ratio = 1.234e-9_dp
+      res%period_stuck = 1.234e5_dp
+      res%record_pga = 1.234e7_dp
       call run_warnings(res, w)
-      call check(error, size(w), 8)
+      call check(error, size(w), 10)
       if (allocated(error)) return
       do k = 1, size(w)
          call check(error, len(w(k)%text) <= 220 .and. index(w(k)%text, new_line('a')) == 0 .and. &

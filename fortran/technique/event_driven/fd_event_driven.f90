@@ -41,7 +41,7 @@ module fd_event_driven
    use fd_statistics, only: count_event, count_accumulation
    use fd_observer, only: observer_type, observer_init, observe_start, observe_sample, observe_transitions, &
                           observe_end, observe_extrema, observe_extremum, observe_work, &
-                          observe_poll, observe_stop_error, observe_storeys
+                          observe_poll, observe_stop_error, observe_storeys, observe_device_motion
    use fd_run_control, only: run_control, stat_cancelled
    use fd_engineering, only: storey_values, engineering_columns
    use fd_taylor, only: poly_value, poly_value_deriv, poly_abs_bound, first_crossing, stationary_points
@@ -487,12 +487,13 @@ contains
          end do
          call update_global(w, res, s_use, t + s_use)
          call energy(w, res, s_use)
-         ! friction work: P mu |Delta s| over the slide
+         ! friction work: P mu |Delta s| over the slide, in all and per device
          do j = 1, st%nd
             if (.not. st%active(j) .or. st%phase(j) == phase_stick) cycle
             x = poly_value(st%yc(0:kk, iq_s(st%n, j)), s_use)
             y = st%yc(0, iq_s(st%n, j))
             w%w_fric = w%w_fric + st%slip(j)*abs(x - y)
+            call observe_device_motion(w%obs, j, st%slip(j)*abs(x - y), abs(x - y))
          end do
       end associate
    end subroutine observe_subinterval

@@ -205,7 +205,7 @@ contains
       if (allocated(error)) return
       call consistent_acceleration(model, exc, 0.0_dp, w)
       call observe_start_energies(w%obs, 0.5_dp*sum(w%mass*w%v**2), strain_energy(model, w%u), &
-                                  device_energy(model, w%st, w%s))
+                                  device_energy(model, w%st, w%s), friction_energy(model%dev(1:w%nd), w%st, w%s))
       w%phase0 = w%st%phase
       res%started_sliding = any(w%phase0 /= phase_stick)
       call observe_sample(w%obs, res, 0.0_dp, w%ag, w%u, w%v, w%a, w%s, w%sd, w%f, w%phase0, ag2=w%ag2)
@@ -257,7 +257,7 @@ contains
       res%newmark%mu_passes = w%follow_passes
       call observe_end_energies(w%obs, res, 0.5_dp*sum(w%mass*w%v**2), strain_energy(model, w%u), &
                                 device_energy(model, w%st, w%s), &
-                              w%w_device)
+                              w%w_device, friction_energy(model%dev(1:w%nd), w%st, w%s))
       do l = 1, size(w%lev)
          associate (stats => w%lev(l)%sys%stats)
             res%newmark%factorizations = res%newmark%factorizations + stats%factorizations
@@ -861,7 +861,8 @@ contains
       ! device work over the step; the devices move on; the factors follow their stiffness
       ! and damping (whatever changed them); after a phase change, or a sliding force that
       ! follows the velocity (mu(v)), the next step starts in equilibrium with the new forces
-      call device_step(w%nd, w%st, w%st1, w%s, w%sd, w%s1, w%sd1, w%f, w%w_device, changed_k, any_force)
+      call device_step(w%nd, w%st, w%st1, w%s, w%sd, w%s1, w%sd1, w%f, w%w_device, w%obs%device_work, &
+                       w%obs%slip_travel, changed_k, any_force)
       ! the sticking springs' ringing: the step joins its phases' statistics (fd_stick_ringing)
       if (w%ring%n > 0) then
          call phase_statistics(w%nd, t1 - w%t, w%st, w%sd, w%f, w%ring%stats)
@@ -935,10 +936,13 @@ contains
       if (allocated(model%modal_d)) e = e + lowrank_form(model%modal_u, model%modal_d, vsum, du)
    end function viscous_work
 
-   !> Work of the device forces over the step (trapezoid, the step's phases); the devices move
+   !> Work of the device forces over the step (trapezoid, the step's phases), in all and per
+   !> device, and each device's slip travel (|ds| in a step taken sliding), added to the
+   !> observer's totals here, in the loop over the devices (a call a step would cost more
+   !> than the sums); the devices move
    !> on to the trial state (s, s', state) and their force in it; whether a stiffness or
    !> damping changed, and whether a constant force f0 changed.
-   pure subroutine device_step(nd, st, st1, s, sd, s1, sd1, f, w, changed_k, changed_f0)
+   pure subroutine device_step(nd, st, st1, s, sd, s1, sd1, f, w, work, travel, changed_k, changed_f0)
       integer, intent(in) :: nd
       type(device_state), intent(inout) :: st(nd)
       type(device_state), intent(in) :: st1(nd)
@@ -948,8 +952,9 @@ contains
                                                !! by the last call, or at the start of the run); out:
                                                !! at the end, in the phases for the next step
       real(dp), intent(inout) :: w
+      real(dp), intent(inout) :: work(nd), travel(nd) !! per device: work [J], slip travel [m]
       logical, intent(out) :: changed_k, changed_f0
-      real(dp) :: f0, f1
+      real(dp) :: f0, f1, dw
       integer :: d
 
       changed_k = .false.
@@ -957,7 +962,10 @@ contains
       do d = 1, nd
          f0 = f(d)
          f1 = st(d)%ks*s1(d) + st(d)%cs*sd1(d) + st(d)%f0
-         w = w + 0.5_dp*(f0 + f1)*(s1(d) - s(d))
+         dw = 0.5_dp*(f0 + f1)*(s1(d) - s(d))
+         w = w + dw
+         work(d) = work(d) + dw
+         if (st(d)%phase /= phase_stick) travel(d) = travel(d) + abs(s1(d) - s(d))
          s(d) = s1(d)
          sd(d) = sd1(d)
          changed_k = changed_k .or. st1(d)%ks /= st(d)%ks .or. st1(d)%cs /= st(d)%cs
