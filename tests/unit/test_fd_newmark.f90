@@ -42,9 +42,9 @@ contains
       model%spring_j = [0, 0]
       model%spring_k = [1084.0_dp, 2895.0_dp]
       model%n_devices = 2
-      model%dev = [device_type(node_i=1, node_j=2, law=law_hysteretic, p=61.81_dp, mu=0.22_dp, f=1.0e-5_dp, &
+      model%dev = [device_type(node_i=2, node_j=0, law=law_hysteretic, p=20.0_dp, mu=0.1_dp, f=1.0e-5_dp, &
                                eps1=1.0e-3_dp), &
-                   device_type(node_i=2, node_j=0, law=law_velocity, p=20.0_dp, mu=0.1_dp, eps=1.0e-3_dp)]
+                   device_type(node_i=1, node_j=2, law=law_velocity, p=61.81_dp, mu=0.22_dp, eps=1.0e-3_dp)]
       call pairs_of(model)
       exc%kind = excitation_harmonic
       exc%amplitude = 0.004_dp
@@ -56,7 +56,7 @@ contains
       opts%n2 = 20
    end subroutine setup
 
-   !> The same model with the terms of device 1 in the other order (-e_2 + e_1: no longer read
+   !> The same model with the terms of device 2 in the other order (-e_2 + e_1: no longer read
    !> as a pair of nodes, so the whole step goes through fd_kinematics' terms) gives the same
    !> history, peaks, transitions and energies to the bit as the step by the nodes. Both
    !> devices slide, stick and reverse in the run (the comparison covers each law's phases).
@@ -78,12 +78,13 @@ contains
       call check(error, all(by_nodes%stick_to_slip > 0) .and. all(by_nodes%slip_to_stick > 0), &
                  "both devices slide and stick again")
       if (allocated(error)) return
-      ! device 1 as -e_2 + e_1; the nodes kept for the pairs go with the directions they were
+      ! device 2 as -e_2 + e_1 (the last device: the checks that take devices as links still
+      ! find device 1's nodes); the nodes kept for the pairs go with the directions they were
       ! made from
-      model%dev_dof(1:2) = [2, 1]
-      model%dev_coef(1:2) = [-1.0_dp, 1.0_dp]
+      model%dev_dof(2:3) = [2, 1]
+      model%dev_coef(2:3) = [-1.0_dp, 1.0_dp]
       deallocate (model%dev_nodes)
-      call check(error, .not. devices_are_pairs(model), "device 1 is no longer read as a pair")
+      call check(error, .not. devices_are_pairs(model), "device 2 is no longer read as a pair")
       if (allocated(error)) return
       call run_newmark(model, exc, opts, by_terms, err)
       if (allocated(err)) then
