@@ -38,7 +38,7 @@ module fd_newmark
    use fd_matrices, only: structure_damping
    use fd_woodbury, only: woodbury_type, woodbury_setup, woodbury_factor, woodbury_correct, lowrank_matvec, &
                           lowrank_form
-   use fd_kinematics, only: device_kinematics, add_device, relative_motion, device_forces
+   use fd_kinematics, only: device_kinematics, add_device, relative_motion, device_forces, device_nodes
    use fd_stiffness, only: general_form, influence_of
    use fd_banded, only: spd_system, spd_setup, spd_factor, spd_update_devices, spd_solve, spd_k_matvec, &
                         spd_c_matvec, spd_kc_matvec, spd_auto, spd_dense, spd_banded, spd_is_dense, spd_bandwidth, &
@@ -88,6 +88,11 @@ module fd_newmark
       real(dp), allocatable :: u(:), v(:), a(:), u1(:), v1(:), a1(:), rhs(:), tmp(:)
       real(dp), allocatable :: s(:), sd(:), s1(:), sd1(:), f(:), kd(:)
       real(dp), allocatable :: fw(:)                  !! work: the devices' loads of a trial
+      ! devices between two nodes: the step's loads and relative motion by their nodes, in this
+      ! module (pair_loads, pair_motion: three calls to fd_kinematics' kernels a trial cost a
+      ! one-device model about 6 % of its instructions); other directions through fd_kinematics
+      logical :: pairs = .false.                      !! every device joins two nodes (device_nodes)
+      integer, allocatable :: di(:), dj(:)            !! then their nodes (dj = 0: the table)
       type(device_state), allocatable :: st(:), st1(:)
       type(device_state), allocatable :: st0(:)       !! states at the start ('implicit' refinement)
       integer, allocatable :: phase0(:), phase1(:)    !! phases of st, st1 for the observer
@@ -350,12 +355,14 @@ contains
       end do
       allocate (w%u(n), w%v(n), w%a(n), w%u1(n), w%v1(n), w%a1(n), w%rhs(n), w%tmp(n), &
                 w%s(nd), w%sd(nd), w%s1(nd), w%sd1(nd), w%f(nd), w%fw(nd), w%kd(nd), w%st(nd), w%st1(nd), w%st0(nd), &
-                w%phase0(nd), w%phase1(nd), w%phase_end(nd), w%changed(nd), w%ok(nd), stat=stat)
+                w%phase0(nd), w%phase1(nd), w%phase_end(nd), w%changed(nd), w%ok(nd), w%di(nd), w%dj(nd), stat=stat)
       if (stat /= 0) then
          call fatal_error(error, "not enough memory for the state of n_dof = "//trim(fmt_int(n))//" DOFs", &
                           stat_no_memory)
          return
       end if
+      call device_nodes(model, w%di, w%dj, l)
+      w%pairs = l == 0
       w%nf = count(follows_velocity(model%dev))
       allocate (w%fl(w%nf), w%df(w%nf), w%cap(w%nf), stat=stat)
       if (stat /= 0) then
@@ -431,12 +438,20 @@ contains
       end if
       call spd_kc_matvec(w%lev(lv)%sys, w%u1, w%tmp, w%rhs, -1.0_dp)
       if (w%lev(lv)%wb%r > 0) call lowrank_matvec(model%modal_u, model%modal_d, w%tmp, w%rhs, -1.0_dp)
-      call device_loads(model, w%n, w%nd, w%st, w%u1, w%tmp, w%lev(lv)%c0, w%rhs, w%s1, w%sd1, w%fw)
+      if (w%pairs) then
+         call pair_loads(w%n, w%nd, w%di, w%dj, w%st, w%u1, w%tmp, w%lev(lv)%c0, w%rhs)
+      else
+         call device_loads(model, w%n, w%nd, w%st, w%u1, w%tmp, w%lev(lv)%c0, w%rhs, w%s1, w%sd1, w%fw)
+      end if
       call spd_solve(w%lev(lv)%sys, w%rhs, error)
       if (allocated(error)) return
       if (w%lev(lv)%wb%r > 0) call woodbury_correct(w%lev(lv)%wb, model%modal_u, w%rhs)
       call correct(w%n, w%lev(lv)%bh2, w%lev(lv)%gh, w%rhs, w%tmp, w%a1, w%u1, w%v1)
-      call relative_motion(model, w%n, w%nd, w%u1, w%v1, w%s1, w%sd1)
+      if (w%pairs) then
+         call pair_motion(w%n, w%nd, w%di, w%dj, w%u1, w%v1, w%s1, w%sd1)
+      else
+         call relative_motion(model, w%n, w%nd, w%u1, w%v1, w%s1, w%sd1)
+      end if
       if (w%nf > 0) call follow_forces(model, lv, w, error)
    end subroutine try_step
 
@@ -564,6 +579,56 @@ contains
          rhs(i) = c0*rhs(i)
       end do
    end subroutine device_loads
+
+   !> device_loads for devices that all join two nodes (b_d = e_i - e_j, e_i to the table): the
+   !> forces at the predictors subtracted from rhs by the nodes, then rhs scaled by c0. The same
+   !> operations in the same order as device_loads, so the same results to the bit.
+   pure subroutine pair_loads(n, nd, di, dj, st, ut, vt, c0, rhs)
+      integer, intent(in) :: n, nd
+      integer, intent(in) :: di(nd), dj(nd)
+      type(device_state), intent(in) :: st(nd)
+      real(dp), intent(in) :: ut(n), vt(n), c0
+      real(dp), intent(inout) :: rhs(n)
+      real(dp) :: f
+      integer :: d, i, j
+
+      do d = 1, nd
+         i = di(d)
+         j = dj(d)
+         if (j > 0) then
+            f = st(d)%ks*(ut(i) - ut(j)) + st(d)%cs*(vt(i) - vt(j)) + st(d)%f0
+            rhs(j) = rhs(j) + f
+         else
+            f = st(d)%ks*ut(i) + st(d)%cs*vt(i) + st(d)%f0
+         end if
+         rhs(i) = rhs(i) - f
+      end do
+      do i = 1, n
+         rhs(i) = c0*rhs(i)
+      end do
+   end subroutine pair_loads
+
+   !> relative_motion for devices that all join two nodes: s = u_i - u_j, s' = v_i - v_j
+   !> (u_i, v_i to the table).
+   pure subroutine pair_motion(n, nd, di, dj, u1, v1, s1, sd1)
+      integer, intent(in) :: n, nd
+      integer, intent(in) :: di(nd), dj(nd)
+      real(dp), intent(in) :: u1(n), v1(n)
+      real(dp), intent(out) :: s1(nd), sd1(nd)
+      integer :: d, i, j
+
+      do d = 1, nd
+         i = di(d)
+         j = dj(d)
+         if (j > 0) then
+            s1(d) = u1(i) - u1(j)
+            sd1(d) = v1(i) - v1(j)
+         else
+            s1(d) = u1(i)
+            sd1(d) = v1(i)
+         end if
+      end do
+   end subroutine pair_motion
 
    !> The trial state from a1 (in rhs): u1 = u~ + beta h^2 a1, v1 = v~ + gamma h a1.
    pure subroutine correct(n, bh2, gh, a1s, vt, a1, u1, v1)
