@@ -294,11 +294,27 @@ def floor_groups() -> dict[str, dict]:
     }
 
 
+K_MTX = "%%MatrixMarket matrix coordinate real symmetric\n2 2 3\n1 1 3.0e6\n2 1 -1.0e6\n2 2 1.0e6\n"
+M_MTX = "%%MatrixMarket matrix coordinate real symmetric\n2 2 2\n1 1 1000.0\n2 2 800.0\n"
+
+
+def matrix_groups() -> dict[str, dict]:
+    """A short run of a structure of &matrices (K.mtx and M.mtx, two DOFs) with a device."""
+    g = base_groups()
+    for name in ("model", "springs", "storeys", "braces", "isolators"):
+        g.pop(name)
+    g = {"matrices": {"k_file": "K.mtx", "m_file": "M.mtx", "label": ["a", "b"], "influence": [1.0, 1.0],
+                      "influence2": [0.0, 0.5]}, **g}
+    g["damping"] = {"damping_type": "rayleigh", "rayleigh_a0": 0.1, "rayleigh_a1": 0.001}
+    g["friction"].update(node_i=2, node_j=1)
+    return g
+
+
 def deck_with(group: str, var: str, context: str | None, value) -> tuple[dict, dict]:
     """The deck of the context with `value` given to the variable (its last element when the
     deck gives a list), and the deck that does not give that element (what a value taken for
     "not given" ran as)."""
-    g = floor_groups() if group in FLOOR_GROUPS else base_groups()
+    g = floor_groups() if group in FLOOR_GROUPS else matrix_groups() if group == "matrices" else base_groups()
     if context == "floor inertia":
         g["floors"].pop("plan_x")
         g["floors"].pop("plan_y")
@@ -381,6 +397,8 @@ def test_an_extreme_value_is_refused_or_used_never_taken_for_not_given(
     history_dofs = -2147483647: the reader took the value for its "not given" marker."""
     (tmp_path / "r.txt").write_text(RECORD)
     (tmp_path / "r.at2").write_text(AT2)
+    (tmp_path / "K.mtx").write_text(K_MTX)
+    (tmp_path / "M.mtx").write_text(M_MTX)
     groups, without = deck_with(group, var, context, value)
     try:
         result = frictiondyn.run_text(deck_text(groups), "case.nml", tmp_path)

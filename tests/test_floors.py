@@ -302,3 +302,67 @@ def test_profiles_of_rigid_floors_draw_x_and_y_apart(run, tmp_path):
     aabs = np.array(r.summary()["peak_aabs_mps2"]).reshape(3, 3)
     got = {ln.get_label(): ln.get_xdata() for ln in fig.axes[0].get_lines()}
     assert np.allclose(got["x"], aabs[:, 0]) and np.allclose(got["y"], aabs[:, 1])
+
+
+def frame_stiffness(frames: dict, n_floors: int, cm=None) -> np.ndarray:
+    """K of the frames of a &frames group, written out here from their directions
+    (b = (cos a, sin a, sin a x - cos a y) on the floor above minus the floor below)."""
+    K = np.zeros((3 * n_floors, 3 * n_floors))
+    for s, a, x, y, k in zip(frames["storey"], frames["angle"], frames["x"], frames["y"], frames["k"]):
+        c, sn = (round(np.cos(np.radians(a)), 15), round(np.sin(np.radians(a)), 15))
+        b = np.zeros(3 * n_floors)
+        b[3 * s - 3:3 * s] = [c, sn, sn * x - c * y]
+        if s > 1:
+            b[3 * s - 6:3 * s - 3] = [-c, -sn, -(sn * x - c * y)]
+        K += k * np.outer(b, b)
+    return K
+
+
+def mtx(a: np.ndarray, symmetric: bool = True) -> str:
+    """A Matrix Market coordinate file of a (its lower triangle when symmetric)."""
+    n = a.shape[0]
+    entries = [(i, j, a[i, j]) for j in range(n) for i in range(n)
+               if a[i, j] != 0 and (i >= j or not symmetric)]
+    kind = "symmetric" if symmetric else "general"
+    lines = [f"%%MatrixMarket matrix coordinate real {kind}", f"{n} {n} {len(entries)}"]
+    lines += [f"{i + 1} {j + 1} {float(v)!r}" for i, j, v in entries]
+    return "\n".join(lines) + "\n"
+
+
+def test_matrices_reproduce_the_rigid_floors(run):
+    """The symmetric building without braces but with a velocity-law damper from floor 1's
+    ux to the ground (&friction), given as &matrices: K of its frames and M (m, m, J) in
+    Matrix Market files, r along x; the same run (1e-12)."""
+    floors = symmetric()
+    floors.pop("floor_braces")
+    floors["friction"] = {"n_devices": 1, "node_i": 1, "node_j": 0, "law": "velocity", "p": 2.0e5,
+                          "mu": 1.0, "eps": 1.0e-3}
+    floors["excitation"] = dict(HARMONIC, amplitude=0.05)
+    a = ok(run(floors, name="floors"))
+    J = 3.0e5 * (20.0**2 + 12.0**2) / 12
+    deck = {k: v for k, v in floors.items() if k not in ("floors", "frames")}
+    deck["matrices"] = {"k_file": "K.mtx", "m_file": "M.mtx", "influence": [1.0, 0.0, 0.0] * 3}
+    deck = {"matrices": deck.pop("matrices"), **deck}
+    files = {"K.mtx": mtx(frame_stiffness(floors["frames"], 3)), "M.mtx": mtx(np.diag([3.0e5, 3.0e5, J] * 3))}
+    b = ok(run(deck, name="matrices", files=files))
+    ha, hb = a.history(), b.history()
+    u = np.array([ha[f"u{i}"] for i in range(1, 10)])
+    v = np.array([hb[f"u{i}"] for i in range(1, 10)])
+    assert a.summary()["stick_to_slip"][0] > 0
+    assert np.abs(u - v).max() <= 1e-12 * np.abs(u).max()
+    assert b.summary()["peak_base_shear_N"] == pytest.approx(a.summary()["peak_base_shear_N"], rel=1e-12)
+
+
+@pytest.mark.parametrize("k, m, words", [
+    (np.array([[2.0, 1.0], [0.5, 2.0]]), np.eye(2), "K(2, 1) = 0.5"),
+    (np.array([[1.0, -1.0], [-1.0, 1.0]]), np.eye(2), "not positive definite at DOF 2 'b'"),
+    (np.eye(2), np.array([[1.0, 0.1], [0.1, 1.0]]), "diagonal (lumped) mass"),
+    (np.eye(2), np.diag([1.0, 0.0]), "M(2, 2) = 0"),
+    (np.eye(3), np.eye(2), "of K's size"),
+])
+def test_bad_matrices(run, k, m, words):
+    deck = {"matrices": {"k_file": "K.mtx", "m_file": "M.mtx", "influence": [1.0, 1.0], "label": ["a", "b"]},
+            "damping": {"damping_type": "none"}, "excitation": HARMONIC}
+    r = run(deck, files={"K.mtx": mtx(k, symmetric=False), "M.mtx": mtx(m, symmetric=False)})
+    assert r.returncode != 0
+    assert "&matrices" in r.stderr and words in r.stderr, r.stderr

@@ -130,6 +130,7 @@ DECK_VARIABLES: dict[str, tuple[str, ...]] = {
     "floors": ("n_floors", "mass", "inertia", "plan_x", "plan_y", "cm_x", "cm_y", "height",
                "label", "excitation_angle", "p_delta"),
     "frames": ("n_frames", "storey", "angle", "x", "y", "k"),
+    "matrices": ("k_file", "m_file", "label", "influence", "influence2"),
     "floor_braces": ("n_braces", "storey", "angle", "x", "y", "slip_load", "stiffness", "eps1",
                      "eps", "law", "label"),
     "excitation": ("excitation_type", "amplitude", "frequency", "ramp_cycles", "duration",

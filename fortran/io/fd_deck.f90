@@ -35,7 +35,8 @@ module fd_deck
                        default_storey_height, law_name
    use fd_model, only: source_friction, source_brace, source_isolator, source_floor_brace
    use fd_floors, only: floor_dof, plan_direction, floor_inertia, max_plan_terms
-   use fd_stiffness, only: add_general_entry
+   use fd_stiffness, only: add_general_entry, add_general_dense
+   use fd_matrix_market, only: sparse_matrix, read_matrix_market
    use fd_linalg, only: cholesky_factor
    use fd_friction, only: law_mu_of_speed
    use fd_matrices, only: modes_type, natural_modes, natural_modes_sparse, stiffness_matrix, modes_dense_dofs
@@ -55,6 +56,9 @@ module fd_deck
    integer, parameter :: max_springs = 4000000  !! springs (n_springs)
    integer, parameter :: max_devices = 1000000  !! friction devices (n_devices)
    integer, parameter :: max_floors = max_dof/3 !! rigid floors (n_floors), three DOFs each
+   !> Most DOFs of &matrices whose K is checked as a dense matrix (symmetry of a 'general'
+   !> file, positive definiteness): 3000 DOFs, 72 MB
+   integer, parameter :: max_dense_check = 3000
    !> What the variables read hold before the read: a filler only. Whether the deck gives a
    !> value is read from its text (given_elements), never from a value: any value a deck can
    !> write, this one too, is a value given.
@@ -132,21 +136,24 @@ contains
       type(run_config), intent(inout) :: cfg
       type(error_type), allocatable, intent(out) :: error
       integer :: stat
-      logical :: floors
+      logical :: floors, matrices
 
       cfg%deck_path = deck%path
       call check_groups(deck, [character(len=12) :: 'model', 'springs', 'damping', 'friction', &
                                'braces', 'isolators', 'storeys', 'floors', 'frames', 'floor_braces', &
-                               'excitation', 'excitation2', 'integration', 'output'], error)
+                               'matrices', 'excitation', 'excitation2', 'integration', 'output'], error)
       if (allocated(error)) return
-      ! the DOFs: a building of rigid floors (&floors, &frames), or masses (&model, &springs)
+      ! the DOFs: a building of rigid floors (&floors, &frames), a structure's matrices
+      ! (&matrices), or masses (&model, &springs)
       call read_floors_group(deck, cfg, floors, error)
       if (allocated(error)) return
-      call one_model(deck, floors, error)
+      if (.not. floors) call read_matrices_group(deck, cfg, matrices, error)
+      if (allocated(error)) return
+      call one_model(deck, floors, matrices, error)
       if (allocated(error)) return
       if (floors) then
          call read_frames_group(deck, cfg, error)
-      else
+      else if (.not. matrices) then
          call read_model_group(deck, cfg, error)
       end if
       if (allocated(error)) return
@@ -163,7 +170,7 @@ contains
       if (allocated(error)) return
       call read_isolators_group(deck, cfg, error)
       if (allocated(error)) return
-      if (.not. floors) call read_storeys_group(deck, cfg, error)
+      if (.not. (floors .or. matrices)) call read_storeys_group(deck, cfg, error)
       if (allocated(error)) return
       ! each device's direction from its two nodes (fd_kinematics)
       call set_pair_directions(cfg%model, stat)
@@ -191,30 +198,35 @@ contains
       end if
    end subroutine read_groups
 
-   !> The model is one of two kinds: masses (&model) or rigid floors (&floors, &frames,
-   !> &floor_braces); the groups of the other kind are refused, and &storeys with floors.
-   subroutine one_model(deck, floors, error)
+   !> The model is one of three kinds: masses (&model), rigid floors (&floors, &frames,
+   !> &floor_braces) or matrices (&matrices); the groups of another kind are refused, and
+   !> &storeys with floors or matrices (whose storeys are not pairs of nodes).
+   subroutine one_model(deck, floors, matrices, error)
       type(deck_text), intent(in) :: deck
       logical, intent(in) :: floors                       !! &floors is given
+      logical, intent(in) :: matrices                     !! &matrices is given
       type(error_type), allocatable, intent(out) :: error
       type(group_text) :: grp
-      character(len=12), parameter :: names(4) = [character(len=12) :: 'model', 'storeys', 'frames', &
-                                                  'floor_braces']
-      character(len=12) :: name
-      logical :: found
+      character(len=12), parameter :: names(5) = [character(len=12) :: 'model', 'storeys', 'frames', &
+                                                  'floor_braces', 'matrices']
+      logical :: found, refused
       integer :: k
 
-      do k = 1, 4
-         name = names(k)
-         if ((k <= 2) .neqv. floors) cycle
-         call find_group(deck, trim(name), grp, found, error)
+      do k = 1, 5
+         refused = (k <= 2 .and. (floors .or. matrices)) .or. (k >= 3 .and. k <= 4 .and. .not. floors) .or. &
+                   (k == 5 .and. floors)
+         if (.not. refused) cycle
+         call find_group(deck, trim(names(k)), grp, found, error)
          if (allocated(error)) return
          if (.not. found) cycle
          if (floors) then
-            call fatal_error(error, deck%path//": group &"//trim(name)//" is not for a building of &floors: "// &
+            call fatal_error(error, deck%path//": group &"//trim(names(k))//" is not for a building of &floors: "// &
                              "its DOFs and storeys are the floors'")
+         else if (matrices .and. k <= 2) then
+            call fatal_error(error, deck%path//": group &"//trim(names(k))//" is not for a structure of "// &
+                             "&matrices: its DOFs are the matrices'")
          else
-            call fatal_error(error, deck%path//": group &"//trim(name)//" is for a building of rigid floors: "// &
+            call fatal_error(error, deck%path//": group &"//trim(names(k))//" is for a building of rigid floors: "// &
                              "give &floors (or leave it out)")
          end if
          return
@@ -291,8 +303,8 @@ contains
       logical :: more, found
 
       n_springs = unset_int
-      if (cfg%model%n_floors > 0) then
-         ! a building of rigid floors: springs between its DOFs are optional
+      if (cfg%model%n_floors > 0 .or. cfg%model%n_kx > 0) then
+         ! rigid floors or matrices: springs between their DOFs are optional
          call find_group(deck, 'springs', grp, found, error)
          if (allocated(error)) return
          if (.not. found) then
@@ -601,9 +613,10 @@ contains
       ! a second horizontal component: perpendicular to the first, for rigid floors
       call read_component(deck, 'excitation2', .false., cfg%exc2, cfg%record2, found, error)
       if (allocated(error) .or. .not. found) return
-      if (cfg%model%n_floors == 0) then
+      if (cfg%model%n_floors == 0 .and. .not. allocated(cfg%model%influence2)) then
          call fatal_error(error, deck%path//": group &excitation2 is the second horizontal component of a "// &
-                          "building of rigid floors (&floors): a model of &model has one direction")
+                          "building of rigid floors (&floors), or of &matrices with influence2: a model of &model "// &
+                          "has one direction")
          return
       end if
       if (cfg%exc2%dt_record /= cfg%exc%dt_record) then
@@ -612,6 +625,7 @@ contains
                   error)
          return
       end if
+      if (cfg%model%n_floors == 0) return   ! &matrices gives influence2
       ! r2 = (-sin a, cos a, 0): along excitation_angle + 90 degrees
       allocate (cfg%model%influence2(cfg%model%n_dof))
       do f = 1, cfg%model%n_floors
@@ -1119,6 +1133,219 @@ contains
          end do
       end do
    end subroutine read_floors_group
+
+   ! ---------------------------------------------------------------- &matrices
+   !> A general linear structure from its matrices: K and M in Matrix Market files (the
+   !> coordinate format; M diagonal, a lumped mass), the DOFs' labels, and the table
+   !> motion's direction over the DOFs for &excitation (influence) and &excitation2
+   !> (influence2). K becomes the stiffness entries K_x; springs, devices and dashpots join
+   !> DOFs as in a model of masses.
+   subroutine read_matrices_group(deck, cfg, found, error)
+      type(deck_text), intent(in) :: deck
+      type(run_config), intent(inout) :: cfg
+      logical, intent(out) :: found
+      type(error_type), allocatable, intent(out) :: error
+      character(len=path_len) :: k_file, m_file
+      real(dp), allocatable :: influence(:), influence2(:)
+      character(len=label_len), allocatable :: label(:)
+      namelist /matrices/ k_file, m_file, label, influence, influence2
+      type(group_text) :: grp
+      type(sparse_matrix) :: km, mm
+      character(len=512) :: msg
+      character(len=:), allocatable :: path
+      integer :: ios, i, n, e
+      logical :: more
+
+      k_file = ''; m_file = ''
+      call find_group(deck, 'matrices', grp, found, error)
+      if (allocated(error) .or. .not. found) return
+      call check_length(deck, grp, 'k_file', path_len, error)
+      if (.not. allocated(error)) call check_length(deck, grp, 'm_file', path_len, error)
+      if (.not. allocated(error)) call check_length(deck, grp, 'label', label_len - 1, error)
+      if (allocated(error)) return
+      ! the matrices first: their size gives the arrays' capacity
+      do i = 1, 2
+         call given_text(deck, grp, merge('k_file', 'm_file', i == 1), path, error)
+         if (allocated(error)) return
+         if (i == 1) call read_matrix_market(path, km, error)
+         if (i == 2) call read_matrix_market(path, mm, error)
+         if (allocated(error)) then
+            error%message = deck%path//", group &matrices, "//merge('k_file', 'm_file', i == 1)//": "//error%message
+            return
+         end if
+      end do
+      n = km%n_rows
+      allocate (influence(n), influence2(n), label(n), stat=ios)
+      if (ios /= 0) then
+         call no_memory(deck, 'matrices', n, 'DOFs', error); return
+      end if
+      influence = unset; influence2 = unset; label = ''
+      do
+         read (grp%lines, nml=matrices, iostat=ios, iomsg=msg)
+         call next_read(deck, grp, ios, msg, more, error)
+         if (.not. more) exit
+      end do
+      if (allocated(error)) return
+      call check_matrices(deck, km, mm, error)
+      if (allocated(error)) return
+      call signed_reals(deck, 'matrices', 'influence', influence, given_of(grp, 'influence', n), n, '-', error)
+      if (allocated(error)) return
+      call check_labels(deck, grp, 'matrices', label, n, error)
+      if (allocated(error)) return
+      cfg%model%n_dof = n
+      allocate (cfg%model%mass(n), cfg%model%u0(n), cfg%model%v0(n))
+      cfg%model%u0 = 0.0_dp
+      cfg%model%v0 = 0.0_dp
+      do e = 1, mm%nnz
+         cfg%model%mass(mm%row(e)) = mm%val(e)
+      end do
+      cfg%model%dof_label = label
+      cfg%model%influence = influence
+      if (is_given(grp, 'influence2')) then
+         call signed_reals(deck, 'matrices', 'influence2', influence2, given_of(grp, 'influence2', n), n, '-', error)
+         if (allocated(error)) return
+         cfg%model%influence2 = influence2
+      end if
+      ! K's entries on and above the diagonal
+      cfg%model%n_kx = count(km%row(1:km%nnz) <= km%col(1:km%nnz))
+      if (km%symmetric) cfg%model%n_kx = km%nnz
+      allocate (cfg%model%kx_i(cfg%model%n_kx), cfg%model%kx_j(cfg%model%n_kx), cfg%model%kx_v(cfg%model%n_kx))
+      i = 0
+      do e = 1, km%nnz
+         if (.not. km%symmetric .and. km%row(e) > km%col(e)) cycle
+         i = i + 1
+         cfg%model%kx_i(i) = min(km%row(e), km%col(e))
+         cfg%model%kx_j(i) = max(km%row(e), km%col(e))
+         cfg%model%kx_v(i) = km%val(e)
+      end do
+      call check_definite(deck, cfg, error)
+   end subroutine read_matrices_group
+
+   !> K square and symmetric (a general file's K checked entry by entry, as a dense matrix up
+   !> to max_dense_check DOFs), M of K's size and diagonal with masses > 0.
+   subroutine check_matrices(deck, km, mm, error)
+      type(deck_text), intent(in) :: deck
+      type(sparse_matrix), intent(in) :: km, mm
+      type(error_type), allocatable, intent(out) :: error
+      real(dp), allocatable :: a(:, :)
+      integer :: n, e, i, j
+
+      n = km%n_rows
+      if (km%n_cols /= n .or. n < 1) then
+         call bad(deck, 'matrices', 'k_file', trim(fmt_int(km%n_rows))//' x '//trim(fmt_int(km%n_cols)), &
+                  'a square matrix', error)
+         return
+      end if
+      if (mm%n_rows /= n .or. mm%n_cols /= n) then
+         call bad(deck, 'matrices', 'm_file', trim(fmt_int(mm%n_rows))//' x '//trim(fmt_int(mm%n_cols)), &
+                  "of K's size, "//trim(fmt_int(n))//' x '//trim(fmt_int(n)), error)
+         return
+      end if
+      do e = 1, mm%nnz
+         if (mm%row(e) /= mm%col(e) .and. mm%val(e) /= 0.0_dp) then
+            call bad(deck, 'matrices', 'm_file', 'an entry ('//trim(fmt_int(mm%row(e)))//', '// &
+                     trim(fmt_int(mm%col(e)))//') = '//trim(fmt_real(mm%val(e))), 'a diagonal (lumped) mass '// &
+                     'matrix: lump a consistent mass first', error)
+            return
+         end if
+      end do
+      allocate (a(1, n))
+      a = 0.0_dp
+      do e = 1, mm%nnz
+         if (mm%row(e) == mm%col(e)) a(1, mm%row(e)) = mm%val(e)
+      end do
+      do i = 1, n
+         if (.not. (a(1, i) > 0.0_dp)) then
+            call bad(deck, 'matrices', 'm_file', 'M('//trim(fmt_int(i))//', '//trim(fmt_int(i))//') = '// &
+                     trim(fmt_real(a(1, i))), '> 0 at every DOF: a DOF without mass is condensed out of K and M '// &
+                     'before (static condensation)', error)
+            return
+         end if
+      end do
+      if (km%symmetric) return
+      if (n > max_dense_check) then
+         call bad(deck, 'matrices', 'k_file', "a 'general' file of "//trim(fmt_int(n))//' DOFs', "a 'symmetric' "// &
+                  'Matrix Market file above '//trim(fmt_int(max_dense_check))//' DOFs (scipy.io.mmwrite writes one '// &
+                  'for a symmetric matrix)', error)
+         return
+      end if
+      deallocate (a)
+      allocate (a(n, n))
+      a = 0.0_dp
+      do e = 1, km%nnz
+         a(km%row(e), km%col(e)) = km%val(e)
+      end do
+      do j = 1, n
+         do i = j + 1, n
+            if (abs(a(i, j) - a(j, i)) > 1.0e-12_dp*max(abs(a(i, j)), abs(a(j, i)))) then
+               call bad(deck, 'matrices', 'k_file', 'K('//trim(fmt_int(i))//', '//trim(fmt_int(j))//') = '// &
+                        trim(fmt_real(a(i, j)))//' and K('//trim(fmt_int(j))//', '//trim(fmt_int(i))//') = '// &
+                        trim(fmt_real(a(j, i))), 'a symmetric stiffness (equal to 1e-12)', error)
+               return
+            end if
+         end do
+      end do
+   end subroutine check_matrices
+
+   !> K positive definite (up to max_dense_check DOFs, by a dense Cholesky factorization): a
+   !> mechanism or an indefinite K is named by the first DOF where the factorization fails.
+   subroutine check_definite(deck, cfg, error)
+      type(deck_text), intent(in) :: deck
+      type(run_config), intent(in) :: cfg
+      type(error_type), allocatable, intent(out) :: error
+      real(dp), allocatable :: k(:, :)
+      integer :: n, info, stat
+
+      n = cfg%model%n_dof
+      if (n > max_dense_check) return
+      allocate (k(n, n), stat=stat)
+      if (stat /= 0) return
+      k = 0.0_dp
+      call add_general_dense(cfg%model, k)
+      call cholesky_factor(k, info)
+      if (info /= 0) then
+         call bad(deck, 'matrices', 'k_file', 'K not positive definite at DOF '//trim(fmt_int(info))// &
+                  trim(merge(" '"//trim(cfg%model%dof_label(info))//"'", repeat(' ', label_len + 3), &
+                  len_trim(cfg%model%dof_label(info)) > 0)), &
+                  'the stiffness of a structure held to the table (a mechanism, or an indefinite K, fails there)', error)
+      end if
+   end subroutine check_definite
+
+   !> The path of a file named by a text variable of a group (its last assignment, quoted),
+   !> relative to the deck: the files are read before the group's arrays, which K sizes.
+   subroutine given_text(deck, grp, var, path, error)
+      type(deck_text), intent(in) :: deck
+      type(group_text), intent(in) :: grp
+      character(len=*), intent(in) :: var
+      character(len=:), allocatable, intent(out) :: path
+      type(error_type), allocatable, intent(out) :: error
+      character(len=:), allocatable :: item, value
+      integer :: i, eq
+
+      path = ''
+      do i = size(grp%items), 1, -1
+         item = grp%items(i)%s
+         eq = index(item, '=')
+         if (eq < 2) cycle
+         if (lower(trim(adjustl(item(1:eq - 1)))) /= var) cycle
+         value = trim(adjustl(item(eq + 1:)))
+         if (len(value) >= 2) then
+            if ((value(1:1) == "'" .or. value(1:1) == '"') .and. value(len(value):len(value)) == value(1:1)) &
+               path = value(2:len(value) - 1)
+         end if
+         if (len(path) == 0) then
+            call bad(deck, 'matrices', var, value, "a file name in quotes ('K.mtx')", error)
+            return
+         end if
+         exit
+      end do
+      if (len(path) == 0) then
+         call fatal_error(error, deck%path//", group &matrices: "//var//" is not given")
+         return
+      end if
+      value = path
+      call relative_to(deck%path, value, path)
+   end subroutine given_text
 
    ! ---------------------------------------------------------------- &frames
    !> The lateral elements of a building of rigid floors: frame or wall e of storey s

@@ -58,7 +58,7 @@ contains
       if (opts%technique /= technique_newmark .and. model%n_kx > 0) then
          call fatal_error(error, "group &integration: technique = '"//trim(technique_name(opts%technique))// &
                           "' takes a structure of springs between two nodes: a building of rigid floors "// &
-                          "(&floors, &frames) is integrated by technique = 'newmark'")
+                          "(&floors, &frames) or of &matrices is integrated by technique = 'newmark'")
          return
       end if
       call check_braces(model, opts%technique, error)
