@@ -110,9 +110,24 @@ def test_scaled_to_sa(tmp_path):
     assert loaded.records["scale_to"] == "sa" and loaded.records["period"] == 0.6
 
 
+def test_scaled_to_sa_at_the_structures_first_period(tmp_path):
+    """Without a period, 'sa' is taken at the base deck's T1: here its stuck system is rigid
+    (the device holds the mass to the table), so the free system's, 2 pi sqrt(m / k)."""
+    spec = suite(tmp_path, '[records]\nfiles = ["rec/a.AT2"]\nscale_to = "sa"\nintensities = [0.4]\n')
+    t1 = 2 * math.pi * math.sqrt(1000.0 / 4.0e5)
+    with sw.expand(spec, tmp_path / "s") as sweep:
+        for run in sweep.runs:
+            s = response_spectrum(tmp_path / "rec" / "a.AT2", periods=[t1],
+                                  scale=run.params["excitation.record_scale"])
+            assert s.psa[0] == pytest.approx(0.4 * G, rel=1e-9)
+    loaded = sw.load(tmp_path / "s")
+    assert loaded.records["period"] == pytest.approx(t1, rel=1e-12)
+    assert loaded.records["period_of"] == "free system"
+
+
 @pytest.mark.parametrize("records, words", [
     ('[records]\nfiles = ["rec/none*.AT2"]\nintensities = [0.1]\n', "names no file"),
-    ('[records]\nfiles = ["rec/a.AT2"]\nscale_to = "sa"\nintensities = [0.1]\n', "needs the period"),
+    ('[records]\nfiles = ["rec/a.AT2"]\nscale_to = "sa"\nperiod = -1.0\nintensities = [0.1]\n', "> 0"),
     ('[records]\nfiles = ["rec/a.AT2"]\nintensities = [0.0]\n', "numbers > 0"),
     ('[records]\nfiles = ["rec/a.AT2"]\nscale_to = "pgv"\nintensities = [0.1]\n', "'pga' or 'sa'"),
     ('[records]\nfiles = ["rec/a.AT2", "rec/a.AT2"]\nintensities = [0.1]\n', "named twice"),

@@ -78,6 +78,7 @@ import subprocess
 import sys
 import threading
 import time
+import warnings
 from collections.abc import Sequence
 from concurrent.futures import ThreadPoolExecutor, as_completed
 from dataclasses import dataclass, field
@@ -87,7 +88,7 @@ from typing import Any
 import f90nml
 
 from . import __version__
-from ._api import FrictiondynError
+from ._api import FrictiondynError, run_text
 from ._exe import executable
 from ._nml import copy_namelist, read_namelist, write_namelist
 
@@ -740,10 +741,11 @@ def _check_records(spec: dict, path: Path, seen: dict) -> None:
     scale_to = rec.get("scale_to", "pga")
     if scale_to not in ("pga", "sa"):
         raise SweepError(f"{where} scale_to = {_short(scale_to)}: 'pga' or 'sa'")
-    if scale_to == "sa":
+    if scale_to == "sa" and "period" in rec:
         t = rec.get("period")
         if isinstance(t, bool) or not isinstance(t, (int, float)) or not (0 < t < math.inf):
-            raise SweepError(f"{where} period = {_short(t)}: scale_to = 'sa' needs the period [s], > 0")
+            raise SweepError(f"{where} period = {_short(t)}: the period of 'sa' [s], > 0 (leave it out "
+                             "for the structure's first period)")
     elif "period" in rec:
         raise SweepError(f"{where} period: only with scale_to = 'sa'")
     xi = rec.get("damping", 0.05)
@@ -779,6 +781,8 @@ def _suite_rows(spec: dict, spec_dir: Path, nml: f90nml.Namelist, where: str) ->
         "kind": str(exc.get("record_kind", "acceleration")),
         "dt": exc.get("dt_record"),
     }
+    if rec["scale_to"] == "sa" and "period" not in rec:
+        rec["period"], rec["period_of"] = _first_period(nml, spec_dir, where)
     t = float(rec.get("period", 0.0))
     rows = []
     for f in rec["_files"]:
@@ -796,6 +800,34 @@ def _suite_rows(spec: dict, spec_dir: Path, nml: f90nml.Namelist, where: str) ->
                          "excitation.record_file": os.path.relpath(f, spec_dir),
                          "excitation.record_scale": float(level) * G / measured})
     return rows
+
+
+def _first_period(nml: f90nml.Namelist, base_dir: Path, where: str) -> tuple[float, str]:
+    """The base deck's first period T1 and the system it is of: the first period of its
+    stuck system (every device stuck, a brace its sticking spring), else, when that system
+    has none (devices holding every mass to the table), of its free system (the devices
+    removed); from a run of the deck over one record step."""
+    deck = copy_namelist(nml)
+    exc = deck["excitation"]
+    dt = exc.get("dt_record")
+    if dt is None:  # an AT2 record gives its step: the record's own reading decides
+        exc["duration"] = 1.0e-3
+    else:
+        exc["duration"] = float(dt)
+    deck.setdefault("output", f90nml.Namelist())
+    deck["output"]["n_modes"] = max(1, int(deck["output"].get("n_modes", 1)))
+    try:
+        with warnings.catch_warnings():
+            warnings.simplefilter("ignore")
+            r = run_text(write_namelist(deck), "base.nml", base_dir)
+    except FrictiondynError as exc:
+        raise SweepError(f"{where} [records]: the base deck's first period for scale_to = 'sa': {exc}") from None
+    for system in ("stuck", "free"):
+        periods = [p for p in (r.summary.get(f"periods_{system}_s") or []) if p]
+        if periods:
+            return float(periods[0]), f"{system} system"
+    raise SweepError(f"{where} [records]: the base deck has no finite first period (stuck or free); "
+                     "give period")
 
 
 def _set(nml: f90nml.Namelist, key: str, value: Any, where: str) -> None:
