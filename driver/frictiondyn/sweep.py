@@ -22,7 +22,7 @@ of records, each scaled to a target intensity (docs/batch.md, "Record suites"):
     [records]
     files = ["records/*.AT2"]         # globs, relative to the spec's directory
     scale_to = "sa"                   # "pga", or "sa": the 5 %-damped PSA at `period`
-    period = 1.2                      # s (for "sa")
+    period = 1.2                      # s (for "sa"; left out: the structure's T1)
     intensities = [0.2, 0.4, 0.8]     # g
 
 A ``[derived]`` table computes deck variables (or labels) in each run from an expression
