@@ -61,11 +61,14 @@ class OpenSeesSettings:
     test: str = "NormDispIncr"
     tol: float = 1e-8  # m
     max_iter: int = 50
+    #: 'Plain' for the chains; the 3D building's rigidDiaphragm floors need 'Transformation'
+    constraints: str = "Plain"
 
     def describe(self) -> str:
         return (
             f"Newmark(0.5, 0.25), {self.algorithm}, {self.system}, numberer {self.numberer}, "
-            f"test {self.test} {self.tol:g} (max {self.max_iter} iterations), constraints Plain"
+            f"test {self.test} {self.tol:g} (max {self.max_iter} iterations), "
+            f"constraints {self.constraints}"
         )
 
 
@@ -464,7 +467,7 @@ def _recorders(ops, workdir: Path, nodes: list[int], devices: list[int]) -> None
 
 
 def _analysis(ops, s: OpenSeesSettings) -> None:
-    ops.constraints("Plain")
+    ops.constraints(s.constraints)
     ops.numberer(s.numberer)
     ops.system(s.system)
     ops.test(s.test, s.tol, s.max_iter)
@@ -521,6 +524,271 @@ def compare_peaks(a: dict, b: dict) -> dict[str, tuple[float, int]]:
     and where it is (0-based)."""
     out = {}
     for q in QUANTITIES:
+        x, y = np.abs(np.asarray(a[q], float)), np.abs(np.asarray(b[q], float))
+        if x.shape != y.shape:
+            raise ValueError(f"peak {q}: {x.shape} values against {y.shape}")
+        rel = np.abs(x - y) / np.maximum(y, 1e-300)
+        out[q] = (float(rel.max()), int(rel.argmax()))
+    return out
+
+
+# ----------------------------------------------------------------------------- 3D building
+
+
+@dataclass
+class Building3DCase:
+    """An eccentric building of rigid floors (three DOFs a floor: ux, uy, rz at its centre of
+    mass) with four braces with friction dampers a storey, under two ground components.
+
+    Floors ``plan_x`` x ``plan_y`` of mass ``total_mass / n`` and rotational inertia
+    m (plan_x² + plan_y²) / 12, their centres of mass ``cm_step`` further east a storey. In
+    storey i, along x two frames at y = -plan_y/2 and +plan_y/2 sharing the storey's stiffness
+    k_i as ``(1 - ecc, 1 + ecc) / 2``, along y two equal frames at x = -plan_x/2, +plan_x/2
+    (k_i proportional to the weight carried, scaled to a first x period ``period`` of the
+    planar chain). Four braces a storey, two along x at y = -brace_y, +brace_y and two along
+    y at x = -brace_x, +brace_x, each of stiffness k_i / 2 and slip load ``slip_ratio`` times
+    half the weight above. Rayleigh a0, a1 (2 % at the chain's modes 1 and 3), given
+    explicitly to both codes: C = a0 M + a1 K with K the frames only. Ground: two
+    ``synthetic_record`` components (seeds ``seeds``, the second scaled by ``scale2``) along
+    x and y; step dt1 = dt_record / n1 in both codes.
+
+    frictiondyn: the deck's &floors, &frames, &floor_braces (hysteretic law, P mu = slip load,
+    f = slip load / brace stiffness, end-of-sliding band ``eps1``) and &excitation2 with
+    ``refinement``. OpenSees: a 3D model (ndf 6), a node at each floor's centre of mass with
+    the mass (m, m, J) and its out-of-plane DOFs fixed, a ``rigidDiaphragm`` (perpendicular z)
+    tying to it a node at each frame's and brace's plan point, each frame a ``zeroLength``
+    with an ``Elastic`` material (k, damping tangent a1 k) and each brace a ``zeroLength``
+    with ``ElasticPP`` (E = brace stiffness, yield strain slip / stiffness), both oriented
+    along their plan direction; ``rayleigh(a0, 0, 0, 0)``; ``UniformExcitation`` in x and y.
+    """
+
+    n_storeys: int
+    duration: float = 10.0
+    dt_record: float = 0.01
+    n1: int = 10
+    n2: int = 50
+    refinement: str = "implicit"
+    eps1: float = 1.0e-3
+    period: float = 1.0
+    total_mass: float = 1.0e6
+    plan_x: float = 20.0
+    plan_y: float = 12.0
+    cm_step: float = 0.3
+    ecc: float = 0.3
+    brace_x: float = 6.0
+    brace_y: float = 4.0
+    slip_ratio: float = 0.05
+    xi: float = 0.02
+    pga: float = 0.3 * G
+    scale2: float = 0.7
+    seeds: tuple[int, int] = (20240613, 20240614)
+    records: tuple[np.ndarray, np.ndarray] = field(default=None, repr=False)
+
+    def __post_init__(self) -> None:
+        n = self.n_storeys
+        if self.records is None:
+            a1 = synthetic_record(self.dt_record, self.duration, self.pga, self.seeds[0])
+            a2 = synthetic_record(self.dt_record, self.duration, self.pga, self.seeds[1])
+            self.records = (a1, self.scale2 * a2)
+        self.m = self.total_mass / n
+        self.inertia = self.m * (self.plan_x**2 + self.plan_y**2) / 12
+        self.cm_x = self.cm_step * np.arange(n, dtype=float)
+        above = np.arange(n, 0, -1, dtype=float)
+        lam = _chain_eigenvalues(above, self.m)
+        scale = (2 * math.pi / self.period) ** 2 / lam[0]
+        self.k = above * scale  # storey stiffness along x and along y
+        w1 = 2 * math.pi / self.period
+        w3 = math.sqrt(lam[min(2, n - 1)] * scale)
+        self.a0 = 2 * self.xi * w1 * w3 / (w1 + w3)
+        self.a1 = 2 * self.xi / (w1 + w3)
+        hx, hy, bx, by = self.plan_x / 2, self.plan_y / 2, self.brace_x, self.brace_y
+        # (storey, angle deg, x, y, k): frames; (storey, angle, x, y, slip, kb): braces
+        self.frames = []
+        self.braces = []
+        for i in range(n):
+            k = float(self.k[i])
+            self.frames += [
+                (i + 1, 0.0, 0.0, -hy, k * (1 - self.ecc) / 2),
+                (i + 1, 0.0, 0.0, hy, k * (1 + self.ecc) / 2),
+                (i + 1, 90.0, -hx, 0.0, k / 2),
+                (i + 1, 90.0, hx, 0.0, k / 2),
+            ]
+            fs = float(self.slip_ratio * G * self.m * above[i] / 2)
+            self.braces += [
+                (i + 1, 0.0, 0.0, -by, fs, k / 2),
+                (i + 1, 0.0, 0.0, by, fs, k / 2),
+                (i + 1, 90.0, -bx, 0.0, fs, k / 2),
+                (i + 1, 90.0, bx, 0.0, fs, k / 2),
+            ]
+        self.slip = np.array([b[4] for b in self.braces])
+        self.kb = np.array([b[5] for b in self.braces])
+        self.dt = self.dt_record / self.n1
+        self.n_steps = round(self.duration / self.dt)
+
+    @property
+    def name(self) -> str:
+        return f"building3d_{self.n_storeys}"
+
+    @property
+    def n_dof(self) -> int:
+        return 3 * self.n_storeys
+
+    # ------------------------------------------------------------------ frictiondyn
+
+    def deck(self, record_files: tuple[str, str] = ("ag_x.txt", "ag_y.txt")) -> str:
+        """The frictiondyn deck; its records are read from ``record_files`` (values, m/s2)."""
+
+        def arr(xs) -> str:
+            return ", ".join(repr(float(x)) for x in xs)
+
+        n, fr, br = self.n_storeys, self.frames, self.braces
+        exc = (
+            "  excitation_type = 'record'\n  record_format = 'values'\n  record_units = 'm/s2'\n"
+            f"  dt_record = {self.dt_record!r}\n  duration = {self.duration!r}\n"
+        )
+        return (
+            f"&floors\n  n_floors = {n}\n  mass = {n}*{self.m!r}\n"
+            f"  inertia = {n}*{self.inertia!r}\n"
+            f"  cm_x = {arr(self.cm_x)}\n  height = {n}*3.0\n/\n"
+            f"&frames\n  n_frames = {len(fr)}\n  storey = {', '.join(str(f[0]) for f in fr)}\n"
+            f"  angle = {arr(f[1] for f in fr)}\n  x = {arr(f[2] for f in fr)}\n"
+            f"  y = {arr(f[3] for f in fr)}\n  k = {arr(f[4] for f in fr)}\n/\n"
+            f"&damping\n  damping_type = 'rayleigh'\n  rayleigh_a0 = {self.a0!r}\n"
+            f"  rayleigh_a1 = {self.a1!r}\n/\n"
+            f"&floor_braces\n  n_braces = {len(br)}\n"
+            f"  storey = {', '.join(str(b[0]) for b in br)}\n"
+            f"  angle = {arr(b[1] for b in br)}\n  x = {arr(b[2] for b in br)}\n"
+            f"  y = {arr(b[3] for b in br)}\n  slip_load = {arr(b[4] for b in br)}\n"
+            f"  stiffness = {arr(b[5] for b in br)}\n  eps1 = {len(br)}*{self.eps1!r}\n/\n"
+            f"&excitation\n{exc}  record_file = '{record_files[0]}'\n/\n"
+            f"&excitation2\n{exc}  record_file = '{record_files[1]}'\n/\n"
+            f"&integration\n  n1 = {self.n1}\n  n2 = {self.n2}\n"
+            f"  refinement = '{self.refinement}'\n/\n"
+        )
+
+    def run_frictiondyn(self):
+        """frictiondyn's Result of the deck (records written to a temporary directory)."""
+        import frictiondyn as fd
+
+        with tempfile.TemporaryDirectory(prefix="fd_3d_") as tmp:
+            for name, rec in zip(("ag_x.txt", "ag_y.txt"), self.records):
+                np.savetxt(Path(tmp) / name, rec, fmt="%.17g")
+            return fd.run_text(self.deck(), f"{self.name}.nml", tmp)
+
+    # ------------------------------------------------------------------ OpenSees
+
+    def build_opensees(self, ops, settings: OpenSeesSettings, workdir: Path) -> None:
+        n = self.n_storeys
+        ops.wipe()
+        ops.model("basic", "-ndm", 3, "-ndf", 6)
+        masters = [1000 * (f + 1) for f in range(n)]
+        for f, tag in enumerate(masters):
+            ops.node(tag, float(self.cm_x[f]), 0.0, 0.0)
+            ops.fix(tag, 0, 0, 1, 1, 1, 0)
+            ops.mass(tag, self.m, self.m, 0.0, 0.0, 0.0, self.inertia)
+        points: dict[tuple[int, float, float], int] = {}
+        slaves: dict[int, list[int]] = {f: [] for f in range(1, n + 1)}
+
+        def point(floor: int, x: float, y: float) -> int:
+            key = (floor, x, y)
+            if key not in points:
+                tag = 1000 * floor + 1 + len([p for p in points if p[0] == floor])
+                if floor == 0:
+                    tag += 1000 * (n + 1)
+                ops.node(tag, x, y, 0.0)
+                if floor == 0:
+                    ops.fix(tag, 1, 1, 1, 1, 1, 1)
+                else:
+                    ops.fix(tag, 0, 0, 1, 1, 1, 0)
+                    slaves[floor].append(tag)
+                points[key] = tag
+            return points[key]
+
+        def link(tag: int, storey: int, angle: float, x: float, y: float, mat: int) -> None:
+            c, s = math.cos(math.radians(angle)), math.sin(math.radians(angle))
+            i, j = point(storey - 1, x, y), point(storey, x, y)
+            # deformation u_j - u_i along (c, s): the storey's motion at (x, y) along angle
+            ops.element("zeroLength", tag, i, j, "-mat", mat, "-dir", 1,
+                        "-orient", c, s, 0.0, -s, c, 0.0)
+
+        for e, (st, ang, x, y, k) in enumerate(self.frames, start=1):
+            ops.uniaxialMaterial("Elastic", e, k, self.a1 * k)
+            link(e, st, ang, x, y, e)
+        first = len(self.frames) + 1
+        for b, (st, ang, x, y, fs, kb) in enumerate(self.braces, start=first):
+            ops.uniaxialMaterial("ElasticPP", b, kb, fs / kb)
+            link(b, st, ang, x, y, b)
+        for f, tag in enumerate(masters, start=1):
+            ops.rigidDiaphragm(3, tag, *slaves[f])
+        ops.rayleigh(self.a0, 0.0, 0.0, 0.0)
+        for d, rec in enumerate(self.records, start=1):
+            ops.timeSeries("Path", d, "-dt", self.dt_record, "-values", *map(float, rec))
+            ops.pattern("UniformExcitation", d, d, "-accel", d)
+        prec = ("-precision", 12)
+        devices = list(range(first, first + len(self.braces)))
+        ops.recorder("EnvelopeNode", "-file", str(workdir / "u.env"), *prec, "-node", *masters,
+                     "-dof", 1, 2, 6, "disp")
+        ops.recorder("Node", "-file", str(workdir / "u.out"), *prec, "-node", *masters,
+                     "-dof", 1, 2, "disp")
+        ops.recorder("EnvelopeElement", "-file", str(workdir / "s.env"), *prec, "-ele",
+                     *devices, "deformation")
+        ops.recorder("EnvelopeElement", "-file", str(workdir / "F.env"), *prec, "-ele",
+                     *devices, "basicForce")
+        if settings.constraints != "Transformation":
+            raise ValueError("the rigidDiaphragm floors need constraints 'Transformation'")
+        ops.constraints(settings.constraints)
+        ops.numberer(settings.numberer)
+        ops.system(settings.system)
+        ops.test(settings.test, settings.tol, settings.max_iter)
+        ops.algorithm(settings.algorithm)
+        ops.integrator("Newmark", 0.5, 0.25)
+        ops.analysis("Transient")
+
+
+#: peak |ux, uy, rz| of each floor, |drift x, y| of each storey, |s| and |F| of each brace
+QUANTITIES_3D = ("u", "drift", "s", "F")
+
+
+def frictiondyn_peaks_3d(result) -> dict[str, np.ndarray]:
+    """Peaks of a frictiondyn Result of a Building3DCase: 'u' (ux, uy, rz of each floor),
+    'drift' (x, y of each storey, between the centres of mass), 's' and 'F' of each brace."""
+    s = result.summary
+    keys = {"u": "peak_u_m", "drift": "peak_drift_m", "s": "peak_s_m", "F": "peak_force_N"}
+    return {q: np.abs(np.asarray(s[k], dtype=float)) for q, k in keys.items()}
+
+
+def run_opensees_3d(case: Building3DCase, settings: OpenSeesSettings | None = None) -> OpenSeesRun:
+    """Build the 3D case in OpenSees (timed apart), analyze it (timed), read its peaks (the
+    drifts from the centres of mass' histories). Settings: ``OpenSeesSettings`` with
+    constraints 'Transformation' by default."""
+    ops = import_opensees()
+    settings = settings or OpenSeesSettings(constraints="Transformation")
+    with tempfile.TemporaryDirectory(prefix="fd_ops3d_") as tmp:
+        work = Path(tmp)
+        t0 = time.perf_counter()
+        case.build_opensees(ops, settings, work)
+        t1, c1 = time.perf_counter(), time.process_time()
+        status = ops.analyze(case.n_steps, case.dt)
+        t2, c2 = time.perf_counter(), time.process_time()
+        t_now = ops.getTime()
+        ops.wipe()
+        if status != 0:
+            raise RuntimeError(
+                f"{case.name}: OpenSees analyze failed (status {status}) at t = {t_now} s"
+            )
+        peaks = {q: np.loadtxt(work / f"{q}.env", ndmin=2)[2].copy() for q in ("u", "s", "F")}
+        hist = np.loadtxt(work / "u.out", ndmin=2)  # ux, uy of each floor, a row a step
+        xy = np.concatenate([np.zeros((hist.shape[0], 2)), hist], axis=1)
+        drift = np.abs(np.diff(xy.reshape(hist.shape[0], -1, 2), axis=1)).max(axis=0)
+        peaks["drift"] = drift.reshape(-1)  # storey 1 x, 1 y, 2 x, ...
+    peaks = {q: np.abs(v) for q, v in peaks.items()}
+    return OpenSeesRun(t2 - t1, c2 - c1, t1 - t0, peaks)
+
+
+def compare_peaks_3d(a: dict, b: dict) -> dict[str, tuple[float, int]]:
+    """As ``compare_peaks``, over QUANTITIES_3D."""
+    out = {}
+    for q in QUANTITIES_3D:
         x, y = np.abs(np.asarray(a[q], float)), np.abs(np.asarray(b[q], float))
         if x.shape != y.shape:
             raise ValueError(f"peak {q}: {x.shape} values against {y.shape}")
