@@ -366,3 +366,31 @@ def test_bad_matrices(run, k, m, words):
     r = run(deck, files={"K.mtx": mtx(k, symmetric=False), "M.mtx": mtx(m, symmetric=False)})
     assert r.returncode != 0
     assert "&matrices" in r.stderr and words in r.stderr, r.stderr
+
+
+def test_corner_drifts_of_a_turning_floor(run):
+    """The eccentric floor (one storey, 20 m x 12 m): the drift along x at the corners is
+    ux - rz (y_c) with y_c = +-6 m, along y uy + rz x_c with x_c = +-10 m; its peak over
+    the corners and time is at least the centre's and at most the centre's plus the arm times
+    the peak rotation. From the history at every step: the summary's peak equals the
+    largest corner value the history holds when the history keeps every step."""
+    deck = eccentric()
+    deck["floors"]["height"] = [3.0]
+    deck["output"] = {"output_every": 1}
+    r = ok(run(deck, name="ecc"))
+    s, h = r.summary(), r.history()
+    ux, uy, rz = (np.asarray(h[f"u{i}"]) for i in (1, 2, 3))
+    cx = max(np.abs(ux - rz * yc).max() for yc in (-6.0, 6.0))
+    cy = max(np.abs(uy + rz * xc).max() for xc in (-10.0, 10.0))
+    assert s["peak_corner_drift_m"] == pytest.approx([cx, cy], rel=1e-12)
+    assert s["peak_corner_drift_ratio"] == pytest.approx([cx / 3.0, cy / 3.0], rel=1e-12)
+    assert cx > 1.05 * s["peak_drift_m"][0]   # the floor turns: the edges drift more
+
+
+def test_corner_drifts_are_undefined_without_a_plan(run):
+    deck = eccentric()
+    deck["floors"].pop("plan_x")
+    deck["floors"].pop("plan_y")
+    deck["floors"]["inertia"] = [2.0e5 * (20.0**2 + 12.0**2) / 12]
+    s = ok(run(deck, name="ecc")).summary()
+    assert s["peak_corner_drift_m"] == [None, None]

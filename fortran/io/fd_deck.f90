@@ -1118,6 +1118,8 @@ contains
       cfg%model%n_floors = n
       cfg%model%floor_height = height(1:n)
       cfg%model%floor_inertia = inertia(1:n)
+      cfg%model%floor_lx = merge(plan_x(1:n), 0.0_dp, .not. g_in(1:n))
+      cfg%model%floor_ly = merge(plan_y(1:n), 0.0_dp, .not. g_in(1:n))
       cfg%model%p_delta = p_delta
       ! storeys: s along x (2s - 1) and along y (2s), between the floors' centres of mass
       cfg%model%n_storeys = 2*n

@@ -737,6 +737,12 @@ contains
       call kr(jt, 'peak_storey_shear_N', eng%peak_shear(1:))
       call kr(jt, 'peak_storey_shear_time_s', eng%peak_shear_time(1:), eng%peak_shear(1:) /= 0.0_dp)
       call kr(jt, 'residual_storey_shear_N', eng%shear(1:))
+      ! a building of rigid floors: the drift at the floors' plan corners (undefined, null,
+      ! for a floor given by its inertia, whose plan is not known)
+      if (.not. allocated(eng%peak_corner)) return
+      call kr(jt, 'peak_corner_drift_m', eng%peak_corner, eng%has_corners)
+      where (eng%height > 0.0_dp) ratio = eng%peak_corner/eng%height
+      call kr(jt, 'peak_corner_drift_ratio', ratio, eng%has_corners .and. eng%height > 0.0_dp)
    end subroutine storeys_part
 
    !> The modes of one system: status, periods (0: a rigid-body mode), shapes, mass ratios, damping.

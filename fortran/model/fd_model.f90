@@ -101,6 +101,8 @@ module fd_model
       real(dp), allocatable :: floor_y(:)     !! and y [m]
       real(dp), allocatable :: floor_height(:) !! height of the storey below each floor [m]; 0 = not given
       real(dp), allocatable :: floor_inertia(:) !! rotational inertia of each floor [kg m2]
+      real(dp), allocatable :: floor_lx(:)    !! plan dimension along x of each floor [m]; 0 = not given
+      real(dp), allocatable :: floor_ly(:)    !! and along y [m] (a rectangle about the centre of mass)
       logical :: p_delta = .false.            !! the gravity loads' geometric stiffness is in K_x
       ! the forces of a storey that are no springs or devices between its two nodes (the
       ! frames and braces of rigid floors): its shear adds sum coef (u + a1 v)(dof) over the

@@ -18,6 +18,7 @@ module fd_engineering
                        damping_stiffness, damping_rayleigh
    use fd_kinematics, only: pair_nodes, devices_are_pairs, device_relative
    use fd_stiffness, only: add_general_times, influence_of
+   use fd_floors, only: floor_dof
    use fd_excitation, only: excitation_type, excitation_harmonic
    use fd_matrices, only: modes_type, natural_modes, natural_modes_sparse, stiffness_matrix, damping_matrix, &
                           stiffness_damping_factor, modes_dense_dofs
@@ -66,6 +67,14 @@ module fd_engineering
       ! frames and braces), by storey: xs_first(c):xs_first(c+1)-1 and xd_first likewise
       integer, allocatable :: xs_first(:), xs_dof(:), xd_first(:), xd_dev(:)
       real(dp), allocatable :: xs_coef(:), xd_coef(:)
+      ! a building of rigid floors: the drift of each storey along its axis at the four plan
+      ! corners of its floor (a rectangle about the floor's centre of mass), as functionals
+      ! corner_coef(t, c, q) u(corner_dof(t, c, q)), t = 1..4; its peak over the corners
+      logical, allocatable :: has_corners(:)      !! (n_storeys) the floor's plan is known
+      integer, allocatable :: corner_dof(:, :, :) !! (4, 4, n_storeys)
+      real(dp), allocatable :: corner_coef(:, :, :) !! (4, 4, n_storeys)
+      real(dp), allocatable :: peak_corner(:)     !! (n_storeys) max |drift| over the corners [m]
+      real(dp), allocatable :: peak_corner_time(:) !! its time [s]
       ! values at the last state observed (the residual values at the end of the run)
       real(dp), allocatable :: drift(:)         !! (n_storeys) drift [m]
       real(dp), allocatable :: shear(:)         !! (0:n_storeys) shear, 0 = base [N]
@@ -165,6 +174,7 @@ contains
       end if
       call storey_elements(model, eng, stat)
       if (stat == 0 .and. allocated(model%xs_storey)) call storey_extras(model, eng, stat)
+      if (stat == 0 .and. model%n_floors > 0) call floor_corners(model, eng, stat)
       if (stat /= 0) then
          call no_memory('the elements of the storeys'); return
       end if
@@ -407,7 +417,7 @@ contains
       real(dp), intent(in) :: s(nd)                 !! device relative displacements [m]
       real(dp), intent(in) :: force(nd)             !! device forces [N]
       real(dp) :: x
-      integer :: i
+      integer :: i, c
 
       if (.not. allocated(eng%drift)) return
       do i = 1, nd
@@ -427,7 +437,64 @@ contains
             eng%peak_shear(i) = abs(x); eng%peak_shear_time(i) = t
          end if
       end do
+      if (.not. allocated(eng%peak_corner)) return
+      do i = 1, eng%n_storeys
+         if (.not. eng%has_corners(i)) cycle
+         do c = 1, 4
+            x = abs(sum(eng%corner_coef(:, c, i)*u(eng%corner_dof(:, c, i))))
+            if (x > eng%peak_corner(i)) then
+               eng%peak_corner(i) = x; eng%peak_corner_time(i) = t
+            end if
+         end do
+      end do
    end subroutine observe_engineering
+
+   !> The plan corners of a building of rigid floors: storey q = 2 s - 2 + a (a = 1 along x,
+   !> 2 along y) at the corners (x_s +- l_x / 2, y_s +- l_y / 2) of floor s: the motion of
+   !> the corner P along a on floor s, ux - rz (y_P - y_s) (uy + rz (x_P - x_s)), minus the
+   !> same point's on floor s - 1 (none on the ground). Unused terms point at DOF 1 with 0.
+   subroutine floor_corners(model, eng, stat)
+      type(model_type), intent(in) :: model
+      type(engineering_type), intent(inout) :: eng
+      integer, intent(out) :: stat                 !! not 0: not enough memory
+      real(dp) :: px, py, arm
+      integer :: ns, q, s, a, c, f, k, t
+
+      ns = eng%n_storeys
+      allocate (eng%has_corners(ns), eng%corner_dof(4, 4, ns), eng%corner_coef(4, 4, ns), eng%peak_corner(ns), &
+                eng%peak_corner_time(ns), stat=stat)
+      if (stat /= 0) return
+      eng%corner_dof = 1
+      eng%corner_coef = 0.0_dp
+      eng%peak_corner = 0.0_dp
+      eng%peak_corner_time = 0.0_dp
+      do q = 1, ns
+         s = (q + 1)/2
+         a = q - 2*(s - 1)
+         eng%has_corners(q) = model%floor_lx(s) > 0.0_dp .and. model%floor_ly(s) > 0.0_dp
+         if (.not. eng%has_corners(q)) cycle
+         do c = 1, 4
+            px = model%floor_x(s) + merge(0.5_dp, -0.5_dp, c == 1 .or. c == 4)*model%floor_lx(s)
+            py = model%floor_y(s) + merge(0.5_dp, -0.5_dp, c <= 2)*model%floor_ly(s)
+            t = 0
+            do k = 0, 1
+               f = s - k
+               if (f < 1) exit
+               if (a == 1) then
+                  arm = -(py - model%floor_y(f))
+               else
+                  arm = px - model%floor_x(f)
+               end if
+               t = t + 1
+               eng%corner_dof(t, c, q) = floor_dof(f, a)
+               eng%corner_coef(t, c, q) = merge(1.0_dp, -1.0_dp, k == 0)
+               t = t + 1
+               eng%corner_dof(t, c, q) = floor_dof(f, 3)
+               eng%corner_coef(t, c, q) = merge(1.0_dp, -1.0_dp, k == 0)*arm
+            end do
+         end do
+      end do
+   end subroutine floor_corners
 
    !> One value into a peak of the storeys (a technique that knows its solution between
    !> steps passes the exact extrema, with their times): q numbers the storey quantities in
