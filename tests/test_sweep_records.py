@@ -5,6 +5,7 @@ statistics over records per intensity (intensity.csv) are those of the runs' sum
 from __future__ import annotations
 
 import csv
+import json
 import math
 import subprocess
 import sys
@@ -140,3 +141,33 @@ def test_bad_records(tmp_path, records, words):
         sw.expand(spec, tmp_path / "s")
     assert words in str(err.value)
     assert not (tmp_path / "s").exists()
+
+
+def test_ida_curves_are_the_medians_of_the_runs(tmp_path):
+    """sweep ida: per intensity, the median and the 16th/84th percentiles over the records of
+    each run's largest peak drift ratio, as the runs' own summaries give it; and the PNG."""
+    spec = suite(tmp_path, '[records]\nfiles = ["rec/a.AT2", "rec/b.AT2"]\nintensities = [0.2, 0.4]\n')
+    base = (tmp_path / "base.nml").read_text().replace(
+        "&output", "&storeys\n  n_storeys = 1, node_i = 1, node_j = 0, height = 3.0\n/\n&output")
+    (tmp_path / "base.nml").write_text(base)
+    out = tmp_path / "s"
+    r = subprocess.run([*SWEEP, str(spec), "--out", str(out), "--quiet"], capture_output=True, text=True)
+    assert r.returncode == 0, r.stderr
+    curves = sw.ida_curves(out, by="friction.mu")
+    loaded = sw.load(out)
+    assert sorted(curves) == ["friction.mu = 0.05", "friction.mu = 0.1"]
+    for run in loaded.runs:
+        summary = json.loads((out / run.summary).read_text())
+        drift = 100 * max(summary["peak_drift_ratio"])
+        c = curves[f"friction.mu = {run.params['friction.mu']}"]
+        assert (run.params["intensity_g"], pytest.approx(drift, rel=1e-12)) in [
+            (i, pytest.approx(x, rel=1e-12)) for i, x in c["records"][run.params["record"]]]
+    for c in curves.values():
+        for k, level in enumerate(c["intensity"]):
+            xs = [dict(p)[level] for p in c["records"].values()]
+            assert c["median"][k] == pytest.approx(np.median(xs), rel=1e-12)
+            assert c["p16"][k] == pytest.approx(np.percentile(xs, 16), rel=1e-12)
+    r = subprocess.run([*SWEEP, "ida", str(out), "--by", "friction.mu", "--dpi", "60"], capture_output=True,
+                       text=True)
+    assert r.returncode == 0, r.stderr
+    assert (out / "ida_drift_ratio.png").stat().st_size > 3000

@@ -768,9 +768,11 @@ def _check_records(spec: dict, path: Path, seen: dict) -> None:
     rec["damping"] = float(xi)
 
 
-def _suite_rows(spec: dict, spec_dir: Path, nml: f90nml.Namelist, where: str) -> list[dict]:
+def _suite_rows(spec: dict, spec_dir: Path, nml: f90nml.Namelist, where: str,
+                base_dir: Path | None = None) -> list[dict]:
     """One row per record and intensity: the record's file and the scale that brings it,
-    read with the base deck's record settings, to the intensity."""
+    read with the base deck's record settings, to the intensity (the base deck's own files
+    relative to ``base_dir``, its folder; default the spec's)."""
     from .spectrum import G, response_spectrum
 
     rec = spec["records"]
@@ -782,7 +784,7 @@ def _suite_rows(spec: dict, spec_dir: Path, nml: f90nml.Namelist, where: str) ->
         "dt": exc.get("dt_record"),
     }
     if rec["scale_to"] == "sa" and "period" not in rec:
-        rec["period"], rec["period_of"] = _first_period(nml, spec_dir, where)
+        rec["period"], rec["period_of"] = _first_period(nml, base_dir or spec_dir, where)
     t = float(rec.get("period", 0.0))
     rows = []
     for f in rec["_files"]:
@@ -959,7 +961,7 @@ def expand(
     suite = None
     if "records" in spec:  # each record's scale, from the base deck's record settings
         base_path, nml = _read_base(spec["base"], base_dir, where)
-        suite = _suite_rows(spec, base_dir, nml, where)
+        suite = _suite_rows(spec, base_dir, nml, where, base_path.parent)
     keys, rows = _combinations(spec, suite)
     if "derived" in spec:  # each run's derived values, from its parameters and the base deck
         keys += _derive(spec, rows, base_dir, where)
@@ -1891,6 +1893,103 @@ def envelope(
     return target
 
 
+def ida_curves(
+    directory: str | os.PathLike,
+    quantity: str = "drift_ratio",
+    by: str | None = None,
+    units: str | None = None,
+) -> dict[str, dict[str, Any]]:
+    """The incremental dynamic analysis curves of a record suite (results_storeys.csv of
+    ``collect``): per group (one, or one per value of the parameter ``by``) each record's
+    points (intensity [g], largest storey quantity of the run, ``ENVELOPE_QUANTITIES``, in %
+    or ``units``) and, per intensity, the median over the records and their 16th and 84th
+    percentiles: ``{group: {"records": {record: [(intensity, value)]}, "intensity": [...],
+    "median": [...], "p16": [...], "p84": [...], "axis": label}}``."""
+    import numpy as np
+
+    from .plots import _FACTORS, Units
+
+    if quantity not in ENVELOPE_QUANTITIES:
+        raise SweepError(f"ida quantity {quantity!r}: one of {', '.join(ENVELOPE_QUANTITIES)}")
+    column, axis, kind = ENVELOPE_QUANTITIES[quantity]
+    sweep = load(directory)
+    path = Path(directory) / "results_storeys.csv"
+    try:
+        with open(path, newline="", encoding="utf-8") as fh:
+            rows = list(csv.DictReader(fh))
+    except FileNotFoundError:
+        raise SweepError(f"{path}: no such file (the sweep has no storeys, or run 'sweep "
+                         "collect' first)") from None
+    if not rows or "intensity_g" not in rows[0]:
+        raise SweepError(f"{path}: an IDA needs a record suite ([records]: intensity_g, record)")
+    if by is not None and by not in rows[0]:
+        raise _no_column(by, [c for c in rows[0] if c in sweep.parameters])
+    if kind == "percent":
+        factor, unit = 100.0, ""
+    else:
+        name = getattr(Units.parse(units), kind)
+        factor, unit = _FACTORS[kind][name], f" [{name}]"
+    peak: dict[tuple[str, str, float], float] = {}   # (group, record, intensity) -> max over storeys
+    for r in rows:
+        v = _number(r.get(column))
+        if v is None:
+            continue
+        key = ("" if by is None else f"{by} = {r[by]}", r["record"], float(r["intensity_g"]))
+        peak[key] = max(peak.get(key, 0.0), factor * abs(v))
+    if not peak:
+        raise SweepError(f"{path}: no run has a number for {column}")
+    curves: dict[str, dict[str, Any]] = {}
+    for group in sorted({k[0] for k in peak}):
+        records = {rec: sorted((i, x) for (g, rr, i), x in peak.items() if g == group and rr == rec)
+                   for rec in sorted({k[1] for k in peak if k[0] == group})}
+        levels = sorted({k[2] for k in peak if k[0] == group})
+        values = [[x for (g, _, i), x in peak.items() if g == group and i == lev] for lev in levels]
+        curves[group] = {"records": records, "intensity": levels,
+                         "median": [float(np.median(v)) for v in values],
+                         "p16": [float(np.percentile(v, 16)) for v in values],
+                         "p84": [float(np.percentile(v, 84)) for v in values],
+                         "axis": "largest " + axis + unit, "sweep": sweep.name}
+    return curves
+
+
+def ida(
+    directory: str | os.PathLike,
+    quantity: str = "drift_ratio",
+    by: str | None = None,
+    out: str | os.PathLike | None = None,
+    units: str | None = None,
+    dpi: int = 150,
+) -> Path:
+    """The IDA curves of ``ida_curves`` drawn: each record's curve, the median and the band
+    of the 16th and 84th percentiles. Writes a PNG (default ``<dir>/ida_<quantity>.png``)."""
+    from matplotlib.backends.backend_agg import FigureCanvasAgg
+    from matplotlib.figure import Figure
+
+    curves = ida_curves(directory, quantity, by, units)
+    fig = Figure(figsize=(6, 4.5))
+    FigureCanvasAgg(fig)
+    ax = fig.add_subplot()
+    for g, (group, c) in enumerate(curves.items()):
+        color = f"C{g}"
+        for pts in c["records"].values():
+            ax.plot([x for _, x in pts], [i for i, _ in pts], color=color, alpha=0.35, linewidth=0.8)
+        ax.plot(c["median"], c["intensity"], color=color, marker="o", linewidth=2.0,
+                label=f"{group}, median" if group else "median")
+        ax.fill_betweenx(c["intensity"], c["p16"], c["p84"], color=color, alpha=0.15)
+    first = next(iter(curves.values()))
+    ax.set_xlabel(first["axis"])
+    ax.set_ylabel("intensity [g]")
+    ax.set_title(f"sweep '{first['sweep']}': IDA, each record, median and 16th-84th percentiles",
+                 fontsize="medium")
+    ax.set_xlim(left=0)
+    ax.set_ylim(bottom=0)
+    ax.grid(True, alpha=0.3)
+    ax.legend(fontsize="small")
+    target = Path(out) if out else Path(directory) / f"ida_{quantity}.png"
+    fig.savefig(target, dpi=dpi, bbox_inches="tight")
+    return target
+
+
 # -------------------------------------------------------------------------- command line
 def add_parser(sub: argparse._SubParsersAction) -> None:
     """Register ``sweep`` on the command line of ``python -m frictiondyn``."""
@@ -1898,7 +1997,7 @@ def add_parser(sub: argparse._SubParsersAction) -> None:
         "sweep",
         help="parameter sweeps: run locally or as a Slurm job array; collect; plot",
         description="sweep SPEC.toml [options] | sweep collect DIR [--resubmit] | "
-        "sweep plot DIR X Y | sweep envelope DIR (docs/batch.md)",
+        "sweep plot DIR X Y | sweep envelope DIR | sweep ida DIR (docs/batch.md)",
         add_help=False,
     )
     p.add_argument("args", nargs=argparse.REMAINDER)
@@ -1996,6 +2095,21 @@ def main(argv: Sequence[str]) -> int:
         p.add_argument("--out", metavar="PNG")
         a = p.parse_args(argv[1:])
         print(f"plot: {envelope(a.directory, a.quantity, a.by, a.out, a.units, a.dpi)}")
+        return 0
+    if argv and argv[0] == "ida":
+        p = argparse.ArgumentParser(prog="python -m frictiondyn sweep ida",
+                                    description="Incremental dynamic analysis curves of a record "
+                                    "suite: intensity against the largest storey quantity, each "
+                                    "record, and the median with its 16th-84th percentiles "
+                                    "(docs/batch.md).")
+        p.add_argument("directory")
+        p.add_argument("--quantity", default="drift_ratio", choices=list(ENVELOPE_QUANTITIES))
+        p.add_argument("--by", help="one set of curves per value of this parameter")
+        p.add_argument("--units", help="units of drift and shear, e.g. mm,kN (default SI)")
+        p.add_argument("--dpi", type=int, default=150, help="resolution (default 150; 300 for a report)")
+        p.add_argument("--out", metavar="PNG")
+        a = p.parse_args(argv[1:])
+        print(f"plot: {ida(a.directory, a.quantity, a.by, a.out, a.units, a.dpi)}")
         return 0
     a = _run_parser().parse_args(argv)
     if a.max_runs < 1:
