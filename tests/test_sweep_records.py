@@ -167,6 +167,11 @@ def test_ida_curves_are_the_medians_of_the_runs(tmp_path):
             xs = [dict(p)[level] for p in c["records"].values()]
             assert c["median"][k] == pytest.approx(np.median(xs), rel=1e-12)
             assert c["p16"][k] == pytest.approx(np.percentile(xs, 16), rel=1e-12)
+    # without --by, a record's point would pool the two mu's runs: refused, naming mu
+    with pytest.raises(sw.SweepError, match="friction.mu"):
+        sw.ida_curves(out)
+    one = sw.ida_curves(out, where={"friction.mu": "0.1"})
+    assert one[""]["median"] == curves["friction.mu = 0.1"]["median"]
     r = subprocess.run([*SWEEP, "ida", str(out), "--by", "friction.mu", "--dpi", "60"], capture_output=True,
                        text=True)
     assert r.returncode == 0, r.stderr

@@ -1898,13 +1898,16 @@ def ida_curves(
     quantity: str = "drift_ratio",
     by: str | None = None,
     units: str | None = None,
+    where: dict[str, str] | None = None,
 ) -> dict[str, dict[str, Any]]:
     """The incremental dynamic analysis curves of a record suite (results_storeys.csv of
     ``collect``): per group (one, or one per value of the parameter ``by``) each record's
     points (intensity [g], largest storey quantity of the run, ``ENVELOPE_QUANTITIES``, in %
     or ``units``) and, per intensity, the median over the records and their 16th and 84th
     percentiles: ``{group: {"records": {record: [(intensity, value)]}, "intensity": [...],
-    "median": [...], "p16": [...], "p84": [...], "axis": label}}``."""
+    "median": [...], "p16": [...], "p84": [...], "axis": label}}``. ``where`` keeps the runs
+    whose parameters have these values (as results_storeys.csv writes them); a record's point
+    that would pool several runs (another parameter varies) is an error naming it."""
     import numpy as np
 
     from .plots import _FACTORS, Units
@@ -1924,18 +1927,33 @@ def ida_curves(
         raise SweepError(f"{path}: an IDA needs a record suite ([records]: intensity_g, record)")
     if by is not None and by not in rows[0]:
         raise _no_column(by, [c for c in rows[0] if c in sweep.parameters])
+    for k, value in (where or {}).items():
+        if k not in rows[0]:
+            raise _no_column(k, [c for c in rows[0] if c in sweep.parameters])
+        rows = [r for r in rows if r[k] == value]
+        if not rows:
+            raise SweepError(f"{path}: no run has {k} = {value}")
     if kind == "percent":
         factor, unit = 100.0, ""
     else:
         name = getattr(Units.parse(units), kind)
         factor, unit = _FACTORS[kind][name], f" [{name}]"
     peak: dict[tuple[str, str, float], float] = {}   # (group, record, intensity) -> max over storeys
+    runs: dict[tuple[str, str, float], set[str]] = {}
     for r in rows:
         v = _number(r.get(column))
         if v is None:
             continue
         key = ("" if by is None else f"{by} = {r[by]}", r["record"], float(r["intensity_g"]))
         peak[key] = max(peak.get(key, 0.0), factor * abs(v))
+        runs.setdefault(key, set()).add(r["run"])
+    pooled = [k for k, ids in runs.items() if len(ids) > 1]
+    if pooled:
+        g, rec, level = pooled[0]
+        others = [p for p in sweep.parameters if p not in SUITE_KEYS and p != by and p not in (where or {})]
+        raise SweepError(f"{path}: record {rec} at {level} g{' with ' + g if g else ''} has "
+                         f"{len(runs[pooled[0]])} runs: fix the other parameters ({', '.join(others)}) "
+                         "with --where, or give one as --by")
     if not peak:
         raise SweepError(f"{path}: no run has a number for {column}")
     curves: dict[str, dict[str, Any]] = {}
@@ -1959,13 +1977,14 @@ def ida(
     out: str | os.PathLike | None = None,
     units: str | None = None,
     dpi: int = 150,
+    where: dict[str, str] | None = None,
 ) -> Path:
     """The IDA curves of ``ida_curves`` drawn: each record's curve, the median and the band
     of the 16th and 84th percentiles. Writes a PNG (default ``<dir>/ida_<quantity>.png``)."""
     from matplotlib.backends.backend_agg import FigureCanvasAgg
     from matplotlib.figure import Figure
 
-    curves = ida_curves(directory, quantity, by, units)
+    curves = ida_curves(directory, quantity, by, units, where)
     fig = Figure(figsize=(6, 4.5))
     FigureCanvasAgg(fig)
     ax = fig.add_subplot()
@@ -2105,11 +2124,19 @@ def main(argv: Sequence[str]) -> int:
         p.add_argument("directory")
         p.add_argument("--quantity", default="drift_ratio", choices=list(ENVELOPE_QUANTITIES))
         p.add_argument("--by", help="one set of curves per value of this parameter")
+        p.add_argument("--where", action="append", default=[], metavar="PARAM=VALUE",
+                       help="keep the runs with this value of a parameter (repeatable)")
         p.add_argument("--units", help="units of drift and shear, e.g. mm,kN (default SI)")
         p.add_argument("--dpi", type=int, default=150, help="resolution (default 150; 300 for a report)")
         p.add_argument("--out", metavar="PNG")
         a = p.parse_args(argv[1:])
-        print(f"plot: {ida(a.directory, a.quantity, a.by, a.out, a.units, a.dpi)}")
+        where = {}
+        for item in a.where:
+            if "=" not in item:
+                raise SweepError(f"--where {item!r}: PARAM=VALUE")
+            k, v = item.split("=", 1)
+            where[k.strip()] = v.strip()
+        print(f"plot: {ida(a.directory, a.quantity, a.by, a.out, a.units, a.dpi, where)}")
         return 0
     a = _run_parser().parse_args(argv)
     if a.max_runs < 1:
