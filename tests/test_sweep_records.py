@@ -176,3 +176,18 @@ def test_ida_curves_are_the_medians_of_the_runs(tmp_path):
                        text=True)
     assert r.returncode == 0, r.stderr
     assert (out / "ida_drift_ratio.png").stat().st_size > 3000
+
+
+def test_sweep_plot_of_a_suite_at_a_resolution(tmp_path):
+    """sweep plot of a record suite at --dpi: the image's width doubles with the dpi."""
+    import matplotlib.image as mpimg
+
+    spec = suite(tmp_path, '[records]\nfiles = ["rec/a.AT2", "rec/b.AT2"]\nintensities = [0.2, 0.4]\n')
+    out = tmp_path / "s"
+    r = subprocess.run([*SWEEP, str(spec), "--out", str(out), "--quiet"], capture_output=True, text=True)
+    assert r.returncode == 0, r.stderr
+    sizes = []
+    for dpi in (50, 100):
+        png = sw.plot(out, "friction.mu", "peak_u_m[1]", out=tmp_path / f"p{dpi}.png", dpi=dpi)
+        sizes.append(mpimg.imread(png).shape[1])
+    assert sizes[1] == pytest.approx(2 * sizes[0], rel=0.05)

@@ -1750,11 +1750,13 @@ def plot(
     y: str,
     by: str | None = None,
     out: str | os.PathLike | None = None,
+    dpi: int = 150,
 ) -> Path:
     """One summary quantity (``y``, a results.csv column such as ``peak_u_m[5]``) against
     one parameter (``x``), one line per value of ``by`` (default: the other varied
-    parameters, together, less those zipped with ``x``, which vary with it). Writes a PNG
-    (default ``<dir>/<y>_vs_<x>.png``). A point whose x or y is not a number (NaN: a
+    parameters, together, less those zipped with ``x``, which vary with it, and a record
+    suite's file and scale, which follow its record and intensity). Writes a PNG (default
+    ``<dir>/<y>_vs_<x>.png``, ``dpi`` dots per inch). A point whose x or y is not a number (NaN: a
     quantity the run does not define) is left out."""
     from matplotlib.backends.backend_agg import FigureCanvasAgg
     from matplotlib.figure import Figure
@@ -1768,7 +1770,8 @@ def plot(
         if col not in rows[0]:
             raise _no_column(col, columns)
     along = sweep.zipped if x in sweep.zipped else [x]
-    others = [by] if by else [p for p in sweep.parameters if p not in along and p in rows[0]]
+    others = [by] if by else [p for p in sweep.parameters
+                              if p not in along and p in rows[0] and p not in SUITE_KEYS[2:]]
     groups: dict[str, list[tuple[float, float]]] = {}
     skipped = 0
     for r in rows:
@@ -1798,7 +1801,7 @@ def plot(
         ax.legend(fontsize="small")
     safe = re.sub(r"[^\w.-]+", "_", f"{y}_vs_{x}").strip("_")
     path = Path(out) if out else Path(directory) / f"{safe}.png"
-    fig.savefig(path, dpi=110, bbox_inches="tight")
+    fig.savefig(path, dpi=dpi, bbox_inches="tight")
     return path
 
 
@@ -2098,9 +2101,10 @@ def main(argv: Sequence[str]) -> int:
         p.add_argument("x", help="parameter (a column of results.csv), e.g. friction.p")
         p.add_argument("y", help="summary quantity, e.g. 'peak_u_m[5]'")
         p.add_argument("--by", help="one line per value of this parameter")
+        p.add_argument("--dpi", type=int, default=150, help="resolution (default 150; 300 for a report)")
         p.add_argument("--out", metavar="PNG")
         a = p.parse_args(argv[1:])
-        print(f"plot: {plot(a.directory, a.x, a.y, a.by, a.out)}")
+        print(f"plot: {plot(a.directory, a.x, a.y, a.by, a.out, a.dpi)}")
         return 0
     if argv and argv[0] == "envelope":
         p = argparse.ArgumentParser(prog="python -m frictiondyn sweep envelope",
