@@ -67,3 +67,20 @@ def test_bad_expressions(tmp_path, derived, words):
         sw.expand(s, tmp_path / "o")
     assert words in str(err.value)
     assert not (tmp_path / "o").exists()
+
+
+def test_t1_is_the_base_decks_first_period(tmp_path):
+    """T1 in an expression: the base deck's first period, here that of the bare 5-storey
+    frame with its braces stuck (the stuck system's, with the hysteretic devices' sticking
+    springs), as the base deck's own run reports it in periods_stuck_s."""
+    import frictiondyn
+
+    s = spec(tmp_path, '[cross]\nk = [1.0, 2.0]\n[derived]\nperiod_x = "k * T1"\n'
+                       '"excitation.duration" = "0.05"\n')
+    out = tmp_path / "o"
+    r = subprocess.run([*SWEEP, str(s), "--out", str(out), "--quiet"], capture_output=True, text=True)
+    assert r.returncode == 0, r.stderr
+    t1 = frictiondyn.run(INPUTS / "building5_friction.nml").summary["periods_stuck_s"][0]
+    with open(out / "results.csv", newline="") as fh:
+        rows = list(csv.DictReader(fh))
+    assert sorted(float(r["period_x"]) / float(r["k"]) for r in rows) == pytest.approx([t1, t1], rel=1e-12)

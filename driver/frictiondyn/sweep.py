@@ -657,10 +657,14 @@ def _derive(spec: dict, rows: list[dict[str, Any]], base_dir: Path, where: str) 
 
     quantities: dict[str, dict[str, Any]] = {}
     trees = {k: _parse_expression(e) for k, e in spec["derived"].items()}
+    uses_t1 = any(re.search(r"\bt1\b", str(e), re.I) for e in spec["derived"].values())
     for row in rows:
         base = row.get("deck", spec.get("base"))
         if base not in quantities:
-            quantities[base] = _base_quantities(_read_base(base, base_dir, where)[1])
+            base_path, nml = _read_base(base, base_dir, where)
+            quantities[base] = _base_quantities(nml)
+            if uses_t1:  # the base deck's first period (a run of one record step)
+                quantities[base]["t1"] = _first_period(nml, base_path.parent, where)[0]
         names = dict(quantities[base])
         names.update({k.lower(): v for k, v in row.items() if k != "deck"})
         for key, tree in trees.items():
