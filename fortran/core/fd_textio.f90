@@ -242,30 +242,35 @@ contains
       end do
    end function lower
 
-   !> Split a string at blanks, tabs and commas into tokens.
+   !> Split a string at blanks, tabs and commas into tokens. Two passes, count then fill:
+   !> growing the array by a constructor of line_type leaks the constructor's temporaries
+   !> (their allocatable components) under gfortran.
    pure subroutine split_tokens(str, tokens)
       character(len=*), intent(in) :: str                    !! text to split
       type(line_type), allocatable, intent(out) :: tokens(:)  !! the tokens, in order
-      integer :: i, start, n
+      integer :: i, start, n, pass
       logical :: sep
 
-      allocate (tokens(0))
-      n = 0
-      start = 0
-      do i = 1, len(str) + 1
-         if (i > len(str)) then
-            sep = .true.
-         else
-            sep = str(i:i) == ' ' .or. str(i:i) == ',' .or. str(i:i) == achar(9)
-         end if
-         if (sep) then
-            if (start > 0) then
-               tokens = [tokens, line_type(str(start:i - 1))]
-               start = 0
+      do pass = 1, 2
+         n = 0
+         start = 0
+         do i = 1, len(str) + 1
+            if (i > len(str)) then
+               sep = .true.
+            else
+               sep = str(i:i) == ' ' .or. str(i:i) == ',' .or. str(i:i) == achar(9)
             end if
-         else if (start == 0) then
-            start = i
-         end if
+            if (sep) then
+               if (start > 0) then
+                  n = n + 1
+                  if (pass == 2) tokens(n)%s = str(start:i - 1)
+                  start = 0
+               end if
+            else if (start == 0) then
+               start = i
+            end if
+         end do
+         if (pass == 1) allocate (tokens(n))
       end do
    end subroutine split_tokens
 
