@@ -1296,6 +1296,7 @@ contains
       type(run_config), intent(in) :: cfg
       type(error_type), allocatable, intent(out) :: error
       real(dp), allocatable :: k(:, :)
+      character(len=label_len + 3) :: name
       integer :: n, info, stat
 
       n = cfg%model%n_dof
@@ -1306,9 +1307,9 @@ contains
       call add_general_dense(cfg%model, k)
       call cholesky_factor(k, info)
       if (info /= 0) then
-         call bad(deck, 'matrices', 'k_file', 'K not positive definite at DOF '//trim(fmt_int(info))// &
-                  trim(merge(" '"//trim(cfg%model%dof_label(info))//"'", repeat(' ', label_len + 3), &
-                  len_trim(cfg%model%dof_label(info)) > 0)), &
+         name = ''
+         if (len_trim(cfg%model%dof_label(info)) > 0) name = " '"//trim(cfg%model%dof_label(info))//"'"
+         call bad(deck, 'matrices', 'k_file', 'K not positive definite at DOF '//trim(fmt_int(info))//trim(name), &
                   'the stiffness of a structure held to the table (a mechanism, or an indefinite K, fails there)', error)
       end if
    end subroutine check_definite
