@@ -1819,6 +1819,29 @@ ENVELOPE_QUANTITIES = {
 }
 
 
+def _storey_table(directory: str | os.PathLike, quantity: str, units: str | None,
+                  what: str) -> tuple[Sweep, Path, list[dict[str, str]], str, str, float, str]:
+    """results_storeys.csv of a collected sweep and how to show a storey quantity of it:
+    (sweep, path, rows, column, axis label, factor, unit text)."""
+    from .plots import _FACTORS, Units
+
+    if quantity not in ENVELOPE_QUANTITIES:
+        raise SweepError(f"{what} quantity {quantity!r}: one of {', '.join(ENVELOPE_QUANTITIES)}")
+    column, axis, kind = ENVELOPE_QUANTITIES[quantity]
+    sweep = load(directory)
+    path = Path(directory) / "results_storeys.csv"
+    try:
+        with open(path, newline="", encoding="utf-8") as fh:
+            rows = list(csv.DictReader(fh))
+    except FileNotFoundError:
+        raise SweepError(f"{path}: no such file (the sweep has no storeys, or run 'sweep "
+                         "collect' first)") from None
+    if kind == "percent":
+        return sweep, path, rows, column, axis, 100.0, ""
+    name = getattr(Units.parse(units), kind)
+    return sweep, path, rows, column, axis, _FACTORS[kind][name], f" [{name}]"
+
+
 def envelope(
     directory: str | os.PathLike,
     quantity: str = "drift_ratio",
@@ -1837,29 +1860,11 @@ def envelope(
     from matplotlib.backends.backend_agg import FigureCanvasAgg
     from matplotlib.figure import Figure
 
-    from .plots import _FACTORS, Units
-
-    if quantity not in ENVELOPE_QUANTITIES:
-        raise SweepError(f"envelope quantity {quantity!r}: one of {', '.join(ENVELOPE_QUANTITIES)}")
-    column, axis, kind = ENVELOPE_QUANTITIES[quantity]
-    sweep = load(directory)
-    path = Path(directory) / "results_storeys.csv"
-    try:
-        with open(path, newline="", encoding="utf-8") as fh:
-            rows = list(csv.DictReader(fh))
-    except FileNotFoundError:
-        raise SweepError(f"{path}: no such file (the sweep has no storeys, or run 'sweep "
-                         "collect' first)") from None
+    sweep, path, rows, column, axis, factor, unit = _storey_table(directory, quantity, units, "envelope")
     if not rows:
         raise SweepError(f"{path}: no storey of a complete run")
     if by is not None and by not in rows[0]:
         raise _no_column(by, [c for c in rows[0] if c in sweep.parameters])
-    if kind == "percent":
-        factor, unit = 100.0, ""
-    else:
-        u = Units.parse(units)
-        name = getattr(u, kind)
-        factor, unit = _FACTORS[kind][name], f" [{name}]"
     n = max(int(r["storey"]) for r in rows)
     labels = {int(r["storey"]): r["storey_label"] for r in rows}
     series: dict[str, dict[int, list[float]]] = {}
@@ -1917,19 +1922,7 @@ def ida_curves(
     that would pool several runs (another parameter varies) is an error naming it."""
     import numpy as np
 
-    from .plots import _FACTORS, Units
-
-    if quantity not in ENVELOPE_QUANTITIES:
-        raise SweepError(f"ida quantity {quantity!r}: one of {', '.join(ENVELOPE_QUANTITIES)}")
-    column, axis, kind = ENVELOPE_QUANTITIES[quantity]
-    sweep = load(directory)
-    path = Path(directory) / "results_storeys.csv"
-    try:
-        with open(path, newline="", encoding="utf-8") as fh:
-            rows = list(csv.DictReader(fh))
-    except FileNotFoundError:
-        raise SweepError(f"{path}: no such file (the sweep has no storeys, or run 'sweep "
-                         "collect' first)") from None
+    sweep, path, rows, column, axis, factor, unit = _storey_table(directory, quantity, units, "ida")
     if not rows or "intensity_g" not in rows[0]:
         raise SweepError(f"{path}: an IDA needs a record suite ([records]: intensity_g, record)")
     if by is not None and by not in rows[0]:
@@ -1940,11 +1933,6 @@ def ida_curves(
         rows = [r for r in rows if r[k] == value]
         if not rows:
             raise SweepError(f"{path}: no run has {k} = {value}")
-    if kind == "percent":
-        factor, unit = 100.0, ""
-    else:
-        name = getattr(Units.parse(units), kind)
-        factor, unit = _FACTORS[kind][name], f" [{name}]"
     peak: dict[tuple[str, str, float], float] = {}   # (group, record, intensity) -> max over storeys
     runs: dict[tuple[str, str, float], set[str]] = {}
     for r in rows:

@@ -375,34 +375,36 @@ contains
       type(model_type), intent(in) :: model
       type(engineering_type), intent(inout) :: eng
       integer, intent(out) :: stat                 !! not 0: not enough memory
-      integer :: ns, c, e, k
 
-      ns = eng%n_storeys
-      allocate (eng%xs_first(ns + 1), eng%xd_first(ns + 1), eng%xs_dof(size(model%xs_dof)), &
-                eng%xs_coef(size(model%xs_dof)), eng%xd_dev(size(model%xd_dev)), eng%xd_coef(size(model%xd_dev)), &
-                stat=stat)
+      call by_storey(eng%n_storeys, model%xs_storey, model%xs_dof, model%xs_coef, eng%xs_first, eng%xs_dof, &
+                     eng%xs_coef, stat)
+      if (stat == 0) call by_storey(eng%n_storeys, model%xd_storey, model%xd_dev, model%xd_coef, eng%xd_first, &
+                                    eng%xd_dev, eng%xd_coef, stat)
+   end subroutine storey_extras
+
+   !> Entries (storey, index, coefficient) sorted by storey: those of storey c at
+   !> first(c):first(c+1)-1 of idx and coef.
+   pure subroutine by_storey(ns, storey, index, coefficient, first, idx, coef, stat)
+      integer, intent(in) :: ns, storey(:), index(:)
+      real(dp), intent(in) :: coefficient(:)
+      integer, allocatable, intent(out) :: first(:), idx(:)
+      real(dp), allocatable, intent(out) :: coef(:)
+      integer, intent(out) :: stat
+      integer :: c, e, k
+
+      allocate (first(ns + 1), idx(size(storey)), coef(size(storey)), stat=stat)
       if (stat /= 0) return
       k = 0
       do c = 1, ns
-         eng%xs_first(c) = k + 1
-         do e = 1, size(model%xs_storey)
-            if (model%xs_storey(e) /= c) cycle
+         first(c) = k + 1
+         do e = 1, size(storey)
+            if (storey(e) /= c) cycle
             k = k + 1
-            eng%xs_dof(k) = model%xs_dof(e); eng%xs_coef(k) = model%xs_coef(e)
+            idx(k) = index(e); coef(k) = coefficient(e)
          end do
       end do
-      eng%xs_first(ns + 1) = k + 1
-      k = 0
-      do c = 1, ns
-         eng%xd_first(c) = k + 1
-         do e = 1, size(model%xd_storey)
-            if (model%xd_storey(e) /= c) cycle
-            k = k + 1
-            eng%xd_dev(k) = model%xd_dev(e); eng%xd_coef(k) = model%xd_coef(e)
-         end do
-      end do
-      eng%xd_first(ns + 1) = k + 1
-   end subroutine storey_extras
+      first(ns + 1) = k + 1
+   end subroutine by_storey
 
    !> One accepted state: drifts and shears, their peaks, and the values kept as the
    !> residual ones (those of the last state observed). Runs at every accepted step: the
@@ -417,7 +419,7 @@ contains
       real(dp), intent(in) :: s(nd)                 !! device relative displacements [m]
       real(dp), intent(in) :: force(nd)             !! device forces [N]
       real(dp) :: x
-      integer :: i, c
+      integer :: i, c, k
 
       if (.not. allocated(eng%drift)) return
       do i = 1, nd
@@ -441,7 +443,12 @@ contains
       do i = 1, eng%n_storeys
          if (.not. eng%has_corners(i)) cycle
          do c = 1, 4
-            x = abs(sum(eng%corner_coef(:, c, i)*u(eng%corner_dof(:, c, i))))
+            ! term by term: a vector subscript of u would make a temporary at every step
+            x = 0.0_dp
+            do k = 1, 4
+               x = x + eng%corner_coef(k, c, i)*u(eng%corner_dof(k, c, i))
+            end do
+            x = abs(x)
             if (x > eng%peak_corner(i)) then
                eng%peak_corner(i) = x; eng%peak_corner_time(i) = t
             end if
