@@ -11,8 +11,6 @@ lam = (2 / h) (mu - 1) / (mu + 1) gives xi = -Re(lam) / |lam| and w = |lam|."""
 
 from __future__ import annotations
 
-import time
-
 import frictiondyn as fd
 import numpy as np
 import pytest
@@ -148,23 +146,18 @@ def chain_analysis(n: int, duration: float, xi=0.05, modes_kept=None) -> fd.Anal
     )
 
 
-def test_large_model_low_rank_and_linear_in_size():
+def test_large_model_low_rank_and_outside_the_band():
     """Above the dense limit (200 DOFs) the modes come from subspace iteration and C is kept
-    low-rank: the summary's stuck modes carry the ratio, and doubling the DOFs about
-    doubles the time of the steps (not x4 or x8 as a dense C would)."""
+    low-rank: the summary's stuck modes carry the ratio, and the step's matrix keeps the band
+    of K (half-bandwidth 1 for a chain), so no n x n damping matrix is assembled. The time per
+    step against the size is measured by bench/modal_damping.py."""
     r = chain_analysis(400, 0.2, modes_kept=20).run()
     assert r.summary["modal_xi_stuck"] == pytest.approx([0.05] * 3, abs=1e-8)
-    times = {}
-    for n in (1000, 4000):
-        best = []
-        for _ in range(2):  # the better of two: the machine may be shared
-            t0 = time.perf_counter()
-            chain_analysis(n, 2.0, modes_kept=10).run()
-            t1 = time.perf_counter()
-            chain_analysis(n, 0.02, modes_kept=10).run()
-            best.append((t1 - t0) - (time.perf_counter() - t1))  # 400 steps, set-up removed
-        times[n] = min(best)
-    assert times[4000] / times[1000] < 8.0
+    r = chain_analysis(4000, 0.02, modes_kept=10).run()
+    assert r.summary["modal_xi_stuck"] == pytest.approx([0.05] * 3, abs=1e-8)
+    assert r.summary["linear_system"] == "banded"
+    assert r.summary["half_bandwidth"] == 1
+    assert r.summary["factorizations"] == 1
 
 
 BAD = [
