@@ -24,6 +24,7 @@ from __future__ import annotations
 
 import argparse
 import random
+import re
 import subprocess
 import sys
 import tempfile
@@ -217,19 +218,9 @@ def shift_value(c: Case, rng: random.Random) -> None:
         return
     k = rng.choice(body)
     s = c.lines[k]
-    j = rng.randrange(1, len(s.split()))
-    # the start of the j-th token
-    pos, count = 0, -1
-    while True:
-        while s[pos] == " ":
-            pos += 1
-        count += 1
-        if count == j:
-            break
-        while pos < len(s) and s[pos] != " ":
-            pos += 1
-    end = s.find(" ", pos)
-    end = len(s) if end < 0 else end
+    tokens = list(re.finditer(r"\S+", s))  # split() splits at tabs too: find the same tokens
+    j = rng.randrange(1, len(tokens))
+    pos, end = tokens[j].start(), tokens[j].end()
     if s[pos - 2] != " ":
         return   # one blank before it: moved, it would be glued to the value before
     c.lines[k] = s[:pos - 1] + s[pos:end] + " " + s[end:]
