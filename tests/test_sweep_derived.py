@@ -84,3 +84,36 @@ def test_t1_is_the_base_decks_first_period(tmp_path):
     with open(out / "results.csv", newline="") as fh:
         rows = list(csv.DictReader(fh))
     assert sorted(float(r["period_x"]) / float(r["k"]) for r in rows) == pytest.approx([t1, t1], rel=1e-12)
+
+
+def test_weight_above_of_storeys_given_by_springs_and_of_rigid_floors(tmp_path):
+    """weight_above where &storeys names springs (storey s is spring s's two nodes) equals
+    the one given by nodes; for rigid floors it is the weight of floors s and above, and
+    brace_weight_above that of each brace's storey (inputs/building3d.nml: 3 floors of 300 t,
+    braces two a storey)."""
+    import f90nml
+
+    by_nodes = f90nml.read(INPUTS / "building5_friction.nml")
+    by_nodes["storeys"] = {"n_storeys": 5, "node_i": [1, 2, 3, 4, 5], "node_j": [0, 1, 2, 3, 4]}
+    q_nodes = sw._base_quantities(by_nodes)
+    by_spring = f90nml.read(INPUTS / "building5_friction.nml")
+    springs = by_spring["springs"]
+    by_spring["storeys"] = {"n_storeys": 5}
+    st = by_spring["storeys"]
+    # the same storeys named by their springs, in reverse order of the springs' list
+    order = list(range(len(springs["node_i"])))[::-1]
+    springs["node_i"] = [springs["node_i"][k] for k in order]
+    springs["node_j"] = [springs["node_j"][k] for k in order]
+    springs["k"] = [springs["k"][k] for k in order]
+    st["spring"] = [len(order) - s for s in range(5)]
+    q_spring = sw._base_quantities(by_spring)
+    above = G * np.cumsum(MASS[::-1])[::-1]
+    np.testing.assert_allclose(q_nodes["weight_above"], above, rtol=1e-14)
+    np.testing.assert_allclose(q_spring["weight_above"], above, rtol=1e-14)
+
+    q = sw._base_quantities(f90nml.read(INPUTS / "building3d.nml"))
+    np.testing.assert_allclose(q["weight_above"], G * np.array([900e3, 600e3, 300e3]), rtol=1e-14)
+    np.testing.assert_allclose(q["brace_weight_above"],
+                               G * np.array([900e3, 900e3, 600e3, 600e3, 300e3, 300e3]), rtol=1e-14)
+    assert q["total_mass"] == pytest.approx(900e3, rel=1e-15)
+    assert q["storey_height"] == [3.0, 3.0, 3.0]

@@ -596,6 +596,9 @@ def _base_quantities(nml: f90nml.Namelist) -> dict[str, Any]:
         for var, v in variables.items():
             if isinstance(v, (int, float, list)) and not isinstance(v, bool):
                 q[f"{group.lower()}.{var.lower()}"] = v
+    if nml.get("floors") is not None:
+        q.update(_floor_quantities(nml["floors"], nml.get("floor_braces") or {}))
+        return q
     model = nml.get("model") or {}
     mass = model.get("mass")
     n = int(model.get("n_dof", 0) or 0)
@@ -635,9 +638,17 @@ def _base_quantities(nml: f90nml.Namelist) -> dict[str, Any]:
         return float(G * sum(m[k - 1] for k in seen if 1 <= k <= n))
 
     st = nml.get("storeys") or {}
-    if st.get("node_i") is not None and st.get("node_j") is not None:
-        si = st["node_i"] if isinstance(st["node_i"], list) else [st["node_i"]]
-        sj = st["node_j"] if isinstance(st["node_j"], list) else [st["node_j"]]
+    si, sj = _as_list(st.get("node_i")), _as_list(st.get("node_j"))
+    if st.get("spring") is not None:  # storey s is the two nodes of spring spring(s)
+        sp = nml.get("springs") or {}
+        pi, pj = _as_list(sp.get("node_i")), _as_list(sp.get("node_j"))
+        si, sj = [], []
+        for k in _as_list(st["spring"]):
+            if not 1 <= int(k) <= min(len(pi), len(pj)):
+                break  # the deck's own check names it when the run starts
+            si.append(pi[int(k) - 1])
+            sj.append(pj[int(k) - 1])
+    if si and sj:
         q["weight_above"] = [above(int(a), int(b)) for a, b in zip(si, sj)]
         h = st.get("height")
         if h is not None:
@@ -648,6 +659,37 @@ def _base_quantities(nml: f90nml.Namelist) -> dict[str, Any]:
         fj = fr["node_j"] if isinstance(fr["node_j"], list) else [fr["node_j"]]
         q["device_weight_above"] = [above(int(a), int(b)) for a, b in zip(fi, fj)]
     return q
+
+
+def _as_list(v: Any) -> list:
+    """A namelist value as a list ([] when not given)."""
+    if v is None:
+        return []
+    return v if isinstance(v, list) else [v]
+
+
+def _floor_quantities(floors: dict, braces: dict) -> dict[str, Any]:
+    """The quantities of a building of rigid floors: mass and weight per floor, their sums,
+    weight_above (per storey s, the weight of floors s and above: storey s is the one below
+    floor s), brace_weight_above (per brace of &floor_braces, that of its storey) and
+    storey_height (each floor's height)."""
+    from .spectrum import G
+
+    n = int(floors.get("n_floors", 0) or 0)
+    mass = [float(x) for x in _as_list(floors.get("mass"))]
+    if n < 1 or len(mass) < n:
+        return {}  # the deck's own check names what is missing when a run starts
+    mass = mass[:n]
+    out: dict[str, Any] = dict(mass=mass, weight=[G * m for m in mass], total_mass=sum(mass),
+                               total_weight=G * sum(mass))
+    out["weight_above"] = [G * sum(mass[s:]) for s in range(n)]
+    storeys = [int(k) for k in _as_list(braces.get("storey"))]
+    if storeys and all(1 <= k <= n for k in storeys):
+        out["brace_weight_above"] = [out["weight_above"][k - 1] for k in storeys]
+    h = _as_list(floors.get("height"))
+    if h:
+        out["storey_height"] = [float(x) for x in h]
+    return out
 
 
 def _derive(spec: dict, rows: list[dict[str, Any]], base_dir: Path, where: str) -> list[str]:
