@@ -117,3 +117,24 @@ def test_weight_above_of_storeys_given_by_springs_and_of_rigid_floors(tmp_path):
                                G * np.array([900e3, 900e3, 600e3, 600e3, 300e3, 300e3]), rtol=1e-14)
     assert q["total_mass"] == pytest.approx(900e3, rel=1e-15)
     assert q["storey_height"] == [3.0, 3.0, 3.0]
+
+
+def test_sweep_plot_draws_one_line_across_a_derived_value(tmp_path, monkeypatch):
+    """A derived key follows the parameter it is computed from: sweep plot against alpha
+    draws one line through both alphas (not a line per value of friction.p), and the
+    manifest names the derived keys."""
+    from matplotlib.figure import Figure
+
+    s = spec(tmp_path, '[cross]\nalpha = [0.02, 0.05]\n[derived]\n'
+                       '"friction.p" = "alpha * device_weight_above / friction.mu"\n'
+                       '"excitation.duration" = "1.0"\n')
+    out = tmp_path / "o"
+    r = subprocess.run([*SWEEP, str(s), "--out", str(out), "--quiet"], capture_output=True, text=True)
+    assert r.returncode == 0, r.stderr
+    assert json.loads((out / "manifest.json").read_text())["derived"] == [
+        "friction.p", "excitation.duration"]
+    drawn = []
+    monkeypatch.setattr(Figure, "savefig", lambda fig, *a, **k: drawn.append(fig))
+    sw.plot(out, "alpha", "peak_force_N[1]")
+    (ax,) = drawn[0].axes
+    assert [len(line.get_xdata()) for line in ax.lines] == [2]

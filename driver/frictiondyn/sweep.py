@@ -205,6 +205,7 @@ class Sweep:
     jobs: int | None = None  #: the spec's ``jobs``
     records: dict | None = None  #: the spec's [records] (a record suite), if any
     labels: dict | None = None  #: key -> {"values": [...], "names": [...]} ([labels])
+    derived: list[str] = field(default_factory=list)  #: the keys of [derived]
     lock: SweepLock | None = field(default=None, repr=False)
 
     def state(self, run: Run) -> tuple[str, dict | None, str]:
@@ -1051,7 +1052,7 @@ def _write_runs(spec, spec_path, sdir, keys, rows, bases) -> Sweep:
                   spec_sha256=spec["_sha256"], jobs=spec.get("jobs"),
                   records={k: v for k, v in spec["records"].items() if not k.startswith("_")}
                   if "records" in spec else None,
-                  labels=_spec_labels(spec))
+                  labels=_spec_labels(spec), derived=list(spec.get("derived", {})))
     records: dict[str, str] = {}
     for index, params in enumerate(rows):
         base_path, base_nml = bases[params.get("deck", spec.get("base"))]
@@ -1111,6 +1112,7 @@ def _write_runs(spec, spec_path, sdir, keys, rows, bases) -> Sweep:
         "zip": sweep.zipped,
         "records": sweep.records,
         "labels": sweep.labels,
+        "derived": sweep.derived,
         "runs": [
             {"index": r.index, "id": r.id, "deck": r.deck, "deck_sha256": r.deck_sha256,
              "record_sha256": r.record_sha256, "params": r.params}
@@ -1207,9 +1209,12 @@ def load(directory: str | os.PathLike) -> Sweep:
             k in params and isinstance(v, dict) and isinstance(v.get("values"), list)
             and isinstance(v.get("names"), list) for k, v in labels.items())):
         raise _damaged_manifest(sdir, f"labels is {_short(labels)}")
+    derived = m.get("derived", [])
+    if not isinstance(derived, list) or not all(isinstance(k, str) and k in params for k in derived):
+        raise _damaged_manifest(sdir, f"derived is {_short(derived)}")
     return Sweep(name=name, directory=sdir, parameters=params, runs=runs, zipped=zipped,
                  version=version, spec_sha256=spec_sha if isinstance(spec_sha, str) else "",
-                 records=records, labels=labels)
+                 records=records, labels=labels, derived=derived)
 
 
 def _no_constant(name: str):
@@ -1800,8 +1805,9 @@ def plot(
 ) -> Path:
     """One summary quantity (``y``, a results.csv column such as ``peak_u_m[5]``) against
     one parameter (``x``), one line per value of ``by`` (default: the other varied
-    parameters, together, less those zipped with ``x``, which vary with it, and a record
-    suite's file and scale, which follow its record and intensity). Writes a PNG (default
+    parameters, together, less those zipped with ``x``, which vary with it, a record
+    suite's file and scale, which follow its record and intensity, and the [derived] keys,
+    which follow the parameters they are computed from). Writes a PNG (default
     ``<dir>/<y>_vs_<x>.png``, ``dpi`` dots per inch). A point whose x or y is not a number (NaN: a
     quantity the run does not define) is left out."""
     from matplotlib.backends.backend_agg import FigureCanvasAgg
@@ -1817,7 +1823,8 @@ def plot(
             raise _no_column(col, columns)
     along = sweep.zipped if x in sweep.zipped else [x]
     others = [by] if by else [p for p in sweep.parameters
-                              if p not in along and p in rows[0] and p not in SUITE_KEYS[2:]]
+                              if p not in along and p in rows[0] and p not in SUITE_KEYS[2:]
+                              and p not in sweep.derived]
     groups: dict[str, list[tuple[float, float]]] = {}
     skipped = 0
     for r in rows:
