@@ -795,3 +795,174 @@ def compare_peaks_3d(a: dict, b: dict) -> dict[str, tuple[float, int]]:
         rel = np.abs(x - y) / np.maximum(y, 1e-300)
         out[q] = (float(rel.max()), int(rel.argmax()))
     return out
+
+
+# ----------------------------------------------------------------------------- isolated block
+
+
+@dataclass
+class IsolatedBlockCase:
+    """A rigid block on four sliding bearings at the corners of its plan, under the table's
+    motion along x (one component) or along x and y (two).
+
+    The block: mass ``mass``, plan ``2 a`` x ``2 b`` about its centre of mass (rotational
+    inertia m ((2a)² + (2b)²) / 12), each bearing carrying a quarter of its weight W. Bearings:
+    friction coefficient ``mu`` (Coulomb), a concave surface of radius ``radius`` (0: flat),
+    initial stiffness ``k_init`` each. Ground: ``synthetic_record`` components (seeds
+    ``seeds``, the second scaled by ``scale2``).
+
+    OpenSees: ndf 6; a node at the block's centre with its mass and its out-of-plane DOFs
+    fixed, a ``rigidDiaphragm`` (perpendicular z) tying to it a node above each bearing;
+    each bearing a zero-length ``singleFPBearing`` (frictionModel Coulomb, Reff = radius, or
+    ``flatSliderBearing`` when flat) with a stiff axial material, oriented with its local x
+    along z; the gravity load W/4 on each bearing's node by a static step held constant
+    (``loadConst``); Newmark's average acceleration at dt_record / n1, one ``analyze`` a step
+    (the histories read from the domain).
+
+    frictiondyn, one component: ``&isolators`` in the 1D model of the block along x (one DOF,
+    one isolator carrying W: the four bearings' sum), hysteretic law with P mu = mu W and
+    the sticking displacement f = mu (W/4) / (k_init - (W/4)/R): OpenSees's k_init is the
+    bearing's whole initial stiffness, the friction part's spring and the pendulum's N/R
+    together (SingleFPSimple3d::update, k0 = kInit - N/R).
+
+    A difference to know: OpenSees's singleFPBearing adds to the normal force the shear
+    force's component along the curved surface's normal, N = W/4 + q . u / R (large-angle
+    geometry, second order in u/R), where frictiondyn's &isolators keeps N = W/4: for a
+    curved surface the two codes differ by about (mu + u/R) u/R (0.1 % here); for a flat
+    slider they solve the same equations.
+    """
+
+    mass: float = 1.0e5
+    a: float = 5.0
+    b: float = 3.0
+    mu: float = 0.06
+    radius: float = 2.0
+    k_init: float = 1.0e8
+    components: int = 1
+    duration: float = 10.0
+    dt_record: float = 0.01
+    n1: int = 10
+    pga: float = 0.3 * G
+    scale2: float = 0.7
+    seeds: tuple[int, int] = (1, 2)
+    eps1: float = 1.0e-6
+    records: tuple = field(default=None, repr=False)
+
+    def __post_init__(self) -> None:
+        if self.records is None:
+            recs = [synthetic_record(self.dt_record, self.duration, self.pga, self.seeds[0])]
+            if self.components == 2:
+                recs.append(self.scale2 * synthetic_record(self.dt_record, self.duration,
+                                                           self.pga, self.seeds[1]))
+            self.records = tuple(recs)
+        self.weight = self.mass * G
+        self.dt = self.dt_record / self.n1
+        self.n_steps = round(self.duration / self.dt)
+        self.corners = [(-self.a, -self.b), (self.a, -self.b), (self.a, self.b), (-self.a, self.b)]
+
+    @property
+    def name(self) -> str:
+        kind = "flat" if self.radius == 0 else f"R{self.radius:g}"
+        return f"isolated_block_{kind}_{self.components}c"
+
+    @property
+    def f(self) -> float:
+        """The hysteretic law's sticking displacement of a bearing (the class docstring)."""
+        n = self.weight / 4
+        k2 = n / self.radius if self.radius > 0 else 0.0
+        return self.mu * n / (self.k_init - k2)
+
+    # ------------------------------------------------------------------ frictiondyn
+
+    def deck_1d(self, record_file: str = "ag_x.txt") -> str:
+        """The frictiondyn deck of the block along x: one DOF on one isolator carrying W."""
+        if self.components != 1:
+            raise ValueError("deck_1d is the model of one component along x")
+        return (
+            f"&model\n  n_dof = 1\n  mass = {self.mass!r}\n/\n&springs\n  n_springs = 0\n/\n"
+            "&damping\n  damping_type = 'none'\n/\n"
+            f"&isolators\n  n_isolators = 1\n  node_i = 1\n  node_j = 0\n"
+            f"  weight = {self.weight!r}\n  radius = {self.radius!r}\n  law = 'hysteretic'\n"
+            f"  mu = {self.mu!r}\n  f = {self.f!r}\n  eps1 = {self.eps1!r}\n/\n"
+            "&excitation\n  excitation_type = 'record'\n  record_format = 'values'\n"
+            f"  record_units = 'm/s2'\n  dt_record = {self.dt_record!r}\n"
+            f"  duration = {self.duration!r}\n  record_file = '{record_file}'\n/\n"
+            f"&integration\n  n1 = {self.n1}\n  refinement = 'implicit'\n/\n"
+        )
+
+    def run_frictiondyn_1d(self):
+        """frictiondyn's Result of ``deck_1d`` (its record written to a temporary directory)."""
+        import frictiondyn as fd
+
+        with tempfile.TemporaryDirectory(prefix="fd_iso_") as tmp:
+            np.savetxt(Path(tmp) / "ag_x.txt", self.records[0], fmt="%.17g")
+            return fd.run_text(self.deck_1d(), f"{self.name}.nml", tmp)
+
+    # ------------------------------------------------------------------ OpenSees
+
+    def run_opensees(self) -> tuple[np.ndarray, np.ndarray]:
+        """(history, normal forces): the history a row a step (t = 0 included) of the block's
+        ux, uy, rz and each bearing's ux, uy; the bearings' normal forces at the end [N]."""
+        ops = import_opensees()
+        ops.wipe()
+        ops.model("basic", "-ndm", 3, "-ndf", 6)
+        inertia = self.mass * ((2 * self.a) ** 2 + (2 * self.b) ** 2) / 12
+        centre = 100
+        ops.node(centre, 0.0, 0.0, 0.0)
+        ops.fix(centre, 0, 0, 1, 1, 1, 0)
+        ops.mass(centre, self.mass, self.mass, 0.0, 0.0, 0.0, inertia)
+        ops.frictionModel("Coulomb", 1, self.mu)
+        ops.uniaxialMaterial("Elastic", 1, 1.0e10)   # axial: stiff
+        ops.uniaxialMaterial("Elastic", 2, 1.0e-6)   # torsion: none
+        ops.uniaxialMaterial("Elastic", 3, 1.0e6)    # rocking: both ends' rotations are fixed
+        tops = []
+        for k, (x, y) in enumerate(self.corners, start=1):
+            ops.node(k, x, y, 0.0)
+            ops.fix(k, 1, 1, 1, 1, 1, 1)
+            ops.node(10 + k, x, y, 0.0)
+            ops.fix(10 + k, 0, 0, 0, 1, 1, 0)
+            tops.append(10 + k)
+            kind = ("flatSliderBearing", 1) if self.radius == 0 else ("singleFPBearing", 1,
+                                                                       self.radius)
+            ops.element(kind[0], k, k, 10 + k, *kind[1:], self.k_init, "-P", 1, "-T", 2,
+                        "-My", 3, "-Mz", 3, "-orient", 0.0, 0.0, 1.0, 1.0, 0.0, 0.0,
+                        "-iter", 100, 1.0e-6)
+        ops.rigidDiaphragm(3, centre, *tops)
+        ops.timeSeries("Linear", 10)
+        ops.pattern("Plain", 10, 10)
+        for t in tops:
+            ops.load(t, 0.0, 0.0, -self.weight / 4, 0.0, 0.0, 0.0)
+        ops.constraints("Transformation")
+        ops.numberer("RCM")
+        ops.system("BandGeneral")
+        ops.test("NormDispIncr", 1.0e-12, 50)
+        ops.algorithm("Newton")
+        ops.integrator("LoadControl", 1.0)
+        ops.analysis("Static")
+        if ops.analyze(1) != 0:
+            raise RuntimeError(f"{self.name}: OpenSees gravity step failed")
+        ops.loadConst("-time", 0.0)
+        ops.wipeAnalysis()
+        for d, rec in enumerate(self.records, start=1):
+            ops.timeSeries("Path", d, "-dt", self.dt_record, "-values", *map(float, rec))
+            ops.pattern("UniformExcitation", d, d, "-accel", d)
+        ops.constraints("Transformation")
+        ops.numberer("RCM")
+        ops.system("BandGeneral")
+        ops.test("NormDispIncr", 1.0e-8, 100)
+        ops.algorithm("Newton")
+        ops.integrator("Newmark", 0.5, 0.25)
+        ops.analysis("Transient")
+        hist = np.zeros((self.n_steps + 1, 3 + 2 * len(tops)))
+        for s in range(1, self.n_steps + 1):
+            if ops.analyze(1, self.dt) != 0:
+                t_now = ops.getTime()
+                ops.wipe()
+                raise RuntimeError(f"{self.name}: OpenSees analyze failed at t = {t_now} s")
+            row = [ops.nodeDisp(centre, 1), ops.nodeDisp(centre, 2), ops.nodeDisp(centre, 6)]
+            for t in tops:
+                row += [ops.nodeDisp(t, 1), ops.nodeDisp(t, 2)]
+            hist[s] = row
+        normal = np.array([-ops.eleResponse(k, "basicForce")[0] for k in range(1, 5)])
+        ops.wipe()
+        return hist, normal

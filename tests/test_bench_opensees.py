@@ -6,8 +6,7 @@ OpenSees ElasticPP zeroLength link are the same force law; both codes integrate 
 average acceleration at the same dt1, frictiondyn with its own step control at phase changes,
 OpenSees with Newton iterations on the links. Their peaks must agree within 3 %.
 
-openseespy is not a test dependency: this file is skipped when it cannot be imported
-(``bench/compare_opensees.py`` installs it). No timing here: speed is measured by the bench.
+openseespy is in the test extra; this file is skipped where it cannot be imported. No timing here: speed is measured by the bench.
 """
 
 from __future__ import annotations
