@@ -519,11 +519,11 @@ def frictiondyn_peaks(result) -> dict[str, np.ndarray]:
     return {q: np.asarray(result.summary[SUMMARY_KEYS[q]], dtype=float) for q in QUANTITIES}
 
 
-def compare_peaks(a: dict, b: dict) -> dict[str, tuple[float, int]]:
+def compare_peaks(a: dict, b: dict, quantities=QUANTITIES) -> dict[str, tuple[float, int]]:
     """For each quantity, the largest relative difference |a - b| / |b| over DOFs (devices)
     and where it is (0-based)."""
     out = {}
-    for q in QUANTITIES:
+    for q in quantities:
         x, y = np.abs(np.asarray(a[q], float)), np.abs(np.asarray(b[q], float))
         if x.shape != y.shape:
             raise ValueError(f"peak {q}: {x.shape} values against {y.shape}")
@@ -787,14 +787,7 @@ def run_opensees_3d(case: Building3DCase, settings: OpenSeesSettings | None = No
 
 def compare_peaks_3d(a: dict, b: dict) -> dict[str, tuple[float, int]]:
     """As ``compare_peaks``, over QUANTITIES_3D."""
-    out = {}
-    for q in QUANTITIES_3D:
-        x, y = np.abs(np.asarray(a[q], float)), np.abs(np.asarray(b[q], float))
-        if x.shape != y.shape:
-            raise ValueError(f"peak {q}: {x.shape} values against {y.shape}")
-        rel = np.abs(x - y) / np.maximum(y, 1e-300)
-        out[q] = (float(rel.max()), int(rel.argmax()))
-    return out
+    return compare_peaks(a, b, QUANTITIES_3D)
 
 
 # ----------------------------------------------------------------------------- isolated block

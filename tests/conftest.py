@@ -201,3 +201,22 @@ def chain(n: int, duration: float, *, name: str = "run", out: str = "out", n1: i
         "integration": {"n1": n1},
         "output": {"name": name, "output_every": every, "dir": out},
     }
+
+
+def opensees_models():
+    """bench/opensees_models.py as a module, for the cross-checks against OpenSeesPy; the
+    calling test module is skipped when openseespy cannot be imported (not installed, or
+    installed without its shared library)."""
+    import importlib.util
+
+    try:
+        import openseespy.opensees  # noqa: F401
+    except Exception as exc:  # noqa: BLE001 - any failure to load the library
+        pytest.skip(f"openseespy is not importable: {exc}", allow_module_level=True)
+    if "opensees_models" not in sys.modules:
+        spec = importlib.util.spec_from_file_location("opensees_models",
+                                                      ROOT / "bench" / "opensees_models.py")
+        module = importlib.util.module_from_spec(spec)
+        sys.modules["opensees_models"] = module
+        spec.loader.exec_module(module)
+    return sys.modules["opensees_models"]

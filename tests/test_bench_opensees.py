@@ -11,31 +11,14 @@ openseespy is in the test extra; this file is skipped where it cannot be importe
 
 from __future__ import annotations
 
-import importlib.util
-import sys
-from pathlib import Path
 
 import numpy as np
-import pytest
+from conftest import opensees_models
 
-try:
-    import openseespy.opensees  # noqa: F401
-except ImportError as exc:  # not installed (or installed without its shared library)
-    pytest.skip(f"openseespy is not importable: {exc}", allow_module_level=True)
-
-BENCH = Path(__file__).resolve().parent.parent / "bench"
-
-
-def _models():
-    spec = importlib.util.spec_from_file_location("opensees_models", BENCH / "opensees_models.py")
-    module = importlib.util.module_from_spec(spec)
-    sys.modules.setdefault("opensees_models", module)
-    spec.loader.exec_module(module)
-    return module
 
 
 def test_two_storey_friction_building_peaks_agree_with_opensees():
-    om = _models()
+    om = opensees_models()
     case = om.BuildingCase(2)  # 20 s of the synthetic record, dt1 = 1 ms
     result = case.analysis().run()
     fd_peaks = om.frictiondyn_peaks(result)

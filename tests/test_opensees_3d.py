@@ -14,32 +14,16 @@ displacements and rotations, storey drifts and brace deformations and forces agr
 
 from __future__ import annotations
 
-import importlib.util
-import sys
-from pathlib import Path
 
 import numpy as np
 import pytest
+from conftest import opensees_models
 
-try:
-    import openseespy.opensees  # noqa: F401
-except ImportError as exc:  # not installed (or installed without its shared library)
-    pytest.skip(f"openseespy is not importable: {exc}", allow_module_level=True)
-
-BENCH = Path(__file__).resolve().parent.parent / "bench"
-
-
-def _models():
-    spec = importlib.util.spec_from_file_location("opensees_models", BENCH / "opensees_models.py")
-    module = importlib.util.module_from_spec(spec)
-    sys.modules.setdefault("opensees_models", module)
-    spec.loader.exec_module(module)
-    return module
 
 
 @pytest.fixture(scope="module")
 def case_and_opensees():
-    om = _models()
+    om = opensees_models()
     case = om.Building3DCase(3, duration=5.0, n1=10)  # 15 DOFs, 12 braces, 5000 steps of 1 ms
     return om, case, om.run_opensees_3d(case)
 

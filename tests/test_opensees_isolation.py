@@ -9,21 +9,11 @@ Skipped when openseespy cannot be imported."""
 
 from __future__ import annotations
 
-import sys
-from pathlib import Path
-
 import numpy as np
 import pytest
+from conftest import opensees_models
 
-ROOT = Path(__file__).resolve().parent.parent
-sys.path.insert(0, str(ROOT / "bench"))
-
-try:
-    import openseespy.opensees  # noqa: F401
-except Exception as exc:  # pragma: no cover - depends on the environment
-    pytest.skip(f"openseespy is not importable: {exc}", allow_module_level=True)
-
-from opensees_models import IsolatedBlockCase  # noqa: E402
+IsolatedBlockCase = opensees_models().IsolatedBlockCase
 
 
 @pytest.mark.parametrize("radius, rel", [(0.0, 2e-4), (2.0, 5e-3)], ids=["flat", "pendulum"])
