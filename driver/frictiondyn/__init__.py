@@ -42,6 +42,7 @@ from .model import (
     Spring,
     Storey,
 )
+from .tolerance import ToleranceError
 
 __all__ = [
     "Analysis",
@@ -70,6 +71,7 @@ __all__ = [
     "Spectrum",
     "Spring",
     "Storey",
+    "ToleranceError",
     "__version__",
     "executable",
     "newmark_steps",

@@ -590,6 +590,8 @@ def run(
     dofs: Sequence[int] | None = None,
     devices: Sequence[int] | None = None,
     progress: ProgressCallback | None = None,
+    tolerance: float | None = None,
+    tolerance_floor: float | None = None,
 ) -> Result:
     """Run a namelist deck file and return its Result (no output file is written).
 
@@ -597,8 +599,21 @@ def run(
     the deck's ``&output`` selection of that kind, all by default; the summary covers all). ``progress(t, duration)``: called about twenty times a second. Ctrl-C stops
     the run and raises KeyboardInterrupt. Raises DeckError for a missing, malformed or
     invalid deck, SolverError when the analysis fails.
+
+    ``tolerance`` (or ``tolerance`` in the deck's &integration), with ``tolerance_floor``: a
+    tolerance run (``frictiondyn.tolerance``): the technique and its steps chosen and refined
+    until every estimated peak's error is below it; the summary carries ``estimated_error``,
+    ``estimate_method`` and ``tolerance_run``. Raises ToleranceError when it cannot be met.
     """
-    with Session(deck) as session:
+    if tolerance is not None or tolerance_floor is not None:
+        return _tolerance_run(tolerance, tolerance_floor, deck=deck, dofs=dofs, devices=devices)
+    try:
+        session = Session(deck)
+    except DeckError as exc:
+        if _TOLERANCE_RUN not in str(exc):
+            raise
+        return _tolerance_run(None, None, deck=deck, dofs=dofs, devices=devices)
+    with session:
         if dofs is not None or devices is not None:
             session.select(dofs, devices)
         return session.solve(progress).result()
@@ -611,13 +626,37 @@ def run_text(
     dofs: Sequence[int] | None = None,
     devices: Sequence[int] | None = None,
     progress: ProgressCallback | None = None,
+    tolerance: float | None = None,
+    tolerance_floor: float | None = None,
 ) -> Result:
     """Run a deck given as text. ``name`` names it in messages; a relative record_file is
-    looked up in ``base_dir``; ``dofs``, ``devices``, ``progress`` as for ``run``."""
-    with Session.from_text(text, name, base_dir) as session:
+    looked up in ``base_dir``; ``dofs``, ``devices``, ``progress``, ``tolerance`` and
+    ``tolerance_floor`` as for ``run``."""
+    kw = {"text": text, "name": name, "base_dir": base_dir, "dofs": dofs, "devices": devices}
+    if tolerance is not None or tolerance_floor is not None:
+        return _tolerance_run(tolerance, tolerance_floor, **kw)
+    try:
+        session = Session.from_text(text, name, base_dir)
+    except DeckError as exc:
+        if _TOLERANCE_RUN not in str(exc):
+            raise
+        return _tolerance_run(None, None, **kw)
+    with session:
         if dofs is not None or devices is not None:
             session.select(dofs, devices)
         return session.solve(progress).result()
+
+
+#: the library's words for a deck that gives &integration tolerance (fortran/io/fd_deck.f90)
+_TOLERANCE_RUN = "is a tolerance run"
+
+
+def _tolerance_run(tolerance: float | None, floor: float | None, **deck) -> Result:
+    from .tolerance import tolerance_run
+
+    result, _, session = tolerance_run(tolerance=tolerance, tolerance_floor=floor, **deck)
+    session.close()
+    return result
 
 
 _UNITS_LABEL = {"m/s2": "m/s²"}

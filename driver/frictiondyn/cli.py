@@ -157,11 +157,38 @@ class _ProgressBar:
             self.bar.close()
 
 
+def _tolerance_outputs(args: argparse.Namespace) -> tuple[Result, Path | None, Path]:
+    """A tolerance run: the chosen run written as the executable writes one, its summary with
+    the estimated errors and what was chosen (the summary rewritten whole, then renamed)."""
+    from .tolerance import tolerance_run
+
+    result, report, session = tolerance_run(args.deck, args.tolerance, args.tolerance_floor)
+    with session:
+        csv, summ = session.write(args.out)
+    data = json.loads(summ.read_text())
+    data.update({k: result.summary[k] for k in ("estimated_error", "estimate_method", "tolerance_run")})
+    temp = summ.with_name(summ.name + ".tolerance.tmp")
+    temp.write_text(json.dumps(data, indent=2) + "\n")
+    os.replace(temp, summ)
+    print(str(report))
+    return result, csv, summ
+
+
 def cmd_run(args: argparse.Namespace) -> int:
     trange = _trange(args.t_range)
     from .plots import plot_kinds
 
     kinds = plot_kinds(args.plots)
+    if args.tolerance is not None or args.tolerance_floor is not None or _asks_tolerance(args.deck):
+        with warnings.catch_warnings():
+            warnings.simplefilter("ignore", FrictiondynWarning)
+            result, csv, summ = _tolerance_outputs(args)
+        _print_summary(result, args.deck)
+        if csv is not None:
+            print(f"  history: {csv}")
+        print(f"  summary: {summ}")
+        _plots(args, result, summ, trange, kinds)
+        return 0
     bar = _ProgressBar(sys.stderr.isatty() and not args.quiet)
     with Session(args.deck) as session:  # the deck is read once; the library writes
         # the history goes to its file as the run goes (memory does not grow with the
@@ -179,6 +206,20 @@ def cmd_run(args: argparse.Namespace) -> int:
     if csv is not None:
         print(f"  history: {csv}")
     print(f"  summary: {summ}")
+    _plots(args, result, summ, trange, kinds)
+    return 0
+
+
+def _asks_tolerance(deck: str) -> bool:
+    """Whether a deck gives &integration tolerance (the library refuses it as one setting)."""
+    try:
+        Session(deck).close()
+    except FrictiondynError as exc:
+        return "is a tolerance run" in str(exc)
+    return False
+
+
+def _plots(args: argparse.Namespace, result: Result, summ: Path, trange, kinds) -> None:
     if args.plot:
         from . import plots
 
@@ -192,7 +233,6 @@ def cmd_run(args: argparse.Namespace) -> int:
             kinds=kinds,
         ):
             print(f"  plot: {p}")
-    return 0
 
 
 def cmd_plot(args: argparse.Namespace) -> int:
@@ -408,6 +448,15 @@ def build_parser() -> argparse.ArgumentParser:
     p.add_argument("--quiet", action="store_true", help="no progress bar")
     p.add_argument("--units", **units)
     p.add_argument("--dpi", **dpi)
+    p.add_argument(
+        "--tolerance", type=float, metavar="T",
+        help="a tolerance run: the technique and its steps chosen and refined until the estimated "
+        "error of every peak is below T (relative; docs/namelist.md, &integration tolerance)",
+    )
+    p.add_argument(
+        "--tolerance-floor", type=float, metavar="F",
+        help="a peak is judged against at least F times the largest of its kind (default 0.01)",
+    )
     p.set_defaults(func=cmd_run)
 
     p = sub.add_parser("plot", help="PNGs of a result (.csv or .npz)")

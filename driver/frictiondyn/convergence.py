@@ -171,6 +171,7 @@ class Quantity:
     estimate: Estimate | None = None  #: its step error (the quantities of ESTIMATED)
     #: the error of a regularized law's eps or f, from the law levels (at the finest step)
     law_estimate: Estimate | None = None
+    index: int = 0  #: the item's place in the summary's list (0 for a scalar)
 
     @property
     def error(self) -> float | None:
@@ -455,7 +456,8 @@ def _claims(estimate: Estimate, tol: float) -> bool:
 
 
 def _compare(
-    summaries: list[dict], rtol: float, factor: int = 2, law_summaries: Sequence[dict] = ()
+    summaries: list[dict], rtol: float, factor: int = 2, law_summaries: Sequence[dict] = (),
+    floor_share: float = FLOOR,
 ) -> list[Quantity]:
     out = []
     for key, what, unit, kind, peak_key in _GROUPS:
@@ -468,7 +470,7 @@ def _compare(
         n = len(rows[0])
         if n == 0 or any(len(r) != n for r in rows):
             continue
-        floor = FLOOR * max(abs(x) for r in rows for x in r)
+        floor = floor_share * max(abs(x) for r in rows for x in r)
         peaks = None
         if peak_key is not None:  # a residual: judged against the peak of the same item
             peaks = [p if isinstance(p, list) else [p] for p in (s[peak_key] for s in summaries)]
@@ -488,7 +490,7 @@ def _compare(
                 if len(values) >= 3:  # from two levels, the change is all there is to judge
                     agrees = agrees and error <= tol and _claims(estimate, tol) and (
                         law is None or _claims(law, tol))
-            out.append(Quantity(key, what, item, unit, values, size, tol, agrees, estimate, law))
+            out.append(Quantity(key, what, item, unit, values, size, tol, agrees, estimate, law, i))
     for key, what in _COUNTS:
         if any(key not in s for s in summaries):
             continue

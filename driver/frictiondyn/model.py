@@ -350,6 +350,8 @@ class Integration:
     dt_min: float | None = None
     theta: float | None = None
     refinement: str | None = None
+    tolerance: float | None = None  #: a tolerance run (frictiondyn.tolerance)
+    tolerance_floor: float | None = None
 
     def group(self) -> dict:
         g: dict = {}
@@ -365,6 +367,8 @@ class Integration:
             dt_min=self.dt_min,
             theta=self.theta,
             refinement=self.refinement,
+            tolerance=self.tolerance,
+            tolerance_floor=self.tolerance_floor,
         )
         return g
 
@@ -597,6 +601,7 @@ class Analysis:
     isolators: list[SlidingIsolator] = field(default_factory=list)
     storeys: list[Storey] = field(default_factory=list)
     labels: list[str] | None = None  #: a name per DOF ('floor 3')
+    tolerance: float | None = None  #: a tolerance run: Integration's tolerance, given here
 
     def namelist(
         self, directory: Path | None = None, cwd: Path | None = None, record_name: str | None = None
@@ -722,7 +727,7 @@ class Analysis:
         values is the caller's, relative to the current working directory). ``dofs``,
         ``devices``, ``progress``: as for ``frictiondyn.run`` (each None: the ``output``'s
         history_dofs, history_devices)."""
-        kw = {"dofs": dofs, "devices": devices, "progress": progress}
+        kw = {"dofs": dofs, "devices": devices, "progress": progress, "tolerance": self.tolerance}
         cwd = Path.cwd()
         if not isinstance(self.excitation, Record) or self.excitation.values is None:
             text = self.deck_text(None, cwd)

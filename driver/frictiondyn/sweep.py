@@ -141,7 +141,8 @@ DECK_VARIABLES: dict[str, tuple[str, ...]] = {
                     "dt_record", "record_file", "record_kind", "record_scale", "record_format",
                     "record_units"),
     "integration": ("technique", "beta", "gamma", "n1", "n2", "n", "check_correctness",
-                    "dt_min", "theta", "linear_system", "refinement"),
+                    "dt_min", "theta", "linear_system", "refinement", "tolerance",
+                    "tolerance_floor"),
     "output": ("dir", "name", "output_every", "write_history", "history_dofs",
                "history_devices", "n_modes", "max_history_mb"),
 }

@@ -778,21 +778,23 @@ contains
       type(run_config), intent(inout) :: cfg
       type(error_type), allocatable, intent(out) :: error
       character(len=name_len) :: technique, linear_system, refinement
-      real(dp) :: beta, gamma, n, dt_min, theta
+      real(dp) :: beta, gamma, n, dt_min, theta, tolerance, tolerance_floor
       integer :: n1, n2
       logical :: check_correctness
       namelist /integration/ technique, beta, gamma, n1, n2, n, check_correctness, dt_min, theta, linear_system, &
-                             refinement
+                             refinement, tolerance, tolerance_floor
       type(group_text) :: grp
       character(len=512) :: msg
       integer :: ios, technique_id, system_id, refinement_id
-      logical :: found, more
+      logical :: found, more, given_tol, given_floor
 
       technique = technique_name(default_technique)
       linear_system = linear_systems(default_linear_system)%name
       refinement = refinements(default_refinement)%name
       beta = default_beta; gamma = default_gamma; n1 = default_n1; n2 = default_n2; n = default_n
       check_correctness = default_check_correctness; dt_min = default_dt_min; theta = default_theta
+      tolerance = 0.0_dp; tolerance_floor = 0.0_dp
+      given_tol = .false.; given_floor = .false.
       call find_group(deck, 'integration', grp, found, error)
       if (allocated(error)) return
       if (found) then
@@ -806,6 +808,8 @@ contains
             if (.not. more) exit
          end do
          if (allocated(error)) return
+         given_tol = is_given(grp, 'tolerance')
+         given_floor = is_given(grp, 'tolerance_floor')
       end if
       call keyword_value(deck, 'integration', 'technique', techniques, technique, technique_id, error)
       if (allocated(error)) return
@@ -833,6 +837,8 @@ contains
       if (allocated(error)) return
       call check_real(deck, 'integration', 'theta', theta, 0.5_dp, 1.0_dp, '', error)
       if (allocated(error)) return
+      call refuse_tolerance(deck, tolerance, given_tol, tolerance_floor, given_floor, error)
+      if (allocated(error)) return
       ! the run takes duration / dt1 steps, counted in a default integer
       if (cfg%exc%duration/(cfg%exc%dt_record/n1) > 2.0e9_dp) then
          call bad(deck, 'integration', 'n1', trim(fmt_int(n1)), 'such that duration / (dt_record / n1) = '// &
@@ -853,6 +859,29 @@ contains
       cfg%opts%linear_system = system_id
       cfg%opts%refinement = refinement_id
    end subroutine read_integration_group
+
+   !> A tolerance run (tolerance, tolerance_floor of &integration) chooses the technique and
+   !> refines it from Python (frictiondyn.tolerance): this reader runs one setting, so a deck
+   !> that gives either is refused, its values validated first.
+   subroutine refuse_tolerance(deck, tolerance, given_tol, tolerance_floor, given_floor, error)
+      type(deck_text), intent(in) :: deck
+      real(dp), intent(in) :: tolerance, tolerance_floor
+      logical, intent(in) :: given_tol, given_floor            !! each given in the deck's text
+      type(error_type), allocatable, intent(out) :: error
+      character(len=*), parameter :: how = ' is a tolerance run, made by Python: python -m frictiondyn run '// &
+         'DECK (or frictiondyn.run); this executable and the session run one setting of the deck'
+      if (given_tol) then
+         call check_real(deck, 'integration', 'tolerance', tolerance, 0.0_dp, 1.0_dp, '', error, &
+                         open_lo=.true., open_hi=.true.)
+         if (allocated(error)) return
+         call fatal_error(error, deck%path//', group &integration: tolerance = '//trim(fmt_real(tolerance))//how)
+      else if (given_floor) then
+         call check_real(deck, 'integration', 'tolerance_floor', tolerance_floor, 0.0_dp, 1.0_dp, '', error)
+         if (allocated(error)) return
+         call fatal_error(error, deck%path//', group &integration: tolerance_floor = '// &
+                          trim(fmt_real(tolerance_floor))//how)
+      end if
+   end subroutine refuse_tolerance
 
    ! ---------------------------------------------------------------- &output
    subroutine read_output_group(deck, cfg, error)

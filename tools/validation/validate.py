@@ -286,7 +286,9 @@ def main(outdir: str | Path, progress=None) -> Path:
     lines[intro_end:intro_end] = summary
     mj_section(lines, figs, subplots, step)
     path = out / "validation.md"
-    path.write_text("\n".join(lines) + "\n")
+    old = path.read_text() if path.exists() else ""  # section 7 is bench/tolerance.py's: kept
+    kept = old[old.index("\n## 7. "):] if "\n## 7. " in old else ""
+    path.write_text("\n".join(lines) + "\n" + kept)
     return path
 
 
