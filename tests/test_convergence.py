@@ -195,11 +195,12 @@ def test_ctrl_c_stops_every_level(tmp_path):
         [sys.executable, "-m", "frictiondyn", "converge", str(deck), "--levels", "2"],
         stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True,
     )
-    # the imports done (the extension mapped: under load they take seconds), then the deck
-    # read and the levels started
+    # the imports done (frictiondyn's extension mapped, not numpy's own _core folder: under
+    # load the imports take seconds), then the deck read and the levels started
     maps = Path(f"/proc/{proc.pid}/maps")
     limit = time.monotonic() + 60.0
-    while proc.poll() is None and time.monotonic() < limit and "_core" not in maps.read_text():
+    while (proc.poll() is None and time.monotonic() < limit
+           and "frictiondyn/_core" not in maps.read_text()):
         time.sleep(0.05)
     time.sleep(1.0)
     assert proc.poll() is None, proc.communicate()
