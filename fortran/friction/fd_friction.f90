@@ -268,18 +268,24 @@ contains
       type(device_state), intent(in) :: st(:)
       type(device_state), intent(inout) :: st1(:)
       logical, intent(inout) :: changed(:), ok(:)
-      type(device_state) :: pair(2)
+      type(device_state) :: pair(2), pair0(2)
+      real(dp) :: x1(2), v1(2), v0(2)
       logical :: ch(2), good
 
-      pair = st(pq)
+      ! local copies: no array temporary for a vector subscript in a call
+      pair0 = st(pq)
+      pair = pair0
+      x1 = s1(pq)
+      v1 = sd1(pq)
+      v0 = sd(pq)
       good = .true.
       select case (dev%law)
       case (law_hysteretic)
-         call planar_hysteretic_update(dev, s1(pq), sd1(pq), pair, ch)
-         good = planar_hysteretic_correct(dev, n, st(pq), sd(pq), sd1(pq))
+         call planar_hysteretic_update(dev, x1, v1, pair, ch)
+         good = planar_hysteretic_correct(dev, n, pair0, v0, v1)
       case (law_velocity)
-         call planar_velocity_update(dev, s1(pq), sd1(pq), pair, ch)
-         good = planar_velocity_correct(dev, n, st(pq), sd(pq), sd1(pq))
+         call planar_velocity_update(dev, x1, v1, pair, ch)
+         good = planar_velocity_correct(dev, n, pair0, v0, v1)
       case default
          ch = .false.
       end select
@@ -358,20 +364,24 @@ contains
       type(device_state), intent(in) :: st0(:), st1(:)
       type(device_state), intent(inout) :: st(:)
       logical, intent(out) :: can
-      type(device_state) :: pair(2)
+      type(device_state) :: pair(2), pair0(2), pair1(2)
+      real(dp) :: v1(2)
 
       can = .true.
-      if (all(st1(pq)%phase == st0(pq)%phase)) then
-         st(pq) = st0(pq)
+      pair0 = st0(pq)
+      pair1 = st1(pq)
+      v1 = sd1(pq)
+      if (pair1(1)%phase == pair0(1)%phase .and. pair1(2)%phase == pair0(2)%phase) then
+         st(pq) = pair0
          return
       end if
       select case (dev%law)
       case (law_hysteretic)
-         call planar_hysteretic_settle(dev, sd1(pq), st0(pq), st1(pq), pair, can)
+         call planar_hysteretic_settle(dev, v1, pair0, pair1, pair, can)
       case (law_velocity)
-         call planar_velocity_settle(st0(pq), st1(pq), pair, can)
+         call planar_velocity_settle(pair0, pair1, pair, can)
       case default
-         pair = st0(pq)
+         pair = pair0
          can = .false.
       end select
       st(pq) = pair
@@ -438,11 +448,15 @@ contains
       integer, intent(in) :: d                  !! the component
       real(dp), intent(in) :: sd1(:)            !! relative velocities [m/s]
       type(device_state), intent(in) :: st(:)   !! states during the step
+      type(device_state) :: pair(2)
+      real(dp) :: v1(2)
       integer :: pq(2)
 
       pq = [d, dev(d)%partner]
       if (dev(d)%component == 2) pq = [dev(d)%partner, d]
-      f0 = planar_velocity_follow(dev(pq(1)), sd1(pq), st(pq), dev(d)%component)
+      pair = st(pq)
+      v1 = sd1(pq)
+      f0 = planar_velocity_follow(dev(pq(1)), v1, pair, dev(d)%component)
    end function planar_follow
 
    !> Initial phase and force coefficients of every device; an error for a device whose
@@ -477,13 +491,16 @@ contains
       real(dp), intent(in) :: s(:), sdot(:)
       type(device_state), intent(inout) :: st(:)
       type(device_state) :: pair(2)
+      real(dp) :: x(2), v(2)
 
+      x = s(pq)
+      v = sdot(pq)
       select case (dev%law)
       case (law_hysteretic)
-         call planar_hysteretic_init(dev, s(pq), sdot(pq), pair)
+         call planar_hysteretic_init(dev, x, v, pair)
          st(pq) = pair
       case (law_velocity)
-         call planar_velocity_init(dev, s(pq), sdot(pq), pair)
+         call planar_velocity_init(dev, x, v, pair)
          st(pq) = pair
       end select
    end subroutine planar_init
