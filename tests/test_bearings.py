@@ -90,15 +90,15 @@ A0 = 1.0               # Rayleigh a0: C = a0 M [1/s], damps the start's transien
 AMP = 2.0 * MU * G / W**2   # table orbit radius: |a_g| = 2 mu g
 
 
-def orbit_radius() -> float:
+def orbit_radius(mu: float = MU) -> float:
     """The steady orbit of m z'' + c z' + k z = -m a_g - mu m g z'/|z'| with a_g the circular
     motion A w^2 (cos, sin): z = Z e^{iwt}, z'/|z'| = i Z/|Z|, so with Z = R e^{i phi}
     ((k - m w^2) R + i (c w R + mu m g)) e^{i phi} = m A w^2 e^{i psi}: the magnitudes give
     (k - m w^2)^2 R^2 + (c w R + mu m g)^2 = (m A w^2)^2, a quadratic in R."""
     c = A0 * M
     qa = (K - M * W**2) ** 2 + (c * W) ** 2
-    qb = 2.0 * c * W * MU * M * G
-    qc = (MU * M * G) ** 2 - (M * AMP * W**2) ** 2
+    qb = 2.0 * c * W * mu * M * G
+    qc = (mu * M * G) ** 2 - (M * AMP * W**2) ** 2
     return (-qb + math.sqrt(qb * qb - 4.0 * qa * qc)) / (2.0 * qa)
 
 
@@ -115,7 +115,7 @@ def circular_run(tmp_path, bearing: dict, dt_record: float, n1: int) -> float:
         "matrices": matrices(tmp_path, K, M, True),
         "damping": {"damping_type": "rayleigh", "rayleigh_a0": A0, "rayleigh_a1": 0.0},
         "bearings": {"n_bearings": 1, "dof_xi": 1, "dof_yi": 2, "dof_xj": 0, "dof_yj": 0,
-                     "p": M * G, "mu": MU, **bearing},
+                     "p": M * G, **({} if "mu_law" in bearing else {"mu": MU}), **bearing},
         "excitation": {**rec, "record_file": "ax.txt"},
         "excitation2": {**rec, "record_file": "ay.txt"},
         "integration": {"n1": n1},
@@ -149,6 +149,20 @@ def test_circular_orbit_hysteretic_law_converges_with_f(tmp_path):
     assert errors[-1] < 1.5e-2
     orders = [math.log2(errors[k] / errors[k + 1]) for k in range(2)]
     assert all(0.8 < q < 1.2 for q in orders), (errors, orders)
+
+
+def test_circular_orbit_speed_dependent_mu_at_the_resultant_speed(tmp_path):
+    """mu(|v|) = mu_max - (mu_max - mu_min) exp(-rate |v|) taken at the resultant speed: the
+    steady orbit is the closed form's with mu = mu(R w), R and mu found together (a fixed
+    point); the step's first-order error (8e-4 at n1 = 8, the test above) bounds the gap."""
+    law = {"law": "velocity", "eps": 1.0e-4, "mu_law": "exponential", "mu_max": 0.1, "mu_min": 0.05,
+           "mu_rate": 5.0}
+    r = 0.05
+    for _ in range(60):
+        mu = 0.1 - 0.05 * math.exp(-5.0 * r * W)
+        r = orbit_radius(mu)
+    got = circular_run(tmp_path, law, 0.004, 8)
+    assert abs(got - r) / r < 1.5e-3, (got, r)
 
 
 # ---------------------------------------------------------------- friction pendulum
@@ -275,3 +289,18 @@ def test_base_mat_on_four_bearings_of_rigid_floors(tmp_path):
         angle = res.summary["bearing_peak_direction_deg"][b]
         assert min(abs(angle - 30.0), abs(angle + 150.0)) < 1.0
     assert abs(res.summary["energy_residual_ratio"]) < 1.0e-9
+
+
+def test_a_bearing_on_one_dof_for_both_directions_is_refused(tmp_path):
+    groups = {
+        "model": {"n_dof": 3, "mass": [M, M, M]},
+        "springs": {"n_springs": 1, "node_i": [3], "node_j": [0], "k": [1.0e5]},
+        "damping": {"damping_type": "none"},
+        "bearings": {"n_bearings": 1, "dof_xi": 1, "dof_yi": 2, "dof_xj": 3, "dof_yj": 3,
+                     "p": M * G, "mu": 0.1},
+        "excitation": {"excitation_type": "harmonic", "amplitude": 0.05, "frequency": 1.0,
+                       "dt_record": 0.01, "duration": 1.0},
+        "output": {"dir": "out"},
+    }
+    with pytest.raises(FrictiondynError, match=r"&bearings.*dof_yj\(1\) = 1, 2, 3, 3"):
+        frictiondyn.run_text(deck_text(groups), "bad.nml", tmp_path)

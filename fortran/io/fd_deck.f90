@@ -1784,10 +1784,12 @@ contains
          if (allocated(error)) return
       end if
       if (.not. floors) then
-         if (dofs(1) == dofs(3) .or. dofs(2) == dofs(4) .or. dofs(1) == dofs(2)) then
+         if (dofs(1) == dofs(3) .or. dofs(2) == dofs(4) .or. dofs(1) == dofs(2) .or. &
+             (dofs(3) == dofs(4) .and. dofs(3) > 0)) then
             call bad(deck, 'bearings', 'dof_xi'//idx//', dof_yi'//idx//', dof_xj'//idx//', dof_yj'//idx, &
                      trim(fmt_int(dofs(1)))//', '//trim(fmt_int(dofs(2)))//', '//trim(fmt_int(dofs(3)))//', '// &
-                     trim(fmt_int(dofs(4))), 'dof_xi /= dof_yi, dof_xi /= dof_xj and dof_yi /= dof_yj', error)
+                     trim(fmt_int(dofs(4))), 'dof_xi /= dof_yi, dof_xi /= dof_xj, dof_yi /= dof_yj, and '// &
+                     'dof_xj /= dof_yj unless both are 0 (the table)', error)
             return
          end if
       end if
