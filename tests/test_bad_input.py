@@ -245,6 +245,7 @@ CONTEXTS = {
                            "duration": 0.1}),
     "hysteretic": ("friction", {"law": "hysteretic", "f": 1.0e-5}),
     "hysteretic isolator": ("isolators", {"law": "hysteretic", "f": 1.0e-5}),
+    "hysteretic bearing": ("bearings", {"law": "hysteretic", "f": 1.0e-5}),
 }
 USED_IN = {
     ("damping", "rayleigh_a0"): ["rayleigh"], ("damping", "rayleigh_a1"): ["rayleigh"],
@@ -262,6 +263,7 @@ USED_IN = {
     ("excitation", "duration"): [None, "record", "at2"],
     ("friction", "f"): ["hysteretic"], ("friction", "eps1"): ["hysteretic"],
     ("isolators", "f"): ["hysteretic isolator"], ("isolators", "eps1"): ["hysteretic isolator"],
+    ("bearings", "f"): ["hysteretic bearing"], ("bearings", "eps1"): ["hysteretic bearing"],
 }
 
 
@@ -315,6 +317,9 @@ def deck_with(group: str, var: str, context: str | None, value) -> tuple[dict, d
     deck gives a list), and the deck that does not give that element (what a value taken for
     "not given" ran as)."""
     g = floor_groups() if group in FLOOR_GROUPS else matrix_groups() if group == "matrices" else base_groups()
+    if group == "bearings":  # a planar bearing under both masses (x: mass 1, y: mass 2)
+        g["bearings"] = {"n_bearings": 1, "dof_xi": 1, "dof_yi": 2, "dof_xj": 0, "dof_yj": 0,
+                         "law": "velocity", "p": 24.8, "mu": 0.1, "radius": 2.0}
     if context == "floor inertia":
         g["floors"].pop("plan_x")
         g["floors"].pop("plan_y")
@@ -382,6 +387,7 @@ USED = {
     ("braces", "eps1"): _runs,
     ("isolators", "eps1"): _runs,
     ("floor_braces", "eps1"): _runs,
+    ("bearings", "eps1"): _runs,
 }
 
 

@@ -44,6 +44,8 @@ module fd_device_state
       integer :: phase = phase_stick   !! stick, slip + or slip -
       real(dp) :: centre = 0.0_dp      !! hysteretic law: s at which the elastic force is zero [m]
       logical :: armed = .false.       !! hysteretic law: |sdot| has reached eps1 in this slip
+      real(dp) :: dir = 0.0_dp         !! a planar bearing's component: its component of the
+                                       !! unit sliding direction while it slides (fd_friction_planar)
       real(dp) :: ks = 0.0_dp          !! stiffness in this phase [N/m]
       real(dp) :: cs = 0.0_dp          !! damping in this phase [N s/m]
       real(dp) :: f0 = 0.0_dp          !! constant force in this phase [N]

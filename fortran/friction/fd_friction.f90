@@ -18,6 +18,9 @@ module fd_friction
    use fd_friction_hysteretic, only: hysteretic_law, hysteretic_update, hysteretic_correct, hysteretic_settle, &
                                      hysteretic_energy, hysteretic_traits, hysteretic_stiffness, hysteretic_holds
    use fd_friction_coulomb, only: coulomb_traits, coulomb_holds
+   use fd_friction_planar, only: planar_velocity_update, planar_velocity_init, planar_velocity_correct, &
+                                 planar_velocity_follow, planar_velocity_settle, planar_hysteretic_update, &
+                                 planar_hysteretic_init, planar_hysteretic_correct, planar_hysteretic_settle
    implicit none
    private
 
@@ -230,6 +233,14 @@ contains
       any_changed = .false.
       any_bad = .false.
       do d = 1, nd
+         if (dev(d)%partner > 0) then
+            ! a planar bearing: its two components together, once
+            if (dev(d)%partner < d) cycle
+            call planar_step(dev(d), n, [d, dev(d)%partner], s1, sd1, sd, st, st1, changed, ok)
+            any_changed = any_changed .or. changed(d) .or. changed(dev(d)%partner)
+            any_bad = any_bad .or. .not. ok(d)
+            cycle
+         end if
          st1(d) = st(d)
          select case (dev(d)%law)
          case (law_hysteretic)
@@ -245,6 +256,43 @@ contains
          any_bad = any_bad .or. .not. ok(d)
       end do
    end subroutine friction_step
+
+   !> friction_step for a planar bearing, the devices pq = (x, y) components: the phases for the
+   !> next step and the correctness condition on the resultant (fd_friction_planar), the same
+   !> verdict for both components.
+   pure subroutine planar_step(dev, n, pq, s1, sd1, sd, st, st1, changed, ok)
+      type(device_type), intent(in) :: dev      !! the bearing's parameters (its x component)
+      real(dp), intent(in) :: n                 !! n > 1 of the correctness condition
+      integer, intent(in) :: pq(2)              !! its two devices
+      real(dp), intent(in) :: s1(:), sd1(:), sd(:)
+      type(device_state), intent(in) :: st(:)
+      type(device_state), intent(inout) :: st1(:)
+      logical, intent(inout) :: changed(:), ok(:)
+      type(device_state) :: pair(2), pair0(2)
+      real(dp) :: x1(2), v1(2), v0(2)
+      logical :: ch(2), good
+
+      ! local copies: no array temporary for a vector subscript in a call
+      pair0 = st(pq)
+      pair = pair0
+      x1 = s1(pq)
+      v1 = sd1(pq)
+      v0 = sd(pq)
+      good = .true.
+      select case (dev%law)
+      case (law_hysteretic)
+         call planar_hysteretic_update(dev, x1, v1, pair, ch)
+         good = planar_hysteretic_correct(dev, n, pair0, v0, v1)
+      case (law_velocity)
+         call planar_velocity_update(dev, x1, v1, pair, ch)
+         good = planar_velocity_correct(dev, n, pair0, v0, v1)
+      case default
+         ch = .false.
+      end select
+      st1(pq) = pair
+      changed(pq) = ch
+      ok(pq) = good
+   end subroutine planar_step
 
    !> friction_step for one device of a law without a case of its own there: the update and
    !> the correctness condition through `dispatch`.
@@ -284,6 +332,12 @@ contains
 
       can = .true.
       do d = 1, nd
+         if (dev(d)%partner > 0) then
+            if (dev(d)%partner < d) cycle
+            call planar_settle(dev(d), [d, dev(d)%partner], sd1, st0, st1, st, ok)
+            can = can .and. ok
+            cycle
+         end if
          if (st1(d)%phase == st0(d)%phase) then
             st(d) = st0(d)
             cycle
@@ -300,6 +354,38 @@ contains
          can = can .and. ok
       end do
    end subroutine friction_settle
+
+   !> friction_settle for a planar bearing, the devices pq = (x, y): both keep their start's
+   !> states when neither changes phase, else the law's planar settle decides for both.
+   pure subroutine planar_settle(dev, pq, sd1, st0, st1, st, can)
+      type(device_type), intent(in) :: dev      !! the bearing's parameters (its x component)
+      integer, intent(in) :: pq(2)              !! its two devices
+      real(dp), intent(in) :: sd1(:)
+      type(device_state), intent(in) :: st0(:), st1(:)
+      type(device_state), intent(inout) :: st(:)
+      logical, intent(out) :: can
+      type(device_state) :: pair(2), pair0(2), pair1(2)
+      real(dp) :: v1(2)
+
+      can = .true.
+      pair0 = st0(pq)
+      pair1 = st1(pq)
+      v1 = sd1(pq)
+      if (pair1(1)%phase == pair0(1)%phase .and. pair1(2)%phase == pair0(2)%phase) then
+         st(pq) = pair0
+         return
+      end if
+      select case (dev%law)
+      case (law_hysteretic)
+         call planar_hysteretic_settle(dev, v1, pair0, pair1, pair, can)
+      case (law_velocity)
+         call planar_velocity_settle(pair0, pair1, pair, can)
+      case default
+         pair = pair0
+         can = .false.
+      end select
+      st(pq) = pair
+   end subroutine planar_settle
 
    !> Elastic energy a device stores at relative displacement s in its state [J] (a law whose
    !> traits say stores_energy: the hysteretic law's spring; the velocity law stores none: its
@@ -343,12 +429,35 @@ contains
          d = fl(q)
          select case (dev(d)%law)
          case (law_velocity)
-            df(q) = velocity_follow(dev(d), sd1(d), st(d)) - st(d)%f0
+            if (dev(d)%partner > 0) then
+               ! a planar bearing's component: mu at the resultant speed, along its direction
+               df(q) = planar_follow(dev, d, sd1, st) - st(d)%f0
+            else
+               df(q) = velocity_follow(dev(d), sd1(d), st(d)) - st(d)%f0
+            end if
          case default
             df(q) = 0.0_dp
          end select
       end do
    end subroutine friction_follow
+
+   !> The velocity law's sliding force of component d of a planar bearing at the velocities sd1
+   !> (planar_velocity_follow, the bearing's parameters those of its x component).
+   pure real(dp) function planar_follow(dev, d, sd1, st) result(f0)
+      type(device_type), intent(in) :: dev(:)   !! all devices
+      integer, intent(in) :: d                  !! the component
+      real(dp), intent(in) :: sd1(:)            !! relative velocities [m/s]
+      type(device_state), intent(in) :: st(:)   !! states during the step
+      type(device_state) :: pair(2)
+      real(dp) :: v1(2)
+      integer :: pq(2)
+
+      pq = [d, dev(d)%partner]
+      if (dev(d)%component == 2) pq = [dev(d)%partner, d]
+      pair = st(pq)
+      v1 = sd1(pq)
+      f0 = planar_velocity_follow(dev(pq(1)), v1, pair, dev(d)%component)
+   end function planar_follow
 
    !> Initial phase and force coefficients of every device; an error for a device whose
    !> law is not a regularized law of this dispatch.
@@ -362,6 +471,10 @@ contains
       integer :: d
 
       do d = 1, size(dev)
+         if (dev(d)%partner > 0) then
+            if (dev(d)%partner > d) call planar_init(dev(d), [d, dev(d)%partner], s, sdot, st)
+            if (dev(d)%law == law_velocity .or. dev(d)%law == law_hysteretic) cycle
+         end if
          call dispatch(job_init, dev(d), 0.0_dp, s(d), sdot(d), 0.0_dp, st(d), changed, ok, known)
          if (.not. known) then
             call fatal_error(error, "device "//trim(fmt_int(d))//": friction law '"//trim(law_name(dev(d)%law))// &
@@ -370,6 +483,27 @@ contains
          end if
       end do
    end subroutine friction_init
+
+   !> Initial states of a planar bearing's components pq = (x, y).
+   pure subroutine planar_init(dev, pq, s, sdot, st)
+      type(device_type), intent(in) :: dev      !! the bearing's parameters (its x component)
+      integer, intent(in) :: pq(2)              !! its two devices
+      real(dp), intent(in) :: s(:), sdot(:)
+      type(device_state), intent(inout) :: st(:)
+      type(device_state) :: pair(2)
+      real(dp) :: x(2), v(2)
+
+      x = s(pq)
+      v = sdot(pq)
+      select case (dev%law)
+      case (law_hysteretic)
+         call planar_hysteretic_init(dev, x, v, pair)
+         st(pq) = pair
+      case (law_velocity)
+         call planar_velocity_init(dev, x, v, pair)
+         st(pq) = pair
+      end select
+   end subroutine planar_init
 
    !> Phase of a device for the next step, from the state at the end of this one.
    elemental subroutine friction_update(dev, s, sdot, st, changed)

@@ -30,10 +30,10 @@ module fd_deck
    use fd_excitation, only: excitation_type
    use fd_record, only: read_record, record_info, record_formats, record_units_list, units_factor
    use fd_names, only: label_len, max_mu_points, mu_laws, mu_constant, mu_exponential, mu_table, mode_systems, &
-                       system_stuck, law_hysteretic, &
+                       system_stuck, law_hysteretic, law_velocity, &
                        default_mu_law, default_mode_system, default_n_modes, default_radius, default_modal_modes, &
                        default_storey_height, law_name
-   use fd_model, only: source_friction, source_brace, source_isolator, source_floor_brace
+   use fd_model, only: source_friction, source_brace, source_isolator, source_floor_brace, source_bearing
    use fd_floors, only: floor_dof, plan_direction, floor_inertia, max_plan_terms
    use fd_stiffness, only: add_general_entry, add_general_dense
    use fd_matrix_market, only: sparse_matrix, read_matrix_market
@@ -141,7 +141,7 @@ contains
       cfg%deck_path = deck%path
       call check_groups(deck, [character(len=12) :: 'model', 'springs', 'damping', 'friction', &
                                'braces', 'isolators', 'storeys', 'floors', 'frames', 'floor_braces', &
-                               'matrices', 'excitation', 'excitation2', 'integration', 'output'], error)
+                               'matrices', 'excitation', 'excitation2', 'integration', 'output', 'bearings'], error)
       if (allocated(error)) return
       ! the DOFs: a building of rigid floors (&floors, &frames), a structure's matrices
       ! (&matrices), or masses (&model, &springs)
@@ -180,6 +180,9 @@ contains
       end if
       ! the braces at plan positions of rigid floors: devices of any direction
       if (floors) call read_floor_braces_group(deck, cfg, error)
+      if (allocated(error)) return
+      ! planar bearings: two devices each, of any direction
+      call read_bearings_group(deck, cfg, floors, error)
       if (allocated(error)) return
       call read_excitation_group(deck, cfg, error)
       if (allocated(error)) return
@@ -1611,6 +1614,279 @@ contains
          end do
       end do
    end subroutine read_floor_braces_group
+
+   ! ---------------------------------------------------------------- &bearings
+   !> Planar sliding bearings: bearing i is two devices, its components along x and y, that
+   !> name each other (partner) and slide together on the resultant (fd_friction_planar). In
+   !> a building of rigid floors it stands at the plan point (x, y) of storey s (between floor
+   !> s and floor s - 1, the ground for s = 1); in a model of masses or matrices it joins the
+   !> DOFs dof_xi, dof_yi to dof_xj, dof_yj (0: the table). p defaults, for rigid floors, to the
+   !> weight of the floors it carries shared among the bearings of its storey. radius > 0: a
+   !> friction pendulum, the restoring stiffness p / radius along both components.
+   subroutine read_bearings_group(deck, cfg, floors, error)
+      type(deck_text), intent(in) :: deck
+      type(run_config), intent(inout) :: cfg
+      logical, intent(in) :: floors                      !! a building of rigid floors
+      type(error_type), allocatable, intent(out) :: error
+      integer :: n_bearings
+      integer, allocatable :: storey(:), dof_xi(:), dof_yi(:), dof_xj(:), dof_yj(:), mu_ids(:)
+      real(dp), allocatable :: x(:), y(:), p(:), mu(:), radius(:), eps(:), eps1(:), f(:)
+      real(dp), allocatable :: mu_max(:), mu_min(:), mu_rate(:), mu_table_v(:, :), mu_table_mu(:, :)
+      character(len=name_len), allocatable :: law(:), mu_law(:)
+      character(len=label_len), allocatable :: label(:)
+      logical, allocatable :: g_mu(:), g_table(:, :), g_p(:)
+      namelist /bearings/ n_bearings, storey, x, y, dof_xi, dof_yi, dof_xj, dof_yj, law, p, mu, radius, eps, &
+         eps1, f, mu_law, mu_max, mu_min, mu_rate, mu_table_v, mu_table_mu, label
+      type(group_text) :: grp
+      character(len=512) :: msg
+      integer :: ios, i, n
+      logical :: found, more
+
+      n_bearings = 0
+      call find_group(deck, 'bearings', grp, found, error)
+      if (allocated(error) .or. .not. found) return
+      i = array_capacity(grp, 'n_bearings', max_devices/2)
+      allocate (storey(i), dof_xi(i), dof_yi(i), dof_xj(i), dof_yj(i), x(i), y(i), p(i), mu(i), radius(i), &
+                eps(i), eps1(i), f(i), law(i), stat=ios)
+      if (ios == 0) call new_mu_inputs(i, mu_law, mu_max, mu_min, mu_rate, mu_table_v, mu_table_mu, label, ios)
+      if (ios /= 0) then
+         call no_memory(deck, 'bearings', i, 'bearings', error); return
+      end if
+      storey = unset_int; dof_xi = unset_int; dof_yi = unset_int; dof_xj = unset_int; dof_yj = unset_int
+      x = unset; y = unset; p = unset; mu = unset; radius = unset; eps = unset; eps1 = unset; f = unset
+      law = 'velocity'
+      ! a label and its components' ' x', ' y' within label_len - 1
+      call check_length(deck, grp, 'label', label_len - 3, error)
+      if (.not. allocated(error)) call check_length(deck, grp, 'law', name_len, error)
+      if (.not. allocated(error)) call check_length(deck, grp, 'mu_law', name_len, error)
+      if (allocated(error)) return
+      do
+         read (grp%lines, nml=bearings, iostat=ios, iomsg=msg)
+         call next_read(deck, grp, ios, msg, more, error)
+         if (.not. more) exit
+      end do
+      if (allocated(error)) return
+      call need_int(deck, 'bearings', 'n_bearings', n_bearings, .true., 0, (max_devices - cfg%model%n_devices)/2, &
+                    error)
+      if (allocated(error)) return
+      n = n_bearings
+      call bearing_places(deck, grp, cfg, floors, n, storey, x, y, dof_xi, dof_yi, dof_xj, dof_yj, error)
+      if (allocated(error)) return
+      g_mu = given_of(grp, 'mu', size(mu))
+      call read_mu_laws(deck, grp, n, mu_law, mu, g_mu, mu_max, mu_min, mu_rate, mu_table_v, mu_table_mu, &
+                        mu_ids, g_table, error)
+      if (allocated(error)) return
+      call need_reals(deck, 'bearings', 'mu', mu, g_mu, n, '', error, positive=.false.)
+      if (allocated(error)) return
+      g_p = given_of(grp, 'p', size(p))
+      if (floors) call gravity_shares(cfg%model, n, storey, g_p, p)
+      call need_reals(deck, 'bearings', 'p', p, g_p, n, 'N', error, positive=.true.)
+      if (allocated(error)) return
+      call optional_reals(deck, 'bearings', 'radius', radius, given_of(grp, 'radius', size(radius)), n, &
+                          default_radius, 'm', error)
+      if (allocated(error)) return
+      call optional_reals(deck, 'bearings', 'eps', eps, given_of(grp, 'eps', size(eps)), n, default_eps, 'm/s', &
+                          error, positive=.true.)
+      if (allocated(error)) return
+      call optional_reals(deck, 'bearings', 'eps1', eps1, given_of(grp, 'eps1', size(eps1)), n, default_eps1, &
+                          'm/s', error, positive=.true.)
+      if (allocated(error)) return
+      call optional_reals(deck, 'bearings', 'f', f, given_of(grp, 'f', size(f)), n, default_f, 'm', error, &
+                          positive=.true.)
+      if (allocated(error)) return
+      call check_labels(deck, grp, 'bearings', label, n, error)
+      if (allocated(error)) return
+      do i = 1, n
+         call add_bearing(deck, cfg, floors, i, storey(i), x(i), y(i), [dof_xi(i), dof_yi(i), dof_xj(i), dof_yj(i)], &
+                          law(i), p(i), mu(i), radius(i), eps(i), eps1(i), f(i), label(i), mu_ids(i), mu_min(i), &
+                          mu_rate(i), mu_table_v(:, i), mu_table_mu(:, i), g_table(:, i), error)
+         if (allocated(error)) return
+      end do
+   end subroutine read_bearings_group
+
+   !> Where the bearings stand: storey, x, y (rigid floors) or their four DOFs (other models);
+   !> the variables of the other kind refused.
+   subroutine bearing_places(deck, grp, cfg, floors, n, storey, x, y, dof_xi, dof_yi, dof_xj, dof_yj, error)
+      type(deck_text), intent(in) :: deck
+      type(group_text), intent(in) :: grp
+      type(run_config), intent(in) :: cfg
+      logical, intent(in) :: floors
+      integer, intent(in) :: n
+      integer, intent(inout) :: storey(:), dof_xi(:), dof_yi(:), dof_xj(:), dof_yj(:)
+      real(dp), intent(inout) :: x(:), y(:)
+      type(error_type), allocatable, intent(out) :: error
+      character(len=8), parameter :: plan(3) = [character(len=8) :: 'storey', 'x', 'y']
+      character(len=8), parameter :: dofs(4) = [character(len=8) :: 'dof_xi', 'dof_yi', 'dof_xj', 'dof_yj']
+      integer :: k
+
+      do k = 1, merge(4, 3, floors)
+         if (floors) then
+            if (.not. is_given(grp, trim(dofs(k)))) cycle
+            call bad(deck, 'bearings', trim(dofs(k)), '(given)', 'not given in a building of rigid floors (&floors): '// &
+                     'a bearing stands at a plan point, storey, x and y', error)
+         else
+            if (.not. is_given(grp, trim(plan(k)))) cycle
+            call bad(deck, 'bearings', trim(plan(k)), '(given)', 'given only for a building of rigid floors '// &
+                     '(&floors): a bearing of a model of masses or matrices joins dof_xi, dof_yi to dof_xj, dof_yj', error)
+         end if
+         return
+      end do
+      if (floors) then
+         call node_list(deck, 'bearings', 'storey', storey, given_of(grp, 'storey', size(storey)), n, 1, &
+                        cfg%model%n_floors, error)
+         if (allocated(error)) return
+         call signed_reals(deck, 'bearings', 'x', x, given_of(grp, 'x', size(x)), n, 'm', error)
+         if (allocated(error)) return
+         call signed_reals(deck, 'bearings', 'y', y, given_of(grp, 'y', size(y)), n, 'm', error)
+         return
+      end if
+      call node_list(deck, 'bearings', 'dof_xi', dof_xi, given_of(grp, 'dof_xi', size(dof_xi)), n, 1, &
+                     cfg%model%n_dof, error)
+      if (.not. allocated(error)) call node_list(deck, 'bearings', 'dof_yi', dof_yi, &
+                                                 given_of(grp, 'dof_yi', size(dof_yi)), n, 1, cfg%model%n_dof, error)
+      if (.not. allocated(error)) call node_list(deck, 'bearings', 'dof_xj', dof_xj, &
+                                                 given_of(grp, 'dof_xj', size(dof_xj)), n, 0, cfg%model%n_dof, error)
+      if (.not. allocated(error)) call node_list(deck, 'bearings', 'dof_yj', dof_yj, &
+                                                 given_of(grp, 'dof_yj', size(dof_yj)), n, 0, cfg%model%n_dof, error)
+   end subroutine bearing_places
+
+   !> The normal force of the bearings not given one: the weight g sum m_f of the floors
+   !> f >= s above storey s, shared equally among the bearings of that storey.
+   pure subroutine gravity_shares(model, n, storey, g_p, p)
+      type(model_type), intent(in) :: model
+      integer, intent(in) :: n
+      integer, intent(in) :: storey(:)
+      logical, intent(inout) :: g_p(:)
+      real(dp), intent(inout) :: p(:)
+      real(dp), parameter :: g = 9.80665_dp
+      integer :: i, f
+
+      do i = 1, n
+         if (g_p(i) .or. storey(i) < 1 .or. storey(i) > model%n_floors) cycle
+         p(i) = 0.0_dp
+         do f = storey(i), model%n_floors
+            p(i) = p(i) + g*model%mass(floor_dof(f, 1))
+         end do
+         p(i) = p(i)/count(storey(1:n) == storey(i))
+         g_p(i) = .true.
+      end do
+   end subroutine gravity_shares
+
+   !> Bearing i as its two components (x, then y) and, curved, its pendulum's stiffness p / R
+   !> along each.
+   subroutine add_bearing(deck, cfg, floors, i, storey, x, y, dofs, law, p, mu, radius, eps, eps1, f, label, &
+                          mu_id, mu_min, mu_rate, tab_v, tab_mu, g_table, error)
+      type(deck_text), intent(in) :: deck
+      type(run_config), intent(inout) :: cfg
+      logical, intent(in) :: floors
+      integer, intent(in) :: i, storey, dofs(4), mu_id
+      real(dp), intent(in) :: x, y, p, mu, radius, eps, eps1, f, mu_min, mu_rate, tab_v(:), tab_mu(:)
+      character(len=*), intent(in) :: law, label
+      logical, intent(in) :: g_table(:)
+      type(error_type), allocatable, intent(out) :: error
+      type(device_type) :: dev
+      character(len=:), allocatable :: idx
+      integer :: dof(max_plan_terms), nt, m, id, ios, d0
+      real(dp) :: coef(max_plan_terms)
+
+      idx = '('//trim(fmt_int(i))//')'
+      call device_law(deck, 'bearings', i, law, id, error)
+      if (allocated(error)) return
+      if (id /= law_velocity .and. id /= law_hysteretic) then
+         call bad(deck, 'bearings', 'law'//idx, "'"//trim(law)//"'", "'velocity' or 'hysteretic': the laws "// &
+                  "a planar bearing has", error)
+         return
+      end if
+      if (p*mu /= 0.0_dp .and. p*mu < min_scale) then
+         call bad(deck, 'bearings', 'p'//idx//' * mu'//idx, trim(fmt_real(p*mu)), '0 (no friction) or at least '// &
+                  trim(fmt_real(min_scale))//' N: the friction force P mu of a bearing', error)
+         return
+      end if
+      if (radius < 0.0_dp) then
+         call bad(deck, 'bearings', 'radius'//idx, trim(fmt_real(radius)), '>= 0 m (0 = flat)', error)
+         return
+      end if
+      if (radius > 0.0_dp) then
+         call check_magnitude(deck, 'bearings', 'radius'//idx, radius, 'm', .true., error)
+         if (.not. allocated(error)) call check_magnitude(deck, 'bearings', 'p'//idx//' / radius'//idx, p/radius, &
+                                                          'N/m', .true., error)
+         if (allocated(error)) return
+      end if
+      if (.not. floors) then
+         if (dofs(1) == dofs(3) .or. dofs(2) == dofs(4) .or. dofs(1) == dofs(2) .or. &
+             (dofs(3) == dofs(4) .and. dofs(3) > 0)) then
+            call bad(deck, 'bearings', 'dof_xi'//idx//', dof_yi'//idx//', dof_xj'//idx//', dof_yj'//idx, &
+                     trim(fmt_int(dofs(1)))//', '//trim(fmt_int(dofs(2)))//', '//trim(fmt_int(dofs(3)))//', '// &
+                     trim(fmt_int(dofs(4))), 'dof_xi /= dof_yi, dof_xi /= dof_xj, dof_yi /= dof_yj, and '// &
+                     'dof_xj /= dof_yj unless both are 0 (the table)', error)
+            return
+         end if
+      end if
+      dev = device_type(law=id, p=p, mu=mu, eps=eps, eps1=eps1, f=f)
+      call apply_mu_law(deck, 'bearings', i, mu_id, mu_min, mu_rate, tab_v, tab_mu, g_table, dev, error)
+      if (allocated(error)) return
+      dev%source = source_bearing
+      dev%source_index = i
+      d0 = cfg%model%n_devices
+      do m = 1, 2
+         dev%component = m
+         dev%partner = d0 + 3 - m
+         dev%label = trim(label)//merge(' x', ' y', m == 1)
+         if (len_trim(label) == 0) dev%label = 'bearing '//trim(fmt_int(i))//merge(' x', ' y', m == 1)
+         if (floors) then
+            call plan_direction(storey, merge(0.0_dp, 90.0_dp, m == 1), x, y, cfg%model%floor_x, cfg%model%floor_y, &
+                                dof, coef, nt)
+         else
+            nt = 1
+            dof(1) = dofs(m)
+            coef(1) = 1.0_dp
+            if (dofs(m + 2) > 0) then
+               nt = 2
+               dof(2) = dofs(m + 2)
+               coef(2) = -1.0_dp
+            end if
+         end if
+         call append_device(cfg%model, dev, dof(1:nt), coef(1:nt), ios)
+         if (floors) then
+            ! its force along x or y in the shear of its storey
+            cfg%model%xd_storey = [cfg%model%xd_storey, 2*storey - 2 + m]
+            cfg%model%xd_dev = [cfg%model%xd_dev, cfg%model%n_devices]
+            cfg%model%xd_coef = [cfg%model%xd_coef, 1.0_dp]
+         end if
+         if (radius > 0.0_dp) call pendulum_stiffness(deck, cfg, floors, dof(1:nt), coef(1:nt), p/radius, error)
+         if (allocated(error)) return
+      end do
+   end subroutine add_bearing
+
+   !> A friction pendulum's restoring stiffness k along a component of direction (dof, coef):
+   !> a spring between its two DOFs (a model of masses or matrices), or K_x's entries k b b'
+   !> (rigid floors).
+   subroutine pendulum_stiffness(deck, cfg, floors, dof, coef, k, error)
+      type(deck_text), intent(in) :: deck
+      type(run_config), intent(inout) :: cfg
+      logical, intent(in) :: floors
+      integer, intent(in) :: dof(:)
+      real(dp), intent(in) :: coef(:), k
+      type(error_type), allocatable, intent(out) :: error
+      integer :: j
+
+      if (floors) then
+         call add_general_entry(cfg%model, dof, coef, k)
+         return
+      end if
+      if (cfg%model%n_springs + 1 > max_springs) then
+         call bad(deck, 'bearings', 'n_bearings', trim(fmt_int(cfg%model%n_devices/2)), 'such that the springs of '// &
+                  'the curved bearings and the others are at most '//trim(fmt_int(max_springs)), error)
+         return
+      end if
+      j = 0
+      if (size(dof) == 2) j = dof(2)
+      cfg%model%spring_i = [cfg%model%spring_i, dof(1)]
+      cfg%model%spring_j = [cfg%model%spring_j, j]
+      cfg%model%spring_k = [cfg%model%spring_k, k]
+      cfg%model%spring_source = [cfg%model%spring_source, source_bearing]
+      cfg%model%n_springs = cfg%model%n_springs + 1
+   end subroutine pendulum_stiffness
 
    ! ---------------------------------------------------------------- &braces
    !> Friction dampers in series with an elastic brace (Pall type), a shorthand: brace b

@@ -14,7 +14,7 @@ module fd_output
    use fd_undefined, only: undefined_why
    use fd_version, only: frictiondyn_version
    use fd_history_stream, only: format_row, stream_value_width
-   use fd_names, only: excitation_types, keyword_len
+   use fd_names, only: excitation_types, keyword_len, label_len
    use fd_matrices, only: modes_type, modes_flexible, modes_rigid, modes_unrestrained
    use fd_engineering, only: engineering_type
    use fd_statistics, only: newmark_stats, event_driven_stats, moreau_jean_stats, summary_counts, &
@@ -386,6 +386,7 @@ contains
                       res%stick_resolution)
       call band_part(jt, res)
       call peaks_part(jt, res)
+      if (res%n_bearings > 0) call bearings_part(jt, model, res)
       call statistics_part(jt, res)
       call correctness_part(jt, res)
       call mu_part(jt, res)
@@ -534,6 +535,36 @@ contains
       call kr(jt, 'dissipated_energy_J', res%dissipated)
       call kr(jt, 'slip_travel_m', res%slip_travel)
    end subroutine peaks_part
+
+   !> The planar bearings (&bearings): per bearing its label, the peak resultant displacement
+   !> |(s_x, s_y)| with its direction (from x, counter-clockwise) and time, the residual
+   !> resultant displacement at the run's end with its direction, and the energy its friction
+   !> dissipated (its two components').
+   subroutine bearings_part(jt, model, res)
+      type(json_text), intent(inout) :: jt     !! the summary
+      type(model_type), intent(in) :: model    !! the model
+      type(result_type), intent(in) :: res     !! the result
+      real(dp), parameter :: deg = 180.0_dp/acos(-1.0_dp)
+      character(len=label_len) :: labels(res%n_bearings)
+      real(dp) :: residual(res%n_bearings), angle(res%n_bearings), energy(res%n_bearings)
+      integer :: b, d
+
+      do b = 1, res%n_bearings
+         d = res%bearing_dev(1, b)
+         labels(b) = model%dev(d)%label
+         labels(b)(max(1, len_trim(labels(b)) - 1):) = ''
+         residual(b) = hypot(res%bearing_last(1, b), res%bearing_last(2, b))
+         angle(b) = atan2(res%bearing_last(2, b), res%bearing_last(1, b))*deg
+         energy(b) = res%dissipated(d) + res%dissipated(res%bearing_dev(2, b))
+      end do
+      call ks(jt, 'bearing_labels', labels)
+      call kr(jt, 'bearing_peak_displacement_m', res%bearing_peak)
+      call kr(jt, 'bearing_peak_direction_deg', res%bearing_peak_angle, res%bearing_peak > 0.0_dp)
+      call kr(jt, 'bearing_peak_time_s', res%bearing_peak_time, res%bearing_peak > 0.0_dp)
+      call kr(jt, 'bearing_residual_displacement_m', residual)
+      call kr(jt, 'bearing_residual_direction_deg', angle, residual > 0.0_dp)
+      call kr(jt, 'bearing_dissipated_energy_J', energy)
+   end subroutine bearings_part
 
    !> What the technique did: the part of the technique that ran (its own statistics, under
    !> the summary's counter keys; fd_statistics).

@@ -23,7 +23,7 @@ module fd_model
    public :: technique_newmark, technique_event_driven, technique_moreau_jean, technique_name
    public :: mu_constant, mu_exponential, mu_table, label_len, max_mu_points
    public :: system_stuck, system_free
-   public :: source_friction, source_brace, source_isolator, source_floor_brace
+   public :: source_friction, source_brace, source_isolator, source_floor_brace, source_bearing
    public :: sliding_mu, device_parameter
 
    ! where a device (or spring) of the model comes from in the deck
@@ -31,6 +31,7 @@ module fd_model
    integer, parameter :: source_brace = 1     !! &braces (a friction damper in series with a brace)
    integer, parameter :: source_isolator = 2  !! &isolators (a sliding isolator)
    integer, parameter :: source_floor_brace = 3 !! &floor_braces (a brace at a plan position of rigid floors)
+   integer, parameter :: source_bearing = 4   !! &bearings (a component of a planar bearing)
 
    !> One friction device. Its geometry is its direction b over the DOFs, kept in the model
    !> (dev_ptr, dev_dof, dev_coef) and reached only through fd_kinematics: its relative
@@ -57,6 +58,10 @@ module fd_model
       character(len=label_len) :: label = ''     !! name in outputs ('damper 2')
       integer :: source = source_friction  !! the deck group it comes from
       integer :: source_index = 0          !! its index in that group
+      ! a planar bearing (&bearings) is two devices, its components along x and y, each with
+      ! its own direction b; each names the other (0: an ordinary one-dimensional device)
+      integer :: partner = 0               !! the bearing's other component (0: none)
+      integer :: component = 0             !! 1: the bearing's x component, 2: its y component
    end type device_type
 
    !> The whole structural model.

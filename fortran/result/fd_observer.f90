@@ -226,7 +226,32 @@ contains
          res%peak_force(i) = max(res%peak_force(i), abs(force(i)))
       end do
       call observe_engineering(res%eng, t, n, nd, u, v, s, force)
+      if (res%n_bearings > 0) call observe_bearings(res, t, nd, s)
    end subroutine observe_peaks
+
+   !> The planar bearings' resultant displacement |(s_x, s_y)|: its peak, the peak's direction
+   !> and time, and the last value observed (the residual at the run's end).
+   pure subroutine observe_bearings(res, t, nd, s)
+      type(result_type), intent(inout) :: res  !! the result
+      real(dp), intent(in) :: t                !! time [s]
+      integer, intent(in) :: nd                !! devices
+      real(dp), intent(in) :: s(nd)            !! device relative displacements [m]
+      real(dp), parameter :: deg = 180.0_dp/acos(-1.0_dp)
+      real(dp) :: sx, sy, r
+      integer :: b
+
+      do b = 1, res%n_bearings
+         sx = s(res%bearing_dev(1, b))
+         sy = s(res%bearing_dev(2, b))
+         res%bearing_last(:, b) = [sx, sy]
+         r = hypot(sx, sy)
+         if (r > res%bearing_peak(b)) then
+            res%bearing_peak(b) = r
+            res%bearing_peak_angle(b) = atan2(sy, sx)*deg
+            res%bearing_peak_time(b) = t
+         end if
+      end do
+   end subroutine observe_bearings
 
    !> The exact extrema of a technique that knows its solution between steps: |y(q)| of every
    !> output quantity q at time t into the summary's peaks (observe_extremum's order).

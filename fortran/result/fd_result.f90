@@ -100,6 +100,13 @@ module fd_result
                                                 !! over its relative motion minus the elastic energy
                                                 !! it stores (end minus start) [J]
       real(dp), allocatable :: slip_travel(:)   !! integral of |ds| while it slides [m]
+      ! per planar bearing (&bearings: two devices, its x and y components)
+      integer :: n_bearings = 0                 !! bearings
+      integer, allocatable :: bearing_dev(:, :) !! (2, n_bearings) the devices of its x and y components
+      real(dp), allocatable :: bearing_peak(:)  !! max |(s_x, s_y)|, the resultant displacement [m]
+      real(dp), allocatable :: bearing_peak_angle(:) !! its direction, from x counter-clockwise [deg]
+      real(dp), allocatable :: bearing_peak_time(:)  !! its time [s]
+      real(dp), allocatable :: bearing_last(:, :)    !! (2, n_bearings) (s_x, s_y) at the last step observed [m]
       real(dp), allocatable :: harmonic_error(:)      !! per DOF: the step's error in the linear steady state
       real(dp), allocatable :: record_error(:)        !! per DOF: the step's error in the linear peak response
                                                       !! of the system the run was in
@@ -300,7 +307,36 @@ contains
       res%stick_freq_error = 0.0_dp; res%stick_ringing_ratio = 0.0_dp
       res%stick_ringing = 0.0_dp; res%stick_margin = 0.0_dp
       res%band_x = 0.0_dp; res%band_alternation = 0.0_dp; res%band_alternation_time = 0.0_dp
+      call init_bearings(model, res, error)
    end subroutine init_result
+
+   !> The planar bearings' part of the result: each bearing's two devices (x, y), its peaks at 0.
+   subroutine init_bearings(model, res, error)
+      type(model_type), intent(in) :: model         !! the model run
+      type(result_type), intent(inout) :: res       !! the result
+      type(error_type), allocatable, intent(out) :: error !! no memory
+      integer :: d, b, nb, stat
+
+      nb = 0
+      do d = 1, model%n_devices
+         if (model%dev(d)%component == 1) nb = nb + 1
+      end do
+      res%n_bearings = nb
+      allocate (res%bearing_dev(2, nb), res%bearing_peak(nb), res%bearing_peak_angle(nb), res%bearing_peak_time(nb), &
+                res%bearing_last(2, nb), stat=stat)
+      if (stat /= 0) then
+         call fatal_error(error, "not enough memory for the summary of "//trim(fmt_int(nb))//" bearings", stat_no_memory)
+         return
+      end if
+      b = 0
+      do d = 1, model%n_devices
+         if (model%dev(d)%component /= 1) cycle
+         b = b + 1
+         res%bearing_dev(:, b) = [d, model%dev(d)%partner]
+      end do
+      res%bearing_peak = 0.0_dp; res%bearing_peak_angle = 0.0_dp; res%bearing_peak_time = 0.0_dp
+      res%bearing_last = 0.0_dp
+   end subroutine init_bearings
 
    !> For each id, the history's columns prefix//name//id [unit], one for each name, from
    !> column c + 1; c becomes the last column named.

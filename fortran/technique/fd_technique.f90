@@ -46,7 +46,16 @@ contains
       type(integration_type), intent(in) :: opts    !! the technique and its settings
       type(error_type), allocatable, intent(out) :: error !! what cannot be integrated
       type(technique_traits_type) :: traits
+      integer :: d
 
+      ! a planar bearing (&bearings) slides on its resultant: the planar laws are Newmark's
+      do d = 1, model%n_devices
+         if (opts%technique == technique_newmark .or. model%dev(d)%partner == 0) cycle
+         call fatal_error(error, "group &integration: technique = '"//trim(technique_name(opts%technique))// &
+                          "' does not integrate planar bearings (&bearings, here bearing "// &
+                          trim(fmt_int(model%dev(d)%source_index))//"); set technique = 'newmark'")
+         return
+      end do
       ! the exact techniques' phase patterns and sticking groups take each device as a link
       ! between two nodes (fd_kinematics); Newmark takes any direction
       if (opts%technique /= technique_newmark .and. .not. devices_are_pairs(model)) then

@@ -9,6 +9,7 @@ program tester
    use test_fd_matrices, only: collect_matrices
    use test_fd_friction, only: collect_friction
    use test_fd_friction_laws, only: collect_friction_laws
+   use test_fd_friction_planar, only: collect_friction_planar
    use test_fd_namelist, only: collect_namelist
    use test_fd_record, only: collect_record
    use test_fd_record_parse, only: collect_record_parse
@@ -60,6 +61,7 @@ program tester
    testsuites = [testsuites, new_testsuite("matrices", collect_matrices)]
    testsuites = [testsuites, new_testsuite("friction", collect_friction)]
    testsuites = [testsuites, new_testsuite("friction_laws", collect_friction_laws)]
+   testsuites = [testsuites, new_testsuite("friction_planar", collect_friction_planar)]
    testsuites = [testsuites, new_testsuite("namelist", collect_namelist)]
    testsuites = [testsuites, new_testsuite("record", collect_record)]
    testsuites = [testsuites, new_testsuite("record_parse", collect_record_parse)]

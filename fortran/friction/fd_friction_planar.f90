@@ -1,0 +1,327 @@
+!> The paper's two laws in the plane, for a planar bearing: two devices (its components along
+!> x and y, each with its own direction b) that know each other (device_type's partner). A
+!> component keeps the one-dimensional form F = ks s + cs s' + f0 (fd_device_state), so the
+!> time-step loop, the outputs, the energy and the checks see two ordinary devices; only the
+!> phase, the sliding direction and the correctness condition are decided on the resultant.
+!>
+!> - Velocity law: F = c1 v inside the disc |v| < eps (each component its dashpot
+!>   c1 = P mu(eps) / eps), F = P mu(|v|) v/|v| outside, the direction that of the velocity at
+!>   the previous step's end (the 1D law's sign, eq. 8). Correctness condition on the
+!>   resultant: v(t).v(t - dt) > eps^2 (1 - 1/n).
+!> - Hysteretic law: elastic-perfectly-plastic with the circular yield surface |F| <= P mu,
+!>   the sticking spring k = P mu / f on each component, radial return (the trial force
+!>   k (s - centre) brought back onto the circle along itself), the end of sliding at
+!>   |v| < eps1 with the velocity turned against the sliding direction (v.d <= 0), the 1D
+!>   law's arming rule with |v| for |s'|. Correctness condition: v(t).v(t - dt) > eps1^2 (1 - 1/n)
+!>   in an armed slide.
+!>
+!> A component's phase is stick while the bearing sticks, and the sign of its component of the
+!> sliding direction (d_x, d_y; st%dir) while it slides; a component with d = 0 keeps the sign
+!> it had (slip + at the start of a slide). For motion along one axis every operation is the
+!> one-dimensional law's (hypot(x, 0) = |x|, x/|x| = +-1, a + 0 = a): the same numbers to the
+!> bit (docs/theory.md, "Planar bearings").
+module fd_friction_planar
+   use fd_kinds, only: dp
+   use fd_model, only: device_type, mu_constant, sliding_mu
+   use fd_device_state, only: device_state, phase_stick, phase_slip_pos, phase_slip_neg
+   use fd_friction_velocity, only: largest_mu
+   implicit none
+   private
+
+   public :: planar_velocity_update, planar_velocity_init, planar_velocity_correct, planar_velocity_follow
+   public :: planar_hysteretic_update, planar_hysteretic_init, planar_hysteretic_correct
+   public :: planar_velocity_settle, planar_hysteretic_settle
+
+contains
+
+   ! ---------------------------------------------------------------- velocity law
+
+   !> Phase and coefficients of a bearing at the start of a run (velocity law).
+   pure subroutine planar_velocity_init(dev, s, sd, st)
+      type(device_type), intent(in) :: dev          !! the bearing's parameters (its x component)
+      real(dp), intent(in) :: s(2)                  !! relative displacement (x, y) [m]
+      real(dp), intent(in) :: sd(2)                 !! relative velocity (x, y) [m/s]
+      type(device_state), intent(out) :: st(2)      !! initial states of its components
+      logical :: changed(2)
+
+      st(1)%phase = phase_stick
+      st(2)%phase = phase_stick
+      call planar_velocity_update(dev, s, sd, st, changed)
+   end subroutine planar_velocity_init
+
+   !> Phase for the next step from the velocity at the end of this one: stick inside the disc
+   !> |v| < eps, else sliding along v/|v|; the force's coefficients of that phase (mu at |v|).
+   pure subroutine planar_velocity_update(dev, s, sd, st, changed)
+      type(device_type), intent(in) :: dev          !! the bearing's parameters
+      real(dp), intent(in) :: s(2)                  !! relative displacement (x, y) [m]
+      real(dp), intent(in) :: sd(2)                 !! relative velocity (x, y) [m/s]
+      type(device_state), intent(inout) :: st(2)    !! states, updated
+      logical, intent(out) :: changed(2)            !! each component's phase changed
+      real(dp) :: speed, c, pmu
+      integer :: old(2), m
+      logical :: slides
+
+      old = st%phase
+      speed = hypot(sd(1), sd(2))
+      slides = .not. speed < dev%eps
+      ! no friction capacity: F = 0, never slips
+      if (slides .and. dev%p*dev%mu == 0.0_dp) slides = dev%p*largest_mu(dev) /= 0.0_dp
+      if (slides) then
+         pmu = dev%p*sliding_mu(dev, speed)
+         if (dev%mu_law == mu_constant) pmu = dev%p*dev%mu
+         do m = 1, 2
+            st(m)%dir = sd(m)/speed
+            st(m)%phase = slide_phase(st(m)%dir, old(m))
+            st(m)%ks = 0.0_dp
+            st(m)%cs = 0.0_dp
+            st(m)%f0 = pmu*st(m)%dir
+         end do
+      else
+         if (dev%mu_law == mu_constant) then
+            c = dev%p*dev%mu/dev%eps
+         else
+            c = dev%p*sliding_mu(dev, dev%eps)/dev%eps
+         end if
+         do m = 1, 2
+            st(m)%phase = phase_stick
+            st(m)%dir = 0.0_dp
+            st(m)%ks = 0.0_dp
+            st(m)%cs = c
+            st(m)%f0 = 0.0_dp
+         end do
+      end if
+      do m = 1, 2
+         st(m)%centre = s(m)
+         changed(m) = st(m)%phase /= old(m)
+      end do
+   end subroutine planar_velocity_update
+
+   !> Correctness condition of a step taken sliding: v(t).v(t - dt) > eps^2 (1 - 1/n).
+   pure logical function planar_velocity_correct(dev, n, st, sd_old, sd_new) result(ok)
+      type(device_type), intent(in) :: dev          !! the bearing's parameters
+      real(dp), intent(in) :: n                     !! n > 1
+      type(device_state), intent(in) :: st(2)      !! phases during the step
+      real(dp), intent(in) :: sd_old(2)             !! relative velocity at t - dt [m/s]
+      real(dp), intent(in) :: sd_new(2)             !! relative velocity at t [m/s]
+
+      ok = .true.
+      if (st(1)%phase /= phase_stick) ok = sd_new(1)*sd_old(1) + sd_new(2)*sd_old(2) > dev%eps**2*(1.0_dp - 1.0_dp/n)
+   end function planar_velocity_correct
+
+   !> The constant force of component m in the phase st at the velocity sd at the step's end:
+   !> sliding with a speed-dependent mu, P mu(|v|) d_m; otherwise st(m)%f0 as it is.
+   pure real(dp) function planar_velocity_follow(dev, sd, st, m) result(f0)
+      type(device_type), intent(in) :: dev          !! the bearing's parameters
+      real(dp), intent(in) :: sd(2)                 !! relative velocity at the step's end [m/s]
+      type(device_state), intent(in) :: st(2)      !! phases during the step
+      integer, intent(in) :: m                      !! the component (1: x, 2: y)
+
+      f0 = st(m)%f0
+      if (dev%mu_law /= mu_constant .and. st(m)%phase /= phase_stick) &
+         f0 = dev%p*sliding_mu(dev, hypot(sd(1), sd(2)))*st(m)%dir
+   end function planar_velocity_follow
+
+   !> The states to take a step in that ends in st1's phases (`refinement = 'implicit'`): those
+   !> of the end, unless the bearing slides at both ends in a direction that turned through a
+   !> component's sign (the 1D law's reversal), which is not taken in one phase.
+   pure subroutine planar_velocity_settle(st0, st1, st, can)
+      type(device_state), intent(in) :: st0(2)      !! states at the step's start
+      type(device_state), intent(in) :: st1(2)      !! the update's states at its end
+      type(device_state), intent(out) :: st(2)      !! states to take the step in
+      logical, intent(out) :: can                   !! the step can be taken in one phase
+
+      st = st1
+      can = st0(1)%phase == phase_stick .or. st1(1)%phase == phase_stick
+   end subroutine planar_velocity_settle
+
+   ! ---------------------------------------------------------------- hysteretic law
+
+   !> A bearing starts sticking with no force, or sliding along v when |v| >= eps1.
+   pure subroutine planar_hysteretic_init(dev, s, sd, st)
+      type(device_type), intent(in) :: dev          !! the bearing's parameters
+      real(dp), intent(in) :: s(2)                  !! relative displacement (x, y) [m]
+      real(dp), intent(in) :: sd(2)                 !! relative velocity (x, y) [m/s]
+      type(device_state), intent(out) :: st(2)      !! initial states
+      real(dp) :: speed
+      integer :: m
+
+      speed = hypot(sd(1), sd(2))
+      do m = 1, 2
+         st(m)%phase = phase_stick
+         st(m)%centre = s(m)
+         st(m)%armed = .false.
+         st(m)%dir = 0.0_dp
+         if (speed >= dev%eps1 .and. dev%p*dev%mu > 0.0_dp) then
+            st(m)%dir = sd(m)/speed
+            st(m)%phase = slide_phase(st(m)%dir, phase_stick)
+            st(m)%centre = s(m) - dev%f*st(m)%dir
+            st(m)%armed = .true.
+         end if
+      end do
+      call hysteretic_coefficients(dev, st)
+   end subroutine planar_hysteretic_init
+
+   !> Phase for the next step from the state at the end of this one: a sticking bearing
+   !> slides when its elastic force reaches the circle |F| = P mu (along F); an armed slide
+   !> sticks when |v| < eps1 with v turned (v.d <= 0) and goes on unarmed when still along d;
+   !> one whose velocity crossed the disc in one step (v.d < 0, |v| >= eps1) slides along v;
+   !> an unarmed slide sticks when v.d <= 0 and arms at |v| >= eps1. While sliding, the trial
+   !> force k (s - centre) is returned radially onto the circle: d = its direction, and the
+   !> centre follows so that k (s - centre) = P mu d.
+   pure subroutine planar_hysteretic_update(dev, s, sd, st, changed)
+      type(device_type), intent(in) :: dev          !! the bearing's parameters
+      real(dp), intent(in) :: s(2)                  !! relative displacement (x, y) [m]
+      real(dp), intent(in) :: sd(2)                 !! relative velocity (x, y) [m/s]
+      type(device_state), intent(inout) :: st(2)    !! states, updated
+      logical, intent(out) :: changed(2)            !! each component's phase changed
+      real(dp) :: k, force(2), size_f, speed, along, dir0(2)
+      integer :: old(2), m
+      logical :: sticks, slides_now, armed
+
+      old = st%phase
+      changed = .false.
+      if (dev%p*dev%mu == 0.0_dp) return       ! no friction capacity: F = 0, never slips
+      k = dev%p*dev%mu/dev%f
+      speed = hypot(sd(1), sd(2))
+      dir0 = st%dir
+      along = sd(1)*dir0(1) + sd(2)*dir0(2)
+      armed = st(1)%armed
+      sticks = old(1) == phase_stick
+      slides_now = .false.
+      if (sticks) then
+         force = k*(s - st%centre)
+         size_f = hypot(force(1), force(2))
+         if (size_f >= dev%p*dev%mu) then
+            slides_now = .true.
+            sticks = .false.
+            armed = speed >= dev%eps1
+         end if
+      else if (armed) then
+         if (speed < dev%eps1) then
+            if (along > 0.0_dp) then
+               armed = .false.
+            else
+               sticks = .true.
+            end if
+         else if (along < 0.0_dp) then
+            ! crossed the disc within a step: slides along v
+            force = sd
+            size_f = speed
+            slides_now = .true.
+         end if
+      else
+         if (.not. along > 0.0_dp) then
+            sticks = .true.
+         else if (speed >= dev%eps1) then
+            armed = .true.
+         end if
+      end if
+      if (sticks) then
+         if (old(1) /= phase_stick) then
+            ! end of sliding: the force stays P mu d
+            do m = 1, 2
+               st(m)%centre = s(m) - dev%f*dir0(m)
+               st(m)%phase = phase_stick
+               st(m)%dir = 0.0_dp
+               st(m)%armed = .false.
+            end do
+            call hysteretic_coefficients(dev, st)
+         end if
+      else
+         if (.not. slides_now) then
+            ! going on sliding: the radial return of the trial force
+            force = k*(s - st%centre)
+            size_f = hypot(force(1), force(2))
+            if (size_f == 0.0_dp) then
+               force = dir0
+               size_f = 1.0_dp
+            end if
+         end if
+         do m = 1, 2
+            st(m)%dir = force(m)/size_f
+            st(m)%phase = slide_phase(st(m)%dir, old(m))
+            st(m)%centre = s(m) - dev%f*st(m)%dir
+            st(m)%armed = armed
+         end do
+         call hysteretic_coefficients(dev, st)
+      end if
+      changed = st%phase /= old
+   end subroutine planar_hysteretic_update
+
+   !> Correctness condition in an armed slide: v(t).v(t - dt) > eps1^2 (1 - 1/n).
+   pure logical function planar_hysteretic_correct(dev, n, st, sd_old, sd_new) result(ok)
+      type(device_type), intent(in) :: dev          !! the bearing's parameters
+      real(dp), intent(in) :: n                     !! n > 1
+      type(device_state), intent(in) :: st(2)      !! phases during the step
+      real(dp), intent(in) :: sd_old(2)             !! relative velocity at t - dt [m/s]
+      real(dp), intent(in) :: sd_new(2)             !! relative velocity at t [m/s]
+
+      ok = .true.
+      if (st(1)%phase /= phase_stick .and. st(1)%armed) &
+         ok = sd_new(1)*sd_old(1) + sd_new(2)*sd_old(2) > dev%eps1**2*(1.0_dp - 1.0_dp/n)
+   end function planar_hysteretic_correct
+
+   !> The states to take a step in that ends in st1's phases (`refinement = 'implicit'`), as
+   !> the 1D law's: a slide that starts, in its sliding force, unarmed; one that ends, in the
+   !> slide, when the velocity has not turned beyond the disc (v.d > -eps1); a slide at both
+   !> ends whose phases differ (a component's sign turned) is not taken in one phase.
+   pure subroutine planar_hysteretic_settle(dev, sd, st0, st1, st, can)
+      type(device_type), intent(in) :: dev          !! the bearing's parameters
+      real(dp), intent(in) :: sd(2)                 !! relative velocity at the last trial's end [m/s]
+      type(device_state), intent(in) :: st0(2)      !! states at the step's start
+      type(device_state), intent(in) :: st1(2)      !! the update's states at its end
+      type(device_state), intent(out) :: st(2)      !! states to take the step in
+      logical, intent(out) :: can                   !! the step can be taken in one phase
+
+      can = .true.
+      st = st0
+      if (st0(1)%phase == phase_stick) then
+         st = st1
+         st%armed = .false.
+      else if (st1(1)%phase /= phase_stick) then
+         can = .false.
+      else
+         can = sd(1)*st0(1)%dir + sd(2)*st0(2)%dir > -dev%eps1
+      end if
+   end subroutine planar_hysteretic_settle
+
+   ! ---------------------------------------------------------------- helpers
+
+   !> A sliding component's phase: the sign of its direction, the old one kept for d = 0.
+   elemental integer function slide_phase(dir, old) result(phase)
+      real(dp), intent(in) :: dir                   !! its component of the sliding direction
+      integer, intent(in) :: old                    !! its phase before
+
+      if (dir > 0.0_dp) then
+         phase = phase_slip_pos
+      else if (dir < 0.0_dp) then
+         phase = phase_slip_neg
+      else if (old /= phase_stick) then
+         phase = old
+      else
+         phase = phase_slip_pos
+      end if
+   end function slide_phase
+
+   !> The hysteretic coefficients of each component's phase: ks = P mu / f, f0 = -k centre
+   !> while sticking; the force P mu d while sliding.
+   pure subroutine hysteretic_coefficients(dev, st)
+      type(device_type), intent(in) :: dev
+      type(device_state), intent(inout) :: st(2)
+      real(dp) :: k
+      integer :: m
+
+      k = dev%p*dev%mu/dev%f
+      do m = 1, 2
+         st(m)%cs = 0.0_dp
+         if (st(m)%phase == phase_stick) then
+            st(m)%ks = k
+            st(m)%f0 = -k*st(m)%centre
+         else
+            st(m)%ks = 0.0_dp
+            st(m)%f0 = dev%p*dev%mu*st(m)%dir
+         end if
+      end do
+   end subroutine hysteretic_coefficients
+
+end module fd_friction_planar

@@ -1,0 +1,204 @@
+!> Unit tests of the planar bearings' laws (fd_friction_planar): each law for motion along one
+!> axis gives the one-dimensional law's state to the bit; off the axes the velocity law's disc
+!> and sliding force P mu v/|v|, its correctness condition on the resultant, and the
+!> hysteretic law's circular yield surface, radial return and end of sliding.
+!>
+!> P = 16 N, mu = 0.25 (P mu = 4 N), f = 2**-10 m, eps = 2**-7 m/s, eps1 = 2**-6 m/s.
+module test_fd_friction_planar
+   use testdrive, only: new_unittest, unittest_type, error_type, check
+   use fd_kinds, only: dp
+   use fd_model, only: device_type, law_velocity, law_hysteretic
+   use fd_device_state, only: device_state, phase_stick, phase_slip_pos, phase_slip_neg
+   use fd_friction_velocity, only: velocity_update, velocity_init
+   use fd_friction_hysteretic, only: hysteretic_update, hysteretic_init
+   use fd_friction_planar, only: planar_velocity_update, planar_velocity_init, planar_velocity_correct, &
+                                 planar_hysteretic_update, planar_hysteretic_init, planar_hysteretic_correct
+   implicit none
+   private
+
+   public :: collect_friction_planar
+
+   real(dp), parameter :: p = 16.0_dp, mu = 0.25_dp, f = 2.0_dp**(-10)
+   real(dp), parameter :: eps = 2.0_dp**(-7), eps1 = 2.0_dp**(-6)
+
+contains
+
+   subroutine collect_friction_planar(testsuite)
+      type(unittest_type), allocatable, intent(out) :: testsuite(:)
+
+      testsuite = [ &
+                  new_unittest("velocity: along x, the 1D law's states", test_velocity_axis), &
+                  new_unittest("velocity: the disc and the force P mu v/|v|", test_velocity_disc), &
+                  new_unittest("velocity: correctness on the resultant", test_velocity_correct), &
+                  new_unittest("hysteretic: along y, the 1D law's states", test_hysteretic_axis), &
+                  new_unittest("hysteretic: circular yield surface", test_hysteretic_yield), &
+                  new_unittest("hysteretic: radial return while sliding", test_hysteretic_return), &
+                  new_unittest("hysteretic: end of sliding, force continuous", test_hysteretic_end) &
+                  ]
+   end subroutine collect_friction_planar
+
+   pure function device(law) result(dev)
+      integer, intent(in) :: law
+      type(device_type) :: dev
+      dev = device_type(law=law, p=p, mu=mu, eps=eps, eps1=eps1, f=f)
+   end function device
+
+   !> Whether two states are the same to the bit (phase, coefficients, centre).
+   pure logical function same(a, b)
+      type(device_state), intent(in) :: a, b
+      same = a%phase == b%phase .and. a%ks == b%ks .and. a%cs == b%cs .and. a%f0 == b%f0 .and. &
+             a%centre == b%centre .and. (a%armed .eqv. b%armed)
+   end function same
+
+   subroutine test_velocity_axis(error)
+      type(error_type), allocatable, intent(out) :: error
+      type(device_state) :: st1, pair(2)
+      logical :: ch1, ch(2)
+      real(dp), parameter :: v(6) = [0.0_dp, 3.0e-3_dp, 0.05_dp, -0.2_dp, -1.0e-3_dp, 0.7_dp]
+      real(dp) :: s
+      integer :: k
+
+      call velocity_init(device(law_velocity), 0.0_dp, 0.0_dp, st1)
+      call planar_velocity_init(device(law_velocity), [0.0_dp, 0.0_dp], [0.0_dp, 0.0_dp], pair)
+      do k = 1, size(v)
+         s = 0.01_dp*k
+         call velocity_update(device(law_velocity), s, v(k), st1, ch1)
+         call planar_velocity_update(device(law_velocity), [s, 0.0_dp], [v(k), 0.0_dp], pair, ch)
+         call check(error, same(pair(1), st1) .and. (ch(1) .eqv. ch1), "along x: the 1D law's state")
+         if (allocated(error)) return
+         call check(error, pair(2)%f0 == 0.0_dp .and. pair(2)%ks == 0.0_dp, "along x: no force along y")
+         if (allocated(error)) return
+      end do
+   end subroutine test_velocity_axis
+
+   subroutine test_velocity_disc(error)
+      type(error_type), allocatable, intent(out) :: error
+      type(device_state) :: pair(2)
+      logical :: ch(2)
+
+      call planar_velocity_init(device(law_velocity), [0.0_dp, 0.0_dp], [0.0_dp, 0.0_dp], pair)
+      ! each component inside the band, the resultant outside the disc: sliding along (1, 1)
+      call planar_velocity_update(device(law_velocity), [0.0_dp, 0.0_dp], [0.75_dp*eps, 0.75_dp*eps], pair, ch)
+      call check(error, pair(1)%phase == phase_slip_pos .and. pair(2)%phase == phase_slip_pos .and. all(ch), &
+                 "|v| = 1.06 eps slides")
+      if (allocated(error)) return
+      call check(error, abs(pair(1)%f0 - p*mu/sqrt(2.0_dp)) < 1.0e-15_dp*p*mu .and. pair(1)%f0 == pair(2)%f0 .and. &
+                 pair(1)%cs == 0.0_dp, "the force P mu v/|v|")
+      if (allocated(error)) return
+      ! along (3, -4): F = P mu (0.6, -0.8)
+      call planar_velocity_update(device(law_velocity), [0.0_dp, 0.0_dp], [0.3_dp, -0.4_dp], pair, ch)
+      call check(error, abs(pair(1)%f0 - 0.6_dp*p*mu) < 1.0e-15_dp .and. abs(pair(2)%f0 + 0.8_dp*p*mu) < 1.0e-15_dp &
+                 .and. pair(2)%phase == phase_slip_neg .and. ch(2) .and. .not. ch(1), "F = P mu (0.6, -0.8)")
+      if (allocated(error)) return
+      ! inside the disc: each component its dashpot P mu / eps
+      call planar_velocity_update(device(law_velocity), [0.0_dp, 0.0_dp], [0.6_dp*eps, 0.7_dp*eps], pair, ch)
+      call check(error, all(pair%phase == phase_stick) .and. all(pair%cs == p*mu/eps) .and. all(pair%f0 == 0.0_dp), &
+                 "|v| = 0.92 eps sticks, dashpots P mu / eps")
+   end subroutine test_velocity_disc
+
+   subroutine test_velocity_correct(error)
+      type(error_type), allocatable, intent(out) :: error
+      type(device_state) :: pair(2)
+      real(dp), parameter :: n = 2.0_dp
+      real(dp) :: a
+
+      pair%phase = phase_slip_pos
+      a = 2.0_dp*eps
+      ! a quarter turn within a step: v.v_old = 0 violates; each component alone would not see it
+      call check(error, .not. planar_velocity_correct(device(law_velocity), n, pair, [a, 0.0_dp], [0.0_dp, a]), &
+                 "a quarter turn violates")
+      if (allocated(error)) return
+      call check(error, planar_velocity_correct(device(law_velocity), n, pair, [a, a], [a, 0.9_dp*a]), &
+                 "a small turn is correct")
+      if (allocated(error)) return
+      ! the bound eps^2 (1 - 1/n) on the dot product: v.v_old = 0.5 eps^2 is not above it
+      call check(error, .not. planar_velocity_correct(device(law_velocity), n, pair, [0.5_dp*eps, 0.5_dp*eps], &
+                                                      [eps, 0.0_dp]), "v.v_old = eps^2 / 2 is not > eps^2 (1 - 1/2)")
+      if (allocated(error)) return
+      pair%phase = phase_stick
+      call check(error, planar_velocity_correct(device(law_velocity), n, pair, [a, 0.0_dp], [-a, 0.0_dp]), &
+                 "not checked while sticking")
+   end subroutine test_velocity_correct
+
+   subroutine test_hysteretic_axis(error)
+      type(error_type), allocatable, intent(out) :: error
+      type(device_state) :: st1, pair(2)
+      logical :: ch1, ch(2)
+      real(dp), parameter :: s(7) = [0.5_dp, 1.5_dp, 3.0_dp, 4.0_dp, 4.0_dp, 2.0_dp, -1.0_dp]*f
+      real(dp), parameter :: v(7) = [0.1_dp, 1.0_dp, 2.0_dp, 0.5_dp, -0.1_dp, -1.0_dp, -2.0_dp]*eps1
+      integer :: k
+
+      call hysteretic_init(device(law_hysteretic), 0.0_dp, 0.0_dp, st1)
+      call planar_hysteretic_init(device(law_hysteretic), [0.0_dp, 0.0_dp], [0.0_dp, 0.0_dp], pair)
+      do k = 1, size(s)
+         call hysteretic_update(device(law_hysteretic), s(k), v(k), st1, ch1)
+         call planar_hysteretic_update(device(law_hysteretic), [0.0_dp, s(k)], [0.0_dp, v(k)], pair, ch)
+         call check(error, same(pair(2), st1) .and. (ch(2) .eqv. ch1), "along y: the 1D law's state")
+         if (allocated(error)) return
+      end do
+   end subroutine test_hysteretic_axis
+
+   subroutine test_hysteretic_yield(error)
+      type(error_type), allocatable, intent(out) :: error
+      type(device_state) :: pair(2)
+      logical :: ch(2)
+      real(dp) :: k
+
+      k = p*mu/f
+      call planar_hysteretic_init(device(law_hysteretic), [0.0_dp, 0.0_dp], [0.0_dp, 0.0_dp], pair)
+      ! |k s| = 0.8 sqrt(2) P mu < P mu? no: 1.13 P mu, on the circle's outside: slides along (1, 1)
+      call planar_hysteretic_update(device(law_hysteretic), [0.8_dp*f, 0.8_dp*f], [eps1, eps1], pair, ch)
+      call check(error, all(pair%phase == phase_slip_pos) .and. all(ch) .and. pair(1)%armed, "slides along (1, 1)")
+      if (allocated(error)) return
+      call check(error, abs(pair(1)%f0 - p*mu/sqrt(2.0_dp)) < 1.0e-14_dp .and. &
+                 abs(k*(0.8_dp*f - pair(1)%centre) - pair(1)%f0) < 1.0e-12_dp, "radial return onto the circle")
+      if (allocated(error)) return
+      ! inside the circle: |k s| = 0.6 sqrt(2) P mu = 0.85 P mu sticks (each component 0.6 P mu)
+      call planar_hysteretic_init(device(law_hysteretic), [0.0_dp, 0.0_dp], [0.0_dp, 0.0_dp], pair)
+      call planar_hysteretic_update(device(law_hysteretic), [0.6_dp*f, -0.6_dp*f], [eps1, -eps1], pair, ch)
+      call check(error, all(pair%phase == phase_stick) .and. .not. any(ch) .and. all(pair%ks == k), &
+                 "inside the circle: sticks, springs P mu / f")
+   end subroutine test_hysteretic_yield
+
+   subroutine test_hysteretic_return(error)
+      type(error_type), allocatable, intent(out) :: error
+      type(device_state) :: pair(2)
+      logical :: ch(2)
+
+      ! sliding along x from the start, centre at s - f
+      call planar_hysteretic_init(device(law_hysteretic), [0.0_dp, 0.0_dp], [2.0_dp*eps1, 0.0_dp], pair)
+      call check(error, pair(1)%phase == phase_slip_pos .and. pair(1)%f0 == p*mu .and. pair(1)%centre == -f, &
+                 "starts sliding along x")
+      if (allocated(error)) return
+      ! then moved by (0, f): the trial force P mu (1, 1), returned to P mu (1, 1)/sqrt(2)
+      call planar_hysteretic_update(device(law_hysteretic), [0.0_dp, f], [0.0_dp, 2.0_dp*eps1], pair, ch)
+      call check(error, abs(pair(1)%dir - 1.0_dp/sqrt(2.0_dp)) < 1.0e-15_dp .and. &
+                 abs(pair(2)%dir - 1.0_dp/sqrt(2.0_dp)) < 1.0e-15_dp .and. pair(1)%phase == phase_slip_pos, &
+                 "the direction of the trial force")
+      if (allocated(error)) return
+      call check(error, abs(hypot(pair(1)%f0, pair(2)%f0) - p*mu) < 1.0e-14_dp, "|F| = P mu")
+   end subroutine test_hysteretic_return
+
+   subroutine test_hysteretic_end(error)
+      type(error_type), allocatable, intent(out) :: error
+      type(device_state) :: pair(2)
+      logical :: ch(2)
+      real(dp) :: k, fx, fy
+      real(dp), parameter :: s(2) = [3.0_dp*f, 4.0_dp*f]
+
+      k = p*mu/f
+      call planar_hysteretic_init(device(law_hysteretic), [0.0_dp, 0.0_dp], [0.6_dp*eps1*2, 0.8_dp*eps1*2], pair)
+      ! armed; the velocity turned against the sliding direction inside the disc: sticks
+      call planar_hysteretic_update(device(law_hysteretic), s, [-0.1_dp*eps1, 0.05_dp*eps1], pair, ch)
+      call check(error, all(pair%phase == phase_stick) .and. all(ch), "sticks at the turn inside the disc")
+      if (allocated(error)) return
+      fx = k*(s(1) - pair(1)%centre)
+      fy = k*(s(2) - pair(2)%centre)
+      call check(error, abs(fx - 0.6_dp*p*mu) < 1.0e-12_dp .and. abs(fy - 0.8_dp*p*mu) < 1.0e-12_dp, &
+                 "the force P mu d stays at the end of sliding")
+      if (allocated(error)) return
+      call check(error, planar_hysteretic_correct(device(law_hysteretic), 2.0_dp, pair, [1.0_dp, 0.0_dp], &
+                                                  [-1.0_dp, 0.0_dp]), "not checked while sticking")
+   end subroutine test_hysteretic_end
+
+end module test_fd_friction_planar
