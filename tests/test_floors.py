@@ -394,3 +394,27 @@ def test_corner_drifts_are_undefined_without_a_plan(run):
     deck["floors"]["inertia"] = [2.0e5 * (20.0**2 + 12.0**2) / 12]
     s = ok(run(deck, name="ecc")).summary()
     assert s["peak_corner_drift_m"] == [None, None]
+
+
+@pytest.mark.parametrize("n", [3005, 40])
+def test_matrices_mechanism_named_at_every_size(run, n):
+    """K of a chain of n DOFs to the table whose second half floats free (a mechanism: no
+    spring joins DOF n/2 to n/2 + 1): refused at every size, above 3000 DOFs as below, by
+    the banded factor's first non-positive pivot, the free chain's last DOF by its label
+    (its pivots are k, k, ..., exactly 0 at its end); no output is left."""
+    h, k = n // 2, 1.0e6
+    ent = [(i, i, 2 * k) for i in range(1, h)] + [(h, h, k)]            # grounded chain 1..h
+    ent += [(i, i, 2 * k if h + 1 < i < n else k) for i in range(h + 1, n + 1)]  # free chain h+1..n
+    ent += [(i + 1, i, -k) for i in range(1, n) if i != h]
+    kfile = "%%MatrixMarket matrix coordinate real symmetric\n" + f"{n} {n} {len(ent)}\n" + \
+        "".join(f"{i} {j} {v!r}\n" for i, j, v in ent)
+    mfile = "%%MatrixMarket matrix coordinate real symmetric\n" + f"{n} {n} {n}\n" + \
+        "".join(f"{i} {i} 1000.0\n" for i in range(1, n + 1))
+    deck = {"matrices": {"k_file": "K.mtx", "m_file": "M.mtx", "influence": [1.0] * n,
+                         "label": [f"x{i}" for i in range(1, n + 1)]},
+            "damping": {"damping_type": "none"},
+            "excitation": dict(HARMONIC, duration=0.02), "output": {"n_modes": 0}}
+    r = run(deck, files={"K.mtx": kfile, "M.mtx": mfile})
+    assert r.returncode != 0
+    assert f"K not positive definite at DOF {n} 'x{n}'" in r.stderr, r.stderr
+    assert not (r.workdir / "out").exists() or not any((r.workdir / "out").iterdir())

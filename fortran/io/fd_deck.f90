@@ -35,11 +35,12 @@ module fd_deck
                        default_storey_height, law_name
    use fd_model, only: source_friction, source_brace, source_isolator, source_floor_brace, source_bearing
    use fd_floors, only: floor_dof, plan_direction, floor_inertia, max_plan_terms
-   use fd_stiffness, only: add_general_entry, add_general_dense
+   use fd_stiffness, only: add_general_entry
    use fd_matrix_market, only: sparse_matrix, read_matrix_market
    use fd_linalg, only: cholesky_factor
    use fd_friction, only: law_mu_of_speed
-   use fd_matrices, only: modes_type, natural_modes, natural_modes_sparse, stiffness_matrix, modes_dense_dofs
+   use fd_matrices, only: modes_type, natural_modes, natural_modes_sparse, stiffness_matrix, modes_dense_dofs, &
+                          stiffness_pivot
    use fd_modal_damping, only: modal_damping_basis
    use fd_sha256, only: sha256_text
    use fd_textio, only: read_file_text, cr_line_ends
@@ -57,7 +58,7 @@ module fd_deck
    integer, parameter :: max_devices = 1000000  !! friction devices (n_devices)
    integer, parameter :: max_floors = max_dof/3 !! rigid floors (n_floors), three DOFs each
    !> Most DOFs of &matrices whose K is checked as a dense matrix (symmetry of a 'general'
-   !> file, positive definiteness): 3000 DOFs, 72 MB
+   !> file): 3000 DOFs, 72 MB
    integer, parameter :: max_dense_check = 3000
    !> What the variables read hold before the read: a filler only. Whether the deck gives a
    !> value is read from its text (given_elements), never from a value: any value a deck can
@@ -158,6 +159,10 @@ contains
       end if
       if (allocated(error)) return
       call read_springs_group(deck, cfg, error)
+      if (allocated(error)) return
+      if (.not. floors) then
+         if (matrices) call check_definite(deck, cfg, error)
+      end if
       if (allocated(error)) return
       if (cfg%model%p_delta) call add_p_delta(deck, cfg, error)
       if (allocated(error)) return
@@ -1252,7 +1257,6 @@ contains
          cfg%model%kx_j(i) = max(km%row(e), km%col(e))
          cfg%model%kx_v(i) = km%val(e)
       end do
-      call check_definite(deck, cfg, error)
    end subroutine read_matrices_group
 
    !> K square and symmetric (a general file's K checked entry by entry, as a dense matrix up
@@ -1321,23 +1325,18 @@ contains
       end do
    end subroutine check_matrices
 
-   !> K positive definite (up to max_dense_check DOFs, by a dense Cholesky factorization): a
-   !> mechanism or an indefinite K is named by the first DOF where the factorization fails.
+   !> K of &matrices with the springs positive definite, at every size by its banded Cholesky
+   !> factor (stiffness_pivot): a mechanism or an indefinite K is named by the first DOF where
+   !> the factorization fails.
    subroutine check_definite(deck, cfg, error)
       type(deck_text), intent(in) :: deck
       type(run_config), intent(in) :: cfg
       type(error_type), allocatable, intent(out) :: error
-      real(dp), allocatable :: k(:, :)
       character(len=label_len + 3) :: name
-      integer :: n, info, stat
+      integer :: info
 
-      n = cfg%model%n_dof
-      if (n > max_dense_check) return
-      allocate (k(n, n), stat=stat)
-      if (stat /= 0) return
-      k = 0.0_dp
-      call add_general_dense(cfg%model, k)
-      call cholesky_factor(k, info)
+      call stiffness_pivot(cfg%model, info, error)
+      if (allocated(error)) return
       if (info /= 0) then
          name = ''
          if (len_trim(cfg%model%dof_label(info)) > 0) name = " '"//trim(cfg%model%dof_label(info))//"'"

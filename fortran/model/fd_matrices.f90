@@ -4,6 +4,7 @@
 !> structure with every device stuck or free (natural_modes).
 module fd_matrices
    use, intrinsic :: ieee_arithmetic, only: ieee_value, ieee_positive_inf, ieee_quiet_nan
+   use, intrinsic :: iso_fortran_env, only: int64
    use fd_kinds, only: dp
    use fd_error, only: error_type, fatal_error, fmt_real, fmt_int, stat_no_memory
    use fd_model, only: model_type, damping_none, damping_stiffness, damping_rayleigh, damping_modal, &
@@ -11,6 +12,7 @@ module fd_matrices
    use fd_friction, only: sticking_stiffness, holds_when_stuck, links_when_stuck
    use fd_linalg, only: generalized_eigen, lowest_eigen, lowest_eigen_band
    use fd_rcm, only: rcm_order
+   use fd_lapack, only: dpbtrf
    use fd_modes, only: lowest_modes
    use fd_kinematics, only: add_device_outer, pair_nodes, devices_are_pairs
    use fd_stiffness, only: add_general_dense, general_form, influence_of
@@ -18,7 +20,7 @@ module fd_matrices
    private
 
    public :: stiffness_matrix, damping_matrix, stuck_first_mode, structure_matrices, link_groups
-   public :: system_modes, structure_damping
+   public :: system_modes, structure_damping, stiffness_pivot
    public :: modes_type, natural_modes, natural_modes_sparse, stiffness_damping_factor
    public :: modes_none, modes_flexible, modes_rigid, modes_unrestrained
    public :: modes_dense_dofs, modes_kept, mode_damping, mode_participation
@@ -109,6 +111,100 @@ contains
       end do
       call add_general_dense(model, k)
    end subroutine stiffness_matrix
+
+   !> Whether the structure's stiffness K (the springs and K_x, as stiffness_matrix) is
+   !> positive definite, by its Cholesky factor in band storage (LAPACK dpbtrf) in the
+   !> ordering of the smaller half-bandwidth kb, the DOFs' own (on a tie) or reverse
+   !> Cuthill-McKee's: time O(n kb^2) and memory O(n kb), as the run's own factor, at every
+   !> size. dof = 0 when it is; else the DOF (the model's numbering) of the first pivot that
+   !> is not positive, or whose square is below 4 (kb + 1) eps of its diagonal (singular to
+   !> working precision, as fd_banded judges K^): a DOF of a mechanism, or where an
+   !> indefinite K fails.
+   subroutine stiffness_pivot(model, dof, error)
+      type(model_type), intent(in) :: model               !! the model
+      integer, intent(out) :: dof                         !! 0, or the failing DOF
+      type(error_type), allocatable, intent(out) :: error !! not enough memory
+      integer, allocatable :: ei(:), ej(:), perm(:), inv(:)
+      real(dp), allocatable :: ab(:, :), diag(:)
+      integer :: n, ne, e, i, j, kb, kb_rcm, info, stat
+
+      dof = 0
+      n = model%n_dof
+      if (n < 1) return
+      ne = 0
+      allocate (ei(model%n_springs + model%n_kx), ej(model%n_springs + model%n_kx), perm(n), inv(n), stat=stat)
+      if (stat /= 0) then
+         call no_memory(); return
+      end if
+      do e = 1, model%n_springs
+         ne = ne + 1
+         ei(ne) = model%spring_i(e); ej(ne) = model%spring_j(e)
+      end do
+      do e = 1, model%n_kx
+         ne = ne + 1
+         ei(ne) = model%kx_i(e); ej(ne) = model%kx_j(e)
+      end do
+      inv = [(i, i=1, n)]
+      kb = band_of(inv)
+      call rcm_order(n, ei(1:ne), ej(1:ne), perm)
+      inv(perm) = [(i, i=1, n)]
+      kb_rcm = band_of(inv)
+      if (kb_rcm >= kb) then
+         perm = [(i, i=1, n)]
+         inv = perm
+      else
+         kb = kb_rcm
+      end if
+      if (int(kb + 1, int64)*n > int(huge(n), int64)) then
+         call no_memory(); return
+      end if
+      allocate (ab(kb + 1, n), diag(n), stat=stat)
+      if (stat /= 0) then
+         call no_memory(); return
+      end if
+      ab = 0.0_dp
+      do e = 1, model%n_springs
+         i = model%spring_i(e); j = model%spring_j(e)
+         if (i > 0) call add_entry(inv(i), inv(i), model%spring_k(e))
+         if (j > 0) call add_entry(inv(j), inv(j), model%spring_k(e))
+         if (i > 0 .and. j > 0) call add_entry(inv(i), inv(j), -model%spring_k(e))
+      end do
+      do e = 1, model%n_kx
+         call add_entry(inv(model%kx_i(e)), inv(model%kx_j(e)), model%kx_v(e))
+      end do
+      diag = ab(kb + 1, :)
+      call dpbtrf('U', n, kb, ab, kb + 1, info)
+      if (info > 0) then
+         dof = perm(info)
+         return
+      end if
+      do j = 1, n
+         if (ab(kb + 1, j)**2 <= 4.0_dp*(kb + 1)*epsilon(1.0_dp)*diag(j)) then
+            dof = perm(j)
+            return
+         end if
+      end do
+   contains
+      !> The half-bandwidth of K's graph in the numbering new = num(old).
+      pure integer function band_of(num) result(b)
+         integer, intent(in) :: num(:)
+         integer :: k
+         b = 0
+         do k = 1, ne
+            if (ei(k) > 0 .and. ej(k) > 0) b = max(b, abs(num(ei(k)) - num(ej(k))))
+         end do
+      end function band_of
+      !> K(p, q) = K(p, q) + v in the new numbering, by its entry on or above the diagonal.
+      subroutine add_entry(p, q, v)
+         integer, intent(in) :: p, q
+         real(dp), intent(in) :: v
+         ab(kb + 1 + min(p, q) - max(p, q), max(p, q)) = ab(kb + 1 + min(p, q) - max(p, q), max(p, q)) + v
+      end subroutine add_entry
+      subroutine no_memory()
+         call fatal_error(error, "not enough memory for the banded factor of K, "//trim(fmt_int(n))//" DOFs", &
+                          stat_no_memory)
+      end subroutine no_memory
+   end subroutine stiffness_pivot
 
    !> The nev lowest natural modes of the structure with the devices flagged in `linked` made
    !> rigid links between their nodes (none: the free structure of springs alone; every device

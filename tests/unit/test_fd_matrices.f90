@@ -5,7 +5,8 @@ module test_fd_matrices
    use fd_kinds, only: dp
    use fd_error, only: fd_error_type => error_type
    use fd_model, only: model_type, damping_stiffness, damping_rayleigh, law_velocity
-   use fd_matrices, only: link_groups, stiffness_matrix, damping_matrix, stuck_first_mode, structure_matrices
+   use fd_matrices, only: link_groups, stiffness_matrix, damping_matrix, stuck_first_mode, structure_matrices, &
+                          stiffness_pivot
    use test_fd_helpers, only: check_close, check_matrix, pairs_of
    implicit none
    private
@@ -29,7 +30,9 @@ contains
                   new_unittest("stuck mode, device between the masses", test_stuck_linked), &
                   new_unittest("stuck mode, no friction capacity", test_stuck_free), &
                   new_unittest("stuck mode, everything locked", test_stuck_locked), &
-                  new_unittest("damping ratio of the stuck mode", test_structure_xi) &
+                  new_unittest("damping ratio of the stuck mode", test_structure_xi), &
+                  new_unittest("stiffness pivot: mechanisms and indefinite K", test_stiffness_pivot), &
+                  new_unittest("stiffness pivot in the RCM ordering", test_stiffness_pivot_rcm) &
                   ]
    end subroutine collect_matrices
 
@@ -125,6 +128,66 @@ contains
       expected = reshape([120.5_dp, -20.0_dp, -0.5_dp, -20.0_dp, 23.0_dp, -3.0_dp, -0.5_dp, -3.0_dp, 3.5_dp], [3, 3])
       call check_matrix(error, k, expected, 0.0_dp, 'stiffness of a chain with a cross spring (exact)')
    end subroutine test_stiffness
+
+   !> K positive definite or not, by the banded factor in the DOFs' own ordering (a chain has
+   !> band 1 either way): a grounded chain passes; the free chain 1 - 2 - 3 (pivots k, k/2...
+   !> exactly 0 at the last) fails at DOF 3; k 0.1, 0.3 free fails at DOF 3 by round-off or
+   !> zero alike; K_x with a negative diagonal at DOF 2 fails there.
+   subroutine test_stiffness_pivot(error)
+      type(error_type), allocatable, intent(out) :: error
+      type(fd_error_type), allocatable :: ferr
+      type(model_type) :: model
+      integer :: no_devices(2, 0), dof
+
+      call make_model(model, [1.0_dp, 1.0_dp, 1.0_dp], reshape([1.0_dp, 0.0_dp, 100.0_dp, 2.0_dp, 1.0_dp, 20.0_dp, &
+                      3.0_dp, 2.0_dp, 3.0_dp], [3, 3]), no_devices)
+      call stiffness_pivot(model, dof, ferr)
+      call check(error, .not. allocated(ferr) .and. dof == 0, 'a grounded chain is positive definite')
+      if (allocated(error)) return
+      call make_model(model, [1.0_dp, 1.0_dp, 1.0_dp], reshape([2.0_dp, 1.0_dp, 20.0_dp, 3.0_dp, 2.0_dp, 20.0_dp], &
+                      [3, 2]), no_devices)
+      call stiffness_pivot(model, dof, ferr)
+      call check(error, dof, 3, 'a free chain fails at its last DOF')
+      if (allocated(error)) return
+      call make_model(model, [1.0_dp, 1.0_dp, 1.0_dp], reshape([1.0_dp, 2.0_dp, 0.1_dp, 2.0_dp, 3.0_dp, 0.3_dp], &
+                      [3, 2]), no_devices)
+      call stiffness_pivot(model, dof, ferr)
+      call check(error, dof, 3, 'a free chain of 0.1 and 0.3: its last pivot zero to working precision')
+      if (allocated(error)) return
+      ! the grounded chain with K_x: 5 at (1, 1), -30 at (2, 2) (K(2, 2) = 23 - 30 < 0)
+      call make_model(model, [1.0_dp, 1.0_dp, 1.0_dp], reshape([1.0_dp, 0.0_dp, 100.0_dp, 2.0_dp, 1.0_dp, 20.0_dp, &
+                      3.0_dp, 2.0_dp, 3.0_dp], [3, 3]), no_devices)
+      model%n_kx = 2
+      model%kx_i = [1, 2]
+      model%kx_j = [1, 2]
+      model%kx_v = [5.0_dp, -30.0_dp]
+      call stiffness_pivot(model, dof, ferr)
+      call check(error, dof, 2, 'K_x making K(2, 2) negative fails at DOF 2')
+   end subroutine test_stiffness_pivot
+
+   !> Two chains numbered across each other (springs 1-6, 6-2 and 1 to the table; 5-3, 3-4
+   !> free): band 5 in the DOFs' ordering, 1 in reverse Cuthill-McKee's, which the check
+   !> takes; the DOF it names is one of the free chain's, in the model's numbering. With 4
+   !> on the table too, positive definite.
+   subroutine test_stiffness_pivot_rcm(error)
+      type(error_type), allocatable, intent(out) :: error
+      type(fd_error_type), allocatable :: ferr
+      type(model_type) :: model
+      integer :: no_devices(2, 0), dof
+
+      call make_model(model, [1.0_dp, 1.0_dp, 1.0_dp, 1.0_dp, 1.0_dp, 1.0_dp], reshape([1.0_dp, 0.0_dp, 7.0_dp, &
+                      1.0_dp, 6.0_dp, 3.0_dp, 6.0_dp, 2.0_dp, 5.0_dp, 5.0_dp, 3.0_dp, 2.0_dp, 3.0_dp, 4.0_dp, 4.0_dp], &
+                      [3, 5]), no_devices)
+      call stiffness_pivot(model, dof, ferr)
+      call check(error, any(dof == [3, 4, 5]), 'the free chain {5, 3, 4} named (DOF '//char(48 + dof)//')')
+      if (allocated(error)) return
+      model%n_kx = 1
+      model%kx_i = [4]
+      model%kx_j = [4]
+      model%kx_v = [1.0_dp]
+      call stiffness_pivot(model, dof, ferr)
+      call check(error, .not. allocated(ferr) .and. dof == 0, 'both chains grounded: positive definite')
+   end subroutine test_stiffness_pivot_rcm
 
    !> C = (T xi / pi) K for 'stiffness'; C = a0 M + a1 K for 'rayleigh'.
    subroutine test_damping(error)
