@@ -155,8 +155,9 @@ contains
          di%lo(d) = -g(d)
          di%hi(d) = g(d)
       end do
-      call lcp_step(di, di%a, nd, lam, error)
+      call lcp_step(di, di%a, nd, error)
       if (allocated(error)) return
+      lam = di%zz(1:nd)
       do d = 1, nd
          v1 = v1 - di%z(:, d)*lam(d)
       end do
@@ -170,12 +171,12 @@ contains
       end do
    end subroutine dense_solve
 
-   !> The box LCP -w = a z + q over the first m entries of di%q, di%lo, di%hi: z on return.
-   subroutine lcp_step(di, a, m, z, error)
+   !> The box LCP -w = a z + q over the first m entries of di%q, di%lo, di%hi: z in
+   !> di%zz(1:m) on return.
+   subroutine lcp_step(di, a, m, error)
       type(dense_impulse), intent(inout) :: di      !! the solver (q, lo, hi set)
       real(dp), intent(in) :: a(:, :)               !! (m, m) the operator
       integer, intent(in) :: m                      !! size
-      real(dp), intent(out) :: z(:)                 !! (m) solution
       type(error_type), allocatable, intent(out) :: error !! unsolved
       type(lcp_info) :: info
 
@@ -185,9 +186,7 @@ contains
          call fatal_error(error, "the Moreau-Jean box LCP of "//trim(fmt_int(m))//" devices was not solved ("// &
                           trim(lcp_status_text(info%status))//", residual "//trim(fmt_real(info%residual))// &
                           "); try technique = 'newmark' with law = 'velocity'")
-         return
       end if
-      z(1:m) = di%zz(1:m)
    end subroutine lcp_step
 
    !> The acceleration at the end of a step from forces f (all but friction): a sliding device
@@ -230,7 +229,7 @@ contains
                di%sub(a, b) = di%am(d, di%idx(b))
             end do
          end do
-         call lcp_step(di, di%sub, m, di%zz, error)
+         call lcp_step(di, di%sub(1:m, 1:m), m, error)
          if (allocated(error)) return
          do a = 1, m
             d = di%idx(a)
