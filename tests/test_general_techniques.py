@@ -157,3 +157,25 @@ def test_a_hysteretic_floor_brace_is_refused_naming_its_group(run):
     r = run(deck)
     assert r.returncode != 0
     assert "&floor_braces: law(1) = 'hysteretic'" in r.stderr and "law = 'coulomb'" in r.stderr, r.stderr
+
+
+@pytest.mark.parametrize("technique", ["event_driven", "moreau_jean"])
+def test_symmetric_floors_along_x_are_the_planar_building(run, technique):
+    """A doubly symmetric building of rigid floors with Coulomb braces through the centres of
+    mass, excited along x (general patterns, dense Moreau-Jean), is the planar shear building
+    with node-pair devices (groups of nodes, band solver) to 1e-12 (measured 4e-13 and 1e-13)."""
+    from test_floors import planar, symmetric, SLIP
+    p = planar()
+    p.pop("braces")
+    p["friction"] = {"n_devices": 3, "node_i": [1, 2, 3], "node_j": [0, 1, 2], "law": ["coulomb"] * 3,
+                     "p": SLIP, "mu": [1.0] * 3}
+    p["integration"] = {"technique": technique, "n1": 20}
+    f = symmetric()
+    f["floor_braces"]["law"] = ["coulomb"] * 6
+    del f["floor_braces"]["stiffness"]
+    f["integration"] = {"technique": technique, "n1": 20}
+    a, b = ok(run(p, name="planar")), ok(run(f, name="floors"))
+    up = np.array([a.history()[f"u{i}"] for i in (1, 2, 3)])
+    uf = np.array([b.history()[f"u{3 * i - 2}"] for i in (1, 2, 3)])
+    assert min(a.summary()["stick_to_slip"]) > 0
+    assert np.abs(up - uf).max() <= 1e-12 * np.abs(up).max()
