@@ -142,17 +142,6 @@ def test_eccentric_floor_equals_modal_closed_form(run):
     assert np.abs(u[2]).max() > 1e-5  # it turns
 
 
-@pytest.mark.parametrize("technique", ["event_driven", "moreau_jean"])
-def test_exact_techniques_refuse_rigid_floors(run, technique):
-    deck = symmetric()
-    deck["floor_braces"]["law"] = ["coulomb"] * 6
-    del deck["floor_braces"]["stiffness"]
-    deck["integration"] = {"technique": technique}
-    r = run(deck)
-    assert r.returncode != 0
-    assert "technique = 'newmark'" in r.stderr
-
-
 @pytest.mark.parametrize("change, words", [
     (lambda d: d.update(model={"n_dof": 1, "mass": [1.0]}), "group &model is not for a building of &floors"),
     (lambda d: d["frames"].update(storey=[4] + [1] * 11), "storey(1) = 4"),

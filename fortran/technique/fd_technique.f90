@@ -13,12 +13,11 @@ module fd_technique
    use fd_kinds, only: dp
    use fd_error, only: error_type, fatal_error, fmt_int
    use fd_names, only: technique_newmark, technique_event_driven, technique_moreau_jean, techniques, &
-                       keyword_choices, technique_name, technique_traits_type, technique_traits, &
+                       keyword_choices, technique_name, law_name, technique_traits_type, technique_traits, &
                        technique_integrates, technique_step_rule, rule_newmark, rule_theta
-   use fd_model, only: model_type, integration_type, source_brace, damping_modal
+   use fd_model, only: model_type, integration_type, source_brace, source_floor_brace, damping_modal
    use fd_step_limits, only: check_step_limits
-   use fd_kinematics, only: devices_are_pairs
-   use fd_excitation, only: excitation_type
+   use fd_excitation, only: excitation_type, excitation_none
    use fd_result, only: result_type, energy_balance_of
    use fd_run_control, only: run_control
    use fd_newmark, only: run_newmark, newmark_check
@@ -56,20 +55,6 @@ contains
                           trim(fmt_int(model%dev(d)%source_index))//"); set technique = 'newmark'")
          return
       end do
-      ! the exact techniques' phase patterns and sticking groups take each device as a link
-      ! between two nodes (fd_kinematics); Newmark takes any direction
-      if (opts%technique /= technique_newmark .and. .not. devices_are_pairs(model)) then
-         call fatal_error(error, "group &integration: technique = '"//trim(technique_name(opts%technique))// &
-                          "' takes devices between two nodes (&friction, &braces, &isolators): a brace at a "// &
-                          "plan position of rigid floors (&floor_braces) is integrated by technique = 'newmark'")
-         return
-      end if
-      if (opts%technique /= technique_newmark .and. model%n_kx > 0) then
-         call fatal_error(error, "group &integration: technique = '"//trim(technique_name(opts%technique))// &
-                          "' takes a structure of springs between two nodes: a building of rigid floors "// &
-                          "(&floors, &frames) or of &matrices is integrated by technique = 'newmark'")
-         return
-      end if
       call check_braces(model, opts%technique, error)
       if (allocated(error)) return
       select case (opts%technique)
@@ -105,7 +90,8 @@ contains
 
    !> The braces of the deck are hysteretic devices: an error naming &braces for a technique
    !> that does not integrate their law (the exact Coulomb techniques' devices are rigid while
-   !> stuck).
+   !> stuck); a brace of &floor_braces whose law the technique does not integrate, an error
+   !> naming &floor_braces.
    subroutine check_braces(model, technique, error)
       type(model_type), intent(in) :: model         !! the model
       integer, intent(in) :: technique             !! the technique
@@ -113,6 +99,14 @@ contains
       integer :: d
 
       do d = 1, model%n_devices
+         if (model%dev(d)%source == source_floor_brace .and. .not. technique_integrates(technique, &
+                                                                                      model%dev(d)%law)) then
+            call fatal_error(error, "group &floor_braces: law("//trim(fmt_int(model%dev(d)%source_index))// &
+                             ") = '"//trim(law_name(model%dev(d)%law))//"' is invalid with technique = '"// &
+                             trim(technique_name(technique))//"' of &integration: it integrates 'coulomb' "// &
+                             "braces (rigid while stuck); set law = 'coulomb' or technique = 'newmark'")
+            return
+         end if
          if (model%dev(d)%source /= source_brace) cycle
          if (technique_integrates(technique, model%dev(d)%law)) cycle
          call fatal_error(error, "group &braces: brace "//trim(fmt_int(model%dev(d)%source_index))// &
@@ -137,6 +131,14 @@ contains
       type(excitation_type), intent(in), optional :: exc2 !! a second horizontal component
                                                           !! (along the model's influence2)
 
+      if (opts%technique /= technique_newmark .and. present(exc2)) then
+         if (exc2%kind /= excitation_none) then
+            call fatal_error(error, "group &excitation2: a second horizontal component is integrated by "// &
+                             "technique = 'newmark' only; technique = '"//trim(technique_name(opts%technique))// &
+                             "' takes one component (&excitation)")
+            return
+         end if
+      end if
       select case (opts%technique)
       case (technique_newmark)
          call run_newmark(model, exc, opts, res, error, ctl, exc2)

@@ -13,7 +13,8 @@ module test_fd_phase_pattern
    use fd_excitation, only: excitation_type, excitation_none, excitation_harmonic, excitation_record, &
                             table_taylor
    use fd_phase_pattern, only: pattern_type, pattern_cache, cache_init, cache_find, build_pattern, &
-                               pattern_entry, pattern_taylor, remainder_bound, kmax
+                               pattern_entry, pattern_taylor, remainder_bound, kmax, null_space_basis
+   use fd_kinematics, only: append_device
    use fd_taylor, only: poly_value
    use test_fd_helpers, only: check_close, pairs_of
    implicit none
@@ -43,7 +44,9 @@ contains
                   new_unittest("mass stuck to the table", test_stuck_to_table), &
                   new_unittest("force that keeps two masses together", test_two_masses), &
                   new_unittest("devices in parallel share in proportion", test_parallel), &
-                  new_unittest("cache: one build per pattern", test_cache) &
+                  new_unittest("cache: one build per pattern", test_cache), &
+                  new_unittest("null space basis of a general direction", test_null_space), &
+                  new_unittest("general pattern: the two masses' force", test_general_two_masses) &
                   ]
    end subroutine collect_phase_pattern
 
@@ -351,5 +354,65 @@ contains
       if (allocated(error)) return
       call check(error, s1 == s3 .and. s1 /= s2 .and. cache%builds == 2, "one build per pattern")
    end subroutine test_cache
+
+   !> Three masses (2, 1, 3), a device of direction b = (1, -0.5, 0.25) linked: the basis T
+   !> has two columns, T'MT = I and b'T = 0 (to round-off).
+   subroutine test_null_space(error)
+      type(error_type), allocatable, intent(out) :: error
+      type(model_type) :: model
+      type(fd_error_type), allocatable :: err
+      real(dp), allocatable :: tm(:, :)
+      real(dp) :: mt(2, 2), bt(2)
+      integer :: nq, stat, i
+
+      call make_model([2.0_dp, 1.0_dp, 3.0_dp], [integer ::], [integer ::], [real(dp) ::], model)
+      call append_device(model, device_type(law=law_coulomb, p=1.0_dp, mu=1.0_dp), [1, 2, 3], &
+                         [1.0_dp, -0.5_dp, 0.25_dp], stat)
+      call null_space_basis(model, model%mass, [.true.], tm, nq, err)
+      call check(error, .not. allocated(err) .and. nq == 2, "two free coordinates")
+      if (allocated(error)) return
+      mt = matmul(transpose(tm), matmul(reshape([2.0_dp, 0.0_dp, 0.0_dp, 0.0_dp, 1.0_dp, 0.0_dp, 0.0_dp, 0.0_dp, &
+                                                 3.0_dp], [3, 3]), tm))
+      bt = matmul([1.0_dp, -0.5_dp, 0.25_dp], tm)
+      call check(error, abs(mt(1, 1) - 1.0_dp) + abs(mt(2, 2) - 1.0_dp) + abs(mt(1, 2)) + abs(mt(2, 1)) <= 1e-14_dp, &
+                 "T'MT = I")
+      if (allocated(error)) return
+      do i = 1, 2
+         call check(error, abs(bt(i)) <= 1e-14_dp, "b'T = 0")
+         if (allocated(error)) return
+      end do
+   end subroutine test_null_space
+
+   !> The two masses of test_two_masses with the table motion's direction r = (1, 1) given:
+   !> the general pattern (T over the null space of b, Mq = I, lq = T'M r) gives the closed
+   !> form of the force that keeps them together, and u = T q + uc.
+   subroutine test_general_two_masses(error)
+      type(error_type), allocatable, intent(out) :: error
+      type(model_type) :: model
+      type(excitation_type) :: exc
+      type(entered) :: e
+      real(dp) :: k(2, 2), c(2, 2), m1, m2, k1, k2, psi, u, v, aabs, f
+
+      m1 = 6.301_dp; m2 = 2.53_dp; k1 = 1084.0_dp; k2 = 2895.0_dp; psi = 1.4e-3_dp
+      call make_model([m1, m2], [1], [2], [61.81_dp*0.22_dp], model)
+      model%influence = [1.0_dp, 1.0_dp]
+      k = 0.0_dp
+      k(1, 1) = k1; k(2, 2) = k2
+      c = psi*k
+      exc%kind = excitation_harmonic
+      exc%amplitude = 0.004052_dp
+      exc%frequency = 4.104_dp
+      u = 0.003_dp; v = -0.05_dp
+      call enter_at(model, k, c, [0], exc, 0.1_dp, [u, u], [v, v], e, error)
+      if (allocated(error)) return
+      call check(error, e%pat%general .and. e%pat%nq == 1 .and. e%pat%ns == 1, "general, one coordinate")
+      if (allocated(error)) return
+      aabs = -((k1 + k2)*u + psi*(k1 + k2)*v)/(m1 + m2)
+      f = -(m1*aabs + k1*u + psi*k1*v)
+      call check_close(error, e%pat%fq(1, 1)*e%q(1) + e%pat%fp(1, 1)*e%p(1) + e%pat%fag(1)*e%g(0) + e%f0(1), f, &
+                       1e-13_dp, "force that keeps the masses together")
+      if (allocated(error)) return
+      call check_close(error, e%pat%tm(2, 1)*e%q(1) + e%uc(2), u, 1e-14_dp, "u = T q + uc")
+   end subroutine test_general_two_masses
 
 end module test_fd_phase_pattern

@@ -12,7 +12,8 @@ module fd_ed_state
    use fd_kinds, only: dp
    use fd_error, only: error_type, fatal_error, fmt_int
    use fd_model, only: model_type
-   use fd_kinematics, only: pair_nodes
+   use fd_kinematics, only: pair_nodes, device_relative
+   use fd_stiffness, only: influence_of
    use fd_excitation, only: excitation_type, table_taylor
    use fd_device_state, only: phase_stick
    use fd_lcp, only: lcp_work, lcp_init
@@ -29,6 +30,7 @@ module fd_ed_state
       integer :: nbase = 0                                 !! quantities of the state (3 n + 2 nd); the
                                                            !! others (storeys) are the caller's
       real(dp), allocatable :: mass(:), k(:, :), c(:, :)   !! structure
+      real(dp), allocatable :: rinf(:)                     !! the table motion's direction r (n)
       real(dp), allocatable :: slip(:)                     !! P mu
       logical, allocatable :: active(:)                    !! P mu > 0
       real(dp), allocatable :: u(:), v(:)                  !! full state at the current instant
@@ -112,7 +114,7 @@ contains
       st%nbase = nq_of(n, nd)
       nqt = st%nbase + extra
       st%nquant = nqt
-      allocate (st%mass(n), st%k(n, n), st%c(n, n), st%slip(nd), st%active(nd), st%u(n), st%v(n), st%phase(nd), &
+      allocate (st%mass(n), st%rinf(n), st%k(n, n), st%c(n, n), st%slip(nd), st%active(nd), st%u(n), st%v(n), st%phase(nd), &
                 st%q(n), st%p(n), st%uc(n), st%b1(n), st%f0(max(nd, 1)), &
                 st%qc(n, 0:kmax + 1), st%pc(n, 0:kmax + 1), st%cp(n, 0:kmax + 1), st%g(0:kmax), st%gn(0:kmax), &
                 st%yc(0:kmax, nqt), st%yrem(nqt), st%ec(0:kmax, 2*nd), st%erem(2*nd), st%eta(2*nd), &
@@ -126,6 +128,9 @@ contains
          return
       end if
       st%mass = model%mass
+      do d = 1, n
+         st%rinf(d) = influence_of(model, d)
+      end do
       do d = 1, nd
          st%slip(d) = model%dev(d)%p*model%dev(d)%mu
          st%active(d) = st%slip(d) > 0.0_dp
@@ -166,7 +171,7 @@ contains
          ! the magnitude of the terms that make up each group's acceleration: the rounding
          ! level of the velocities' and forces' variation over the sub-interval
          do i = 1, pat%nq
-            a0 = abs(st%b1(i)) + abs(st%g(0))
+            a0 = abs(st%b1(i)) + abs(st%g(0))*abs(pat%lq(i))
             do j = 1, pat%nq
                a0 = a0 + abs(pat%kt(i, j)*st%q(j)) + abs(pat%ct(i, j)*st%p(j))
             end do
@@ -175,7 +180,9 @@ contains
          ! per DOF: u, v, aabs
          do i = 1, st%n
             gi = pat%grp(i)
-            if (gi == 0) then
+            if (pat%general) then
+               call general_dof(st, i, kk, rg)
+            else if (gi == 0) then
                st%yc(0:kk, iq_u(i)) = 0.0_dp
                st%yc(0, iq_u(i)) = st%uc(i)
                st%yc(0:kk, iq_v(i)) = 0.0_dp
@@ -197,18 +204,24 @@ contains
          end do
          ! per device: s, F, and the event functions
          do d = 1, st%nd
-            call pair_nodes(model, d, ni, nj)
-            st%yc(0:kk, iq_s(st%n, d)) = st%yc(0:kk, iq_u(ni))
-            gi = pat%grp(ni)
-            gj = 0
-            if (nj > 0) then
-               st%yc(0:kk, iq_s(st%n, d)) = st%yc(0:kk, iq_s(st%n, d)) - st%yc(0:kk, iq_u(nj))
-               gj = pat%grp(nj)
-            end if
-            st%yrem(iq_s(st%n, d)) = 0.0_dp
-            if (gi /= gj) then
-               if (gi > 0) st%yrem(iq_s(st%n, d)) = pat%wq(gi)*st%rem
-               if (gj > 0) st%yrem(iq_s(st%n, d)) = st%yrem(iq_s(st%n, d)) + pat%wq(gj)*st%rem
+            if (pat%general) then
+               call general_device(model, st, d, kk)
+               gi = 0
+               gj = 0
+            else
+               call pair_nodes(model, d, ni, nj)
+               st%yc(0:kk, iq_s(st%n, d)) = st%yc(0:kk, iq_u(ni))
+               gi = pat%grp(ni)
+               gj = 0
+               if (nj > 0) then
+                  st%yc(0:kk, iq_s(st%n, d)) = st%yc(0:kk, iq_s(st%n, d)) - st%yc(0:kk, iq_u(nj))
+                  gj = pat%grp(nj)
+               end if
+               st%yrem(iq_s(st%n, d)) = 0.0_dp
+               if (gi /= gj) then
+                  if (gi > 0) st%yrem(iq_s(st%n, d)) = pat%wq(gi)*st%rem
+                  if (gj > 0) st%yrem(iq_s(st%n, d)) = st%yrem(iq_s(st%n, d)) + pat%wq(gj)*st%rem
+               end if
             end if
             e = 2*d - 1
             r = pat%row(d)
@@ -223,6 +236,10 @@ contains
                st%yrem(iq_f(st%n, d)) = 0.0_dp
                st%eon(e) = .true.
                st%eon(e + 1) = .false.
+               if (pat%general) then
+                  call general_slide_event(st, d, e, kk, span)
+                  cycle
+               end if
                a0 = 0.0_dp
                st%erem(e) = 0.0_dp
                do j = 0, kk
@@ -274,5 +291,83 @@ contains
          end do
       end associate
    end subroutine ed_polynomials
+
+   !> u_i, v_i and aabs_i of a general pattern: u = T q + uc, aabs = u'' + r ag.
+   pure subroutine general_dof(st, i, kk, rg)
+      type(ed_state), intent(inout) :: st           !! the state
+      integer, intent(in) :: i, kk                  !! the DOF, the degree
+      real(dp), intent(in) :: rg                    !! the table acceleration's remainder
+      integer :: g, j
+      real(dp) :: wu, wv, wa
+
+      associate (pat => st%cache%slot(st%cur))
+         st%yc(0:kk, iq_u(i)) = 0.0_dp
+         st%yc(0:kk, iq_v(i)) = 0.0_dp
+         do j = 0, kk
+            st%yc(j, iq_a(i)) = st%rinf(i)*st%g(j)
+         end do
+         wu = 0.0_dp
+         wv = 0.0_dp
+         wa = 0.0_dp
+         do g = 1, pat%nq
+            st%yc(0:kk, iq_u(i)) = st%yc(0:kk, iq_u(i)) + pat%tm(i, g)*st%qc(g, 0:kk)
+            st%yc(0:kk, iq_v(i)) = st%yc(0:kk, iq_v(i)) + pat%tm(i, g)*st%pc(g, 0:kk)
+            do j = 0, kk
+               st%yc(j, iq_a(i)) = st%yc(j, iq_a(i)) + pat%tm(i, g)*((j + 1)*st%pc(g, j + 1))
+            end do
+            wu = wu + abs(pat%tm(i, g))*pat%wq(g)
+            wv = wv + abs(pat%tm(i, g))*pat%wp(g)
+            wa = wa + abs(pat%tm(i, g))*pat%wacc(g)
+         end do
+         st%yc(0, iq_u(i)) = st%yc(0, iq_u(i)) + st%uc(i)
+         st%yrem(iq_u(i)) = wu*st%rem
+         st%yrem(iq_v(i)) = wv*st%rem
+         st%yrem(iq_a(i)) = wa*st%rem + abs(st%rinf(i))*rg
+      end associate
+   end subroutine general_dof
+
+   !> s_d = b_d' u of a general pattern: (T'b_d)' q + b_d' uc, and its remainder.
+   pure subroutine general_device(model, st, d, kk)
+      type(model_type), intent(in) :: model         !! the model
+      type(ed_state), intent(inout) :: st           !! the state
+      integer, intent(in) :: d, kk                  !! the device, the degree
+      integer :: g
+      real(dp) :: wu
+
+      associate (pat => st%cache%slot(st%cur))
+         st%yc(0:kk, iq_s(st%n, d)) = 0.0_dp
+         wu = 0.0_dp
+         do g = 1, pat%nq
+            st%yc(0:kk, iq_s(st%n, d)) = st%yc(0:kk, iq_s(st%n, d)) + pat%tb(g, d)*st%qc(g, 0:kk)
+            wu = wu + abs(pat%tb(g, d))*pat%wq(g)
+         end do
+         st%yc(0, iq_s(st%n, d)) = st%yc(0, iq_s(st%n, d)) + device_relative(model, d, st%uc)
+         st%yrem(iq_s(st%n, d)) = wu*st%rem
+      end associate
+   end subroutine general_device
+
+   !> A sliding device's event function sgn s' in a general pattern, its remainder and its
+   !> rounding level.
+   pure subroutine general_slide_event(st, d, e, kk, span)
+      type(ed_state), intent(inout) :: st           !! the state
+      integer, intent(in) :: d, e, kk               !! the device, its event function, the degree
+      real(dp), intent(in) :: span                  !! sub-interval length
+      integer :: g, j
+      real(dp) :: a0
+
+      associate (pat => st%cache%slot(st%cur))
+         st%ec(0:kk, e) = 0.0_dp
+         st%erem(e) = 0.0_dp
+         a0 = 0.0_dp
+         do g = 1, pat%nq
+            do j = 0, kk
+               st%ec(j, e) = st%ec(j, e) + st%phase(d)*pat%tb(g, d)*st%pc(g, j)
+            end do
+            st%erem(e) = st%erem(e) + abs(pat%tb(g, d))*pat%wp(g)*st%rem
+            a0 = a0 + abs(pat%tb(g, d))*(abs(st%pc(g, 0)) + span*st%aab(g))
+         end do
+         st%eta(e) = 256.0_dp*epsilon(1.0_dp)*(a0 + poly_abs_bound(st%ec(0:kk, e), span))
+      end associate
+   end subroutine general_slide_event
 
 end module fd_ed_state

@@ -347,6 +347,15 @@ contains
             st%q(gi) = poly_value(st%qc(gi, 0:st%order), s)
             st%p(gi) = poly_value(st%pc(gi, 0:st%order), s)
          end do
+         if (pat%general) then
+            st%u = st%uc
+            st%v = 0.0_dp
+            do gi = 1, pat%nq
+               st%u = st%u + pat%tm(:, gi)*st%q(gi)
+               st%v = st%v + pat%tm(:, gi)*st%p(gi)
+            end do
+            return
+         end if
          do i = 1, st%n
             gi = pat%grp(i)
             if (gi == 0) then
@@ -406,7 +415,7 @@ contains
          do i = 1, st%n
             w%uu(i) = w%yv(iq_u(i))
             w%vv(i) = w%yv(iq_v(i))
-            w%aa(i) = w%yv(iq_a(i)) - ag
+            w%aa(i) = w%yv(iq_a(i)) - st%rinf(i)*ag
          end do
          do dd = 1, st%nd
             w%ss(dd) = w%yv(iq_s(st%n, dd))
@@ -532,7 +541,7 @@ contains
          do m = 0, kk
             w%mp(m) = 0.0_dp
             do gi = 1, pat%nq
-               w%mp(m) = w%mp(m) + pat%mq(gi)*st%pc(gi, m)
+               w%mp(m) = w%mp(m) + pat%mq(gi)*pat%lq(gi)*st%pc(gi, m)
             end do
          end do
          w%ein(0:2*kk) = 0.0_dp

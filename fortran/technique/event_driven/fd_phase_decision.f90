@@ -146,10 +146,10 @@ contains
       integer :: a, b, d, i, j, nc
 
       nc = dc%nc
-      ! p = -M 1 ag - C v - K u - sum_(other sliders) b sgn P mu, and its magnitude
+      ! p = -M r ag - C v - K u - sum_(other sliders) b sgn P mu, and its magnitude
       do i = 1, st%n
-         st%pe(i) = -st%mass(i)*dc%ag
-         st%pa(i) = abs(st%mass(i)*dc%ag)
+         st%pe(i) = -st%mass(i)*st%rinf(i)*dc%ag
+         st%pa(i) = abs(st%mass(i)*st%rinf(i)*dc%ag)
       end do
       do j = 1, st%n
          do i = 1, st%n
@@ -250,6 +250,10 @@ contains
             call abs_taylor(st, dc%slot1, lev + 2)
             do a = 1, dc%ndg
                d = st%cand(a)
+               if (pat%general) then
+                  call general_level(st, dc%slot1, a, lev, dc%ndg)
+                  cycle
+               end if
                call pair_nodes(model, d, ni, nj)
                gi = pat%grp(ni)
                gj = 0
@@ -501,7 +505,7 @@ contains
          do k1 = 0, m - 1
             do ii = 1, pat%nq
                st%qa(ii, k1 + 1) = st%pq(ii, k1)/(k1 + 1)
-               st%pq(ii, k1 + 1) = abs(st%g(k1))
+               st%pq(ii, k1 + 1) = abs(st%g(k1))*abs(pat%lq(ii))
                if (k1 == 0) st%pq(ii, 1) = st%pq(ii, 1) + abs(st%b1(ii))
             end do
             do jj = 1, pat%nq
@@ -541,6 +545,28 @@ contains
          end do
       end do
    end function group_delassus
+
+   !> Row a of the level-lev LCP in a general pattern: q_L = sgn (T'b_d)' q^(L+2), its
+   !> magnitude, and W1(a, b) = sgn_a sgn_b (T'b_a)'(T'b_b) (Mq = I).
+   pure subroutine general_level(st, slot, a, lev, ndg)
+      type(ed_state), intent(inout) :: st     !! the state, the pattern in slot entered
+      integer, intent(in) :: slot, a, lev, ndg !! the pattern, the row, the level, the rows
+      integer :: b, g, d
+
+      associate (pat => st%cache%slot(slot))
+         d = st%cand(a)
+         st%lq(a) = 0.0_dp
+         st%lqa(a) = 0.0_dp
+         do g = 1, pat%nq
+            st%lq(a) = st%lq(a) + pat%tb(g, d)*st%qc(g, lev + 2)
+            st%lqa(a) = st%lqa(a) + abs(pat%tb(g, d))*st%qa(g, lev + 2)
+         end do
+         st%lq(a) = st%sig(a)*st%lq(a)
+         do b = 1, ndg
+            st%wm(a, b) = st%sig(a)*st%sig(b)*dot_product(pat%tb(1:pat%nq, d), pat%tb(1:pat%nq, st%cand(b)))
+         end do
+      end associate
+   end subroutine general_level
 
    !> "device d" or "devices d1, d2, ..." of the devices idx(1:m) (at most 20 named).
    subroutine device_list(idx, m, text)

@@ -30,6 +30,15 @@
 !> A component is bounded by the norm: |q_g| <= ||x|| / (alpha sqrt(mq_g)),
 !> |p_g| <= ||x|| / sqrt(mq_g), which gives the remainder of every output quantity.
 !>
+!> **Devices of any direction, stiffness beyond springs.** When a device is not between two
+!> nodes, K has entries beyond springs (K_x) or the table motion has a direction r over the
+!> DOFs (general_pattern), the sticking devices' constraints B_S' u = const are no groups of
+!> nodes: T is then an M-orthonormal basis of the null space of B_S' (an orthonormal basis
+!> Z from the eigenvectors of B_S B_S', then the modes of (Z'KZ, Z'MZ), so that T'MT = I and
+!> Mq = I), u = T q + uc with q = T'M u, and the table's load on each coordinate is
+!> -lq ag, lq = T'M r (1 for a group). The closed form, its bounds and the force map are
+!> the same with these T, Mq and lq; T and T'B are kept with the pattern.
+!>
 !> **Cache.** A pattern is built once (its groups, reduced matrices and force map: one
 !> SVD) and kept in a cache keyed by the phases, so that an event costs a lookup; the
 !> cache holds at most `nslots` patterns (least recently used replaced).
@@ -39,14 +48,15 @@ module fd_phase_pattern
    use fd_model, only: model_type
    use fd_excitation, only: excitation_type, forcing_frequency
    use fd_matrices, only: link_groups
-   use fd_kinematics, only: add_device
-   use fd_linalg, only: least_squares, least_squares_work
+   use fd_kinematics, only: add_device, devices_are_pairs
+   use fd_stiffness, only: influence_of
+   use fd_linalg, only: least_squares, least_squares_work, generalized_eigen
    use fd_device_state, only: phase_stick
    implicit none
    private
 
    public :: pattern_type, pattern_cache, cache_init, cache_find, build_pattern, pattern_entry
-   public :: pattern_taylor, pattern_series, remainder_bound, kmax
+   public :: pattern_taylor, pattern_series, remainder_bound, kmax, general_pattern, null_space_basis
 
    integer, parameter :: kmax = 40                !! largest Taylor degree
    real(dp), parameter :: theta = 1.0_dp          !! (2 w + c + w_f) S: sub-interval length
@@ -60,7 +70,11 @@ module fd_phase_pattern
       integer, allocatable :: grp(:)                 !! group of each DOF (0 = with the table)
       integer, allocatable :: ids(:)                 !! the sticking devices (ns)
       integer, allocatable :: row(:)                 !! row of device d in the force map (0: none)
-      real(dp), allocatable :: mq(:)                 !! group masses (nq)
+      real(dp), allocatable :: mq(:)                 !! group masses (nq); 1 in a general pattern
+      real(dp), allocatable :: lq(:)                 !! table load per unit mass of each coordinate (nq)
+      logical :: general = .false.                   !! coordinates T q over a null space, not groups
+      real(dp), allocatable :: tm(:, :)              !! general: T (n, nq), T'MT = I
+      real(dp), allocatable :: tb(:, :)              !! general: T'b_d (nq, nd)
       real(dp), allocatable :: kt(:, :), ct(:, :)    !! Mq^-1 Kq, Mq^-1 Cq (nq, nq)
       real(dp), allocatable :: pinv(:, :)            !! D (B_S D)^+ (ns, n), D = diag(sqrt(P mu))
       real(dp), allocatable :: fq(:, :), fp(:, :)    !! force map: F = fq q + fp p + fag ag + f0
@@ -198,7 +212,9 @@ contains
       type(pattern_type), intent(inout) :: pat
       if (allocated(pat%key)) deallocate (pat%key)
       if (allocated(pat%grp)) deallocate (pat%grp, pat%ids, pat%row, pat%mq, pat%kt, pat%ct, pat%pinv, &
-                                           pat%fq, pat%fp, pat%fag, pat%wq, pat%wp, pat%wacc, pat%wf)
+                                           pat%fq, pat%fp, pat%fag, pat%wq, pat%wp, pat%wacc, pat%wf, pat%lq)
+      if (allocated(pat%tm)) deallocate (pat%tm)
+      if (allocated(pat%tb)) deallocate (pat%tb)
    end subroutine free_pattern
 
    !> Build the pattern of these phases: groups, reduced matrices, force map, sub-interval
@@ -228,17 +244,25 @@ contains
          return
       end if
       pat%key = phase
-      call link_groups(model, active .and. phase == phase_stick, pat%grp, nq)
+      pat%general = general_pattern(model)
+      if (pat%general) then
+         pat%grp = -1
+         call null_space_basis(model, mass, active .and. phase == phase_stick, pat%tm, nq, error)
+         if (allocated(error)) return
+      else
+         call link_groups(model, active .and. phase == phase_stick, pat%grp, nq)
+      end if
       ns = count(active .and. phase == phase_stick)
       pat%nq = nq
       pat%ns = ns
       allocate (pat%ids(ns), pat%mq(nq), pat%kt(nq, nq), pat%ct(nq, nq), pat%pinv(ns, n), pat%fq(ns, nq), &
-                pat%fp(ns, nq), pat%fag(ns), pat%wq(nq), pat%wp(nq), pat%wacc(nq), pat%wf(ns), &
+                pat%fp(ns, nq), pat%fag(ns), pat%wq(nq), pat%wp(nq), pat%wacc(nq), pat%wf(ns), pat%lq(nq), &
                 kq(nq, nq), cq(nq, nq), stat=stat)
       if (stat /= 0) then
          call no_memory(n, nd, error)
          return
       end if
+      pat%lq = 1.0_dp
       pat%row = 0
       r = 0
       do d = 1, nd
@@ -247,18 +271,12 @@ contains
          pat%ids(r) = d
          pat%row(d) = r
       end do
-      pat%mq = 0.0_dp
-      kq = 0.0_dp
-      cq = 0.0_dp
-      do i = 1, n
-         if (pat%grp(i) == 0) cycle
-         pat%mq(pat%grp(i)) = pat%mq(pat%grp(i)) + mass(i)
-         do j = 1, n
-            if (pat%grp(j) == 0) cycle
-            kq(pat%grp(i), pat%grp(j)) = kq(pat%grp(i), pat%grp(j)) + k(i, j)
-            cq(pat%grp(i), pat%grp(j)) = cq(pat%grp(i), pat%grp(j)) + c(i, j)
-         end do
-      end do
+      if (pat%general) then
+         call general_reduced(model, mass, k, c, pat, kq, cq, error)
+         if (allocated(error)) return
+      else
+         call group_reduced(mass, k, c, pat, kq, cq)
+      end if
       do g = 1, nq
          pat%kt(g, :) = kq(g, :)/pat%mq(g)
          pat%ct(g, :) = cq(g, :)/pat%mq(g)
@@ -284,7 +302,7 @@ contains
       end do
       pat%order = max(5, kk - 1)
       pat%w2 = w2
-      pat%msum = sqrt(sum(pat%mq))
+      pat%msum = sqrt(sum(pat%mq*pat%lq**2))
       do g = 1, nq
          pat%wp(g) = 1.0_dp/sqrt(pat%mq(g))
          pat%wq(g) = pat%wp(g)/pat%alpha
@@ -318,6 +336,10 @@ contains
       do r = 1, ns
          pat%pinv(r, :) = sqrt(slip(pat%ids(r)))*b(r, 1:n)
       end do
+      if (pat%general) then
+         call general_force_map(model, mass, k, c, pat)
+         return
+      end if
       do i = 1, n
          g = pat%grp(i)
          do j = 1, nq
@@ -348,6 +370,29 @@ contains
       end do
    end subroutine build_pattern
 
+   !> A pattern of groups' reduced matrices: the group masses Mq, Kq = T'KT, Cq = T'CT (T the
+   !> 0/1 matrix of the groups).
+   pure subroutine group_reduced(mass, k, c, pat, kq, cq)
+      real(dp), intent(in) :: mass(:), k(:, :), c(:, :) !! structure
+      type(pattern_type), intent(inout) :: pat      !! the pattern, grp set
+      real(dp), intent(out) :: kq(:, :), cq(:, :)   !! (nq, nq)
+      integer :: i, j, n
+
+      n = size(mass)
+      pat%mq = 0.0_dp
+      kq = 0.0_dp
+      cq = 0.0_dp
+      do i = 1, n
+         if (pat%grp(i) == 0) cycle
+         pat%mq(pat%grp(i)) = pat%mq(pat%grp(i)) + mass(i)
+         do j = 1, n
+            if (pat%grp(j) == 0) cycle
+            kq(pat%grp(i), pat%grp(j)) = kq(pat%grp(i), pat%grp(j)) + k(i, j)
+            cq(pat%grp(i), pat%grp(j)) = cq(pat%grp(i), pat%grp(j)) + c(i, j)
+         end do
+      end do
+   end subroutine group_reduced
+
    subroutine no_memory(n, nd, error)
       integer, intent(in) :: n, nd
       type(error_type), allocatable, intent(out) :: error
@@ -377,6 +422,10 @@ contains
       n = size(mass)
       q(1:pat%nq) = 0.0_dp
       p(1:pat%nq) = 0.0_dp
+      if (pat%general) then
+         call general_entry(pat, model, mass, k, phase, slip, u, v, q, p, uc, b1, f0, fn)
+         return
+      end if
       do i = 1, n
          g = pat%grp(i)
          if (g == 0) cycle
@@ -525,7 +574,7 @@ contains
       f = 1.0_dp/(kk + 1)
       do i = 1, nq
          qc(i, kk + 1) = pc(i, kk)*f
-         pc(i, kk + 1) = -gk
+         pc(i, kk + 1) = -gk*pat%lq(i)
          cp(i, kk) = 0.0_dp
       end do
       if (kk == 0) pc(1:nq, 1) = pc(1:nq, 1) + b1(1:nq)
@@ -564,5 +613,194 @@ contains
       end do
       r = exp(0.5_dp*pat%alpha*s)*(sqrt(max(e, 0.0_dp))*s**kk + s**(kk + 1)*pat%msum*gnext)
    end function remainder_bound
+
+   !> Whether the model's patterns take general coordinates T q (module header): a device
+   !> not between two nodes, stiffness beyond springs, or a table motion's direction r.
+   pure logical function general_pattern(model) result(general)
+      type(model_type), intent(in) :: model         !! the model
+
+      general = .not. devices_are_pairs(model) .or. model%n_kx > 0 .or. allocated(model%influence)
+   end function general_pattern
+
+   !> T, an M-orthonormal basis of the null space of the linked devices' directions
+   !> (b_d' T = 0, T'MT = I): Z, orthonormal, from the eigenvectors of B B' whose eigenvalue
+   !> is below 1e-12 of the largest (I without a linked device); Z'MZ = Y diag(lam) Y' and
+   !> T = Z Y diag(lam)^-1/2. nq its columns.
+   subroutine null_space_basis(model, mass, linked, tm, nq, error)
+      type(model_type), intent(in) :: model         !! the model (directions)
+      real(dp), intent(in) :: mass(:)               !! lumped masses
+      logical, intent(in) :: linked(:)              !! the devices that constrain
+      real(dp), allocatable, intent(out) :: tm(:, :) !! (n, nq)
+      integer, intent(out) :: nq                    !! dimension of the null space
+      type(error_type), allocatable, intent(out) :: error !! LAPACK failure, no memory
+      real(dp), allocatable :: bb(:, :), eye(:, :), ev(:), vec(:, :), mz(:, :), y(:, :), lam(:)
+      integer :: n, d, i, j, stat
+
+      n = size(mass)
+      allocate (bb(n, n), eye(n, n), ev(n), vec(n, n), stat=stat)
+      if (stat /= 0) then
+         call no_memory(n, size(linked), error)
+         return
+      end if
+      bb = 0.0_dp
+      eye = 0.0_dp
+      do i = 1, n
+         eye(i, i) = 1.0_dp
+      end do
+      do d = 1, size(linked)
+         if (linked(d)) call add_device_outer_dense(model, d, bb)
+      end do
+      if (any(bb /= 0.0_dp)) then
+         call generalized_eigen(bb, eye, ev, vec, error)
+         if (allocated(error)) return
+         nq = count(ev <= 1.0e-12_dp*maxval(abs(ev)))
+      else
+         nq = n
+         vec = eye
+      end if
+      allocate (tm(n, nq), mz(nq, nq), y(nq, nq), lam(nq), stat=stat)
+      if (stat /= 0) then
+         call no_memory(n, size(linked), error)
+         return
+      end if
+      if (nq == 0) return
+      ! Z'MZ = Y diag(lam) Y': T = Z Y diag(lam)^-1/2
+      do j = 1, nq
+         do i = 1, nq
+            mz(i, j) = sum(vec(:, i)*mass*vec(:, j))
+         end do
+      end do
+      mz = 0.5_dp*(mz + transpose(mz))
+      call generalized_eigen(mz, eye(1:nq, 1:nq), lam, y, error)
+      if (allocated(error)) return
+      tm = matmul(vec(:, 1:nq), y)
+      do j = 1, nq
+         tm(:, j) = tm(:, j)/sqrt(lam(j))
+      end do
+   end subroutine null_space_basis
+
+   !> a = a + b_d b_d'.
+   pure subroutine add_device_outer_dense(model, d, a)
+      type(model_type), intent(in) :: model
+      integer, intent(in) :: d
+      real(dp), intent(inout) :: a(:, :)
+      integer :: k, l
+
+      do k = model%dev_ptr(d), model%dev_ptr(d + 1) - 1
+         do l = model%dev_ptr(d), model%dev_ptr(d + 1) - 1
+            a(model%dev_dof(k), model%dev_dof(l)) = a(model%dev_dof(k), model%dev_dof(l)) + &
+                                                    model%dev_coef(k)*model%dev_coef(l)
+         end do
+      end do
+   end subroutine add_device_outer_dense
+
+   !> A general pattern's reduced matrices: Mq = I, Kq = T'KT, Cq = T'CT, lq = T'M r and
+   !> T'b_d of every device.
+   subroutine general_reduced(model, mass, k, c, pat, kq, cq, error)
+      type(model_type), intent(in) :: model         !! the model
+      real(dp), intent(in) :: mass(:), k(:, :), c(:, :) !! structure
+      type(pattern_type), intent(inout) :: pat      !! the pattern, tm set
+      real(dp), intent(out) :: kq(:, :), cq(:, :)   !! (nq, nq)
+      type(error_type), allocatable, intent(out) :: error !! no memory
+      real(dp), allocatable :: mr(:), col(:)
+      integer :: n, nq, nd, i, d, stat
+
+      n = size(mass)
+      nq = pat%nq
+      nd = model%n_devices
+      allocate (pat%tb(nq, nd), mr(n), col(n), stat=stat)
+      if (stat /= 0) then
+         call no_memory(n, nd, error)
+         return
+      end if
+      pat%mq = 1.0_dp
+      kq = matmul(transpose(pat%tm), matmul(k, pat%tm))
+      cq = matmul(transpose(pat%tm), matmul(c, pat%tm))
+      kq = 0.5_dp*(kq + transpose(kq))
+      cq = 0.5_dp*(cq + transpose(cq))
+      do i = 1, n
+         mr(i) = mass(i)*influence_of(model, i)
+      end do
+      pat%lq = matmul(mr, pat%tm)
+      do d = 1, nd
+         col = 0.0_dp
+         call add_device(model, d, 1.0_dp, col)
+         pat%tb(:, d) = matmul(col, pat%tm)
+      end do
+   end subroutine general_reduced
+
+   !> A general pattern's force map (pinv set): F = fq q + fp p + fag ag + f0 with
+   !> fq = pinv (M T Kt - K T), fp = pinv (M T Ct - C T), fag = -pinv (M r - M T lq).
+   subroutine general_force_map(model, mass, k, c, pat)
+      type(model_type), intent(in) :: model         !! the model
+      real(dp), intent(in) :: mass(:), k(:, :), c(:, :) !! structure
+      type(pattern_type), intent(inout) :: pat      !! the pattern
+      real(dp), allocatable :: mt(:, :), rr(:)
+      integer :: n, i, r
+
+      n = size(mass)
+      allocate (mt(n, pat%nq), rr(n))
+      do i = 1, n
+         mt(i, :) = mass(i)*pat%tm(i, :)
+      end do
+      pat%fq = matmul(pat%pinv, matmul(mt, pat%kt) - matmul(k, pat%tm))
+      pat%fp = matmul(pat%pinv, matmul(mt, pat%ct) - matmul(c, pat%tm))
+      rr = matmul(mt, pat%lq)
+      do i = 1, n
+         rr(i) = mass(i)*influence_of(model, i) - rr(i)
+      end do
+      pat%fag = -matmul(pat%pinv, rr)
+      do r = 1, pat%ns
+         pat%wf(r) = sum(abs(pat%fq(r, :))*pat%wq) + sum(abs(pat%fp(r, :))*pat%wp)
+      end do
+   end subroutine general_force_map
+
+   !> pattern_entry of a general pattern: q = T'M u, p = T'M v, uc = u - T q, v = T p,
+   !> b1 = T'(-K uc - sum_slide b sgn P mu), f0 = pinv (fn - M T b1).
+   pure subroutine general_entry(pat, model, mass, k, phase, slip, u, v, q, p, uc, b1, f0, fn)
+      type(pattern_type), intent(in) :: pat         !! the pattern
+      type(model_type), intent(in) :: model         !! the model
+      real(dp), intent(in) :: mass(:), k(:, :)      !! structure
+      integer, intent(in) :: phase(:)               !! the pattern's phases
+      real(dp), intent(in) :: slip(:)               !! P mu
+      real(dp), intent(in) :: u(:)                  !! displacements
+      real(dp), intent(inout) :: v(:)               !! velocities, projected on return
+      real(dp), intent(out) :: q(:), p(:)           !! reduced state (nq used)
+      real(dp), intent(out) :: uc(:)                !! offsets (n)
+      real(dp), intent(out) :: b1(:)                !! constant load (nq used)
+      real(dp), intent(out) :: f0(:)                !! force map's constant (ns used)
+      real(dp), intent(inout) :: fn(:)              !! work (n)
+      integer :: i, g, n, d, r, nq
+
+      n = size(mass)
+      nq = pat%nq
+      do g = 1, nq
+         q(g) = sum(pat%tm(:, g)*mass*u)
+         p(g) = sum(pat%tm(:, g)*mass*v)
+      end do
+      uc = u
+      v = 0.0_dp
+      do g = 1, nq
+         uc = uc - pat%tm(:, g)*q(g)
+         v = v + pat%tm(:, g)*p(g)
+      end do
+      fn = -matmul(k, uc)
+      do d = 1, size(phase)
+         if (phase(d) == phase_stick .or. slip(d) <= 0.0_dp) cycle
+         call add_device(model, d, -phase(d)*slip(d), fn)
+      end do
+      do g = 1, nq
+         b1(g) = sum(pat%tm(:, g)*fn)
+      end do
+      do g = 1, nq
+         fn = fn - mass*pat%tm(:, g)*b1(g)
+      end do
+      do r = 1, pat%ns
+         f0(r) = 0.0_dp
+         do i = 1, n
+            f0(r) = f0(r) + pat%pinv(r, i)*fn(i)
+         end do
+      end do
+   end subroutine general_entry
 
 end module fd_phase_pattern

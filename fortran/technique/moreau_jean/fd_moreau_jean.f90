@@ -26,7 +26,9 @@ module fd_moreau_jean
                        technique_newmark, damping_stiffness, damping_rayleigh, technique_integrates
    use fd_model, only: model_type, integration_type
    use fd_excitation, only: excitation_type, table_motion
-   use fd_kinematics, only: device_kinematics, device_nodes
+   use fd_kinematics, only: device_kinematics, device_nodes, devices_are_pairs, device_relative
+   use fd_stiffness, only: influence_of
+   use fd_matrices, only: structure_damping
    use fd_result, only: result_type
    use fd_observer, only: observer_type, observer_init, sample_due, observe_peaks, observe_sample, &
                           observe_transitions, observe_start_energies, observe_end_energies, &
@@ -35,6 +37,8 @@ module fd_moreau_jean
    use fd_stick_groups, only: groups_build, edge_relative
    use fd_group_system, only: gs_k_matvec, gs_k_absmatvec, gs_lowest_eigenvalue
    use fd_impulse_solver, only: impulse_solver, solver_setup, solve_impulses, predict_pattern, pattern_acceleration
+   use fd_dense_impulse, only: dense_impulse, dense_setup, dense_factor, dense_solve, dense_acceleration, &
+                               dense_k_times
    implicit none
    private
 
@@ -44,7 +48,12 @@ module fd_moreau_jean
 
    !> Everything the loop works on, allocated before it starts.
    type :: mj_work
-      type(impulse_solver) :: p                           !! the one-step solver
+      type(impulse_solver) :: p                           !! the one-step solver (devices between nodes)
+      type(dense_impulse) :: di                           !! the dense one-step solver (any device, K_x)
+      logical :: general = .false.                        !! the dense form is used
+      real(dp), allocatable :: mr(:)                      !! (n) M r, r the table motion's direction
+      real(dp), allocatable :: lam(:), wrel(:), fend(:)   !! (nd) dense form: impulses, b'v1, end forces
+      integer, allocatable :: sig(:), sa(:)               !! (nd) dense form: statuses of a step, its end
       type(observer_type) :: obs                          !! peaks, history, energy balance
       integer :: n = 0, nd = 0, ne = 0
       real(dp) :: a0 = 0.0_dp, a1 = 0.0_dp                !! C = a0 M + a1 K
@@ -156,6 +165,13 @@ contains
       res%dt1 = h
       res%dt2 = 0.0_dp
       res%dt_min = 0.0_dp
+      if (w%general) then
+         call dense_run(model, exc, opts, w, res, error)
+         if (allocated(error)) return
+         call system_clock(c1)
+         res%run_time = real(c1 - c0, dp)/real(max(crate, 1), dp)
+         return
+      end if
       ! W = M + h theta C + (h theta)^2 K = alpha M + beta K
       alpha = 1.0_dp + h*th*w%a0
       beta = h*th*w%a1 + (h*th)**2
@@ -276,6 +292,11 @@ contains
       nd = model%n_devices
       w%n = n
       w%nd = nd
+      w%general = dense_form(model)
+      if (w%general) then
+         call dense_init(model, w, res, error)
+         return
+      end if
       ! the devices' nodes and forces as arrays of their own (a component of an array of
       ! derived type passed as an argument is copied to a temporary at the call)
       allocate (dev_i(nd), dev_j(nd), pmu(nd), stat=stat)
@@ -326,6 +347,169 @@ contains
                 w%rel_edge(w%ne), stat=stat)
       if (stat /= 0) call no_memory(error, n)
    end subroutine setup
+
+   !> Whether the model takes the dense form of the one-step problem (fd_dense_impulse): a
+   !> device not between two nodes, stiffness beyond springs (K_x) or a table motion's
+   !> direction over the DOFs. Models of springs and node-pair devices keep the band form
+   !> of their sticking groups.
+   pure logical function dense_form(model) result(dense)
+      type(model_type), intent(in) :: model         !! the model
+
+      dense = .not. devices_are_pairs(model) .or. model%n_kx > 0 .or. allocated(model%influence)
+   end function dense_form
+
+   !> Setup of the dense form: its matrices, C = a0 M + a1 K (fd_matrices' structure_damping:
+   !> the stuck system's first period on the null space of the devices' directions), work.
+   subroutine dense_init(model, w, res, error)
+      type(model_type), intent(in) :: model
+      type(mj_work), intent(inout) :: w
+      type(result_type), intent(inout) :: res
+      type(error_type), allocatable, intent(out) :: error
+      integer :: n, nd, i, stat
+
+      n = w%n
+      nd = w%nd
+      call dense_setup(w%di, model, error)
+      if (allocated(error)) return
+      call structure_damping(model, w%a0, w%a1, res%period_stuck, res%xi_stuck, error)
+      if (allocated(error)) return
+      w%ne = nd
+      allocate (w%u(n), w%v(n), w%u1(n), w%v1(n), w%acc(n), w%r(n), w%du(n), w%kx(n), w%rabs(n), w%mr(n), &
+                w%s(nd), w%sd(nd), w%force(nd), w%phase0(nd), w%phase1(nd), w%counted(nd), w%pending(nd), &
+                w%ta(nd), w%tb(nd), w%g_step(nd), w%g_force(nd), w%f_edge(nd), w%rel_edge(nd), w%lam(nd), &
+                w%wrel(nd), w%fend(nd), w%sig(nd), w%sa(nd), stat=stat)
+      if (stat /= 0) then
+         call no_memory(error, n)
+         return
+      end if
+      do i = 1, n
+         w%mr(i) = model%mass(i)*influence_of(model, i)
+      end do
+      w%g_force = model%dev%p*model%dev%mu
+   end subroutine dense_init
+
+   !> The time-step loop of the dense form (run_moreau_jean's, with fd_dense_impulse's
+   !> one-step problem: every device an edge of its own, r the table motion's direction).
+   subroutine dense_run(model, exc, opts, w, res, error)
+      type(model_type), intent(in) :: model
+      type(excitation_type), intent(in) :: exc
+      type(integration_type), intent(in) :: opts
+      type(mj_work), intent(inout) :: w
+      type(result_type), intent(inout) :: res
+      type(error_type), allocatable, intent(out) :: error
+      real(dp) :: h, th, cm, ck, t1, ag0, ag1, agt, xg, vg, e_kin, e_str, ein
+      integer :: k, d
+      logical :: stop
+
+      th = opts%theta
+      h = exc%dt_record/opts%n1
+      cm = 1.0_dp - h*(1.0_dp - th)*w%a0
+      ck = h*(1.0_dp - th)*(w%a1 + h*th)
+      call dense_factor(w%di, 1.0_dp + h*th*w%a0, h*th*w%a1 + (h*th)**2, error)
+      if (allocated(error)) return
+      w%g_step = h*w%g_force
+      w%u = model%u0
+      w%v = model%v0
+      call table_motion(exc, 0.0_dp, xg, vg, ag0)
+      ! devices moving at t = 0 slide that way, the others by the acceleration problem
+      do d = 1, w%nd
+         w%sig(d) = int(sign(1.0_dp, device_relative(model, d, w%v)))
+         if (device_relative(model, d, w%v) == 0.0_dp .or. w%g_force(d) <= 0.0_dp) w%sig(d) = 0
+      end do
+      call dense_end_state(w, ag0, w%u, w%v, error)
+      if (allocated(error)) return
+      call dense_device_state(model, w, w%phase0)
+      w%counted = w%phase0
+      w%pending = .false.
+      call dense_energies(w, e_kin, e_str)
+      call observe_start_energies(w%obs, e_kin, e_str, 0.0_dp)
+      call observe_sample(w%obs, res, 0.0_dp, ag0, w%u, w%v, w%acc, w%s, w%sd, w%force, w%phase0)
+      call observe_peaks(res, 0.0_dp, size(w%u), size(w%s), w%u, w%v, w%acc, ag0, w%s, w%force)
+      do k = 1, w%obs%nsteps
+         t1 = k*h
+         call table_motion(exc, t1, xg, vg, ag1)
+         agt = (1.0_dp - th)*ag0 + th*ag1
+         ! r = cm M v - K (ck v + h u) - h M r_table agt
+         w%kx = ck*w%v + h*w%u
+         call dense_k_times(w%di, w%kx, w%r, -1.0_dp, 0.0_dp)
+         w%r = w%r + model%mass*cm*w%v - h*agt*w%mr
+         call dense_solve(w%di, w%r, w%g_step, w%v1, w%lam, w%wrel, w%sig, error)
+         if (allocated(error)) return
+         w%u1 = w%u + h*((1.0_dp - th)*w%v + th*w%v1)
+         w%du = w%u1 - w%u
+         ein = agt*sum(w%mr*w%du)
+         call dense_k_times(w%di, w%du, w%kx, 1.0_dp, 0.0_dp)
+         call observe_work(res, -ein, (w%a0*sum(model%mass*w%du**2) + w%a1*dot_product(w%du, w%kx))/h)
+         do d = 1, w%nd
+            w%rel_edge(d) = device_relative(model, d, w%du)
+            w%w_fric = w%w_fric + w%lam(d)*w%rel_edge(d)/h
+            w%obs%device_work(d) = w%obs%device_work(d) + w%lam(d)*w%rel_edge(d)/h
+            w%obs%slip_travel(d) = w%obs%slip_travel(d) + abs(w%rel_edge(d))
+         end do
+         call dense_end_state(w, ag1, w%u1, w%v1, error)
+         if (allocated(error)) return
+         w%u = w%u1
+         w%v = w%v1
+         ag0 = ag1
+         call dense_device_state(model, w, w%phase1)
+         call count_transitions(w, res, .false.)
+         w%phase0 = w%phase1
+         call observe_peaks(res, t1, size(w%u), size(w%s), w%u, w%v, w%acc, ag1, w%s, w%force)
+         res%moreau_jean%steps = res%moreau_jean%steps + 1
+         if (sample_due(w%obs, k)) then
+            if (.not. all(ieee_is_finite(w%u)) .or. .not. all(ieee_is_finite(w%acc))) then
+               call fatal_error(error, "moreau_jean: the solution is not finite at t = "//trim(fmt_real(t1))//" s")
+               return
+            end if
+            call observe_sample(w%obs, res, t1, ag1, w%u, w%v, w%acc, w%s, w%sd, w%force, w%phase1)
+         end if
+         call observe_poll(w%obs, t1, stop)
+         if (stop) then
+            call observe_stop_error(w%obs, error)
+            return
+         end if
+      end do
+      call count_transitions(w, res, .true.)
+      call dense_energies(w, e_kin, e_str)
+      call observe_end_energies(w%obs, res, e_kin, e_str, 0.0_dp, w%w_fric)
+      res%moreau_jean%factorizations = w%di%factorizations
+      res%moreau_jean%patterns = w%di%lcp_solves
+      res%moreau_jean%lcp_fallbacks = 0
+   end subroutine dense_run
+
+   !> The acceleration (relative to the table) and the device forces at an instant from
+   !> equilibrium, the step's statuses w%sig held (fd_dense_impulse's dense_acceleration).
+   subroutine dense_end_state(w, ag, u, v, error)
+      type(mj_work), intent(inout) :: w
+      real(dp), intent(in) :: ag, u(:), v(:)
+      type(error_type), allocatable, intent(out) :: error
+
+      w%kx = w%a1*v + u
+      call dense_k_times(w%di, w%kx, w%r, -1.0_dp, 0.0_dp)
+      w%r = w%r - w%mr*ag - w%a0*w%di%mass*v
+      call dense_acceleration(w%di, w%r, w%g_force, w%sig, w%acc, w%fend, w%sa, error)
+   end subroutine dense_end_state
+
+   !> Device kinematics, forces and phases of the dense form (statuses of the step).
+   pure subroutine dense_device_state(model, w, phase)
+      type(model_type), intent(in) :: model
+      type(mj_work), intent(inout) :: w
+      integer, intent(out) :: phase(:)
+
+      call device_kinematics(model, w%u, w%v, w%s, w%sd)
+      w%force = w%fend
+      phase = w%sig
+   end subroutine dense_device_state
+
+   !> Kinetic and strain energy of the current state (dense form).
+   subroutine dense_energies(w, e_kin, e_str)
+      type(mj_work), intent(inout) :: w
+      real(dp), intent(out) :: e_kin, e_str
+
+      e_kin = 0.5_dp*sum(w%di%mass*w%v**2)
+      call dense_k_times(w%di, w%u, w%kx, 1.0_dp, 0.0_dp)
+      e_str = 0.5_dp*dot_product(w%u, w%kx)
+   end subroutine dense_energies
 
    !> The error of an allocation sized by the deck that failed.
    subroutine no_memory(error, n)

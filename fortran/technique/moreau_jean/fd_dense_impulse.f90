@@ -1,0 +1,251 @@
+!> The one-step problem of Moreau-Jean time stepping for devices of any direction b_d and a
+!> stiffness with entries beyond springs (K_x): the dense form, for models of tens to a
+!> few hundred DOFs whose devices are coupled through general b vectors (rigid floors,
+!> matrices read from files).
+!>
+!>   W v1 = r - B lambda,   W = alpha M + beta K,   w = B' v1,
+!>   |lambda_d| <= g_d,   w_d > 0 => lambda_d = g_d,   w_d < 0 => lambda_d = -g_d.
+!>
+!> W is constant over a run (the step is), so it is factored once (Cholesky) with
+!> Z = W^-1 B and the Delassus operator A = B' W^-1 B (symmetric positive semidefinite). A
+!> step is then one solve x = W^-1 r, the box LCP of the devices' impulses
+!>   -w = A lambda - B' x,   lambda in [-g, g]
+!> (fd_lcp: Lemke, exact; its w is unique, and lambda too unless devices are redundant), and
+!> v1 = x - Z lambda. The acceleration at the end of a step (Coulomb's law at the level of
+!> accelerations, W = M) is the same problem with A_M = B' M^-1 B over the devices at rest,
+!> the sliding ones carrying sigma P mu. Memory: n^2 + 2 n nd + 2 nd^2 reals.
+module fd_dense_impulse
+   use fd_kinds, only: dp
+   use fd_error, only: error_type, fatal_error, fmt_int, fmt_real, stat_no_memory
+   use fd_model, only: model_type
+   use fd_kinematics, only: add_device
+   use fd_matrices, only: stiffness_matrix
+   use fd_linalg, only: cholesky_factor, cholesky_solve
+   use fd_lcp, only: lcp_work, lcp_info, lcp_init, box_lcp_solve, lcp_solved, lcp_status_text
+   implicit none
+   private
+
+   public :: dense_impulse, dense_setup, dense_factor, dense_solve, dense_acceleration, dense_k_times
+
+   real(dp), parameter :: tol_rel = 1.0e-10_dp    !! a relative velocity is 0 below this share of its terms
+
+   !> The structure's dense matrices, the devices' directions and the factored step system.
+   type :: dense_impulse
+      integer :: n = 0                               !! DOFs
+      integer :: nd = 0                              !! devices
+      real(dp), allocatable :: mass(:)               !! (n) lumped masses
+      real(dp), allocatable :: k(:, :)               !! (n, n) K, springs and K_x
+      real(dp), allocatable :: b(:, :)               !! (n, nd) directions b_d
+      real(dp), allocatable :: wf(:, :)              !! (n, n) Cholesky factor of W
+      real(dp), allocatable :: z(:, :)               !! (n, nd) W^-1 B
+      real(dp), allocatable :: a(:, :)               !! (nd, nd) B' W^-1 B
+      real(dp), allocatable :: am(:, :)              !! (nd, nd) B' M^-1 B
+      real(dp), allocatable :: x(:)                  !! (n) work
+      real(dp), allocatable :: q(:), lo(:), hi(:), zz(:), ww(:), sub(:, :) !! (nd) LCP data
+      integer, allocatable :: idx(:)                 !! (nd) devices of a sub-problem
+      type(lcp_work) :: lcp                          !! Lemke's workspace
+      integer :: factorizations = 0                  !! factorizations of W
+      integer :: lcp_solves = 0                      !! box LCPs solved
+   end type dense_impulse
+
+contains
+
+   !> The dense matrices of a model: K with its K_x, the directions B, and A_M = B' M^-1 B.
+   subroutine dense_setup(di, model, error)
+      type(dense_impulse), intent(out) :: di        !! the solver
+      type(model_type), intent(in) :: model         !! the model
+      type(error_type), allocatable, intent(out) :: error !! not enough memory
+      integer :: n, nd, d, e, stat
+
+      n = model%n_dof
+      nd = model%n_devices
+      di%n = n
+      di%nd = nd
+      allocate (di%mass(n), di%k(n, n), di%b(n, nd), di%wf(n, n), di%z(n, nd), di%a(nd, nd), di%am(nd, nd), &
+                di%x(n), di%q(nd), di%lo(nd), di%hi(nd), di%zz(nd), di%ww(nd), di%sub(nd, nd), di%idx(nd), &
+                stat=stat)
+      if (stat /= 0) then
+         call fatal_error(error, "not enough memory for the dense Moreau-Jean system of "//trim(fmt_int(n))// &
+                          " DOFs and "//trim(fmt_int(nd))//" devices", stat_no_memory)
+         return
+      end if
+      di%mass = model%mass
+      call stiffness_matrix(model, di%k)
+      di%b = 0.0_dp
+      do d = 1, nd
+         call add_device(model, d, 1.0_dp, di%b(:, d))
+      end do
+      do e = 1, nd
+         do d = 1, nd
+            di%am(d, e) = sum(di%b(:, d)*di%b(:, e)/di%mass)
+         end do
+      end do
+      if (nd > 0) call lcp_init(di%lcp, nd, nd, error)
+   end subroutine dense_setup
+
+   !> Factor W = alpha M + beta K and form Z = W^-1 B and A = B' Z.
+   subroutine dense_factor(di, alpha, beta, error)
+      type(dense_impulse), intent(inout) :: di      !! the solver
+      real(dp), intent(in) :: alpha, beta           !! W = alpha M + beta K (alpha > 0, beta >= 0)
+      type(error_type), allocatable, intent(out) :: error !! W not positive definite
+      integer :: i, d, info
+
+      di%wf = beta*di%k
+      do i = 1, di%n
+         di%wf(i, i) = di%wf(i, i) + alpha*di%mass(i)
+      end do
+      call cholesky_factor(di%wf, info)
+      if (info /= 0) then
+         call fatal_error(error, "the Moreau-Jean step matrix M + h theta C + (h theta)^2 K is not positive "// &
+                          "definite (leading minor "//trim(fmt_int(info))//"): check the stiffness")
+         return
+      end if
+      di%factorizations = di%factorizations + 1
+      do d = 1, di%nd
+         di%z(:, d) = di%b(:, d)
+         call cholesky_solve(di%wf, di%z(:, d))
+      end do
+      di%a = matmul(transpose(di%b), di%z)
+      di%a = 0.5_dp*(di%a + transpose(di%a))
+   end subroutine dense_factor
+
+   !> y = alpha K x + beta y.
+   pure subroutine dense_k_times(di, x, y, alpha, beta)
+      type(dense_impulse), intent(in) :: di         !! the solver
+      real(dp), intent(in) :: x(:)                  !! (n)
+      real(dp), intent(inout) :: y(:)               !! (n)
+      real(dp), intent(in) :: alpha, beta           !! factors
+      integer :: i, j
+      real(dp) :: s
+
+      do i = 1, di%n
+         s = 0.0_dp
+         do j = 1, di%n
+            s = s + di%k(i, j)*x(j)
+         end do
+         y(i) = alpha*s + beta*y(i)
+      end do
+   end subroutine dense_k_times
+
+   !> One step: v1 and the impulses lam of W v1 = r - B lam under Coulomb's law with bounds
+   !> g; sigma the devices' statuses (0 at rest at the end of the step, +-1 sliding that
+   !> way) and w their end-of-step relative velocities.
+   subroutine dense_solve(di, r, g, v1, lam, w, sigma, error)
+      type(dense_impulse), intent(inout) :: di      !! the solver, factored
+      real(dp), intent(in) :: r(:)                  !! (n) right-hand side
+      real(dp), intent(in) :: g(:)                  !! (nd) bounds of the impulses, >= 0
+      real(dp), intent(out) :: v1(:)                !! (n) end-of-step velocities
+      real(dp), intent(out) :: lam(:)               !! (nd) impulses
+      real(dp), intent(out) :: w(:)                 !! (nd) b_d' v1
+      integer, intent(out) :: sigma(:)              !! (nd) statuses
+      type(error_type), allocatable, intent(out) :: error !! the LCP unsolved
+      integer :: d, e, nd
+      real(dp) :: sc
+
+      nd = di%nd
+      di%x = r
+      call cholesky_solve(di%wf, di%x)
+      v1 = di%x
+      lam = 0.0_dp
+      w = 0.0_dp
+      sigma = 0
+      if (nd == 0) return
+      do d = 1, nd
+         di%q(d) = -dot_product(di%b(:, d), di%x)
+         di%lo(d) = -g(d)
+         di%hi(d) = g(d)
+      end do
+      call lcp_step(di, di%a, nd, error)
+      if (allocated(error)) return
+      lam = di%zz(1:nd)
+      do d = 1, nd
+         v1 = v1 - di%z(:, d)*lam(d)
+      end do
+      do d = 1, nd
+         w(d) = dot_product(di%b(:, d), v1)
+         sc = abs(di%q(d))
+         do e = 1, nd
+            sc = sc + abs(di%a(d, e)*lam(e))
+         end do
+         if (abs(w(d)) > tol_rel*sc) sigma(d) = merge(1, -1, w(d) > 0.0_dp)
+      end do
+   end subroutine dense_solve
+
+   !> The box LCP -w = a z + q over the first m entries of di%q, di%lo, di%hi: z in
+   !> di%zz(1:m) on return.
+   subroutine lcp_step(di, a, m, error)
+      type(dense_impulse), intent(inout) :: di      !! the solver (q, lo, hi set)
+      real(dp), intent(in) :: a(:, :)               !! (m, m) the operator
+      integer, intent(in) :: m                      !! size
+      type(error_type), allocatable, intent(out) :: error !! unsolved
+      type(lcp_info) :: info
+
+      di%lcp_solves = di%lcp_solves + 1
+      call box_lcp_solve(di%lcp, a(1:m, 1:m), di%q(1:m), di%lo(1:m), di%hi(1:m), di%zz(1:m), di%ww(1:m), info)
+      if (info%status /= lcp_solved) then
+         call fatal_error(error, "the Moreau-Jean box LCP of "//trim(fmt_int(m))//" devices was not solved ("// &
+                          trim(lcp_status_text(info%status))//", residual "//trim(fmt_real(info%residual))// &
+                          "); try technique = 'newmark' with law = 'velocity'")
+      end if
+   end subroutine lcp_step
+
+   !> The acceleration at the end of a step from forces f (all but friction): a sliding device
+   !> (sigma /= 0) carries sigma P mu, the devices at rest the forces of the box LCP with
+   !> A_M over them (they hold within P mu, or start to slide the way of their force).
+   !> force: each device's force; sa: its status at the level of accelerations.
+   subroutine dense_acceleration(di, f, pmu, sigma, acc, force, sa, error)
+      type(dense_impulse), intent(inout) :: di      !! the solver
+      real(dp), intent(in) :: f(:)                  !! (n) forces but friction [N]
+      real(dp), intent(in) :: pmu(:)                !! (nd) P mu [N]
+      integer, intent(in) :: sigma(:)               !! (nd) statuses of the step
+      real(dp), intent(out) :: acc(:)               !! (n) accelerations [m/s2]
+      real(dp), intent(out) :: force(:)             !! (nd) forces [N]
+      integer, intent(out) :: sa(:)                 !! (nd) 0 holding, +-1 sliding
+      type(error_type), allocatable, intent(out) :: error !! the LCP unsolved
+      integer :: d, e, m, a, b
+      real(dp) :: sc, x
+
+      di%x = f
+      m = 0
+      do d = 1, di%nd
+         force(d) = 0.0_dp
+         sa(d) = sigma(d)
+         if (sigma(d) /= 0) then
+            force(d) = sigma(d)*pmu(d)
+            di%x = di%x - di%b(:, d)*force(d)
+         else
+            m = m + 1
+            di%idx(m) = d
+         end if
+      end do
+      acc = di%x/di%mass
+      if (m > 0) then
+         do a = 1, m
+            d = di%idx(a)
+            di%q(a) = -dot_product(di%b(:, d), acc)
+            di%lo(a) = -pmu(d)
+            di%hi(a) = pmu(d)
+            do b = 1, m
+               di%sub(a, b) = di%am(d, di%idx(b))
+            end do
+         end do
+         call lcp_step(di, di%sub(1:m, 1:m), m, error)
+         if (allocated(error)) return
+         do a = 1, m
+            d = di%idx(a)
+            force(d) = di%zz(a)
+            acc = acc - di%b(:, d)*(force(d)/di%mass)
+         end do
+         do a = 1, m
+            d = di%idx(a)
+            x = dot_product(di%b(:, d), acc)
+            sc = abs(di%q(a))
+            do e = 1, m
+               sc = sc + abs(di%sub(a, e)*force(di%idx(e)))
+            end do
+            if (abs(x) > tol_rel*sc) sa(d) = merge(1, -1, x > 0.0_dp)
+         end do
+      end if
+   end subroutine dense_acceleration
+
+end module fd_dense_impulse
