@@ -293,8 +293,10 @@ def test_the_default_plots_are_the_key_ones(tmp_path):
     assert r.returncode == 0, r.stderr
     pngs = announced(r.stdout, "plot")
     assert len(pngs) == 5 + 5 and pngs[0].endswith("_phase1.png")
+    r = cli("plot", "out/building5_friction.csv", "--plots", "spin", cwd=tmp_path)
+    assert r.returncode == 1 and "not a plot kind (spin)" in r.stderr
     r = cli("plot", "out/building5_friction.csv", "--plots", "orbit", cwd=tmp_path)
-    assert r.returncode == 1 and "not a plot kind (orbit)" in r.stderr
+    assert r.returncode == 1 and "not a building of rigid floors" in r.stderr
 
 
 def _num(x: float) -> str:

@@ -433,9 +433,10 @@ def build_parser() -> argparse.ArgumentParser:
     which = {
         "metavar": "SET",
         "help": "which PNGs: 'key' (default: the roof's acceleration, the hysteresis of the most "
-        "loaded device, with storeys the drift and acceleration profiles and the base shear), "
-        "'all', or kinds separated by commas: aabs, sdot, hysteresis, phase, drift_profile, "
-        "acceleration_profile, storey_loop, base_shear",
+        "loaded device, with storeys the drift and acceleration profiles and the base shear, with "
+        "rigid floors the roof's orbit and the braces in plan), 'all', or kinds separated by "
+        "commas: aabs, sdot, hysteresis, phase, drift_profile, acceleration_profile, storey_loop, "
+        "base_shear, orbit, device_plan",
     }
     p = sub.add_parser("run", help="run a deck; write its history CSV and summary JSON")
     p.add_argument("deck", help="namelist deck (.nml)")

@@ -27,10 +27,15 @@ __all__ = [
     "Analysis",
     "Damping",
     "Device",
+    "Floor",
+    "FloorBrace",
+    "Floors",
+    "Frame",
     "FreeVibration",
     "FrictionBrace",
     "Harmonic",
     "Integration",
+    "Matrices",
     "Output",
     "Record",
     "SlidingIsolator",
@@ -180,6 +185,134 @@ class Storey:
         cls, spring: int, height: float | None = None, label: str | None = None
     ) -> Storey:
         return cls(height=height, label=label, spring=spring)
+
+
+@dataclass
+class Floor:
+    """One rigid floor of a building (&floors): its mass [kg], its rotational inertia
+    [kg m2] or its plan plan_x by plan_y [m] (a uniform rectangle about the centre of mass),
+    its centre of mass (cm_x, cm_y) [m] in plan, the height [m] of the storey below it and a
+    label. None takes the reader's default (cm 0, height not given, 'floor f')."""
+
+    mass: float
+    plan_x: float | None = None
+    plan_y: float | None = None
+    inertia: float | None = None
+    cm_x: float | None = None
+    cm_y: float | None = None
+    height: float | None = None
+    label: str | None = None
+
+
+@dataclass
+class Floors:
+    """A building of rigid floors (&floors), floor 1 the lowest: three DOFs a floor (ux, uy,
+    rz at its centre of mass), instead of ``masses``; the table moves along
+    excitation_angle [deg] in plan; p_delta adds the gravity loads' geometric stiffness.
+    Its lateral elements are ``Analysis.frames``, its friction braces
+    ``Analysis.floor_braces`` (docs/namelist.md, &floors)."""
+
+    floors: list[Floor]
+    excitation_angle: float | None = None
+    p_delta: bool | None = None
+
+    def group(self) -> dict:
+        fl = self.floors
+        if isinstance(fl, Floor) or not len(fl):
+            raise DeckError("Floors.floors must be a list of at least one Floor")
+        g: dict = {"n_floors": len(fl), "mass": [float(x.mass) for x in fl]}
+        for key in ("inertia", "plan_x", "plan_y", "cm_x", "cm_y", "height", "label"):
+            _per_device(g, key, [getattr(x, key) for x in fl])
+        _put(g, excitation_angle=self.excitation_angle, p_delta=self.p_delta)
+        return g
+
+
+@dataclass
+class Frame:
+    """A frame or wall of a building of rigid floors (&frames): a shear spring of stiffness
+    k [N/m] in storey ``storey`` (between floor storey and the one below) along the plan
+    direction ``angle`` [deg from x] through the plan point (x, y) [m]."""
+
+    storey: int
+    angle: float
+    x: float
+    y: float
+    k: float
+
+
+@dataclass
+class FloorBrace:
+    """A brace with a friction damper in a building of rigid floors (&floor_braces): one
+    device in storey ``storey`` along ``angle`` [deg] through (x, y) [m], slipping at
+    slip_load [N]; law 'hysteretic' (the reader's default: the damper in series with a
+    brace of ``stiffness`` [N/m]), 'velocity' or 'coulomb' (a rigid brace, no stiffness).
+    None takes the reader's default."""
+
+    storey: int
+    angle: float
+    x: float
+    y: float
+    slip_load: float
+    stiffness: float | None = None
+    law: str | None = None
+    eps: float | None = None
+    eps1: float | None = None
+    label: str | None = None
+
+
+@dataclass
+class Matrices:
+    """A structure from its stiffness and lumped mass matrices (&matrices), instead of
+    ``masses``: ``k`` and ``m`` each a Matrix Market file (a path, relative to the working
+    directory for ``run``) or a matrix (a numpy array or a scipy sparse matrix, written as a
+    Matrix Market file for the run); ``influence`` the table motion's component along each
+    DOF (r, the load -M r a_g), ``influence2`` that of ``Analysis.excitation2``; ``labels``
+    a name per DOF."""
+
+    k: str | os.PathLike | np.ndarray | object
+    m: str | os.PathLike | np.ndarray | object
+    influence: Sequence[float]
+    influence2: Sequence[float] | None = None
+    labels: list[str] | None = None
+
+    def group(self, directory: Path | None, cwd: Path | None, stem: str) -> dict:
+        g: dict = {
+            "k_file": _matrix_file(self.k, directory, cwd, f"{stem}.K.mtx", "k"),
+            "m_file": _matrix_file(self.m, directory, cwd, f"{stem}.M.mtx", "m"),
+        }
+        if self.labels is not None:
+            _per_device(g, "label", [None if x is None else str(x) for x in self.labels])
+        g["influence"] = [float(x) for x in self.influence]
+        if self.influence2 is not None:
+            g["influence2"] = [float(x) for x in self.influence2]
+        return g
+
+
+def _matrix_file(a: object, directory: Path | None, cwd: Path | None, name: str, what: str) -> str:
+    """A matrix of Matrices as the deck names it: a path (made absolute against cwd when
+    given), or a matrix written to ``directory/name`` in the Matrix Market coordinate format
+    (every nonzero entry, 17 significant digits)."""
+    if isinstance(a, (str, os.PathLike)):
+        file = os.fspath(a)
+        if cwd is not None and not os.path.isabs(file):
+            file = os.fspath(Path(cwd) / file)
+        return file
+    if directory is None:
+        raise ValueError(f"Matrices.{what} given as a matrix needs a directory to write its file")
+    if hasattr(a, "tocoo"):
+        coo = a.tocoo()
+        rows, cols, vals, shape = coo.row, coo.col, coo.data, coo.shape
+    else:
+        dense = np.asarray(a, dtype=float)
+        if dense.ndim != 2:
+            raise DeckError(f"Matrices.{what} must be a matrix (2-D), not of shape {dense.shape}")
+        rows, cols = np.nonzero(dense)
+        vals, shape = dense[rows, cols], dense.shape
+    lines = ["%%MatrixMarket matrix coordinate real general",
+             f"{shape[0]} {shape[1]} {len(vals)}"]
+    lines += [f"{i + 1} {j + 1} {float(v):.17e}" for i, j, v in zip(rows, cols, vals, strict=True)]
+    (Path(directory) / name).write_text("\n".join(lines) + "\n")
+    return name
 
 
 @dataclass
@@ -529,9 +662,16 @@ _GROUP_FIELDS: dict[str, tuple[str, bool, dict[str, str]]] = {
     "braces": ("braces", True, {}),
     "isolators": ("isolators", True, {"mu_table_v": "mu_table", "mu_table_mu": "mu_table"}),
     "storeys": ("storeys", True, {}),
+    "floors": ("floors.floors", True, {}),
+    "frames": ("frames", True, {}),
+    "floor_braces": ("floor_braces", True, {}),
+    "matrices": ("matrices", False, {"k_file": "k", "m_file": "m", "label": "labels"}),
     "excitation": ("excitation", False, {"record_file": "file", "record_kind": "kind",
                                          "record_scale": "scale", "record_format": "format",
                                          "record_units": "units"}),
+    "excitation2": ("excitation2", False, {"record_file": "file", "record_kind": "kind",
+                                           "record_scale": "scale", "record_format": "format",
+                                           "record_units": "units"}),
     "integration": ("integration", False, {}),
     "output": ("output", False, {}),
 }
@@ -551,8 +691,10 @@ def python_place(message: str) -> str | None:
     index = m["j"] or (m["i"] if m["i"] != ":" else None)  # mu_table_v(:, i): item i
     if attr == "":  # &model: the Analysis's own lists
         return f"{var}[{int(index) - 1}]" if index else var
+    if m["group"] == "floors" and (m["var"] in ("excitation_angle", "p_delta") or not index):
+        return f"floors.{var}"  # the building's, or a list of every floor's
     if indexed and index and m["var"] not in ("n_springs", "n_devices", "n_braces", "n_isolators",
-                                              "n_storeys"):
+                                              "n_storeys", "n_frames", "n_floors"):
         return f"{attr}[{int(index) - 1}].{var}"
     if indexed:
         return attr
@@ -586,11 +728,15 @@ def _run_named(name: str, base_dir: str | os.PathLike, run: Callable[[], Result]
 
 @dataclass
 class Analysis:
-    """One run: masses, springs, damping, friction devices, table motion and settings."""
+    """One run: masses, springs, damping, friction devices, table motion and settings. The
+    structure is ``masses`` (one DOF each, joined by ``springs``), or ``floors`` (a building
+    of rigid floors with its ``frames`` and ``floor_braces``), or ``matrices`` (K and M);
+    ``excitation2`` is a second horizontal component of the table motion (with ``floors``
+    or ``matrices``)."""
 
-    masses: list[float]
-    springs: list[Spring]
-    excitation: Harmonic | Record | FreeVibration
+    masses: list[float] | None = None
+    springs: list[Spring] = field(default_factory=list)
+    excitation: Harmonic | Record | FreeVibration | None = None
     damping: Damping = field(default_factory=Damping)
     devices: list[Device] = field(default_factory=list)
     integration: Integration = field(default_factory=Integration)
@@ -601,23 +747,42 @@ class Analysis:
     isolators: list[SlidingIsolator] = field(default_factory=list)
     storeys: list[Storey] = field(default_factory=list)
     labels: list[str] | None = None  #: a name per DOF ('floor 3')
+    floors: Floors | None = None
+    frames: list[Frame] = field(default_factory=list)
+    floor_braces: list[FloorBrace] = field(default_factory=list)
+    matrices: Matrices | None = None
+    excitation2: Harmonic | Record | None = None
     tolerance: float | None = None  #: a tolerance run: Integration's tolerance, given here
 
     def namelist(
-        self, directory: Path | None = None, cwd: Path | None = None, record_name: str | None = None
+        self, directory: Path | None = None, cwd: Path | None = None, record_name: str | None = None,
+        record_name2: str | None = None, stem: str = "analysis",
     ) -> f90nml.Namelist:
         """The deck as an f90nml Namelist (writes a Record's values into directory; with
         cwd, a relative record file is made absolute against it)."""
         nml = f90nml.Namelist()
-        for name, values in self.groups(directory, cwd, record_name):
+        for name, values in self.groups(directory, cwd, record_name, record_name2, stem):
             nml[name] = f90nml.Namelist(values)
         return nml
 
-    def groups(
-        self, directory: Path | None = None, cwd: Path | None = None, record_name: str | None = None
-    ) -> list[tuple[str, dict]]:
-        """The deck's groups and their values, in order (writes a Record's values into
-        directory; with cwd, a relative record file is made absolute against it)."""
+    def _structure(self, directory: Path | None, cwd: Path | None, stem: str) -> list[tuple[str, dict]]:
+        """The groups of the structure: &model, or &floors and &frames, or &matrices."""
+        given = [k for k, v in (("masses", self.masses), ("floors", self.floors),
+                                ("matrices", self.matrices)) if v is not None]
+        if len(given) != 1:
+            raise DeckError("Analysis: give the structure as one of masses, floors or matrices"
+                            + (f", not {' and '.join(given)}" if given else ""))
+        if self.floors is not None:
+            groups = [("floors", self.floors.group())]
+            fr = self.frames
+            if fr:
+                frames = {"n_frames": len(fr), "storey": _nodes(fr, "storey")}
+                for key in ("angle", "x", "y", "k"):
+                    frames[key] = [float(getattr(x, key)) for x in fr]
+                groups.append(("frames", frames))
+            return groups
+        if self.matrices is not None:
+            return [("matrices", self.matrices.group(directory, cwd, stem))]
         n = len(self.masses)
         model = {"n_dof": n, "mass": [float(m) for m in self.masses]}
         if self.u0 is not None:
@@ -629,15 +794,29 @@ class Analysis:
                 raise TypeError(f"labels must be a list (a label per DOF), not {self.labels!r}")
             # None: the default label of that DOF (a null value in the deck)
             _per_device(model, "label", [None if x is None else str(x) for x in self.labels])
-        groups = [("model", model)]
-        springs = {"n_springs": len(self.springs)}
-        if self.springs:
-            springs.update(
-                node_i=_nodes(self.springs, "node_i"),
-                node_j=_nodes(self.springs, "node_j"),
-                k=[float(s.k) for s in self.springs],
-            )
-        groups.append(("springs", springs))
+        return [("model", model)]
+
+    def groups(
+        self, directory: Path | None = None, cwd: Path | None = None, record_name: str | None = None,
+        record_name2: str | None = None, stem: str = "analysis",
+    ) -> list[tuple[str, dict]]:
+        """The deck's groups and their values, in order (writes a Record's values, and the
+        matrices of ``matrices`` given as arrays, into directory, the second component's
+        values under record_name2, the matrices as <stem>.K.mtx and <stem>.M.mtx; with cwd,
+        a relative record or matrix file is made absolute against it)."""
+        if self.excitation is None:
+            raise DeckError("Analysis.excitation: the table motion is required (Harmonic, Record "
+                            "or FreeVibration)")
+        groups = self._structure(directory, cwd, stem)
+        if self.springs or self.masses is not None:
+            springs = {"n_springs": len(self.springs)}
+            if self.springs:
+                springs.update(
+                    node_i=_nodes(self.springs, "node_i"),
+                    node_j=_nodes(self.springs, "node_j"),
+                    k=[float(s.k) for s in self.springs],
+                )
+            groups.append(("springs", springs))
         groups.append(("damping", self.damping.group()))
         if self.devices:
             d = self.devices
@@ -674,6 +853,14 @@ class Analysis:
             _per_device(isolators, "radius", [x.radius for x in s])
             _friction_values(isolators, s)
             groups.append(("isolators", isolators))
+        if self.floor_braces:
+            fb = self.floor_braces
+            braces = {"n_braces": len(fb), "storey": _nodes(fb, "storey")}
+            for key in ("angle", "x", "y", "slip_load"):
+                braces[key] = [float(getattr(x, key)) for x in fb]
+            for key in ("stiffness", "law", "eps", "eps1", "label"):
+                _per_device(braces, key, [getattr(x, key) for x in fb])
+            groups.append(("floor_braces", braces))
         if self.storeys:
             st = self.storeys
             storeys: dict = {"n_storeys": len(st)}
@@ -683,6 +870,8 @@ class Analysis:
                 _per_device(storeys, key, [getattr(x, key) for x in st])
             groups.append(("storeys", storeys))
         groups.append(("excitation", self.excitation.group(directory, cwd, record_name)))
+        if self.excitation2 is not None:
+            groups.append(("excitation2", self.excitation2.group(directory, cwd, record_name2)))
         integration = self.integration.group()
         if integration:
             groups.append(("integration", integration))
@@ -692,27 +881,38 @@ class Analysis:
         return groups
 
     def deck_text(
-        self, directory: Path | None = None, cwd: Path | None = None, record_name: str | None = None
+        self, directory: Path | None = None, cwd: Path | None = None, record_name: str | None = None,
+        record_name2: str | None = None, stem: str = "analysis",
     ) -> str:
         """The deck as namelist text (writes a Record's values into directory, under
-        record_name or the Record's file; with cwd, a relative record file is made absolute
-        against it)."""
+        record_name (record_name2 for ``excitation2``) or the Record's file, and matrices
+        given as arrays as <stem>.K.mtx, <stem>.M.mtx; with cwd, a relative record or matrix
+        file is made absolute against it)."""
         return "\n".join(
             _group_text(name, values)
-            for name, values in self.groups(directory, cwd, record_name)
+            for name, values in self.groups(directory, cwd, record_name, record_name2, stem)
         )
 
     def write_deck(self, path: str | os.PathLike) -> Path:
         """Write the deck (and a Record's values next to it: to its ``file``, or when that is
-        None to ``<deck stem>.record.txt``, so that decks written into one directory do not
-        share one record file) for the executable."""
+        None to ``<deck stem>.record.txt`` (``.record2.txt`` for ``excitation2``), so that
+        decks written into one directory do not share one record file; matrices given as
+        arrays to ``<deck stem>.K.mtx``, ``.M.mtx``) for the executable."""
         path = Path(path)
-        name = None
-        ex = self.excitation
-        if isinstance(ex, Record) and ex.values is not None and ex.file is None:
-            name = path.stem + ".record.txt"
-        path.write_text(self.deck_text(path.parent, record_name=name))
+        names = []
+        for ex, suffix in ((self.excitation, ".record.txt"), (self.excitation2, ".record2.txt")):
+            unnamed = isinstance(ex, Record) and ex.values is not None and ex.file is None
+            names.append(path.stem + suffix if unnamed else None)
+        path.write_text(self.deck_text(path.parent, None, names[0], names[1], path.stem))
         return path
+
+    def _needs_directory(self) -> bool:
+        """Whether the deck needs files written for it: a Record's values, a matrix."""
+        records = any(isinstance(ex, Record) and ex.values is not None
+                      for ex in (self.excitation, self.excitation2))
+        mats = self.matrices is not None and not all(
+            isinstance(a, (str, os.PathLike)) for a in (self.matrices.k, self.matrices.m))
+        return records or mats
 
     def run(
         self,
@@ -729,17 +929,22 @@ class Analysis:
         history_dofs, history_devices)."""
         kw = {"dofs": dofs, "devices": devices, "progress": progress, "tolerance": self.tolerance}
         cwd = Path.cwd()
-        if not isinstance(self.excitation, Record) or self.excitation.values is None:
-            text = self.deck_text(None, cwd)
+        stem = Path(name).stem
+        if not self._needs_directory():
+            text = self.deck_text(None, cwd, stem=stem)
             return _run_named(name, ".", lambda: run_text(text, name=name, base_dir=".", **kw))
-        file = self.excitation.file
         # only inside the temporary directory: a file given with a directory (absolute or
         # not) is never written to
-        # (no file: named as write_deck names it, <stem of name>.record.txt)
-        default = Path(name).stem + ".record.txt"
-        record_name = default if file is None else (Path(os.fspath(file)).name or default)
+        # (no file: named as write_deck names it, <stem of name>.record.txt, .record2.txt)
+        names = []
+        for ex, suffix in ((self.excitation, ".record.txt"), (self.excitation2, ".record2.txt")):
+            file = ex.file if isinstance(ex, Record) else None
+            default = stem + suffix
+            names.append(default if file is None else (Path(os.fspath(file)).name or default))
+        if names[1] == names[0]:
+            names[1] = stem + ".record2.txt"
         with tempfile.TemporaryDirectory() as tmp:
             directory = Path(tmp)
-            text = self.deck_text(directory, cwd, record_name)
+            text = self.deck_text(directory, cwd, names[0], names[1], stem)
             return _run_named(name, directory,
                               lambda: run_text(text, name=name, base_dir=directory, **kw))

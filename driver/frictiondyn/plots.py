@@ -24,8 +24,10 @@ TypeError naming it.
 Time histories: ``plot_acceleration``, ``plot_relative_velocity``, ``plot_phase``,
 ``plot_drift``, ``plot_storey_shear``, ``plot_base_shear``, ``plot_columns``; loops:
 ``plot_hysteresis`` (device force vs slip), ``plot_storey_loop`` (storey shear vs drift);
-profiles over the height: ``plot_drift_profile``, ``plot_acceleration_profile``; sets:
-``plot_compare`` and ``plot_all`` (what the command line writes).
+profiles over the height: ``plot_drift_profile``, ``plot_acceleration_profile``; a building
+of rigid floors: ``plot_orbit`` (the roof's ux against uy), ``plot_device_plan`` (the braces
+in plan with their peak forces); sets: ``plot_compare`` and ``plot_all`` (what the command
+line writes).
 """
 
 from __future__ import annotations
@@ -55,9 +57,11 @@ __all__ = [
     "plot_base_shear",
     "plot_columns",
     "plot_compare",
+    "plot_device_plan",
     "plot_drift",
     "plot_drift_profile",
     "plot_hysteresis",
+    "plot_orbit",
     "plot_phase",
     "plot_relative_velocity",
     "plot_storey_loop",
@@ -699,6 +703,171 @@ def plot_acceleration_profile(
     return _finish(fig, path, dpi)
 
 
+# --------------------------------------------------------------------------- rigid floors
+
+
+def _floors(r: Result, name: str) -> int:
+    """The number of rigid floors of a result (its summary's floor_cm_x_m), or a ValueError."""
+    cm = (r.summary or {}).get("floor_cm_x_m")
+    if not cm:
+        raise ValueError(f"{name}: not a building of rigid floors (give &floors in the deck)")
+    return len(cm)
+
+
+def orbit_series(r: Result, floor: int | None = None) -> dict[str, np.ndarray]:
+    """The plan motion of a floor (default: the top one) from the history rows: ``cm`` (ux,
+    uy of its centre of mass) and, when its plan is known, ``corner`` (ux - rz dy, uy + rz
+    dx at the corner (dx, dy) = (+-plan_x / 2, +-plan_y / 2) from the centre of mass whose
+    orbit reaches farthest out), ``corner_at`` that (dx, dy) [m]; SI."""
+    f = floor or _floors(r, "result")
+    cols = [f"u{3 * f - 2}", f"u{3 * f - 1}", f"u{3 * f}"]
+    _check_column([r], cols[0])
+    _check_column([r], cols[2])
+    ux, uy, rz = (np.asarray(r[c], dtype=float) for c in cols)
+    out = {"cm": np.column_stack([ux, uy])}
+    s = r.summary
+    lx, ly = s["floor_plan_x_m"][f - 1], s["floor_plan_y_m"][f - 1]
+    if lx is not None and ly is not None:
+        best = None
+        for dx in (-lx / 2, lx / 2):
+            for dy in (-ly / 2, ly / 2):
+                xy = np.column_stack([ux - rz * dy, uy + rz * dx])
+                reach = float(np.hypot(xy[:, 0], xy[:, 1]).max())
+                if best is None or reach > best[0]:
+                    best = (reach, xy, (dx, dy))
+        out["corner"], out["corner_at"] = best[1], np.array(best[2])
+    return out
+
+
+def plot_orbit(
+    results: Results,
+    path: PathLike = None,
+    *,
+    ax: Axes | None = None,
+    floor: int | None = None,
+    labels: Sequence[str] | None = None,
+    title: str | None = None,
+    units: Units | str | None = None,
+    dpi: int | None = None,
+) -> Figure:
+    """The orbit of a floor of a building of rigid floors (default: the roof, the top
+    floor): uy against ux of its centre of mass and of its corner that goes farthest out,
+    from the history rows (every row: t_range does not apply), equal axes."""
+    rs = _as_list(results)
+    names = _labels(rs, labels)
+    fig, ax = _axes(ax, (5.0, 5.0))
+    u = Units.parse(units)
+    f = u.factor("m")
+    for k, (r, name) in enumerate(zip(rs, names, strict=True)):
+        top = floor or _floors(r, name)
+        series = orbit_series(r, top)
+        pre = f"{name}, " if len(rs) > 1 else ""
+        cm = series["cm"] * f
+        ax.plot(cm[:, 0], cm[:, 1], "-", color=f"C{2 * k}", linewidth=0.9, label=f"{pre}centre of mass")
+        if "corner" in series:
+            dx, dy = series["corner_at"]
+            c = series["corner"] * f
+            ax.plot(c[:, 0], c[:, 1], "-", color=f"C{2 * k + 1}", linewidth=0.7,
+                    label=f"{pre}corner ({dx:+g}, {dy:+g}) m")
+    ax.set_aspect("equal", adjustable="datalim")
+    ax.axhline(0.0, color="0.6", linewidth=0.5)
+    ax.axvline(0.0, color="0.6", linewidth=0.5)
+    ax.set_xlabel(f"ux [{u.name('m')}]")
+    ax.set_ylabel(f"uy [{u.name('m')}]")
+    ax.grid(True, linewidth=0.3)
+    ax.legend(fontsize="small", loc="best")
+    r0 = rs[0]
+    label = r0.dof_labels[3 * (floor or _floors(r0, names[0])) - 3].removesuffix(" ux")
+    _title(ax, title, f"{label}: orbit in plan")
+    return _finish(fig, path, dpi)
+
+
+def brace_segments(r: Result, storey: int, length: float) -> tuple[np.ndarray, np.ndarray, list[int]]:
+    """The braces of &floor_braces in a storey as plan segments of ``length`` [m] centred at
+    the point of each one's line nearest its floor's centre of mass, along its angle:
+    (segments (n, 2, 2) [m], peak forces (n) [N], devices (1-based))."""
+    s = r.summary
+    devices = [d + 1 for d, st in enumerate(s["device_storey"]) if st == storey]
+    segs = []
+    for d in devices:
+        x, y = s["device_plan_x_m"][d - 1], s["device_plan_y_m"][d - 1]
+        a = np.radians(s["device_angle_deg"][d - 1])
+        h = 0.5 * length * np.array([np.cos(a), np.sin(a)])
+        segs.append([[x - h[0], y - h[1]], [x + h[0], y + h[1]]])
+    forces = np.array([s["peak_force_N"][d - 1] for d in devices], dtype=float)
+    return np.array(segs, dtype=float).reshape(-1, 2, 2), forces, devices
+
+
+def plot_device_plan(
+    result: Result,
+    path: PathLike = None,
+    *,
+    storeys: Sequence[int] | None = None,
+    title: str | None = None,
+    units: Units | str | None = None,
+    dpi: int | None = None,
+) -> Figure:
+    """A plan view of the braces of a building of rigid floors (&floor_braces), one panel
+    per storey (``storeys``, default every storey with a brace, at most 12): the floor's
+    outline and centre of mass, each brace drawn along its direction through its position,
+    coloured by its peak force (one colour scale for all panels) and labelled with it."""
+    from matplotlib import colormaps
+    from matplotlib.collections import LineCollection
+    from matplotlib.colors import Normalize
+
+    r = result
+    nf = _floors(r, default_label(r, 0))
+    s = r.summary
+    u = Units.parse(units)
+    braced = sorted({st for st in s["device_storey"] if st > 0})
+    chosen = list(storeys) if storeys is not None else braced[:12]
+    if not chosen:
+        raise ValueError(f"{default_label(r, 0)}: no brace of &floor_braces to draw")
+    bad = [st for st in chosen if not 1 <= st <= nf]
+    if bad:
+        raise ValueError(f"storeys {bad}: the building has storeys 1 to {nf}")
+    forces_all = np.array([s["peak_force_N"][d] for d, st in enumerate(s["device_storey"]) if st > 0])
+    norm = Normalize(0.0, float(forces_all.max()) if forces_all.size and forces_all.max() > 0 else 1.0)
+    cmap = colormaps["viridis"]
+    cols = min(3, len(chosen))
+    rows = (len(chosen) + cols - 1) // cols
+    fig = _figure((4.2 * cols + 1.0, 3.6 * rows))
+    axes = fig.subplots(rows, cols, squeeze=False)
+    fu = u.factor("N")
+    for ax, st in zip(axes.flat, chosen, strict=False):
+        cx, cy = s["floor_cm_x_m"][st - 1], s["floor_cm_y_m"][st - 1]
+        lx, ly = s["floor_plan_x_m"][st - 1], s["floor_plan_y_m"][st - 1]
+        if lx is not None and ly is not None:
+            ax.plot(cx + np.array([-1, 1, 1, -1, -1]) * lx / 2, cy + np.array([-1, -1, 1, 1, -1]) * ly / 2,
+                    "-", color="0.4", linewidth=0.8)
+        ax.plot([cx], [cy], "+", color="k", markersize=8)
+        size = max(lx or 0.0, ly or 0.0)
+        segs, forces, devices = brace_segments(r, st, 0.15 * size if size > 0 else 2.0)
+        lc = LineCollection(segs, cmap=cmap, norm=norm, linewidths=4.0)
+        lc.set_array(forces)
+        ax.add_collection(lc)
+        for seg, force, d in zip(segs, forces, devices, strict=True):
+            mid = seg.mean(axis=0)
+            ax.annotate(f"{r.device_labels[d - 1]}\n{force * fu:.4g} {u.name('N')}", mid, fontsize=7,
+                        xytext=(4, 4), textcoords="offset points")
+        ax.autoscale_view()
+        ax.set_aspect("equal", adjustable="datalim")
+        ax.set_xlabel("x [m]")
+        ax.set_ylabel("y [m]")
+        ax.grid(True, linewidth=0.3)
+        ax.set_title(f"storey {st}")
+    for ax in list(axes.flat)[len(chosen):]:
+        ax.set_visible(False)
+    bar = fig.colorbar(LineCollection([], cmap=cmap, norm=norm), ax=axes, shrink=0.8)
+    bar.ax.set_ylabel(f"peak force [{u.name('N')}]")
+    bar.ax.yaxis.set_major_formatter(lambda x, _: f"{x * fu:.4g}")
+    if title is None:
+        title = "braces in plan, coloured by their peak force"
+    if title:
+        fig.suptitle(title)
+    return _finish(fig, path, dpi)
+
+
 # --------------------------------------------------------------------------- sets
 
 
@@ -738,7 +907,7 @@ def plot_compare(
 
 #: What plot_all can write, in its order; KEY_PLOTS is the default set.
 PLOT_KINDS = ("aabs", "sdot", "hysteresis", "phase", "drift_profile", "acceleration_profile",
-              "storey_loop", "base_shear")
+              "storey_loop", "base_shear", "orbit", "device_plan")
 KEY_PLOTS = "key"
 
 
@@ -774,17 +943,20 @@ def plot_all(
     ``<stem>_hysteresis<d>.png`` and ``<stem>_phase<d>.png`` per device (the first
     ``max_items`` DOFs and devices), and with storeys ``<stem>_drift_profile.png``,
     ``<stem>_acceleration_profile.png``, ``<stem>_storey_loop<s>.png`` and
-    ``<stem>_base_shear.png``. "key" is the last DOF's acceleration, the hysteresis of the
-    device whose peak force is largest, and with storeys the two profiles and the base
-    shear."""
+    ``<stem>_base_shear.png``, and for a building of rigid floors ``<stem>_orbit.png`` and
+    (with &floor_braces) ``<stem>_device_plan.png``. "key" is the last DOF's acceleration,
+    the hysteresis of the device whose peak force is largest, with storeys the two profiles
+    and the base shear, and for rigid floors the orbit and the plan of the braces."""
     directory = Path(directory)
     written: list[Path] = []
+    explicit = kinds != KEY_PLOTS and tuple(kinds) != PLOT_KINDS   # kinds named one by one
     kw = {"t_range": t_range, "units": units, "dpi": dpi}
     dofs = range(1, min(result.n_dof, max_items) + 1)
     devices = range(1, min(result.n_devices, max_items) + 1)
     chosen: dict[str, range | list[int]] = {k: (dofs if k == "aabs" else devices) for k in PLOT_KINDS}
     if kinds == KEY_PLOTS:
-        kinds = ("aabs", "hysteresis", "drift_profile", "acceleration_profile", "base_shear")
+        kinds = ("aabs", "hysteresis", "drift_profile", "acceleration_profile", "base_shear", "orbit",
+                 "device_plan")
         chosen["aabs"] = [result.n_dof] if result.n_dof else []
         forces = result.summary.get("peak_force_N") or []
         chosen["hysteresis"] = [1 + int(np.argmax(forces))] if len(forces) else []
@@ -815,4 +987,17 @@ def plot_all(
             p = directory / f"{stem}_base_shear.png"
             plot_base_shear(result, p, **kw)
             written.append(p)
+    floors = (result.summary or {}).get("floor_cm_x_m")
+    asked = [k for k in ("orbit", "device_plan") if k in kinds] if explicit else []
+    if asked and not floors:
+        raise ValueError(f"plots {', '.join(asked)}: {default_label(result, 0)} is not a building of rigid "
+                         "floors (&floors)")
+    if floors and "orbit" in kinds and f"u{3 * len(floors)}" in result:
+        p = directory / f"{stem}_orbit.png"
+        plot_orbit(result, p, units=units, dpi=dpi)
+        written.append(p)
+    if floors and "device_plan" in kinds and any(st > 0 for st in result.summary["device_storey"]):
+        p = directory / f"{stem}_device_plan.png"
+        plot_device_plan(result, p, units=units, dpi=dpi)
+        written.append(p)
     return written

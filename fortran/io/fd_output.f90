@@ -737,7 +737,62 @@ contains
          call kreal(jt, res, 'residual_base_shear_N', eng%shear(0))
       end associate
       call storeys_part(jt, res%eng)
+      if (res%eng%n_floors > 0) call floors_part(jt, res)
    end subroutine engineering_part
+
+   !> A building of rigid floors: the base shears along x and y and the base torque about
+   !> the plan origin, the modal mass ratios along x, y and rz, the floors' rotations and
+   !> the absolute accelerations at their corners, the plan and the braces in it.
+   subroutine floors_part(jt, res)
+      type(json_text), intent(inout) :: jt     !! the summary
+      type(result_type), intent(in) :: res     !! the result
+      character(len=*), parameter :: base(3) = [character(len=13) :: 'base_shear_x', 'base_shear_y', &
+                                                'base_torque']
+      character(len=*), parameter :: unit(3) = [character(len=2) :: 'N', 'N', 'Nm']
+      character(len=*), parameter :: axis(3) = [character(len=2) :: 'x', 'y', 'rz']
+      real(dp), allocatable :: x(:), tx(:)
+      integer :: a, f
+
+      associate (eng => res%eng)
+         do a = 1, 3
+            call kr1(trim(base(a))//'_'//trim(unit(a)), eng%peak_base3(a), .true.)
+            call kr1(trim(base(a))//'_time_s', eng%peak_base3_time(a), eng%peak_base3(a) /= 0.0_dp)
+            call kv(jt, 'residual_'//trim(base(a))//'_'//trim(unit(a)), trim(json_real(eng%base3(a))))
+         end do
+         do a = 1, 3
+            x = eng%ratio_stuck(:, a)
+            call kr(jt, 'modal_mass_ratio_stuck_'//trim(axis(a)), x)
+         end do
+         do a = 1, 3
+            x = eng%ratio_free(:, a)
+            call kr(jt, 'modal_mass_ratio_free_'//trim(axis(a)), x)
+         end do
+         x = [(res%peak_u(3*f), f=1, eng%n_floors)]
+         tx = [(res%peak_u_time(3*f), f=1, eng%n_floors)]
+         call kr(jt, 'peak_floor_rotation_rad', x)
+         call kr(jt, 'peak_floor_rotation_time_s', tx, x /= 0.0_dp)
+         call kr(jt, 'peak_corner_aabs_mps2', reshape(eng%peak_corner_aabs, [2*eng%n_floors]), &
+                 reshape(eng%half_plan, [2*eng%n_floors]) > 0.0_dp)
+         call kr(jt, 'peak_corner_aabs_time_s', reshape(eng%peak_corner_aabs_time, [2*eng%n_floors]), &
+                 reshape(eng%peak_corner_aabs, [2*eng%n_floors]) /= 0.0_dp)
+         call kr(jt, 'floor_cm_x_m', eng%floor_x)
+         call kr(jt, 'floor_cm_y_m', eng%floor_y)
+         call kr(jt, 'floor_plan_x_m', eng%floor_lx, eng%floor_lx > 0.0_dp)
+         call kr(jt, 'floor_plan_y_m', eng%floor_ly, eng%floor_ly > 0.0_dp)
+         call ki(jt, 'device_storey', eng%dev_storey)
+         call kr(jt, 'device_plan_x_m', eng%dev_x, eng%dev_storey > 0)
+         call kr(jt, 'device_plan_y_m', eng%dev_y, eng%dev_storey > 0)
+         call kr(jt, 'device_angle_deg', eng%dev_angle, eng%dev_storey > 0)
+      end associate
+   contains
+      !> 'peak_<key>' as a number, or null when not defined.
+      subroutine kr1(key, x, defined)
+         character(len=*), intent(in) :: key
+         real(dp), intent(in) :: x
+         logical, intent(in) :: defined
+         call kv(jt, 'peak_'//key, trim(merge(json_real(x), 'null' // repeat(' ', 28), defined)))
+      end subroutine kr1
+   end subroutine floors_part
 
    !> The storeys: labels, nodes, heights, drifts (and their ratios) and shears.
    subroutine storeys_part(jt, eng)

@@ -15,7 +15,7 @@ module fd_engineering
    use fd_kinds, only: dp
    use fd_error, only: error_type, fatal_error, fmt_int, stat_no_memory
    use fd_model, only: model_type, integration_type, label_len, system_stuck, system_free, &
-                       damping_stiffness, damping_rayleigh
+                       damping_stiffness, damping_rayleigh, source_floor_brace
    use fd_kinematics, only: pair_nodes, devices_are_pairs, device_relative
    use fd_stiffness, only: add_general_times, influence_of
    use fd_floors, only: floor_dof
@@ -26,7 +26,7 @@ module fd_engineering
    private
 
    public :: engineering_type, engineering_init, storey_values, observe_engineering, engineering_columns
-   public :: observe_storey_peak
+   public :: observe_storey_peak, observe_floor_accelerations
 
    !> The engineering outputs of a run.
    type :: engineering_type
@@ -75,6 +75,29 @@ module fd_engineering
       real(dp), allocatable :: corner_coef(:, :, :) !! (4, 4, n_storeys)
       real(dp), allocatable :: peak_corner(:)     !! (n_storeys) max |drift| over the corners [m]
       real(dp), allocatable :: peak_corner_time(:) !! its time [s]
+      ! a building of rigid floors: the forces the elements pass to the table along the rigid
+      ! motions t_a of the floors, a = 1 along x, 2 along y, 3 a rotation about the vertical
+      ! axis through the plan origin (the base shears and the base torque):
+      ! t_a' (K u + a1 K v) + sum_d (b_d' t_a) F_d
+      integer :: n_floors = 0                     !! floors (0: no building of rigid floors)
+      real(dp), allocatable :: kt(:, :)           !! (n_dof, 3) K t_a [N/m, N]
+      real(dp), allocatable :: bt(:, :)           !! (n_devices, 3) b_d' t_a [-, m]
+      real(dp) :: base3(3) = 0.0_dp               !! at the last state [N, N, N m]
+      real(dp) :: peak_base3(3) = 0.0_dp          !! their peaks [N, N, N m]
+      real(dp) :: peak_base3_time(3) = 0.0_dp     !! their times [s]
+      ! the effective modal mass along x, y and the floors' rotations (rz) over its total,
+      ! (mode, direction), of the stuck and the free system
+      real(dp), allocatable :: ratio_stuck(:, :), ratio_free(:, :)
+      ! the absolute acceleration at the plan corners of each floor along x and along y: the
+      ! largest over the corners is |a_x| + |a_rz| l_y / 2 and |a_y| + |a_rz| l_x / 2
+      real(dp), allocatable :: half_plan(:, :)    !! (2, n_floors) l_y / 2, l_x / 2 (0: no plan) [m]
+      real(dp), allocatable :: peak_corner_aabs(:, :)      !! (2, n_floors) [m/s2]
+      real(dp), allocatable :: peak_corner_aabs_time(:, :) !! (2, n_floors) [s]
+      ! the floors' plan, and where each brace of &floor_braces lies in it: its storey (0:
+      ! another device), the point of its line nearest its floor's centre of mass, its angle
+      real(dp), allocatable :: floor_x(:), floor_y(:), floor_lx(:), floor_ly(:)
+      integer, allocatable :: dev_storey(:)       !! (n_devices)
+      real(dp), allocatable :: dev_x(:), dev_y(:), dev_angle(:) !! [m, m, deg]
       ! values at the last state observed (the residual values at the end of the run)
       real(dp), allocatable :: drift(:)         !! (n_storeys) drift [m]
       real(dp), allocatable :: shear(:)         !! (0:n_storeys) shear, 0 = base [N]
@@ -175,6 +198,7 @@ contains
       call storey_elements(model, eng, stat)
       if (stat == 0 .and. allocated(model%xs_storey)) call storey_extras(model, eng, stat)
       if (stat == 0 .and. model%n_floors > 0) call floor_corners(model, eng, stat)
+      if (stat == 0 .and. model%n_floors > 0) call floor_outputs(model, eng, stat)
       if (stat /= 0) then
          call no_memory('the elements of the storeys'); return
       end if
@@ -265,30 +289,42 @@ contains
       type(engineering_type), intent(inout) :: eng
       integer, intent(out) :: stat                 !! not 0: not enough memory
       real(dp), allocatable :: r(:)
-      real(dp) :: x
-      integer :: i, j, s, d
+      integer :: i
 
       allocate (r(model%n_dof), eng%kr(model%n_dof), eng%br(model%n_devices), stat=stat)
       if (stat /= 0) return
       do i = 1, model%n_dof
          r(i) = influence_of(model, i)
       end do
-      eng%kr = 0.0_dp
+      call base_along(model, r, eng%kr, eng%br)
+      eng%general = .true.
+   end subroutine general_base
+
+   !> The forces the elements pass to the table along a motion t of the DOFs: K t (the
+   !> springs' and K_x's) and b_d' t of every device.
+   pure subroutine base_along(model, t, kt, bt)
+      type(model_type), intent(in) :: model
+      real(dp), intent(in) :: t(:)                 !! (n_dof) the motion
+      real(dp), intent(out) :: kt(:)               !! (n_dof) K t
+      real(dp), intent(out) :: bt(:)               !! (n_devices) b_d' t
+      real(dp) :: x
+      integer :: i, j, s, d
+
+      kt = 0.0_dp
       do s = 1, model%n_springs
          i = model%spring_i(s); j = model%spring_j(s)
          x = 0.0_dp
-         if (i > 0) x = r(i)
-         if (j > 0) x = x - r(j)
+         if (i > 0) x = t(i)
+         if (j > 0) x = x - t(j)
          x = model%spring_k(s)*x
-         if (i > 0) eng%kr(i) = eng%kr(i) + x
-         if (j > 0) eng%kr(j) = eng%kr(j) - x
+         if (i > 0) kt(i) = kt(i) + x
+         if (j > 0) kt(j) = kt(j) - x
       end do
-      call add_general_times(model, r, eng%kr)
+      call add_general_times(model, t, kt)
       do d = 1, model%n_devices
-         eng%br(d) = device_relative(model, d, r)
+         bt(d) = device_relative(model, d, t)
       end do
-      eng%general = .true.
-   end subroutine general_base
+   end subroutine base_along
 
    !> Drift and shear of every storey, and the base shear, at one state.
    pure subroutine storey_values(eng, u, v, force, drift, shear, base)
@@ -439,6 +475,21 @@ contains
             eng%peak_shear(i) = abs(x); eng%peak_shear_time(i) = t
          end if
       end do
+      if (allocated(eng%kt)) then
+         do c = 1, 3
+            x = 0.0_dp
+            do i = 1, n
+               x = x + eng%kt(i, c)*(u(i) + eng%a1*v(i))
+            end do
+            do i = 1, nd
+               x = x + eng%bt(i, c)*force(i)
+            end do
+            eng%base3(c) = x
+            if (abs(x) > eng%peak_base3(c)) then
+               eng%peak_base3(c) = abs(x); eng%peak_base3_time(c) = t
+            end if
+         end do
+      end if
       if (.not. allocated(eng%peak_corner)) return
       do i = 1, eng%n_storeys
          if (.not. eng%has_corners(i)) cycle
@@ -502,6 +553,146 @@ contains
          end do
       end do
    end subroutine floor_corners
+
+   !> A building of rigid floors: the rigid motions of the base shears along x and y and of
+   !> the base torque about the plan origin, the modal mass ratios along x, y and rz, the
+   !> floors' plan and the plan position of each brace of &floor_braces.
+   subroutine floor_outputs(model, eng, stat)
+      type(model_type), intent(in) :: model
+      type(engineering_type), intent(inout) :: eng
+      integer, intent(out) :: stat                 !! not 0: not enough memory
+      real(dp), allocatable :: t(:), kt(:), bt(:)
+      integer :: nf, n, nd, f, a
+
+      nf = model%n_floors
+      n = model%n_dof
+      nd = model%n_devices
+      eng%n_floors = nf
+      allocate (t(n), kt(n), bt(nd), eng%kt(n, 3), eng%bt(nd, 3), eng%half_plan(2, nf), &
+                eng%peak_corner_aabs(2, nf), eng%peak_corner_aabs_time(2, nf), stat=stat)
+      if (stat /= 0) return
+      do a = 1, 3
+         t = 0.0_dp
+         do f = 1, nf
+            if (a < 3) then
+               t(floor_dof(f, a)) = 1.0_dp
+            else
+               ! a rotation rz = 1 about the origin moves the centre of mass by (-y_f, x_f)
+               t(floor_dof(f, 1)) = -model%floor_y(f)
+               t(floor_dof(f, 2)) = model%floor_x(f)
+               t(floor_dof(f, 3)) = 1.0_dp
+            end if
+         end do
+         call base_along(model, t, kt, bt)
+         eng%kt(:, a) = kt
+         eng%bt(:, a) = bt
+      end do
+      eng%half_plan(1, :) = 0.5_dp*model%floor_ly
+      eng%half_plan(2, :) = 0.5_dp*model%floor_lx
+      eng%peak_corner_aabs = 0.0_dp
+      eng%peak_corner_aabs_time = 0.0_dp
+      call direction_ratios(model, eng%stuck, eng%ratio_stuck, stat)
+      if (stat == 0) call direction_ratios(model, eng%free, eng%ratio_free, stat)
+      if (stat == 0) call brace_plan(model, eng, stat)
+   end subroutine floor_outputs
+
+   !> The effective modal mass of each mode along x, y and rz (every floor's DOF of that
+   !> component 1, the others 0), (phi' M t)^2 / (phi' M phi), over the total t' M t.
+   subroutine direction_ratios(model, modes, ratio, stat)
+      type(model_type), intent(in) :: model
+      type(modes_type), intent(in) :: modes
+      real(dp), allocatable, intent(out) :: ratio(:, :)   !! (modes%n, 3)
+      integer, intent(out) :: stat                 !! not 0: not enough memory
+      real(dp) :: l, total
+      integer :: j, a, f, i
+
+      allocate (ratio(modes%n, 3), stat=stat)
+      if (stat /= 0) return
+      do a = 1, 3
+         total = 0.0_dp
+         do f = 1, model%n_floors
+            total = total + model%mass(floor_dof(f, a))
+         end do
+         do j = 1, modes%n
+            l = 0.0_dp
+            do f = 1, model%n_floors
+               i = floor_dof(f, a)
+               l = l + model%mass(i)*modes%shape(i, j)
+            end do
+            ratio(j, a) = l*l/sum(model%mass*modes%shape(:, j)**2)/total
+         end do
+      end do
+   end subroutine direction_ratios
+
+   !> The floors' plan and, for each brace of &floor_braces (direction b of terms c, s and
+   !> sin a (x - x_f) - cos a (y - y_f) at the ux, uy, rz of its floor f), its storey, angle
+   !> and the point of its line nearest the centre of mass: (x_f, y_f) + d (sin a, -cos a).
+   subroutine brace_plan(model, eng, stat)
+      type(model_type), intent(in) :: model
+      type(engineering_type), intent(inout) :: eng
+      integer, intent(out) :: stat                 !! not 0: not enough memory
+      real(dp), allocatable :: e(:)
+      real(dp) :: b(3)
+      integer :: nd, d, k, f, c
+
+      nd = model%n_devices
+      allocate (eng%floor_x, source=model%floor_x, stat=stat)
+      if (stat == 0) allocate (eng%floor_y, source=model%floor_y, stat=stat)
+      if (stat == 0) allocate (eng%floor_lx, source=model%floor_lx, stat=stat)
+      if (stat == 0) allocate (eng%floor_ly, source=model%floor_ly, stat=stat)
+      if (stat == 0) allocate (eng%dev_storey(nd), eng%dev_x(nd), eng%dev_y(nd), eng%dev_angle(nd), &
+                               e(model%n_dof), stat=stat)
+      if (stat /= 0) return
+      eng%dev_storey = 0
+      eng%dev_x = 0.0_dp; eng%dev_y = 0.0_dp; eng%dev_angle = 0.0_dp
+      e = 0.0_dp
+      if (.not. allocated(model%xd_dev)) return
+      do k = 1, size(model%xd_dev)
+         d = model%xd_dev(k)
+         if (model%dev(d)%source /= source_floor_brace .or. eng%dev_storey(d) /= 0) cycle
+         f = (model%xd_storey(k) + 1)/2
+         do c = 1, 3
+            e(floor_dof(f, c)) = 1.0_dp
+            b(c) = device_relative(model, d, e)
+            e(floor_dof(f, c)) = 0.0_dp
+         end do
+         eng%dev_storey(d) = f
+         eng%dev_angle(d) = atan2(b(2), b(1))*180.0_dp/acos(-1.0_dp)
+         eng%dev_x(d) = model%floor_x(f) + b(3)*b(2)
+         eng%dev_y(d) = model%floor_y(f) - b(3)*b(1)
+      end do
+   end subroutine brace_plan
+
+   !> The absolute accelerations at the floors' plan corners at one accepted state: along x
+   !> the largest over the corners |a_x| + |a_rz| l_y / 2, along y |a_y| + |a_rz| l_x / 2
+   !> (a the relative acceleration plus the table's along each DOF's r and r2).
+   pure subroutine observe_floor_accelerations(eng, t, n, acc, ag, ag2)
+      type(engineering_type), intent(inout) :: eng  !! the outputs
+      real(dp), intent(in) :: t                     !! time [s]
+      integer, intent(in) :: n                      !! DOFs
+      real(dp), intent(in) :: acc(n)                !! relative accelerations [m/s2]
+      real(dp), intent(in) :: ag                    !! table acceleration [m/s2]
+      real(dp), intent(in), optional :: ag2         !! a second component's [m/s2]
+      real(dp) :: a(3), x
+      integer :: f, c, i
+
+      if (.not. allocated(eng%peak_corner_aabs)) return
+      do f = 1, eng%n_floors
+         do c = 1, 3
+            i = floor_dof(f, c)
+            a(c) = acc(i)
+            if (allocated(eng%r)) a(c) = a(c) + eng%r(i)*ag
+            if (present(ag2) .and. allocated(eng%r2)) a(c) = a(c) + eng%r2(i)*ag2
+         end do
+         do c = 1, 2
+            if (eng%half_plan(c, f) <= 0.0_dp) cycle
+            x = abs(a(c)) + abs(a(3))*eng%half_plan(c, f)
+            if (x > eng%peak_corner_aabs(c, f)) then
+               eng%peak_corner_aabs(c, f) = x; eng%peak_corner_aabs_time(c, f) = t
+            end if
+         end do
+      end do
+   end subroutine observe_floor_accelerations
 
    !> One value into a peak of the storeys (a technique that knows its solution between
    !> steps passes the exact extrema, with their times): q numbers the storey quantities in

@@ -28,7 +28,8 @@ module fd_observer
    use fd_linalg, only: sym_matvec
    use fd_run_control, only: run_control, cancel_requested, stat_cancelled
    use fd_result, only: history_header
-   use fd_engineering, only: engineering_init, observe_engineering, storey_values, observe_storey_peak
+   use fd_engineering, only: engineering_init, observe_engineering, storey_values, observe_storey_peak, &
+                             observe_floor_accelerations
    implicit none
    private
 
@@ -227,6 +228,7 @@ contains
       end do
       call observe_engineering(res%eng, t, n, nd, u, v, s, force)
       if (res%n_bearings > 0) call observe_bearings(res, t, nd, s)
+      if (res%eng%n_floors > 0) call observe_floor_accelerations(res%eng, t, n, acc, ag, ag2)
    end subroutine observe_peaks
 
    !> The planar bearings' resultant displacement |(s_x, s_y)|: its peak, the peak's direction

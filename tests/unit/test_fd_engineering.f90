@@ -12,7 +12,8 @@ module test_fd_engineering
    use fd_excitation, only: excitation_type, excitation_none
    use fd_matrices, only: modes_type, natural_modes, stiffness_matrix, damping_matrix, modes_flexible, &
                           modes_rigid, modes_unrestrained, natural_modes_sparse
-   use fd_engineering, only: engineering_type, engineering_init, storey_values, observe_engineering
+   use fd_engineering, only: engineering_type, engineering_init, storey_values, observe_engineering, &
+                             observe_floor_accelerations
    use test_fd_helpers, only: check_close, pairs_of
    implicit none
    private
@@ -34,7 +35,8 @@ contains
                   new_unittest("rigid and unrestrained systems", test_rigid), &
                   new_unittest("modal damping ratios of Rayleigh damping", test_rayleigh_xi), &
                   new_unittest("storey drifts and shears of a hand-computed state", test_storeys), &
-                  new_unittest("large-model modes (no n x n matrix) = dense modes", test_sparse_modes) &
+                  new_unittest("large-model modes (no n x n matrix) = dense modes", test_sparse_modes), &
+                  new_unittest("floor corner accelerations: the largest over the corners", test_corner_acc) &
                   ]
    end subroutine collect_engineering
 
@@ -363,5 +365,34 @@ contains
          end do
       end do
    end subroutine test_sparse_modes
+
+   !> The absolute acceleration at the corners of a rigid floor 20 m x 12 m whose centre of
+   !> mass accelerates by (a_x, a_y) and turns by a_rz (the table's r ag and r2 ag2 added):
+   !> the largest over the four corners is |a_x| + |a_rz| 6 along x, |a_y| + |a_rz| 10 along y;
+   !> a floor without a plan keeps none; a smaller state later leaves the peaks and times.
+   subroutine test_corner_acc(error)
+      type(error_type), allocatable, intent(out) :: error
+      type(engineering_type) :: eng
+      real(dp) :: acc(6)
+
+      eng%n_floors = 2
+      allocate (eng%half_plan(2, 2), eng%peak_corner_aabs(2, 2), eng%peak_corner_aabs_time(2, 2))
+      eng%half_plan = reshape([6.0_dp, 10.0_dp, 0.0_dp, 0.0_dp], [2, 2])
+      eng%peak_corner_aabs = 0.0_dp
+      eng%peak_corner_aabs_time = 0.0_dp
+      eng%r = [0.8_dp, 0.6_dp, 0.0_dp, 0.8_dp, 0.6_dp, 0.0_dp]
+      eng%r2 = [-0.6_dp, 0.8_dp, 0.0_dp, -0.6_dp, 0.8_dp, 0.0_dp]
+      acc = [1.0_dp, -2.0_dp, 0.3_dp, 5.0_dp, 5.0_dp, 1.0_dp]
+      call observe_floor_accelerations(eng, 1.5_dp, 6, acc, 2.0_dp, -1.0_dp)
+      ! a_x = 1 + 0.8 * 2 + 0.6 = 3.2, a_y = -2 + 1.2 - 0.8 = -1.6
+      call check_close(error, eng%peak_corner_aabs(1, 1), 3.2_dp + 0.3_dp*6.0_dp, 1.0e-15_dp, "corner a_x")
+      if (allocated(error)) return
+      call check_close(error, eng%peak_corner_aabs(2, 1), 1.6_dp + 0.3_dp*10.0_dp, 1.0e-15_dp, "corner a_y")
+      if (allocated(error)) return
+      call check(error, all(eng%peak_corner_aabs(:, 2) == 0.0_dp), "a floor without a plan has no corners")
+      if (allocated(error)) return
+      call observe_floor_accelerations(eng, 2.0_dp, 6, 0.1_dp*acc, 0.0_dp, 0.0_dp)
+      call check(error, all(eng%peak_corner_aabs_time(:, 1) == 1.5_dp), "the peak's time stays")
+   end subroutine test_corner_acc
 
 end module test_fd_engineering
