@@ -883,6 +883,29 @@ class IsolatedBlockCase:
             f"&integration\n  n1 = {self.n1}\n  refinement = 'implicit'\n/\n"
         )
 
+    def deck_planar(self, record_files: tuple[str, ...] = ("ag_x.txt", "ag_y.txt")) -> str:
+        """The frictiondyn deck of the block as a rigid floor (ux, uy, rz at its centre) on
+        four planar bearings (&bearings) at the corners of its plan, each carrying W/4."""
+
+        def arr(xs) -> str:
+            return ", ".join(repr(float(v)) for v in xs)
+
+        exc = ("  excitation_type = 'record'\n  record_format = 'values'\n  record_units = 'm/s2'\n"
+               f"  dt_record = {self.dt_record!r}\n  duration = {self.duration!r}\n")
+        deck = (
+            f"&floors\n  n_floors = 1\n  mass = {self.mass!r}\n  plan_x = {2 * self.a!r}\n"
+            f"  plan_y = {2 * self.b!r}\n/\n&frames\n  n_frames = 0\n/\n"
+            "&damping\n  damping_type = 'none'\n/\n"
+            f"&bearings\n  n_bearings = 4\n  storey = 4*1\n"
+            f"  x = {arr(c[0] for c in self.corners)}\n  y = {arr(c[1] for c in self.corners)}\n"
+            f"  p = 4*{self.weight / 4!r}\n  law = 4*'hysteretic'\n  mu = 4*{self.mu!r}\n"
+            f"  f = 4*{self.f!r}\n  eps1 = 4*{self.eps1!r}\n  radius = 4*{self.radius!r}\n/\n"
+            f"&excitation\n{exc}  record_file = '{record_files[0]}'\n/\n"
+        )
+        if self.components == 2:
+            deck += f"&excitation2\n{exc}  record_file = '{record_files[1]}'\n/\n"
+        return deck + f"&integration\n  n1 = {self.n1}\n  refinement = 'implicit'\n/\n"
+
     def run_frictiondyn_1d(self):
         """frictiondyn's Result of ``deck_1d`` (its record written to a temporary directory)."""
         import frictiondyn as fd
@@ -890,6 +913,16 @@ class IsolatedBlockCase:
         with tempfile.TemporaryDirectory(prefix="fd_iso_") as tmp:
             np.savetxt(Path(tmp) / "ag_x.txt", self.records[0], fmt="%.17g")
             return fd.run_text(self.deck_1d(), f"{self.name}.nml", tmp)
+
+    def run_frictiondyn_planar(self):
+        """frictiondyn's Result of ``deck_planar`` (its records written to a temporary
+        directory)."""
+        import frictiondyn as fd
+
+        with tempfile.TemporaryDirectory(prefix="fd_iso_") as tmp:
+            for name, rec in zip(("ag_x.txt", "ag_y.txt"), self.records):
+                np.savetxt(Path(tmp) / name, rec, fmt="%.17g")
+            return fd.run_text(self.deck_planar(), f"{self.name}.nml", tmp)
 
     # ------------------------------------------------------------------ OpenSees
 

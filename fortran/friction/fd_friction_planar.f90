@@ -204,10 +204,16 @@ contains
                sticks = .true.
             end if
          else if (along < 0.0_dp) then
-            ! crossed the disc within a step: slides along v
-            force = sd
-            size_f = speed
-            slides_now = .true.
+            if (sd(1)*dir0(2) - sd(2)*dir0(1) == 0.0_dp) then
+               ! along the slide's line: the velocity crossed the disc within a step (the 1D
+               ! law's reversal): slides along v
+               force = sd
+               size_f = speed
+               slides_now = .true.
+            else
+               ! turned against the force: the elastic unloading of the radial return
+               sticks = .true.
+            end if
          end if
       else
          if (.not. along > 0.0_dp) then

@@ -1419,7 +1419,7 @@ contains
          if (.not. more) exit
       end do
       if (allocated(error)) return
-      call need_int(deck, 'frames', 'n_frames', n_frames, is_given(grp, 'n_frames'), 1, max_springs, error)
+      call need_int(deck, 'frames', 'n_frames', n_frames, is_given(grp, 'n_frames'), 0, max_springs, error)
       if (allocated(error)) return
       n = n_frames
       call plan_elements(deck, 'frames', grp, cfg, n, storey, angle, x, y, error)

@@ -33,7 +33,8 @@ contains
                   new_unittest("hysteretic: along y, the 1D law's states", test_hysteretic_axis), &
                   new_unittest("hysteretic: circular yield surface", test_hysteretic_yield), &
                   new_unittest("hysteretic: radial return while sliding", test_hysteretic_return), &
-                  new_unittest("hysteretic: end of sliding, force continuous", test_hysteretic_end) &
+                  new_unittest("hysteretic: end of sliding, force continuous", test_hysteretic_end), &
+                  new_unittest("hysteretic: a fast turn unloads elastically", test_hysteretic_turn) &
                   ]
    end subroutine collect_friction_planar
 
@@ -200,5 +201,30 @@ contains
       call check(error, planar_hysteretic_correct(device(law_hysteretic), 2.0_dp, pair, [1.0_dp, 0.0_dp], &
                                                   [-1.0_dp, 0.0_dp]), "not checked while sticking")
    end subroutine test_hysteretic_end
+
+   subroutine test_hysteretic_turn(error)
+      type(error_type), allocatable, intent(out) :: error
+      type(device_state) :: pair(2)
+      logical :: ch(2)
+      real(dp) :: k
+      real(dp), parameter :: s(2) = [3.0_dp*f, 4.0_dp*f]
+
+      k = p*mu/f
+      ! armed along (0.6, 0.8); the velocity turned beyond 90 degrees from the force at a speed
+      ! far outside the disc, not along the slide's line: the radial return's elastic
+      ! unloading (the trial force falls inside the circle), not a slide along v
+      call planar_hysteretic_init(device(law_hysteretic), [0.0_dp, 0.0_dp], [0.6_dp*eps1*2, 0.8_dp*eps1*2], pair)
+      call planar_hysteretic_update(device(law_hysteretic), s, [-8.0_dp*eps1, 2.0_dp*eps1], pair, ch)
+      call check(error, all(pair%phase == phase_stick) .and. all(ch), "sticks after a fast turn")
+      if (allocated(error)) return
+      call check(error, abs(k*(s(1) - pair(1)%centre) - 0.6_dp*p*mu) < 1.0e-12_dp .and. &
+                 abs(k*(s(2) - pair(2)%centre) - 0.8_dp*p*mu) < 1.0e-12_dp, "the force P mu d continuous")
+      if (allocated(error)) return
+      ! a reversal along the slide's line is the 1D law's: slides along v
+      call planar_hysteretic_init(device(law_hysteretic), [0.0_dp, 0.0_dp], [0.6_dp*eps1*2, 0.8_dp*eps1*2], pair)
+      call planar_hysteretic_update(device(law_hysteretic), s, [-0.6_dp*eps1*4, -0.8_dp*eps1*4], pair, ch)
+      call check(error, pair(1)%phase == phase_slip_neg .and. pair(2)%phase == phase_slip_neg, &
+                 "a reversal along the line slides along v")
+   end subroutine test_hysteretic_turn
 
 end module test_fd_friction_planar
