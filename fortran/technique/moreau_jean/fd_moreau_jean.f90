@@ -204,9 +204,7 @@ contains
       w%counted = w%phase0
       w%pending = .false.
       call energies(w, e_kin, e_str)
-      call observe_start_energies(w%obs, e_kin, e_str, 0.0_dp)
-      call observe_sample(w%obs, res, 0.0_dp, ag0, w%u, w%v, w%acc, w%s, w%sd, w%force, w%phase0)
-      call observe_peaks(res, 0.0_dp, size(w%u), size(w%s), w%u, w%v, w%acc, ag0, w%s, w%force)
+      call start_observing(w, res, ag0, e_kin, e_str)
 
       do k = 1, w%obs%nsteps
          t1 = k*h
@@ -249,22 +247,8 @@ contains
          w%v = w%v1
          ag0 = ag1
          call device_state(model, w, w%f_edge, w%phase1)
-         call count_transitions(w, res, .false.)
-         w%phase0 = w%phase1
-         call observe_peaks(res, t1, size(w%u), size(w%s), w%u, w%v, w%acc, ag1, w%s, w%force)
-         res%moreau_jean%steps = res%moreau_jean%steps + 1
-         if (sample_due(w%obs, k)) then
-            if (.not. all(ieee_is_finite(w%u)) .or. .not. all(ieee_is_finite(w%acc))) then
-               call fatal_error(error, "moreau_jean: the solution is not finite at t = "//trim(fmt_real(t1))//" s")
-               return
-            end if
-            call observe_sample(w%obs, res, t1, ag1, w%u, w%v, w%acc, w%s, w%sd, w%force, w%phase1)
-         end if
-         call observe_poll(w%obs, t1, stop)
-         if (stop) then
-            call observe_stop_error(w%obs, error)
-            return
-         end if
+         call end_step(w, res, k, t1, ag1, stop, error)
+         if (allocated(error) .or. stop) return
       end do
       call count_transitions(w, res, .true.)
       call energies(w, e_kin, e_str)
@@ -422,9 +406,7 @@ contains
       w%counted = w%phase0
       w%pending = .false.
       call dense_energies(w, e_kin, e_str)
-      call observe_start_energies(w%obs, e_kin, e_str, 0.0_dp)
-      call observe_sample(w%obs, res, 0.0_dp, ag0, w%u, w%v, w%acc, w%s, w%sd, w%force, w%phase0)
-      call observe_peaks(res, 0.0_dp, size(w%u), size(w%s), w%u, w%v, w%acc, ag0, w%s, w%force)
+      call start_observing(w, res, ag0, e_kin, e_str)
       do k = 1, w%obs%nsteps
          t1 = k*h
          call table_motion(exc, t1, xg, vg, ag1)
@@ -452,22 +434,8 @@ contains
          w%v = w%v1
          ag0 = ag1
          call dense_device_state(model, w, w%phase1)
-         call count_transitions(w, res, .false.)
-         w%phase0 = w%phase1
-         call observe_peaks(res, t1, size(w%u), size(w%s), w%u, w%v, w%acc, ag1, w%s, w%force)
-         res%moreau_jean%steps = res%moreau_jean%steps + 1
-         if (sample_due(w%obs, k)) then
-            if (.not. all(ieee_is_finite(w%u)) .or. .not. all(ieee_is_finite(w%acc))) then
-               call fatal_error(error, "moreau_jean: the solution is not finite at t = "//trim(fmt_real(t1))//" s")
-               return
-            end if
-            call observe_sample(w%obs, res, t1, ag1, w%u, w%v, w%acc, w%s, w%sd, w%force, w%phase1)
-         end if
-         call observe_poll(w%obs, t1, stop)
-         if (stop) then
-            call observe_stop_error(w%obs, error)
-            return
-         end if
+         call end_step(w, res, k, t1, ag1, stop, error)
+         if (allocated(error) .or. stop) return
       end do
       call count_transitions(w, res, .true.)
       call dense_energies(w, e_kin, e_str)
@@ -510,6 +478,47 @@ contains
       call dense_k_times(w%di, w%u, w%kx, 1.0_dp, 0.0_dp)
       e_str = 0.5_dp*dot_product(w%u, w%kx)
    end subroutine dense_energies
+
+   !> The observation of the state at t = 0, common to both forms: its energies, its sample
+   !> and its peaks.
+   subroutine start_observing(w, res, ag0, e_kin, e_str)
+      type(mj_work), intent(inout) :: w
+      type(result_type), intent(inout) :: res
+      real(dp), intent(in) :: ag0            !! table acceleration at t = 0 [m/s2]
+      real(dp), intent(in) :: e_kin, e_str   !! kinetic and strain energy at t = 0 [J]
+
+      call observe_start_energies(w%obs, e_kin, e_str, 0.0_dp)
+      call observe_sample(w%obs, res, 0.0_dp, ag0, w%u, w%v, w%acc, w%s, w%sd, w%force, w%phase0)
+      call observe_peaks(res, 0.0_dp, size(w%u), size(w%s), w%u, w%v, w%acc, ag0, w%s, w%force)
+   end subroutine start_observing
+
+   !> The end of step k, common to both forms, once the state at t1 and its device phases
+   !> (phase1) are known: transitions counted, peaks, a sample when due (an error if the
+   !> solution is not finite), the stop request polled (stop = .true., with its error).
+   subroutine end_step(w, res, k, t1, ag1, stop, error)
+      type(mj_work), intent(inout) :: w
+      type(result_type), intent(inout) :: res
+      integer, intent(in) :: k               !! the step
+      real(dp), intent(in) :: t1             !! its end [s]
+      real(dp), intent(in) :: ag1            !! table acceleration at t1 [m/s2]
+      logical, intent(out) :: stop           !! a stop was requested
+      type(error_type), allocatable, intent(out) :: error !! not finite, or the stop
+
+      stop = .false.
+      call count_transitions(w, res, .false.)
+      w%phase0 = w%phase1
+      call observe_peaks(res, t1, size(w%u), size(w%s), w%u, w%v, w%acc, ag1, w%s, w%force)
+      res%moreau_jean%steps = res%moreau_jean%steps + 1
+      if (sample_due(w%obs, k)) then
+         if (.not. all(ieee_is_finite(w%u)) .or. .not. all(ieee_is_finite(w%acc))) then
+            call fatal_error(error, "moreau_jean: the solution is not finite at t = "//trim(fmt_real(t1))//" s")
+            return
+         end if
+         call observe_sample(w%obs, res, t1, ag1, w%u, w%v, w%acc, w%s, w%sd, w%force, w%phase1)
+      end if
+      call observe_poll(w%obs, t1, stop)
+      if (stop) call observe_stop_error(w%obs, error)
+   end subroutine end_step
 
    !> The error of an allocation sized by the deck that failed.
    subroutine no_memory(error, n)
