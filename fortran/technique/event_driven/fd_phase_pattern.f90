@@ -417,7 +417,7 @@ contains
       real(dp), intent(out) :: b1(:)                !! constant load of the reduced system (nq used)
       real(dp), intent(out) :: f0(:)                !! constant term of the force map (ns used)
       real(dp), intent(inout) :: fn(:)              !! work (n)
-      integer :: i, j, g, n, d, r
+      integer :: i, j, g, n, d
 
       n = size(mass)
       q(1:pat%nq) = 0.0_dp
@@ -471,12 +471,7 @@ contains
          g = pat%grp(i)
          if (g > 0) fn(i) = fn(i) - mass(i)*b1(g)
       end do
-      do r = 1, pat%ns
-         f0(r) = 0.0_dp
-         do i = 1, n
-            f0(r) = f0(r) + pat%pinv(r, i)*fn(i)
-         end do
-      end do
+      call pinv_times(pat, fn, f0)
    end subroutine pattern_entry
 
    !> Taylor coefficients of the reduced state about an instant to degree K + 1, K =
@@ -770,7 +765,7 @@ contains
       real(dp), intent(out) :: b1(:)                !! constant load (nq used)
       real(dp), intent(out) :: f0(:)                !! force map's constant (ns used)
       real(dp), intent(inout) :: fn(:)              !! work (n)
-      integer :: i, g, n, d, r, nq
+      integer :: g, n, d, nq
 
       n = size(mass)
       nq = pat%nq
@@ -795,12 +790,22 @@ contains
       do g = 1, nq
          fn = fn - mass*pat%tm(:, g)*b1(g)
       end do
+      call pinv_times(pat, fn, f0)
+   end subroutine general_entry
+
+   !> f0 = pinv fn: the sticking devices' forces of a net load on the pattern's DOFs.
+   pure subroutine pinv_times(pat, fn, f0)
+      type(pattern_type), intent(in) :: pat  !! the pattern
+      real(dp), intent(in) :: fn(:)          !! the load [N], one per DOF
+      real(dp), intent(out) :: f0(:)         !! the forces [N], one per sticking device
+      integer :: r, i
+
       do r = 1, pat%ns
          f0(r) = 0.0_dp
-         do i = 1, n
+         do i = 1, size(fn)
             f0(r) = f0(r) + pat%pinv(r, i)*fn(i)
          end do
       end do
-   end subroutine general_entry
+   end subroutine pinv_times
 
 end module fd_phase_pattern
