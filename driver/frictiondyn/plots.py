@@ -905,9 +905,74 @@ def plot_compare(
     return _finish(fig, path, dpi)
 
 
+def bearing_series(r: Result, b: int) -> dict[str, np.ndarray]:
+    """A planar bearing's history (1-based ``b``, as the summary's ``bearing_*`` lists): its
+    components' displacements (n, 2) [m] and forces (n, 2) [N], found by their device labels
+    ('<label> x', '<label> y')."""
+    labels = (r.summary or {}).get("bearing_labels") or []
+    if not 1 <= b <= len(labels):
+        raise ValueError(f"bearing {b}: the run has {len(labels)} planar bearing(s) (&bearings)")
+    devices = r.device_labels
+    dx, dy = (devices.index(f"{labels[b - 1]} {c}") + 1 for c in ("x", "y"))
+    for d in (dx, dy):
+        if f"s{d}" not in r or f"F{d}" not in r:
+            raise ValueError(f"bearing {b}: device {d} is not in the history (history_devices)")
+    s = np.column_stack([r[f"s{dx}"], r[f"s{dy}"]])
+    f = np.column_stack([r[f"F{dx}"], r[f"F{dy}"]])
+    return {"s": s, "F": f}
+
+
+def plot_bearings(
+    results: Results,
+    path: PathLike = None,
+    *,
+    bearings: Sequence[int] | None = None,
+    labels: Sequence[str] | None = None,
+    title: str | None = None,
+    units: Units | str | None = None,
+    dpi: int | None = None,
+) -> Figure:
+    """Planar bearings (&bearings): left, each bearing's orbit (s_y against s_x, equal axes);
+    right, its resultant force |F| against its resultant displacement |s|, from the history
+    rows. ``bearings``: 1-based, default every bearing (at most 8)."""
+    rs = _as_list(results)
+    names = _labels(rs, labels)
+    u = Units.parse(units)
+    fl, ff = u.factor("m"), u.factor("N")
+    fig = Figure(figsize=(10.0, 4.6))
+    FigureCanvasAgg(fig)
+    ax_o, ax_f = fig.subplots(1, 2)
+    for k, (r, name) in enumerate(zip(rs, names, strict=True)):
+        count = len((r.summary or {}).get("bearing_labels") or [])
+        if count == 0:
+            raise ValueError(f"{name}: no planar bearing (&bearings)")
+        chosen = list(bearings) if bearings else list(range(1, min(count, 8) + 1))
+        for b in chosen:
+            ser = bearing_series(r, b)
+            tag = (f"{name}, " if len(rs) > 1 else "") + r.summary["bearing_labels"][b - 1]
+            color = f"C{(k * len(chosen) + b - 1) % 10}"
+            s, f = ser["s"] * fl, ser["F"] * ff
+            ax_o.plot(s[:, 0], s[:, 1], "-", color=color, linewidth=0.8, label=tag)
+            ax_f.plot(np.hypot(s[:, 0], s[:, 1]), np.hypot(f[:, 0], f[:, 1]), "-", color=color,
+                      linewidth=0.8, label=tag)
+    ax_o.set_aspect("equal", adjustable="datalim")
+    ax_o.axhline(0.0, color="0.6", linewidth=0.5)
+    ax_o.axvline(0.0, color="0.6", linewidth=0.5)
+    ax_o.set_xlabel(f"s_x [{u.name('m')}]")
+    ax_o.set_ylabel(f"s_y [{u.name('m')}]")
+    ax_f.set_xlabel(f"|s| [{u.name('m')}]")
+    ax_f.set_ylabel(f"|F| [{u.name('N')}]")
+    for ax in (ax_o, ax_f):
+        ax.grid(True, linewidth=0.3)
+    ax_o.legend(fontsize="small", loc="best")
+    _title(ax_o, title, "bearings: orbits in plan")
+    _title(ax_f, None, "resultant force against resultant displacement")
+    return _finish(fig, path, dpi)
+
+
 #: What plot_all can write, in its order; KEY_PLOTS is the default set.
 PLOT_KINDS = ("aabs", "sdot", "hysteresis", "phase", "drift_profile", "acceleration_profile",
-              "storey_loop", "base_shear", "orbit", "device_plan")
+              "storey_loop", "base_shear", "orbit", "device_plan", "bearings")
 KEY_PLOTS = "key"
 
 
@@ -943,10 +1008,11 @@ def plot_all(
     ``<stem>_hysteresis<d>.png`` and ``<stem>_phase<d>.png`` per device (the first
     ``max_items`` DOFs and devices), and with storeys ``<stem>_drift_profile.png``,
     ``<stem>_acceleration_profile.png``, ``<stem>_storey_loop<s>.png`` and
-    ``<stem>_base_shear.png``, and for a building of rigid floors ``<stem>_orbit.png`` and
-    (with &floor_braces) ``<stem>_device_plan.png``. "key" is the last DOF's acceleration,
+    ``<stem>_base_shear.png``, for a building of rigid floors ``<stem>_orbit.png`` and
+    (with &floor_braces) ``<stem>_device_plan.png``, and with &bearings ``<stem>_bearings.png``. "key" is the last DOF's acceleration,
     the hysteresis of the device whose peak force is largest, with storeys the two profiles
-    and the base shear, and for rigid floors the orbit and the plan of the braces."""
+    and the base shear, for rigid floors the orbit and the plan of the braces, and the
+    bearings' orbits."""
     directory = Path(directory)
     written: list[Path] = []
     explicit = kinds != KEY_PLOTS and tuple(kinds) != PLOT_KINDS   # kinds named one by one
@@ -956,7 +1022,7 @@ def plot_all(
     chosen: dict[str, range | list[int]] = {k: (dofs if k == "aabs" else devices) for k in PLOT_KINDS}
     if kinds == KEY_PLOTS:
         kinds = ("aabs", "hysteresis", "drift_profile", "acceleration_profile", "base_shear", "orbit",
-                 "device_plan")
+                 "device_plan", "bearings")
         chosen["aabs"] = [result.n_dof] if result.n_dof else []
         forces = result.summary.get("peak_force_N") or []
         chosen["hysteresis"] = [1 + int(np.argmax(forces))] if len(forces) else []
@@ -999,5 +1065,12 @@ def plot_all(
     if floors and "device_plan" in kinds and any(st > 0 for st in result.summary["device_storey"]):
         p = directory / f"{stem}_device_plan.png"
         plot_device_plan(result, p, units=units, dpi=dpi)
+        written.append(p)
+    has_bearings = bool((result.summary or {}).get("bearing_labels"))
+    if explicit and "bearings" in kinds and not has_bearings:
+        raise ValueError(f"plots bearings: {default_label(result, 0)} has no planar bearing (&bearings)")
+    if has_bearings and "bearings" in kinds:
+        p = directory / f"{stem}_bearings.png"
+        plot_bearings(result, p, units=units, dpi=dpi)
         written.append(p)
     return written
