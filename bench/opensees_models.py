@@ -532,6 +532,29 @@ def compare_peaks(a: dict, b: dict, quantities=QUANTITIES) -> dict[str, tuple[fl
     return out
 
 
+def _floats(xs) -> str:
+    """Numbers as a namelist list, exactly (repr)."""
+    return ", ".join(repr(float(x)) for x in xs)
+
+
+def _record_group(group: str, dt_record: float, duration: float, record_file: str) -> str:
+    """A namelist group (&excitation or &excitation2) of a record of values in m/s2."""
+    return (f"&{group}\n  excitation_type = 'record'\n  record_format = 'values'\n"
+            f"  record_units = 'm/s2'\n  dt_record = {dt_record!r}\n  duration = {duration!r}\n"
+            f"  record_file = '{record_file}'\n/\n")
+
+
+def _run_with_records(deck: str, name: str, records) -> object:
+    """frictiondyn's Result of ``deck``, its records written as ag_x.txt, ag_y.txt (values,
+    m/s2) in a temporary directory."""
+    import frictiondyn as fd
+
+    with tempfile.TemporaryDirectory(prefix="fd_case_") as tmp:
+        for file, rec in zip(("ag_x.txt", "ag_y.txt"), records):
+            np.savetxt(Path(tmp) / file, rec, fmt="%.17g")
+        return fd.run_text(deck, f"{name}.nml", tmp)
+
+
 # ----------------------------------------------------------------------------- 3D building
 
 
@@ -637,15 +660,8 @@ class Building3DCase:
 
     def deck(self, record_files: tuple[str, str] = ("ag_x.txt", "ag_y.txt")) -> str:
         """The frictiondyn deck; its records are read from ``record_files`` (values, m/s2)."""
-
-        def arr(xs) -> str:
-            return ", ".join(repr(float(x)) for x in xs)
-
+        arr = _floats
         n, fr, br = self.n_storeys, self.frames, self.braces
-        exc = (
-            "  excitation_type = 'record'\n  record_format = 'values'\n  record_units = 'm/s2'\n"
-            f"  dt_record = {self.dt_record!r}\n  duration = {self.duration!r}\n"
-        )
         return (
             f"&floors\n  n_floors = {n}\n  mass = {n}*{self.m!r}\n"
             f"  inertia = {n}*{self.inertia!r}\n"
@@ -660,20 +676,15 @@ class Building3DCase:
             f"  angle = {arr(b[1] for b in br)}\n  x = {arr(b[2] for b in br)}\n"
             f"  y = {arr(b[3] for b in br)}\n  slip_load = {arr(b[4] for b in br)}\n"
             f"  stiffness = {arr(b[5] for b in br)}\n  eps1 = {len(br)}*{self.eps1!r}\n/\n"
-            f"&excitation\n{exc}  record_file = '{record_files[0]}'\n/\n"
-            f"&excitation2\n{exc}  record_file = '{record_files[1]}'\n/\n"
-            f"&integration\n  n1 = {self.n1}\n  n2 = {self.n2}\n"
+            + _record_group("excitation", self.dt_record, self.duration, record_files[0])
+            + _record_group("excitation2", self.dt_record, self.duration, record_files[1])
+            + f"&integration\n  n1 = {self.n1}\n  n2 = {self.n2}\n"
             f"  refinement = '{self.refinement}'\n/\n"
         )
 
     def run_frictiondyn(self):
         """frictiondyn's Result of the deck (records written to a temporary directory)."""
-        import frictiondyn as fd
-
-        with tempfile.TemporaryDirectory(prefix="fd_3d_") as tmp:
-            for name, rec in zip(("ag_x.txt", "ag_y.txt"), self.records):
-                np.savetxt(Path(tmp) / name, rec, fmt="%.17g")
-            return fd.run_text(self.deck(), f"{self.name}.nml", tmp)
+        return _run_with_records(self.deck(), self.name, self.records)
 
     # ------------------------------------------------------------------ OpenSees
 
@@ -877,52 +888,35 @@ class IsolatedBlockCase:
             f"&isolators\n  n_isolators = 1\n  node_i = 1\n  node_j = 0\n"
             f"  weight = {self.weight!r}\n  radius = {self.radius!r}\n  law = 'hysteretic'\n"
             f"  mu = {self.mu!r}\n  f = {self.f!r}\n  eps1 = {self.eps1!r}\n/\n"
-            "&excitation\n  excitation_type = 'record'\n  record_format = 'values'\n"
-            f"  record_units = 'm/s2'\n  dt_record = {self.dt_record!r}\n"
-            f"  duration = {self.duration!r}\n  record_file = '{record_file}'\n/\n"
-            f"&integration\n  n1 = {self.n1}\n  refinement = 'implicit'\n/\n"
+            + _record_group("excitation", self.dt_record, self.duration, record_file)
+            + f"&integration\n  n1 = {self.n1}\n  refinement = 'implicit'\n/\n"
         )
 
     def deck_planar(self, record_files: tuple[str, ...] = ("ag_x.txt", "ag_y.txt")) -> str:
         """The frictiondyn deck of the block as a rigid floor (ux, uy, rz at its centre) on
         four planar bearings (&bearings) at the corners of its plan, each carrying W/4."""
-
-        def arr(xs) -> str:
-            return ", ".join(repr(float(v)) for v in xs)
-
-        exc = ("  excitation_type = 'record'\n  record_format = 'values'\n  record_units = 'm/s2'\n"
-               f"  dt_record = {self.dt_record!r}\n  duration = {self.duration!r}\n")
         deck = (
             f"&floors\n  n_floors = 1\n  mass = {self.mass!r}\n  plan_x = {2 * self.a!r}\n"
             f"  plan_y = {2 * self.b!r}\n/\n&frames\n  n_frames = 0\n/\n"
             "&damping\n  damping_type = 'none'\n/\n"
             f"&bearings\n  n_bearings = 4\n  storey = 4*1\n"
-            f"  x = {arr(c[0] for c in self.corners)}\n  y = {arr(c[1] for c in self.corners)}\n"
+            f"  x = {_floats(c[0] for c in self.corners)}\n  y = {_floats(c[1] for c in self.corners)}\n"
             f"  p = 4*{self.weight / 4!r}\n  law = 4*'hysteretic'\n  mu = 4*{self.mu!r}\n"
             f"  f = 4*{self.f!r}\n  eps1 = 4*{self.eps1!r}\n  radius = 4*{self.radius!r}\n/\n"
-            f"&excitation\n{exc}  record_file = '{record_files[0]}'\n/\n"
         )
-        if self.components == 2:
-            deck += f"&excitation2\n{exc}  record_file = '{record_files[1]}'\n/\n"
+        for c in range(self.components):
+            deck += _record_group(("excitation", "excitation2")[c], self.dt_record, self.duration,
+                                  record_files[c])
         return deck + f"&integration\n  n1 = {self.n1}\n  refinement = 'implicit'\n/\n"
 
     def run_frictiondyn_1d(self):
         """frictiondyn's Result of ``deck_1d`` (its record written to a temporary directory)."""
-        import frictiondyn as fd
-
-        with tempfile.TemporaryDirectory(prefix="fd_iso_") as tmp:
-            np.savetxt(Path(tmp) / "ag_x.txt", self.records[0], fmt="%.17g")
-            return fd.run_text(self.deck_1d(), f"{self.name}.nml", tmp)
+        return _run_with_records(self.deck_1d(), self.name, self.records[:1])
 
     def run_frictiondyn_planar(self):
         """frictiondyn's Result of ``deck_planar`` (its records written to a temporary
         directory)."""
-        import frictiondyn as fd
-
-        with tempfile.TemporaryDirectory(prefix="fd_iso_") as tmp:
-            for name, rec in zip(("ag_x.txt", "ag_y.txt"), self.records):
-                np.savetxt(Path(tmp) / name, rec, fmt="%.17g")
-            return fd.run_text(self.deck_planar(), f"{self.name}.nml", tmp)
+        return _run_with_records(self.deck_planar(), self.name, self.records)
 
     # ------------------------------------------------------------------ OpenSees
 

@@ -183,25 +183,20 @@ def cmd_run(args: argparse.Namespace) -> int:
         with warnings.catch_warnings():
             warnings.simplefilter("ignore", FrictiondynWarning)
             result, csv, summ = _tolerance_outputs(args)
-        _print_summary(result, args.deck)
-        if csv is not None:
-            print(f"  history: {csv}")
-        print(f"  summary: {summ}")
-        _plots(args, result, summ, trange, kinds)
-        return 0
-    bar = _ProgressBar(sys.stderr.isatty() and not args.quiet)
-    with Session(args.deck) as session:  # the deck is read once; the library writes
-        # the history goes to its file as the run goes (memory does not grow with the
-        # duration); it is also kept in memory only for the plots
-        session.stream(args.out)
-        try:
-            session.solve(progress=bar, history=args.plot)
-        finally:
-            bar.close()
-        with warnings.catch_warnings():  # _print_summary prints them, as the executable does
-            warnings.simplefilter("ignore", FrictiondynWarning)
-            result = session.result()
-        csv, summ = session.write()
+    else:
+        bar = _ProgressBar(sys.stderr.isatty() and not args.quiet)
+        with Session(args.deck) as session:  # the deck is read once; the library writes
+            # the history goes to its file as the run goes (memory does not grow with the
+            # duration); it is also kept in memory only for the plots
+            session.stream(args.out)
+            try:
+                session.solve(progress=bar, history=args.plot)
+            finally:
+                bar.close()
+            with warnings.catch_warnings():  # _print_summary prints them, as the executable does
+                warnings.simplefilter("ignore", FrictiondynWarning)
+                result = session.result()
+            csv, summ = session.write()
     _print_summary(result, args.deck)
     if csv is not None:
         print(f"  history: {csv}")

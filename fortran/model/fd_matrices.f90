@@ -23,7 +23,7 @@ module fd_matrices
    public :: system_modes, structure_damping, stiffness_pivot
    public :: modes_type, natural_modes, natural_modes_sparse, stiffness_damping_factor
    public :: modes_none, modes_flexible, modes_rigid, modes_unrestrained
-   public :: modes_dense_dofs, modes_kept, mode_damping, mode_participation
+   public :: modes_dense_dofs, modes_kept, mode_damping, mode_participation, device_null_space
 
    !> Above this many DOFs the modes are found without an n x n matrix (natural_modes_sparse):
    !> the dense matrices would make peak memory grow as n**2
@@ -460,6 +460,46 @@ contains
       phi(:, 1:m) = z(:, 1:m)
    end subroutine dense_system_modes
 
+   !> Z, an orthonormal basis of the null space of the directions b_d of the devices in
+   !> `linked` (b_d' Z = 0): the eigenvectors of B B' (B = [b_d]) whose eigenvalue is below
+   !> 1e-12 of the largest; the identity when no linked device has a direction. nq its
+   !> columns (-1 when the memory is refused).
+   subroutine device_null_space(model, linked, z, nq, error)
+      type(model_type), intent(in) :: model          !! the model (directions)
+      logical, intent(in) :: linked(:)               !! the devices that constrain
+      real(dp), allocatable, intent(out) :: z(:, :)  !! (n_dof, nq)
+      integer, intent(out) :: nq                     !! dimension of the null space
+      type(error_type), allocatable, intent(out) :: error !! LAPACK failure, no memory
+      real(dp), allocatable :: bb(:, :), eye(:, :), ev(:), vec(:, :)
+      integer :: n, d, i, stat
+
+      n = model%n_dof
+      allocate (bb(n, n), eye(n, n), ev(n), vec(n, n), stat=stat)
+      if (stat /= 0) then
+         nq = -1
+         call fatal_error(error, "not enough memory for the eigenproblem of "//trim(fmt_int(n))//" DOFs", &
+                          stat_no_memory)
+         return
+      end if
+      bb = 0.0_dp
+      eye = 0.0_dp
+      do i = 1, n
+         eye(i, i) = 1.0_dp
+      end do
+      do d = 1, size(linked)
+         if (linked(d)) call add_device_outer(model, d, 1.0_dp, bb)
+      end do
+      if (any(bb /= 0.0_dp)) then
+         call generalized_eigen(bb, eye, ev, vec, error)
+         if (allocated(error)) return
+         nq = count(ev <= 1.0e-12_dp*maxval(abs(ev)))
+         z = vec(:, 1:nq)
+      else
+         nq = n
+         z = eye
+      end if
+   end subroutine device_null_space
+
    !> The modes of K u = w^2 M u under the constraints b_d' u = 0 of the devices in `linked`:
    !> Z an orthonormal basis of their null space (the eigenvectors of B B' whose eigenvalue
    !> is below 1e-12 of the largest, B = [b_d]), then (Z' K Z) y = w^2 (Z' M Z) y and
@@ -473,39 +513,15 @@ contains
       real(dp), intent(out) :: phi(:, :)             !! shapes (n_dof, n_dof), M-normalized
       integer, intent(out) :: nq                     !! free DOFs
       type(error_type), allocatable, intent(out) :: error !! LAPACK failure, no memory
-      real(dp), allocatable :: bb(:, :), eye(:, :), ev(:), vec(:, :), z(:, :), kq(:, :), mq(:, :), y(:, :)
-      real(dp), allocatable :: col(:)
-      integer :: n, d, i, j, stat
+      real(dp), allocatable :: z(:, :), kq(:, :), mq(:, :), y(:, :), col(:)
+      integer :: n, i, j, stat
 
       n = model%n_dof
       lam = 0.0_dp
       phi = 0.0_dp
-      allocate (bb(n, n), eye(n, n), ev(n), vec(n, n), col(n), stat=stat)
-      if (stat /= 0) then
-         nq = -1
-         call fatal_error(error, "not enough memory for the eigenproblem of "//trim(fmt_int(n))//" DOFs", &
-                          stat_no_memory)
-         return
-      end if
-      bb = 0.0_dp
-      eye = 0.0_dp
-      do i = 1, n
-         eye(i, i) = 1.0_dp
-      end do
-      do d = 1, model%n_devices
-         if (linked(d)) call add_device_outer(model, d, 1.0_dp, bb)
-      end do
-      if (any(bb /= 0.0_dp)) then
-         call generalized_eigen(bb, eye, ev, vec, error)
-         if (allocated(error)) return
-         nq = count(ev <= 1.0e-12_dp*maxval(abs(ev)))
-         z = vec(:, 1:nq)
-      else
-         nq = n
-         z = eye
-      end if
-      if (nq == 0) return
-      allocate (kq(nq, nq), mq(nq, nq), y(nq, nq), stat=stat)
+      call device_null_space(model, linked, z, nq, error)
+      if (allocated(error) .or. nq == 0) return
+      allocate (kq(nq, nq), mq(nq, nq), y(nq, nq), col(n), stat=stat)
       if (stat /= 0) then
          call fatal_error(error, "not enough memory for the eigenproblem of "//trim(fmt_int(nq))//" DOFs", &
                           stat_no_memory)
@@ -658,7 +674,7 @@ contains
       integer, allocatable :: grp(:)
       real(dp), allocatable :: ks(:, :), kq(:, :), mq(:, :), cq(:, :), lam(:), z(:, :), sq(:), zcz(:)
       real(dp) :: kd, big
-      integer :: n, nq, i, j, d, ni, nj, kfirst, stat
+      integer :: n, nq, i, j, d, kfirst, stat
 
       n = model%n_dof
       modes%system = system

@@ -47,7 +47,7 @@ module fd_phase_pattern
    use fd_error, only: error_type, fatal_error, fmt_int
    use fd_model, only: model_type
    use fd_excitation, only: excitation_type, forcing_frequency
-   use fd_matrices, only: link_groups
+   use fd_matrices, only: link_groups, device_null_space
    use fd_kinematics, only: add_device, devices_are_pairs
    use fd_stiffness, only: influence_of
    use fd_linalg, only: least_squares, least_squares_work, generalized_eigen
@@ -618,8 +618,8 @@ contains
    end function general_pattern
 
    !> T, an M-orthonormal basis of the null space of the linked devices' directions
-   !> (b_d' T = 0, T'MT = I): Z, orthonormal, from the eigenvectors of B B' whose eigenvalue
-   !> is below 1e-12 of the largest (I without a linked device); Z'MZ = Y diag(lam) Y' and
+   !> (b_d' T = 0, T'MT = I): Z, orthonormal, from fd_matrices' device_null_space (the
+   !> null space the constrained modes use); Z'MZ = Y diag(lam) Y' and
    !> T = Z Y diag(lam)^-1/2. nq its columns.
    subroutine null_space_basis(model, mass, linked, tm, nq, error)
       type(model_type), intent(in) :: model         !! the model (directions)
@@ -628,66 +628,34 @@ contains
       real(dp), allocatable, intent(out) :: tm(:, :) !! (n, nq)
       integer, intent(out) :: nq                    !! dimension of the null space
       type(error_type), allocatable, intent(out) :: error !! LAPACK failure, no memory
-      real(dp), allocatable :: bb(:, :), eye(:, :), ev(:), vec(:, :), mz(:, :), y(:, :), lam(:)
-      integer :: n, d, i, j, stat
+      real(dp), allocatable :: z(:, :), mz(:, :), eye(:, :), y(:, :), lam(:)
+      integer :: n, i, j, stat
 
       n = size(mass)
-      allocate (bb(n, n), eye(n, n), ev(n), vec(n, n), stat=stat)
-      if (stat /= 0) then
-         call no_memory(n, size(linked), error)
-         return
-      end if
-      bb = 0.0_dp
-      eye = 0.0_dp
-      do i = 1, n
-         eye(i, i) = 1.0_dp
-      end do
-      do d = 1, size(linked)
-         if (linked(d)) call add_device_outer_dense(model, d, bb)
-      end do
-      if (any(bb /= 0.0_dp)) then
-         call generalized_eigen(bb, eye, ev, vec, error)
-         if (allocated(error)) return
-         nq = count(ev <= 1.0e-12_dp*maxval(abs(ev)))
-      else
-         nq = n
-         vec = eye
-      end if
-      allocate (tm(n, nq), mz(nq, nq), y(nq, nq), lam(nq), stat=stat)
+      call device_null_space(model, linked, z, nq, error)
+      if (allocated(error)) return
+      allocate (tm(n, nq), mz(nq, nq), eye(nq, nq), y(nq, nq), lam(nq), stat=stat)
       if (stat /= 0) then
          call no_memory(n, size(linked), error)
          return
       end if
       if (nq == 0) return
       ! Z'MZ = Y diag(lam) Y': T = Z Y diag(lam)^-1/2
+      eye = 0.0_dp
       do j = 1, nq
+         eye(j, j) = 1.0_dp
          do i = 1, nq
-            mz(i, j) = sum(vec(:, i)*mass*vec(:, j))
+            mz(i, j) = sum(z(:, i)*mass*z(:, j))
          end do
       end do
       mz = 0.5_dp*(mz + transpose(mz))
-      call generalized_eigen(mz, eye(1:nq, 1:nq), lam, y, error)
+      call generalized_eigen(mz, eye, lam, y, error)
       if (allocated(error)) return
-      tm = matmul(vec(:, 1:nq), y)
+      tm = matmul(z, y)
       do j = 1, nq
          tm(:, j) = tm(:, j)/sqrt(lam(j))
       end do
    end subroutine null_space_basis
-
-   !> a = a + b_d b_d'.
-   pure subroutine add_device_outer_dense(model, d, a)
-      type(model_type), intent(in) :: model
-      integer, intent(in) :: d
-      real(dp), intent(inout) :: a(:, :)
-      integer :: k, l
-
-      do k = model%dev_ptr(d), model%dev_ptr(d + 1) - 1
-         do l = model%dev_ptr(d), model%dev_ptr(d + 1) - 1
-            a(model%dev_dof(k), model%dev_dof(l)) = a(model%dev_dof(k), model%dev_dof(l)) + &
-                                                    model%dev_coef(k)*model%dev_coef(l)
-         end do
-      end do
-   end subroutine add_device_outer_dense
 
    !> A general pattern's reduced matrices: Mq = I, Kq = T'KT, Cq = T'CT, lq = T'M r and
    !> T'b_d of every device.

@@ -150,7 +150,6 @@ contains
       type(mj_work) :: w
       real(dp) :: h, th, alpha, beta, cm, ck, t1, ag0, ag1, agt, xg, vg, e_kin, e_str, ein
       integer :: k, e, c0, c1, crate
-      logical :: stop
 
       call system_clock(c0, crate)
       call moreau_jean_check(model, exc, opts, error)
@@ -201,8 +200,6 @@ contains
       if (allocated(error)) return
       w%p%locked = .false.
       call device_state(model, w, w%p%lam, w%phase0)
-      w%counted = w%phase0
-      w%pending = .false.
       call energies(w, e_kin, e_str)
       call start_observing(w, res, ag0, e_kin, e_str)
 
@@ -247,8 +244,8 @@ contains
          w%v = w%v1
          ag0 = ag1
          call device_state(model, w, w%f_edge, w%phase1)
-         call end_step(w, res, k, t1, ag1, stop, error)
-         if (allocated(error) .or. stop) return
+         call end_step(w, res, k, t1, ag1, error)
+         if (allocated(error)) return
       end do
       call count_transitions(w, res, .true.)
       call energies(w, e_kin, e_str)
@@ -383,7 +380,6 @@ contains
       type(error_type), allocatable, intent(out) :: error
       real(dp) :: h, th, cm, ck, t1, ag0, ag1, agt, xg, vg, e_kin, e_str, ein
       integer :: k, d
-      logical :: stop
 
       th = opts%theta
       h = exc%dt_record/opts%n1
@@ -403,8 +399,6 @@ contains
       call dense_end_state(w, ag0, w%u, w%v, error)
       if (allocated(error)) return
       call dense_device_state(model, w, w%phase0)
-      w%counted = w%phase0
-      w%pending = .false.
       call dense_energies(w, e_kin, e_str)
       call start_observing(w, res, ag0, e_kin, e_str)
       do k = 1, w%obs%nsteps
@@ -434,8 +428,8 @@ contains
          w%v = w%v1
          ag0 = ag1
          call dense_device_state(model, w, w%phase1)
-         call end_step(w, res, k, t1, ag1, stop, error)
-         if (allocated(error) .or. stop) return
+         call end_step(w, res, k, t1, ag1, error)
+         if (allocated(error)) return
       end do
       call count_transitions(w, res, .true.)
       call dense_energies(w, e_kin, e_str)
@@ -479,14 +473,16 @@ contains
       e_str = 0.5_dp*dot_product(w%u, w%kx)
    end subroutine dense_energies
 
-   !> The observation of the state at t = 0, common to both forms: its energies, its sample
-   !> and its peaks.
+   !> The observation of the state at t = 0 and its phases (phase0), common to both forms:
+   !> the transitions counted from them, its energies, its sample and its peaks.
    subroutine start_observing(w, res, ag0, e_kin, e_str)
       type(mj_work), intent(inout) :: w
       type(result_type), intent(inout) :: res
       real(dp), intent(in) :: ag0            !! table acceleration at t = 0 [m/s2]
       real(dp), intent(in) :: e_kin, e_str   !! kinetic and strain energy at t = 0 [J]
 
+      w%counted = w%phase0
+      w%pending = .false.
       call observe_start_energies(w%obs, e_kin, e_str, 0.0_dp)
       call observe_sample(w%obs, res, 0.0_dp, ag0, w%u, w%v, w%acc, w%s, w%sd, w%force, w%phase0)
       call observe_peaks(res, 0.0_dp, size(w%u), size(w%s), w%u, w%v, w%acc, ag0, w%s, w%force)
@@ -494,17 +490,16 @@ contains
 
    !> The end of step k, common to both forms, once the state at t1 and its device phases
    !> (phase1) are known: transitions counted, peaks, a sample when due (an error if the
-   !> solution is not finite), the stop request polled (stop = .true., with its error).
-   subroutine end_step(w, res, k, t1, ag1, stop, error)
+   !> solution is not finite), the stop request polled (a requested stop is an error).
+   subroutine end_step(w, res, k, t1, ag1, error)
       type(mj_work), intent(inout) :: w
       type(result_type), intent(inout) :: res
       integer, intent(in) :: k               !! the step
       real(dp), intent(in) :: t1             !! its end [s]
       real(dp), intent(in) :: ag1            !! table acceleration at t1 [m/s2]
-      logical, intent(out) :: stop           !! a stop was requested
-      type(error_type), allocatable, intent(out) :: error !! not finite, or the stop
+      type(error_type), allocatable, intent(out) :: error !! not finite, or a requested stop
+      logical :: stopped
 
-      stop = .false.
       call count_transitions(w, res, .false.)
       w%phase0 = w%phase1
       call observe_peaks(res, t1, size(w%u), size(w%s), w%u, w%v, w%acc, ag1, w%s, w%force)
@@ -516,8 +511,8 @@ contains
          end if
          call observe_sample(w%obs, res, t1, ag1, w%u, w%v, w%acc, w%s, w%sd, w%force, w%phase1)
       end if
-      call observe_poll(w%obs, t1, stop)
-      if (stop) call observe_stop_error(w%obs, error)
+      call observe_poll(w%obs, t1, stopped)
+      if (stopped) call observe_stop_error(w%obs, error)
    end subroutine end_step
 
    !> The error of an allocation sized by the deck that failed.
