@@ -13,20 +13,19 @@ frictiondyn run DECK --tolerance T``, or ``tolerance`` in the deck's ``&integrat
   error and, where the deck has numerical eps or f (the velocity and hysteretic devices of
   ``&friction`` and ``&isolators``; a brace's f is physical), the law levels the law's.
 
-The run returned is the finest level: n1 = N (the deck's n1 in the first round, rounded up to
-a multiple of 4) with eps and f divided by D (1 in the first round). The step levels are N / 4,
-N / 2 and N; the law levels are the coarsest step, N / 4, with eps and f times 4 and 2, and
-with them (the law's error is taken apart from the step's, which the levels at one step cancel).
-Each level's estimate is that of ``frictiondyn converge`` (``frictiondyn.convergence``,
-docs/theory.md, section 16): Richardson extrapolation at the measured order where it is
-consistent, a plain difference (times 3) otherwise; the finest level's error, the step's plus
-the law's, is its estimate. While that is above the allowed error of a quantity, N (and D) are
-multiplied by the power of 2 its measured order asks for; a plain difference above the noise
-claims nothing and doubles them. When the returned run would need more than ``MAX_REFINEMENT``
-times the deck's n1 (or eps and f divided by more), or ``MAX_ROUNDS`` rounds do not meet it,
-``ToleranceError`` is raised naming the quantity, its estimate and why: no unmet tolerance is
-ever returned. A run costs the finest level and 1.25 times it (1 / 4 + 1 / 2 for the coarser
-step levels, and 1 / 2 for the two law levels at the coarsest step) in each round.
+The levels start from the model, not the deck's n1: a probe of one record step gives the
+modes and dt_record, and the first round's finest step resolves the highest reported frequency
+to the tolerance (``_probe_start``). Under a regularized law the law levels come first, at that
+step: eps and f divided by 0.5, 2 and 8, then 4 times finer a level at a time, until the law's
+estimate is within half the budget; then the step levels at that eps and f, n1 = n_c, 2 n_c,
+4 n_c, then one finer level a round, each round reusing the runs of the one before. Each
+estimate is Richardson's at the measured order capped at the theoretical one (``STEP_ORDER``,
+``LAW_ORDER``), from the larger of the last two changes' predictions; a plain difference (times
+3) where no order is consistent, or Richardson's over every other level (a ratio of 4) when five
+levels exist. The run returned, the finest, is the first whose every estimate, step's plus law's,
+is below ``MARGIN`` times its allowed error. When that would need more than ``MAX_REFINEMENT``
+times the deck's n1 (or eps and f divided by more), ``ToleranceError`` is raised naming the
+quantity, its estimate and why: no unmet tolerance is ever returned.
 
 The allowed error of a quantity is tolerance x max(|q|, tolerance_floor x the largest |q| of
 its kind) (the friction energy against the energy input): ``tolerance_floor`` keeps a DOF that
@@ -52,14 +51,15 @@ from .convergence import (
     ESTIMATED,
     Estimate,
     Quantity,
-    estimate_error,
+    SAFETY_DIFFERENCE,
+    SAFETY_RICHARDSON,
     _claims,
     _compare,
     _cpus,
     _law_text,
 )
 
-__all__ = ["DEFAULT_FLOOR", "EXACT_DEVICES", "MAX_REFINEMENT", "MAX_ROUNDS", "ToleranceError",
+__all__ = ["DEFAULT_FLOOR", "EXACT_DEVICES", "MAX_REFINEMENT", "ToleranceError",
            "ToleranceReport", "tolerance_run"]
 
 #: tolerance_floor when neither the deck nor the caller gives it
@@ -69,8 +69,17 @@ EXACT_DEVICES = 10
 #: the cost limit: the run returned has n1 at most this times the deck's, eps and f at least
 #: the deck's / this
 MAX_REFINEMENT = 128
-#: refinement rounds at most (each runs the step levels and, under a regularized law, the law levels)
-MAX_ROUNDS = 4
+#: the theoretical order of each technique's step error, and of the regularized laws' error in
+#: eps and f: a measured order above it is capped (docs/theory.md, section 16.1)
+STEP_ORDER = {"newmark": 2.0, "moreau_jean": 1.0}
+LAW_ORDER = 1.0
+#: a run is returned when every estimate is below MARGIN times its allowed error (the law's
+#: below half of that, the step taking the rest)
+MARGIN = 0.8
+#: the law levels: eps and f divided by LAW_START in the first round, each level LAW_RATIO
+#: times finer than the one before (0.5, 2, 8, then 32 and 128, the cost limit)
+LAW_START = (0.5, 2, 8)
+LAW_RATIO = 4
 #: the estimate of an exact technique's peaks, relative to the quantity (round-off)
 ROUND_OFF = 1e-9
 #: the two deck variables of a tolerance run (&integration)
@@ -111,9 +120,12 @@ class ToleranceReport:
         }
 
     def __str__(self) -> str:
-        lines = [f"tolerance run: {self.tolerance:g} (floor {self.floor:g}): {self.technique}, n1 = {self.n1}"
-                 + (f", eps and f / {self.law_divisor}" if self.law_divisor > 1 else "")
-                 + f" ({self.runs} runs, {self.rounds} round{'s' * (self.rounds != 1)}): {self.why}"]
+        head = (f"tolerance run: {self.tolerance:g} (floor {self.floor:g}): {self.technique}, "
+                f"n1 = {self.n1}")
+        if self.law_divisor > 1:
+            head += f", eps and f / {self.law_divisor}"
+        rounds = f"{self.rounds} round{'s' * (self.rounds != 1)}"
+        lines = [f"{head} ({self.runs} runs, {rounds}): {self.why}"]
         worst: dict[str, dict] = {}
         for q in self.quantities:
             if q["key"] not in worst or q["relative_error"] > worst[q["key"]]["relative_error"]:
@@ -152,10 +164,15 @@ def _strip(text: str, path: Path) -> tuple[str, float | None, float | None]:
 
 
 def _check(tolerance: float, floor: float, path: Path) -> None:
-    if isinstance(tolerance, bool) or not isinstance(tolerance, (int, float)) or not 0 < tolerance < 1:
-        raise DeckError(f"{path}, group &integration: tolerance = {tolerance!r} is invalid: must be in (0, 1)")
-    if isinstance(floor, bool) or not isinstance(floor, (int, float)) or not 0 <= floor <= 1:
-        raise DeckError(f"{path}, group &integration: tolerance_floor = {floor!r} is invalid: must be in [0, 1]")
+    def number(x) -> bool:
+        return isinstance(x, (int, float)) and not isinstance(x, bool)
+
+    if not number(tolerance) or not 0 < tolerance < 1:
+        raise DeckError(f"{path}, group &integration: tolerance = {tolerance!r} is invalid: "
+                        "must be in (0, 1)")
+    if not number(floor) or not 0 <= floor <= 1:
+        raise DeckError(f"{path}, group &integration: tolerance_floor = {floor!r} is invalid: "
+                        "must be in [0, 1]")
 
 
 def _with(nml: f90nml.Namelist, n1: int, technique: str | None = None) -> f90nml.Namelist:
@@ -226,7 +243,8 @@ class _Runner:
 
 def _cost(summary: dict) -> int:
     """The steps a run solved (an exact run: its events and sampled intervals)."""
-    keys = ("steps_dt1", "steps_nested", "steps_dt2", "steps_finer", "steps_implicit", "implicit_redos")
+    keys = ("steps_dt1", "steps_nested", "steps_dt2", "steps_finer", "steps_implicit",
+            "implicit_redos")
     return int(sum(summary.get(k, 0) for k in keys))
 
 
@@ -240,6 +258,9 @@ def _error_of(q: Quantity) -> tuple[float, float]:
 def _method(e: Estimate | None, what: str) -> str:
     if e is None:
         return ""
+    if e.method == "richardson" and e.reason.startswith("measured "):
+        measured = e.reason.split()[1]
+        return f"{what}: Richardson at order {e.order:g}, the theoretical ({measured} measured)"
     if e.method == "richardson":
         return f"{what}: Richardson at order {e.order:.2f}"
     if e.method == "unchanged":
@@ -264,7 +285,7 @@ def _quantity_rows(quantities: list[Quantity], tol: float, values_of) -> list[di
             continue
         step, law = _error_of(q)
         error = max(step + law, ROUND_OFF * q.scale)  # no estimate below round-off
-        method = "; ".join(x for x in (_method(q.estimate, "step"), _method(q.law_estimate, "law")) if x)
+        method = _methods(q.estimate, q.law_estimate)
         rows.append({"key": q.key, "index": q.index, "what": q.what, "item": q.item, "unit": q.unit,
                      "value": values_of(q), "estimated_error": error,
                      "relative_error": error / q.scale if q.scale > 0 else 0.0,
@@ -272,7 +293,12 @@ def _quantity_rows(quantities: list[Quantity], tol: float, values_of) -> list[di
     return rows
 
 
-def _exact(runner: _Runner, nml, n1: int, tol: float, floor: float, why: str) -> tuple[ToleranceReport, str]:
+def _methods(step: Estimate | None, law: Estimate | None) -> str:
+    return "; ".join(x for x in (_method(step, "step"), _method(law, "law")) if x)
+
+
+def _exact(runner: _Runner, nml, n1: int, tol: float, floor: float,
+           why: str) -> tuple[ToleranceReport, str]:
     text = write_namelist(_with(nml, n1, "event_driven"))
     (summary,) = runner.run([text], keep=text)
     qs = _compare([summary, summary], tol, 2, (), floor)
@@ -280,32 +306,155 @@ def _exact(runner: _Runner, nml, n1: int, tol: float, floor: float, why: str) ->
     for q in qs:
         if q.key in ESTIMATED:
             err = ROUND_OFF * q.scale
-            rows.append({"key": q.key, "index": q.index, "what": q.what, "item": q.item, "unit": q.unit,
-                         "value": q.values[0], "estimated_error": err, "relative_error": ROUND_OFF, "allowed": tol * q.scale,
+            rows.append({"key": q.key, "index": q.index, "what": q.what, "item": q.item,
+                         "unit": q.unit, "value": q.values[0], "estimated_error": err,
+                         "relative_error": ROUND_OFF, "allowed": tol * q.scale,
                          "method": "exact: event-driven technique (round-off)"})
-    report = ToleranceReport(tol, floor, "event_driven", why, n1, 1, len(runner.summaries), 1, runner.steps, rows)
+    report = ToleranceReport(tol, floor, "event_driven", why, n1, 1, len(runner.summaries), 1,
+                             runner.steps, rows)
     return report, text
+
+
+def _sound(e: Estimate | None, values: list[float], cap: float, factor: float) -> Estimate | None:
+    """The estimate of the finest of three levels that a tolerance run stands on.
+
+    Richardson's at the measured order p, but never above ``cap``, the theoretical order of
+    the error (a measured order above it, the peaks of a sampled history falling at 3 or 4
+    before their asymptotic 1 or 2, extrapolates too little), from the larger of the two
+    changes' predictions, |d2| and |d1| / factor^p: a ladder whose changes come in steps (a
+    sampled peak that moves to the next step, an event to the next step) has one small change
+    beside a large one, and the small one alone says the error is smaller than it is. Without
+    an order, the plain difference is SAFETY_DIFFERENCE times the larger change."""
+    if e is None or e.method == "unchanged" or len(values) < 3:
+        return e
+    d1, d2 = abs(values[-2] - values[-3]), abs(values[-1] - values[-2])
+    if e.method == "difference":
+        errors = list(e.errors[:-1]) + [SAFETY_DIFFERENCE * max(d1, d2)]
+        return Estimate("difference", errors, reason=e.reason, changes=e.changes)
+    p = min(e.order, cap)
+    limit = values[-1] + (values[-1] - values[-2]) / (factor**p - 1)
+    error = SAFETY_RICHARDSON * max(d2, d1 / factor**p) / (factor**p - 1)
+    reason = f"measured {e.order:.2f}" if e.order > cap else ""
+    return Estimate("richardson", list(e.errors[:-1]) + [error], order=p, extrapolated=limit,
+                    reason=reason, changes=e.changes)
+
+
+def _measured(e: Estimate) -> float | None:
+    """The measured order of a Richardson estimate (before any cap), to predict the refinement
+    a quantity needs; None for a difference."""
+    if e.method != "richardson":
+        return None
+    return float(e.reason.split()[1]) if e.reason.startswith("measured ") else e.order
+
+
+def _probe_start(runner: _Runner, nml, technique: str, tol: float) -> tuple[int, str]:
+    """The coarsest step level chosen from the model: the finest level of the first round,
+    n1 = 4 n_c, resolves the highest frequency that carries the response, omega (the reported
+    modes, stuck and free, and a harmonic table motion's), to the tolerance: Newmark's (the
+    trapezoidal rule's) relative period error (omega dt1)^2 / 12 at most the tolerance. The
+    model's modes come from a probe of one record step (dt1 = dt_record)."""
+    probe = _with(nml, 1, technique)
+    if "excitation" in probe:
+        probe["excitation"]["duration"] = 1e-9  # one step: the modes and dt_record, no response
+    try:
+        (summary,) = runner.run([write_namelist(probe)], keep=None)
+    except (SolverError, DeckError):
+        summary = {}
+    periods = [float(t) for key in ("periods_free_s", "periods_stuck_s")
+               for t in summary.get(key) or [] if t is not None]
+    periods = [t for t in periods if math.isfinite(t) and t > 0]
+    omegas = [2 * math.pi / t for t in periods]
+    if summary.get("excitation_frequency_Hz"):
+        omegas.append(2 * math.pi * float(summary["excitation_frequency_Hz"]))
+    if not omegas or not summary.get("dt1_s"):
+        n_c = max(1, int(nml.get("integration", {}).get("n1") or DEFAULT_N1) // 4)
+        return n_c, (f"n1 = {n_c}, {2 * n_c}, {4 * n_c} from the deck's n1 (no mode or record step "
+                     "known)")
+    omega, dt_record = max(omegas), float(summary["dt1_s"])
+    n_fine = max(1, math.ceil(dt_record * omega / math.sqrt(12 * tol)))
+    n_c = 2 ** max(0, math.ceil(math.log2(n_fine)) - 2)
+    return n_c, (f"n1 = {n_c}, {2 * n_c}, {4 * n_c} first (omega = {omega:.4g} rad/s, dt_record = "
+                 f"{dt_record:g} s: (omega dt1)^2 / 12 <= {tol:g} at n1 = {n_fine})")
+
+
+def _text_at(nml, technique: str, n: int, divisor: float) -> str:
+    """The deck at n1 = n with eps and f of the regularized devices divided by ``divisor``."""
+    text = write_namelist(_with(nml, n, technique))
+    return text if divisor == 1 else _law_text(text, divisor)
+
+
+def _law_levels(runner: _Runner, nml, technique: str, n: int, tol: float, floor: float,
+                divisors: list[float]) -> dict[tuple[str, int], Quantity]:
+    """The law's estimate per quantity, from the last three law levels at step n1 = n."""
+    texts = [_text_at(nml, technique, n, d) for d in divisors[-3:]]
+    runner.close()
+    runs = runner.run(texts, keep=texts[-1])  # its finest may be the run returned
+    out = {}
+    for q in _compare(runs, tol, LAW_RATIO, (), floor):
+        if q.estimate is not None:
+            q.estimate = _sound(q.estimate, q.values, LAW_ORDER, LAW_RATIO)
+            out[(q.key, q.index)] = q
+    return out
 
 
 def _refine(runner: _Runner, nml, path: Path, n1: int, technique: str, tol: float, floor: float,
             why: str) -> tuple[ToleranceReport, str]:
-    """Step levels (and law levels) refined until every estimate is below the allowed error."""
-    top, divisor = 4 * math.ceil(n1 / 4), 1  # the run returned: n1 = top, eps and f / divisor
-    regularized = technique == "newmark" and _law_text(write_namelist(_with(nml, n1)), 2) is not None
-    for rounds in range(1, MAX_ROUNDS + 1):
-        levels = [write_namelist(_with(nml, top // f, technique)) for f in (4, 2, 1)]
-        if regularized and divisor > 1:
-            levels = [_law_text(t, divisor) for t in levels]
-        # the law levels at the coarsest step, eps and f x 4 and x 2, with its own level last
-        laws = [_law_text(levels[0], 1 / f) for f in (4, 2)] if regularized else []
+    """The law levels refined until the law's estimate is within half the budget, then the
+    step levels until every estimate, step's plus law's, is within it (MARGIN times the
+    allowed error): each round adds one level to a ladder and reuses the runs of the rounds
+    before (the runner makes each deck text once)."""
+    regularized = (technique == "newmark"
+                   and _law_text(write_namelist(_with(nml, n1)), 2) is not None)
+    start, start_why = _probe_start(runner, nml, technique, tol)
+    steps = [start, 2 * start, 4 * start]
+    divisors = list(LAW_START) if regularized else [1]
+    laws: dict[tuple[str, int], Quantity] = {}
+    rounds = 0
+    while regularized:  # the law levels, at the first round's finest step
+        rounds += 1
+        laws = _law_levels(runner, nml, technique, steps[-1], tol, floor, divisors)
+        worst, need = None, 1
+        for q in laws.values():
+            if q.key not in ESTIMATED:
+                continue
+            allowed = tol * q.scale
+            claims = _claims(q.estimate, allowed)
+            if q.estimate.errors[-1] <= MARGIN * allowed / 2 and claims:
+                continue
+            ratio = q.estimate.errors[-1] / max(allowed, 1e-300)
+            if worst is None or ratio > worst[1]:
+                worst = (q, ratio)
+            budget = MARGIN * allowed / 2
+            need = max(need, _factor(q.estimate.errors[-1], budget, _measured(q.estimate))
+                       if claims else 2)
+        if worst is None:
+            break
+        if divisors[-1] * need > MAX_REFINEMENT or divisors[-1] * LAW_RATIO > MAX_REFINEMENT:
+            q = worst[0]
+            what = _what(q, q.values[-1], 0.0, q.estimate.errors[-1], None, q.estimate)
+            why = (f"meeting it needs more than eps and f / {MAX_REFINEMENT}, the cost limit "
+                   f"({MAX_REFINEMENT} times the deck's setting)")
+            raise ToleranceError(_unmet(path, tol, what, q.estimate, why))
+        divisors.append(divisors[-1] * LAW_RATIO)
+    divisor = divisors[-1]
+    while True:
+        rounds += 1
+        levels = [_text_at(nml, technique, n, divisor) for n in steps[-5:]]
         final = levels[-1]
-        runs = runner.run(levels + laws, keep=final)
-        summaries, law_sums = runs[:3], (runs[3:] + [runs[0]] if laws else [])
-        qs = _compare(summaries, tol, 2, law_sums[1:], floor)
-        if laws:  # the law's estimate from its three levels, coarse to fine (the step's own last)
-            for q in qs:
-                if q.estimate is not None:
-                    q.law_estimate = estimate_error([_value(s, q) for s in law_sums], 2, q.scale)
+        summaries = runner.run(levels, keep=final)
+        qs = _compare(summaries[-3:], tol, 2, (), floor)
+        wide = {}  # five levels: every other one, a ratio of 4
+        if len(levels) == 5:
+            wide = {(q.key, q.index): q for q in _compare(summaries[::2], tol, 4, (), floor)}
+        for q in qs:
+            if q.estimate is not None:
+                q.estimate = _sound(q.estimate, q.values, STEP_ORDER[technique], 2)
+                other = wide.get((q.key, q.index))
+                if (q.estimate.method == "difference" and other is not None
+                        and other.estimate.method != "difference"):
+                    q.estimate = _sound(other.estimate, other.values, STEP_ORDER[technique], 4)
+                law = laws.get((q.key, q.index))
+                q.law_estimate = law.estimate if law is not None else None
         last = summaries[-1]
 
         def value(q: Quantity, last=last) -> float:
@@ -314,46 +463,41 @@ def _refine(runner: _Runner, nml, path: Path, n1: int, technique: str, tol: floa
         if regularized:
             _initial_peaks(path, tol, last, qs)
         rows = _quantity_rows(qs, tol, value)
-        step_need, law_need, worst = 1, 1, None
+        worst, need = None, 1
         for q in qs:
             if q.key not in ESTIMATED:
                 continue
             step, law = _error_of(q)
             allowed = tol * q.scale
-            step_claims = q.estimate is None or _claims(q.estimate, tol * q.scale)
-            law_claims = q.law_estimate is None or _claims(q.law_estimate, tol * q.scale)
-            if step + law <= allowed and step_claims and law_claims:
+            claims = _claims(q.estimate, allowed)
+            if step + law <= MARGIN * allowed and claims:
                 continue
-            if worst is None or (step + law) / max(allowed, 1e-300) > worst[1]:
-                worst = (q, (step + law) / max(allowed, 1e-300), step, law, step_claims, law_claims)
-            share = allowed / 2 if q.law_estimate is not None else allowed
-            if step > share or not step_claims:
-                order = q.estimate.order if q.estimate is not None and q.estimate.method == "richardson" else None
-                step_need = max(step_need, _factor(step, share, order) if step_claims else 2)
-            if q.law_estimate is not None and (law > share or not law_claims):
-                e = q.law_estimate
-                order = e.order if e.method == "richardson" else None
-                law_need = max(law_need, _factor(law, share, order) if law_claims else 2)
+            ratio = (step + law) / max(allowed, 1e-300)
+            if worst is None or ratio > worst[1]:
+                worst = (q, ratio, step, law)
+            budget = MARGIN * allowed - law
+            need = max(need, _factor(step, budget, _measured(q.estimate)) if claims else 2)
         if worst is None:
-            report = ToleranceReport(tol, floor, technique, why, top, divisor,
-                                     len(runner.summaries), rounds, runner.steps, rows)
+            report = ToleranceReport(tol, floor, technique, f"{why}; {start_why}", steps[-1],
+                                     int(divisor), len(runner.summaries), rounds, runner.steps,
+                                     rows)
             return report, final
         runner.close()
-        q, ratio, step, law, step_claims, law_claims = worst
-        name = f"{q.what} {q.item}".strip()
-        what = (f"{name} = {value(q):.6g} {q.unit}: estimated error {step + law:.3g} {q.unit} "
-                f"({100 * (step + law) / q.scale:.3g} % of its scale {q.scale:.6g}, allowed {100 * tol:g} %; "
-                f"{'; '.join(x for x in (_method(q.estimate, 'step'), _method(q.law_estimate, 'law')) if x)})")
-        law_cause = q.law_estimate is not None and (law >= step or not law_claims)
-        over_step = top * step_need > MAX_REFINEMENT * n1
-        over_law = divisor * law_need > MAX_REFINEMENT
-        if over_step or over_law:
-            limit = (f"eps and f / {MAX_REFINEMENT}" if over_law else f"n1 = {MAX_REFINEMENT * n1}")
-            raise ToleranceError(_unmet(path, tol, what, q, law_cause, f"meeting it needs more than {limit}, "
-                                        f"the cost limit ({MAX_REFINEMENT} times the deck's setting)"))
-        top *= step_need
-        divisor *= law_need
-    raise ToleranceError(_unmet(path, tol, what, q, law_cause, f"{MAX_ROUNDS} rounds of refinement did not meet it"))
+        q, _, step, law = worst
+        if steps[-1] * need > MAX_REFINEMENT * n1 or 2 * steps[-1] > MAX_REFINEMENT * n1:
+            what = _what(q, value(q), step, law, q.estimate, q.law_estimate)
+            why = (f"meeting it needs more than n1 = {MAX_REFINEMENT * n1}, the cost limit "
+                   f"({MAX_REFINEMENT} times the deck's n1)")
+            raise ToleranceError(_unmet(path, tol, what, None, why))
+        steps.append(2 * steps[-1])
+
+
+def _what(q: Quantity, value: float, step: float, law: float, step_e: Estimate | None,
+          law_e: Estimate | None) -> str:
+    name = f"{q.what} {q.item}".strip()
+    return (f"{name} = {value:.6g} {q.unit}: estimated error {step + law:.3g} {q.unit} "
+            f"({100 * (step + law) / q.scale:.3g} % of its scale {q.scale:.6g}; "
+            f"{_methods(step_e, law_e)})")
 
 
 def _initial_peaks(path: Path, tol: float, summary: dict, qs: list[Quantity]) -> None:
@@ -364,22 +508,25 @@ def _initial_peaks(path: Path, tol: float, summary: dict, qs: list[Quantity]) ->
     for q in qs:
         if q.key == "peak_aabs_mps2" and q.index < len(times) and times[q.index] == 0.0:
             raise ToleranceError(
-                f"{path}: tolerance {tol:g} cannot be met: {q.what} {q.item} = {_value(summary, q):.6g} "
-                f"{q.unit} is reached at t = 0, where a regularized device starts unloaded (no force at rest, "
-                "whatever eps or f; Coulomb's force up to P mu): no refinement changes it and no estimate "
-                "sees it; give the devices law = 'coulomb' (the exact technique or Moreau-Jean)")
+                f"{path}: tolerance {tol:g} cannot be met: {q.what} {q.item} = "
+                f"{_value(summary, q):.6g} {q.unit} is reached at t = 0, where a regularized "
+                "device starts unloaded (no force at rest, whatever eps or f; Coulomb's force up "
+                "to P mu): no refinement changes it and no estimate sees it; give the devices "
+                "law = 'coulomb' (the exact technique or Moreau-Jean)")
 
 
-def _unmet(path: Path, tol: float, what: str, q: Quantity, law_cause: bool, why: str) -> str:
-    if law_cause:
-        e = q.law_estimate
-        rate = (f"it falls at order {e.order:.2f} in eps or f" if e.method == "richardson"
+def _unmet(path: Path, tol: float, what: str, law: Estimate | None, why: str) -> str:
+    """The refusal: ``law`` is the law's estimate when the law governs (None: the step)."""
+    if law is not None:
+        rate = (f"it falls at order {law.order:.2f} in eps or f" if law.method == "richardson"
                 else "it falls at no measurable order in eps or f")
-        hint = (f"the regularized law's error governs and {rate} (the hysteretic law's peaks at about 1/2 in "
-                "f, and its accelerations where the exact force jumps not at all: docs/theory.md, section 16); "
-                "give the devices law = 'coulomb' (the exact technique or Moreau-Jean), or a larger tolerance")
+        hint = (f"the regularized law's error governs and {rate} (the hysteretic law's peaks at "
+                "about 1/2 in f, and its accelerations where the exact force jumps not at all: "
+                "docs/theory.md, section 16); give the devices law = 'coulomb' (the exact "
+                "technique or Moreau-Jean), or a larger tolerance")
     else:
-        hint = "the step's error governs: a larger tolerance, or a shorter or smaller model, is needed"
+        hint = ("the step's error governs: a larger tolerance, or a shorter or smaller model, is "
+                "needed")
     return f"{path}: tolerance {tol:g} cannot be met: {what}; {why}; {hint}"
 
 
@@ -390,8 +537,8 @@ def _value(summary: dict, q: Quantity) -> float:
 
 def _summary_block(report: ToleranceReport) -> dict:
     block = report.block()
-    return {"estimated_error": block.pop("estimated_error"), "estimate_method": block.pop("estimate_method"),
-            "tolerance_run": block}
+    return {"estimated_error": block.pop("estimated_error"),
+            "estimate_method": block.pop("estimate_method"), "tolerance_run": block}
 
 
 def tolerance_run(
@@ -439,10 +586,10 @@ def tolerance_run(
     runner = _Runner(path, threads, (dofs, devices))
     try:
         if technique == "newmark":
-            why = ("the paper's regularized laws: n1 refined by the step levels, and eps and f by the law "
-                   "levels" if _law_text(stripped, 2) is not None else
-                   "Newmark without a numerical eps or f (no velocity or hysteretic device of &friction or "
-                   "&isolators): n1 refined by the step levels")
+            why = ("the paper's regularized laws: n1 refined by the step levels, and eps and f by "
+                   "the law levels" if _law_text(stripped, 2) is not None else
+                   "Newmark without a numerical eps or f (no velocity or hysteretic device of "
+                   "&friction or &isolators): n1 refined by the step levels")
             report, final = _refine(runner, nml, path, n1, "newmark", tol, floor, why)
         else:
             with Session.from_text(stripped, path.name, path.parent) as s:
@@ -450,23 +597,25 @@ def tolerance_run(
             exact_ok = n_dev <= EXACT_DEVICES
             if exact_ok:
                 try:
-                    with Session.from_text(write_namelist(_with(nml, n1, "event_driven")), path.name, path.parent):
+                    exact = write_namelist(_with(nml, n1, "event_driven"))
+                    with Session.from_text(exact, path.name, path.parent):
                         pass
                 except DeckError:
-                    exact_ok = False  # a device the exact technique cannot take (not between two nodes)
+                    exact_ok = False  # a device the exact technique cannot take (not a pair's)
             report = final = None
             if exact_ok:
                 try:
-                    report, final = _exact(runner, nml, n1, tol, floor,
-                                           f"{n_dev} Coulomb device{'s' * (n_dev != 1)} (at most {EXACT_DEVICES}): "
-                                           "the exact event-driven technique, whose peaks are exact")
+                    why = (f"{n_dev} Coulomb device{'s' * (n_dev != 1)} (at most {EXACT_DEVICES}): "
+                           "the exact event-driven technique, whose peaks are exact")
+                    report, final = _exact(runner, nml, n1, tol, floor, why)
                 except SolverError as exc:
                     why = f"the exact technique failed ({exc}); "
                 else:
                     why = ""
             if report is None:
                 if not exact_ok:
-                    why = (f"{n_dev} Coulomb devices (more than {EXACT_DEVICES}, or one not between two nodes): ")
+                    why = (f"{n_dev} Coulomb devices (more than {EXACT_DEVICES}, or one not "
+                           "between two nodes): ")
                 report, final = _refine(runner, nml, path, n1, "moreau_jean", tol, floor,
                                         why + "Moreau-Jean with n1 refined by its step levels")
         session = runner.kept.pop(final)
