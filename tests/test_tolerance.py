@@ -10,6 +10,7 @@ from __future__ import annotations
 import json
 import math
 import warnings
+from pathlib import Path
 
 import frictiondyn as fd
 import numpy as np
@@ -138,6 +139,23 @@ def test_the_first_levels_come_from_the_model(monkeypatch):
     assert s["steps"] == 1 + 400 + 800 + 1600, s["steps"]
 
 
+def test_a_hysteretic_sticking_spring_does_not_set_the_first_levels():
+    """Under the hysteretic law the stuck system holds the sticking spring, k = P mu / f
+    (Den Hartog's at f = 1e-5 m: 76.4 rad/s), a numerical stiffness whose ringing the paper's
+    dt2 steps resolve: the first levels follow the structure's period of 1 s (n1 = 1, 2, 4 at
+    1e-3), not the spring's (n1 = 2, 4, 8)."""
+    from frictiondyn._nml import read_namelist
+
+    nml = read_namelist(hysteretic_den_hartog(), Path("dh.nml"))
+    runner = tolerance_module._Runner(Path("dh.nml"), None)
+    try:
+        start, why = tolerance_module._probe_start(runner, nml, "newmark", 1e-3)
+    finally:
+        runner.close()
+    assert start == 1 and "omega = 6.283 rad/s" in why, why
+    assert runner.steps == 1
+
+
 def test_sound_estimate_caps_the_order_and_takes_the_larger_change():
     """A measured order of 3.5 on a technique of order 1: the estimate of the finest level
     is Richardson's at order 1, 1.25 max(|d2|, |d1| / 2) / (2 - 1), not 1.25 |d2| / (2^3.5 - 1)
@@ -148,7 +166,8 @@ def test_sound_estimate_caps_the_order_and_takes_the_larger_change():
     e = tolerance_module._sound(estimate_error(values, 2, 1.0), values, 1.0, 2)
     assert e.method == "richardson" and e.order == 1.0
     assert e.errors[-1] == pytest.approx(1.25 * 0.008 / 2)
-    assert tolerance_module._method(e, "step") == "step: Richardson at order 1, the theoretical (3.50 measured)"
+    method = tolerance_module._method(e, "step")
+    assert method == "step: Richardson at order 1, the theoretical (3.50 measured)"
     values = [1.0, 1.008, 1.008 + 0.008 / 2**1.5]
     e = tolerance_module._sound(estimate_error(values, 2, 1.0), values, 2.0, 2)
     assert e.order == pytest.approx(1.5)
@@ -166,7 +185,8 @@ def test_moreau_jean_building_estimates_bound_the_true_errors(tmp_path, monkeypa
     ladder n1 = 1, 2, 4, ... reuses each level: each run is made once."""
     from test_convergence import building
 
-    exact = quiet_run(building(tmp_path, "coulomb", "event_driven").read_text(), base_dir=tmp_path).summary
+    exact_deck = building(tmp_path, "coulomb", "event_driven")
+    exact = quiet_run(exact_deck.read_text(), base_dir=tmp_path).summary
     monkeypatch.setattr(tolerance_module, "EXACT_DEVICES", 0)
     deck = building(tmp_path, "coulomb", "moreau_jean")
     r, report, session = tolerance_module.tolerance_run(deck, 1e-2)
