@@ -1,6 +1,6 @@
 """Tolerance runs over the verification battery: the four figures of docs/validation.md, section 7.
 
-    .venv/bin/python bench/tolerance.py              # both tolerances (a few minutes)
+    .venv/bin/python bench/tolerance.py              # both tolerances (20 to 30 s)
     .venv/bin/python bench/tolerance.py --tol 1e-2   # one
 
 Each case has an exact answer: Den Hartog's steady state (closed form: amplitude A, peak
@@ -17,7 +17,8 @@ within the tolerance (of the quantity's scale, the run's own allowed error), the
 estimate is at least the true error, the median of estimate / true error (quantities whose
 true error is below 1e-9 of the scale, round-off, left out), and per case the cost (steps
 solved, every run of the tolerance run) over the cheapest manual setting that meets the
-tolerance against the exact answer (a grid of n1 and of eps and f divided by 2^k).
+tolerance against the exact answer (a grid of n1 and of eps and f divided by 2^k); a tolerance
+run's steps include its probe (one step) and every level it made, each once.
 Nothing is asserted here: it is measured (tests/test_tolerance.py asserts the short cases).
 """
 
@@ -40,7 +41,9 @@ from conftest import deck_text  # noqa: E402
 from frictiondyn import tolerance as tm  # noqa: E402
 from frictiondyn.convergence import ESTIMATED, _law_text  # noqa: E402
 from oracles import den_hartog  # noqa: E402
-from test_verification import F0, FF, FV_A, FV_K, FV_M, FV_U0, K, M, W, den_hartog_groups  # noqa: E402
+from test_verification import (  # noqa: E402
+    F0, FF, FV_A, FV_K, FV_M, FV_U0, K, M, W, den_hartog_groups,
+)
 
 INPUTS = ROOT / "inputs"
 
@@ -54,14 +57,15 @@ def building_text(storeys: int, law: str, technique: str, duration: float = 8.0)
     nodes = list(range(1, storeys + 1))
     return deck_text({
         "model": {"n_dof": storeys, "mass": mass},
-        "springs": {"n_springs": storeys, "node_i": nodes, "node_j": [n - 1 for n in nodes], "k": k},
+        "springs": {"n_springs": storeys, "node_i": nodes, "node_j": [n - 1 for n in nodes],
+                    "k": k},
         "damping": {"damping_type": "rayleigh", "rayleigh_a0": 0.3, "rayleigh_a1": 8e-4},
         "friction": {"n_devices": storeys, "node_i": nodes, "node_j": [n - 1 for n in nodes],
                      "law": [law] * storeys, "mu": [0.3] * storeys, "p": [s / 0.3 for s in slip],
                      "f": [1e-5] * storeys, "eps1": [1e-3] * storeys, "eps": [1e-3] * storeys},
         "storeys": {"n_storeys": storeys, "node_i": nodes, "node_j": [n - 1 for n in nodes]},
-        "excitation": {"excitation_type": "record", "record_file": str(INPUTS / "synthetic_pga035.AT2"),
-                       "duration": duration},
+        "excitation": {"excitation_type": "record",
+                       "record_file": str(INPUTS / "synthetic_pga035.AT2"), "duration": duration},
         "integration": {"technique": technique, "n1": 20},
     })
 
@@ -88,8 +92,8 @@ def den_hartog_exact() -> dict:
     its last step, not on the fourth period's end: 16 A F is 5e-5 above it)."""
     amplitude = float(den_hartog(np.array([0.0]), M, K, FF, F0, W)[2])
     exact = exact_summary(deck_text(den_hartog_groups("coulomb", "event_driven", 20)))
-    return {"peak_u_m": [amplitude], "peak_aabs_mps2": [(K * amplitude + FF) / M], "peak_force_N": [FF],
-            "energy_friction_J": exact["energy_friction_J"]}
+    return {"peak_u_m": [amplitude], "peak_aabs_mps2": [(K * amplitude + FF) / M],
+            "peak_force_N": [FF], "energy_friction_J": exact["energy_friction_J"]}
 
 
 FV_EXACT = {"peak_u_m": [FV_U0], "peak_aabs_mps2": [FV_K * (FV_U0 - FV_A) / FV_M],
@@ -105,25 +109,31 @@ def exact_summary(text: str) -> dict:
 def cases() -> list[tuple[str, str, dict, bool]]:
     """(name, deck text, exact values by summary key, Moreau-Jean forced)."""
     dh = den_hartog_exact()
+    def dh_text(law: str, technique: str, **friction) -> str:
+        return deck_text(den_hartog_groups(law, technique, 20, **friction))
+
     out = [
-        ("Den Hartog, velocity law", deck_text(den_hartog_groups("velocity", "newmark", 20, eps=1e-3)), dh, False),
-        ("Den Hartog, hysteretic law", deck_text(den_hartog_groups("hysteretic", "newmark", 20, f=1e-5, eps1=1e-3)),
-         dh, False),
-        ("Den Hartog, Coulomb (auto)", deck_text(den_hartog_groups("coulomb", "moreau_jean", 20)), dh, False),
-        ("Den Hartog, Coulomb, Moreau-Jean", deck_text(den_hartog_groups("coulomb", "moreau_jean", 20)), dh, True),
-        ("free vibration, velocity law", free_vibration_text("velocity", "newmark"), FV_EXACT, False),
-        ("free vibration, hysteretic law", free_vibration_text("hysteretic", "newmark"), FV_EXACT, False),
-        ("free vibration, Coulomb (auto)", free_vibration_text("coulomb", "moreau_jean"), FV_EXACT, False),
-        ("free vibration, Coulomb, Moreau-Jean", free_vibration_text("coulomb", "moreau_jean"), FV_EXACT, True),
+        ("Den Hartog, velocity law", dh_text("velocity", "newmark", eps=1e-3), dh, False),
+        ("Den Hartog, hysteretic law", dh_text("hysteretic", "newmark", f=1e-5, eps1=1e-3), dh,
+         False),
+        ("Den Hartog, Coulomb (auto)", dh_text("coulomb", "moreau_jean"), dh, False),
+        ("Den Hartog, Coulomb, Moreau-Jean", dh_text("coulomb", "moreau_jean"), dh, True),
     ]
+    for law, technique in (("velocity", "newmark"), ("hysteretic", "newmark")):
+        out.append((f"free vibration, {law} law", free_vibration_text(law, technique), FV_EXACT,
+                    False))
+    coulomb = free_vibration_text("coulomb", "moreau_jean")
+    out.append(("free vibration, Coulomb (auto)", coulomb, FV_EXACT, False))
+    out.append(("free vibration, Coulomb, Moreau-Jean", coulomb, FV_EXACT, True))
     test4 = fd.run(INPUTS / "test4_coulomb.nml").summary
     for law in ("velocity", "hysteretic"):
-        out.append((f"Table 1 test 4, {law} law", (INPUTS / f"test4_{law}.nml").read_text(), test4, False))
+        out.append((f"Table 1 test 4, {law} law", (INPUTS / f"test4_{law}.nml").read_text(), test4,
+                    False))
     for storeys in (3, 8):
         exact = exact_summary(building_text(storeys, "coulomb", "event_driven"))
         for law in ("velocity", "hysteretic"):
-            out.append((f"{storeys}-storey building, {law} law", building_text(storeys, law, "newmark"), exact,
-                        False))
+            out.append((f"{storeys}-storey building, {law} law",
+                        building_text(storeys, law, "newmark"), exact, False))
         out.append((f"{storeys}-storey building, Coulomb, Moreau-Jean",
                     building_text(storeys, "coulomb", "moreau_jean"), exact, True))
     return out
@@ -150,13 +160,15 @@ def meets(summary: dict, exact: dict, tol: float, scales: dict) -> bool:
     return True
 
 
-def cheapest_manual(text: str, exact: dict, tol: float, scales: dict, mj: bool, cache: dict) -> int | None:
+def cheapest_manual(text: str, exact: dict, tol: float, scales: dict, mj: bool,
+                    cache: dict) -> int | None:
     """The fewest steps of a setting that meets ``tol`` against the exact answer: n1 from 5 to
     1280, and under a regularized law eps and f divided by 1 to 128."""
     base = text
     if mj:
         base = base.replace("'event_driven'", "'moreau_jean'")
-    regularized = not any(t in base for t in ("moreau_jean", "event_driven")) and _law_text(base, 2) is not None
+    regularized = (not any(t in base for t in ("moreau_jean", "event_driven"))
+                   and _law_text(base, 2) is not None)
     best, per_n1 = None, None
     for n1 in (5, 10, 20, 40, 80, 160, 320, 640, 1280):
         if best is not None and per_n1 is not None and n1 * per_n1 >= best:
@@ -182,7 +194,8 @@ def cheapest_manual(text: str, exact: dict, tol: float, scales: dict, mj: bool, 
 
 def main(argv: list[str] | None = None) -> int:
     parser = argparse.ArgumentParser(description=__doc__.split("\n")[0])
-    parser.add_argument("--tol", type=float, action="append", help="tolerance (default: 1e-2 and 1e-3)")
+    parser.add_argument("--tol", type=float, action="append",
+                        help="tolerance (default: 1e-2 and 1e-3)")
     args = parser.parse_args(argv)
     warnings.simplefilter("ignore", fd.FrictiondynWarning)
     battery = cases()
@@ -195,7 +208,8 @@ def main(argv: list[str] | None = None) -> int:
             saved = tm.EXACT_DEVICES
             tm.EXACT_DEVICES = 0 if mj else saved
             try:
-                result, report, session = tm.tolerance_run(text=text, tolerance=tol, name="case.nml")
+                result, report, session = tm.tolerance_run(text=text, tolerance=tol,
+                                                           name="case.nml")
                 session.close()
             except fd.ToleranceError as exc:
                 refused.append(name)
@@ -217,22 +231,27 @@ def main(argv: list[str] | None = None) -> int:
             if report.technique == "event_driven":  # one exact run: no cheaper setting
                 manual = report.steps
             else:
-                manual = cheapest_manual(text, {k: exact[k] for k in ESTIMATED if k in exact}, tol, scales, mj,
+                estimated = {k: exact[k] for k in ESTIMATED if k in exact}
+                manual = cheapest_manual(text, estimated, tol, scales, mj,
                                          manual_cache.setdefault(name, {}))
             ratio = report.steps / manual if manual else math.nan
             costs.append(ratio)
-            print(f"  {name}: {report.technique}, n1 = {report.n1}, eps and f / {report.law_divisor}, "
-                  f"{report.runs} runs; within {case_in}/{len(pairs)}, estimate >= true {case_bound}/{len(pairs)}; "
-                  f"cost {report.steps} steps, cheapest manual {manual} ({ratio:.2f} x)")
+            print(f"  {name}: {report.technique}, n1 = {report.n1}, eps and f / "
+                  f"{report.law_divisor}, {report.runs} runs; within {case_in}/{len(pairs)}, "
+                  f"estimate >= true {case_bound}/{len(pairs)}; cost {report.steps} steps, "
+                  f"cheapest manual {manual} ({ratio:.2f} x)")
         finite = [c for c in costs if math.isfinite(c)]
-        print(f"  quantities {total} in {len(battery) - len(refused)} runs ({len(refused)} refused: "
+        print(f"  quantities {total} in {len(battery) - len(refused)} runs "
+              f"({len(refused)} refused: "
               f"{', '.join(refused) or 'none'})")
         print(f"  within tolerance: {100 * within / max(total, 1):.1f} %")
         print(f"  estimate >= true error: {100 * bounded / max(total, 1):.1f} %")
         if ratios:
-            print(f"  median estimate / true error: {statistics.median(ratios):.2f} (of {len(ratios)} above round-off)")
+            print(f"  median estimate / true error: {statistics.median(ratios):.2f} "
+                  f"(of {len(ratios)} above round-off)")
         if finite:
-            print(f"  cost / cheapest manual: median {statistics.median(finite):.2f}, max {max(finite):.2f} "
+            print(f"  cost / cheapest manual: median {statistics.median(finite):.2f}, "
+                  f"max {max(finite):.2f} "
                   f"(of {len(finite)} cases)")
     return 0
 

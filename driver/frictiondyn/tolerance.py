@@ -70,7 +70,7 @@ EXACT_DEVICES = 10
 #: the deck's / this
 MAX_REFINEMENT = 128
 #: the theoretical order of each technique's step error, and of the regularized laws' error in
-#: eps and f: a measured order above it is capped (docs/theory.md, section 16.1)
+#: eps and f: a measured order above it is capped (docs/theory.md, section 16.2)
 STEP_ORDER = {"newmark": 2.0, "moreau_jean": 1.0}
 LAW_ORDER = 1.0
 #: a run is returned when every estimate is below MARGIN times its allowed error (the law's
