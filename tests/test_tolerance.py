@@ -129,7 +129,7 @@ def test_the_first_levels_come_from_the_model(monkeypatch):
     """Moreau-Jean on the free vibration (period 1 s, dt_record = 0.01 s) at 1e-3: the probe
     of one record step finds omega = 2 pi rad/s, (omega dt_record)^2 / 12 = 3.3e-4 is within
     the tolerance at n1 = 1, so the levels are n1 = 1, 2, 4 whatever the deck's n1 (10), and
-    they meet it: 4 runs (the probe's one step and 700 + 1400 + 2800... steps), not the deck's
+    they meet it: 4 runs (the probe's one step and 400 + 800 + 1600 steps), not the deck's
     n1 = 12 and its coarser levels (8400 steps)."""
     monkeypatch.setattr(tolerance_module, "EXACT_DEVICES", 0)
     run = quiet_run(free_vibration_text("event_driven"))
