@@ -22,8 +22,10 @@ estimate is within half the budget; then the step levels at that eps and f, n1 =
 estimate is Richardson's at the measured order capped at the theoretical one (``STEP_ORDER``,
 ``LAW_ORDER``), from the larger of the last two changes' predictions; a plain difference (times
 3) where no order is consistent, or Richardson's over every other level (a ratio of 4) when five
-levels exist. The run returned, the finest, is the first whose every estimate, step's plus law's,
-is below ``MARGIN`` times its allowed error. When that would need more than ``MAX_REFINEMENT``
+levels exist; the step's difference stands for its error (a technique that converges), the
+law's only below the noise (a regularized law's error need not vanish). The run returned, the
+finest, is the first whose every estimate, step's plus law's, is below ``MARGIN`` times its
+allowed error. When that would need more than ``MAX_REFINEMENT``
 times the deck's n1 (or eps and f divided by more), ``ToleranceError`` is raised naming the
 quantity, its estimate and why: no unmet tolerance is ever returned.
 
