@@ -192,7 +192,10 @@ contains
             exit
          end if
       end do
-      w = q - matmul(a, lam)
+      ! w = q - a lam, without a temporary for the product
+      do i = 1, m
+         w(i) = q(i) - dot_product(a(i, :), lam)
+      end do
    end subroutine disc_gauss_seidel
 
 end module fd_disc_solver
