@@ -360,7 +360,6 @@ contains
    !> keep the band form of their sticking groups.
    pure logical function dense_form(model) result(dense)
       type(model_type), intent(in) :: model         !! the model
-
       integer :: d
 
       dense = .not. devices_are_pairs(model) .or. model%n_kx > 0 .or. allocated(model%influence)
