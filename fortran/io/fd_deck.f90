@@ -30,7 +30,7 @@ module fd_deck
    use fd_excitation, only: excitation_type
    use fd_record, only: read_record, record_info, record_formats, record_units_list, units_factor
    use fd_names, only: label_len, max_mu_points, mu_laws, mu_constant, mu_exponential, mu_table, mode_systems, &
-                       system_stuck, law_hysteretic, law_velocity, &
+                       system_stuck, law_hysteretic, law_velocity, law_coulomb, &
                        default_mu_law, default_mode_system, default_n_modes, default_radius, default_modal_modes, &
                        default_storey_height, law_name
    use fd_model, only: source_friction, source_brace, source_isolator, source_floor_brace, source_bearing
@@ -1791,9 +1791,9 @@ contains
       idx = '('//trim(fmt_int(i))//')'
       call device_law(deck, 'bearings', i, law, id, error)
       if (allocated(error)) return
-      if (id /= law_velocity .and. id /= law_hysteretic) then
-         call bad(deck, 'bearings', 'law'//idx, "'"//trim(law)//"'", "'velocity' or 'hysteretic': the laws "// &
-                  "a planar bearing has", error)
+      if (id /= law_velocity .and. id /= law_hysteretic .and. id /= law_coulomb) then
+         call bad(deck, 'bearings', 'law'//idx, "'"//trim(law)//"'", "'velocity', 'hysteretic' or 'coulomb' "// &
+                  "(technique = 'moreau_jean'): the laws a planar bearing has", error)
          return
       end if
       if (p*mu /= 0.0_dp .and. p*mu < min_scale) then

@@ -45,14 +45,28 @@ contains
       type(integration_type), intent(in) :: opts    !! the technique and its settings
       type(error_type), allocatable, intent(out) :: error !! what cannot be integrated
       type(technique_traits_type) :: traits
+      character(len=96) :: fix
       integer :: d
 
-      ! a planar bearing (&bearings) slides on its resultant: the planar laws are Newmark's
+      ! a planar bearing (&bearings) slides on its resultant: Newmark integrates the planar
+      ! regularized laws, Moreau-Jean planar Coulomb friction, the event-driven technique none
       do d = 1, model%n_devices
-         if (opts%technique == technique_newmark .or. model%dev(d)%partner == 0) cycle
-         call fatal_error(error, "group &integration: technique = '"//trim(technique_name(opts%technique))// &
-                          "' does not integrate planar bearings (&bearings, here bearing "// &
-                          trim(fmt_int(model%dev(d)%source_index))//"); set technique = 'newmark'")
+         if (model%dev(d)%partner == 0) cycle
+         if (opts%technique == technique_event_driven) then
+            call fatal_error(error, "group &integration: technique = '"//trim(technique_name(opts%technique))// &
+                             "' does not integrate planar bearings (&bearings, here bearing "// &
+                             trim(fmt_int(model%dev(d)%source_index))//"); set technique = 'newmark' or 'moreau_jean'")
+            return
+         end if
+         if (technique_integrates(opts%technique, model%dev(d)%law)) cycle
+         if (opts%technique == technique_newmark) then
+            fix = "it integrates 'velocity' or 'hysteretic' bearings; set one, or technique = 'moreau_jean'"
+         else
+            fix = "it integrates 'coulomb' bearings; set law = 'coulomb' or technique = 'newmark'"
+         end if
+         call fatal_error(error, "group &bearings: law("//trim(fmt_int(model%dev(d)%source_index))//") = '"// &
+                          trim(law_name(model%dev(d)%law))//"' is invalid with technique = '"// &
+                          trim(technique_name(opts%technique))//"' of &integration: "//trim(fix))
          return
       end do
       call check_braces(model, opts%technique, error)
@@ -131,11 +145,11 @@ contains
       type(excitation_type), intent(in), optional :: exc2 !! a second horizontal component
                                                           !! (along the model's influence2)
 
-      if (opts%technique /= technique_newmark .and. present(exc2)) then
+      if (opts%technique == technique_event_driven .and. present(exc2)) then
          if (exc2%kind /= excitation_none) then
             call fatal_error(error, "group &excitation2: a second horizontal component is integrated by "// &
-                             "technique = 'newmark' only; technique = '"//trim(technique_name(opts%technique))// &
-                             "' takes one component (&excitation)")
+                             "technique = 'newmark' or 'moreau_jean'; technique = '"// &
+                             trim(technique_name(opts%technique))//"' takes one component (&excitation)")
             return
          end if
       end if
@@ -145,7 +159,7 @@ contains
       case (technique_event_driven)
          call run_event_driven(model, exc, opts, res, error, ctl)
       case (technique_moreau_jean)
-         call run_moreau_jean(model, exc, opts, res, error, ctl)
+         call run_moreau_jean(model, exc, opts, res, error, ctl, exc2)
       case default
          call unknown_technique(opts%technique, error)
       end select

@@ -36,6 +36,7 @@ program tester
    use test_fd_group_system, only: collect_group_system
    use test_fd_impulse_solver, only: collect_impulse_solver
    use test_fd_dense_impulse, only: collect_dense_impulse
+   use test_fd_disc_solver, only: collect_disc_solver
    use test_fd_step_limits, only: collect_step_limits
    use test_fd_stick_ringing, only: collect_stick_ringing
    use test_fd_band_alternation, only: collect_band_alternation
@@ -89,6 +90,7 @@ program tester
    testsuites = [testsuites, new_testsuite("group_system", collect_group_system)]
    testsuites = [testsuites, new_testsuite("impulse_solver", collect_impulse_solver)]
    testsuites = [testsuites, new_testsuite("dense_impulse", collect_dense_impulse)]
+   testsuites = [testsuites, new_testsuite("disc_solver", collect_disc_solver)]
    testsuites = [testsuites, new_testsuite("step_limits", collect_step_limits)]
    testsuites = [testsuites, new_testsuite("stick_ringing", collect_stick_ringing)]
    testsuites = [testsuites, new_testsuite("band_alternation", collect_band_alternation)]

@@ -14,6 +14,12 @@
 !> v1 = x - Z lambda. The acceleration at the end of a step (Coulomb's law at the level of
 !> accelerations, W = M) is the same problem with A_M = B' M^-1 B over the devices at rest,
 !> the sliding ones carrying sigma P mu. Memory: n^2 + 2 n nd + 2 nd^2 reals.
+!>
+!> A model with planar bearings (devices that name a partner) takes the friction disc of
+!> each bearing in place of its components' intervals: the same problem with
+!> |lambda_b| <= g_b, solved by projected block Gauss-Seidel (fd_disc_solver) from the last
+!> solution; a bearing that slides at the end of a step carries P mu along its end velocity
+!> in the acceleration problem. A model without bearings keeps Lemke's method.
 module fd_dense_impulse
    use fd_kinds, only: dp
    use fd_error, only: error_type, fatal_error, fmt_int, fmt_real, stat_no_memory
@@ -22,12 +28,16 @@ module fd_dense_impulse
    use fd_matrices, only: stiffness_matrix
    use fd_linalg, only: cholesky_factor, cholesky_solve
    use fd_lcp, only: lcp_work, lcp_info, lcp_init, box_lcp_solve, lcp_solved, lcp_status_text
+   use fd_disc_solver, only: disc_gauss_seidel, disc_ok, disc_unconverged
    implicit none
    private
 
    public :: dense_impulse, dense_setup, dense_factor, dense_solve, dense_acceleration, dense_k_times
 
    real(dp), parameter :: tol_rel = 1.0e-10_dp    !! a relative velocity is 0 below this share of its terms
+   real(dp), parameter :: tol_sweep = 1.0e-13_dp  !! bearings: the sweeps stop below this change of an
+                                                  !! impulse (force), relative to the largest bound
+   integer, parameter :: max_sweeps = 20000       !! bearings: the sweeps' cap (an error beyond)
 
    !> The structure's dense matrices, the devices' directions and the factored step system.
    type :: dense_impulse
@@ -44,8 +54,16 @@ module fd_dense_impulse
       real(dp), allocatable :: q(:), lo(:), hi(:), zz(:), ww(:), sub(:, :) !! (nd) LCP data
       integer, allocatable :: idx(:)                 !! (nd) devices of a sub-problem
       type(lcp_work) :: lcp                          !! Lemke's workspace
+      logical :: planar = .false.                    !! some devices are planar bearings' components
+      integer, allocatable :: partner(:)             !! (nd) a bearing's other component, 0: none
+      integer, allocatable :: psub(:)                !! (nd) partner within a sub-problem
+      integer, allocatable :: pos(:)                 !! (nd) a device's place in a sub-problem
+      real(dp), allocatable :: lam0(:), f0(:)        !! (nd) bearings: the last impulses, forces
+      real(dp), allocatable :: gsub(:)               !! (nd) bounds of a sub-problem
+      integer :: sweeps = 0                          !! bearings: Gauss-Seidel sweeps made
       integer :: factorizations = 0                  !! factorizations of W
-      integer :: lcp_solves = 0                      !! box LCPs solved
+      integer :: lcp_solves = 0                      !! box LCPs solved (with bearings: the problems
+                                                     !! solved by block Gauss-Seidel)
    end type dense_impulse
 
 contains
@@ -63,7 +81,7 @@ contains
       di%nd = nd
       allocate (di%mass(n), di%k(n, n), di%b(n, nd), di%wf(n, n), di%z(n, nd), di%a(nd, nd), di%am(nd, nd), &
                 di%x(n), di%q(nd), di%lo(nd), di%hi(nd), di%zz(nd), di%ww(nd), di%sub(nd, nd), di%idx(nd), &
-                stat=stat)
+                di%partner(nd), di%psub(nd), di%pos(nd), di%lam0(nd), di%f0(nd), di%gsub(nd), stat=stat)
       if (stat /= 0) then
          call fatal_error(error, "not enough memory for the dense Moreau-Jean system of "//trim(fmt_int(n))// &
                           " DOFs and "//trim(fmt_int(nd))//" devices", stat_no_memory)
@@ -74,7 +92,11 @@ contains
       di%b = 0.0_dp
       do d = 1, nd
          call add_device(model, d, 1.0_dp, di%b(:, d))
+         di%partner(d) = model%dev(d)%partner
       end do
+      di%planar = any(di%partner > 0)
+      di%lam0 = 0.0_dp
+      di%f0 = 0.0_dp
       do e = 1, nd
          do d = 1, nd
             di%am(d, e) = sum(di%b(:, d)*di%b(:, e)/di%mass)
@@ -150,6 +172,15 @@ contains
       w = 0.0_dp
       sigma = 0
       if (nd == 0) return
+      if (di%planar) then
+         call planar_solve(di, g, lam, error)
+         if (allocated(error)) return
+         do d = 1, nd
+            v1 = v1 - di%z(:, d)*lam(d)
+         end do
+         call planar_statuses(di, v1, lam, w, sigma)
+         return
+      end if
       do d = 1, nd
          di%q(d) = -dot_product(di%b(:, d), di%x)
          di%lo(d) = -g(d)
@@ -193,7 +224,7 @@ contains
    !> (sigma /= 0) carries sigma P mu, the devices at rest the forces of the box LCP with
    !> A_M over them (they hold within P mu, or start to slide the way of their force).
    !> force: each device's force; sa: its status at the level of accelerations.
-   subroutine dense_acceleration(di, f, pmu, sigma, acc, force, sa, error)
+   subroutine dense_acceleration(di, f, pmu, sigma, acc, force, sa, error, wend)
       type(dense_impulse), intent(inout) :: di      !! the solver
       real(dp), intent(in) :: f(:)                  !! (n) forces but friction [N]
       real(dp), intent(in) :: pmu(:)                !! (nd) P mu [N]
@@ -202,9 +233,15 @@ contains
       real(dp), intent(out) :: force(:)             !! (nd) forces [N]
       integer, intent(out) :: sa(:)                 !! (nd) 0 holding, +-1 sliding
       type(error_type), allocatable, intent(out) :: error !! the LCP unsolved
+      real(dp), intent(in), optional :: wend(:)     !! (nd) bearings: the relative velocities whose
+                                                    !! direction a sliding bearing's force takes
       integer :: d, e, m, a, b
       real(dp) :: sc, x
 
+      if (di%planar .and. present(wend)) then
+         call planar_acceleration(di, f, pmu, sigma, wend, acc, force, sa, error)
+         return
+      end if
       di%x = f
       m = 0
       do d = 1, di%nd
@@ -247,5 +284,154 @@ contains
          end do
       end if
    end subroutine dense_acceleration
+
+   !> Bearings: the impulses of the step by block Gauss-Seidel from the last step's, with
+   !> q = B' x (x = W^-1 r) the velocities without friction.
+   subroutine planar_solve(di, g, lam, error)
+      type(dense_impulse), intent(inout) :: di      !! the solver, x set
+      real(dp), intent(in) :: g(:)                  !! (nd) bounds
+      real(dp), intent(out) :: lam(:)               !! (nd) impulses
+      type(error_type), allocatable, intent(out) :: error !! unconverged
+      integer :: d
+
+      do d = 1, di%nd
+         di%q(d) = dot_product(di%b(:, d), di%x)
+      end do
+      lam = di%lam0
+      call sweeps_solve(di, di%a, di%nd, g, di%partner, lam, error)
+      if (allocated(error)) return
+      di%lam0 = lam
+   end subroutine planar_solve
+
+   !> Block Gauss-Seidel (fd_disc_solver) on the first m entries of di%q: z in lam(1:m) (its
+   !> start on entry); an error when it does not converge within its cap.
+   subroutine sweeps_solve(di, a, m, g, partner, lam, error)
+      type(dense_impulse), intent(inout) :: di      !! the solver (q set)
+      real(dp), intent(in) :: a(:, :)               !! (m, m) the operator
+      integer, intent(in) :: m                      !! size
+      real(dp), intent(in) :: g(:)                  !! (m) bounds
+      integer, intent(in) :: partner(:)             !! (m) bearings' pairs
+      real(dp), intent(inout) :: lam(:)             !! (m) impulses or forces
+      type(error_type), allocatable, intent(out) :: error !! unconverged, not definite
+      integer :: sweeps, status
+      real(dp) :: change
+
+      call disc_gauss_seidel(a(1:m, 1:m), di%q(1:m), g(1:m), partner(1:m), tol_sweep, max_sweeps, lam(1:m), &
+                             di%ww(1:m), sweeps, change, status)
+      di%sweeps = di%sweeps + sweeps
+      di%lcp_solves = di%lcp_solves + 1
+      if (status == disc_ok) return
+      if (status == disc_unconverged) then
+         call fatal_error(error, "the Moreau-Jean one-step problem of "//trim(fmt_int(m))//" devices with planar "// &
+                          "bearings did not converge: "//trim(fmt_int(sweeps))//" block Gauss-Seidel sweeps left a "// &
+                          "change of "//trim(fmt_real(change))//" of the largest bound; try technique = 'newmark'")
+      else
+         call fatal_error(error, "the Moreau-Jean one-step problem of "//trim(fmt_int(m))//" devices: a planar "// &
+                          "bearing's block of the Delassus operator is not positive definite (its two components "// &
+                          "move together)")
+      end if
+   end subroutine sweeps_solve
+
+   !> Bearings: the end-of-step relative velocities w = B' v1 and the statuses, a component
+   !> sliding (its sign) when its velocity exceeds tol_rel of its terms, those of its bearing's
+   !> larger component.
+   pure subroutine planar_statuses(di, v1, lam, w, sigma)
+      type(dense_impulse), intent(inout) :: di      !! the solver (q set)
+      real(dp), intent(in) :: v1(:)                 !! (n) end velocities
+      real(dp), intent(in) :: lam(:)                !! (nd) impulses
+      real(dp), intent(out) :: w(:)                 !! (nd) relative velocities
+      integer, intent(out) :: sigma(:)              !! (nd) statuses
+      integer :: d, e, p
+      real(dp) :: sc
+
+      do d = 1, di%nd
+         w(d) = dot_product(di%b(:, d), v1)
+         di%zz(d) = abs(di%q(d))
+         do e = 1, di%nd
+            di%zz(d) = di%zz(d) + abs(di%a(d, e)*lam(e))
+         end do
+      end do
+      do d = 1, di%nd
+         p = di%partner(d)
+         sc = di%zz(d)
+         if (p > 0) sc = max(sc, di%zz(p))
+         sigma(d) = 0
+         if (abs(w(d)) > tol_rel*sc) sigma(d) = merge(1, -1, w(d) > 0.0_dp)
+      end do
+   end subroutine planar_statuses
+
+   !> dense_acceleration with bearings: a bearing sliding at the end of the step (either
+   !> component's status not 0) carries P mu along its end velocity wend; the devices at rest
+   !> take the planar problem with A_M over them (each bearing's force in its disc).
+   subroutine planar_acceleration(di, f, pmu, sigma, wend, acc, force, sa, error)
+      type(dense_impulse), intent(inout) :: di      !! the solver
+      real(dp), intent(in) :: f(:)                  !! (n) forces but friction [N]
+      real(dp), intent(in) :: pmu(:)                !! (nd) P mu [N]
+      integer, intent(in) :: sigma(:)               !! (nd) statuses of the step
+      real(dp), intent(in) :: wend(:)               !! (nd) relative velocities at the end
+      real(dp), intent(out) :: acc(:)               !! (n) accelerations [m/s2]
+      real(dp), intent(out) :: force(:)             !! (nd) forces [N]
+      integer, intent(out) :: sa(:)                 !! (nd) 0 holding, +-1 sliding
+      type(error_type), allocatable, intent(out) :: error !! unconverged
+      integer :: d, e, m, a, b, p
+      real(dp) :: sc, x
+      logical :: sliding
+
+      di%x = f
+      m = 0
+      do d = 1, di%nd
+         p = di%partner(d)
+         force(d) = 0.0_dp
+         sa(d) = sigma(d)
+         sliding = sigma(d) /= 0
+         if (p > 0) sliding = sliding .or. sigma(p) /= 0
+         di%pos(d) = 0
+         if (sliding) then
+            force(d) = sigma(d)*pmu(d)
+            if (p > 0) force(d) = pmu(d)*(wend(d)/hypot(wend(d), wend(p)))
+            di%x = di%x - di%b(:, d)*force(d)
+         else
+            m = m + 1
+            di%idx(m) = d
+            di%pos(d) = m
+         end if
+      end do
+      acc = di%x/di%mass
+      if (m == 0) return
+      do a = 1, m
+         d = di%idx(a)
+         di%q(a) = dot_product(di%b(:, d), acc)
+         di%gsub(a) = pmu(d)
+         di%psub(a) = 0
+         if (di%partner(d) > 0) di%psub(a) = di%pos(di%partner(d))
+         di%zz(a) = di%f0(d)
+         do b = 1, m
+            di%sub(a, b) = di%am(d, di%idx(b))
+         end do
+      end do
+      call sweeps_solve(di, di%sub, m, di%gsub, di%psub, di%zz, error)
+      if (allocated(error)) return
+      do a = 1, m
+         d = di%idx(a)
+         force(d) = di%zz(a)
+         di%f0(d) = force(d)
+         acc = acc - di%b(:, d)*(force(d)/di%mass)
+      end do
+      do a = 1, m
+         d = di%idx(a)
+         sc = abs(di%q(a))
+         do e = 1, m
+            sc = sc + abs(di%sub(a, e)*force(di%idx(e)))
+         end do
+         di%lo(a) = sc
+      end do
+      do a = 1, m
+         d = di%idx(a)
+         x = dot_product(di%b(:, d), acc)
+         sc = di%lo(a)
+         if (di%psub(a) > 0) sc = max(sc, di%lo(di%psub(a)))
+         if (abs(x) > tol_rel*sc) sa(d) = merge(1, -1, x > 0.0_dp)
+      end do
+   end subroutine planar_acceleration
 
 end module fd_dense_impulse

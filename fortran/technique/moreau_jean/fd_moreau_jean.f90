@@ -25,7 +25,7 @@ module fd_moreau_jean
    use fd_names, only: law_coulomb, law_name, excitation_types, technique_name, technique_moreau_jean, &
                        technique_newmark, damping_stiffness, damping_rayleigh, technique_integrates
    use fd_model, only: model_type, integration_type
-   use fd_excitation, only: excitation_type, table_motion
+   use fd_excitation, only: excitation_type, table_motion, excitation_none
    use fd_kinematics, only: device_kinematics, device_nodes, devices_are_pairs, device_relative
    use fd_stiffness, only: influence_of
    use fd_matrices, only: structure_damping
@@ -52,6 +52,10 @@ module fd_moreau_jean
       type(dense_impulse) :: di                           !! the dense one-step solver (any device, K_x)
       logical :: general = .false.                        !! the dense form is used
       real(dp), allocatable :: mr(:)                      !! (n) M r, r the table motion's direction
+      ! a second horizontal component (dense form): its motion and M r2 (two = .false.: none)
+      logical :: two = .false.
+      type(excitation_type) :: exc2
+      real(dp), allocatable :: mr2(:)
       real(dp), allocatable :: lam(:), wrel(:), fend(:)   !! (nd) dense form: impulses, b'v1, end forces
       integer, allocatable :: sig(:), sa(:)               !! (nd) dense form: statuses of a step, its end
       type(observer_type) :: obs                          !! peaks, history, energy balance
@@ -86,6 +90,13 @@ contains
       do d = 1, model%n_devices
          if (technique_integrates(technique_moreau_jean, model%dev(d)%law)) cycle
          idx = 'law('//trim(fmt_int(d))//')'
+         if (model%dev(d)%partner > 0) then
+            idx = 'law('//trim(fmt_int(model%dev(d)%source_index))//')'
+            call fatal_error(error, "group &bearings: "//idx//" = '"//trim(law_name(model%dev(d)%law))// &
+                             "' is invalid with "//tech//" of &integration: it integrates 'coulomb' bearings; "// &
+                             "set "//idx//" = 'coulomb' or technique = 'newmark'")
+            return
+         end if
          call fatal_error(error, "group &friction: "//idx//" = '"//trim(law_name(model%dev(d)%law))// &
                           "' is invalid with "//tech//" of &integration: the Moreau-Jean technique "// &
                           "integrates unregularized Coulomb friction, 'coulomb' devices only; set "//idx// &
@@ -140,13 +151,15 @@ contains
    end subroutine stuck_period
 
    !> Integrate a model whose devices all follow Coulomb's law by Moreau-Jean time stepping.
-   subroutine run_moreau_jean(model, exc, opts, res, error, ctl)
+   subroutine run_moreau_jean(model, exc, opts, res, error, ctl, exc2)
       type(model_type), intent(in) :: model         !! validated model (all devices coulomb)
       type(excitation_type), intent(in) :: exc      !! table motion
       type(integration_type), intent(in) :: opts    !! n1, theta and output_every are used
       type(result_type), intent(out) :: res         !! histories and summary
       type(error_type), allocatable, intent(out) :: error !! singular system, LCP failure, stop
       type(run_control), intent(inout), target, optional :: ctl !! the run's control (fd_run_control)
+      type(excitation_type), intent(in), optional :: exc2 !! a second horizontal component, along
+                                                          !! the model's influence2 (kind none: none)
       type(mj_work) :: w
       real(dp) :: h, th, alpha, beta, cm, ck, t1, ag0, ag1, agt, xg, vg, e_kin, e_str, ein
       integer :: k, e, c0, c1, crate
@@ -156,6 +169,18 @@ contains
       if (allocated(error)) return
       call setup(model, w, res, error)
       if (allocated(error)) return
+      if (present(exc2)) then
+         if (exc2%kind /= excitation_none) then
+            if (.not. (allocated(model%influence2) .and. w%general)) then
+               call fatal_error(error, "a second horizontal component needs the model's direction of it "// &
+                                "(a building of rigid floors, &floors, or influence2 of &matrices)")
+               return
+            end if
+            w%two = .true.
+            w%exc2 = exc2
+            w%mr2 = model%mass*model%influence2
+         end if
+      end if
       call observer_init(model, exc, opts, res%period_stuck, res, w%obs, error, ctl)
       if (allocated(error)) return
       th = opts%theta
@@ -330,13 +355,18 @@ contains
    end subroutine setup
 
    !> Whether the model takes the dense form of the one-step problem (fd_dense_impulse): a
-   !> device not between two nodes, stiffness beyond springs (K_x) or a table motion's
-   !> direction over the DOFs. Models of springs and node-pair devices keep the band form
-   !> of their sticking groups.
+   !> device not between two nodes, stiffness beyond springs (K_x), a table motion's
+   !> direction over the DOFs or a planar bearing. Models of springs and node-pair devices
+   !> keep the band form of their sticking groups.
    pure logical function dense_form(model) result(dense)
       type(model_type), intent(in) :: model         !! the model
+      integer :: d
 
       dense = .not. devices_are_pairs(model) .or. model%n_kx > 0 .or. allocated(model%influence)
+      ! planar bearings: their friction discs are solved in the dense form
+      do d = 1, model%n_devices
+         if (model%dev(d)%partner > 0) dense = .true.
+      end do
    end function dense_form
 
    !> Setup of the dense form: its matrices, C = a0 M + a1 K (fd_matrices' structure_damping:
@@ -378,9 +408,12 @@ contains
       type(mj_work), intent(inout) :: w
       type(result_type), intent(inout) :: res
       type(error_type), allocatable, intent(out) :: error
-      real(dp) :: h, th, cm, ck, t1, ag0, ag1, agt, xg, vg, e_kin, e_str, ein
+      real(dp) :: h, th, cm, ck, t1, ag0, ag1, agt, xg, vg, e_kin, e_str, ein, b0, b1, bt
       integer :: k, d
 
+      b0 = 0.0_dp
+      b1 = 0.0_dp
+      bt = 0.0_dp
       th = opts%theta
       h = exc%dt_record/opts%n1
       cm = 1.0_dp - h*(1.0_dp - th)*w%a0
@@ -391,16 +424,18 @@ contains
       w%u = model%u0
       w%v = model%v0
       call table_motion(exc, 0.0_dp, xg, vg, ag0)
+      if (w%two) call table_motion(w%exc2, 0.0_dp, xg, vg, b0)
       ! devices moving at t = 0 slide that way, the others by the acceleration problem
       do d = 1, w%nd
-         w%sig(d) = int(sign(1.0_dp, device_relative(model, d, w%v)))
-         if (device_relative(model, d, w%v) == 0.0_dp .or. w%g_force(d) <= 0.0_dp) w%sig(d) = 0
+         w%wrel(d) = device_relative(model, d, w%v)
+         w%sig(d) = int(sign(1.0_dp, w%wrel(d)))
+         if (w%wrel(d) == 0.0_dp .or. w%g_force(d) <= 0.0_dp) w%sig(d) = 0
       end do
-      call dense_end_state(w, ag0, w%u, w%v, error)
+      call dense_end_state(w, ag0, b0, w%u, w%v, error)
       if (allocated(error)) return
       call dense_device_state(model, w, w%phase0)
       call dense_energies(w, e_kin, e_str)
-      call start_observing(w, res, ag0, e_kin, e_str)
+      call start_observing(w, res, ag0, e_kin, e_str, b0)
       do k = 1, w%obs%nsteps
          t1 = k*h
          call table_motion(exc, t1, xg, vg, ag1)
@@ -409,11 +444,17 @@ contains
          w%kx = ck*w%v + h*w%u
          call dense_k_times(w%di, w%kx, w%r, -1.0_dp, 0.0_dp)
          w%r = w%r + model%mass*cm*w%v - h*agt*w%mr
+         if (w%two) then
+            call table_motion(w%exc2, t1, xg, vg, b1)
+            bt = (1.0_dp - th)*b0 + th*b1
+            w%r = w%r - h*bt*w%mr2
+         end if
          call dense_solve(w%di, w%r, w%g_step, w%v1, w%lam, w%wrel, w%sig, error)
          if (allocated(error)) return
          w%u1 = w%u + h*((1.0_dp - th)*w%v + th*w%v1)
          w%du = w%u1 - w%u
          ein = agt*sum(w%mr*w%du)
+         if (w%two) ein = ein + bt*sum(w%mr2*w%du)
          call dense_k_times(w%di, w%du, w%kx, 1.0_dp, 0.0_dp)
          call observe_work(res, -ein, (w%a0*sum(model%mass*w%du**2) + w%a1*dot_product(w%du, w%kx))/h)
          do d = 1, w%nd
@@ -422,13 +463,14 @@ contains
             w%obs%device_work(d) = w%obs%device_work(d) + w%lam(d)*w%rel_edge(d)/h
             w%obs%slip_travel(d) = w%obs%slip_travel(d) + abs(w%rel_edge(d))
          end do
-         call dense_end_state(w, ag1, w%u1, w%v1, error)
+         call dense_end_state(w, ag1, b1, w%u1, w%v1, error)
          if (allocated(error)) return
          w%u = w%u1
          w%v = w%v1
          ag0 = ag1
+         b0 = b1
          call dense_device_state(model, w, w%phase1)
-         call end_step(w, res, k, t1, ag1, error)
+         call end_step(w, res, k, t1, ag1, error, b1)
          if (allocated(error)) return
       end do
       call count_transitions(w, res, .true.)
@@ -441,15 +483,16 @@ contains
 
    !> The acceleration (relative to the table) and the device forces at an instant from
    !> equilibrium, the step's statuses w%sig held (fd_dense_impulse's dense_acceleration).
-   subroutine dense_end_state(w, ag, u, v, error)
+   subroutine dense_end_state(w, ag, ag2, u, v, error)
       type(mj_work), intent(inout) :: w
-      real(dp), intent(in) :: ag, u(:), v(:)
+      real(dp), intent(in) :: ag, ag2, u(:), v(:)
       type(error_type), allocatable, intent(out) :: error
 
       w%kx = w%a1*v + u
       call dense_k_times(w%di, w%kx, w%r, -1.0_dp, 0.0_dp)
       w%r = w%r - w%mr*ag - w%a0*w%di%mass*v
-      call dense_acceleration(w%di, w%r, w%g_force, w%sig, w%acc, w%fend, w%sa, error)
+      if (w%two) w%r = w%r - w%mr2*ag2
+      call dense_acceleration(w%di, w%r, w%g_force, w%sig, w%acc, w%fend, w%sa, error, w%wrel)
    end subroutine dense_end_state
 
    !> Device kinematics, forces and phases of the dense form (statuses of the step).
@@ -475,15 +518,21 @@ contains
 
    !> The observation of the state at t = 0 and its phases (phase0), common to both forms:
    !> the transitions counted from them, its energies, its sample and its peaks.
-   subroutine start_observing(w, res, ag0, e_kin, e_str)
+   subroutine start_observing(w, res, ag0, e_kin, e_str, ag2)
       type(mj_work), intent(inout) :: w
       type(result_type), intent(inout) :: res
       real(dp), intent(in) :: ag0            !! table acceleration at t = 0 [m/s2]
       real(dp), intent(in) :: e_kin, e_str   !! kinetic and strain energy at t = 0 [J]
+      real(dp), intent(in), optional :: ag2  !! the second component's at t = 0 [m/s2]
 
       w%counted = w%phase0
       w%pending = .false.
       call observe_start_energies(w%obs, e_kin, e_str, 0.0_dp)
+      if (w%two .and. present(ag2)) then
+         call observe_sample(w%obs, res, 0.0_dp, ag0, w%u, w%v, w%acc, w%s, w%sd, w%force, w%phase0, ag2=ag2)
+         call observe_peaks(res, 0.0_dp, size(w%u), size(w%s), w%u, w%v, w%acc, ag0, w%s, w%force, ag2)
+         return
+      end if
       call observe_sample(w%obs, res, 0.0_dp, ag0, w%u, w%v, w%acc, w%s, w%sd, w%force, w%phase0)
       call observe_peaks(res, 0.0_dp, size(w%u), size(w%s), w%u, w%v, w%acc, ag0, w%s, w%force)
    end subroutine start_observing
@@ -491,25 +540,35 @@ contains
    !> The end of step k, common to both forms, once the state at t1 and its device phases
    !> (phase1) are known: transitions counted, peaks, a sample when due (an error if the
    !> solution is not finite), the stop request polled (a requested stop is an error).
-   subroutine end_step(w, res, k, t1, ag1, error)
+   subroutine end_step(w, res, k, t1, ag1, error, ag2)
       type(mj_work), intent(inout) :: w
       type(result_type), intent(inout) :: res
       integer, intent(in) :: k               !! the step
       real(dp), intent(in) :: t1             !! its end [s]
       real(dp), intent(in) :: ag1            !! table acceleration at t1 [m/s2]
       type(error_type), allocatable, intent(out) :: error !! not finite, or a requested stop
-      logical :: stopped
+      real(dp), intent(in), optional :: ag2  !! the second component's at t1 [m/s2]
+      logical :: stopped, two
 
+      two = w%two .and. present(ag2)
       call count_transitions(w, res, .false.)
       w%phase0 = w%phase1
-      call observe_peaks(res, t1, size(w%u), size(w%s), w%u, w%v, w%acc, ag1, w%s, w%force)
+      if (two) then
+         call observe_peaks(res, t1, size(w%u), size(w%s), w%u, w%v, w%acc, ag1, w%s, w%force, ag2)
+      else
+         call observe_peaks(res, t1, size(w%u), size(w%s), w%u, w%v, w%acc, ag1, w%s, w%force)
+      end if
       res%moreau_jean%steps = res%moreau_jean%steps + 1
       if (sample_due(w%obs, k)) then
          if (.not. all(ieee_is_finite(w%u)) .or. .not. all(ieee_is_finite(w%acc))) then
             call fatal_error(error, "moreau_jean: the solution is not finite at t = "//trim(fmt_real(t1))//" s")
             return
          end if
-         call observe_sample(w%obs, res, t1, ag1, w%u, w%v, w%acc, w%s, w%sd, w%force, w%phase1)
+         if (two) then
+            call observe_sample(w%obs, res, t1, ag1, w%u, w%v, w%acc, w%s, w%sd, w%force, w%phase1, ag2=ag2)
+         else
+            call observe_sample(w%obs, res, t1, ag1, w%u, w%v, w%acc, w%s, w%sd, w%force, w%phase1)
+         end if
       end if
       call observe_poll(w%obs, t1, stopped)
       if (stopped) call observe_stop_error(w%obs, error)
