@@ -43,18 +43,15 @@ module fd_record_resolution
    use fd_model, only: model_type
    use fd_friction, only: law_stuck, stuck_dashpot
    use fd_excitation, only: excitation_type, table_acceleration
-   use fd_result, only: result_type, resolution_none, resolution_resolved, resolution_unresolved, &
-                        record_system_none, record_system_structure, record_system_stuck, &
-                        record_system_free, record_system_both
+   use fd_result, only: result_type, run_setup, setup_of, record_error_limit, record_system_none, &
+                        record_system_structure, record_system_stuck, record_system_free, record_system_both
    use fd_spectrum, only: exact_step_map
    implicit none
    private
 
+   !> record_error_limit: the relative change of a DOF's combined peak linear response above
+   !> which the step does not resolve the record (fd_result's, by which fd_warnings judges)
    public :: record_resolution, exact_step_map, newmark_step_map, theta_step_map, record_error_limit
-
-   !> relative change of a DOF's combined peak linear response above which the step does not
-   !> resolve the record
-   real(dp), parameter :: record_error_limit = 0.05_dp
 
    !> One pass of the modes of both systems through the record: each mode a row.
    type :: mode_pass
@@ -114,8 +111,8 @@ contains
 
    !> Sets res%record_error_stuck and res%record_error_free (per DOF, for the DOFs whose
    !> combined exact peak is at least 1 % of the largest), res%record_error (that of the
-   !> system the run was in) and res%record_resolution,
-   !> from the summary's modes (res%eng), the record (exc), res%dt1, the run's duration and
+   !> system the run was in) and res%record_checked (the verdict: fd_warnings),
+   !> from the summary's modes (res%eng), the record (exc), the technique's dt1, the run's duration and
    !> Newmark's beta, gamma (Moreau-Jean's theta). One pass through the record for the modes
    !> of both systems.
    subroutine record_resolution(model, exc, beta, gamma, theta, res, error)
@@ -128,16 +125,18 @@ contains
       type(mode_pass) :: ps
       integer :: n, stat, nm, ns, m, judged
       logical :: ok, some
+      type(run_setup) :: setup
 
       n = model%n_dof
-      res%record_resolution = resolution_none
+      setup = setup_of(res)
+      res%record_checked = .false.
       res%record_system = record_system_none
       res%record_error = 0.0_dp               ! allocated with the summary (init_result)
       res%record_error_stuck = 0.0_dp
       res%record_error_free = 0.0_dp
       if (technique_step_rule(res%technique) == rule_none) return
       if (res%eng%excitation /= excitation_record) return
-      if (res%dt1 <= 0.0_dp .or. .not. (exc%duration > 0.0_dp)) return
+      if (setup%dt1 <= 0.0_dp .or. .not. (exc%duration > 0.0_dp)) return
       judged = judged_system(model, res)
       ns = modes_kept(res%eng%stuck)
       nm = ns
@@ -154,7 +153,7 @@ contains
                           trim(fmt_int(n))//" DOFs", stat_no_memory)
          return
       end if
-      ps%h = res%dt1
+      ps%h = setup%dt1
       ! the largest wn dt1 the check integrates: mode_resolution's limit 2, and Newmark's
       ! stability limit 1 / sqrt(gamma / 2 - beta) when it is conditionally stable
       ps%limit = 2.0_dp
@@ -188,11 +187,12 @@ contains
       ok = combine(ps, model%u0(1:n), res%eng%stuck, 0, res%record_error_stuck)
       if (ok .and. nm > ns) ok = combine(ps, model%u0(1:n), res%eng%free, ns, res%record_error_free)
       res%record_system = judged
+      res%record_checked = .true.
       if (.not. ok) then
+         ! the estimate failed: an error of 1, beyond the limit
          res%record_error = 1.0_dp
          res%record_error_stuck = 1.0_dp
          res%record_error_free = 1.0_dp
-         res%record_resolution = resolution_unresolved
          return
       end if
       if (nm == ns) res%record_error_free = res%record_error_stuck
@@ -204,8 +204,6 @@ contains
       case default
          res%record_error = res%record_error_stuck
       end select
-      res%record_resolution = resolution_resolved
-      if (any(res%record_error > record_error_limit)) res%record_resolution = resolution_unresolved
    end subroutine record_resolution
 
    !> The system the run was in, which the verdict judges: the stuck one when no device slid
@@ -221,7 +219,8 @@ contains
       type(result_type), intent(in) :: res      !! the run's transitions
       logical :: slid
 
-      slid = res%started_sliding .or. any(res%stick_to_slip > 0) .or. any(res%slip_to_stick > 0) &
+      ! a device sliding at t = 0 has one slide more than its stick-to-slip transitions
+      slid = any(res%slip_excursions > res%stick_to_slip) .or. any(res%stick_to_slip > 0) .or. any(res%slip_to_stick > 0) &
              .or. any(res%reversals > 0)
       if (model%n_devices == 0) then
          judged = record_system_structure

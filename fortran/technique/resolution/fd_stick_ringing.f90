@@ -40,7 +40,7 @@ module fd_stick_ringing
    use fd_stiffness, only: general_form
    use fd_friction, only: sticking_stiffness, law_stuck, stuck_dashpot
    use fd_device_state, only: device_state, phase_stick
-   use fd_result, only: result_type, resolution_none, resolution_resolved, resolution_unresolved
+   use fd_result, only: result_type
    implicit none
    private
 
@@ -115,7 +115,7 @@ contains
       real(dp), intent(in) :: beta, gamma           !! Newmark's parameters
       real(dp), intent(in) :: a0, a1                !! C = a0 M + a1 K (K of the springs)
       type(ringing_type), intent(out) :: rg         !! the devices watched
-      type(result_type), intent(inout) :: res       !! stick_freq_error, stick_resolution set
+      type(result_type), intent(inout) :: res       !! stick_freq_error, stick_checked set
       type(error_type), allocatable, intent(out) :: error !! not enough memory
       integer, allocatable :: sp_first(:), sp_list(:), vd_first(:), vd_list(:), di(:), dj(:)
       logical, allocatable :: velocity(:)
@@ -129,7 +129,7 @@ contains
       end if
       nd = model%n_devices
       ns = model%n_springs
-      res%stick_resolution = resolution_none
+      res%stick_checked = .false.
       rg%n = count(sticking_stiffness(model%dev(1:nd)) > 0.0_dp)
       allocate (di(nd), dj(nd), velocity(nd), stat=stat)
       if (stat == 0) then
@@ -159,7 +159,7 @@ contains
       rg%stats = 0.0_dp
       rg%c_start = 0.0_dp
       if (rg%n == 0) return
-      res%stick_resolution = resolution_resolved
+      res%stick_checked = .true.
       q = 0
       nb = 0
       do d = 1, nd
@@ -255,7 +255,7 @@ contains
       real(dp), intent(in) :: beta, gamma           !! Newmark's parameters
       real(dp), intent(in) :: a0, a1                !! C = a0 M + a1 K
       type(ringing_type), intent(out) :: rg         !! the devices watched
-      type(result_type), intent(inout) :: res       !! stick_freq_error, stick_resolution set
+      type(result_type), intent(inout) :: res       !! stick_freq_error, stick_checked set
       type(error_type), allocatable, intent(out) :: error !! not enough memory
       real(dp), allocatable :: phi(:)
       logical, allocatable :: velocity(:)
@@ -264,7 +264,7 @@ contains
       logical :: osc
 
       nd = model%n_devices
-      res%stick_resolution = resolution_none
+      res%stick_checked = .false.
       rg%n = count(sticking_stiffness(model%dev(1:nd)) > 0.0_dp)
       allocate (phi(model%n_dof), velocity(nd), rg%dev(rg%n), rg%k(rg%n), rg%omega(rg%n), rg%pmu(rg%n), &
                 rg%drift(rg%n), rg%c_fixed(rg%n), rg%mr(rg%n), rg%first(rg%n + 1), rg%c_start(rg%n), &
@@ -330,7 +330,7 @@ contains
          end if
       end do
       rg%first(rg%n + 1) = nb + 1
-      if (rg%n > 0) res%stick_resolution = resolution_resolved
+      res%stick_checked = rg%n > 0
    end subroutine general_ringing_init
 
    !> The elements at each node 1..n (node 0, the table, left out) of those with use: the
@@ -395,7 +395,7 @@ contains
       end do
    end subroutine ringing_changed
 
-   !> The end of the run: the stick phases still open measured, the run's stick_resolution.
+   !> The end of the run: the stick phases still open measured (the verdict: fd_warnings).
    subroutine ringing_finish(rg, phase, res)
       type(ringing_type), intent(inout) :: rg       !! the devices watched
       integer, intent(in) :: phase(:)               !! the phases at the end
@@ -406,8 +406,6 @@ contains
       do q = 1, rg%n
          if (phase(rg%dev(q)) == phase_stick) call close_phase(rg, q, res)
       end do
-      res%stick_resolution = resolution_resolved
-      if (any(res%stick_ringing_ratio > 1.0_dp)) res%stick_resolution = resolution_unresolved
    end subroutine ringing_finish
 
    !> The damping integral of watched device q's band devices on its mode.
