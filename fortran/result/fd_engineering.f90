@@ -17,7 +17,7 @@ module fd_engineering
    use fd_model, only: model_type, integration_type, label_len, system_stuck, system_free, &
                        damping_stiffness, damping_rayleigh, source_floor_brace
    use fd_kinematics, only: pair_nodes, devices_are_pairs, device_relative
-   use fd_stiffness, only: add_general_times, influence_of
+   use fd_stiffness, only: stiffness_times, influence_of
    use fd_floors, only: floor_dof
    use fd_excitation, only: excitation_type, excitation_harmonic
    use fd_matrices, only: modes_type, natural_modes, natural_modes_sparse, stiffness_matrix, damping_matrix, &
@@ -307,20 +307,9 @@ contains
       real(dp), intent(in) :: t(:)                 !! (n_dof) the motion
       real(dp), intent(out) :: kt(:)               !! (n_dof) K t
       real(dp), intent(out) :: bt(:)               !! (n_devices) b_d' t
-      real(dp) :: x
-      integer :: i, j, s, d
+      integer :: d
 
-      kt = 0.0_dp
-      do s = 1, model%n_springs
-         i = model%spring_i(s); j = model%spring_j(s)
-         x = 0.0_dp
-         if (i > 0) x = t(i)
-         if (j > 0) x = x - t(j)
-         x = model%spring_k(s)*x
-         if (i > 0) kt(i) = kt(i) + x
-         if (j > 0) kt(j) = kt(j) - x
-      end do
-      call add_general_times(model, t, kt)
+      call stiffness_times(model, t, kt)
       do d = 1, model%n_devices
          bt(d) = device_relative(model, d, t)
       end do

@@ -164,8 +164,8 @@ contains
    !> stick ringing, band alternation): its key, its verdict (when `checked`: 'unresolved'
    !> when a value is above `limit`), and (when it applies) the figures `what` (the DOF or
    !> device of the largest value, d; 0 when the check does not apply) and that value under
-   !> the name `name`.
-   pure subroutine largest_check(c, key, checked, limit, values, what, name, d)
+   !> the name `name`, then the step dt1 [s] when given (a DOF's step error).
+   pure subroutine largest_check(c, key, checked, limit, values, what, name, d, dt1)
       type(check_type), intent(out) :: c                 !! the check
       character(len=*), intent(in) :: key                !! its key
       logical, intent(in) :: checked                     !! the check applies
@@ -174,6 +174,7 @@ contains
       character(len=*), intent(in) :: what               !! 'dof' or 'device'
       character(len=*), intent(in) :: name               !! the values' summary key
       integer, intent(out) :: d                          !! the DOF or device of the largest value
+      real(dp), intent(in), optional :: dt1              !! the step judged [s]
       logical :: beyond
 
       d = 0
@@ -186,20 +187,19 @@ contains
       d = maxloc(values, 1)
       call add_figure(c, what, real(d, dp))
       call add_figure(c, name, values(d))
+      if (present(dt1)) call add_figure(c, 'dt1_s', dt1)
    end subroutine largest_check
 
    !> Whether dt1 resolves a harmonic table motion's steady state (fd_harmonic_resolution).
    pure subroutine harmonic_check(res, c)
       type(result_type), intent(in) :: res   !! the result
       type(check_type), intent(out) :: c     !! the check
-      integer :: d
-
       real(dp) :: dt1
+      integer :: d
 
       dt1 = step_of(res)
       call largest_check(c, 'harmonic_resolution', res%harmonic_checked, harmonic_error_limit, res%harmonic_error, &
-                         'dof', 'harmonic_step_error', d)
-      if (d > 0) call add_figure(c, 'dt1_s', dt1)
+                         'dof', 'harmonic_step_error', d, dt1)
       if (c%verdict /= verdict_warns .or. d == 0) return
       c%warning = 'dt1 = '//trim(es(dt1, 3))//' s takes '//trim(fx(1.0_dp/(res%eng%frequency*dt1), 2))// &
                   ' steps a table period: the step alone moves the linear steady-state amplitude of DOF '// &
@@ -211,14 +211,12 @@ contains
    pure subroutine record_check(res, c)
       type(result_type), intent(in) :: res   !! the result
       type(check_type), intent(out) :: c     !! the check
-      integer :: d
-
       real(dp) :: dt1
+      integer :: d
 
       dt1 = step_of(res)
       call largest_check(c, 'record_resolution', res%record_checked, record_error_limit, res%record_error, 'dof', &
-                         'record_step_error', d)
-      if (d > 0) call add_figure(c, 'dt1_s', dt1)
+                         'record_step_error', d, dt1)
       if (c%verdict /= verdict_warns .or. d == 0) return
       c%warning = 'dt1 = '//trim(es(dt1, 3))//' s does not resolve the record: the step alone moves the peak '// &
                   'linear response of DOF '//trim(fmt_int(d))//' by '//trim(fx(100*res%record_error(d), 1))// &

@@ -39,7 +39,7 @@ module fd_newmark
    use fd_woodbury, only: woodbury_type, woodbury_setup, woodbury_factor, woodbury_correct, lowrank_matvec, &
                           lowrank_form
    use fd_kinematics, only: device_kinematics, add_device, relative_motion, device_forces, device_nodes
-   use fd_stiffness, only: general_form, influence_of
+   use fd_stiffness, only: stiffness_form, influence_of
    use fd_banded, only: spd_system, spd_setup, spd_factor, spd_update_devices, spd_solve, spd_k_matvec, &
                         spd_c_matvec, spd_kc_matvec, spd_auto, spd_dense, spd_banded, spd_is_dense, spd_bandwidth, &
                         spd_copy
@@ -973,8 +973,7 @@ contains
       real(dp), intent(in) :: a0, a1
       integer, intent(in) :: n
       real(dp), intent(in) :: mass(n), du(n), vsum(n)
-      real(dp) :: ek, x, y
-      integer :: i, s
+      integer :: i
 
       e = 0.0_dp
       if (a0 /= 0.0_dp) then
@@ -983,24 +982,7 @@ contains
          end do
          e = a0*e
       end if
-      if (a1 /= 0.0_dp) then
-         ek = 0.0_dp
-         do s = 1, model%n_springs
-            x = 0.0_dp
-            y = 0.0_dp
-            if (model%spring_i(s) > 0) then
-               x = du(model%spring_i(s))
-               y = vsum(model%spring_i(s))
-            end if
-            if (model%spring_j(s) > 0) then
-               x = x - du(model%spring_j(s))
-               y = y - vsum(model%spring_j(s))
-            end if
-            ek = ek + model%spring_k(s)*x*y
-         end do
-         if (model%n_kx > 0) ek = ek + general_form(model, du, vsum)
-         e = e + a1*ek
-      end if
+      if (a1 /= 0.0_dp) e = e + a1*stiffness_form(model, du, vsum)
       if (allocated(model%modal_d)) e = e + lowrank_form(model%modal_u, model%modal_d, vsum, du)
    end function viscous_work
 
@@ -1068,18 +1050,8 @@ contains
    pure real(dp) function strain_energy(model, u) result(e)
       type(model_type), intent(in) :: model
       real(dp), intent(in) :: u(:)
-      real(dp) :: x
-      integer :: s
 
-      e = 0.0_dp
-      do s = 1, model%n_springs
-         x = 0.0_dp
-         if (model%spring_i(s) > 0) x = u(model%spring_i(s))
-         if (model%spring_j(s) > 0) x = x - u(model%spring_j(s))
-         e = e + model%spring_k(s)*x*x
-      end do
-      if (model%n_kx > 0) e = e + general_form(model, u, u)
-      e = 0.5_dp*e
+      e = 0.5_dp*stiffness_form(model, u, u)
    end function strain_energy
 
    !> Elastic energy stored in the devices (each law's: fd_friction's friction_energy).

@@ -38,7 +38,7 @@ module fd_record_resolution
    use fd_kinds, only: dp
    use fd_error, only: error_type, fatal_error, fmt_int, stat_no_memory
    use fd_names, only: technique_step_rule, rule_none, rule_newmark, rule_theta, excitation_record
-   use fd_stiffness, only: add_general_times
+   use fd_stiffness, only: stiffness_times
    use fd_matrices, only: modes_type, modes_kept, mode_damping, mode_participation
    use fd_model, only: model_type
    use fd_friction, only: law_stuck, stuck_dashpot
@@ -159,7 +159,7 @@ contains
       ps%limit = 2.0_dp
       if (technique_step_rule(res%technique) == rule_newmark .and. beta < 0.5_dp*gamma) &
          ps%limit = min(ps%limit, 1.0_dp/sqrt(0.5_dp*gamma - beta))
-      call springs_times(model, model%u0, ps%ku0)
+      call stiffness_times(model, model%u0, ps%ku0)
       ! every mode q'' + c q' + wn^2 q = -g ag (g its participation) from the run's initial
       ! conditions, through the run's dt1 steps (fd_result's count) at the accelerations the
       ! run saw; z: the exact (q, q') and Newmark's (q, q', q'')
@@ -378,26 +378,5 @@ contains
          if (peak(i) >= 0.01_dp*big) err(i) = max(err(i), change(i)/peak(i))
       end do
    end function combine
-
-   !> ku = K u, K the structure's stiffness: the springs (node 0 the table, at rest) and K_x.
-   pure subroutine springs_times(model, u, ku)
-      type(model_type), intent(in) :: model
-      real(dp), intent(in) :: u(:)
-      real(dp), intent(out) :: ku(:)
-      real(dp) :: x
-      integer :: s, i, j
-
-      ku = 0.0_dp
-      do s = 1, model%n_springs
-         i = model%spring_i(s); j = model%spring_j(s)
-         x = 0.0_dp
-         if (i > 0) x = u(i)
-         if (j > 0) x = x - u(j)
-         x = model%spring_k(s)*x
-         if (i > 0) ku(i) = ku(i) + x
-         if (j > 0) ku(j) = ku(j) - x
-      end do
-      call add_general_times(model, u, ku)
-   end subroutine springs_times
 
 end module fd_record_resolution

@@ -37,7 +37,7 @@ module fd_stick_ringing
    use fd_error, only: error_type, fatal_error, fmt_int, stat_no_memory
    use fd_model, only: model_type
    use fd_kinematics, only: moved_mass, device_nodes, devices_are_pairs, add_device, device_relative
-   use fd_stiffness, only: general_form
+   use fd_stiffness, only: stiffness_form
    use fd_friction, only: sticking_stiffness, law_stuck, stuck_dashpot
    use fd_device_state, only: device_state, phase_stick
    use fd_result, only: result_type
@@ -151,13 +151,8 @@ contains
                    rg%c_fixed(rg%n), rg%mr(rg%n), rg%first(rg%n + 1), rg%band_dev(nb), rg%band_shape(nb), &
                    rg%c_start(rg%n), rg%stats(4, nd), stat=stat)
       end if
-      if (stat /= 0) then
-         call fatal_error(error, "not enough memory for the sticking springs of "//trim(fmt_int(rg%n))// &
-                          " devices", stat_no_memory)
-         return
-      end if
-      rg%stats = 0.0_dp
-      rg%c_start = 0.0_dp
+      call ringing_ready(rg, stat, error)
+      if (allocated(error)) return
       if (rg%n == 0) return
       res%stick_checked = .true.
       q = 0
@@ -260,7 +255,7 @@ contains
       real(dp), allocatable :: phi(:)
       logical, allocatable :: velocity(:)
       real(dp) :: k, c, x, wt, zn, y, ek
-      integer :: nd, d, e, q, nb, sp, pass, stat
+      integer :: nd, d, e, q, nb, pass, stat
       logical :: osc
 
       nd = model%n_devices
@@ -269,13 +264,8 @@ contains
       allocate (phi(model%n_dof), velocity(nd), rg%dev(rg%n), rg%k(rg%n), rg%omega(rg%n), rg%pmu(rg%n), &
                 rg%drift(rg%n), rg%c_fixed(rg%n), rg%mr(rg%n), rg%first(rg%n + 1), rg%c_start(rg%n), &
                 rg%stats(4, nd), stat=stat)
-      if (stat /= 0) then
-         call fatal_error(error, "not enough memory for the sticking springs of "//trim(fmt_int(rg%n))// &
-                          " devices", stat_no_memory)
-         return
-      end if
-      rg%stats = 0.0_dp
-      rg%c_start = 0.0_dp
+      call ringing_ready(rg, stat, error)
+      if (allocated(error)) return
       velocity = law_stuck(model%dev(1:nd)%law) == stuck_dashpot
       ! two passes: count the band devices, then list them
       do pass = 1, 2
@@ -303,13 +293,7 @@ contains
             rg%dev(q) = d
             rg%k(q) = k
             rg%mr(q) = moved_mass(model, d)
-            ek = general_form(model, phi, phi)
-            do sp = 1, model%n_springs
-               y = 0.0_dp
-               if (model%spring_i(sp) > 0) y = phi(model%spring_i(sp))
-               if (model%spring_j(sp) > 0) y = y - phi(model%spring_j(sp))
-               ek = ek + model%spring_k(sp)*y*y
-            end do
+            ek = stiffness_form(model, phi, phi)
             c = a0*rg%mr(q) + a1*ek
             rg%omega(q) = sqrt(k/rg%mr(q))
             rg%pmu(q) = model%dev(d)%p*model%dev(d)%mu
@@ -394,6 +378,22 @@ contains
          rg%stats(stat_time:stat_fmax, d) = 0.0_dp
       end do
    end subroutine ringing_changed
+
+   !> The arrays of the devices watched allocated (stat 0: their statistics zeroed), or the
+   !> error of their memory.
+   pure subroutine ringing_ready(rg, stat, error)
+      type(ringing_type), intent(inout) :: rg       !! the devices watched
+      integer, intent(in) :: stat                   !! the allocation's status
+      type(error_type), allocatable, intent(out) :: error !! not enough memory
+
+      if (stat /= 0) then
+         call fatal_error(error, "not enough memory for the sticking springs of "//trim(fmt_int(rg%n))// &
+                          " devices", stat_no_memory)
+         return
+      end if
+      rg%stats = 0.0_dp
+      rg%c_start = 0.0_dp
+   end subroutine ringing_ready
 
    !> The end of the run: the stick phases still open measured (the verdict: fd_warnings).
    subroutine ringing_finish(rg, phase, res)
