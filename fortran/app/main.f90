@@ -24,7 +24,7 @@ program frictiondyn_main
    use fd_error, only: fmt_text
    use fd_textio, only: line_type, read_file_text, split_lines, cr_line_ends
    use fd_undefined, only: undefined_why
-   use fd_statistics, only: technique_counts
+   use fd_statistics, only: technique_counts, technique_setup
    use fd_result, only: result_type
    use fd_matrices, only: modes_type, modes_flexible, modes_rigid, modes_unrestrained
    implicit none
@@ -117,7 +117,8 @@ program frictiondyn_main
    if (allocated(error)) call fail(error%message)
 
    associate (res => ses%res, cfg => ses%cfg, &
-              n => technique_counts(ses%res%newmark, ses%res%exact, ses%res%moreau_jean))
+              n => technique_counts(ses%res%newmark, ses%res%exact, ses%res%moreau_jean), &
+              setup => technique_setup(ses%res%newmark, ses%res%exact, ses%res%moreau_jean))
    ! the warnings the result calls for (fd_warnings: the summary holds the same texts)
    call run_warnings(res, warns)
    do i = 1, size(warns)
@@ -131,7 +132,7 @@ program frictiondyn_main
          trim(undefined_why(res, 'period_stuck_s'))//'); steps dt1 ', &
          n%steps_dt1, ', nested ', n%steps_nested, ', dt2 ', n%steps_dt2, ', finer ', n%steps_finer
    else
-      write (output_unit, '(a,i0,a,i0,a,i0,a,i0)') '  stuck period '//trim(num(res%period_stuck))//' s; steps dt1 ', &
+      write (output_unit, '(a,i0,a,i0,a,i0,a,i0)') '  stuck period '//trim(num(setup%period_stuck))//' s; steps dt1 ', &
          n%steps_dt1, ', nested ', n%steps_nested, ', dt2 ', n%steps_dt2, ', finer ', n%steps_finer
    end if
    call print_periods(res)

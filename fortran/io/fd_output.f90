@@ -7,10 +7,10 @@ module fd_output
    use fd_kinds, only: dp
    use fd_error, only: error_type, fatal_error, fmt_int, fmt_real
    use fd_model, only: model_type, output_type, law_name, technique_name
-   use fd_result, only: result_type, resolution_names, energy_balance_names, record_system_names, history_header
+   use fd_result, only: result_type, record_system_names, history_header, run_setup, setup_of
    use fd_record, only: record_info
-   use fd_warnings, only: warning_text, run_warnings, run_checks, n_checks
-   use fd_check, only: check_type, verdict_names
+   use fd_warnings, only: warning_text, run_checks, n_checks
+   use fd_check, only: check_type, check_warnings, outcome_of
    use fd_undefined, only: undefined_why
    use fd_version, only: frictiondyn_version
    use fd_history_stream, only: format_row, stream_value_width
@@ -365,7 +365,8 @@ contains
    !> The summary of a run as a JSON object (keys documented in docs/namelist.md): its parts in
    !> order, each written by its own routine (the run and its model, each check of the step,
    !> the peaks and phase changes, the technique's statistics, the checks of the run, the
-   !> energy balance, the engineering outputs, the warnings).
+   !> energy balance, the engineering outputs, the warnings). Every verdict is its check
+   !> record's (fd_warnings' run_checks), the steps and the stuck mode the technique's set-up.
    subroutine summary_json(model, res, deck_path, js, record, record2)
       type(model_type), intent(in) :: model                !! the model run
       type(result_type), intent(in) :: res                 !! its result
@@ -374,27 +375,29 @@ contains
       type(record_info), intent(in), optional :: record    !! the record read, if any
       type(record_info), intent(in), optional :: record2   !! the second component's record, if any
       type(json_text) :: jt
+      type(check_type) :: checks(n_checks)
 
+      call run_checks(res, checks)
       allocate (character(len=4096 + 64*(res%n_dof + res%n_devices)*8) :: jt%buf)
       call put(jt, '{'//nl)
       call run_part(jt, deck_path, record, record2)
       call model_part(jt, model, res)
-      call mode_part(jt, res)
-      call harmonic_part(jt, res%harmonic_error, res%harmonic_resolution)
-      call record_step_part(jt, res)
+      call mode_part(jt, res, outcome_of(checks, 'mode_resolution'))
+      call harmonic_part(jt, res%harmonic_error, outcome_of(checks, 'harmonic_resolution'))
+      call record_step_part(jt, res, outcome_of(checks, 'record_resolution'))
       call stick_part(jt, res%stick_freq_error, res%stick_ringing_ratio, res%stick_ringing, res%stick_margin, &
-                      res%stick_resolution)
-      call band_part(jt, res)
+                      outcome_of(checks, 'stick_resolution'))
+      call band_part(jt, res, outcome_of(checks, 'band_resolution'))
       call peaks_part(jt, res)
       if (res%n_bearings > 0) call bearings_part(jt, model, res)
       call statistics_part(jt, res)
       call correctness_part(jt, res)
       call mu_part(jt, res)
-      call energy_part(jt, res)
-      call plausibility_part(jt, res)
+      call energy_part(jt, res, outcome_of(checks, 'energy_balance'))
+      call plausibility_part(jt, checks)
       call engineering_part(jt, model, res)
       call kint(jt, 'samples', res%nout)
-      call warnings_part(jt, res)
+      call warnings_part(jt, checks)
       call put(jt, '  "run_time_s": '//trim(json_real(res%run_time))//nl//'}')
       js = jt%buf(1:jt%pos)
    end subroutine summary_json
@@ -436,83 +439,92 @@ contains
       call put(jt, '},'//nl)
    end subroutine record_item
 
-   !> The model's size, technique and laws, the stuck system's first mode and the steps.
+   !> The model's size, technique and laws, the stuck system's first mode and the steps (the
+   !> technique's set-up).
    subroutine model_part(jt, model, res)
       type(json_text), intent(inout) :: jt     !! the summary
       type(model_type), intent(in) :: model    !! the model run
       type(result_type), intent(in) :: res     !! its result
+      type(run_setup) :: setup
       integer :: d
 
+      setup = setup_of(res)
       call kint(jt, 'n_dof', res%n_dof)
       call kint(jt, 'n_devices', res%n_devices)
       call kv(jt, 'technique', '"'//trim(technique_name(res%technique))//'"')
       call ks(jt, 'device_law', [character(len=keyword_len) :: (law_name(model%dev(d)%law), d=1, model%n_devices)])
-      call kreal(jt, res, 'period_stuck_s', res%period_stuck)
-      call kreal(jt, res, 'xi_stuck', res%xi_stuck)
-      call kreal(jt, res, 'dt1_s', res%dt1)
-      call kreal(jt, res, 'dt2_s', res%dt2)
-      call kreal(jt, res, 'dt_min_s', res%dt_min)
+      call kreal(jt, res, 'period_stuck_s', setup%period_stuck)
+      call kreal(jt, res, 'xi_stuck', setup%xi_stuck)
+      call kreal(jt, res, 'dt1_s', setup%dt1)
+      call kreal(jt, res, 'dt2_s', setup%dt2)
+      call kreal(jt, res, 'dt_min_s', setup%dt_min)
    end subroutine model_part
 
-   !> Whether dt1 resolves the highest modes (fd_mode_resolution).
-   subroutine mode_part(jt, res)
+   !> Whether dt1 resolves the highest modes (fd_mode_resolution): omega_max, omega_max dt1
+   !> and the verdict.
+   subroutine mode_part(jt, res, verdict)
       type(json_text), intent(inout) :: jt     !! the summary
       type(result_type), intent(in) :: res     !! the result
+      character(len=*), intent(in) :: verdict  !! its check's outcome
+      type(run_setup) :: setup
 
+      setup = setup_of(res)
       call kreal(jt, res, 'omega_max_rad_s', res%omega_max)
-      call kreal(jt, res, 'omega_max_dt1', res%omega_max*res%dt1)
-      call kv(jt, 'mode_resolution', '"'//trim(resolution_names(res%mode_resolution))//'"')
+      call kreal(jt, res, 'omega_max_dt1', res%omega_max*setup%dt1)
+      call kv(jt, 'mode_resolution', '"'//trim(verdict)//'"')
    end subroutine mode_part
 
    !> Whether dt1 resolves a harmonic table motion (fd_harmonic_resolution): the step's error
    !> per DOF and the verdict.
-   subroutine harmonic_part(jt, step_error, resolution)
+   subroutine harmonic_part(jt, step_error, verdict)
       type(json_text), intent(inout) :: jt     !! the summary
       real(dp), intent(in) :: step_error(:)    !! per DOF: the step's error in the steady state
-      integer, intent(in) :: resolution        !! resolution_*
+      character(len=*), intent(in) :: verdict  !! its check's outcome
 
       call kr(jt, 'harmonic_step_error', step_error)
-      call kv(jt, 'harmonic_resolution', '"'//trim(resolution_names(resolution))//'"')
+      call kv(jt, 'harmonic_resolution', '"'//trim(verdict)//'"')
    end subroutine harmonic_part
 
    !> Whether dt1 resolves a recorded table motion (fd_record_resolution).
-   subroutine record_step_part(jt, res)
+   subroutine record_step_part(jt, res, verdict)
       type(json_text), intent(inout) :: jt     !! the summary
       type(result_type), intent(in) :: res     !! the result
+      character(len=*), intent(in) :: verdict  !! its check's outcome
 
       call kr(jt, 'record_step_error', res%record_error)
       call kr(jt, 'record_step_error_stuck', res%record_error_stuck)
       call kr(jt, 'record_step_error_free', res%record_error_free)
-      call kv(jt, 'record_resolution', '"'//trim(resolution_names(res%record_resolution))//'"')
+      call kv(jt, 'record_resolution', '"'//trim(verdict)//'"')
       call kv(jt, 'record_step_system', '"'//trim(record_system_names(res%record_system))//'"')
    end subroutine record_step_part
 
    !> Whether dt1 resolves the sticking springs' ringing (fd_stick_ringing): per device the
    !> frequency error, the ringing ratio, amplitude and margin, then the verdict.
-   subroutine stick_part(jt, freq_error, ratio, ringing, margin, resolution)
+   subroutine stick_part(jt, freq_error, ratio, ringing, margin, verdict)
       type(json_text), intent(inout) :: jt     !! the summary
       real(dp), intent(in) :: freq_error(:)    !! 1 - omega~/omega of each sticking spring's mode
       real(dp), intent(in) :: ratio(:)         !! largest ringing / margin of a dephased stick phase
       real(dp), intent(in) :: ringing(:)       !! that phase's ringing amplitude [N]
       real(dp), intent(in) :: margin(:)        !! that phase's margin [N]
-      integer, intent(in) :: resolution        !! resolution_*
+      character(len=*), intent(in) :: verdict  !! its check's outcome
 
       call kr(jt, 'stick_frequency_error', freq_error)
       call kr(jt, 'stick_ringing_ratio', ratio)
       call kr(jt, 'stick_ringing_N', ringing)
       call kr(jt, 'stick_margin_N', margin)
-      call kv(jt, 'stick_resolution', '"'//trim(resolution_names(resolution))//'"')
+      call kv(jt, 'stick_resolution', '"'//trim(verdict)//'"')
    end subroutine stick_part
 
    !> Whether the step damps the velocity-law bands (fd_band_alternation).
-   subroutine band_part(jt, res)
+   subroutine band_part(jt, res, verdict)
       type(json_text), intent(inout) :: jt     !! the summary
       type(result_type), intent(in) :: res     !! the result
+      character(len=*), intent(in) :: verdict  !! its check's outcome
 
       call kr(jt, 'band_x', res%band_x)
       call kr(jt, 'band_alternation_N', res%band_alternation)
       call kr(jt, 'band_alternation_s', res%band_alternation_time, res%band_alternation /= 0.0_dp)
-      call kv(jt, 'band_resolution', '"'//trim(resolution_names(res%band_resolution))//'"')
+      call kv(jt, 'band_resolution', '"'//trim(verdict)//'"')
    end subroutine band_part
 
    !> The peaks per DOF and device, with their times, the devices' phase changes, and each
@@ -679,9 +691,10 @@ contains
    end subroutine mu_part
 
    !> The energy balance and its verdict.
-   subroutine energy_part(jt, res)
+   subroutine energy_part(jt, res, verdict)
       type(json_text), intent(inout) :: jt     !! the summary
       type(result_type), intent(in) :: res     !! the result
+      character(len=*), intent(in) :: verdict  !! its check's outcome
 
       call kreal(jt, res, 'energy_input_J', res%e_input)
       call kreal(jt, res, 'energy_kinetic_J', res%e_kinetic)
@@ -691,22 +704,17 @@ contains
       call kreal(jt, res, 'energy_device_elastic_J', res%e_device)
       call kreal(jt, res, 'energy_residual_J', res%e_residual)
       call kreal(jt, res, 'energy_residual_ratio', res%e_residual_ratio)
-      call kv(jt, 'energy_balance', '"'//trim(energy_balance_names(res%energy_balance))//'"')
+      call kv(jt, 'energy_balance', '"'//trim(verdict)//'"')
    end subroutine energy_part
 
    !> Whether the first period and a record's peak acceleration lie where structures and
    !> earthquakes have theirs (fd_warnings' period and record checks): their verdicts.
-   subroutine plausibility_part(jt, res)
+   subroutine plausibility_part(jt, checks)
       type(json_text), intent(inout) :: jt     !! the summary
-      type(result_type), intent(in) :: res     !! the result
-      type(check_type) :: checks(n_checks)
-      integer :: k
+      type(check_type), intent(in) :: checks(:) !! the run's checks
 
-      call run_checks(res, checks)
-      do k = 1, n_checks
-         if (checks(k)%key /= 'period_plausibility' .and. checks(k)%key /= 'record_plausibility') cycle
-         call kv(jt, trim(checks(k)%key), '"'//trim(verdict_names(checks(k)%verdict))//'"')
-      end do
+      call kv(jt, 'period_plausibility', '"'//trim(outcome_of(checks, 'period_plausibility'))//'"')
+      call kv(jt, 'record_plausibility', '"'//trim(outcome_of(checks, 'record_plausibility'))//'"')
    end subroutine plausibility_part
 
    !> What produced the run, the table motion, the labels, the damping, the modes, the
@@ -865,15 +873,15 @@ contains
       call kr(jt, 'modal_xi_'//name, merge(m%xi, 0.0_dp, m%omega2 > 0.0_dp), m%omega2 > 0.0_dp)
    end subroutine modes_part
 
-   !> The run's warnings (fd_warnings), one string each.
-   subroutine warnings_part(jt, res)
+   !> The run's warnings (fd_warnings: the lines of the checks that warn), one string each.
+   subroutine warnings_part(jt, checks)
       type(json_text), intent(inout) :: jt     !! the summary
-      type(result_type), intent(in) :: res     !! the result
+      type(check_type), intent(in) :: checks(:) !! the run's checks
       type(warning_text), allocatable :: w(:)
       character(len=:), allocatable :: e
       integer :: k
 
-      call run_warnings(res, w)
+      call check_warnings(checks, w)
       call put(jt, '  "warnings": [')
       do k = 1, size(w)
          call json_escape(w(k)%text, e)

@@ -11,7 +11,7 @@ module fd_stiffness
    private
 
    public :: has_general_stiffness, add_general_times, general_form, add_general_dense
-   public :: general_row_bound, influence_of, add_general_entry
+   public :: general_row_bound, influence_of, add_general_entry, stiffness_times, stiffness_form
 
 contains
 
@@ -39,6 +39,48 @@ contains
          if (i /= j) ku(j) = ku(j) + f*model%kx_v(e)*u(i)
       end do
    end subroutine add_general_times
+
+   !> ku = K u, the structure's stiffness: the springs' and K_x's.
+   pure subroutine stiffness_times(model, u, ku)
+      type(model_type), intent(in) :: model  !! the model
+      real(dp), intent(in) :: u(:)           !! a vector over the DOFs
+      real(dp), intent(out) :: ku(:)         !! K u
+      real(dp) :: x
+      integer :: s
+
+      ku = 0.0_dp
+      do s = 1, model%n_springs
+         x = model%spring_k(s)*stretch(model, s, u)
+         if (model%spring_i(s) > 0) ku(model%spring_i(s)) = ku(model%spring_i(s)) + x
+         if (model%spring_j(s) > 0) ku(model%spring_j(s)) = ku(model%spring_j(s)) - x
+      end do
+      call add_general_times(model, u, ku)
+   end subroutine stiffness_times
+
+   !> x' K y, the structure's stiffness: the springs' sum_s k_s (x_i - x_j)(y_i - y_j) (no
+   !> cancellation), then K_x's.
+   pure real(dp) function stiffness_form(model, x, y) result(e)
+      type(model_type), intent(in) :: model  !! the model
+      real(dp), intent(in) :: x(:), y(:)     !! vectors over the DOFs
+      integer :: s
+
+      e = 0.0_dp
+      do s = 1, model%n_springs
+         e = e + model%spring_k(s)*stretch(model, s, x)*stretch(model, s, y)
+      end do
+      if (model%n_kx > 0) e = e + general_form(model, x, y)
+   end function stiffness_form
+
+   !> x_i - x_j of spring s (node 0, the table, at rest).
+   pure real(dp) function stretch(model, s, x) result(d)
+      type(model_type), intent(in) :: model  !! the model
+      integer, intent(in) :: s               !! the spring
+      real(dp), intent(in) :: x(:)           !! a vector over the DOFs
+
+      d = 0.0_dp
+      if (model%spring_i(s) > 0) d = x(model%spring_i(s))
+      if (model%spring_j(s) > 0) d = d - x(model%spring_j(s))
+   end function stretch
 
    !> x' K_x y.
    pure real(dp) function general_form(model, x, y) result(e)

@@ -3,7 +3,8 @@
 !> motion and of the sticking springs' ringing, a velocity-law band's alternation, the energy
 !> balance): its key (the summary key of its verdict), its verdict (not applicable, passed,
 !> warns), the figures it judged by (name and value pairs, named as the summary keys they
-!> come from where there is one) and, when it warns, its warning's one line. The warnings of
+!> come from where there is one), the word the summary writes for its verdict (its outcome:
+!> 'resolved', 'closed', 'passed' ...) and, when it warns, its warning's one line. The warnings of
 !> a run are a filter over its checks (check_warnings): each check that warns gives its
 !> line, in the order of the checks.
 module fd_check
@@ -11,13 +12,14 @@ module fd_check
    implicit none
    private
 
-   public :: check_type, warning_text, add_figure, figure_of, check_warnings, check_warns
+   public :: check_type, warning_text, add_figure, figure_of, check_warnings, check_warns, outcome_of
    public :: verdict_not_applicable, verdict_passed, verdict_warns, verdict_names
-   public :: check_key_len, figure_name_len, max_figures
+   public :: check_key_len, figure_name_len, max_figures, outcome_len
 
    integer, parameter :: check_key_len = 24     !! length of a check's key
    integer, parameter :: figure_name_len = 32   !! length of a figure's name
    integer, parameter :: max_figures = 8        !! figures a check keeps
+   integer, parameter :: outcome_len = 14       !! length of a verdict's word in the summary
 
    integer, parameter :: verdict_not_applicable = 1 !! the check does not apply to the run
    integer, parameter :: verdict_passed = 2         !! it applies and the run passes it
@@ -29,6 +31,7 @@ module fd_check
    type :: check_type
       character(len=check_key_len) :: key = ''      !! the summary key of its verdict
       integer :: verdict = verdict_not_applicable   !! verdict_*
+      character(len=outcome_len) :: outcome = 'not applicable' !! the summary's word for it
       integer :: n_figures = 0                      !! figures used
       character(len=figure_name_len) :: figure_name(max_figures) = '' !! their names
       real(dp) :: figure(max_figures) = 0.0_dp      !! their values
@@ -71,6 +74,21 @@ contains
          return
       end do
    end subroutine figure_of
+
+   !> The summary's word for the verdict of the check of that key (blank: no such check).
+   pure function outcome_of(checks, key) result(word)
+      type(check_type), intent(in) :: checks(:)   !! the run's checks
+      character(len=*), intent(in) :: key         !! a check's key
+      character(len=outcome_len) :: word          !! its outcome
+      integer :: k
+
+      word = ''
+      do k = 1, size(checks)
+         if (checks(k)%key /= key) cycle
+         word = checks(k)%outcome
+         return
+      end do
+   end function outcome_of
 
    !> Whether the check warns (its verdict is verdict_warns and it has a line).
    pure logical function check_warns(c)

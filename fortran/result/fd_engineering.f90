@@ -17,7 +17,7 @@ module fd_engineering
    use fd_model, only: model_type, integration_type, label_len, system_stuck, system_free, &
                        damping_stiffness, damping_rayleigh, source_floor_brace
    use fd_kinematics, only: pair_nodes, devices_are_pairs, device_relative
-   use fd_stiffness, only: add_general_times, influence_of
+   use fd_stiffness, only: stiffness_times, influence_of
    use fd_floors, only: floor_dof
    use fd_excitation, only: excitation_type, excitation_harmonic
    use fd_matrices, only: modes_type, natural_modes, natural_modes_sparse, stiffness_matrix, damping_matrix, &
@@ -307,20 +307,9 @@ contains
       real(dp), intent(in) :: t(:)                 !! (n_dof) the motion
       real(dp), intent(out) :: kt(:)               !! (n_dof) K t
       real(dp), intent(out) :: bt(:)               !! (n_devices) b_d' t
-      real(dp) :: x
-      integer :: i, j, s, d
+      integer :: d
 
-      kt = 0.0_dp
-      do s = 1, model%n_springs
-         i = model%spring_i(s); j = model%spring_j(s)
-         x = 0.0_dp
-         if (i > 0) x = t(i)
-         if (j > 0) x = x - t(j)
-         x = model%spring_k(s)*x
-         if (i > 0) kt(i) = kt(i) + x
-         if (j > 0) kt(j) = kt(j) - x
-      end do
-      call add_general_times(model, t, kt)
+      call stiffness_times(model, t, kt)
       do d = 1, model%n_devices
          bt(d) = device_relative(model, d, t)
       end do
@@ -369,16 +358,11 @@ contains
       real(dp) :: du, dv
       integer :: e, i, j
 
-      f = 0.0_dp
       if (cut == 0 .and. eng%general) then
-         do i = 1, size(u)
-            f = f + eng%kr(i)*(u(i) + eng%a1*v(i))
-         end do
-         do e = 1, size(force)
-            f = f + eng%br(e)*force(e)
-         end do
+         f = general_base_force(eng, u, v, force)
          return
       end if
+      f = 0.0_dp
       do e = eng%sp_first(cut), eng%sp_first(cut + 1) - 1
          i = eng%sp_i(e)
          j = eng%sp_j(e)
@@ -405,6 +389,24 @@ contains
          f = f + eng%xd_coef(e)*force(eng%xd_dev(e))
       end do
    end function cut_force
+
+   !> The base shear of a general model (kr, br: general_base), apart from cut_force, whose
+   !> springs' and devices' sums run at every accepted step.
+   pure real(dp) function general_base_force(eng, u, v, force) result(f)
+      type(engineering_type), intent(in) :: eng  !! the set-up outputs
+      real(dp), intent(in) :: u(:)               !! relative displacements [m]
+      real(dp), intent(in) :: v(:)               !! relative velocities [m/s]
+      real(dp), intent(in) :: force(:)           !! device forces [N]
+      integer :: i, e
+
+      f = 0.0_dp
+      do i = 1, size(u)
+         f = f + eng%kr(i)*(u(i) + eng%a1*v(i))
+      end do
+      do e = 1, size(force)
+         f = f + eng%br(e)*force(e)
+      end do
+   end function general_base_force
 
    !> The model's storey forces beyond its storeys' elements (xs_*, xd_*), by storey.
    subroutine storey_extras(model, eng, stat)
@@ -455,7 +457,7 @@ contains
       real(dp), intent(in) :: s(nd)                 !! device relative displacements [m]
       real(dp), intent(in) :: force(nd)             !! device forces [N]
       real(dp) :: x
-      integer :: i, c, k
+      integer :: i
 
       if (.not. allocated(eng%drift)) return
       do i = 1, nd
@@ -475,6 +477,24 @@ contains
             eng%peak_shear(i) = abs(x); eng%peak_shear_time(i) = t
          end if
       end do
+      ! a building of rigid floors: base shears x, y and torque, corner drifts
+      if (allocated(eng%kt) .or. allocated(eng%peak_corner)) call observe_floor_peaks(eng, t, n, nd, u, v, force)
+   end subroutine observe_engineering
+
+   !> The peaks of a building of rigid floors at one accepted state: the base shears along
+   !> x, y and the base torque (kt, bt), and each storey's largest corner drift (apart from
+   !> observe_engineering, which runs them only for such a building).
+   pure subroutine observe_floor_peaks(eng, t, n, nd, u, v, force)
+      type(engineering_type), intent(inout) :: eng  !! the outputs
+      real(dp), intent(in) :: t                     !! time [s]
+      integer, intent(in) :: n                      !! DOFs
+      integer, intent(in) :: nd                     !! devices
+      real(dp), intent(in) :: u(n)                  !! relative displacements [m]
+      real(dp), intent(in) :: v(n)                  !! relative velocities [m/s]
+      real(dp), intent(in) :: force(nd)             !! device forces [N]
+      real(dp) :: x
+      integer :: i, c, k
+
       if (allocated(eng%kt)) then
          do c = 1, 3
             x = 0.0_dp
@@ -505,7 +525,7 @@ contains
             end if
          end do
       end do
-   end subroutine observe_engineering
+   end subroutine observe_floor_peaks
 
    !> The plan corners of a building of rigid floors: storey q = 2 s - 2 + a (a = 1 along x,
    !> 2 along y) at the corners (x_s +- l_x / 2, y_s +- l_y / 2) of floor s: the motion of

@@ -9,24 +9,32 @@ module fd_result
    use fd_excitation, only: excitation_type
    use fd_engineering, only: engineering_type, engineering_columns
    use fd_matrices, only: modes_type
-   use fd_statistics, only: newmark_stats, event_driven_stats, moreau_jean_stats, max_event_times
+   use fd_statistics, only: newmark_stats, event_driven_stats, moreau_jean_stats, max_event_times, run_setup, &
+                            technique_setup
    implicit none
    private
 
    public :: result_type, max_violation_times, column_name_len, init_result, history_shape, check_finite
    public :: nonfinite_history_error, history_header
-   public :: max_event_times, has_envelope
+   public :: max_event_times, has_envelope, run_setup, setup_of
    public :: resolution_none, resolution_resolved, resolution_unresolved, resolution_names
+   public :: mode_resolution_limit, harmonic_error_limit, record_error_limit
    public :: residual_ratio_limit, roundoff_ratio_limit, energy_balance_of, energy_balance_names
    public :: balance_closed, balance_dissipative, balance_error, balance_digits
    public :: record_system_none, record_system_structure, record_system_stuck, record_system_free, &
              record_system_both, record_system_names
 
    integer, parameter :: max_violation_times = 10 !! first violation times kept
-   ! whether dt1 resolves the highest natural modes (fd_mode_resolution)
+   ! the verdict of a step check (resolution/), as fd_warnings judges it from the check's figures
    integer, parameter :: resolution_none = 1        !! not applicable: no step (event-driven)
-   integer, parameter :: resolution_resolved = 2    !! omega_max dt1 <= 2
-   integer, parameter :: resolution_unresolved = 3  !! omega_max dt1 > 2
+   integer, parameter :: resolution_resolved = 2    !! within its limit
+   integer, parameter :: resolution_unresolved = 3  !! beyond it
+   !> omega_max dt1 above which the highest modes are not resolved (pi steps a period)
+   real(dp), parameter :: mode_resolution_limit = 2.0_dp
+   !> a DOF's harmonic_step_error above which the step does not resolve the steady state
+   real(dp), parameter :: harmonic_error_limit = 0.05_dp
+   !> a DOF's record_step_error above which the step does not resolve the record
+   real(dp), parameter :: record_error_limit = 0.05_dp
    !> their names in the summary
    character(len=14), parameter :: resolution_names(3) = [character(len=14) :: 'not applicable', 'resolved', &
                                                           'unresolved']
@@ -65,23 +73,16 @@ module fd_result
       real(dp), allocatable :: hist(:, :)               !! history (ncol, nout)
       character(len=column_name_len), allocatable :: names(:) !! column names
       character(len=8), allocatable :: units(:)         !! column units
-      ! model data
-      real(dp) :: period_stuck = 0.0_dp    !! first period of the stuck system [s]
-      real(dp) :: xi_stuck = 0.0_dp        !! damping ratio of that mode [-]
-      real(dp) :: dt1 = 0.0_dp             !! main step [s]
-      real(dp) :: dt2 = 0.0_dp             !! step around phase changes [s]
-      real(dp) :: dt_min = 0.0_dp          !! floor of step halving [s]
+      ! the step checks (resolution/): whether each applies to the run (its figures are set);
+      ! their verdicts are the check records' (fd_warnings' run_checks), from those figures
       real(dp) :: omega_max = 0.0_dp       !! highest natural circular frequency integrated at dt1 [rad/s]
-      integer :: mode_resolution = resolution_none !! whether dt1 resolves the highest modes
-      integer :: harmonic_resolution = resolution_none !! whether dt1 resolves the table's frequency
-      integer :: record_resolution = resolution_none !! whether dt1 resolves the recorded table motion
+      logical :: mode_checked = .false.    !! omega_max is set: the highest modes against dt1
+      logical :: harmonic_checked = .false. !! harmonic_error is set: a harmonic table motion
+      logical :: record_checked = .false.  !! record_error is set: a recorded table motion
       integer :: record_system = 1         !! the system record_error judges (record_system_*)
-      integer :: stick_resolution = resolution_none !! whether dt1 resolves the sticking springs'
-                                                    !! ringing (fd_stick_ringing)
-      integer :: band_resolution = resolution_none  !! whether the step damps the velocity-law
-                                                    !! bands (fd_band_alternation)
+      logical :: stick_checked = .false.   !! stick_ringing_ratio is set: sticking springs watched
+      logical :: band_checked = .false.    !! band_alternation is set: velocity-law bands watched
       integer :: technique = 0             !! technique id of the run (fd_names)
-      logical :: started_sliding = .false. !! a device was sliding at t = 0 (Newmark)
       ! peaks per DOF (over every step taken)
       real(dp), allocatable :: peak_u(:)        !! max |u| [m]
       real(dp), allocatable :: peak_u_time(:)   !! time of max |u| [s]
@@ -146,7 +147,6 @@ module fd_result
       real(dp) :: e_input_gross = 0.0_dp !! sum over the steps of |input work of the step|
       real(dp) :: e_residual_ratio = 0.0_dp !! e_residual / e_through (0 when e_through is 0)
       real(dp) :: e_through = 0.0_dp   !! initial energy + e_input_gross (0: the ratio is undefined)
-      integer :: energy_balance = balance_closed !! e_residual_ratio's verdict (energy_balance_of)
       real(dp) :: run_time = 0.0_dp    !! wall-clock time of the integration [s]
       real(dp) :: record_pga = 0.0_dp  !! a record's max |table acceleration| fed to the run [m/s2]
                                        !! (0: no record)
@@ -156,7 +156,16 @@ module fd_result
 
 contains
 
-   !> The summary's energy_balance (res%energy_balance, set once after the run). With a rule
+   !> What the set-up of the technique that ran fixed (fd_statistics' run_setup): its steps
+   !> dt1, dt2, dt_min, the stuck system's first mode, its rule's energy accounting.
+   pure function setup_of(res) result(s)
+      type(result_type), intent(in) :: res   !! the result
+      type(run_setup) :: s                   !! the set-up of its technique
+
+      s = technique_setup(res%newmark, res%exact, res%moreau_jean)
+   end function setup_of
+
+   !> The summary's energy_balance (its check's verdict, fd_warnings). With a rule
    !> whose accounting is exact (exact_accounting: Newmark's average acceleration) the residual
    !> is round-off: balance_closed when |e_residual_ratio| <= roundoff_ratio_limit, else
    !> balance_digits (the integration lost digits: a coupling far stiffer than the step, such
@@ -399,10 +408,12 @@ contains
    subroutine check_finite(res, error)
       type(result_type), intent(in) :: res                !! the result of a run
       type(error_type), allocatable, intent(out) :: error !! the first quantity not finite
+      type(run_setup) :: setup
       integer :: i, j
 
-      call scalar('period_stuck_s', res%period_stuck)
-      call scalar('xi_stuck', res%xi_stuck)
+      setup = setup_of(res)
+      call scalar('period_stuck_s', setup%period_stuck)
+      call scalar('xi_stuck', setup%xi_stuck)
       call scalar('energy_input_J', res%e_input)
       call scalar('energy_kinetic_J', res%e_kinetic)
       call scalar('energy_strain_J', res%e_strain)

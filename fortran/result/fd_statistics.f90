@@ -1,7 +1,10 @@
 !> What each technique did, counted by its own loop in its own small type: Newmark's steps of
 !> each size, refinements and factorizations; the exact technique's sampling intervals,
 !> matrix exponentials, events and accumulation points; Moreau-Jean's steps, factorizations,
-!> patterns and Lemke fallbacks. Each counter means one thing. The summary's counter keys
+!> patterns and Lemke fallbacks. Each counter means one thing. Each type also keeps what the
+!> technique's set-up fixed (run_setup: its steps, the stuck system's first mode, what its rule
+!> means for the energy balance), from which the summary writes period_stuck_s ... dt_min_s and
+!> the energy balance's check judges (technique_setup). The summary's counter keys
 !> (steps_dt1 ... lcp_fallbacks) are one table for every technique: each type
 !> says which of its counters goes under which key (its *_counts function), and a technique's
 !> part of the summary writes that table (fd_output).
@@ -10,7 +13,8 @@ module fd_statistics
    implicit none
    private
 
-   public :: newmark_stats, event_driven_stats, moreau_jean_stats, summary_counts
+   public :: newmark_stats, event_driven_stats, moreau_jean_stats, summary_counts, run_setup
+   public :: technique_setup
    public :: newmark_counts, event_driven_counts, moreau_jean_counts, technique_counts
    public :: count_event, count_accumulation
    public :: max_event_times, max_accumulation_times
@@ -18,9 +22,22 @@ module fd_statistics
    integer, parameter :: max_event_times = 1000       !! first event times kept (exact technique)
    integer, parameter :: max_accumulation_times = 10  !! first accumulation times kept
 
+   !> What a technique's set-up fixed: its steps, the stuck system's first mode (as the
+   !> technique builds its matrices) and what its rule means for the energy balance.
+   type :: run_setup
+      real(dp) :: dt1 = 0.0_dp          !! main step (the exact technique: its sampling interval) [s]
+      real(dp) :: dt2 = 0.0_dp          !! step around phase changes (0: none) [s]
+      real(dp) :: dt_min = 0.0_dp       !! floor of step halving (0: none) [s]
+      real(dp) :: period_stuck = 0.0_dp !! first period of the stuck system [s] (0: none)
+      real(dp) :: xi_stuck = 0.0_dp     !! damping ratio of that mode [-]
+      logical :: damping_method = .false.   !! the rule damps numerically (gamma or theta > 1/2)
+      logical :: exact_accounting = .false. !! its energy residual is round-off (average acceleration)
+   end type run_setup
+
    !> The Newmark technique (fd_newmark).
    type :: newmark_stats
       logical :: ran = .false.         !! the run was Newmark's
+      type(run_setup) :: setup         !! its steps dt1, dt2, dt_min and the stuck system's mode
       integer :: steps_dt1 = 0         !! steps taken whole with dt1
       integer :: steps_dt2 = 0         !! steps taken with dt2
       integer :: steps_nested = 0      !! steps of the sizes between dt1 and dt2 (refinement 'nested')
@@ -40,6 +57,7 @@ module fd_statistics
    !> The exact event-driven technique (fd_event_driven).
    type :: event_driven_stats
       logical :: ran = .false.         !! the run was the exact technique's
+      type(run_setup) :: setup         !! its sampling interval and the stuck system's mode
       integer :: intervals = 0         !! sampling intervals dt1 integrated
       integer :: exponentials = 0      !! matrix exponentials built (one per phase pattern met)
       integer :: events = 0            !! events located: instants at which phases changed
@@ -53,6 +71,7 @@ module fd_statistics
    !> The Moreau-Jean technique (fd_moreau_jean).
    type :: moreau_jean_stats
       logical :: ran = .false.         !! the run was Moreau-Jean's
+      type(run_setup) :: setup         !! its step and the stuck system's mode
       integer :: steps = 0             !! time steps taken (each of dt1)
       integer :: factorizations = 0    !! factorizations of the stick groups' systems
       integer :: patterns = 0          !! stick-slip patterns solved in one-step problems
@@ -119,6 +138,22 @@ contains
          c = moreau_jean_counts(mj)
       end if
    end function technique_counts
+
+   !> What the set-up of the technique that ran fixed (all 0 when none ran).
+   pure function technique_setup(newmark, exact, mj) result(s)
+      type(newmark_stats), intent(in) :: newmark      !! Newmark's statistics
+      type(event_driven_stats), intent(in) :: exact   !! the exact technique's
+      type(moreau_jean_stats), intent(in) :: mj       !! Moreau-Jean's
+      type(run_setup) :: s                            !! its set-up
+
+      if (newmark%ran) then
+         s = newmark%setup
+      else if (exact%ran) then
+         s = exact%setup
+      else if (mj%ran) then
+         s = mj%setup
+      end if
+   end function technique_setup
 
    !> An event at time t (phases changed): counted, its time kept (the first max_event_times).
    pure subroutine count_event(st, t)

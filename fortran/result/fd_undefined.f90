@@ -12,7 +12,7 @@
 !> the time of a peak that stayed 0.
 module fd_undefined
    use fd_kinds, only: dp
-   use fd_result, only: result_type, resolution_none
+   use fd_result, only: result_type, run_setup, setup_of
    use fd_names, only: excitation_harmonic
    implicit none
    private
@@ -30,15 +30,17 @@ contains
       type(result_type), intent(in) :: res   !! the result of a run
       character(len=*), intent(in) :: key    !! a summary key
       character(len=why_len) :: why          !! the reason, or blank
+      type(run_setup) :: setup
 
       why = ''
       select case (key)
       case ('period_stuck_s', 'xi_stuck')
          ! the paper's stuck system: every device a rigid link, also a hysteretic one
-         if (.not. (res%period_stuck > 0.0_dp)) &
+         setup = setup_of(res)
+         if (.not. (setup%period_stuck > 0.0_dp)) &
             why = 'with every device a rigid link the structure has no free DOF or a rigid-body mode'
       case ('omega_max_rad_s', 'omega_max_dt1')
-         if (res%mode_resolution == resolution_none) why = 'the event-driven technique takes no step dt1'
+         if (.not. res%mode_checked) why = 'the event-driven technique takes no step dt1'
       case ('energy_residual_ratio')
          if (.not. (res%e_through > 0.0_dp)) why = 'no energy passed through the structure'
       case ('excitation_frequency_Hz')

@@ -16,11 +16,13 @@
 module fd_warnings
    use fd_kinds, only: dp
    use fd_error, only: fmt_int
-   use fd_result, only: result_type, resolution_none, resolution_unresolved, residual_ratio_limit, &
-                        roundoff_ratio_limit, balance_closed, balance_digits, balance_dissipative, &
+   use fd_result, only: result_type, run_setup, setup_of, resolution_none, resolution_resolved, &
+                        resolution_unresolved, resolution_names, residual_ratio_limit, roundoff_ratio_limit, &
+                        balance_closed, balance_digits, balance_dissipative, energy_balance_of, energy_balance_names, &
+                        mode_resolution_limit, harmonic_error_limit, record_error_limit, &
                         record_system_stuck, record_system_free, record_system_both
    use fd_check, only: check_type, warning_text, add_figure, check_warnings, verdict_not_applicable, &
-                       verdict_passed, verdict_warns
+                       verdict_passed, verdict_warns, verdict_names
    implicit none
    private
 
@@ -49,7 +51,7 @@ contains
       call check_warnings(checks, w)
    end subroutine run_warnings
 
-   !> The checks of a result, each filled from the verdicts and figures the run left in it:
+   !> The checks of a result, each judged here from the figures the run left in it:
    !> the correctness condition, a speed-dependent mu, the highest modes, a harmonic table
    !> motion, a record, the sticking springs' ringing, the velocity-law bands, the energy
    !> balance, the first period's and the record's peak acceleration's plausibility.
@@ -69,19 +71,23 @@ contains
       call record_range_check(res, checks(10))
    end subroutine run_checks
 
-   !> The verdict of a resolution check (resolution_*): not applicable, passed or warns.
-   pure integer function resolution_verdict(resolution) result(verdict)
-      integer, intent(in) :: resolution   !! resolution_none, _resolved or _unresolved
+   !> The verdict of a step check and its word in the summary: not applicable when the check
+   !> did not apply (`checked` false), else 'unresolved' (warns) when a figure is beyond its
+   !> limit (`beyond`), 'resolved' (passed) otherwise.
+   pure subroutine resolution_verdict(c, checked, beyond)
+      type(check_type), intent(inout) :: c   !! the check
+      logical, intent(in) :: checked         !! the check applies (its figures are set)
+      logical, intent(in) :: beyond          !! a figure is beyond its limit
+      integer :: resolution
 
-      select case (resolution)
-      case (resolution_none)
-         verdict = verdict_not_applicable
-      case (resolution_unresolved)
-         verdict = verdict_warns
-      case default
-         verdict = verdict_passed
-      end select
-   end function resolution_verdict
+      resolution = resolution_none
+      c%verdict = verdict_not_applicable
+      if (checked) then
+         resolution = merge(resolution_unresolved, resolution_resolved, beyond)
+         c%verdict = merge(verdict_warns, verdict_passed, beyond)
+      end if
+      c%outcome = resolution_names(resolution)
+   end subroutine resolution_verdict
 
    !> The correctness condition (eqs. 9, 12): steps accepted that violate it.
    pure subroutine correctness_check(res, c)
@@ -92,6 +98,7 @@ contains
 
       c%key = 'correctness_violations'
       c%verdict = merge(verdict_warns, verdict_passed, res%violations > 0)
+      c%outcome = verdict_names(c%verdict)
       call add_figure(c, 'correctness_violations', real(res%violations, dp))
       do k = 1, min(3, res%n_violation_times)   ! the first three; the summary keeps more
          call add_figure(c, 'violation_times_s('//trim(fmt_int(k))//')', res%violation_time(k))
@@ -113,6 +120,7 @@ contains
 
       c%key = 'mu_unconverged_steps'
       c%verdict = merge(verdict_warns, verdict_passed, res%mu_unconverged > 0)
+      c%outcome = verdict_names(c%verdict)
       call add_figure(c, 'mu_unconverged_steps', real(res%mu_unconverged, dp))
       if (c%verdict /= verdict_warns) return
       call add_figure(c, 'mu_unconverged_s', res%mu_unconverged_time)
@@ -123,57 +131,77 @@ contains
                   trim(see('mu-unconverged'))
    end subroutine mu_check
 
-   !> Whether dt1 resolves the highest modes (fd_mode_resolution).
+   !> Whether dt1 resolves the highest modes (fd_mode_resolution): omega_max dt1 against
+   !> mode_resolution_limit.
    pure subroutine mode_check(res, c)
       type(result_type), intent(in) :: res   !! the result
       type(check_type), intent(out) :: c     !! the check
+      real(dp) :: dt1
 
+      dt1 = step_of(res)
       c%key = 'mode_resolution'
-      c%verdict = resolution_verdict(res%mode_resolution)
+      call resolution_verdict(c, res%mode_checked, res%omega_max*dt1 > mode_resolution_limit)
       if (c%verdict == verdict_not_applicable) return
-      call add_figure(c, 'dt1_s', res%dt1)
-      call add_figure(c, 'omega_max_dt1', res%omega_max*res%dt1)
+      call add_figure(c, 'dt1_s', dt1)
+      call add_figure(c, 'omega_max_dt1', res%omega_max*dt1)
       if (c%verdict /= verdict_warns) return
-      c%warning = 'dt1 = '//trim(es(res%dt1, 3))//' s does not resolve the highest modes (shortest period '// &
+      c%warning = 'dt1 = '//trim(es(dt1, 3))//' s does not resolve the highest modes (shortest period '// &
                   trim(es(2*acos(-1.0_dp)/res%omega_max, 3))//' s, omega_max_dt1 = '// &
-                  trim(fx(res%omega_max*res%dt1, 2))//' > 2): peak accelerations may be off; raise n1'// &
+                  trim(fx(res%omega_max*dt1, 2))//' > 2): peak accelerations may be off; raise n1'// &
                   trim(see('mode-resolution'))
    end subroutine mode_check
 
+   !> The main step dt1 of the technique that ran [s] (0: none).
+   pure real(dp) function step_of(res) result(dt1)
+      type(result_type), intent(in) :: res   !! the result
+      type(run_setup) :: setup
+
+      setup = setup_of(res)
+      dt1 = setup%dt1
+   end function step_of
+
    !> The head of a check judged by its largest value per DOF or device (harmonic, record,
-   !> stick ringing, band alternation): its key, its verdict from `resolution`, and (when it
-   !> applies) the figures `what` (the DOF or device of the largest value, d; 0 when the check
-   !> does not apply) and that value under the name `name`.
-   pure subroutine largest_check(c, key, resolution, values, what, name, d)
+   !> stick ringing, band alternation): its key, its verdict (when `checked`: 'unresolved'
+   !> when a value is above `limit`), and (when it applies) the figures `what` (the DOF or
+   !> device of the largest value, d; 0 when the check does not apply) and that value under
+   !> the name `name`, then the step dt1 [s] when given (a DOF's step error).
+   pure subroutine largest_check(c, key, checked, limit, values, what, name, d, dt1)
       type(check_type), intent(out) :: c                 !! the check
       character(len=*), intent(in) :: key                !! its key
-      integer, intent(in) :: resolution                  !! resolution_*
+      logical, intent(in) :: checked                     !! the check applies
+      real(dp), intent(in) :: limit                      !! a value above it: unresolved
       real(dp), allocatable, intent(in) :: values(:)     !! per DOF or device (not allocated: none)
       character(len=*), intent(in) :: what               !! 'dof' or 'device'
       character(len=*), intent(in) :: name               !! the values' summary key
       integer, intent(out) :: d                          !! the DOF or device of the largest value
+      real(dp), intent(in), optional :: dt1              !! the step judged [s]
+      logical :: beyond
 
       d = 0
       c%key = key
-      c%verdict = resolution_verdict(resolution)
+      beyond = .false.
+      if (allocated(values)) beyond = any(values > limit)
+      call resolution_verdict(c, checked, beyond)
       if (c%verdict == verdict_not_applicable .or. .not. allocated(values)) return
       if (size(values) == 0) return
       d = maxloc(values, 1)
       call add_figure(c, what, real(d, dp))
       call add_figure(c, name, values(d))
+      if (present(dt1)) call add_figure(c, 'dt1_s', dt1)
    end subroutine largest_check
 
    !> Whether dt1 resolves a harmonic table motion's steady state (fd_harmonic_resolution).
    pure subroutine harmonic_check(res, c)
       type(result_type), intent(in) :: res   !! the result
       type(check_type), intent(out) :: c     !! the check
+      real(dp) :: dt1
       integer :: d
 
-      call largest_check(c, 'harmonic_resolution', res%harmonic_resolution, res%harmonic_error, 'dof', &
-                         'harmonic_step_error', d)
-      if (d > 0) call add_figure(c, 'dt1_s', res%dt1)
+      dt1 = step_of(res)
+      call largest_check(c, 'harmonic_resolution', res%harmonic_checked, harmonic_error_limit, res%harmonic_error, &
+                         'dof', 'harmonic_step_error', d, dt1)
       if (c%verdict /= verdict_warns .or. d == 0) return
-      c%warning = 'dt1 = '//trim(es(res%dt1, 3))//' s takes '//trim(fx(1.0_dp/(res%eng%frequency*res%dt1), 2))// &
+      c%warning = 'dt1 = '//trim(es(dt1, 3))//' s takes '//trim(fx(1.0_dp/(res%eng%frequency*dt1), 2))// &
                   ' steps a table period: the step alone moves the linear steady-state amplitude of DOF '// &
                   trim(fmt_int(d))//' by '//trim(fx(100*res%harmonic_error(d), 1))//' % (harmonic_step_error > '// &
                   '0.05); raise n1'//trim(see('harmonic-resolution'))
@@ -183,13 +211,14 @@ contains
    pure subroutine record_check(res, c)
       type(result_type), intent(in) :: res   !! the result
       type(check_type), intent(out) :: c     !! the check
+      real(dp) :: dt1
       integer :: d
 
-      call largest_check(c, 'record_resolution', res%record_resolution, res%record_error, 'dof', &
-                         'record_step_error', d)
-      if (d > 0) call add_figure(c, 'dt1_s', res%dt1)
+      dt1 = step_of(res)
+      call largest_check(c, 'record_resolution', res%record_checked, record_error_limit, res%record_error, 'dof', &
+                         'record_step_error', d, dt1)
       if (c%verdict /= verdict_warns .or. d == 0) return
-      c%warning = 'dt1 = '//trim(es(res%dt1, 3))//' s does not resolve the record: the step alone moves the peak '// &
+      c%warning = 'dt1 = '//trim(es(dt1, 3))//' s does not resolve the record: the step alone moves the peak '// &
                   'linear response of DOF '//trim(fmt_int(d))//' by '//trim(fx(100*res%record_error(d), 1))// &
                   ' % (record_step_error > 0.05, '//trim(record_system_text(res%record_system))//'); raise n1'// &
                   trim(see('record-resolution'))
@@ -201,7 +230,7 @@ contains
       type(check_type), intent(out) :: c     !! the check
       integer :: d, more
 
-      call largest_check(c, 'stick_resolution', res%stick_resolution, res%stick_ringing_ratio, 'device', &
+      call largest_check(c, 'stick_resolution', res%stick_checked, 1.0_dp, res%stick_ringing_ratio, 'device', &
                          'stick_ringing_ratio', d)
       if (c%verdict /= verdict_warns .or. d == 0) return
       more = count(res%stick_ringing_ratio > 1.0_dp) - 1
@@ -221,14 +250,14 @@ contains
       character(len=:), allocatable :: s
       integer :: d, more
 
-      call largest_check(c, 'band_resolution', res%band_resolution, res%band_alternation, 'device', &
+      call largest_check(c, 'band_resolution', res%band_checked, 0.0_dp, res%band_alternation, 'device', &
                          'band_alternation_N', d)
       if (c%verdict /= verdict_warns .or. d == 0) return
       more = count(res%band_alternation > 0.0_dp) - 1
       call add_figure(c, 'band_x', res%band_x(d))
       call add_figure(c, 'more_devices', real(more, dp))
       if (res%band_x(d) > 1.0_dp) then
-         s = 'raise n1 until dt1 < '//trim(es(res%dt1/res%band_x(d), 3))//' s or widen eps'
+         s = 'raise n1 until dt1 < '//trim(es(step_of(res)/res%band_x(d), 3))//' s or widen eps'
       else
          s = 'another mode the step does not resolve drives it; raise n1'
       end if
@@ -237,22 +266,28 @@ contains
                   trim(es(res%band_x(d), 3))//trim(likewise(more))//'): '//s//trim(see('band-alternation'))
    end subroutine band_check
 
-   !> Whether the energy balance closes (energy_balance_of): round-off beyond
-   !> roundoff_ratio_limit, or a residual beyond residual_ratio_limit, warns.
+   !> Whether the energy balance closes (energy_balance_of, with what the technique's rule
+   !> means for it: run_setup): round-off beyond roundoff_ratio_limit, or a residual beyond
+   !> residual_ratio_limit, warns.
    pure subroutine energy_check(res, c)
       type(result_type), intent(in) :: res   !! the result
       type(check_type), intent(out) :: c     !! the check
       character(len=:), allocatable :: s
+      type(run_setup) :: setup
+      integer :: balance
 
+      setup = setup_of(res)
+      balance = energy_balance_of(res%e_residual_ratio, setup%damping_method, setup%exact_accounting)
       c%key = 'energy_balance'
-      c%verdict = merge(verdict_passed, verdict_warns, res%energy_balance == balance_closed)
+      c%verdict = merge(verdict_passed, verdict_warns, balance == balance_closed)
+      c%outcome = energy_balance_names(balance)
       call add_figure(c, 'energy_residual_ratio', res%e_residual_ratio)
-      if (res%energy_balance == balance_digits) then
+      if (balance == balance_digits) then
          c%warning = 'the integration lost digits to round-off (|energy_residual_ratio| = '// &
                      trim(es(abs(res%e_residual_ratio), 1))//' > '//trim(es(roundoff_ratio_limit, 1))// &
                      '): a coupling too stiff for dt1; widen eps or soften it'//trim(see('energy-round-off'))
-      else if (res%energy_balance /= balance_closed) then
-         if (res%energy_balance == balance_dissipative) then
+      else if (balance /= balance_closed) then
+         if (balance == balance_dissipative) then
             s = 'numerical damping (gamma or theta > 1/2); raise n1 or use gamma = theta = 1/2'
          else
             s = 'an energy error of the step (Newmark beta /= 1/4 or unstable); raise n1 or use beta = 1/4'
@@ -270,12 +305,14 @@ contains
       type(result_type), intent(in) :: res   !! the result
       real(dp), intent(out) :: t1            !! T1 [s] (0: none)
       character(len=*), intent(out) :: key   !! its summary key
+      type(run_setup) :: setup
       integer :: k
 
       t1 = 0.0_dp
       key = ''
-      if (res%period_stuck > 0.0_dp) then
-         t1 = res%period_stuck
+      setup = setup_of(res)
+      if (setup%period_stuck > 0.0_dp) then
+         t1 = setup%period_stuck
          key = 'period_stuck_s'
          return
       end if
@@ -301,13 +338,11 @@ contains
       call first_period(res, t1, key)
       if (.not. (t1 > 0.0_dp)) return
       call add_figure(c, trim(key), t1)
-      c%verdict = verdict_passed
+      call plausible(c, t1 > period_longest .or. t1 < period_shortest)
       if (t1 > period_longest) then
-         c%verdict = verdict_warns
          c%warning = 'the first period T1 = '//trim(fx(t1, 1))//' s ('//trim(key)//') is beyond 10 s, '// &
                      'longer than structures have: a stiffness in kN/m typed as N/m?'//trim(see('implausible-period'))
       else if (t1 < period_shortest) then
-         c%verdict = verdict_warns
          c%warning = 'the first period T1 = '//trim(es(t1, 2))//' s ('//trim(key)//') is below 0.01 s, '// &
                      'shorter than structures have: masses in t typed as kg, or a stiffness in N/mm typed as N/m?'// &
                      trim(see('implausible-period'))
@@ -328,21 +363,29 @@ contains
       pga = res%record_pga/standard_gravity
       call add_figure(c, 'record.peak_acc_mps2', res%record_pga)
       call add_figure(c, 'pga_g', pga)
-      c%verdict = verdict_passed
+      call plausible(c, pga > pga_largest .or. pga < pga_smallest)
       if (pga > pga_largest) then
-         c%verdict = verdict_warns
          c%warning = 'the record peaks at '//trim(fx(pga, 1))//' g (record.peak_acc_mps2 = '// &
                      trim(es(res%record_pga, 3))//'), beyond 3 g, more than '// &
                      'earthquakes have: a record in cm/s2 read as g or m/s2? set record_units'// &
                      trim(see('implausible-record'))
       else if (pga < pga_smallest) then
-         c%verdict = verdict_warns
          c%warning = 'the record peaks at '//trim(es(pga, 2))//' g (record.peak_acc_mps2 = '// &
                      trim(es(res%record_pga, 3))//'), below 0.005 g, less than '// &
                      'earthquakes have: a record in g or m/s2 read as cm/s2? set record_units, record_scale'// &
                      trim(see('implausible-record'))
       end if
    end subroutine record_range_check
+
+   !> A plausibility check's verdict and its word in the summary: warns when the figure is
+   !> outside what structures and earthquakes have, else passed.
+   pure subroutine plausible(c, outside)
+      type(check_type), intent(inout) :: c   !! the check
+      logical, intent(in) :: outside         !! its figure is outside the range
+
+      c%verdict = merge(verdict_warns, verdict_passed, outside)
+      c%outcome = verdict_names(c%verdict)
+   end subroutine plausible
 
    ! The helpers below return fixed-length text, trimmed where it is used: a function with a
    ! character(len=:), allocatable result keeps its length in a static variable of the caller

@@ -14,11 +14,11 @@ module fd_technique
    use fd_error, only: error_type, fatal_error, fmt_int
    use fd_names, only: technique_newmark, technique_event_driven, technique_moreau_jean, techniques, &
                        keyword_choices, technique_name, law_name, technique_traits_type, technique_traits, &
-                       technique_integrates, technique_step_rule, rule_newmark, rule_theta
+                       technique_integrates, technique_step_rule
    use fd_model, only: model_type, integration_type, source_brace, source_floor_brace, damping_modal
    use fd_step_limits, only: check_step_limits
    use fd_excitation, only: excitation_type, excitation_none
-   use fd_result, only: result_type, energy_balance_of
+   use fd_result, only: result_type
    use fd_run_control, only: run_control
    use fd_newmark, only: run_newmark, newmark_check
    use fd_event_driven, only: run_event_driven, event_driven_check
@@ -163,16 +163,6 @@ contains
       case default
          call unknown_technique(opts%technique, error)
       end select
-      ! the energy balance's verdict; a residual is the method's numerical damping when the
-      ! method damps, and round-off when its accounting is exact (average acceleration) (set
-      ! after the run: each technique's res is intent(out))
-      associate (rule => technique_step_rule(opts%technique))
-         res%energy_balance = energy_balance_of(res%e_residual_ratio, &
-                                                (rule == rule_newmark .and. opts%gamma > 0.5_dp) .or. &
-                                                (rule == rule_theta .and. opts%theta > 0.5_dp), &
-                                                rule == rule_newmark .and. opts%beta == 0.25_dp .and. &
-                                                opts%gamma == 0.5_dp)
-      end associate
       ! whether the step resolves the highest modes: one report for every stepping technique
       if (.not. allocated(error)) call mode_resolution(model, res, error)
       ! and the table's motion: a harmonic's frequency, a record's spectrum

@@ -7,6 +7,7 @@ module test_fd_matrices
    use fd_model, only: model_type, damping_stiffness, damping_rayleigh, law_velocity
    use fd_matrices, only: link_groups, stiffness_matrix, damping_matrix, stuck_first_mode, structure_matrices, &
                           stiffness_pivot
+   use fd_stiffness, only: stiffness_times, stiffness_form
    use test_fd_helpers, only: check_close, check_matrix, pairs_of
    implicit none
    private
@@ -26,6 +27,7 @@ contains
                   new_unittest("link groups", test_link_groups), &
                   new_unittest("link groups through the table", test_link_groups_table), &
                   new_unittest("stiffness matrix", test_stiffness), &
+                  new_unittest("K u and x' K y without the matrix", test_stiffness_products), &
                   new_unittest("damping matrices", test_damping), &
                   new_unittest("stuck mode, device between the masses", test_stuck_linked), &
                   new_unittest("stuck mode, no friction capacity", test_stuck_free), &
@@ -128,6 +130,30 @@ contains
       expected = reshape([120.5_dp, -20.0_dp, -0.5_dp, -20.0_dp, 23.0_dp, -3.0_dp, -0.5_dp, -3.0_dp, 3.5_dp], [3, 3])
       call check_matrix(error, k, expected, 0.0_dp, 'stiffness of a chain with a cross spring (exact)')
    end subroutine test_stiffness
+
+   !> K u and x' K y of the chain with a cross spring above, and K_x's entries (1, 3) and
+   !> (2, 2) added: the stiffness matrix's products, exact in binary (small integers).
+   subroutine test_stiffness_products(error)
+      type(error_type), allocatable, intent(out) :: error
+      type(model_type) :: model
+      real(dp) :: k(3, 3), ku(3)
+      real(dp), parameter :: u(3) = [1.0_dp, -2.0_dp, 4.0_dp], y(3) = [3.0_dp, 0.5_dp, -1.0_dp]
+      integer :: no_devices(2, 0)
+
+      call make_model(model, [1.0_dp, 1.0_dp, 1.0_dp], reshape([1.0_dp, 0.0_dp, 100.0_dp, 2.0_dp, 1.0_dp, 20.0_dp, &
+                      3.0_dp, 2.0_dp, 3.0_dp, 3.0_dp, 1.0_dp, 0.5_dp], [3, 4]), no_devices)
+      model%n_kx = 2
+      model%kx_i = [1, 2]
+      model%kx_j = [3, 2]
+      model%kx_v = [-2.0_dp, 7.0_dp]
+      call stiffness_matrix(model, k)
+      call stiffness_times(model, u, ku)
+      call check(error, all(ku == matmul(k, u)), 'K u')
+      if (allocated(error)) return
+      call check(error, stiffness_form(model, u, y), dot_product(u, matmul(k, y)), "x' K y")
+      if (allocated(error)) return
+      call check(error, stiffness_form(model, u, y), stiffness_form(model, y, u), "x' K y = y' K x")
+   end subroutine test_stiffness_products
 
    !> K positive definite or not, by the banded factor in the DOFs' own ordering (a chain has
    !> band 1 either way): a grounded chain passes; the free chain 1 - 2 - 3 (pivots k, k/2...

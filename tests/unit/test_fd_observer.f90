@@ -77,7 +77,7 @@ contains
       exc%dt_record = 0.01_dp
       exc%duration = 0.0123_dp
       opts%n1 = 20
-      call observer_init(model, exc, opts, res%period_stuck, res, obs, err)
+      call observer_init(model, exc, opts, 0.0_dp, res, obs, err)
       if (allocated(err)) call test_failed(error, err%message)
    end subroutine setup
 
@@ -293,7 +293,7 @@ contains
       opts%n1 = 20
       ctl%buffer => buf
       ctl%keep = .false.
-      call observer_init(model, exc, opts, res%period_stuck, res, obs, err, ctl)
+      call observer_init(model, exc, opts, 0.0_dp, res, obs, err, ctl)
       if (allocated(err)) call test_failed(error, err%message)
       if (allocated(error)) return
       call check(error, size(res%hist, 2) == 0 .and. res%nout == 3, 'no rows in the result')
@@ -343,7 +343,7 @@ contains
       call select_history(ctl, [3], [2], 3, 2, err)
       if (allocated(err)) call test_failed(error, err%message)
       if (allocated(error)) return
-      call observer_init(model, exc, opts, res%period_stuck, res, obs, err, ctl)
+      call observer_init(model, exc, opts, 0.0_dp, res, obs, err, ctl)
       if (allocated(err)) call test_failed(error, err%message)
       if (allocated(error)) return
       call check(error, res%ncol == 2 + 3 + 4 + 3 + 2, 'columns: t, ag, 3 of DOF 3, 4 of device 2, 3 + 2 maxima')
@@ -447,7 +447,7 @@ contains
          exc%dt_record = 0.01_dp
          exc%duration = 0.0123_dp
          opts%n1 = 20
-         call observer_init(model, exc, opts, res%period_stuck, res, obs, err)
+         call observer_init(model, exc, opts, 0.0_dp, res, obs, err)
          if (allocated(err)) call test_failed(error, err%message)
       end subroutine reinit
    end subroutine test_device_work
@@ -478,7 +478,7 @@ contains
       opts%n1 = 20
       ctl%keep = .false.
       allocate (memory_sink :: ctl%sink)
-      call observer_init(model, exc, opts, res%period_stuck, res, obs, err, ctl)
+      call observer_init(model, exc, opts, 0.0_dp, res, obs, err, ctl)
       if (allocated(err)) call test_failed(error, err%message)
       if (allocated(error)) return
       call observe_sample(obs, res, 0.0_dp, -0.5_dp, [1.0_dp, 2.0_dp], [3.0_dp, 4.0_dp], [0.0_dp, 0.0_dp], &

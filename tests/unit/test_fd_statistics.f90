@@ -6,7 +6,7 @@ module test_fd_statistics
    use testdrive, only: new_unittest, unittest_type, error_type, check
    use fd_kinds, only: dp
    use fd_statistics, only: newmark_stats, event_driven_stats, moreau_jean_stats, summary_counts, &
-                            technique_counts, count_event, count_accumulation, max_event_times, &
+                            technique_counts, technique_setup, run_setup, count_event, count_accumulation, max_event_times, &
                             max_accumulation_times
    implicit none
    private
@@ -20,7 +20,8 @@ contains
 
       testsuite = [ &
                   new_unittest("events: all counted, the first times kept", test_events), &
-                  new_unittest("each technique's counters under the summary's keys", test_counts) &
+                  new_unittest("each technique's counters under the summary's keys", test_counts), &
+                  new_unittest("the set-up of the technique that ran", test_setup) &
                   ]
    end subroutine collect_statistics
 
@@ -44,6 +45,27 @@ contains
                  st%n_accumulation_times == max_accumulation_times .and. st%accumulation_time(1) == 1.0_dp, &
                  'accumulation points')
    end subroutine test_events
+
+   !> None ran: zeros; the technique that ran gives its steps and stuck mode, not another's.
+   subroutine test_setup(error)
+      type(error_type), allocatable, intent(out) :: error
+      type(newmark_stats) :: nm
+      type(event_driven_stats) :: ed
+      type(moreau_jean_stats) :: mj
+      type(run_setup) :: s
+
+      nm%setup%dt1 = 0.02_dp        ! counted only once Newmark ran
+      mj%setup%dt1 = 0.005_dp
+      mj%setup%period_stuck = 0.4_dp
+      mj%setup%damping_method = .true.
+      s = technique_setup(nm, ed, mj)
+      call check(error, s%dt1 == 0.0_dp .and. s%period_stuck == 0.0_dp .and. .not. s%damping_method, 'none ran')
+      if (allocated(error)) return
+      mj%ran = .true.
+      s = technique_setup(nm, ed, mj)
+      call check(error, s%dt1 == 0.005_dp .and. s%period_stuck == 0.4_dp .and. s%damping_method .and. &
+                 s%dt2 == 0.0_dp .and. .not. s%exact_accounting, "Moreau-Jean's")
+   end subroutine test_setup
 
    subroutine test_counts(error)
       type(error_type), allocatable, intent(out) :: error

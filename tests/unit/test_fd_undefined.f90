@@ -4,7 +4,7 @@
 module test_fd_undefined
    use testdrive, only: new_unittest, unittest_type, error_type, check
    use fd_kinds, only: dp
-   use fd_result, only: result_type, resolution_none, resolution_resolved
+   use fd_result, only: result_type
    use fd_names, only: excitation_harmonic, excitation_record
    use fd_undefined, only: undefined_why
    implicit none
@@ -33,8 +33,9 @@ contains
                                                  'excitation_frequency_Hz', 'peak_base_shear_time_s', 'peak_u_m']
       integer :: k
 
-      res%period_stuck = 0.3_dp
-      res%mode_resolution = resolution_resolved
+      res%newmark%ran = .true.
+      res%newmark%setup%period_stuck = 0.3_dp
+      res%mode_checked = .true.
       res%e_through = 12.0_dp
       res%eng%excitation = excitation_harmonic
       res%mu_unconverged = 1
@@ -53,8 +54,9 @@ contains
       type(error_type), allocatable, intent(out) :: error
       type(result_type) :: res
 
-      res%period_stuck = 0.0_dp
-      res%mode_resolution = resolution_none
+      res%exact%ran = .true.
+      res%exact%setup%period_stuck = 0.0_dp
+      res%mode_checked = .false.
       res%e_through = 0.0_dp
       res%eng%excitation = excitation_record
       res%mu_unconverged = 0

@@ -5,8 +5,7 @@
 module test_fd_warnings
    use testdrive, only: new_unittest, unittest_type, error_type, check
    use fd_kinds, only: dp
-   use fd_result, only: result_type, resolution_unresolved, balance_dissipative, balance_error, balance_digits, &
-                        record_system_both
+   use fd_result, only: result_type, record_system_both
    use fd_warnings, only: warning_text, run_warnings
    implicit none
    private
@@ -64,8 +63,9 @@ contains
       type(result_type) :: res
       type(warning_text), allocatable :: w(:)
 
-      res%band_resolution = resolution_unresolved
-      res%dt1 = 0.01_dp
+      res%band_checked = .true.
+      res%newmark%ran = .true.
+      res%newmark%setup%dt1 = 0.01_dp
       res%band_alternation = [0.5_dp, 0.0_dp, 2.5_dp]
       res%band_alternation_time = [0.1_dp, 0.0_dp, 0.125_dp]
       res%band_x = [2.0_dp, 0.5_dp, 4.0_dp]
@@ -83,7 +83,8 @@ contains
       type(result_type) :: res
       type(warning_text), allocatable :: w(:)
 
-      res%energy_balance = balance_dissipative
+      res%newmark%ran = .true.
+      res%newmark%setup%damping_method = .true.   ! gamma > 1/2: a positive residual is its damping
       res%e_residual_ratio = 0.0734_dp
       call run_warnings(res, w)
       call check(error, size(w), 1)
@@ -92,8 +93,7 @@ contains
                  '0.05): numerical damping (gamma or theta > 1/2); raise n1 or use gamma = theta = 1/2; '// &
                  'see docs/warnings.md#energy-balance')
       if (allocated(error)) return
-      res%energy_balance = balance_error
-      res%e_residual_ratio = -0.0734_dp
+      res%e_residual_ratio = -0.0734_dp   ! energy created: an error of the step
       call run_warnings(res, w)
       call check(error, index(w(1)%text, 'the integration created 7.3 % of the energy') == 1 .and. &
                  index(w(1)%text, 'an energy error of the step') > 0, w(1)%text)
@@ -107,10 +107,10 @@ contains
       type(result_type) :: res
       type(warning_text), allocatable :: w(:)
 
-      res%energy_balance = balance_error
       res%e_residual_ratio = -1.0e40_dp
-      res%stick_resolution = resolution_unresolved
-      res%dt1 = 0.2_dp
+      res%stick_checked = .true.
+      res%newmark%ran = .true.
+      res%newmark%setup%dt1 = 0.2_dp
       res%stick_freq_error = [0.5_dp]
       res%stick_ringing = [1.0e45_dp]
       res%stick_margin = [0.0_dp]
@@ -133,14 +133,15 @@ contains
       type(result_type) :: res
       type(warning_text), allocatable :: w(:)
 
-      res%period_stuck = 31.6_dp
+      res%newmark%ran = .true.
+      res%newmark%setup%period_stuck = 31.6_dp
       call run_warnings(res, w)
       call check(error, size(w), 1)
       if (allocated(error)) return
       call check(error, w(1)%text, 'the first period T1 = 31.6 s (period_stuck_s) is beyond 10 s, longer than '// &
                  'structures have: a stiffness in kN/m typed as N/m?; see docs/warnings.md#implausible-period')
       if (allocated(error)) return
-      res%period_stuck = 3.2e-3_dp
+      res%newmark%setup%period_stuck = 3.2e-3_dp
       call run_warnings(res, w)
       call check(error, size(w), 1)
       if (allocated(error)) return
@@ -148,11 +149,11 @@ contains
                  'than structures have: masses in t typed as kg, or a stiffness in N/mm typed as N/m?; '// &
                  'see docs/warnings.md#implausible-period')
       if (allocated(error)) return
-      res%period_stuck = 0.3_dp
+      res%newmark%setup%period_stuck = 0.3_dp
       call run_warnings(res, w)
       call check(error, size(w), 0)
       if (allocated(error)) return
-      res%period_stuck = 0.0_dp
+      res%newmark%setup%period_stuck = 0.0_dp
       call run_warnings(res, w)
       call check(error, size(w), 0)
       if (allocated(error)) return
@@ -212,27 +213,28 @@ contains
       res%mu_unconverged = 123456
       res%mu_unconverged_time = 12345.678_dp
       res%mu_misfit = 1.234e-3_dp
-      res%dt1 = 1.234e-3_dp
-      res%mode_resolution = resolution_unresolved
+      res%newmark%ran = .true.
+      res%newmark%setup%dt1 = 1.234e-3_dp
+      res%mode_checked = .true.
       res%omega_max = 1.234e5_dp
-      res%harmonic_resolution = resolution_unresolved
+      res%harmonic_checked = .true.
       res%harmonic_error = [0.1_dp, 12.345_dp]
       res%eng%frequency = 0.25_dp
-      res%record_resolution = resolution_unresolved
+      res%record_checked = .true.
       res%record_error = [0.1_dp, 12.345_dp]
       res%record_system = record_system_both
-      res%stick_resolution = resolution_unresolved
+      res%stick_checked = .true.
       res%stick_ringing_ratio = [12345.67_dp, 2.0_dp, 3.0_dp]
       res%stick_ringing = [1.234e5_dp, 1.0_dp, 1.0_dp]
       res%stick_margin = [1.234e2_dp, 1.0_dp, 1.0_dp]
       res%stick_freq_error = [0.5_dp, 0.1_dp, 0.1_dp]
-      res%band_resolution = resolution_unresolved
+      res%band_checked = .true.
       res%band_alternation = [1.234e4_dp, 1.0_dp, 1.0_dp]
       res%band_alternation_time = [1.234e1_dp, 1.0_dp, 1.0_dp]
       res%band_x = [1.234e3_dp, 1.0_dp, 1.0_dp]
-      res%energy_balance = balance_digits
-      res%e_residual_ratio = 1.234e-9_dp
-      res%period_stuck = 1.234e5_dp
+      res%newmark%setup%exact_accounting = .true.   ! round-off beyond 1e-8: digits lost
+      res%e_residual_ratio = 1.234e-5_dp
+      res%newmark%setup%period_stuck = 1.234e5_dp
       res%record_pga = 1.234e7_dp
       call run_warnings(res, w)
       call check(error, size(w), 10)
@@ -242,7 +244,7 @@ contains
                     index(w(k)%text, '; see docs/warnings.md#') > 0, w(k)%text)
          if (allocated(error)) return
       end do
-      res%energy_balance = balance_error
+      res%newmark%setup%exact_accounting = .false.
       res%e_residual_ratio = -1234.5_dp
       call run_warnings(res, w)
       k = size(w)

@@ -156,14 +156,12 @@ contains
          return
       end if
       associate (st => w%st, t => w%t, h => w%h, t_end => w%t_end)
-         call structure_matrices(model, st%k, st%c, res%period_stuck, res%xi_stuck, error)
+         call structure_matrices(model, st%k, st%c, res%exact%setup%period_stuck, res%exact%setup%xi_stuck, error)
          if (allocated(error)) return
-         call observer_init(model, exc, opts, res%period_stuck, res, w%obs, error, ctl)
+         call observer_init(model, exc, opts, res%exact%setup%period_stuck, res, w%obs, error, ctl)
          if (allocated(error)) return
          h = exc%dt_record/opts%n1
-         res%dt1 = h
-         res%dt2 = 0.0_dp
-         res%dt_min = 0.0_dp
+         res%exact%setup%dt1 = h
          t_end = w%obs%nsteps*h
          res%exact%ran = .true.
          res%exact%intervals = w%obs%nsteps

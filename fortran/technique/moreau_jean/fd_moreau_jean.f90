@@ -181,14 +181,13 @@ contains
             w%mr2 = model%mass*model%influence2
          end if
       end if
-      call observer_init(model, exc, opts, res%period_stuck, res, w%obs, error, ctl)
+      call observer_init(model, exc, opts, res%moreau_jean%setup%period_stuck, res, w%obs, error, ctl)
       if (allocated(error)) return
       th = opts%theta
       h = exc%dt_record/opts%n1
       res%moreau_jean%ran = .true.
-      res%dt1 = h
-      res%dt2 = 0.0_dp
-      res%dt_min = 0.0_dp
+      res%moreau_jean%setup%dt1 = h
+      res%moreau_jean%setup%damping_method = th > 0.5_dp   ! theta > 1/2 damps
       if (w%general) then
          call dense_run(model, exc, opts, w, res, error)
          if (allocated(error)) return
@@ -340,12 +339,12 @@ contains
          w%a0 = model%rayleigh_a0
          w%a1 = model%rayleigh_a1
       end select
-      res%period_stuck = 0.0_dp
-      res%xi_stuck = 0.0_dp
+      res%moreau_jean%setup%period_stuck = 0.0_dp
+      res%moreau_jean%setup%xi_stuck = 0.0_dp
       if (.not. allocated(eig_error)) then
-         res%period_stuck = period
+         res%moreau_jean%setup%period_stuck = period
          om = 2.0_dp*pi/period
-         res%xi_stuck = (w%a0 + w%a1*om**2)/(2.0_dp*om)
+         res%moreau_jean%setup%xi_stuck = (w%a0 + w%a1*om**2)/(2.0_dp*om)
       end if
       allocate (w%u(n), w%v(n), w%u1(n), w%v1(n), w%acc(n), w%r(n), w%du(n), w%kx(n), w%rabs(n), &
                 w%s(nd), w%sd(nd), w%force(nd), w%phase0(nd), w%phase1(nd), w%counted(nd), w%pending(nd), &
@@ -382,7 +381,8 @@ contains
       nd = w%nd
       call dense_setup(w%di, model, error)
       if (allocated(error)) return
-      call structure_damping(model, w%a0, w%a1, res%period_stuck, res%xi_stuck, error)
+      call structure_damping(model, w%a0, w%a1, res%moreau_jean%setup%period_stuck, &
+                             res%moreau_jean%setup%xi_stuck, error)
       if (allocated(error)) return
       w%ne = nd
       allocate (w%u(n), w%v(n), w%u1(n), w%v1(n), w%acc(n), w%r(n), w%du(n), w%kx(n), w%rabs(n), w%mr(n), &

@@ -46,11 +46,11 @@ module fd_band_alternation
    use fd_kinematics, only: add_device_abs, device_abs_inverse_mass_relative
    use fd_friction, only: holds_when_stuck, law_checks_band_alternation
    use fd_device_state, only: device_state, phase_stick
-   use fd_result, only: result_type, resolution_none, resolution_resolved, resolution_unresolved
+   use fd_result, only: result_type
    implicit none
    private
 
-   public :: alternation_type, band_watch, alternation_init, alternation_step, alternation_finish
+   public :: alternation_type, band_watch, alternation_init, alternation_step
    public :: alternation_floor, alternation_run
 
    !> Share of P mu below which an alternation is not counted.
@@ -82,7 +82,7 @@ module fd_band_alternation
 
 contains
 
-   !> The devices watched, every device's x at dt1 (res%band_x), and band_resolution
+   !> The devices watched, every device's x at dt1 (res%band_x), and band_checked
    !> 'resolved' when there is one ('not applicable' otherwise). x of a device between nodes
    !> i and j: (1 - gamma) dt1 (c_i / m_i + c_j / m_j), c_n the band couplings P mu(eps) / eps
    !> of every velocity-law device at node n (the table, n = 0, adds nothing), so that the
@@ -93,13 +93,13 @@ contains
       real(dp), intent(in) :: dt1                   !! main step [s]
       real(dp), intent(in) :: gamma                 !! Newmark's gamma
       type(alternation_type), intent(out) :: al     !! the devices watched
-      type(result_type), intent(inout) :: res       !! band_x and band_resolution set
+      type(result_type), intent(inout) :: res       !! band_x and band_checked set
       type(error_type), allocatable, intent(out) :: error !! not enough memory
       real(dp), allocatable :: c(:)
       integer :: d, q, stat
       real(dp) :: pmu, scale
 
-      res%band_resolution = resolution_none
+      res%band_checked = .false.
       al%n = count(watched(model%dev(1:model%n_devices)))
       allocate (al%w(al%n), c(model%n_dof), stat=stat)
       if (stat /= 0) then
@@ -122,7 +122,7 @@ contains
       do q = 1, al%n
          res%band_x(al%w(q)%dev) = device_abs_inverse_mass_relative(model, al%w(q)%dev, c, scale)
       end do
-      if (al%n > 0) res%band_resolution = resolution_resolved
+      res%band_checked = al%n > 0
    end subroutine alternation_init
 
    !> A device the step may leave alternating: the velocity law with a band coupling,
@@ -188,13 +188,5 @@ contains
          end associate
       end do
    end subroutine alternation_step
-
-   !> band_resolution 'unresolved' when a device's alternation was counted.
-   pure subroutine alternation_finish(res)
-      type(result_type), intent(inout) :: res       !! band_resolution, from band_alternation
-
-      if (res%band_resolution == resolution_resolved .and. any(res%band_alternation > 0.0_dp)) &
-         res%band_resolution = resolution_unresolved
-   end subroutine alternation_finish
 
 end module fd_band_alternation

@@ -25,15 +25,14 @@ module fd_harmonic_resolution
    use fd_names, only: technique_step_rule, rule_none, rule_theta, excitation_harmonic
    use fd_matrices, only: modes_type, modes_kept, mode_damping, mode_participation
    use fd_model, only: model_type
-   use fd_result, only: result_type, resolution_none, resolution_resolved, resolution_unresolved
+   use fd_result, only: result_type, run_setup, setup_of, harmonic_error_limit
    implicit none
    private
 
+   !> harmonic_error_limit: the relative change of a DOF's linear steady-state amplitude above
+   !> which the step does not resolve the table's frequency (fd_result's, by which fd_warnings
+   !> judges)
    public :: harmonic_resolution, newmark_response, theta_response, harmonic_error_limit
-
-   !> relative change of a DOF's linear steady-state amplitude above which the step does not
-   !> resolve the table's frequency
-   real(dp), parameter :: harmonic_error_limit = 0.05_dp
 
 contains
 
@@ -90,8 +89,8 @@ contains
 
    !> Sets res%harmonic_error (per DOF, the larger over the stuck and the free system of
    !> | |U_step| / |U| - 1 |, for the DOFs whose amplitude |U| is at least 1 % of the largest)
-   !> and res%harmonic_resolution, from the summary's modes (res%eng), the table's frequency,
-   !> res%dt1 and Newmark's beta, gamma.
+   !> and res%harmonic_checked, from the summary's modes (res%eng), the table's frequency,
+   !> the technique's dt1 and Newmark's beta, gamma (the verdict: fd_warnings).
    subroutine harmonic_resolution(model, beta, gamma, theta, res, error)
       type(model_type), intent(in) :: model               !! the model (masses)
       real(dp), intent(in) :: beta, gamma                 !! Newmark's parameters
@@ -100,14 +99,18 @@ contains
       type(error_type), allocatable, intent(out) :: error !! not enough memory
       complex(dp), allocatable :: ue(:), ud(:)
       integer :: n, stat
-      logical :: any_system, ok
+      type(run_setup) :: setup
+      real(dp) :: dt1
+      logical :: any_system
 
       n = model%n_dof
-      res%harmonic_resolution = resolution_none
+      res%harmonic_checked = .false.
       res%harmonic_error = 0.0_dp               ! allocated with the summary (init_result)
+      setup = setup_of(res)
+      dt1 = setup%dt1
       if (technique_step_rule(res%technique) == rule_none) return
       if (res%eng%excitation /= excitation_harmonic) return
-      if (res%dt1 <= 0.0_dp .or. .not. (res%eng%frequency > 0.0_dp)) return
+      if (dt1 <= 0.0_dp .or. .not. (res%eng%frequency > 0.0_dp)) return
       allocate (ue(n), ud(n), stat=stat)
       if (stat /= 0) then
          call fatal_error(error, "the step against the table's frequency: not enough memory for "// &
@@ -115,13 +118,9 @@ contains
          return
       end if
       any_system = .false.
-      ok = .true.
       call one_system(res%eng%stuck)
       call one_system(res%eng%free)
-      if (.not. any_system) return
-      res%harmonic_resolution = resolution_resolved
-      if (.not. ok .or. any(res%harmonic_error > harmonic_error_limit)) &
-         res%harmonic_resolution = resolution_unresolved
+      res%harmonic_checked = any_system
 
    contains
 
@@ -142,15 +141,14 @@ contains
             c = mode_damping(modes, k, res%eng%a0)
             gamma_k = mode_participation(modes, k, model%mass(1:n), model%influence)
             if (technique_step_rule(res%technique) == rule_theta) then
-               call theta_response(w, wn, c, res%dt1, theta, hd, ok_k)
+               call theta_response(w, wn, c, dt1, theta, hd, ok_k)
             else
-               call newmark_response(w, wn, c, res%dt1, beta, gamma, hd, ok_k)
+               call newmark_response(w, wn, c, dt1, beta, gamma, hd, ok_k)
             end if
             he = cmplx(wn*wn - w*w, c*w, dp)
             if (.not. ok_k .or. he == (0.0_dp, 0.0_dp)) then
                ! the steps see a constant force, or an undamped resonance (no steady state):
-               ! no step resolves its amplitude
-               ok = .false.
+               ! no step resolves its amplitude (an error of 1, beyond the limit)
                res%harmonic_error = 1.0_dp
                return
             end if
@@ -161,7 +159,6 @@ contains
          ! checked build): the estimate failed, which is not a "resolved"
          if (.not. (all(ieee_is_finite(real(ue))) .and. all(ieee_is_finite(aimag(ue))) .and. &
                     all(ieee_is_finite(real(ud))) .and. all(ieee_is_finite(aimag(ud))))) then
-            ok = .false.
             res%harmonic_error = 1.0_dp
             return
          end if

@@ -25,20 +25,20 @@ module fd_mode_resolution
    use fd_matrices, only: stiffness_matrix
    use fd_linalg, only: generalized_eigen
    use fd_modes, only: highest_eigenvalue
-   use fd_result, only: result_type, resolution_none, resolution_resolved, resolution_unresolved
+   use fd_result, only: result_type, run_setup, setup_of, resolution_limit => mode_resolution_limit
    implicit none
    private
 
+   !> resolution_limit: omega_max dt1 above which the highest modes are not resolved (pi
+   !> steps a period), fd_result's mode_resolution_limit, by which fd_warnings judges
    public :: mode_resolution, resolution_limit
-
-   !> omega_max dt1 above which the highest modes are not resolved (pi steps a period).
-   real(dp), parameter :: resolution_limit = 2.0_dp
 
 contains
 
    !> Sets res%omega_max (the highest natural circular frequency of the system the technique
    !> integrates at dt1, a lower bound accurate to 1e-4: fd_modes' Lanczos) and
-   !> res%mode_resolution, from res%technique and res%dt1.
+   !> res%mode_checked, from res%technique and its dt1; the verdict is the check's
+   !> (fd_warnings: omega_max dt1 against resolution_limit).
    subroutine mode_resolution(model, res, error)
       type(model_type), intent(in) :: model               !! the model
       type(result_type), intent(inout) :: res             !! the result of the run
@@ -47,18 +47,19 @@ contains
       real(dp), allocatable :: ek(:)
       real(dp) :: lam, bound, kd
       integer :: ns, nd, ne, d, stat
+      type(run_setup) :: setup
 
-      res%mode_resolution = resolution_none
+      res%mode_checked = .false.
       res%omega_max = 0.0_dp
+      setup = setup_of(res)
       if (technique_step_rule(res%technique) == rule_none) return
-      if (res%dt1 <= 0.0_dp .or. model%n_dof == 0) return
+      if (setup%dt1 <= 0.0_dp .or. model%n_dof == 0) return
       if (model%n_kx > 0 .or. .not. devices_are_pairs(model)) then
          ! stiffness beyond springs, or devices of any direction: the dense eigenproblem
          call dense_highest(model, lam, error)
          if (allocated(error)) return
          res%omega_max = sqrt(max(lam, 0.0_dp))
-         res%mode_resolution = merge(resolution_unresolved, resolution_resolved, &
-                                     res%omega_max*res%dt1 > resolution_limit)
+         res%mode_checked = .true.
          return
       end if
       ns = model%n_springs
@@ -87,11 +88,7 @@ contains
          return
       end if
       res%omega_max = sqrt(max(lam, 0.0_dp))
-      if (res%omega_max*res%dt1 > resolution_limit) then
-         res%mode_resolution = resolution_unresolved
-      else
-         res%mode_resolution = resolution_resolved
-      end if
+      res%mode_checked = .true.
    end subroutine mode_resolution
 
    !> The largest eigenvalue w^2 of (K + the sticking springs' k_d b_d b_d', M) of a general

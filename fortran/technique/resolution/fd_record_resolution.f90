@@ -38,23 +38,20 @@ module fd_record_resolution
    use fd_kinds, only: dp
    use fd_error, only: error_type, fatal_error, fmt_int, stat_no_memory
    use fd_names, only: technique_step_rule, rule_none, rule_newmark, rule_theta, excitation_record
-   use fd_stiffness, only: add_general_times
+   use fd_stiffness, only: stiffness_times
    use fd_matrices, only: modes_type, modes_kept, mode_damping, mode_participation
    use fd_model, only: model_type
    use fd_friction, only: law_stuck, stuck_dashpot
    use fd_excitation, only: excitation_type, table_acceleration
-   use fd_result, only: result_type, resolution_none, resolution_resolved, resolution_unresolved, &
-                        record_system_none, record_system_structure, record_system_stuck, &
-                        record_system_free, record_system_both
+   use fd_result, only: result_type, run_setup, setup_of, record_error_limit, record_system_none, &
+                        record_system_structure, record_system_stuck, record_system_free, record_system_both
    use fd_spectrum, only: exact_step_map
    implicit none
    private
 
+   !> record_error_limit: the relative change of a DOF's combined peak linear response above
+   !> which the step does not resolve the record (fd_result's, by which fd_warnings judges)
    public :: record_resolution, exact_step_map, newmark_step_map, theta_step_map, record_error_limit
-
-   !> relative change of a DOF's combined peak linear response above which the step does not
-   !> resolve the record
-   real(dp), parameter :: record_error_limit = 0.05_dp
 
    !> One pass of the modes of both systems through the record: each mode a row.
    type :: mode_pass
@@ -114,8 +111,8 @@ contains
 
    !> Sets res%record_error_stuck and res%record_error_free (per DOF, for the DOFs whose
    !> combined exact peak is at least 1 % of the largest), res%record_error (that of the
-   !> system the run was in) and res%record_resolution,
-   !> from the summary's modes (res%eng), the record (exc), res%dt1, the run's duration and
+   !> system the run was in) and res%record_checked (the verdict: fd_warnings),
+   !> from the summary's modes (res%eng), the record (exc), the technique's dt1, the run's duration and
    !> Newmark's beta, gamma (Moreau-Jean's theta). One pass through the record for the modes
    !> of both systems.
    subroutine record_resolution(model, exc, beta, gamma, theta, res, error)
@@ -128,16 +125,18 @@ contains
       type(mode_pass) :: ps
       integer :: n, stat, nm, ns, m, judged
       logical :: ok, some
+      type(run_setup) :: setup
 
       n = model%n_dof
-      res%record_resolution = resolution_none
+      setup = setup_of(res)
+      res%record_checked = .false.
       res%record_system = record_system_none
       res%record_error = 0.0_dp               ! allocated with the summary (init_result)
       res%record_error_stuck = 0.0_dp
       res%record_error_free = 0.0_dp
       if (technique_step_rule(res%technique) == rule_none) return
       if (res%eng%excitation /= excitation_record) return
-      if (res%dt1 <= 0.0_dp .or. .not. (exc%duration > 0.0_dp)) return
+      if (setup%dt1 <= 0.0_dp .or. .not. (exc%duration > 0.0_dp)) return
       judged = judged_system(model, res)
       ns = modes_kept(res%eng%stuck)
       nm = ns
@@ -154,13 +153,13 @@ contains
                           trim(fmt_int(n))//" DOFs", stat_no_memory)
          return
       end if
-      ps%h = res%dt1
+      ps%h = setup%dt1
       ! the largest wn dt1 the check integrates: mode_resolution's limit 2, and Newmark's
       ! stability limit 1 / sqrt(gamma / 2 - beta) when it is conditionally stable
       ps%limit = 2.0_dp
       if (technique_step_rule(res%technique) == rule_newmark .and. beta < 0.5_dp*gamma) &
          ps%limit = min(ps%limit, 1.0_dp/sqrt(0.5_dp*gamma - beta))
-      call springs_times(model, model%u0, ps%ku0)
+      call stiffness_times(model, model%u0, ps%ku0)
       ! every mode q'' + c q' + wn^2 q = -g ag (g its participation) from the run's initial
       ! conditions, through the run's dt1 steps (fd_result's count) at the accelerations the
       ! run saw; z: the exact (q, q') and Newmark's (q, q', q'')
@@ -188,11 +187,12 @@ contains
       ok = combine(ps, model%u0(1:n), res%eng%stuck, 0, res%record_error_stuck)
       if (ok .and. nm > ns) ok = combine(ps, model%u0(1:n), res%eng%free, ns, res%record_error_free)
       res%record_system = judged
+      res%record_checked = .true.
       if (.not. ok) then
+         ! the estimate failed: an error of 1, beyond the limit
          res%record_error = 1.0_dp
          res%record_error_stuck = 1.0_dp
          res%record_error_free = 1.0_dp
-         res%record_resolution = resolution_unresolved
          return
       end if
       if (nm == ns) res%record_error_free = res%record_error_stuck
@@ -204,8 +204,6 @@ contains
       case default
          res%record_error = res%record_error_stuck
       end select
-      res%record_resolution = resolution_resolved
-      if (any(res%record_error > record_error_limit)) res%record_resolution = resolution_unresolved
    end subroutine record_resolution
 
    !> The system the run was in, which the verdict judges: the stuck one when no device slid
@@ -221,7 +219,8 @@ contains
       type(result_type), intent(in) :: res      !! the run's transitions
       logical :: slid
 
-      slid = res%started_sliding .or. any(res%stick_to_slip > 0) .or. any(res%slip_to_stick > 0) &
+      ! a device sliding at t = 0 has one slide more than its stick-to-slip transitions
+      slid = any(res%slip_excursions > res%stick_to_slip) .or. any(res%stick_to_slip > 0) .or. any(res%slip_to_stick > 0) &
              .or. any(res%reversals > 0)
       if (model%n_devices == 0) then
          judged = record_system_structure
@@ -379,26 +378,5 @@ contains
          if (peak(i) >= 0.01_dp*big) err(i) = max(err(i), change(i)/peak(i))
       end do
    end function combine
-
-   !> ku = K u, K the structure's stiffness: the springs (node 0 the table, at rest) and K_x.
-   pure subroutine springs_times(model, u, ku)
-      type(model_type), intent(in) :: model
-      real(dp), intent(in) :: u(:)
-      real(dp), intent(out) :: ku(:)
-      real(dp) :: x
-      integer :: s, i, j
-
-      ku = 0.0_dp
-      do s = 1, model%n_springs
-         i = model%spring_i(s); j = model%spring_j(s)
-         x = 0.0_dp
-         if (i > 0) x = u(i)
-         if (j > 0) x = x - u(j)
-         x = model%spring_k(s)*x
-         if (i > 0) ku(i) = ku(i) + x
-         if (j > 0) ku(j) = ku(j) - x
-      end do
-      call add_general_times(model, u, ku)
-   end subroutine springs_times
 
 end module fd_record_resolution

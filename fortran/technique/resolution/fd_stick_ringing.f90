@@ -37,10 +37,10 @@ module fd_stick_ringing
    use fd_error, only: error_type, fatal_error, fmt_int, stat_no_memory
    use fd_model, only: model_type
    use fd_kinematics, only: moved_mass, device_nodes, devices_are_pairs, add_device, device_relative
-   use fd_stiffness, only: general_form
+   use fd_stiffness, only: stiffness_form
    use fd_friction, only: sticking_stiffness, law_stuck, stuck_dashpot
    use fd_device_state, only: device_state, phase_stick
-   use fd_result, only: result_type, resolution_none, resolution_resolved, resolution_unresolved
+   use fd_result, only: result_type
    implicit none
    private
 
@@ -115,7 +115,7 @@ contains
       real(dp), intent(in) :: beta, gamma           !! Newmark's parameters
       real(dp), intent(in) :: a0, a1                !! C = a0 M + a1 K (K of the springs)
       type(ringing_type), intent(out) :: rg         !! the devices watched
-      type(result_type), intent(inout) :: res       !! stick_freq_error, stick_resolution set
+      type(result_type), intent(inout) :: res       !! stick_freq_error, stick_checked set
       type(error_type), allocatable, intent(out) :: error !! not enough memory
       integer, allocatable :: sp_first(:), sp_list(:), vd_first(:), vd_list(:), di(:), dj(:)
       logical, allocatable :: velocity(:)
@@ -129,7 +129,7 @@ contains
       end if
       nd = model%n_devices
       ns = model%n_springs
-      res%stick_resolution = resolution_none
+      res%stick_checked = .false.
       rg%n = count(sticking_stiffness(model%dev(1:nd)) > 0.0_dp)
       allocate (di(nd), dj(nd), velocity(nd), stat=stat)
       if (stat == 0) then
@@ -151,15 +151,10 @@ contains
                    rg%c_fixed(rg%n), rg%mr(rg%n), rg%first(rg%n + 1), rg%band_dev(nb), rg%band_shape(nb), &
                    rg%c_start(rg%n), rg%stats(4, nd), stat=stat)
       end if
-      if (stat /= 0) then
-         call fatal_error(error, "not enough memory for the sticking springs of "//trim(fmt_int(rg%n))// &
-                          " devices", stat_no_memory)
-         return
-      end if
-      rg%stats = 0.0_dp
-      rg%c_start = 0.0_dp
+      call ringing_ready(rg, stat, error)
+      if (allocated(error)) return
       if (rg%n == 0) return
-      res%stick_resolution = resolution_resolved
+      res%stick_checked = .true.
       q = 0
       nb = 0
       do d = 1, nd
@@ -255,27 +250,22 @@ contains
       real(dp), intent(in) :: beta, gamma           !! Newmark's parameters
       real(dp), intent(in) :: a0, a1                !! C = a0 M + a1 K
       type(ringing_type), intent(out) :: rg         !! the devices watched
-      type(result_type), intent(inout) :: res       !! stick_freq_error, stick_resolution set
+      type(result_type), intent(inout) :: res       !! stick_freq_error, stick_checked set
       type(error_type), allocatable, intent(out) :: error !! not enough memory
       real(dp), allocatable :: phi(:)
       logical, allocatable :: velocity(:)
       real(dp) :: k, c, x, wt, zn, y, ek
-      integer :: nd, d, e, q, nb, sp, pass, stat
+      integer :: nd, d, e, q, nb, pass, stat
       logical :: osc
 
       nd = model%n_devices
-      res%stick_resolution = resolution_none
+      res%stick_checked = .false.
       rg%n = count(sticking_stiffness(model%dev(1:nd)) > 0.0_dp)
       allocate (phi(model%n_dof), velocity(nd), rg%dev(rg%n), rg%k(rg%n), rg%omega(rg%n), rg%pmu(rg%n), &
                 rg%drift(rg%n), rg%c_fixed(rg%n), rg%mr(rg%n), rg%first(rg%n + 1), rg%c_start(rg%n), &
                 rg%stats(4, nd), stat=stat)
-      if (stat /= 0) then
-         call fatal_error(error, "not enough memory for the sticking springs of "//trim(fmt_int(rg%n))// &
-                          " devices", stat_no_memory)
-         return
-      end if
-      rg%stats = 0.0_dp
-      rg%c_start = 0.0_dp
+      call ringing_ready(rg, stat, error)
+      if (allocated(error)) return
       velocity = law_stuck(model%dev(1:nd)%law) == stuck_dashpot
       ! two passes: count the band devices, then list them
       do pass = 1, 2
@@ -303,13 +293,7 @@ contains
             rg%dev(q) = d
             rg%k(q) = k
             rg%mr(q) = moved_mass(model, d)
-            ek = general_form(model, phi, phi)
-            do sp = 1, model%n_springs
-               y = 0.0_dp
-               if (model%spring_i(sp) > 0) y = phi(model%spring_i(sp))
-               if (model%spring_j(sp) > 0) y = y - phi(model%spring_j(sp))
-               ek = ek + model%spring_k(sp)*y*y
-            end do
+            ek = stiffness_form(model, phi, phi)
             c = a0*rg%mr(q) + a1*ek
             rg%omega(q) = sqrt(k/rg%mr(q))
             rg%pmu(q) = model%dev(d)%p*model%dev(d)%mu
@@ -330,7 +314,7 @@ contains
          end if
       end do
       rg%first(rg%n + 1) = nb + 1
-      if (rg%n > 0) res%stick_resolution = resolution_resolved
+      res%stick_checked = rg%n > 0
    end subroutine general_ringing_init
 
    !> The elements at each node 1..n (node 0, the table, left out) of those with use: the
@@ -395,7 +379,23 @@ contains
       end do
    end subroutine ringing_changed
 
-   !> The end of the run: the stick phases still open measured, the run's stick_resolution.
+   !> The arrays of the devices watched allocated (stat 0: their statistics zeroed), or the
+   !> error of their memory.
+   pure subroutine ringing_ready(rg, stat, error)
+      type(ringing_type), intent(inout) :: rg       !! the devices watched
+      integer, intent(in) :: stat                   !! the allocation's status
+      type(error_type), allocatable, intent(out) :: error !! not enough memory
+
+      if (stat /= 0) then
+         call fatal_error(error, "not enough memory for the sticking springs of "//trim(fmt_int(rg%n))// &
+                          " devices", stat_no_memory)
+         return
+      end if
+      rg%stats = 0.0_dp
+      rg%c_start = 0.0_dp
+   end subroutine ringing_ready
+
+   !> The end of the run: the stick phases still open measured (the verdict: fd_warnings).
    subroutine ringing_finish(rg, phase, res)
       type(ringing_type), intent(inout) :: rg       !! the devices watched
       integer, intent(in) :: phase(:)               !! the phases at the end
@@ -406,8 +406,6 @@ contains
       do q = 1, rg%n
          if (phase(rg%dev(q)) == phase_stick) call close_phase(rg, q, res)
       end do
-      res%stick_resolution = resolution_resolved
-      if (any(res%stick_ringing_ratio > 1.0_dp)) res%stick_resolution = resolution_unresolved
    end subroutine ringing_finish
 
    !> The damping integral of watched device q's band devices on its mode.
