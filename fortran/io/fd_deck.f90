@@ -1821,7 +1821,7 @@ contains
             return
          end if
       end if
-      dev = device_type(law=id, p=p, mu=mu, eps=eps, eps1=eps1, f=f)
+      dev = device_type(law=id, p=p, mu=mu, eps=eps, eps1=eps1, f=f, radius=radius)
       call apply_mu_law(deck, 'bearings', i, mu_id, mu_min, mu_rate, tab_v, tab_mu, g_table, dev, error)
       if (allocated(error)) return
       dev%source = source_bearing
