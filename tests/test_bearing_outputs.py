@@ -174,7 +174,8 @@ def test_reversals_along_one_axis_are_the_one_dimensional_devices(tmp_path):
 
 def test_isolation_shear_of_a_block_is_its_base_shear(tmp_path):
     """A rigid floor on four friction pendulums, nothing else below it and no damping: the
-    bearings carry the whole base shear, along x and along y, friction and restoring force."""
+    bearings carry the whole base shear, along x and along y, friction and restoring force, and
+    so does storey 1's shear."""
     dt, dur = 0.01, 4.0
     t = np.arange(0.0, dur + dt / 2, dt)
     for name, a in (("ax.txt", 2.0 * np.sin(2 * math.pi * 0.7 * t)), ("ay.txt", 1.5 * np.sin(2 * math.pi * 1.1 * t))):
@@ -197,5 +198,8 @@ def test_isolation_shear_of_a_block_is_its_base_shear(tmp_path):
     assert sm["peak_isolation_shear_x_N"] == pytest.approx(sm["peak_base_shear_x_N"], rel=1e-9)
     assert sm["peak_isolation_shear_y_N"] == pytest.approx(sm["peak_base_shear_y_N"], rel=1e-9)
     assert sm["peak_isolation_shear_x_time_s"] == pytest.approx(sm["peak_base_shear_x_time_s"], abs=1e-12)
+    # the storey of the bearings passes their friction and restoring forces alike
+    assert sm["peak_storey_shear_N"] == pytest.approx([sm["peak_base_shear_x_N"], sm["peak_base_shear_y_N"]],
+                                                      rel=1e-9)
     x, y = sm["peak_isolation_shear_x_N"], sm["peak_isolation_shear_y_N"]
     assert max(x, y) <= sm["peak_isolation_shear_N"] <= math.hypot(x, y)
