@@ -986,3 +986,264 @@ class IsolatedBlockCase:
         normal = np.array([-ops.eleResponse(k, "basicForce")[0] for k in range(1, 5)])
         ops.wipe()
         return hist, normal
+
+
+# ----------------------------------------------------------------------------- isolated building
+
+
+@dataclass
+class IsolatedBuildingCase:
+    """An eccentric building of rigid floors on a rigid base mat carried by friction pendulum
+    bearings, under two ground components.
+
+    Floors (frictiondyn's &floors): floor 1 the base mat, floors 2 ... n + 1 the superstructure,
+    each of mass ``floor_mass`` and rotational inertia m (plan_x² + plan_y²) / 12 over a
+    ``plan_x`` x ``plan_y`` plan, the superstructure's centres of mass ``cm_step`` further east
+    a storey. Storey 1 holds the bearings alone: ``bearings_x`` x ``bearings_y`` of them on a
+    grid over the plan, each carrying an equal share N of the whole weight (``p``), with
+    friction coefficient ``mu`` (Coulomb), a concave surface of radius ``radius`` and the
+    initial stiffness ``k_init``. Storeys 2 ... n + 1 as ``Building3DCase``'s frames: along x
+    two frames at y = -plan_y/2, +plan_y/2 sharing the storey's stiffness as (1 - ecc, 1 + ecc)/2,
+    along y two equal frames at x = -plan_x/2, +plan_x/2, scaled to a fixed-base first period
+    ``period``. Rayleigh C = a0 M + a1 K (2 % at the fixed-base chain's modes 1 and 3), K the
+    frames and the pendulums' N/R. Ground: two ``synthetic_record`` components (the second
+    scaled by ``scale2``); step dt1 = dt_record / n1 in both codes.
+
+    frictiondyn: the hysteretic law carried to the plane (a circular yield surface with radial
+    return) with P = N, f = mu N / (k_init - N/R) (OpenSees's k_init is the friction spring and
+    the pendulum's N/R together), ``refinement = 'implicit'``, end of sliding ``eps1``.
+
+    OpenSees: ndf 6; a node at each floor's centre of mass with its mass (m, m, J) and its
+    out-of-plane DOFs fixed, a ``rigidDiaphragm`` tying to it the nodes of the frames' ends
+    and, for the base mat, the top node of each bearing (its vertical DOF free); each bearing a
+    zero-length ``singleFPBearing`` (frictionModel Coulomb, Reff = radius, k_init, a stiff
+    axial material) with the gravity load N on its top node by a static step held constant
+    (``loadConst``), and a dashpot a1 N/R along x and y beside it (frictiondyn's C = a1 K damps
+    the pendulum's stiffness); each frame a ``zeroLength`` Elastic link (k, damping tangent
+    a1 k); ``rayleigh(a0, 0, 0, 0)``; Newmark's average acceleration, Newton iterations.
+
+    Where the two differ: OpenSees's singleFPBearing takes its normal force from its own axial
+    response and adds the shear's component along the surface's normal (second order in u/R,
+    as ``IsolatedBlockCase`` says): the stiff axial material keeps N at the gravity share to
+    1e-6, the geometric term changes the friction and restoring forces by about (mu + u/R) u/R.
+    """
+
+    n_storeys: int
+    bearings_x: int = 8
+    bearings_y: int = 5
+    duration: float = 30.0
+    dt_record: float = 0.01
+    n1: int = 10
+    floor_mass: float = 2.4e5
+    plan_x: float = 20.0
+    plan_y: float = 12.0
+    cm_step: float = 0.3
+    ecc: float = 0.3
+    period: float = 1.0
+    xi: float = 0.02
+    mu: float = 0.05
+    radius: float = 2.5
+    k_init: float = 5.0e7
+    eps1: float = 1.0e-6
+    pga: float = 0.3 * G
+    scale2: float = 0.7
+    seeds: tuple[int, int] = (20240613, 20240614)
+    records: tuple = field(default=None, repr=False)
+
+    def __post_init__(self) -> None:
+        n = self.n_storeys
+        if self.records is None:
+            a1 = synthetic_record(self.dt_record, self.duration, self.pga, self.seeds[0])
+            a2 = synthetic_record(self.dt_record, self.duration, self.pga, self.seeds[1])
+            self.records = (a1, self.scale2 * a2)
+        self.m = self.floor_mass
+        self.inertia = self.m * (self.plan_x**2 + self.plan_y**2) / 12
+        self.n_floors = n + 1
+        # the base mat at the plan origin, the superstructure's floors further east
+        self.cm_x = np.concatenate([[0.0], self.cm_step * np.arange(n, dtype=float)])
+        above = np.arange(n, 0, -1, dtype=float)
+        lam = _chain_eigenvalues(above, self.m)
+        scale = (2 * math.pi / self.period) ** 2 / lam[0]
+        self.k = above * scale  # superstructure storey stiffness along x and along y
+        w1 = 2 * math.pi / self.period
+        w3 = math.sqrt(lam[min(2, n - 1)] * scale)
+        self.a0 = 2 * self.xi * w1 * w3 / (w1 + w3)
+        self.a1 = 2 * self.xi / (w1 + w3)
+        hx, hy = self.plan_x / 2, self.plan_y / 2
+        self.frames = []  # (storey, angle deg, x, y, k); storey 1 is the bearings'
+        for i in range(n):
+            k = float(self.k[i])
+            self.frames += [
+                (i + 2, 0.0, 0.0, -hy, k * (1 - self.ecc) / 2),
+                (i + 2, 0.0, 0.0, hy, k * (1 + self.ecc) / 2),
+                (i + 2, 90.0, -hx, 0.0, k / 2),
+                (i + 2, 90.0, hx, 0.0, k / 2),
+            ]
+        xs = np.linspace(-hx, hx, self.bearings_x)
+        ys = np.linspace(-hy, hy, self.bearings_y)
+        self.bearings = [(float(x), float(y)) for y in ys for x in xs]
+        self.weight = self.n_floors * self.m * G
+        self.p = self.weight / len(self.bearings)
+        self.dt = self.dt_record / self.n1
+        self.n_steps = round(self.duration / self.dt)
+
+    @property
+    def name(self) -> str:
+        return f"isolated_building_{self.n_storeys}_{len(self.bearings)}"
+
+    @property
+    def f(self) -> float:
+        """The hysteretic law's sticking displacement of a bearing (the class docstring)."""
+        return self.mu * self.p / (self.k_init - self.p / self.radius)
+
+    # ------------------------------------------------------------------ frictiondyn
+
+    def deck(self, record_files: tuple[str, str] = ("ag_x.txt", "ag_y.txt")) -> str:
+        """The frictiondyn deck; its records are read from ``record_files`` (values, m/s2)."""
+        arr = _floats
+        nf, fr, nb = self.n_floors, self.frames, len(self.bearings)
+        return (
+            f"&floors\n  n_floors = {nf}\n  mass = {nf}*{self.m!r}\n"
+            f"  inertia = {nf}*{self.inertia!r}\n"
+            f"  cm_x = {arr(self.cm_x)}\n  height = {nf}*3.0\n/\n"
+            f"&frames\n  n_frames = {len(fr)}\n  storey = {', '.join(str(f[0]) for f in fr)}\n"
+            f"  angle = {arr(f[1] for f in fr)}\n  x = {arr(f[2] for f in fr)}\n"
+            f"  y = {arr(f[3] for f in fr)}\n  k = {arr(f[4] for f in fr)}\n/\n"
+            f"&damping\n  damping_type = 'rayleigh'\n  rayleigh_a0 = {self.a0!r}\n"
+            f"  rayleigh_a1 = {self.a1!r}\n/\n"
+            f"&bearings\n  n_bearings = {nb}\n  storey = {nb}*1\n"
+            f"  x = {arr(b[0] for b in self.bearings)}\n  y = {arr(b[1] for b in self.bearings)}\n"
+            f"  p = {nb}*{self.p!r}\n  law = {nb}*'hysteretic'\n  mu = {nb}*{self.mu!r}\n"
+            f"  f = {nb}*{self.f!r}\n  eps1 = {nb}*{self.eps1!r}\n  radius = {nb}*{self.radius!r}\n/\n"
+            + _record_group("excitation", self.dt_record, self.duration, record_files[0])
+            + _record_group("excitation2", self.dt_record, self.duration, record_files[1])
+            + f"&integration\n  n1 = {self.n1}\n  refinement = 'implicit'\n/\n"
+        )
+
+    def run_frictiondyn(self):
+        """frictiondyn's Result of the deck (records written to a temporary directory)."""
+        return _run_with_records(self.deck(), self.name, self.records)
+
+    def frictiondyn_peaks(self, result) -> dict[str, np.ndarray]:
+        """'bearing': each bearing's peak |(s_x, s_y)|; 'drift': |drift| of every storey along
+        x and y (storey 1 x, 1 y, 2 x, ...; storey 1 the base mat over the ground)."""
+        s = result.summary
+        return {"bearing": np.asarray(s["bearing_peak_displacement_m"], float),
+                "drift": np.abs(np.asarray(s["peak_drift_m"], float))}
+
+    # ------------------------------------------------------------------ OpenSees
+
+    def build_opensees(self, ops, workdir: Path) -> list[int]:
+        """The model, its gravity step held and its transient analysis set up, with recorders
+        of the floors' and the bearings' tops' ux, uy in ``workdir``; returns the masters."""
+        nf = self.n_floors
+        ops.wipe()
+        ops.model("basic", "-ndm", 3, "-ndf", 6)
+        masters = [1000 * (f + 1) for f in range(nf)]
+        for f, tag in enumerate(masters):
+            ops.node(tag, float(self.cm_x[f]), 0.0, 0.0)
+            ops.fix(tag, 0, 0, 1, 1, 1, 0)
+            ops.mass(tag, self.m, self.m, 0.0, 0.0, 0.0, self.inertia)
+        slaves: dict[int, list[int]] = {f: [] for f in range(1, nf + 1)}
+        points: dict[tuple[int, float, float], int] = {}
+
+        def point(floor: int, x: float, y: float) -> int:
+            key = (floor, x, y)
+            if key not in points:
+                tag = 1000 * floor + 1 + len([p for p in points if p[0] == floor])
+                if floor == 0:
+                    tag += 1000 * (nf + 1)
+                ops.node(tag, x, y, 0.0)
+                if floor == 0:
+                    ops.fix(tag, 1, 1, 1, 1, 1, 1)
+                else:
+                    ops.fix(tag, 0, 0, 1, 1, 1, 0)
+                    slaves[floor].append(tag)
+                points[key] = tag
+            return points[key]
+
+        for e, (st, ang, x, y, k) in enumerate(self.frames, start=1):
+            c, s = math.cos(math.radians(ang)), math.sin(math.radians(ang))
+            ops.uniaxialMaterial("Elastic", e, k, self.a1 * k)
+            ops.element("zeroLength", e, point(st - 1, x, y), point(st, x, y), "-mat", e, "-dir", 1,
+                        "-orient", c, s, 0.0, -s, c, 0.0)
+        # the bearings: ground node, top node (vertical free) slaved to the base mat
+        base = 100000
+        ops.frictionModel("Coulomb", 1, self.mu)
+        mats = base + 1
+        ops.uniaxialMaterial("Elastic", mats, 1.0e12)          # axial: stiff
+        ops.uniaxialMaterial("Elastic", mats + 1, 1.0e-6)      # torsion: none
+        ops.uniaxialMaterial("Elastic", mats + 2, 1.0e6)       # rocking: both ends' rotations fixed
+        eta = self.a1 * self.p / self.radius
+        ops.uniaxialMaterial("Elastic", mats + 3, 0.0, eta)    # the pendulum's a1 N/R dashpot
+        tops = []
+        for b, (x, y) in enumerate(self.bearings, start=1):
+            lo, hi = base + 2 * b, base + 2 * b + 1
+            ops.node(lo, x, y, 0.0)
+            ops.fix(lo, 1, 1, 1, 1, 1, 1)
+            ops.node(hi, x, y, 0.0)
+            ops.fix(hi, 0, 0, 0, 1, 1, 0)
+            tops.append(hi)
+            ops.element("singleFPBearing", base + b, lo, hi, 1, self.radius, self.k_init, "-P", mats,
+                        "-T", mats + 1, "-My", mats + 2, "-Mz", mats + 2,
+                        "-orient", 0.0, 0.0, 1.0, 1.0, 0.0, 0.0, "-iter", 100, 1.0e-8)
+            ops.element("zeroLength", 2 * base + b, lo, hi, "-mat", mats + 3, mats + 3, "-dir", 1, 2)
+        for f, tag in enumerate(masters, start=1):
+            ops.rigidDiaphragm(3, tag, *(slaves[f] + (tops if f == 1 else [])))
+        # gravity, held
+        ops.timeSeries("Linear", 100)
+        ops.pattern("Plain", 100, 100)
+        for t in tops:
+            ops.load(t, 0.0, 0.0, -self.p, 0.0, 0.0, 0.0)
+        ops.constraints("Transformation")
+        ops.numberer("RCM")
+        ops.system("BandGeneral")
+        ops.test("NormDispIncr", 1.0e-12, 50)
+        ops.algorithm("Newton")
+        ops.integrator("LoadControl", 1.0)
+        ops.analysis("Static")
+        if ops.analyze(1) != 0:
+            raise RuntimeError(f"{self.name}: OpenSees gravity step failed")
+        ops.loadConst("-time", 0.0)
+        ops.wipeAnalysis()
+        ops.rayleigh(self.a0, 0.0, 0.0, 0.0)
+        for d, rec in enumerate(self.records, start=1):
+            ops.timeSeries("Path", d, "-dt", self.dt_record, "-values", *map(float, rec))
+            ops.pattern("UniformExcitation", d, d, "-accel", d)
+        prec = ("-precision", 12)
+        ops.recorder("Node", "-file", str(workdir / "u.out"), *prec, "-node", *masters, "-dof", 1, 2, "disp")
+        ops.recorder("Node", "-file", str(workdir / "b.out"), *prec, "-node", *tops, "-dof", 1, 2, "disp")
+        ops.constraints("Transformation")
+        ops.numberer("RCM")
+        ops.system("BandGeneral")
+        ops.test("NormDispIncr", 1.0e-8, 100)
+        ops.algorithm("Newton")
+        ops.integrator("Newmark", 0.5, 0.25)
+        ops.analysis("Transient")
+        return masters
+
+    def run_opensees(self) -> OpenSeesRun:
+        """Build (timed apart), analyze (timed), read the peaks: each bearing's |(ux, uy)| of its
+        top and each storey's |drift| along x and y between the centres of mass ('normal': the
+        bearings' normal forces at the end)."""
+        ops = import_opensees()
+        with tempfile.TemporaryDirectory(prefix="fd_opsiso_") as tmp:
+            work = Path(tmp)
+            t0 = time.perf_counter()
+            self.build_opensees(ops, work)
+            t1, c1 = time.perf_counter(), time.process_time()
+            status = ops.analyze(self.n_steps, self.dt)
+            t2, c2 = time.perf_counter(), time.process_time()
+            t_now = ops.getTime()
+            base = 100000
+            normal = np.array([-ops.eleResponse(base + b, "basicForce")[0]
+                               for b in range(1, len(self.bearings) + 1)])
+            ops.wipe()
+            if status != 0:
+                raise RuntimeError(f"{self.name}: OpenSees analyze failed (status {status}) at t = {t_now} s")
+            hist = np.loadtxt(work / "u.out", ndmin=2)
+            tops = np.loadtxt(work / "b.out", ndmin=2)
+        xy = np.concatenate([np.zeros((hist.shape[0], 2)), hist], axis=1)
+        drift = np.abs(np.diff(xy.reshape(hist.shape[0], -1, 2), axis=1)).max(axis=0).reshape(-1)
+        bearing = np.hypot(tops[:, 0::2], tops[:, 1::2]).max(axis=0)
+        return OpenSeesRun(t2 - t1, c2 - c1, t1 - t0, {"bearing": bearing, "drift": drift, "normal": normal})

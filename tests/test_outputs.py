@@ -328,10 +328,10 @@ def test_undefined_summary_values_are_null_never_0(tmp_path):
         summ[name] = json.loads((tmp_path / "out" / f"{name}.summary.json").read_text())
         assert und.null_keys(summ[name]) <= keys, und.null_keys(summ[name]) - keys
         # the list names real keys (those of rigid floors in a building of rigid floors only,
-        # the bearing_* keys with &bearings only: tests/test_bearings.py)
+        # the bearing_* and peak_isolation_* keys with &bearings only: tests/test_bearings.py)
         floor_only = {k for k in keys if "corner" in k or k.startswith(
             ("floor_", "device_", "peak_floor_", "peak_base_shear_x", "peak_base_shear_y", "peak_base_torque",
-             "bearing_"))}
+             "bearing_", "peak_isolation_"))}
         assert keys - floor_only <= set(summ[name]), keys - set(summ[name])
         if name == "braced":
             assert ("stuck period not defined (with every device a rigid link the structure has "

@@ -1821,7 +1821,7 @@ contains
             return
          end if
       end if
-      dev = device_type(law=id, p=p, mu=mu, eps=eps, eps1=eps1, f=f)
+      dev = device_type(law=id, p=p, mu=mu, eps=eps, eps1=eps1, f=f, radius=radius)
       call apply_mu_law(deck, 'bearings', i, mu_id, mu_min, mu_rate, tab_v, tab_mu, g_table, dev, error)
       if (allocated(error)) return
       dev%source = source_bearing
@@ -1851,6 +1851,11 @@ contains
             cfg%model%xd_storey = [cfg%model%xd_storey, 2*storey - 2 + m]
             cfg%model%xd_dev = [cfg%model%xd_dev, cfg%model%n_devices]
             cfg%model%xd_coef = [cfg%model%xd_coef, 1.0_dp]
+            if (radius > 0.0_dp) then   ! and its pendulum's restoring force (p / R) b' u
+               cfg%model%xs_storey = [cfg%model%xs_storey, spread(2*storey - 2 + m, 1, nt)]
+               cfg%model%xs_dof = [cfg%model%xs_dof, dof(1:nt)]
+               cfg%model%xs_coef = [cfg%model%xs_coef, (p/radius)*coef(1:nt)]
+            end if
          end if
          if (radius > 0.0_dp) call pendulum_stiffness(deck, cfg, floors, dof(1:nt), coef(1:nt), p/radius, error)
          if (allocated(error)) return

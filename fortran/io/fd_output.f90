@@ -551,15 +551,17 @@ contains
    !> The planar bearings (&bearings): per bearing its label, the peak resultant displacement
    !> |(s_x, s_y)| with its direction (from x, counter-clockwise) and time, the residual
    !> resultant displacement at the run's end with its direction, and the energy its friction
-   !> dissipated (its two components').
+   !> dissipated (its two components'), its travel and reversals; the isolation shear's peaks
+   !> along x, y and of the resultant, with their times.
    subroutine bearings_part(jt, model, res)
       type(json_text), intent(inout) :: jt     !! the summary
       type(model_type), intent(in) :: model    !! the model
       type(result_type), intent(in) :: res     !! the result
       real(dp), parameter :: deg = 180.0_dp/acos(-1.0_dp)
       character(len=label_len) :: labels(res%n_bearings)
+      character(len=*), parameter :: axis(3) = [character(len=2) :: '_x', '_y', '']
       real(dp) :: residual(res%n_bearings), angle(res%n_bearings), energy(res%n_bearings)
-      integer :: b, d
+      integer :: b, d, k
 
       do b = 1, res%n_bearings
          d = res%bearing_dev(1, b)
@@ -576,6 +578,13 @@ contains
       call kr(jt, 'bearing_residual_displacement_m', residual)
       call kr(jt, 'bearing_residual_direction_deg', angle, residual > 0.0_dp)
       call kr(jt, 'bearing_dissipated_energy_J', energy)
+      call kr(jt, 'bearing_slip_travel_m', res%bearing_travel)
+      call ki(jt, 'bearing_slip_reversals', res%bearing_reversals)
+      do k = 1, 3
+         call kv(jt, 'peak_isolation_shear'//trim(axis(k))//'_N', trim(json_real(res%peak_iso_shear(k))))
+         call kv(jt, 'peak_isolation_shear'//trim(axis(k))//'_time_s', &
+                 trim(merge(json_real(res%peak_iso_shear_time(k)), 'null'//repeat(' ', 28), res%peak_iso_shear(k) > 0.0_dp)))
+      end do
    end subroutine bearings_part
 
    !> What the technique did: the part of the technique that ran (its own statistics, under

@@ -62,6 +62,7 @@ module fd_model
       ! its own direction b; each names the other (0: an ordinary one-dimensional device)
       integer :: partner = 0               !! the bearing's other component (0: none)
       integer :: component = 0             !! 1: the bearing's x component, 2: its y component
+      real(dp) :: radius = 0.0_dp          !! a bearing's sliding surface radius R (0: flat) [m]
    end type device_type
 
    !> The whole structural model.

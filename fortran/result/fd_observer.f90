@@ -227,24 +227,33 @@ contains
          res%peak_force(i) = max(res%peak_force(i), abs(force(i)))
       end do
       call observe_engineering(res%eng, t, n, nd, u, v, s, force)
-      if (res%n_bearings > 0) call observe_bearings(res, t, nd, s)
+      if (res%n_bearings > 0) call observe_bearings(res, t, nd, s, force)
       if (res%eng%n_floors > 0) call observe_floor_accelerations(res%eng, t, n, acc, ag, ag2)
    end subroutine observe_peaks
 
    !> The planar bearings' resultant displacement |(s_x, s_y)|: its peak, the peak's direction
-   !> and time, and the last value observed (the residual at the run's end).
-   pure subroutine observe_bearings(res, t, nd, s)
+   !> and time, and the last value observed (the residual at the run's end); each bearing's
+   !> travel (the chord |(ds_x, ds_y)| of every accepted step it slid in: at its start, at its
+   !> end or in a phase it was taken in) and the turns of its sliding
+   !> direction (bearing_turns); the isolation shear, the bearings' forces summed along x and
+   !> y: friction F plus the pendulum's restoring (p / R) s of each component.
+   pure subroutine observe_bearings(res, t, nd, s, force)
       type(result_type), intent(inout) :: res  !! the result
       real(dp), intent(in) :: t                !! time [s]
       integer, intent(in) :: nd                !! devices
       real(dp), intent(in) :: s(nd)            !! device relative displacements [m]
+      real(dp), intent(in) :: force(nd)        !! device forces [N]
       real(dp), parameter :: deg = 180.0_dp/acos(-1.0_dp)
-      real(dp) :: sx, sy, r
-      integer :: b
+      real(dp) :: sx, sy, r, fx, fy, v(3)
+      integer :: b, k
 
+      v = 0.0_dp
       do b = 1, res%n_bearings
          sx = s(res%bearing_dev(1, b))
          sy = s(res%bearing_dev(2, b))
+         if (res%bearing_seen .and. (res%bearing_slid(b) .or. res%bearing_sliding(b))) &
+            res%bearing_travel(b) = res%bearing_travel(b) + hypot(sx - res%bearing_last(1, b), sy - res%bearing_last(2, b))
+         res%bearing_slid(b) = res%bearing_sliding(b)
          res%bearing_last(:, b) = [sx, sy]
          r = hypot(sx, sy)
          if (r > res%bearing_peak(b)) then
@@ -252,8 +261,64 @@ contains
             res%bearing_peak_angle(b) = atan2(sy, sx)*deg
             res%bearing_peak_time(b) = t
          end if
+         fx = force(res%bearing_dev(1, b))
+         fy = force(res%bearing_dev(2, b))
+         if (res%bearing_sliding(b)) call bearing_turns(res, b, fx, fy)
+         v(1) = v(1) + fx + res%bearing_k(b)*sx
+         v(2) = v(2) + fy + res%bearing_k(b)*sy
+      end do
+      res%bearing_seen = .true.
+      v(3) = hypot(v(1), v(2))
+      v(1:2) = abs(v(1:2))
+      do k = 1, 3
+         if (v(k) > res%peak_iso_shear(k)) then
+            res%peak_iso_shear(k) = v(k)
+            res%peak_iso_shear_time(k) = t
+         end if
       end do
    end subroutine observe_bearings
+
+   !> A sliding bearing's reversals: the signed angle its friction force (fx, fy) turned since
+   !> the last sliding step observed is added to its turn since the slide's start; each 180
+   !> degrees turned either way is a reversal (the turn keeps what exceeds them). Back
+   !> and forth along a line each turn back is one (the 1D slip_reversals); a circular orbit
+   !> makes two a revolution.
+   pure subroutine bearing_turns(res, b, fx, fy)
+      type(result_type), intent(inout) :: res  !! the result
+      integer, intent(in) :: b                 !! the bearing
+      real(dp), intent(in) :: fx, fy           !! its components' friction forces [N]
+      real(dp), parameter :: pi = acos(-1.0_dp)
+      real(dp) :: px, py
+
+      if (fx == 0.0_dp .and. fy == 0.0_dp) return
+      px = res%bearing_dir(1, b)
+      py = res%bearing_dir(2, b)
+      res%bearing_dir(:, b) = [fx, fy]
+      if (px == 0.0_dp .and. py == 0.0_dp) return   ! the slide's first direction
+      res%bearing_turn(b) = res%bearing_turn(b) + atan2(px*fy - py*fx, px*fx + py*fy)
+      if (abs(res%bearing_turn(b)) >= pi) then
+         res%bearing_reversals(b) = res%bearing_reversals(b) + 1
+         res%bearing_turn(b) = res%bearing_turn(b) - sign(pi, res%bearing_turn(b))
+      end if
+   end subroutine bearing_turns
+
+   !> A bearing starts or stops sliding (its x component's phase leaves or enters stick): a
+   !> slide's direction and turn start again; a step taken sliding counts in its travel.
+   pure subroutine bearing_phases(res, old, new)
+      type(result_type), intent(inout) :: res  !! the result
+      integer, intent(in) :: old(:)            !! phases before (0 stick, +-1 slip)
+      integer, intent(in) :: new(:)            !! phases after
+      integer :: b, d
+
+      do b = 1, res%n_bearings
+         d = res%bearing_dev(1, b)
+         if (new(d) /= 0) res%bearing_slid(b) = .true.
+         if ((old(d) == 0) .eqv. (new(d) == 0)) cycle
+         res%bearing_sliding(b) = new(d) /= 0
+         res%bearing_dir(:, b) = 0.0_dp
+         res%bearing_turn(b) = 0.0_dp
+      end do
+   end subroutine bearing_phases
 
    !> The exact extrema of a technique that knows its solution between steps: |y(q)| of every
    !> output quantity q at time t into the summary's peaks (observe_extremum's order).
@@ -371,6 +436,11 @@ contains
       if (obs%rows == 1 .and. allocated(res%slip_excursions)) then
          do i = 1, min(size(phase), size(res%slip_excursions))
             if (phase(i) /= 0) res%slip_excursions(i) = res%slip_excursions(i) + 1
+         end do
+         ! and a bearing sliding in it begins sliding
+         do i = 1, res%n_bearings
+            res%bearing_sliding(i) = phase(res%bearing_dev(1, i)) /= 0
+            res%bearing_slid(i) = res%bearing_sliding(i)
          end do
       end if
       associate (row => obs%row)
@@ -540,6 +610,7 @@ contains
             res%reversals(d) = res%reversals(d) + 1
          end if
       end do
+      if (res%n_bearings > 0) call bearing_phases(res, old, new)
    end subroutine observe_transitions
 
    !> Count the devices that violate the correctness condition (eqs. 9, 12) in a step

@@ -108,6 +108,20 @@ module fd_result
       real(dp), allocatable :: bearing_peak_angle(:) !! its direction, from x counter-clockwise [deg]
       real(dp), allocatable :: bearing_peak_time(:)  !! its time [s]
       real(dp), allocatable :: bearing_last(:, :)    !! (2, n_bearings) (s_x, s_y) at the last step observed [m]
+      ! each bearing's travel and reversals, and the isolation system's shear (fd_observer's
+      ! observe_bearings; the sliding flags follow observe_transitions)
+      real(dp), allocatable :: bearing_k(:)          !! its pendulum's restoring stiffness p / R (0: flat) [N/m]
+      real(dp), allocatable :: bearing_travel(:)     !! path length of (s_x, s_y) over the steps it slid in [m]
+      integer, allocatable :: bearing_reversals(:)   !! turns of its sliding direction by 180 deg without sticking
+      logical, allocatable :: bearing_sliding(:)     !! it slides (its components' phase is not stick)
+      logical, allocatable :: bearing_slid(:)        !! it slid in the step being taken (at its start or since)
+      real(dp), allocatable :: bearing_dir(:, :)     !! (2, n_bearings) its friction force at the last sliding
+                                                     !! step observed; 0 at a slide's start [N]
+      real(dp), allocatable :: bearing_turn(:)       !! signed turn of that force since the slide's start,
+                                                     !! less 180 deg a reversal counted [rad]
+      logical :: bearing_seen = .false.              !! a state was observed (the first sets bearing_last)
+      real(dp) :: peak_iso_shear(3) = 0.0_dp         !! max |Vx|, |Vy|, |(Vx, Vy)| of the bearings together [N]
+      real(dp) :: peak_iso_shear_time(3) = 0.0_dp    !! their times [s]
       real(dp), allocatable :: harmonic_error(:)      !! per DOF: the step's error in the linear steady state
       real(dp), allocatable :: record_error(:)        !! per DOF: the step's error in the linear peak response
                                                       !! of the system the run was in
@@ -345,7 +359,34 @@ contains
       end do
       res%bearing_peak = 0.0_dp; res%bearing_peak_angle = 0.0_dp; res%bearing_peak_time = 0.0_dp
       res%bearing_last = 0.0_dp
+      call init_isolation(model, res, error)
    end subroutine init_bearings
+
+   !> Each bearing's travel, reversals and restoring stiffness, and the isolation shear's
+   !> peaks, at 0.
+   subroutine init_isolation(model, res, error)
+      type(model_type), intent(in) :: model         !! the model run
+      type(result_type), intent(inout) :: res       !! the result, its bearings set up
+      type(error_type), allocatable, intent(out) :: error !! no memory
+      integer :: b, d, nb, stat
+
+      nb = res%n_bearings
+      allocate (res%bearing_k(nb), res%bearing_travel(nb), res%bearing_reversals(nb), res%bearing_sliding(nb), &
+                res%bearing_slid(nb), res%bearing_dir(2, nb), res%bearing_turn(nb), stat=stat)
+      if (stat /= 0) then
+         call fatal_error(error, "not enough memory for the summary of "//trim(fmt_int(nb))//" bearings", stat_no_memory)
+         return
+      end if
+      do b = 1, nb
+         d = res%bearing_dev(1, b)
+         res%bearing_k(b) = 0.0_dp
+         if (model%dev(d)%radius > 0.0_dp) res%bearing_k(b) = model%dev(d)%p/model%dev(d)%radius
+      end do
+      res%bearing_travel = 0.0_dp; res%bearing_reversals = 0; res%bearing_sliding = .false.
+      res%bearing_slid = .false.
+      res%bearing_dir = 0.0_dp; res%bearing_turn = 0.0_dp; res%bearing_seen = .false.
+      res%peak_iso_shear = 0.0_dp; res%peak_iso_shear_time = 0.0_dp
+   end subroutine init_isolation
 
    !> For each id, the history's columns prefix//name//id [unit], one for each name, from
    !> column c + 1; c becomes the last column named.
@@ -429,6 +470,12 @@ contains
       if (allocated(res%peak_force)) call vector('peak_force_N', res%peak_force)
       if (allocated(res%dissipated)) call vector('dissipated_energy_J', res%dissipated)
       if (allocated(res%slip_travel)) call vector('slip_travel_m', res%slip_travel)
+      if (allocated(res%bearing_travel)) call vector('bearing_slip_travel_m', res%bearing_travel)
+      if (res%n_bearings > 0) then
+         call scalar('peak_isolation_shear_x_N', res%peak_iso_shear(1))
+         call scalar('peak_isolation_shear_y_N', res%peak_iso_shear(2))
+         call scalar('peak_isolation_shear_N', res%peak_iso_shear(3))
+      end if
       call engineering()
       if (allocated(error) .or. .not. allocated(res%hist)) return
       do j = 1, min(res%nout, size(res%hist, 2))

@@ -54,7 +54,8 @@ contains
                   new_unittest("exact extrema in the envelope's order", test_extrema), &
                   new_unittest("the work of the steps into the balance", test_work), &
                   new_unittest("each device's work, dissipation and slip travel", test_device_work), &
-                  new_unittest("rows into the control's row sink; its failure stops the run", test_sink) &
+                  new_unittest("rows into the control's row sink; its failure stops the run", test_sink), &
+                  new_unittest("a bearing's travel, reversals and the isolation shear", test_bearing_orbit) &
                   ]
    end subroutine collect_observer
 
@@ -140,6 +141,67 @@ contains
       if (allocated(error)) return
       call check(error, res%peak_s(1) == 0.05_dp .and. res%peak_force(1) == 3.0_dp, "peak |s| and |F|")
    end subroutine test_peaks
+
+   !> A friction pendulum bearing (p = 10 N, mu = 0.2, R = 2 m: restoring stiffness 5 N/m) on a
+   !> circle of radius 0.4 m in steps of 45 degrees, its friction force mu P along the tangent:
+   !> each chord 0.8 sin(pi/8), the force turning 675 degrees after the slide's first step
+   !> (3 reversals), the shear (F + 5 s) of magnitude sqrt(2^2 + 2^2) and max |V_x| at 135
+   !> degrees. Once it sticks, a force turned back is no reversal, and a step no travel.
+   subroutine test_bearing_orbit(error)
+      type(error_type), allocatable, intent(out) :: error
+      type(model_type) :: model
+      type(result_type) :: res
+      type(observer_type) :: obs
+      type(excitation_type) :: exc
+      type(integration_type) :: opts
+      type(fd_error_type), allocatable :: err
+      real(dp), parameter :: pi = acos(-1.0_dp), r = 0.4_dp
+      real(dp) :: th, s(2), f(2), z(2)
+      integer :: k
+
+      model%n_dof = 2
+      model%mass = [1.0_dp, 1.0_dp]
+      model%n_devices = 2
+      model%dev = [device_type(node_i=1, node_j=0, law=law_velocity, p=10.0_dp, mu=0.2_dp, partner=2, component=1, &
+                               radius=2.0_dp), &
+                   device_type(node_i=2, node_j=0, law=law_velocity, p=10.0_dp, mu=0.2_dp, partner=1, component=2, &
+                               radius=2.0_dp)]
+      call pairs_of(model)
+      exc%kind = excitation_none
+      exc%dt_record = 0.01_dp
+      exc%duration = 0.2_dp
+      opts%n1 = 1
+      call observer_init(model, exc, opts, res%period_stuck, res, obs, err)
+      call check(error, .not. allocated(err), "observer_init")
+      if (allocated(error)) return
+      call check(error, res%n_bearings, 1)
+      if (allocated(error)) return
+      z = 0.0_dp
+      call observe_peaks(res, 0.0_dp, 2, 2, z, z, z, 0.0_dp, [r, 0.0_dp], z)
+      call observe_transitions(res, [0, 0], [1, 1])
+      do k = 1, 16
+         th = k*pi/4
+         s = r*[cos(th), sin(th)]
+         f = 2.0_dp*[-sin(th), cos(th)]
+         call observe_peaks(res, 0.01_dp*k, 2, 2, s, z, z, 0.0_dp, s, f)
+      end do
+      call check(error, abs(res%bearing_travel(1) - 16*2*r*sin(pi/8)) <= 1e-14_dp, "travel: the chords")
+      if (allocated(error)) return
+      call check(error, res%bearing_reversals(1), 3)
+      if (allocated(error)) return
+      call check(error, abs(res%peak_iso_shear(3) - sqrt(8.0_dp)) <= 1e-14_dp .and. &
+                 abs(res%peak_iso_shear(1) - sqrt(8.0_dp)) <= 1e-14_dp, "isolation shear |V|, |V_x|")
+      if (allocated(error)) return
+      call check(error, abs(res%peak_iso_shear_time(1) - 0.03_dp) <= 1e-15_dp, "time of max |V_x| (135 degrees)")
+      if (allocated(error)) return
+      ! it sticks at the end of a step taken sliding (whose chord counts), then moves stuck:
+      ! neither travel nor reversals, whatever its force does
+      call observe_transitions(res, [1, 1], [0, 0])
+      call observe_peaks(res, 0.17_dp, 2, 2, z, z, z, 0.0_dp, s, [0.0_dp, -2.0_dp])
+      call observe_peaks(res, 0.18_dp, 2, 2, z, z, z, 0.0_dp, [r, 0.01_dp], [0.0_dp, 2.0_dp])
+      call check(error, res%bearing_reversals(1) == 3 .and. &
+                 abs(res%bearing_travel(1) - 16*2*r*sin(pi/8)) <= 1e-14_dp, "a stuck bearing")
+   end subroutine test_bearing_orbit
 
    subroutine test_transitions(error)
       type(error_type), allocatable, intent(out) :: error
