@@ -564,6 +564,11 @@ contains
       call kr(jt, 'bearing_residual_displacement_m', residual)
       call kr(jt, 'bearing_residual_direction_deg', angle, residual > 0.0_dp)
       call kr(jt, 'bearing_dissipated_energy_J', energy)
+      call kr(jt, 'bearing_min_normal_force_N', res%bearing_n_min)
+      call kr(jt, 'bearing_max_normal_force_N', res%bearing_n_max)
+      call ki(jt, 'bearing_uplift_count', res%bearing_uplifts)
+      call kr(jt, 'bearing_uplift_duration_s', res%bearing_uplift_time)
+      call kr(jt, 'bearing_uplift_first_time_s', res%bearing_uplift_first, res%bearing_uplifts > 0)
    end subroutine bearings_part
 
    !> What the technique did: the part of the technique that ran (its own statistics, under
