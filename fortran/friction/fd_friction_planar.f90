@@ -37,7 +37,9 @@ module fd_friction_planar
 
    public :: planar_velocity_update, planar_velocity_init, planar_velocity_correct, planar_velocity_follow
    public :: planar_hysteretic_update, planar_hysteretic_init, planar_hysteretic_correct
-   public :: planar_velocity_settle, planar_hysteretic_settle, pendulum_excess
+   public :: planar_velocity_settle, planar_hysteretic_settle, pendulum_excess, normal_force, with_normal_force
+
+   real(dp), parameter :: g = 9.80665_dp   !! standard gravity [m/s2]
 
 contains
 
@@ -365,6 +367,28 @@ contains
          if (kp /= 0.0_dp) st(m)%f0 = st(m)%f0 + kp*s(m)
       end do
    end subroutine hysteretic_coefficients
+
+   !> A bearing's normal force under the ground's vertical acceleration az (upward positive; the
+   !> vertical support rigid): N = P (1 + az / g), P = p_static, the deck's p. N <= 0 is uplift.
+   !> What every technique asks for a bearing's N at a time (az = table_acceleration of the
+   !> vertical component then).
+   elemental real(dp) function normal_force(dev, az) result(n)
+      type(device_type), intent(in) :: dev          !! the bearing (a component) as the deck made it
+      real(dp), intent(in) :: az                    !! vertical ground acceleration [m/s2]
+
+      n = dev%p_static*(1.0_dp + az/g)
+   end function normal_force
+
+   !> The bearing dev0 with p = max(N, 0) at the vertical acceleration az, as the laws take it;
+   !> another device (no partner) as it is.
+   elemental subroutine with_normal_force(dev0, az, dev)
+      type(device_type), intent(in) :: dev0         !! the device as the deck made it
+      real(dp), intent(in) :: az                    !! vertical ground acceleration [m/s2]
+      type(device_type), intent(inout) :: dev       !! its copy for the step, p set
+
+      if (dev0%partner == 0) return
+      dev%p = max(normal_force(dev0, az), 0.0_dp)
+   end subroutine with_normal_force
 
    !> The pendulum's stiffness beyond the one K holds, (P - P_static) / R, of a bearing whose
    !> normal force P varies (0 for a flat slider and for P = P_static) [N/m].

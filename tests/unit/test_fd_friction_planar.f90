@@ -14,7 +14,7 @@ module test_fd_friction_planar
    use fd_friction_hysteretic, only: hysteretic_update, hysteretic_init
    use fd_friction_planar, only: planar_velocity_update, planar_velocity_init, planar_velocity_correct, &
                                  planar_hysteretic_update, planar_hysteretic_init, planar_hysteretic_correct, &
-                                 pendulum_excess
+                                 pendulum_excess, normal_force, with_normal_force
    implicit none
    private
 
@@ -235,7 +235,7 @@ contains
    !> N mu (sliding force, band dashpot, sticking spring), and f0 holds (N - P) / R s.
    subroutine test_normal_force(error)
       type(error_type), allocatable, intent(out) :: error
-      type(device_type) :: dev
+      type(device_type) :: dev, lifted
       type(device_state) :: pair(2)
       logical :: ch(2)
       real(dp), parameter :: s(2) = [0.5_dp, -0.25_dp], n = 8.0_dp, r = 2.0_dp
@@ -245,6 +245,15 @@ contains
       dev%radius = r
       dev%p_static = p
       call check(error, pendulum_excess(dev), 0.0_dp)   ! N = P: no excess
+      if (allocated(error)) return
+      ! N = P (1 + az / g): P at az = 0, 0 at az = -g, 1.5 P at g / 2 (upward); the laws get max(N, 0)
+      call check(error, normal_force(dev, 0.0_dp) == p .and. normal_force(dev, -9.80665_dp) == 0.0_dp .and. &
+                 normal_force(dev, 0.5_dp*9.80665_dp) == 1.5_dp*p, "N = P (1 + az / g)")
+      if (allocated(error)) return
+      dev%partner = 2
+      lifted = dev
+      call with_normal_force(dev, -2.0_dp*9.80665_dp, lifted)
+      call check(error, lifted%p == 0.0_dp .and. lifted%p_static == p, "lifted: p = 0, p_static kept")
       if (allocated(error)) return
       dev%p = n
       kp = pendulum_excess(dev)

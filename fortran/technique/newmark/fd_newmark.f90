@@ -44,7 +44,7 @@ module fd_newmark
                         spd_c_matvec, spd_kc_matvec, spd_auto, spd_dense, spd_banded, spd_is_dense, spd_bandwidth, &
                         spd_copy
    use fd_device_state, only: device_state, device_force, phase_stick
-   use fd_friction_planar, only: pendulum_excess
+   use fd_friction_planar, only: pendulum_excess, normal_force, with_normal_force
    use fd_friction, only: friction_init, friction_step, friction_settle, follows_velocity, friction_follow, &
                           friction_energy, friction_capacity
    use fd_result, only: result_type
@@ -406,15 +406,13 @@ contains
       type(model_type), intent(in) :: model
       real(dp), intent(in) :: t
       type(workspace), intent(inout) :: w
-      real(dp), parameter :: g = 9.80665_dp
       real(dp) :: cap
       integer :: d, q
 
       if (.not. w%three) return
       w%az = table_acceleration(w%exc3, t)
       do d = 1, w%nd
-         if (model%dev(d)%partner == 0) cycle
-         w%dev(d)%p = max(model%dev(d)%p*(1.0_dp + w%az/g), 0.0_dp)
+         call with_normal_force(model%dev(d), w%az, w%dev(d))
       end do
       do q = 1, w%nf
          cap = friction_capacity(w%dev(w%fl(q)))
@@ -429,11 +427,10 @@ contains
       real(dp), intent(in) :: t, h
       type(workspace), intent(inout) :: w
       type(result_type), intent(inout) :: res
-      real(dp), parameter :: g = 9.80665_dp
       integer :: b
 
       do b = 1, res%n_bearings
-         w%pn(b) = model%dev(res%bearing_dev(1, b))%p*(1.0_dp + w%az/g)
+         w%pn(b) = normal_force(model%dev(res%bearing_dev(1, b)), w%az)
       end do
       call observe_normal_forces(res, t, h, w%pn)
    end subroutine observe_bearing_forces
