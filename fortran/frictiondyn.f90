@@ -36,7 +36,7 @@ contains
       type(error_type), allocatable, intent(out) :: error !! failure of the solver, a value not finite
       type(run_control), intent(inout), target, optional :: ctl !! history selection and
                                                           !! destinations, stop, progress
-      call run_technique(cfg%model, cfg%exc, cfg%opts, res, error, ctl, cfg%exc2)
+      call run_technique(cfg%model, cfg%exc, cfg%opts, res, error, ctl, cfg%exc2, cfg%exc3)
       if (allocated(error)) return
       ! no null in a summary, no NaN in a history: a quantity that overflowed is an error
       call check_finite(res, error)

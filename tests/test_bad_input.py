@@ -34,6 +34,10 @@ def _drop(group):
     return change
 
 
+# a planar bearing under both masses (x: mass 1, y: mass 2)
+_BEARING = {"n_bearings": 1, "dof_xi": 1, "dof_yi": 2, "dof_xj": 0, "dof_yj": 0, "law": "velocity",
+            "p": 24.8, "mu": 0.1}
+
 CASES = [
     # (id, change, words the message must contain)
     ("missing group", _drop("springs"), ["&springs", "missing"]),
@@ -86,6 +90,22 @@ CASES = [
         "unknown refinement",
         _set("integration", "refinement", "fine"),
         ["&integration", "refinement", "'fine'", "'step'", "'nested'"],
+    ),
+    # the vertical component: only bearings take it, on the first component's step
+    (
+        "vertical component without bearings",
+        lambda g: g.update(excitation3=dict(g["excitation"])),
+        ["&excitation3", "vertical", "&bearings"],
+    ),
+    (
+        "vertical component's dt_record",
+        lambda g: g.update(bearings=_BEARING, excitation3={**g["excitation"], "dt_record": 0.003}),
+        ["&excitation3", "dt_record = 0.003", "&excitation's"],
+    ),
+    (
+        "vertical component's frequency",
+        lambda g: g.update(bearings=_BEARING, excitation3={**g["excitation"], "frequency": -2.0}),
+        ["&excitation3", "frequency", "-2"],
     ),
 ]
 

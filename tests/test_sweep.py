@@ -652,6 +652,7 @@ def test_deck_variables_are_the_deck_readers(tmp_path):
              for m in re.finditer(r"namelist\s*/(\w+)/([^\n!]*)", src, re.I)}
     # &excitation2, the second horizontal component, is read with &excitation's statement
     found["excitation2"] = found["excitation"]
+    found["excitation3"] = found["excitation"]   # the vertical component, likewise
     assert found == {g: tuple(v) for g, v in sw.DECK_VARIABLES.items()}
 
 

@@ -20,6 +20,13 @@
 !> it had (slip + at the start of a slide). For motion along one axis every operation is the
 !> one-dimensional law's (hypot(x, 0) = |x|, x/|x| = +-1, a + 0 = a): the same numbers to the
 !> bit (docs/theory.md, "Planar bearings").
+!>
+!> A normal force that varies (docs/theory.md, "Varying normal force"): the time-step loop
+!> hands the kernels the bearing with p its current normal force N (max(N, 0)) and p_static
+!> the N0 whose pendulum stiffness N0 / R the structure's K holds. The friction is that of p
+!> (P mu, the band's P mu / eps, the sticking spring P mu / f: the hysteretic law's yield
+!> |s - c| >= f does not depend on P), and the pendulum's excess (p - p_static) / R s, at s of
+!> the step's start, joins f0. p <= 0 (uplift): no friction and no restoring force.
 module fd_friction_planar
    use fd_kinds, only: dp
    use fd_model, only: device_type, mu_constant, sliding_mu
@@ -30,7 +37,9 @@ module fd_friction_planar
 
    public :: planar_velocity_update, planar_velocity_init, planar_velocity_correct, planar_velocity_follow
    public :: planar_hysteretic_update, planar_hysteretic_init, planar_hysteretic_correct
-   public :: planar_velocity_settle, planar_hysteretic_settle
+   public :: planar_velocity_settle, planar_hysteretic_settle, pendulum_excess, normal_force, with_normal_force
+
+   real(dp), parameter :: g = 9.80665_dp   !! standard gravity [m/s2]
 
 contains
 
@@ -57,7 +66,7 @@ contains
       real(dp), intent(in) :: sd(2)                 !! relative velocity (x, y) [m/s]
       type(device_state), intent(inout) :: st(2)    !! states, updated
       logical, intent(out) :: changed(2)            !! each component's phase changed
-      real(dp) :: speed, c, pmu
+      real(dp) :: speed, c, pmu, kp
       integer :: old(2), m
       logical :: slides
 
@@ -90,8 +99,10 @@ contains
             st(m)%f0 = 0.0_dp
          end do
       end if
+      kp = pendulum_excess(dev)
       do m = 1, 2
          st(m)%centre = s(m)
+         if (kp /= 0.0_dp) st(m)%f0 = st(m)%f0 + kp*s(m)
          changed(m) = st(m)%phase /= old(m)
       end do
    end subroutine planar_velocity_update
@@ -109,16 +120,22 @@ contains
    end function planar_velocity_correct
 
    !> The constant force of component m in the phase st at the velocity sd at the step's end:
-   !> sliding with a speed-dependent mu, P mu(|v|) d_m; otherwise st(m)%f0 as it is.
+   !> sliding with a speed-dependent mu, P mu(|v|) d_m (and the pendulum's excess at the
+   !> step's start, st%centre); otherwise st(m)%f0 as it is.
    pure real(dp) function planar_velocity_follow(dev, sd, st, m) result(f0)
       type(device_type), intent(in) :: dev          !! the bearing's parameters
       real(dp), intent(in) :: sd(2)                 !! relative velocity at the step's end [m/s]
       type(device_state), intent(in) :: st(2)      !! phases during the step
       integer, intent(in) :: m                      !! the component (1: x, 2: y)
 
+      real(dp) :: kp
+
       f0 = st(m)%f0
-      if (dev%mu_law /= mu_constant .and. st(m)%phase /= phase_stick) &
+      if (dev%mu_law /= mu_constant .and. st(m)%phase /= phase_stick) then
          f0 = dev%p*sliding_mu(dev, hypot(sd(1), sd(2)))*st(m)%dir
+         kp = pendulum_excess(dev)
+         if (kp /= 0.0_dp) f0 = f0 + kp*st(m)%centre
+      end if
    end function planar_velocity_follow
 
    !> The states to take a step in that ends in st1's phases (`refinement = 'implicit'`): those
@@ -158,7 +175,7 @@ contains
             st(m)%armed = .true.
          end if
       end do
-      call hysteretic_coefficients(dev, st)
+      call hysteretic_coefficients(dev, s, st)
    end subroutine planar_hysteretic_init
 
    !> Phase for the next step from the state at the end of this one: a sticking bearing
@@ -180,7 +197,24 @@ contains
 
       old = st%phase
       changed = .false.
-      if (dev%p*dev%mu == 0.0_dp) return       ! no friction capacity: F = 0, never slips
+      if (dev%p <= 0.0_dp) then
+         ! lifted off (a varying normal force at or below 0): no force; sticks, unloaded, when
+         ! the bearing comes down again
+         do m = 1, 2
+            st(m)%phase = phase_stick
+            st(m)%centre = s(m)
+            st(m)%dir = 0.0_dp
+            st(m)%armed = .false.
+         end do
+         call hysteretic_coefficients(dev, s, st)
+         changed = st%phase /= old
+         return
+      end if
+      if (dev%p*dev%mu == 0.0_dp) then
+         ! no friction capacity: F = 0 (and the pendulum's excess), never slips
+         call hysteretic_coefficients(dev, s, st)
+         return
+      end if
       k = dev%p*dev%mu/dev%f
       speed = hypot(sd(1), sd(2))
       dir0 = st%dir
@@ -231,8 +265,9 @@ contains
                st(m)%dir = 0.0_dp
                st(m)%armed = .false.
             end do
-            call hysteretic_coefficients(dev, st)
          end if
+         ! the sticking spring and the pendulum's excess of the current normal force
+         call hysteretic_coefficients(dev, s, st)
       else
          if (.not. slides_now) then
             ! going on sliding: the radial return of the trial force
@@ -249,7 +284,7 @@ contains
             st(m)%centre = s(m) - dev%f*st(m)%dir
             st(m)%armed = armed
          end do
-         call hysteretic_coefficients(dev, st)
+         call hysteretic_coefficients(dev, s, st)
       end if
       changed = st%phase /= old
    end subroutine planar_hysteretic_update
@@ -310,14 +345,16 @@ contains
    end function slide_phase
 
    !> The hysteretic coefficients of each component's phase: ks = P mu / f, f0 = -k centre
-   !> while sticking; the force P mu d while sliding.
-   pure subroutine hysteretic_coefficients(dev, st)
+   !> while sticking; the force P mu d while sliding; and the pendulum's excess at s.
+   pure subroutine hysteretic_coefficients(dev, s, st)
       type(device_type), intent(in) :: dev
+      real(dp), intent(in) :: s(2)
       type(device_state), intent(inout) :: st(2)
-      real(dp) :: k
+      real(dp) :: k, kp
       integer :: m
 
-      k = dev%p*dev%mu/dev%f
+      k = max(dev%p, 0.0_dp)*dev%mu/dev%f
+      kp = pendulum_excess(dev)
       do m = 1, 2
          st(m)%cs = 0.0_dp
          if (st(m)%phase == phase_stick) then
@@ -327,7 +364,39 @@ contains
             st(m)%ks = 0.0_dp
             st(m)%f0 = dev%p*dev%mu*st(m)%dir
          end if
+         if (kp /= 0.0_dp) st(m)%f0 = st(m)%f0 + kp*s(m)
       end do
    end subroutine hysteretic_coefficients
+
+   !> A bearing's normal force under the ground's vertical acceleration az (upward positive; the
+   !> vertical support rigid): N = P (1 + az / g), P = p_static, the deck's p. N <= 0 is uplift.
+   !> What every technique asks for a bearing's N at a time (az = table_acceleration of the
+   !> vertical component then).
+   elemental real(dp) function normal_force(dev, az) result(n)
+      type(device_type), intent(in) :: dev          !! the bearing (a component) as the deck made it
+      real(dp), intent(in) :: az                    !! vertical ground acceleration [m/s2]
+
+      n = dev%p_static*(1.0_dp + az/g)
+   end function normal_force
+
+   !> The bearing dev0 with p = max(N, 0) at the vertical acceleration az, as the laws take it;
+   !> another device (no partner) as it is.
+   elemental subroutine with_normal_force(dev0, az, dev)
+      type(device_type), intent(in) :: dev0         !! the device as the deck made it
+      real(dp), intent(in) :: az                    !! vertical ground acceleration [m/s2]
+      type(device_type), intent(inout) :: dev       !! its copy for the step, p set
+
+      if (dev0%partner == 0) return
+      dev%p = max(normal_force(dev0, az), 0.0_dp)
+   end subroutine with_normal_force
+
+   !> The pendulum's stiffness beyond the one K holds, (P - P_static) / R, of a bearing whose
+   !> normal force P varies (0 for a flat slider and for P = P_static) [N/m].
+   elemental real(dp) function pendulum_excess(dev) result(kp)
+      type(device_type), intent(in) :: dev          !! the bearing: p its current normal force
+
+      kp = 0.0_dp
+      if (dev%radius > 0.0_dp .and. dev%p /= dev%p_static) kp = (max(dev%p, 0.0_dp) - dev%p_static)/dev%radius
+   end function pendulum_excess
 
 end module fd_friction_planar

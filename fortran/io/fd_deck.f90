@@ -82,6 +82,8 @@ module fd_deck
       type(record_info) :: record                 !! the record read (excitation_type = 'record')
       type(excitation_type) :: exc2               !! the second horizontal component (kind none: not given)
       type(record_info) :: record2                !! its record
+      type(excitation_type) :: exc3               !! the vertical component (kind none: not given)
+      type(record_info) :: record3                !! its record
    end type run_config
 
 contains
@@ -142,7 +144,8 @@ contains
       cfg%deck_path = deck%path
       call check_groups(deck, [character(len=12) :: 'model', 'springs', 'damping', 'friction', &
                                'braces', 'isolators', 'storeys', 'floors', 'frames', 'floor_braces', &
-                               'matrices', 'excitation', 'excitation2', 'integration', 'output', 'bearings'], error)
+                               'matrices', 'excitation', 'excitation2', 'excitation3', 'integration', 'output', &
+                               'bearings'], error)
       if (allocated(error)) return
       ! the DOFs: a building of rigid floors (&floors, &frames), a structure's matrices
       ! (&matrices), or masses (&model, &springs)
@@ -618,6 +621,8 @@ contains
 
       call read_component(deck, 'excitation', .true., cfg%exc, cfg%record, found, error)
       if (allocated(error)) return
+      call read_vertical_component(deck, cfg, error)
+      if (allocated(error)) return
       ! a second horizontal component: perpendicular to the first, for rigid floors
       call read_component(deck, 'excitation2', .false., cfg%exc2, cfg%record2, found, error)
       if (allocated(error) .or. .not. found) return
@@ -641,6 +646,30 @@ contains
          cfg%model%influence2(floor_dof(f, [1, 2, 3])) = [-cfg%model%influence(floor_dof(f, 2)), a, 0.0_dp]
       end do
    end subroutine read_excitation_group
+
+   !> The vertical component (&excitation3): the ground's vertical acceleration a_z (upward
+   !> positive), which scales each bearing's normal force, N = N0 (1 + a_z / g); the vertical
+   !> support is rigid (no vertical DOF). Only bearings (&bearings) take it.
+   subroutine read_vertical_component(deck, cfg, error)
+      type(deck_text), intent(in) :: deck
+      type(run_config), intent(inout) :: cfg
+      type(error_type), allocatable, intent(out) :: error
+      logical :: found
+
+      call read_component(deck, 'excitation3', .false., cfg%exc3, cfg%record3, found, error)
+      if (allocated(error) .or. .not. found) return
+      if (.not. any(cfg%model%dev(1:cfg%model%n_devices)%partner > 0)) then
+         call fatal_error(error, deck%path//": group &excitation3 is the vertical ground motion, which changes "// &
+                          "the normal force of planar bearings (&bearings): the deck has none, and nothing else "// &
+                          "takes it; remove &excitation3 or add &bearings")
+         return
+      end if
+      if (cfg%exc3%dt_record /= cfg%exc%dt_record) then
+         call bad(deck, 'excitation3', 'dt_record', trim(fmt_real(cfg%exc3%dt_record)), "equal to &excitation's "// &
+                  trim(fmt_real(cfg%exc%dt_record))//' s (the components share the step dt1 = dt_record / n1)', &
+                  error)
+      end if
+   end subroutine read_vertical_component
 
    subroutine read_component(deck, gname, required, exc, record, found, error)
       type(deck_text), intent(in) :: deck
@@ -1821,7 +1850,7 @@ contains
             return
          end if
       end if
-      dev = device_type(law=id, p=p, mu=mu, eps=eps, eps1=eps1, f=f, radius=radius)
+      dev = device_type(law=id, p=p, mu=mu, eps=eps, eps1=eps1, f=f, radius=radius, p_static=p)
       call apply_mu_law(deck, 'bearings', i, mu_id, mu_min, mu_rate, tab_v, tab_mu, g_table, dev, error)
       if (allocated(error)) return
       dev%source = source_bearing

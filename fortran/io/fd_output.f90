@@ -585,6 +585,11 @@ contains
          call kv(jt, 'peak_isolation_shear'//trim(axis(k))//'_time_s', &
                  trim(merge(json_real(res%peak_iso_shear_time(k)), 'null'//repeat(' ', 28), res%peak_iso_shear(k) > 0.0_dp)))
       end do
+      call kr(jt, 'bearing_min_normal_force_N', res%bearing_n_min)
+      call kr(jt, 'bearing_max_normal_force_N', res%bearing_n_max)
+      call ki(jt, 'bearing_uplift_count', res%bearing_uplifts)
+      call kr(jt, 'bearing_uplift_duration_s', res%bearing_uplift_time)
+      call kr(jt, 'bearing_uplift_first_time_s', res%bearing_uplift_first, res%bearing_uplifts > 0)
    end subroutine bearings_part
 
    !> What the technique did: the part of the technique that ran (its own statistics, under

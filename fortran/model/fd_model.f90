@@ -62,7 +62,10 @@ module fd_model
       ! its own direction b; each names the other (0: an ordinary one-dimensional device)
       integer :: partner = 0               !! the bearing's other component (0: none)
       integer :: component = 0             !! 1: the bearing's x component, 2: its y component
-      real(dp) :: radius = 0.0_dp          !! a bearing's sliding surface radius R (0: flat) [m]
+      ! a bearing whose normal force varies (a vertical component): p is its current value,
+      ! p_static the one whose pendulum stiffness p_static / radius K holds
+      real(dp) :: radius = 0.0_dp          !! a bearing's pendulum radius R [m] (0: flat)
+      real(dp) :: p_static = 0.0_dp        !! a bearing's normal force in K's pendulum stiffness [N]
    end type device_type
 
    !> The whole structural model.

@@ -37,7 +37,7 @@ module fd_observer
    public :: observe_transitions, observe_violations, observe_end, strain_energy
    public :: observe_start_energies, observe_end_energies, observe_poll, observe_stop_error
    public :: observe_extrema, observe_extremum, observe_work, observe_device_motion
-   public :: observe_storeys
+   public :: observe_storeys, observe_normal_forces
 
    !> Wall-clock time aimed at between two polls that look at the clock [s].
    real(dp), parameter :: poll_target = 0.01_dp
@@ -319,6 +319,33 @@ contains
          res%bearing_turn(b) = 0.0_dp
       end do
    end subroutine bearing_phases
+   !> The planar bearings' normal forces N at t (a vertical component): their extremes, and
+   !> uplift (N <= 0): an episode starts where N falls to <= 0 (at t = 0 when it starts so),
+   !> and the steps that start lifted (which carry no friction, no restoring force) add their
+   !> length h to the time spent lifted.
+   pure subroutine observe_normal_forces(res, t, h, pn)
+      type(result_type), intent(inout) :: res  !! the result
+      real(dp), intent(in) :: t                !! time [s]
+      real(dp), intent(in) :: h                !! the step that reached t (0: the start) [s]
+      real(dp), intent(in) :: pn(:)            !! N of each bearing at t [N]
+      integer :: b
+
+      do b = 1, res%n_bearings
+         if (h > 0.0_dp .and. .not. res%bearing_n_last(b) > 0.0_dp) &
+            res%bearing_uplift_time(b) = res%bearing_uplift_time(b) + h
+         if (.not. pn(b) > 0.0_dp .and. (h == 0.0_dp .or. res%bearing_n_last(b) > 0.0_dp)) then
+            res%bearing_uplifts(b) = res%bearing_uplifts(b) + 1
+            if (res%bearing_uplifts(b) == 1) res%bearing_uplift_first(b) = t
+         end if
+         if (h == 0.0_dp) then
+            res%bearing_n_min(b) = pn(b)
+            res%bearing_n_max(b) = pn(b)
+         end if
+         res%bearing_n_min(b) = min(res%bearing_n_min(b), pn(b))
+         res%bearing_n_max(b) = max(res%bearing_n_max(b), pn(b))
+         res%bearing_n_last(b) = pn(b)
+      end do
+   end subroutine observe_normal_forces
 
    !> The exact extrema of a technique that knows its solution between steps: |y(q)| of every
    !> output quantity q at time t into the summary's peaks (observe_extremum's order).

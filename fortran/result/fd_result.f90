@@ -122,6 +122,13 @@ module fd_result
       logical :: bearing_seen = .false.              !! a state was observed (the first sets bearing_last)
       real(dp) :: peak_iso_shear(3) = 0.0_dp         !! max |Vx|, |Vy|, |(Vx, Vy)| of the bearings together [N]
       real(dp) :: peak_iso_shear_time(3) = 0.0_dp    !! their times [s]
+      ! its normal force N (constant P, or varying with a vertical component) and its uplift (N <= 0)
+      real(dp), allocatable :: bearing_n_min(:)      !! min N over the accepted states [N]
+      real(dp), allocatable :: bearing_n_max(:)      !! max N [N]
+      real(dp), allocatable :: bearing_n_last(:)     !! N at the last state observed [N]
+      integer, allocatable :: bearing_uplifts(:)     !! uplift episodes (N falls to <= 0)
+      real(dp), allocatable :: bearing_uplift_time(:)  !! time spent lifted: the steps that start at N <= 0 [s]
+      real(dp), allocatable :: bearing_uplift_first(:) !! start of the first episode [s]
       real(dp), allocatable :: harmonic_error(:)      !! per DOF: the step's error in the linear steady state
       real(dp), allocatable :: record_error(:)        !! per DOF: the step's error in the linear peak response
                                                       !! of the system the run was in
@@ -346,7 +353,8 @@ contains
       end do
       res%n_bearings = nb
       allocate (res%bearing_dev(2, nb), res%bearing_peak(nb), res%bearing_peak_angle(nb), res%bearing_peak_time(nb), &
-                res%bearing_last(2, nb), stat=stat)
+                res%bearing_last(2, nb), res%bearing_n_min(nb), res%bearing_n_max(nb), res%bearing_n_last(nb), &
+                res%bearing_uplifts(nb), res%bearing_uplift_time(nb), res%bearing_uplift_first(nb), stat=stat)
       if (stat /= 0) then
          call fatal_error(error, "not enough memory for the summary of "//trim(fmt_int(nb))//" bearings", stat_no_memory)
          return
@@ -356,7 +364,11 @@ contains
          if (model%dev(d)%component /= 1) cycle
          b = b + 1
          res%bearing_dev(:, b) = [d, model%dev(d)%partner]
+         res%bearing_n_min(b) = model%dev(d)%p
+         res%bearing_n_max(b) = model%dev(d)%p
+         res%bearing_n_last(b) = model%dev(d)%p
       end do
+      res%bearing_uplifts = 0; res%bearing_uplift_time = 0.0_dp; res%bearing_uplift_first = 0.0_dp
       res%bearing_peak = 0.0_dp; res%bearing_peak_angle = 0.0_dp; res%bearing_peak_time = 0.0_dp
       res%bearing_last = 0.0_dp
       call init_isolation(model, res, error)

@@ -30,7 +30,7 @@ module fd_warnings
    public :: period_shortest, period_longest, pga_smallest, pga_largest, standard_gravity
 
    !> The checks of a run, in the order of their warnings.
-   integer, parameter :: n_checks = 10
+   integer, parameter :: n_checks = 11
 
    ! what structures and earthquakes have: a first period, a record's peak acceleration
    real(dp), parameter :: period_shortest = 0.01_dp   !! below: implausible [s]
@@ -54,7 +54,8 @@ contains
    !> The checks of a result, each judged here from the figures the run left in it:
    !> the correctness condition, a speed-dependent mu, the highest modes, a harmonic table
    !> motion, a record, the sticking springs' ringing, the velocity-law bands, the energy
-   !> balance, the first period's and the record's peak acceleration's plausibility.
+   !> balance, the first period's and the record's peak acceleration's plausibility, a planar
+   !> bearing's uplift.
    pure subroutine run_checks(res, checks)
       type(result_type), intent(in) :: res                 !! the run's result
       type(check_type), intent(out) :: checks(n_checks)    !! its checks
@@ -69,7 +70,34 @@ contains
       call energy_check(res, checks(8))
       call period_check(res, checks(9))
       call record_range_check(res, checks(10))
+      call uplift_check(res, checks(11))
    end subroutine run_checks
+
+   !> Whether a planar bearing lifted off (its normal force N <= 0 under a vertical component):
+   !> while lifted it carries no friction and no restoring force.
+   pure subroutine uplift_check(res, c)
+      type(result_type), intent(in) :: res   !! the result
+      type(check_type), intent(out) :: c     !! the check
+      integer :: b, worst
+
+      c%key = 'bearing_uplift'
+      if (res%n_bearings == 0) return
+      c%verdict = merge(verdict_warns, verdict_passed, any(res%bearing_uplifts > 0))
+      c%outcome = verdict_names(c%verdict)
+      call add_figure(c, 'bearings_lifted', real(count(res%bearing_uplifts > 0), dp))
+      if (c%verdict /= verdict_warns) return
+      worst = 1
+      do b = 2, res%n_bearings
+         if (res%bearing_uplift_time(b) > res%bearing_uplift_time(worst)) worst = b
+      end do
+      call add_figure(c, 'bearing', real(worst, dp))
+      call add_figure(c, 'bearing_uplift_duration_s', res%bearing_uplift_time(worst))
+      c%warning = trim(fmt_int(count(res%bearing_uplifts > 0)))//' bearing(s) lifted off (N <= 0: no friction, '// &
+                  'no restoring force), bearing '//trim(fmt_int(worst))//' for '// &
+                  trim(es(res%bearing_uplift_time(worst), 3))//' s from t = '// &
+                  trim(es(res%bearing_uplift_first(worst), 3))//' s (bearing_uplift_*): check the vertical '// &
+                  'record and the bearings'//trim(see('bearing-uplift'))
+   end subroutine uplift_check
 
    !> The verdict of a step check and its word in the summary: not applicable when the check
    !> did not apply (`checked` false), else 'unresolved' (warns) when a figure is beyond its

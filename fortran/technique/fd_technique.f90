@@ -134,7 +134,7 @@ contains
 
    !> Run the technique the settings choose (with the caller's control of the run, if any:
    !> history columns and destinations, stop requests, progress).
-   subroutine run_technique(model, exc, opts, res, error, ctl, exc2)
+   subroutine run_technique(model, exc, opts, res, error, ctl, exc2, exc3)
       type(model_type), intent(in) :: model         !! validated model
       type(excitation_type), intent(in) :: exc      !! validated table motion
       type(integration_type), intent(in) :: opts    !! validated settings
@@ -144,6 +144,8 @@ contains
       type(run_control), intent(inout), target, optional :: ctl !! the run's control
       type(excitation_type), intent(in), optional :: exc2 !! a second horizontal component
                                                           !! (along the model's influence2)
+      type(excitation_type), intent(in), optional :: exc3 !! the vertical component (bearings'
+                                                          !! normal forces; Newmark only, as they are)
 
       if (opts%technique == technique_event_driven .and. present(exc2)) then
          if (exc2%kind /= excitation_none) then
@@ -153,9 +155,17 @@ contains
             return
          end if
       end if
+      if (opts%technique /= technique_newmark .and. present(exc3)) then
+         if (exc3%kind /= excitation_none) then
+            call fatal_error(error, "group &excitation3: a vertical component (bearings' varying normal force) "// &
+                             "is integrated by technique = 'newmark'; technique = '"// &
+                             trim(technique_name(opts%technique))//"' holds each bearing's p constant")
+            return
+         end if
+      end if
       select case (opts%technique)
       case (technique_newmark)
-         call run_newmark(model, exc, opts, res, error, ctl, exc2)
+         call run_newmark(model, exc, opts, res, error, ctl, exc2, exc3)
       case (technique_event_driven)
          call run_event_driven(model, exc, opts, res, error, ctl)
       case (technique_moreau_jean)

@@ -188,6 +188,10 @@ contains
       res%e_residual_ratio = 1.0e-6_dp
       res%newmark%setup%period_stuck = 30.0_dp
       res%record_pga = 1000.0_dp
+      res%n_bearings = 2
+      res%bearing_uplifts = [0, 2]
+      res%bearing_uplift_time = [0.0_dp, 0.25_dp]
+      res%bearing_uplift_first = [0.0_dp, 1.5_dp]
       call run_checks(res, c)
       call run_warnings(res, w)
       call check(error, size(w), n_checks)
@@ -196,6 +200,10 @@ contains
          call check(error, c(k)%verdict == verdict_warns .and. w(k)%text == c(k)%warning, c(k)%key)
          if (allocated(error)) return
       end do
+      ! the uplift's line names the bearing that stayed lifted longest, its time and first start
+      call check(error, index(w(n_checks)%text, '1 bearing(s) lifted off') == 1 .and. &
+                 index(w(n_checks)%text, 'bearing 2 for 2.500E-01 s from t = 1.500E+00 s') > 0 .and. &
+                 len_trim(w(n_checks)%text) <= 220, w(n_checks)%text)
    end subroutine test_every_warning
 
 end module test_fd_check

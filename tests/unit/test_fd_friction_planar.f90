@@ -1,7 +1,8 @@
 !> Unit tests of the planar bearings' laws (fd_friction_planar): each law for motion along one
 !> axis gives the one-dimensional law's state to the bit; off the axes the velocity law's disc
 !> and sliding force P mu v/|v|, its correctness condition on the resultant, and the
-!> hysteretic law's circular yield surface, radial return and end of sliding.
+!> hysteretic law's circular yield surface, radial return and end of sliding; a normal force
+!> that varies (p the current N, p_static the pendulum's in K) and uplift.
 !>
 !> P = 16 N, mu = 0.25 (P mu = 4 N), f = 2**-10 m, eps = 2**-7 m/s, eps1 = 2**-6 m/s.
 module test_fd_friction_planar
@@ -12,7 +13,8 @@ module test_fd_friction_planar
    use fd_friction_velocity, only: velocity_update, velocity_init
    use fd_friction_hysteretic, only: hysteretic_update, hysteretic_init
    use fd_friction_planar, only: planar_velocity_update, planar_velocity_init, planar_velocity_correct, &
-                                 planar_hysteretic_update, planar_hysteretic_init, planar_hysteretic_correct
+                                 planar_hysteretic_update, planar_hysteretic_init, planar_hysteretic_correct, &
+                                 pendulum_excess, normal_force, with_normal_force
    implicit none
    private
 
@@ -34,7 +36,9 @@ contains
                   new_unittest("hysteretic: circular yield surface", test_hysteretic_yield), &
                   new_unittest("hysteretic: radial return while sliding", test_hysteretic_return), &
                   new_unittest("hysteretic: end of sliding, force continuous", test_hysteretic_end), &
-                  new_unittest("hysteretic: a fast turn unloads elastically", test_hysteretic_turn) &
+                  new_unittest("hysteretic: a fast turn unloads elastically", test_hysteretic_turn), &
+                  new_unittest("a varying normal force: friction of N, the pendulum's excess", test_normal_force), &
+                  new_unittest("uplift (N <= 0): no force, a hysteretic spring unloaded", test_uplift) &
                   ]
    end subroutine collect_friction_planar
 
@@ -226,5 +230,91 @@ contains
       call check(error, pair(1)%phase == phase_slip_neg .and. pair(2)%phase == phase_slip_neg, &
                  "a reversal along the line slides along v")
    end subroutine test_hysteretic_turn
+
+   !> A bearing of P = 16 N (p_static) on a pendulum of R = 2 m now at N = 8 N: the friction is
+   !> N mu (sliding force, band dashpot, sticking spring), and f0 holds (N - P) / R s.
+   subroutine test_normal_force(error)
+      type(error_type), allocatable, intent(out) :: error
+      type(device_type) :: dev, lifted
+      type(device_state) :: pair(2)
+      logical :: ch(2)
+      real(dp), parameter :: s(2) = [0.5_dp, -0.25_dp], n = 8.0_dp, r = 2.0_dp
+      real(dp) :: kp
+
+      dev = device(law_velocity)
+      dev%radius = r
+      dev%p_static = p
+      call check(error, pendulum_excess(dev), 0.0_dp)   ! N = P: no excess
+      if (allocated(error)) return
+      ! N = P (1 + az / g): P at az = 0, 0 at az = -g, 1.5 P at g / 2 (upward); the laws get max(N, 0)
+      call check(error, normal_force(dev, 0.0_dp) == p .and. normal_force(dev, -9.80665_dp) == 0.0_dp .and. &
+                 normal_force(dev, 0.5_dp*9.80665_dp) == 1.5_dp*p, "N = P (1 + az / g)")
+      if (allocated(error)) return
+      dev%partner = 2
+      lifted = dev
+      call with_normal_force(dev, -2.0_dp*9.80665_dp, lifted)
+      call check(error, lifted%p == 0.0_dp .and. lifted%p_static == p, "lifted: p = 0, p_static kept")
+      if (allocated(error)) return
+      dev%p = n
+      kp = pendulum_excess(dev)
+      call check(error, kp, (n - p)/r)
+      if (allocated(error)) return
+      ! sliding along x: f0 = N mu + kp s
+      call planar_velocity_init(dev, s, [2.0_dp*eps, 0.0_dp], pair)
+      call check(error, pair(1)%f0 == n*mu + kp*s(1) .and. pair(2)%f0 == kp*s(2), "sliding: N mu d + kp s")
+      if (allocated(error)) return
+      ! in the disc: the dashpot N mu / eps
+      call planar_velocity_update(dev, s, [0.0_dp, 0.0_dp], pair, ch)
+      call check(error, all(pair%phase == phase_stick) .and. all(pair%cs == n*mu/eps) .and. &
+                 pair(1)%f0 == kp*s(1), "in the disc: N mu / eps")
+      if (allocated(error)) return
+      ! hysteretic: sticking spring N mu / f, kept up while sticking as N changes
+      dev%law = law_hysteretic
+      call planar_hysteretic_init(dev, [0.0_dp, 0.0_dp], [0.0_dp, 0.0_dp], pair)
+      dev%p = 2.0_dp*n
+      call planar_hysteretic_update(dev, [0.5_dp*f, 0.0_dp], [0.0_dp, 0.0_dp], pair, ch)
+      call check(error, all(pair%phase == phase_stick) .and. all(pair%ks == 2.0_dp*n*mu/f) .and. &
+                 pair(1)%f0 == 0.0_dp, "sticking: the spring of the current N")
+      if (allocated(error)) return
+      ! its yield is |s - c| >= f whatever N: 1.01 f slides at N mu
+      call planar_hysteretic_update(dev, [1.01_dp*f, 0.0_dp], [eps1, 0.0_dp], pair, ch)
+      call check(error, pair(1)%phase == phase_slip_pos .and. pair(1)%f0 == 2.0_dp*n*mu, "slides at N mu")
+   end subroutine test_normal_force
+
+   !> N <= 0 (p = 0 given to the law): no friction, and a pendulum's excess -P / R s that
+   !> cancels K's P / R s; a hysteretic bearing sliding when it lifts off comes down sticking
+   !> with its spring unloaded (c = s).
+   subroutine test_uplift(error)
+      type(error_type), allocatable, intent(out) :: error
+      type(device_type) :: dev
+      type(device_state) :: pair(2)
+      logical :: ch(2)
+      real(dp), parameter :: s(2) = [0.5_dp, -0.25_dp], r = 2.0_dp
+
+      dev = device(law_velocity)
+      dev%radius = r
+      dev%p_static = p
+      dev%p = 0.0_dp
+      call planar_velocity_init(dev, s, [2.0_dp*eps, eps], pair)
+      call check(error, all(pair%phase == phase_stick) .and. all(pair%cs == 0.0_dp) .and. &
+                 all(pair%ks == 0.0_dp) .and. pair(1)%f0 == -p/r*s(1) .and. pair(2)%f0 == -p/r*s(2), &
+                 "velocity law lifted: no friction, -P / R s")
+      if (allocated(error)) return
+      dev%law = law_hysteretic
+      dev%radius = 0.0_dp
+      dev%p = p
+      call planar_hysteretic_init(dev, [0.0_dp, 0.0_dp], [2.0_dp*eps1, 0.0_dp], pair)
+      call check(error, pair(1)%phase == phase_slip_pos, "slides")
+      if (allocated(error)) return
+      dev%p = 0.0_dp
+      call planar_hysteretic_update(dev, s, [2.0_dp*eps1, 0.0_dp], pair, ch)
+      call check(error, all(pair%phase == phase_stick) .and. all(ch) .and. all(pair%ks == 0.0_dp) .and. &
+                 all(pair%f0 == 0.0_dp) .and. all(pair%centre == s), "hysteretic lifted: no force, c = s")
+      if (allocated(error)) return
+      dev%p = p
+      call planar_hysteretic_update(dev, s, [0.0_dp, 0.0_dp], pair, ch)
+      call check(error, all(pair%phase == phase_stick) .and. all(pair%ks == p*mu/f) .and. &
+                 abs(pair(1)%ks*s(1) + pair(1)%f0) == 0.0_dp, "down again: sticks, unloaded")
+   end subroutine test_uplift
 
 end module test_fd_friction_planar

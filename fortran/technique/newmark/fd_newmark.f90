@@ -44,13 +44,14 @@ module fd_newmark
                         spd_c_matvec, spd_kc_matvec, spd_auto, spd_dense, spd_banded, spd_is_dense, spd_bandwidth, &
                         spd_copy
    use fd_device_state, only: device_state, device_force, phase_stick
+   use fd_friction_planar, only: pendulum_excess, normal_force, with_normal_force
    use fd_friction, only: friction_init, friction_step, friction_settle, follows_velocity, friction_follow, &
                           friction_energy, friction_capacity
    use fd_result, only: result_type
    use fd_run_control, only: run_control
    use fd_observer, only: observer_type, observer_init, sample_due, observe_start_energies, observe_peaks, &
                           observe_sample, observe_transitions, observe_violations, observe_end_energies, &
-                          observe_poll, observe_stop_error, observe_work
+                          observe_poll, observe_stop_error, observe_work, observe_normal_forces
    use fd_step_limits, only: halving_levels, unresolved_band, max_nested, nested_splits, max_settle, max_follow, &
                              follow_tol
    use fd_stick_ringing, only: ringing_type, ringing_init, ringing_changed, ringing_finish, stat_time, stat_sd2, &
@@ -112,6 +113,14 @@ module fd_newmark
       type(excitation_type) :: exc2
       real(dp) :: ag2 = 0.0_dp, ag21 = 0.0_dp
       real(dp), allocatable :: mr2(:)
+      ! a vertical component: the bearings' normal forces N = N0 (1 + a_z / g) (three = .false.:
+      ! constant); dev holds the devices with p = max(N, 0) at the time normal_forces was
+      ! last called for (the laws take it), az that time's a_z
+      logical :: three = .false.
+      type(excitation_type) :: exc3
+      real(dp) :: az = 0.0_dp
+      type(device_type), allocatable :: dev(:)
+      real(dp), allocatable :: pn(:)                  !! per bearing: N at the accepted state [N]
       real(dp) :: w_device = 0.0_dp                   !! work of the device forces [J]
       real(dp) :: t = 0.0_dp                          !! time of the accepted state [s]
       integer :: k = 0                                !! the dt1 step being taken, from k - 1 to k
@@ -154,7 +163,7 @@ contains
 
    !> Integrate a model under a table motion and fill the result. With a control: the
    !> history columns and destinations it selects, stop requests and progress reports.
-   subroutine run_newmark(model, exc, opts, res, error, ctl, exc2)
+   subroutine run_newmark(model, exc, opts, res, error, ctl, exc2, exc3)
       type(model_type), intent(in) :: model         !! validated model
       type(excitation_type), intent(in) :: exc      !! validated table motion
       type(integration_type), intent(in) :: opts    !! validated settings
@@ -163,6 +172,8 @@ contains
       type(run_control), intent(inout), target, optional :: ctl !! the run's control
       type(excitation_type), intent(in), optional :: exc2 !! a second horizontal component, along
                                                           !! the model's influence2 (kind none: none)
+      type(excitation_type), intent(in), optional :: exc3 !! the vertical component: the bearings'
+                                                          !! normal forces (kind none: none)
       type(workspace) :: w
       real(dp) :: dt1, dt2, t0
       integer :: k, c0, c1, crate, l
@@ -197,6 +208,10 @@ contains
             w%mr2 = model%mass*model%influence2
          end if
       end if
+      if (present(exc3)) then
+         w%three = exc3%kind /= excitation_none
+         if (w%three) w%exc3 = exc3
+      end if
       call observer_init(model, exc, opts, res%newmark%setup%period_stuck, res, w%obs, error, ctl)
       if (allocated(error)) return
       call grid_init(exc, dt1, w%grid)
@@ -205,7 +220,9 @@ contains
       w%u = model%u0
       w%v = model%v0
       call device_kinematics(model, w%u, w%v, w%s, w%sd)
-      call friction_init(model%dev, w%s, w%sd, w%st, error)
+      call normal_forces(model, 0.0_dp, w)
+      if (w%three) call observe_bearing_forces(model, 0.0_dp, 0.0_dp, w, res)
+      call friction_init(w%dev, w%s, w%sd, w%st, error)
       if (allocated(error)) return
       ! the devices' forces, kept from here on by device_step
       w%f = device_force(w%st, w%s, w%sd)
@@ -215,7 +232,7 @@ contains
       if (allocated(error)) return
       call consistent_acceleration(model, exc, 0.0_dp, w)
       call observe_start_energies(w%obs, 0.5_dp*sum(w%mass*w%v**2), strain_energy(model, w%u), &
-                                  device_energy(model, w%st, w%s), friction_energy(model%dev(1:w%nd), w%st, w%s))
+                                  device_energy(w%dev, w%st, w%s), stored_energies(w%dev, w%st, w%s))
       w%phase0 = w%st%phase
       call observe_sample(w%obs, res, 0.0_dp, w%ag, w%u, w%v, w%a, w%s, w%sd, w%f, w%phase0, ag2=w%ag2)
       call observe_peaks(res, 0.0_dp, w%n, w%nd, w%u, w%v, w%a, w%ag, w%s, w%f, w%ag2)
@@ -264,8 +281,8 @@ contains
       call ringing_finish(w%ring, w%phase0, res)
       res%newmark%mu_passes = w%follow_passes
       call observe_end_energies(w%obs, res, 0.5_dp*sum(w%mass*w%v**2), strain_energy(model, w%u), &
-                                device_energy(model, w%st, w%s), &
-                              w%w_device, friction_energy(model%dev(1:w%nd), w%st, w%s))
+                                device_energy(w%dev, w%st, w%s), &
+                              w%w_device, stored_energies(w%dev, w%st, w%s))
       do l = 1, size(w%lev)
          associate (stats => w%lev(l)%sys%stats)
             res%newmark%factorizations = res%newmark%factorizations + stats%factorizations
@@ -375,7 +392,51 @@ contains
       end if
       w%fl = pack([(l, l=1, nd)], follows_velocity(model%dev))
       w%cap = friction_capacity(model%dev(w%fl))
+      allocate (w%dev(nd), w%pn(nd), stat=stat)
+      if (stat /= 0) then
+         call fatal_error(error, "not enough memory for the state of n_devices = "//trim(fmt_int(nd))//" devices", &
+                          stat_no_memory)
+         return
+      end if
+      w%dev = model%dev(1:nd)
    end subroutine setup
+
+   !> A vertical component: each bearing's normal force at t, N = N0 (1 + a_z(t) / g) (a_z
+   !> upward positive; the vertical support rigid), into w%dev's p as max(N, 0) for the laws
+   !> (fd_friction_planar), and the followed devices' capacities P mu_largest with it (kept
+   !> while lifted). Nothing without one.
+   subroutine normal_forces(model, t, w)
+      type(model_type), intent(in) :: model
+      real(dp), intent(in) :: t
+      type(workspace), intent(inout) :: w
+      real(dp) :: cap
+      integer :: d, q
+
+      if (.not. w%three) return
+      w%az = table_acceleration(w%exc3, t)
+      do d = 1, w%nd
+         call with_normal_force(model%dev(d), w%az, w%dev(d))
+      end do
+      do q = 1, w%nf
+         cap = friction_capacity(w%dev(w%fl(q)))
+         if (cap > 0.0_dp) w%cap(q) = cap
+      end do
+   end subroutine normal_forces
+
+   !> The bearings' normal forces at the accepted time t (the one normal_forces was last
+   !> called for) to the observer: extremes and uplift; h the step that reached t (0 at the start).
+   subroutine observe_bearing_forces(model, t, h, w, res)
+      type(model_type), intent(in) :: model
+      real(dp), intent(in) :: t, h
+      type(workspace), intent(inout) :: w
+      type(result_type), intent(inout) :: res
+      integer :: b
+
+      do b = 1, res%n_bearings
+         w%pn(b) = normal_force(model%dev(res%bearing_dev(1, b)), w%az)
+      end do
+      call observe_normal_forces(res, t, h, w%pn)
+   end subroutine observe_bearing_forces
 
    !> Acceleration in equilibrium with the current phases: M a = p - C v - K u - sum b F
    !> (F: the devices' forces kept in w%f).
@@ -431,9 +492,11 @@ contains
          ag1 = table_acceleration(exc, t + h)
       end if
       w%ag1 = ag1
+      ! the normal forces of the step's start (the follow's), then of its end (the laws' update)
+      call normal_forces(model, t, w)
       ! a speed-dependent mu's sliding forces start from the velocity at the step's start,
       ! whatever an earlier trial of the step left in them (follow_forces takes them on)
-      if (w%nf > 0) call start_forces(model%dev, w)
+      if (w%nf > 0) call start_forces(w%dev, w)
       call predict(w%n, h, w%lev(lv)%g1h, w%lev(lv)%b2h2, ag1, w%mr, w%u, w%v, w%a, w%tmp, w%u1, w%rhs)
       if (w%two) then
          w%ag21 = table_acceleration(w%exc2, t + h)
@@ -456,6 +519,7 @@ contains
          call relative_motion(model, w%n, w%nd, w%u1, w%v1, w%s1, w%sd1)
       end if
       if (w%nf > 0) call follow_forces(model, lv, w, error)
+      call normal_forces(model, t + h, w)
    end subroutine try_step
 
    !> A speed-dependent mu at the velocity at the step's end (implicit, as a Newton-Raphson
@@ -481,7 +545,7 @@ contains
       w%follow_failed = .false.
       last = huge(1.0_dp)
       do it = 0, max_follow
-         call friction_follow(w%nf, w%fl, model%dev, w%sd1, w%st, w%df)
+         call friction_follow(w%nf, w%fl, w%dev, w%sd1, w%st, w%df)
          misfit = 0.0_dp
          do q = 1, w%nf
             if (abs(w%df(q)) > follow_tol*w%cap(q)) misfit = max(misfit, abs(w%df(q))/w%cap(q))
@@ -498,7 +562,7 @@ contains
       ! back to the trial with the forces it started with, mu at the step's start (start_forces)
       w%follow_failed = .true.
       w%follow_misfit = misfit
-      call friction_follow(w%nf, w%fl, model%dev, w%sd, w%st, w%df)
+      call friction_follow(w%nf, w%fl, w%dev, w%sd, w%st, w%df)
       call move_forces(model, lv, w, error)
    end subroutine follow_forces
 
@@ -689,7 +753,7 @@ contains
       type(workspace), intent(inout) :: w
       logical, intent(out) :: any_changed, any_bad
 
-      call friction_step(w%nd, model%dev, opts%n_corr, w%s1, w%sd1, w%sd, w%st, w%st1, w%changed, w%ok, &
+      call friction_step(w%nd, w%dev, opts%n_corr, w%s1, w%sd1, w%sd, w%st, w%st1, w%changed, w%ok, &
                          any_changed, any_bad)
       ! a speed-dependent mu whose forces did not converge in the step: refined as a violation
       any_bad = any_bad .or. w%follow_failed
@@ -837,7 +901,7 @@ contains
       do it = 1, max_settle
          ! the phases at the end of the last trial, and the states to take the step in
          w%phase_end = w%st1%phase
-         call friction_settle(w%nd, model%dev, w%sd1, w%st0, w%st1, w%st, can)
+         call friction_settle(w%nd, w%dev, w%sd1, w%st0, w%st1, w%st, can)
          if (.not. can) exit
          if (it > 1 .or. .not. same_phases(w%nd, w%st, w%phase0)) then
             w%version = w%version + 1
@@ -846,7 +910,7 @@ contains
             if (allocated(error)) return
             res%newmark%implicit_redos = res%newmark%implicit_redos + 1
             ! the phases this trial ends in, judged from the start
-            call friction_step(w%nd, model%dev, opts%n_corr, w%s1, w%sd1, w%sd, w%st0, w%st1, w%changed, w%ok, &
+            call friction_step(w%nd, w%dev, opts%n_corr, w%s1, w%sd1, w%sd, w%st0, w%st1, w%changed, w%ok, &
                                any_changed, any_bad)
             if (.not. any_changed) exit
             if (.not. same_phases(w%nd, w%st1, w%phase_end)) cycle
@@ -939,9 +1003,11 @@ contains
       ! the velocity-law bands' forces: an alternation from step to step (fd_band_alternation)
       if (w%alt%n > 0) call alternation_step(w%alt, w%nd, t1 - w%t, w%st, w%f, res%band_alternation, &
                                              res%band_alternation_time)
+      if (w%three) call observe_bearing_forces(model, t1, t1 - w%t, w, res)
       w%t = t1
       if (changed_k) w%version = w%version + 1
-      if (any_changed .or. any_force) call consistent_acceleration(model, exc, t1, w)
+      ! (a varying normal force changes a band's dashpot or a sticking spring within a phase)
+      if (any_changed .or. any_force .or. (w%three .and. changed_k)) call consistent_acceleration(model, exc, t1, w)
       call observe_peaks(res, t1, w%n, w%nd, w%u, w%v, w%a, w%ag, w%s, w%f, w%ag2)
    end subroutine accept
 
@@ -1075,12 +1141,32 @@ contains
    end function strain_energy
 
    !> Elastic energy stored in the devices (each law's: fd_friction's friction_energy).
-   pure real(dp) function device_energy(model, st, s) result(e)
-      type(model_type), intent(in) :: model
+   pure real(dp) function device_energy(dev, st, s) result(e)
+      type(device_type), intent(in) :: dev(:)   !! the devices at the current normal forces
       type(device_state), intent(in) :: st(:)
       real(dp), intent(in) :: s(:)
 
-      e = sum(friction_energy(model%dev(1:size(st)), st, s))
+      e = sum(stored_energies(dev, st, s))
    end function device_energy
+
+   !> Each device's elastic energy at the current normal forces (dev's p): a bearing's force
+   !> without its pendulum's excess (fd_friction_planar's pendulum_excess, at s: its f0 took
+   !> it at the s of the state's update), which is the pendulum's, not the friction's.
+   pure function stored_energies(dev, st, s) result(e)
+      type(device_type), intent(in) :: dev(:)
+      type(device_state), intent(in) :: st(:)
+      real(dp), intent(in) :: s(:)
+      real(dp) :: e(size(st))
+      type(device_state) :: one
+      real(dp) :: kp
+      integer :: d
+
+      do d = 1, size(st)
+         one = st(d)
+         kp = pendulum_excess(dev(d))
+         if (kp /= 0.0_dp) one%f0 = one%f0 - kp*s(d)
+         e(d) = friction_energy(dev(d), one, s(d))
+      end do
+   end function stored_energies
 
 end module fd_newmark
