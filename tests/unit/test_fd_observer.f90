@@ -171,7 +171,7 @@ contains
       exc%dt_record = 0.01_dp
       exc%duration = 0.2_dp
       opts%n1 = 1
-      call observer_init(model, exc, opts, res%period_stuck, res, obs, err)
+      call observer_init(model, exc, opts, 0.0_dp, res, obs, err)
       call check(error, .not. allocated(err), "observer_init")
       if (allocated(error)) return
       call check(error, res%n_bearings, 1)
