@@ -1,7 +1,7 @@
 """&matrices at scale: a general linear structure of 1000 to 5000 DOFs from Matrix Market
 files, with 200 friction devices, under Newmark with each regularized law.
 
-    .venv/bin/python bench/matrix_scale.py                      # both families (about 20 min)
+    .venv/bin/python bench/matrix_scale.py                      # towers of 1080 to 5022 DOFs (about 15 min)
     .venv/bin/python bench/matrix_scale.py --family tower --storeys 20,40
     .venv/bin/python bench/matrix_scale.py --family plan --plans 4,6 --laws hysteretic
 
@@ -19,12 +19,16 @@ an interstorey damper. The table moves along x, harmonic, 0.05 m at 1 Hz, dt_rec
 dt1 = 1 ms (n1 = 10); Rayleigh damping (a0 = 0.3 /s, a1 = 1e-3 s); n_modes = 0 and no
 history file, so that the run is the time-step loop.
 
-Each case is run by the executable (.venv/bin/frictiondyn) for two durations, each in a
-process of its own (its peak resident memory, VmHWM, from wait4). The set-up time is the
-shorter run's time less its steps at the time per step, the time per step (per dt1 step and
-per Newmark step taken: dt1, dt2 and finer) the difference of the two runs over the
-difference of their steps. Processor time (user + system of the child): the machine may be
-shared. Writes <out>/matrix_scale.json and prints the table. Nothing here asserts a speed.
+Each case is run by the executable (.venv/bin/frictiondyn) for two durations and a short
+one, each in a process of its own; its peak resident memory is its VmHWM, polled from /proc.
+The time per step (per dt1 step, and per Newmark step taken: dt1, dt2 and finer) is the
+difference of the two long runs over the difference of their steps; the set-up, the short
+run (0.02 s, 20 dt1 steps) less its Newmark steps at that time per step. Processor time (user
++ system of the child): the machine may be shared. For each law the exponent p of time per
+step ~ nnz(K)^p is fitted (least squares in logarithms) over the sizes; the phase changes'
+cost is counted as the banded factor's rank-one updates and partial refactorizations per
+dt1 step (the summary's factor_updates, partial_factorizations). Writes
+<out>/matrix_scale.json and prints the command and the table. Nothing here asserts a speed.
 """
 
 from __future__ import annotations
@@ -49,6 +53,7 @@ BEAM = (0.24, 0.0072, 0.0032, 0.0075)       # 0.4 x 0.6 m
 BAY, STOREY = 6.0, 3.5                      # [m]
 NODE_MASS, NODE_INERTIA = 3.0e4, 3.0e4      # [kg], [kg m^2]
 N_DEVICES = 200
+SETUP_DURATION = 0.02                       # [s]: the run that measures the set-up
 
 
 def beam_stiffness(a: float, iy: float, iz: float, j: float, length: float) -> np.ndarray:
@@ -194,20 +199,36 @@ def write_deck(case: dict, law: str, duration: float) -> Path:
 
 
 def run(deck: Path) -> dict:
-    """The executable on the deck in a process of its own: its processor time and peak
-    resident memory (wait4's rusage of that child alone)."""
+    """The executable on the deck in a process of its own: its processor time (wait4's
+    rusage of that child alone) and peak resident memory, VmHWM polled from /proc while it
+    runs (its own address space's high-water mark: wait4's ru_maxrss would also count the
+    pages of this Python process, which the child shares between fork and exec)."""
     t0 = time.perf_counter()
     with open(deck.with_suffix(".log"), "wb") as log:
         p = subprocess.Popen([str(EXE), deck.name], cwd=deck.parent, stdout=log, stderr=subprocess.STDOUT,
                              env=dict(os.environ, OPENBLAS_NUM_THREADS="1"))
-        _, status, ru = os.wait4(p.pid, 0)
+        hwm = 0
+        status_file = Path(f"/proc/{p.pid}/status")
+        while True:
+            pid, status, ru = os.wait4(p.pid, os.WNOHANG)
+            if pid:
+                break
+            try:
+                hwm = max(hwm, int(status_file.read_text().split("VmHWM:")[1].split()[0]))
+            except (OSError, IndexError, ValueError):
+                pass
+            time.sleep(0.01)
         p.returncode = os.waitstatus_to_exitcode(status)
     wall = time.perf_counter() - t0
     if p.returncode != 0:
         raise RuntimeError(f"{deck}: exit {p.returncode}: {deck.with_suffix('.log').read_text()[-800:]}")
     summary = json.loads((deck.parent / "out" / f"{deck.stem}.summary.json").read_text())
-    return {"wall_s": wall, "cpu_s": ru.ru_utime + ru.ru_stime, "vmhwm_mb": ru.ru_maxrss / 1024.0,
-            "summary": summary}
+    return {"wall_s": wall, "cpu_s": ru.ru_utime + ru.ru_stime, "vmhwm_mb": hwm / 1024.0, "summary": summary}
+
+
+def newmark_steps(st: dict) -> int:
+    """Newmark steps of every size a run took (dt1, dt2, finer, nested, implicit)."""
+    return sum(int(st.get(k, 0)) for k in ("steps_dt1", "steps_dt2", "steps_finer", "steps_nested", "steps_implicit"))
 
 
 def measure(case: dict, law: str, durations: tuple[float, float]) -> dict:
@@ -215,25 +236,39 @@ def measure(case: dict, law: str, durations: tuple[float, float]) -> dict:
     for dur in durations:
         r = run(write_deck(case, law, dur))
         st = r["summary"]
-        newmark = sum(int(st.get(k, 0)) for k in ("steps_dt1", "steps_dt2", "steps_finer", "steps_nested",
-                                                     "steps_implicit"))
+        newmark = newmark_steps(st)
         rows.append({"duration_s": dur, "cpu_s": r["cpu_s"], "wall_s": r["wall_s"], "vmhwm_mb": r["vmhwm_mb"],
                      "steps_dt1": int(st["steps_dt1"]), "newmark_steps": newmark,
                      "half_bandwidth": st.get("half_bandwidth"), "linear_system": st.get("linear_system"),
                      "factorizations": st.get("factorizations"), "factor_updates": st.get("factor_updates"),
-                     "transitions": int(sum(st["stick_to_slip"]))})
+                     "partial_factorizations": st.get("partial_factorizations"),
+                     "transitions": int(sum(st["stick_to_slip"])), "period_stuck_s": st.get("period_stuck_s"),
+                     "omega_max_rad_s": st.get("omega_max_rad_s")})
     a, b = rows
     per_dt1 = (b["cpu_s"] - a["cpu_s"]) / max(b["steps_dt1"] - a["steps_dt1"], 1)
     per_nm = (b["cpu_s"] - a["cpu_s"]) / max(b["newmark_steps"] - a["newmark_steps"], 1)
-    setup = a["cpu_s"] - per_dt1 * a["steps_dt1"]
+    # the set-up: a run of two record steps (20 dt1 steps, the motion still small), less them
+    short = run(write_deck(case, law, SETUP_DURATION))
+    setup = short["cpu_s"] - per_nm * newmark_steps(short["summary"])
+    dsteps = max(b["steps_dt1"] - a["steps_dt1"], 1)
     return {"law": law, "n": case["n"], "nnz": case["nnz"], "runs": rows, "us_per_dt1_step": 1e6 * per_dt1,
-            "us_per_newmark_step": 1e6 * per_nm, "setup_s": setup}
+            "us_per_newmark_step": 1e6 * per_nm, "setup_s": setup,
+            "newmark_per_dt1": (b["newmark_steps"] - a["newmark_steps"]) / dsteps,
+            "updates_per_dt1": ((b["factor_updates"] or 0) - (a["factor_updates"] or 0)) / dsteps,
+            "partial_per_dt1": ((b["partial_factorizations"] or 0) - (a["partial_factorizations"] or 0)) / dsteps}
+
+
+def exponent(rows: list[dict], key: str) -> float:
+    """p of key ~ nnz^p, least squares in logarithms."""
+    x = np.log([r["nnz"] for r in rows])
+    y = np.log([max(r[key], 1e-9) for r in rows])
+    return float(np.polyfit(x, y, 1)[0])
 
 
 def main() -> int:
     ap = argparse.ArgumentParser(description=__doc__, formatter_class=argparse.RawDescriptionHelpFormatter)
-    ap.add_argument("--family", choices=("tower", "plan", "both"), default="both")
-    ap.add_argument("--storeys", default="20,40,80", help="tower: storeys of the 3 x 3 plan")
+    ap.add_argument("--family", choices=("tower", "plan", "both"), default="tower")
+    ap.add_argument("--storeys", default="20,40,60,93", help="tower: storeys of the 3 x 3 plan (93: 5022 DOFs)")
     ap.add_argument("--plans", default="4,6,9", help="plan: nodes along a side of the 10-storey plan")
     ap.add_argument("--laws", default="velocity,hysteretic")
     ap.add_argument("--durations", default="1,2", help="two durations [s]")
@@ -250,9 +285,10 @@ def main() -> int:
     if args.family in ("plan", "both"):
         shapes += [("plan", int(p), int(p), 10) for p in args.plans.split(",")]
     results = []
+    print("command: " + " ".join([Path(sys.executable).name, "bench/matrix_scale.py"] + sys.argv[1:]), flush=True)
     print(f"{'family':6s} {'plan':>5s} {'storeys':>7s} {'law':10s} {'DOFs':>5s} {'nnz(K)':>8s} {'band':>5s} "
           f"{'set-up s':>8s} {'us/dt1':>8s} {'us/NM':>8s} {'us/NM/nnz':>9s} "
-          f"{'VmHWM MB (' + args.durations + ' s)':>20s}", flush=True)
+          f"{'VmHWM MB (' + args.durations + ' s)':>20s} {'NM/dt1':>6s} {'upd/dt1':>7s} {'part/dt1':>8s}", flush=True)
     for family, nx, ny, nz in shapes:
         case = make_case(work, family, nx, ny, nz)
         for law in args.laws.split(","):
@@ -262,8 +298,17 @@ def main() -> int:
             a, b = r["runs"]
             print(f"{family:6s} {nx}x{ny:<3d} {nz:7d} {law:10s} {r['n']:5d} {r['nnz']:8d} {a['half_bandwidth']!s:>5s} "
                   f"{r['setup_s']:8.2f} {r['us_per_dt1_step']:8.0f} {r['us_per_newmark_step']:8.1f} "
-                  f"{1e3 * r['us_per_newmark_step'] / r['nnz']:9.3f} {a['vmhwm_mb']:9.1f} {b['vmhwm_mb']:9.1f}",
+                  f"{1e3 * r['us_per_newmark_step'] / r['nnz']:9.3f} {a['vmhwm_mb']:9.1f} {b['vmhwm_mb']:9.1f} "
+                  f"{r['newmark_per_dt1']:6.1f} {r['updates_per_dt1']:7.1f} {r['partial_per_dt1']:8.2f}",
                   flush=True)
+    for family in sorted({r["family"] for r in results}):
+        for law in args.laws.split(","):
+            rows = [r for r in results if r["family"] == family and r["law"] == law]
+            if len(rows) > 1:
+                print(f"{family} {law}: time per step ~ nnz^p, p = {exponent(rows, 'us_per_newmark_step'):.2f} "
+                      f"(per Newmark step), {exponent(rows, 'us_per_dt1_step'):.2f} (per dt1 step), "
+                      f"set-up {exponent(rows, 'setup_s'):.2f}, over nnz = "
+                      f"{', '.join(str(r['nnz']) for r in rows)}", flush=True)
     out = Path(args.out) if args.out else work
     out.mkdir(parents=True, exist_ok=True)
     (out / "matrix_scale.json").write_text(json.dumps(results, indent=1, default=str))

@@ -106,7 +106,7 @@ program frictiondyn_main
    if (progress_wanted()) call session_set_progress(ses, progress_show, 0.2_dp)
    call session_stream(ses, error, tag)
    if (allocated(error)) call fail(deck//": "//error%message)
-   call session_solve(ses, error)
+   call session_solve(ses, error, keep=.false.)   ! the history goes to its file or nowhere: none in memory
    call progress_clear()
    if (allocated(error)) then
       call clear_temps()

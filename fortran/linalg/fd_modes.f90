@@ -19,7 +19,7 @@
 !> has no cancellation: the eigenvalues come out to a few ulps of the projected problem.
 module fd_modes
    use fd_kinds, only: dp
-   use fd_lapack, only: dsterf
+   use fd_lapack, only: dsterf, dpotrf, dpotrs
    use fd_error, only: error_type, fatal_error, fmt_int, fmt_real, stat_no_memory
    use fd_linalg, only: generalized_eigen
    use fd_banded, only: spd_system, spd_setup, spd_factor, spd_solve
@@ -27,7 +27,17 @@ module fd_modes
    private
 
    public :: lowest_modes, modes_auto, modes_dense, modes_iterative, modes_dense_max
-   public :: highest_eigenvalue
+   public :: highest_eigenvalue, general_lowest_modes, general_highest_eigenvalue
+
+   !> The operator of general_lowest_modes: the banded factor of A = K + sum kd b b' + delta M
+   !> and the constraints' orthonormal basis W (n x r), Y = A^-1 W and the Cholesky factor
+   !> of S = W' Y.
+   type :: constrained_operator
+      type(spd_system) :: sys
+      integer :: r = 0
+      real(dp) :: delta = 0.0_dp
+      real(dp), allocatable :: w(:, :), y(:, :), s(:, :), t(:)
+   end type constrained_operator
 
    integer, parameter :: modes_auto = 0        !! dense up to modes_dense_max DOFs, else iterative
    integer, parameter :: modes_dense = 1       !! LAPACK dsygv on the dense matrices
@@ -46,6 +56,10 @@ module fd_modes
    !> Ritz value below which it stops.
    integer, parameter :: lanczos_max_steps = 120
    real(dp), parameter :: lanczos_tol = 1.0e-10_dp
+   !> Multiple of eps times the spectrum's bound below which general_lowest_modes takes a
+   !> change of an eigenvalue (or, over the gap to its neighbours, of a shape) as rounding:
+   !> products with a K_x of any sign carry errors of that size, which no iteration removes.
+   real(dp), parameter :: rounding_floor = 64.0_dp
 
 contains
 
@@ -265,6 +279,369 @@ contains
       end function relative
    end subroutine subspace_modes
 
+   !> The nev lowest modes of a general structure, without an n x n matrix:
+   !>
+   !>   (K + sum_d kd_d b_d b_d') phi = lambda M phi   on   b_d' phi = 0 for every linked d,
+   !>
+   !> K the springs and K_x (its entries on and above the diagonal), b_d device d's direction
+   !> (compressed by device), M = diag(mass). Subspace iteration (Bathe, 11.6) on
+   !> q = min(nfree, max(2 nev, nev + 8)) vectors with the constrained shift-invert operator
+   !> X <- (A^-1 - Y S^-1 Y') M X: A = K + sum kd b b' + delta M factored in band storage
+   !> after reverse Cuthill-McKee (fd_banded, delta = 1e-10 of the Gershgorin bound), W an
+   !> orthonormal basis of the linked directions' span (the eigenvectors of their Gram matrix
+   !> whose eigenvalue is above 1e-12 of the largest, as the dense null space takes those of
+   !> B B'), Y = A^-1 W and S = W' Y (r x r): each iterate satisfies W' x = 0, so the
+   !> modes are those on the constraints' null space (dimension nfree = n - r). Memory
+   !> O(n (bandwidth + r + q)); time O(n bandwidth^2 + r n bandwidth) to set up and
+   !> O(n q (bandwidth + q)) an iteration. Converged when every wanted eigenvalue changes by
+   !> less than 1e-13 of itself, and every simple wanted shape by less than 1e-9 (M-norm),
+   !> or by less than the rounding of the spectrum's scale (rounding_floor eps scale, over
+   !> the gap for a shape), which products with K_x cannot go below. m = min(nev, nfree)
+   !> modes are returned (none when nfree = 0), M-normalized, the largest component of each
+   !> positive; scale is the Gershgorin bound of M^-1 (K + sum kd b b').
+   subroutine general_lowest_modes(mass, spring_i, spring_j, spring_k, kx_i, kx_j, kx_v, dev_ptr, dev_dof, &
+                                   dev_coef, kd, linked, nev, lambda, phi, nfree, scale, error)
+      real(dp), intent(in) :: mass(:)             !! masses m_i > 0, n = size(mass)
+      integer, intent(in) :: spring_i(:)          !! first node of each spring (0..n)
+      integer, intent(in) :: spring_j(:)          !! second node of each spring (0..n, 0 = fixed)
+      real(dp), intent(in) :: spring_k(:)         !! spring stiffness >= 0
+      integer, intent(in) :: kx_i(:)              !! K_x: row of each entry (1..n)
+      integer, intent(in) :: kx_j(:)              !! its column (kx_i <= kx_j)
+      real(dp), intent(in) :: kx_v(:)             !! its value
+      integer, intent(in) :: dev_ptr(:)           !! start of each device's terms (devices + 1)
+      integer, intent(in) :: dev_dof(:)           !! DOF of each term
+      real(dp), intent(in) :: dev_coef(:)         !! coefficient of each term
+      real(dp), intent(in) :: kd(:)               !! each device's stiffness in K (>= 0; 0: none)
+      logical, intent(in) :: linked(:)            !! the devices whose direction is a constraint
+      integer, intent(in) :: nev                  !! modes wanted, >= 1
+      real(dp), intent(out) :: lambda(:)          !! eigenvalues w^2, ascending, size >= nev
+      real(dp), intent(out) :: phi(:, :)          !! mode shapes (n, >= nev), phi' M phi = I
+      integer, intent(out) :: nfree               !! dimension of the constraints' null space
+      real(dp), intent(out) :: scale              !! Gershgorin bound of the spectrum
+      type(error_type), allocatable, intent(out) :: error !! no stiffness, no memory, no convergence
+      type(constrained_operator) :: op
+      integer, allocatable :: ci(:), cj(:)
+      real(dp), allocatable :: cv(:), row(:)
+      integer :: n, stat
+
+      n = size(mass)
+      lambda = 0.0_dp
+      phi = 0.0_dp
+      nfree = n
+      scale = 0.0_dp
+      if (nev < 1 .or. size(lambda) < nev .or. size(phi, 1) /= n .or. size(phi, 2) < nev) then
+         call fatal_error(error, "general_lowest_modes: "//trim(fmt_int(nev))//" modes asked, or result arrays "// &
+                          "too small for them")
+         return
+      end if
+      call stiffness_entries(n, spring_i, spring_j, spring_k, kx_i, kx_j, kx_v, dev_ptr, dev_dof, dev_coef, kd, &
+                             ci, cj, cv, stat)
+      if (stat == 0) allocate (row(n), stat=stat)
+      if (stat /= 0) then
+         call fatal_error(error, "not enough memory for the modes of "//trim(fmt_int(n))//" DOFs", stat_no_memory)
+         return
+      end if
+      call entry_rows(ci, cj, cv, row)
+      scale = maxval(row/mass)
+      if (.not. (scale > 0.0_dp)) then
+         call fatal_error(error, "lowest_modes: the structure has no stiffness")
+         return
+      end if
+      call operator_setup(op, mass, spring_i, spring_j, spring_k, kx_i, kx_j, kx_v, dev_ptr, dev_dof, dev_coef, &
+                          kd, linked, 1.0e-10_dp*scale, error)
+      if (allocated(error)) return
+      nfree = n - op%r
+      if (nfree == 0) return
+      call constrained_subspace(op, mass, ci, cj, cv, min(nev, nfree), nfree, scale, lambda, phi, error)
+   end subroutine general_lowest_modes
+
+   !> K + sum kd b b' as a list of entries on and above the diagonal (ci <= cj): the springs'
+   !> (k on both diagonals, -k off them), K_x's, and kd c_p c_q for each pair of a device's terms.
+   subroutine stiffness_entries(n, spring_i, spring_j, spring_k, kx_i, kx_j, kx_v, dev_ptr, dev_dof, dev_coef, &
+                                kd, ci, cj, cv, stat)
+      integer, intent(in) :: n, spring_i(:), spring_j(:), kx_i(:), kx_j(:), dev_ptr(:), dev_dof(:)
+      real(dp), intent(in) :: spring_k(:), kx_v(:), dev_coef(:), kd(:)
+      integer, allocatable, intent(out) :: ci(:), cj(:)
+      real(dp), allocatable, intent(out) :: cv(:)
+      integer, intent(out) :: stat
+      integer :: ne, e, d, p, q, a, b
+
+      ne = 3*size(spring_k) + size(kx_v)
+      do d = 1, size(dev_ptr) - 1
+         if (kd(d) /= 0.0_dp) ne = ne + (dev_ptr(d + 1) - dev_ptr(d))*(dev_ptr(d + 1) - dev_ptr(d) + 1)/2
+      end do
+      allocate (ci(ne), cj(ne), cv(ne), stat=stat)
+      if (stat /= 0 .or. n < 0) return
+      ne = 0
+      do e = 1, size(spring_k)
+         a = spring_i(e); b = spring_j(e)
+         if (a > 0) call put(a, a, spring_k(e))
+         if (b > 0) call put(b, b, spring_k(e))
+         if (a > 0 .and. b > 0 .and. a /= b) call put(min(a, b), max(a, b), -spring_k(e))
+      end do
+      do e = 1, size(kx_v)
+         call put(kx_i(e), kx_j(e), kx_v(e))
+      end do
+      do d = 1, size(dev_ptr) - 1
+         if (kd(d) == 0.0_dp) cycle
+         do p = dev_ptr(d), dev_ptr(d + 1) - 1
+            do q = p, dev_ptr(d + 1) - 1
+               a = dev_dof(p); b = dev_dof(q)
+               if (a == b .and. p /= q) then
+                  call put(a, a, 2.0_dp*kd(d)*dev_coef(p)*dev_coef(q))
+               else
+                  call put(min(a, b), max(a, b), kd(d)*dev_coef(p)*dev_coef(q))
+               end if
+            end do
+         end do
+      end do
+      ci = ci(1:ne); cj = cj(1:ne); cv = cv(1:ne)
+   contains
+      subroutine put(i, j, v)
+         integer, intent(in) :: i, j
+         real(dp), intent(in) :: v
+         ne = ne + 1
+         ci(ne) = i; cj(ne) = j; cv(ne) = v
+      end subroutine put
+   end subroutine stiffness_entries
+
+   !> y = A x for the symmetric A given by its entries on and above the diagonal.
+   pure subroutine entry_product(ci, cj, cv, x, y)
+      integer, intent(in) :: ci(:), cj(:)
+      real(dp), intent(in) :: cv(:), x(:)
+      real(dp), intent(out) :: y(:)
+      integer :: e
+
+      y = 0.0_dp
+      do e = 1, size(cv)
+         y(ci(e)) = y(ci(e)) + cv(e)*x(cj(e))
+         if (ci(e) /= cj(e)) y(cj(e)) = y(cj(e)) + cv(e)*x(ci(e))
+      end do
+   end subroutine entry_product
+
+   !> The rows' sums of |A| (Gershgorin) of the symmetric A given by its upper entries.
+   pure subroutine entry_rows(ci, cj, cv, row)
+      integer, intent(in) :: ci(:), cj(:)
+      real(dp), intent(in) :: cv(:)
+      real(dp), intent(out) :: row(:)
+      integer :: e
+
+      row = 0.0_dp
+      do e = 1, size(cv)
+         row(ci(e)) = row(ci(e)) + abs(cv(e))
+         if (ci(e) /= cj(e)) row(cj(e)) = row(cj(e)) + abs(cv(e))
+      end do
+   end subroutine entry_rows
+
+   !> The constrained operator: A factored (fd_banded), the linked directions' Gram matrix
+   !> G = B' B and its eigenvectors V, W = B V_r diag(e_r)^-1/2 for the r eigenvalues e above
+   !> 1e-12 of the largest (orthonormal), Y = A^-1 W, S = W' Y and its Cholesky factor.
+   subroutine operator_setup(op, mass, spring_i, spring_j, spring_k, kx_i, kx_j, kx_v, dev_ptr, dev_dof, &
+                             dev_coef, kd, linked, delta, error)
+      type(constrained_operator), intent(out) :: op
+      real(dp), intent(in) :: mass(:), spring_k(:), kx_v(:), dev_coef(:), kd(:), delta
+      integer, intent(in) :: spring_i(:), spring_j(:), kx_i(:), kx_j(:), dev_ptr(:), dev_dof(:)
+      logical, intent(in) :: linked(:)
+      type(error_type), allocatable, intent(out) :: error
+      real(dp), allocatable :: g(:, :), eye(:, :), ev(:), vec(:, :), v(:)
+      integer, allocatable :: lk(:)
+      integer :: n, nc, a, b, k, p, col, info, stat
+
+      n = size(mass)
+      op%delta = delta
+      call spd_setup(op%sys, mass, spring_i, spring_j, spring_k, dev_ptr, dev_dof, dev_coef, error, &
+                     kx_i=kx_i, kx_j=kx_j, kx_v=kx_v)
+      if (allocated(error)) return
+      call spd_factor(op%sys, delta, 0.0_dp, kd, error)
+      if (allocated(error)) return
+      lk = pack([(a, a=1, size(linked))], linked)
+      nc = size(lk)
+      op%r = 0
+      allocate (op%w(n, 0), op%y(n, 0), op%s(0, 0), op%t(0))
+      if (nc == 0) return
+      allocate (g(nc, nc), eye(nc, nc), ev(nc), vec(nc, nc), v(n), stat=stat)
+      if (stat /= 0) then
+         call fatal_error(error, "not enough memory for the constraints of "//trim(fmt_int(nc))//" devices", &
+                          stat_no_memory)
+         return
+      end if
+      ! G = B' B by the devices' terms: b_a scattered into v, dotted with each b_b
+      v = 0.0_dp
+      eye = 0.0_dp
+      do a = 1, nc
+         eye(a, a) = 1.0_dp
+         do p = dev_ptr(lk(a)), dev_ptr(lk(a) + 1) - 1
+            v(dev_dof(p)) = v(dev_dof(p)) + dev_coef(p)
+         end do
+         do b = a, nc
+            g(a, b) = 0.0_dp
+            do p = dev_ptr(lk(b)), dev_ptr(lk(b) + 1) - 1
+               g(a, b) = g(a, b) + v(dev_dof(p))*dev_coef(p)
+            end do
+            g(b, a) = g(a, b)
+         end do
+         v(dev_dof(dev_ptr(lk(a)):dev_ptr(lk(a) + 1) - 1)) = 0.0_dp
+      end do
+      call generalized_eigen(g, eye, ev, vec, error)
+      if (allocated(error)) return
+      op%r = count(ev > 1.0e-12_dp*maxval(abs(ev)))
+      deallocate (op%w, op%y, op%s, op%t)
+      allocate (op%w(n, op%r), op%y(n, op%r), op%s(op%r, op%r), op%t(op%r), stat=stat)
+      if (stat /= 0) then
+         call fatal_error(error, "not enough memory for the constraints of "//trim(fmt_int(nc))//" devices on "// &
+                          trim(fmt_int(n))//" DOFs", stat_no_memory)
+         return
+      end if
+      op%w = 0.0_dp
+      do k = 1, op%r
+         col = nc - op%r + k
+         do a = 1, nc
+            do p = dev_ptr(lk(a)), dev_ptr(lk(a) + 1) - 1
+               op%w(dev_dof(p), k) = op%w(dev_dof(p), k) + vec(a, col)*dev_coef(p)/sqrt(ev(col))
+            end do
+         end do
+         op%y(:, k) = op%w(:, k)
+         call spd_solve(op%sys, op%y(:, k), error)
+         if (allocated(error)) return
+      end do
+      op%s = matmul(transpose(op%w), op%y)
+      op%s = 0.5_dp*(op%s + transpose(op%s))
+      if (op%r > 0) then
+         call dpotrf('U', op%r, op%s, op%r, info)
+         if (info /= 0) then
+            call fatal_error(error, "lowest_modes: the constraints' Schur complement is not positive definite "// &
+                             "(info = "//trim(fmt_int(info))//")")
+            return
+         end if
+      end if
+   end subroutine operator_setup
+
+   !> x <- (A^-1 - Y S^-1 Y') x: the solution of A x' = x + W t with W' x' = 0.
+   subroutine operator_apply(op, x, error)
+      type(constrained_operator), intent(inout) :: op
+      real(dp), intent(inout), contiguous :: x(:)
+      type(error_type), allocatable, intent(out) :: error
+      integer :: info
+
+      call spd_solve(op%sys, x, error)
+      if (allocated(error) .or. op%r == 0) return
+      op%t = matmul(x, op%w)
+      call dpotrs('U', op%r, 1, op%s, op%r, op%t, op%r, info)
+      x = x - matmul(op%y, op%t)
+   end subroutine operator_apply
+
+   !> x <- x - W W' x: x's part in the constraints' null space.
+   subroutine operator_project(op, x)
+      type(constrained_operator), intent(inout) :: op
+      real(dp), intent(inout) :: x(:)
+
+      if (op%r == 0) return
+      op%t = matmul(x, op%w)
+      x = x - matmul(op%w, op%t)
+   end subroutine operator_project
+
+   !> The subspace iteration of general_lowest_modes on the operator op; m modes wanted.
+   subroutine constrained_subspace(op, mass, ci, cj, cv, m, nfree, scale, lambda, phi, error)
+      type(constrained_operator), intent(inout) :: op
+      real(dp), intent(in) :: mass(:), cv(:), scale
+      integer, intent(in) :: ci(:), cj(:), m, nfree
+      real(dp), intent(out) :: lambda(:), phi(:, :)
+      type(error_type), allocatable, intent(out) :: error
+      real(dp), allocatable :: x(:, :), y(:, :), kr(:, :), mr(:, :), lam(:), lam_old(:), q(:, :), ky(:)
+      real(dp) :: change, norm, floor, gap
+      integer :: n, nq, it, i, j, pass, stat
+      logical :: done
+
+      n = size(mass)
+      nq = min(nfree, max(2*m, m + 8))
+      floor = rounding_floor*epsilon(1.0_dp)*scale
+      allocate (x(n, nq), y(n, nq), kr(nq, nq), mr(nq, nq), lam(nq), lam_old(nq), q(nq, nq), ky(n), stat=stat)
+      if (stat /= 0) then
+         call fatal_error(error, "not enough memory for the subspace iteration of the modes of "// &
+                          trim(fmt_int(n))//" DOFs ("//trim(fmt_int(nq))//" vectors)", stat_no_memory)
+         return
+      end if
+      x(:, 1) = mass
+      do j = 2, nq
+         do i = 1, n
+            x(i, j) = start_value(i, j)
+         end do
+      end do
+      lam_old = huge(1.0_dp)
+      done = .false.
+      do it = 1, max_iterations
+         do j = 1, nq
+            y(:, j) = mass*x(:, j)
+            call operator_apply(op, y(:, j), error)
+            if (allocated(error)) return
+         end do
+         ! M-orthonormal columns (modified Gram-Schmidt, twice; a collapsed column replaced
+         ! by a fresh one in the null space)
+         do j = 1, nq
+            do pass = 1, 2
+               do i = 1, j - 1
+                  y(:, j) = y(:, j) - sum(mass*y(:, i)*y(:, j))*y(:, i)
+               end do
+            end do
+            norm = sqrt(sum(mass*y(:, j)**2))
+            if (.not. (norm > 1.0e-12_dp*maxval(abs(y(:, j))) .and. norm > 0.0_dp)) then
+               do i = 1, n
+                  y(i, j) = start_value(i, j + nq*it)
+               end do
+               call operator_project(op, y(:, j))
+               do pass = 1, 2
+                  do i = 1, j - 1
+                     y(:, j) = y(:, j) - sum(mass*y(:, i)*y(:, j))*y(:, i)
+                  end do
+               end do
+               norm = sqrt(sum(mass*y(:, j)**2))
+            end if
+            y(:, j) = y(:, j)/norm
+         end do
+         ! Ritz projection: kr = Y' (K + sum kd b b') Y, mr = Y' M Y
+         do j = 1, nq
+            call entry_product(ci, cj, cv, y(:, j), ky)
+            do i = 1, j
+               kr(i, j) = dot_product(y(:, i), ky)
+               mr(i, j) = sum(mass*y(:, i)*y(:, j))
+               kr(j, i) = kr(i, j)
+               mr(j, i) = mr(i, j)
+            end do
+         end do
+         call generalized_eigen(kr, mr, lam, q, error)
+         if (allocated(error)) return
+         x = matmul(y, q)
+         done = it > 1
+         do i = 1, m
+            if (abs(lam(i) - lam_old(i)) > max(lambda_tol*abs(lam(i)), floor)) done = .false.
+         end do
+         if (done) then
+            do i = 1, m
+               gap = huge(1.0_dp)
+               if (i > 1) gap = lam(i) - lam(i - 1)
+               if (i < nq) gap = min(gap, lam(i + 1) - lam(i))
+               if (gap <= cluster_tol*abs(lam(i))) cycle
+               change = sign(1.0_dp, sum(mass*x(:, i)*phi(:, i)))
+               change = sqrt(sum(mass*(x(:, i) - change*phi(:, i))**2))
+               if (change > max(vector_tol, floor/gap)) done = .false.
+            end do
+         end if
+         lam_old = lam
+         phi(:, 1:m) = x(:, 1:m)
+         if (done) exit
+      end do
+      if (.not. done) then
+         call fatal_error(error, "lowest_modes: the subspace iteration did not converge in "// &
+                          trim(fmt_int(max_iterations))//" iterations (lambda_1 = "//trim(fmt_real(lam(1)))//")")
+         return
+      end if
+      lambda(1:m) = lam(1:m)
+      do i = 1, m
+         j = maxloc(abs(phi(:, i)), 1)
+         if (phi(j, i) < 0.0_dp) phi(:, i) = -phi(:, i)
+      end do
+   end subroutine constrained_subspace
+
    !> The largest eigenvalue of K phi = lambda M phi (the square of the highest natural
    !> circular frequency), from below and from above:
    !>
@@ -395,6 +772,102 @@ contains
       end do
       lambda = min(top, bound)
    end subroutine highest_eigenvalue
+
+   !> highest_eigenvalue of a general structure: K the springs and K_x, plus kd_d b_d b_d' of
+   !> each device (matrix free, from their entries: O(nonzeros) a Lanczos step, no n x n
+   !> matrix beyond modes_dense_max DOFs, where dsygv gives it exactly). The same bounds:
+   !> lambda a lower bound (the largest Ritz value), bound Gershgorin's upper bound.
+   subroutine general_highest_eigenvalue(mass, spring_i, spring_j, spring_k, kx_i, kx_j, kx_v, dev_ptr, dev_dof, &
+                                         dev_coef, kd, lambda, bound, error)
+      real(dp), intent(in) :: mass(:)             !! masses m_i > 0, n = size(mass)
+      integer, intent(in) :: spring_i(:)          !! first node of each spring (0..n)
+      integer, intent(in) :: spring_j(:)          !! second node of each spring (0..n, 0 = fixed)
+      real(dp), intent(in) :: spring_k(:)         !! spring stiffness >= 0
+      integer, intent(in) :: kx_i(:)              !! K_x: row of each entry (1..n)
+      integer, intent(in) :: kx_j(:)              !! its column (kx_i <= kx_j)
+      real(dp), intent(in) :: kx_v(:)             !! its value
+      integer, intent(in) :: dev_ptr(:)           !! start of each device's terms (devices + 1)
+      integer, intent(in) :: dev_dof(:)           !! DOF of each term
+      real(dp), intent(in) :: dev_coef(:)         !! coefficient of each term
+      real(dp), intent(in) :: kd(:)               !! each device's stiffness in K (>= 0; 0: none)
+      real(dp), intent(out) :: lambda             !! largest Ritz value [1/s^2] (a lower bound)
+      real(dp), intent(out) :: bound              !! Gershgorin bound [1/s^2] (an upper bound)
+      type(error_type), allocatable, intent(out) :: error !! no memory, LAPACK failure
+      integer, allocatable :: ci(:), cj(:)
+      real(dp), allocatable :: cv(:), dm(:), q0(:), q1(:), w(:), alpha(:), beta(:), d(:), e(:), a(:, :), m(:, :)
+      real(dp), allocatable :: z(:, :)
+      real(dp) :: nrm, top, prev
+      integer :: n, i, k, info, stat
+
+      n = size(mass)
+      lambda = 0.0_dp
+      bound = 0.0_dp
+      if (n == 0) return
+      call stiffness_entries(n, spring_i, spring_j, spring_k, kx_i, kx_j, kx_v, dev_ptr, dev_dof, dev_coef, kd, &
+                             ci, cj, cv, stat)
+      if (stat == 0) allocate (dm(n), q0(n), q1(n), w(n), alpha(lanczos_max_steps), beta(lanczos_max_steps), &
+                               d(lanczos_max_steps), e(lanczos_max_steps), stat=stat)
+      if (stat /= 0) then
+         call no_memory(); return
+      end if
+      dm = 1.0_dp/sqrt(mass)
+      ! Gershgorin on D K D, D = M^-1/2: the entries scaled, |K_ij| / sqrt(m_i m_j)
+      call entry_rows(ci, cj, cv*dm(ci)*dm(cj), w)
+      bound = maxval(w)
+      if (bound == 0.0_dp) return
+      if (n <= modes_dense_max) then   ! dsygv: every eigenvalue, the largest exact
+         allocate (a(n, n), m(n, n), z(n, n), stat=stat)
+         if (stat /= 0) then
+            call no_memory(); return
+         end if
+         m = 0.0_dp
+         do i = 1, n
+            q1 = 0.0_dp
+            q1(i) = 1.0_dp
+            call entry_product(ci, cj, cv, q1, a(:, i))
+            m(i, i) = mass(i)
+         end do
+         call generalized_eigen(a, m, w, z, error)
+         if (allocated(error)) return
+         lambda = w(n)
+         return
+      end if
+      do i = 1, n
+         q1(i) = start_value(i, 1)
+      end do
+      q1 = q1/norm2(q1)
+      q0 = 0.0_dp
+      prev = -1.0_dp
+      top = 0.0_dp
+      do k = 1, min(lanczos_max_steps, n)
+         call entry_product(ci, cj, cv, dm*q1, w)
+         w = dm*w
+         if (k > 1) w = w - beta(k - 1)*q0
+         alpha(k) = dot_product(w, q1)
+         w = w - alpha(k)*q1
+         nrm = norm2(w)
+         beta(k) = nrm
+         d(1:k) = alpha(1:k)
+         e(1:k) = beta(1:k)
+         call dsterf(k, d, e, info)
+         if (info /= 0) then
+            call fatal_error(error, "highest_eigenvalue: dsterf failed with info = "//trim(fmt_int(info)))
+            return
+         end if
+         top = d(k)
+         if (nrm <= epsilon(1.0_dp)*bound) exit
+         if (abs(top - prev) <= lanczos_tol*abs(top)) exit
+         prev = top
+         q0 = q1
+         q1 = w/nrm
+      end do
+      lambda = min(top, bound)
+   contains
+      subroutine no_memory()
+         call fatal_error(error, "highest_eigenvalue: not enough memory for "//trim(fmt_int(n))//" DOFs", &
+                          stat_no_memory)
+      end subroutine no_memory
+   end subroutine general_highest_eigenvalue
 
    !> A reproducible pseudo-random number in [-1, 1) for entry (i, j) of the start vectors
    !> (a hash of i and j: no generator state).

@@ -13,7 +13,7 @@ module fd_matrices
    use fd_linalg, only: generalized_eigen, lowest_eigen, lowest_eigen_band
    use fd_rcm, only: rcm_order
    use fd_lapack, only: dpbtrf
-   use fd_modes, only: lowest_modes
+   use fd_modes, only: lowest_modes, general_lowest_modes, modes_auto, modes_dense
    use fd_kinematics, only: add_device_outer, pair_nodes, devices_are_pairs
    use fd_stiffness, only: add_general_dense, general_form, influence_of
    implicit none
@@ -225,14 +225,21 @@ contains
       integer, allocatable :: grp(:), ea(:), eb(:)
       real(dp), allocatable :: mq(:), ek(:), lam(:), z(:, :)
       real(dp) :: scale
-      integer :: n, i, s, ne, m, stat
+      integer :: n, i, s, ne, m, stat, mode
 
       omega2 = 0.0_dp
       phi = 0.0_dp
       n = model%n_dof
       if (model%n_kx > 0 .or. .not. devices_are_pairs(model)) then
-         ! stiffness beyond springs, or devices that are no links between two nodes: dense
-         call dense_system_modes(model, linked, nev, omega2, phi, nq, error)
+         ! stiffness beyond springs, or devices that are no links between two nodes: the
+         ! dense (K, M) on the null space of the links up to modes_dense_dofs, else banded
+         mode = modes_auto
+         if (present(path)) mode = path
+         if (mode == modes_dense .or. (mode == modes_auto .and. n <= modes_dense_dofs)) then
+            call dense_system_modes(model, linked, nev, omega2, phi, nq, error)
+         else
+            call banded_system_modes(model, linked, nev, omega2, phi, nq, error)
+         end if
          return
       end if
       allocate (grp(n), stat=stat)
@@ -460,6 +467,55 @@ contains
       phi(:, 1:m) = z(:, 1:m)
    end subroutine dense_system_modes
 
+   !> system_modes of a general model without an n x n matrix: the modes of (K, M) on the
+   !> null space of the linked devices' directions by fd_modes' general_lowest_modes
+   !> (subspace iteration with the banded factor of K, the constraints through their r x r
+   !> Schur complement). The same outputs and errors as dense_system_modes.
+   subroutine banded_system_modes(model, linked, nev, omega2, phi, nq, error)
+      type(model_type), intent(in) :: model          !! the model
+      logical, intent(in) :: linked(:)               !! devices acting as rigid links
+      integer, intent(in) :: nev                     !! modes wanted
+      real(dp), intent(out) :: omega2(:)             !! w^2 [1/s^2], size nev (0 beyond nq)
+      real(dp), intent(out) :: phi(:, :)             !! M-normalized mode shapes, n_dof x nev
+      integer, intent(out) :: nq                     !! free DOFs of the constrained system
+      type(error_type), allocatable, intent(out) :: error !! no free DOF, rigid-body mode
+      real(dp), allocatable :: kd(:), kv(:)
+      integer, allocatable :: ki(:), kj(:)
+      real(dp) :: big
+
+      allocate (kd(model%n_devices))
+      kd = 0.0_dp
+      call kx_entries(model, ki, kj, kv)
+      call general_lowest_modes(model%mass, model%spring_i(1:model%n_springs), model%spring_j(1:model%n_springs), &
+                                model%spring_k(1:model%n_springs), ki, kj, kv, model%dev_ptr, model%dev_dof, &
+                                model%dev_coef, kd, linked, nev, omega2, phi, nq, big, error)
+      if (allocated(error)) return
+      if (nq == 0) then
+         call fatal_error(error, "the system has no free DOF: every mass is locked to the table by rigid links")
+         return
+      end if
+      if (omega2(1) <= 1.0e-12_dp*big) then
+         call fatal_error(error, "the system has a rigid-body mode (first eigenvalue "// &
+                          trim(fmt_real(omega2(1)))//"): a mass or group of masses has no spring to the table")
+         return
+      end if
+   end subroutine banded_system_modes
+
+   !> K_x's entries (kx_i, kx_j, kx_v) as arrays of n_kx entries (none when it has none).
+   pure subroutine kx_entries(model, ki, kj, kv)
+      type(model_type), intent(in) :: model            !! the model
+      integer, allocatable, intent(out) :: ki(:), kj(:) !! rows, columns (ki <= kj)
+      real(dp), allocatable, intent(out) :: kv(:)       !! values
+
+      if (model%n_kx > 0) then
+         ki = model%kx_i(1:model%n_kx)
+         kj = model%kx_j(1:model%n_kx)
+         kv = model%kx_v(1:model%n_kx)
+      else
+         allocate (ki(0), kj(0), kv(0))
+      end if
+   end subroutine kx_entries
+
    !> Z, an orthonormal basis of the null space of the directions b_d of the devices in
    !> `linked` (b_d' Z = 0): the eigenvectors of B B' (B = [b_d]) whose eigenvalue is below
    !> 1e-12 of the largest; the identity when no linked device has a direction. nq its
@@ -596,32 +652,86 @@ contains
                                       " DOFs", stat_no_memory)
    end subroutine constrained_natural_modes
 
-   !> natural_modes_sparse of a general model: the dense matrices K and C = a0 M + a1 K, then
-   !> natural_modes (memory n_dof**2).
-   subroutine dense_natural_modes(model, a0, a1, system, nmax, modes, error)
+   !> natural_modes_sparse of a general model (K_x, devices of any direction) without an
+   !> n x n matrix: the stuck system's linking devices as constraints and its sticking springs
+   !> in K, by fd_modes' general_lowest_modes (banded factor, the constraints through their
+   !> Schur complement); C = a0 M + a1 K (K the springs and K_x) and 'modal' damping's
+   !> low-rank term give each mode's damping ratio. The same outputs as natural_modes.
+   subroutine banded_natural_modes(model, a0, a1, system, nmax, modes, error)
       type(model_type), intent(in) :: model          !! the model
       real(dp), intent(in) :: a0, a1                 !! C = a0 M + a1 K
       integer, intent(in) :: system                  !! system_stuck or system_free
       integer, intent(in) :: nmax                    !! modes to keep at most
-      type(modes_type), intent(out) :: modes         !! the modes
+      type(modes_type), intent(inout) :: modes       !! the modes
       type(error_type), allocatable, intent(out) :: error !! solver failure, no memory
-      real(dp), allocatable :: k(:, :), c(:, :)
-      integer :: n, i, stat
+      real(dp), allocatable :: kd(:), kv(:), lam(:), z(:, :), zcz(:)
+      integer, allocatable :: ki(:), kj(:), grp(:)
+      logical, allocatable :: linked(:)
+      real(dp) :: big, w
+      integer :: n, nd, ns, d, j, s, m, stat
 
       n = model%n_dof
-      allocate (k(n, n), c(n, n), stat=stat)
+      nd = model%n_devices
+      ns = model%n_springs
+      allocate (kd(nd), linked(nd), stat=stat)
       if (stat /= 0) then
-         call fatal_error(error, "not enough memory for the natural modes of "//trim(fmt_int(n))// &
-                          " DOFs (two dense matrices)", stat_no_memory)
+         call no_memory(); return
+      end if
+      do d = 1, nd
+         linked(d) = system == system_stuck .and. links_when_stuck(model%dev(d))
+         kd(d) = 0.0_dp
+         if (system == system_stuck) kd(d) = max(sticking_stiffness(model%dev(d)), 0.0_dp)
+      end do
+      m = max(min(nmax, n), 1)
+      allocate (lam(m), z(n, m), stat=stat)
+      if (stat /= 0) then
+         call no_memory(); return
+      end if
+      call kx_entries(model, ki, kj, kv)
+      call general_lowest_modes(model%mass, model%spring_i(1:ns), model%spring_j(1:ns), model%spring_k(1:ns), &
+                                ki, kj, kv, model%dev_ptr, model%dev_dof, model%dev_coef, kd, linked, m, lam, z, &
+                                modes%nq, big, error)
+      if (allocated(error)) then
+         error%message = "the natural modes of the "//trim(merge('stuck', 'free ', system == system_stuck))// &
+                         " system: "//error%message
          return
       end if
-      call stiffness_matrix(model, k)
-      c = a1*k
-      do i = 1, n
-         c(i, i) = c(i, i) + a0*model%mass(i)
+      if (modes%nq == 0) then
+         modes%status = modes_rigid
+         allocate (modes%omega2(0), modes%period(0), modes%shape(n, 0), modes%mass_ratio(0), modes%xi(0))
+         return
+      end if
+      modes%n = min(max(nmax, 0), modes%nq)
+      allocate (zcz(modes%n), grp(n), stat=stat)
+      if (stat /= 0) then
+         call no_memory(); return
+      end if
+      ! z' C z = a0 + a1 z' K z (z' M z = 1), K the springs and K_x; 'modal' damping's z' U diag(d) U' z
+      do j = 1, modes%n
+         w = 0.0_dp
+         do s = 1, ns
+            w = w + model%spring_k(s)*(node_z(model%spring_i(s), j) - node_z(model%spring_j(s), j))**2
+         end do
+         zcz(j) = a0 + a1*(w + general_form(model, z(:, j), z(:, j)))
+         if (allocated(model%modal_d)) zcz(j) = zcz(j) + sum(model%modal_d*matmul(z(:, j), model%modal_u)**2)
       end do
-      call natural_modes(model, k, c, system, nmax, modes, error)
-   end subroutine dense_natural_modes
+      modes%status = modes_flexible
+      if (lam(1) <= 1.0e-12_dp*big) modes%status = modes_unrestrained
+      grp = [(j, j=1, n)]
+      call store_modes(grp, model%mass, lam, z, lam(1:modes%n) <= 1.0e-12_dp*big, zcz, modes, stat, &
+                       model%influence)
+      if (stat /= 0) call no_memory()
+   contains
+      pure real(dp) function node_z(node, j)
+         integer, intent(in) :: node, j
+         node_z = 0.0_dp
+         if (node > 0) node_z = z(node, j)
+      end function node_z
+      subroutine no_memory()
+         call fatal_error(error, "not enough memory for the natural modes of "//trim(fmt_int(n))//" DOFs", &
+                          stat_no_memory)
+      end subroutine no_memory
+   end subroutine banded_natural_modes
 
    !> Groups of DOFs joined by rigid links (the devices flagged in `linked`), by union-find
    !> over the nodes 0..n_dof: grp(i) = 1..nq for a group that moves, 0 for a DOF linked
@@ -777,8 +887,8 @@ contains
       nd = model%n_devices
       modes%system = system
       if (model%n_kx > 0 .or. .not. devices_are_pairs(model)) then
-         ! stiffness beyond springs, or devices that are no links between two nodes: dense
-         call dense_natural_modes(model, a0, a1, system, nmax, modes, error)
+         ! stiffness beyond springs, or devices that are no links between two nodes
+         call banded_natural_modes(model, a0, a1, system, nmax, modes, error)
          return
       end if
       call system_groups(model, system, grp, modes, stat)

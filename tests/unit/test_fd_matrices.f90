@@ -4,10 +4,13 @@ module test_fd_matrices
    use testdrive, only: new_unittest, unittest_type, error_type, check
    use fd_kinds, only: dp
    use fd_error, only: fd_error_type => error_type
-   use fd_model, only: model_type, damping_stiffness, damping_rayleigh, law_velocity
+   use fd_model, only: model_type, device_type, damping_stiffness, damping_rayleigh, law_velocity, law_hysteretic, &
+                       system_stuck, system_free
    use fd_matrices, only: link_groups, stiffness_matrix, damping_matrix, stuck_first_mode, structure_matrices, &
-                          stiffness_pivot
+                          stiffness_pivot, system_modes, natural_modes, natural_modes_sparse, modes_type
    use fd_stiffness, only: stiffness_times, stiffness_form
+   use fd_modes, only: modes_dense, modes_iterative
+   use fd_kinematics, only: append_device
    use test_fd_helpers, only: check_close, check_matrix, pairs_of
    implicit none
    private
@@ -34,7 +37,9 @@ contains
                   new_unittest("stuck mode, everything locked", test_stuck_locked), &
                   new_unittest("damping ratio of the stuck mode", test_structure_xi), &
                   new_unittest("stiffness pivot: mechanisms and indefinite K", test_stiffness_pivot), &
-                  new_unittest("stiffness pivot in the RCM ordering", test_stiffness_pivot_rcm) &
+                  new_unittest("stiffness pivot in the RCM ordering", test_stiffness_pivot_rcm), &
+                  new_unittest("general modes: banded against dense", test_general_system_modes), &
+                  new_unittest("general natural modes: banded against dense", test_general_natural_modes) &
                   ]
    end subroutine collect_matrices
 
@@ -214,6 +219,144 @@ contains
       call stiffness_pivot(model, dof, ferr)
       call check(error, .not. allocated(ferr) .and. dof == 0, 'both chains grounded: positive definite')
    end subroutine test_stiffness_pivot_rcm
+
+   !> A general model of 60 DOFs: springs of a chain to the table, K_x coupling each DOF to
+   !> the third after it (diagonally dominant: 40 on the diagonal, -10 to -14 off it), masses
+   !> 1 to 3; devices 5-20, 20-40 and 5-40
+   !> (velocity law: three links of rank two), 50 to the table, and a hysteretic device of
+   !> direction (1, -0.5, 0.25) on DOFs 10, 30, 59 (its sticking spring 400).
+   subroutine general_model(model)
+      type(model_type), intent(out) :: model
+      type(device_type) :: dev
+      real(dp) :: springs(3, 60), mass(60)
+      integer :: i, stat
+
+      do i = 1, 60
+         mass(i) = 1.0_dp + 2.0_dp*real(mod(7*i, 11), dp)/10.0_dp
+         springs(:, i) = [real(i, dp), real(i - 1, dp), 100.0_dp + real(mod(3*i, 7), dp)*20.0_dp]
+      end do
+      call make_model(model, mass, springs, reshape([5, 20, 20, 40, 5, 40, 50, 0], [2, 4]))
+      model%n_kx = 60 + 57
+      allocate (model%kx_i(model%n_kx), model%kx_j(model%n_kx), model%kx_v(model%n_kx))
+      do i = 1, 60
+         model%kx_i(i) = i
+         model%kx_j(i) = i
+         model%kx_v(i) = 40.0_dp
+      end do
+      do i = 1, 57
+         model%kx_i(60 + i) = i
+         model%kx_j(60 + i) = i + 3
+         model%kx_v(60 + i) = -10.0_dp - real(mod(i, 5), dp)
+      end do
+      dev%law = law_hysteretic
+      dev%p = 4.0_dp
+      dev%mu = 1.0_dp
+      dev%f = 0.01_dp
+      call append_device(model, dev, [10, 30, 59], [1.0_dp, -0.5_dp, 0.25_dp], stat)
+      if (stat /= 0) error stop "general_model: not enough memory"
+   end subroutine general_model
+
+   !> The modes of a general model with the links as constraints (system_modes): the banded
+   !> path (subspace iteration on the null space through the constraints' Schur complement)
+   !> against the dense one (the null space's basis, dsygv), eigenvalues to 1e-10 relative
+   !> and M-normalized shapes to 1e-8; the null space has 60 - 3 free DOFs (the three links
+   !> 5-20-40-5 constrain two).
+   subroutine test_general_system_modes(error)
+      type(error_type), allocatable, intent(out) :: error
+      type(fd_error_type), allocatable :: ferr
+      type(model_type) :: model
+      real(dp) :: w_dense(6), w_band(6), z_dense(60, 6), z_band(60, 6), s
+      integer :: nq_dense, nq_band, j
+      logical :: linked(5)
+
+      call general_model(model)
+      linked = [.true., .true., .true., .true., .false.]
+      call system_modes(model, linked, 6, w_dense, z_dense, nq_dense, ferr, modes_dense)
+      call check(error, .not. allocated(ferr), 'dense modes'//message_of(ferr))
+      if (allocated(error)) return
+      call system_modes(model, linked, 6, w_band, z_band, nq_band, ferr, modes_iterative)
+      call check(error, .not. allocated(ferr), 'banded modes'//message_of(ferr))
+      if (allocated(error)) return
+      call check(error, nq_dense, 57, 'dense: 60 DOFs less the rank 3 of four links')
+      if (allocated(error)) return
+      call check(error, nq_band, 57, 'banded: 60 DOFs less the rank 3 of four links')
+      if (allocated(error)) return
+      call check_each(error, w_band, w_dense, 1.0e-10_dp, 'eigenvalues')
+      if (allocated(error)) return
+      do j = 1, 6
+         s = sign(1.0_dp, sum(model%mass*z_band(:, j)*z_dense(:, j)))
+         call check_each(error, s*z_band(:, j), z_dense(:, j), 1.0e-8_dp, 'mode shape', absolute=.true.)
+         if (allocated(error)) return
+      end do
+      ! the banded shapes satisfy the links: u_5 = u_20 = u_40, u_50 = 0
+      call check(error, maxval(abs([z_band(5, :) - z_band(20, :), z_band(20, :) - z_band(40, :), z_band(50, :)])) &
+                 < 1.0e-12_dp*maxval(abs(z_band)), 'the links hold in the banded shapes')
+   end subroutine test_general_system_modes
+
+   !> natural_modes_sparse of a general model (banded: the hysteretic device's sticking spring
+   !> in K, the linking devices as constraints) against natural_modes (dense matrices), stuck
+   !> and free: periods, damping ratios (Rayleigh) and mass ratios to 1e-10, shapes to 1e-8.
+   subroutine test_general_natural_modes(error)
+      type(error_type), allocatable, intent(out) :: error
+      type(fd_error_type), allocatable :: ferr
+      type(model_type) :: model
+      type(modes_type) :: dense, band
+      real(dp) :: k(60, 60), c(60, 60)
+      real(dp), parameter :: a0 = 0.3_dp, a1 = 2.0e-3_dp
+      integer :: system, i, is
+
+      call general_model(model)
+      call stiffness_matrix(model, k)
+      c = a1*k
+      do i = 1, 60
+         c(i, i) = c(i, i) + a0*model%mass(i)
+      end do
+      do is = 1, 2
+         system = merge(system_stuck, system_free, is == 1)
+         call natural_modes(model, k, c, system, 5, dense, ferr)
+         call check(error, .not. allocated(ferr), 'dense natural modes'//message_of(ferr))
+         if (allocated(error)) return
+         call natural_modes_sparse(model, a0, a1, system, 5, band, ferr)
+         call check(error, .not. allocated(ferr), 'banded natural modes'//message_of(ferr))
+         if (allocated(error)) return
+         call check(error, band%nq, dense%nq, 'free DOFs')
+         if (allocated(error)) return
+         call check(error, band%status, dense%status, 'status')
+         if (allocated(error)) return
+         call check_each(error, band%period, dense%period, 1.0e-10_dp, 'periods')
+         if (allocated(error)) return
+         call check_each(error, band%xi, dense%xi, 1.0e-10_dp, 'damping ratios')
+         if (allocated(error)) return
+         call check_each(error, band%mass_ratio, dense%mass_ratio, 1.0e-10_dp, 'mass ratios', absolute=.true.)
+         if (allocated(error)) return
+         call check_each(error, reshape(band%shape, [300]), reshape(dense%shape, [300]), 1.0e-8_dp, 'shapes', &
+                          absolute=.true.)
+         if (allocated(error)) return
+      end do
+   end subroutine test_general_natural_modes
+
+   !> ": " and an error's message, or nothing.
+   function message_of(ferr) result(text)
+      type(fd_error_type), allocatable, intent(in) :: ferr
+      character(len=200) :: text
+      text = ''
+      if (allocated(ferr)) text = ': '//ferr%message
+   end function message_of
+
+   !> check_close of each element of two arrays of one size.
+   subroutine check_each(error, actual, expected, tol, what, absolute)
+      type(error_type), allocatable, intent(out) :: error
+      real(dp), intent(in) :: actual(:), expected(:), tol
+      character(len=*), intent(in) :: what
+      logical, intent(in), optional :: absolute
+      integer :: i
+
+      call check(error, size(actual), size(expected), what//': sizes')
+      do i = 1, size(expected)
+         if (allocated(error)) return
+         call check_close(error, actual(i), expected(i), tol, what, absolute)
+      end do
+   end subroutine check_each
 
    !> C = (T xi / pi) K for 'stiffness'; C = a0 M + a1 K for 'rayleigh'.
    subroutine test_damping(error)

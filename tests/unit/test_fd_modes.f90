@@ -3,12 +3,15 @@
 !> randomly numbered chains and a plane frame; the mode shapes M-normalized, K-orthogonal,
 !> and the residual of K phi = lambda M phi at round-off; a structure with a rigid-body mode
 !> recognised (lambda ~ 0 against the scale of the spectrum). The highest eigenvalue
-!> (highest_eigenvalue: Lanczos, with Gershgorin's bound) against closed forms and dsygv.
+!> (highest_eigenvalue: Lanczos, with Gershgorin's bound) against closed forms and dsygv. The
+!> general forms (K_x entries, device directions as constraints or sticking springs) against
+!> the closed form of a chain held at both ends.
 module test_fd_modes
    use testdrive, only: new_unittest, unittest_type, error_type, check
    use fd_kinds, only: dp
    use fd_error, only: lib_error => error_type
-   use fd_modes, only: lowest_modes, modes_dense, modes_iterative, highest_eigenvalue
+   use fd_modes, only: lowest_modes, modes_dense, modes_iterative, highest_eigenvalue, general_lowest_modes, &
+                       general_highest_eigenvalue
    use test_fd_helpers, only: check_close
    implicit none
    private
@@ -29,9 +32,83 @@ contains
                   new_unittest("rigid-body mode has lambda ~ 0", test_rigid), &
                   new_unittest("highest eigenvalue: two masses, closed form", test_highest_two), &
                   new_unittest("highest eigenvalue: chain, closed form and bounds", test_highest_chain), &
-                  new_unittest("highest eigenvalue: Lanczos equals dsygv", test_highest_against_dense) &
+                  new_unittest("highest eigenvalue: Lanczos equals dsygv", test_highest_against_dense), &
+                  new_unittest("general modes: constrained chain closed form", test_general_chain), &
+                  new_unittest("general highest eigenvalue: chain closed form", test_general_highest) &
                   ]
    end subroutine collect_modes
+
+   !> A chain of n = 300 masses m given as K_x entries alone (k on the diagonal's neighbours'
+   !> sums, -k off it: DOF 1 to the table), held at DOF n by two linked devices of directions
+   !> 2 e_n and -e_n (one constraint, given twice: rank one) and a third, unlinked device
+   !> between 10 and 20 with no stiffness: the chain fixed at both ends, n - 1 moving masses,
+   !> w_j^2 = (4 k / m) sin^2(j pi / (2 n)). The five lowest to 1e-10; nfree = n - 1; the
+   !> shapes M-normalized and zero at DOF n.
+   subroutine test_general_chain(error)
+      type(error_type), allocatable, intent(out) :: error
+      integer, parameter :: n = 300, nev = 5
+      real(dp), parameter :: m = 3.0_dp, k = 1.0e6_dp
+      real(dp) :: mass(n), kv(2*n - 1), lam(nev), phi(n, nev), scale, exact
+      integer :: ki(2*n - 1), kj(2*n - 1), i, j, nfree
+      type(lib_error), allocatable :: err
+
+      mass = m
+      do i = 1, n
+         ki(i) = i; kj(i) = i; kv(i) = merge(k, 2.0_dp*k, i == n)
+      end do
+      do i = 1, n - 1
+         ki(n + i) = i; kj(n + i) = i + 1; kv(n + i) = -k
+      end do
+      call general_lowest_modes(mass, [integer ::], [integer ::], [real(dp) ::], ki, kj, kv, [1, 2, 3, 5], &
+                                [n, n, 10, 20], [2.0_dp, -1.0_dp, 1.0_dp, -1.0_dp], [0.0_dp, 0.0_dp, 0.0_dp], &
+                                [.true., .true., .false.], nev, lam, phi, nfree, scale, err)
+      call check(error, .not. allocated(err), 'general_lowest_modes')
+      if (allocated(error)) return
+      call check(error, nfree, n - 1, 'one constraint given twice: n - 1 free DOFs')
+      if (allocated(error)) return
+      do j = 1, nev
+         exact = 4.0_dp*k/m*sin(j*pi/(2.0_dp*n))**2
+         call check_close(error, lam(j), exact, 1.0e-10_dp, 'w^2 of the chain fixed at both ends')
+         if (allocated(error)) return
+         call check_close(error, sum(mass*phi(:, j)**2), 1.0_dp, 1.0e-12_dp, 'M-normalized')
+         if (allocated(error)) return
+         call check(error, abs(phi(n, j)) <= 1.0e-13_dp*maxval(abs(phi(:, j))), 'held at DOF n')
+         if (allocated(error)) return
+      end do
+   end subroutine test_general_chain
+
+   !> The highest eigenvalue of a fixed-base chain of n masses given as K_x entries plus a
+   !> device of stiffness 0 (4 k / m sin^2((2n - 1) pi / (2 (2n + 1)))): n = 40 by dsygv to
+   !> 1e-12, n = 3000 by Lanczos within 1e-4 and never above it; Gershgorin's bound 4 k / m
+   !> above it in both.
+   subroutine test_general_highest(error)
+      type(error_type), allocatable, intent(out) :: error
+      real(dp), parameter :: m = 2.0_dp, k = 5.0e5_dp
+      real(dp), allocatable :: mass(:), kv(:)
+      integer, allocatable :: ki(:), kj(:)
+      real(dp) :: lam, bound, exact
+      integer :: n, i, c
+      type(lib_error), allocatable :: err
+
+      do c = 1, 2
+         n = merge(40, 3000, c == 1)
+         mass = [(m, i=1, n)]
+         ki = [(i, i=1, n), (i, i=1, n - 1)]
+         kj = [(i, i=1, n), (i + 1, i=1, n - 1)]
+         kv = [(merge(k, 2.0_dp*k, i == n), i=1, n), (-k, i=1, n - 1)]
+         call general_highest_eigenvalue(mass, [integer ::], [integer ::], [real(dp) ::], ki, kj, kv, [1, 3], &
+                                         [1, 2], [1.0_dp, -1.0_dp], [0.0_dp], lam, bound, err)
+         call check(error, .not. allocated(err), 'general_highest_eigenvalue')
+         if (allocated(error)) return
+         exact = 4.0_dp*k/m*sin((2*n - 1)*pi/(2.0_dp*(2*n + 1)))**2
+         call check_close(error, lam, exact, merge(1.0e-12_dp, 1.0e-4_dp, n == 40), 'largest eigenvalue')
+         if (allocated(error)) return
+         call check(error, lam <= exact*(1.0_dp + 1.0e-12_dp), 'a lower bound')
+         if (allocated(error)) return
+         call check(error, bound >= exact .and. bound <= 4.0_dp*k/m*(1.0_dp + 1.0e-15_dp), 'Gershgorin: 4 k / m')
+         if (allocated(error)) return
+      end do
+   end subroutine test_general_highest
 
    !> A fixed-base chain of n equal masses m and springs k: w_j^2 = (4 k / m) sin^2((2j - 1) pi
    !> / (2 (2 n + 1))). n = 2000 by subspace iteration, the five lowest to 1e-12.

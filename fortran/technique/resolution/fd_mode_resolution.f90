@@ -22,9 +22,9 @@ module fd_mode_resolution
    use fd_model, only: model_type
    use fd_friction, only: sticking_stiffness
    use fd_kinematics, only: pair_nodes, devices_are_pairs, add_device_outer
-   use fd_matrices, only: stiffness_matrix
+   use fd_matrices, only: stiffness_matrix, modes_dense_dofs
    use fd_linalg, only: generalized_eigen
-   use fd_modes, only: highest_eigenvalue
+   use fd_modes, only: highest_eigenvalue, general_highest_eigenvalue
    use fd_result, only: result_type, run_setup, setup_of, resolution_limit => mode_resolution_limit
    implicit none
    private
@@ -55,8 +55,13 @@ contains
       if (technique_step_rule(res%technique) == rule_none) return
       if (setup%dt1 <= 0.0_dp .or. model%n_dof == 0) return
       if (model%n_kx > 0 .or. .not. devices_are_pairs(model)) then
-         ! stiffness beyond springs, or devices of any direction: the dense eigenproblem
-         call dense_highest(model, lam, error)
+         ! stiffness beyond springs, or devices of any direction: the dense eigenproblem up to
+         ! modes_dense_dofs DOFs, else Lanczos on the matrices' entries (no n x n matrix)
+         if (model%n_dof <= modes_dense_dofs) then
+            call dense_highest(model, lam, error)
+         else
+            call general_highest(model, lam, error)
+         end if
          if (allocated(error)) return
          res%omega_max = sqrt(max(lam, 0.0_dp))
          res%mode_checked = .true.
@@ -90,6 +95,33 @@ contains
       res%omega_max = sqrt(max(lam, 0.0_dp))
       res%mode_checked = .true.
    end subroutine mode_resolution
+
+   !> The largest eigenvalue w^2 of (K + the sticking springs' k_d b_d b_d', M) of a general
+   !> model by fd_modes' Lanczos on the entries (a lower bound accurate to 1e-10 relative).
+   subroutine general_highest(model, lam, error)
+      type(model_type), intent(in) :: model               !! the model
+      real(dp), intent(out) :: lam                        !! largest w^2 [1/s2]
+      type(error_type), allocatable, intent(out) :: error !! no memory, solver failure
+      real(dp) :: bound
+      integer :: ns, nk
+
+      ns = model%n_springs
+      nk = model%n_kx
+      if (nk == 0) then
+         call general_highest_eigenvalue(model%mass, model%spring_i(1:ns), model%spring_j(1:ns), &
+                                         model%spring_k(1:ns), [integer ::], [integer ::], [real(dp) ::], &
+                                         model%dev_ptr, model%dev_dof, model%dev_coef, &
+                                         max(sticking_stiffness(model%dev(1:model%n_devices)), 0.0_dp), &
+                                         lam, bound, error)
+      else
+         call general_highest_eigenvalue(model%mass, model%spring_i(1:ns), model%spring_j(1:ns), &
+                                         model%spring_k(1:ns), model%kx_i(1:nk), model%kx_j(1:nk), &
+                                         model%kx_v(1:nk), model%dev_ptr, model%dev_dof, model%dev_coef, &
+                                         max(sticking_stiffness(model%dev(1:model%n_devices)), 0.0_dp), &
+                                         lam, bound, error)
+      end if
+      if (allocated(error)) error%message = "the highest natural frequency: "//error%message
+   end subroutine general_highest
 
    !> The largest eigenvalue w^2 of (K + the sticking springs' k_d b_d b_d', M) of a general
    !> model, from the dense generalized eigenproblem.
