@@ -145,7 +145,7 @@ contains
       type(error_type), allocatable, intent(out) :: error
       type(spd_system) :: sys
       real(dp), allocatable :: x(:, :), y(:, :), kr(:, :), mr(:, :), lam(:), lam_old(:), q(:, :), row(:)
-      real(dp) :: delta, change, norm
+      real(dp) :: delta, norm
       integer :: n, nq, it, i, j, e, a, b, pass, stat
       integer :: none(0)
       real(dp) :: no_coef(0)
@@ -235,25 +235,10 @@ contains
          call generalized_eigen(kr, mr, lam, q, error)
          if (allocated(error)) return
          x = matmul(y, q)
-         ! converged: every wanted eigenvalue, and every wanted simple mode's shape
+         ! converged: every wanted eigenvalue (relative to itself, or to the shift for one at
+         ! round-off: a rigid-body mode), and every wanted simple mode's shape
          done = it > 1
-         do i = 1, nev
-            ! relative to the eigenvalue, or to the shift for one at round-off (a rigid-body mode)
-            if (abs(lam(i) - lam_old(i)) > lambda_tol*max(abs(lam(i)), delta)) done = .false.
-         end do
-         if (done) then
-            do i = 1, nev
-               if (i > 1) then
-                  if (abs(lam(i) - lam(i - 1)) <= cluster_tol*abs(lam(i))) cycle
-               end if
-               if (i < nq) then
-                  if (abs(lam(i + 1) - lam(i)) <= cluster_tol*abs(lam(i))) cycle
-               end if
-               change = sign(1.0_dp, sum(mass*x(:, i)*phi(:, i)))
-               change = sqrt(sum(mass*(x(:, i) - change*phi(:, i))**2))
-               if (change > vector_tol) done = .false.
-            end do
-         end if
+         if (done) done = subspace_settled(mass, x, phi, lam, lam_old, nev, lambda_tol*delta, 0.0_dp)
          lam_old = lam
          phi(:, 1:nev) = x(:, 1:nev)
          if (done) exit
@@ -264,11 +249,7 @@ contains
          return
       end if
       lambda(1:nev) = lam(1:nev)
-      ! a reproducible sign: the largest component of each mode positive
-      do i = 1, nev
-         j = maxloc(abs(phi(:, i)), 1)
-         if (phi(j, i) < 0.0_dp) phi(:, i) = -phi(:, i)
-      end do
+      call positive_largest(phi(:, 1:nev))
    contains
       pure real(dp) function relative(v, a, b)
          real(dp), intent(in) :: v(:)
@@ -548,7 +529,7 @@ contains
       real(dp), intent(out) :: lambda(:), phi(:, :)
       type(error_type), allocatable, intent(out) :: error
       real(dp), allocatable :: x(:, :), y(:, :), kr(:, :), mr(:, :), lam(:), lam_old(:), q(:, :), ky(:)
-      real(dp) :: change, norm, floor, gap
+      real(dp) :: norm, floor
       integer :: n, nq, it, i, j, pass, stat
       logical :: done
 
@@ -612,20 +593,7 @@ contains
          if (allocated(error)) return
          x = matmul(y, q)
          done = it > 1
-         do i = 1, m
-            if (abs(lam(i) - lam_old(i)) > max(lambda_tol*abs(lam(i)), floor)) done = .false.
-         end do
-         if (done) then
-            do i = 1, m
-               gap = huge(1.0_dp)
-               if (i > 1) gap = lam(i) - lam(i - 1)
-               if (i < nq) gap = min(gap, lam(i + 1) - lam(i))
-               if (gap <= cluster_tol*abs(lam(i))) cycle
-               change = sign(1.0_dp, sum(mass*x(:, i)*phi(:, i)))
-               change = sqrt(sum(mass*(x(:, i) - change*phi(:, i))**2))
-               if (change > max(vector_tol, floor/gap)) done = .false.
-            end do
-         end if
+         if (done) done = subspace_settled(mass, x, phi, lam, lam_old, m, floor, floor)
          lam_old = lam
          phi(:, 1:m) = x(:, 1:m)
          if (done) exit
@@ -636,11 +604,51 @@ contains
          return
       end if
       lambda(1:m) = lam(1:m)
+      call positive_largest(phi(:, 1:m))
+   end subroutine constrained_subspace
+
+   !> Whether a subspace iteration has settled: each of the m wanted eigenvalues changed by at
+   !> most max(lambda_tol |lambda|, lam_floor), and each wanted simple mode's shape (the M-norm
+   !> of its change, up to sign) by at most max(vector_tol, vec_floor / its gap to its
+   !> neighbours); a mode within cluster_tol of a neighbour has no shape of its own to settle.
+   pure logical function subspace_settled(mass, x, phi, lam, lam_old, m, lam_floor, vec_floor) result(done)
+      real(dp), intent(in) :: mass(:)      !! the masses
+      real(dp), intent(in) :: x(:, :)      !! this iteration's Ritz vectors
+      real(dp), intent(in) :: phi(:, :)    !! the last iteration's
+      real(dp), intent(in) :: lam(:)       !! this iteration's Ritz values, ascending
+      real(dp), intent(in) :: lam_old(:)   !! the last iteration's
+      integer, intent(in) :: m             !! the wanted modes
+      real(dp), intent(in) :: lam_floor    !! the least change of an eigenvalue that counts
+      real(dp), intent(in) :: vec_floor    !! the round-off of a shape, times its gap
+      real(dp) :: change, gap
+      integer :: i, nq
+
+      nq = size(lam)
+      done = .true.
       do i = 1, m
+         if (abs(lam(i) - lam_old(i)) > max(lambda_tol*abs(lam(i)), lam_floor)) done = .false.
+      end do
+      if (.not. done) return
+      do i = 1, m
+         gap = merge(lam(i) - lam(max(i - 1, 1)), huge(1.0_dp), i > 1)
+         if (i < nq) gap = min(gap, lam(i + 1) - lam(i))
+         if (gap <= cluster_tol*abs(lam(i))) cycle
+         change = sign(1.0_dp, sum(mass*x(:, i)*phi(:, i)))
+         change = sqrt(sum(mass*(x(:, i) - change*phi(:, i))**2))
+         if (change > max(vector_tol, vec_floor/gap)) done = .false.
+      end do
+   end function subspace_settled
+
+   !> A reproducible sign for each mode (column): its largest component positive.
+   pure subroutine positive_largest(phi)
+      real(dp), intent(inout) :: phi(:, :)  !! the modes
+      integer :: i, j
+
+      do i = 1, size(phi, 2)
          j = maxloc(abs(phi(:, i)), 1)
          if (phi(j, i) < 0.0_dp) phi(:, i) = -phi(:, i)
       end do
-   end subroutine constrained_subspace
+   end subroutine positive_largest
 
    !> The largest eigenvalue of K phi = lambda M phi (the square of the highest natural
    !> circular frequency), from below and from above:
