@@ -544,6 +544,39 @@ def _record_group(group: str, dt_record: float, duration: float, record_file: st
             f"  record_file = '{record_file}'\n/\n")
 
 
+
+def _diaphragm_floors(ops, n: int, cm_x, m: float, inertia: float):
+    """A fresh 3D OpenSees model (6 DOFs a node) with the masters of n rigid floors at their
+    centres of mass (ux, uy, rz free; mass m, m and the rotational inertia), and ``point``:
+    the node of a plan point (x, y) of floor f (0 the ground, fixed), made once, each floor's
+    nodes listed in ``slaves`` for its rigidDiaphragm. Returns (masters, slaves, point)."""
+    ops.wipe()
+    ops.model("basic", "-ndm", 3, "-ndf", 6)
+    masters = [1000 * (f + 1) for f in range(n)]
+    for f, tag in enumerate(masters):
+        ops.node(tag, float(cm_x[f]), 0.0, 0.0)
+        ops.fix(tag, 0, 0, 1, 1, 1, 0)
+        ops.mass(tag, m, m, 0.0, 0.0, 0.0, inertia)
+    points: dict[tuple[int, float, float], int] = {}
+    slaves: dict[int, list[int]] = {f: [] for f in range(1, n + 1)}
+
+    def point(floor: int, x: float, y: float) -> int:
+        key = (floor, x, y)
+        if key not in points:
+            tag = 1000 * floor + 1 + len([p for p in points if p[0] == floor])
+            if floor == 0:
+                tag += 1000 * (n + 1)
+            ops.node(tag, x, y, 0.0)
+            if floor == 0:
+                ops.fix(tag, 1, 1, 1, 1, 1, 1)
+            else:
+                ops.fix(tag, 0, 0, 1, 1, 1, 0)
+                slaves[floor].append(tag)
+            points[key] = tag
+        return points[key]
+
+    return masters, slaves, point
+
 def _run_with_records(deck: str, name: str, records) -> object:
     """frictiondyn's Result of ``deck``, its records written as ag_x.txt, ag_y.txt (values,
     m/s2) in a temporary directory."""
@@ -690,30 +723,7 @@ class Building3DCase:
 
     def build_opensees(self, ops, settings: OpenSeesSettings, workdir: Path) -> None:
         n = self.n_storeys
-        ops.wipe()
-        ops.model("basic", "-ndm", 3, "-ndf", 6)
-        masters = [1000 * (f + 1) for f in range(n)]
-        for f, tag in enumerate(masters):
-            ops.node(tag, float(self.cm_x[f]), 0.0, 0.0)
-            ops.fix(tag, 0, 0, 1, 1, 1, 0)
-            ops.mass(tag, self.m, self.m, 0.0, 0.0, 0.0, self.inertia)
-        points: dict[tuple[int, float, float], int] = {}
-        slaves: dict[int, list[int]] = {f: [] for f in range(1, n + 1)}
-
-        def point(floor: int, x: float, y: float) -> int:
-            key = (floor, x, y)
-            if key not in points:
-                tag = 1000 * floor + 1 + len([p for p in points if p[0] == floor])
-                if floor == 0:
-                    tag += 1000 * (n + 1)
-                ops.node(tag, x, y, 0.0)
-                if floor == 0:
-                    ops.fix(tag, 1, 1, 1, 1, 1, 1)
-                else:
-                    ops.fix(tag, 0, 0, 1, 1, 1, 0)
-                    slaves[floor].append(tag)
-                points[key] = tag
-            return points[key]
+        masters, slaves, point = _diaphragm_floors(ops, n, self.cm_x, self.m, self.inertia)
 
         def link(tag: int, storey: int, angle: float, x: float, y: float, mat: int) -> None:
             c, s = math.cos(math.radians(angle)), math.sin(math.radians(angle))
@@ -1137,30 +1147,7 @@ class IsolatedBuildingCase:
         """The model, its gravity step held and its transient analysis set up, with recorders
         of the floors' and the bearings' tops' ux, uy in ``workdir``; returns the masters."""
         nf = self.n_floors
-        ops.wipe()
-        ops.model("basic", "-ndm", 3, "-ndf", 6)
-        masters = [1000 * (f + 1) for f in range(nf)]
-        for f, tag in enumerate(masters):
-            ops.node(tag, float(self.cm_x[f]), 0.0, 0.0)
-            ops.fix(tag, 0, 0, 1, 1, 1, 0)
-            ops.mass(tag, self.m, self.m, 0.0, 0.0, 0.0, self.inertia)
-        slaves: dict[int, list[int]] = {f: [] for f in range(1, nf + 1)}
-        points: dict[tuple[int, float, float], int] = {}
-
-        def point(floor: int, x: float, y: float) -> int:
-            key = (floor, x, y)
-            if key not in points:
-                tag = 1000 * floor + 1 + len([p for p in points if p[0] == floor])
-                if floor == 0:
-                    tag += 1000 * (nf + 1)
-                ops.node(tag, x, y, 0.0)
-                if floor == 0:
-                    ops.fix(tag, 1, 1, 1, 1, 1, 1)
-                else:
-                    ops.fix(tag, 0, 0, 1, 1, 1, 0)
-                    slaves[floor].append(tag)
-                points[key] = tag
-            return points[key]
+        masters, slaves, point = _diaphragm_floors(ops, nf, self.cm_x, self.m, self.inertia)
 
         for e, (st, ang, x, y, k) in enumerate(self.frames, start=1):
             c, s = math.cos(math.radians(ang)), math.sin(math.radians(ang))
