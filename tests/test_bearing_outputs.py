@@ -167,6 +167,10 @@ def test_reversals_along_one_axis_are_the_one_dimensional_devices(tmp_path):
     assert a.summary["slip_reversals"][0] > 50
     assert b.summary["bearing_slip_reversals"] == a.summary["slip_reversals"]
     assert b.summary["peak_isolation_shear_N"] == a.summary["peak_force_N"][0]
+    # the correctness condition is the bearing's, on its resultant: one (step, bearing) pair
+    # per violation, as the 1D device's, not one per component
+    assert a.summary["correctness_violations"] > 0
+    assert b.summary["correctness_violations"] == a.summary["correctness_violations"]
 
 
 # ---------------------------------------------------------------- a block on four pendulums
