@@ -1710,17 +1710,7 @@ contains
       if (floors) call gravity_shares(cfg%model, n, storey, g_p, p)
       call need_reals(deck, 'bearings', 'p', p, g_p, n, 'N', error, positive=.true.)
       if (allocated(error)) return
-      call optional_reals(deck, 'bearings', 'radius', radius, given_of(grp, 'radius', size(radius)), n, &
-                          default_radius, 'm', error)
-      if (allocated(error)) return
-      call optional_reals(deck, 'bearings', 'eps', eps, given_of(grp, 'eps', size(eps)), n, default_eps, 'm/s', &
-                          error, positive=.true.)
-      if (allocated(error)) return
-      call optional_reals(deck, 'bearings', 'eps1', eps1, given_of(grp, 'eps1', size(eps1)), n, default_eps1, &
-                          'm/s', error, positive=.true.)
-      if (allocated(error)) return
-      call optional_reals(deck, 'bearings', 'f', f, given_of(grp, 'f', size(f)), n, default_f, 'm', error, &
-                          positive=.true.)
+      call slider_settings(deck, grp, 'bearings', n, radius, eps, eps1, f, error)
       if (allocated(error)) return
       call check_labels(deck, grp, 'bearings', label, n, error)
       if (allocated(error)) return
@@ -2068,17 +2058,7 @@ contains
       if (allocated(error)) return
       call need_reals(deck, 'isolators', 'mu', mu, g_mu, n, '', error, positive=.false.)
       if (allocated(error)) return
-      call optional_reals(deck, 'isolators', 'radius', radius, given_of(grp, 'radius', size(radius)), n, &
-                          default_radius, 'm', error)
-      if (allocated(error)) return
-      call optional_reals(deck, 'isolators', 'eps', eps, given_of(grp, 'eps', size(eps)), n, default_eps, 'm/s', &
-                          error, positive=.true.)
-      if (allocated(error)) return
-      call optional_reals(deck, 'isolators', 'eps1', eps1, given_of(grp, 'eps1', size(eps1)), n, default_eps1, &
-                          'm/s', error, positive=.true.)
-      if (allocated(error)) return
-      call optional_reals(deck, 'isolators', 'f', f, given_of(grp, 'f', size(f)), n, default_f, 'm', error, &
-                          positive=.true.)
+      call slider_settings(deck, grp, 'isolators', n, radius, eps, eps1, f, error)
       if (allocated(error)) return
       call check_labels(deck, grp, 'isolators', label, n, error)
       if (allocated(error)) return
@@ -2138,6 +2118,29 @@ contains
       cfg%model%dev = [cfg%model%dev, dev]
       cfg%model%n_devices = size(cfg%model%dev)
    end subroutine read_isolators_group
+
+   !> A sliding device's settings that have defaults (&isolators, &bearings): the surface's
+   !> radius, the velocity law's eps, the hysteretic law's eps1 and f.
+   subroutine slider_settings(deck, grp, group, n, radius, eps, eps1, f, error)
+      type(deck_text), intent(in) :: deck                 !! the deck
+      type(group_text), intent(in) :: grp                 !! the group's text
+      character(len=*), intent(in) :: group               !! its name
+      integer, intent(in) :: n                            !! the devices it defines
+      real(dp), intent(inout) :: radius(:), eps(:), eps1(:), f(:) !! read, defaults where not given
+      type(error_type), allocatable, intent(out) :: error !! a value out of range, named
+
+      call optional_reals(deck, group, 'radius', radius, given_of(grp, 'radius', size(radius)), n, &
+                          default_radius, 'm', error)
+      if (allocated(error)) return
+      call optional_reals(deck, group, 'eps', eps, given_of(grp, 'eps', size(eps)), n, default_eps, 'm/s', &
+                          error, positive=.true.)
+      if (allocated(error)) return
+      call optional_reals(deck, group, 'eps1', eps1, given_of(grp, 'eps1', size(eps1)), n, default_eps1, &
+                          'm/s', error, positive=.true.)
+      if (allocated(error)) return
+      call optional_reals(deck, group, 'f', f, given_of(grp, 'f', size(f)), n, default_f, 'm', error, &
+                          positive=.true.)
+   end subroutine slider_settings
 
    ! ---------------------------------------------------------------- &storeys
    !> The storeys whose drift and shear the outputs report: each a pair of nodes (upper
