@@ -539,3 +539,30 @@ def test_moreau_jean_is_judged_by_its_own_recursion():
     fine = fd.run_text(deck.replace("TECH", "moreau_jean")
                        .replace("INTEGRATION", ", theta = 1.0, n1 = 10")).summary
     assert fine["record_resolution"] == "resolved"
+
+
+@pytest.mark.parametrize("technique", ["newmark", "moreau_jean"])
+def test_a_device_sliding_from_the_start_is_judged_free(run, record_file, technique):
+    """The tuned-mass deck with a Coulomb device (velocity law under Newmark) and the second
+    mass thrown at 1 m/s: the device slides from t = 0 through the whole second of record
+    (P mu = 0.01 N slows it by 0.01 m/s) with no transition and no reversal. Its one slide
+    makes the run the free system's, under each technique (the stuck system's error, the
+    2 kg oscillator's, is not the run's)."""
+    law = "'coulomb'" if technique == "moreau_jean" else "'velocity'\n  eps = 1.0e-4"
+    groups = OSCILLATOR_GROUPS.replace("MASSES", "2\n  mass = 1.0, 1.0\n  v0 = 0.0, 1.0") + f"""
+&friction
+  n_devices = 1
+  node_i = 2
+  node_j = 1
+  law = {law}
+  p = 0.1
+  mu = 0.1
+/
+"""
+    deck = _deck_with(groups, 4, f"\n  technique = '{technique}'", duration=1.0)
+    s = ok(run(deck, name=f"thrown_{technique}", files={"rec.AT2": record_file})).summary()
+    assert s["slip_excursions"] == [1] and s["stick_to_slip"] == [0]
+    assert s["slip_to_stick"] == [0] and s["slip_reversals"] == [0]
+    assert s["record_step_system"] == "free"
+    assert s["record_step_error"] == s["record_step_error_free"]
+    assert s["record_step_error_free"] != s["record_step_error_stuck"]
