@@ -107,6 +107,12 @@ CASES = [
         lambda g: g.update(bearings=_BEARING, excitation3={**g["excitation"], "frequency": -2.0}),
         ["&excitation3", "frequency", "-2"],
     ),
+    # the overturning takes floors at their storey heights: a model of masses has none
+    (
+        "overturning of a model of masses",
+        lambda g: g.update(bearings={**_BEARING, "overturning": True}),
+        ["&bearings", "overturning", "&floors"],
+    ),
 ]
 
 

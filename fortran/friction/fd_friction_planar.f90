@@ -369,25 +369,29 @@ contains
    end subroutine hysteretic_coefficients
 
    !> A bearing's normal force under the ground's vertical acceleration az (upward positive; the
-   !> vertical support rigid): N = P (1 + az / g), P = p_static, the deck's p. N <= 0 is uplift.
+   !> vertical support rigid): N = P (1 + az / g), P = p_static, the deck's p, plus dn, the
+   !> overturning's share (fd_overturning; 0 when not given). N <= 0 is uplift.
    !> What every technique asks for a bearing's N at a time (az = table_acceleration of the
-   !> vertical component then).
-   elemental real(dp) function normal_force(dev, az) result(n)
+   !> vertical component then, dn = overturning_forces' of the state).
+   elemental real(dp) function normal_force(dev, az, dn) result(n)
       type(device_type), intent(in) :: dev          !! the bearing (a component) as the deck made it
       real(dp), intent(in) :: az                    !! vertical ground acceleration [m/s2]
+      real(dp), intent(in), optional :: dn          !! the overturning's change of N [N]
 
       n = dev%p_static*(1.0_dp + az/g)
+      if (present(dn)) n = n + dn
    end function normal_force
 
-   !> The bearing dev0 with p = max(N, 0) at the vertical acceleration az, as the laws take it;
-   !> another device (no partner) as it is.
-   elemental subroutine with_normal_force(dev0, az, dev)
+   !> The bearing dev0 with p = max(N, 0) at the vertical acceleration az (and the overturning's
+   !> dn, if given), as the laws take it; another device (no partner) as it is.
+   elemental subroutine with_normal_force(dev0, az, dev, dn)
       type(device_type), intent(in) :: dev0         !! the device as the deck made it
       real(dp), intent(in) :: az                    !! vertical ground acceleration [m/s2]
       type(device_type), intent(inout) :: dev       !! its copy for the step, p set
+      real(dp), intent(in), optional :: dn          !! the overturning's change of N [N]
 
       if (dev0%partner == 0) return
-      dev%p = max(normal_force(dev0, az), 0.0_dp)
+      dev%p = max(normal_force(dev0, az, dn), 0.0_dp)
    end subroutine with_normal_force
 
    !> The pendulum's stiffness beyond the one K holds, (P - P_static) / R, of a bearing whose

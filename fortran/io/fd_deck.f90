@@ -39,6 +39,7 @@ module fd_deck
    use fd_matrix_market, only: sparse_matrix, read_matrix_market
    use fd_linalg, only: cholesky_factor
    use fd_friction, only: law_mu_of_speed
+   use fd_overturning, only: overturning_arms
    use fd_matrices, only: modes_type, natural_modes, natural_modes_sparse, stiffness_matrix, modes_dense_dofs, &
                           stiffness_pivot
    use fd_modal_damping, only: modal_damping_basis
@@ -1663,14 +1664,16 @@ contains
       character(len=name_len), allocatable :: law(:), mu_law(:)
       character(len=label_len), allocatable :: label(:)
       logical, allocatable :: g_mu(:), g_table(:, :), g_p(:)
+      logical :: overturning
       namelist /bearings/ n_bearings, storey, x, y, dof_xi, dof_yi, dof_xj, dof_yj, law, p, mu, radius, eps, &
-         eps1, f, mu_law, mu_max, mu_min, mu_rate, mu_table_v, mu_table_mu, label
+         eps1, f, mu_law, mu_max, mu_min, mu_rate, mu_table_v, mu_table_mu, label, overturning
       type(group_text) :: grp
       character(len=512) :: msg
-      integer :: ios, i, n
+      integer :: ios, i, n, d0
       logical :: found, more
 
       n_bearings = 0
+      overturning = .false.
       call find_group(deck, 'bearings', grp, found, error)
       if (allocated(error) .or. .not. found) return
       i = array_capacity(grp, 'n_bearings', max_devices/2)
@@ -1714,13 +1717,58 @@ contains
       if (allocated(error)) return
       call check_labels(deck, grp, 'bearings', label, n, error)
       if (allocated(error)) return
+      d0 = cfg%model%n_devices
       do i = 1, n
          call add_bearing(deck, cfg, floors, i, storey(i), x(i), y(i), [dof_xi(i), dof_yi(i), dof_xj(i), dof_yj(i)], &
                           law(i), p(i), mu(i), radius(i), eps(i), eps1(i), f(i), label(i), mu_ids(i), mu_min(i), &
                           mu_rate(i), mu_table_v(:, i), mu_table_mu(:, i), g_table(:, i), error)
          if (allocated(error)) return
       end do
+      if (overturning) call bearings_overturning(deck, cfg, floors, n, d0, storey, x, y, error)
    end subroutine read_bearings_group
+
+   !> overturning = .true.: the bearings' normal forces take the overturning moments of the
+   !> floors they carry (fd_overturning), which needs the storey heights of a building of rigid
+   !> floors above each storey of bearings and, in each such storey, bearings not all on one line.
+   subroutine bearings_overturning(deck, cfg, floors, n, d0, storey, x, y, error)
+      type(deck_text), intent(in) :: deck
+      type(run_config), intent(inout) :: cfg
+      logical, intent(in) :: floors                      !! a building of rigid floors
+      integer, intent(in) :: n                           !! bearings
+      integer, intent(in) :: d0                          !! devices before the bearings
+      integer, intent(in) :: storey(:)
+      real(dp), intent(in) :: x(:), y(:)
+      type(error_type), allocatable, intent(out) :: error
+      integer :: i, f, bad_storey
+
+      if (.not. floors) then
+         call bad(deck, 'bearings', 'overturning', '.true.', '.false. in a model of masses or matrices: the '// &
+                  'overturning takes the floors'' masses at their storey heights (a building of rigid floors, &floors)', &
+                  error)
+         return
+      end if
+      if (n == 0) return
+      do i = 1, n
+         do f = storey(i) + 1, cfg%model%n_floors
+            if (cfg%model%floor_height(f) > 0.0_dp) cycle
+            call bad(deck, 'bearings', 'overturning', '.true.', 'given with the storey heights of the floors the '// &
+                     'bearings carry: height('//trim(fmt_int(f))//') of &floors is '// &
+                     trim(fmt_real(cfg%model%floor_height(f)))//' (not given); give it > 0 m', error)
+            return
+         end do
+      end do
+      allocate (cfg%model%ot_arm(2, n))
+      call overturning_arms(storey(1:n), x(1:n), y(1:n), cfg%model%ot_arm, bad_storey)
+      if (bad_storey /= 0) then
+         call bad(deck, 'bearings', 'overturning', '.true.', 'given with bearings not all on one line in each '// &
+                  'storey: those of storey = '//trim(fmt_int(bad_storey))//' are one or on a line, which shares '// &
+                  'no overturning moment about it', error)
+         return
+      end if
+      cfg%model%overturning = .true.
+      cfg%model%ot_storey = storey(1:n)
+      cfg%model%ot_dev = [(d0 + 2*i - 1, i=1, n)]
+   end subroutine bearings_overturning
 
    !> Where the bearings stand: storey, x, y (rigid floors) or their four DOFs (other models);
    !> the variables of the other kind refused.

@@ -113,6 +113,13 @@ module fd_model
       real(dp), allocatable :: floor_lx(:)    !! plan dimension along x of each floor [m]; 0 = not given
       real(dp), allocatable :: floor_ly(:)    !! and along y [m] (a rectangle about the centre of mass)
       logical :: p_delta = .false.            !! the gravity loads' geometric stiffness is in K_x
+      ! the overturning of rigid floors on planar bearings (&bearings overturning = .true.;
+      ! fd_overturning): bearing b, whose x component is device ot_dev(b), on storey ot_storey(b),
+      ! takes dN_b = -ot_arm(:, b) . O, O the moments of the inertia forces of the floors it carries
+      logical :: overturning = .false.        !! the bearings' normal forces take the overturning
+      integer, allocatable :: ot_dev(:)       !! (n_bearings) each bearing's x component
+      integer, allocatable :: ot_storey(:)    !! (n_bearings) its storey
+      real(dp), allocatable :: ot_arm(:, :)   !! (2, n_bearings) S^-1 (x_b - x_c, y_b - y_c) [1/m]
       ! the forces of a storey that are no springs or devices between its two nodes (the
       ! frames and braces of rigid floors): its shear adds sum coef (u + a1 v)(dof) over the
       ! entries (xs_*) of the storey, and sum coef F(dev) over the entries (xd_*)

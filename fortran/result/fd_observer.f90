@@ -502,6 +502,11 @@ contains
                                row(c + 2*i + 1))
             c = c + 2*i + 1
          end if
+         ! each planar bearing's normal force at the state (observe_normal_forces'; p when constant)
+         do i = 1, res%n_bearings
+            row(c + i) = res%bearing_n_last(i)
+         end do
+         c = c + res%n_bearings
          if (present(env) .and. res%env_col > 0) then
             nq = 3*size(u)
             if (obs%all_columns) then

@@ -226,10 +226,11 @@ contains
 
    !> Size of the history a run writes: columns t, ag, (u, v, aabs) per DOF and
    !> (s, sdot, F, phase) per device, then (drift, V) per storey and Vb when the model names
-   !> storeys, then (exact technique) the maxima since the previous row: (peak_u, peak_v,
-   !> peak_aabs) per DOF, (peak_s, peak_F) per device and (peak_drift, peak_V) per storey and
-   !> peak_Vb; of the DOFs and devices only those kept when given (the storey columns always);
-   !> samples at t = 0, every `every` dt1 steps and at the end.
+   !> storeys, then N per planar bearing when it has bearings, then (exact technique) the
+   !> maxima since the previous row: (peak_u, peak_v, peak_aabs) per DOF, (peak_s, peak_F) per
+   !> device and (peak_drift, peak_V) per storey and peak_Vb; of the DOFs and devices only those
+   !> kept when given (the storey and bearing columns always); samples at t = 0, every `every`
+   !> dt1 steps and at the end.
    pure subroutine history_shape(model, exc, opts, ncol, nout, nsteps, every, n_dof_kept, n_devices_kept)
       type(model_type), intent(in) :: model         !! the model
       type(excitation_type), intent(in) :: exc      !! the table motion
@@ -246,7 +247,7 @@ contains
       ndk = model%n_devices
       if (present(n_dof_kept)) nk = n_dof_kept
       if (present(n_devices_kept)) ndk = n_devices_kept
-      ncol = 2 + 3*nk + 4*ndk + engineering_columns(model)
+      ncol = 2 + 3*nk + 4*ndk + engineering_columns(model) + bearings_of(model)
       if (has_envelope(opts)) ncol = ncol + 3*nk + 2*ndk + engineering_columns(model)
       nsteps = max(1, nint(exc%duration/(exc%dt_record/opts%n1)))
       every = opts%output_every
@@ -308,6 +309,8 @@ contains
       call add_columns(res, c, '', kd, dof_names, dof_units)
       call add_columns(res, c, '', kv, [character(len=5) :: 's', 'sdot', 'F', 'phase'], [character(len=3) :: 'm', 'm/s', 'N', '-'])
       if (engineering_columns(model) > 0) call storey_columns(res, c, '', model%n_storeys)
+      ! each planar bearing's normal force (always all of them)
+      call add_columns(res, c, '', [(i, i=1, bearings_of(model))], [character(len=1) :: 'N'], [character(len=1) :: 'N'])
       if (has_envelope(opts)) then
          res%env_col = c + 1
          call add_columns(res, c, 'peak_', kd, dof_names, dof_units)
@@ -339,6 +342,17 @@ contains
       res%band_x = 0.0_dp; res%band_alternation = 0.0_dp; res%band_alternation_time = 0.0_dp
       call init_bearings(model, res, error)
    end subroutine init_result
+
+   !> The planar bearings of a model: its devices that are a bearing's x component.
+   pure integer function bearings_of(model) result(nb)
+      type(model_type), intent(in) :: model         !! the model
+      integer :: d
+
+      nb = 0
+      do d = 1, model%n_devices
+         if (model%dev(d)%component == 1) nb = nb + 1
+      end do
+   end function bearings_of
 
    !> The planar bearings' part of the result: each bearing's two devices (x, y), its peaks at 0.
    subroutine init_bearings(model, res, error)

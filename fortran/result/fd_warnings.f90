@@ -73,7 +73,7 @@ contains
       call uplift_check(res, checks(11))
    end subroutine run_checks
 
-   !> Whether a planar bearing lifted off (its normal force N <= 0 under a vertical component):
+   !> Whether a planar bearing lifted off (its normal force N <= 0 under a vertical component or the overturning):
    !> while lifted it carries no friction and no restoring force.
    pure subroutine uplift_check(res, c)
       type(result_type), intent(in) :: res   !! the result
@@ -95,8 +95,8 @@ contains
       c%warning = trim(fmt_int(count(res%bearing_uplifts > 0)))//' bearing(s) lifted off (N <= 0: no friction, '// &
                   'no restoring force), bearing '//trim(fmt_int(worst))//' for '// &
                   trim(es(res%bearing_uplift_time(worst), 3))//' s from t = '// &
-                  trim(es(res%bearing_uplift_first(worst), 3))//' s (bearing_uplift_*): check the vertical '// &
-                  'record and the bearings'//trim(see('bearing-uplift'))
+                  trim(es(res%bearing_uplift_first(worst), 3))//' s (bearing_uplift_*): check the ground '// &
+                  'motion and the bearings'//trim(see('bearing-uplift'))
    end subroutine uplift_check
 
    !> The verdict of a step check and its word in the summary: not applicable when the check

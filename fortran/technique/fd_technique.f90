@@ -163,6 +163,12 @@ contains
             return
          end if
       end if
+      if (opts%technique /= technique_newmark .and. model%overturning) then
+         call fatal_error(error, "group &bearings: overturning = .true. (bearings' varying normal force) is "// &
+                          "integrated by technique = 'newmark'; technique = '"// &
+                          trim(technique_name(opts%technique))//"' holds each bearing's p constant")
+         return
+      end if
       select case (opts%technique)
       case (technique_newmark)
          call run_newmark(model, exc, opts, res, error, ctl, exc2, exc3)

@@ -2,13 +2,16 @@
 !> axis gives the one-dimensional law's state to the bit; off the axes the velocity law's disc
 !> and sliding force P mu v/|v|, its correctness condition on the resultant, and the
 !> hysteretic law's circular yield surface, radial return and end of sliding; a normal force
-!> that varies (p the current N, p_static the pendulum's in K) and uplift.
+!> that varies (p the current N, p_static the pendulum's in K) and uplift; the overturning's
+!> share of it (fd_overturning: a rigid mat's arms, dN of the floors' inertia forces).
 !>
 !> P = 16 N, mu = 0.25 (P mu = 4 N), f = 2**-10 m, eps = 2**-7 m/s, eps1 = 2**-6 m/s.
 module test_fd_friction_planar
    use testdrive, only: new_unittest, unittest_type, error_type, check
    use fd_kinds, only: dp
-   use fd_model, only: device_type, law_velocity, law_hysteretic
+   use fd_model, only: device_type, law_velocity, law_hysteretic, model_type
+   use fd_overturning, only: overturning_arms, overturning_forces
+   use test_fd_helpers, only: check_close
    use fd_device_state, only: device_state, phase_stick, phase_slip_pos, phase_slip_neg
    use fd_friction_velocity, only: velocity_update, velocity_init
    use fd_friction_hysteretic, only: hysteretic_update, hysteretic_init
@@ -38,7 +41,9 @@ contains
                   new_unittest("hysteretic: end of sliding, force continuous", test_hysteretic_end), &
                   new_unittest("hysteretic: a fast turn unloads elastically", test_hysteretic_turn), &
                   new_unittest("a varying normal force: friction of N, the pendulum's excess", test_normal_force), &
-                  new_unittest("uplift (N <= 0): no force, a hysteretic spring unloaded", test_uplift) &
+                  new_unittest("uplift (N <= 0): no force, a hysteretic spring unloaded", test_uplift), &
+                  new_unittest("overturning: a rigid mat's arms, 2x2 and on a line", test_overturning_arms), &
+                  new_unittest("overturning: dN of a block at height h on two rows", test_overturning_forces) &
                   ]
    end subroutine collect_friction_planar
 
@@ -316,5 +321,79 @@ contains
       call check(error, all(pair%phase == phase_stick) .and. all(pair%ks == p*mu/f) .and. &
                  abs(pair(1)%ks*s(1) + pair(1)%f0) == 0.0_dp, "down again: sticks, unloaded")
    end subroutine test_uplift
+
+   !> Four bearings at (+-3, +-2) m: S = diag(36, 16), arms (x'/36, y'/16). A skewed triangle
+   !> (S not diagonal): sum of the arms 0 and sum arm r'' = I (S^-1 S), so dN = -arm . O sums to 0
+   !> and balances any moment O. Bearings of a storey on one line, or one alone: that storey.
+   subroutine test_overturning_arms(error)
+      type(error_type), allocatable, intent(out) :: error
+      real(dp) :: arm4(2, 4), arm3(2, 3), arm5(2, 5), id(2, 2), xr(3), yr(3)
+      real(dp), parameter :: x3(3) = [-3.0_dp, 4.0_dp, 1.5_dp], y3(3) = [-2.0_dp, -1.0_dp, 3.5_dp]
+      integer :: bad, b
+
+      call overturning_arms([1, 1, 1, 1], [-3.0_dp, 3.0_dp, 3.0_dp, -3.0_dp], [-2.0_dp, -2.0_dp, 2.0_dp, 2.0_dp], &
+                            arm4, bad)
+      call check(error, bad == 0 .and. &
+                 maxval(abs(arm4(1, :) - [-3.0_dp, 3.0_dp, 3.0_dp, -3.0_dp]/36.0_dp)) < 1.0e-16_dp .and. &
+                 maxval(abs(arm4(2, :) - [-2.0_dp, -2.0_dp, 2.0_dp, 2.0_dp]/16.0_dp)) < 1.0e-16_dp, &
+                 "four corners: x'/36, y'/16")
+      if (allocated(error)) return
+      call overturning_arms([2, 2, 2], x3, y3, arm3, bad)
+      xr = x3 - sum(x3)/3.0_dp
+      yr = y3 - sum(y3)/3.0_dp
+      do b = 1, 2
+         id(b, 1) = sum(arm3(b, :)*xr)
+         id(b, 2) = sum(arm3(b, :)*yr)
+      end do
+      call check(error, bad == 0 .and. maxval(abs(sum(arm3, dim=2))) < 1.0e-15_dp, "skewed: the arms sum to 0")
+      if (allocated(error)) return
+      call check(error, maxval(abs(id - reshape([1.0_dp, 0.0_dp, 0.0_dp, 1.0_dp], [2, 2]))) < 1.0e-14_dp, &
+                 "skewed: sum arm r'' = I")
+      if (allocated(error)) return
+      ! storey 1 fine, storey 3 on a line (y = 1), storey 1 first: storey 3 reported
+      call overturning_arms([1, 3, 1, 3, 1], [0.0_dp, -1.0_dp, 4.0_dp, 2.0_dp, 0.0_dp], &
+                            [0.0_dp, 1.0_dp, 0.0_dp, 1.0_dp, 3.0_dp], arm5, bad)
+      call check(error, bad == 3, "a storey's bearings on one line")
+      if (allocated(error)) return
+      call overturning_arms([1], [2.0_dp], [1.0_dp], arm5(:, 1:1), bad)
+      call check(error, bad == 1, "one bearing alone")
+   end subroutine test_overturning_arms
+
+   !> A base mat (floor 1, 2000 kg, in the bearing plane) and a block (floor 2, 1000 kg, 3 m above
+   !> it) on four bearings at (+-3, +-2) m; the table at 2 m/s2 along x and 1 m/s2 along y (its
+   !> second component), the block 0.5 m/s2 along x relative to it: O = 1000 3 (2.5, 1), and
+   !> dN = -(O_x x'/36 + O_y y'/16); the mat carries no moment. With N = P + dN.
+   subroutine test_overturning_forces(error)
+      type(error_type), allocatable, intent(out) :: error
+      type(model_type) :: model
+      type(device_type) :: dev
+      real(dp) :: dn(4), a(6)
+      real(dp), parameter :: x4(4) = [-3.0_dp, 3.0_dp, 3.0_dp, -3.0_dp], y4(4) = [-2.0_dp, -2.0_dp, 2.0_dp, 2.0_dp]
+      integer :: bad, b
+
+      model%n_floors = 2
+      model%n_dof = 6
+      model%mass = [2000.0_dp, 2000.0_dp, 1.0e4_dp, 1000.0_dp, 1000.0_dp, 5.0e3_dp]
+      model%floor_height = [0.0_dp, 3.0_dp]
+      model%influence = [1.0_dp, 0.0_dp, 0.0_dp, 1.0_dp, 0.0_dp, 0.0_dp]
+      model%influence2 = [0.0_dp, 1.0_dp, 0.0_dp, 0.0_dp, 1.0_dp, 0.0_dp]
+      model%overturning = .true.
+      model%ot_storey = [1, 1, 1, 1]
+      allocate (model%ot_arm(2, 4))
+      call overturning_arms(model%ot_storey, x4, y4, model%ot_arm, bad)
+      a = [7.0_dp, -3.0_dp, 0.2_dp, 0.5_dp, 0.0_dp, 0.1_dp]
+      call overturning_forces(model, a, 2.0_dp, 1.0_dp, dn)
+      do b = 1, 4
+         call check_close(error, dn(b), -(3000.0_dp*2.5_dp*x4(b)/36.0_dp + 3000.0_dp*y4(b)/16.0_dp), 1.0e-15_dp, &
+                          "dN of bearing b")
+         if (allocated(error)) return
+      end do
+      call check(error, abs(sum(dn)) < 1.0e-12_dp, "sum dN = 0")
+      if (allocated(error)) return
+      dev = device(law_velocity)
+      dev%p_static = p
+      call check(error, normal_force(dev, 0.0_dp, dn(1)) == p + dn(1) .and. normal_force(dev, 0.0_dp) == p, &
+                 "N = P (1 + az / g) + dN")
+   end subroutine test_overturning_forces
 
 end module test_fd_friction_planar

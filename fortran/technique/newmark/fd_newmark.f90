@@ -45,6 +45,7 @@ module fd_newmark
                         spd_copy
    use fd_device_state, only: device_state, device_force, phase_stick
    use fd_friction_planar, only: pendulum_excess, normal_force, with_normal_force
+   use fd_overturning, only: overturning_forces
    use fd_friction, only: friction_init, friction_step, friction_settle, follows_velocity, friction_follow, &
                           friction_energy, friction_capacity
    use fd_result, only: result_type
@@ -119,6 +120,11 @@ module fd_newmark
       logical :: three = .false.
       type(excitation_type) :: exc3
       real(dp) :: az = 0.0_dp
+      ! the overturning (the model's overturning): each bearing's dN from the floors' inertia
+      ! forces at the accepted state (dn) and at the trial's end (dn1); N varies (varies) with
+      ! a vertical component or the overturning
+      logical :: tilt = .false., varies = .false.
+      real(dp), allocatable :: dn(:), dn1(:)          !! per bearing [N]
       type(device_type), allocatable :: dev(:)
       real(dp), allocatable :: pn(:)                  !! per bearing: N at the accepted state [N]
       real(dp) :: w_device = 0.0_dp                   !! work of the device forces [J]
@@ -212,6 +218,8 @@ contains
          w%three = exc3%kind /= excitation_none
          if (w%three) w%exc3 = exc3
       end if
+      w%tilt = model%overturning
+      w%varies = w%three .or. w%tilt
       call observer_init(model, exc, opts, res%newmark%setup%period_stuck, res, w%obs, error, ctl)
       if (allocated(error)) return
       call grid_init(exc, dt1, w%grid)
@@ -220,8 +228,9 @@ contains
       w%u = model%u0
       w%v = model%v0
       call device_kinematics(model, w%u, w%v, w%s, w%sd)
-      call normal_forces(model, 0.0_dp, w)
-      if (w%three) call observe_bearing_forces(model, 0.0_dp, 0.0_dp, w, res)
+      if (w%tilt) call start_overturning(model, exc, w)
+      call normal_forces(model, 0.0_dp, w, .false.)
+      if (w%varies) call observe_bearing_forces(model, 0.0_dp, 0.0_dp, w, res)
       call friction_init(w%dev, w%s, w%sd, w%st, error)
       if (allocated(error)) return
       ! the devices' forces, kept from here on by device_step
@@ -399,24 +408,64 @@ contains
          return
       end if
       w%dev = model%dev(1:nd)
+      if (model%overturning) then
+         allocate (w%dn(size(model%ot_dev)), w%dn1(size(model%ot_dev)), stat=stat)
+         if (stat /= 0) then
+            call fatal_error(error, "not enough memory for the normal forces of "//trim(fmt_int(nd/2))//" bearings", &
+                             stat_no_memory)
+            return
+         end if
+      end if
    end subroutine setup
 
+   !> The overturning's dN at the start: the floors' absolute accelerations those of the table
+   !> (the structure at rest relative to it: its acceleration is not known before the friction
+   !> forces, which take N).
+   subroutine start_overturning(model, exc, w)
+      type(model_type), intent(in) :: model
+      type(excitation_type), intent(in) :: exc
+      type(workspace), intent(inout) :: w
+      real(dp) :: ag2
+
+      ag2 = 0.0_dp
+      if (w%two) ag2 = table_acceleration(w%exc2, 0.0_dp)
+      w%a1 = 0.0_dp
+      call overturning_forces(model, w%a1, table_acceleration(exc, 0.0_dp), ag2, w%dn)
+      w%dn1 = w%dn
+   end subroutine start_overturning
+
    !> A vertical component: each bearing's normal force at t, N = N0 (1 + a_z(t) / g) (a_z
-   !> upward positive; the vertical support rigid), into w%dev's p as max(N, 0) for the laws
-   !> (fd_friction_planar), and the followed devices' capacities P mu_largest with it (kept
-   !> while lifted). Nothing without one.
-   subroutine normal_forces(model, t, w)
+   !> upward positive; the vertical support rigid), plus the overturning's dN (fd_overturning:
+   !> of the accepted state at a step's start, of the trial state at its end, trial), into w%dev's
+   !> p as max(N, 0) for the laws (fd_friction_planar), and the followed devices' capacities
+   !> P mu_largest with it (kept while lifted). Nothing when N is constant.
+   subroutine normal_forces(model, t, w, trial)
       type(model_type), intent(in) :: model
       real(dp), intent(in) :: t
       type(workspace), intent(inout) :: w
+      logical, intent(in) :: trial                 !! t ends the trial step (a1, ag1, ag21 its state)
       real(dp) :: cap
-      integer :: d, q
+      integer :: d, q, b
 
-      if (.not. w%three) return
-      w%az = table_acceleration(w%exc3, t)
-      do d = 1, w%nd
-         call with_normal_force(model%dev(d), w%az, w%dev(d))
-      end do
+      if (.not. w%varies) return
+      if (w%three) w%az = table_acceleration(w%exc3, t)
+      if (w%tilt) then
+         if (trial) call overturning_forces(model, w%a1, w%ag1, w%ag21, w%dn1)
+         do b = 1, size(model%ot_dev)
+            d = model%ot_dev(b)
+            if (trial) then
+               call with_normal_force(model%dev(d), w%az, w%dev(d), w%dn1(b))
+               call with_normal_force(model%dev(d + 1), w%az, w%dev(d + 1), w%dn1(b))
+            else
+               call with_normal_force(model%dev(d), w%az, w%dev(d), w%dn(b))
+               call with_normal_force(model%dev(d + 1), w%az, w%dev(d + 1), w%dn(b))
+            end if
+         end do
+      else
+         do d = 1, w%nd
+            call with_normal_force(model%dev(d), w%az, w%dev(d))
+         end do
+      end if
       do q = 1, w%nf
          cap = friction_capacity(w%dev(w%fl(q)))
          if (cap > 0.0_dp) w%cap(q) = cap
@@ -432,9 +481,15 @@ contains
       type(result_type), intent(inout) :: res
       integer :: b
 
-      do b = 1, res%n_bearings
-         w%pn(b) = normal_force(model%dev(res%bearing_dev(1, b)), w%az)
-      end do
+      if (w%tilt) then
+         do b = 1, res%n_bearings
+            w%pn(b) = normal_force(model%dev(res%bearing_dev(1, b)), w%az, w%dn(b))
+         end do
+      else
+         do b = 1, res%n_bearings
+            w%pn(b) = normal_force(model%dev(res%bearing_dev(1, b)), w%az)
+         end do
+      end if
       call observe_normal_forces(res, t, h, w%pn)
    end subroutine observe_bearing_forces
 
@@ -493,7 +548,7 @@ contains
       end if
       w%ag1 = ag1
       ! the normal forces of the step's start (the follow's), then of its end (the laws' update)
-      call normal_forces(model, t, w)
+      call normal_forces(model, t, w, .false.)
       ! a speed-dependent mu's sliding forces start from the velocity at the step's start,
       ! whatever an earlier trial of the step left in them (follow_forces takes them on)
       if (w%nf > 0) call start_forces(w%dev, w)
@@ -519,7 +574,7 @@ contains
          call relative_motion(model, w%n, w%nd, w%u1, w%v1, w%s1, w%sd1)
       end if
       if (w%nf > 0) call follow_forces(model, lv, w, error)
-      call normal_forces(model, t + h, w)
+      call normal_forces(model, t + h, w, .true.)
    end subroutine try_step
 
    !> A speed-dependent mu at the velocity at the step's end (implicit, as a Newton-Raphson
@@ -1003,11 +1058,12 @@ contains
       ! the velocity-law bands' forces: an alternation from step to step (fd_band_alternation)
       if (w%alt%n > 0) call alternation_step(w%alt, w%nd, t1 - w%t, w%st, w%f, res%band_alternation, &
                                              res%band_alternation_time)
-      if (w%three) call observe_bearing_forces(model, t1, t1 - w%t, w, res)
+      if (w%tilt) w%dn = w%dn1
+      if (w%varies) call observe_bearing_forces(model, t1, t1 - w%t, w, res)
       w%t = t1
       if (changed_k) w%version = w%version + 1
       ! (a varying normal force changes a band's dashpot or a sticking spring within a phase)
-      if (any_changed .or. any_force .or. (w%three .and. changed_k)) call consistent_acceleration(model, exc, t1, w)
+      if (any_changed .or. any_force .or. (w%varies .and. changed_k)) call consistent_acceleration(model, exc, t1, w)
       call observe_peaks(res, t1, w%n, w%nd, w%u, w%v, w%a, w%ag, w%s, w%f, w%ag2)
    end subroutine accept
 
