@@ -35,6 +35,7 @@ import numpy as np
 ROOT = Path(__file__).resolve().parent.parent
 INPUTS = ROOT / "inputs"
 G = 9.81  # m/s2
+G_FD = 9.80665  # frictiondyn's g in N = p (1 + a_z / g) [m/s2]
 
 QUANTITIES = (
     "u",
@@ -578,12 +579,12 @@ def _diaphragm_floors(ops, n: int, cm_x, m: float, inertia: float):
     return masters, slaves, point
 
 def _run_with_records(deck: str, name: str, records) -> object:
-    """frictiondyn's Result of ``deck``, its records written as ag_x.txt, ag_y.txt (values,
-    m/s2) in a temporary directory."""
+    """frictiondyn's Result of ``deck``, its records written as ag_x.txt, ag_y.txt, ag_z.txt
+    (values, m/s2) in a temporary directory."""
     import frictiondyn as fd
 
     with tempfile.TemporaryDirectory(prefix="fd_case_") as tmp:
-        for file, rec in zip(("ag_x.txt", "ag_y.txt"), records):
+        for file, rec in zip(("ag_x.txt", "ag_y.txt", "ag_z.txt"), records):
             np.savetxt(Path(tmp) / file, rec, fmt="%.17g")
         return fd.run_text(deck, f"{name}.nml", tmp)
 
@@ -1004,7 +1005,7 @@ class IsolatedBlockCase:
 @dataclass
 class IsolatedBuildingCase:
     """An eccentric building of rigid floors on a rigid base mat carried by friction pendulum
-    bearings, under two ground components.
+    bearings, under two ground components (three with ``vertical``).
 
     Floors (frictiondyn's &floors): floor 1 the base mat, floors 2 ... n + 1 the superstructure,
     each of mass ``floor_mass`` and rotational inertia m (plan_x² + plan_y²) / 12 over a
@@ -1036,6 +1037,16 @@ class IsolatedBuildingCase:
     response and adds the shear's component along the surface's normal (second order in u/R,
     as ``IsolatedBlockCase`` says): the stiff axial material keeps N at the gravity share to
     1e-6, the geometric term changes the friction and restoring forces by about (mu + u/R) u/R.
+
+    ``vertical`` > 0 adds a third, vertical component (a ``synthetic_record`` of seed ``seed_z``
+    scaled to ``vertical`` pga): frictiondyn's &excitation3 (a rigid vertical support, N = p (1 +
+    a_z / g)); in OpenSees the vertical base motion on the mass p / g (g = 9.80665 m/s2, so that
+    the rigid limits agree) at each bearing's top node, carried by the bearing's axial spring
+    ``kv``: the vertical period 2 pi sqrt(p / (g kv)) must be well below the record step for N
+    to be the rigid limit (1e13 N/m: 0.5 to 0.7 ms here). Under a varying N the regularized
+    friction differs in proportion to f: frictiondyn keeps f and scales the sticking stiffness
+    mu N / f with N, OpenSees keeps k_init - N/R and scales the yield displacement; a stiffer
+    ``k_init`` makes the difference small.
     """
 
     n_storeys: int
@@ -1059,6 +1070,9 @@ class IsolatedBuildingCase:
     scale2: float = 0.7
     seeds: tuple[int, int] = (20240613, 20240614)
     records: tuple = field(default=None, repr=False)
+    vertical: float = 0.0  # a third, vertical component of PGA vertical * pga (0: none)
+    seed_z: int = 20240615
+    kv: float = 1.0e12  # OpenSees: a bearing's axial stiffness [N/m]
 
     def __post_init__(self) -> None:
         n = self.n_storeys
@@ -1066,6 +1080,9 @@ class IsolatedBuildingCase:
             a1 = synthetic_record(self.dt_record, self.duration, self.pga, self.seeds[0])
             a2 = synthetic_record(self.dt_record, self.duration, self.pga, self.seeds[1])
             self.records = (a1, self.scale2 * a2)
+            if self.vertical:
+                az = synthetic_record(self.dt_record, self.duration, self.pga, self.seed_z)
+                self.records += (self.vertical * az,)
         self.m = self.floor_mass
         self.inertia = self.m * (self.plan_x**2 + self.plan_y**2) / 12
         self.n_floors = n + 1
@@ -1108,8 +1125,9 @@ class IsolatedBuildingCase:
 
     # ------------------------------------------------------------------ frictiondyn
 
-    def deck(self, record_files: tuple[str, str] = ("ag_x.txt", "ag_y.txt")) -> str:
-        """The frictiondyn deck; its records are read from ``record_files`` (values, m/s2)."""
+    def deck(self, record_files: tuple[str, ...] = ("ag_x.txt", "ag_y.txt", "ag_z.txt")) -> str:
+        """The frictiondyn deck; its records are read from ``record_files`` (values, m/s2),
+        a third (vertical) one as &excitation3."""
         arr = _floats
         nf, fr, nb = self.n_floors, self.frames, len(self.bearings)
         return (
@@ -1127,6 +1145,8 @@ class IsolatedBuildingCase:
             f"  f = {nb}*{self.f!r}\n  eps1 = {nb}*{self.eps1!r}\n  radius = {nb}*{self.radius!r}\n/\n"
             + _record_group("excitation", self.dt_record, self.duration, record_files[0])
             + _record_group("excitation2", self.dt_record, self.duration, record_files[1])
+            + (_record_group("excitation3", self.dt_record, self.duration, record_files[2])
+               if len(self.records) > 2 else "")
             + f"&integration\n  n1 = {self.n1}\n  refinement = 'implicit'\n/\n"
         )
 
@@ -1139,7 +1159,9 @@ class IsolatedBuildingCase:
         x and y (storey 1 x, 1 y, 2 x, ...; storey 1 the base mat over the ground)."""
         s = result.summary
         return {"bearing": np.asarray(s["bearing_peak_displacement_m"], float),
-                "drift": np.abs(np.asarray(s["peak_drift_m"], float))}
+                "drift": np.abs(np.asarray(s["peak_drift_m"], float)),
+                "normal_min": np.asarray(s["bearing_min_normal_force_N"], float),
+                "normal_max": np.asarray(s["bearing_max_normal_force_N"], float)}
 
     # ------------------------------------------------------------------ OpenSees
 
@@ -1158,7 +1180,7 @@ class IsolatedBuildingCase:
         base = 100000
         ops.frictionModel("Coulomb", 1, self.mu)
         mats = base + 1
-        ops.uniaxialMaterial("Elastic", mats, 1.0e12)          # axial: stiff
+        ops.uniaxialMaterial("Elastic", mats, self.kv)         # axial: stiff
         ops.uniaxialMaterial("Elastic", mats + 1, 1.0e-6)      # torsion: none
         ops.uniaxialMaterial("Elastic", mats + 2, 1.0e6)       # rocking: both ends' rotations fixed
         eta = self.a1 * self.p / self.radius
@@ -1170,6 +1192,8 @@ class IsolatedBuildingCase:
             ops.fix(lo, 1, 1, 1, 1, 1, 1)
             ops.node(hi, x, y, 0.0)
             ops.fix(hi, 0, 0, 0, 1, 1, 0)
+            if len(self.records) > 2:  # the vertical mass its normal force carries, p / g
+                ops.mass(hi, 0.0, 0.0, self.p / G_FD, 0.0, 0.0, 0.0)
             tops.append(hi)
             ops.element("singleFPBearing", base + b, lo, hi, 1, self.radius, self.k_init, "-P", mats,
                         "-T", mats + 1, "-My", mats + 2, "-Mz", mats + 2,
@@ -1200,6 +1224,8 @@ class IsolatedBuildingCase:
         prec = ("-precision", 12)
         ops.recorder("Node", "-file", str(workdir / "u.out"), *prec, "-node", *masters, "-dof", 1, 2, "disp")
         ops.recorder("Node", "-file", str(workdir / "b.out"), *prec, "-node", *tops, "-dof", 1, 2, "disp")
+        ops.recorder("Element", "-file", str(workdir / "n.out"), *prec, "-ele",
+                     *(base + b for b in range(1, len(self.bearings) + 1)), "basicForce")
         ops.constraints("Transformation")
         ops.numberer("RCM")
         ops.system("BandGeneral")
@@ -1230,7 +1256,10 @@ class IsolatedBuildingCase:
                 raise RuntimeError(f"{self.name}: OpenSees analyze failed (status {status}) at t = {t_now} s")
             hist = np.loadtxt(work / "u.out", ndmin=2)
             tops = np.loadtxt(work / "b.out", ndmin=2)
+            forces = -np.loadtxt(work / "n.out", ndmin=2)[:, 0::6]  # each bearing's N, a row a step
         xy = np.concatenate([np.zeros((hist.shape[0], 2)), hist], axis=1)
         drift = np.abs(np.diff(xy.reshape(hist.shape[0], -1, 2), axis=1)).max(axis=0).reshape(-1)
         bearing = np.hypot(tops[:, 0::2], tops[:, 1::2]).max(axis=0)
-        return OpenSeesRun(t2 - t1, c2 - c1, t1 - t0, {"bearing": bearing, "drift": drift, "normal": normal})
+        return OpenSeesRun(t2 - t1, c2 - c1, t1 - t0, {
+            "bearing": bearing, "drift": drift, "normal": normal, "normal_history": forces,
+            "normal_min": forces.min(axis=0), "normal_max": forces.max(axis=0)})

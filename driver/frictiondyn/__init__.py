@@ -30,6 +30,7 @@ from ._version import __version__
 from .spectrum import Spectrum, response_spectrum
 from .model import (
     Analysis,
+    Bearing,
     Damping,
     Device,
     Floor,
@@ -51,6 +52,7 @@ from .tolerance import ToleranceError
 
 __all__ = [
     "Analysis",
+    "Bearing",
     "Damping",
     "DeckError",
     "Device",

@@ -25,6 +25,7 @@ from ._api import DeckError, FrictiondynWarning, Result, _user_stacklevel, run_t
 
 __all__ = [
     "Analysis",
+    "Bearing",
     "Damping",
     "Device",
     "Floor",
@@ -166,6 +167,105 @@ class SlidingIsolator:
     mu_rate: float | None = None
     mu_table: list[tuple[float, float]] | None = None
     label: str | None = None
+
+
+@dataclass(kw_only=True)
+class Bearing:
+    """A planar sliding bearing (&bearings): a flat slider or a friction pendulum whose
+    friction force has one magnitude P mu along its sliding direction in the plane. It stands,
+    in a building of rigid floors (``Analysis.floors``), at the plan point (x, y) [m] of
+    storey ``storey``; in a model of masses or matrices it joins the DOFs dof_xi, dof_yi of the
+    sliding body (along x and y) to dof_xj, dof_yj of what it slides on (0 = the table). law
+    'velocity' (band eps [m/s]), 'hysteretic' (f [m], eps1 [m/s]) or 'coulomb' (technique
+    'moreau_jean'); p the normal force [N] (rigid floors: None takes the gravity share); mu,
+    or mu_law 'exponential' (mu_max, mu_min, mu_rate) or 'table' (mu_table: points
+    (v [m/s], mu)); radius [m] of the concave surface (0: flat). A vertical ground motion
+    (``Analysis.excitation3``) scales its normal force. Keyword arguments only; None takes the
+    reader's default (docs/namelist.md, &bearings)."""
+
+    storey: int | None = None
+    x: float | None = None
+    y: float | None = None
+    dof_xi: int | None = None
+    dof_yi: int | None = None
+    dof_xj: int | None = None
+    dof_yj: int | None = None
+    law: str | None = None
+    p: float | None = None
+    mu: float | None = None
+    radius: float | None = None
+    eps: float | None = None
+    eps1: float | None = None
+    f: float | None = None
+    mu_law: str | None = None
+    mu_max: float | None = None
+    mu_min: float | None = None
+    mu_rate: float | None = None
+    mu_table: list[tuple[float, float]] | None = None
+    label: str | None = None
+
+
+_BEARING_PLAN = ("storey", "x", "y")
+_BEARING_DOFS = ("dof_xi", "dof_yi", "dof_xj", "dof_yj")
+_BEARING_REALS = ("x", "y", "p", "mu", "radius", "eps", "eps1", "f", "mu_max", "mu_min", "mu_rate")
+_BEARING_TEXTS = ("law", "mu_law", "label")
+
+
+def _real(x: object, name: str) -> float:
+    """A real setting as a Python float: a bool, a string or anything not a real number
+    raises DeckError naming the setting and the value."""
+    v = _value(x)
+    if isinstance(v, bool) or not isinstance(v, (int, float)):
+        raise DeckError(f"{name} must be a number, not {x!r}")
+    return float(v)
+
+
+def _bearing(b: object, i: int, floors: bool) -> Bearing:
+    """Bearing i of Analysis.bearings checked for what the deck cannot say of it: its type,
+    where it stands (a plan point for rigid floors, DOFs otherwise), and the type of each
+    value; its values are checked by the reader."""
+    where = f"Analysis.bearings[{i}]"
+    if not isinstance(b, Bearing):
+        raise DeckError(f"{where} must be a Bearing, not {b!r}")
+    wrong, right = (_BEARING_DOFS, _BEARING_PLAN) if floors else (_BEARING_PLAN, _BEARING_DOFS)
+    for key in wrong:
+        if getattr(b, key) is not None:
+            model = "a building of rigid floors" if floors else "a model of masses or matrices"
+            raise DeckError(f"{where}.{key} = {getattr(b, key)!r}: a bearing of {model} is "
+                            f"placed by {', '.join(right)}")
+    for key in ("storey",) + _BEARING_DOFS:
+        if getattr(b, key) is not None:
+            _int(getattr(b, key), f"{where}.{key}")
+    for key in _BEARING_REALS:
+        if getattr(b, key) is not None:
+            _real(getattr(b, key), f"{where}.{key}")
+    for key in _BEARING_TEXTS:
+        value = getattr(b, key)
+        if value is not None and not isinstance(value, str):
+            raise DeckError(f"{where}.{key} must be a string, not {value!r}")
+    if b.mu_table is not None:
+        table = b.mu_table
+        if isinstance(table, (str, bytes)) or np.ndim(table) != 2 or np.shape(table)[1] != 2:
+            raise DeckError(f"{where}.mu_table must be a list of points (v, mu), not {table!r}")
+        for point in table:
+            for value in point:
+                _real(value, f"{where}.mu_table")
+    return b
+
+
+def _bearings_group(items: object, floors: bool) -> dict:
+    """The &bearings group of Analysis.bearings (floors: the structure is a building of rigid
+    floors)."""
+    if isinstance(items, (Bearing, str, bytes)) or not isinstance(items, Sequence):
+        raise DeckError(f"Analysis.bearings must be a list of Bearing, not {items!r}")
+    b = [_bearing(x, i, floors) for i, x in enumerate(items)]
+    group: dict = {"n_bearings": len(b)}
+    for key in ("storey",) + _BEARING_DOFS:
+        _per_device(group, key, [_opt_int(getattr(x, key), key) for x in b])
+    for key in ("x", "y", "law", "p", "radius"):
+        _per_device(group, key, [getattr(x, key) for x in b])
+    _friction_values(group, b)
+    return group
 
 
 @dataclass
@@ -661,6 +761,7 @@ _GROUP_FIELDS: dict[str, tuple[str, bool, dict[str, str]]] = {
     "friction": ("devices", True, {"mu_table_v": "mu_table", "mu_table_mu": "mu_table"}),
     "braces": ("braces", True, {}),
     "isolators": ("isolators", True, {"mu_table_v": "mu_table", "mu_table_mu": "mu_table"}),
+    "bearings": ("bearings", True, {"mu_table_v": "mu_table", "mu_table_mu": "mu_table"}),
     "storeys": ("storeys", True, {}),
     "floors": ("floors.floors", True, {}),
     "frames": ("frames", True, {}),
@@ -672,11 +773,14 @@ _GROUP_FIELDS: dict[str, tuple[str, bool, dict[str, str]]] = {
     "excitation2": ("excitation2", False, {"record_file": "file", "record_kind": "kind",
                                            "record_scale": "scale", "record_format": "format",
                                            "record_units": "units"}),
+    "excitation3": ("excitation3", False, {"record_file": "file", "record_kind": "kind",
+                                           "record_scale": "scale", "record_format": "format",
+                                           "record_units": "units"}),
     "integration": ("integration", False, {}),
     "output": ("output", False, {}),
 }
 _DECK_PLACE = re.compile(
-    r"group &(?P<group>[a-z_]+): (?P<var>[a-z_0-9]+)(?:\((?P<i>\d+|:)(?:, *(?P<j>\d+))?\))?"
+    r"group &(?P<group>[a-z_0-9]+): (?P<var>[a-z_0-9]+)(?:\((?P<i>\d+|:)(?:, *(?P<j>\d+))?\))?"
 )
 
 
@@ -694,7 +798,7 @@ def python_place(message: str) -> str | None:
     if m["group"] == "floors" and (m["var"] in ("excitation_angle", "p_delta") or not index):
         return f"floors.{var}"  # the building's, or a list of every floor's
     if indexed and index and m["var"] not in ("n_springs", "n_devices", "n_braces", "n_isolators",
-                                              "n_storeys", "n_frames", "n_floors"):
+                                              "n_storeys", "n_frames", "n_floors", "n_bearings"):
         return f"{attr}[{int(index) - 1}].{var}"
     if indexed:
         return attr
@@ -711,7 +815,9 @@ def _run_named(name: str, base_dir: str | os.PathLike, run: Callable[[], Result]
             warnings.simplefilter("always", FrictiondynWarning)
             result = run()
     except DeckError as exc:
-        text = str(exc).replace(deck + ", ", "Analysis: ", 1)
+        text = str(exc)
+        for sep in (", ", ": "):  # "deck, group &g: ..." and "deck: group &g is ..."
+            text = text.replace(deck + sep, "Analysis: ", 1)
         place = python_place(text)
         if place is not None:
             text = f"Analysis.{place}: " + text.replace("Analysis: ", "", 1)
@@ -726,13 +832,19 @@ def _run_named(name: str, base_dir: str | os.PathLike, run: Callable[[], Result]
     return result
 
 
+#: the file names of the components' values next to a deck: <deck stem> + suffix
+_RECORD_SUFFIXES = (".record.txt", ".record2.txt", ".record3.txt")
+
+
 @dataclass
 class Analysis:
     """One run: masses, springs, damping, friction devices, table motion and settings. The
     structure is ``masses`` (one DOF each, joined by ``springs``), or ``floors`` (a building
     of rigid floors with its ``frames`` and ``floor_braces``), or ``matrices`` (K and M);
-    ``excitation2`` is a second horizontal component of the table motion (with ``floors``
-    or ``matrices``)."""
+    ``bearings`` are planar sliding bearings (``Bearing``) on any of them; ``excitation2`` is
+    a second horizontal component of the table motion (with ``floors`` or ``matrices``),
+    ``excitation3`` the vertical one (upward positive: it scales the bearings' normal
+    forces; with ``bearings``)."""
 
     masses: list[float] | None = None
     springs: list[Spring] = field(default_factory=list)
@@ -752,16 +864,19 @@ class Analysis:
     floor_braces: list[FloorBrace] = field(default_factory=list)
     matrices: Matrices | None = None
     excitation2: Harmonic | Record | None = None
+    bearings: list[Bearing] = field(default_factory=list)
+    excitation3: Harmonic | Record | None = None
     tolerance: float | None = None  #: a tolerance run: Integration's tolerance, given here
 
     def namelist(
         self, directory: Path | None = None, cwd: Path | None = None, record_name: str | None = None,
-        record_name2: str | None = None, stem: str = "analysis",
+        record_name2: str | None = None, stem: str = "analysis", record_name3: str | None = None,
     ) -> f90nml.Namelist:
         """The deck as an f90nml Namelist (writes a Record's values into directory; with
         cwd, a relative record file is made absolute against it)."""
         nml = f90nml.Namelist()
-        for name, values in self.groups(directory, cwd, record_name, record_name2, stem):
+        for name, values in self.groups(directory, cwd, record_name, record_name2, stem,
+                                        record_name3):
             nml[name] = f90nml.Namelist(values)
         return nml
 
@@ -798,12 +913,13 @@ class Analysis:
 
     def groups(
         self, directory: Path | None = None, cwd: Path | None = None, record_name: str | None = None,
-        record_name2: str | None = None, stem: str = "analysis",
+        record_name2: str | None = None, stem: str = "analysis", record_name3: str | None = None,
     ) -> list[tuple[str, dict]]:
         """The deck's groups and their values, in order (writes a Record's values, and the
         matrices of ``matrices`` given as arrays, into directory, the second component's
-        values under record_name2, the matrices as <stem>.K.mtx and <stem>.M.mtx; with cwd,
-        a relative record or matrix file is made absolute against it)."""
+        values under record_name2, the vertical one's under record_name3, the matrices as
+        <stem>.K.mtx and <stem>.M.mtx; with cwd, a relative record or matrix file is made
+        absolute against it)."""
         if self.excitation is None:
             raise DeckError("Analysis.excitation: the table motion is required (Harmonic, Record "
                             "or FreeVibration)")
@@ -861,6 +977,10 @@ class Analysis:
             for key in ("stiffness", "law", "eps", "eps1", "label"):
                 _per_device(braces, key, [getattr(x, key) for x in fb])
             groups.append(("floor_braces", braces))
+        bearings = self.bearings
+        if bearings is not None and (not isinstance(bearings, Sequence)
+                                     or isinstance(bearings, (str, bytes)) or len(bearings)):
+            groups.append(("bearings", _bearings_group(bearings, self.floors is not None)))
         if self.storeys:
             st = self.storeys
             storeys: dict = {"n_storeys": len(st)}
@@ -872,6 +992,11 @@ class Analysis:
         groups.append(("excitation", self.excitation.group(directory, cwd, record_name)))
         if self.excitation2 is not None:
             groups.append(("excitation2", self.excitation2.group(directory, cwd, record_name2)))
+        if self.excitation3 is not None:
+            if not isinstance(self.excitation3, (Harmonic, Record)):
+                raise DeckError("Analysis.excitation3 must be a Harmonic or a Record (the vertical "
+                                f"ground motion), not {self.excitation3!r}")
+            groups.append(("excitation3", self.excitation3.group(directory, cwd, record_name3)))
         integration = self.integration.group()
         if integration:
             groups.append(("integration", integration))
@@ -882,34 +1007,39 @@ class Analysis:
 
     def deck_text(
         self, directory: Path | None = None, cwd: Path | None = None, record_name: str | None = None,
-        record_name2: str | None = None, stem: str = "analysis",
+        record_name2: str | None = None, stem: str = "analysis", record_name3: str | None = None,
     ) -> str:
         """The deck as namelist text (writes a Record's values into directory, under
-        record_name (record_name2 for ``excitation2``) or the Record's file, and matrices
-        given as arrays as <stem>.K.mtx, <stem>.M.mtx; with cwd, a relative record or matrix
-        file is made absolute against it)."""
+        record_name (record_name2 for ``excitation2``, record_name3 for ``excitation3``) or
+        the Record's file, and matrices given as arrays as <stem>.K.mtx, <stem>.M.mtx; with
+        cwd, a relative record or matrix file is made absolute against it)."""
         return "\n".join(
             _group_text(name, values)
-            for name, values in self.groups(directory, cwd, record_name, record_name2, stem)
+            for name, values in self.groups(directory, cwd, record_name, record_name2, stem,
+                                            record_name3)
         )
 
     def write_deck(self, path: str | os.PathLike) -> Path:
         """Write the deck (and a Record's values next to it: to its ``file``, or when that is
-        None to ``<deck stem>.record.txt`` (``.record2.txt`` for ``excitation2``), so that
-        decks written into one directory do not share one record file; matrices given as
-        arrays to ``<deck stem>.K.mtx``, ``.M.mtx``) for the executable."""
+        None to ``<deck stem>.record.txt`` (``.record2.txt`` for ``excitation2``,
+        ``.record3.txt`` for ``excitation3``), so that decks written into one directory do not
+        share one record file; matrices given as arrays to ``<deck stem>.K.mtx``, ``.M.mtx``)
+        for the executable."""
         path = Path(path)
         names = []
-        for ex, suffix in ((self.excitation, ".record.txt"), (self.excitation2, ".record2.txt")):
+        for ex, suffix in zip(self._components(), _RECORD_SUFFIXES, strict=True):
             unnamed = isinstance(ex, Record) and ex.values is not None and ex.file is None
             names.append(path.stem + suffix if unnamed else None)
-        path.write_text(self.deck_text(path.parent, None, names[0], names[1], path.stem))
+        path.write_text(self.deck_text(path.parent, None, names[0], names[1], path.stem, names[2]))
         return path
+
+    def _components(self) -> tuple:
+        """The three components of the ground motion (None where not given)."""
+        return (self.excitation, self.excitation2, self.excitation3)
 
     def _needs_directory(self) -> bool:
         """Whether the deck needs files written for it: a Record's values, a matrix."""
-        records = any(isinstance(ex, Record) and ex.values is not None
-                      for ex in (self.excitation, self.excitation2))
+        records = any(isinstance(ex, Record) and ex.values is not None for ex in self._components())
         mats = self.matrices is not None and not all(
             isinstance(a, (str, os.PathLike)) for a in (self.matrices.k, self.matrices.m))
         return records or mats
@@ -935,16 +1065,16 @@ class Analysis:
             return _run_named(name, ".", lambda: run_text(text, name=name, base_dir=".", **kw))
         # only inside the temporary directory: a file given with a directory (absolute or
         # not) is never written to
-        # (no file: named as write_deck names it, <stem of name>.record.txt, .record2.txt)
-        names = []
-        for ex, suffix in ((self.excitation, ".record.txt"), (self.excitation2, ".record2.txt")):
+        # (no file: named as write_deck names it, <stem of name>.record.txt, .record2.txt,
+        # .record3.txt; a name another component took: that default)
+        names: list[str] = []
+        for ex, suffix in zip(self._components(), _RECORD_SUFFIXES, strict=True):
             file = ex.file if isinstance(ex, Record) else None
             default = stem + suffix
-            names.append(default if file is None else (Path(os.fspath(file)).name or default))
-        if names[1] == names[0]:
-            names[1] = stem + ".record2.txt"
+            name_k = default if file is None else (Path(os.fspath(file)).name or default)
+            names.append(default if name_k in names else name_k)
         with tempfile.TemporaryDirectory() as tmp:
             directory = Path(tmp)
-            text = self.deck_text(directory, cwd, names[0], names[1], stem)
+            text = self.deck_text(directory, cwd, names[0], names[1], stem, names[2])
             return _run_named(name, directory,
                               lambda: run_text(text, name=name, base_dir=directory, **kw))
