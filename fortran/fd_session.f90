@@ -228,7 +228,8 @@ contains
       end if
       s%have_history = s%ctl%keep
       call history_header(s%res, s%header)
-      call summary_json(s%cfg%model, s%res, s%cfg%deck_path, s%summary, s%cfg%record, s%cfg%record2)
+      call summary_json(s%cfg%model, s%res, s%cfg%deck_path, s%summary, s%cfg%record, s%cfg%record2, &
+                        s%cfg%record3)
       s%state = session_solved
    end subroutine session_solve
 

@@ -64,8 +64,10 @@ def test_python_isolated_building_under_three_components_is_the_deck(example):
     record, and every number of the summary and every history column are the deck's."""
     r = isolated_vertical().run()
     same_numbers(r, example)
-    for key in ("record", "record2"):
+    for key in ("record", "record2", "record3"):
         assert r.summary[key]["sha256"] == example.summary[key]["sha256"]
+    assert example.summary["record3"]["file"].endswith("synthetic_s33.AT2")
+    assert example.summary["record3"]["scale"] == pytest.approx(2 / 3, rel=1e-15)
     # each bearing carries a quarter of the weight, p = g 850 t / 4, swung by 2/3 s33
     p = 9.80665 * 850.0e3 / 4
     n_min, n_max = r.summary["bearing_min_normal_force_N"], r.summary["bearing_max_normal_force_N"]

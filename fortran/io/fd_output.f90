@@ -367,20 +367,21 @@ contains
    !> the peaks and phase changes, the technique's statistics, the checks of the run, the
    !> energy balance, the engineering outputs, the warnings). Every verdict is its check
    !> record's (fd_warnings' run_checks), the steps and the stuck mode the technique's set-up.
-   subroutine summary_json(model, res, deck_path, js, record, record2)
+   subroutine summary_json(model, res, deck_path, js, record, record2, record3)
       type(model_type), intent(in) :: model                !! the model run
       type(result_type), intent(in) :: res                 !! its result
       character(len=*), intent(in) :: deck_path            !! deck named in the summary
       character(len=:), allocatable, intent(out) :: js     !! the JSON text
       type(record_info), intent(in), optional :: record    !! the record read, if any
       type(record_info), intent(in), optional :: record2   !! the second component's record, if any
+      type(record_info), intent(in), optional :: record3   !! the vertical component's record, if any
       type(json_text) :: jt
       type(check_type) :: checks(n_checks)
 
       call run_checks(res, checks)
       allocate (character(len=4096 + 64*(res%n_dof + res%n_devices)*8) :: jt%buf)
       call put(jt, '{'//nl)
-      call run_part(jt, deck_path, record, record2)
+      call run_part(jt, deck_path, record, record2, record3)
       call model_part(jt, model, res)
       call mode_part(jt, res, outcome_of(checks, 'mode_resolution'))
       call harmonic_part(jt, res%harmonic_error, outcome_of(checks, 'harmonic_resolution'))
@@ -403,11 +404,12 @@ contains
    end subroutine summary_json
 
    !> The deck, the program's version and the records read (if any).
-   subroutine run_part(jt, deck_path, record, record2)
+   subroutine run_part(jt, deck_path, record, record2, record3)
       type(json_text), intent(inout) :: jt                 !! the summary
       character(len=*), intent(in) :: deck_path            !! deck named in the summary
       type(record_info), intent(in), optional :: record    !! the record read, if any
       type(record_info), intent(in), optional :: record2   !! the second component's, if any
+      type(record_info), intent(in), optional :: record3   !! the vertical component's, if any
       character(len=:), allocatable :: esc
 
       call json_escape(deck_path, esc)
@@ -415,6 +417,7 @@ contains
       call put(jt, '  "frictiondyn_version": "'//frictiondyn_version//'",'//nl)
       if (present(record)) call record_item(jt, 'record', record)
       if (present(record2)) call record_item(jt, 'record2', record2)
+      if (present(record3)) call record_item(jt, 'record3', record3)
    end subroutine run_part
 
    !> A record read: its file, format, units, samples, step, scale, peak and hash.
