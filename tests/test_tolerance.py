@@ -383,3 +383,39 @@ def test_converge_reports_the_tolerance_runs_estimates(tmp_path, monkeypatch, ca
         assert row["method"] == q["estimate_method"], (row, q["estimate_method"])
         capped += "the theoretical" in row["method"]
     assert capped >= 1  # a measured order above the technique's: both cap it
+
+
+def bench_module():
+    """bench/tolerance.py, whose battery builds the shear buildings."""
+    import importlib.util
+
+    path = Path(__file__).resolve().parent.parent / "bench" / "tolerance.py"
+    spec = importlib.util.spec_from_file_location("bench_tolerance", path)
+    module = importlib.util.module_from_spec(spec)
+    spec.loader.exec_module(module)
+    return module
+
+
+def test_the_run_stops_as_soon_as_every_estimate_is_within_the_tolerance():
+    """The battery's 3-storey building under the velocity law at 1e-3: the run is returned at
+    the first level whose every estimate, step's plus law's, is within its allowed error (the
+    law's within half of it), with no margin beyond the estimate's own safety factors: eps / 32
+    and n1 = 8 in 7 runs (a margin of 0.8 on the estimate, the law's within 0.4 of the allowed
+    error, took eps / 128 and n1 = 32, 10 runs, 1.8 times the steps). Every estimated quantity
+    is within the tolerance of the exact technique's peaks and each estimate is at least its
+    true error."""
+    bench = bench_module()
+    exact = quiet_run(bench.building_text(3, "coulomb", "event_driven")).summary
+    with warnings.catch_warnings():
+        warnings.simplefilter("ignore", fd.FrictiondynWarning)
+        r, report, session = tolerance_module.tolerance_run(
+            text=bench.building_text(3, "velocity", "newmark"), tolerance=1e-3, name="b3.nml")
+    session.close()
+    assert (report.n1, report.law_divisor, report.runs) == (8, 32, 7), report
+    assert report.steps < 100_000, report.steps
+    worst = max(row["estimated_error"] / row["allowed"] for row in report.quantities)
+    assert worst <= 1.0, worst
+    for row in report.quantities:
+        ref = exact[row["key"]]
+        true = abs(row["value"] - (ref[row["index"]] if isinstance(ref, list) else ref))
+        assert true <= row["allowed"] and row["estimated_error"] >= true, row
