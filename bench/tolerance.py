@@ -2,6 +2,7 @@
 
     .venv/bin/python bench/tolerance.py              # both tolerances (20 to 30 s)
     .venv/bin/python bench/tolerance.py --tol 1e-2   # one
+    .venv/bin/python bench/tolerance.py --split      # and every run each case made
 
 Each case has an exact answer: Den Hartog's steady state (closed form: amplitude A, peak
 absolute acceleration (k A + F) / m; the friction energy of the exact technique), free
@@ -196,6 +197,8 @@ def main(argv: list[str] | None = None) -> int:
     parser = argparse.ArgumentParser(description=__doc__.split("\n")[0])
     parser.add_argument("--tol", type=float, action="append",
                         help="tolerance (default: 1e-2 and 1e-3)")
+    parser.add_argument("--split", action="store_true",
+                        help="also print every run a tolerance run made, with its steps")
     args = parser.parse_args(argv)
     warnings.simplefilter("ignore", fd.FrictiondynWarning)
     battery = cases()
@@ -203,7 +206,7 @@ def main(argv: list[str] | None = None) -> int:
     for tol in args.tol or [1e-2, 1e-3]:
         print(f"\ntolerance {tol:g}")
         within = bounded = total = 0
-        ratios, costs, refused = [], [], []
+        ratios, costs, refused, split = [], [], [], []
         for name, text, exact, mj in battery:
             saved = tm.EXACT_DEVICES
             tm.EXACT_DEVICES = 0 if mj else saved
@@ -240,6 +243,20 @@ def main(argv: list[str] | None = None) -> int:
                   f"{report.law_divisor}, {report.runs} runs; within {case_in}/{len(pairs)}, "
                   f"estimate >= true {case_bound}/{len(pairs)}; cost {report.steps} steps, "
                   f"cheapest manual {manual} ({ratio:.2f} x)")
+            if args.split:
+                for label, steps in report.made:
+                    print(f"      {label}: {steps} steps")
+                finest = f"n1 = {report.n1}" + (f", eps and f / {report.law_divisor:g}"
+                                                 if report.law_divisor != 1 else "")
+                returned = [s for label, s in report.made if label.split(": ", 1)[-1] == finest
+                            or label == f"exact, {finest}"]
+                split.append((name, report.steps, manual, report.runs, returned[-1]))
+        if args.split and split:
+            print("  cost split (all runs / cheapest manual; the run returned / cheapest manual):")
+            for name, steps, manual, runs, returned in split:
+                if manual:
+                    print(f"    {name}: {steps / manual:.2f} x in {runs} runs; the run returned "
+                          f"{returned / manual:.2f} x")
         finite = [c for c in costs if math.isfinite(c)]
         print(f"  quantities {total} in {len(battery) - len(refused)} runs "
               f"({len(refused)} refused: "

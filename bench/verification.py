@@ -39,7 +39,7 @@ ROOT = Path(__file__).resolve().parent.parent
 sys.path.insert(0, str(ROOT / "tests"))
 
 import frictiondyn as fd  # noqa: E402
-from frictiondyn.convergence import step_convergence  # noqa: E402
+from frictiondyn.convergence import methods_text, step_convergence  # noqa: E402
 from test_convergence import BUILDING  # noqa: E402
 from test_verification import (  # noqa: E402
     FV_A,
@@ -127,10 +127,7 @@ def estimate_table(duration: float) -> None:
                 ref = exact[q.key]
                 ref = float(ref) if not isinstance(ref, list) else float(ref[int(q.item.split()[-1]) - 1])
                 true = abs(q.values[0] - ref)
-                methods = q.estimate.method + (f" p={q.estimate.order:.2f}" if q.estimate.order else "")
-                if q.law_estimate is not None:
-                    e = q.law_estimate
-                    methods += " / law " + e.method + (f" p={e.order:.2f}" if e.order else "")
+                methods = methods_text(q.estimate, q.law_estimate)
                 if true <= 1e-9 * abs(ref):
                     print(f"    {q.key:<18} {q.item:<9} round-off (true {true:.1e})")
                     continue

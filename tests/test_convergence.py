@@ -9,6 +9,7 @@ from __future__ import annotations
 import json
 import math
 import os
+import re
 import signal
 import subprocess
 import sys
@@ -238,18 +239,25 @@ def test_estimate_error_on_known_series():
 def test_richardson_on_the_resonant_oscillator(tmp_path):
     """The resonant oscillator at n1 = 6, 12, 24: the peak displacement converges at the
     measured order 2.9 (Newmark's frequency error is of second order; the amplitude, near a
-    resonance, goes with its square as the step shrinks), and the estimated error of n1 = 6
-    is 1.25 times its distance to the extrapolated limit: 1.24 times its true error against
-    the closed form (the amplitude at dt -> 0, 25 mm)."""
+    resonance, goes with its square as the step shrinks), above Newmark's theoretical 2: the
+    estimate is Richardson's at order 2, named with the order measured, and the estimated
+    error of n1 = 6, 1.25 times its distance to the finest level plus the finest's own, is
+    1.30 times its true error against the closed form (the amplitude at dt -> 0, 25 mm)."""
     report = step_convergence(write(tmp_path, OSCILLATOR.replace("N1", "6")))
     assert report.n1 == [6, 12, 24] and report.converged, str(report)
     (u,) = [q for q in report.quantities if q.key == "peak_u_m"]
     e = u.estimate
-    assert e.method == "richardson" and 2.5 < e.order < 3.2 and u.law_estimate is None
+    assert e.method == "richardson" and e.order == 2.0 and u.law_estimate is None
+    assert 2.5 < e.measured < 3.2
     true = abs(u.values[0] - newmark_amplitude(1e-12))
     assert 1.0 < u.error / true < 1.5, (u.error, true)
     assert e.extrapolated == pytest.approx(0.025, rel=5e-5)
-    assert "peak |u| DOF 1" in str(report) and "Richardson at the measured order" in str(report)
+    assert e.errors[0] == pytest.approx(SAFETY_RICHARDSON * abs(u.values[0] - u.values[2]) + e.errors[2])
+    assert "peak |u| DOF 1" in str(report)
+    assert f"step {e.error:.3g}: Richardson at order 2, the theoretical ({e.measured:.2f} measured)" \
+        in str(report)
+    assert report.to_dict()["quantities"][0]["estimate_method"] == (
+        f"step: Richardson at order 2, the theoretical ({e.measured:.2f} measured)")
 
 
 def test_the_velocity_laws_error_estimate_against_the_exact_technique():
@@ -346,7 +354,7 @@ def test_the_hysteretic_laws_acceleration_error_does_not_vanish_with_the_step(tm
     assert cli(["converge", str(deck), "--json", str(out)]) == 3
     text = capsys.readouterr().out
     assert "NOT converged" in text and "carry the law's error (eps or f)" in text
-    assert "law " in text and "a plain difference" in text
+    assert re.search(r"; law [0-9.e+-]+: difference \(", text), text
     saved = json.loads(out.read_text())
     (row,) = [x for x in saved["quantities"] if x["key"] == "peak_aabs_mps2" and x["item"] == "DOF 1"]
     assert row["law"]["method"] == "difference" and row["estimated_error"] == pytest.approx(a1.error)

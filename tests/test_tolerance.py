@@ -9,6 +9,7 @@ from __future__ import annotations
 
 import json
 import math
+import re
 import warnings
 from pathlib import Path
 
@@ -159,22 +160,42 @@ def test_a_hysteretic_sticking_spring_does_not_set_the_first_levels():
 def test_sound_estimate_caps_the_order_and_takes_the_larger_change():
     """A measured order of 3.5 on a technique of order 1: the estimate of the finest level
     is Richardson's at order 1, 1.25 max(|d2|, |d1| / 2) / (2 - 1), not 1.25 |d2| / (2^3.5 - 1)
-    (0.08 of it); an order below the cap is kept; without an order, 3 times the larger change."""
-    from frictiondyn.convergence import estimate_error
+    (0.08 of it); an order below the cap is kept; without an order, 3 times the larger change.
+    A coarser level's error is 1.25 times its distance to the finest plus the finest's."""
+    from frictiondyn.convergence import method_text, methods_text, sound_estimate
 
     values = [1.0, 1.008, 1.008 + 0.008 / 2**3.5]
-    e = tolerance_module._sound(estimate_error(values, 2, 1.0), values, 1.0, 2)
-    assert e.method == "richardson" and e.order == 1.0
+    e = sound_estimate(values, 2, 1.0, 1.0)
+    assert e.method == "richardson" and e.order == 1.0 and e.measured == pytest.approx(3.5)
     assert e.errors[-1] == pytest.approx(1.25 * 0.008 / 2)
-    method = tolerance_module._method(e, "step")
-    assert method == "step: Richardson at order 1, the theoretical (3.50 measured)"
+    assert e.errors[0] == pytest.approx(1.25 * (values[2] - values[0]) + e.errors[-1])
+    assert methods_text(e, None) == "step: Richardson at order 1, the theoretical (3.50 measured)"
     values = [1.0, 1.008, 1.008 + 0.008 / 2**1.5]
-    e = tolerance_module._sound(estimate_error(values, 2, 1.0), values, 2.0, 2)
-    assert e.order == pytest.approx(1.5)
+    e = sound_estimate(values, 2, 1.0, 2.0)
+    assert e.order == pytest.approx(1.5) and e.measured is None
     assert e.errors[-1] == pytest.approx(1.25 * 0.008 / 2**1.5 / (2**1.5 - 1))
+    assert method_text(e) == "Richardson at order 1.50"
     values = [1.0, 1.008, 1.004]
-    e = tolerance_module._sound(estimate_error(values, 2, 1.0), values, 2.0, 2)
+    e = sound_estimate(values, 2, 1.0, 2.0)
     assert e.method == "difference" and e.errors[-1] == pytest.approx(3 * 0.008)
+    assert method_text(e) == "difference (the changes between levels alternate in sign)"
+
+
+def test_sound_estimate_over_every_other_level():
+    """Five levels whose last three alternate (a sampled peak that moves by steps) but whose
+    every other level converges at order 1 (a ratio of 4): Richardson's over levels 1, 3, 5,
+    named as such; when every other level has no order either, the difference of the last
+    three."""
+    from frictiondyn.convergence import method_text, sound_estimate
+
+    values = [1.0, 1.03, 1.012, 1.0135, 1.015]  # every other: 1.0, 1.012, 1.015 (order 1)
+    e = sound_estimate(values, 2, 1.0, 2.0)
+    assert e.method == "richardson" and e.order == pytest.approx(1.0)
+    assert e.errors[-1] == pytest.approx(1.25 * max(0.003, 0.012 / 4) / 3)
+    assert method_text(e) == "Richardson at order 1.00 (every other level)"
+    values = [1.0, 1.03, 1.0, 1.0135, 1.03]
+    e = sound_estimate(values, 2, 1.0, 2.0)
+    assert e.method == "difference" and e.errors[-1] == pytest.approx(3 * 0.0165)
 
 
 def test_moreau_jean_building_estimates_bound_the_true_errors(tmp_path, monkeypatch):
@@ -317,3 +338,84 @@ def test_a_peak_at_the_first_instant_of_a_regularized_law_is_refused():
         "'coulomb'", "'velocity'")
     with pytest.raises(fd.ToleranceError, match=r"peak \|a_abs\| DOF 1 = 0.406628 m/s2 is reached at t = 0"):
         quiet_run(text)
+
+
+def converge_on_the_same_levels(tmp_path, text: str, report) -> dict:
+    """``converge`` (its JSON report) of ``text`` on the step levels a tolerance run's last
+    round stood on: the last (at most) five of n1 = ..., report.n1 / 2, report.n1."""
+    from frictiondyn.convergence import step_convergence
+
+    ladder = min(5, 2 + report.rounds)
+    deck = tmp_path / "levels.nml"
+    first = report.n1 // 2 ** (ladder - 1)
+    stripped = text.replace("  tolerance = 0.001\n", "")
+    deck.write_text(re.sub(r"n1 = \d+", f"n1 = {first}", stripped))
+    study = step_convergence(deck, levels=ladder - 1)
+    assert study.n1 == [first * 2**k for k in range(ladder)] and study.n1[-1] == report.n1
+    return {(q["key"], q["item"]): q for q in study.to_dict()["quantities"]}
+
+
+@pytest.mark.parametrize("case", ["moreau_jean", "newmark"])
+def test_converge_reports_the_tolerance_runs_estimates(tmp_path, monkeypatch, case):
+    """``frictiondyn converge`` on the levels a tolerance run stood on reports, for every
+    estimated quantity, the estimate of the finest level and its method exactly as the
+    tolerance run does (one estimator: the order capped at the technique's, 1 for
+    Moreau-Jean and 2 for Newmark, from the larger of the last two changes): Moreau-Jean on the
+    free vibration (the exact technique ruled out) at 1e-3, whose peaks measure orders above 1,
+    and Newmark on the resonant oscillator of test_convergence at 1e-2."""
+    from test_convergence import OSCILLATOR
+
+    if case == "moreau_jean":
+        monkeypatch.setattr(tolerance_module, "EXACT_DEVICES", 0)
+        text, tol = free_vibration_text("event_driven").replace("'event_driven'", "'moreau_jean'"), 1e-3
+    else:
+        text, tol = OSCILLATOR.replace("N1", "20"), 1e-2
+    r, report, session = tolerance_module.tolerance_run(text=text, tolerance=tol, name="case.nml",
+                                                        base_dir=tmp_path)
+    session.close()
+    assert report.technique == case
+    study = converge_on_the_same_levels(tmp_path, text, report)
+    capped = 0
+    for row in report.quantities:
+        q = study[(row["key"], row["item"])]
+        finest = q["step"]["errors"][-1]
+        assert row["estimated_error"] == max(finest, tolerance_module.ROUND_OFF * q["scale"]), row
+        assert row["method"] == q["estimate_method"], (row, q["estimate_method"])
+        capped += "the theoretical" in row["method"]
+    assert capped >= 1  # a measured order above the technique's: both cap it
+
+
+def bench_module():
+    """bench/tolerance.py, whose battery builds the shear buildings."""
+    import importlib.util
+
+    path = Path(__file__).resolve().parent.parent / "bench" / "tolerance.py"
+    spec = importlib.util.spec_from_file_location("bench_tolerance", path)
+    module = importlib.util.module_from_spec(spec)
+    spec.loader.exec_module(module)
+    return module
+
+
+def test_the_run_stops_as_soon_as_every_estimate_is_within_the_tolerance():
+    """The battery's 3-storey building under the velocity law at 1e-3: the run is returned at
+    the first level whose every estimate, step's plus law's, is within its allowed error (the
+    law's within half of it), with no margin beyond the estimate's own safety factors: eps / 32
+    and n1 = 8 in 7 runs (a margin of 0.8 on the estimate, the law's within 0.4 of the allowed
+    error, took eps / 128 and n1 = 32, 10 runs, 1.8 times the steps). Every estimated quantity
+    is within the tolerance of the exact technique's peaks and each estimate is at least its
+    true error."""
+    bench = bench_module()
+    exact = quiet_run(bench.building_text(3, "coulomb", "event_driven")).summary
+    with warnings.catch_warnings():
+        warnings.simplefilter("ignore", fd.FrictiondynWarning)
+        r, report, session = tolerance_module.tolerance_run(
+            text=bench.building_text(3, "velocity", "newmark"), tolerance=1e-3, name="b3.nml")
+    session.close()
+    assert (report.n1, report.law_divisor, report.runs) == (8, 32, 7), report
+    assert report.steps < 100_000, report.steps
+    worst = max(row["estimated_error"] / row["allowed"] for row in report.quantities)
+    assert worst <= 1.0, worst
+    for row in report.quantities:
+        ref = exact[row["key"]]
+        true = abs(row["value"] - (ref[row["index"]] if isinstance(ref, list) else ref))
+        assert true <= row["allowed"] and row["estimated_error"] >= true, row

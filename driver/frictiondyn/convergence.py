@@ -16,9 +16,11 @@ answer moves). docs/python.md documents both.
 
 With three levels or more (the default: n1, 2 n1, 4 n1) it also estimates the error of the
 quantities a design reads (peak displacements, drifts, absolute accelerations, device forces
-and the friction energy) a posteriori: the order of convergence measured from the last three
-levels and Richardson extrapolation where that order is consistent, a plain difference,
-flagged as such and no claim of convergence, where it is not (``Estimate``). Under a
+and the friction energy) a posteriori, with the estimator a tolerance run stands on
+(``sound_estimate``: the order of convergence measured from the last three levels, capped at
+the technique's theoretical one, and Richardson extrapolation where that order is consistent;
+a plain difference, flagged as such and no claim of convergence, where it is not), each
+quantity's method named (``methods_text``) as a tolerance run names it. Under a
 regularized law the step levels converge to the law's solution, not to Coulomb's: law levels
 (the finest step with eps, or f and eps1, divided) estimate the law's error too
 (docs/theory.md, section 16).
@@ -41,7 +43,8 @@ from ._nml import copy_namelist, read_namelist, write_namelist
 
 DEFAULT_N1 = 20  # n1 when a deck does not give it (fortran/model/fd_names.f90, default_n1)
 
-__all__ = ["ConvergenceReport", "Estimate", "Quantity", "estimate_error", "step_convergence"]
+__all__ = ["ConvergenceReport", "Estimate", "Quantity", "estimate_error", "method_text",
+           "methods_text", "sound_estimate", "step_convergence"]
 
 #: (summary key, what, unit, item kind, peak key): a quantity is judged relative to its own
 #: size, but not below FLOOR times the largest of its kind (a DOF that hardly moves is judged
@@ -85,6 +88,10 @@ NOISE = 0.1
 #: measured, consistent order, 3 without one), so that an estimate is a bound more often than
 #: not: the extrapolated limit is a best guess, and the order at finer steps may differ
 SAFETY_RICHARDSON, SAFETY_DIFFERENCE = 1.25, 3.0
+#: the theoretical order of each technique's step error, and of the regularized laws' error in
+#: eps and f: a measured order above it is capped (``sound_estimate``; docs/theory.md, section 16)
+STEP_ORDER = {"newmark": 2.0, "moreau_jean": 1.0}
+LAW_ORDER = 1.0
 
 
 @dataclass
@@ -107,6 +114,8 @@ class Estimate:
     extrapolated: float | None = None  #: Richardson's limit
     reason: str = ""
     changes: list[float] = field(default_factory=list)  #: |change| between consecutive levels
+    #: the order measured, when ``order`` is capped below it (``sound_estimate``)
+    measured: float | None = None
 
     @property
     def error(self) -> float:
@@ -154,6 +163,70 @@ def estimate_error(values: Sequence[float], factor: int = 2, scale: float = 0.0)
     limit = q[-1] + d[-1] / (factor**p - 1)
     return Estimate("richardson", [SAFETY_RICHARDSON * abs(v - limit) for v in q], order=p,
                     extrapolated=limit, changes=changes)
+
+
+def sound_estimate(values: Sequence[float], factor: int, scale: float, cap: float) -> Estimate:
+    """The estimate ``converge`` reports and a tolerance run stands on: the error of each of
+    ``values``, a quantity at a parameter h, h/factor, h/factor**2, ... whose error is of
+    theoretical order ``cap`` (``STEP_ORDER``, ``LAW_ORDER``).
+
+    From the last three levels (``estimate_error``), with three rules on the finest level's
+    error: Richardson's at the measured order p, but never above ``cap`` (a measured order
+    above it, the peaks of a sampled history falling at 3 or 4 before their asymptotic 1 or 2,
+    extrapolates too little); from the larger of the two changes' predictions, |d2| and
+    |d1| / factor^p (a ladder whose changes come in steps, a sampled peak or an event that
+    moves to the next step, has one small change beside a large one, and the small one alone
+    says the error is smaller than it is); without an order, SAFETY_DIFFERENCE times the
+    larger change. With five levels or more and no order in the last three, Richardson's over
+    every other one of the last five (a ratio factor**2, where the steps of such a ladder
+    average out) stands for it if that has an order. A coarser level's error is its distance
+    to the finest level's value plus the finest's error (Richardson's: SAFETY_RICHARDSON times
+    the distance; a difference: the larger of SAFETY_DIFFERENCE times the distance and the
+    finest's error)."""
+    q = [float(v) for v in values]
+    e = estimate_error(q[-3:], factor, scale)
+    changes = [abs(b - a) for a, b in zip(q, q[1:])]
+    used, ratio, suffix = q[-3:], factor, ""
+    if e.method == "difference" and len(q) >= 5:
+        wide = estimate_error(q[-5::2], factor**2, scale)
+        if wide.method == "richardson":
+            e, used, ratio, suffix = wide, q[-5::2], factor**2, "every other level"
+    if e.method == "unchanged":
+        last = max(changes[-2:])
+        errors = [max(abs(v - q[-1]), last) for v in q[:-1]] + [last]
+        return Estimate("unchanged", errors, changes=changes, reason=suffix)
+    if e.method == "difference":
+        last = SAFETY_DIFFERENCE * max(changes[-2:])
+        errors = [max(SAFETY_DIFFERENCE * abs(v - q[-1]), last) for v in q[:-1]] + [last]
+        return Estimate("difference", errors, reason=e.reason, changes=changes)
+    d1, d2 = abs(used[-2] - used[-3]), abs(used[-1] - used[-2])
+    p = min(e.order, cap)
+    gain = ratio**p - 1
+    limit = q[-1] + (used[-1] - used[-2]) / gain
+    last = SAFETY_RICHARDSON * max(d2, d1 / ratio**p) / gain
+    errors = [SAFETY_RICHARDSON * abs(v - q[-1]) + last for v in q[:-1]] + [last]
+    return Estimate("richardson", errors, order=p, extrapolated=limit, reason=suffix,
+                    changes=changes, measured=e.order if e.order > cap else None)
+
+
+def method_text(e: Estimate | None) -> str:
+    """How ``e`` was made, as ``converge`` prints it and a tolerance run's ``estimate_method``
+    names it."""
+    if e is None:
+        return ""
+    if e.method == "richardson":
+        text = (f"Richardson at order {e.order:g}, the theoretical ({e.measured:.2f} measured)"
+                if e.measured is not None else f"Richardson at order {e.order:.2f}")
+        return text + (f" ({e.reason})" if e.reason else "")
+    if e.method == "unchanged":
+        return "unchanged (round-off)"
+    return f"difference ({e.reason})"
+
+
+def methods_text(step: Estimate | None, law: Estimate | None) -> str:
+    """The methods of a quantity's step and law estimates: ``"step: ...; law: ..."``."""
+    return "; ".join(f"{what}: {method_text(e)}" for what, e in (("step", step), ("law", law))
+                     if e is not None)
 
 
 @dataclass
@@ -338,8 +411,9 @@ def _rank(q: Quantity) -> tuple[int, float]:
 
 
 def _estimate_part(e: Estimate) -> dict:
-    return {"method": e.method, "order": e.order, "extrapolated": e.extrapolated,
-            "error": e.error, "errors": e.errors, "reason": e.reason}
+    return {"method": e.method, "order": e.order, "measured_order": e.measured,
+            "extrapolated": e.extrapolated, "error": e.error, "errors": e.errors,
+            "reason": e.reason}
 
 
 def _estimate_dict(q: Quantity) -> dict:
@@ -347,18 +421,17 @@ def _estimate_dict(q: Quantity) -> dict:
         return {}
     return {
         "estimated_error": q.error, "relative_error": q.relative_error,
+        "estimate_method": methods_text(q.estimate, q.law_estimate),
         "step": _estimate_part(q.estimate),
         "law": None if q.law_estimate is None else _estimate_part(q.law_estimate),
     }
 
 
 def _describe(e: Estimate, what: str, unit: str) -> str:
+    text = f"{what} {e.error:.3g}: {method_text(e)}"
     if e.method == "richardson":
-        return (f"{what} {e.error:.3g} by Richardson at the measured order {e.order:.2f} "
-                f"(limit {e.extrapolated:.6g}{unit})")
-    if e.method == "unchanged":
-        return f"{what} {e.error:.3g}, unchanged between levels (round-off)"
-    return f"{what} {e.error:.3g}, a plain difference ({e.reason})"
+        text += f", limit {e.extrapolated:.6g}{unit}"
+    return text
 
 
 def _estimate_line(q: Quantity) -> str:
@@ -457,8 +530,11 @@ def _claims(estimate: Estimate, tol: float) -> bool:
 
 def _compare(
     summaries: list[dict], rtol: float, factor: int = 2, law_summaries: Sequence[dict] = (),
-    floor_share: float = FLOOR,
+    floor_share: float = FLOOR, cap: float = STEP_ORDER["newmark"],
 ) -> list[Quantity]:
+    """The quantities of ``summaries`` (levels a ratio ``factor`` apart); the estimated ones
+    with ``sound_estimate`` at the step's theoretical order ``cap`` and, from the law levels
+    (``law_summaries``, below the last of ``summaries``), at the law's (LAW_ORDER)."""
     out = []
     for key, what, unit, kind, peak_key in _GROUPS:
         if any(key not in s for s in summaries):
@@ -483,9 +559,10 @@ def _compare(
             agrees = all(abs(b - a) <= tol for a, b in zip(values, values[1:]))
             estimate = law = None
             if key in ESTIMATED:
-                estimate = estimate_error(values, factor, size)
+                estimate = sound_estimate(values, factor, size, cap)
                 if law_rows:
-                    law = estimate_error([values[-1]] + [float(r[i]) for r in law_rows], factor, size)
+                    law = sound_estimate([values[-1]] + [float(r[i]) for r in law_rows], factor,
+                                         size, LAW_ORDER)
                 error = estimate.error + (law.error if law else 0.0)
                 if len(values) >= 3:  # from two levels, the change is all there is to judge
                     agrees = agrees and error <= tol and _claims(estimate, tol) and (
@@ -542,7 +619,7 @@ def step_convergence(
     if not (isinstance(rtol, (int, float)) and 0 < rtol < 1):
         raise ValueError(f"rtol = {rtol!r}: must be in (0, 1)")
     nml, path = _deck(deck)
-    technique = str(nml.get("integration", {}).get("technique", "newmark")).strip().lower()
+    technique = str(nml.get("integration", {}).get("technique") or "newmark").strip().lower()
     if technique == "event_driven":
         raise DeckError(
             f"{path}: &integration technique = 'event_driven' is exact: its events, peaks and "
@@ -595,5 +672,5 @@ def step_convergence(
         warnings=[summary_warnings(s) for s in steps], law_summaries=laws,
         law_warnings=[summary_warnings(s) for s in laws], factor=factor,
     )
-    report.quantities = _compare(steps, rtol, factor, laws)
+    report.quantities = _compare(steps, rtol, factor, laws, cap=STEP_ORDER.get(technique, STEP_ORDER["newmark"]))
     return report

@@ -51,14 +51,15 @@ from ._nml import copy_namelist, read_namelist, write_namelist
 from .convergence import (
     DEFAULT_N1,
     ESTIMATED,
+    LAW_ORDER,
+    STEP_ORDER,
     Estimate,
     Quantity,
-    SAFETY_DIFFERENCE,
-    SAFETY_RICHARDSON,
     _claims,
     _compare,
     _cpus,
     _law_text,
+    methods_text,
 )
 
 __all__ = ["DEFAULT_FLOOR", "EXACT_DEVICES", "MAX_REFINEMENT", "ToleranceError",
@@ -71,13 +72,11 @@ EXACT_DEVICES = 10
 #: the cost limit: the run returned has n1 at most this times the deck's, eps and f at least
 #: the deck's / this
 MAX_REFINEMENT = 128
-#: the theoretical order of each technique's step error, and of the regularized laws' error in
-#: eps and f: a measured order above it is capped (docs/theory.md, section 16.2)
-STEP_ORDER = {"newmark": 2.0, "moreau_jean": 1.0}
-LAW_ORDER = 1.0
 #: a run is returned when every estimate is below MARGIN times its allowed error (the law's
-#: below half of that, the step taking the rest)
-MARGIN = 0.8
+#: below half of that, the step taking the rest): as soon as it is within it, the estimate
+#: carrying its own safety factors (a margin of 0.8 cost up to 1.8 times the steps and bounded
+#: no more quantities over the battery: docs/validation.md, section 7)
+MARGIN = 1.0
 #: the law levels: eps and f divided by LAW_START in the first round, each level LAW_RATIO
 #: times finer than the one before (0.5, 2, 8, then 32 and 128, the cost limit)
 LAW_START = (0.5, 2, 8)
@@ -107,6 +106,8 @@ class ToleranceReport:
     rounds: int
     steps: int  #: the steps of every run made (newmark_steps of each summary)
     quantities: list[dict] = field(default_factory=list)
+    #: every run made, in order: (what it was, its steps), the split of ``steps``
+    made: list[tuple[str, int]] = field(default_factory=list)
 
     def block(self) -> dict:
         errors: dict[str, list[float]] = {}
@@ -202,8 +203,13 @@ class _Runner:
         self.summaries: dict[str, dict] = {}
         self.kept: dict[str, Session] = {}
         self.steps = 0
+        self.labels: dict[str, str] = {}  #: what each deck text is (the report's ``made``)
+        self.made: list[tuple[str, int]] = []
 
-    def run(self, texts: list[str], keep: str | None) -> list[dict]:
+    def run(self, texts: list[str], keep: str | None, labels: list[str] | None = None
+            ) -> list[dict]:
+        for t, label in zip(texts, labels or []):
+            self.labels.setdefault(t, label)
         todo = [t for t in dict.fromkeys(texts) if t not in self.summaries]
         sessions = []
         try:
@@ -228,6 +234,7 @@ class _Runner:
                 summary = json.loads(s._text(_SUMMARY))
                 self.summaries[t] = summary
                 self.steps += _cost(summary)
+                self.made.append((self.labels.get(t, "run"), _cost(summary)))
                 if t == keep:
                     self.kept[t] = s
         finally:
@@ -257,19 +264,6 @@ def _error_of(q: Quantity) -> tuple[float, float]:
     return step, law
 
 
-def _method(e: Estimate | None, what: str) -> str:
-    if e is None:
-        return ""
-    if e.method == "richardson" and e.reason.startswith("measured "):
-        measured = e.reason.split()[1]
-        return f"{what}: Richardson at order {e.order:g}, the theoretical ({measured} measured)"
-    if e.method == "richardson":
-        return f"{what}: Richardson at order {e.order:.2f}"
-    if e.method == "unchanged":
-        return f"{what}: unchanged (round-off)"
-    return f"{what}: difference ({e.reason})"
-
-
 def _factor(error: float, allowed: float, order: float | None) -> int:
     """The power of 2 by which to divide a parameter so that an error at ``order`` falls
     below ``allowed`` (with a margin of 1.5)."""
@@ -287,7 +281,7 @@ def _quantity_rows(quantities: list[Quantity], tol: float, values_of) -> list[di
             continue
         step, law = _error_of(q)
         error = max(step + law, ROUND_OFF * q.scale)  # no estimate below round-off
-        method = _methods(q.estimate, q.law_estimate)
+        method = methods_text(q.estimate, q.law_estimate)
         rows.append({"key": q.key, "index": q.index, "what": q.what, "item": q.item, "unit": q.unit,
                      "value": values_of(q), "estimated_error": error,
                      "relative_error": error / q.scale if q.scale > 0 else 0.0,
@@ -295,14 +289,10 @@ def _quantity_rows(quantities: list[Quantity], tol: float, values_of) -> list[di
     return rows
 
 
-def _methods(step: Estimate | None, law: Estimate | None) -> str:
-    return "; ".join(x for x in (_method(step, "step"), _method(law, "law")) if x)
-
-
 def _exact(runner: _Runner, nml, n1: int, tol: float, floor: float,
            why: str) -> tuple[ToleranceReport, str]:
     text = write_namelist(_with(nml, n1, "event_driven"))
-    (summary,) = runner.run([text], keep=text)
+    (summary,) = runner.run([text], keep=text, labels=[f"exact, n1 = {n1}"])
     qs = _compare([summary, summary], tol, 2, (), floor)
     rows = []
     for q in qs:
@@ -313,32 +303,8 @@ def _exact(runner: _Runner, nml, n1: int, tol: float, floor: float,
                          "relative_error": ROUND_OFF, "allowed": tol * q.scale,
                          "method": "exact: event-driven technique (round-off)"})
     report = ToleranceReport(tol, floor, "event_driven", why, n1, 1, len(runner.summaries), 1,
-                             runner.steps, rows)
+                             runner.steps, rows, list(runner.made))
     return report, text
-
-
-def _sound(e: Estimate | None, values: list[float], cap: float, factor: float) -> Estimate | None:
-    """The estimate of the finest of three levels that a tolerance run stands on.
-
-    Richardson's at the measured order p, but never above ``cap``, the theoretical order of
-    the error (a measured order above it, the peaks of a sampled history falling at 3 or 4
-    before their asymptotic 1 or 2, extrapolates too little), from the larger of the two
-    changes' predictions, |d2| and |d1| / factor^p: a ladder whose changes come in steps (a
-    sampled peak that moves to the next step, an event to the next step) has one small change
-    beside a large one, and the small one alone says the error is smaller than it is. Without
-    an order, the plain difference is SAFETY_DIFFERENCE times the larger change."""
-    if e is None or e.method == "unchanged" or len(values) < 3:
-        return e
-    d1, d2 = abs(values[-2] - values[-3]), abs(values[-1] - values[-2])
-    if e.method == "difference":
-        errors = list(e.errors[:-1]) + [SAFETY_DIFFERENCE * max(d1, d2)]
-        return Estimate("difference", errors, reason=e.reason, changes=e.changes)
-    p = min(e.order, cap)
-    limit = values[-1] + (values[-1] - values[-2]) / (factor**p - 1)
-    error = SAFETY_RICHARDSON * max(d2, d1 / factor**p) / (factor**p - 1)
-    reason = f"measured {e.order:.2f}" if e.order > cap else ""
-    return Estimate("richardson", list(e.errors[:-1]) + [error], order=p, extrapolated=limit,
-                    reason=reason, changes=e.changes)
 
 
 def _measured(e: Estimate) -> float | None:
@@ -346,7 +312,7 @@ def _measured(e: Estimate) -> float | None:
     a quantity needs; None for a difference."""
     if e.method != "richardson":
         return None
-    return float(e.reason.split()[1]) if e.reason.startswith("measured ") else e.order
+    return e.measured if e.measured is not None else e.order
 
 
 def _probe_start(runner: _Runner, nml, technique: str, tol: float) -> tuple[int, str]:
@@ -360,7 +326,7 @@ def _probe_start(runner: _Runner, nml, technique: str, tol: float) -> tuple[int,
     if "excitation" in probe:
         probe["excitation"]["duration"] = 1e-9  # one step: the modes and dt_record, no response
     try:
-        (summary,) = runner.run([write_namelist(probe)], keep=None)
+        (summary,) = runner.run([write_namelist(probe)], keep=None, labels=["probe"])
     except (SolverError, DeckError):
         summary = {}
     # the stuck system of a hysteretic device holds its sticking spring, k = P mu / f: a
@@ -389,18 +355,19 @@ def _text_at(nml, technique: str, n: int, divisor: float) -> str:
     return text if divisor == 1 else _law_text(text, divisor)
 
 
+def _label(kind: str, n: int, divisor: float) -> str:
+    return f"{kind}: n1 = {n}" + (f", eps and f / {divisor:g}" if divisor != 1 else "")
+
+
 def _law_levels(runner: _Runner, nml, technique: str, n: int, tol: float, floor: float,
                 divisors: list[float]) -> dict[tuple[str, int], Quantity]:
     """The law's estimate per quantity, from the last three law levels at step n1 = n."""
     texts = [_text_at(nml, technique, n, d) for d in divisors[-3:]]
     runner.close()
-    runs = runner.run(texts, keep=texts[-1])  # its finest may be the run returned
-    out = {}
-    for q in _compare(runs, tol, LAW_RATIO, (), floor):
-        if q.estimate is not None:
-            q.estimate = _sound(q.estimate, q.values, LAW_ORDER, LAW_RATIO)
-            out[(q.key, q.index)] = q
-    return out
+    labels = [_label("law level", n, d) for d in divisors[-3:]]
+    runs = runner.run(texts, keep=texts[-1], labels=labels)  # its finest may be the run returned
+    return {(q.key, q.index): q for q in _compare(runs, tol, LAW_RATIO, (), floor, LAW_ORDER)
+            if q.estimate is not None}
 
 
 def _refine(runner: _Runner, nml, path: Path, n1: int, technique: str, tol: float, floor: float,
@@ -447,18 +414,11 @@ def _refine(runner: _Runner, nml, path: Path, n1: int, technique: str, tol: floa
         rounds += 1
         levels = [_text_at(nml, technique, n, divisor) for n in steps[-5:]]
         final = levels[-1]
-        summaries = runner.run(levels, keep=final)
-        qs = _compare(summaries[-3:], tol, 2, (), floor)
-        wide = {}  # five levels: every other one, a ratio of 4
-        if len(levels) == 5:
-            wide = {(q.key, q.index): q for q in _compare(summaries[::2], tol, 4, (), floor)}
+        labels = [_label("step level", n, divisor) for n in steps[-5:]]
+        summaries = runner.run(levels, keep=final, labels=labels)
+        qs = _compare(summaries, tol, 2, (), floor, STEP_ORDER[technique])
         for q in qs:
             if q.estimate is not None:
-                q.estimate = _sound(q.estimate, q.values, STEP_ORDER[technique], 2)
-                other = wide.get((q.key, q.index))
-                if (q.estimate.method == "difference" and other is not None
-                        and other.estimate.method != "difference"):
-                    q.estimate = _sound(other.estimate, other.values, STEP_ORDER[technique], 4)
                 law = laws.get((q.key, q.index))
                 q.law_estimate = law.estimate if law is not None else None
         last = summaries[-1]
@@ -488,7 +448,7 @@ def _refine(runner: _Runner, nml, path: Path, n1: int, technique: str, tol: floa
         if worst is None:
             report = ToleranceReport(tol, floor, technique, f"{why}; {start_why}", steps[-1],
                                      int(divisor), len(runner.summaries), rounds, runner.steps,
-                                     rows)
+                                     rows, list(runner.made))
             return report, final
         runner.close()
         q, _, step, law = worst
@@ -505,7 +465,7 @@ def _what(q: Quantity, value: float, step: float, law: float, step_e: Estimate |
     name = f"{q.what} {q.item}".strip()
     return (f"{name} = {value:.6g} {q.unit}: estimated error {step + law:.3g} {q.unit} "
             f"({100 * (step + law) / q.scale:.3g} % of its scale {q.scale:.6g}; "
-            f"{_methods(step_e, law_e)})")
+            f"{methods_text(step_e, law_e)})")
 
 
 def _initial_peaks(path: Path, tol: float, summary: dict, qs: list[Quantity]) -> None:
