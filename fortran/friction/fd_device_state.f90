@@ -8,17 +8,11 @@ module fd_device_state
    private
 
    public :: device_state, phase_stick, phase_slip_pos, phase_slip_neg, device_force
-   public :: job_init, job_update, job_correct
    public :: law_traits_type, stuck_none, stuck_rigid, stuck_spring, stuck_dashpot
 
    integer, parameter :: phase_stick = 0     !! sticking (adherence)
    integer, parameter :: phase_slip_pos = 1  !! sliding with positive relative velocity
    integer, parameter :: phase_slip_neg = -1 !! sliding with negative relative velocity
-
-   ! what the dispatch (fd_friction) asks of a law's entry
-   integer, parameter :: job_init = 1        !! phase and coefficients at t = 0
-   integer, parameter :: job_update = 2      !! phase for the next step
-   integer, parameter :: job_correct = 3     !! correctness condition of a step
 
    ! how a sticking device joins the stuck system (a law's traits)
    integer, parameter :: stuck_none = 0      !! not at all (a law without a case)

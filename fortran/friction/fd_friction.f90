@@ -11,11 +11,11 @@ module fd_friction
    use fd_error, only: error_type, fatal_error, fmt_int
    use fd_names, only: law_velocity, law_hysteretic, law_coulomb, law_name
    use fd_model, only: device_type, mu_constant, device_parameter
-   use fd_device_state, only: device_state, job_init, job_update, job_correct, law_traits_type, &
+   use fd_device_state, only: device_state, law_traits_type, &
                               stuck_none, stuck_rigid, stuck_spring, stuck_dashpot
-   use fd_friction_velocity, only: velocity_law, velocity_update, velocity_correct, velocity_settle, velocity_follow, &
+   use fd_friction_velocity, only: velocity_init, velocity_update, velocity_correct, velocity_settle, velocity_follow, &
                                    velocity_traits, velocity_damping, velocity_holds, velocity_capacity
-   use fd_friction_hysteretic, only: hysteretic_law, hysteretic_update, hysteretic_correct, hysteretic_settle, &
+   use fd_friction_hysteretic, only: hysteretic_init, hysteretic_update, hysteretic_correct, hysteretic_settle, &
                                      hysteretic_energy, hysteretic_traits, hysteretic_stiffness, hysteretic_holds
    use fd_friction_coulomb, only: coulomb_traits, coulomb_holds
    use fd_friction_planar, only: planar_velocity_update, planar_velocity_init, planar_velocity_correct, &
@@ -24,7 +24,7 @@ module fd_friction
    implicit none
    private
 
-   public :: friction_init, friction_update, friction_correct, friction_step, friction_settle
+   public :: friction_init, friction_step, friction_settle
    public :: follows_velocity, friction_follow, friction_energy
    ! what a law says of itself (law_traits) and of a device of it
    public :: law_traits_type, law_traits, stuck_none, stuck_rigid, stuck_spring, stuck_dashpot
@@ -181,40 +181,13 @@ contains
 
    ! ---------------------------------------------------------------- the time step
 
-   !> The one dispatch over the laws: do `job` for device dev with its law.
-   elemental subroutine dispatch(job, dev, n, s, sdot, sdot_old, st, changed, ok, known)
-      integer, intent(in) :: job                !! job_init, job_update or job_correct
-      type(device_type), intent(in) :: dev      !! device parameters
-      real(dp), intent(in) :: n                 !! n > 1 of the correctness condition
-      real(dp), intent(in) :: s                 !! relative displacement [m]
-      real(dp), intent(in) :: sdot              !! relative velocity (at the end of the step) [m/s]
-      real(dp), intent(in) :: sdot_old          !! relative velocity at the start of the step [m/s]
-      type(device_state), intent(inout) :: st   !! state
-      logical, intent(out) :: changed           !! update: the phase changed
-      logical, intent(out) :: ok                !! correct: the step satisfies the condition
-      logical, intent(out) :: known             !! the law has a case here
-
-      changed = .false.
-      ok = .true.
-      known = .true.
-      select case (dev%law)
-      case (law_velocity)
-         call velocity_law(job, dev, n, s, sdot, sdot_old, st, changed, ok)
-      case (law_hysteretic)
-         call hysteretic_law(job, dev, n, s, sdot, sdot_old, st, changed, ok)
-      case default
-         known = .false.
-      end select
-   end subroutine dispatch
-
    !> After a trial step, for every device: the phase for the next step (st1, from st at
    !> the trial state s1, sd1) and the correctness condition of the step (eqs. 9, 12), with
-   !> whether any phase changed and any device violates the condition. What friction_update
-   !> and friction_correct do device by device, in one loop that calls each law's routines
+   !> whether any phase changed and any device violates the condition: each law's update and
+   !> correctness condition device by device, in one loop that calls each law's routines
    !> directly (the time step's per-device cost in a large structure; explicit shapes, since
    !> building array descriptors at every call cost more than a two-mass model's laws). A
-   !> law with no case of its own here goes through `dispatch` (a law unknown there too keeps
-   !> its state: friction_init rejected it before the first step).
+   !> law with no case here keeps its state (friction_init rejected it before the first step).
    subroutine friction_step(nd, dev, n, s1, sd1, sd, st, st1, changed, ok, any_changed, any_bad)
       integer, intent(in) :: nd                 !! devices
       type(device_type), intent(in) :: dev(nd)  !! devices
@@ -250,7 +223,8 @@ contains
             call velocity_update(dev(d), s1(d), sd1(d), st1(d), changed(d))
             ok(d) = velocity_correct(dev(d), n, st(d), sd(d), sd1(d))
          case default
-            call step_by_dispatch(dev(d), n, s1(d), sd1(d), sd(d), st(d), st1(d), changed(d), ok(d))
+            changed(d) = .false.
+            ok(d) = .true.
          end select
          any_changed = any_changed .or. changed(d)
          any_bad = any_bad .or. .not. ok(d)
@@ -294,25 +268,6 @@ contains
       ok(pq) = good
    end subroutine planar_step
 
-   !> friction_step for one device of a law without a case of its own there: the update and
-   !> the correctness condition through `dispatch`.
-   elemental subroutine step_by_dispatch(dev, n, s1, sd1, sd, st, st1, changed, ok)
-      type(device_type), intent(in) :: dev      !! device parameters
-      real(dp), intent(in) :: n                 !! n > 1 of the correctness condition
-      real(dp), intent(in) :: s1                !! relative displacement at the step's end [m]
-      real(dp), intent(in) :: sd1               !! relative velocity at the step's end [m/s]
-      real(dp), intent(in) :: sd                !! relative velocity at its start [m/s]
-      type(device_state), intent(in) :: st      !! state during the step
-      type(device_state), intent(inout) :: st1  !! state for the next step
-      logical, intent(out) :: changed           !! the phase changed
-      logical, intent(out) :: ok                !! the step satisfies the condition
-      type(device_state) :: st_copy
-      logical :: known, unused
-
-      call dispatch(job_update, dev, n, s1, sd1, sd, st1, changed, ok, known)
-      st_copy = st
-      call dispatch(job_correct, dev, n, s1, sd1, sd, st_copy, unused, ok, known)
-   end subroutine step_by_dispatch
 
    !> `refinement = 'implicit'`: the state of every device in which to take a step that ends
    !> in the phases of st1 (the law's update at the end of the last trial, where the relative
@@ -460,14 +415,13 @@ contains
    end function planar_follow
 
    !> Initial phase and force coefficients of every device; an error for a device whose
-   !> law is not a regularized law of this dispatch.
+   !> law has no case here.
    subroutine friction_init(dev, s, sdot, st, error)
       type(device_type), intent(in) :: dev(:)   !! devices
       real(dp), intent(in) :: s(:)              !! relative displacements [m]
       real(dp), intent(in) :: sdot(:)           !! relative velocities [m/s]
       type(device_state), intent(out) :: st(:)  !! initial states
       type(error_type), allocatable, intent(out) :: error !! a law without a case here
-      logical :: changed, ok, known
       integer :: d
 
       do d = 1, size(dev)
@@ -475,12 +429,16 @@ contains
             if (dev(d)%partner > d) call planar_init(dev(d), [d, dev(d)%partner], s, sdot, st)
             if (dev(d)%law == law_velocity .or. dev(d)%law == law_hysteretic) cycle
          end if
-         call dispatch(job_init, dev(d), 0.0_dp, s(d), sdot(d), 0.0_dp, st(d), changed, ok, known)
-         if (.not. known) then
+         select case (dev(d)%law)
+         case (law_velocity)
+            call velocity_init(dev(d), s(d), sdot(d), st(d))
+         case (law_hysteretic)
+            call hysteretic_init(dev(d), s(d), sdot(d), st(d))
+         case default
             call fatal_error(error, "device "//trim(fmt_int(d))//": friction law '"//trim(law_name(dev(d)%law))// &
                              "' (id "//trim(fmt_int(dev(d)%law))//") is not a law the Newmark technique integrates")
             return
-         end if
+         end select
       end do
    end subroutine friction_init
 
@@ -505,30 +463,5 @@ contains
       end select
    end subroutine planar_init
 
-   !> Phase of a device for the next step, from the state at the end of this one.
-   elemental subroutine friction_update(dev, s, sdot, st, changed)
-      type(device_type), intent(in) :: dev      !! device parameters
-      real(dp), intent(in) :: s                 !! relative displacement [m]
-      real(dp), intent(in) :: sdot              !! relative velocity [m/s]
-      type(device_state), intent(inout) :: st   !! state, updated
-      logical, intent(out) :: changed           !! the phase changed
-      logical :: ok, known
-
-      call dispatch(job_update, dev, 0.0_dp, s, sdot, 0.0_dp, st, changed, ok, known)
-   end subroutine friction_update
-
-   !> Correctness condition (eqs. 9 and 12) of a step taken in phase st.
-   elemental logical function friction_correct(dev, n, st, sdot_old, sdot_new) result(ok)
-      type(device_type), intent(in) :: dev   !! device parameters
-      real(dp), intent(in) :: n              !! n > 1 of eqs. 9 and 12
-      type(device_state), intent(in) :: st   !! phase during the step
-      real(dp), intent(in) :: sdot_old       !! relative velocity at t - dt [m/s]
-      real(dp), intent(in) :: sdot_new       !! relative velocity at t [m/s]
-      type(device_state) :: st_copy
-      logical :: changed, known
-
-      st_copy = st
-      call dispatch(job_correct, dev, n, 0.0_dp, sdot_new, sdot_old, st_copy, changed, ok, known)
-   end function friction_correct
 
 end module fd_friction

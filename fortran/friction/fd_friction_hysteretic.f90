@@ -16,11 +16,11 @@ module fd_friction_hysteretic
    use fd_kinds, only: dp
    use fd_model, only: device_type
    use fd_device_state, only: device_state, phase_stick, phase_slip_pos, phase_slip_neg, &
-                              job_init, job_update, job_correct, law_traits_type, stuck_spring
+                              law_traits_type, stuck_spring
    implicit none
    private
 
-   public :: hysteretic_law, hysteretic_init, hysteretic_update, hysteretic_correct, hysteretic_settle
+   public :: hysteretic_init, hysteretic_update, hysteretic_correct, hysteretic_settle
    public :: hysteretic_energy, hysteretic_traits, hysteretic_stiffness, hysteretic_holds
 
 contains
@@ -65,28 +65,6 @@ contains
       force = st%ks*s + st%f0          ! no damping in the law: the spring's force
       e = 0.5_dp*force*force/k
    end function hysteretic_energy
-
-   !> The law's entry for the dispatch (fd_friction): init, update or correct, by job.
-   elemental subroutine hysteretic_law(job, dev, n, s, sdot, sdot_old, st, changed, ok)
-      integer, intent(in) :: job                !! job_init, job_update or job_correct
-      type(device_type), intent(in) :: dev      !! device parameters
-      real(dp), intent(in) :: n                 !! n > 1 of the correctness condition
-      real(dp), intent(in) :: s                 !! relative displacement [m]
-      real(dp), intent(in) :: sdot              !! relative velocity (at the end of the step) [m/s]
-      real(dp), intent(in) :: sdot_old          !! relative velocity at the start of the step [m/s]
-      type(device_state), intent(inout) :: st   !! state
-      logical, intent(inout) :: changed         !! update: the phase changed
-      logical, intent(inout) :: ok              !! correct: the step satisfies the condition
-
-      select case (job)
-      case (job_init)
-         call hysteretic_init(dev, s, sdot, st)
-      case (job_update)
-         call hysteretic_update(dev, s, sdot, st, changed)
-      case (job_correct)
-         ok = hysteretic_correct(dev, n, st, sdot_old, sdot)
-      end select
-   end subroutine hysteretic_law
 
    !> A run starts sticking with no force, or sliding if the initial relative velocity is
    !> already outside the band |sdot| < eps1.

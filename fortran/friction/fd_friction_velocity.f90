@@ -13,11 +13,11 @@ module fd_friction_velocity
    use fd_kinds, only: dp
    use fd_model, only: device_type, mu_constant, mu_exponential, mu_table, sliding_mu
    use fd_device_state, only: device_state, phase_stick, phase_slip_pos, phase_slip_neg, &
-                              job_init, job_update, job_correct, law_traits_type, stuck_dashpot
+                              law_traits_type, stuck_dashpot
    implicit none
    private
 
-   public :: velocity_law, velocity_init, velocity_update, velocity_correct, velocity_settle, velocity_follow
+   public :: velocity_init, velocity_update, velocity_correct, velocity_settle, velocity_follow
    public :: velocity_traits, velocity_damping, velocity_holds, velocity_capacity, largest_mu
 
 contains
@@ -65,28 +65,6 @@ contains
       if (dev%mu_law == mu_table) mu = maxval(dev%mu_at(1:dev%n_mu_points))
       if (dev%mu_law == mu_exponential) mu = max(dev%mu, dev%mu_min)
    end function largest_mu
-
-   !> The law's entry for the dispatch (fd_friction): init, update or correct, by job.
-   elemental subroutine velocity_law(job, dev, n, s, sdot, sdot_old, st, changed, ok)
-      integer, intent(in) :: job                !! job_init, job_update or job_correct
-      type(device_type), intent(in) :: dev      !! device parameters
-      real(dp), intent(in) :: n                 !! n > 1 of the correctness condition
-      real(dp), intent(in) :: s                 !! relative displacement [m]
-      real(dp), intent(in) :: sdot              !! relative velocity (at the end of the step) [m/s]
-      real(dp), intent(in) :: sdot_old          !! relative velocity at the start of the step [m/s]
-      type(device_state), intent(inout) :: st   !! state
-      logical, intent(inout) :: changed         !! update: the phase changed
-      logical, intent(inout) :: ok              !! correct: the step satisfies the condition
-
-      select case (job)
-      case (job_init)
-         call velocity_init(dev, s, sdot, st)
-      case (job_update)
-         call velocity_update(dev, s, sdot, st, changed)
-      case (job_correct)
-         ok = velocity_correct(dev, n, st, sdot_old, sdot)
-      end select
-   end subroutine velocity_law
 
    !> Phase at the start of a run and its force coefficients.
    pure subroutine velocity_init(dev, s, sdot, st)

@@ -145,8 +145,8 @@ contains
       type(error_type), allocatable, intent(out) :: error
       type(spd_system) :: sys
       real(dp), allocatable :: x(:, :), y(:, :), kr(:, :), mr(:, :), lam(:), lam_old(:), q(:, :), row(:)
-      real(dp) :: delta, norm
-      integer :: n, nq, it, i, j, e, a, b, pass, stat
+      real(dp) :: delta
+      integer :: n, nq, it, j, e, a, b
       integer :: none(0)
       real(dp) :: no_coef(0)
       real(dp) :: nokd(0)
@@ -173,47 +173,17 @@ contains
       call spd_factor(sys, delta, 0.0_dp, nokd, error)
       if (allocated(error)) return
 
-      allocate (x(n, nq), y(n, nq), kr(nq, nq), mr(nq, nq), lam(nq), lam_old(nq), q(nq, nq), stat=stat)
-      if (stat /= 0) then
-         call fatal_error(error, "not enough memory for the subspace iteration of the modes of "// &
-                          trim(fmt_int(n))//" DOFs ("//trim(fmt_int(nq))//" vectors)", stat_no_memory)
-         return
-      end if
-      ! start: the mass vector (it excites every DOF), then reproducible pseudo-random vectors
-      x(:, 1) = mass
-      do j = 2, nq
-         do i = 1, n
-            x(i, j) = start_value(i, j)
-         end do
-      end do
-      lam_old = huge(1.0_dp)
+      call subspace_start(mass, nq, x, y, kr, mr, lam, lam_old, q, error)
+      if (allocated(error)) return
       do it = 1, max_iterations
          do j = 1, nq
             y(:, j) = mass*x(:, j)
             call spd_solve(sys, y(:, j), error)
             if (allocated(error)) return
          end do
-         ! M-orthonormal columns (modified Gram-Schmidt, twice): the operator scales them by up
-         ! to lambda_q / lambda_1 (1e10 and more with a rigid-body mode), which would leave
-         ! Y' M Y numerically singular; a column that collapses is replaced by a fresh one
-         do j = 1, nq
-            do pass = 1, 2
-               do i = 1, j - 1
-                  y(:, j) = y(:, j) - sum(mass*y(:, i)*y(:, j))*y(:, i)
-               end do
-            end do
-            norm = sqrt(sum(mass*y(:, j)**2))
-            if (.not. (norm > 1.0e-12_dp*maxval(abs(y(:, j))) .and. norm > 0.0_dp)) then
-               do i = 1, n
-                  y(i, j) = start_value(i, j + nq*it)
-               end do
-               do i = 1, j - 1
-                  y(:, j) = y(:, j) - sum(mass*y(:, i)*y(:, j))*y(:, i)
-               end do
-               norm = sqrt(sum(mass*y(:, j)**2))
-            end if
-            y(:, j) = y(:, j)/norm
-         end do
+         ! M-orthonormal columns: the operator scales them by up to lambda_q / lambda_1 (1e10
+         ! and more with a rigid-body mode), which would leave Y' M Y numerically singular
+         call m_orthonormalize(mass, y, it, 1)
          ! Ritz projection: kr = Y' K Y from the elements, mr = Y' M Y
          kr = 0.0_dp
          do e = 1, size(ei)
@@ -225,16 +195,8 @@ contains
                kr(1:j, j) = kr(1:j, j) + ek(e)*row(1:j)*row(j)
             end do
          end do
-         do j = 1, nq
-            do i = 1, j
-               mr(i, j) = sum(mass*y(:, i)*y(:, j))
-               kr(j, i) = kr(i, j)
-               mr(j, i) = mr(i, j)
-            end do
-         end do
-         call generalized_eigen(kr, mr, lam, q, error)
+         call ritz_vectors(mass, y, kr, mr, lam, q, x, error)
          if (allocated(error)) return
-         x = matmul(y, q)
          ! converged: every wanted eigenvalue (relative to itself, or to the shift for one at
          ! round-off: a rigid-body mode), and every wanted simple mode's shape
          done = it > 1
@@ -243,13 +205,7 @@ contains
          phi(:, 1:nev) = x(:, 1:nev)
          if (done) exit
       end do
-      if (.not. done) then
-         call fatal_error(error, "lowest_modes: the subspace iteration did not converge in "// &
-                          trim(fmt_int(max_iterations))//" iterations (lambda_1 = "//trim(fmt_real(lam(1)))//")")
-         return
-      end if
-      lambda(1:nev) = lam(1:nev)
-      call positive_largest(phi(:, 1:nev))
+      call subspace_result(done, lam, nev, lambda, phi, error)
    contains
       pure real(dp) function relative(v, a, b)
          real(dp), intent(in) :: v(:)
@@ -529,26 +485,15 @@ contains
       real(dp), intent(out) :: lambda(:), phi(:, :)
       type(error_type), allocatable, intent(out) :: error
       real(dp), allocatable :: x(:, :), y(:, :), kr(:, :), mr(:, :), lam(:), lam_old(:), q(:, :), ky(:)
-      real(dp) :: norm, floor
-      integer :: n, nq, it, i, j, pass, stat
+      real(dp) :: floor
+      integer :: n, nq, it, i, j
       logical :: done
 
       n = size(mass)
       nq = min(nfree, max(2*m, m + 8))
       floor = rounding_floor*epsilon(1.0_dp)*scale
-      allocate (x(n, nq), y(n, nq), kr(nq, nq), mr(nq, nq), lam(nq), lam_old(nq), q(nq, nq), ky(n), stat=stat)
-      if (stat /= 0) then
-         call fatal_error(error, "not enough memory for the subspace iteration of the modes of "// &
-                          trim(fmt_int(n))//" DOFs ("//trim(fmt_int(nq))//" vectors)", stat_no_memory)
-         return
-      end if
-      x(:, 1) = mass
-      do j = 2, nq
-         do i = 1, n
-            x(i, j) = start_value(i, j)
-         end do
-      end do
-      lam_old = huge(1.0_dp)
+      call subspace_start(mass, nq, x, y, kr, mr, lam, lam_old, q, error, ky)
+      if (allocated(error)) return
       done = .false.
       do it = 1, max_iterations
          do j = 1, nq
@@ -556,48 +501,144 @@ contains
             call operator_apply(op, y(:, j), error)
             if (allocated(error)) return
          end do
-         ! M-orthonormal columns (modified Gram-Schmidt, twice; a collapsed column replaced
-         ! by a fresh one in the null space)
-         do j = 1, nq
-            do pass = 1, 2
-               do i = 1, j - 1
-                  y(:, j) = y(:, j) - sum(mass*y(:, i)*y(:, j))*y(:, i)
-               end do
-            end do
-            norm = sqrt(sum(mass*y(:, j)**2))
-            if (.not. (norm > 1.0e-12_dp*maxval(abs(y(:, j))) .and. norm > 0.0_dp)) then
-               do i = 1, n
-                  y(i, j) = start_value(i, j + nq*it)
-               end do
-               call operator_project(op, y(:, j))
-               do pass = 1, 2
-                  do i = 1, j - 1
-                     y(:, j) = y(:, j) - sum(mass*y(:, i)*y(:, j))*y(:, i)
-                  end do
-               end do
-               norm = sqrt(sum(mass*y(:, j)**2))
-            end if
-            y(:, j) = y(:, j)/norm
-         end do
+         ! M-orthonormal columns (a collapsed column replaced by a fresh one in the null space)
+         call m_orthonormalize(mass, y, it, 2, op)
          ! Ritz projection: kr = Y' (K + sum kd b b') Y, mr = Y' M Y
          do j = 1, nq
             call entry_product(ci, cj, cv, y(:, j), ky)
             do i = 1, j
                kr(i, j) = dot_product(y(:, i), ky)
-               mr(i, j) = sum(mass*y(:, i)*y(:, j))
-               kr(j, i) = kr(i, j)
-               mr(j, i) = mr(i, j)
             end do
          end do
-         call generalized_eigen(kr, mr, lam, q, error)
+         call ritz_vectors(mass, y, kr, mr, lam, q, x, error)
          if (allocated(error)) return
-         x = matmul(y, q)
          done = it > 1
          if (done) done = subspace_settled(mass, x, phi, lam, lam_old, m, floor, floor)
          lam_old = lam
          phi(:, 1:m) = x(:, 1:m)
          if (done) exit
       end do
+      call subspace_result(done, lam, m, lambda, phi, error)
+   end subroutine constrained_subspace
+
+   !> The arrays of a subspace iteration on q vectors and its start (start_vectors); ky, a
+   !> vector of n, for an iteration that needs one.
+   subroutine subspace_start(mass, nq, x, y, kr, mr, lam, lam_old, q, error, ky)
+      real(dp), intent(in) :: mass(:)                          !! the masses, n = size(mass)
+      integer, intent(in) :: nq                                !! vectors
+      real(dp), allocatable, intent(out) :: x(:, :), y(:, :)   !! the iterates (n x q)
+      real(dp), allocatable, intent(out) :: kr(:, :), mr(:, :) !! the projected K and M (q x q)
+      real(dp), allocatable, intent(out) :: lam(:), lam_old(:) !! the Ritz values, now and before
+      real(dp), allocatable, intent(out) :: q(:, :)            !! the projected eigenvectors
+      type(error_type), allocatable, intent(out) :: error      !! no memory
+      real(dp), allocatable, intent(out), optional :: ky(:)    !! a work vector
+      integer :: n, stat
+
+      n = size(mass)
+      allocate (x(n, nq), y(n, nq), kr(nq, nq), mr(nq, nq), lam(nq), lam_old(nq), q(nq, nq), stat=stat)
+      if (stat == 0 .and. present(ky)) allocate (ky(n), stat=stat)
+      if (stat /= 0) then
+         call fatal_error(error, "not enough memory for the subspace iteration of the modes of "// &
+                          trim(fmt_int(n))//" DOFs ("//trim(fmt_int(nq))//" vectors)", stat_no_memory)
+         return
+      end if
+      call start_vectors(mass, x)
+      lam_old = huge(1.0_dp)
+   end subroutine subspace_start
+
+   !> Rayleigh-Ritz on the M-orthonormal columns of y: mr = Y' M Y, kr (given on and above
+   !> its diagonal) made symmetric, their eigenpairs (lam, q) and the Ritz vectors x = Y q.
+   subroutine ritz_vectors(mass, y, kr, mr, lam, q, x, error)
+      real(dp), intent(in) :: mass(:)                      !! the masses
+      real(dp), intent(in) :: y(:, :)                      !! the vectors (n x q)
+      real(dp), intent(inout) :: kr(:, :)                  !! Y' K Y (q x q), its upper part given
+      real(dp), intent(out) :: mr(:, :)                    !! Y' M Y
+      real(dp), intent(out) :: lam(:)                      !! the Ritz values, ascending
+      real(dp), intent(out) :: q(:, :)                     !! their eigenvectors
+      real(dp), intent(out) :: x(:, :)                     !! the Ritz vectors
+      type(error_type), allocatable, intent(out) :: error  !! LAPACK failure
+      integer :: i, j
+
+      do j = 1, size(y, 2)
+         do i = 1, j
+            mr(i, j) = sum(mass*y(:, i)*y(:, j))
+            kr(j, i) = kr(i, j)
+            mr(j, i) = mr(i, j)
+         end do
+      end do
+      call generalized_eigen(kr, mr, lam, q, error)
+      if (allocated(error)) return
+      x = matmul(y, q)
+   end subroutine ritz_vectors
+
+   !> The start vectors of a subspace iteration: the mass vector (it excites every DOF), then
+   !> reproducible pseudo-random vectors.
+   pure subroutine start_vectors(mass, x)
+      real(dp), intent(in) :: mass(:)       !! the masses, n = size(mass)
+      real(dp), intent(out) :: x(:, :)      !! n x q start vectors
+      integer :: i, j
+
+      x(:, 1) = mass
+      do j = 2, size(x, 2)
+         do i = 1, size(x, 1)
+            x(i, j) = start_value(i, j)
+         end do
+      end do
+   end subroutine start_vectors
+
+   !> The columns of y made M-orthonormal in place by modified Gram-Schmidt, twice. A column
+   !> that collapses is replaced by a fresh one (start_value of iteration it), projected on
+   !> the constraints' null space when op is given, and orthogonalized fresh_passes times.
+   subroutine m_orthonormalize(mass, y, it, fresh_passes, op)
+      real(dp), intent(in) :: mass(:)                              !! the masses
+      real(dp), intent(inout) :: y(:, :)                           !! n x q vectors
+      integer, intent(in) :: it                                    !! the iteration
+      integer, intent(in) :: fresh_passes                          !! passes for a fresh column
+      type(constrained_operator), intent(inout), optional :: op    !! the constraints
+      real(dp) :: norm
+      integer :: nq, i, j
+
+      nq = size(y, 2)
+      do j = 1, nq
+         call m_orthogonalize(mass, y, j, 2)
+         norm = sqrt(sum(mass*y(:, j)**2))
+         if (.not. (norm > 1.0e-12_dp*maxval(abs(y(:, j))) .and. norm > 0.0_dp)) then
+            do i = 1, size(y, 1)
+               y(i, j) = start_value(i, j + nq*it)
+            end do
+            if (present(op)) call operator_project(op, y(:, j))
+            call m_orthogonalize(mass, y, j, fresh_passes)
+            norm = sqrt(sum(mass*y(:, j)**2))
+         end if
+         y(:, j) = y(:, j)/norm
+      end do
+   end subroutine m_orthonormalize
+
+   !> Column j of y made M-orthogonal to columns 1..j-1 (modified Gram-Schmidt, passes times).
+   pure subroutine m_orthogonalize(mass, y, j, passes)
+      real(dp), intent(in) :: mass(:)       !! the masses
+      real(dp), intent(inout) :: y(:, :)    !! n x q vectors
+      integer, intent(in) :: j              !! the column
+      integer, intent(in) :: passes         !! how many times
+      integer :: i, pass
+
+      do pass = 1, passes
+         do i = 1, j - 1
+            y(:, j) = y(:, j) - sum(mass*y(:, i)*y(:, j))*y(:, i)
+         end do
+      end do
+   end subroutine m_orthogonalize
+
+   !> The end of a subspace iteration: the m wanted eigenvalues and shapes (the largest
+   !> component of each positive), or an error when it did not settle.
+   subroutine subspace_result(done, lam, m, lambda, phi, error)
+      logical, intent(in) :: done                          !! it settled
+      real(dp), intent(in) :: lam(:)                       !! the Ritz values
+      integer, intent(in) :: m                             !! modes wanted
+      real(dp), intent(inout) :: lambda(:)                 !! eigenvalues
+      real(dp), intent(inout) :: phi(:, :)                 !! mode shapes (already the Ritz vectors)
+      type(error_type), allocatable, intent(out) :: error  !! no convergence
+
       if (.not. done) then
          call fatal_error(error, "lowest_modes: the subspace iteration did not converge in "// &
                           trim(fmt_int(max_iterations))//" iterations (lambda_1 = "//trim(fmt_real(lam(1)))//")")
@@ -605,7 +646,7 @@ contains
       end if
       lambda(1:m) = lam(1:m)
       call positive_largest(phi(:, 1:m))
-   end subroutine constrained_subspace
+   end subroutine subspace_result
 
    !> Whether a subspace iteration has settled: each of the m wanted eigenvalues changed by at
    !> most max(lambda_tol |lambda|, lam_floor), and each wanted simple mode's shape (the M-norm
@@ -672,9 +713,9 @@ contains
       real(dp), intent(out) :: lambda             !! largest Ritz value [1/s^2] (a lower bound)
       real(dp), intent(out) :: bound              !! Gershgorin bound [1/s^2] (an upper bound)
       type(error_type), allocatable, intent(out) :: error !! bad input, no memory, LAPACK failure
-      real(dp), allocatable :: rs(:), dm(:), q0(:), q1(:), w(:), alpha(:), beta(:), d(:), e(:), lam(:), phi(:, :)
-      real(dp) :: nrm, top, prev, x
-      integer :: n, ne, i, a, b, k, info, stat
+      real(dp), allocatable :: rs(:), dm(:), lam(:), phi(:, :)
+      real(dp) :: x
+      integer :: n, ne, i, a, b, stat
 
       n = size(mass)
       ne = size(ek)
@@ -695,7 +736,7 @@ contains
       end if
       ! Gershgorin on D K D, D = M^-1/2: row i holds k_e / m_i on the diagonal and
       ! k_e / sqrt(m_i m_j) off it, for each element e at i
-      allocate (rs(n), stat=stat)
+      allocate (rs(n), dm(n), stat=stat)
       if (stat /= 0) then
          call fatal_error(error, "highest_eigenvalue: not enough memory for "//trim(fmt_int(n))//" DOFs", &
                           stat_no_memory)
@@ -724,8 +765,94 @@ contains
          call dense_modes(mass, ei, ej, ek, 1, lam, phi, lambda, error)
          return
       end if
-      ! Lanczos on A = D K D from a reproducible pseudo-random start
-      allocate (dm(n), q0(n), q1(n), w(n), alpha(lanczos_max_steps), beta(lanczos_max_steps), &
+      ! Lanczos on A = D K D
+      dm = 1.0_dp/sqrt(mass)
+      call lanczos_largest(dm, bound, lambda, error, ei=ei, ej=ej, ek=ek)
+   end subroutine highest_eigenvalue
+
+   !> highest_eigenvalue of a general structure: K the springs and K_x, plus kd_d b_d b_d' of
+   !> each device (matrix free, from their entries: O(nonzeros) a Lanczos step, no n x n
+   !> matrix beyond modes_dense_max DOFs, where dsygv gives it exactly). The same bounds:
+   !> lambda a lower bound (the largest Ritz value), bound Gershgorin's upper bound.
+   subroutine general_highest_eigenvalue(mass, spring_i, spring_j, spring_k, kx_i, kx_j, kx_v, dev_ptr, dev_dof, &
+                                         dev_coef, kd, lambda, bound, error)
+      real(dp), intent(in) :: mass(:)             !! masses m_i > 0, n = size(mass)
+      integer, intent(in) :: spring_i(:)          !! first node of each spring (0..n)
+      integer, intent(in) :: spring_j(:)          !! second node of each spring (0..n, 0 = fixed)
+      real(dp), intent(in) :: spring_k(:)         !! spring stiffness >= 0
+      integer, intent(in) :: kx_i(:)              !! K_x: row of each entry (1..n)
+      integer, intent(in) :: kx_j(:)              !! its column (kx_i <= kx_j)
+      real(dp), intent(in) :: kx_v(:)             !! its value
+      integer, intent(in) :: dev_ptr(:)           !! start of each device's terms (devices + 1)
+      integer, intent(in) :: dev_dof(:)           !! DOF of each term
+      real(dp), intent(in) :: dev_coef(:)         !! coefficient of each term
+      real(dp), intent(in) :: kd(:)               !! each device's stiffness in K (>= 0; 0: none)
+      real(dp), intent(out) :: lambda             !! largest Ritz value [1/s^2] (a lower bound)
+      real(dp), intent(out) :: bound              !! Gershgorin bound [1/s^2] (an upper bound)
+      type(error_type), allocatable, intent(out) :: error !! no memory, LAPACK failure
+      integer, allocatable :: ci(:), cj(:)
+      real(dp), allocatable :: cv(:), dm(:), q1(:), w(:), a(:, :), m(:, :), z(:, :)
+      integer :: n, i, stat
+
+      n = size(mass)
+      lambda = 0.0_dp
+      bound = 0.0_dp
+      if (n == 0) return
+      call stiffness_entries(n, spring_i, spring_j, spring_k, kx_i, kx_j, kx_v, dev_ptr, dev_dof, dev_coef, kd, &
+                             ci, cj, cv, stat)
+      if (stat == 0) allocate (dm(n), w(n), stat=stat)
+      if (stat /= 0) then
+         call no_memory(); return
+      end if
+      dm = 1.0_dp/sqrt(mass)
+      ! Gershgorin on D K D, D = M^-1/2: the entries scaled, |K_ij| / sqrt(m_i m_j)
+      call entry_rows(ci, cj, cv*dm(ci)*dm(cj), w)
+      bound = maxval(w)
+      if (bound == 0.0_dp) return
+      if (n <= modes_dense_max) then   ! dsygv: every eigenvalue, the largest exact
+         allocate (a(n, n), m(n, n), z(n, n), q1(n), stat=stat)
+         if (stat /= 0) then
+            call no_memory(); return
+         end if
+         m = 0.0_dp
+         do i = 1, n
+            q1 = 0.0_dp
+            q1(i) = 1.0_dp
+            call entry_product(ci, cj, cv, q1, a(:, i))
+            m(i, i) = mass(i)
+         end do
+         call generalized_eigen(a, m, w, z, error)
+         if (allocated(error)) return
+         lambda = w(n)
+         return
+      end if
+      call lanczos_largest(dm, bound, lambda, error, ci=ci, cj=cj, cv=cv)
+   contains
+      subroutine no_memory()
+         call fatal_error(error, "highest_eigenvalue: not enough memory for "//trim(fmt_int(n))//" DOFs", &
+                          stat_no_memory)
+      end subroutine no_memory
+   end subroutine general_highest_eigenvalue
+
+   !> The largest Ritz value of A = D K D, D = M^-1/2 (dm its diagonal), by Lanczos from a
+   !> reproducible pseudo-random start, at most bound: K from the elements (ei, ej, ek) or
+   !> from its entries on and above the diagonal (ci, cj, cv).
+   subroutine lanczos_largest(dm, bound, lambda, error, ei, ej, ek, ci, cj, cv)
+      real(dp), intent(in) :: dm(:)                        !! D's diagonal, n = size(dm)
+      real(dp), intent(in) :: bound                        !! Gershgorin bound of A
+      real(dp), intent(out) :: lambda                      !! largest Ritz value
+      type(error_type), allocatable, intent(out) :: error  !! no memory, dsterf failed
+      integer, intent(in), optional :: ei(:), ej(:)        !! elements' nodes (0 = the table)
+      real(dp), intent(in), optional :: ek(:)              !! elements' stiffness
+      integer, intent(in), optional :: ci(:), cj(:)        !! entries' rows and columns
+      real(dp), intent(in), optional :: cv(:)              !! entries' values
+      real(dp), allocatable :: q0(:), q1(:), w(:), dq(:), alpha(:), beta(:), d(:), e(:)
+      real(dp) :: nrm, top, prev
+      integer :: n, i, k, info, stat
+
+      n = size(dm)
+      lambda = 0.0_dp
+      allocate (q0(n), q1(n), w(n), dq(n), alpha(lanczos_max_steps), beta(lanczos_max_steps), &
                 d(lanczos_max_steps), e(lanczos_max_steps), stat=stat)
       if (stat /= 0) then
          call fatal_error(error, "highest_eigenvalue: not enough memory for "//trim(fmt_int(n))//" DOFs", &
@@ -733,7 +860,6 @@ contains
          return
       end if
       do i = 1, n
-         dm(i) = 1.0_dp/sqrt(mass(i))   ! D, once
          q1(i) = start_value(i, 1)
       end do
       q1 = q1/norm2(q1)
@@ -741,20 +867,15 @@ contains
       prev = -1.0_dp
       top = 0.0_dp
       do k = 1, min(lanczos_max_steps, n)
-         ! w = D K D q1 - beta_(k-1) q0 (rs, free after Gershgorin, holds D q1)
+         ! w = D K D q1 - beta_(k-1) q0
          do i = 1, n
-            rs(i) = dm(i)*q1(i)
+            dq(i) = dm(i)*q1(i)
          end do
-         w = 0.0_dp
-         do i = 1, ne
-            a = ei(i); b = ej(i)
-            x = 0.0_dp
-            if (a > 0) x = rs(a)
-            if (b > 0) x = x - rs(b)
-            x = ek(i)*x
-            if (a > 0) w(a) = w(a) + x
-            if (b > 0) w(b) = w(b) - x
-         end do
+         if (present(ek)) then
+            call element_product(ei, ej, ek, dq, w)
+         else
+            call entry_product(ci, cj, cv, dq, w)
+         end if
          do i = 1, n
             w(i) = dm(i)*w(i)
          end do
@@ -779,103 +900,28 @@ contains
          q1 = w/nrm
       end do
       lambda = min(top, bound)
-   end subroutine highest_eigenvalue
+   end subroutine lanczos_largest
 
-   !> highest_eigenvalue of a general structure: K the springs and K_x, plus kd_d b_d b_d' of
-   !> each device (matrix free, from their entries: O(nonzeros) a Lanczos step, no n x n
-   !> matrix beyond modes_dense_max DOFs, where dsygv gives it exactly). The same bounds:
-   !> lambda a lower bound (the largest Ritz value), bound Gershgorin's upper bound.
-   subroutine general_highest_eigenvalue(mass, spring_i, spring_j, spring_k, kx_i, kx_j, kx_v, dev_ptr, dev_dof, &
-                                         dev_coef, kd, lambda, bound, error)
-      real(dp), intent(in) :: mass(:)             !! masses m_i > 0, n = size(mass)
-      integer, intent(in) :: spring_i(:)          !! first node of each spring (0..n)
-      integer, intent(in) :: spring_j(:)          !! second node of each spring (0..n, 0 = fixed)
-      real(dp), intent(in) :: spring_k(:)         !! spring stiffness >= 0
-      integer, intent(in) :: kx_i(:)              !! K_x: row of each entry (1..n)
-      integer, intent(in) :: kx_j(:)              !! its column (kx_i <= kx_j)
-      real(dp), intent(in) :: kx_v(:)             !! its value
-      integer, intent(in) :: dev_ptr(:)           !! start of each device's terms (devices + 1)
-      integer, intent(in) :: dev_dof(:)           !! DOF of each term
-      real(dp), intent(in) :: dev_coef(:)         !! coefficient of each term
-      real(dp), intent(in) :: kd(:)               !! each device's stiffness in K (>= 0; 0: none)
-      real(dp), intent(out) :: lambda             !! largest Ritz value [1/s^2] (a lower bound)
-      real(dp), intent(out) :: bound              !! Gershgorin bound [1/s^2] (an upper bound)
-      type(error_type), allocatable, intent(out) :: error !! no memory, LAPACK failure
-      integer, allocatable :: ci(:), cj(:)
-      real(dp), allocatable :: cv(:), dm(:), q0(:), q1(:), w(:), alpha(:), beta(:), d(:), e(:), a(:, :), m(:, :)
-      real(dp), allocatable :: z(:, :)
-      real(dp) :: nrm, top, prev
-      integer :: n, i, k, info, stat
+   !> y = K x for K given by its two-node elements (node 0 the table).
+   pure subroutine element_product(ei, ej, ek, x, y)
+      integer, intent(in) :: ei(:), ej(:)   !! the elements' nodes
+      real(dp), intent(in) :: ek(:)         !! their stiffness
+      real(dp), intent(in) :: x(:)          !! the vector
+      real(dp), intent(out) :: y(:)         !! K x
+      real(dp) :: f
+      integer :: i, a, b
 
-      n = size(mass)
-      lambda = 0.0_dp
-      bound = 0.0_dp
-      if (n == 0) return
-      call stiffness_entries(n, spring_i, spring_j, spring_k, kx_i, kx_j, kx_v, dev_ptr, dev_dof, dev_coef, kd, &
-                             ci, cj, cv, stat)
-      if (stat == 0) allocate (dm(n), q0(n), q1(n), w(n), alpha(lanczos_max_steps), beta(lanczos_max_steps), &
-                               d(lanczos_max_steps), e(lanczos_max_steps), stat=stat)
-      if (stat /= 0) then
-         call no_memory(); return
-      end if
-      dm = 1.0_dp/sqrt(mass)
-      ! Gershgorin on D K D, D = M^-1/2: the entries scaled, |K_ij| / sqrt(m_i m_j)
-      call entry_rows(ci, cj, cv*dm(ci)*dm(cj), w)
-      bound = maxval(w)
-      if (bound == 0.0_dp) return
-      if (n <= modes_dense_max) then   ! dsygv: every eigenvalue, the largest exact
-         allocate (a(n, n), m(n, n), z(n, n), stat=stat)
-         if (stat /= 0) then
-            call no_memory(); return
-         end if
-         m = 0.0_dp
-         do i = 1, n
-            q1 = 0.0_dp
-            q1(i) = 1.0_dp
-            call entry_product(ci, cj, cv, q1, a(:, i))
-            m(i, i) = mass(i)
-         end do
-         call generalized_eigen(a, m, w, z, error)
-         if (allocated(error)) return
-         lambda = w(n)
-         return
-      end if
-      do i = 1, n
-         q1(i) = start_value(i, 1)
+      y = 0.0_dp
+      do i = 1, size(ek)
+         a = ei(i); b = ej(i)
+         f = 0.0_dp
+         if (a > 0) f = x(a)
+         if (b > 0) f = f - x(b)
+         f = ek(i)*f
+         if (a > 0) y(a) = y(a) + f
+         if (b > 0) y(b) = y(b) - f
       end do
-      q1 = q1/norm2(q1)
-      q0 = 0.0_dp
-      prev = -1.0_dp
-      top = 0.0_dp
-      do k = 1, min(lanczos_max_steps, n)
-         call entry_product(ci, cj, cv, dm*q1, w)
-         w = dm*w
-         if (k > 1) w = w - beta(k - 1)*q0
-         alpha(k) = dot_product(w, q1)
-         w = w - alpha(k)*q1
-         nrm = norm2(w)
-         beta(k) = nrm
-         d(1:k) = alpha(1:k)
-         e(1:k) = beta(1:k)
-         call dsterf(k, d, e, info)
-         if (info /= 0) then
-            call fatal_error(error, "highest_eigenvalue: dsterf failed with info = "//trim(fmt_int(info)))
-            return
-         end if
-         top = d(k)
-         if (nrm <= epsilon(1.0_dp)*bound) exit
-         if (abs(top - prev) <= lanczos_tol*abs(top)) exit
-         prev = top
-         q0 = q1
-         q1 = w/nrm
-      end do
-      lambda = min(top, bound)
-   contains
-      subroutine no_memory()
-         call fatal_error(error, "highest_eigenvalue: not enough memory for "//trim(fmt_int(n))//" DOFs", &
-                          stat_no_memory)
-      end subroutine no_memory
-   end subroutine general_highest_eigenvalue
+   end subroutine element_product
 
    !> A reproducible pseudo-random number in [-1, 1) for entry (i, j) of the start vectors
    !> (a hash of i and j: no generator state).

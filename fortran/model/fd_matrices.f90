@@ -245,7 +245,7 @@ contains
       allocate (grp(n), stat=stat)
       if (stat /= 0) then
          nq = -1
-         call no_memory(n); return
+         call out_of_memory('eigenproblem', n, error); return
       end if
       call link_groups(model, linked, grp, nq)
       if (nq == 0) then
@@ -254,7 +254,7 @@ contains
       end if
       allocate (mq(nq), ea(model%n_springs), eb(model%n_springs), ek(model%n_springs), stat=stat)
       if (stat /= 0) then
-         call no_memory(nq); return
+         call out_of_memory('eigenproblem', nq, error); return
       end if
       call group_masses(grp, model%mass, mq)
       ne = 0
@@ -264,7 +264,7 @@ contains
       m = min(nev, nq)
       allocate (lam(m), z(nq, m), stat=stat)
       if (stat /= 0) then
-         call no_memory(nq); return
+         call out_of_memory('eigenproblem', nq, error); return
       end if
       call lowest_modes(mq, ea(1:ne), eb(1:ne), ek(1:ne), m, lam, z, scale, error, path)
       if (allocated(error)) return
@@ -277,12 +277,6 @@ contains
       do i = 1, n
          if (grp(i) /= 0) phi(i, 1:m) = z(grp(i), :)
       end do
-   contains
-      subroutine no_memory(size)
-         integer, intent(in) :: size
-         call fatal_error(error, "not enough memory for the eigenproblem of "//trim(fmt_int(size))// &
-                          " DOFs", stat_no_memory)
-      end subroutine no_memory
    end subroutine system_modes
 
    !> First natural period of the stuck system (every device that holds its nodes together
@@ -442,8 +436,7 @@ contains
       allocate (k(n, n), lam(n), z(n, n), stat=stat)
       if (stat /= 0) then
          nq = -1
-         call fatal_error(error, "not enough memory for the eigenproblem of "//trim(fmt_int(n))//" DOFs", &
-                          stat_no_memory)
+         call out_of_memory('eigenproblem', n, error)
          return
       end if
       call stiffness_matrix(model, k)
@@ -533,8 +526,7 @@ contains
       allocate (bb(n, n), eye(n, n), ev(n), vec(n, n), stat=stat)
       if (stat /= 0) then
          nq = -1
-         call fatal_error(error, "not enough memory for the eigenproblem of "//trim(fmt_int(n))//" DOFs", &
-                          stat_no_memory)
+         call out_of_memory('eigenproblem', n, error)
          return
       end if
       bb = 0.0_dp
@@ -579,8 +571,7 @@ contains
       if (allocated(error) .or. nq == 0) return
       allocate (kq(nq, nq), mq(nq, nq), y(nq, nq), col(n), stat=stat)
       if (stat /= 0) then
-         call fatal_error(error, "not enough memory for the eigenproblem of "//trim(fmt_int(nq))//" DOFs", &
-                          stat_no_memory)
+         call out_of_memory('eigenproblem', nq, error)
          return
       end if
       kq = matmul(transpose(z), matmul(k, z))
@@ -617,8 +608,7 @@ contains
       n = model%n_dof
       allocate (ks(n, n), lam(n), z(n, n), linked(model%n_devices), grp(n), stat=stat)
       if (stat /= 0) then
-         call fatal_error(error, "not enough memory for the natural modes of "//trim(fmt_int(n))//" DOFs", &
-                          stat_no_memory)
+         call out_of_memory('natural modes', n, error)
          return
       end if
       ks = k
@@ -648,8 +638,7 @@ contains
       grp = [(j, j=1, n)]
       call store_modes(grp, model%mass, lam, z, lam(1:modes%n) <= 1.0e-12_dp*big, zcz, modes, stat, &
                        model%influence)
-      if (stat /= 0) call fatal_error(error, "not enough memory for the natural modes of "//trim(fmt_int(n))// &
-                                      " DOFs", stat_no_memory)
+      if (stat /= 0) call out_of_memory('natural modes', n, error)
    end subroutine constrained_natural_modes
 
    !> natural_modes_sparse of a general model (K_x, devices of any direction) without an
@@ -675,7 +664,7 @@ contains
       ns = model%n_springs
       allocate (kd(nd), linked(nd), stat=stat)
       if (stat /= 0) then
-         call no_memory(); return
+         call out_of_memory('natural modes', n, error); return
       end if
       do d = 1, nd
          linked(d) = system == system_stuck .and. links_when_stuck(model%dev(d))
@@ -685,7 +674,7 @@ contains
       m = max(min(nmax, n), 1)
       allocate (lam(m), z(n, m), stat=stat)
       if (stat /= 0) then
-         call no_memory(); return
+         call out_of_memory('natural modes', n, error); return
       end if
       call kx_entries(model, ki, kj, kv)
       call general_lowest_modes(model%mass, model%spring_i(1:ns), model%spring_j(1:ns), model%spring_k(1:ns), &
@@ -704,7 +693,7 @@ contains
       modes%n = min(max(nmax, 0), modes%nq)
       allocate (zcz(modes%n), grp(n), stat=stat)
       if (stat /= 0) then
-         call no_memory(); return
+         call out_of_memory('natural modes', n, error); return
       end if
       ! z' C z = a0 + a1 z' K z (z' M z = 1), K the springs and K_x; 'modal' damping's z' U diag(d) U' z
       do j = 1, modes%n
@@ -720,17 +709,13 @@ contains
       grp = [(j, j=1, n)]
       call store_modes(grp, model%mass, lam, z, lam(1:modes%n) <= 1.0e-12_dp*big, zcz, modes, stat, &
                        model%influence)
-      if (stat /= 0) call no_memory()
+      if (stat /= 0) call out_of_memory('natural modes', n, error)
    contains
       pure real(dp) function node_z(node, j)
          integer, intent(in) :: node, j
          node_z = 0.0_dp
          if (node > 0) node_z = z(node, j)
       end function node_z
-      subroutine no_memory()
-         call fatal_error(error, "not enough memory for the natural modes of "//trim(fmt_int(n))//" DOFs", &
-                          stat_no_memory)
-      end subroutine no_memory
    end subroutine banded_natural_modes
 
    !> Groups of DOFs joined by rigid links (the devices flagged in `linked`), by union-find
@@ -795,7 +780,7 @@ contains
       call system_groups(model, system, grp, modes, stat)
       if (stat == 0) allocate (ks(n, n), stat=stat)
       if (stat /= 0) then
-         call no_memory(n); return
+         call out_of_memory('natural modes', n, error, ' (an eigenproblem of that size)'); return
       end if
       nq = modes%nq
       if (nq == 0) return
@@ -809,7 +794,7 @@ contains
       ! Kq = T' K T, Cq = T' C T, Mq = T' M T by summing over the groups (T is 0/1: O(n^2))
       allocate (kq(nq, nq), cq(nq, nq), mq(nq, nq), sq(nq), stat=stat)
       if (stat /= 0) then
-         call no_memory(nq); return
+         call out_of_memory('natural modes', nq, error, ' (an eigenproblem of that size)'); return
       end if
       kq = 0.0_dp; cq = 0.0_dp; mq = 0.0_dp
       do j = 1, n
@@ -838,7 +823,7 @@ contains
       kfirst = max(modes%n, 1)
       allocate (lam(kfirst), z(nq, kfirst), zcz(modes%n), stat=stat)
       if (stat /= 0) then
-         call no_memory(nq); return
+         call out_of_memory('natural modes', nq, error, ' (an eigenproblem of that size)'); return
       end if
       call lowest_pairs(kq, kfirst, lam, z, error)
       if (allocated(error)) return
@@ -852,13 +837,7 @@ contains
          zcz(j) = dot_product(z(:, j), matmul(cq, z(:, j)))
       end do
       call store_modes(grp, model%mass, lam, z, lam(1:modes%n) <= 1.0e-12_dp*big, zcz, modes, stat, model%influence)
-      if (stat /= 0) call no_memory(n)
-   contains
-      subroutine no_memory(size)
-         integer, intent(in) :: size
-         call fatal_error(error, "not enough memory for the natural modes of "//trim(fmt_int(size))// &
-                          " DOFs (an eigenproblem of that size)", stat_no_memory)
-      end subroutine no_memory
+      if (stat /= 0) call out_of_memory('natural modes', n, error, ' (an eigenproblem of that size)')
    end subroutine natural_modes
 
    !> The natural modes of a large model without an n x n matrix: the springs (and, stuck,
@@ -894,13 +873,13 @@ contains
       call system_groups(model, system, grp, modes, stat)
       if (stat == 0) allocate (ea(ns + nd + n), eb(ns + nd + n), ek(ns + nd + n), stat=stat)
       if (stat /= 0) then
-         call no_memory(n); return
+         call out_of_memory('natural modes', n, error); return
       end if
       nq = modes%nq
       if (nq == 0) return
       allocate (mq(nq), root(0:nq), grounded(0:nq), ebig(nq), stat=stat)
       if (stat /= 0) then
-         call no_memory(nq); return
+         call out_of_memory('natural modes', nq, error); return
       end if
       call group_masses(grp, model%mass, mq)
       ne = 0
@@ -950,7 +929,7 @@ contains
       m = max(modes%n, 1)
       allocate (lam(m), z(nq, m), zcz(modes%n), stat=stat)
       if (stat /= 0) then
-         call no_memory(nq); return
+         call out_of_memory('natural modes', nq, error); return
       end if
       call lowest_modes(mq, ea(1:ne), eb(1:ne), ek(1:ne), m, lam, z, scale, error)
       if (allocated(error)) then
@@ -983,7 +962,7 @@ contains
       end do
       call store_modes(grp, model%mass, lam, z, lam(1:modes%n) <= 1.0e-9_dp*big .and. shifted, zcz, modes, stat, &
                        model%influence)
-      if (stat /= 0) call no_memory(n)
+      if (stat /= 0) call out_of_memory('natural modes', n, error)
    contains
       !> Component j of z at a node (0 on the table and in its group).
       pure real(dp) function node_z(node, j)
@@ -992,11 +971,6 @@ contains
          if (node == 0) return
          if (grp(node) /= 0) node_z = z(grp(node), j)
       end function node_z
-      subroutine no_memory(size)
-         integer, intent(in) :: size
-         call fatal_error(error, "not enough memory for the natural modes of "//trim(fmt_int(size))// &
-                          " DOFs", stat_no_memory)
-      end subroutine no_memory
    end subroutine natural_modes_sparse
 
    !> The k lowest eigenpairs of a symmetric matrix: in band storage after a reverse
@@ -1020,7 +994,7 @@ contains
       end do
       allocate (ei(ne), ej(ne), perm(n), inv(n), stat=stat)
       if (stat /= 0) then
-         call no_memory(); return
+         call out_of_memory('natural modes', n, error, ' (an eigenproblem of that size)'); return
       end if
       ne = 0
       do j = 1, n
@@ -1042,7 +1016,7 @@ contains
       end if
       allocate (ab(bw + 1, n), vp(n, k), stat=stat)
       if (stat /= 0) then
-         call no_memory(); return
+         call out_of_memory('natural modes', n, error, ' (an eigenproblem of that size)'); return
       end if
       ab = 0.0_dp
       do j = 1, n
@@ -1053,11 +1027,6 @@ contains
       call lowest_eigen_band(ab, k, lambda, vp, error)
       if (allocated(error)) return
       vec(perm, :) = vp
-   contains
-      subroutine no_memory()
-         call fatal_error(error, "not enough memory for the natural modes of "//trim(fmt_int(n))// &
-                          " DOFs (an eigenproblem of that size)", stat_no_memory)
-      end subroutine no_memory
    end subroutine lowest_pairs
 
    !> The factor b of the stiffness-proportional part of C = a0 M + b K: psi = T xi / pi
@@ -1228,5 +1197,22 @@ contains
          find = root(find)
       end do
    end function find
+
+   !> The error of an allocation that failed: "not enough memory for the <what> of <size>
+   !> DOFs<note>".
+   subroutine out_of_memory(what, size, error, note)
+      character(len=*), intent(in) :: what                 !! what the memory was for
+      integer, intent(in) :: size                          !! its DOFs
+      type(error_type), allocatable, intent(out) :: error  !! the error
+      character(len=*), intent(in), optional :: note       !! said after the DOFs
+
+      if (present(note)) then
+         call fatal_error(error, "not enough memory for the "//what//" of "//trim(fmt_int(size))//" DOFs"//note, &
+                          stat_no_memory)
+      else
+         call fatal_error(error, "not enough memory for the "//what//" of "//trim(fmt_int(size))//" DOFs", &
+                          stat_no_memory)
+      end if
+   end subroutine out_of_memory
 
 end module fd_matrices

@@ -548,7 +548,7 @@ contains
       end if
       w%ag1 = ag1
       ! the normal forces of the step's start (the follow's), then of its end (the laws' update)
-      call normal_forces(model, t, w, .false.)
+      if (w%varies) call normal_forces(model, t, w, .false.)
       ! a speed-dependent mu's sliding forces start from the velocity at the step's start,
       ! whatever an earlier trial of the step left in them (follow_forces takes them on)
       if (w%nf > 0) call start_forces(w%dev, w)
@@ -574,7 +574,7 @@ contains
          call relative_motion(model, w%n, w%nd, w%u1, w%v1, w%s1, w%sd1)
       end if
       if (w%nf > 0) call follow_forces(model, lv, w, error)
-      call normal_forces(model, t + h, w, .true.)
+      if (w%varies) call normal_forces(model, t + h, w, .true.)
    end subroutine try_step
 
    !> A speed-dependent mu at the velocity at the step's end (implicit, as a Newton-Raphson
