@@ -44,7 +44,7 @@ module fd_newmark
                         spd_c_matvec, spd_kc_matvec, spd_auto, spd_dense, spd_banded, spd_is_dense, spd_bandwidth, &
                         spd_copy
    use fd_device_state, only: device_state, device_force, phase_stick
-   use fd_friction_planar, only: pendulum_excess, normal_force, with_normal_force
+   use fd_friction_planar, only: pendulum_excess, normal_force, devices_at_normal_force
    use fd_friction, only: friction_init, friction_step, friction_settle, follows_velocity, friction_follow, &
                           friction_energy, friction_capacity
    use fd_result, only: result_type
@@ -410,13 +410,11 @@ contains
       real(dp), intent(in) :: t
       type(workspace), intent(inout) :: w
       real(dp) :: cap
-      integer :: d, q
+      integer :: q
 
       if (.not. w%three) return
       w%az = table_acceleration(w%exc3, t)
-      do d = 1, w%nd
-         call with_normal_force(model%dev(d), w%az, w%dev(d))
-      end do
+      call devices_at_normal_force(w%nd, model%dev, w%az, w%dev)
       do q = 1, w%nf
          cap = friction_capacity(w%dev(w%fl(q)))
          if (cap > 0.0_dp) w%cap(q) = cap
