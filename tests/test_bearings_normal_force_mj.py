@@ -1,5 +1,5 @@
 """Planar Coulomb bearings whose normal force varies with a vertical ground motion (&excitation3)
-under the Moreau-Jean technique.
+under the Moreau-Jean technique, and the step checks of Newmark's bearings with N(t).
 
 Moreau-Jean takes each step's friction disc h mu N and pendulum excess (N - N0) / R at the
 step's theta point, N = N0 (1 + a_z / g), the excess as a force with s of the step's start (K
@@ -12,6 +12,8 @@ holds N0 / R); N <= 0 is uplift: no friction, no restoring force, reported as Ne
 - the energy balance closes to round-off under a 0.5 g vertical motion (theta = 1/2);
 - a block on a friction pendulum under horizontal and vertical motion: Moreau-Jean tends to
   Newmark's velocity law (small eps, fine step) at first order in h.
+- Newmark's stick-ringing and band-alternation checks take a bearing's sticking spring and band
+  dashpot at the largest N of the run, where the step resolves them worst.
 """
 from __future__ import annotations
 
@@ -179,3 +181,43 @@ def test_moreau_jean_tends_to_newmarks_velocity_law_at_first_order(tmp_path):
     orders = [math.log2(errors[k] / errors[k + 1]) for k in range(2)]
     assert all(0.7 < q < 1.4 for q in orders), (errors, orders)
     assert errors[-1] < 1.0e-2, errors
+
+
+# ---------------------------------------------------------------- Newmark's step checks with N(t)
+
+def newmark_frequency_error(x: float) -> float:
+    """Average acceleration's relative frequency error at omega dt = x: 1 - 2 atan(x / 2) / x."""
+    return 1.0 - 2.0 * math.atan(x / 2.0) / x
+
+
+def test_step_checks_take_the_largest_normal_force(tmp_path):
+    """A velocity-law bearing's band dashpot N mu / eps and a hysteretic bearing's sticking
+    spring N mu / f grow with N: under a vertical motion that lifts N to 1.5 N0 the checks take
+    them at the largest N of the run. band_x at N0 is 0.8 (the step damps the band) and 1.2 at
+    1.5 N0 (it alternates); the sticking mode's frequency error is that of omega at 1.5 N0."""
+    t = times()
+    az = 0.5 * G * np.sin(2 * np.pi * 1.5 * t)
+    write_record(tmp_path, "azh.txt", az)
+    n_max = M * G * (1.0 + az.max() / G)
+    n1 = 2
+    dt1 = DT / n1
+    # band_x = (1 - gamma) dt1 N mu / (eps m) = 0.8 at N0
+    eps = 0.5 * dt1 * M * G * MU / (0.8 * M)
+    vel = {"law": "velocity", "eps": eps}
+    integ = {"n1": n1}
+    plain = run(tmp_path, groups(0.0, bearing=vel, integration=integ), "vplain.nml")
+    varied = run(tmp_path, groups(0.0, az="azh.txt", bearing=vel, integration=integ), "vvaried.nml")
+    assert plain.summary["band_x"][0] == pytest.approx(0.8, rel=1e-12)
+    x = 0.5 * dt1 * n_max * MU / (eps * M)
+    assert x == pytest.approx(0.8 * 1.5, rel=1e-3)
+    assert varied.summary["band_x"] == [pytest.approx(x, rel=1e-12)] * 2
+    # the hysteretic bearing's sticking spring
+    f = 2.0e-4
+    hys = {"law": "hysteretic", "f": f, "eps1": 1.0e-3}
+    plain = run(tmp_path, groups(0.0, bearing=hys, integration=integ), "hplain.nml")
+    varied = run(tmp_path, groups(0.0, az="azh.txt", bearing=hys, integration=integ), "hvaried.nml")
+    x0 = math.sqrt(M * G * MU / f / M) * dt1
+    x1 = math.sqrt(n_max * MU / f / M) * dt1
+    assert plain.summary["stick_frequency_error"][0] == pytest.approx(newmark_frequency_error(x0), rel=1e-9)
+    assert varied.summary["stick_frequency_error"] == [pytest.approx(newmark_frequency_error(x1), rel=1e-9)] * 2
+    assert varied.summary["stick_frequency_error"][0] > 1.4 * plain.summary["stick_frequency_error"][0]
