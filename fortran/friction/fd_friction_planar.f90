@@ -38,6 +38,7 @@ module fd_friction_planar
    public :: planar_velocity_update, planar_velocity_init, planar_velocity_correct, planar_velocity_follow
    public :: planar_hysteretic_update, planar_hysteretic_init, planar_hysteretic_correct
    public :: planar_velocity_settle, planar_hysteretic_settle, pendulum_excess, normal_force, with_normal_force
+   public :: devices_at_normal_force, normal_force_range
 
    real(dp), parameter :: g = 9.80665_dp   !! standard gravity [m/s2]
 
@@ -393,6 +394,40 @@ contains
       if (dev0%partner == 0) return
       dev%p = max(normal_force(dev0, az, dn), 0.0_dp)
    end subroutine with_normal_force
+
+   !> Every device at the vertical acceleration az, as the laws and the techniques take them:
+   !> a bearing's copy with p = max(N, 0) (with_normal_force), every other device's as it is.
+   !> The one routine every technique calls for the normal forces at a time (explicit-shape
+   !> arrays: no descriptor, no temporary, no allocation).
+   pure subroutine devices_at_normal_force(nd, dev0, az, dev)
+      integer, intent(in) :: nd                     !! devices
+      type(device_type), intent(in) :: dev0(nd)     !! the devices as the deck made them
+      real(dp), intent(in) :: az                    !! vertical ground acceleration [m/s2]
+      type(device_type), intent(inout) :: dev(nd)   !! their copies for the time, p set
+      integer :: d
+
+      do d = 1, nd
+         call with_normal_force(dev0(d), az, dev(d))
+      end do
+   end subroutine devices_at_normal_force
+
+   !> Each device's smallest and largest normal force while the vertical acceleration spans
+   !> [az_lo, az_hi] (N, not max(N, 0): N <= 0 is uplift): a bearing's N at both ends (N grows
+   !> with az), another device's p for both.
+   pure subroutine normal_force_range(nd, dev0, az_lo, az_hi, nrange)
+      integer, intent(in) :: nd                     !! devices
+      type(device_type), intent(in) :: dev0(nd)     !! the devices as the deck made them
+      real(dp), intent(in) :: az_lo, az_hi          !! the vertical acceleration's extremes [m/s2]
+      real(dp), intent(out) :: nrange(2, nd)        !! smallest and largest N [N]
+      integer :: d
+
+      do d = 1, nd
+         nrange(:, d) = dev0(d)%p
+         if (dev0(d)%partner == 0) cycle
+         nrange(1, d) = normal_force(dev0(d), az_lo)
+         nrange(2, d) = normal_force(dev0(d), az_hi)
+      end do
+   end subroutine normal_force_range
 
    !> The pendulum's stiffness beyond the one K holds, (P - P_static) / R, of a bearing whose
    !> normal force P varies (0 for a flat slider and for P = P_static) [N/m].

@@ -145,7 +145,7 @@ contains
       type(excitation_type), intent(in), optional :: exc2 !! a second horizontal component
                                                           !! (along the model's influence2)
       type(excitation_type), intent(in), optional :: exc3 !! the vertical component (bearings'
-                                                          !! normal forces; Newmark only, as they are)
+                                                          !! normal forces; Newmark and Moreau-Jean)
 
       if (opts%technique == technique_event_driven .and. present(exc2)) then
          if (exc2%kind /= excitation_none) then
@@ -155,10 +155,10 @@ contains
             return
          end if
       end if
-      if (opts%technique /= technique_newmark .and. present(exc3)) then
+      if (opts%technique == technique_event_driven .and. present(exc3)) then
          if (exc3%kind /= excitation_none) then
             call fatal_error(error, "group &excitation3: a vertical component (bearings' varying normal force) "// &
-                             "is integrated by technique = 'newmark'; technique = '"// &
+                             "is integrated by technique = 'newmark' or 'moreau_jean'; technique = '"// &
                              trim(technique_name(opts%technique))//"' holds each bearing's p constant")
             return
          end if
@@ -175,7 +175,7 @@ contains
       case (technique_event_driven)
          call run_event_driven(model, exc, opts, res, error, ctl)
       case (technique_moreau_jean)
-         call run_moreau_jean(model, exc, opts, res, error, ctl, exc2)
+         call run_moreau_jean(model, exc, opts, res, error, ctl, exc2, exc3)
       case default
          call unknown_technique(opts%technique, error)
       end select

@@ -17,7 +17,8 @@ module test_fd_friction_planar
    use fd_friction_hysteretic, only: hysteretic_update, hysteretic_init
    use fd_friction_planar, only: planar_velocity_update, planar_velocity_init, planar_velocity_correct, &
                                  planar_hysteretic_update, planar_hysteretic_init, planar_hysteretic_correct, &
-                                 pendulum_excess, normal_force, with_normal_force
+                                 pendulum_excess, normal_force, with_normal_force, devices_at_normal_force, &
+                                 normal_force_range
    implicit none
    private
 
@@ -43,7 +44,8 @@ contains
                   new_unittest("a varying normal force: friction of N, the pendulum's excess", test_normal_force), &
                   new_unittest("uplift (N <= 0): no force, a hysteretic spring unloaded", test_uplift), &
                   new_unittest("overturning: a rigid mat's arms, 2x2 and on a line", test_overturning_arms), &
-                  new_unittest("overturning: dN of a block at height h on two rows", test_overturning_forces) &
+                  new_unittest("overturning: dN of a block at height h on two rows", test_overturning_forces), &
+                  new_unittest("every device at a vertical acceleration; N's range", test_devices_normal_force) &
                   ]
    end subroutine collect_friction_planar
 
@@ -285,6 +287,31 @@ contains
       call planar_hysteretic_update(dev, [1.01_dp*f, 0.0_dp], [eps1, 0.0_dp], pair, ch)
       call check(error, pair(1)%phase == phase_slip_pos .and. pair(1)%f0 == 2.0_dp*n*mu, "slides at N mu")
    end subroutine test_normal_force
+
+   !> devices_at_normal_force: a bearing's components take p = max(N, 0), a 1D device (no
+   !> partner) keeps its p; normal_force_range: a bearing's N at the extremes of az (N < 0 kept:
+   !> uplift), a 1D device's p twice.
+   subroutine test_devices_normal_force(error)
+      type(error_type), allocatable, intent(out) :: error
+      type(device_type) :: dev0(3), dev(3)
+      real(dp) :: nr(2, 3)
+      real(dp), parameter :: g = 9.80665_dp
+
+      dev0 = device(law_velocity)
+      dev0%p_static = p
+      dev0(1)%partner = 2
+      dev0(2)%partner = 1
+      dev = dev0
+      call devices_at_normal_force(3, dev0, 0.5_dp*g, dev)
+      call check(error, dev(1)%p == 1.5_dp*p .and. dev(2)%p == 1.5_dp*p .and. dev(3)%p == p, "N at g / 2 up")
+      if (allocated(error)) return
+      call devices_at_normal_force(3, dev0, -2.0_dp*g, dev)
+      call check(error, dev(1)%p == 0.0_dp .and. dev(2)%p == 0.0_dp .and. dev(3)%p == p, "lifted: p = 0")
+      if (allocated(error)) return
+      call normal_force_range(3, dev0, -2.0_dp*g, 0.5_dp*g, nr)
+      call check(error, all(nr(:, 1) == [-p, 1.5_dp*p]) .and. all(nr(:, 2) == [-p, 1.5_dp*p]) .and. &
+                 all(nr(:, 3) == p), "N's range: -P (uplift) to 1.5 P; a 1D device's p")
+   end subroutine test_devices_normal_force
 
    !> N <= 0 (p = 0 given to the law): no friction, and a pendulum's excess -P / R s that
    !> cancels K's P / R s; a hysteretic bearing sliding when it lifts off comes down sticking

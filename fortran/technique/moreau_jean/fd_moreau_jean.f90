@@ -18,21 +18,29 @@
 !> devices' phases (sticking, sliding which way) and transitions. Energy: input and viscous
 !> work and the friction work sum lambda_d Delta s_d / h over each step; the balance closes
 !> to round-off for theta = 1/2 and leaves the method's numerical dissipation for theta > 1/2.
+!>
+!> A vertical component (&excitation3, planar bearings, the dense form): each bearing's normal
+!> force N = N0 (1 + a_z / g) (fd_friction_planar, the one place that computes it) at the step's
+!> theta point gives the step's disc h mu max(N, 0) and the pendulum's excess (N - N0) / R,
+!> whose force at s of the step's start joins r (K keeps N0 / R: W is factored once); the end of
+!> the step takes N there. N <= 0 (uplift): no friction, no restoring force; N's extremes and
+!> the uplift are observed at the steps' ends, as Newmark does (docs/theory.md, 12.8).
 module fd_moreau_jean
    use, intrinsic :: ieee_arithmetic, only: ieee_is_finite
    use fd_kinds, only: dp
    use fd_error, only: error_type, fatal_error, fmt_real, fmt_int, stat_no_memory
    use fd_names, only: law_coulomb, law_name, excitation_types, technique_name, technique_moreau_jean, &
                        technique_newmark, damping_stiffness, damping_rayleigh, technique_integrates
-   use fd_model, only: model_type, integration_type
-   use fd_excitation, only: excitation_type, table_motion, excitation_none
+   use fd_model, only: model_type, integration_type, device_type
+   use fd_excitation, only: excitation_type, table_motion, table_acceleration, excitation_none
+   use fd_friction_planar, only: devices_at_normal_force, normal_force, pendulum_excess
    use fd_kinematics, only: device_kinematics, device_nodes, devices_are_pairs, device_relative
    use fd_stiffness, only: influence_of
    use fd_matrices, only: structure_damping
    use fd_result, only: result_type
    use fd_observer, only: observer_type, observer_init, sample_due, observe_peaks, observe_sample, &
                           observe_transitions, observe_start_energies, observe_end_energies, &
-                         observe_poll, observe_stop_error, observe_work
+                         observe_poll, observe_stop_error, observe_work, observe_normal_forces
    use fd_run_control, only: run_control
    use fd_stick_groups, only: groups_build, edge_relative
    use fd_group_system, only: gs_k_matvec, gs_k_absmatvec, gs_lowest_eigenvalue
@@ -56,6 +64,15 @@ module fd_moreau_jean
       logical :: two = .false.
       type(excitation_type) :: exc2
       real(dp), allocatable :: mr2(:)
+      ! a vertical component (dense form: the bearings' normal forces N = N0 (1 + a_z / g);
+      ! three = .false.: constant): the devices at the N of the time normal_forces was last
+      ! called for, each device's pendulum excess (N - N0) / R then, its force kp s, and each
+      ! bearing's N at the accepted state
+      logical :: three = .false.
+      type(excitation_type) :: exc3
+      type(device_type), allocatable :: dev(:)            !! (nd)
+      real(dp), allocatable :: kp(:), fx(:)               !! (nd) [N/m], [N]
+      real(dp), allocatable :: pn(:)                      !! (n_bearings) [N]
       real(dp), allocatable :: lam(:), wrel(:), fend(:)   !! (nd) dense form: impulses, b'v1, end forces
       integer, allocatable :: sig(:), sa(:)               !! (nd) dense form: statuses of a step, its end
       type(observer_type) :: obs                          !! peaks, history, energy balance
@@ -151,7 +168,7 @@ contains
    end subroutine stuck_period
 
    !> Integrate a model whose devices all follow Coulomb's law by Moreau-Jean time stepping.
-   subroutine run_moreau_jean(model, exc, opts, res, error, ctl, exc2)
+   subroutine run_moreau_jean(model, exc, opts, res, error, ctl, exc2, exc3)
       type(model_type), intent(in) :: model         !! validated model (all devices coulomb)
       type(excitation_type), intent(in) :: exc      !! table motion
       type(integration_type), intent(in) :: opts    !! n1, theta and output_every are used
@@ -160,6 +177,8 @@ contains
       type(run_control), intent(inout), target, optional :: ctl !! the run's control (fd_run_control)
       type(excitation_type), intent(in), optional :: exc2 !! a second horizontal component, along
                                                           !! the model's influence2 (kind none: none)
+      type(excitation_type), intent(in), optional :: exc3 !! the vertical component: the bearings'
+                                                          !! normal forces (kind none: none)
       type(mj_work) :: w
       real(dp) :: h, th, alpha, beta, cm, ck, t1, ag0, ag1, agt, xg, vg, e_kin, e_str, ein
       integer :: k, e, c0, c1, crate
@@ -183,6 +202,13 @@ contains
       end if
       call observer_init(model, exc, opts, res%moreau_jean%setup%period_stuck, res, w%obs, error, ctl)
       if (allocated(error)) return
+      ! a vertical component acts on planar bearings alone, which take the dense form
+      if (present(exc3)) then
+         if (exc3%kind /= excitation_none .and. w%general .and. res%n_bearings > 0) then
+            call vertical_init(model, exc3, w, res%n_bearings, error)
+            if (allocated(error)) return
+         end if
+      end if
       th = opts%theta
       h = exc%dt_record/opts%n1
       res%moreau_jean%ran = .true.
@@ -408,9 +434,11 @@ contains
       type(mj_work), intent(inout) :: w
       type(result_type), intent(inout) :: res
       type(error_type), allocatable, intent(out) :: error
-      real(dp) :: h, th, cm, ck, t1, ag0, ag1, agt, xg, vg, e_kin, e_str, ein, b0, b1, bt
+      real(dp) :: h, th, cm, ck, t1, ag0, ag1, agt, xg, vg, e_kin, e_str, ein, b0, b1, bt, az0, az1
       integer :: k, d
 
+      az0 = 0.0_dp
+      az1 = 0.0_dp
       b0 = 0.0_dp
       b1 = 0.0_dp
       bt = 0.0_dp
@@ -425,17 +453,22 @@ contains
       w%v = model%v0
       call table_motion(exc, 0.0_dp, xg, vg, ag0)
       if (w%two) call table_motion(w%exc2, 0.0_dp, xg, vg, b0)
+      if (w%three) then
+         az0 = table_acceleration(w%exc3, 0.0_dp)
+         call normal_forces(model, az0, 1.0_dp, w, w%g_force)
+      end if
       ! devices moving at t = 0 slide that way, the others by the acceleration problem
       do d = 1, w%nd
          w%wrel(d) = device_relative(model, d, w%v)
          w%sig(d) = int(sign(1.0_dp, w%wrel(d)))
          if (w%wrel(d) == 0.0_dp .or. w%g_force(d) <= 0.0_dp) w%sig(d) = 0
       end do
-      call dense_end_state(w, ag0, b0, w%u, w%v, error)
+      call dense_end_state(model, w, ag0, b0, az0, w%u, w%v, error)
       if (allocated(error)) return
       call dense_device_state(model, w, w%phase0)
       call dense_energies(w, e_kin, e_str)
       call start_observing(w, res, ag0, e_kin, e_str, b0)
+      if (w%three) call observe_bearing_forces(model, 0.0_dp, 0.0_dp, az0, w, res)
       do k = 1, w%obs%nsteps
          t1 = k*h
          call table_motion(exc, t1, xg, vg, ag1)
@@ -448,6 +481,13 @@ contains
             call table_motion(w%exc2, t1, xg, vg, b1)
             bt = (1.0_dp - th)*b0 + th*b1
             w%r = w%r - h*bt*w%mr2
+         end if
+         if (w%three) then
+            ! the step's friction bounds h N mu and pendulum excess at its theta point (as its
+            ! load f_theta), the excess's force kp s with s of its start (w%s: a force, as Newmark's)
+            az1 = table_acceleration(w%exc3, t1)
+            call normal_forces(model, (1.0_dp - th)*az0 + th*az1, h, w, w%g_step)
+            call excess_forces(model, w, w%u, -h, w%r)
          end if
          call dense_solve(w%di, w%r, w%g_step, w%v1, w%lam, w%wrel, w%sig, error)
          if (allocated(error)) return
@@ -463,13 +503,17 @@ contains
             w%obs%device_work(d) = w%obs%device_work(d) + w%lam(d)*w%rel_edge(d)/h
             w%obs%slip_travel(d) = w%obs%slip_travel(d) + abs(w%rel_edge(d))
          end do
-         call dense_end_state(w, ag1, b1, w%u1, w%v1, error)
+         ! the pendulum excess's work over the step, with the devices' (as Newmark's)
+         if (w%three) call excess_work(w)
+         call dense_end_state(model, w, ag1, b1, az1, w%u1, w%v1, error)
          if (allocated(error)) return
          w%u = w%u1
          w%v = w%v1
          ag0 = ag1
          b0 = b1
+         az0 = az1
          call dense_device_state(model, w, w%phase1)
+         if (w%three) call observe_bearing_forces(model, t1, h, az1, w, res)
          call end_step(w, res, k, t1, ag1, error, b1)
          if (allocated(error)) return
       end do
@@ -483,17 +527,116 @@ contains
 
    !> The acceleration (relative to the table) and the device forces at an instant from
    !> equilibrium, the step's statuses w%sig held (fd_dense_impulse's dense_acceleration).
-   subroutine dense_end_state(w, ag, ag2, u, v, error)
+   subroutine dense_end_state(model, w, ag, ag2, az, u, v, error)
+      type(model_type), intent(in) :: model
       type(mj_work), intent(inout) :: w
-      real(dp), intent(in) :: ag, ag2, u(:), v(:)
+      real(dp), intent(in) :: ag, ag2, az, u(:), v(:)
       type(error_type), allocatable, intent(out) :: error
+      integer :: d
 
       w%kx = w%a1*v + u
       call dense_k_times(w%di, w%kx, w%r, -1.0_dp, 0.0_dp)
       w%r = w%r - w%mr*ag - w%a0*w%di%mass*v
       if (w%two) w%r = w%r - w%mr2*ag2
+      ! a vertical component: the bounds N mu and the pendulum excess's force at the instant
+      if (w%three) then
+         call normal_forces(model, az, 1.0_dp, w, w%g_force)
+         call excess_forces(model, w, u, -1.0_dp, w%r)
+      end if
       call dense_acceleration(w%di, w%r, w%g_force, w%sig, w%acc, w%fend, w%sa, error, w%wrel)
+      if (allocated(error) .or. .not. w%three) return
+      ! the devices' forces: the friction's and the excess's (both act along b)
+      do d = 1, w%nd
+         w%fend(d) = w%fend(d) + w%fx(d)
+      end do
    end subroutine dense_end_state
+
+   !> A vertical component: its motion, the devices' copies and work arrays (set up once: the
+   !> loop allocates nothing).
+   subroutine vertical_init(model, exc3, w, nb, error)
+      type(model_type), intent(in) :: model
+      type(excitation_type), intent(in) :: exc3
+      type(mj_work), intent(inout) :: w
+      integer, intent(in) :: nb                       !! bearings
+      type(error_type), allocatable, intent(out) :: error
+      integer :: stat
+
+      allocate (w%dev(w%nd), w%kp(w%nd), w%fx(w%nd), w%pn(nb), stat=stat)
+      if (stat /= 0) then
+         call no_memory(error, w%n)
+         return
+      end if
+      w%three = .true.
+      w%exc3 = exc3
+      w%dev = model%dev(1:w%nd)
+      w%kp = 0.0_dp
+      w%fx = 0.0_dp
+   end subroutine vertical_init
+
+   !> The devices at the vertical acceleration az (fd_friction_planar's devices_at_normal_force:
+   !> a bearing's p = max(N, 0), N = N0 (1 + az / g)), their bounds scale P mu into g (h: the
+   !> impulses' h P mu; 1: the forces' P mu) and their pendulum excesses (N - N0) / R into w%kp
+   !> (0 for every device but a curved bearing's components).
+   pure subroutine normal_forces(model, az, scale, w, g)
+      type(model_type), intent(in) :: model
+      real(dp), intent(in) :: az, scale
+      type(mj_work), intent(inout) :: w
+      real(dp), intent(out) :: g(:)
+      integer :: d
+
+      call devices_at_normal_force(w%nd, model%dev, az, w%dev)
+      do d = 1, w%nd
+         g(d) = scale*(w%dev(d)%p*w%dev(d)%mu)
+         w%kp(d) = 0.0_dp
+         if (w%dev(d)%partner > 0) w%kp(d) = pendulum_excess(w%dev(d))
+      end do
+   end subroutine normal_forces
+
+   !> The pendulum excesses' forces kp s at the displacements u into w%fx, added times c to r
+   !> along each device's b (the K of the structure holds N0 / R; the rest is a force).
+   subroutine excess_forces(model, w, u, c, r)
+      type(model_type), intent(in) :: model
+      type(mj_work), intent(inout) :: w
+      real(dp), intent(in) :: u(:)
+      real(dp), intent(in) :: c
+      real(dp), intent(inout) :: r(:)
+      integer :: d
+
+      do d = 1, w%nd
+         w%fx(d) = 0.0_dp
+         if (w%kp(d) == 0.0_dp) cycle
+         w%fx(d) = w%kp(d)*device_relative(model, d, u)
+         r = r + (c*w%fx(d))*w%di%b(:, d)
+      end do
+   end subroutine excess_forces
+
+   !> The work of the pendulum excesses' forces over the step's relative displacements
+   !> (w%rel_edge), with the friction's: the devices' work and the balance's friction term.
+   pure subroutine excess_work(w)
+      type(mj_work), intent(inout) :: w
+      integer :: d
+
+      do d = 1, w%nd
+         if (w%fx(d) == 0.0_dp) cycle
+         w%w_fric = w%w_fric + w%fx(d)*w%rel_edge(d)
+         w%obs%device_work(d) = w%obs%device_work(d) + w%fx(d)*w%rel_edge(d)
+      end do
+   end subroutine excess_work
+
+   !> The bearings' normal forces N = N0 (1 + az / g) at the accepted time t to the observer:
+   !> extremes and uplift, as Newmark reports them; h the step that reached t (0 at the start).
+   subroutine observe_bearing_forces(model, t, h, az, w, res)
+      type(model_type), intent(in) :: model
+      real(dp), intent(in) :: t, h, az
+      type(mj_work), intent(inout) :: w
+      type(result_type), intent(inout) :: res
+      integer :: b
+
+      do b = 1, res%n_bearings
+         w%pn(b) = normal_force(model%dev(res%bearing_dev(1, b)), az)
+      end do
+      call observe_normal_forces(res, t, h, w%pn)
+   end subroutine observe_bearing_forces
 
    !> Device kinematics, forces and phases of the dense form (statuses of the step).
    pure subroutine dense_device_state(model, w, phase)

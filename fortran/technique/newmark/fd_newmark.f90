@@ -44,7 +44,8 @@ module fd_newmark
                         spd_c_matvec, spd_kc_matvec, spd_auto, spd_dense, spd_banded, spd_is_dense, spd_bandwidth, &
                         spd_copy
    use fd_device_state, only: device_state, device_force, phase_stick
-   use fd_friction_planar, only: pendulum_excess, normal_force, with_normal_force
+   use fd_friction_planar, only: pendulum_excess, normal_force, with_normal_force, devices_at_normal_force, &
+                                 normal_force_range
    use fd_overturning, only: overturning_forces
    use fd_friction, only: friction_init, friction_step, friction_settle, follows_velocity, friction_follow, &
                           friction_energy, friction_capacity
@@ -127,6 +128,8 @@ module fd_newmark
       real(dp), allocatable :: dn(:), dn1(:)          !! per bearing [N]
       type(device_type), allocatable :: dev(:)
       real(dp), allocatable :: pn(:)                  !! per bearing: N at the accepted state [N]
+      real(dp), allocatable :: nrange(:, :)           !! (2, nd) each device's N extremes at the
+                                                      !! dt1 steps, for the step checks [N]
       real(dp) :: w_device = 0.0_dp                   !! work of the device forces [J]
       real(dp) :: t = 0.0_dp                          !! time of the accepted state [s]
       integer :: k = 0                                !! the dt1 step being taken, from k - 1 to k
@@ -235,9 +238,11 @@ contains
       if (allocated(error)) return
       ! the devices' forces, kept from here on by device_step
       w%f = device_force(w%st, w%s, w%sd)
-      call ringing_init(model, dt1, opts%beta, opts%gamma, w%a0, w%a1c, w%ring, res, error)
+      if (w%three) call normal_extremes(model, dt1, w, error)
       if (allocated(error)) return
-      call alternation_init(model, dt1, opts%gamma, w%alt, res, error)
+      call ringing_init(model, dt1, opts%beta, opts%gamma, w%a0, w%a1c, w%ring, res, error, w%nrange)
+      if (allocated(error)) return
+      call alternation_init(model, dt1, opts%gamma, w%alt, res, error, w%nrange)
       if (allocated(error)) return
       call consistent_acceleration(model, exc, 0.0_dp, w)
       call observe_start_energies(w%obs, 0.5_dp*sum(w%mass*w%v**2), strain_energy(model, w%u), &
@@ -462,15 +467,39 @@ contains
             end if
          end do
       else
-         do d = 1, w%nd
-            call with_normal_force(model%dev(d), w%az, w%dev(d))
-         end do
+         call devices_at_normal_force(w%nd, model%dev, w%az, w%dev)
       end if
       do q = 1, w%nf
          cap = friction_capacity(w%dev(w%fl(q)))
          if (cap > 0.0_dp) w%cap(q) = cap
       end do
    end subroutine normal_forces
+
+   !> A vertical component: each device's smallest and largest normal force at the dt1 steps'
+   !> ends (w%nrange), the step checks' (fd_stick_ringing, fd_band_alternation).
+   subroutine normal_extremes(model, dt1, w, error)
+      type(model_type), intent(in) :: model
+      real(dp), intent(in) :: dt1
+      type(workspace), intent(inout) :: w
+      type(error_type), allocatable, intent(out) :: error
+      real(dp) :: az, lo, hi
+      integer :: k, stat
+
+      lo = table_acceleration(w%exc3, 0.0_dp)
+      hi = lo
+      do k = 1, w%obs%nsteps
+         az = table_acceleration(w%exc3, k*dt1)
+         lo = min(lo, az)
+         hi = max(hi, az)
+      end do
+      allocate (w%nrange(2, w%nd), stat=stat)
+      if (stat /= 0) then
+         call fatal_error(error, "not enough memory for the normal forces of n_devices = "//trim(fmt_int(w%nd))// &
+                          " devices", stat_no_memory)
+         return
+      end if
+      call normal_force_range(w%nd, model%dev, lo, hi, w%nrange)
+   end subroutine normal_extremes
 
    !> The bearings' normal forces at the accepted time t (the one normal_forces was last
    !> called for) to the observer: extremes and uplift; h the step that reached t (0 at the start).

@@ -39,6 +39,12 @@
 !> band_x = 2 (1 - gamma) x at dt1, above 1 where the factor r is negative, with the couplings
 !> of every velocity-law device at its nodes (exact for one device or devices in parallel on
 !> two masses alone).
+!>
+!> A planar bearing whose normal force N varies over the run (a vertical component, its range
+!> [N_min, N_max] given): its band dashpot is N mu(eps) / eps, so band_x is taken at N_max (the
+!> largest dashpot, the factor r most negative: where the step alternates most), and the floor
+!> of the count at N_min (the smallest capacity: an alternation of 5 % of the smallest N mu is
+!> counted); a bearing that lifts off (N_min <= 0) has its floor at N_max.
 module fd_band_alternation
    use fd_kinds, only: dp
    use fd_error, only: error_type, fatal_error, fmt_int, stat_no_memory
@@ -88,16 +94,19 @@ contains
    !> of every velocity-law device at node n (the table, n = 0, adds nothing), so that the
    !> step's factor on the band is negative where x > 1: c1 dt1 / (2 m_r) for one device and
    !> average acceleration.
-   subroutine alternation_init(model, dt1, gamma, al, res, error)
+   subroutine alternation_init(model, dt1, gamma, al, res, error, nrange)
       type(model_type), intent(in) :: model         !! the model
       real(dp), intent(in) :: dt1                   !! main step [s]
       real(dp), intent(in) :: gamma                 !! Newmark's gamma
       type(alternation_type), intent(out) :: al     !! the devices watched
       type(result_type), intent(inout) :: res       !! band_x and band_checked set
       type(error_type), allocatable, intent(out) :: error !! not enough memory
+      real(dp), intent(in), optional :: nrange(:, :) !! (2, n_devices) each device's smallest and
+                                                     !! largest normal force over the run [N]
+                                                     !! (absent: the deck's p throughout)
       real(dp), allocatable :: c(:)
       integer :: d, q, stat
-      real(dp) :: pmu, scale
+      real(dp) :: pmu, scale, pfloor
 
       res%band_checked = .false.
       al%n = count(watched(model%dev(1:model%n_devices)))
@@ -114,7 +123,9 @@ contains
             if (.not. watched(dev)) cycle
             q = q + 1
             pmu = dev%p*sliding_mu(dev, dev%eps)
-            al%w(q) = band_watch(dev=d, floor4=4.0_dp*alternation_floor*pmu)
+            pfloor = pmu
+            if (present(nrange)) call varying_band(dev, nrange(:, d), pmu, pfloor)
+            al%w(q) = band_watch(dev=d, floor4=4.0_dp*alternation_floor*pfloor)
             call add_device_abs(model, d, pmu/dev%eps, c)
          end associate
       end do
@@ -124,6 +135,23 @@ contains
       end do
       res%band_checked = al%n > 0
    end subroutine alternation_init
+
+   !> A device whose normal force varies over the run (nrange(1) < nrange(2)): P mu(eps) of its
+   !> band's dashpot at the largest N, of the count's floor at the smallest (at the largest when
+   !> it lifts off, N_min <= 0); both kept otherwise.
+   pure subroutine varying_band(dev, nrange, pmu, pfloor)
+      type(device_type), intent(in) :: dev          !! the device as the deck made it
+      real(dp), intent(in) :: nrange(2)             !! its smallest and largest N [N]
+      real(dp), intent(inout) :: pmu                !! P mu(eps) of the dashpot [N]
+      real(dp), intent(inout) :: pfloor             !! P mu(eps) of the floor [N]
+      real(dp) :: mu
+
+      if (.not. nrange(1) < nrange(2)) return
+      mu = sliding_mu(dev, dev%eps)
+      pmu = max(nrange(2), 0.0_dp)*mu
+      pfloor = max(nrange(1), 0.0_dp)*mu
+      if (.not. pfloor > 0.0_dp) pfloor = pmu
+   end subroutine varying_band
 
    !> A device the step may leave alternating: the velocity law with a band coupling,
    !> P mu(eps) > 0 (one that holds its nodes while it sticks).

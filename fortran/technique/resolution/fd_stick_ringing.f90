@@ -32,10 +32,17 @@
 !> - R_p = A_p / max(M_p, P mu / 4) where Phi_p > 1, else 0.
 !> A device whose largest R_p exceeds 1 is not resolved: the step dephases a ringing of at
 !> least a quarter of P mu and larger than the margin to sliding. Halving dt1 quarters delta.
+!>
+!> A planar bearing whose normal force N varies over the run (a vertical component, its range
+!> [N_min, N_max] given): the sticking spring is N mu / f, so the mode, its frequency error and
+!> its ringing force are taken at N_max (the stiffest spring, which the step resolves worst),
+!> and the capacity P mu of the margin and of the floor at N_min (the bearing nearest to
+!> sliding). A bearing that lifts off (N_min <= 0) has no margin at its minimum (M_p = 0); its
+!> floor is then a quarter of N_max mu.
 module fd_stick_ringing
    use fd_kinds, only: dp
    use fd_error, only: error_type, fatal_error, fmt_int, stat_no_memory
-   use fd_model, only: model_type
+   use fd_model, only: model_type, device_type
    use fd_kinematics, only: moved_mass, device_nodes, devices_are_pairs, add_device, device_relative
    use fd_stiffness, only: stiffness_form
    use fd_friction, only: sticking_stiffness, law_stuck, stuck_dashpot
@@ -61,7 +68,8 @@ module fd_stick_ringing
       integer, allocatable :: dev(:)            !! their numbers
       real(dp), allocatable :: k(:)             !! sticking stiffness P mu / f [N/m]
       real(dp), allocatable :: omega(:)         !! its mode's circular frequency [rad/s]
-      real(dp), allocatable :: pmu(:)           !! P mu [N]
+      real(dp), allocatable :: pmu(:)           !! P mu of the margin to sliding [N]
+      real(dp), allocatable :: pfloor(:)        !! P mu of the floor [N]
       real(dp), allocatable :: drift(:)         !! |delta| omega: dephasing rate [rad/s]
       real(dp), allocatable :: c_fixed(:)       !! damping of the mode: the structure's C and
                                                 !! Newmark's own, as 2 m_r omega zeta [N s/m]
@@ -109,7 +117,7 @@ contains
    !> The devices with a sticking spring, their modes and Newmark's error on them at dt1
    !> (res%stick_freq_error), and the phase statistics zeroed. The springs and velocity-law
    !> devices that act on a mode are found through the nodes' incidence lists: O(elements).
-   subroutine ringing_init(model, dt1, beta, gamma, a0, a1, rg, res, error)
+   subroutine ringing_init(model, dt1, beta, gamma, a0, a1, rg, res, error, nrange)
       type(model_type), intent(in) :: model         !! the model
       real(dp), intent(in) :: dt1                   !! main step [s]
       real(dp), intent(in) :: beta, gamma           !! Newmark's parameters
@@ -117,6 +125,9 @@ contains
       type(ringing_type), intent(out) :: rg         !! the devices watched
       type(result_type), intent(inout) :: res       !! stick_freq_error, stick_checked set
       type(error_type), allocatable, intent(out) :: error !! not enough memory
+      real(dp), intent(in), optional :: nrange(:, :) !! (2, n_devices) each device's smallest and
+                                                     !! largest normal force over the run [N]
+                                                     !! (absent: the deck's p throughout)
       integer, allocatable :: sp_first(:), sp_list(:), vd_first(:), vd_list(:), di(:), dj(:)
       logical, allocatable :: velocity(:)
       real(dp) :: k, ai, aj, c, x, wt, zn
@@ -125,6 +136,8 @@ contains
 
       if (model%n_kx > 0 .or. .not. devices_are_pairs(model)) then
          call general_ringing_init(model, dt1, beta, gamma, a0, a1, rg, res, error)
+         if (present(nrange) .and. .not. allocated(error)) &
+            call vary_normal_force(model, dt1, beta, gamma, nrange, rg, res)
          return
       end if
       nd = model%n_devices
@@ -149,7 +162,7 @@ contains
          end do
          allocate (rg%dev(rg%n), rg%k(rg%n), rg%omega(rg%n), rg%pmu(rg%n), rg%drift(rg%n), &
                    rg%c_fixed(rg%n), rg%mr(rg%n), rg%first(rg%n + 1), rg%band_dev(nb), rg%band_shape(nb), &
-                   rg%c_start(rg%n), rg%stats(4, nd), stat=stat)
+                   rg%c_start(rg%n), rg%stats(4, nd), rg%pfloor(rg%n), stat=stat)
       end if
       call ringing_ready(rg, stat, error)
       if (allocated(error)) return
@@ -173,6 +186,7 @@ contains
          call spring_damping(j)
          rg%omega(q) = sqrt(k/rg%mr(q))
          rg%pmu(q) = model%dev(d)%p*model%dev(d)%mu
+         rg%pfloor(q) = rg%pmu(q)
          x = rg%omega(q)*dt1
          call newmark_frequency(x, beta, gamma, wt, zn, osc)
          if (osc) then
@@ -184,6 +198,7 @@ contains
          rg%c_fixed(q) = c + 2.0_dp*rg%mr(q)*rg%omega(q)*zn
       end do
       rg%first(rg%n + 1) = nb + 1
+      if (present(nrange)) call vary_normal_force(model, dt1, beta, gamma, nrange, rg, res)
    contains
       !> The mode of device d: node i moves ai, node j -aj, the centre of mass stays.
       subroutine mode_of(d)
@@ -263,7 +278,7 @@ contains
       rg%n = count(sticking_stiffness(model%dev(1:nd)) > 0.0_dp)
       allocate (phi(model%n_dof), velocity(nd), rg%dev(rg%n), rg%k(rg%n), rg%omega(rg%n), rg%pmu(rg%n), &
                 rg%drift(rg%n), rg%c_fixed(rg%n), rg%mr(rg%n), rg%first(rg%n + 1), rg%c_start(rg%n), &
-                rg%stats(4, nd), stat=stat)
+                rg%stats(4, nd), rg%pfloor(rg%n), stat=stat)
       call ringing_ready(rg, stat, error)
       if (allocated(error)) return
       velocity = law_stuck(model%dev(1:nd)%law) == stuck_dashpot
@@ -297,6 +312,7 @@ contains
             c = a0*rg%mr(q) + a1*ek
             rg%omega(q) = sqrt(k/rg%mr(q))
             rg%pmu(q) = model%dev(d)%p*model%dev(d)%mu
+            rg%pfloor(q) = rg%pmu(q)
             x = rg%omega(q)*dt1
             call newmark_frequency(x, beta, gamma, wt, zn, osc)
             res%stick_freq_error(d) = 1.0_dp
@@ -316,6 +332,45 @@ contains
       rg%first(rg%n + 1) = nb + 1
       res%stick_checked = rg%n > 0
    end subroutine general_ringing_init
+
+   !> The watched devices whose normal force varies over the run (nrange(1, d) < nrange(2, d)):
+   !> the sticking spring, its mode's frequency, Newmark's error on it (res%stick_freq_error),
+   !> its drift and Newmark's own damping of it at the largest normal force; the margin's P mu
+   !> at the smallest (0 when the bearing lifts off), the floor's there too unless it lifts off
+   !> (then at the largest).
+   subroutine vary_normal_force(model, dt1, beta, gamma, nrange, rg, res)
+      type(model_type), intent(in) :: model         !! the model
+      real(dp), intent(in) :: dt1                   !! main step [s]
+      real(dp), intent(in) :: beta, gamma           !! Newmark's parameters
+      real(dp), intent(in) :: nrange(:, :)          !! (2, n_devices) smallest and largest N [N]
+      type(ringing_type), intent(inout) :: rg       !! the devices watched
+      type(result_type), intent(inout) :: res       !! stick_freq_error
+      type(device_type) :: dv
+      real(dp) :: x, wt, zn, zn0, wt0
+      integer :: q, d
+      logical :: osc
+
+      do q = 1, rg%n
+         d = rg%dev(q)
+         if (.not. nrange(1, d) < nrange(2, d)) cycle
+         dv = model%dev(d)
+         dv%p = max(nrange(2, d), 0.0_dp)
+         ! Newmark's own damping of the deck's mode out of c_fixed, that of N_max's in
+         call newmark_frequency(rg%omega(q)*dt1, beta, gamma, wt0, zn0, osc)
+         rg%c_fixed(q) = rg%c_fixed(q) - 2.0_dp*rg%mr(q)*rg%omega(q)*zn0
+         rg%k(q) = sticking_stiffness(dv)
+         rg%omega(q) = sqrt(rg%k(q)/rg%mr(q))
+         x = rg%omega(q)*dt1
+         call newmark_frequency(x, beta, gamma, wt, zn, osc)
+         res%stick_freq_error(d) = 1.0_dp
+         if (osc) res%stick_freq_error(d) = 1.0_dp - wt/x
+         rg%drift(q) = abs(res%stick_freq_error(d))*rg%omega(q)
+         rg%c_fixed(q) = rg%c_fixed(q) + 2.0_dp*rg%mr(q)*rg%omega(q)*zn
+         rg%pmu(q) = max(nrange(1, d), 0.0_dp)*model%dev(d)%mu
+         rg%pfloor(q) = rg%pmu(q)
+         if (.not. rg%pfloor(q) > 0.0_dp) rg%pfloor(q) = dv%p*model%dev(d)%mu
+      end do
+   end subroutine vary_normal_force
 
    !> The elements at each node 1..n (node 0, the table, left out) of those with use: the
    !> elements at node m are list(first(m) : first(m + 1) - 1); one entry when both ends
@@ -438,7 +493,7 @@ contains
       if (.not. (rg%drift(q)*t_mem > ringing_phase_gate)) return
       amp = sqrt(2.0_dp*rg%stats(stat_sd2, d)/t)*rg%k(q)/rg%omega(q)
       margin = max(rg%pmu(q) - rg%stats(stat_fmax, d), 0.0_dp)
-      ratio = amp/max(margin, ringing_floor*rg%pmu(q))
+      ratio = amp/max(margin, ringing_floor*rg%pfloor(q))
       if (ratio > res%stick_ringing_ratio(d)) then
          res%stick_ringing_ratio(d) = ratio
          res%stick_ringing(d) = amp
