@@ -1,9 +1,11 @@
 """&matrices at scale: a general linear structure of 1000 to 5000 DOFs from Matrix Market
-files, with 200 friction devices, under Newmark with each regularized law.
+files, with 200 friction devices, under Newmark with each regularized law, and under
+Moreau-Jean with Coulomb's law (law `coulomb`).
 
     .venv/bin/python bench/matrix_scale.py                      # towers of 1080 to 5022 DOFs (about 15 min)
     .venv/bin/python bench/matrix_scale.py --family tower --storeys 20,40
     .venv/bin/python bench/matrix_scale.py --family plan --plans 4,6 --laws hysteretic
+    .venv/bin/python bench/matrix_scale.py --laws coulomb --linear-system dense   # Moreau-Jean's dense form
 
 The structure is a 3D reinforced-concrete frame: nx x ny columns 6 m apart, storeys of
 3.5 m, columns fixed at the base, beams along x and y at every floor, each member a 3D
@@ -27,7 +29,10 @@ run (0.02 s, 20 dt1 steps) less its Newmark steps at that time per step. Process
 + system of the child): the machine may be shared. For each law the exponent p of time per
 step ~ nnz(K)^p is fitted (least squares in logarithms) over the sizes; the phase changes'
 cost is counted as the banded factor's rank-one updates and partial refactorizations per
-dt1 step (the summary's factor_updates, partial_factorizations). Writes
+dt1 step (the summary's factor_updates, partial_factorizations). Law `coulomb` runs
+technique = 'moreau_jean' (theta = 1/2, a step of dt1, its one-step problem in the form
+--linear-system chooses: 'auto', banded at this size, or 'dense'); its "Newmark steps" are
+its steps. Writes
 <out>/matrix_scale.json and prints the command and the table. Nothing here asserts a speed.
 """
 
@@ -159,13 +164,16 @@ def make_case(work: Path, family: str, nx: int, ny: int, nz: int) -> dict:
     return {"dir": d, "n": n, "nnz": len(ent) + off, "node_i": ni, "node_j": nj}
 
 
-def write_deck(case: dict, law: str, duration: float) -> Path:
+def write_deck(case: dict, law: str, duration: float, linear_system: str = "auto") -> Path:
     n = case["n"]
     infl = ["1.0" if i % 6 == 0 else "0.0" for i in range(n)]
     labels = [f"'n{i // 6 + 1} {('ux', 'uy', 'uz', 'rx', 'ry', 'rz')[i % 6]}'" for i in range(n)]
     nd = len(case["node_i"])
     extra = "eps = {0}".format(", ".join(["1.0e-3"] * nd)) if law == "velocity" else \
         "f = {0}".format(", ".join(["1.0e-4"] * nd))
+    technique = "newmark"
+    if law == "coulomb":
+        extra, technique = "", "moreau_jean"
     text = f"""&matrices
   k_file = 'K.mtx', m_file = 'M.mtx'
   influence = {", ".join(infl)}
@@ -187,7 +195,7 @@ def write_deck(case: dict, law: str, duration: float) -> Path:
   excitation_type = 'harmonic', amplitude = 0.05, frequency = 1.0, dt_record = 0.01, duration = {duration!r}
 /
 &integration
-  n1 = 10
+  n1 = 10, technique = '{technique}', linear_system = '{linear_system}'
 /
 &output
   dir = 'out', name = '{law}_{duration:g}', write_history = .false., n_modes = 0
@@ -231,10 +239,10 @@ def newmark_steps(st: dict) -> int:
     return sum(int(st.get(k, 0)) for k in ("steps_dt1", "steps_dt2", "steps_finer", "steps_nested", "steps_implicit"))
 
 
-def measure(case: dict, law: str, durations: tuple[float, float]) -> dict:
+def measure(case: dict, law: str, durations: tuple[float, float], linear_system: str = "auto") -> dict:
     rows = []
     for dur in durations:
-        r = run(write_deck(case, law, dur))
+        r = run(write_deck(case, law, dur, linear_system))
         st = r["summary"]
         newmark = newmark_steps(st)
         rows.append({"duration_s": dur, "cpu_s": r["cpu_s"], "wall_s": r["wall_s"], "vmhwm_mb": r["vmhwm_mb"],
@@ -248,7 +256,7 @@ def measure(case: dict, law: str, durations: tuple[float, float]) -> dict:
     per_dt1 = (b["cpu_s"] - a["cpu_s"]) / max(b["steps_dt1"] - a["steps_dt1"], 1)
     per_nm = (b["cpu_s"] - a["cpu_s"]) / max(b["newmark_steps"] - a["newmark_steps"], 1)
     # the set-up: a run of two record steps (20 dt1 steps, the motion still small), less them
-    short = run(write_deck(case, law, SETUP_DURATION))
+    short = run(write_deck(case, law, SETUP_DURATION, linear_system))
     setup = short["cpu_s"] - per_nm * newmark_steps(short["summary"])
     dsteps = max(b["steps_dt1"] - a["steps_dt1"], 1)
     return {"law": law, "n": case["n"], "nnz": case["nnz"], "runs": rows, "us_per_dt1_step": 1e6 * per_dt1,
@@ -270,7 +278,10 @@ def main() -> int:
     ap.add_argument("--family", choices=("tower", "plan", "both"), default="tower")
     ap.add_argument("--storeys", default="20,40,60,93", help="tower: storeys of the 3 x 3 plan (93: 5022 DOFs)")
     ap.add_argument("--plans", default="4,6,9", help="plan: nodes along a side of the 10-storey plan")
-    ap.add_argument("--laws", default="velocity,hysteretic")
+    ap.add_argument("--laws", default="velocity,hysteretic", help="velocity, hysteretic (Newmark), coulomb "
+                    "(Moreau-Jean)")
+    ap.add_argument("--linear-system", default="auto", choices=("auto", "dense", "banded"),
+                    help="&integration's linear_system")
     ap.add_argument("--durations", default="1,2", help="two durations [s]")
     ap.add_argument("--work", default=str(ROOT / "build" / "matrix_scale"))
     ap.add_argument("--out", default=None, help="directory of matrix_scale.json (default: --work)")
@@ -292,7 +303,7 @@ def main() -> int:
     for family, nx, ny, nz in shapes:
         case = make_case(work, family, nx, ny, nz)
         for law in args.laws.split(","):
-            r = measure(case, law, durations)
+            r = measure(case, law, durations, args.linear_system)
             r.update(family=family, plan=f"{nx}x{ny}", storeys=nz)
             results.append(r)
             a, b = r["runs"]

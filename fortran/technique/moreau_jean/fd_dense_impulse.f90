@@ -13,7 +13,14 @@
 !> (fd_lcp: Lemke, exact; its w is unique, and lambda too unless devices are redundant), and
 !> v1 = x - Z lambda. The acceleration at the end of a step (Coulomb's law at the level of
 !> accelerations, W = M) is the same problem with A_M = B' M^-1 B over the devices at rest,
-!> the sliding ones carrying sigma P mu. Memory: n^2 + 2 n nd + 2 nd^2 reals.
+!> the sliding ones carrying sigma P mu. Memory: n^2 + 2 n nd + 3 nd^2 reals.
+!>
+!> The banded form (`banded`, chosen by impulse_banded) holds no n x n matrix: K and the
+!> factor of W in fd_banded's band storage after reverse Cuthill-McKee (W = beta (K + alpha /
+!> beta M), the springs and K_x its graph), the directions as their sparse terms. A is formed
+!> from nd solves at set-up; a step is x = W^-1 r, the same box LCP, and v1 = W^-1 (r - B lambda)
+!> by a second solve (no n x nd Z). Memory O(n (kb + 1) + 3 nd^2 + terms); nothing allocates
+!> after set-up. The two forms agree to round-off.
 !>
 !> A model with planar bearings (devices that name a partner) takes the friction disc of
 !> each bearing in place of its components' intervals: the same problem with
@@ -24,20 +31,26 @@ module fd_dense_impulse
    use fd_kinds, only: dp
    use fd_error, only: error_type, fatal_error, fmt_int, fmt_real, stat_no_memory
    use fd_model, only: model_type
-   use fd_kinematics, only: add_device
+   use fd_kinematics, only: add_device, device_coupling
    use fd_matrices, only: stiffness_matrix
    use fd_linalg, only: cholesky_factor, cholesky_solve
+   use fd_banded, only: spd_system, spd_setup, spd_factor, spd_solve, spd_k_matvec, spd_banded, spd_bandwidth
+   use fd_names, only: linear_system_dense, linear_system_banded
    use fd_lcp, only: lcp_work, lcp_info, lcp_init, box_lcp_solve, lcp_solved, lcp_status_text
    use fd_disc_solver, only: disc_gauss_seidel, disc_ok, disc_unconverged
    implicit none
    private
 
    public :: dense_impulse, dense_setup, dense_factor, dense_solve, dense_acceleration, dense_k_times
+   public :: impulse_banded, impulse_bandwidth, banded_min_dofs
 
    real(dp), parameter :: tol_rel = 1.0e-10_dp    !! a relative velocity is 0 below this share of its terms
    real(dp), parameter :: tol_sweep = 1.0e-13_dp  !! bearings: the sweeps stop below this change of an
                                                   !! impulse (force), relative to the largest bound
    integer, parameter :: max_sweeps = 20000       !! bearings: the sweeps' cap (an error beyond)
+   !> Fewest DOFs for which linear_system = 'auto' takes the banded form: the measured crossover
+   !> of a step's cost (bench/moreau_jean_scale.py; docs/theory.md, section 12.6).
+   integer, parameter :: banded_min_dofs = 12
 
    !> The structure's dense matrices, the devices' directions and the factored step system.
    type :: dense_impulse
@@ -62,19 +75,51 @@ module fd_dense_impulse
       real(dp), allocatable :: gsub(:)               !! (nd) bounds of a sub-problem
       integer :: sweeps = 0                          !! bearings: Gauss-Seidel sweeps made
       integer :: factorizations = 0                  !! factorizations of W
+      logical :: banded = .false.                    !! the banded form: no k, b, wf, z
+      type(spd_system) :: sys                        !! banded form: K and the factor of K + c0 M
+      real(dp) :: alpha = 1.0_dp, beta = 0.0_dp      !! banded form: W = alpha M + beta K
+      integer, allocatable :: bptr(:), bdof(:)       !! banded form: the directions' terms
+      real(dp), allocatable :: bcoef(:)              !!   (model%dev_ptr, dev_dof, dev_coef)
+      real(dp), allocatable :: y(:)                  !! (n) banded form: work
       integer :: lcp_solves = 0                      !! box LCPs solved (with bearings: the problems
                                                      !! solved by block Gauss-Seidel)
    end type dense_impulse
 
 contains
 
-   !> The dense matrices of a model: K with its K_x, the directions B, and A_M = B' M^-1 B.
-   subroutine dense_setup(di, model, error)
+   !> Whether a model of n DOFs takes the banded form under &integration's linear_system:
+   !> 'dense' never, 'banded' always, 'auto' from banded_min_dofs DOFs on.
+   pure logical function impulse_banded(n, linear_system) result(banded)
+      integer, intent(in) :: n                      !! DOFs
+      integer, intent(in) :: linear_system          !! fd_names' linear_system_*
+
+      banded = linear_system == linear_system_banded
+      if (linear_system /= linear_system_dense .and. linear_system /= linear_system_banded) &
+         banded = n >= banded_min_dofs
+   end function impulse_banded
+
+   !> The half-bandwidth of the banded form's W after ordering (-1 for the dense form).
+   integer function impulse_bandwidth(di) result(kb)
+      type(dense_impulse), intent(in) :: di         !! the solver (set up)
+
+      kb = -1
+      if (di%banded) kb = spd_bandwidth(di%sys)
+   end function impulse_bandwidth
+
+   !> The matrices of a model: K with its K_x, the directions B, and A_M = B' M^-1 B; dense,
+   !> or in the banded form when banded is given and true.
+   subroutine dense_setup(di, model, error, banded)
       type(dense_impulse), intent(out) :: di        !! the solver
       type(model_type), intent(in) :: model         !! the model
       type(error_type), allocatable, intent(out) :: error !! not enough memory
+      logical, intent(in), optional :: banded       !! the banded form (default: dense)
       integer :: n, nd, d, e, stat
 
+      if (present(banded)) di%banded = banded
+      if (di%banded) then
+         call banded_setup(di, model, error)
+         return
+      end if
       n = model%n_dof
       nd = model%n_devices
       di%n = n
@@ -105,6 +150,109 @@ contains
       if (nd > 0) call lcp_init(di%lcp, nd, nd, error)
    end subroutine dense_setup
 
+   !> dense_setup's banded form: K (springs and K_x) in fd_banded's band storage, ordered by
+   !> reverse Cuthill-McKee over its own graph (the devices do not enter W), the directions'
+   !> sparse terms, A_M from them.
+   subroutine banded_setup(di, model, error)
+      type(dense_impulse), intent(inout) :: di      !! the solver (banded set)
+      type(model_type), intent(in) :: model         !! the model
+      type(error_type), allocatable, intent(out) :: error !! not enough memory
+      integer, allocatable :: none(:)
+      real(dp), allocatable :: no_coef(:)
+      integer :: n, nd, d, e, stat
+
+      n = model%n_dof
+      nd = model%n_devices
+      di%n = n
+      di%nd = nd
+      allocate (di%mass(n), di%a(nd, nd), di%am(nd, nd), di%x(n), di%y(n), di%q(nd), di%lo(nd), di%hi(nd), &
+                di%zz(nd), di%ww(nd), di%sub(nd, nd), di%idx(nd), di%partner(nd), di%psub(nd), di%pos(nd), &
+                di%lam0(nd), di%f0(nd), di%gsub(nd), di%bptr(nd + 1), di%bdof(model%dev_ptr(nd + 1) - 1), &
+                di%bcoef(model%dev_ptr(nd + 1) - 1), none(0), no_coef(0), stat=stat)
+      if (stat /= 0) then
+         call fatal_error(error, "not enough memory for the banded Moreau-Jean system of "//trim(fmt_int(n))// &
+                          " DOFs and "//trim(fmt_int(nd))//" devices", stat_no_memory)
+         return
+      end if
+      di%mass = model%mass
+      di%bptr = model%dev_ptr(1:nd + 1)
+      di%bdof = model%dev_dof(1:size(di%bdof))
+      di%bcoef = model%dev_coef(1:size(di%bcoef))
+      call spd_setup(di%sys, model%mass, model%spring_i, model%spring_j, model%spring_k, [1], none, no_coef, &
+                     error, path=spd_banded, kx_i=model%kx_i, kx_j=model%kx_j, kx_v=model%kx_v)
+      if (allocated(error)) return
+      do d = 1, nd
+         di%partner(d) = model%dev(d)%partner
+      end do
+      di%planar = any(di%partner > 0)
+      di%lam0 = 0.0_dp
+      di%f0 = 0.0_dp
+      do e = 1, nd
+         do d = 1, nd
+            di%am(d, e) = device_coupling(model, d, e)
+         end do
+      end do
+      if (nd > 0) call lcp_init(di%lcp, nd, nd, error)
+   end subroutine banded_setup
+
+   !> b_d' x.
+   pure real(dp) function b_dot(di, d, x) result(s)
+      type(dense_impulse), intent(in) :: di         !! the solver
+      integer, intent(in) :: d                      !! device
+      real(dp), intent(in) :: x(:)                  !! (n)
+      integer :: k
+
+      if (.not. di%banded) then
+         s = dot_product(di%b(:, d), x)
+         return
+      end if
+      s = 0.0_dp
+      do k = di%bptr(d), di%bptr(d + 1) - 1
+         s = s + di%bcoef(k)*x(di%bdof(k))
+      end do
+   end function b_dot
+
+   !> x = x - b_d f, or x = x - b_d f / m (each DOF's mass) when per_mass.
+   pure subroutine b_sub(di, d, f, x, per_mass)
+      type(dense_impulse), intent(in) :: di         !! the solver
+      integer, intent(in) :: d                      !! device
+      real(dp), intent(in) :: f                     !! factor
+      real(dp), intent(inout) :: x(:)               !! (n)
+      logical, intent(in) :: per_mass               !! divide by the masses
+      integer :: k, i
+
+      if (.not. di%banded) then
+         if (per_mass) then
+            x = x - di%b(:, d)*(f/di%mass)
+         else
+            x = x - di%b(:, d)*f
+         end if
+         return
+      end if
+      do k = di%bptr(d), di%bptr(d + 1) - 1
+         i = di%bdof(k)
+         if (per_mass) then
+            x(i) = x(i) - di%bcoef(k)*(f/di%mass(i))
+         else
+            x(i) = x(i) - di%bcoef(k)*f
+         end if
+      end do
+   end subroutine b_sub
+
+   !> x = W^-1 x in the banded form: beta (K + alpha / beta M) factored, or alpha M alone.
+   subroutine w_solve(di, x, error)
+      type(dense_impulse), intent(inout) :: di      !! the solver (banded, factored)
+      real(dp), intent(inout), contiguous :: x(:)   !! (n) right-hand side, then solution
+      type(error_type), allocatable, intent(out) :: error !! not factored
+
+      if (di%beta > 0.0_dp) then
+         call spd_solve(di%sys, x, error)
+         x = x/di%beta
+      else
+         x = x/(di%alpha*di%mass)
+      end if
+   end subroutine w_solve
+
    !> Factor W = alpha M + beta K and form Z = W^-1 B and A = B' Z.
    subroutine dense_factor(di, alpha, beta, error)
       type(dense_impulse), intent(inout) :: di      !! the solver
@@ -112,6 +260,10 @@ contains
       type(error_type), allocatable, intent(out) :: error !! W not positive definite
       integer :: i, d, info
 
+      if (di%banded) then
+         call banded_factor(di, alpha, beta, error)
+         return
+      end if
       di%wf = beta*di%k
       do i = 1, di%n
          di%wf(i, i) = di%wf(i, i) + alpha*di%mass(i)
@@ -131,15 +283,51 @@ contains
       di%a = 0.5_dp*(di%a + transpose(di%a))
    end subroutine dense_factor
 
+   !> dense_factor's banded form: K + (alpha / beta) M factored in band storage (W / beta),
+   !> A = B' W^-1 B from nd solves, one device's direction at a time.
+   subroutine banded_factor(di, alpha, beta, error)
+      type(dense_impulse), intent(inout) :: di      !! the solver
+      real(dp), intent(in) :: alpha, beta           !! W = alpha M + beta K (alpha > 0, beta >= 0)
+      type(error_type), allocatable, intent(out) :: error !! W not positive definite
+      real(dp) :: no_kd(0)
+      integer :: d, e
+
+      di%alpha = alpha
+      di%beta = beta
+      if (beta > 0.0_dp) then
+         call spd_factor(di%sys, alpha/beta, 0.0_dp, no_kd, error)
+         if (allocated(error)) then
+            error%message = "the Moreau-Jean step matrix M + h theta C + (h theta)^2 K is not positive definite: "// &
+                            trim(error%message)
+            return
+         end if
+      end if
+      di%factorizations = di%factorizations + 1
+      do d = 1, di%nd
+         di%y = 0.0_dp
+         call b_sub(di, d, -1.0_dp, di%y, .false.)
+         call w_solve(di, di%y, error)
+         if (allocated(error)) return
+         do e = 1, di%nd
+            di%a(e, d) = b_dot(di, e, di%y)
+         end do
+      end do
+      di%a = 0.5_dp*(di%a + transpose(di%a))
+   end subroutine banded_factor
+
    !> y = alpha K x + beta y.
-   pure subroutine dense_k_times(di, x, y, alpha, beta)
-      type(dense_impulse), intent(in) :: di         !! the solver
-      real(dp), intent(in) :: x(:)                  !! (n)
-      real(dp), intent(inout) :: y(:)               !! (n)
+   subroutine dense_k_times(di, x, y, alpha, beta)
+      type(dense_impulse), intent(inout) :: di      !! the solver
+      real(dp), intent(in), contiguous :: x(:)      !! (n)
+      real(dp), intent(inout), contiguous :: y(:)   !! (n)
       real(dp), intent(in) :: alpha, beta           !! factors
       integer :: i, j
       real(dp) :: s
 
+      if (di%banded) then
+         call spd_k_matvec(di%sys, x, y, alpha, beta)
+         return
+      end if
       do i = 1, di%n
          s = 0.0_dp
          do j = 1, di%n
@@ -166,7 +354,12 @@ contains
 
       nd = di%nd
       di%x = r
-      call cholesky_solve(di%wf, di%x)
+      if (di%banded) then
+         call w_solve(di, di%x, error)
+         if (allocated(error)) return
+      else
+         call cholesky_solve(di%wf, di%x)
+      end if
       v1 = di%x
       lam = 0.0_dp
       w = 0.0_dp
@@ -175,25 +368,23 @@ contains
       if (di%planar) then
          call planar_solve(di, g, lam, error)
          if (allocated(error)) return
-         do d = 1, nd
-            v1 = v1 - di%z(:, d)*lam(d)
-         end do
+         call impulses_effect(di, r, lam, v1, error)
+         if (allocated(error)) return
          call planar_statuses(di, v1, lam, w, sigma)
          return
       end if
       do d = 1, nd
-         di%q(d) = -dot_product(di%b(:, d), di%x)
+         di%q(d) = -b_dot(di, d, di%x)
          di%lo(d) = -g(d)
          di%hi(d) = g(d)
       end do
       call lcp_step(di, di%a, nd, error)
       if (allocated(error)) return
       lam = di%zz(1:nd)
+      call impulses_effect(di, r, lam, v1, error)
+      if (allocated(error)) return
       do d = 1, nd
-         v1 = v1 - di%z(:, d)*lam(d)
-      end do
-      do d = 1, nd
-         w(d) = dot_product(di%b(:, d), v1)
+         w(d) = b_dot(di, d, v1)
          sc = abs(di%q(d))
          do e = 1, nd
             sc = sc + abs(di%a(d, e)*lam(e))
@@ -201,6 +392,30 @@ contains
          if (abs(w(d)) > tol_rel*sc) sigma(d) = merge(1, -1, w(d) > 0.0_dp)
       end do
    end subroutine dense_solve
+
+   !> v1 = W^-1 (r - B lam): x - Z lam in the dense form (v1 = x on entry), a second solve in
+   !> the banded form.
+   subroutine impulses_effect(di, r, lam, v1, error)
+      type(dense_impulse), intent(inout) :: di      !! the solver, factored
+      real(dp), intent(in) :: r(:)                  !! (n) right-hand side
+      real(dp), intent(in) :: lam(:)                !! (nd) impulses
+      real(dp), intent(inout) :: v1(:)              !! (n) W^-1 r on entry, end velocities on exit
+      type(error_type), allocatable, intent(out) :: error !! not factored
+      integer :: d
+
+      if (.not. di%banded) then
+         do d = 1, di%nd
+            v1 = v1 - di%z(:, d)*lam(d)
+         end do
+         return
+      end if
+      di%y = r
+      do d = 1, di%nd
+         call b_sub(di, d, lam(d), di%y, .false.)
+      end do
+      call w_solve(di, di%y, error)
+      v1 = di%y
+   end subroutine impulses_effect
 
    !> The box LCP -w = a z + q over the first m entries of di%q, di%lo, di%hi: z in
    !> di%zz(1:m) on return.
@@ -249,7 +464,7 @@ contains
          sa(d) = sigma(d)
          if (sigma(d) /= 0) then
             force(d) = sigma(d)*pmu(d)
-            di%x = di%x - di%b(:, d)*force(d)
+            call b_sub(di, d, force(d), di%x, .false.)
          else
             m = m + 1
             di%idx(m) = d
@@ -259,7 +474,7 @@ contains
       if (m > 0) then
          do a = 1, m
             d = di%idx(a)
-            di%q(a) = -dot_product(di%b(:, d), acc)
+            di%q(a) = -b_dot(di, d, acc)
             di%lo(a) = -pmu(d)
             di%hi(a) = pmu(d)
             do b = 1, m
@@ -271,11 +486,11 @@ contains
          do a = 1, m
             d = di%idx(a)
             force(d) = di%zz(a)
-            acc = acc - di%b(:, d)*(force(d)/di%mass)
+            call b_sub(di, d, force(d), acc, .true.)
          end do
          do a = 1, m
             d = di%idx(a)
-            x = dot_product(di%b(:, d), acc)
+            x = b_dot(di, d, acc)
             sc = abs(di%q(a))
             do e = 1, m
                sc = sc + abs(di%sub(a, e)*force(di%idx(e)))
@@ -295,7 +510,7 @@ contains
       integer :: d
 
       do d = 1, di%nd
-         di%q(d) = dot_product(di%b(:, d), di%x)
+         di%q(d) = b_dot(di, d, di%x)
       end do
       lam = di%lam0
       call sweeps_solve(di, di%a, di%nd, g, di%partner, lam, error)
@@ -345,7 +560,7 @@ contains
       real(dp) :: sc
 
       do d = 1, di%nd
-         w(d) = dot_product(di%b(:, d), v1)
+         w(d) = b_dot(di, d, v1)
          di%zz(d) = abs(di%q(d))
          do e = 1, di%nd
             di%zz(d) = di%zz(d) + abs(di%a(d, e)*lam(e))
@@ -389,7 +604,7 @@ contains
          if (sliding) then
             force(d) = sigma(d)*pmu(d)
             if (p > 0) force(d) = pmu(d)*(wend(d)/hypot(wend(d), wend(p)))
-            di%x = di%x - di%b(:, d)*force(d)
+            call b_sub(di, d, force(d), di%x, .false.)
          else
             m = m + 1
             di%idx(m) = d
@@ -400,7 +615,7 @@ contains
       if (m == 0) return
       do a = 1, m
          d = di%idx(a)
-         di%q(a) = dot_product(di%b(:, d), acc)
+         di%q(a) = b_dot(di, d, acc)
          di%gsub(a) = pmu(d)
          di%psub(a) = 0
          if (di%partner(d) > 0) di%psub(a) = di%pos(di%partner(d))
@@ -415,7 +630,7 @@ contains
          d = di%idx(a)
          force(d) = di%zz(a)
          di%f0(d) = force(d)
-         acc = acc - di%b(:, d)*(force(d)/di%mass)
+         call b_sub(di, d, force(d), acc, .true.)
       end do
       do a = 1, m
          d = di%idx(a)
@@ -427,7 +642,7 @@ contains
       end do
       do a = 1, m
          d = di%idx(a)
-         x = dot_product(di%b(:, d), acc)
+         x = b_dot(di, d, acc)
          sc = di%lo(a)
          if (di%psub(a) > 0) sc = max(sc, di%lo(di%psub(a)))
          if (abs(x) > tol_rel*sc) sa(d) = merge(1, -1, x > 0.0_dp)

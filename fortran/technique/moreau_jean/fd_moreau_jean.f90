@@ -46,7 +46,7 @@ module fd_moreau_jean
    use fd_group_system, only: gs_k_matvec, gs_k_absmatvec, gs_lowest_eigenvalue
    use fd_impulse_solver, only: impulse_solver, solver_setup, solve_impulses, predict_pattern, pattern_acceleration
    use fd_dense_impulse, only: dense_impulse, dense_setup, dense_factor, dense_solve, dense_acceleration, &
-                               dense_k_times
+                               dense_k_times, impulse_banded
    implicit none
    private
 
@@ -59,6 +59,7 @@ module fd_moreau_jean
       type(impulse_solver) :: p                           !! the one-step solver (devices between nodes)
       type(dense_impulse) :: di                           !! the dense one-step solver (any device, K_x)
       logical :: general = .false.                        !! the dense form is used
+      integer :: linear_system = 0                        !! &integration's: dense form's storage
       real(dp), allocatable :: mr(:)                      !! (n) M r, r the table motion's direction
       ! a second horizontal component (dense form): its motion and M r2 (two = .false.: none)
       logical :: two = .false.
@@ -186,6 +187,7 @@ contains
       call system_clock(c0, crate)
       call moreau_jean_check(model, exc, opts, error)
       if (allocated(error)) return
+      w%linear_system = opts%linear_system
       call setup(model, w, res, error)
       if (allocated(error)) return
       if (present(exc2)) then
@@ -405,7 +407,7 @@ contains
 
       n = w%n
       nd = w%nd
-      call dense_setup(w%di, model, error)
+      call dense_setup(w%di, model, error, impulse_banded(n, w%linear_system))
       if (allocated(error)) return
       call structure_damping(model, w%a0, w%a1, res%moreau_jean%setup%period_stuck, &
                              res%moreau_jean%setup%xi_stuck, error)
