@@ -116,17 +116,23 @@ contains
    end function sparse_available
 
    !> Half-bandwidth of K^'s graph in reverse Cuthill-McKee ordering (fd_banded's own band).
-   function sparse_band(n, spring_i, spring_j, dev_ptr, dev_dof, kx_i, kx_j, dashpot_i, dashpot_j) result(kb)
+   function sparse_band(n, spring_i, spring_j, dev_ptr, dev_dof, dashpot_i, dashpot_j, kx_i, kx_j) result(kb)
       integer, intent(in) :: n                   !! DOFs
       integer, intent(in) :: spring_i(:), spring_j(:) !! springs' nodes (0 = table)
       integer, intent(in) :: dev_ptr(:), dev_dof(:)   !! devices' terms
-      integer, intent(in) :: kx_i(:), kx_j(:)         !! K_x's entries
       integer, intent(in) :: dashpot_i(:), dashpot_j(:) !! dashpots' nodes
+      integer, intent(in), optional :: kx_i(:), kx_j(:) !! K_x's entries (none: not present)
       integer :: kb                              !! half-bandwidth
-      integer, allocatable :: ei(:), ej(:), perm(:), inv(:)
+      integer, allocatable :: ei(:), ej(:), perm(:), inv(:), xi(:), xj(:)
       integer :: ne, d, p, q, i
 
-      call edges(spring_i, spring_j, dev_ptr, dev_dof, kx_i, kx_j, dashpot_i, dashpot_j, ei, ej, ne)
+      if (present(kx_i) .and. present(kx_j)) then
+         xi = kx_i
+         xj = kx_j
+      else
+         allocate (xi(0), xj(0))
+      end if
+      call edges(spring_i, spring_j, dev_ptr, dev_dof, xi, xj, dashpot_i, dashpot_j, ei, ej, ne)
       allocate (perm(n), inv(n))
       call rcm_order(n, ei(1:ne), ej(1:ne), perm)
       do i = 1, n
@@ -186,7 +192,7 @@ contains
    !> Set up the system: K^'s pattern and its analysis by CHOLMOD, K and C on it. The input is
    !> fd_banded's spd_setup's, checked there (the caller sets that up or has checked it).
    subroutine sparse_setup(sys, mass, spring_i, spring_j, spring_k, dev_ptr, dev_dof, dev_coef, a0, a1, &
-                           dashpot_i, dashpot_j, dashpot_c, kx_i, kx_j, kx_v, error)
+                           dashpot_i, dashpot_j, dashpot_c, error, kx_i, kx_j, kx_v)
       type(sparse_system), intent(inout) :: sys  !! the system (freed first)
       real(dp), intent(in) :: mass(:)            !! masses [kg]
       integer, intent(in) :: spring_i(:), spring_j(:) !! springs' nodes (0 = table)
@@ -196,10 +202,11 @@ contains
       real(dp), intent(in) :: a0, a1             !! C = a0 M + a1 K + dashpots
       integer, intent(in) :: dashpot_i(:), dashpot_j(:) !! dashpots' nodes
       real(dp), intent(in) :: dashpot_c(:)       !! their coefficients [N s/m]
-      integer, intent(in) :: kx_i(:), kx_j(:)    !! K_x's entries (row <= column)
-      real(dp), intent(in) :: kx_v(:)            !! their values [N/m]
       type(error_type), allocatable, intent(out) :: error !! no CHOLMOD, no memory
-      integer, allocatable :: ei(:), ej(:)
+      integer, intent(in), optional :: kx_i(:), kx_j(:) !! K_x's entries (row <= column; none: not present)
+      real(dp), intent(in), optional :: kx_v(:)  !! their values [N/m]
+      integer, allocatable :: ei(:), ej(:), xi(:), xj(:)
+      real(dp), allocatable :: xv(:)
       integer :: n, nd, ne, st, i, k, d, p, q, np
       real(dp) :: lnz, fl
 
@@ -209,11 +216,18 @@ contains
                           &or rebuild with SuiteSparse's CHOLMOD (libsuitesparse-dev)")
          return
       end if
+      if (present(kx_i) .and. present(kx_j) .and. present(kx_v)) then
+         xi = kx_i
+         xj = kx_j
+         xv = kx_v
+      else
+         allocate (xi(0), xj(0), xv(0))
+      end if
       n = size(mass)
       nd = size(dev_ptr) - 1
       sys%n = n
       sys%nd = nd
-      call edges(spring_i, spring_j, dev_ptr, dev_dof, kx_i, kx_j, dashpot_i, dashpot_j, ei, ej, ne)
+      call edges(spring_i, spring_j, dev_ptr, dev_dof, xi, xj, dashpot_i, dashpot_j, ei, ej, ne)
       call pattern(n, ei(1:ne), ej(1:ne), sys%colptr, sys%rowind, sys%diag)
       np = size(sys%rowind)
       allocate (sys%kv(np), sys%cv(np), sys%av(np), sys%mass(n), sys%kd0(nd), sys%slot(nd), stat=st)
@@ -231,9 +245,9 @@ contains
       do k = 1, size(spring_i)
          call add_link(sys, sys%kv, spring_i(k), spring_j(k), spring_k(k))
       end do
-      do k = 1, size(kx_i)
-         i = position(sys, min(kx_i(k), kx_j(k)), max(kx_i(k), kx_j(k)))
-         sys%kv(i) = sys%kv(i) + kx_v(k)
+      do k = 1, size(xi)
+         i = position(sys, min(xi(k), xj(k)), max(xi(k), xj(k)))
+         sys%kv(i) = sys%kv(i) + xv(k)
       end do
       sys%cv = a1*sys%kv
       do i = 1, n

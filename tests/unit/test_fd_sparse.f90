@@ -155,7 +155,7 @@ contains
       end if
       call grid(g)
       call sparse_setup(sys, g%mass, g%si, g%sj, g%sk, g%ptr, g%dof, g%coef, a0, a1, none, none, [real(dp) ::], &
-                        g%kxi, g%kxj, g%kxv, lerr)
+                        lerr, g%kxi, g%kxj, g%kxv)
       call check(error, .not. allocated(lerr), "sparse_setup")
    end subroutine setup
 
@@ -376,7 +376,7 @@ contains
       g%kxj = [g%kxj, 40]
       g%kxv = [g%kxv, -1.0e12_dp]
       call sparse_setup(sys, g%mass, g%si, g%sj, g%sk, g%ptr, g%dof, g%coef, a0, a1, none, none, [real(dp) ::], &
-                        g%kxi, g%kxj, g%kxv, lerr)
+                        lerr, g%kxi, g%kxj, g%kxv)
       call check(error, .not. allocated(lerr), "sparse_setup")
       if (allocated(error)) return
       kd = 0.0_dp
@@ -394,7 +394,7 @@ contains
       integer :: none(0), kb
 
       call grid(g)
-      kb = sparse_band(n, g%si, g%sj, [1], none, none, none, none, none)
+      kb = sparse_band(n, g%si, g%sj, [1], none, none, none)
       call check(error, kb >= m - 1 .and. kb <= m + 1, "band of the grid")
    end subroutine test_band
 
@@ -411,7 +411,7 @@ contains
       end if
       call grid(g)
       call sparse_setup(sys, g%mass, g%si, g%sj, g%sk, g%ptr, g%dof, g%coef, a0, a1, none, none, [real(dp) ::], &
-                        g%kxi, g%kxj, g%kxv, lerr)
+                        lerr, g%kxi, g%kxj, g%kxv)
       call check(error, allocated(lerr), "set-up without CHOLMOD")
       if (.not. allocated(error)) call check(error, index(lerr%message, "no sparse solver (CHOLMOD)") > 0, &
                                              lerr%message)
