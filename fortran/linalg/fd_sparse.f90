@@ -14,6 +14,7 @@ module fd_sparse
    use, intrinsic :: iso_c_binding, only: c_int, c_double, c_ptr, c_null_ptr, c_associated, c_long
    use fd_kinds, only: dp
    use fd_error, only: error_type, fatal_error, fmt_int, stat_no_memory
+   use fd_lapack, only: dgetrf, dgetrs  ! the capacitance matrix's LU (not positive definite)
    use fd_rcm, only: rcm_order, graph_bandwidth
    implicit none
    private
@@ -28,22 +29,6 @@ module fd_sparse
    integer, parameter :: changed_cap = 64
 
    interface
-      ! LAPACK's LU of the capacitance matrix (not symmetric positive definite: a device whose
-      ! stiffness shrank gives a negative term)
-      subroutine dgetrf(m, n, a, lda, ipiv, info)
-         import :: dp
-         integer, intent(in) :: m, n, lda
-         real(dp), intent(inout) :: a(lda, *)
-         integer, intent(out) :: ipiv(*), info
-      end subroutine dgetrf
-      subroutine dgetrs(trans, n, nrhs, a, lda, ipiv, b, ldb, info)
-         import :: dp
-         character(len=1), intent(in) :: trans
-         integer, intent(in) :: n, nrhs, lda, ldb, ipiv(*)
-         real(dp), intent(in) :: a(lda, *)
-         real(dp), intent(inout) :: b(ldb, *)
-         integer, intent(out) :: info
-      end subroutine dgetrs
       integer(c_int) function fd_chol_available() bind(c)
          import :: c_int
       end function fd_chol_available
