@@ -390,6 +390,10 @@ contains
       integer :: i, d, p, q, k
       integer(c_int) :: st, col
 
+      if (.not. c_associated(sys%h)) then
+         call fatal_error(error, "sparse_factor: the system is not set up (sparse_setup)")
+         return
+      end if
       sys%c0 = c0
       sys%c1 = c1
       sys%av = sys%kv + c1*sys%cv
@@ -619,11 +623,12 @@ contains
       if (c_associated(sys%h)) sparse_allocations = int(fd_chol_allocations(sys%h))
    end function sparse_allocations
 
-   !> Free CHOLMOD's part of the system (the rest is Fortran's).
+   !> Free the system: CHOLMOD's part and every array (it may be set up again).
    subroutine sparse_free(sys)
       type(sparse_system), intent(inout) :: sys  !! the system
+      type(sparse_system) :: empty
       if (c_associated(sys%h)) call fd_chol_free(sys%h)
-      sys%h = c_null_ptr
+      sys = empty
    end subroutine sparse_free
 
    !> An error of the interface, as text.

@@ -201,6 +201,14 @@ contains
       if (.not. allocated(error)) call solve_error(g, sys, kd, err, error)
       if (.not. allocated(error)) call check(error, err < 1.0e-13_dp, "relative error above 1e-13")
       if (.not. allocated(error)) call check(error, sparse_factor_entries(sys) > real(n, dp), "factor entries")
+      if (allocated(error)) return
+      ! a system set up again starts afresh (its arrays and CHOLMOD's handle replaced)
+      call setup(g, sys, error)
+      if (allocated(error)) return
+      call sparse_factor(sys, c0, c1, kd, lerr)
+      call check(error, .not. allocated(lerr), "sparse_factor after a second set-up")
+      if (.not. allocated(error)) call solve_error(g, sys, kd, err, error)
+      if (.not. allocated(error)) call check(error, err < 1.0e-13_dp, "relative error above 1e-13")
       call sparse_free(sys)
    end subroutine test_solve
 
