@@ -5,7 +5,9 @@ Moreau-Jean with Coulomb's law (law `coulomb`).
     .venv/bin/python bench/matrix_scale.py                      # towers of 1080 to 5022 DOFs (about 15 min)
     .venv/bin/python bench/matrix_scale.py --family tower --storeys 20,40
     .venv/bin/python bench/matrix_scale.py --family plan --plans 4,6 --laws hysteretic
-    .venv/bin/python bench/matrix_scale.py --laws coulomb --linear-system dense   # Moreau-Jean's dense form
+    .venv/bin/python bench/matrix_scale.py --laws coulomb --solvers dense   # Moreau-Jean's dense form
+    .venv/bin/python bench/matrix_scale.py --family plan --plans 6,9 --solvers banded,sparse,auto \
+        --laws hysteretic --durations 0.05,0.1          # the band's and CHOLMOD's paths side by side
 
 The structure is a 3D reinforced-concrete frame: nx x ny columns 6 m apart, storeys of
 3.5 m, columns fixed at the base, beams along x and y at every floor, each member a 3D
@@ -29,9 +31,11 @@ run (0.02 s, 20 dt1 steps) less its Newmark steps at that time per step. Process
 + system of the child): the machine may be shared. For each law the exponent p of time per
 step ~ nnz(K)^p is fitted (least squares in logarithms) over the sizes; the phase changes'
 cost is counted as the banded factor's rank-one updates and partial refactorizations per
-dt1 step (the summary's factor_updates, partial_factorizations). Law `coulomb` runs
+dt1 step (the summary's factor_updates, partial_factorizations). With --solvers each case
+runs once per `linear_system` (dense, banded, sparse: SuiteSparse's CHOLMOD; auto: the choice
+the summary names), rows side by side. Law `coulomb` runs
 technique = 'moreau_jean' (theta = 1/2, a step of dt1, its one-step problem in the form
---linear-system chooses: 'auto', banded at this size, or 'dense'); its "Newmark steps" are
+--solvers chooses: 'auto', banded at this size, or 'dense'); its "Newmark steps" are
 its steps. Writes
 <out>/matrix_scale.json and prints the command and the table. Nothing here asserts a speed.
 """
@@ -50,7 +54,7 @@ import numpy as np
 
 HERE = Path(__file__).resolve().parent
 ROOT = HERE.parent
-EXE = ROOT / ".venv" / "bin" / "frictiondyn"
+EXE = Path(os.environ.get("FRICTIONDYN_EXE", ROOT / ".venv" / "bin" / "frictiondyn"))  # or another build's
 
 E, G = 30.0e9, 12.5e9                       # concrete [Pa]
 COLUMN = (0.36, 0.0108, 0.0108, 0.0182)     # 0.6 x 0.6 m: A, Iy, Iz, J
@@ -164,7 +168,7 @@ def make_case(work: Path, family: str, nx: int, ny: int, nz: int) -> dict:
     return {"dir": d, "n": n, "nnz": len(ent) + off, "node_i": ni, "node_j": nj}
 
 
-def write_deck(case: dict, law: str, duration: float, linear_system: str = "auto") -> Path:
+def write_deck(case: dict, law: str, duration: float, system: str = "auto") -> Path:
     n = case["n"]
     infl = ["1.0" if i % 6 == 0 else "0.0" for i in range(n)]
     labels = [f"'n{i // 6 + 1} {('ux', 'uy', 'uz', 'rx', 'ry', 'rz')[i % 6]}'" for i in range(n)]
@@ -195,13 +199,13 @@ def write_deck(case: dict, law: str, duration: float, linear_system: str = "auto
   excitation_type = 'harmonic', amplitude = 0.05, frequency = 1.0, dt_record = 0.01, duration = {duration!r}
 /
 &integration
-  n1 = 10, technique = '{technique}', linear_system = '{linear_system}'
+  n1 = 10, technique = '{technique}', linear_system = '{system}'
 /
 &output
-  dir = 'out', name = '{law}_{duration:g}', write_history = .false., n_modes = 0
+  dir = 'out', name = '{law}_{system}_{duration:g}', write_history = .false., n_modes = 0
 /
 """
-    path = case["dir"] / f"{law}_{duration:g}.nml"
+    path = case["dir"] / f"{law}_{system}_{duration:g}.nml"
     path.write_text(text)
     return path
 
@@ -239,10 +243,10 @@ def newmark_steps(st: dict) -> int:
     return sum(int(st.get(k, 0)) for k in ("steps_dt1", "steps_dt2", "steps_finer", "steps_nested", "steps_implicit"))
 
 
-def measure(case: dict, law: str, durations: tuple[float, float], linear_system: str = "auto") -> dict:
+def measure(case: dict, law: str, durations: tuple[float, float], system: str = "auto") -> dict:
     rows = []
     for dur in durations:
-        r = run(write_deck(case, law, dur, linear_system))
+        r = run(write_deck(case, law, dur, system))
         st = r["summary"]
         newmark = newmark_steps(st)
         rows.append({"duration_s": dur, "cpu_s": r["cpu_s"], "wall_s": r["wall_s"], "vmhwm_mb": r["vmhwm_mb"],
@@ -256,10 +260,10 @@ def measure(case: dict, law: str, durations: tuple[float, float], linear_system:
     per_dt1 = (b["cpu_s"] - a["cpu_s"]) / max(b["steps_dt1"] - a["steps_dt1"], 1)
     per_nm = (b["cpu_s"] - a["cpu_s"]) / max(b["newmark_steps"] - a["newmark_steps"], 1)
     # the set-up: a run of two record steps (20 dt1 steps, the motion still small), less them
-    short = run(write_deck(case, law, SETUP_DURATION, linear_system))
+    short = run(write_deck(case, law, SETUP_DURATION, system))
     setup = short["cpu_s"] - per_nm * newmark_steps(short["summary"])
     dsteps = max(b["steps_dt1"] - a["steps_dt1"], 1)
-    return {"law": law, "n": case["n"], "nnz": case["nnz"], "runs": rows, "us_per_dt1_step": 1e6 * per_dt1,
+    return {"law": law, "system": system, "n": case["n"], "nnz": case["nnz"], "runs": rows, "us_per_dt1_step": 1e6 * per_dt1,
             "us_per_newmark_step": 1e6 * per_nm, "setup_s": setup,
             "newmark_per_dt1": (b["newmark_steps"] - a["newmark_steps"]) / dsteps,
             "updates_per_dt1": ((b["factor_updates"] or 0) - (a["factor_updates"] or 0)) / dsteps,
@@ -280,8 +284,8 @@ def main() -> int:
     ap.add_argument("--plans", default="4,6,9", help="plan: nodes along a side of the 10-storey plan")
     ap.add_argument("--laws", default="velocity,hysteretic", help="velocity, hysteretic (Newmark), coulomb "
                     "(Moreau-Jean)")
-    ap.add_argument("--linear-system", default="auto", choices=("auto", "dense", "banded"),
-                    help="&integration's linear_system")
+    ap.add_argument("--solvers", default="auto",
+                    help="&integration's linear_system of each run: auto, dense, banded, sparse (comma list)")
     ap.add_argument("--durations", default="1,2", help="two durations [s]")
     ap.add_argument("--work", default=str(ROOT / "build" / "matrix_scale"))
     ap.add_argument("--out", default=None, help="directory of matrix_scale.json (default: --work)")
@@ -297,26 +301,27 @@ def main() -> int:
         shapes += [("plan", int(p), int(p), 10) for p in args.plans.split(",")]
     results = []
     print("command: " + " ".join([Path(sys.executable).name, "bench/matrix_scale.py"] + sys.argv[1:]), flush=True)
-    print(f"{'family':6s} {'plan':>5s} {'storeys':>7s} {'law':10s} {'DOFs':>5s} {'nnz(K)':>8s} {'band':>5s} "
+    print(f"{'family':6s} {'plan':>5s} {'storeys':>7s} {'law':10s} {'system':13s} {'DOFs':>5s} {'nnz(K)':>8s} {'band':>5s} "
           f"{'set-up s':>8s} {'us/dt1':>8s} {'us/NM':>8s} {'us/NM/nnz':>9s} "
           f"{'VmHWM MB (' + args.durations + ' s)':>20s} {'NM/dt1':>6s} {'upd/dt1':>7s} {'part/dt1':>8s}", flush=True)
     for family, nx, ny, nz in shapes:
         case = make_case(work, family, nx, ny, nz)
-        for law in args.laws.split(","):
-            r = measure(case, law, durations, args.linear_system)
+        for law, system in [(lw, sy) for lw in args.laws.split(",") for sy in args.solvers.split(",")]:
+            r = measure(case, law, durations, system)
             r.update(family=family, plan=f"{nx}x{ny}", storeys=nz)
             results.append(r)
             a, b = r["runs"]
-            print(f"{family:6s} {nx}x{ny:<3d} {nz:7d} {law:10s} {r['n']:5d} {r['nnz']:8d} {a['half_bandwidth']!s:>5s} "
+            took = f"{system}->{a['linear_system']}" if system == "auto" else system
+            print(f"{family:6s} {nx}x{ny:<3d} {nz:7d} {law:10s} {took:13s} {r['n']:5d} {r['nnz']:8d} {a['half_bandwidth']!s:>5s} "
                   f"{r['setup_s']:8.2f} {r['us_per_dt1_step']:8.0f} {r['us_per_newmark_step']:8.1f} "
                   f"{1e3 * r['us_per_newmark_step'] / r['nnz']:9.3f} {a['vmhwm_mb']:9.1f} {b['vmhwm_mb']:9.1f} "
                   f"{r['newmark_per_dt1']:6.1f} {r['updates_per_dt1']:7.1f} {r['partial_per_dt1']:8.2f}",
                   flush=True)
     for family in sorted({r["family"] for r in results}):
-        for law in args.laws.split(","):
-            rows = [r for r in results if r["family"] == family and r["law"] == law]
+        for law, system in [(lw, sy) for lw in args.laws.split(",") for sy in args.solvers.split(",")]:
+            rows = [r for r in results if r["family"] == family and r["law"] == law and r["system"] == system]
             if len(rows) > 1:
-                print(f"{family} {law}: time per step ~ nnz^p, p = {exponent(rows, 'us_per_newmark_step'):.2f} "
+                print(f"{family} {law} {system}: time per step ~ nnz^p, p = {exponent(rows, 'us_per_newmark_step'):.2f} "
                       f"(per Newmark step), {exponent(rows, 'us_per_dt1_step'):.2f} (per dt1 step), "
                       f"set-up {exponent(rows, 'setup_s'):.2f}, over nnz = "
                       f"{', '.join(str(r['nnz']) for r in rows)}", flush=True)

@@ -87,6 +87,11 @@ CASES = [
     ("more than 2e9 steps", _set("excitation", "duration", 4.0e7), ["&integration", "n1", "2e9"]),
     ("dt_min above dt2", _set("integration", "dt_min", 1.0), ["&integration", "dt_min", "= 1"]),
     (
+        "unknown linear_system",
+        _set("integration", "linear_system", "cholmod"),
+        ["&integration", "linear_system", "'cholmod'", "'banded'", "'sparse'"],
+    ),
+    (
         "unknown refinement",
         _set("integration", "refinement", "fine"),
         ["&integration", "refinement", "'fine'", "'step'", "'nested'"],

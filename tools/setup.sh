@@ -1,13 +1,14 @@
 #!/usr/bin/env bash
-# Set up frictiondyn on a fresh machine: the Fortran compiler and LAPACK from Debian
-# (when missing), a virtual environment in .venv, and the package (library, executable,
-# Python driver) built by meson-python and installed into it.
+# Set up frictiondyn on a fresh machine: the Fortran compiler, LAPACK and SuiteSparse's CHOLMOD
+# (the sparse path of wide-band structures; the build works without it) from Debian (when
+# missing), a virtual environment in .venv, and the package (library, executable, Python
+# driver) built by meson-python and installed into it.
 set -euo pipefail
 cd "$(dirname "$0")/.."
 
 need=()
 if command -v dpkg >/dev/null 2>&1; then
-  for pkg in gfortran liblapack-dev pkg-config; do
+  for pkg in gfortran liblapack-dev pkg-config libsuitesparse-dev; do
     dpkg -s "$pkg" >/dev/null 2>&1 || need+=("$pkg")
   done
 fi

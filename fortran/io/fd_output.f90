@@ -681,6 +681,8 @@ contains
          name = 'dense'
       case (2)
          name = 'banded'
+      case (3)
+         name = 'sparse'
       case default
          name = 'none'
       end select

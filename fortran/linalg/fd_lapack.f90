@@ -5,7 +5,7 @@ module fd_lapack
    implicit none
    private
 
-   public :: dgelss, dgemv, dgesv, dpbtf2, dpbtrf, dpbtrs, dpotf2, dpotrf, dpotrs, dpttrf, dpttrs, &
+   public :: dgelss, dgemv, dgesv, dgetrf, dgetrs, dpbtf2, dpbtrf, dpbtrs, dpotf2, dpotrf, dpotrs, dpttrf, dpttrs, &
              dsbevx, dsbgvx, dsbmv, dsterf, dsyevr, dsygv, dsymv, dsyrk, dtrsv
 
    interface
@@ -31,6 +31,20 @@ module fd_lapack
          real(dp), intent(inout) :: a(lda, *), b(ldb, *)
          integer, intent(out) :: ipiv(*), info
       end subroutine dgesv
+      subroutine dgetrf(m, n, a, lda, ipiv, info)
+         import :: dp
+         integer, intent(in) :: m, n, lda
+         real(dp), intent(inout) :: a(lda, *)
+         integer, intent(out) :: ipiv(*), info
+      end subroutine dgetrf
+      subroutine dgetrs(trans, n, nrhs, a, lda, ipiv, b, ldb, info)
+         import :: dp
+         character(len=1), intent(in) :: trans
+         integer, intent(in) :: n, nrhs, lda, ldb, ipiv(*)
+         real(dp), intent(in) :: a(lda, *)
+         real(dp), intent(inout) :: b(ldb, *)
+         integer, intent(out) :: info
+      end subroutine dgetrs
       subroutine dpbtf2(uplo, n, kd, ab, ldab, info)
          import :: dp
          character(len=1), intent(in) :: uplo

@@ -22,7 +22,7 @@ module fd_names
    public :: default_modal_modes, max_default_modal_modes
    public :: excitation_types, excitation_harmonic, excitation_record, excitation_none
    public :: record_kinds, record_acceleration, record_displacement
-   public :: linear_systems, linear_system_auto, linear_system_dense, linear_system_banded
+   public :: linear_systems, linear_system_auto, linear_system_dense, linear_system_banded, linear_system_sparse
    public :: refinements, refinement_step, refinement_nested, refinement_implicit
    public :: mu_laws, mu_constant, mu_exponential, mu_table
    public :: mode_systems, system_stuck, system_free
@@ -125,12 +125,14 @@ module fd_names
 
    ! ------------------------------------------------------------------ linear systems
    type(keyword_type), parameter :: linear_systems(*) = [ &
-                                    keyword_type('auto', 'dense up to 8 DOFs, else banded'), &
+                                    keyword_type('auto', 'dense up to 8 DOFs, sparse where cheaper, else banded'), &
                                     keyword_type('dense', ''), &
-                                    keyword_type('banded', '')]
+                                    keyword_type('banded', ''), &
+                                    keyword_type('sparse', 'CHOLMOD')]
    integer, parameter :: linear_system_auto = 1   !! storage chosen by the kernel (fd_banded)
    integer, parameter :: linear_system_dense = 2  !! dense effective stiffness
    integer, parameter :: linear_system_banded = 3 !! banded, reverse Cuthill-McKee ordering
+   integer, parameter :: linear_system_sparse = 4 !! sparse, CHOLMOD (fd_sparse)
    ! ------------------------------------------------------------------ step refinement (Newmark)
    type(keyword_type), parameter :: refinements(*) = [ &
                                     keyword_type('step', 'the paper: whole dt1 step in dt2 steps'), &

@@ -48,6 +48,7 @@ program tester
    use test_fd_statistics, only: collect_statistics
    use test_fd_event_driven, only: collect_event_driven
    use test_fd_woodbury, only: collect_woodbury
+   use test_fd_sparse, only: collect_sparse
    use test_fd_newmark, only: collect_newmark
    implicit none
    integer :: stat, is
@@ -102,6 +103,7 @@ program tester
    testsuites = [testsuites, new_testsuite("statistics", collect_statistics)]
    testsuites = [testsuites, new_testsuite("event_driven", collect_event_driven)]
    testsuites = [testsuites, new_testsuite("woodbury", collect_woodbury)]
+   testsuites = [testsuites, new_testsuite("sparse", collect_sparse)]
    testsuites = [testsuites, new_testsuite("newmark", collect_newmark)]
 
    call get_argument(1, suite_name)

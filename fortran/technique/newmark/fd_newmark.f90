@@ -21,6 +21,9 @@
 !> used. When the pattern of sticking devices has changed since a system was last used, its
 !> factor is updated (rank-one updates and downdates, or a refactorization from the first
 !> changed column when that is cheaper: spd_update_devices), never refactored from scratch.
+!> Where the band after ordering is wide, K^ is instead fd_sparse's (CHOLMOD's factor, phase
+!> changes by the Woodbury identity on it: linear_system = 'sparse', or chosen by 'auto' when a
+!> step costs less so, choose_sparse).
 !> K and C (C = a0 M + a1 K, the damping of fd_matrices' structure_damping) are never formed
 !> densely; nothing in this module holds an n x n array, and nothing allocates once the loop
 !> has started.
@@ -30,6 +33,7 @@ module fd_newmark
    use fd_error, only: error_type, fatal_error, fmt_real, fmt_int, stat_no_memory
    use fd_names, only: technique_integrates, law_name, law_choices, excitation_types, technique_name, technique_newmark, &
                        technique_event_driven, technique_moreau_jean, linear_system_dense, linear_system_banded, &
+                       linear_system_sparse, &
                        refinement_nested, refinement_implicit
    use fd_model, only: model_type, integration_type, device_type
    use fd_names, only: excitation_none
@@ -42,7 +46,10 @@ module fd_newmark
    use fd_stiffness, only: stiffness_form, general_form, influence_of
    use fd_banded, only: spd_system, spd_setup, spd_factor, spd_update_devices, spd_solve, spd_k_matvec, &
                         spd_c_matvec, spd_kc_matvec, spd_auto, spd_dense, spd_banded, spd_is_dense, spd_bandwidth, &
-                        spd_copy
+                        spd_copy, spd_dense_max_n
+   use fd_sparse, only: sparse_system, sparse_available, sparse_setup, sparse_factor, sparse_update_devices, &
+                        sparse_solve, sparse_k_matvec, sparse_c_matvec, sparse_kc_matvec, sparse_free, sparse_band, &
+                        sparse_factor_entries, sparse_nonzeros
    use fd_device_state, only: device_state, device_force, phase_stick
    use fd_friction_planar, only: pendulum_excess, normal_force, with_normal_force, devices_at_normal_force, &
                                  normal_force_range
@@ -64,13 +71,26 @@ module fd_newmark
 
    public :: run_newmark, newmark_check
 
+   !> linear_system = 'sparse' (fd_sparse), beside fd_banded's spd_auto, spd_dense, spd_banded
+   integer, parameter :: path_sparse = -1
+   !> 'auto' asks CHOLMOD's analysis only above this half-bandwidth: a band this narrow is
+   !> the factor's own fill (a chain, a plane frame), and the reference decks keep their path
+   integer, parameter :: auto_band = 32
+   !> Cost of an entry of the sparse factor or K^ in a step, in entries of the band (CHOLMOD's
+   !> simplicial solve and the compressed-column products against LAPACK's band routines,
+   !> measured on bench/matrix_scale.py's towers and plans, where they cost about the same
+   !> per step at 6 n (kb + 1) = 3 to 4 (2 nnz(L) + 4 nnz(K^)))
+   real(dp), parameter :: sparse_weight = 4.0_dp
+
    !> The effective stiffness of one step size.
    type :: level_type
       real(dp) :: h = 0.0_dp               !! step size [s]
       real(dp) :: c0 = 0.0_dp, c1 = 0.0_dp             !! K^ = K + c1 C + c0 M + ...
       real(dp) :: gh = 0.0_dp, g1h = 0.0_dp            !! gamma h, (1 - gamma) h
       real(dp) :: bh2 = 0.0_dp, b2h2 = 0.0_dp          !! beta h^2, (1/2 - beta) h^2
-      type(spd_system) :: sys              !! its factored K^
+      type(spd_system) :: sys              !! its factored K^ (banded or dense)
+      logical :: sparse = .false.          !! K^ is sps instead (fd_sparse, CHOLMOD)
+      type(sparse_system) :: sps           !! its factored K^ on the sparse path
       logical :: factored = .false.        !! factored once (then only updated)
       type(woodbury_type) :: wb            !! 'modal' damping's low-rank c1 C in K^ (fd_woodbury)
       integer :: version = -1              !! the pattern of device stiffnesses it holds
@@ -179,11 +199,33 @@ contains
       type(result_type), intent(out) :: res         !! histories and summary
       type(error_type), allocatable, intent(out) :: error !! singular system, divergence, stop
       type(run_control), intent(inout), target, optional :: ctl !! the run's control
+      type(excitation_type), intent(in), optional :: exc2 !! a second horizontal component
+      type(excitation_type), intent(in), optional :: exc3 !! the vertical component
+      type(workspace) :: w
+      integer :: l
+
+      call run_loop(model, exc, opts, res, error, w, ctl, exc2, exc3)
+      ! the sparse factors are CHOLMOD's (C memory): freed on every way out of the loop
+      if (allocated(w%lev)) then
+         do l = 1, size(w%lev)
+            call sparse_free(w%lev(l)%sps)
+         end do
+      end if
+   end subroutine run_newmark
+
+   !> run_newmark's set-up and time-step loop in the workspace w.
+   subroutine run_loop(model, exc, opts, res, error, w, ctl, exc2, exc3)
+      type(model_type), intent(in) :: model         !! validated model
+      type(excitation_type), intent(in) :: exc      !! validated table motion
+      type(integration_type), intent(in) :: opts    !! validated settings
+      type(result_type), intent(out) :: res         !! histories and summary
+      type(error_type), allocatable, intent(out) :: error !! singular system, divergence, stop
+      type(run_control), intent(inout), target, optional :: ctl !! the run's control
       type(excitation_type), intent(in), optional :: exc2 !! a second horizontal component, along
                                                           !! the model's influence2 (kind none: none)
       type(excitation_type), intent(in), optional :: exc3 !! the vertical component: the bearings'
                                                           !! normal forces (kind none: none)
-      type(workspace) :: w
+      type(workspace), intent(inout) :: w           !! the workspace (set up here)
       real(dp) :: dt1, dt2, t0
       integer :: k, c0, c1, crate, l
       logical :: any_changed, any_bad, stop, settled
@@ -298,6 +340,8 @@ contains
                                 device_energy(w%dev, w%st, w%s), &
                               w%w_device, stored_energies(w%dev, w%st, w%s))
       do l = 1, size(w%lev)
+         res%newmark%factorizations = res%newmark%factorizations + w%lev(l)%sps%factorizations
+         res%newmark%factor_updates = res%newmark%factor_updates + w%lev(l)%sps%changes
          associate (stats => w%lev(l)%sys%stats)
             res%newmark%factorizations = res%newmark%factorizations + stats%factorizations
             res%newmark%partial_factorizations = res%newmark%partial_factorizations + stats%partial
@@ -306,7 +350,7 @@ contains
       end do
       call system_clock(c1)
       res%run_time = real(c1 - c0, dp)/real(max(crate, 1), dp)
-   end subroutine run_newmark
+   end subroutine run_loop
 
    !> The effective stiffness systems (one set up, copied for every step size; factored when
    !> first used) and the workspace. Memory linear in the number of DOFs and devices.
@@ -320,7 +364,9 @@ contains
       type(error_type), allocatable, intent(out) :: error
       type(spd_system) :: base
       real(dp) :: a0, a1, b, g, h
-      integer :: n, nd, l, path, stat
+      integer :: n, nd, l, path, stat, kb
+      integer :: none(0)
+      logical :: sparse
 
       n = model%n_dof
       nd = model%n_devices
@@ -345,15 +391,24 @@ contains
          path = spd_dense
       case (linear_system_banded)
          path = spd_banded
+      case (linear_system_sparse)
+         path = path_sparse
       case default
          path = spd_auto
       end select
-      call spd_setup(base, model%mass, model%spring_i, model%spring_j, model%spring_k, model%dev_ptr, model%dev_dof, &
-                     model%dev_coef, error, &
-                     a0=a0, a1=a1, path=path, kx_i=model%kx_i, kx_j=model%kx_j, kx_v=model%kx_v)
+      call choose_sparse(model, a0, a1, path, sparse, kb, error)
       if (allocated(error)) return
-      res%newmark%storage = merge(1, 2, spd_is_dense(base))
-      res%newmark%bandwidth = spd_bandwidth(base)
+      if (sparse) then
+         res%newmark%storage = 3
+         res%newmark%bandwidth = kb
+      else
+         call spd_setup(base, model%mass, model%spring_i, model%spring_j, model%spring_k, model%dev_ptr, &
+                        model%dev_dof, model%dev_coef, error, &
+                        a0=a0, a1=a1, path=path, kx_i=model%kx_i, kx_j=model%kx_j, kx_v=model%kx_v)
+         if (allocated(error)) return
+         res%newmark%storage = merge(1, 2, spd_is_dense(base))
+         res%newmark%bandwidth = spd_bandwidth(base)
+      end if
       w%lmax = lmax
       ! the levels of the refinement: the paper's is one, dt1 to dt2 = dt1 / n2
       w%nested = 0
@@ -382,7 +437,14 @@ contains
          w%lev(l)%c0 = 1.0_dp/(b*h*h); w%lev(l)%c1 = g/(b*h)
          w%lev(l)%gh = g*h; w%lev(l)%g1h = (1.0_dp - g)*h
          w%lev(l)%bh2 = b*h*h; w%lev(l)%b2h2 = (0.5_dp - b)*h*h
-         call spd_copy(base, w%lev(l)%sys, error)
+         w%lev(l)%sparse = sparse
+         if (sparse) then
+            call sparse_setup(w%lev(l)%sps, model%mass, model%spring_i, model%spring_j, model%spring_k, &
+                              model%dev_ptr, model%dev_dof, model%dev_coef, a0, a1, none, none, [real(dp) ::], &
+                              error, model%kx_i, model%kx_j, model%kx_v)
+         else
+            call spd_copy(base, w%lev(l)%sys, error)
+         end if
          if (allocated(error)) return
          if (allocated(model%modal_d)) call woodbury_setup(w%lev(l)%wb, model%modal_u, model%modal_d, w%lev(l)%c1, error)
          if (allocated(error)) return
@@ -538,9 +600,14 @@ contains
          call table_motion(w%exc2, t, xg, vg, w%ag2)
          w%rhs = w%rhs - w%mr2*w%ag2
       end if
-      call spd_c_matvec(w%lev(1)%sys, w%v, w%rhs, -1.0_dp, 1.0_dp)
-      if (allocated(model%modal_d)) call lowrank_matvec(model%modal_u, model%modal_d, w%v, w%rhs, -1.0_dp)
-      call spd_k_matvec(w%lev(1)%sys, w%u, w%rhs, -1.0_dp, 1.0_dp)
+      if (w%lev(1)%sparse) then
+         call sparse_c_matvec(w%lev(1)%sps, w%v, w%rhs, -1.0_dp, 1.0_dp)
+         call sparse_k_matvec(w%lev(1)%sps, w%u, w%rhs, -1.0_dp, 1.0_dp)
+      else
+         call spd_c_matvec(w%lev(1)%sys, w%v, w%rhs, -1.0_dp, 1.0_dp)
+         if (allocated(model%modal_d)) call lowrank_matvec(model%modal_u, model%modal_d, w%v, w%rhs, -1.0_dp)
+         call spd_k_matvec(w%lev(1)%sys, w%u, w%rhs, -1.0_dp, 1.0_dp)
+      end if
       do d = 1, w%nd
          call add_device(model, d, -w%f(d), w%rhs)
       end do
@@ -586,14 +653,22 @@ contains
          w%ag21 = table_acceleration(w%exc2, t + h)
          w%rhs = w%rhs - w%mr2*w%ag21
       end if
-      call spd_kc_matvec(w%lev(lv)%sys, w%u1, w%tmp, w%rhs, -1.0_dp)
+      if (w%lev(lv)%sparse) then
+         call sparse_kc_matvec(w%lev(lv)%sps, w%u1, w%tmp, w%rhs, -1.0_dp)
+      else
+         call spd_kc_matvec(w%lev(lv)%sys, w%u1, w%tmp, w%rhs, -1.0_dp)
+      end if
       if (w%lev(lv)%wb%r > 0) call lowrank_matvec(model%modal_u, model%modal_d, w%tmp, w%rhs, -1.0_dp)
       if (w%pairs) then
          call pair_loads(w%n, w%nd, w%di, w%dj, w%st, w%u1, w%tmp, w%lev(lv)%c0, w%rhs)
       else
          call device_loads(model, w%n, w%nd, w%st, w%u1, w%tmp, w%lev(lv)%c0, w%rhs, w%s1, w%sd1, w%fw)
       end if
-      call spd_solve(w%lev(lv)%sys, w%rhs, error)
+      if (w%lev(lv)%sparse) then
+         call sparse_solve(w%lev(lv)%sps, w%rhs, error)
+      else
+         call spd_solve(w%lev(lv)%sys, w%rhs, error)
+      end if
       if (allocated(error)) return
       if (w%lev(lv)%wb%r > 0) call woodbury_correct(w%lev(lv)%wb, model%modal_u, w%rhs)
       call correct(w%n, w%lev(lv)%bh2, w%lev(lv)%gh, w%rhs, w%tmp, w%a1, w%u1, w%v1)
@@ -680,7 +755,11 @@ contains
          w%st(d)%f0 = w%st(d)%f0 + w%df(q)
          call add_device(model, d, -(w%lev(lv)%c0*w%df(q)), w%rhs)
       end do
-      call spd_solve(w%lev(lv)%sys, w%rhs, error)
+      if (w%lev(lv)%sparse) then
+         call sparse_solve(w%lev(lv)%sps, w%rhs, error)
+      else
+         call spd_solve(w%lev(lv)%sys, w%rhs, error)
+      end if
       if (allocated(error)) return
       if (w%lev(lv)%wb%r > 0) call woodbury_correct(w%lev(lv)%wb, model%modal_u, w%rhs)
       w%follow_passes = w%follow_passes + 1
@@ -798,6 +877,58 @@ contains
       end do
    end subroutine correct
 
+   !> Whether K^ goes to the sparse path (fd_sparse, CHOLMOD): asked for, or, with 'auto', when
+   !> a step there costs less than on the band (docs/theory.md, section 10.7): a step solves
+   !> with the factor and multiplies by K and C, 6 n (kb + 1) entries read on the band of
+   !> half-width kb after reverse Cuthill-McKee ordering, 2 nnz(L) + 4 nnz(K^) sparse (nnz(L)
+   !> from CHOLMOD's symbolic analysis, made only when kb > auto_band), each sparse entry
+   !> costing sparse_weight band entries (indirect indexing). kb: the band.
+   subroutine choose_sparse(model, a0, a1, path, sparse, kb, error)
+      type(model_type), intent(in) :: model
+      real(dp), intent(in) :: a0, a1
+      integer, intent(inout) :: path
+      logical, intent(out) :: sparse
+      integer, intent(out) :: kb
+      type(error_type), allocatable, intent(out) :: error
+      type(sparse_system) :: probe
+      integer :: none(0)
+      real(dp) :: banded_cost, sparse_cost
+
+      sparse = .false.
+      kb = 0
+      if (path == path_sparse) then
+         if (.not. sparse_available()) then
+            call fatal_error(error, "&integration: linear_system = 'sparse' needs the sparse solver, and this build has &
+                             &no CHOLMOD (SuiteSparse): use 'auto' or 'banded', or rebuild with libsuitesparse-dev")
+         else if (allocated(model%modal_d)) then
+            call fatal_error(error, "&integration: linear_system = 'sparse' does not take damping = 'modal' (its &
+                             &low-rank term goes with the banded factor): use 'auto' or 'banded'")
+         else
+            sparse = .true.
+            kb = sparse_band(model%n_dof, model%spring_i, model%spring_j, model%dev_ptr, model%dev_dof, none, none, &
+                             model%kx_i, model%kx_j)
+         end if
+         return
+      end if
+      if (path /= spd_auto .or. allocated(model%modal_d) .or. model%n_dof <= spd_dense_max_n) return
+      if (.not. sparse_available()) return
+      kb = sparse_band(model%n_dof, model%spring_i, model%spring_j, model%dev_ptr, model%dev_dof, none, none, &
+                       model%kx_i, model%kx_j)
+      if (kb <= auto_band) return
+      call sparse_setup(probe, model%mass, model%spring_i, model%spring_j, model%spring_k, model%dev_ptr, &
+                        model%dev_dof, model%dev_coef, a0, a1, none, none, [real(dp) ::], error, model%kx_i, &
+                        model%kx_j, model%kx_v)
+      if (allocated(error)) then
+         call sparse_free(probe)
+         return
+      end if
+      banded_cost = 6.0_dp*real(model%n_dof, dp)*real(kb + 1, dp)
+      sparse_cost = 2.0_dp*sparse_factor_entries(probe) + 4.0_dp*real(sparse_nonzeros(probe), dp)
+      call sparse_free(probe)
+      sparse = sparse_weight*sparse_cost < banded_cost
+      if (sparse) path = path_sparse
+   end subroutine choose_sparse
+
    !> The factored effective stiffness of level lv for the current phases: factored the
    !> first time the level is used, updated (never refactored from scratch) when the
    !> devices' stiffnesses have changed since it was last used; with 'modal' damping, the
@@ -814,7 +945,12 @@ contains
          do d = 1, w%nd
             w%kd(d) = w%st(d)%ks + lev%c1*w%st(d)%cs
          end do
-         if (.not. lev%factored) then
+         if (lev%sparse .and. .not. lev%factored) then
+            call sparse_factor(lev%sps, lev%c0, lev%c1, w%kd, error)
+            lev%factored = .not. allocated(error)
+         else if (lev%sparse) then
+            call sparse_update_devices(lev%sps, w%kd, error)
+         else if (.not. lev%factored) then
             call spd_factor(lev%sys, lev%c0, lev%c1, w%kd, error)
             lev%factored = .not. allocated(error)
          else
