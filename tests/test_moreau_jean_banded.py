@@ -53,6 +53,9 @@ def test_eccentric_building_banded_equals_dense(run):
     s, sd = banded.summary(), dense.summary()
     assert sum(s["stick_to_slip"]) > 4 and s["stick_to_slip"] == sd["stick_to_slip"]
     assert abs(s["energy_residual_ratio"]) < 1e-12 and abs(sd["energy_residual_ratio"]) < 1e-12
+    # the summary names the form each ran: W of 6 DOFs dense (half-bandwidth n - 1) or banded
+    assert (sd["linear_system"], sd["half_bandwidth"]) == ("dense", 5)
+    assert s["linear_system"] == "banded" and 0 < s["half_bandwidth"] <= 5
 
 
 def circular_run(tmp_path, linear_system: str, dt_record: float = 0.004, n1: int = 2):

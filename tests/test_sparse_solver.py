@@ -150,3 +150,18 @@ def test_sparse_without_cholmod_is_an_error(run, has_cholmod):
     assert r.returncode != 0
     assert "&integration" in r.stderr and "linear_system = 'sparse'" in r.stderr and NO_CHOLMOD in r.stderr
     assert not r.outdir.exists()
+
+
+@pytest.mark.parametrize("technique", ["moreau_jean", "event_driven"])
+def test_sparse_is_newmarks_alone(run, technique):
+    """Moreau-Jean's and the exact technique's systems have no sparse path: asking for one is
+    an error naming the group, the variable and what the technique takes, with or without
+    CHOLMOD in the build (not a silent banded or dense run)."""
+    groups = paper_groups(4, "coulomb")
+    groups["excitation"]["duration"] = 0.05
+    groups["integration"] = {"technique": technique, "linear_system": "sparse"}
+    r = run(groups)
+    assert r.returncode != 0
+    assert "group &integration: linear_system = 'sparse'" in r.stderr, r.stderr
+    assert f"technique = '{technique}' takes 'auto', 'dense' or 'banded'" in r.stderr
+    assert not r.outdir.exists()

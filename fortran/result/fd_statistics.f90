@@ -76,6 +76,9 @@ module fd_statistics
       integer :: factorizations = 0    !! factorizations of the stick groups' systems
       integer :: patterns = 0          !! stick-slip patterns solved in one-step problems
       integer :: lcp_fallbacks = 0     !! one-step problems that needed Lemke's fallback
+      integer :: storage = 0           !! the general form's W stored 1 dense, 2 banded (0: the
+                                       !! stick groups' form, no W of the whole model)
+      integer :: bandwidth = 0         !! its half-bandwidth in the solver's ordering
    end type moreau_jean_stats
 
    !> The summary's counter keys, one table for every technique (0: not the technique's).
@@ -121,6 +124,8 @@ contains
       c%factorizations = st%factorizations
       c%patterns = st%patterns
       c%lcp_fallbacks = st%lcp_fallbacks
+      c%storage = st%storage
+      c%bandwidth = st%bandwidth
    end function moreau_jean_counts
 
    !> The summary's counters of the technique that ran (all 0 when none did).

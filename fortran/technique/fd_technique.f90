@@ -14,7 +14,7 @@ module fd_technique
    use fd_error, only: error_type, fatal_error, fmt_int
    use fd_names, only: technique_newmark, technique_event_driven, technique_moreau_jean, techniques, &
                        keyword_choices, technique_name, law_name, technique_traits_type, technique_traits, &
-                       technique_integrates, technique_step_rule
+                       technique_integrates, technique_step_rule, linear_system_sparse
    use fd_model, only: model_type, integration_type, source_brace, source_floor_brace, damping_modal
    use fd_step_limits, only: check_step_limits
    use fd_excitation, only: excitation_type, excitation_none
@@ -162,6 +162,11 @@ contains
                              trim(technique_name(opts%technique))//"' holds each bearing's p constant")
             return
          end if
+      end if
+      if (opts%technique /= technique_newmark .and. opts%linear_system == linear_system_sparse) then
+         call fatal_error(error, "group &integration: linear_system = 'sparse' (CHOLMOD) is Newmark's; technique = '"// &
+                          trim(technique_name(opts%technique))//"' takes 'auto', 'dense' or 'banded'")
+         return
       end if
       if (opts%technique /= technique_newmark .and. model%overturning) then
          call fatal_error(error, "group &bearings: overturning = .true. (bearings' varying normal force) is "// &

@@ -46,7 +46,7 @@ module fd_moreau_jean
    use fd_group_system, only: gs_k_matvec, gs_k_absmatvec, gs_lowest_eigenvalue
    use fd_impulse_solver, only: impulse_solver, solver_setup, solve_impulses, predict_pattern, pattern_acceleration
    use fd_dense_impulse, only: dense_impulse, dense_setup, dense_factor, dense_solve, dense_acceleration, &
-                               dense_k_times, impulse_banded
+                               dense_k_times, impulse_banded, impulse_bandwidth
    implicit none
    private
 
@@ -409,6 +409,9 @@ contains
       nd = w%nd
       call dense_setup(w%di, model, error, impulse_banded(n, w%linear_system))
       if (allocated(error)) return
+      ! the summary's linear_system and half_bandwidth (impulse_bandwidth: -1 when dense)
+      res%moreau_jean%storage = merge(2, 1, impulse_banded(n, w%linear_system))
+      res%moreau_jean%bandwidth = merge(impulse_bandwidth(w%di), n - 1, res%moreau_jean%storage == 2)
       call structure_damping(model, w%a0, w%a1, res%moreau_jean%setup%period_stuck, &
                              res%moreau_jean%setup%xi_stuck, error)
       if (allocated(error)) return
@@ -469,8 +472,9 @@ contains
       if (allocated(error)) return
       call dense_device_state(model, w, w%phase0)
       call dense_energies(w, e_kin, e_str)
-      call start_observing(w, res, ag0, e_kin, e_str, b0)
+      ! the normal forces before the first row, which holds them
       if (w%three) call observe_bearing_forces(model, 0.0_dp, 0.0_dp, az0, w, res)
+      call start_observing(w, res, ag0, e_kin, e_str, b0)
       do k = 1, w%obs%nsteps
          t1 = k*h
          call table_motion(exc, t1, xg, vg, ag1)
