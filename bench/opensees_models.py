@@ -845,6 +845,11 @@ class IsolatedBlockCase:
     geometry, second order in u/R), where frictiondyn's &isolators keeps N = W/4: for a
     curved surface the two codes differ by about (mu + u/R) u/R (0.1 % here); for a flat
     slider they solve the same equations.
+
+    Velocity-dependent friction (``mu_min`` given, ``eps`` the velocity law's band): frictiondyn's
+    &bearings with the velocity law and mu_law 'exponential' (mu_max = ``mu``), OpenSees's
+    frictionModel VelDependent; its elastic-plastic friction approaches the velocity law's
+    rigid-plastic limit as ``k_init`` grows. ``components`` = 3 adds a vertical component.
     """
 
     mass: float = 1.0e5
@@ -862,13 +867,30 @@ class IsolatedBlockCase:
     seeds: tuple[int, int] = (1, 2)
     eps1: float = 1.0e-6
     records: tuple = field(default=None, repr=False)
+    #: velocity-dependent friction mu(v) = mu - (mu - mu_min) exp(-mu_rate |v|) (``mu`` the fast
+    #: value; OpenSees's frictionModel VelDependent muSlow = mu_min, muFast = mu, transRate =
+    #: mu_rate [s/m]); None: Coulomb, mu constant
+    mu_min: float | None = None
+    mu_rate: float = 20.0
+    #: frictiondyn's planar bearings with the velocity law of band ``eps`` [m/s] (mu_law
+    #: 'exponential' with ``mu_min``); None: the hysteretic law (f, eps1)
+    eps: float | None = None
+    #: a third, vertical component of PGA vertical * pga (``components`` = 3): frictiondyn's
+    #: &excitation3 (N = W/4 (1 + a_z / g)); OpenSees: the mass W / (4 g) on each bearing's
+    #: top node, carried by its axial spring ``kv`` [N/m]
+    vertical: float = 2 / 3
+    seed_z: int = 3
+    kv: float = 1.0e10
 
     def __post_init__(self) -> None:
         if self.records is None:
             recs = [synthetic_record(self.dt_record, self.duration, self.pga, self.seeds[0])]
-            if self.components == 2:
+            if self.components >= 2:
                 recs.append(self.scale2 * synthetic_record(self.dt_record, self.duration,
                                                            self.pga, self.seeds[1]))
+            if self.components == 3:
+                recs.append(self.vertical * synthetic_record(self.dt_record, self.duration,
+                                                             self.pga, self.seed_z))
             self.records = tuple(recs)
         self.weight = self.mass * G
         self.dt = self.dt_record / self.n1
@@ -903,7 +925,7 @@ class IsolatedBlockCase:
             + f"&integration\n  n1 = {self.n1}\n  refinement = 'implicit'\n/\n"
         )
 
-    def deck_planar(self, record_files: tuple[str, ...] = ("ag_x.txt", "ag_y.txt")) -> str:
+    def deck_planar(self, record_files: tuple[str, ...] = ("ag_x.txt", "ag_y.txt", "ag_z.txt")) -> str:
         """The frictiondyn deck of the block as a rigid floor (ux, uy, rz at its centre) on
         four planar bearings (&bearings) at the corners of its plan, each carrying W/4."""
         deck = (
@@ -912,12 +934,21 @@ class IsolatedBlockCase:
             "&damping\n  damping_type = 'none'\n/\n"
             f"&bearings\n  n_bearings = 4\n  storey = 4*1\n"
             f"  x = {_floats(c[0] for c in self.corners)}\n  y = {_floats(c[1] for c in self.corners)}\n"
-            f"  p = 4*{self.weight / 4!r}\n  law = 4*'hysteretic'\n  mu = 4*{self.mu!r}\n"
-            f"  f = 4*{self.f!r}\n  eps1 = 4*{self.eps1!r}\n  radius = 4*{self.radius!r}\n/\n"
+            f"  p = 4*{self.weight / 4!r}\n"
         )
+        if self.eps is None:
+            deck += (f"  law = 4*'hysteretic'\n  mu = 4*{self.mu!r}\n"
+                     f"  f = 4*{self.f!r}\n  eps1 = 4*{self.eps1!r}\n")
+        elif self.mu_min is None:
+            deck += f"  law = 4*'velocity'\n  mu = 4*{self.mu!r}\n  eps = 4*{self.eps!r}\n"
+        else:
+            deck += (f"  law = 4*'velocity'\n  eps = 4*{self.eps!r}\n  mu_law = 4*'exponential'\n"
+                     f"  mu_max = 4*{self.mu!r}\n  mu_min = 4*{self.mu_min!r}\n"
+                     f"  mu_rate = 4*{self.mu_rate!r}\n")
+        deck += f"  radius = 4*{self.radius!r}\n/\n"
         for c in range(self.components):
-            deck += _record_group(("excitation", "excitation2")[c], self.dt_record, self.duration,
-                                  record_files[c])
+            deck += _record_group(("excitation", "excitation2", "excitation3")[c], self.dt_record,
+                                  self.duration, record_files[c])
         return deck + f"&integration\n  n1 = {self.n1}\n  refinement = 'implicit'\n/\n"
 
     def run_frictiondyn_1d(self):
@@ -942,8 +973,11 @@ class IsolatedBlockCase:
         ops.node(centre, 0.0, 0.0, 0.0)
         ops.fix(centre, 0, 0, 1, 1, 1, 0)
         ops.mass(centre, self.mass, self.mass, 0.0, 0.0, 0.0, inertia)
-        ops.frictionModel("Coulomb", 1, self.mu)
-        ops.uniaxialMaterial("Elastic", 1, 1.0e10)   # axial: stiff
+        if self.mu_min is None:
+            ops.frictionModel("Coulomb", 1, self.mu)
+        else:
+            ops.frictionModel("VelDependent", 1, self.mu_min, self.mu, self.mu_rate)
+        ops.uniaxialMaterial("Elastic", 1, self.kv)  # axial: stiff
         ops.uniaxialMaterial("Elastic", 2, 1.0e-6)   # torsion: none
         ops.uniaxialMaterial("Elastic", 3, 1.0e6)    # rocking: both ends' rotations are fixed
         tops = []
@@ -952,6 +986,8 @@ class IsolatedBlockCase:
             ops.fix(k, 1, 1, 1, 1, 1, 1)
             ops.node(10 + k, x, y, 0.0)
             ops.fix(10 + k, 0, 0, 0, 1, 1, 0)
+            if self.components == 3:  # the vertical mass its normal force carries, W / (4 g)
+                ops.mass(10 + k, 0.0, 0.0, self.weight / 4 / G_FD, 0.0, 0.0, 0.0)
             tops.append(10 + k)
             kind = ("flatSliderBearing", 1) if self.radius == 0 else ("singleFPBearing", 1,
                                                                        self.radius)

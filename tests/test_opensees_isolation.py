@@ -6,10 +6,14 @@ slider the two codes solve the same equations; on a concave surface OpenSees add
 force's component along the surface's normal to the normal force (second order in u/R;
 measured 0.12 % on the peak here), which frictiondyn's constant normal force leaves out.
 Last, a small isolated building (bench/isolated_building.py's model, IsolatedBuildingCase)
-against its OpenSeesPy 3D model, under two components and under three (a vertical one).
+against its OpenSeesPy 3D model, under two components and under three (a vertical one), and
+the block on four friction pendulums with velocity-dependent friction (frictiondyn's velocity
+law with mu_law 'exponential', OpenSees's frictionModel VelDependent) under two and three.
 Skipped when openseespy cannot be imported."""
 
 from __future__ import annotations
+
+from dataclasses import replace
 
 import numpy as np
 import pytest
@@ -96,3 +100,41 @@ def test_isolated_building_under_three_components_equals_opensees():
     assert fd["bearing"].min() > 20 * case.f  # the bearings slid
     for q in ("bearing", "drift"):
         np.testing.assert_allclose(fd[q], ops.peaks[q], rtol=0.02)
+
+
+@pytest.mark.parametrize("components", [2, 3], ids=["two", "three"])
+def test_block_on_four_pendulums_with_velocity_dependent_friction_equals_opensees(components):
+    """The block on four friction pendulum bearings (R = 2 m) with friction that rises with the
+    sliding speed, mu(v) = 0.10 - 0.06 exp(-20 |v|): frictiondyn's &bearings with the velocity law
+    (mu_law 'exponential' at the resultant speed) against OpenSees's singleFPBearing with
+    frictionModel VelDependent (muSlow 0.04, muFast 0.10, transRate 20 s/m), under x and 0.7 y,
+    and under a third, vertical component (PGA 0.2 g: frictiondyn's rigid support N = W/4 (1 +
+    a_z / g); OpenSees's vertical mass W / (4 g) on an axial spring kv = 1e13 N/m, a vertical
+    period of 0.3 ms). Each bearing's peak resultant displacement within 0.5 % (the issue asks
+    2 %; measured 0.12 % and 0.07 %).
+
+    The band eps = 1e-4 m/s: the peaks move by 6e-5 (relative) from eps = 1e-4 to 1e-5, so the
+    band's error is about 6e-5, far below 2 %; at 1e-5 and below the velocity law's force
+    alternates in the band at this step (a warning). OpenSees's friction is elastic-plastic:
+    k_init = 1e11 N/m (yield displacement 0.1 um) puts its sticking error at 0.13 %; its
+    difference from the rigid-plastic limit falls about as the square root of k_init (3.8 %,
+    1.2 %, 0.4 %, 0.13 % at 1e8 ... 1e11 N/m). Velocity dependence matters: the same
+    frictiondyn run with mu constant, mu_max or mu_min, is off OpenSees's peaks by more than
+    10 % (measured -17 % and +109 % under two components, -11 % and +101 % under three); those
+    runs take eps = 1e-3 m/s (at mu_max = 0.10 the band of 1e-4 alternates)."""
+    case = IsolatedBlockCase(radius=2.0, components=components, duration=6.0, mu=0.10,
+                             mu_min=0.04, mu_rate=20.0, eps=1.0e-4, k_init=1.0e11,
+                             kv=1.0e13 if components == 3 else 1.0e10)
+    hist, _ = case.run_opensees()
+    ops_peak = np.hypot(hist[:, 3::2], hist[:, 4::2]).max(axis=0)
+    r = case.run_frictiondyn_planar()
+    fd_peak = np.asarray(r.summary["bearing_peak_displacement_m"], float)
+    np.testing.assert_allclose(fd_peak, ops_peak, rtol=5e-3)
+    assert fd_peak.min() > 0.02  # the bearings slid well beyond the band's creep
+    if components == 3:  # the vertical component moved the normal forces
+        assert max(r.summary["bearing_min_normal_force_N"]) < 0.9 * case.weight / 4
+        assert min(r.summary["bearing_max_normal_force_N"]) > 1.1 * case.weight / 4
+    for mu in (case.mu, case.mu_min):
+        constant = replace(case, mu=mu, mu_min=None, eps=1.0e-3)
+        peak = np.asarray(constant.run_frictiondyn_planar().summary["bearing_peak_displacement_m"], float)
+        assert np.abs(peak / ops_peak - 1).min() > 0.10
