@@ -925,7 +925,8 @@ class IsolatedBlockCase:
             + f"&integration\n  n1 = {self.n1}\n  refinement = 'implicit'\n/\n"
         )
 
-    def deck_planar(self, record_files: tuple[str, ...] = ("ag_x.txt", "ag_y.txt", "ag_z.txt")) -> str:
+    def deck_planar(self, record_files: tuple[str, ...] = ("ag_x.txt", "ag_y.txt",
+                                                           "ag_z.txt")) -> str:
         """The frictiondyn deck of the block as a rigid floor (ux, uy, rz at its centre) on
         four planar bearings (&bearings) at the corners of its plan, each carrying W/4."""
         deck = (
