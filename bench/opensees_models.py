@@ -716,6 +716,16 @@ class Building3DCase:
             f"  refinement = '{self.refinement}'\n/\n"
         )
 
+    def _friction(self, nb: int) -> str:
+        """The &bearings' friction: the hysteretic law (Coulomb) or the velocity law with
+        mu_law 'exponential' (``mu_min`` given)."""
+        if self.mu_min is None:
+            return (f"  law = {nb}*'hysteretic'\n  mu = {nb}*{self.mu!r}\n"
+                    f"  f = {nb}*{self.f!r}\n  eps1 = {nb}*{self.eps1!r}\n")
+        return (f"  law = {nb}*'velocity'\n  eps = {nb}*{self.eps!r}\n"
+                f"  mu_law = {nb}*'exponential'\n  mu_max = {nb}*{self.mu!r}\n"
+                f"  mu_min = {nb}*{self.mu_min!r}\n  mu_rate = {nb}*{self.mu_rate!r}\n")
+
     def run_frictiondyn(self):
         """frictiondyn's Result of the deck (records written to a temporary directory)."""
         return _run_with_records(self.deck(), self.name, self.records)
@@ -1110,6 +1120,12 @@ class IsolatedBuildingCase:
     vertical: float = 0.0  # a third, vertical component of PGA vertical * pga (0: none)
     seed_z: int = 20240615
     kv: float = 1.0e12  # OpenSees: a bearing's axial stiffness [N/m]
+    #: velocity-dependent friction as IsolatedBlockCase's: mu(v) = mu - (mu - mu_min)
+    #: exp(-mu_rate |v|), frictiondyn's velocity law of band ``eps`` [m/s] with mu_law
+    #: 'exponential', OpenSees's frictionModel VelDependent; None: Coulomb, the hysteretic law
+    mu_min: float | None = None
+    mu_rate: float = 20.0
+    eps: float = 1.0e-4
 
     def __post_init__(self) -> None:
         n = self.n_storeys
@@ -1178,14 +1194,23 @@ class IsolatedBuildingCase:
             f"  rayleigh_a1 = {self.a1!r}\n/\n"
             f"&bearings\n  n_bearings = {nb}\n  storey = {nb}*1\n"
             f"  x = {arr(b[0] for b in self.bearings)}\n  y = {arr(b[1] for b in self.bearings)}\n"
-            f"  p = {nb}*{self.p!r}\n  law = {nb}*'hysteretic'\n  mu = {nb}*{self.mu!r}\n"
-            f"  f = {nb}*{self.f!r}\n  eps1 = {nb}*{self.eps1!r}\n  radius = {nb}*{self.radius!r}\n/\n"
+            f"  p = {nb}*{self.p!r}\n" + self._friction(nb) + f"  radius = {nb}*{self.radius!r}\n/\n"
             + _record_group("excitation", self.dt_record, self.duration, record_files[0])
             + _record_group("excitation2", self.dt_record, self.duration, record_files[1])
             + (_record_group("excitation3", self.dt_record, self.duration, record_files[2])
                if len(self.records) > 2 else "")
             + f"&integration\n  n1 = {self.n1}\n  refinement = 'implicit'\n/\n"
         )
+
+    def _friction(self, nb: int) -> str:
+        """The &bearings' friction: the hysteretic law (Coulomb) or the velocity law with
+        mu_law 'exponential' (``mu_min`` given)."""
+        if self.mu_min is None:
+            return (f"  law = {nb}*'hysteretic'\n  mu = {nb}*{self.mu!r}\n"
+                    f"  f = {nb}*{self.f!r}\n  eps1 = {nb}*{self.eps1!r}\n")
+        return (f"  law = {nb}*'velocity'\n  eps = {nb}*{self.eps!r}\n"
+                f"  mu_law = {nb}*'exponential'\n  mu_max = {nb}*{self.mu!r}\n"
+                f"  mu_min = {nb}*{self.mu_min!r}\n  mu_rate = {nb}*{self.mu_rate!r}\n")
 
     def run_frictiondyn(self):
         """frictiondyn's Result of the deck (records written to a temporary directory)."""
@@ -1215,7 +1240,10 @@ class IsolatedBuildingCase:
                         "-orient", c, s, 0.0, -s, c, 0.0)
         # the bearings: ground node, top node (vertical free) slaved to the base mat
         base = 100000
-        ops.frictionModel("Coulomb", 1, self.mu)
+        if self.mu_min is None:
+            ops.frictionModel("Coulomb", 1, self.mu)
+        else:
+            ops.frictionModel("VelDependent", 1, self.mu_min, self.mu, self.mu_rate)
         mats = base + 1
         ops.uniaxialMaterial("Elastic", mats, self.kv)         # axial: stiff
         ops.uniaxialMaterial("Elastic", mats + 1, 1.0e-6)      # torsion: none
