@@ -168,9 +168,9 @@ contains
                           trim(technique_name(opts%technique))//"' takes 'auto', 'dense' or 'banded'")
          return
       end if
-      if (opts%technique /= technique_newmark .and. model%overturning) then
+      if (opts%technique == technique_event_driven .and. model%overturning) then
          call fatal_error(error, "group &bearings: overturning = .true. (bearings' varying normal force) is "// &
-                          "integrated by technique = 'newmark'; technique = '"// &
+                          "integrated by technique = 'newmark' or 'moreau_jean'; technique = '"// &
                           trim(technique_name(opts%technique))//"' holds each bearing's p constant")
          return
       end if

@@ -25,6 +25,9 @@
 !> whose force at s of the step's start joins r (K keeps N0 / R: W is factored once); the end of
 !> the step takes N there. N <= 0 (uplift): no friction, no restoring force; N's extremes and
 !> the uplift are observed at the steps' ends, as Newmark does (docs/theory.md, 12.8).
+!> The overturning (&bearings overturning = .true.) adds each bearing's dN (fd_overturning) from
+!> the floors' accelerations of the accepted state (those of its end-of-step equilibrium, the
+!> reported ones), held over the next step: explicit, one step behind, as Newmark takes it.
 module fd_moreau_jean
    use, intrinsic :: ieee_arithmetic, only: ieee_is_finite
    use fd_kinds, only: dp
@@ -33,7 +36,8 @@ module fd_moreau_jean
                        technique_newmark, damping_stiffness, damping_rayleigh, technique_integrates
    use fd_model, only: model_type, integration_type, device_type
    use fd_excitation, only: excitation_type, table_motion, table_acceleration, excitation_none
-   use fd_friction_planar, only: devices_at_normal_force, normal_force, pendulum_excess
+   use fd_friction_planar, only: devices_at_normal_force, normal_force, pendulum_excess, with_normal_force
+   use fd_overturning, only: overturning_forces
    use fd_kinematics, only: device_kinematics, device_nodes, devices_are_pairs, device_relative
    use fd_stiffness, only: influence_of
    use fd_matrices, only: structure_damping
@@ -71,6 +75,10 @@ module fd_moreau_jean
       ! bearing's N at the accepted state
       logical :: three = .false.
       type(excitation_type) :: exc3
+      ! the overturning (tilt): each bearing's dN from the floors' accelerations of the accepted
+      ! state, held over the next step; N varies (varies) with a vertical component or it
+      logical :: tilt = .false., varies = .false.
+      real(dp), allocatable :: dn(:)                      !! (n_bearings) [N]
       type(device_type), allocatable :: dev(:)            !! (nd)
       real(dp), allocatable :: kp(:), fx(:)               !! (nd) [N/m], [N]
       real(dp), allocatable :: pn(:)                      !! (n_bearings) [N]
@@ -204,12 +212,15 @@ contains
       end if
       call observer_init(model, exc, opts, res%moreau_jean%setup%period_stuck, res, w%obs, error, ctl)
       if (allocated(error)) return
-      ! a vertical component acts on planar bearings alone, which take the dense form
-      if (present(exc3)) then
-         if (exc3%kind /= excitation_none .and. w%general .and. res%n_bearings > 0) then
-            call vertical_init(model, exc3, w, res%n_bearings, error)
-            if (allocated(error)) return
-         end if
+      ! a vertical component and the overturning act on planar bearings alone, which take the
+      ! dense form
+      if (w%general .and. res%n_bearings > 0) then
+         if (present(exc3)) w%three = exc3%kind /= excitation_none
+         if (w%three) w%exc3 = exc3
+         w%tilt = model%overturning
+         w%varies = w%three .or. w%tilt
+         if (w%varies) call vertical_init(model, w, res%n_bearings, error)
+         if (allocated(error)) return
       end if
       th = opts%theta
       h = exc%dt_record/opts%n1
@@ -458,10 +469,14 @@ contains
       w%v = model%v0
       call table_motion(exc, 0.0_dp, xg, vg, ag0)
       if (w%two) call table_motion(w%exc2, 0.0_dp, xg, vg, b0)
-      if (w%three) then
-         az0 = table_acceleration(w%exc3, 0.0_dp)
-         call normal_forces(model, az0, 1.0_dp, w, w%g_force)
+      if (w%three) az0 = table_acceleration(w%exc3, 0.0_dp)
+      if (w%tilt) then
+         ! the overturning at the start: the floors at the table's acceleration (the structure at
+         ! rest relative to it: its acceleration is not known before the friction, which takes N)
+         w%acc = 0.0_dp
+         call overturning_forces(model, w%acc, ag0, b0, w%dn)
       end if
+      if (w%varies) call normal_forces(model, az0, 1.0_dp, w, w%g_force)
       ! devices moving at t = 0 slide that way, the others by the acceleration problem
       do d = 1, w%nd
          w%wrel(d) = device_relative(model, d, w%v)
@@ -473,7 +488,7 @@ contains
       call dense_device_state(model, w, w%phase0)
       call dense_energies(w, e_kin, e_str)
       ! the normal forces before the first row, which holds them
-      if (w%three) call observe_bearing_forces(model, 0.0_dp, 0.0_dp, az0, w, res)
+      if (w%varies) call observe_bearing_forces(model, 0.0_dp, 0.0_dp, az0, w, res)
       call start_observing(w, res, ag0, e_kin, e_str, b0)
       do k = 1, w%obs%nsteps
          t1 = k*h
@@ -488,10 +503,11 @@ contains
             bt = (1.0_dp - th)*b0 + th*b1
             w%r = w%r - h*bt*w%mr2
          end if
-         if (w%three) then
+         if (w%three) az1 = table_acceleration(w%exc3, t1)
+         if (w%varies) then
             ! the step's friction bounds h N mu and pendulum excess at its theta point (as its
-            ! load f_theta), the excess's force kp s with s of its start (w%s: a force, as Newmark's)
-            az1 = table_acceleration(w%exc3, t1)
+            ! load f_theta; the overturning's dN of the step's start), the excess's force kp s
+            ! with s of its start (w%s: a force, as Newmark's)
             call normal_forces(model, (1.0_dp - th)*az0 + th*az1, h, w, w%g_step)
             call excess_forces(model, w, w%u, -h, w%r)
          end if
@@ -510,7 +526,7 @@ contains
             w%obs%slip_travel(d) = w%obs%slip_travel(d) + abs(w%rel_edge(d))
          end do
          ! the pendulum excess's work over the step, with the devices' (as Newmark's)
-         if (w%three) call excess_work(w)
+         if (w%varies) call excess_work(w)
          call dense_end_state(model, w, ag1, b1, az1, w%u1, w%v1, error)
          if (allocated(error)) return
          w%u = w%u1
@@ -519,7 +535,10 @@ contains
          b0 = b1
          az0 = az1
          call dense_device_state(model, w, w%phase1)
-         if (w%three) call observe_bearing_forces(model, t1, h, az1, w, res)
+         ! the overturning's dN of the accepted state, from its end-of-step accelerations (the
+         ! next step's, one step behind)
+         if (w%tilt) call overturning_forces(model, w%acc, ag1, b1, w%dn)
+         if (w%varies) call observe_bearing_forces(model, t1, h, az1, w, res)
          call end_step(w, res, k, t1, ag1, error, b1)
          if (allocated(error)) return
       end do
@@ -544,53 +563,60 @@ contains
       call dense_k_times(w%di, w%kx, w%r, -1.0_dp, 0.0_dp)
       w%r = w%r - w%mr*ag - w%a0*w%di%mass*v
       if (w%two) w%r = w%r - w%mr2*ag2
-      ! a vertical component: the bounds N mu and the pendulum excess's force at the instant
-      if (w%three) then
+      ! a varying N: the bounds N mu and the pendulum excess's force at the instant (the
+      ! overturning's dN that of the last accepted state)
+      if (w%varies) then
          call normal_forces(model, az, 1.0_dp, w, w%g_force)
          call excess_forces(model, w, u, -1.0_dp, w%r)
       end if
       call dense_acceleration(w%di, w%r, w%g_force, w%sig, w%acc, w%fend, w%sa, error, w%wrel)
-      if (allocated(error) .or. .not. w%three) return
+      if (allocated(error) .or. .not. w%varies) return
       ! the devices' forces: the friction's and the excess's (both act along b)
       do d = 1, w%nd
          w%fend(d) = w%fend(d) + w%fx(d)
       end do
    end subroutine dense_end_state
 
-   !> A vertical component: its motion, the devices' copies and work arrays (set up once: the
-   !> loop allocates nothing).
-   subroutine vertical_init(model, exc3, w, nb, error)
+   !> A varying normal force (a vertical component, the overturning): the devices' copies and
+   !> work arrays (set up once: the loop allocates nothing).
+   subroutine vertical_init(model, w, nb, error)
       type(model_type), intent(in) :: model
-      type(excitation_type), intent(in) :: exc3
       type(mj_work), intent(inout) :: w
       integer, intent(in) :: nb                       !! bearings
       type(error_type), allocatable, intent(out) :: error
       integer :: stat
 
-      allocate (w%dev(w%nd), w%kp(w%nd), w%fx(w%nd), w%pn(nb), stat=stat)
+      allocate (w%dev(w%nd), w%kp(w%nd), w%fx(w%nd), w%pn(nb), w%dn(nb), stat=stat)
       if (stat /= 0) then
          call no_memory(error, w%n)
          return
       end if
-      w%three = .true.
-      w%exc3 = exc3
+      w%dn = 0.0_dp
       w%dev = model%dev(1:w%nd)
       w%kp = 0.0_dp
       w%fx = 0.0_dp
    end subroutine vertical_init
 
    !> The devices at the vertical acceleration az (fd_friction_planar's devices_at_normal_force:
-   !> a bearing's p = max(N, 0), N = N0 (1 + az / g)), their bounds scale P mu into g (h: the
-   !> impulses' h P mu; 1: the forces' P mu) and their pendulum excesses (N - N0) / R into w%kp
-   !> (0 for every device but a curved bearing's components).
+   !> a bearing's p = max(N, 0), N = N0 (1 + az / g), plus w%dn with the overturning), their
+   !> bounds scale P mu into g (h: the impulses' h P mu; 1: the forces' P mu) and their pendulum
+   !> excesses (N - N0) / R into w%kp (0 for every device but a curved bearing's components).
    pure subroutine normal_forces(model, az, scale, w, g)
       type(model_type), intent(in) :: model
       real(dp), intent(in) :: az, scale
       type(mj_work), intent(inout) :: w
       real(dp), intent(out) :: g(:)
-      integer :: d
+      integer :: d, b
 
-      call devices_at_normal_force(w%nd, model%dev, az, w%dev)
+      if (w%tilt) then
+         do b = 1, size(model%ot_dev)
+            d = model%ot_dev(b)
+            call with_normal_force(model%dev(d), az, w%dev(d), w%dn(b))
+            call with_normal_force(model%dev(d + 1), az, w%dev(d + 1), w%dn(b))
+         end do
+      else
+         call devices_at_normal_force(w%nd, model%dev, az, w%dev)
+      end if
       do d = 1, w%nd
          g(d) = scale*(w%dev(d)%p*w%dev(d)%mu)
          w%kp(d) = 0.0_dp
@@ -629,8 +655,9 @@ contains
       end do
    end subroutine excess_work
 
-   !> The bearings' normal forces N = N0 (1 + az / g) at the accepted time t to the observer:
-   !> extremes and uplift, as Newmark reports them; h the step that reached t (0 at the start).
+   !> The bearings' normal forces N = N0 (1 + az / g) (+ dN, the overturning's of the state) at
+   !> the accepted time t to the observer: extremes and uplift, as Newmark reports them; h the
+   !> step that reached t (0 at the start).
    subroutine observe_bearing_forces(model, t, h, az, w, res)
       type(model_type), intent(in) :: model
       real(dp), intent(in) :: t, h, az
@@ -638,9 +665,15 @@ contains
       type(result_type), intent(inout) :: res
       integer :: b
 
-      do b = 1, res%n_bearings
-         w%pn(b) = normal_force(model%dev(res%bearing_dev(1, b)), az)
-      end do
+      if (w%tilt) then
+         do b = 1, res%n_bearings
+            w%pn(b) = normal_force(model%dev(res%bearing_dev(1, b)), az, w%dn(b))
+         end do
+      else
+         do b = 1, res%n_bearings
+            w%pn(b) = normal_force(model%dev(res%bearing_dev(1, b)), az)
+         end do
+      end if
       call observe_normal_forces(res, t, h, w%pn)
    end subroutine observe_bearing_forces
 
