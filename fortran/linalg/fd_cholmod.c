@@ -4,8 +4,9 @@
  * columns (0-based), factored as a simplicial L L'. Nothing prints (Common->print = 0); errors come back as status codes.
  *
  * The solve goes through cholmod_solve2 with its solution and workspace kept in the handle,
- * so that after the first solve (made by fd_chol_factor) a solve allocates nothing; the
- * handle counts the solves that had to (re)allocate them (fd_chol_allocations).
+ * one column at a time, so that after the first solve (made by fd_chol_factor) a solve
+ * allocates nothing; the handle counts the solves that had to (re)allocate them
+ * (fd_chol_allocations).
  *
  * Built without CHOLMOD (FD_HAVE_CHOLMOD undefined), every call returns FD_CHOL_UNAVAILABLE. */
 #include <stdlib.h>
@@ -91,6 +92,31 @@ int fd_chol_create(int n, const int *colptr, const int *rowind, int nrhs_max, vo
     return FD_CHOL_OK;
 }
 
+/* Solve A x = b for one column b (n values), overwritten by x, with the handle's solution
+ * and workspace; a solve that had to (re)allocate them is counted: by their addresses, and
+ * by their shapes (cholmod_ensure_dense reallocates on a change of shape, and the C library
+ * may hand back a freed block at the same address). */
+static int solve_column(fd_chol *h, double *b) {
+    cholmod_dense bd, *x0 = h->x, *y0 = h->y, *e0 = h->e;
+    size_t xc0 = x0 ? x0->ncol : 0, yr0 = y0 ? y0->nrow : 0, yc0 = y0 ? y0->ncol : 0;
+    memset(&bd, 0, sizeof bd);
+    bd.nrow = (size_t)h->n;
+    bd.ncol = 1;
+    bd.nzmax = bd.nrow;
+    bd.d = bd.nrow;
+    bd.x = b;
+    bd.xtype = CHOLMOD_REAL;
+    bd.dtype = CHOLMOD_DOUBLE;
+    if (!cholmod_solve2(CHOLMOD_A, h->l, &bd, NULL, &h->x, NULL, &h->y, &h->e, &h->c)) {
+        return h->c.status == CHOLMOD_OUT_OF_MEMORY ? FD_CHOL_NO_MEMORY : FD_CHOL_FAILED;
+    }
+    if (x0 && (h->x != x0 || h->y != y0 || h->e != e0 || h->x->ncol != xc0 || (h->y && (h->y->nrow != yr0 ||
+                                                                                   h->y->ncol != yc0))))
+        h->allocations++;
+    memcpy(b, h->x->x, sizeof(double) * (size_t)h->n);
+    return FD_CHOL_OK;
+}
+
 /* Factor the matrix of values x (colptr[n] of them, the pattern's order). Not positive
  * definite: FD_CHOL_NOT_POSDEF and column, the 1-based original DOF where it failed. */
 int fd_chol_factor(void *handle, const double *x, int *column) {
@@ -108,48 +134,30 @@ int fd_chol_factor(void *handle, const double *x, int *column) {
         return FD_CHOL_NOT_POSDEF;
     }
     if (h->c.status < CHOLMOD_OK) return FD_CHOL_FAILED;
-    /* the first solve allocates the solution and the workspace for nrhs_max columns */
+    /* the first solve allocates the solution and the workspace (one column: every solve is
+     * of one column, so that cholmod_solve2 finds them of the right size and keeps them) */
     if (!h->x) {
-        b = calloc((size_t)h->n * (size_t)h->nrhs_max, sizeof(double));
+        b = calloc((size_t)h->n, sizeof(double));
         if (!b) return FD_CHOL_NO_MEMORY;
         for (i = 0; i < h->n; i++) b[i] = 1.0;
-        st = 0;
-        {
-            cholmod_dense bd;
-            memset(&bd, 0, sizeof bd);
-            bd.nrow = (size_t)h->n;
-            bd.ncol = (size_t)h->nrhs_max;
-            bd.nzmax = bd.nrow * bd.ncol;
-            bd.d = bd.nrow;
-            bd.x = b;
-            bd.xtype = CHOLMOD_REAL;
-            bd.dtype = CHOLMOD_DOUBLE;
-            if (!cholmod_solve2(CHOLMOD_A, h->l, &bd, NULL, &h->x, NULL, &h->y, &h->e, &h->c)) st = 1;
-        }
+        st = solve_column(h, b);
         free(b);
-        if (st) return h->c.status == CHOLMOD_OUT_OF_MEMORY ? FD_CHOL_NO_MEMORY : FD_CHOL_FAILED;
+        if (st != FD_CHOL_OK) return st;
     }
     return FD_CHOL_OK;
 }
 
-/* Solve A X = B for nrhs columns of b (leading dimension n), overwritten by X. */
+/* Solve A X = B for nrhs columns of b (leading dimension n), overwritten by X: column by
+ * column, since cholmod_solve2 frees and reallocates its solution when the number of
+ * columns changes (cholmod_ensure_dense), which a step's solve must not do. */
 int fd_chol_solve(void *handle, int nrhs, double *b) {
     fd_chol *h = handle;
-    cholmod_dense bd, *x0 = h->x, *y0 = h->y, *e0 = h->e;
+    int j, st;
     if (nrhs < 1 || nrhs > h->nrhs_max) return FD_CHOL_FAILED;
-    memset(&bd, 0, sizeof bd);
-    bd.nrow = (size_t)h->n;
-    bd.ncol = (size_t)nrhs;
-    bd.nzmax = bd.nrow * bd.ncol;
-    bd.d = bd.nrow;
-    bd.x = b;
-    bd.xtype = CHOLMOD_REAL;
-    bd.dtype = CHOLMOD_DOUBLE;
-    if (!cholmod_solve2(CHOLMOD_A, h->l, &bd, NULL, &h->x, NULL, &h->y, &h->e, &h->c)) {
-        return h->c.status == CHOLMOD_OUT_OF_MEMORY ? FD_CHOL_NO_MEMORY : FD_CHOL_FAILED;
+    for (j = 0; j < nrhs; j++) {
+        st = solve_column(h, b + (size_t)j * (size_t)h->n);
+        if (st != FD_CHOL_OK) return st;
     }
-    if (h->x != x0 || h->y != y0 || h->e != e0) h->allocations++;
-    memcpy(b, h->x->x, sizeof(double) * (size_t)h->n * (size_t)nrhs);
     return FD_CHOL_OK;
 }
 

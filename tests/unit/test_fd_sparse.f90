@@ -345,7 +345,7 @@ contains
       type(grid_type) :: g
       type(sparse_system) :: sys
       type(lib_error), allocatable :: lerr
-      real(dp) :: kd(14), x(n)
+      real(dp) :: kd(14), x(n), xs(n, 3)
       integer :: k
 
       call setup(g, sys, error)
@@ -353,12 +353,15 @@ contains
       kd = 1.0e7_dp
       call sparse_factor(sys, c0, c1, kd, lerr)
       x = 1.0_dp
+      xs = 1.0_dp
+      ! solves of one and of several columns in turn, as a step's and a phase change's are
       do k = 1, 50
          if (allocated(lerr)) exit
          kd(1 + mod(k, 14)) = 1.0e7_dp*mod(k, 3)
          if (mod(k, 10) == 0) call sparse_factor(sys, c0, c1, kd, lerr)
          if (.not. allocated(lerr)) call sparse_update_devices(sys, kd, lerr)
          if (.not. allocated(lerr)) call sparse_solve(sys, x, lerr)
+         if (.not. allocated(lerr) .and. mod(k, 2) == 0) call sparse_solve_many(sys, xs, lerr)
       end do
       call check(error, .not. allocated(lerr), "solve")
       if (.not. allocated(error)) call check(error, sparse_allocations(sys), 0, "solves that allocated")
