@@ -3,10 +3,8 @@
  * symmetric positive definite matrix of a fixed pattern, its upper triangle in compressed
  * columns (0-based), factored as a simplicial L L'. Nothing prints (Common->print = 0); errors come back as status codes.
  *
- * The solve goes through cholmod_solve2 with its solution and workspace kept in the handle,
- * one column at a time, so that after the first solve (made by fd_chol_factor) a solve
- * allocates nothing; the handle counts the solves that had to (re)allocate them
- * (fd_chol_allocations).
+ * The solve is this file's own substitution over the factor's columns, in a work vector the
+ * handle keeps: a solve allocates nothing.
  *
  * Built without CHOLMOD (FD_HAVE_CHOLMOD undefined), every call returns FD_CHOL_UNAVAILABLE. */
 #include <stdlib.h>
@@ -33,17 +31,14 @@ typedef struct {
     cholmod_common c;
     cholmod_sparse *a;     /* upper triangle, stype 1, values set by fd_chol_factor */
     cholmod_factor *l;
-    cholmod_dense *x, *y, *e;
+    double *w;             /* n: the permuted right-hand side of a solve */
     int n, nrhs_max;
-    long allocations;      /* solves whose solution or workspace was (re)allocated */
 } fd_chol;
 
 int fd_chol_available(void) { return 1; }
 
 static void release(fd_chol *h) {
-    if (h->x) cholmod_free_dense(&h->x, &h->c);
-    if (h->y) cholmod_free_dense(&h->y, &h->c);
-    if (h->e) cholmod_free_dense(&h->e, &h->c);
+    free(h->w);
     if (h->l) cholmod_free_factor(&h->l, &h->c);
     if (h->a) cholmod_free_sparse(&h->a, &h->c);
     cholmod_finish(&h->c);
@@ -71,6 +66,11 @@ int fd_chol_create(int n, const int *colptr, const int *rowind, int nrhs_max, vo
     h->c.final_ll = 1;
     h->n = n;
     h->nrhs_max = nrhs_max;
+    h->w = malloc(sizeof(double) * (size_t)n);
+    if (!h->w) {
+        release(h);
+        return FD_CHOL_NO_MEMORY;
+    }
     nz = colptr[n];
     h->a = cholmod_allocate_sparse((size_t)n, (size_t)n, (size_t)nz, 1, 1, 1, CHOLMOD_REAL, &h->c);
     if (!h->a) {
@@ -92,37 +92,36 @@ int fd_chol_create(int n, const int *colptr, const int *rowind, int nrhs_max, vo
     return FD_CHOL_OK;
 }
 
-/* Solve A x = b for one column b (n values), overwritten by x, with the handle's solution
- * and workspace; a solve that had to (re)allocate them is counted: by their addresses, and
- * by their shapes (cholmod_ensure_dense reallocates on a change of shape, and the C library
- * may hand back a freed block at the same address). */
-static int solve_column(fd_chol *h, double *b) {
-    cholmod_dense bd, *x0 = h->x, *y0 = h->y, *e0 = h->e;
-    size_t xc0 = x0 ? x0->ncol : 0, yr0 = y0 ? y0->nrow : 0, yc0 = y0 ? y0->ncol : 0;
-    memset(&bd, 0, sizeof bd);
-    bd.nrow = (size_t)h->n;
-    bd.ncol = 1;
-    bd.nzmax = bd.nrow;
-    bd.d = bd.nrow;
-    bd.x = b;
-    bd.xtype = CHOLMOD_REAL;
-    bd.dtype = CHOLMOD_DOUBLE;
-    if (!cholmod_solve2(CHOLMOD_A, h->l, &bd, NULL, &h->x, NULL, &h->y, &h->e, &h->c)) {
-        return h->c.status == CHOLMOD_OUT_OF_MEMORY ? FD_CHOL_NO_MEMORY : FD_CHOL_FAILED;
+/* Solve A x = b for one column b (n values), overwritten by x, with the simplicial L L' of
+ * A (Perm, Perm): w = b (Perm), L L' w = w by forward and back substitution over L's columns
+ * (each its diagonal first), x (Perm) = w. Written here rather than through cholmod_solve2,
+ * which reallocates its workspace in a solve (CHOLMOD 5.12, seen under the sanitizer): a
+ * step's solve allocates nothing. */
+static void solve_column(fd_chol *h, double *b) {
+    const cholmod_factor *l = h->l;
+    const int *lp = l->p, *li = l->i, *lnz = l->nz;
+    const int *perm = l->ordering == CHOLMOD_NATURAL ? NULL : l->Perm;
+    const double *lx = l->x;
+    double *w = h->w, t;
+    int j, p, n = h->n;
+    for (j = 0; j < n; j++) w[j] = b[perm ? perm[j] : j];
+    for (j = 0; j < n; j++) {
+        t = w[j] / lx[lp[j]];
+        w[j] = t;
+        for (p = lp[j] + 1; p < lp[j] + lnz[j]; p++) w[li[p]] -= lx[p] * t;
     }
-    if (x0 && (h->x != x0 || h->y != y0 || h->e != e0 || h->x->ncol != xc0 || (h->y && (h->y->nrow != yr0 ||
-                                                                                   h->y->ncol != yc0))))
-        h->allocations++;
-    memcpy(b, h->x->x, sizeof(double) * (size_t)h->n);
-    return FD_CHOL_OK;
+    for (j = n - 1; j >= 0; j--) {
+        t = w[j];
+        for (p = lp[j] + 1; p < lp[j] + lnz[j]; p++) t -= lx[p] * w[li[p]];
+        w[j] = t / lx[lp[j]];
+    }
+    for (j = 0; j < n; j++) b[perm ? perm[j] : j] = w[j];
 }
 
 /* Factor the matrix of values x (colptr[n] of them, the pattern's order). Not positive
  * definite: FD_CHOL_NOT_POSDEF and column, the 1-based original DOF where it failed. */
 int fd_chol_factor(void *handle, const double *x, int *column) {
     fd_chol *h = handle;
-    double *b;
-    int i, st;
     *column = 0;
     memcpy(h->a->x, x, sizeof(double) * (size_t)((int *)h->a->p)[h->n]);
     if (!cholmod_factorize(h->a, h->l, &h->c)) {
@@ -134,34 +133,19 @@ int fd_chol_factor(void *handle, const double *x, int *column) {
         return FD_CHOL_NOT_POSDEF;
     }
     if (h->c.status < CHOLMOD_OK) return FD_CHOL_FAILED;
-    /* the first solve allocates the solution and the workspace (one column: every solve is
-     * of one column, so that cholmod_solve2 finds them of the right size and keeps them) */
-    if (!h->x) {
-        b = calloc((size_t)h->n, sizeof(double));
-        if (!b) return FD_CHOL_NO_MEMORY;
-        for (i = 0; i < h->n; i++) b[i] = 1.0;
-        st = solve_column(h, b);
-        free(b);
-        if (st != FD_CHOL_OK) return st;
-    }
+    /* solve_column reads a simplicial L L' (Common: simplicial, final_ll) */
+    if (h->l->is_super || !h->l->is_ll || h->l->xtype != CHOLMOD_REAL) return FD_CHOL_FAILED;
     return FD_CHOL_OK;
 }
 
-/* Solve A X = B for nrhs columns of b (leading dimension n), overwritten by X: column by
- * column, since cholmod_solve2 frees and reallocates its solution when the number of
- * columns changes (cholmod_ensure_dense), which a step's solve must not do. */
+/* Solve A X = B for nrhs columns of b (leading dimension n), overwritten by X. */
 int fd_chol_solve(void *handle, int nrhs, double *b) {
     fd_chol *h = handle;
-    int j, st;
+    int j;
     if (nrhs < 1 || nrhs > h->nrhs_max) return FD_CHOL_FAILED;
-    for (j = 0; j < nrhs; j++) {
-        st = solve_column(h, b + (size_t)j * (size_t)h->n);
-        if (st != FD_CHOL_OK) return st;
-    }
+    for (j = 0; j < nrhs; j++) solve_column(h, b + (size_t)j * (size_t)h->n);
     return FD_CHOL_OK;
 }
-
-long fd_chol_allocations(void *handle) { return handle ? ((fd_chol *)handle)->allocations : 0; }
 
 /* Bytes held by the factor (its values and indices). */
 double fd_chol_factor_bytes(void *handle) {
@@ -201,7 +185,6 @@ int fd_chol_solve(void *handle, int nrhs, double *b) {
     return FD_CHOL_UNAVAILABLE;
 }
 
-long fd_chol_allocations(void *handle) { (void)handle; return 0; }
 
 double fd_chol_factor_bytes(void *handle) { (void)handle; return 0.0; }
 

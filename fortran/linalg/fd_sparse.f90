@@ -21,7 +21,7 @@ module fd_sparse
 
    public :: sparse_system, sparse_available, sparse_setup, sparse_factor, sparse_update_devices, sparse_solve
    public :: sparse_k_matvec, sparse_c_matvec, sparse_kc_matvec, sparse_free, sparse_band, sparse_factor_entries
-   public :: sparse_allocations, sparse_solve_many, sparse_factor_bytes, sparse_nonzeros
+   public :: sparse_solve_many, sparse_factor_bytes, sparse_nonzeros
 
    integer(c_int), parameter :: chol_ok = 0, chol_unavailable = 1, chol_no_memory = 2, chol_not_posdef = 3
 
@@ -51,10 +51,6 @@ module fd_sparse
          integer(c_int), value :: nrhs
          real(c_double), intent(inout) :: b(*)
       end function fd_chol_solve
-      integer(c_long) function fd_chol_allocations(handle) bind(c)
-         import :: c_long, c_ptr
-         type(c_ptr), value :: handle
-      end function fd_chol_allocations
       real(c_double) function fd_chol_factor_bytes(handle) bind(c)
          import :: c_double, c_ptr
          type(c_ptr), value :: handle
@@ -615,13 +611,6 @@ contains
       sparse_factor_bytes = 0.0_dp
       if (c_associated(sys%h)) sparse_factor_bytes = fd_chol_factor_bytes(sys%h)
    end function sparse_factor_bytes
-
-   !> Solves that had to allocate their solution or work space (0 after the first).
-   integer function sparse_allocations(sys)
-      type(sparse_system), intent(in) :: sys
-      sparse_allocations = 0
-      if (c_associated(sys%h)) sparse_allocations = int(fd_chol_allocations(sys%h))
-   end function sparse_allocations
 
    !> Free the system: CHOLMOD's part and every array (it may be set up again).
    subroutine sparse_free(sys)
