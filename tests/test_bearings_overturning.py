@@ -46,13 +46,16 @@ def record(name: str) -> dict:
 
 
 def block(x, y, ax: str, duration: float, ay: str | None = None, mu: float = 0.3, n1: int = 4,
-          overturning: bool | None = True, **bearing) -> dict:
+          overturning: bool | None = True, integration: dict | None = None, **bearing) -> dict:
     """A block (floor 2, mass M, at height H above the bearing plane, on stiff damped frames)
     on a base mat (floor 1, mass M0, in the plane) on bearings at (x, y) of storey 1, under the
-    x record `ax` (and the y record `ay`)."""
+    x record `ax` (and the y record `ay`); velocity-law bearings under Newmark unless told
+    (`integration`, the bearings' `law`: 'coulomb' takes no eps)."""
     n = len(x)
     b = {"n_bearings": n, "storey": [1] * n, "x": list(x), "y": list(y), "mu": [mu] * n,
          "law": ["velocity"] * n, "eps": [1.0e-3] * n, **bearing}
+    if b["law"][0] == "coulomb":
+        b.pop("eps")
     if overturning is not None:
         b["overturning"] = overturning
     g = {
@@ -63,7 +66,7 @@ def block(x, y, ax: str, duration: float, ay: str | None = None, mu: float = 0.3
         "damping": {"damping_type": "rayleigh", "rayleigh_a0": 0.0, "rayleigh_a1": 0.002},
         "bearings": b,
         "excitation": {**record(ax), "duration": duration},
-        "integration": {"n1": n1, "n2": 10},
+        "integration": integration if integration is not None else {"n1": n1, "n2": 10},
         "output": {"dir": "out", "output_every": 1},
     }
     if ay is not None:

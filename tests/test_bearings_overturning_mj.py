@@ -22,68 +22,21 @@ import numpy as np
 import pytest
 
 import frictiondyn
-from conftest import deck_text
+from test_bearings_overturning import D, DT, G, H, M, M0, X4, Y4, hold, normal_forces, run, write_record
+from test_bearings_overturning import block as newmark_block
 
-G = 9.80665
-M0 = 5.0e4         # the base mat, in the bearing plane [kg]
-M = 1.0e5          # the block on it, stiff frames between [kg]
-H = 3.0            # the block's height above the bearing plane [m]
-D = 6.0            # the rows' distance along x [m]
-E = 4.0            # along y [m]
-DT = 0.01
-X4 = [-D / 2, D / 2, D / 2, -D / 2]
-Y4 = [-E / 2, -E / 2, E / 2, E / 2]
 XS = [-3.0, 4.0, 1.5]      # a skewed triangle: S = sum r' r' not diagonal
 YS = [-2.0, -1.0, 3.5]
 
 
-def write_record(tmp_path, name: str, values) -> None:
-    (tmp_path / name).write_text("".join(f"{v:.17e}\n" for v in values))
-
-
-def record(name: str) -> dict:
-    return {"excitation_type": "record", "record_file": name, "record_format": "values",
-            "record_units": "m/s2", "dt_record": DT}
-
-
 def block(x, y, ax: str, duration: float, ay: str | None = None, mu: float = 0.3, n1: int = 4,
           overturning: bool | None = True, integration: dict | None = None, **bearing) -> dict:
-    """A block (floor 2, mass M, at height H above the bearing plane, on stiff damped frames) on
-    a base mat (floor 1, mass M0, in the plane) on Coulomb bearings at (x, y) of storey 1, under
-    the x record `ax` (and the y record `ay`), integrated by Moreau-Jean unless told."""
-    n = len(x)
-    b = {"n_bearings": n, "storey": [1] * n, "x": list(x), "y": list(y), "mu": [mu] * n,
-         "law": ["coulomb"] * n, **bearing}
-    if overturning is not None:
-        b["overturning"] = overturning
-    g = {
-        "floors": {"n_floors": 2, "mass": [M0, M], "plan_x": [10.0, 10.0], "plan_y": [8.0, 8.0],
-                   "height": [0.0, H]},
-        "frames": {"n_frames": 4, "storey": [2] * 4, "angle": [0.0, 0.0, 90.0, 90.0],
-                   "x": [0.0, 0.0, -4.0, 4.0], "y": [-3.0, 3.0, 0.0, 0.0], "k": [1.0e9] * 4},
-        "damping": {"damping_type": "rayleigh", "rayleigh_a0": 0.0, "rayleigh_a1": 0.002},
-        "bearings": b,
-        "excitation": {**record(ax), "duration": duration},
-        "integration": integration if integration is not None else {"technique": "moreau_jean", "n1": n1},
-        "output": {"dir": "out", "output_every": 1},
-    }
-    if ay is not None:
-        g["excitation2"] = {**record(ay), "duration": duration}
-    return g
-
-
-def run(tmp_path, g: dict, name: str) -> frictiondyn.Result:
-    return frictiondyn.run_text(deck_text(g), name, tmp_path)
-
-
-def normal_forces(r: frictiondyn.Result, n: int) -> np.ndarray:
-    return np.array([r[f"N{b + 1}"] for b in range(n)])
-
-
-def hold(tmp_path, name: str, a: float, duration: float = 1.0) -> None:
-    """A base acceleration rising smoothly to a over 0.2 s, then held."""
-    t = np.arange(0.0, duration + DT / 2, DT)
-    write_record(tmp_path, name, a * np.where(t < 0.2, 0.5 - 0.5 * np.cos(np.pi * t / 0.2), 1.0))
+    """test_bearings_overturning's block on Coulomb bearings, integrated by Moreau-Jean unless
+    told."""
+    bearing = {"law": ["coulomb"] * len(x), **bearing}
+    moreau_jean = {"technique": "moreau_jean", "n1": n1}
+    return newmark_block(x, y, ax, duration, ay, mu, n1, overturning,
+                         integration if integration is not None else moreau_jean, **bearing)
 
 
 def test_block_on_two_rows_takes_m_a_h_over_2d(tmp_path):
