@@ -399,25 +399,13 @@ contains
    !> a bearing's copy with p = max(N, 0) (with_normal_force), every other device's as it is.
    !> The one routine every technique calls for the normal forces at a time (explicit-shape
    !> arrays: no descriptor, no temporary, no allocation).
-   !> With the overturning (first, dn): bearing b's two components, first(b) and first(b) + 1,
-   !> take its share dn(b); the other devices are left as they are.
-   pure subroutine devices_at_normal_force(nd, dev0, az, dev, first, dn)
+   pure subroutine devices_at_normal_force(nd, dev0, az, dev)
       integer, intent(in) :: nd                     !! devices
       type(device_type), intent(in) :: dev0(nd)     !! the devices as the deck made them
       real(dp), intent(in) :: az                    !! vertical ground acceleration [m/s2]
       type(device_type), intent(inout) :: dev(nd)   !! their copies for the time, p set
-      integer, intent(in), optional :: first(:)     !! each bearing's x component (model%ot_dev)
-      real(dp), intent(in), optional :: dn(:)       !! each bearing's overturning share [N]
-      integer :: d, b
+      integer :: d
 
-      if (present(first) .and. present(dn)) then
-         do b = 1, size(first)
-            d = first(b)
-            call with_normal_force(dev0(d), az, dev(d), dn(b))
-            call with_normal_force(dev0(d + 1), az, dev(d + 1), dn(b))
-         end do
-         return
-      end if
       do d = 1, nd
          call with_normal_force(dev0(d), az, dev(d))
       end do

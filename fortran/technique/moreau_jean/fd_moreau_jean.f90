@@ -36,7 +36,7 @@ module fd_moreau_jean
                        technique_newmark, damping_stiffness, damping_rayleigh, technique_integrates
    use fd_model, only: model_type, integration_type, device_type
    use fd_excitation, only: excitation_type, table_motion, table_acceleration, excitation_none
-   use fd_friction_planar, only: devices_at_normal_force, normal_force, pendulum_excess
+   use fd_friction_planar, only: devices_at_normal_force, normal_force, pendulum_excess, with_normal_force
    use fd_overturning, only: overturning_forces
    use fd_kinematics, only: device_kinematics, device_nodes, devices_are_pairs, device_relative
    use fd_stiffness, only: influence_of
@@ -606,10 +606,14 @@ contains
       real(dp), intent(in) :: az, scale
       type(mj_work), intent(inout) :: w
       real(dp), intent(out) :: g(:)
-      integer :: d
+      integer :: d, b
 
       if (w%tilt) then
-         call devices_at_normal_force(w%nd, model%dev, az, w%dev, model%ot_dev, w%dn)
+         do b = 1, size(model%ot_dev)
+            d = model%ot_dev(b)
+            call with_normal_force(model%dev(d), az, w%dev(d), w%dn(b))
+            call with_normal_force(model%dev(d + 1), az, w%dev(d + 1), w%dn(b))
+         end do
       else
          call devices_at_normal_force(w%nd, model%dev, az, w%dev)
       end if

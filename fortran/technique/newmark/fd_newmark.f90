@@ -51,7 +51,7 @@ module fd_newmark
                         sparse_solve, sparse_k_matvec, sparse_c_matvec, sparse_kc_matvec, sparse_free, sparse_band, &
                         sparse_factor_entries, sparse_nonzeros
    use fd_device_state, only: device_state, device_force, phase_stick
-   use fd_friction_planar, only: pendulum_excess, normal_force, devices_at_normal_force, &
+   use fd_friction_planar, only: pendulum_excess, normal_force, with_normal_force, devices_at_normal_force, &
                                  normal_force_range
    use fd_overturning, only: overturning_forces
    use fd_friction, only: friction_init, friction_step, friction_settle, follows_velocity, friction_follow, &
@@ -298,7 +298,7 @@ contains
          w%k = k
          call try_step(model, exc, t0, 1, w, error)
          if (allocated(error)) return
-         call judge(opts, w, any_changed, any_bad)
+         call judge(model, opts, w, any_changed, any_bad)
          if (w%nd == 0 .or. .not. (any_changed .or. (any_bad .and. opts%check))) then
             call accept(model, exc, t0 + dt1, w, res, any_changed, .false.)
             res%newmark%steps_dt1 = res%newmark%steps_dt1 + 1
@@ -512,15 +512,22 @@ contains
       type(workspace), intent(inout) :: w
       logical, intent(in) :: trial                 !! t ends the trial step (a1, ag1, ag21 its state)
       real(dp) :: cap
-      integer :: q
+      integer :: d, q, b
 
       if (.not. w%varies) return
       if (w%three) w%az = table_acceleration(w%exc3, t)
-      if (w%tilt .and. trial) then
-         call overturning_forces(model, w%a1, w%ag1, w%ag21, w%dn1)
-         call devices_at_normal_force(w%nd, model%dev, w%az, w%dev, model%ot_dev, w%dn1)
-      else if (w%tilt) then
-         call devices_at_normal_force(w%nd, model%dev, w%az, w%dev, model%ot_dev, w%dn)
+      if (w%tilt) then
+         if (trial) call overturning_forces(model, w%a1, w%ag1, w%ag21, w%dn1)
+         do b = 1, size(model%ot_dev)
+            d = model%ot_dev(b)
+            if (trial) then
+               call with_normal_force(model%dev(d), w%az, w%dev(d), w%dn1(b))
+               call with_normal_force(model%dev(d + 1), w%az, w%dev(d + 1), w%dn1(b))
+            else
+               call with_normal_force(model%dev(d), w%az, w%dev(d), w%dn(b))
+               call with_normal_force(model%dev(d + 1), w%az, w%dev(d + 1), w%dn(b))
+            end if
+         end do
       else
          call devices_at_normal_force(w%nd, model%dev, w%az, w%dev)
       end if
@@ -960,7 +967,8 @@ contains
 
    !> Phases after the trial step, and the correctness condition of the step (with the
    !> convergence of a speed-dependent mu's forces).
-   subroutine judge(opts, w, any_changed, any_bad)
+   subroutine judge(model, opts, w, any_changed, any_bad)
+      type(model_type), intent(in) :: model
       type(integration_type), intent(in) :: opts
       type(workspace), intent(inout) :: w
       logical, intent(out) :: any_changed, any_bad
@@ -1005,7 +1013,7 @@ contains
          end if
          call try_step(model, exc, tj, lv, w, error)
          if (allocated(error)) return
-         call judge(opts, w, any_changed, any_bad)
+         call judge(model, opts, w, any_changed, any_bad)
          if (any_changed .or. (any_bad .and. opts%check)) then
             call advance_nested(model, exc, opts, tj, k + 1, w, res, error)
             if (allocated(error)) return
@@ -1044,7 +1052,7 @@ contains
          tl = t + sub*real(pos, dp)/real(units, dp)
          call try_step(model, exc, tl, 2 + level, w, error)
          if (allocated(error)) return
-         call judge(opts, w, any_changed, any_bad)
+         call judge(model, opts, w, any_changed, any_bad)
          if (any_bad .and. opts%check .and. level < lmax) then
             level = level + 1
             cycle
@@ -1130,7 +1138,7 @@ contains
          ! from the states the step was taken in, the same phases at its end; the condition in
          ! the devices that keep their phase through the step (it is a condition inside a
          ! phase: a changing device's velocities at the two ends belong to different phases)
-         call judge(opts, w, any_changed, any_bad)
+         call judge(model, opts, w, any_changed, any_bad)
          if (.not. same_phases(w%nd, w%st1, w%phase_end)) exit
          any_bad = w%follow_failed
          do d = 1, w%nd
