@@ -242,5 +242,7 @@ def test_what_the_overturning_cannot_take_is_refused(tmp_path, change, words):
         g["bearings"].pop("eps")
     with pytest.raises(frictiondyn.FrictiondynError) as err:
         run(tmp_path, g, "bad.nml")
+    # The folder's name holds the test's name ("overturning"): only the message itself counts.
+    message = str(err.value).replace(str(tmp_path), "<dir>")
     for w in words:
-        assert w in str(err.value), (w, str(err.value))
+        assert w in message, (w, message)
