@@ -509,3 +509,21 @@ def test_a_combined_order_not_measured_falls_back_to_the_separate_ladders(monkey
                for row in report.quantities)
     total, bounded = against_exact(report, exact)
     assert total == 13
+
+
+def test_moreau_jean_jumps_to_the_level_its_order_predicts(monkeypatch):
+    """Den Hartog by Moreau-Jean (the exact technique ruled out) at 1e-3: from n1 = 1, 2, 4 the
+    estimate at Moreau-Jean's order 1 predicts n1 = 32, run next; the changes across that jump
+    show no order, so n1 = 16 is filled in below it and the estimate of n1 = 32 stands on the
+    ladder 4, 16, 32: 5 levels and the probe, 31 430 steps (the ladder 1, 2, ..., 32 took 6
+    levels and 36 001 steps). Every estimated quantity is within the tolerance of the exact
+    technique's and each estimate at least its true error."""
+    monkeypatch.setattr(tolerance_module, "EXACT_DEVICES", 0)
+    text = deck_text(den_hartog_groups("coulomb", "moreau_jean", 20))
+    r, report, session = tolerance_module.tolerance_run(text=text, tolerance=1e-3, name="dh.nml")
+    session.close()
+    assert [label for label, _ in report.made] == ["probe"] + [
+        f"step level: n1 = {n}" for n in (1, 2, 4, 32, 16)]
+    assert (report.technique, report.n1, report.runs) == ("moreau_jean", 32, 6)
+    assert report.steps < 36_001, report.steps
+    assert against_exact(report, exact_den_hartog()) == (4, 4)

@@ -8,7 +8,7 @@ frictiondyn run DECK --tolerance T``, or ``tolerance`` in the deck's ``&integrat
 - Coulomb devices (a deck of ``technique = 'event_driven'`` or ``'moreau_jean'``): the exact
   event-driven technique when there are at most ``EXACT_DEVICES`` devices, all between two
   nodes (its peaks are exact: the estimate is round-off); otherwise Moreau-Jean, whose n1 is
-  refined from the step levels' estimate.
+  refined from the step levels' estimate (its next level the one their order predicts).
 - The paper's regularized laws (``technique = 'newmark'``): where the deck has numerical eps or
   f (the velocity and hysteretic devices of ``&friction`` and ``&isolators``; a brace's f is
   physical), the combined ladder refines n1 and eps and f together; where it cannot measure an
@@ -99,6 +99,11 @@ LAW_RATIO = 4
 #: the combined ladder ties eps and f to the step as its TIE-th power: the law's error, first
 #: order in eps and f, then falls at Newmark's second order in the step, as the step's does
 TIE = 2
+#: the techniques whose step ladder jumps to the level the measured order predicts (at most
+#: JUMP_MAX times the finest), filling in the level below it when the order is not confirmed
+#: across the jump
+JUMPS = ("moreau_jean",)
+JUMP_MAX = 8
 #: the combined ladder's coarsest eps and f: the deck's divided by this
 COMBINED_START = 0.5
 #: levels the combined ladder adds, one a round, before it falls back when its order is not measured
@@ -509,7 +514,10 @@ def _refine(runner: _Runner, nml, path: Path, n1: int, technique: str, tol: floa
     an order, the separate ladders, saying so: the law levels refined until the law's
     estimate is within half the budget, then the step levels until every estimate, step's
     plus law's, is within it (MARGIN times the allowed error): each round adds one level to a
-    ladder and reuses the runs of the rounds before (the runner makes each deck text once)."""
+    ladder and reuses the runs of the rounds before (the runner makes each deck text once).
+    Moreau-Jean's step ladder (JUMPS) adds the level the order its estimate stands on
+    predicts (at most JUMP_MAX times the finest), and, where the changes across that jump show
+    no order, the level halfway below it."""
     regularized = (technique == "newmark"
                    and _law_text(write_namelist(_with(nml, n1)), 2) is not None)
     start, start_why = _probe_start(runner, nml, technique, tol)
@@ -558,8 +566,10 @@ def _refine(runner: _Runner, nml, path: Path, n1: int, technique: str, tol: floa
         labels = [_label("step level", n, divisor) for n in steps[-5:]]
         summaries = runner.run(levels, keep=final, labels=labels)
         qs = _compare(summaries, tol, 2, (), floor, STEP_ORDER[technique])
+        ratios = [b / a for a, b in zip(steps[-5:], steps[-5:][1:])]
         for q in qs:
             if q.estimate is not None:
+                q.estimate = ladder_estimate(q.values, ratios, q.scale, STEP_ORDER[technique])
                 law = laws.get((q.key, q.index))
                 q.law_estimate = law.estimate if law is not None else None
         last = summaries[-1]
@@ -570,7 +580,7 @@ def _refine(runner: _Runner, nml, path: Path, n1: int, technique: str, tol: floa
         if regularized:
             _initial_peaks(path, tol, last, qs)
         rows = _quantity_rows(qs, tol, value)
-        worst, need = None, 1
+        worst, need, jump = None, 1, 2
         for q in qs:
             if q.key not in ESTIMATED:
                 continue
@@ -586,19 +596,30 @@ def _refine(runner: _Runner, nml, path: Path, n1: int, technique: str, tol: floa
                 worst = (q, ratio, step, law)
             budget = MARGIN * allowed - law
             need = max(need, _factor(step, budget, _measured(q.estimate)) if claims else 2)
+            # the level the order the estimate stands on predicts; none without an order
+            jump = (max(jump, _factor(step, budget, q.estimate.order)) if jump
+                    and q.estimate.method == "richardson" else 0)
         if worst is None:
             report = ToleranceReport(tol, floor, technique, f"{why}; {start_why}", steps[-1],
                                      int(divisor), len(runner.summaries), rounds, runner.steps,
                                      rows, list(runner.made))
             return report, final
-        runner.close()
+        runner.close(but=final)  # a level filled in below keeps the finest
         q, _, step, law = worst
         if steps[-1] * need > MAX_REFINEMENT * n1 or 2 * steps[-1] > MAX_REFINEMENT * n1:
             what = _what(q, value(q), step, law, q.estimate, q.law_estimate)
             why = (f"meeting it needs more than n1 = {MAX_REFINEMENT * n1}, the cost limit "
                    f"({MAX_REFINEMENT} times the deck's n1)")
             raise ToleranceError(_unmet(path, tol, what, None, why))
-        steps.append(2 * steps[-1])
+        if technique not in JUMPS:
+            steps.append(2 * steps[-1])
+        elif steps[-1] > 2 * steps[-2] and not jump and steps[-1] // 2 not in steps:
+            steps.insert(len(steps) - 1, steps[-1] // 2)  # the jump's order not confirmed
+        else:
+            jump = min(max(jump, 2), JUMP_MAX)
+            while steps[-1] * jump > MAX_REFINEMENT * n1:
+                jump //= 2
+            steps.append(steps[-1] * jump)
 
 
 def _what(q: Quantity, value: float, step: float, law: float, step_e: Estimate | None,
