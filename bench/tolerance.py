@@ -2,7 +2,8 @@
 
     .venv/bin/python bench/tolerance.py              # both tolerances (20 to 30 s)
     .venv/bin/python bench/tolerance.py --tol 1e-2   # one
-    .venv/bin/python bench/tolerance.py --split      # and every run each case made
+    .venv/bin/python bench/tolerance.py --split      # and every run each case made (and why
+                                                     # a combined ladder fell back)
 
 Each case has an exact answer: Den Hartog's steady state (closed form: amplitude A, peak
 absolute acceleration (k A + F) / m; the friction energy of the exact technique), free
@@ -244,6 +245,9 @@ def main(argv: list[str] | None = None) -> int:
                   f"estimate >= true {case_bound}/{len(pairs)}; cost {report.steps} steps, "
                   f"cheapest manual {manual} ({ratio:.2f} x)")
             if args.split:
+                if "measured no order" in report.why:  # the combined ladder fell back
+                    reason = report.why.split("measured no order (", 1)[1].split("): ", 1)[0]
+                    print(f"      the combined ladder fell back: {reason}")
                 for label, steps in report.made:
                     print(f"      {label}: {steps} steps")
                 finest = f"n1 = {report.n1}" + (f", eps and f / {report.law_divisor:g}"

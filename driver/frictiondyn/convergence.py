@@ -43,8 +43,8 @@ from ._nml import copy_namelist, read_namelist, write_namelist
 
 DEFAULT_N1 = 20  # n1 when a deck does not give it (fortran/model/fd_names.f90, default_n1)
 
-__all__ = ["ConvergenceReport", "Estimate", "Quantity", "estimate_error", "method_text",
-           "methods_text", "sound_estimate", "step_convergence"]
+__all__ = ["ConvergenceReport", "Estimate", "Quantity", "estimate_error", "ladder_estimate",
+           "method_text", "methods_text", "sound_estimate", "step_convergence"]
 
 #: (summary key, what, unit, item kind, peak key): a quantity is judged relative to its own
 #: size, but not below FLOOR times the largest of its kind (a DOF that hardly moves is judged
@@ -207,6 +207,70 @@ def sound_estimate(values: Sequence[float], factor: int, scale: float, cap: floa
     errors = [SAFETY_RICHARDSON * abs(v - q[-1]) + last for v in q[:-1]] + [last]
     return Estimate("richardson", errors, order=p, extrapolated=limit, reason=suffix,
                     changes=changes, measured=e.order if e.order > cap else None)
+
+
+def _order_between(d1: float, d2: float, r1: float, r2: float) -> float | None:
+    """The order p of two changes d1, d2 (one sign) between levels whose parameter falls by
+    r1 and then r2: d1 / d2 = r2^p (r1^p - 1) / (r2^p - 1), increasing in p; None outside
+    [ORDER_MIN, ORDER_MAX]."""
+    def g(p: float) -> float:
+        return r2**p * (r1**p - 1) / (r2**p - 1)
+
+    target = d1 / d2
+    lo, hi = ORDER_MIN, ORDER_MAX
+    if not g(lo) <= target <= g(hi):
+        return None
+    for _ in range(60):
+        mid = 0.5 * (lo + hi)
+        lo, hi = (mid, hi) if g(mid) < target else (lo, mid)
+    return 0.5 * (lo + hi)
+
+
+def ladder_estimate(values: Sequence[float], ratios: Sequence[float], scale: float,
+                    cap: float) -> Estimate:
+    """``sound_estimate`` on a ladder whose parameter falls by ``ratios[i]`` from level i to
+    i + 1 (one ratio fewer than values): with one ratio throughout, ``sound_estimate`` itself;
+    with the last two equal, ``sound_estimate`` of the last three levels; otherwise the order
+    of the last three levels solves d1 / d2 = r2^p (r1^p - 1) / (r2^p - 1) (a ladder that jumps
+    to a level predicted from the order the levels before it measured confirms that order
+    across the jump, or has none), and the same rules follow: the order capped at ``cap``, the
+    finest level's error 1.25 max(|d2|, the d2 that d1 predicts at that order) / (r2^p - 1), a
+    plain difference (3 times the larger of the last two changes) without a consistent
+    order."""
+    q = [float(v) for v in values]
+    r = [float(x) for x in ratios]
+    if len(r) != len(q) - 1:
+        raise ValueError("a ladder's ratios are one fewer than its values")
+    if len(set(r)) == 1:
+        return sound_estimate(q, r[0], scale, cap)
+    if r[-1] == r[-2]:
+        return sound_estimate(q[-3:], r[-1], scale, cap)
+    changes = [abs(b - a) for a, b in zip(q, q[1:])]
+    d1, d2 = q[-2] - q[-3], q[-1] - q[-2]
+    if max(changes[-2:]) <= UNCHANGED * scale:
+        last = max(changes[-2:])
+        errors = [max(abs(v - q[-1]), last) for v in q[:-1]] + [last]
+        return Estimate("unchanged", errors, changes=changes)
+    p = None
+    if d1 * d2 < 0:
+        reason = "the changes between levels alternate in sign"
+    elif d1 * d2 == 0:
+        reason = "a change between levels is zero"
+    else:
+        p = _order_between(d1, d2, r[-2], r[-1])
+        reason = f"no order in [{ORDER_MIN:g}, {ORDER_MAX:g}] fits the changes across the jump"
+    if p is None:
+        last = SAFETY_DIFFERENCE * max(changes[-2:])
+        errors = [max(SAFETY_DIFFERENCE * abs(v - q[-1]), last) for v in q[:-1]] + [last]
+        return Estimate("difference", errors, reason=reason, changes=changes)
+    pc = min(p, cap)
+    gain = r[-1]**pc - 1
+    predicted = abs(d1) * gain / (r[-1]**pc * (r[-2]**pc - 1))
+    last = SAFETY_RICHARDSON * max(abs(d2), predicted) / gain
+    errors = [SAFETY_RICHARDSON * abs(v - q[-1]) + last for v in q[:-1]] + [last]
+    return Estimate("richardson", errors, order=pc, extrapolated=q[-1] + d2 / gain,
+                    reason=f"ratios {r[-2]:g} and {r[-1]:g}", changes=changes,
+                    measured=p if p > cap else None)
 
 
 def method_text(e: Estimate | None) -> str:

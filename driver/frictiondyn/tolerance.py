@@ -8,17 +8,28 @@ frictiondyn run DECK --tolerance T``, or ``tolerance`` in the deck's ``&integrat
 - Coulomb devices (a deck of ``technique = 'event_driven'`` or ``'moreau_jean'``): the exact
   event-driven technique when there are at most ``EXACT_DEVICES`` devices, all between two
   nodes (its peaks are exact: the estimate is round-off); otherwise Moreau-Jean, whose n1 is
-  refined from the step levels' estimate.
-- The paper's regularized laws (``technique = 'newmark'``): the step levels estimate the step's
-  error and, where the deck has numerical eps or f (the velocity and hysteretic devices of
-  ``&friction`` and ``&isolators``; a brace's f is physical), the law levels the law's.
+  refined from the step levels' estimate (its next level the one their order predicts).
+- The paper's regularized laws (``technique = 'newmark'``): where the deck has numerical eps or
+  f (the velocity and hysteretic devices of ``&friction`` and ``&isolators``; a brace's f is
+  physical), the combined ladder refines n1 and eps and f together; where it cannot measure an
+  order, the step levels estimate the step's error and the law levels the law's.
 
 The levels start from the model, not the deck's n1: a probe of one record step gives the
 modes and dt_record, and the first round's finest step resolves the highest reported frequency
-to the tolerance (``_probe_start``). Under a regularized law the law levels come first, at that
-step: eps and f divided by 0.5, 2 and 8, then 4 times finer a level at a time, until the law's
-estimate is within half the budget; then the step levels at that eps and f, n1 = n_c, 2 n_c,
-4 n_c, then one finer level a round, each round reusing the runs of the one before. Each
+to the tolerance (``_probe_start``). Under a regularized law the combined ladder comes first
+(``_combined``): n1 = n_c, 2 n_c, 4 n_c with eps and f divided by 0.5, 2 and 8 (eps and f fall
+as the step squared, so that the law's first-order error falls as Newmark's second-order step
+error does, and one order measured from three levels covers both), then the one level the
+measured order predicts meets the tolerance, its estimate from the last three levels (their
+order confirmed across the jump, ``ladder_estimate``); one extra level, 8 n_c, when the first
+three measure no order. Where the combined order cannot be measured (the changes alternate,
+do not shrink, or the order is below the range, above the noise; changes of one sign that
+shrink faster than order 4 settle, ``_settles``, and their difference stands), or its next
+level is beyond the cost limit, the separate ladders take over, reusing its runs, and the
+report's ``why`` says so. The separate ladders: the law levels first, at the first round's
+finest step: eps and f divided by 0.5, 2 and 8, then 4 times finer a level at a time, until
+the law's estimate is within half the budget; then the step levels at that eps and f, n1 =
+n_c, 2 n_c, 4 n_c, then one finer level a round, each round reusing the runs before. Each
 estimate is Richardson's at the measured order capped at the theoretical one (``STEP_ORDER``,
 ``LAW_ORDER``), from the larger of the last two changes' predictions; a plain difference (times
 3) where no order is consistent, or Richardson's over every other level (a ratio of 4) when five
@@ -52,6 +63,8 @@ from .convergence import (
     DEFAULT_N1,
     ESTIMATED,
     LAW_ORDER,
+    NOISE,
+    ORDER_MAX,
     STEP_ORDER,
     Estimate,
     Quantity,
@@ -59,6 +72,8 @@ from .convergence import (
     _compare,
     _cpus,
     _law_text,
+    ladder_estimate,
+    method_text,
     methods_text,
 )
 
@@ -81,6 +96,20 @@ MARGIN = 1.0
 #: times finer than the one before (0.5, 2, 8, then 32 and 128, the cost limit)
 LAW_START = (0.5, 2, 8)
 LAW_RATIO = 4
+#: the combined ladder ties eps and f to the step as its TIE-th power: the law's error, first
+#: order in eps and f, then falls at Newmark's second order in the step, as the step's does
+TIE = 2
+#: the techniques whose step ladder jumps to the level the measured order predicts (at most
+#: JUMP_MAX times the finest), filling in the level below it when the order is not confirmed
+#: across the jump
+JUMPS = ("moreau_jean",)
+JUMP_MAX = 8
+#: the combined ladder's coarsest eps and f: the deck's divided by this
+COMBINED_START = 0.5
+#: levels the combined ladder adds, one a round, before it falls back when its order is not measured
+COMBINED_EXTRA = 1
+#: the method of a combined ladder's estimate
+COMBINED = "step and law together (eps and f / the step squared)"
 #: the estimate of an exact technique's peaks, relative to the quantity (round-off)
 ROUND_OFF = 1e-9
 #: the two deck variables of a tolerance run (&integration)
@@ -210,7 +239,9 @@ class _Runner:
             ) -> list[dict]:
         for t, label in zip(texts, labels or []):
             self.labels.setdefault(t, label)
-        todo = [t for t in dict.fromkeys(texts) if t not in self.summaries]
+        # a run made before and closed is made again if it is the one to keep
+        todo = [t for t in dict.fromkeys(texts)
+                if t not in self.summaries or (t == keep and t not in self.kept)]
         sessions = []
         try:
             for t in todo:
@@ -363,22 +394,140 @@ def _law_levels(runner: _Runner, nml, technique: str, n: int, tol: float, floor:
                 divisors: list[float]) -> dict[tuple[str, int], Quantity]:
     """The law's estimate per quantity, from the last three law levels at step n1 = n."""
     texts = [_text_at(nml, technique, n, d) for d in divisors[-3:]]
-    runner.close()
+    runner.close(but=texts[-1])  # the combined ladder's finest level may be the law's
     labels = [_label("law level", n, d) for d in divisors[-3:]]
     runs = runner.run(texts, keep=texts[-1], labels=labels)  # its finest may be the run returned
     return {(q.key, q.index): q for q in _compare(runs, tol, LAW_RATIO, (), floor, LAW_ORDER)
             if q.estimate is not None}
 
 
+def _measures(e: Estimate, allowed: float) -> bool:
+    """Whether a combined ladder's estimate may stand for the error: Richardson's, unchanged,
+    or a plain difference whose last two changes are below NOISE times the allowed error (the
+    scatter of sampled peaks; ``_claims`` on the levels the estimate stands on)."""
+    return e.method != "difference" or max(e.changes[-2:]) <= NOISE * allowed
+
+
+def _settles(values: list[float], ratios: list[float]) -> bool:
+    """Whether the last three levels' changes have one sign and shrink faster than any order
+    of the range (ORDER_MAX), or the last is zero: a quantity that settles before the
+    asymptotic order shows, whose plain difference (3 times the larger change) is then an
+    upper estimate, not a guess."""
+    d1, d2 = values[-2] - values[-3], values[-1] - values[-2]
+    if d1 == 0:
+        return False
+    if d2 == 0:
+        return True
+    r1, r2 = ratios[-2], ratios[-1]
+    fastest = r2**ORDER_MAX * (r1**ORDER_MAX - 1) / (r2**ORDER_MAX - 1)
+    return d1 * d2 > 0 and d1 / d2 > fastest
+
+
+def _tied(start: int, s: int) -> tuple[int, float]:
+    """The combined ladder's level of scale ``s``: n1 = s start, and eps and f divided by
+    COMBINED_START s^TIE."""
+    return start * s, COMBINED_START * s**TIE
+
+
+def _combined(runner: _Runner, nml, path: Path, n1: int, technique: str, tol: float,
+              floor: float, start: int, why: str) -> tuple[ToleranceReport, str] | str:
+    """The combined ladder of a regularized law: the step and the law's eps and f refined
+    together (``_tied``), so that one ratio moves both error sources and three levels measure
+    one order (capped at the step's theoretical one: the law's first order in eps and f is
+    order TIE in the step). From scales 1, 2 and 4, each round adds the one level the measured
+    order predicts meets the tolerance (a power of 2 times the finest, with a margin of 1.5),
+    every run made once; the estimate of the finest level then stands on the last three levels,
+    whose order confirms the prediction across the jump (``ladder_estimate``). Returns the
+    report and the text of the run returned, or, where a quantity's combined order cannot be
+    measured (no consistent order, changes above the noise) or the next level is beyond the
+    cost limit, the reason, for the separate ladders to take over."""
+    scales = [1, 2, 4]
+    cap = STEP_ORDER[technique]
+    rounds = extra = 0
+    while True:
+        rounds += 1
+        texts = [_text_at(nml, technique, *_tied(start, s)) for s in scales]
+        labels = [_label("combined level", *_tied(start, s)) for s in scales]
+        runner.close()
+        summaries = runner.run(texts, keep=texts[-1], labels=labels)
+        ratios = [b / a for a, b in zip(scales, scales[1:])]
+        qs = _compare(summaries, tol, 2, (), floor, cap)
+        last = summaries[-1]
+        _initial_peaks(path, tol, last, qs)
+        need, worst, unmeasured = 1, None, None
+        for q in qs:
+            if q.key not in ESTIMATED:
+                continue
+            q.estimate = ladder_estimate(q.values, ratios, q.scale, cap)
+            allowed = tol * q.scale
+            error = q.estimate.errors[-1]
+            if not (_measures(q.estimate, allowed) or _settles(q.values, ratios)):
+                unmeasured = q
+                break
+            if error <= MARGIN * allowed:
+                continue
+            p = q.estimate.order or cap
+            factor = (1.5 * error / allowed) ** (1.0 / p)
+            need = max(need, 2 ** max(1, math.ceil(math.log2(factor))))
+            if worst is None or error / allowed > worst[1]:
+                worst = (q, error / allowed)
+        if unmeasured is not None:
+            if extra < COMBINED_EXTRA and len(scales) == 3 + extra:  # the coarsest level may
+                # come before the asymptotic order: one more level, the coarsest then left out
+                extra += 1
+                scales.append(2 * scales[-1])
+                continue
+            name = f"{unmeasured.what} {unmeasured.item}".strip()
+            return (f"{name}: the combined levels n1 = "
+                    f"{', '.join(str(_tied(start, s)[0]) for s in scales[-3:])} give "
+                    f"{method_text(unmeasured.estimate)}")
+        if worst is None:
+            rows = []
+            for q in qs:
+                if q.key not in ESTIMATED:
+                    continue
+                error = max(q.estimate.errors[-1], ROUND_OFF * q.scale)
+                rows.append({"key": q.key, "index": q.index, "what": q.what, "item": q.item,
+                             "unit": q.unit, "value": _value(last, q), "estimated_error": error,
+                             "relative_error": error / q.scale if q.scale > 0 else 0.0,
+                             "allowed": tol * q.scale,
+                             "method": f"{COMBINED}: {method_text(q.estimate)}"})
+            n_final, divisor = _tied(start, scales[-1])
+            levels = "; ".join(f"n1 = {n}, eps and f / {d:g}"
+                               for n, d in (_tied(start, s) for s in scales))
+            report = ToleranceReport(tol, floor, technique, f"{why}; the combined ladder: {levels}",
+                                     n_final, int(divisor), len(runner.summaries), rounds,
+                                     runner.steps, rows, list(runner.made))
+            return report, texts[-1]
+        s_next = scales[-1] * need
+        n_next, d_next = _tied(start, s_next)
+        if n_next > MAX_REFINEMENT * n1 or d_next > MAX_REFINEMENT:
+            q = worst[0]
+            return (f"{q.what} {q.item}".strip() + f": the combined ladder's next level, n1 = "
+                    f"{n_next} with eps and f / {d_next:g}, is beyond the cost limit")
+        scales.append(s_next)
+
+
 def _refine(runner: _Runner, nml, path: Path, n1: int, technique: str, tol: float, floor: float,
             why: str) -> tuple[ToleranceReport, str]:
-    """The law levels refined until the law's estimate is within half the budget, then the
-    step levels until every estimate, step's plus law's, is within it (MARGIN times the
-    allowed error): each round adds one level to a ladder and reuses the runs of the rounds
-    before (the runner makes each deck text once)."""
+    """Under a regularized law, the combined ladder (``_combined``); where it cannot measure
+    an order, the separate ladders, saying so: the law levels refined until the law's
+    estimate is within half the budget, then the step levels until every estimate, step's
+    plus law's, is within it (MARGIN times the allowed error): each round adds one level to a
+    ladder and reuses the runs of the rounds before (the runner makes each deck text once).
+    Moreau-Jean's step ladder (JUMPS) adds the level the order its estimate stands on
+    predicts (at most JUMP_MAX times the finest), and, where the changes across that jump show
+    no order, the level halfway below it."""
     regularized = (technique == "newmark"
                    and _law_text(write_namelist(_with(nml, n1)), 2) is not None)
     start, start_why = _probe_start(runner, nml, technique, tol)
+    if regularized:
+        got = _combined(runner, nml, path, n1, technique, tol, floor, start,
+                        f"{why}; {start_why}")
+        if not isinstance(got, str):
+            return got
+        why = (f"{why}; the combined ladder (eps and f tied to the step) measured no order "
+               f"({got}): the separate step and law ladders")
     steps = [start, 2 * start, 4 * start]
     divisors = list(LAW_START) if regularized else [1]
     laws: dict[tuple[str, int], Quantity] = {}
@@ -417,8 +566,10 @@ def _refine(runner: _Runner, nml, path: Path, n1: int, technique: str, tol: floa
         labels = [_label("step level", n, divisor) for n in steps[-5:]]
         summaries = runner.run(levels, keep=final, labels=labels)
         qs = _compare(summaries, tol, 2, (), floor, STEP_ORDER[technique])
+        ratios = [b / a for a, b in zip(steps[-5:], steps[-5:][1:])]
         for q in qs:
             if q.estimate is not None:
+                q.estimate = ladder_estimate(q.values, ratios, q.scale, STEP_ORDER[technique])
                 law = laws.get((q.key, q.index))
                 q.law_estimate = law.estimate if law is not None else None
         last = summaries[-1]
@@ -429,7 +580,7 @@ def _refine(runner: _Runner, nml, path: Path, n1: int, technique: str, tol: floa
         if regularized:
             _initial_peaks(path, tol, last, qs)
         rows = _quantity_rows(qs, tol, value)
-        worst, need = None, 1
+        worst, need, jump = None, 1, 2
         for q in qs:
             if q.key not in ESTIMATED:
                 continue
@@ -445,19 +596,30 @@ def _refine(runner: _Runner, nml, path: Path, n1: int, technique: str, tol: floa
                 worst = (q, ratio, step, law)
             budget = MARGIN * allowed - law
             need = max(need, _factor(step, budget, _measured(q.estimate)) if claims else 2)
+            # the level the order the estimate stands on predicts; none without an order
+            jump = (max(jump, _factor(step, budget, q.estimate.order)) if jump
+                    and q.estimate.method == "richardson" else 0)
         if worst is None:
             report = ToleranceReport(tol, floor, technique, f"{why}; {start_why}", steps[-1],
                                      int(divisor), len(runner.summaries), rounds, runner.steps,
                                      rows, list(runner.made))
             return report, final
-        runner.close()
+        runner.close(but=final)  # a level filled in below keeps the finest
         q, _, step, law = worst
         if steps[-1] * need > MAX_REFINEMENT * n1 or 2 * steps[-1] > MAX_REFINEMENT * n1:
             what = _what(q, value(q), step, law, q.estimate, q.law_estimate)
             why = (f"meeting it needs more than n1 = {MAX_REFINEMENT * n1}, the cost limit "
                    f"({MAX_REFINEMENT} times the deck's n1)")
             raise ToleranceError(_unmet(path, tol, what, None, why))
-        steps.append(2 * steps[-1])
+        if technique not in JUMPS:
+            steps.append(2 * steps[-1])
+        elif steps[-1] > 2 * steps[-2] and not jump and steps[-1] // 2 not in steps:
+            steps.insert(len(steps) - 1, steps[-1] // 2)  # the jump's order not confirmed
+        else:
+            jump = min(max(jump, 2), JUMP_MAX)
+            while steps[-1] * jump > MAX_REFINEMENT * n1:
+                jump //= 2
+            steps.append(steps[-1] * jump)
 
 
 def _what(q: Quantity, value: float, step: float, law: float, step_e: Estimate | None,
@@ -554,8 +716,8 @@ def tolerance_run(
     runner = _Runner(path, threads, (dofs, devices))
     try:
         if technique == "newmark":
-            why = ("the paper's regularized laws: n1 refined by the step levels, and eps and f by "
-                   "the law levels" if _law_text(stripped, 2) is not None else
+            why = ("the paper's regularized laws: n1, eps and f refined together by the combined "
+                   "ladder" if _law_text(stripped, 2) is not None else
                    "Newmark without a numerical eps or f (no velocity or hysteretic device of "
                    "&friction or &isolators): n1 refined by the step levels")
             report, final = _refine(runner, nml, path, n1, "newmark", tol, floor, why)
