@@ -98,6 +98,9 @@ module fd_deck
    interface optional_reals
       module procedure optional_reals_named, optional_reals_of
    end interface optional_reals
+   interface signed_reals
+      module procedure signed_reals_named, signed_reals_of
+   end interface signed_reals
    interface node_list
       module procedure node_list_named, node_list_of
    end interface node_list
@@ -1451,7 +1454,7 @@ contains
       call need_int(deck, grp, 'n_frames', n_frames, 0, max_springs, error)
       if (allocated(error)) return
       n = n_frames
-      call plan_elements(deck, 'frames', grp, cfg, n, storey, angle, x, y, error)
+      call plan_elements(deck, grp, cfg, n, storey, angle, x, y, error)
       if (allocated(error)) return
       call need_reals(deck, grp, 'k', k, n, 'N/m', error, positive=.true.)
       if (allocated(error)) return
@@ -1475,9 +1478,8 @@ contains
 
    !> The plan position of the elements of a group of a building of rigid floors: storey
    !> (1..n_floors), angle [deg], and a point (x, y) of the element's line [m].
-   subroutine plan_elements(deck, group, grp, cfg, n, storey, angle, x, y, error)
+   subroutine plan_elements(deck, grp, cfg, n, storey, angle, x, y, error)
       type(deck_text), intent(in) :: deck
-      character(len=*), intent(in) :: group
       type(group_text), intent(in) :: grp
       type(run_config), intent(in) :: cfg
       integer, intent(in) :: n
@@ -1485,14 +1487,13 @@ contains
       real(dp), intent(inout) :: angle(:), x(:), y(:)
       type(error_type), allocatable, intent(out) :: error
 
-      call node_list(deck, group, 'storey', storey, given_of(grp, 'storey', size(storey)), n, 1, &
-                     cfg%model%n_floors, error)
+      call node_list(deck, grp, 'storey', storey, n, 1, cfg%model%n_floors, error)
       if (allocated(error)) return
-      call signed_reals(deck, group, 'angle', angle, given_of(grp, 'angle', size(angle)), n, 'deg', error)
+      call signed_reals(deck, grp, 'angle', angle, n, 'deg', error)
       if (allocated(error)) return
-      call signed_reals(deck, group, 'x', x, given_of(grp, 'x', size(x)), n, 'm', error)
+      call signed_reals(deck, grp, 'x', x, n, 'm', error)
       if (allocated(error)) return
-      call signed_reals(deck, group, 'y', y, given_of(grp, 'y', size(y)), n, 'm', error)
+      call signed_reals(deck, grp, 'y', y, n, 'm', error)
    end subroutine plan_elements
 
    !> P-Delta of a building of rigid floors: the constant geometric stiffness of the gravity
@@ -1590,7 +1591,7 @@ contains
       call need_int(deck, 'floor_braces', 'n_braces', n_braces, .true., 0, max_devices - cfg%model%n_devices, error)
       if (allocated(error)) return
       n = n_braces
-      call plan_elements(deck, 'floor_braces', grp, cfg, n, storey, angle, x, y, error)
+      call plan_elements(deck, grp, cfg, n, storey, angle, x, y, error)
       if (allocated(error)) return
       call need_reals(deck, grp, 'slip_load', slip_load, n, 'N', error, positive=.true.)
       if (allocated(error)) return
@@ -2813,6 +2814,17 @@ contains
                                 positive)
    end subroutine optional_reals_of
 
+   !> signed_reals of the group's array var, with the elements its text gives.
+   subroutine signed_reals_of(deck, grp, var, x, n, unit, error)
+      type(deck_text), intent(in) :: deck
+      type(group_text), intent(in) :: grp                 !! the group's text
+      character(len=*), intent(in) :: var, unit
+      real(dp), intent(in) :: x(:)
+      integer, intent(in) :: n
+      type(error_type), allocatable, intent(out) :: error
+      call signed_reals_named(deck, grp%name, var, x, given_of(grp, var, size(x)), n, unit, error)
+   end subroutine signed_reals_of
+
    !> node_list of the group's array var, with the elements its text gives.
    subroutine node_list_of(deck, grp, var, x, n, lo, hi, error)
       type(deck_text), intent(in) :: deck
@@ -2921,7 +2933,7 @@ contains
    end subroutine need_reals_named
 
    !> Values that must be given, finite and of either sign (a plan coordinate, an angle).
-   subroutine signed_reals(deck, group, var, x, given, n, unit, error)
+   subroutine signed_reals_named(deck, group, var, x, given, n, unit, error)
       type(deck_text), intent(in) :: deck
       character(len=*), intent(in) :: group, var, unit
       real(dp), intent(in) :: x(:)
@@ -2942,7 +2954,7 @@ contains
          if (allocated(error)) return
       end do
       call no_extra(deck, group, var, x, given, n, error)
-   end subroutine signed_reals
+   end subroutine signed_reals_named
 
    !> Values not given take a default; given ones must be finite (and > 0 if positive).
    subroutine optional_reals_named(deck, group, var, x, given, n, default, unit, error, positive)
