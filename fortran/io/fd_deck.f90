@@ -641,12 +641,8 @@ contains
                           "has one direction")
          return
       end if
-      if (cfg%exc2%dt_record /= cfg%exc%dt_record) then
-         call bad(deck, 'excitation2', 'dt_record', trim(fmt_real(cfg%exc2%dt_record)), "equal to &excitation's "// &
-                  trim(fmt_real(cfg%exc%dt_record))//' s (the two components share the step dt1 = dt_record / n1)', &
-                  error)
-         return
-      end if
+      call same_record_step(deck, 'excitation2', cfg%exc2%dt_record, cfg%exc%dt_record, 'the two components', error)
+      if (allocated(error)) return
       if (cfg%model%n_floors == 0) return   ! &matrices gives influence2
       ! r2 = (-sin a, cos a, 0): along excitation_angle + 90 degrees
       allocate (cfg%model%influence2(cfg%model%n_dof))
@@ -673,12 +669,21 @@ contains
                           "takes it; remove &excitation3 or add &bearings")
          return
       end if
-      if (cfg%exc3%dt_record /= cfg%exc%dt_record) then
-         call bad(deck, 'excitation3', 'dt_record', trim(fmt_real(cfg%exc3%dt_record)), "equal to &excitation's "// &
-                  trim(fmt_real(cfg%exc%dt_record))//' s (the components share the step dt1 = dt_record / n1)', &
-                  error)
-      end if
+      call same_record_step(deck, 'excitation3', cfg%exc3%dt_record, cfg%exc%dt_record, 'the components', error)
    end subroutine read_vertical_component
+
+   !> A further component's dt_record must be &excitation's: the components share the step.
+   subroutine same_record_step(deck, gname, dt, dt_first, components, error)
+      type(deck_text), intent(in) :: deck
+      character(len=*), intent(in) :: gname               !! the further component's group
+      real(dp), intent(in) :: dt                          !! its dt_record [s]
+      real(dp), intent(in) :: dt_first                    !! &excitation's [s]
+      character(len=*), intent(in) :: components          !! the components, as the message names them
+      type(error_type), allocatable, intent(out) :: error
+      if (dt == dt_first) return
+      call bad(deck, gname, 'dt_record', trim(fmt_real(dt)), "equal to &excitation's "//trim(fmt_real(dt_first))// &
+               ' s ('//components//' share the step dt1 = dt_record / n1)', error)
+   end subroutine same_record_step
 
    subroutine read_component(deck, gname, required, exc, record, found, error)
       type(deck_text), intent(in) :: deck
