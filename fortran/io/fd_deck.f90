@@ -87,6 +87,24 @@ module fd_deck
       type(record_info) :: record3                !! its record
    end type run_config
 
+   !> The checks of a group's values, by the group's name and the elements given
+   !> (the *_named forms), or by the group's text (its name and the elements it gives).
+   interface need_int
+      module procedure need_int_named, need_int_of
+   end interface need_int
+   interface need_reals
+      module procedure need_reals_named, need_reals_of
+   end interface need_reals
+   interface optional_reals
+      module procedure optional_reals_named, optional_reals_of
+   end interface optional_reals
+   interface signed_reals
+      module procedure signed_reals_named, signed_reals_of
+   end interface signed_reals
+   interface node_list
+      module procedure node_list_named, node_list_of
+   end interface node_list
+
 contains
 
    !> Read and validate a deck file. Its bytes are read once: split into lines as load_deck
@@ -282,14 +300,14 @@ contains
          if (.not. more) exit
       end do
       if (allocated(error)) return
-      call need_int(deck, 'model', 'n_dof', n_dof, is_given(grp, 'n_dof'), 1, max_dof, error)
+      call need_int(deck, grp, 'n_dof', n_dof, 1, max_dof, error)
       if (allocated(error)) return
       n = n_dof
-      call need_reals(deck, 'model', 'mass', mass, given_of(grp, 'mass', size(mass)), n, 'kg', error, positive=.true.)
+      call need_reals(deck, grp, 'mass', mass, n, 'kg', error, positive=.true.)
       if (allocated(error)) return
-      call optional_reals(deck, 'model', 'u0', u0, given_of(grp, 'u0', size(u0)), n, default_u0, 'm', error)
+      call optional_reals(deck, grp, 'u0', u0, n, default_u0, 'm', error)
       if (allocated(error)) return
-      call optional_reals(deck, 'model', 'v0', v0, given_of(grp, 'v0', size(v0)), n, default_v0, 'm/s', error)
+      call optional_reals(deck, grp, 'v0', v0, n, default_v0, 'm/s', error)
       if (allocated(error)) return
       call check_labels(deck, grp, 'model', label, n, error)
       if (allocated(error)) return
@@ -341,16 +359,14 @@ contains
          if (.not. more) exit
       end do
       if (allocated(error)) return
-      call need_int(deck, 'springs', 'n_springs', n_springs, is_given(grp, 'n_springs'), 0, max_springs, error)
+      call need_int(deck, grp, 'n_springs', n_springs, 0, max_springs, error)
       if (allocated(error)) return
       n = n_springs
-      call node_list(deck, 'springs', 'node_i', node_i, given_of(grp, 'node_i', size(node_i)), n, 1, &
-                     cfg%model%n_dof, error)
+      call node_list(deck, grp, 'node_i', node_i, n, 1, cfg%model%n_dof, error)
       if (allocated(error)) return
-      call node_list(deck, 'springs', 'node_j', node_j, given_of(grp, 'node_j', size(node_j)), n, 0, &
-                     cfg%model%n_dof, error)
+      call node_list(deck, grp, 'node_j', node_j, n, 0, cfg%model%n_dof, error)
       if (allocated(error)) return
-      call need_reals(deck, 'springs', 'k', k, given_of(grp, 'k', size(k)), n, 'N/m', error, positive=.true.)
+      call need_reals(deck, grp, 'k', k, n, 'N/m', error, positive=.true.)
       if (allocated(error)) return
       do i = 1, n
          call distinct_nodes(deck, 'springs', i, node_i(i), node_j(i), 'a spring joins two different nodes', error)
@@ -392,8 +408,7 @@ contains
       modal_modes = default_modal_modes
       call required_group(deck, 'damping', grp, error)
       if (allocated(error)) return
-      call check_length(deck, grp, 'damping_type', name_len, error)
-      if (.not. allocated(error)) call check_length(deck, grp, 'mode_system', name_len, error)
+      call check_lengths(deck, grp, [character(len=16) :: 'damping_type', 'mode_system'], [name_len, name_len], error)
       if (allocated(error)) return
       do
          read (grp%lines, nml=damping, iostat=ios, iomsg=msg)
@@ -536,11 +551,9 @@ contains
       if (ios /= 0) then
          call no_memory(deck, 'friction', i, 'devices', error); return
       end if
-      call check_length(deck, grp, 'law', name_len, error)
-      if (.not. allocated(error)) call check_length(deck, grp, 'mu_law', name_len, error)
-      if (allocated(error)) return
       ! a longer label would be cut by the namelist read: refused from the group's text first
-      call check_length(deck, grp, 'label', label_len - 1, error)
+      call check_lengths(deck, grp, [character(len=16) :: 'law', 'mu_law', 'label'], [name_len, name_len, label_len - 1], &
+                         error)
       if (allocated(error)) return
       do
          read (grp%lines, nml=friction, iostat=ios, iomsg=msg)
@@ -551,13 +564,11 @@ contains
       call need_int(deck, 'friction', 'n_devices', n_devices, .true., 0, max_devices, error)
       if (allocated(error)) return
       n = n_devices
-      call node_list(deck, 'friction', 'node_i', node_i, given_of(grp, 'node_i', size(node_i)), n, 1, &
-                     cfg%model%n_dof, error)
+      call node_list(deck, grp, 'node_i', node_i, n, 1, cfg%model%n_dof, error)
       if (allocated(error)) return
-      call node_list(deck, 'friction', 'node_j', node_j, given_of(grp, 'node_j', size(node_j)), n, 0, &
-                     cfg%model%n_dof, error)
+      call node_list(deck, grp, 'node_j', node_j, n, 0, cfg%model%n_dof, error)
       if (allocated(error)) return
-      call need_reals(deck, 'friction', 'p', p, given_of(grp, 'p', size(p)), n, 'N', error, positive=.false.)
+      call need_reals(deck, grp, 'p', p, n, 'N', error, positive=.false.)
       if (allocated(error)) return
       g_mu = given_of(grp, 'mu', size(mu))
       call read_mu_laws(deck, grp, n, mu_law, mu, g_mu, mu_max, mu_min, mu_rate, mu_table_v, mu_table_mu, &
@@ -567,14 +578,11 @@ contains
       if (allocated(error)) return
       call need_reals(deck, 'friction', 'mu', mu, g_mu, n, '', error, positive=.false.)
       if (allocated(error)) return
-      call optional_reals(deck, 'friction', 'eps', eps, given_of(grp, 'eps', size(eps)), n, default_eps, 'm/s', &
-                          error, positive=.true.)
+      call optional_reals(deck, grp, 'eps', eps, n, default_eps, 'm/s', error, positive=.true.)
       if (allocated(error)) return
-      call optional_reals(deck, 'friction', 'eps1', eps1, given_of(grp, 'eps1', size(eps1)), n, default_eps1, &
-                          'm/s', error, positive=.true.)
+      call optional_reals(deck, grp, 'eps1', eps1, n, default_eps1, 'm/s', error, positive=.true.)
       if (allocated(error)) return
-      call optional_reals(deck, 'friction', 'f', f, given_of(grp, 'f', size(f)), n, default_f, 'm', error, &
-                          positive=.true.)
+      call optional_reals(deck, grp, 'f', f, n, default_f, 'm', error, positive=.true.)
       if (allocated(error)) return
       if (any(law(n + 1:) /= '')) then
          call bad(deck, 'friction', 'law', 'with '//trim(fmt_int(findloc(law /= '', .true., 1, back=.true.))) &
@@ -633,12 +641,8 @@ contains
                           "has one direction")
          return
       end if
-      if (cfg%exc2%dt_record /= cfg%exc%dt_record) then
-         call bad(deck, 'excitation2', 'dt_record', trim(fmt_real(cfg%exc2%dt_record)), "equal to &excitation's "// &
-                  trim(fmt_real(cfg%exc%dt_record))//' s (the two components share the step dt1 = dt_record / n1)', &
-                  error)
-         return
-      end if
+      call same_record_step(deck, 'excitation2', cfg%exc2%dt_record, cfg%exc%dt_record, 'the two components', error)
+      if (allocated(error)) return
       if (cfg%model%n_floors == 0) return   ! &matrices gives influence2
       ! r2 = (-sin a, cos a, 0): along excitation_angle + 90 degrees
       allocate (cfg%model%influence2(cfg%model%n_dof))
@@ -665,12 +669,21 @@ contains
                           "takes it; remove &excitation3 or add &bearings")
          return
       end if
-      if (cfg%exc3%dt_record /= cfg%exc%dt_record) then
-         call bad(deck, 'excitation3', 'dt_record', trim(fmt_real(cfg%exc3%dt_record)), "equal to &excitation's "// &
-                  trim(fmt_real(cfg%exc%dt_record))//' s (the components share the step dt1 = dt_record / n1)', &
-                  error)
-      end if
+      call same_record_step(deck, 'excitation3', cfg%exc3%dt_record, cfg%exc%dt_record, 'the components', error)
    end subroutine read_vertical_component
+
+   !> A further component's dt_record must be &excitation's: the components share the step.
+   subroutine same_record_step(deck, gname, dt, dt_first, components, error)
+      type(deck_text), intent(in) :: deck
+      character(len=*), intent(in) :: gname               !! the further component's group
+      real(dp), intent(in) :: dt                          !! its dt_record [s]
+      real(dp), intent(in) :: dt_first                    !! &excitation's [s]
+      character(len=*), intent(in) :: components          !! the components, as the message names them
+      type(error_type), allocatable, intent(out) :: error
+      if (dt == dt_first) return
+      call bad(deck, gname, 'dt_record', trim(fmt_real(dt)), "equal to &excitation's "//trim(fmt_real(dt_first))// &
+               ' s ('//components//' share the step dt1 = dt_record / n1)', error)
+   end subroutine same_record_step
 
    subroutine read_component(deck, gname, required, exc, record, found, error)
       type(deck_text), intent(in) :: deck
@@ -712,11 +725,9 @@ contains
          ios = index(lower(grp%lines(1)), '&'//gname)
          grp%lines(1)(ios:ios + len(gname)) = '&excitation'//repeat(' ', len(gname) - len('excitation'))
       end if
-      call check_length(deck, grp, 'excitation_type', name_len, error)
-      if (.not. allocated(error)) call check_length(deck, grp, 'record_kind', name_len, error)
-      if (.not. allocated(error)) call check_length(deck, grp, 'record_format', name_len, error)
-      if (.not. allocated(error)) call check_length(deck, grp, 'record_units', name_len, error)
-      if (.not. allocated(error)) call check_length(deck, grp, 'record_file', path_len, error)
+      call check_lengths(deck, grp, [character(len=16) :: 'excitation_type', 'record_kind', 'record_format', &
+                                     'record_units', 'record_file'], [name_len, name_len, name_len, name_len, path_len], &
+                         error)
       if (allocated(error)) return
       do
          read (grp%lines, nml=excitation, iostat=ios, iomsg=msg)
@@ -836,9 +847,8 @@ contains
       call find_group(deck, 'integration', grp, found, error)
       if (allocated(error)) return
       if (found) then
-         call check_length(deck, grp, 'technique', name_len, error)
-         if (.not. allocated(error)) call check_length(deck, grp, 'linear_system', name_len, error)
-         if (.not. allocated(error)) call check_length(deck, grp, 'refinement', name_len, error)
+         call check_lengths(deck, grp, [character(len=16) :: 'technique', 'linear_system', 'refinement'], &
+                            [name_len, name_len, name_len], error)
          if (allocated(error)) return
          do
             read (grp%lines, nml=integration, iostat=ios, iomsg=msg)
@@ -950,8 +960,7 @@ contains
       call find_group(deck, 'output', grp, found, error)
       if (allocated(error)) return
       if (found) then
-         call check_length(deck, grp, 'dir', path_len, error)
-         if (.not. allocated(error)) call check_length(deck, grp, 'name', path_len, error)
+         call check_lengths(deck, grp, [character(len=16) :: 'dir', 'name'], [path_len, path_len], error)
          if (allocated(error)) return
          do
             read (grp%lines, nml=output, iostat=ios, iomsg=msg)
@@ -1109,17 +1118,16 @@ contains
          if (.not. more) exit
       end do
       if (allocated(error)) return
-      call need_int(deck, 'floors', 'n_floors', n_floors, is_given(grp, 'n_floors'), 1, max_floors, error)
+      call need_int(deck, grp, 'n_floors', n_floors, 1, max_floors, error)
       if (allocated(error)) return
       n = n_floors
-      call need_reals(deck, 'floors', 'mass', mass, given_of(grp, 'mass', size(mass)), n, 'kg', error, positive=.true.)
+      call need_reals(deck, grp, 'mass', mass, n, 'kg', error, positive=.true.)
       if (allocated(error)) return
-      call optional_reals(deck, 'floors', 'cm_x', cm_x, given_of(grp, 'cm_x', size(cm_x)), n, 0.0_dp, 'm', error)
+      call optional_reals(deck, grp, 'cm_x', cm_x, n, 0.0_dp, 'm', error)
       if (allocated(error)) return
-      call optional_reals(deck, 'floors', 'cm_y', cm_y, given_of(grp, 'cm_y', size(cm_y)), n, 0.0_dp, 'm', error)
+      call optional_reals(deck, grp, 'cm_y', cm_y, n, 0.0_dp, 'm', error)
       if (allocated(error)) return
-      call optional_reals(deck, 'floors', 'height', height, given_of(grp, 'height', size(height)), n, &
-                          default_storey_height, 'm', error)
+      call optional_reals(deck, grp, 'height', height, n, default_storey_height, 'm', error)
       if (allocated(error)) return
       g_in = given_of(grp, 'inertia', size(inertia))
       g_px = given_of(grp, 'plan_x', size(plan_x))
@@ -1228,9 +1236,8 @@ contains
       k_file = ''; m_file = ''
       call find_group(deck, 'matrices', grp, found, error)
       if (allocated(error) .or. .not. found) return
-      call check_length(deck, grp, 'k_file', path_len, error)
-      if (.not. allocated(error)) call check_length(deck, grp, 'm_file', path_len, error)
-      if (.not. allocated(error)) call check_length(deck, grp, 'label', label_len - 1, error)
+      call check_lengths(deck, grp, [character(len=16) :: 'k_file', 'm_file', 'label'], [path_len, path_len, label_len - 1], &
+                         error)
       if (allocated(error)) return
       ! the matrices first: their size gives the arrays' capacity
       do i = 1, 2
@@ -1449,12 +1456,12 @@ contains
          if (.not. more) exit
       end do
       if (allocated(error)) return
-      call need_int(deck, 'frames', 'n_frames', n_frames, is_given(grp, 'n_frames'), 0, max_springs, error)
+      call need_int(deck, grp, 'n_frames', n_frames, 0, max_springs, error)
       if (allocated(error)) return
       n = n_frames
-      call plan_elements(deck, 'frames', grp, cfg, n, storey, angle, x, y, error)
+      call plan_elements(deck, grp, cfg, n, storey, angle, x, y, error)
       if (allocated(error)) return
-      call need_reals(deck, 'frames', 'k', k, given_of(grp, 'k', size(k)), n, 'N/m', error, positive=.true.)
+      call need_reals(deck, grp, 'k', k, n, 'N/m', error, positive=.true.)
       if (allocated(error)) return
       allocate (cfg%model%kx_i(0), cfg%model%kx_j(0), cfg%model%kx_v(0))
       cfg%model%n_kx = 0
@@ -1476,9 +1483,8 @@ contains
 
    !> The plan position of the elements of a group of a building of rigid floors: storey
    !> (1..n_floors), angle [deg], and a point (x, y) of the element's line [m].
-   subroutine plan_elements(deck, group, grp, cfg, n, storey, angle, x, y, error)
+   subroutine plan_elements(deck, grp, cfg, n, storey, angle, x, y, error)
       type(deck_text), intent(in) :: deck
-      character(len=*), intent(in) :: group
       type(group_text), intent(in) :: grp
       type(run_config), intent(in) :: cfg
       integer, intent(in) :: n
@@ -1486,14 +1492,13 @@ contains
       real(dp), intent(inout) :: angle(:), x(:), y(:)
       type(error_type), allocatable, intent(out) :: error
 
-      call node_list(deck, group, 'storey', storey, given_of(grp, 'storey', size(storey)), n, 1, &
-                     cfg%model%n_floors, error)
+      call node_list(deck, grp, 'storey', storey, n, 1, cfg%model%n_floors, error)
       if (allocated(error)) return
-      call signed_reals(deck, group, 'angle', angle, given_of(grp, 'angle', size(angle)), n, 'deg', error)
+      call signed_reals(deck, grp, 'angle', angle, n, 'deg', error)
       if (allocated(error)) return
-      call signed_reals(deck, group, 'x', x, given_of(grp, 'x', size(x)), n, 'm', error)
+      call signed_reals(deck, grp, 'x', x, n, 'm', error)
       if (allocated(error)) return
-      call signed_reals(deck, group, 'y', y, given_of(grp, 'y', size(y)), n, 'm', error)
+      call signed_reals(deck, grp, 'y', y, n, 'm', error)
    end subroutine plan_elements
 
    !> P-Delta of a building of rigid floors: the constant geometric stiffness of the gravity
@@ -1591,16 +1596,13 @@ contains
       call need_int(deck, 'floor_braces', 'n_braces', n_braces, .true., 0, max_devices - cfg%model%n_devices, error)
       if (allocated(error)) return
       n = n_braces
-      call plan_elements(deck, 'floor_braces', grp, cfg, n, storey, angle, x, y, error)
+      call plan_elements(deck, grp, cfg, n, storey, angle, x, y, error)
       if (allocated(error)) return
-      call need_reals(deck, 'floor_braces', 'slip_load', slip_load, given_of(grp, 'slip_load', size(slip_load)), n, &
-                      'N', error, positive=.true.)
+      call need_reals(deck, grp, 'slip_load', slip_load, n, 'N', error, positive=.true.)
       if (allocated(error)) return
-      call optional_reals(deck, 'floor_braces', 'eps1', eps1, given_of(grp, 'eps1', size(eps1)), n, default_eps1, &
-                          'm/s', error, positive=.true.)
+      call optional_reals(deck, grp, 'eps1', eps1, n, default_eps1, 'm/s', error, positive=.true.)
       if (allocated(error)) return
-      call optional_reals(deck, 'floor_braces', 'eps', eps, given_of(grp, 'eps', size(eps)), n, default_eps, &
-                          'm/s', error, positive=.true.)
+      call optional_reals(deck, grp, 'eps', eps, n, default_eps, 'm/s', error, positive=.true.)
       if (allocated(error)) return
       call check_labels(deck, grp, 'floor_braces', label, n, error)
       if (allocated(error)) return
@@ -2000,20 +2002,15 @@ contains
       call need_int(deck, 'braces', 'n_braces', n_braces, .true., 0, max_devices - cfg%model%n_devices, error)
       if (allocated(error)) return
       n = n_braces
-      call node_list(deck, 'braces', 'node_i', node_i, given_of(grp, 'node_i', size(node_i)), n, 1, &
-                     cfg%model%n_dof, error)
+      call node_list(deck, grp, 'node_i', node_i, n, 1, cfg%model%n_dof, error)
       if (allocated(error)) return
-      call node_list(deck, 'braces', 'node_j', node_j, given_of(grp, 'node_j', size(node_j)), n, 0, &
-                     cfg%model%n_dof, error)
+      call node_list(deck, grp, 'node_j', node_j, n, 0, cfg%model%n_dof, error)
       if (allocated(error)) return
-      call need_reals(deck, 'braces', 'slip_load', slip_load, given_of(grp, 'slip_load', size(slip_load)), n, 'N', &
-                      error, positive=.true.)
+      call need_reals(deck, grp, 'slip_load', slip_load, n, 'N', error, positive=.true.)
       if (allocated(error)) return
-      call need_reals(deck, 'braces', 'stiffness', stiffness, given_of(grp, 'stiffness', size(stiffness)), n, &
-                      'N/m', error, positive=.true.)
+      call need_reals(deck, grp, 'stiffness', stiffness, n, 'N/m', error, positive=.true.)
       if (allocated(error)) return
-      call optional_reals(deck, 'braces', 'eps1', eps1, given_of(grp, 'eps1', size(eps1)), n, default_eps1, 'm/s', &
-                          error, positive=.true.)
+      call optional_reals(deck, grp, 'eps1', eps1, n, default_eps1, 'm/s', error, positive=.true.)
       if (allocated(error)) return
       call check_labels(deck, grp, 'braces', label, n, error)
       if (allocated(error)) return
@@ -2076,10 +2073,8 @@ contains
       node_i = unset_int; node_j = unset_int; law = ''
       weight = unset; mu = unset; radius = unset; eps = unset; eps1 = unset; f = unset
       ! a longer label would be cut by the namelist read: refused from the group's text first
-      call check_length(deck, grp, 'label', label_len - 1, error)
-      if (allocated(error)) return
-      call check_length(deck, grp, 'law', name_len, error)
-      if (.not. allocated(error)) call check_length(deck, grp, 'mu_law', name_len, error)
+      call check_lengths(deck, grp, [character(len=16) :: 'label', 'law', 'mu_law'], [label_len - 1, name_len, name_len], &
+                         error)
       if (allocated(error)) return
       do
          read (grp%lines, nml=isolators, iostat=ios, iomsg=msg)
@@ -2091,14 +2086,11 @@ contains
                     error)
       if (allocated(error)) return
       n = n_isolators
-      call node_list(deck, 'isolators', 'node_i', node_i, given_of(grp, 'node_i', size(node_i)), n, 1, &
-                     cfg%model%n_dof, error)
+      call node_list(deck, grp, 'node_i', node_i, n, 1, cfg%model%n_dof, error)
       if (allocated(error)) return
-      call node_list(deck, 'isolators', 'node_j', node_j, given_of(grp, 'node_j', size(node_j)), n, 0, &
-                     cfg%model%n_dof, error)
+      call node_list(deck, grp, 'node_j', node_j, n, 0, cfg%model%n_dof, error)
       if (allocated(error)) return
-      call need_reals(deck, 'isolators', 'weight', weight, given_of(grp, 'weight', size(weight)), n, 'N', error, &
-                      positive=.true.)
+      call need_reals(deck, grp, 'weight', weight, n, 'N', error, positive=.true.)
       if (allocated(error)) return
       g_mu = given_of(grp, 'mu', size(mu))
       call read_mu_laws(deck, grp, n, mu_law, mu, g_mu, mu_max, mu_min, mu_rate, mu_table_v, mu_table_mu, &
@@ -2266,8 +2258,7 @@ contains
       if (allocated(error)) return
       call node_list(deck, 'storeys', 'node_j', node_j, g_j, n, 0, cfg%model%n_dof, error)
       if (allocated(error)) return
-      call optional_reals(deck, 'storeys', 'height', height, given_of(grp, 'height', size(height)), n, &
-                          default_storey_height, 'm', error)
+      call optional_reals(deck, grp, 'height', height, n, default_storey_height, 'm', error)
       if (allocated(error)) return
       call check_labels(deck, grp, 'storeys', label, n, error)
       if (allocated(error)) return
@@ -2752,6 +2743,20 @@ contains
                        trim(fmt_int(cap))//" characters long")
    end subroutine check_length
 
+   !> check_length of several variables, in their order: the first too long is the error.
+   subroutine check_lengths(deck, grp, vars, caps, error)
+      type(deck_text), intent(in) :: deck
+      type(group_text), intent(in) :: grp
+      character(len=*), intent(in) :: vars(:)             !! the variables, lower case
+      integer, intent(in) :: caps(:)                      !! the capacity of each
+      type(error_type), allocatable, intent(out) :: error
+      integer :: k
+      do k = 1, size(vars)
+         call check_length(deck, grp, trim(vars(k)), caps(k), error)
+         if (allocated(error)) return
+      end do
+   end subroutine check_lengths
+
    !> The value a group's variable has after its read, when the group's text gives one; "not
    !> given" is read from the text (given_elements), never from a value.
    pure logical function is_given(grp, var)
@@ -2778,7 +2783,64 @@ contains
       end if
    end function given_of
 
-   subroutine need_int(deck, group, var, x, given, lo, hi, error)
+   !> need_int of the group's count variable var, given or not as the group's text says.
+   subroutine need_int_of(deck, grp, var, x, lo, hi, error)
+      type(deck_text), intent(in) :: deck
+      type(group_text), intent(in) :: grp                 !! the group's text
+      character(len=*), intent(in) :: var                 !! the variable, lower case
+      integer, intent(in) :: x, lo, hi
+      type(error_type), allocatable, intent(out) :: error
+      call need_int_named(deck, grp%name, var, x, is_given(grp, var), lo, hi, error)
+   end subroutine need_int_of
+
+   !> need_reals of the group's array var, with the elements its text gives.
+   subroutine need_reals_of(deck, grp, var, x, n, unit, error, positive)
+      type(deck_text), intent(in) :: deck
+      type(group_text), intent(in) :: grp                 !! the group's text
+      character(len=*), intent(in) :: var, unit
+      real(dp), intent(in) :: x(:)
+      integer, intent(in) :: n
+      type(error_type), allocatable, intent(out) :: error
+      logical, intent(in) :: positive
+      call need_reals_named(deck, grp%name, var, x, given_of(grp, var, size(x)), n, unit, error, positive)
+   end subroutine need_reals_of
+
+   !> optional_reals of the group's array var, with the elements its text gives.
+   subroutine optional_reals_of(deck, grp, var, x, n, default, unit, error, positive)
+      type(deck_text), intent(in) :: deck
+      type(group_text), intent(in) :: grp                 !! the group's text
+      character(len=*), intent(in) :: var, unit
+      real(dp), intent(inout) :: x(:)
+      integer, intent(in) :: n
+      real(dp), intent(in) :: default
+      type(error_type), allocatable, intent(out) :: error
+      logical, intent(in), optional :: positive
+      call optional_reals_named(deck, grp%name, var, x, given_of(grp, var, size(x)), n, default, unit, error, &
+                                positive)
+   end subroutine optional_reals_of
+
+   !> signed_reals of the group's array var, with the elements its text gives.
+   subroutine signed_reals_of(deck, grp, var, x, n, unit, error)
+      type(deck_text), intent(in) :: deck
+      type(group_text), intent(in) :: grp                 !! the group's text
+      character(len=*), intent(in) :: var, unit
+      real(dp), intent(in) :: x(:)
+      integer, intent(in) :: n
+      type(error_type), allocatable, intent(out) :: error
+      call signed_reals_named(deck, grp%name, var, x, given_of(grp, var, size(x)), n, unit, error)
+   end subroutine signed_reals_of
+
+   !> node_list of the group's array var, with the elements its text gives.
+   subroutine node_list_of(deck, grp, var, x, n, lo, hi, error)
+      type(deck_text), intent(in) :: deck
+      type(group_text), intent(in) :: grp                 !! the group's text
+      character(len=*), intent(in) :: var
+      integer, intent(in) :: x(:), n, lo, hi
+      type(error_type), allocatable, intent(out) :: error
+      call node_list_named(deck, grp%name, var, x, given_of(grp, var, size(x)), n, lo, hi, error)
+   end subroutine node_list_of
+
+   subroutine need_int_named(deck, group, var, x, given, lo, hi, error)
       type(deck_text), intent(in) :: deck
       character(len=*), intent(in) :: group, var
       integer, intent(in) :: x, lo, hi
@@ -2789,7 +2851,7 @@ contains
       end if
       if (x < lo .or. x > hi) &
          call bad(deck, group, var, trim(fmt_int(x)), 'in '//trim(fmt_int(lo))//'..'//trim(fmt_int(hi)), error)
-   end subroutine need_int
+   end subroutine need_int_named
 
    subroutine need_real(deck, group, var, x, given, unit, error, positive)
       type(deck_text), intent(in) :: deck
@@ -2859,7 +2921,7 @@ contains
    end subroutine check_real
 
    !> n values must be given, finite and > 0 (or >= 0); no more than n.
-   subroutine need_reals(deck, group, var, x, given, n, unit, error, positive)
+   subroutine need_reals_named(deck, group, var, x, given, n, unit, error, positive)
       type(deck_text), intent(in) :: deck
       character(len=*), intent(in) :: group, var, unit
       real(dp), intent(in) :: x(:)
@@ -2873,10 +2935,10 @@ contains
          if (allocated(error)) return
       end do
       call no_extra(deck, group, var, x, given, n, error)
-   end subroutine need_reals
+   end subroutine need_reals_named
 
    !> Values that must be given, finite and of either sign (a plan coordinate, an angle).
-   subroutine signed_reals(deck, group, var, x, given, n, unit, error)
+   subroutine signed_reals_named(deck, group, var, x, given, n, unit, error)
       type(deck_text), intent(in) :: deck
       character(len=*), intent(in) :: group, var, unit
       real(dp), intent(in) :: x(:)
@@ -2897,10 +2959,10 @@ contains
          if (allocated(error)) return
       end do
       call no_extra(deck, group, var, x, given, n, error)
-   end subroutine signed_reals
+   end subroutine signed_reals_named
 
    !> Values not given take a default; given ones must be finite (and > 0 if positive).
-   subroutine optional_reals(deck, group, var, x, given, n, default, unit, error, positive)
+   subroutine optional_reals_named(deck, group, var, x, given, n, default, unit, error, positive)
       type(deck_text), intent(in) :: deck
       character(len=*), intent(in) :: group, var, unit
       real(dp), intent(inout) :: x(:)
@@ -2925,7 +2987,7 @@ contains
          if (allocated(error)) return
       end do
       call no_extra(deck, group, var, x, given, n, error)
-   end subroutine optional_reals
+   end subroutine optional_reals_named
 
    subroutine no_extra(deck, group, var, x, given, n, error)
       type(deck_text), intent(in) :: deck
@@ -2940,7 +3002,7 @@ contains
                              'absent: only '//trim(fmt_int(n))//' value(s) are expected', error)
    end subroutine no_extra
 
-   subroutine node_list(deck, group, var, x, given, n, lo, hi, error)
+   subroutine node_list_named(deck, group, var, x, given, n, lo, hi, error)
       type(deck_text), intent(in) :: deck
       character(len=*), intent(in) :: group, var
       integer, intent(in) :: x(:), n, lo, hi
@@ -2961,7 +3023,7 @@ contains
       last = findloc(given, .true., 1, back=.true.)
       if (last > n) call bad(deck, group, var//'('//trim(fmt_int(last))//')', trim(fmt_int(x(last))), &
                              'absent: only '//trim(fmt_int(n))//' value(s) are expected', error)
-   end subroutine node_list
+   end subroutine node_list_named
 
    !> A path relative to the directory of the deck (absolute paths are kept).
    pure subroutine relative_to(deck_path, path, full)

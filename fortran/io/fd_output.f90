@@ -454,7 +454,7 @@ contains
       setup = setup_of(res)
       call kint(jt, 'n_dof', res%n_dof)
       call kint(jt, 'n_devices', res%n_devices)
-      call kv(jt, 'technique', '"'//trim(technique_name(res%technique))//'"')
+      call kword(jt, 'technique', technique_name(res%technique))
       call ks(jt, 'device_law', [character(len=keyword_len) :: (law_name(model%dev(d)%law), d=1, model%n_devices)])
       call kreal(jt, res, 'period_stuck_s', setup%period_stuck)
       call kreal(jt, res, 'xi_stuck', setup%xi_stuck)
@@ -474,7 +474,7 @@ contains
       setup = setup_of(res)
       call kreal(jt, res, 'omega_max_rad_s', res%omega_max)
       call kreal(jt, res, 'omega_max_dt1', res%omega_max*setup%dt1)
-      call kv(jt, 'mode_resolution', '"'//trim(verdict)//'"')
+      call kword(jt, 'mode_resolution', verdict)
    end subroutine mode_part
 
    !> Whether dt1 resolves a harmonic table motion (fd_harmonic_resolution): the step's error
@@ -485,7 +485,7 @@ contains
       character(len=*), intent(in) :: verdict  !! its check's outcome
 
       call kr(jt, 'harmonic_step_error', step_error)
-      call kv(jt, 'harmonic_resolution', '"'//trim(verdict)//'"')
+      call kword(jt, 'harmonic_resolution', verdict)
    end subroutine harmonic_part
 
    !> Whether dt1 resolves a recorded table motion (fd_record_resolution).
@@ -497,8 +497,8 @@ contains
       call kr(jt, 'record_step_error', res%record_error)
       call kr(jt, 'record_step_error_stuck', res%record_error_stuck)
       call kr(jt, 'record_step_error_free', res%record_error_free)
-      call kv(jt, 'record_resolution', '"'//trim(verdict)//'"')
-      call kv(jt, 'record_step_system', '"'//trim(record_system_names(res%record_system))//'"')
+      call kword(jt, 'record_resolution', verdict)
+      call kword(jt, 'record_step_system', record_system_names(res%record_system))
    end subroutine record_step_part
 
    !> Whether dt1 resolves the sticking springs' ringing (fd_stick_ringing): per device the
@@ -515,7 +515,7 @@ contains
       call kr(jt, 'stick_ringing_ratio', ratio)
       call kr(jt, 'stick_ringing_N', ringing)
       call kr(jt, 'stick_margin_N', margin)
-      call kv(jt, 'stick_resolution', '"'//trim(verdict)//'"')
+      call kword(jt, 'stick_resolution', verdict)
    end subroutine stick_part
 
    !> Whether the step damps the velocity-law bands (fd_band_alternation).
@@ -527,7 +527,7 @@ contains
       call kr(jt, 'band_x', res%band_x)
       call kr(jt, 'band_alternation_N', res%band_alternation)
       call kr(jt, 'band_alternation_s', res%band_alternation_time, res%band_alternation /= 0.0_dp)
-      call kv(jt, 'band_resolution', '"'//trim(verdict)//'"')
+      call kword(jt, 'band_resolution', verdict)
    end subroutine band_part
 
    !> The peaks per DOF and device, with their times, the devices' phase changes, and each
@@ -657,7 +657,7 @@ contains
       call kint(jt, 'factorizations', c%factorizations)
       call kint(jt, 'factor_updates', c%factor_updates)
       call kint(jt, 'partial_factorizations', c%partial_factorizations)
-      call kv(jt, 'linear_system', '"'//trim(storage_name(c%storage))//'"')
+      call kword(jt, 'linear_system', storage_name(c%storage))
       call kint(jt, 'half_bandwidth', c%bandwidth)
       call kint(jt, 'events', c%events)
    end subroutine counts_part
@@ -723,7 +723,7 @@ contains
       call kreal(jt, res, 'energy_device_elastic_J', res%e_device)
       call kreal(jt, res, 'energy_residual_J', res%e_residual)
       call kreal(jt, res, 'energy_residual_ratio', res%e_residual_ratio)
-      call kv(jt, 'energy_balance', '"'//trim(verdict)//'"')
+      call kword(jt, 'energy_balance', verdict)
    end subroutine energy_part
 
    !> Whether the first period and a record's peak acceleration lie where structures and
@@ -732,8 +732,8 @@ contains
       type(json_text), intent(inout) :: jt     !! the summary
       type(check_type), intent(in) :: checks(:) !! the run's checks
 
-      call kv(jt, 'period_plausibility', '"'//trim(outcome_of(checks, 'period_plausibility'))//'"')
-      call kv(jt, 'record_plausibility', '"'//trim(outcome_of(checks, 'record_plausibility'))//'"')
+      call kword(jt, 'period_plausibility', outcome_of(checks, 'period_plausibility'))
+      call kword(jt, 'record_plausibility', outcome_of(checks, 'record_plausibility'))
    end subroutine plausibility_part
 
    !> What produced the run, the table motion, the labels, the damping, the modes, the
@@ -743,10 +743,10 @@ contains
       type(model_type), intent(in) :: model    !! the model run
       type(result_type), intent(in) :: res     !! the result
 
-      call kv(jt, 'deck_sha256', '"'//trim(model%deck_sha256)//'"')
+      call kword(jt, 'deck_sha256', model%deck_sha256)
       associate (eng => res%eng)
          if (eng%excitation >= 1 .and. eng%excitation <= size(excitation_types)) then
-            call kv(jt, 'excitation_type', '"'//trim(excitation_types(eng%excitation)%name)//'"')
+            call kword(jt, 'excitation_type', excitation_types(eng%excitation)%name)
          else
             call kv(jt, 'excitation_type', '"unknown"')
          end if
@@ -932,6 +932,15 @@ contains
 
       call put(jt, '  "'//key//'": '//val//','//nl)
    end subroutine kv
+
+   !> A key and a word: its text trimmed, in quotes (a name or a verdict, which needs no
+   !> escape).
+   subroutine kword(jt, key, word)
+      type(json_text), intent(inout) :: jt     !! the text
+      character(len=*), intent(in) :: key, word !! the key and its word
+
+      call kv(jt, key, '"'//trim(word)//'"')
+   end subroutine kword
 
    !> A list of strings.
    subroutine ks(jt, key, x)

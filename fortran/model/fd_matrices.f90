@@ -235,11 +235,8 @@ contains
          ! dense (K, M) on the null space of the links up to modes_dense_dofs, else banded
          mode = modes_auto
          if (present(path)) mode = path
-         if (mode == modes_dense .or. (mode == modes_auto .and. n <= modes_dense_dofs)) then
-            call dense_system_modes(model, linked, nev, omega2, phi, nq, error)
-         else
-            call banded_system_modes(model, linked, nev, omega2, phi, nq, error)
-         end if
+         call general_system_modes(model, linked, nev, mode == modes_dense .or. &
+                                   (mode == modes_auto .and. n <= modes_dense_dofs), omega2, phi, nq, error)
          return
       end if
       allocate (grp(n), stat=stat)
@@ -418,81 +415,66 @@ contains
    end subroutine damping_period
 
    !> system_modes of a general model (stiffness K_x, or devices with any direction b_d): the
-   !> devices in `linked` are the constraints b_d' u = 0, and the modes those of the dense
-   !> (K, M) on their null space (constrained_modes).
-   subroutine dense_system_modes(model, linked, nev, omega2, phi, nq, error)
+   !> devices in `linked` are the constraints b_d' u = 0, and the modes those of (K, M) on
+   !> their null space. Dense: of the dense (K, M) (constrained_modes). Otherwise without an
+   !> n x n matrix, by fd_modes' general_lowest_modes (subspace iteration with the banded
+   !> factor of K, the constraints through their r x r Schur complement).
+   subroutine general_system_modes(model, linked, nev, dense, omega2, phi, nq, error)
       type(model_type), intent(in) :: model          !! the model
       logical, intent(in) :: linked(:)               !! devices acting as rigid links
       integer, intent(in) :: nev                     !! modes wanted
+      logical, intent(in) :: dense                   !! the dense eigenproblem, else the banded one
       real(dp), intent(out) :: omega2(:)             !! w^2 [1/s^2], size nev (0 beyond nq)
       real(dp), intent(out) :: phi(:, :)             !! M-normalized mode shapes, n_dof x nev
       integer, intent(out) :: nq                     !! free DOFs of the constrained system
       type(error_type), allocatable, intent(out) :: error !! no free DOF, rigid-body mode
-      real(dp), allocatable :: k(:, :), lam(:), z(:, :)
-      real(dp) :: big
+      real(dp), allocatable :: k(:, :), lam(:), z(:, :), kd(:), kv(:)
+      integer, allocatable :: ki(:), kj(:)
+      real(dp) :: big, lowest
       integer :: n, m, j, stat
 
       n = model%n_dof
-      allocate (k(n, n), lam(n), z(n, n), stat=stat)
-      if (stat /= 0) then
-         nq = -1
-         call out_of_memory('eigenproblem', n, error)
-         return
+      if (dense) then
+         allocate (k(n, n), lam(n), z(n, n), stat=stat)
+         if (stat /= 0) then
+            nq = -1
+            call out_of_memory('eigenproblem', n, error)
+            return
+         end if
+         call stiffness_matrix(model, k)
+         big = 0.0_dp
+         do j = 1, n
+            big = max(big, sum(abs(k(:, j)))/model%mass(j))
+         end do
+         call constrained_modes(model, k, linked, lam, z, nq, error)
+      else
+         allocate (kd(model%n_devices))
+         kd = 0.0_dp
+         call kx_entries(model, ki, kj, kv)
+         call general_lowest_modes(model%mass, model%spring_i(1:model%n_springs), model%spring_j(1:model%n_springs), &
+                                   model%spring_k(1:model%n_springs), ki, kj, kv, model%dev_ptr, model%dev_dof, &
+                                   model%dev_coef, kd, linked, nev, omega2, phi, nq, big, error)
       end if
-      call stiffness_matrix(model, k)
-      big = 0.0_dp
-      do j = 1, n
-         big = max(big, sum(abs(k(:, j)))/model%mass(j))
-      end do
-      call constrained_modes(model, k, linked, lam, z, nq, error)
       if (allocated(error)) return
       if (nq == 0) then
          call fatal_error(error, "the system has no free DOF: every mass is locked to the table by rigid links")
          return
       end if
-      m = min(nev, nq)
-      if (lam(1) <= 1.0e-12_dp*big) then
+      if (dense) then
+         lowest = lam(1)
+      else
+         lowest = omega2(1)
+      end if
+      if (lowest <= 1.0e-12_dp*big) then
          call fatal_error(error, "the system has a rigid-body mode (first eigenvalue "// &
-                          trim(fmt_real(lam(1)))//"): a mass or group of masses has no spring to the table")
+                          trim(fmt_real(lowest))//"): a mass or group of masses has no spring to the table")
          return
       end if
+      if (.not. dense) return
+      m = min(nev, nq)
       omega2(1:m) = lam(1:m)
       phi(:, 1:m) = z(:, 1:m)
-   end subroutine dense_system_modes
-
-   !> system_modes of a general model without an n x n matrix: the modes of (K, M) on the
-   !> null space of the linked devices' directions by fd_modes' general_lowest_modes
-   !> (subspace iteration with the banded factor of K, the constraints through their r x r
-   !> Schur complement). The same outputs and errors as dense_system_modes.
-   subroutine banded_system_modes(model, linked, nev, omega2, phi, nq, error)
-      type(model_type), intent(in) :: model          !! the model
-      logical, intent(in) :: linked(:)               !! devices acting as rigid links
-      integer, intent(in) :: nev                     !! modes wanted
-      real(dp), intent(out) :: omega2(:)             !! w^2 [1/s^2], size nev (0 beyond nq)
-      real(dp), intent(out) :: phi(:, :)             !! M-normalized mode shapes, n_dof x nev
-      integer, intent(out) :: nq                     !! free DOFs of the constrained system
-      type(error_type), allocatable, intent(out) :: error !! no free DOF, rigid-body mode
-      real(dp), allocatable :: kd(:), kv(:)
-      integer, allocatable :: ki(:), kj(:)
-      real(dp) :: big
-
-      allocate (kd(model%n_devices))
-      kd = 0.0_dp
-      call kx_entries(model, ki, kj, kv)
-      call general_lowest_modes(model%mass, model%spring_i(1:model%n_springs), model%spring_j(1:model%n_springs), &
-                                model%spring_k(1:model%n_springs), ki, kj, kv, model%dev_ptr, model%dev_dof, &
-                                model%dev_coef, kd, linked, nev, omega2, phi, nq, big, error)
-      if (allocated(error)) return
-      if (nq == 0) then
-         call fatal_error(error, "the system has no free DOF: every mass is locked to the table by rigid links")
-         return
-      end if
-      if (omega2(1) <= 1.0e-12_dp*big) then
-         call fatal_error(error, "the system has a rigid-body mode (first eigenvalue "// &
-                          trim(fmt_real(omega2(1)))//"): a mass or group of masses has no spring to the table")
-         return
-      end if
-   end subroutine banded_system_modes
+   end subroutine general_system_modes
 
    !> K_x's entries (kx_i, kx_j, kx_v) as arrays of n_kx entries (none when it has none).
    pure subroutine kx_entries(model, ki, kj, kv)
@@ -601,12 +583,11 @@ contains
       type(error_type), allocatable, intent(out) :: error !! LAPACK failure
       real(dp), allocatable :: ks(:, :), lam(:), z(:, :), zcz(:)
       logical, allocatable :: linked(:)
-      integer, allocatable :: grp(:)
       real(dp) :: kd, big
       integer :: n, d, j, stat
 
       n = model%n_dof
-      allocate (ks(n, n), lam(n), z(n, n), linked(model%n_devices), grp(n), stat=stat)
+      allocate (ks(n, n), lam(n), z(n, n), linked(model%n_devices), stat=stat)
       if (stat /= 0) then
          call out_of_memory('natural modes', n, error)
          return
@@ -620,9 +601,7 @@ contains
       call constrained_modes(model, ks, linked, lam, z, modes%nq, error)
       if (allocated(error)) return
       if (modes%nq == 0) then
-         modes%status = modes_rigid
-         allocate (modes%omega2(0), modes%period(0), modes%shape(n, 0), modes%mass_ratio(0), modes%xi(0))
-         return
+         call no_free_dof(n, modes); return
       end if
       big = 0.0_dp
       do j = 1, n
@@ -633,12 +612,7 @@ contains
       do j = 1, modes%n
          zcz(j) = dot_product(z(:, j), matmul(c, z(:, j)))
       end do
-      modes%status = modes_flexible
-      if (lam(1) <= 1.0e-12_dp*big) modes%status = modes_unrestrained
-      grp = [(j, j=1, n)]
-      call store_modes(grp, model%mass, lam, z, lam(1:modes%n) <= 1.0e-12_dp*big, zcz, modes, stat, &
-                       model%influence)
-      if (stat /= 0) call out_of_memory('natural modes', n, error)
+      call store_dof_modes(model, lam, z, big, zcz, modes, error)
    end subroutine constrained_natural_modes
 
    !> natural_modes_sparse of a general model (K_x, devices of any direction) without an
@@ -654,7 +628,7 @@ contains
       type(modes_type), intent(inout) :: modes       !! the modes
       type(error_type), allocatable, intent(out) :: error !! solver failure, no memory
       real(dp), allocatable :: kd(:), kv(:), lam(:), z(:, :), zcz(:)
-      integer, allocatable :: ki(:), kj(:), grp(:)
+      integer, allocatable :: ki(:), kj(:)
       logical, allocatable :: linked(:)
       real(dp) :: big, w
       integer :: n, nd, ns, d, j, s, m, stat
@@ -686,12 +660,10 @@ contains
          return
       end if
       if (modes%nq == 0) then
-         modes%status = modes_rigid
-         allocate (modes%omega2(0), modes%period(0), modes%shape(n, 0), modes%mass_ratio(0), modes%xi(0))
-         return
+         call no_free_dof(n, modes); return
       end if
       modes%n = min(max(nmax, 0), modes%nq)
-      allocate (zcz(modes%n), grp(n), stat=stat)
+      allocate (zcz(modes%n), stat=stat)
       if (stat /= 0) then
          call out_of_memory('natural modes', n, error); return
       end if
@@ -704,12 +676,7 @@ contains
          zcz(j) = a0 + a1*(w + general_form(model, z(:, j), z(:, j)))
          if (allocated(model%modal_d)) zcz(j) = zcz(j) + sum(model%modal_d*matmul(z(:, j), model%modal_u)**2)
       end do
-      modes%status = modes_flexible
-      if (lam(1) <= 1.0e-12_dp*big) modes%status = modes_unrestrained
-      grp = [(j, j=1, n)]
-      call store_modes(grp, model%mass, lam, z, lam(1:modes%n) <= 1.0e-12_dp*big, zcz, modes, stat, &
-                       model%influence)
-      if (stat /= 0) call out_of_memory('natural modes', n, error)
+      call store_dof_modes(model, lam, z, big, zcz, modes, error)
    contains
       pure real(dp) function node_z(node, j)
          integer, intent(in) :: node, j
@@ -1130,10 +1097,41 @@ contains
          linked(d) = system == system_stuck .and. links_when_stuck(model%dev(d))
       end do
       call link_groups(model, linked, grp, modes%nq)
-      if (modes%nq > 0) return
-      modes%status = modes_rigid
-      allocate (modes%omega2(0), modes%period(0), modes%shape(model%n_dof, 0), modes%mass_ratio(0), modes%xi(0))
+      if (modes%nq == 0) call no_free_dof(model%n_dof, modes)
    end subroutine system_groups
+
+   !> The modes of a system without a free DOF: status modes_rigid, arrays of no mode.
+   subroutine no_free_dof(n, modes)
+      integer, intent(in) :: n                       !! DOFs
+      type(modes_type), intent(inout) :: modes       !! the modes
+      modes%status = modes_rigid
+      allocate (modes%omega2(0), modes%period(0), modes%shape(n, 0), modes%mass_ratio(0), modes%xi(0))
+   end subroutine no_free_dof
+
+   !> store_modes for modes over every DOF (each DOF its own group): status modes_flexible,
+   !> or modes_unrestrained with the eigenvalues below 1e-12 big as rigid-body modes.
+   subroutine store_dof_modes(model, lam, z, big, zcz, modes, error)
+      type(model_type), intent(in) :: model          !! the model
+      real(dp), intent(in) :: lam(:)                 !! eigenvalues, ascending
+      real(dp), intent(in) :: z(:, :)                !! M-normalized shapes over the DOFs
+      real(dp), intent(in) :: big                    !! the spectrum's scale
+      real(dp), intent(in) :: zcz(:)                 !! z' C z of the modes kept
+      type(modes_type), intent(inout) :: modes       !! the modes (nq, n set)
+      type(error_type), allocatable, intent(out) :: error !! no memory
+      integer, allocatable :: grp(:)
+      integer :: j, n, stat
+
+      n = model%n_dof
+      modes%status = modes_flexible
+      if (lam(1) <= 1.0e-12_dp*big) modes%status = modes_unrestrained
+      allocate (grp(n), stat=stat)
+      if (stat == 0) then
+         grp = [(j, j=1, n)]
+         call store_modes(grp, model%mass, lam, z, lam(1:modes%n) <= 1.0e-12_dp*big, zcz, modes, stat, &
+                          model%influence)
+      end if
+      if (stat /= 0) call out_of_memory('natural modes', n, error)
+   end subroutine store_dof_modes
 
    !> The modes' arrays from the lowest modes%n eigenpairs (lam, z) of the reduced system of
    !> the rigid groups grp (z' Mq z = 1): each shape expanded to every DOF and scaled so

@@ -227,11 +227,8 @@ contains
          work%tab(i, 2*nn + 1) = -1.0_dp
          work%tab(i, irhs) = work%dsc(i)*q(i)/s
       end do
-      call lemke_core(work, nn, info%status, info%iterations)
-      if (info%status /= lcp_solved) then
-         call clear(z, w)
-         return
-      end if
+      call lemke_pivots(work, nn, info, z, w)
+      if (info%status /= lcp_solved) return
       work%zb(1:n) = 0.0_dp
       work%state(1:n) = at_lo
       do i = 1, nn
@@ -361,11 +358,8 @@ contains
          work%tab(j, irhs) = work%zb(j)/s
          work%tab(n + j, irhs) = (hi(j) - lo(j))/work%dsc(j)/s
       end do
-      call lemke_core(work, nn, info%status, info%iterations)
-      if (info%status /= lcp_solved) then
-         call clear(z, w)
-         return
-      end if
+      call lemke_pivots(work, nn, info, z, w)
+      if (info%status /= lcp_solved) return
       work%pos(1:2*nn + 1) = 0
       do r = 1, nn
          work%pos(work%basis(r)) = r
@@ -508,6 +502,17 @@ contains
    end function lcp_status_text
 
    ! ------------------------------------------------------------------ internals
+
+   !> lemke_core on the tableau the caller set, its status and pivots in info; z and w
+   !> cleared when it does not solve.
+   pure subroutine lemke_pivots(work, nn, info, z, w)
+      type(lcp_work), intent(inout) :: work
+      integer, intent(in) :: nn
+      type(lcp_info), intent(inout) :: info
+      real(dp), intent(inout) :: z(:), w(:)
+      call lemke_core(work, nn, info%status, info%iterations)
+      if (info%status /= lcp_solved) call clear(z, w)
+   end subroutine lemke_pivots
 
    !> Lemke's method on the tableau [I, -M, -d, q] (nn rows, d = 1, basis = the w's),
    !> set by the caller in work%tab(1:nn, 1:2 nn + 2). On lcp_solved work%basis holds the
