@@ -2043,7 +2043,8 @@ def ida_curves(
     points (intensity [g], largest storey quantity of the run, ``ENVELOPE_QUANTITIES``, in %
     or ``units``) and, per intensity, the median over the records and their 16th and 84th
     percentiles: ``{group: {"records": {record: [(intensity, value)]}, "intensity": [...],
-    "median": [...], "p16": [...], "p84": [...], "axis": label}}``. ``where`` keeps the runs
+    "median": [...], "p16": [...], "p84": [...], "axis": label, "intensity_axis": the
+    intensity's label ("Sa(0.814 s, 5 % damped) [g]" or "PGA [g]")}}``. ``where`` keeps the runs
     whose parameters have these values (as results_storeys.csv writes them); a record's point
     that would pool several runs (another parameter varies) is an error naming it."""
     import numpy as np
@@ -2087,8 +2088,21 @@ def ida_curves(
                          "median": [float(np.median(v)) for v in values],
                          "p16": [float(np.percentile(v, 16)) for v in values],
                          "p84": [float(np.percentile(v, 84)) for v in values],
-                         "axis": "largest " + axis + unit, "sweep": sweep.name}
+                         "axis": "largest " + axis + unit, "sweep": sweep.name,
+                         "intensity_axis": intensity_label(sweep.records)}
     return curves
+
+
+def intensity_label(records: dict | None) -> str:
+    """The intensity measure of a record suite ([records] as the manifest holds it) as an
+    axis label: "Sa(0.814 s, 5 % damped) [g]" or "PGA [g]"."""
+    records = records or {}
+    if records.get("scale_to") == "sa" and isinstance(records.get("period"), (int, float)):
+        damping = records.get("damping", 0.05)
+        return f"Sa({records['period']:.3g} s, {100 * damping:g} % damped) [g]"
+    if records.get("scale_to", "pga") == "pga":
+        return "PGA [g]"
+    return "intensity [g]"
 
 
 def ida(
@@ -2118,7 +2132,7 @@ def ida(
         ax.fill_betweenx(c["intensity"], c["p16"], c["p84"], color=color, alpha=0.15)
     first = next(iter(curves.values()))
     ax.set_xlabel(first["axis"])
-    ax.set_ylabel("intensity [g]")
+    ax.set_ylabel(first["intensity_axis"])
     ax.set_title(f"sweep '{first['sweep']}': IDA, each record, median and 16th-84th percentiles",
                  fontsize="medium")
     ax.set_xlim(left=0)
