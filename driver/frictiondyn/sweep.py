@@ -1872,6 +1872,30 @@ def _no_column(col: str, columns: list[str]) -> SweepError:
     return SweepError(f"{col!r} is not a column of results.csv; {hint}")
 
 
+#: a summary column's SI unit from its name's suffix (peak_aabs_mps2[5]: m/s2)
+_COLUMN_UNITS = (("_mps2", "m/s2"), ("_mps", "m/s"), ("_m", "m"), ("_N", "N"), ("_Nm", "N m"),
+                 ("_J", "J"), ("_s", "s"), ("_rad", "rad"), ("_deg", "deg"), ("_per_s", "1/s"))
+
+
+def column_axis(column: str, units: str | None = None) -> tuple[float, str]:
+    """How ``sweep plot`` shows a results.csv column: (factor, axis label). Its SI unit from
+    its name (``peak_aabs_mps2[5]``: m/s2), shown in ``units`` (text as for ``run --units``:
+    "mm,kN,g"); a drift ratio in %; a column of no known unit as it is."""
+    from .plots import Units
+
+    base = re.sub(r"\[\d+\]$", "", column)
+    if re.search(r"drift_ratio$", base):
+        return 100.0, f"{column} [%]"
+    try:
+        shown = Units.parse(units)
+    except ValueError as exc:
+        raise SweepError(f"--units {units}: {exc}") from None
+    for suffix, si in _COLUMN_UNITS:
+        if base.endswith(suffix):
+            return shown.factor(si), f"{column} [{shown.name(si)}]"
+    return 1.0, column
+
+
 def plot(
     directory: str | os.PathLike,
     x: str,
@@ -1879,14 +1903,16 @@ def plot(
     by: str | None = None,
     out: str | os.PathLike | None = None,
     dpi: int = 150,
+    units: str | None = None,
 ) -> Path:
     """One summary quantity (``y``, a results.csv column such as ``peak_u_m[5]``) against
     one parameter (``x``), one line per value of ``by`` (default: the other varied
     parameters, together, less those zipped with ``x``, which vary with it, a record
     suite's file and scale, which follow its record and intensity, and the [derived] keys,
     which follow the parameters they are computed from). Writes a PNG (default
-    ``<dir>/<y>_vs_<x>.png``, ``dpi`` dots per inch). A point whose x or y is not a number (NaN: a
-    quantity the run does not define) is left out."""
+    ``<dir>/<y>_vs_<x>.png``, ``dpi`` dots per inch). Each axis is in its column's unit
+    (``column_axis``: ``units`` such as "mm,kN,g", a drift ratio in %). A point whose x or y is
+    not a number (NaN: a quantity the run does not define) is left out."""
     from matplotlib.backends.backend_agg import FigureCanvasAgg
     from matplotlib.figure import Figure
 
@@ -1898,6 +1924,7 @@ def plot(
     for col in (x, y) + ((by,) if by else ()):
         if col not in rows[0]:
             raise _no_column(col, columns)
+    (fx, x_axis), (fy, y_axis) = column_axis(x, units), column_axis(y, units)
     along = sweep.zipped if x in sweep.zipped else [x]
     others = [by] if by else [p for p in sweep.parameters
                               if p not in along and p in rows[0] and p not in SUITE_KEYS[2:]
@@ -1910,7 +1937,7 @@ def plot(
             skipped += 1
             continue
         label = ", ".join(f"{k} = {r.get(k, '')}" for k in others)
-        groups.setdefault(label, []).append((xv, yv))
+        groups.setdefault(label, []).append((fx * xv, fy * yv))
     if not groups:
         raise SweepError(f"{directory}: no complete run has numbers for both {x!r} and {y!r} "
                          f"({skipped} left out: text or NaN, a quantity the run does not define)")
@@ -1920,8 +1947,8 @@ def plot(
     for label, pts in groups.items():
         pts.sort()
         ax.plot([p[0] for p in pts], [p[1] for p in pts], marker="o", label=label or None)
-    ax.set_xlabel(x)
-    ax.set_ylabel(y)
+    ax.set_xlabel(x_axis)
+    ax.set_ylabel(y_axis)
     title = f"sweep '{sweep.name}'"
     if skipped:
         title += f" ({skipped} run(s) left out: {y} or {x} not a number)"
@@ -2233,10 +2260,12 @@ def main(argv: Sequence[str]) -> int:
         p.add_argument("x", help="parameter (a column of results.csv), e.g. friction.p")
         p.add_argument("y", help="summary quantity, e.g. 'peak_u_m[5]'")
         p.add_argument("--by", help="one line per value of this parameter")
+        p.add_argument("--units", help="units of the axes, e.g. mm,kN,g (default SI; a drift "
+                       "ratio in %%)")
         p.add_argument("--dpi", type=int, default=150, help="resolution (default 150; 300 for a report)")
         p.add_argument("--out", metavar="PNG")
         a = p.parse_args(argv[1:])
-        print(f"plot: {plot(a.directory, a.x, a.y, a.by, a.out, a.dpi)}")
+        print(f"plot: {plot(a.directory, a.x, a.y, a.by, a.out, a.dpi, a.units)}")
         return 0
     if argv and argv[0] == "envelope":
         p = argparse.ArgumentParser(prog="python -m frictiondyn sweep envelope",
