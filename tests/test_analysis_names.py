@@ -59,6 +59,17 @@ def test_record_of_an_at2_file_needs_no_dt(tmp_path):
     with pytest.raises(fd.DeckError) as err:
         frame(excitation=fd.Record(file=plain)).run()
     assert "dt_record" in str(err.value) and "analysis.nml" not in str(err.value)
+    # values without dt_record: named by the attribute, before any file is written
+    for attr in ("excitation", "excitation2"):
+        kw = {"floors": fd.Floors([fd.Floor(1000.0, plan_x=2.0, plan_y=2.0)]),
+              "frames": [fd.Frame(1, 0, 0, 0, 4.0e5), fd.Frame(1, 90, 0, 0, 4.0e5)],
+              "masses": None, "springs": [], "devices": [],
+              "excitation": fd.Record(file=AT2, duration=0.5)} if attr == "excitation2" else {}
+        kw[attr] = fd.Record(values=[0.0, 0.1, 0.0])
+        with pytest.raises(fd.DeckError) as err:
+            frame(**kw).run()
+        assert str(err.value) == (f"Analysis.{attr}.dt_record: a Record of values needs its step "
+                                  "dt_record [s] (an AT2 file gives its own DT)")
     # format and units reach the reader: cm/s2 values a hundredth of m/s2
     b = frame(excitation=fd.Record(file=plain, dt_record=0.01, format="values", units="cm/s2"))
     assert b.run().summary["record"]["peak_acc_mps2"] == pytest.approx(0.001, rel=1e-12)

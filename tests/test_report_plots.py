@@ -4,6 +4,8 @@ resolution and figures composed of panels."""
 
 from __future__ import annotations
 
+from pathlib import Path
+
 import frictiondyn as fd
 import numpy as np
 import pytest
@@ -126,3 +128,23 @@ def test_plot_all_adds_the_storey_plots(damped, tmp_path):
     assert "b5_drift_profile.png" in names and "b5_acceleration_profile.png" in names
     assert "b5_storey_loop2.png" in names and "b5_storey_loop3.png" not in names
     assert all(p.stat().st_size > 5000 for p in paths)
+
+
+def test_plot_all_titles_name_the_run(damped, tmp_path, monkeypatch):
+    """Every figure plot_all writes (what run --plot and plot write) names the run in its
+    title: the deck's name before the panel's own title."""
+    titles = {}
+    real_save = plots.save
+
+    def save(fig, path, dpi=None):
+        sup = fig._suptitle.get_text() if fig._suptitle is not None else ""
+        titles[Path(path).name] = sup or next(a.get_title() for a in fig.axes if a.get_title())
+        return real_save(fig, path, dpi)
+
+    monkeypatch.setattr(plots, "save", save)
+    paths = plots.plot_all(damped, tmp_path, "b5", kinds="key")
+    assert sorted(titles) == sorted(p.name for p in paths) and len(paths) >= 4
+    name = plots.default_label(damped, 0)
+    assert name == "building5_dampers"
+    assert titles["b5_drift_profile.png"] == f"{name}: peak inter-storey drift"
+    assert all(t.startswith(f"{name}: ") for t in titles.values()), titles

@@ -231,3 +231,32 @@ def test_a_job_array_in_a_folder_named_to_inject_commands(cluster, tmp_path):
     assert sorted(p.name for p in (out / "logs").glob("*.out")) == [f"{job}_0.out", f"{job}_1.out"]
     assert not list(tmp_path.rglob("INJECTED*"))
     assert not list(Path("/").glob("INJECTED*")) and not list(Path.home().glob("INJECTED*"))
+
+
+def test_a_job_array_of_tolerance_runs_gives_the_local_results(cluster, tmp_path):
+    """A sweep of two base decks, one with &integration tolerance: Slurm's tasks run the
+    tolerance run by Python and the other by the executable; every summary equals the local
+    sweep's (but the run time), the tolerance run's with its estimated errors."""
+    from test_sweep_tolerance import BASE
+
+    env, _ = cluster
+    (tmp_path / "tol.nml").write_text(BASE.format(tolerance=", tolerance = 1e-3"))
+    (tmp_path / "plain.nml").write_text(BASE.format(tolerance=""))
+    spec = tmp_path / "tol.toml"
+    spec.write_text('name = "tol"\n[cross]\ndeck = ["tol.nml", "plain.nml"]\n')
+    local, remote = tmp_path / "local", tmp_path / "remote"
+    r = subprocess.run([*SWEEP, str(spec), "--out", str(local), "--quiet"], capture_output=True, text=True)
+    assert r.returncode == 0, r.stderr
+    r = subprocess.run([*SWEEP, str(spec), "--out", str(remote), "--slurm", "--submit"], env=env,
+                       capture_output=True, text=True)
+    assert r.returncode == 0, r.stderr
+    assert 'tolerance_runs=" 0 "' in (remote / "sweep.sbatch").read_text()
+    _wait_job(env, _job_id(r.stdout))
+    c = subprocess.run([*SWEEP, "collect", str(remote)], env=env, capture_output=True, text=True)
+    assert c.returncode == 0 and "2 of 2 runs complete" in c.stdout, c.stdout + c.stderr
+    for i in range(2):
+        sa, sb = (json.loads((d / "runs" / f"r{i:04d}.summary.json").read_text()) for d in (local, remote))
+        sa.pop("run_time_s")
+        sb.pop("run_time_s")
+        assert sa == sb
+        assert ("estimated_error" in sb) == (i == 0)

@@ -1,7 +1,8 @@
 """Elastic response spectra (frictiondyn.response_spectrum, python -m frictiondyn spectrum):
 the library's exact stepping against an independent one, Chopra's closed-form recurrence
 for a load linear in a step (Dynamics of Structures, table 5.2.1), on the bundled synthetic
-AT2 record; the record read with the deck's settings; bad input named."""
+AT2 record; against the closed-form response of an oscillator to a harmonic table motion and
+to an impulse; the record read with the deck's settings; bad input named."""
 
 from __future__ import annotations
 
@@ -73,6 +74,62 @@ def test_against_the_closed_form_recurrence(period):
     # T = 0: the peak ground acceleration (the header says PGA 0.35 g)
     assert s.psa[0] == pytest.approx(np.max(np.abs(ag)), rel=1e-12)
     assert s.psa[0] / G == pytest.approx(0.35, rel=1e-3)
+
+
+def harmonic_response(t, amp, omega_f, period, xi):
+    """u(t) and u'(t) of a unit-mass oscillator from rest under a table acceleration
+    amp sin(omega_f t): the closed form, steady state and transient (Chopra, section 3.2)."""
+    w = 2 * math.pi / period
+    wd = w * math.sqrt(1 - xi * xi)
+    r = omega_f / w
+    den = (1 - r * r) ** 2 + (2 * xi * r) ** 2
+    c = -amp / (w * w) * (1 - r * r) / den  # u_p = c sin + d cos of omega_f t
+    d = -amp / (w * w) * (-2 * xi * r) / den
+    e1 = -d
+    e2 = (xi * w * e1 - c * omega_f) / wd
+    env = np.exp(-xi * w * t)
+    u = env * (e1 * np.cos(wd * t) + e2 * np.sin(wd * t)) + c * np.sin(omega_f * t) + d * np.cos(omega_f * t)
+    v = (env * (-xi * w * (e1 * np.cos(wd * t) + e2 * np.sin(wd * t))
+                + wd * (-e1 * np.sin(wd * t) + e2 * np.cos(wd * t)))
+         + c * omega_f * np.cos(omega_f * t) - d * omega_f * np.sin(omega_f * t))
+    return u, v
+
+
+@pytest.mark.parametrize("period", [0.2, 0.6, 2.0])
+@pytest.mark.parametrize("xi", [0.0, 0.05])
+def test_against_the_closed_form_harmonic_response(tmp_path, period, xi):
+    """A table acceleration 2 m/s2 sin(2 pi 1.5 t) sampled every 0.2 ms for 4 s: the peak
+    displacement and absolute acceleration of the oscillator from rest are the closed form's
+    (transient included) to 1e-5; the differences are the record's sampling (a motion linear
+    between samples, (omega dt)^2 / 8) and the peaks' sampling, each below 1e-6."""
+    dt, amp, omega_f = 2e-4, 2.0, 2 * math.pi * 1.5
+    n = 20001
+    rec = tmp_path / "harmonic.txt"
+    rec.write_text("".join(f"{amp * math.sin(omega_f * k * dt):.17e}\n" for k in range(n)))
+    s = response_spectrum(rec, periods=[period], xi=xi, format="values", units="m/s2", dt=dt)
+    t = np.linspace(0.0, (n - 1) * dt, 2_000_001)
+    u, v = harmonic_response(t, amp, omega_f, period, xi)
+    w = 2 * math.pi / period
+    assert s.sd[0] == pytest.approx(np.max(np.abs(u)), rel=1e-5)
+    assert s.sa[0] == pytest.approx(np.max(np.abs(2 * xi * w * v + w * w * u)), rel=1e-5)
+    assert s.psa[0] == pytest.approx(w * w * s.sd[0], rel=1e-14)
+
+
+@pytest.mark.parametrize("xi", [0.0, 0.05, 0.2])
+def test_against_the_closed_form_impulse_response(tmp_path, xi):
+    """A one-sample pulse (a triangle of area I = a dt, dt = T / 5000) is an impulse to
+    (omega dt)^2: the oscillator's peak displacement is the impulse response's first extreme,
+    (I / omega) exp(-xi omega t*) at omega_d t* = atan(sqrt(1 - xi^2) / xi) (I / omega at a
+    quarter period undamped), to 1e-5."""
+    period, a = 0.5, 10.0
+    dt = period / 5000
+    rec = tmp_path / "pulse.txt"
+    rec.write_text("0.0\n" + f"{a:.17e}\n" + "0.0\n" * 3000)
+    s = response_spectrum(rec, periods=[period], xi=xi, format="values", units="m/s2", dt=dt)
+    w = 2 * math.pi / period
+    wd = w * math.sqrt(1 - xi * xi)
+    t_star = (math.atan(math.sqrt(1 - xi * xi) / xi) if xi > 0 else math.pi / 2) / wd
+    assert s.sd[0] == pytest.approx(a * dt / w * math.exp(-xi * w * t_star), rel=1e-5)
 
 
 def test_record_settings_are_the_decks(tmp_path):

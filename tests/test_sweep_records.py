@@ -172,6 +172,10 @@ def test_ida_curves_are_the_medians_of_the_runs(tmp_path):
         sw.ida_curves(out)
     one = sw.ida_curves(out, where={"friction.mu": "0.1"})
     assert one[""]["median"] == curves["friction.mu = 0.1"]["median"]
+    # the intensity axis names the measure the records were scaled to
+    assert one[""]["intensity_axis"] == "PGA [g]"
+    assert sw.intensity_label({"scale_to": "sa", "period": 0.8139690061706273, "damping": 0.05}) \
+        == "Sa(0.814 s, 5 % damped) [g]"
     r = subprocess.run([*SWEEP, "ida", str(out), "--by", "friction.mu", "--dpi", "60"], capture_output=True,
                        text=True)
     assert r.returncode == 0, r.stderr

@@ -83,6 +83,22 @@ def test_history_to_parquet_and_back(tmp_path):
         fd.Result.from_parquet(plain)
 
 
+def test_run_writes_the_history_as_parquet_from_the_command_line(tmp_path):
+    """``python -m frictiondyn run DECK --parquet``: the history also as <name>.parquet, the
+    CSV's values exactly, with the summary; ``plot`` and ``compare`` read it back."""
+    from frictiondyn.cli import load_result
+    from frictiondyn.cli import main as cli
+
+    out = tmp_path / "out"
+    assert cli(["run", str(INPUTS / "test1_velocity.nml"), "--parquet", "--out", str(out),
+                "--quiet"]) == 0
+    csv_result = fd.Result.from_files(out / "test1_velocity.csv")
+    back = load_result(out / "test1_velocity.parquet")
+    assert back.names == csv_result.names and back.units == csv_result.units
+    np.testing.assert_array_equal(back.data, csv_result.data)
+    assert back.summary == csv_result.summary
+
+
 def test_envelope_over_the_storeys(tmp_path):
     """Envelopes of a sweep with storeys: per run, and per value of a parameter (the median
     and the percentile band); an unknown parameter named."""

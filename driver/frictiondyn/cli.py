@@ -58,11 +58,22 @@ def load_result(path: str | os.PathLike) -> Result:
             return Result.from_files(p, None if _summary_path(p).exists() else False)
         if suffix == ".npz":
             return Result.from_npz(p)
+        if suffix == ".parquet":
+            _need_pyarrow(str(p))
+            return Result.from_parquet(p)
     except (OSError, ValueError, KeyError) as exc:
         raise CliError(f"{p}: not a frictiondyn result ({exc})") from None
     if suffix in (".nml", ".namelist", ".in"):
         return run(p)
-    raise CliError(f"{p}: expected a history .csv, a .npz or a deck .nml")
+    raise CliError(f"{p}: expected a history .csv, a .npz, a .parquet or a deck .nml")
+
+
+def _need_pyarrow(what: str) -> None:
+    """Parquet needs pyarrow, an optional dependency: a CliError saying so when it is missing."""
+    try:
+        import pyarrow  # noqa: F401
+    except ImportError:
+        raise CliError(f"{what}: Parquet needs pyarrow: pip install frictiondyn[parquet]") from None
 
 
 def _stem(path: Path) -> str:
@@ -159,7 +170,10 @@ class _ProgressBar:
 
 def _tolerance_outputs(args: argparse.Namespace) -> tuple[Result, Path | None, Path]:
     """A tolerance run: the chosen run written as the executable writes one, its summary with
-    the estimated errors and what was chosen (the summary rewritten whole, then renamed)."""
+    the estimated errors and what was chosen, and the SHA-256 of the deck given (the run chosen
+    is of a deck written from it; the summary rewritten whole, then renamed)."""
+    import hashlib
+
     from .tolerance import tolerance_run
 
     result, report, session = tolerance_run(args.deck, args.tolerance, args.tolerance_floor)
@@ -167,6 +181,7 @@ def _tolerance_outputs(args: argparse.Namespace) -> tuple[Result, Path | None, P
         csv, summ = session.write(args.out)
     data = json.loads(summ.read_text())
     data.update({k: result.summary[k] for k in ("estimated_error", "estimate_method", "tolerance_run")})
+    data["deck_sha256"] = hashlib.sha256(Path(args.deck).read_bytes()).hexdigest()
     temp = summ.with_name(summ.name + ".tolerance.tmp")
     temp.write_text(json.dumps(data, indent=2) + "\n")
     os.replace(temp, summ)
@@ -179,6 +194,8 @@ def cmd_run(args: argparse.Namespace) -> int:
     from .plots import plot_kinds
 
     kinds = plot_kinds(args.plots)
+    if args.parquet:  # before the run: nothing is written when it cannot be
+        _need_pyarrow("--parquet")
     if args.tolerance is not None or args.tolerance_floor is not None or _asks_tolerance(args.deck):
         with warnings.catch_warnings():
             warnings.simplefilter("ignore", FrictiondynWarning)
@@ -190,7 +207,7 @@ def cmd_run(args: argparse.Namespace) -> int:
             # duration); it is also kept in memory only for the plots
             session.stream(args.out)
             try:
-                session.solve(progress=bar, history=args.plot)
+                session.solve(progress=bar, history=args.plot or args.parquet)
             finally:
                 bar.close()
             with warnings.catch_warnings():  # _print_summary prints them, as the executable does
@@ -200,6 +217,9 @@ def cmd_run(args: argparse.Namespace) -> int:
     _print_summary(result, args.deck)
     if csv is not None:
         print(f"  history: {csv}")
+    if args.parquet:
+        stem = summ.name[: -len(".summary.json")]
+        print(f"  history: {result.to_parquet(summ.parent / (stem + '.parquet'))}")
     print(f"  summary: {summ}")
     _plots(args, result, summ, trange, kinds)
     return 0
@@ -439,6 +459,9 @@ def build_parser() -> argparse.ArgumentParser:
         "--out", metavar="DIR", help="output directory (default: the deck's &output dir)"
     )
     p.add_argument("--plot", action="store_true", help="also write PNGs next to the outputs")
+    p.add_argument("--parquet", action="store_true",
+                   help="also write the history as <name>.parquet (needs pyarrow: "
+                   "frictiondyn[parquet]); with &output write_history = .false. instead of the CSV")
     p.add_argument("--plots", **which)
     p.add_argument("--t-range", **trange)
     p.add_argument("--quiet", action="store_true", help="no progress bar")
@@ -455,8 +478,8 @@ def build_parser() -> argparse.ArgumentParser:
     )
     p.set_defaults(func=cmd_run)
 
-    p = sub.add_parser("plot", help="PNGs of a result (.csv or .npz)")
-    p.add_argument("result", help="history CSV (with its .summary.json), or .npz")
+    p = sub.add_parser("plot", help="PNGs of a result (.csv, .npz or .parquet)")
+    p.add_argument("result", help="history CSV (with its .summary.json), .npz or .parquet")
     p.add_argument("--out", metavar="DIR", help="where the PNGs go (default: next to RESULT)")
     p.add_argument("--plots", **which)
     p.add_argument("--t-range", **trange)
@@ -465,7 +488,7 @@ def build_parser() -> argparse.ArgumentParser:
     p.set_defaults(func=cmd_plot)
 
     p = sub.add_parser("compare", help="overlay two or more results; print peak differences")
-    p.add_argument("results", nargs="+", metavar="RESULT", help=".csv, .npz or deck .nml")
+    p.add_argument("results", nargs="+", metavar="RESULT", help=".csv, .npz, .parquet or deck .nml")
     p.add_argument("--out", metavar="DIR", default=".", help="where the PNGs go (default: .)")
     p.add_argument("--name", default="compare", help="base name of the PNGs (default: compare)")
     p.add_argument("--labels", nargs="+", metavar="LABEL", help="legend names, one per result")

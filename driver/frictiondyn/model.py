@@ -989,6 +989,12 @@ class Analysis:
             for key in ("height", "label"):
                 _per_device(storeys, key, [getattr(x, key) for x in st])
             groups.append(("storeys", storeys))
+        for attr in ("excitation", "excitation2", "excitation3"):  # not the reader's temporary file
+            rec = getattr(self, attr)
+            if isinstance(rec, Record) and rec.values is not None and rec.dt_record is None \
+                    and np.ndim(rec.values) == 1:
+                raise DeckError(f"Analysis.{attr}.dt_record: a Record of values needs its step "
+                                "dt_record [s] (an AT2 file gives its own DT)")
         groups.append(("excitation", self.excitation.group(directory, cwd, record_name)))
         if self.excitation2 is not None:
             groups.append(("excitation2", self.excitation2.group(directory, cwd, record_name2)))

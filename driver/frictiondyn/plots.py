@@ -992,6 +992,20 @@ def plot_kinds(text: str | None) -> tuple[str, ...] | str:
     return kinds
 
 
+def _save_named(fig: Figure, name: str, path: Path, dpi: int | None) -> Path:
+    """Save a figure of plot_all with its title naming the run: its overall title, else the
+    first panel's ("building5_dampers: peak inter-storey drift")."""
+    sup = getattr(fig, "_suptitle", None)
+    if sup is not None and sup.get_text():
+        sup.set_text(f"{name}: {sup.get_text()}")
+    else:
+        for ax in fig.axes:
+            if ax.get_title():
+                ax.set_title(f"{name}: {ax.get_title()}")
+                break
+    return save(fig, path, dpi)
+
+
 def plot_all(
     result: Result,
     directory: str | os.PathLike,
@@ -1012,9 +1026,11 @@ def plot_all(
     (with &floor_braces) ``<stem>_device_plan.png``, and with &bearings ``<stem>_bearings.png``. "key" is the last DOF's acceleration,
     the hysteresis of the device whose peak force is largest, with storeys the two profiles
     and the base shear, for rigid floors the orbit and the plan of the braces, and the
-    bearings' orbits."""
+    bearings' orbits. Each title names the run (the deck's name, else ``stem``):
+    "building5_dampers: peak inter-storey drift"."""
     directory = Path(directory)
     written: list[Path] = []
+    name = default_label(result, 0) if (result.summary or {}).get("deck") else stem
     explicit = kinds != KEY_PLOTS and tuple(kinds) != PLOT_KINDS   # kinds named one by one
     kw = {"t_range": t_range, "units": units, "dpi": dpi}
     dofs = range(1, min(result.n_dof, max_items) + 1)
@@ -1035,24 +1051,20 @@ def plot_all(
         for k in chosen[kind]:
             p = directory / f"{stem}_{kind}{k}.png"
             opts = {"t_range": t_range, "dpi": dpi} if kind == "phase" else kw
-            funcs[kind](result, k, p, **opts)
-            written.append(p)
+            written.append(_save_named(funcs[kind](result, k, None, **opts), name, p, dpi))
     if storeys:
         for kind, func in (("drift_profile", plot_drift_profile),
                            ("acceleration_profile", plot_acceleration_profile)):
             if kind in kinds:
                 p = directory / f"{stem}_{kind}.png"
-                func(result, p, units=units, dpi=dpi)
-                written.append(p)
+                written.append(_save_named(func(result, None, units=units, dpi=dpi), name, p, dpi))
         if "storey_loop" in kinds:
             for s_ in range(1, min(result.n_storeys, max_items) + 1):
                 p = directory / f"{stem}_storey_loop{s_}.png"
-                plot_storey_loop(result, s_, p, **kw)
-                written.append(p)
+                written.append(_save_named(plot_storey_loop(result, s_, None, **kw), name, p, dpi))
         if "base_shear" in kinds and "Vb" in result:
             p = directory / f"{stem}_base_shear.png"
-            plot_base_shear(result, p, **kw)
-            written.append(p)
+            written.append(_save_named(plot_base_shear(result, None, **kw), name, p, dpi))
     floors = (result.summary or {}).get("floor_cm_x_m")
     asked = [k for k in ("orbit", "device_plan") if k in kinds] if explicit else []
     if asked and not floors:
@@ -1060,17 +1072,14 @@ def plot_all(
                          "floors (&floors)")
     if floors and "orbit" in kinds and f"u{3 * len(floors)}" in result:
         p = directory / f"{stem}_orbit.png"
-        plot_orbit(result, p, units=units, dpi=dpi)
-        written.append(p)
+        written.append(_save_named(plot_orbit(result, None, units=units, dpi=dpi), name, p, dpi))
     if floors and "device_plan" in kinds and any(st > 0 for st in result.summary["device_storey"]):
         p = directory / f"{stem}_device_plan.png"
-        plot_device_plan(result, p, units=units, dpi=dpi)
-        written.append(p)
+        written.append(_save_named(plot_device_plan(result, None, units=units, dpi=dpi), name, p, dpi))
     has_bearings = bool((result.summary or {}).get("bearing_labels"))
     if explicit and "bearings" in kinds and not has_bearings:
         raise ValueError(f"plots bearings: {default_label(result, 0)} has no planar bearing (&bearings)")
     if has_bearings and "bearings" in kinds:
         p = directory / f"{stem}_bearings.png"
-        plot_bearings(result, p, units=units, dpi=dpi)
-        written.append(p)
+        written.append(_save_named(plot_bearings(result, None, units=units, dpi=dpi), name, p, dpi))
     return written

@@ -88,7 +88,7 @@ from typing import Any
 import f90nml
 
 from . import __version__
-from ._api import FrictiondynError, run_text
+from ._api import DeckError, FrictiondynError, run_text
 from ._exe import executable
 from ._nml import copy_namelist, read_namelist, write_namelist
 
@@ -182,6 +182,9 @@ class Run:
     deck: str  #: deck path relative to the sweep directory
     deck_sha256: str = ""
     record_sha256: str = ""  #: SHA-256 of the record file the deck names ("" when none)
+    #: the deck sets &integration tolerance: a Python tolerance run (``python -m frictiondyn
+    #: run``), which the executable refuses
+    tolerance: bool = False
 
     @property
     def summary(self) -> str:
@@ -864,6 +867,8 @@ def _first_period(nml: f90nml.Namelist, base_dir: Path, where: str) -> tuple[flo
     has none (devices holding every mass to the table), of its free system (the devices
     removed); from a run of the deck over one record step."""
     deck = copy_namelist(nml)
+    for var in TOLERANCE_VARIABLES:  # the model's modes: one setting of a tolerance run's deck
+        (deck.get("integration") or {}).pop(var, None)
     exc = deck["excitation"]
     dt = exc.get("dt_record")
     if dt is None:  # an AT2 record gives its step: the record's own reading decides
@@ -942,9 +947,41 @@ def _read_base(base: str, base_dir: Path, where: str) -> tuple[Path, f90nml.Name
     except OSError as exc:
         raise SweepError(f"{where}: cannot read the base deck {base_path}: {exc.strerror}") from None
     try:
-        return base_path, read_namelist(text, base_path)
+        return base_path, _read_deck(text, base_path)
     except FrictiondynError as exc:
         raise SweepError(f"{where}: base deck: {exc}") from None
+
+
+#: the variables of a tolerance run (docs/python.md, "A stated accuracy"), which the library
+#: refuses as one setting: a deck that gives them is run by Python's tolerance run
+TOLERANCE_VARIABLES = ("tolerance", "tolerance_floor")
+
+
+def _read_deck(text: str, path: Path) -> f90nml.Namelist:
+    """A base deck as read_namelist reads it; one of a tolerance run (which the library reads
+    only without its tolerance variables) is read without them, and they are put back."""
+    try:
+        return read_namelist(text, path)
+    except DeckError as exc:
+        if "is a tolerance run" not in str(exc):
+            raise
+    from .tolerance import DEFAULT_FLOOR, _check, _strip
+
+    stripped, tol, floor = _strip(text, path)
+    # a value out of range: the tolerance run's DeckError (a tolerance varied by the spec
+    # instead is checked when its run is made)
+    _check(DEFAULT_FLOOR if tol is None else tol, DEFAULT_FLOOR if floor is None else floor, path)
+    nml = read_namelist(stripped, path)
+    integ = nml.setdefault("integration", f90nml.Namelist())
+    for var, value in zip(TOLERANCE_VARIABLES, (tol, floor)):
+        if value is not None:
+            integ[var] = value
+    return nml
+
+
+def _is_tolerance_run(nml: f90nml.Namelist) -> bool:
+    integ = nml.get("integration") or {}
+    return any(integ.get(v) is not None for v in TOLERANCE_VARIABLES)
 
 
 def _record_sha256(nml: f90nml.Namelist, decks: Path, cache: dict[str, str]) -> str:
@@ -1100,7 +1137,7 @@ def _write_runs(spec, spec_path, sdir, keys, rows, bases) -> Sweep:
                 (sdir / stale).unlink(missing_ok=True)
             _write_atomic(deck, data)
         run = Run(index, rid, params, f"decks/{rid}.nml", _sha256(data),
-                  _record_sha256(nml, sdir / "decks", records))
+                  _record_sha256(nml, sdir / "decks", records), _is_tolerance_run(nml))
         sweep.runs.append(run)
     # decks of a larger earlier expansion are no longer part of the sweep
     wanted = {r.deck for r in sweep.runs}
@@ -1122,7 +1159,8 @@ def _write_runs(spec, spec_path, sdir, keys, rows, bases) -> Sweep:
         "derived": sweep.derived,
         "runs": [
             {"index": r.index, "id": r.id, "deck": r.deck, "deck_sha256": r.deck_sha256,
-             "record_sha256": r.record_sha256, "params": r.params}
+             "record_sha256": r.record_sha256, "params": r.params,
+             **({"tolerance": True} if r.tolerance else {})}
             for r in sweep.runs
         ],
     }
@@ -1197,13 +1235,15 @@ def load(directory: str | os.PathLike) -> Sweep:
         sha = want(r, "deck_sha256", str, f"{what}.deck_sha256")
         rec = r.get("record_sha256", "")
         p = want(r, "params", dict, f"{what}.params")
+        tolerance = r.get("tolerance", False)
         if (index != i or not _RUN_ID.fullmatch(rid) or rid in ids or deck != f"decks/{rid}.nml"
                 or not _SHA256.fullmatch(sha) or not isinstance(rec, str)
+                or not isinstance(tolerance, bool)
                 or (rec and not _SHA256.fullmatch(rec))
                 or (runs and len(rid) != len(runs[0].id))):
             raise _damaged_manifest(sdir, f"{what} = {_short(r)}")
         ids.add(rid)
-        runs.append(Run(index, rid, p, deck, sha, rec))
+        runs.append(Run(index, rid, p, deck, sha, rec, tolerance))
     if not runs:
         raise _damaged_manifest(sdir, "no runs")
     spec_sha = m.get("spec_sha256", "")
@@ -1254,10 +1294,12 @@ def run_local(
     exe: str | None = None,
     progress: bool = True,
 ) -> dict[str, int]:
-    """Run the pending runs, ``jobs`` processes at a time (default: the CPU count). A
-    failure is written to ``runs/<id>.error.txt`` and the others go on. SIGINT or SIGTERM
-    stop the sweep: running executables get SIGTERM (they remove their temporary files)
-    and what completed stays complete. Returns counts: done, failed, skipped."""
+    """Run the pending runs, ``jobs`` processes at a time (default: the CPU count): each deck
+    by the executable, a tolerance run's (``Run.tolerance``) by ``python -m frictiondyn run``
+    with this Python. A failure is written to ``runs/<id>.error.txt`` and the others go on.
+    SIGINT or SIGTERM stop the sweep: running processes get SIGTERM (the executable removes
+    its temporary files) and what completed stays complete. Returns counts: done, failed,
+    skipped."""
     exe = exe or executable()
     if jobs is not None and (isinstance(jobs, bool) or not 1 <= jobs <= MAX_JOBS):
         raise SweepError(f"jobs = {jobs}: a whole number from 1 to {MAX_JOBS} is needed")
@@ -1278,8 +1320,9 @@ def run_local(
     def one(run: Run) -> tuple[Run, int, str]:
         if stopping.is_set():
             return run, -1, "not started"
+        command = (_tolerance_command(run.deck) if run.tolerance else [exe, run.deck])
         p = subprocess.Popen(
-            [exe, run.deck], cwd=sweep.directory, stdout=subprocess.DEVNULL,
+            command, cwd=sweep.directory, stdout=subprocess.DEVNULL,
             stderr=subprocess.PIPE, text=True,
         )
         with lock:
@@ -1332,6 +1375,13 @@ def run_local(
         if threading.current_thread() is threading.main_thread():
             signal.signal(signal.SIGTERM, old_term)
     return counts
+
+
+def _tolerance_command(deck: str) -> list[str]:
+    """A tolerance run's command: Python's tolerance run of the deck, written as the
+    executable writes a run (the deck's &output), its summary with the estimated errors
+    (the job script's names the deck by the task's id: it keeps all but the last two)."""
+    return [sys.executable, "-m", "frictiondyn", "run", deck, "--quiet"]
 
 
 # ---------------------------------------------------------------------------------- Slurm
@@ -1396,12 +1446,17 @@ def slurm_script(
     name: str = "sweep.sbatch",
 ) -> Path:
     """Write a job-array script: task i runs ``frictiondyn --list decks.txt --index i`` in
-    the sweep directory (no Python needed on the compute node). ``indices`` default to the
-    pending runs. Returns the script's path."""
+    the sweep directory (no Python needed on the compute node), or, for a tolerance run
+    (``Run.tolerance``), ``python -m frictiondyn run decks/<id>.nml`` with this Python.
+    ``indices`` default to the pending runs. Returns the script's path."""
     exe = os.path.abspath(exe or executable())
     check_slurm_values(sweep.directory, exe, time_limit, partition, extra, job_name)
     if indices is None:
         indices = [r.index for r in sweep.pending()]
+    tolerance = sorted(r.index for r in sweep.runs if r.tolerance and r.index in set(indices))
+    if tolerance and _CONTROL.search(sys.executable):
+        raise SweepError(f"the Python path {json.dumps(sys.executable)} holds a newline or another "
+                         "control character: a job script cannot name it")
     if not indices:
         raise SweepError(f"{sweep.directory}: every run is complete; nothing to submit")
     if not all(_RUN_ID.fullmatch(r.id) for r in sweep.runs) or not _NAME.fullmatch(sweep.name):
@@ -1434,7 +1489,22 @@ def slurm_script(
         "set -u",
         f"cd {shlex.quote(str(sweep.directory))} || exit 1",
         f'id=$(printf "r%0{width}d" "$SLURM_ARRAY_TASK_ID")',
-        f'{shlex.quote(exe)} --list decks.txt --index "$SLURM_ARRAY_TASK_ID" 2> "logs/$id.err"',
+    ]
+    run_exe = f'{shlex.quote(exe)} --list decks.txt --index "$SLURM_ARRAY_TASK_ID" 2> "logs/$id.err"'
+    if tolerance:  # the executable refuses a tolerance run's deck: Python runs it
+        lines += [
+            "# the runs whose deck sets &integration tolerance: Python's tolerance run",
+            f'tolerance_runs=" {" ".join(map(str, tolerance))} "',
+            'if [[ "$tolerance_runs" == *" $SLURM_ARRAY_TASK_ID "* ]]; then',
+            f'  {shlex.join(_tolerance_command("DECK")[:-2])} "decks/$id.nml" --quiet '
+            '2> "logs/$id.err"',
+            "else",
+            "  " + run_exe,
+            "fi",
+        ]
+    else:
+        lines.append(run_exe)
+    lines += [
         "status=$?",
         'if [ "$status" -ne 0 ]; then',
         '  { cat "logs/$id.err"; echo "(exit status $status, job ${SLURM_ARRAY_JOB_ID}_'
@@ -1802,6 +1872,30 @@ def _no_column(col: str, columns: list[str]) -> SweepError:
     return SweepError(f"{col!r} is not a column of results.csv; {hint}")
 
 
+#: a summary column's SI unit from its name's suffix (peak_aabs_mps2[5]: m/s2)
+_COLUMN_UNITS = (("_mps2", "m/s2"), ("_mps", "m/s"), ("_m", "m"), ("_N", "N"), ("_Nm", "N m"),
+                 ("_J", "J"), ("_s", "s"), ("_rad", "rad"), ("_deg", "deg"), ("_per_s", "1/s"))
+
+
+def column_axis(column: str, units: str | None = None) -> tuple[float, str]:
+    """How ``sweep plot`` shows a results.csv column: (factor, axis label). Its SI unit from
+    its name (``peak_aabs_mps2[5]``: m/s2), shown in ``units`` (text as for ``run --units``:
+    "mm,kN,g"); a drift ratio in %; a column of no known unit as it is."""
+    from .plots import Units
+
+    base = re.sub(r"\[\d+\]$", "", column)
+    if re.search(r"drift_ratio$", base):
+        return 100.0, f"{column} [%]"
+    try:
+        shown = Units.parse(units)
+    except ValueError as exc:
+        raise SweepError(f"--units {units}: {exc}") from None
+    for suffix, si in _COLUMN_UNITS:
+        if base.endswith(suffix):
+            return shown.factor(si), f"{column} [{shown.name(si)}]"
+    return 1.0, column
+
+
 def plot(
     directory: str | os.PathLike,
     x: str,
@@ -1809,14 +1903,16 @@ def plot(
     by: str | None = None,
     out: str | os.PathLike | None = None,
     dpi: int = 150,
+    units: str | None = None,
 ) -> Path:
     """One summary quantity (``y``, a results.csv column such as ``peak_u_m[5]``) against
     one parameter (``x``), one line per value of ``by`` (default: the other varied
     parameters, together, less those zipped with ``x``, which vary with it, a record
     suite's file and scale, which follow its record and intensity, and the [derived] keys,
     which follow the parameters they are computed from). Writes a PNG (default
-    ``<dir>/<y>_vs_<x>.png``, ``dpi`` dots per inch). A point whose x or y is not a number (NaN: a
-    quantity the run does not define) is left out."""
+    ``<dir>/<y>_vs_<x>.png``, ``dpi`` dots per inch). Each axis is in its column's unit
+    (``column_axis``: ``units`` such as "mm,kN,g", a drift ratio in %). A point whose x or y is
+    not a number (NaN: a quantity the run does not define) is left out."""
     from matplotlib.backends.backend_agg import FigureCanvasAgg
     from matplotlib.figure import Figure
 
@@ -1828,6 +1924,7 @@ def plot(
     for col in (x, y) + ((by,) if by else ()):
         if col not in rows[0]:
             raise _no_column(col, columns)
+    (fx, x_axis), (fy, y_axis) = column_axis(x, units), column_axis(y, units)
     along = sweep.zipped if x in sweep.zipped else [x]
     others = [by] if by else [p for p in sweep.parameters
                               if p not in along and p in rows[0] and p not in SUITE_KEYS[2:]
@@ -1840,7 +1937,7 @@ def plot(
             skipped += 1
             continue
         label = ", ".join(f"{k} = {r.get(k, '')}" for k in others)
-        groups.setdefault(label, []).append((xv, yv))
+        groups.setdefault(label, []).append((fx * xv, fy * yv))
     if not groups:
         raise SweepError(f"{directory}: no complete run has numbers for both {x!r} and {y!r} "
                          f"({skipped} left out: text or NaN, a quantity the run does not define)")
@@ -1850,8 +1947,8 @@ def plot(
     for label, pts in groups.items():
         pts.sort()
         ax.plot([p[0] for p in pts], [p[1] for p in pts], marker="o", label=label or None)
-    ax.set_xlabel(x)
-    ax.set_ylabel(y)
+    ax.set_xlabel(x_axis)
+    ax.set_ylabel(y_axis)
     title = f"sweep '{sweep.name}'"
     if skipped:
         title += f" ({skipped} run(s) left out: {y} or {x} not a number)"
@@ -1973,7 +2070,8 @@ def ida_curves(
     points (intensity [g], largest storey quantity of the run, ``ENVELOPE_QUANTITIES``, in %
     or ``units``) and, per intensity, the median over the records and their 16th and 84th
     percentiles: ``{group: {"records": {record: [(intensity, value)]}, "intensity": [...],
-    "median": [...], "p16": [...], "p84": [...], "axis": label}}``. ``where`` keeps the runs
+    "median": [...], "p16": [...], "p84": [...], "axis": label, "intensity_axis": the
+    intensity's label ("Sa(0.814 s, 5 % damped) [g]" or "PGA [g]")}}``. ``where`` keeps the runs
     whose parameters have these values (as results_storeys.csv writes them); a record's point
     that would pool several runs (another parameter varies) is an error naming it."""
     import numpy as np
@@ -2017,8 +2115,21 @@ def ida_curves(
                          "median": [float(np.median(v)) for v in values],
                          "p16": [float(np.percentile(v, 16)) for v in values],
                          "p84": [float(np.percentile(v, 84)) for v in values],
-                         "axis": "largest " + axis + unit, "sweep": sweep.name}
+                         "axis": "largest " + axis + unit, "sweep": sweep.name,
+                         "intensity_axis": intensity_label(sweep.records)}
     return curves
+
+
+def intensity_label(records: dict | None) -> str:
+    """The intensity measure of a record suite ([records] as the manifest holds it) as an
+    axis label: "Sa(0.814 s, 5 % damped) [g]" or "PGA [g]"."""
+    records = records or {}
+    if records.get("scale_to") == "sa" and isinstance(records.get("period"), (int, float)):
+        damping = records.get("damping", 0.05)
+        return f"Sa({records['period']:.3g} s, {100 * damping:g} % damped) [g]"
+    if records.get("scale_to", "pga") == "pga":
+        return "PGA [g]"
+    return "intensity [g]"
 
 
 def ida(
@@ -2048,7 +2159,7 @@ def ida(
         ax.fill_betweenx(c["intensity"], c["p16"], c["p84"], color=color, alpha=0.15)
     first = next(iter(curves.values()))
     ax.set_xlabel(first["axis"])
-    ax.set_ylabel("intensity [g]")
+    ax.set_ylabel(first["intensity_axis"])
     ax.set_title(f"sweep '{first['sweep']}': IDA, each record, median and 16th-84th percentiles",
                  fontsize="medium")
     ax.set_xlim(left=0)
@@ -2149,10 +2260,12 @@ def main(argv: Sequence[str]) -> int:
         p.add_argument("x", help="parameter (a column of results.csv), e.g. friction.p")
         p.add_argument("y", help="summary quantity, e.g. 'peak_u_m[5]'")
         p.add_argument("--by", help="one line per value of this parameter")
+        p.add_argument("--units", help="units of the axes, e.g. mm,kN,g (default SI; a drift "
+                       "ratio in %%)")
         p.add_argument("--dpi", type=int, default=150, help="resolution (default 150; 300 for a report)")
         p.add_argument("--out", metavar="PNG")
         a = p.parse_args(argv[1:])
-        print(f"plot: {plot(a.directory, a.x, a.y, a.by, a.out, a.dpi)}")
+        print(f"plot: {plot(a.directory, a.x, a.y, a.by, a.out, a.dpi, a.units)}")
         return 0
     if argv and argv[0] == "envelope":
         p = argparse.ArgumentParser(prog="python -m frictiondyn sweep envelope",
