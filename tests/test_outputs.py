@@ -334,7 +334,7 @@ def test_undefined_summary_values_are_null_never_0(tmp_path):
              "bearing_", "peak_isolation_"))}
         assert keys - floor_only <= set(summ[name]), keys - set(summ[name])
         if name == "braced":
-            assert ("stuck period not defined (with every device a rigid link the structure has "
+            assert ("rigid-link period not defined (with every device a rigid link the structure has "
                     "no free DOF or a rigid-body mode)") in r.stdout
     b, e, s = summ["braced"], summ["event"], summ["slider"]
     assert summ["floor"]["peak_corner_drift_m"] == [None, None]

@@ -333,4 +333,4 @@ def test_the_executables_screen_summary_shows_periods_drifts_and_shears(tmp_path
         assert f", dissipated {_num(e)} J, slip travel {_num(travel)} m\n" in out
     assert (f"  base shear: peak {_num(s['peak_base_shear_N'])} N at t = "
             f"{_num(s['peak_base_shear_time_s'])} s\n") in out
-    assert "stuck period not defined" in out and ".000000" not in out
+    assert "rigid-link period not defined" in out and ".000000" not in out

@@ -89,7 +89,9 @@ def _print_summary(result: Result, deck: str) -> None:
     s = result.summary
     print(f"frictiondyn: {deck}")
     period = s.get("period_stuck_s")
-    stuck = f"stuck period {period:.6g} s" if period else "stuck system has no period"
+    stuck = (f"rigid-link period {period:.6g} s" if period
+             else "rigid-link period not defined (with every device a rigid link the structure has no free DOF "
+                  "or a rigid-body mode)")
     print(
         f"  {stuck}; steps dt1 {s['steps_dt1']}, nested {s.get('steps_nested', 0)}, dt2 {s['steps_dt2']}, "
         f"finer {s['steps_finer']}"

@@ -128,11 +128,11 @@ program frictiondyn_main
    write (output_unit, '(a)') 'frictiondyn: '//deck
    ! an undefined value is said to be so (fd_undefined), never printed as 0
    if (len_trim(undefined_why(res, 'period_stuck_s')) > 0) then
-      write (output_unit, '(a,i0,a,i0,a,i0,a,i0)') '  stuck period not defined ('// &
+      write (output_unit, '(a,i0,a,i0,a,i0,a,i0)') '  rigid-link period not defined ('// &
          trim(undefined_why(res, 'period_stuck_s'))//'); steps dt1 ', &
          n%steps_dt1, ', nested ', n%steps_nested, ', dt2 ', n%steps_dt2, ', finer ', n%steps_finer
    else
-      write (output_unit, '(a,i0,a,i0,a,i0,a,i0)') '  stuck period '//trim(num(setup%period_stuck))//' s; steps dt1 ', &
+      write (output_unit, '(a,i0,a,i0,a,i0,a,i0)') '  rigid-link period '//trim(num(setup%period_stuck))//' s; steps dt1 ', &
          n%steps_dt1, ', nested ', n%steps_nested, ', dt2 ', n%steps_dt2, ', finer ', n%steps_finer
    end if
    call print_periods(res)
