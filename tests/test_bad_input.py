@@ -112,6 +112,22 @@ CASES = [
         lambda g: g.update(bearings=_BEARING, excitation3={**g["excitation"], "frequency": -2.0}),
         ["&excitation3", "frequency", "-2"],
     ),
+    # a bearing's elastic vertical support: kv >= 0, its damping a ratio below critical
+    (
+        "negative vertical stiffness",
+        lambda g: g.update(bearings={**_BEARING, "kv": -2.5e6}),
+        ["&bearings", "kv(1) = -2", ">= 0 N/m"],
+    ),
+    (
+        "vertical damping ratio of 1",
+        lambda g: g.update(bearings={**_BEARING, "kv": 2.5e6, "zeta_v": 1.0}),
+        ["&bearings", "zeta_v(1) = 1", "0 <= zeta_v < 1"],
+    ),
+    (
+        "negative vertical damping ratio",
+        lambda g: g.update(bearings={**_BEARING, "kv": 2.5e6, "zeta_v": -0.05}),
+        ["&bearings", "zeta_v(1) = -0.05", "0 <= zeta_v < 1"],
+    ),
     # the overturning takes floors at their storey heights: a model of masses has none
     (
         "overturning of a model of masses",

@@ -181,6 +181,25 @@ def test_bearing_between_dofs_under_a_harmonic_vertical_motion_is_the_deck():
     assert r.summary["bearing_min_normal_force_N"][0] == pytest.approx(p * (1 - swing), rel=1e-3)
 
 
+def test_bearing_on_an_elastic_vertical_support_is_the_deck():
+    """Bearing(kv=..., zeta_v=...) writes the &bearings' kv and zeta_v: the run equals the
+    hand-written deck's with them, its support (a vertical period of 0.06 s, 3 % damping)
+    amplifies the normal force's swing beyond the rigid support's, and the summary reports the
+    peak uplift (0: it stays down)."""
+    kv = 2.0e4 * (2 * np.pi / 0.06) ** 2
+    bearing = fd.Bearing(dof_xi=1, dof_yi=2, dof_xj=0, dof_yj=0, law="hysteretic", p=196133.0, mu=0.08,
+                         f=1.0e-4, radius=1.5, label="pendulum", kv=kv, zeta_v=0.03)
+    r = block_on_a_bearing(bearings=[bearing]).run()
+    deck = BLOCK_DECK.replace("    radius = 1.5\n", f"    radius = 1.5\n    kv = {kv!r}\n    zeta_v = 0.03\n")
+    assert "zeta_v" in deck
+    same_numbers(r, fd.run_text(deck, "block.nml"))
+    rigid = block_on_a_bearing().run()
+    assert r.summary["bearing_max_normal_force_N"][0] > rigid.summary["bearing_max_normal_force_N"][0]
+    assert r.summary["bearing_uplift_peak_m"] == [0.0]
+    with pytest.raises(fd.DeckError, match=r"Analysis.bearings\[0\].kv must be a number, not 'stiff'"):
+        block_on_a_bearing(bearings=[fd.Bearing(dof_xi=1, dof_yi=2, p=1.0, mu=0.1, kv="stiff")]).run()
+
+
 def test_python_place_of_bearing_and_vertical_messages():
     assert python_place("a.nml, group &bearings: mu(3) = -1 is invalid: must be >= 0") == "bearings[2].mu"
     assert python_place("a.nml, group &bearings: mu_table_v(:, 2) must increase") == "bearings[1].mu_table"

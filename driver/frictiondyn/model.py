@@ -180,8 +180,10 @@ class Bearing:
     'moreau_jean'); p the normal force [N] (rigid floors: None takes the gravity share); mu,
     or mu_law 'exponential' (mu_max, mu_min, mu_rate) or 'table' (mu_table: points
     (v [m/s], mu)); radius [m] of the concave surface (0: flat). A vertical ground motion
-    (``Analysis.excitation3``) scales its normal force. Keyword arguments only; None takes the
-    reader's default (docs/namelist.md, &bearings)."""
+    (``Analysis.excitation3``) changes its normal force: on a rigid vertical support (kv None or
+    0) N = p (1 + a_z / g); kv [N/m] > 0 puts its share p / g of the mass on a vertical spring
+    with the damping ratio zeta_v (a vertical oscillator that can lift off). Keyword arguments
+    only; None takes the reader's default (docs/namelist.md, &bearings)."""
 
     storey: int | None = None
     x: float | None = None
@@ -203,11 +205,14 @@ class Bearing:
     mu_rate: float | None = None
     mu_table: list[tuple[float, float]] | None = None
     label: str | None = None
+    kv: float | None = None
+    zeta_v: float | None = None
 
 
 _BEARING_PLAN = ("storey", "x", "y")
 _BEARING_DOFS = ("dof_xi", "dof_yi", "dof_xj", "dof_yj")
-_BEARING_REALS = ("x", "y", "p", "mu", "radius", "eps", "eps1", "f", "mu_max", "mu_min", "mu_rate")
+_BEARING_REALS = ("x", "y", "p", "mu", "radius", "eps", "eps1", "f", "mu_max", "mu_min", "mu_rate", "kv",
+                  "zeta_v")
 _BEARING_TEXTS = ("law", "mu_law", "label")
 
 
@@ -262,7 +267,7 @@ def _bearings_group(items: object, floors: bool) -> dict:
     group: dict = {"n_bearings": len(b)}
     for key in ("storey",) + _BEARING_DOFS:
         _per_device(group, key, [_opt_int(getattr(x, key), key) for x in b])
-    for key in ("x", "y", "law", "p", "radius"):
+    for key in ("x", "y", "law", "p", "radius", "kv", "zeta_v"):
         _per_device(group, key, [getattr(x, key) for x in b])
     _friction_values(group, b)
     return group

@@ -129,7 +129,7 @@ DECK_VARIABLES: dict[str, tuple[str, ...]] = {
                   "mu_table_mu", "label"),
     "bearings": ("n_bearings", "storey", "x", "y", "dof_xi", "dof_yi", "dof_xj", "dof_yj", "law",
                  "p", "mu", "radius", "eps", "eps1", "f", "mu_law", "mu_max", "mu_min", "mu_rate",
-                 "mu_table_v", "mu_table_mu", "label", "overturning"),
+                 "mu_table_v", "mu_table_mu", "label", "overturning", "kv", "zeta_v"),
     "storeys": ("n_storeys", "node_i", "node_j", "spring", "height", "label"),
     "floors": ("n_floors", "mass", "inertia", "plan_x", "plan_y", "cm_x", "cm_y", "height",
                "label", "excitation_angle", "p_delta"),

@@ -1661,14 +1661,14 @@ contains
       type(error_type), allocatable, intent(out) :: error
       integer :: n_bearings
       integer, allocatable :: storey(:), dof_xi(:), dof_yi(:), dof_xj(:), dof_yj(:), mu_ids(:)
-      real(dp), allocatable :: x(:), y(:), p(:), mu(:), radius(:), eps(:), eps1(:), f(:)
+      real(dp), allocatable :: x(:), y(:), p(:), mu(:), radius(:), eps(:), eps1(:), f(:), kv(:), zeta_v(:)
       real(dp), allocatable :: mu_max(:), mu_min(:), mu_rate(:), mu_table_v(:, :), mu_table_mu(:, :)
       character(len=name_len), allocatable :: law(:), mu_law(:)
       character(len=label_len), allocatable :: label(:)
       logical, allocatable :: g_mu(:), g_table(:, :), g_p(:)
       logical :: overturning
       namelist /bearings/ n_bearings, storey, x, y, dof_xi, dof_yi, dof_xj, dof_yj, law, p, mu, radius, eps, &
-         eps1, f, mu_law, mu_max, mu_min, mu_rate, mu_table_v, mu_table_mu, label, overturning
+         eps1, f, mu_law, mu_max, mu_min, mu_rate, mu_table_v, mu_table_mu, label, overturning, kv, zeta_v
       type(group_text) :: grp
       character(len=512) :: msg
       integer :: ios, i, n, d0
@@ -1680,13 +1680,14 @@ contains
       if (allocated(error) .or. .not. found) return
       i = array_capacity(grp, 'n_bearings', max_devices/2)
       allocate (storey(i), dof_xi(i), dof_yi(i), dof_xj(i), dof_yj(i), x(i), y(i), p(i), mu(i), radius(i), &
-                eps(i), eps1(i), f(i), law(i), stat=ios)
+                eps(i), eps1(i), f(i), law(i), kv(i), zeta_v(i), stat=ios)
       if (ios == 0) call new_mu_inputs(i, mu_law, mu_max, mu_min, mu_rate, mu_table_v, mu_table_mu, label, ios)
       if (ios /= 0) then
          call no_memory(deck, 'bearings', i, 'bearings', error); return
       end if
       storey = unset_int; dof_xi = unset_int; dof_yi = unset_int; dof_xj = unset_int; dof_yj = unset_int
       x = unset; y = unset; p = unset; mu = unset; radius = unset; eps = unset; eps1 = unset; f = unset
+      kv = unset; zeta_v = unset
       law = 'velocity'
       ! a label and its components' ' x', ' y' within label_len - 1
       call check_length(deck, grp, 'label', label_len - 3, error)
@@ -1719,15 +1720,48 @@ contains
       if (allocated(error)) return
       call check_labels(deck, grp, 'bearings', label, n, error)
       if (allocated(error)) return
+      call vertical_supports(deck, grp, n, kv, zeta_v, error)
+      if (allocated(error)) return
       d0 = cfg%model%n_devices
       do i = 1, n
          call add_bearing(deck, cfg, floors, i, storey(i), x(i), y(i), [dof_xi(i), dof_yi(i), dof_xj(i), dof_yj(i)], &
                           law(i), p(i), mu(i), radius(i), eps(i), eps1(i), f(i), label(i), mu_ids(i), mu_min(i), &
                           mu_rate(i), mu_table_v(:, i), mu_table_mu(:, i), g_table(:, i), error)
          if (allocated(error)) return
+         cfg%model%dev(d0 + 2*i - 1:d0 + 2*i)%kv = kv(i)
+         cfg%model%dev(d0 + 2*i - 1:d0 + 2*i)%zeta_v = zeta_v(i)
       end do
       if (overturning) call bearings_overturning(deck, cfg, floors, n, d0, storey, x, y, error)
    end subroutine read_bearings_group
+
+   !> The bearings' vertical supports: kv >= 0 N/m (0, the default: rigid) and the damping ratio
+   !> 0 <= zeta_v < 1 (default 0) of the vertical oscillator of each bearing's share of the mass.
+   subroutine vertical_supports(deck, grp, n, kv, zeta_v, error)
+      type(deck_text), intent(in) :: deck
+      type(group_text), intent(in) :: grp
+      integer, intent(in) :: n
+      real(dp), intent(inout) :: kv(:), zeta_v(:)
+      type(error_type), allocatable, intent(out) :: error
+      integer :: i
+
+      call optional_reals(deck, 'bearings', 'kv', kv, given_of(grp, 'kv', size(kv)), n, 0.0_dp, 'N/m', error)
+      if (allocated(error)) return
+      call optional_reals(deck, 'bearings', 'zeta_v', zeta_v, given_of(grp, 'zeta_v', size(zeta_v)), n, 0.0_dp, &
+                          '', error)
+      if (allocated(error)) return
+      do i = 1, n
+         if (kv(i) < 0.0_dp) then
+            call bad(deck, 'bearings', 'kv('//trim(fmt_int(i))//')', trim(fmt_real(kv(i))), &
+                     '>= 0 N/m (0 = a rigid vertical support)', error)
+            return
+         end if
+         if (zeta_v(i) < 0.0_dp .or. zeta_v(i) >= 1.0_dp) then
+            call bad(deck, 'bearings', 'zeta_v('//trim(fmt_int(i))//')', trim(fmt_real(zeta_v(i))), &
+                     'in 0 <= zeta_v < 1 (a ratio of critical damping)', error)
+            return
+         end if
+      end do
+   end subroutine vertical_supports
 
    !> overturning = .true.: the bearings' normal forces take the overturning moments of the
    !> floors they carry (fd_overturning), which needs the storey heights of a building of rigid

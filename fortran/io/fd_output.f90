@@ -593,6 +593,7 @@ contains
       call ki(jt, 'bearing_uplift_count', res%bearing_uplifts)
       call kr(jt, 'bearing_uplift_duration_s', res%bearing_uplift_time)
       call kr(jt, 'bearing_uplift_first_time_s', res%bearing_uplift_first, res%bearing_uplifts > 0)
+      if (allocated(res%bearing_uplift_peak)) call kr(jt, 'bearing_uplift_peak_m', res%bearing_uplift_peak)
    end subroutine bearings_part
 
    !> What the technique did: the part of the technique that ran (its own statistics, under

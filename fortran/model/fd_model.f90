@@ -66,6 +66,10 @@ module fd_model
       ! p_static the one whose pendulum stiffness p_static / radius K holds
       real(dp) :: radius = 0.0_dp          !! a bearing's pendulum radius R [m] (0: flat)
       real(dp) :: p_static = 0.0_dp        !! a bearing's normal force in K's pendulum stiffness [N]
+      ! a bearing's vertical support (fd_vertical_support): its share p_static / g of the mass
+      ! on a spring kv with a dashpot of ratio zeta_v; kv = 0: rigid
+      real(dp) :: kv = 0.0_dp              !! vertical stiffness [N/m] (0: rigid support)
+      real(dp) :: zeta_v = 0.0_dp          !! vertical damping, ratio of critical [-]
    end type device_type
 
    !> The whole structural model.

@@ -37,7 +37,7 @@ module fd_observer
    public :: observe_transitions, observe_violations, observe_end, strain_energy
    public :: observe_start_energies, observe_end_energies, observe_poll, observe_stop_error
    public :: observe_extrema, observe_extremum, observe_work, observe_device_motion
-   public :: observe_storeys, observe_normal_forces
+   public :: observe_storeys, observe_normal_forces, observe_flights
 
    !> Wall-clock time aimed at between two polls that look at the clock [s].
    real(dp), parameter :: poll_target = 0.01_dp
@@ -346,6 +346,23 @@ contains
          res%bearing_n_last(b) = pn(b)
       end do
    end subroutine observe_normal_forces
+
+   !> A bearing on an elastic vertical support: its peak uplift displacement so far and, when
+   !> its flights are the whole of its uplift (no overturning), their count, the first
+   !> lift-off's time and the time in flight, located within the steps.
+   pure subroutine observe_flights(res, b, gap, flights, first, air)
+      type(result_type), intent(inout) :: res  !! the result
+      integer, intent(in) :: b                 !! the bearing
+      real(dp), intent(in) :: gap              !! its peak uplift so far [m]
+      integer, intent(in), optional :: flights !! its lift-offs so far
+      real(dp), intent(in), optional :: first  !! the first one's time [s]
+      real(dp), intent(in), optional :: air    !! its time in flight so far [s]
+
+      if (allocated(res%bearing_uplift_peak)) res%bearing_uplift_peak(b) = max(res%bearing_uplift_peak(b), gap)
+      if (present(flights)) res%bearing_uplifts(b) = flights
+      if (present(first)) res%bearing_uplift_first(b) = first
+      if (present(air)) res%bearing_uplift_time(b) = air
+   end subroutine observe_flights
 
    !> The exact extrema of a technique that knows its solution between steps: |y(q)| of every
    !> output quantity q at time t into the summary's peaks (observe_extremum's order).

@@ -129,6 +129,8 @@ module fd_result
       integer, allocatable :: bearing_uplifts(:)     !! uplift episodes (N falls to <= 0)
       real(dp), allocatable :: bearing_uplift_time(:)  !! time spent lifted: the steps that start at N <= 0 [s]
       real(dp), allocatable :: bearing_uplift_first(:) !! start of the first episode [s]
+      real(dp), allocatable :: bearing_uplift_peak(:)  !! peak uplift displacement (allocated when a bearing
+                                                       !! has an elastic vertical support, kv > 0) [m]
       real(dp), allocatable :: harmonic_error(:)      !! per DOF: the step's error in the linear steady state
       real(dp), allocatable :: record_error(:)        !! per DOF: the step's error in the linear peak response
                                                       !! of the system the run was in
@@ -383,6 +385,15 @@ contains
          res%bearing_n_last(b) = model%dev(d)%p
       end do
       res%bearing_uplifts = 0; res%bearing_uplift_time = 0.0_dp; res%bearing_uplift_first = 0.0_dp
+      if (any(model%dev(1:model%n_devices)%kv > 0.0_dp)) then
+         allocate (res%bearing_uplift_peak(nb), stat=stat)
+         if (stat /= 0) then
+            call fatal_error(error, "not enough memory for the summary of "//trim(fmt_int(nb))//" bearings", &
+                             stat_no_memory)
+            return
+         end if
+         res%bearing_uplift_peak = 0.0_dp
+      end if
       res%bearing_peak = 0.0_dp; res%bearing_peak_angle = 0.0_dp; res%bearing_peak_time = 0.0_dp
       res%bearing_last = 0.0_dp
       call init_isolation(model, res, error)

@@ -33,6 +33,7 @@ program tester
    use test_fd_kinematics, only: collect_kinematics
    use test_fd_matrix_market, only: collect_matrix_market
    use test_fd_spectrum, only: collect_spectrum
+   use test_fd_vertical_support, only: collect_vertical_support
    use test_fd_group_system, only: collect_group_system
    use test_fd_impulse_solver, only: collect_impulse_solver
    use test_fd_dense_impulse, only: collect_dense_impulse
@@ -88,6 +89,7 @@ program tester
    testsuites = [testsuites, new_testsuite("kinematics", collect_kinematics)]
    testsuites = [testsuites, new_testsuite("matrix_market", collect_matrix_market)]
    testsuites = [testsuites, new_testsuite("spectrum", collect_spectrum)]
+   testsuites = [testsuites, new_testsuite("vertical_support", collect_vertical_support)]
    testsuites = [testsuites, new_testsuite("group_system", collect_group_system)]
    testsuites = [testsuites, new_testsuite("impulse_solver", collect_impulse_solver)]
    testsuites = [testsuites, new_testsuite("dense_impulse", collect_dense_impulse)]

@@ -38,13 +38,15 @@ module fd_moreau_jean
    use fd_excitation, only: excitation_type, table_motion, table_acceleration, excitation_none
    use fd_friction_planar, only: devices_at_normal_force, normal_force, pendulum_excess, with_normal_force
    use fd_overturning, only: overturning_forces
+   use fd_vertical_support, only: vertical_support, support_setup, support_advance, support_accept, support_forces, &
+                                  support_normal_force, support_energy
    use fd_kinematics, only: device_kinematics, device_nodes, devices_are_pairs, device_relative
    use fd_stiffness, only: influence_of
    use fd_matrices, only: structure_damping
    use fd_result, only: result_type
    use fd_observer, only: observer_type, observer_init, sample_due, observe_peaks, observe_sample, &
                           observe_transitions, observe_start_energies, observe_end_energies, &
-                         observe_poll, observe_stop_error, observe_work, observe_normal_forces
+                         observe_poll, observe_stop_error, observe_work, observe_normal_forces, observe_flights
    use fd_run_control, only: run_control
    use fd_stick_groups, only: groups_build, edge_relative
    use fd_group_system, only: gs_k_matvec, gs_k_absmatvec, gs_lowest_eigenvalue
@@ -79,6 +81,12 @@ module fd_moreau_jean
       ! state, held over the next step; N varies (varies) with a vertical component or it
       logical :: tilt = .false., varies = .false.
       real(dp), allocatable :: dn(:)                      !! (n_bearings) [N]
+      ! the bearings on elastic vertical supports under a vertical component (elastic): their
+      ! oscillators (fd_vertical_support), advanced over each step; normal_forces takes their N
+      ! at the accepted state (mix = 0), the step's theta point (theta) or its end (1)
+      logical :: elastic = .false.
+      type(vertical_support) :: vs
+      real(dp) :: mix = 0.0_dp
       type(device_type), allocatable :: dev(:)            !! (nd)
       real(dp), allocatable :: kp(:), fx(:)               !! (nd) [N/m], [N]
       real(dp), allocatable :: pn(:)                      !! (n_bearings) [N]
@@ -504,6 +512,11 @@ contains
             w%r = w%r - h*bt*w%mr2
          end if
          if (w%three) az1 = table_acceleration(w%exc3, t1)
+         if (w%elastic) then
+            ! the vertical supports over the step (a_z linear in it); N at its theta point
+            call support_advance(w%vs, 1, t1, az0, az1)
+            w%mix = th
+         end if
          if (w%varies) then
             ! the step's friction bounds h N mu and pendulum excess at its theta point (as its
             ! load f_theta; the overturning's dN of the step's start), the excess's force kp s
@@ -527,8 +540,15 @@ contains
          end do
          ! the pendulum excess's work over the step, with the devices' (as Newmark's)
          if (w%varies) call excess_work(w)
+         w%mix = 1.0_dp
          call dense_end_state(model, w, ag1, b1, az1, w%u1, w%v1, error)
          if (allocated(error)) return
+         if (w%elastic) then
+            ! the vertical supports move on: the ground's work on them and their dashpots'
+            call support_accept(w%vs)
+            call observe_work(res, w%vs%w_in1, w%vs%w_damp1)
+            w%mix = 0.0_dp
+         end if
          w%u = w%u1
          w%v = w%v1
          ag0 = ag1
@@ -587,10 +607,12 @@ contains
       integer :: stat
 
       allocate (w%dev(w%nd), w%kp(w%nd), w%fx(w%nd), w%pn(nb), w%dn(nb), stat=stat)
+      if (stat == 0 .and. w%three) call support_setup(w%nd, model%dev, 1, w%vs, stat)
       if (stat /= 0) then
          call no_memory(error, w%n)
          return
       end if
+      w%elastic = w%vs%nb > 0
       w%dn = 0.0_dp
       w%dev = model%dev(1:w%nd)
       w%kp = 0.0_dp
@@ -616,6 +638,13 @@ contains
          end do
       else
          call devices_at_normal_force(w%nd, model%dev, az, w%dev)
+      end if
+      if (w%elastic) then
+         if (w%tilt) then
+            call support_forces(w%vs, w%mix, w%nd, w%dev, w%dn)
+         else
+            call support_forces(w%vs, w%mix, w%nd, w%dev)
+         end if
       end if
       do d = 1, w%nd
          g(d) = scale*(w%dev(d)%p*w%dev(d)%mu)
@@ -674,7 +703,20 @@ contains
             w%pn(b) = normal_force(model%dev(res%bearing_dev(1, b)), az)
          end do
       end if
+      do b = 1, w%vs%nb
+         w%pn(w%vs%bearing(b)) = support_normal_force(w%vs, b, .false.)
+         if (w%tilt .and. .not. w%vs%fly(b)) w%pn(w%vs%bearing(b)) = w%pn(w%vs%bearing(b)) + w%dn(w%vs%bearing(b))
+      end do
       call observe_normal_forces(res, t, h, w%pn)
+      ! the supports' flights, located within the steps (with the overturning, whose dN may
+      ! unload a bearing in contact, its uplift is counted by the steps as on a rigid support)
+      do b = 1, w%vs%nb
+         if (w%tilt) then
+            call observe_flights(res, w%vs%bearing(b), w%vs%gap(b))
+         else
+            call observe_flights(res, w%vs%bearing(b), w%vs%gap(b), w%vs%flights(b), w%vs%first(b), w%vs%air(b))
+         end if
+      end do
    end subroutine observe_bearing_forces
 
    !> Device kinematics, forces and phases of the dense form (statuses of the step).
@@ -692,10 +734,15 @@ contains
    subroutine dense_energies(w, e_kin, e_str)
       type(mj_work), intent(inout) :: w
       real(dp), intent(out) :: e_kin, e_str
+      real(dp) :: ek_v, ep_v
 
       e_kin = 0.5_dp*sum(w%di%mass*w%v**2)
       call dense_k_times(w%di, w%u, w%kx, 1.0_dp, 0.0_dp)
       e_str = 0.5_dp*dot_product(w%u, w%kx)
+      ! the vertical supports' beside the structure's
+      call support_energy(w%vs, ek_v, ep_v)
+      e_kin = e_kin + ek_v
+      e_str = e_str + ep_v
    end subroutine dense_energies
 
    !> The observation of the state at t = 0 and its phases (phase0), common to both forms:

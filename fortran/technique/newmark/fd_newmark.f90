@@ -54,13 +54,15 @@ module fd_newmark
    use fd_friction_planar, only: pendulum_excess, normal_force, with_normal_force, devices_at_normal_force, &
                                  normal_force_range
    use fd_overturning, only: overturning_forces
+   use fd_vertical_support, only: vertical_support, support_setup, support_advance, support_accept, support_forces, &
+                                  support_normal_force, support_energy
    use fd_friction, only: friction_init, friction_step, friction_settle, follows_velocity, friction_follow, &
                           friction_energy, friction_capacity
    use fd_result, only: result_type
    use fd_run_control, only: run_control
    use fd_observer, only: observer_type, observer_init, sample_due, observe_start_energies, observe_peaks, &
                           observe_sample, observe_transitions, observe_violations, observe_end_energies, &
-                          observe_poll, observe_stop_error, observe_work, observe_normal_forces
+                          observe_poll, observe_stop_error, observe_work, observe_normal_forces, observe_flights
    use fd_step_limits, only: halving_levels, unresolved_band, max_nested, nested_splits, max_settle, max_follow, &
                              follow_tol
    use fd_stick_ringing, only: ringing_type, ringing_init, ringing_changed, ringing_finish, stat_time, stat_sd2, &
@@ -146,6 +148,10 @@ module fd_newmark
       ! a vertical component or the overturning
       logical :: tilt = .false., varies = .false.
       real(dp), allocatable :: dn(:), dn1(:)          !! per bearing [N]
+      ! the bearings on elastic vertical supports under a vertical component (elastic): their
+      ! oscillators, advanced over each trial step (fd_vertical_support)
+      logical :: elastic = .false.
+      type(vertical_support) :: vs
       type(device_type), allocatable :: dev(:)
       real(dp), allocatable :: pn(:)                  !! per bearing: N at the accepted state [N]
       real(dp), allocatable :: nrange(:, :)           !! (2, nd) each device's N extremes at the
@@ -226,7 +232,7 @@ contains
       type(excitation_type), intent(in), optional :: exc3 !! the vertical component: the bearings'
                                                           !! normal forces (kind none: none)
       type(workspace), intent(inout) :: w           !! the workspace (set up here)
-      real(dp) :: dt1, dt2, t0
+      real(dp) :: dt1, dt2, t0, ek_v, ep_v
       integer :: k, c0, c1, crate, l
       logical :: any_changed, any_bad, stop, settled
 
@@ -267,6 +273,14 @@ contains
       w%varies = w%three .or. w%tilt
       call observer_init(model, exc, opts, res%newmark%setup%period_stuck, res, w%obs, error, ctl)
       if (allocated(error)) return
+      if (w%three) then
+         call support_setup(w%nd, model%dev, size(w%lev), w%vs, l)
+         if (l /= 0) then
+            call fatal_error(error, "not enough memory for the vertical supports of the bearings", stat_no_memory)
+            return
+         end if
+         w%elastic = w%vs%nb > 0
+      end if
       call grid_init(exc, dt1, w%grid)
 
       ! initial state: devices from the initial conditions, acceleration from equilibrium
@@ -336,7 +350,9 @@ contains
       w%phase0 = w%st%phase
       call ringing_finish(w%ring, w%phase0, res)
       res%newmark%mu_passes = w%follow_passes
-      call observe_end_energies(w%obs, res, 0.5_dp*sum(w%mass*w%v**2), strain_energy(model, w%u), &
+      ! the vertical supports' energies beside the structure's (0 at the start: at rest)
+      call support_energy(w%vs, ek_v, ep_v)
+      call observe_end_energies(w%obs, res, 0.5_dp*sum(w%mass*w%v**2) + ek_v, strain_energy(model, w%u) + ep_v, &
                                 device_energy(w%dev, w%st, w%s), &
                               w%w_device, stored_energies(w%dev, w%st, w%s))
       do l = 1, size(w%lev)
@@ -531,6 +547,16 @@ contains
       else
          call devices_at_normal_force(w%nd, model%dev, w%az, w%dev)
       end if
+      ! the bearings on elastic supports: their oscillators' N at t (the trial's end: trial)
+      if (w%elastic) then
+         if (.not. w%tilt) then
+            call support_forces(w%vs, merge(1.0_dp, 0.0_dp, trial), w%nd, w%dev)
+         else if (trial) then
+            call support_forces(w%vs, 1.0_dp, w%nd, w%dev, w%dn1)
+         else
+            call support_forces(w%vs, 0.0_dp, w%nd, w%dev, w%dn)
+         end if
+      end if
       do q = 1, w%nf
          cap = friction_capacity(w%dev(w%fl(q)))
          if (cap > 0.0_dp) w%cap(q) = cap
@@ -581,7 +607,20 @@ contains
             w%pn(b) = normal_force(model%dev(res%bearing_dev(1, b)), w%az)
          end do
       end if
+      do b = 1, w%vs%nb
+         w%pn(w%vs%bearing(b)) = support_normal_force(w%vs, b, .false.)
+         if (w%tilt .and. .not. w%vs%fly(b)) w%pn(w%vs%bearing(b)) = w%pn(w%vs%bearing(b)) + w%dn(w%vs%bearing(b))
+      end do
       call observe_normal_forces(res, t, h, w%pn)
+      ! the supports' flights, located within the steps (with the overturning, whose dN may
+      ! unload a bearing in contact, its uplift is counted by the steps as on a rigid support)
+      do b = 1, w%vs%nb
+         if (w%tilt) then
+            call observe_flights(res, w%vs%bearing(b), w%vs%gap(b))
+         else
+            call observe_flights(res, w%vs%bearing(b), w%vs%gap(b), w%vs%flights(b), w%vs%first(b), w%vs%air(b))
+         end if
+      end do
    end subroutine observe_bearing_forces
 
    !> Acceleration in equilibrium with the current phases: M a = p - C v - K u - sum b F
@@ -678,6 +717,8 @@ contains
          call relative_motion(model, w%n, w%nd, w%u1, w%v1, w%s1, w%sd1)
       end if
       if (w%nf > 0) call follow_forces(model, lv, w, error)
+      ! the vertical supports' trial from the accepted state at t (a_z linear in the step)
+      if (w%elastic) call support_advance(w%vs, lv, t + h, table_acceleration(w%exc3, t), table_acceleration(w%exc3, t + h))
       if (w%varies) call normal_forces(model, t + h, w, .true.)
    end subroutine try_step
 
@@ -1224,6 +1265,11 @@ contains
       if (w%alt%n > 0) call alternation_step(w%alt, w%nd, t1 - w%t, w%st, w%f, res%band_alternation, &
                                              res%band_alternation_time)
       if (w%tilt) w%dn = w%dn1
+      if (w%elastic) then
+         ! the vertical supports move on: the ground's work on them and their dashpots'
+         call support_accept(w%vs)
+         call observe_work(res, w%vs%w_in1, w%vs%w_damp1)
+      end if
       if (w%varies) call observe_bearing_forces(model, t1, t1 - w%t, w, res)
       w%t = t1
       if (changed_k) w%version = w%version + 1
