@@ -189,7 +189,7 @@ contains
 
       pmu = dev%p*sliding_mu(dev, dev%eps)
       pfloor = pmu
-      call varying_band(dev, [b%nlo, b%nhi], pmu, pfloor)
+      call varying_band(dev, b%nlo, b%nhi, pmu, pfloor)
    end subroutine band_capacity
 
    !> The watched bearings' N ranges joined with the N observed so far (res%bearing_n_min,
@@ -230,20 +230,20 @@ contains
       if (al%moved) call band_figures(model, dt1, gamma, al, res, error)
    end subroutine alternation_finish
 
-   !> A device whose normal force varies over the run (nrange(1) < nrange(2)): P mu(eps) of its
-   !> band's dashpot at the largest N, of the count's floor at the smallest (at the largest when
-   !> it lifts off, N_min <= 0); both kept otherwise.
-   pure subroutine varying_band(dev, nrange, pmu, pfloor)
+   !> A device whose normal force varies over the run (nlo < nhi): P mu(eps) of its band's
+   !> dashpot at the largest N, of the count's floor at the smallest (at the largest when it
+   !> lifts off, N_min <= 0); both kept otherwise.
+   pure subroutine varying_band(dev, nlo, nhi, pmu, pfloor)
       type(device_type), intent(in) :: dev          !! the device as the deck made it
-      real(dp), intent(in) :: nrange(2)             !! its smallest and largest N [N]
+      real(dp), intent(in) :: nlo, nhi              !! its smallest and largest N [N]
       real(dp), intent(inout) :: pmu                !! P mu(eps) of the dashpot [N]
       real(dp), intent(inout) :: pfloor             !! P mu(eps) of the floor [N]
       real(dp) :: mu
 
-      if (.not. nrange(1) < nrange(2)) return
+      if (.not. nlo < nhi) return
       mu = sliding_mu(dev, dev%eps)
-      pmu = max(nrange(2), 0.0_dp)*mu
-      pfloor = max(nrange(1), 0.0_dp)*mu
+      pmu = max(nhi, 0.0_dp)*mu
+      pfloor = max(nlo, 0.0_dp)*mu
       if (.not. pfloor > 0.0_dp) pfloor = pmu
    end subroutine varying_band
 
