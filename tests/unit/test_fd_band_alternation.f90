@@ -2,12 +2,17 @@
 !> sequences whose second differences are known in closed form: a decaying alternation on a
 !> linear course (its amplitude and counted time from the closed form), a jump and a kink
 !> (not counted), band and slide in turn at the band's edge (counted), an alternation of
-!> sliding forces or one broken by slides (not counted), and one below the floor.
+!> sliding forces or one broken by slides (not counted), and one below the floor; a bearing
+!> whose observed normal force falls below the deck's (alternation_normal_force) counts an
+!> alternation above 5 % of the smaller N mu.
 module test_fd_band_alternation
    use testdrive, only: new_unittest, unittest_type, error_type, check
    use fd_kinds, only: dp
    use fd_device_state, only: device_state, phase_stick, phase_slip_pos, phase_slip_neg
-   use fd_band_alternation, only: alternation_type, band_watch, alternation_step, alternation_floor, alternation_run
+   use fd_band_alternation, only: alternation_type, band_watch, alternation_step, alternation_floor, alternation_run, &
+                                  alternation_normal_force
+   use fd_model, only: model_type, device_type
+   use fd_result, only: result_type
    implicit none
    private
 
@@ -27,7 +32,8 @@ contains
                   new_unittest("band and slide in turn: the band's edge", test_edge), &
                   new_unittest("slides alone, or slides between, break the count", test_broken), &
                   new_unittest("steps of two lengths: a line is not counted, +-A is", test_uneven), &
-                  new_unittest("below the floor: not counted", test_floor) &
+                  new_unittest("below the floor: not counted", test_floor), &
+                  new_unittest("a bearing's observed N: the floor at the smallest", test_observed_floor) &
                   ]
    end subroutine collect_band_alternation
 
@@ -227,5 +233,48 @@ contains
       call feed(f, phase, amp, time)
       call check(error, amp == 0.0_dp .and. time == 0.0_dp, "below the floor")
    end subroutine test_floor
+
+   !> A velocity-law bearing component (P mu = pmu, constant mu) watched at the deck's P; the
+   !> observer sees its N fall to 0.6 P and rise to 1.3 P: the floor moves to 0.6 P mu
+   !> (4 alternation_floor 0.6 pmu), and a steady alternation of 0.8 of the deck's floor, not
+   !> counted at P, is counted at 0.6 P (|D| = 3.2 floor pmu > 4 floor 0.6 pmu). A range that
+   !> does not grow leaves the watch as it is.
+   subroutine test_observed_floor(error)
+      type(error_type), allocatable, intent(out) :: error
+      type(model_type) :: model
+      type(result_type) :: res
+      type(alternation_type) :: al
+      type(device_state) :: st(1)
+      real(dp) :: a(1), t(1), p, f
+      integer :: k
+
+      p = 1.0e4_dp
+      model%n_devices = 1
+      model%dev = [device_type(p=p, mu=pmu/p, eps=1.0e-3_dp, partner=2, component=1)]
+      res%n_bearings = 1
+      res%bearing_n_min = [p]
+      res%bearing_n_max = [p]
+      al%n = 1
+      al%w = [band_watch(dev=1, floor4=4*alternation_floor*pmu, bearing=1, nlo=p, nhi=p)]
+      call alternation_normal_force(model, al, res)
+      call check(error, al%w(1)%floor4 == 4*alternation_floor*pmu .and. .not. al%moved, "the deck's range kept")
+      if (allocated(error)) return
+      res%bearing_n_min = [0.6_dp*p]
+      res%bearing_n_max = [1.3_dp*p]
+      call alternation_normal_force(model, al, res)
+      call check(error, abs(al%w(1)%floor4 - 4*alternation_floor*0.6_dp*pmu) <= 1e-12_dp*pmu, &
+                 "the floor at the smallest N")
+      if (allocated(error)) return
+      call check(error, al%moved .and. al%w(1)%nlo == 0.6_dp*p .and. al%w(1)%nhi == 1.3_dp*p, "the range joined")
+      if (allocated(error)) return
+      st(1)%phase = phase_stick
+      a = 0.0_dp
+      t = 0.0_dp
+      do k = 0, 19
+         f = 0.8_dp*alternation_floor*pmu*(-1)**k
+         call alternation_step(al, 1, h, st, [f], a, t)
+      end do
+      call check(error, abs(a(1) - 0.8_dp*alternation_floor*pmu) <= 1e-12_dp*pmu, "counted at the smaller N")
+   end subroutine test_observed_floor
 
 end module test_fd_band_alternation

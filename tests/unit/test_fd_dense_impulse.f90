@@ -4,6 +4,7 @@
 !> and the acceleration problem at the end of a step; the banded form against the dense one.
 module test_fd_dense_impulse
    use testdrive, only: new_unittest, unittest_type, error_type, check
+   use, intrinsic :: ieee_arithmetic, only: ieee_value, ieee_quiet_nan, ieee_is_finite
    use fd_kinds, only: dp
    use fd_error, only: fd_error_type => error_type
    use fd_model, only: model_type, device_type, law_coulomb
@@ -28,6 +29,7 @@ contains
                   new_unittest("a general direction: stick and slide in closed form", test_general), &
                   new_unittest("acceleration: a slider keeps P mu, a device at rest holds", test_acceleration), &
                   new_unittest("K includes the stiffness beyond springs", test_kx), &
+                  new_unittest("K x with beta = 0 does not read y (a NaN there)", test_k_times_unread), &
                   new_unittest("banded form: the dense form's steps, general devices and K_x", test_banded_general), &
                   new_unittest("banded form: the dense form's steps with a planar bearing", test_banded_bearing), &
                   new_unittest("banded form: W = alpha M alone (beta = 0)", test_banded_inertia), &
@@ -186,6 +188,31 @@ contains
       ! column 2 of K: springs (-300, 300 + 500, -500) plus K_x's 50 at (1, 2)
       call check(error, all(abs(y - [-250.0_dp, 800.0_dp, -500.0_dp]) <= 1.0e-12_dp), "K column 2")
    end subroutine test_kx
+
+   !> y = K x with beta = 0 takes nothing of y, which may be memory never set (a NaN there
+   !> gave 0 NaN = NaN): the dense form's and the banded form's both give K's column.
+   subroutine test_k_times_unread(error)
+      type(error_type), allocatable, intent(out) :: error
+      type(model_type) :: model
+      type(dense_impulse) :: di
+      type(fd_error_type), allocatable :: err
+      real(dp) :: y(3)
+      integer :: form
+
+      do form = 1, 2
+         call chain(model)
+         call dense_setup(di, model, err, banded=form == 2)
+         call check(error, .not. allocated(err), "setup")
+         if (allocated(error)) return
+         y = ieee_value(y, ieee_quiet_nan)
+         call dense_k_times(di, [0.0_dp, 1.0_dp, 0.0_dp], y, 1.0_dp, 0.0_dp)
+         call check(error, all(ieee_is_finite(y)), "K x finite whatever y held")
+         if (allocated(error)) return
+         ! column 2 of the chain's K: springs (-300, 300 + 500, -500)
+         call check(error, all(abs(y - [-300.0_dp, 800.0_dp, -500.0_dp]) <= 1.0e-12_dp), "K column 2")
+         if (allocated(error)) return
+      end do
+   end subroutine test_k_times_unread
 
    !> Nine DOFs, three a floor (springs from each DOF to the one a floor below, the first
    !> floor's to the table) and K_x coupling neighbouring DOFs (a spring written as entries),

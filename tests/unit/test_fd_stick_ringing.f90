@@ -1,11 +1,15 @@
 !> Unit tests of Newmark's own frequency and damping of an oscillator (fd_stick_ringing's
 !> newmark_frequency): the closed forms of the average and linear acceleration rules, the
 !> small-step damping of gamma > 1/2, and the frequency of the recursion itself, run step
-!> by step (an independent computation).
+!> by step (an independent computation); a bearing's observed normal force beyond the deck's
+!> moves its sticking spring, its frequency error and its capacities (ringing_normal_force).
 module test_fd_stick_ringing
    use testdrive, only: new_unittest, unittest_type, error_type, check
    use fd_kinds, only: dp
-   use fd_stick_ringing, only: newmark_frequency
+   use fd_stick_ringing, only: newmark_frequency, ringing_type, ringing_normal_force
+   use fd_model, only: model_type, device_type
+   use fd_names, only: law_hysteretic
+   use fd_result, only: result_type
    implicit none
    private
 
@@ -22,7 +26,8 @@ contains
                   new_unittest("average acceleration: 2 atan(w / 2), no damping", test_average), &
                   new_unittest("linear acceleration: its cosine, unstable beyond sqrt(12)", test_linear), &
                   new_unittest("gamma > 1/2: damping (gamma - 1/2) w / 2 at small steps", test_damped), &
-                  new_unittest("the frequency of the recursion run step by step", test_recursion) &
+                  new_unittest("the frequency of the recursion run step by step", test_recursion), &
+                  new_unittest("a bearing's observed N: spring and error at the largest", test_observed_force) &
                   ]
    end subroutine collect_stick_ringing
 
@@ -122,5 +127,59 @@ contains
          if (allocated(error)) return
       end do
    end subroutine test_recursion
+
+   !> A hysteretic bearing component (P, mu, f) watched at the deck's P on a mode of mass mr;
+   !> the observer sees its N reach 0.5 P and 1.5 P: the spring is 1.5 P mu / f, omega its
+   !> mode's, the frequency error average acceleration's 1 - 2 atan(x / 2) / x at x = omega dt1,
+   !> the drift |error| omega, the margin's capacity 0.5 P mu; a range that does not grow
+   !> leaves the watch as it is.
+   subroutine test_observed_force(error)
+      type(error_type), allocatable, intent(out) :: error
+      type(model_type) :: model
+      type(result_type) :: res
+      type(ringing_type) :: rg
+      real(dp), parameter :: p = 1.0e5_dp, mu = 0.2_dp, f = 1.0e-4_dp, mr = 2.0e4_dp, dt1 = 1.0e-3_dp
+      real(dp) :: k, x, e
+
+      model%n_devices = 1
+      model%dev = [device_type(law=law_hysteretic, p=p, mu=mu, f=f, partner=2, component=1)]
+      res%n_bearings = 1
+      res%bearing_n_min = [p]
+      res%bearing_n_max = [p]
+      res%stick_freq_error = [0.0_dp]
+      k = p*mu/f
+      rg%n = 1
+      rg%dev = [1]
+      rg%bearing = [1]
+      rg%nrange = reshape([p, p], [2, 1])
+      rg%k = [k]
+      rg%mr = [mr]
+      rg%omega = [sqrt(k/mr)]
+      rg%c_fixed = [0.0_dp]
+      rg%drift = [0.0_dp]
+      rg%pmu = [p*mu]
+      rg%pfloor = [p*mu]
+      rg%dt1 = dt1
+      rg%beta = 0.25_dp
+      rg%gamma = 0.5_dp
+      call ringing_normal_force(model, rg, res)
+      call check(error, rg%k(1) == k .and. res%stick_freq_error(1) == 0.0_dp, "the deck's range kept")
+      if (allocated(error)) return
+      res%bearing_n_min = [0.5_dp*p]
+      res%bearing_n_max = [1.5_dp*p]
+      call ringing_normal_force(model, rg, res)
+      x = sqrt(1.5_dp*k/mr)*dt1
+      e = 1.0_dp - 2.0_dp*atan(x/2.0_dp)/x
+      call check(error, abs(rg%k(1) - 1.5_dp*k) <= 1e-12_dp*k, "the spring at the largest N")
+      if (allocated(error)) return
+      call check(error, abs(res%stick_freq_error(1) - e) <= 1e-9_dp*e, "the frequency error at the largest N")
+      if (allocated(error)) return
+      call check(error, abs(rg%drift(1) - e*x/dt1) <= 1e-9_dp*e*x/dt1, "the drift at the largest N")
+      if (allocated(error)) return
+      call check(error, abs(rg%pmu(1) - 0.5_dp*p*mu) <= 1e-12_dp*p*mu .and. rg%pfloor(1) == rg%pmu(1), &
+                 "the capacities at the smallest N")
+      if (allocated(error)) return
+      call check(error, abs(rg%c_fixed(1)) <= 1e-12_dp, "no damping of average acceleration")
+   end subroutine test_observed_force
 
 end module test_fd_stick_ringing

@@ -315,7 +315,8 @@ contains
       di%a = 0.5_dp*(di%a + transpose(di%a))
    end subroutine banded_factor
 
-   !> y = alpha K x + beta y.
+   !> y = alpha K x + beta y (y is not read when beta = 0, as spd_k_matvec's: a y never set
+   !> may hold a NaN, and 0 NaN is NaN).
    subroutine dense_k_times(di, x, y, alpha, beta)
       type(dense_impulse), intent(inout) :: di      !! the solver
       real(dp), intent(in), contiguous :: x(:)      !! (n)
@@ -333,7 +334,11 @@ contains
          do j = 1, di%n
             s = s + di%k(i, j)*x(j)
          end do
-         y(i) = alpha*s + beta*y(i)
+         if (beta == 0.0_dp) then
+            y(i) = alpha*s
+         else
+            y(i) = alpha*s + beta*y(i)
+         end if
       end do
    end subroutine dense_k_times
 

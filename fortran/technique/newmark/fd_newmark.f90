@@ -66,8 +66,9 @@ module fd_newmark
    use fd_step_limits, only: halving_levels, unresolved_band, max_nested, nested_splits, max_settle, max_follow, &
                              follow_tol
    use fd_stick_ringing, only: ringing_type, ringing_init, ringing_changed, ringing_finish, stat_time, stat_sd2, &
-                               stat_fmax, stat_damping
-   use fd_band_alternation, only: alternation_type, alternation_init, alternation_step
+                               stat_fmax, stat_damping, ringing_normal_force
+   use fd_band_alternation, only: alternation_type, alternation_init, alternation_step, alternation_normal_force, &
+                                  alternation_finish
    implicit none
    private
 
@@ -300,6 +301,7 @@ contains
       if (allocated(error)) return
       call alternation_init(model, dt1, opts%gamma, w%alt, res, error, w%nrange)
       if (allocated(error)) return
+      if (w%varies) call checks_normal_force(model, w, res)
       call consistent_acceleration(model, exc, 0.0_dp, w)
       call observe_start_energies(w%obs, 0.5_dp*sum(w%mass*w%v**2), strain_energy(model, w%u), &
                                   device_energy(w%dev, w%st, w%s), stored_energies(w%dev, w%st, w%s))
@@ -349,6 +351,8 @@ contains
       end do
       w%phase0 = w%st%phase
       call ringing_finish(w%ring, w%phase0, res)
+      call alternation_finish(model, dt1, opts%gamma, w%alt, res, error)
+      if (allocated(error)) return
       res%newmark%mu_passes = w%follow_passes
       ! the vertical supports' energies beside the structure's (0 at the start: at rest)
       call support_energy(w%vs, ek_v, ep_v)
@@ -621,7 +625,20 @@ contains
             call observe_flights(res, w%vs%bearing(b), w%vs%gap(b), w%vs%flights(b), w%vs%first(b), w%vs%air(b))
          end if
       end do
+      call checks_normal_force(model, w, res)
    end subroutine observe_bearing_forces
+
+   !> The step checks' N ranges joined with the bearings' N observed so far (the prediction
+   !> before the run is a vertical component's alone: the overturning's dN is known as the run
+   !> goes): fd_stick_ringing's springs and margins, fd_band_alternation's floors.
+   subroutine checks_normal_force(model, w, res)
+      type(model_type), intent(in) :: model
+      type(workspace), intent(inout) :: w
+      type(result_type), intent(inout) :: res
+
+      if (w%ring%n > 0) call ringing_normal_force(model, w%ring, res)
+      if (w%alt%n > 0) call alternation_normal_force(model, w%alt, res)
+   end subroutine checks_normal_force
 
    !> Acceleration in equilibrium with the current phases: M a = p - C v - K u - sum b F
    !> (F: the devices' forces kept in w%f).

@@ -40,11 +40,16 @@
 !> of every velocity-law device at its nodes (exact for one device or devices in parallel on
 !> two masses alone).
 !>
-!> A planar bearing whose normal force N varies over the run (a vertical component, its range
-!> [N_min, N_max] given): its band dashpot is N mu(eps) / eps, so band_x is taken at N_max (the
-!> largest dashpot, the factor r most negative: where the step alternates most), and the floor
-!> of the count at N_min (the smallest capacity: an alternation of 5 % of the smallest N mu is
-!> counted); a bearing that lifts off (N_min <= 0) has its floor at N_max.
+!> A planar bearing whose normal force N varies over the run: its band dashpot is N mu(eps) / eps,
+!> so band_x is taken at N_max (the largest dashpot, the factor r most negative: where the step
+!> alternates most), and the floor of the count at N_min (the smallest capacity: an alternation
+!> of 5 % of the smallest N mu is counted); a bearing that lifts off (N_min <= 0) has its floor
+!> at N_max. [N_min, N_max] is the range predicted before the run (a vertical component's, nrange
+!> of alternation_init) joined with the bearing's N observed at the accepted states (fd_result's
+!> bearing_n_min and bearing_n_max, which the overturning's dN moves beyond the prediction): the
+!> technique calls alternation_normal_force after each accepted state's N is observed (the floor
+!> follows a range that grew, so a step is counted against the smallest N seen up to it), and
+!> alternation_finish at the end of the run (band_x at the run's largest N).
 module fd_band_alternation
    use fd_kinds, only: dp
    use fd_error, only: error_type, fatal_error, fmt_int, stat_no_memory
@@ -56,7 +61,8 @@ module fd_band_alternation
    implicit none
    private
 
-   public :: alternation_type, band_watch, alternation_init, alternation_step
+   public :: alternation_type, band_watch, alternation_init, alternation_step, alternation_normal_force
+   public :: alternation_finish
    public :: alternation_floor, alternation_run
 
    !> Share of P mu below which an alternation is not counted.
@@ -78,12 +84,15 @@ module fd_band_alternation
       real(dp) :: h1 = 0.0_dp                 !! the step that ended at f1 [s]
       real(dp) :: dmax = 0.0_dp               !! the run's largest |D| [N]
       real(dp) :: trun = 0.0_dp               !! the run's time not yet counted [s]
+      integer :: bearing = 0                  !! its planar bearing (0: none)
+      real(dp) :: nlo = 0.0_dp, nhi = 0.0_dp  !! the N range its floor and band_x are at [N]
    end type band_watch
 
    !> The velocity-law devices watched (one array of records: the step loads one descriptor).
    type :: alternation_type
       integer :: n = 0                        !! devices watched: velocity law, P mu(eps) > 0
       type(band_watch), allocatable :: w(:)   !! each of them
+      logical :: moved = .false.              !! a range grew beyond the one band_x was taken at
    end type alternation_type
 
 contains
@@ -104,52 +113,137 @@ contains
       real(dp), intent(in), optional :: nrange(:, :) !! (2, n_devices) each device's smallest and
                                                      !! largest normal force over the run [N]
                                                      !! (absent: the deck's p throughout)
-      real(dp), allocatable :: c(:)
-      integer :: d, q, stat
-      real(dp) :: pmu, scale, pfloor
+      integer, allocatable :: bof(:)
+      integer :: d, q, b, stat
+      real(dp) :: pmu, pfloor
 
       res%band_checked = .false.
       al%n = count(watched(model%dev(1:model%n_devices)))
-      allocate (al%w(al%n), c(model%n_dof), stat=stat)
+      allocate (al%w(al%n), bof(model%n_devices), stat=stat)
+      if (stat /= 0) then
+         call fatal_error(error, "not enough memory for the bands of "//trim(fmt_int(al%n))// &
+                          " velocity-law devices", stat_no_memory)
+         return
+      end if
+      bof = 0
+      do b = 1, res%n_bearings
+         bof(res%bearing_dev(1, b)) = b
+         bof(res%bearing_dev(2, b)) = b
+      end do
+      q = 0
+      do d = 1, model%n_devices
+         associate (dev => model%dev(d))
+            if (.not. watched(dev)) cycle
+            q = q + 1
+            al%w(q) = band_watch(dev=d, bearing=bof(d), nlo=dev%p, nhi=dev%p)
+            if (present(nrange)) then
+               al%w(q)%nlo = nrange(1, d)
+               al%w(q)%nhi = nrange(2, d)
+            end if
+            call band_capacity(dev, al%w(q), pmu, pfloor)
+            al%w(q)%floor4 = 4.0_dp*alternation_floor*pfloor
+         end associate
+      end do
+      call band_figures(model, dt1, gamma, al, res, error)
+      res%band_checked = al%n > 0
+   end subroutine alternation_init
+
+   !> Every watched device's x at dt1 (res%band_x), each velocity-law device's band coupling
+   !> at the largest N of its range.
+   subroutine band_figures(model, dt1, gamma, al, res, error)
+      type(model_type), intent(in) :: model         !! the model
+      real(dp), intent(in) :: dt1                   !! main step [s]
+      real(dp), intent(in) :: gamma                 !! Newmark's gamma
+      type(alternation_type), intent(in) :: al      !! the devices watched
+      type(result_type), intent(inout) :: res       !! band_x
+      type(error_type), allocatable, intent(out) :: error !! not enough memory
+      real(dp), allocatable :: c(:)
+      integer :: d, q, stat
+      real(dp) :: pmu, pfloor, scale
+
+      allocate (c(model%n_dof), stat=stat)
       if (stat /= 0) then
          call fatal_error(error, "not enough memory for the bands of "//trim(fmt_int(al%n))// &
                           " velocity-law devices", stat_no_memory)
          return
       end if
       c = 0.0_dp
-      q = 0
-      do d = 1, model%n_devices
-         associate (dev => model%dev(d))
-            if (.not. watched(dev)) cycle
-            q = q + 1
-            pmu = dev%p*sliding_mu(dev, dev%eps)
-            pfloor = pmu
-            if (present(nrange)) call varying_band(dev, nrange(:, d), pmu, pfloor)
-            al%w(q) = band_watch(dev=d, floor4=4.0_dp*alternation_floor*pfloor)
-            call add_device_abs(model, d, pmu/dev%eps, c)
-         end associate
+      do q = 1, al%n
+         d = al%w(q)%dev
+         call band_capacity(model%dev(d), al%w(q), pmu, pfloor)
+         call add_device_abs(model, d, pmu/model%dev(d)%eps, c)
       end do
       scale = max(0.0_dp, 1.0_dp - gamma)*dt1
       do q = 1, al%n
          res%band_x(al%w(q)%dev) = device_abs_inverse_mass_relative(model, al%w(q)%dev, c, scale)
       end do
-      res%band_checked = al%n > 0
-   end subroutine alternation_init
+   end subroutine band_figures
 
-   !> A device whose normal force varies over the run (nrange(1) < nrange(2)): P mu(eps) of its
-   !> band's dashpot at the largest N, of the count's floor at the smallest (at the largest when
-   !> it lifts off, N_min <= 0); both kept otherwise.
-   pure subroutine varying_band(dev, nrange, pmu, pfloor)
+   !> P mu(eps) of a watched device's band dashpot and of its count's floor at its N range
+   !> (the deck's p when the range is one value).
+   pure subroutine band_capacity(dev, b, pmu, pfloor)
       type(device_type), intent(in) :: dev          !! the device as the deck made it
-      real(dp), intent(in) :: nrange(2)             !! its smallest and largest N [N]
+      type(band_watch), intent(in) :: b             !! its watch, its N range
+      real(dp), intent(out) :: pmu                  !! P mu(eps) of the dashpot [N]
+      real(dp), intent(out) :: pfloor               !! P mu(eps) of the floor [N]
+
+      pmu = dev%p*sliding_mu(dev, dev%eps)
+      pfloor = pmu
+      call varying_band(dev, b%nlo, b%nhi, pmu, pfloor)
+   end subroutine band_capacity
+
+   !> The watched bearings' N ranges joined with the N observed so far (res%bearing_n_min,
+   !> res%bearing_n_max, the observer's at the accepted states): a range that grew moves the
+   !> count's floor to it. Called after each accepted state's normal forces are observed; no
+   !> allocation.
+   pure subroutine alternation_normal_force(model, al, res)
+      type(model_type), intent(in) :: model         !! the model
+      type(alternation_type), intent(inout) :: al   !! the devices watched
+      type(result_type), intent(in) :: res          !! the bearings' observed N
+      real(dp) :: lo, hi, pmu, pfloor
+      integer :: q, b
+
+      do q = 1, al%n
+         b = al%w(q)%bearing
+         if (b == 0) cycle
+         lo = min(al%w(q)%nlo, res%bearing_n_min(b))
+         hi = max(al%w(q)%nhi, res%bearing_n_max(b))
+         if (.not. (lo < al%w(q)%nlo .or. hi > al%w(q)%nhi)) cycle
+         al%w(q)%nlo = lo
+         al%w(q)%nhi = hi
+         call band_capacity(model%dev(al%w(q)%dev), al%w(q), pmu, pfloor)
+         al%w(q)%floor4 = 4.0_dp*alternation_floor*pfloor
+         al%moved = .true.
+      end do
+   end subroutine alternation_normal_force
+
+   !> The end of the run: band_x again where a bearing's N range grew during it (at the
+   !> largest N of the run); nothing otherwise.
+   subroutine alternation_finish(model, dt1, gamma, al, res, error)
+      type(model_type), intent(in) :: model         !! the model
+      real(dp), intent(in) :: dt1                   !! main step [s]
+      real(dp), intent(in) :: gamma                 !! Newmark's gamma
+      type(alternation_type), intent(in) :: al      !! the devices watched
+      type(result_type), intent(inout) :: res       !! band_x
+      type(error_type), allocatable, intent(out) :: error !! not enough memory
+
+      if (al%moved) call band_figures(model, dt1, gamma, al, res, error)
+   end subroutine alternation_finish
+
+   !> A device whose normal force varies over the run (nlo < nhi): P mu(eps) of its band's
+   !> dashpot at the largest N, of the count's floor at the smallest (at the largest when it
+   !> lifts off, N_min <= 0); both kept otherwise.
+   pure subroutine varying_band(dev, nlo, nhi, pmu, pfloor)
+      type(device_type), intent(in) :: dev          !! the device as the deck made it
+      real(dp), intent(in) :: nlo, nhi              !! its smallest and largest N [N]
       real(dp), intent(inout) :: pmu                !! P mu(eps) of the dashpot [N]
       real(dp), intent(inout) :: pfloor             !! P mu(eps) of the floor [N]
       real(dp) :: mu
 
-      if (.not. nrange(1) < nrange(2)) return
+      if (.not. nlo < nhi) return
       mu = sliding_mu(dev, dev%eps)
-      pmu = max(nrange(2), 0.0_dp)*mu
-      pfloor = max(nrange(1), 0.0_dp)*mu
+      pmu = max(nhi, 0.0_dp)*mu
+      pfloor = max(nlo, 0.0_dp)*mu
       if (.not. pfloor > 0.0_dp) pfloor = pmu
    end subroutine varying_band
 

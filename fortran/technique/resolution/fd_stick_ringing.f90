@@ -33,12 +33,18 @@
 !> A device whose largest R_p exceeds 1 is not resolved: the step dephases a ringing of at
 !> least a quarter of P mu and larger than the margin to sliding. Halving dt1 quarters delta.
 !>
-!> A planar bearing whose normal force N varies over the run (a vertical component, its range
-!> [N_min, N_max] given): the sticking spring is N mu / f, so the mode, its frequency error and
-!> its ringing force are taken at N_max (the stiffest spring, which the step resolves worst),
-!> and the capacity P mu of the margin and of the floor at N_min (the bearing nearest to
-!> sliding). A bearing that lifts off (N_min <= 0) has no margin at its minimum (M_p = 0); its
-!> floor is then a quarter of N_max mu.
+!> A planar bearing whose normal force N varies over the run: the sticking spring is N mu / f,
+!> so the mode, its frequency error and its ringing force are taken at N_max (the stiffest
+!> spring, which the step resolves worst), and the capacity P mu of the margin and of the floor
+!> at N_min (the bearing nearest to sliding). A bearing that lifts off (N_min <= 0) has no
+!> margin at its minimum (M_p = 0); its floor is then a quarter of N_max mu. [N_min, N_max] is
+!> the range predicted before the run (a vertical component's, nrange of ringing_init) joined
+!> with the bearing's N observed at the accepted states (fd_result's bearing_n_min and
+!> bearing_n_max, which the overturning's dN moves beyond the prediction): the technique calls
+!> ringing_normal_force after each accepted state's N is observed, and a range that grew moves
+!> the watched bearing's spring, mode and capacities to it. A stick phase, measured at its end,
+!> is so judged at a range that holds every N it had, and stick_freq_error at the end of the run
+!> is that of the largest N of the run.
 module fd_stick_ringing
    use fd_kinds, only: dp
    use fd_error, only: error_type, fatal_error, fmt_int, stat_no_memory
@@ -51,7 +57,7 @@ module fd_stick_ringing
    implicit none
    private
 
-   public :: ringing_type, ringing_init, ringing_changed, ringing_finish, newmark_frequency
+   public :: ringing_type, ringing_init, ringing_changed, ringing_finish, newmark_frequency, ringing_normal_force
    public :: ringing_phase_gate, ringing_floor, stat_time, stat_sd2, stat_fmax, stat_damping
 
    !> Phase drift (rad) within a stick phase above which the ringing is the step's.
@@ -83,6 +89,10 @@ module fd_stick_ringing
       !> phase's length [s], the integral of s'^2 dt [m2/s], the largest |F| [N], and the
       !> integral of the device's damping cs dt [N s2/m] (phase_statistics)
       real(dp), allocatable :: stats(:, :)
+      integer, allocatable :: bearing(:)        !! the planar bearing of each (0: none)
+      real(dp), allocatable :: nrange(:, :)     !! (2, n) the N range k, omega, pmu, pfloor are at [N]
+      real(dp) :: dt1 = 0.0_dp                  !! main step [s]
+      real(dp) :: beta = 0.0_dp, gamma = 0.0_dp !! Newmark's parameters
    end type ringing_type
 
 contains
@@ -136,8 +146,7 @@ contains
 
       if (model%n_kx > 0 .or. .not. devices_are_pairs(model)) then
          call general_ringing_init(model, dt1, beta, gamma, a0, a1, rg, res, error)
-         if (present(nrange) .and. .not. allocated(error)) &
-            call vary_normal_force(model, dt1, beta, gamma, nrange, rg, res)
+         if (.not. allocated(error)) call watch_normal_force(model, dt1, beta, gamma, rg, res, error, nrange)
          return
       end if
       nd = model%n_devices
@@ -198,7 +207,7 @@ contains
          rg%c_fixed(q) = c + 2.0_dp*rg%mr(q)*rg%omega(q)*zn
       end do
       rg%first(rg%n + 1) = nb + 1
-      if (present(nrange)) call vary_normal_force(model, dt1, beta, gamma, nrange, rg, res)
+      call watch_normal_force(model, dt1, beta, gamma, rg, res, error, nrange)
    contains
       !> The mode of device d: node i moves ai, node j -aj, the centre of mass stays.
       subroutine mode_of(d)
@@ -333,44 +342,99 @@ contains
       res%stick_checked = rg%n > 0
    end subroutine general_ringing_init
 
-   !> The watched devices whose normal force varies over the run (nrange(1, d) < nrange(2, d)):
-   !> the sticking spring, its mode's frequency, Newmark's error on it (res%stick_freq_error),
-   !> its drift and Newmark's own damping of it at the largest normal force; the margin's P mu
-   !> at the smallest (0 when the bearing lifts off), the floor's there too unless it lifts off
-   !> (then at the largest).
-   subroutine vary_normal_force(model, dt1, beta, gamma, nrange, rg, res)
+   !> Each watched device's planar bearing (rg%bearing) and the N range its figures are at
+   !> (rg%nrange): the prediction nrange (absent: the deck's p), those that vary moved to it
+   !> (ringing_at).
+   subroutine watch_normal_force(model, dt1, beta, gamma, rg, res, error, nrange)
       type(model_type), intent(in) :: model         !! the model
       real(dp), intent(in) :: dt1                   !! main step [s]
       real(dp), intent(in) :: beta, gamma           !! Newmark's parameters
-      real(dp), intent(in) :: nrange(:, :)          !! (2, n_devices) smallest and largest N [N]
+      type(ringing_type), intent(inout) :: rg       !! the devices watched
+      type(result_type), intent(inout) :: res       !! stick_freq_error
+      type(error_type), allocatable, intent(out) :: error !! not enough memory
+      real(dp), intent(in), optional :: nrange(:, :) !! (2, n_devices) smallest and largest N [N]
+      integer, allocatable :: bof(:)
+      integer :: q, d, b, stat
+
+      rg%dt1 = dt1
+      rg%beta = beta
+      rg%gamma = gamma
+      allocate (rg%bearing(rg%n), rg%nrange(2, rg%n), bof(model%n_devices), stat=stat)
+      if (stat /= 0) then
+         call fatal_error(error, "not enough memory for the sticking springs of "//trim(fmt_int(rg%n))// &
+                          " devices", stat_no_memory)
+         return
+      end if
+      bof = 0
+      do b = 1, res%n_bearings
+         bof(res%bearing_dev(1, b)) = b
+         bof(res%bearing_dev(2, b)) = b
+      end do
+      do q = 1, rg%n
+         d = rg%dev(q)
+         rg%bearing(q) = bof(d)
+         rg%nrange(:, q) = model%dev(d)%p
+         if (.not. present(nrange)) cycle
+         rg%nrange(:, q) = nrange(:, d)
+         if (nrange(1, d) < nrange(2, d)) call ringing_at(model, q, rg, res)
+      end do
+   end subroutine watch_normal_force
+
+   !> The watched bearings' N ranges joined with the N observed so far (res%bearing_n_min,
+   !> res%bearing_n_max, the observer's at the accepted states); a range that grew moves the
+   !> device's spring, mode, frequency error and capacities to it (ringing_at). Called after
+   !> each accepted state's normal forces are observed; no allocation.
+   pure subroutine ringing_normal_force(model, rg, res)
+      type(model_type), intent(in) :: model         !! the model
+      type(ringing_type), intent(inout) :: rg       !! the devices watched
+      type(result_type), intent(inout) :: res       !! stick_freq_error
+      real(dp) :: lo, hi
+      integer :: q, b
+
+      do q = 1, rg%n
+         b = rg%bearing(q)
+         if (b == 0) cycle
+         lo = min(rg%nrange(1, q), res%bearing_n_min(b))
+         hi = max(rg%nrange(2, q), res%bearing_n_max(b))
+         if (.not. (lo < rg%nrange(1, q) .or. hi > rg%nrange(2, q))) cycle
+         rg%nrange(1, q) = lo
+         rg%nrange(2, q) = hi
+         call ringing_at(model, q, rg, res)
+      end do
+   end subroutine ringing_normal_force
+
+   !> Watched device q at its N range rg%nrange(:, q) (smallest below largest): the sticking
+   !> spring, its mode's frequency, Newmark's error on it (res%stick_freq_error), its drift and
+   !> Newmark's own damping of it at the largest N; the margin's P mu at the smallest (0 when
+   !> the bearing lifts off), the floor's there too unless it lifts off (then at the largest).
+   pure subroutine ringing_at(model, q, rg, res)
+      type(model_type), intent(in) :: model         !! the model
+      integer, intent(in) :: q                      !! the watched device
       type(ringing_type), intent(inout) :: rg       !! the devices watched
       type(result_type), intent(inout) :: res       !! stick_freq_error
       type(device_type) :: dv
       real(dp) :: x, wt, zn, zn0, wt0
-      integer :: q, d
+      integer :: d
       logical :: osc
 
-      do q = 1, rg%n
-         d = rg%dev(q)
-         if (.not. nrange(1, d) < nrange(2, d)) cycle
-         dv = model%dev(d)
-         dv%p = max(nrange(2, d), 0.0_dp)
-         ! Newmark's own damping of the deck's mode out of c_fixed, that of N_max's in
-         call newmark_frequency(rg%omega(q)*dt1, beta, gamma, wt0, zn0, osc)
-         rg%c_fixed(q) = rg%c_fixed(q) - 2.0_dp*rg%mr(q)*rg%omega(q)*zn0
-         rg%k(q) = sticking_stiffness(dv)
-         rg%omega(q) = sqrt(rg%k(q)/rg%mr(q))
-         x = rg%omega(q)*dt1
-         call newmark_frequency(x, beta, gamma, wt, zn, osc)
-         res%stick_freq_error(d) = 1.0_dp
-         if (osc) res%stick_freq_error(d) = 1.0_dp - wt/x
-         rg%drift(q) = abs(res%stick_freq_error(d))*rg%omega(q)
-         rg%c_fixed(q) = rg%c_fixed(q) + 2.0_dp*rg%mr(q)*rg%omega(q)*zn
-         rg%pmu(q) = max(nrange(1, d), 0.0_dp)*model%dev(d)%mu
-         rg%pfloor(q) = rg%pmu(q)
-         if (.not. rg%pfloor(q) > 0.0_dp) rg%pfloor(q) = dv%p*model%dev(d)%mu
-      end do
-   end subroutine vary_normal_force
+      d = rg%dev(q)
+      dv = model%dev(d)
+      dv%p = max(rg%nrange(2, q), 0.0_dp)
+      ! Newmark's own damping of the mode it had out of c_fixed, that of N_max's in
+      call newmark_frequency(rg%omega(q)*rg%dt1, rg%beta, rg%gamma, wt0, zn0, osc)
+      rg%c_fixed(q) = rg%c_fixed(q) - 2.0_dp*rg%mr(q)*rg%omega(q)*zn0
+      rg%k(q) = sticking_stiffness(dv)
+      rg%omega(q) = sqrt(rg%k(q)/rg%mr(q))
+      x = rg%omega(q)*rg%dt1
+      call newmark_frequency(x, rg%beta, rg%gamma, wt, zn, osc)
+      res%stick_freq_error(d) = 1.0_dp
+      if (osc) res%stick_freq_error(d) = 1.0_dp - wt/x
+      rg%drift(q) = abs(res%stick_freq_error(d))*rg%omega(q)
+      rg%c_fixed(q) = rg%c_fixed(q) + 2.0_dp*rg%mr(q)*rg%omega(q)*zn
+      rg%pmu(q) = max(rg%nrange(1, q), 0.0_dp)*model%dev(d)%mu
+      rg%pfloor(q) = rg%pmu(q)
+      if (.not. rg%pfloor(q) > 0.0_dp) rg%pfloor(q) = dv%p*model%dev(d)%mu
+   end subroutine ringing_at
 
    !> The elements at each node 1..n (node 0, the table, left out) of those with use: the
    !> elements at node m are list(first(m) : first(m + 1) - 1); one entry when both ends
