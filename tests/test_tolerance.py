@@ -513,17 +513,30 @@ def test_a_combined_order_not_measured_falls_back_to_the_separate_ladders(monkey
 
 def test_moreau_jean_jumps_to_the_level_its_order_predicts(monkeypatch):
     """Den Hartog by Moreau-Jean (the exact technique ruled out) at 1e-3: from n1 = 1, 2, 4 the
-    estimate at Moreau-Jean's order 1 predicts n1 = 32, run next; the changes across that jump
-    show no order, so n1 = 16 is filled in below it and the estimate of n1 = 32 stands on the
-    ladder 4, 16, 32: 5 levels and the probe, 31 430 steps (the ladder 1, 2, ..., 32 took 6
-    levels and 36 001 steps). Every estimated quantity is within the tolerance of the exact
-    technique's and each estimate at least its true error."""
+    estimate at Moreau-Jean's order 1 (3.5 times the allowed error) predicts a step 1.5 x 3.5
+    = 5.2 times finer: n1 = 24, the smallest integer multiple (a power of 2 would be 32), run
+    next; the changes across that jump show no order, so n1 = 8, twice the level it jumped
+    from, is filled in and the estimate of n1 = 24 stands on the ladder 4, 8, 24: 5 levels and
+    the probe, 22 286 steps (the jump to 32 with 16 filled in took 31 430, the ladder 1, 2,
+    ..., 32 36 001). Every estimated quantity is within the tolerance of the exact technique's
+    and each estimate at least its true error."""
     monkeypatch.setattr(tolerance_module, "EXACT_DEVICES", 0)
     text = deck_text(den_hartog_groups("coulomb", "moreau_jean", 20))
     r, report, session = tolerance_module.tolerance_run(text=text, tolerance=1e-3, name="dh.nml")
     session.close()
     assert [label for label, _ in report.made] == ["probe"] + [
-        f"step level: n1 = {n}" for n in (1, 2, 4, 32, 16)]
-    assert (report.technique, report.n1, report.runs) == ("moreau_jean", 32, 6)
-    assert report.steps < 36_001, report.steps
+        f"step level: n1 = {n}" for n in (1, 2, 4, 24, 8)]
+    assert (report.technique, report.n1, report.runs) == ("moreau_jean", 24, 6)
+    assert report.steps == 22_286, report.steps
     assert against_exact(report, exact_den_hartog()) == (4, 4)
+
+
+def test_a_jump_is_the_smallest_integer_multiple_the_order_asks():
+    """An error 3.5 times the allowed at order 1 asks a step 1.5 x 3.5 = 5.25 times finer: the
+    jump is 6 (not 8, the next power of 2); at order 2, sqrt(5.25) = 2.29: 3; within the
+    allowed error with its margin, still 2 (a jump refines)."""
+    assert tolerance_module._multiple(3.5, 1.0, 1.0) == 6
+    assert tolerance_module._multiple(3.5, 1.0, 2.0) == 3
+    assert tolerance_module._multiple(0.5, 1.0, 1.0) == 2
+    assert tolerance_module._multiple(4.0, 1.0, 1.0) == 6
+    assert tolerance_module._multiple(2.0, 1.0, 1.0) == 3

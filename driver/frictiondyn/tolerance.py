@@ -99,9 +99,9 @@ LAW_RATIO = 4
 #: the combined ladder ties eps and f to the step as its TIE-th power: the law's error, first
 #: order in eps and f, then falls at Newmark's second order in the step, as the step's does
 TIE = 2
-#: the techniques whose step ladder jumps to the level the measured order predicts (at most
-#: JUMP_MAX times the finest), filling in the level below it when the order is not confirmed
-#: across the jump
+#: the techniques whose step ladder jumps to the level the measured order predicts (the
+#: smallest integer multiple of the finest, at most JUMP_MAX), filling in the level twice the
+#: one it jumped from when the order is not confirmed across the jump
 JUMPS = ("moreau_jean",)
 JUMP_MAX = 8
 #: the combined ladder's coarsest eps and f: the deck's divided by this
@@ -303,6 +303,16 @@ def _factor(error: float, allowed: float, order: float | None) -> int:
     if not math.isfinite(need):
         return 2 ** 30
     return max(2, 2 ** math.ceil(math.log2(max(need, 1.0))))
+
+
+def _multiple(error: float, allowed: float, order: float) -> int:
+    """The smallest integer by which to divide a parameter so that an error at ``order`` falls
+    below ``allowed`` (with a margin of 1.5), at least 2: the level a jump predicts, no finer
+    than the order asks (a power of 2 costs up to twice as many steps)."""
+    need = (1.5 * error / allowed) ** (1.0 / order) if allowed > 0 else math.inf
+    if not math.isfinite(need):
+        return 2 ** 30
+    return max(2, math.ceil(need - 1e-9))
 
 
 def _quantity_rows(quantities: list[Quantity], tol: float, values_of) -> list[dict]:
@@ -516,8 +526,8 @@ def _refine(runner: _Runner, nml, path: Path, n1: int, technique: str, tol: floa
     plus law's, is within it (MARGIN times the allowed error): each round adds one level to a
     ladder and reuses the runs of the rounds before (the runner makes each deck text once).
     Moreau-Jean's step ladder (JUMPS) adds the level the order its estimate stands on
-    predicts (at most JUMP_MAX times the finest), and, where the changes across that jump show
-    no order, the level halfway below it."""
+    predicts (the smallest integer multiple of the finest, at most JUMP_MAX), and, where the
+    changes across that jump show no order, the level twice the one it jumped from."""
     regularized = (technique == "newmark"
                    and _law_text(write_namelist(_with(nml, n1)), 2) is not None)
     start, start_why = _probe_start(runner, nml, technique, tol)
@@ -559,6 +569,7 @@ def _refine(runner: _Runner, nml, path: Path, n1: int, technique: str, tol: floa
             raise ToleranceError(_unmet(path, tol, what, q.estimate, why))
         divisors.append(divisors[-1] * LAW_RATIO)
     divisor = divisors[-1]
+    filled: set[int] = set()  # the jumps whose order a level filled in below them confirms
     while True:
         rounds += 1
         levels = [_text_at(nml, technique, n, divisor) for n in steps[-5:]]
@@ -597,7 +608,7 @@ def _refine(runner: _Runner, nml, path: Path, n1: int, technique: str, tol: floa
             budget = MARGIN * allowed - law
             need = max(need, _factor(step, budget, _measured(q.estimate)) if claims else 2)
             # the level the order the estimate stands on predicts; none without an order
-            jump = (max(jump, _factor(step, budget, q.estimate.order)) if jump
+            jump = (max(jump, _multiple(step, budget, q.estimate.order)) if jump
                     and q.estimate.method == "richardson" else 0)
         if worst is None:
             report = ToleranceReport(tol, floor, technique, f"{why}; {start_why}", steps[-1],
@@ -613,12 +624,13 @@ def _refine(runner: _Runner, nml, path: Path, n1: int, technique: str, tol: floa
             raise ToleranceError(_unmet(path, tol, what, None, why))
         if technique not in JUMPS:
             steps.append(2 * steps[-1])
-        elif steps[-1] > 2 * steps[-2] and not jump and steps[-1] // 2 not in steps:
-            steps.insert(len(steps) - 1, steps[-1] // 2)  # the jump's order not confirmed
+        elif steps[-1] > 2 * steps[-2] and not jump and steps[-1] not in filled:
+            # the jump's order not confirmed: the level twice the one it jumped from, the
+            # cheapest level between them, so the finest's estimate stands on ratios 2 and r / 2
+            filled.add(steps[-1])
+            steps.insert(len(steps) - 1, 2 * steps[-2])
         else:
-            jump = min(max(jump, 2), JUMP_MAX)
-            while steps[-1] * jump > MAX_REFINEMENT * n1:
-                jump //= 2
+            jump = min(max(jump, 2), JUMP_MAX, MAX_REFINEMENT * n1 // steps[-1])
             steps.append(steps[-1] * jump)
 
 
