@@ -7,6 +7,7 @@ tolerance, which is a Python run, naming the command."""
 
 from __future__ import annotations
 
+import hashlib
 import json
 import math
 import re
@@ -212,6 +213,8 @@ def test_moreau_jean_building_estimates_bound_the_true_errors(tmp_path, monkeypa
     session.close()
     s = r.summary
     assert s["technique"] == "moreau_jean"
+    # the deck given, as sha256sum reads it, not the deck of the run chosen
+    assert s["deck_sha256"] == hashlib.sha256(deck.read_bytes()).hexdigest()
     total = bounded = 0
     for row in report.quantities:
         ref = exact[row["key"]]

@@ -174,16 +174,14 @@ def _tolerance_outputs(args: argparse.Namespace) -> tuple[Result, Path | None, P
     """A tolerance run: the chosen run written as the executable writes one, its summary with
     the estimated errors and what was chosen, and the SHA-256 of the deck given (the run chosen
     is of a deck written from it; the summary rewritten whole, then renamed)."""
-    import hashlib
-
     from .tolerance import tolerance_run
 
     result, report, session = tolerance_run(args.deck, args.tolerance, args.tolerance_floor)
     with session:
         csv, summ = session.write(args.out)
     data = json.loads(summ.read_text())
-    data.update({k: result.summary[k] for k in ("estimated_error", "estimate_method", "tolerance_run")})
-    data["deck_sha256"] = hashlib.sha256(Path(args.deck).read_bytes()).hexdigest()
+    data.update({k: result.summary[k]
+                 for k in ("estimated_error", "estimate_method", "tolerance_run", "deck_sha256")})
     temp = summ.with_name(summ.name + ".tolerance.tmp")
     temp.write_text(json.dumps(data, indent=2) + "\n")
     os.replace(temp, summ)

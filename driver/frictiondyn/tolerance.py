@@ -47,6 +47,7 @@ hardly moves from asking for a relative accuracy the structure's motion does not
 
 from __future__ import annotations
 
+import hashlib
 import json
 import math
 import os
@@ -157,7 +158,8 @@ class ToleranceReport:
         if self.law_divisor > 1:
             head += f", eps and f / {self.law_divisor}"
         rounds = f"{self.rounds} round{'s' * (self.rounds != 1)}"
-        lines = [f"{head} ({self.runs} runs, {rounds}): {self.why}"]
+        runs = f"{self.runs} run{'s' * (self.runs != 1)}"
+        lines = [f"{head} ({runs}, {rounds}): {self.why}"]
         worst: dict[str, dict] = {}
         for q in self.quantities:
             if q["key"] not in worst or q["relative_error"] > worst[q["key"]]["relative_error"]:
@@ -764,6 +766,9 @@ def tolerance_run(
         runner.close()
         result = session.result()
         result.summary.update(_summary_block(report))
+        # the deck given, as sha256sum reads it (the run chosen is of a deck written from it)
+        result.summary["deck_sha256"] = hashlib.sha256(
+            text.encode("utf-8", "surrogateescape")).hexdigest()
         return result, report, session
     finally:
         runner.close()
