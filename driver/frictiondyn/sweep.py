@@ -1484,8 +1484,9 @@ def slurm_script(
     lines += [f"#SBATCH {x}" for x in extra]
     lines += [
         f"# frictiondyn sweep '{sweep.name}': {len(indices)} of {len(sweep.runs)} runs.",
-        "# Each task runs the standalone executable on its own deck (decks.txt, 0-based);",
-        "# a failure leaves runs/<id>.error.txt with the executable's message.",
+        "# Each task runs the standalone executable on its own deck (decks.txt, 0-based)"
+        + (", or Python's tolerance run on a deck that sets &integration tolerance;" if tolerance else ";"),
+        "# a failure leaves runs/<id>.error.txt with its message.",
         "set -u",
         f"cd {shlex.quote(str(sweep.directory))} || exit 1",
         f'id=$(printf "r%0{width}d" "$SLURM_ARRAY_TASK_ID")',
