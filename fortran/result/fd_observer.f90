@@ -29,7 +29,7 @@ module fd_observer
    use fd_run_control, only: run_control, cancel_requested, stat_cancelled
    use fd_result, only: history_header
    use fd_engineering, only: engineering_init, observe_engineering, storey_values, observe_storey_peak, &
-                             observe_floor_accelerations
+                             observe_floor_accelerations, observe_floor_peaks
    implicit none
    private
 
@@ -202,33 +202,54 @@ contains
       real(dp) :: x
       integer :: i
       real(dp) :: ri
-      logical :: has_r
+      logical :: has_r, has_r2
 
       ! (explicit shapes: this runs at every accepted step, and a call that builds array
       ! descriptors costs more than a two-mass model's peaks)
       has_r = allocated(res%eng%r)
-      do i = 1, n
-         if (abs(u(i)) > res%peak_u(i)) then
-            res%peak_u(i) = abs(u(i)); res%peak_u_time(i) = t
-         end if
-         res%peak_v(i) = max(res%peak_v(i), abs(v(i)))
-         ! the absolute acceleration: the table's along the DOF's direction r_i added
-         ri = 1.0_dp
-         if (has_r) ri = res%eng%r(i)
-         x = acc(i) + ri*ag
-         if (present(ag2) .and. allocated(res%eng%r2)) x = x + res%eng%r2(i)*ag2
-         x = abs(x)
-         if (x > res%peak_aabs(i)) then
-            res%peak_aabs(i) = x; res%peak_aabs_time(i) = t
-         end if
-      end do
+      has_r2 = present(ag2)
+      if (has_r2) has_r2 = allocated(res%eng%r2)
+      if (.not. (has_r .or. has_r2)) then
+         ! every DOF along the table motion (r_i = 1), one component: the loop without the
+         ! directions' tests (the paper's models)
+         do i = 1, n
+            if (abs(u(i)) > res%peak_u(i)) then
+               res%peak_u(i) = abs(u(i)); res%peak_u_time(i) = t
+            end if
+            res%peak_v(i) = max(res%peak_v(i), abs(v(i)))
+            x = abs(acc(i) + ag)
+            if (x > res%peak_aabs(i)) then
+               res%peak_aabs(i) = x; res%peak_aabs_time(i) = t
+            end if
+         end do
+      else
+         do i = 1, n
+            if (abs(u(i)) > res%peak_u(i)) then
+               res%peak_u(i) = abs(u(i)); res%peak_u_time(i) = t
+            end if
+            res%peak_v(i) = max(res%peak_v(i), abs(v(i)))
+            ! the absolute acceleration: the table's along the DOF's direction r_i added
+            ri = 1.0_dp
+            if (has_r) ri = res%eng%r(i)
+            x = acc(i) + ri*ag
+            if (has_r2) x = x + res%eng%r2(i)*ag2
+            x = abs(x)
+            if (x > res%peak_aabs(i)) then
+               res%peak_aabs(i) = x; res%peak_aabs_time(i) = t
+            end if
+         end do
+      end if
       do i = 1, nd
          res%peak_s(i) = max(res%peak_s(i), abs(s(i)))
          res%peak_force(i) = max(res%peak_force(i), abs(force(i)))
       end do
-      call observe_engineering(res%eng, t, n, nd, u, v, s, force)
       if (res%n_bearings > 0) call observe_bearings(res, t, nd, s, force)
-      if (res%eng%n_floors > 0) call observe_floor_accelerations(res%eng, t, n, acc, ag, ag2)
+      if (res%eng%n_floors > 0) then
+         call observe_floor_accelerations(res%eng, t, n, acc, ag, ag2)
+         call observe_floor_peaks(res%eng, t, n, nd, u, v, force)
+      end if
+      ! last: the compiler makes it a jump (a tail call), no return through this routine
+      call observe_engineering(res%eng, t, n, nd, u, v, s, force)
    end subroutine observe_peaks
 
    !> The planar bearings' resultant displacement |(s_x, s_y)|: its peak, the peak's direction
@@ -448,6 +469,7 @@ contains
       real(dp), intent(in) :: s(:), force(:)   !! device relative displacements [m], forces [N]
 
       call observe_engineering(res%eng, t, size(u), size(s), u, v, s, force)
+      if (res%eng%n_floors > 0) call observe_floor_peaks(res%eng, t, size(u), size(s), u, v, force)
    end subroutine observe_storeys
 
    !> The next row of the history: t, ag, (u, v, aabs) per kept DOF, (s, s', F, phase) per

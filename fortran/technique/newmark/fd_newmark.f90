@@ -691,48 +691,51 @@ contains
          call factor_for(model, lv, w, error)
          if (allocated(error)) return
       end if
-      h = w%lev(lv)%h
-      if (lv == 1) then
-         ! a dt1 step ends at k dt1 (w%k), a point of the grid
-         call grid_acceleration(exc, w%grid, w%k, t + h, ag1)
-      else
-         ag1 = table_acceleration(exc, t + h)
-      end if
-      w%ag1 = ag1
-      ! the normal forces of the step's start (the follow's), then of its end (the laws' update)
-      if (w%varies) call normal_forces(model, t, w, .false.)
-      ! a speed-dependent mu's sliding forces start from the velocity at the step's start,
-      ! whatever an earlier trial of the step left in them (follow_forces takes them on)
-      if (w%nf > 0) call start_forces(w%dev, w)
-      call predict(w%n, h, w%lev(lv)%g1h, w%lev(lv)%b2h2, ag1, w%mr, w%u, w%v, w%a, w%tmp, w%u1, w%rhs)
-      if (w%two) then
-         w%ag21 = table_acceleration(w%exc2, t + h)
-         w%rhs = w%rhs - w%mr2*w%ag21
-      end if
-      if (w%lev(lv)%sparse) then
-         call sparse_kc_matvec(w%lev(lv)%sps, w%u1, w%tmp, w%rhs, -1.0_dp)
-      else
-         call spd_kc_matvec(w%lev(lv)%sys, w%u1, w%tmp, w%rhs, -1.0_dp)
-      end if
-      if (w%lev(lv)%wb%r > 0) call lowrank_matvec(model%modal_u, model%modal_d, w%tmp, w%rhs, -1.0_dp)
-      if (w%pairs) then
-         call pair_loads(w%n, w%nd, w%di, w%dj, w%st, w%u1, w%tmp, w%lev(lv)%c0, w%rhs)
-      else
-         call device_loads(model, w%n, w%nd, w%st, w%u1, w%tmp, w%lev(lv)%c0, w%rhs, w%s1, w%sd1, w%fw)
-      end if
-      if (w%lev(lv)%sparse) then
-         call sparse_solve(w%lev(lv)%sps, w%rhs, error)
-      else
-         call spd_solve(w%lev(lv)%sys, w%rhs, error)
-      end if
-      if (allocated(error)) return
-      if (w%lev(lv)%wb%r > 0) call woodbury_correct(w%lev(lv)%wb, model%modal_u, w%rhs)
-      call correct(w%n, w%lev(lv)%bh2, w%lev(lv)%gh, w%rhs, w%tmp, w%a1, w%u1, w%v1)
-      if (w%pairs) then
-         call pair_motion(w%n, w%nd, w%di, w%dj, w%u1, w%v1, w%s1, w%sd1)
-      else
-         call relative_motion(model, w%n, w%nd, w%u1, w%v1, w%s1, w%sd1)
-      end if
+      ! the level by association: w%lev(lv) would load its array descriptor at every use
+      associate (lev => w%lev(lv))
+         h = lev%h
+         if (lv == 1) then
+            ! a dt1 step ends at k dt1 (w%k), a point of the grid
+            call grid_acceleration(exc, w%grid, w%k, t + h, ag1)
+         else
+            ag1 = table_acceleration(exc, t + h)
+         end if
+         w%ag1 = ag1
+         ! the normal forces of the step's start (the follow's), then of its end (the laws' update)
+         if (w%varies) call normal_forces(model, t, w, .false.)
+         ! a speed-dependent mu's sliding forces start from the velocity at the step's start,
+         ! whatever an earlier trial of the step left in them (follow_forces takes them on)
+         if (w%nf > 0) call start_forces(w%dev, w)
+         call predict(w%n, h, lev%g1h, lev%b2h2, ag1, w%mr, w%u, w%v, w%a, w%tmp, w%u1, w%rhs)
+         if (w%two) then
+            w%ag21 = table_acceleration(w%exc2, t + h)
+            w%rhs = w%rhs - w%mr2*w%ag21
+         end if
+         if (lev%sparse) then
+            call sparse_kc_matvec(lev%sps, w%u1, w%tmp, w%rhs, -1.0_dp)
+         else
+            call spd_kc_matvec(lev%sys, w%u1, w%tmp, w%rhs, -1.0_dp)
+         end if
+         if (lev%wb%r > 0) call lowrank_matvec(model%modal_u, model%modal_d, w%tmp, w%rhs, -1.0_dp)
+         if (w%pairs) then
+            call pair_loads(w%n, w%nd, w%di, w%dj, w%st, w%u1, w%tmp, lev%c0, w%rhs)
+         else
+            call device_loads(model, w%n, w%nd, w%st, w%u1, w%tmp, lev%c0, w%rhs, w%s1, w%sd1, w%fw)
+         end if
+         if (lev%sparse) then
+            call sparse_solve(lev%sps, w%rhs, error)
+         else
+            call spd_solve(lev%sys, w%rhs, error)
+         end if
+         if (allocated(error)) return
+         if (lev%wb%r > 0) call woodbury_correct(lev%wb, model%modal_u, w%rhs)
+         call correct(w%n, lev%bh2, lev%gh, w%rhs, w%tmp, w%a1, w%u1, w%v1)
+         if (w%pairs) then
+            call pair_motion(w%n, w%nd, w%di, w%dj, w%u1, w%v1, w%s1, w%sd1)
+         else
+            call relative_motion(model, w%n, w%nd, w%u1, w%v1, w%s1, w%sd1)
+         end if
+      end associate
       if (w%nf > 0) call follow_forces(model, lv, w, error)
       ! the vertical supports' trial from the accepted state at t (a_z linear in the step)
       if (w%elastic) call support_advance(w%vs, lv, t + h, table_acceleration(w%exc3, t), table_acceleration(w%exc3, t + h))
@@ -1281,13 +1284,17 @@ contains
       ! the velocity-law bands' forces: an alternation from step to step (fd_band_alternation)
       if (w%alt%n > 0) call alternation_step(w%alt, w%nd, t1 - w%t, w%st, w%f, res%band_alternation, &
                                              res%band_alternation_time)
-      if (w%tilt) w%dn = w%dn1
-      if (w%elastic) then
-         ! the vertical supports move on: the ground's work on them and their dashpots'
-         call support_accept(w%vs)
-         call observe_work(res, w%vs%w_in1, w%vs%w_damp1)
+      if (w%varies) then
+         ! (a vertical component or the overturning, tilt, makes N vary: one test for the models
+         ! without bearings; an elastic support comes with a vertical component)
+         if (w%tilt) w%dn = w%dn1
+         if (w%elastic) then
+            ! the vertical supports move on: the ground's work on them and their dashpots'
+            call support_accept(w%vs)
+            call observe_work(res, w%vs%w_in1, w%vs%w_damp1)
+         end if
+         call observe_bearing_forces(model, t1, t1 - w%t, w, res)
       end if
-      if (w%varies) call observe_bearing_forces(model, t1, t1 - w%t, w, res)
       w%t = t1
       if (changed_k) w%version = w%version + 1
       ! (a varying normal force changes a band's dashpot or a sticking spring within a phase)
