@@ -26,6 +26,7 @@ module fd_vertical_support
    private
 
    public :: vertical_support, support_setup, support_advance, support_accept, support_forces, &
+                supported_normal_forces, &
              support_normal_force, support_energy
 
    real(dp), parameter :: g = 9.80665_dp                  !! standard gravity [m/s2]
@@ -186,6 +187,23 @@ contains
          if (.not. vs%fly(i)) n = vs%p(i) + vs%k(i)*vs%z(i) + vs%c(i)*vs%zd(i)
       end if
    end function support_normal_force
+
+   !> Each bearing on an elastic support's normal force at the accepted state into pn (by
+   !> bearing): its oscillator's, plus the overturning's dn when tilt (dn then present) and it
+   !> is in contact (in flight N = 0 whatever the overturning). Other bearings' pn stay.
+   pure subroutine supported_normal_forces(vs, tilt, pn, dn)
+      type(vertical_support), intent(in) :: vs
+      logical, intent(in) :: tilt                   !! the overturning's dN is added
+      real(dp), intent(inout) :: pn(:)              !! (bearings) normal forces [N]
+      real(dp), intent(in), optional :: dn(:)       !! the overturning's dN per bearing [N] (with tilt)
+      integer :: i, b
+
+      do i = 1, vs%nb
+         b = vs%bearing(i)
+         pn(b) = support_normal_force(vs, i, .false.)
+         if (tilt .and. .not. vs%fly(i)) pn(b) = pn(b) + dn(b)
+      end do
+   end subroutine supported_normal_forces
 
    !> The bearings on elastic supports in dev (the copies the laws take): each component's
    !> p = max(N, 0) with N = (1 - mix) N(accepted) + mix N(trial) (mix = 0: the accepted state,

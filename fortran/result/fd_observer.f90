@@ -368,21 +368,27 @@ contains
       end do
    end subroutine observe_normal_forces
 
-   !> A bearing on an elastic vertical support: its peak uplift displacement so far and, when
-   !> its flights are the whole of its uplift (no overturning), their count, the first
-   !> lift-off's time and the time in flight, located within the steps.
-   pure subroutine observe_flights(res, b, gap, flights, first, air)
+   !> The bearings on elastic supports: each one's peak uplift so far and, where the supports
+   !> locate their flights within the steps (located), its lift-offs, the first one's time and
+   !> its time in flight (otherwise, as with the overturning, uplift is counted by the steps).
+   pure subroutine observe_flights(res, bearing, gap, flights, first, air, located)
       type(result_type), intent(inout) :: res  !! the result
-      integer, intent(in) :: b                 !! the bearing
-      real(dp), intent(in) :: gap              !! its peak uplift so far [m]
-      integer, intent(in), optional :: flights !! its lift-offs so far
-      real(dp), intent(in), optional :: first  !! the first one's time [s]
-      real(dp), intent(in), optional :: air    !! its time in flight so far [s]
+      integer, intent(in) :: bearing(:)        !! (supports) each one's bearing
+      real(dp), intent(in) :: gap(:)           !! its peak uplift so far [m]
+      integer, intent(in) :: flights(:)        !! its lift-offs so far
+      real(dp), intent(in) :: first(:)         !! the first one's time [s]
+      real(dp), intent(in) :: air(:)           !! its time in flight so far [s]
+      logical, intent(in) :: located           !! the flights are the supports' own
+      integer :: i, b
 
-      if (allocated(res%bearing_uplift_peak)) res%bearing_uplift_peak(b) = max(res%bearing_uplift_peak(b), gap)
-      if (present(flights)) res%bearing_uplifts(b) = flights
-      if (present(first)) res%bearing_uplift_first(b) = first
-      if (present(air)) res%bearing_uplift_time(b) = air
+      do i = 1, size(bearing)
+         b = bearing(i)
+         if (allocated(res%bearing_uplift_peak)) res%bearing_uplift_peak(b) = max(res%bearing_uplift_peak(b), gap(i))
+         if (.not. located) cycle
+         res%bearing_uplifts(b) = flights(i)
+         res%bearing_uplift_first(b) = first(i)
+         res%bearing_uplift_time(b) = air(i)
+      end do
    end subroutine observe_flights
 
    !> The exact extrema of a technique that knows its solution between steps: |y(q)| of every

@@ -39,7 +39,7 @@ module fd_moreau_jean
    use fd_friction_planar, only: devices_at_normal_force, normal_force, pendulum_excess, with_normal_force
    use fd_overturning, only: overturning_forces
    use fd_vertical_support, only: vertical_support, support_setup, support_advance, support_accept, support_forces, &
-                                  support_normal_force, support_energy
+                                  supported_normal_forces, support_energy
    use fd_kinematics, only: device_kinematics, device_nodes, devices_are_pairs, device_relative
    use fd_stiffness, only: influence_of
    use fd_matrices, only: structure_damping
@@ -703,20 +703,11 @@ contains
             w%pn(b) = normal_force(model%dev(res%bearing_dev(1, b)), az)
          end do
       end if
-      do b = 1, w%vs%nb
-         w%pn(w%vs%bearing(b)) = support_normal_force(w%vs, b, .false.)
-         if (w%tilt .and. .not. w%vs%fly(b)) w%pn(w%vs%bearing(b)) = w%pn(w%vs%bearing(b)) + w%dn(w%vs%bearing(b))
-      end do
+      call supported_normal_forces(w%vs, w%tilt, w%pn, w%dn)
       call observe_normal_forces(res, t, h, w%pn)
       ! the supports' flights, located within the steps (with the overturning, whose dN may
       ! unload a bearing in contact, its uplift is counted by the steps as on a rigid support)
-      do b = 1, w%vs%nb
-         if (w%tilt) then
-            call observe_flights(res, w%vs%bearing(b), w%vs%gap(b))
-         else
-            call observe_flights(res, w%vs%bearing(b), w%vs%gap(b), w%vs%flights(b), w%vs%first(b), w%vs%air(b))
-         end if
-      end do
+      call observe_flights(res, w%vs%bearing, w%vs%gap, w%vs%flights, w%vs%first, w%vs%air, .not. w%tilt)
    end subroutine observe_bearing_forces
 
    !> Device kinematics, forces and phases of the dense form (statuses of the step).

@@ -55,7 +55,7 @@ module fd_newmark
                                  normal_force_range
    use fd_overturning, only: overturning_forces
    use fd_vertical_support, only: vertical_support, support_setup, support_advance, support_accept, support_forces, &
-                                  support_normal_force, support_energy
+                                  supported_normal_forces, support_energy
    use fd_friction, only: friction_init, friction_step, friction_settle, follows_velocity, friction_follow, &
                           friction_energy, friction_capacity
    use fd_result, only: result_type
@@ -314,7 +314,7 @@ contains
          w%k = k
          call try_step(model, exc, t0, 1, w, error)
          if (allocated(error)) return
-         call judge(model, opts, w, any_changed, any_bad)
+         call judge(opts, w, any_changed, any_bad)
          if (w%nd == 0 .or. .not. (any_changed .or. (any_bad .and. opts%check))) then
             call accept(model, exc, t0 + dt1, w, res, any_changed, .false.)
             res%newmark%steps_dt1 = res%newmark%steps_dt1 + 1
@@ -611,20 +611,11 @@ contains
             w%pn(b) = normal_force(model%dev(res%bearing_dev(1, b)), w%az)
          end do
       end if
-      do b = 1, w%vs%nb
-         w%pn(w%vs%bearing(b)) = support_normal_force(w%vs, b, .false.)
-         if (w%tilt .and. .not. w%vs%fly(b)) w%pn(w%vs%bearing(b)) = w%pn(w%vs%bearing(b)) + w%dn(w%vs%bearing(b))
-      end do
+      call supported_normal_forces(w%vs, w%tilt, w%pn, w%dn)
       call observe_normal_forces(res, t, h, w%pn)
       ! the supports' flights, located within the steps (with the overturning, whose dN may
       ! unload a bearing in contact, its uplift is counted by the steps as on a rigid support)
-      do b = 1, w%vs%nb
-         if (w%tilt) then
-            call observe_flights(res, w%vs%bearing(b), w%vs%gap(b))
-         else
-            call observe_flights(res, w%vs%bearing(b), w%vs%gap(b), w%vs%flights(b), w%vs%first(b), w%vs%air(b))
-         end if
-      end do
+      call observe_flights(res, w%vs%bearing, w%vs%gap, w%vs%flights, w%vs%first, w%vs%air, .not. w%tilt)
       call checks_normal_force(model, w, res)
    end subroutine observe_bearing_forces
 
@@ -1028,8 +1019,7 @@ contains
 
    !> Phases after the trial step, and the correctness condition of the step (with the
    !> convergence of a speed-dependent mu's forces).
-   subroutine judge(model, opts, w, any_changed, any_bad)
-      type(model_type), intent(in) :: model
+   subroutine judge(opts, w, any_changed, any_bad)
       type(integration_type), intent(in) :: opts
       type(workspace), intent(inout) :: w
       logical, intent(out) :: any_changed, any_bad
@@ -1074,7 +1064,7 @@ contains
          end if
          call try_step(model, exc, tj, lv, w, error)
          if (allocated(error)) return
-         call judge(model, opts, w, any_changed, any_bad)
+         call judge(opts, w, any_changed, any_bad)
          if (any_changed .or. (any_bad .and. opts%check)) then
             call advance_nested(model, exc, opts, tj, k + 1, w, res, error)
             if (allocated(error)) return
@@ -1113,7 +1103,7 @@ contains
          tl = t + sub*real(pos, dp)/real(units, dp)
          call try_step(model, exc, tl, 2 + level, w, error)
          if (allocated(error)) return
-         call judge(model, opts, w, any_changed, any_bad)
+         call judge(opts, w, any_changed, any_bad)
          if (any_bad .and. opts%check .and. level < lmax) then
             level = level + 1
             cycle
@@ -1199,7 +1189,7 @@ contains
          ! from the states the step was taken in, the same phases at its end; the condition in
          ! the devices that keep their phase through the step (it is a condition inside a
          ! phase: a changing device's velocities at the two ends belong to different phases)
-         call judge(model, opts, w, any_changed, any_bad)
+         call judge(opts, w, any_changed, any_bad)
          if (.not. same_phases(w%nd, w%st1, w%phase_end)) exit
          any_bad = w%follow_failed
          do d = 1, w%nd
