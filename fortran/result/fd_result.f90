@@ -16,7 +16,7 @@ module fd_result
 
    public :: result_type, max_violation_times, column_name_len, init_result, history_shape, check_finite
    public :: nonfinite_history_error, history_header
-   public :: max_event_times, has_envelope, run_setup, setup_of
+   public :: max_event_times, has_envelope, run_setup, setup_of, device_bearings
    public :: resolution_none, resolution_resolved, resolution_unresolved, resolution_names
    public :: mode_resolution_limit, harmonic_error_limit, record_error_limit
    public :: residual_ratio_limit, roundoff_ratio_limit, energy_balance_of, energy_balance_names
@@ -398,6 +398,19 @@ contains
       res%bearing_last = 0.0_dp
       call init_isolation(model, res, error)
    end subroutine init_bearings
+
+   !> Each device's planar bearing (0: a device of its own), from res%bearing_dev.
+   pure subroutine device_bearings(res, bof)
+      type(result_type), intent(in) :: res          !! the result, its bearings set up
+      integer, intent(out) :: bof(:)                !! (n_devices) each device's bearing
+      integer :: b
+
+      bof = 0
+      do b = 1, res%n_bearings
+         bof(res%bearing_dev(1, b)) = b
+         bof(res%bearing_dev(2, b)) = b
+      end do
+   end subroutine device_bearings
 
    !> Each bearing's travel, reversals and restoring stiffness, and the isolation shear's
    !> peaks, at 0.

@@ -57,7 +57,7 @@ module fd_band_alternation
    use fd_kinematics, only: add_device_abs, device_abs_inverse_mass_relative
    use fd_friction, only: holds_when_stuck, law_checks_band_alternation
    use fd_device_state, only: device_state, phase_stick
-   use fd_result, only: result_type
+   use fd_result, only: result_type, device_bearings
    implicit none
    private
 
@@ -114,7 +114,7 @@ contains
                                                      !! largest normal force over the run [N]
                                                      !! (absent: the deck's p throughout)
       integer, allocatable :: bof(:)
-      integer :: d, q, b, stat
+      integer :: d, q, stat
       real(dp) :: pmu, pfloor
 
       res%band_checked = .false.
@@ -125,11 +125,7 @@ contains
                           " velocity-law devices", stat_no_memory)
          return
       end if
-      bof = 0
-      do b = 1, res%n_bearings
-         bof(res%bearing_dev(1, b)) = b
-         bof(res%bearing_dev(2, b)) = b
-      end do
+      call device_bearings(res, bof)
       q = 0
       do d = 1, model%n_devices
          associate (dev => model%dev(d))

@@ -53,7 +53,7 @@ module fd_stick_ringing
    use fd_stiffness, only: stiffness_form
    use fd_friction, only: sticking_stiffness, law_stuck, stuck_dashpot
    use fd_device_state, only: device_state, phase_stick
-   use fd_result, only: result_type
+   use fd_result, only: result_type, device_bearings
    implicit none
    private
 
@@ -354,7 +354,7 @@ contains
       type(error_type), allocatable, intent(out) :: error !! not enough memory
       real(dp), intent(in), optional :: nrange(:, :) !! (2, n_devices) smallest and largest N [N]
       integer, allocatable :: bof(:)
-      integer :: q, d, b, stat
+      integer :: q, d, stat
 
       rg%dt1 = dt1
       rg%beta = beta
@@ -365,11 +365,7 @@ contains
                           " devices", stat_no_memory)
          return
       end if
-      bof = 0
-      do b = 1, res%n_bearings
-         bof(res%bearing_dev(1, b)) = b
-         bof(res%bearing_dev(2, b)) = b
-      end do
+      call device_bearings(res, bof)
       do q = 1, rg%n
          d = rg%dev(q)
          rg%bearing(q) = bof(d)
