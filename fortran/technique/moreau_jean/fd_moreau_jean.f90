@@ -703,11 +703,13 @@ contains
             w%pn(b) = normal_force(model%dev(res%bearing_dev(1, b)), az)
          end do
       end if
-      call supported_normal_forces(w%vs, w%tilt, w%pn, w%dn)
+      ! (the supports' arrays exist only for a model with elastic supports)
+      if (w%vs%nb > 0) call supported_normal_forces(w%vs, w%tilt, w%pn, w%dn)
       call observe_normal_forces(res, t, h, w%pn)
       ! the supports' flights, located within the steps (with the overturning, whose dN may
       ! unload a bearing in contact, its uplift is counted by the steps as on a rigid support)
-      call observe_flights(res, w%vs%bearing, w%vs%gap, w%vs%flights, w%vs%first, w%vs%air, .not. w%tilt)
+      if (w%vs%nb > 0) &
+         call observe_flights(res, w%vs%bearing, w%vs%gap, w%vs%flights, w%vs%first, w%vs%air, .not. w%tilt)
    end subroutine observe_bearing_forces
 
    !> Device kinematics, forces and phases of the dense form (statuses of the step).
