@@ -8,6 +8,20 @@ module fd_lapack
    public :: dgelss, dgemv, dgesv, dgetrf, dgetrs, dpbtf2, dpbtrf, dpbtrs, dpotf2, dpotrf, dpotrs, dpttrf, dpttrs, &
              dsbevx, dsbgvx, dsbmv, dsterf, dsyevr, dsygv, dsymv, dsyrk, dtrsv
 
+   !> The BLAS products y := alpha A x + beta y of a matrix given by one option and two sizes:
+   !> dgemv (opt = trans; n1, n2 = m, n: A general m x n) and dsbmv (opt = uplo; n1, n2 = n, k:
+   !> A symmetric, k superdiagonals in band storage).
+   abstract interface
+      subroutine blas_matvec(opt, n1, n2, alpha, a, lda, x, incx, beta, y, incy)
+         import :: dp
+         character(len=1), intent(in) :: opt
+         integer, intent(in) :: n1, n2, lda, incx, incy
+         real(dp), intent(in) :: alpha, beta
+         real(dp), intent(in) :: a(lda, *), x(*)
+         real(dp), intent(inout) :: y(*)
+      end subroutine blas_matvec
+   end interface
+
    interface
       subroutine dgelss(m, n, nrhs, a, lda, b, ldb, s, rcond, rank, work, lwork, info)
          import :: dp
@@ -17,14 +31,6 @@ module fd_lapack
          real(dp), intent(in) :: rcond
          integer, intent(out) :: rank, info
       end subroutine dgelss
-      subroutine dgemv(trans, m, n, alpha, a, lda, x, incx, beta, y, incy)
-         import :: dp
-         character(len=1), intent(in) :: trans
-         integer, intent(in) :: m, n, lda, incx, incy
-         real(dp), intent(in) :: alpha, beta
-         real(dp), intent(in) :: a(lda, *), x(*)
-         real(dp), intent(inout) :: y(*)
-      end subroutine dgemv
       subroutine dgesv(n, nrhs, a, lda, ipiv, b, ldb, info)
          import :: dp
          integer, intent(in) :: n, nrhs, lda, ldb
@@ -45,13 +51,6 @@ module fd_lapack
          real(dp), intent(inout) :: b(ldb, *)
          integer, intent(out) :: info
       end subroutine dgetrs
-      subroutine dpbtf2(uplo, n, kd, ab, ldab, info)
-         import :: dp
-         character(len=1), intent(in) :: uplo
-         integer, intent(in) :: n, kd, ldab
-         real(dp), intent(inout) :: ab(ldab, *)
-         integer, intent(out) :: info
-      end subroutine dpbtf2
       subroutine dpbtrf(uplo, n, kd, ab, ldab, info)
          import :: dp
          character(len=1), intent(in) :: uplo
@@ -67,13 +66,6 @@ module fd_lapack
          real(dp), intent(inout) :: b(ldb, *)
          integer, intent(out) :: info
       end subroutine dpbtrs
-      subroutine dpotf2(uplo, n, a, lda, info)
-         import :: dp
-         character(len=1), intent(in) :: uplo
-         integer, intent(in) :: n, lda
-         real(dp), intent(inout) :: a(lda, *)
-         integer, intent(out) :: info
-      end subroutine dpotf2
       subroutine dpotrf(uplo, n, a, lda, info)
          import :: dp
          character(len=1), intent(in) :: uplo
@@ -122,21 +114,6 @@ module fd_lapack
          real(dp), intent(in) :: vl, vu, abstol
          integer, intent(out) :: m, iwork(*), ifail(*), info
       end subroutine dsbgvx
-      subroutine dsbmv(uplo, n, k, alpha, a, lda, x, incx, beta, y, incy)
-         import :: dp
-         character(len=1), intent(in) :: uplo
-         integer, intent(in) :: n, k, lda, incx, incy
-         real(dp), intent(in) :: alpha, beta
-         real(dp), intent(in) :: a(lda, *), x(*)
-         real(dp), intent(inout) :: y(*)
-      end subroutine dsbmv
-      !> LAPACK: every eigenvalue of a symmetric tridiagonal matrix (ascending, in d).
-      pure subroutine dsterf(n, d, e, info)
-         import :: dp
-         integer, intent(in) :: n
-         real(dp), intent(inout) :: d(*), e(*)
-         integer, intent(out) :: info
-      end subroutine dsterf
       subroutine dsyevr(jobz, range, uplo, n, a, lda, vl, vu, il, iu, abstol, m, w, z, ldz, isuppz, &
                         work, lwork, iwork, liwork, info)
          import :: dp
@@ -179,5 +156,13 @@ module fd_lapack
          real(dp), intent(inout) :: x(*)
       end subroutine dtrsv
    end interface
+
+   procedure(blas_matvec) :: dgemv, dsbmv
+   !> The unblocked Cholesky factorizations take the blocked ones' arguments.
+   procedure(dpbtrf) :: dpbtf2
+   procedure(dpotrf) :: dpotf2
+   !> Every eigenvalue of a symmetric tridiagonal matrix (ascending, in d): the tridiagonal
+   !> matrix given as dpttrf takes it (n, d, e, info).
+   procedure(dpttrf) :: dsterf
 
 end module fd_lapack
