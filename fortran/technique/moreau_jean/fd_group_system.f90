@@ -18,7 +18,6 @@ module fd_group_system
    private
 
    public :: group_system, gs_setup, gs_factor, gs_solve, gs_k_matvec, gs_k_absmatvec, gs_lowest_eigenvalue
-   public :: gs_bandwidth, gs_size
 
    !> Springs, masses and the factor of the reduced system of one sticking pattern.
    type :: group_system
@@ -269,20 +268,6 @@ contains
          if (a > 0 .and. b > 0 .and. a /= b) kb = max(kb, abs(a - b))
       end do
    end function reduced_bandwidth
-
-   !> Half-bandwidth of the factored reduced system.
-   pure integer function gs_bandwidth(gs)
-      type(group_system), intent(in) :: gs !! the system
-
-      gs_bandwidth = gs%kb
-   end function gs_bandwidth
-
-   !> Size of the factored reduced system.
-   pure integer function gs_size(gs)
-      type(group_system), intent(in) :: gs !! the system
-
-      gs_size = gs%nr
-   end function gs_size
 
    !> The error of a failed allocation for a band of n rows and half-bandwidth kb.
    subroutine no_memory(error, n, kb)
