@@ -11,7 +11,7 @@ module fd_stiffness
    private
 
    public :: has_general_stiffness, add_general_times, general_form, add_general_dense
-   public :: general_row_bound, influence_of, add_general_entry, stiffness_times, stiffness_form
+   public :: influence_of, add_general_entry, stiffness_times, stiffness_form
 
 contains
 
@@ -22,21 +22,17 @@ contains
       has = model%n_kx > 0
    end function has_general_stiffness
 
-   !> ku = ku + alpha K_x u.
-   pure subroutine add_general_times(model, u, ku, alpha)
+   !> ku = ku + K_x u.
+   pure subroutine add_general_times(model, u, ku)
       type(model_type), intent(in) :: model  !! the model
       real(dp), intent(in) :: u(:)           !! a vector over the DOFs
       real(dp), intent(inout) :: ku(:)       !! the vector added to
-      real(dp), intent(in), optional :: alpha !! factor (default 1)
-      real(dp) :: f
       integer :: e, i, j
 
-      f = 1.0_dp
-      if (present(alpha)) f = alpha
       do e = 1, model%n_kx
          i = model%kx_i(e); j = model%kx_j(e)
-         ku(i) = ku(i) + f*model%kx_v(e)*u(j)
-         if (i /= j) ku(j) = ku(j) + f*model%kx_v(e)*u(i)
+         ku(i) = ku(i) + model%kx_v(e)*u(j)
+         if (i /= j) ku(j) = ku(j) + model%kx_v(e)*u(i)
       end do
    end subroutine add_general_times
 
@@ -99,36 +95,18 @@ contains
       end do
    end function general_form
 
-   !> a = a + alpha K_x (a dense matrix over the DOFs).
-   pure subroutine add_general_dense(model, a, alpha)
+   !> a = a + K_x (a dense matrix over the DOFs).
+   pure subroutine add_general_dense(model, a)
       type(model_type), intent(in) :: model  !! the model
       real(dp), intent(inout) :: a(:, :)     !! matrix over the DOFs
-      real(dp), intent(in), optional :: alpha !! factor (default 1)
-      real(dp) :: f
       integer :: e, i, j
 
-      f = 1.0_dp
-      if (present(alpha)) f = alpha
       do e = 1, model%n_kx
          i = model%kx_i(e); j = model%kx_j(e)
-         a(i, j) = a(i, j) + f*model%kx_v(e)
-         if (i /= j) a(j, i) = a(j, i) + f*model%kx_v(e)
+         a(i, j) = a(i, j) + model%kx_v(e)
+         if (i /= j) a(j, i) = a(j, i) + model%kx_v(e)
       end do
    end subroutine add_general_dense
-
-   !> sum_j |K_x(i, j)| for every DOF i: the rows' bound of K_x (Gershgorin).
-   pure subroutine general_row_bound(model, row)
-      type(model_type), intent(in) :: model  !! the model
-      real(dp), intent(out) :: row(:)        !! (n_dof)
-      integer :: e, i, j
-
-      row = 0.0_dp
-      do e = 1, model%n_kx
-         i = model%kx_i(e); j = model%kx_j(e)
-         row(i) = row(i) + abs(model%kx_v(e))
-         if (i /= j) row(j) = row(j) + abs(model%kx_v(e))
-      end do
-   end subroutine general_row_bound
 
    !> r_i, the table motion's component along DOF i (1 when the model gives none).
    pure real(dp) function influence_of(model, i) result(r)
