@@ -157,26 +157,10 @@ contains
       if (present(a1)) ca1 = a1
       mode = spd_auto
       if (present(path)) mode = path
-      if (present(dashpot_i) .and. present(dashpot_j) .and. present(dashpot_c)) then
-         di = dashpot_i
-         dj = dashpot_j
-         dc = dashpot_c
-      else if (present(dashpot_i) .or. present(dashpot_j) .or. present(dashpot_c)) then
-         call fatal_error(error, "spd_setup: dashpot_i, dashpot_j and dashpot_c go together")
-         return
-      else
-         allocate (di(0), dj(0), dc(0))
-      end if
-      if (present(kx_i) .and. present(kx_j) .and. present(kx_v)) then
-         xi = kx_i
-         xj = kx_j
-         xv = kx_v
-      else if (present(kx_i) .or. present(kx_j) .or. present(kx_v)) then
-         call fatal_error(error, "spd_setup: kx_i, kx_j and kx_v go together")
-         return
-      else
-         allocate (xi(0), xj(0), xv(0))
-      end if
+      call optional_entries("dashpot_i, dashpot_j and dashpot_c", di, dj, dc, error, dashpot_i, dashpot_j, dashpot_c)
+      if (allocated(error)) return
+      call optional_entries("kx_i, kx_j and kx_v", xi, xj, xv, error, kx_i, kx_j, kx_v)
+      if (allocated(error)) return
       call check_entries(xi, xj, xv, n, error)
       if (allocated(error)) return
       call check_setup(mass, spring_i, spring_j, spring_k, dev_ptr, dev_dof, dev_coef, di, dj, dc, ca0, ca1, &
@@ -407,6 +391,27 @@ contains
       end if
       dst = src   ! every array already has its shape: nothing is allocated here
    end subroutine spd_copy
+
+   !> A list of entries (i, j, value) that spd_setup takes whole or not at all: its copy, or
+   !> an empty one when absent (names: the three arguments' names, for the message).
+   subroutine optional_entries(names, ei, ej, ev, error, pi, pj, pv)
+      character(len=*), intent(in) :: names
+      integer, allocatable, intent(out) :: ei(:), ej(:)
+      real(dp), allocatable, intent(out) :: ev(:)
+      type(error_type), allocatable, intent(out) :: error
+      integer, intent(in), optional :: pi(:), pj(:)
+      real(dp), intent(in), optional :: pv(:)
+
+      if (present(pi) .and. present(pj) .and. present(pv)) then
+         ei = pi
+         ej = pj
+         ev = pv
+      else if (present(pi) .or. present(pj) .or. present(pv)) then
+         call fatal_error(error, "spd_setup: "//names//" go together")
+      else
+         allocate (ei(0), ej(0), ev(0))
+      end if
+   end subroutine optional_entries
 
    !> Check the entries of K_x: rows and columns in 1..n with row <= column, finite values.
    subroutine check_entries(xi, xj, xv, n, error)

@@ -816,6 +816,12 @@ contains
       call pair_setup(sys, pb%mass, pb%si, pb%sj, pb%sk, pb%di, pb%dj, err, path=5)
       call expect(err, "path = 5", error)
       if (allocated(error)) return
+      call pair_setup(sys, pb%mass, pb%si, pb%sj, pb%sk, pb%di, pb%dj, err, dashpot_i=[1], dashpot_c=[1.0_dp])
+      call expect(err, "spd_setup: dashpot_i, dashpot_j and dashpot_c go together", error)
+      if (allocated(error)) return
+      call kx_alone(pb, err)
+      call expect(err, "spd_setup: kx_i, kx_j and kx_v go together", error)
+      if (allocated(error)) return
       do path = spd_dense, spd_banded
          call pair_setup(sys, pb%mass, pb%si, pb%sj, pb%sk, pb%di, pb%dj, err, path=path)
          call pass(err, error)
@@ -839,6 +845,12 @@ contains
          call spd_update_device(sys, 7, 1.0_dp, err)
          call expect(err, "device 7 is not in 1..6", error)
          if (allocated(error)) return
+         call spd_update_devices(sys, [1.0_dp], err)
+         call expect(err, "spd_update_devices: 1 device stiffnesses given for 6 devices", error)
+         if (allocated(error)) return
+         call spd_update_devices(sys, [0.0_dp, 0.0_dp, 0.0_dp, 0.0_dp, -2.0_dp, 0.0_dp], err)
+         call expect(err, "spd_update_devices: device 5 stiffness -2.0", error)
+         if (allocated(error)) return
       end do
       ! a free-floating structure without inertia is singular: said so, not solved
       pb%sj(1) = 2
@@ -854,6 +866,18 @@ contains
       call spd_solve(sys, x, err)
       call expect(err, "not factored", error)
    end subroutine test_errors
+
+   !> spd_setup given K_x's rows and values without its columns.
+   subroutine kx_alone(pb, err)
+      type(problem), intent(in) :: pb
+      type(lib_error), allocatable, intent(out) :: err
+      type(spd_system) :: sys
+      integer :: ptr(size(pb%di) + 1), dof(2*size(pb%di))
+      real(dp) :: coef(2*size(pb%di))
+
+      call pair_terms(pb%di, pb%dj, ptr, dof, coef)
+      call spd_setup(sys, pb%mass, pb%si, pb%sj, pb%sk, ptr, dof, coef, err, kx_i=[1], kx_v=[1.0_dp])
+   end subroutine kx_alone
 
    subroutine expect(err, text, error)
       type(lib_error), allocatable, intent(in) :: err
