@@ -674,13 +674,18 @@ contains
       integer :: i
 
       do i = 1, n
-         if (m(i, i) > 0.0_dp) then
-            work%dsc(i) = 1.0_dp/sqrt(m(i, i))
-         else
-            work%dsc(i) = 1.0_dp
-         end if
+         work%dsc(i) = unit_scale(m(i, i))
       end do
    end subroutine unit_scaling
+
+   !> 1/sqrt(M_ii) for a positive diagonal entry M_ii, else 1: the symmetric scaling D M D
+   !> that gives M a unit diagonal.
+   elemental real(dp) function unit_scale(mii) result(d)
+      real(dp), intent(in) :: mii
+
+      d = 1.0_dp
+      if (mii > 0.0_dp) d = 1.0_dp/sqrt(mii)
+   end function unit_scale
 
    !> Clip Lemke's z (work%zb) into the bounds, and polish it: solve the final pattern's
    !> system again on the original data; keep whichever has the smaller residual.
@@ -711,12 +716,7 @@ contains
             end if
          end if
       end if
-      info%residual = r1
-      if (r1 <= work%tol) then
-         info%status = lcp_solved
-      else
-         info%status = lcp_inaccurate
-      end if
+      call judge(r1, work%tol, lcp_inaccurate, info)
    end subroutine finish
 
    !> The z of one pattern (work%state): variables at a bound take it, the free ones solve
@@ -749,11 +749,7 @@ contains
       if (k == 0) return
       do a = 1, k
          i = work%idx(a)
-         if (m(i, i) > 0.0_dp) then
-            work%ds(a) = 1.0_dp/sqrt(m(i, i))
-         else
-            work%ds(a) = 1.0_dp
-         end if
+         work%ds(a) = unit_scale(m(i, i))
       end do
       do a = 1, k
          i = work%idx(a)
@@ -940,13 +936,24 @@ contains
          res = residual_core(m, q, z, w, box, work%blo(1:n), work%bhi(1:n))
       end do
       info%iterations = sweep
+      call judge(res, work%pgs_tol, lcp_not_converged, info)
+   end subroutine pgs_core
+
+   !> The residual of the returned z and the status it earns: lcp_solved within tol, else
+   !> the status given.
+   pure subroutine judge(res, tol, failed, info)
+      real(dp), intent(in) :: res
+      real(dp), intent(in) :: tol
+      integer, intent(in) :: failed
+      type(lcp_info), intent(inout) :: info
+
       info%residual = res
-      if (res <= work%pgs_tol) then
+      if (res <= tol) then
          info%status = lcp_solved
       else
-         info%status = lcp_not_converged
+         info%status = failed
       end if
-   end subroutine pgs_core
+   end subroutine judge
 
    !> w = M z + q.
    pure subroutine affine(m, z, q, w)
