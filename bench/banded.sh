@@ -12,7 +12,8 @@ set -euo pipefail
 cd "$(dirname "$0")/.."
 out=$(mktemp -d)
 trap 'rm -rf "$out"' EXIT
-src=(fortran/core/fd_kinds.f90 fortran/core/fd_error.f90 fortran/linalg/fd_lapack.f90 fortran/linalg/fd_rcm.f90
+src=(fortran/core/fd_kinds.f90 fortran/core/fd_error.f90 fortran/core/fd_textio.f90 fortran/model/fd_names.f90
+     fortran/model/fd_model.f90 fortran/model/fd_kinematics.f90 fortran/linalg/fd_lapack.f90 fortran/linalg/fd_rcm.f90
      fortran/linalg/fd_banded.f90 bench/bench_banded.f90)
 gfortran -O3 -frecursive -ffree-line-length-132 -J "$out" -o "$out/bench_banded" "${src[@]}" \
   $(pkg-config --libs lapack blas 2>/dev/null || echo -llapack -lblas)
