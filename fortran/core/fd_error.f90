@@ -5,6 +5,7 @@ module fd_error
    private
 
    public :: error_type, fatal_error, fmt_real, fmt_int, fmt_text, stat_no_memory, stat_output, echo_chars
+   public :: allocation_error
 
    !> The stat of an error raised because memory could not be had (an allocation the size
    !> of the input failed): the caller may tell it from a bad input.
@@ -37,6 +38,16 @@ contains
       error%message = message
       if (present(stat)) error%stat = stat
    end subroutine fatal_error
+
+   !> The error of an allocate statement whose stat is not 0: "not enough memory for " what,
+   !> with stat_no_memory; none (error not allocated) when stat is 0.
+   pure subroutine allocation_error(error, stat, what)
+      type(error_type), allocatable, intent(out) :: error !! set when stat /= 0
+      integer, intent(in) :: stat                        !! the allocate statement's stat
+      character(len=*), intent(in) :: what               !! what the memory was for
+
+      if (stat /= 0) call fatal_error(error, "not enough memory for "//what, stat_no_memory)
+   end subroutine allocation_error
 
    !> A real number as short text, for messages: the fewest significant digits that
    !> read back to the same value, in fixed notation when that is short.

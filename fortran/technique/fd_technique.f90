@@ -147,21 +147,15 @@ contains
       type(excitation_type), intent(in), optional :: exc3 !! the vertical component (bearings'
                                                           !! normal forces; Newmark and Moreau-Jean)
 
-      if (opts%technique == technique_event_driven .and. present(exc2)) then
-         if (exc2%kind /= excitation_none) then
-            call fatal_error(error, "group &excitation2: a second horizontal component is integrated by "// &
-                             "technique = 'newmark' or 'moreau_jean'; technique = '"// &
-                             trim(technique_name(opts%technique))//"' takes one component (&excitation)")
-            return
-         end if
+      if (opts%technique == technique_event_driven .and. given(exc2)) then
+         call stepping_only("excitation2: a second horizontal component", opts%technique, &
+                            "takes one component (&excitation)", error)
+         return
       end if
-      if (opts%technique == technique_event_driven .and. present(exc3)) then
-         if (exc3%kind /= excitation_none) then
-            call fatal_error(error, "group &excitation3: a vertical component (bearings' varying normal force) "// &
-                             "is integrated by technique = 'newmark' or 'moreau_jean'; technique = '"// &
-                             trim(technique_name(opts%technique))//"' holds each bearing's p constant")
-            return
-         end if
+      if (opts%technique == technique_event_driven .and. given(exc3)) then
+         call stepping_only("excitation3: a vertical component (bearings' varying normal force)", opts%technique, &
+                            "holds each bearing's p constant", error)
+         return
       end if
       if (opts%technique /= technique_newmark .and. opts%linear_system == linear_system_sparse) then
          call fatal_error(error, "group &integration: linear_system = 'sparse' (CHOLMOD) is Newmark's; technique = '"// &
@@ -169,9 +163,8 @@ contains
          return
       end if
       if (opts%technique == technique_event_driven .and. model%overturning) then
-         call fatal_error(error, "group &bearings: overturning = .true. (bearings' varying normal force) is "// &
-                          "integrated by technique = 'newmark' or 'moreau_jean'; technique = '"// &
-                          trim(technique_name(opts%technique))//"' holds each bearing's p constant")
+         call stepping_only("bearings: overturning = .true. (bearings' varying normal force)", opts%technique, &
+                            "holds each bearing's p constant", error)
          return
       end if
       select case (opts%technique)
@@ -190,6 +183,27 @@ contains
       if (.not. allocated(error)) call harmonic_resolution(model, opts%beta, opts%gamma, opts%theta, res, error)
       if (.not. allocated(error)) call record_resolution(model, exc, opts%beta, opts%gamma, opts%theta, res, error)
    end subroutine run_technique
+
+   !> Whether an optional table motion's component is given (present, and of a kind).
+   pure logical function given(exc)
+      type(excitation_type), intent(in), optional :: exc !! the component
+
+      given = present(exc)
+      if (given) given = exc%kind /= excitation_none
+   end function given
+
+   !> The error of an input that the time-stepping techniques integrate and this one does
+   !> not: "group &<what> is integrated by technique = 'newmark' or 'moreau_jean'; technique
+   !> = '<technique>' <instead>".
+   subroutine stepping_only(what, technique, instead, error)
+      character(len=*), intent(in) :: what          !! the group, its variable or component
+      integer, intent(in) :: technique              !! the technique chosen
+      character(len=*), intent(in) :: instead       !! what the technique does instead
+      type(error_type), allocatable, intent(out) :: error !! the error
+
+      call fatal_error(error, "group &"//what//" is integrated by technique = 'newmark' or 'moreau_jean'; "// &
+                       "technique = '"//trim(technique_name(technique))//"' "//instead)
+   end subroutine stepping_only
 
    subroutine unknown_technique(technique, error)
       integer, intent(in) :: technique

@@ -4,13 +4,16 @@
 !> (not counted), band and slide in turn at the band's edge (counted), an alternation of
 !> sliding forces or one broken by slides (not counted), and one below the floor; a bearing
 !> whose observed normal force falls below the deck's (alternation_normal_force) counts an
-!> alternation above 5 % of the smaller N mu.
+!> alternation above 5 % of the smaller N mu; band_x in closed form at the start, and again at
+!> the end only where a range grew (alternation_init, alternation_finish).
 module test_fd_band_alternation
    use testdrive, only: new_unittest, unittest_type, error_type, check
    use fd_kinds, only: dp
    use fd_device_state, only: device_state, phase_stick, phase_slip_pos, phase_slip_neg
    use fd_band_alternation, only: alternation_type, band_watch, alternation_step, alternation_floor, alternation_run, &
-                                  alternation_normal_force
+                                  alternation_normal_force, alternation_init, alternation_finish
+   use fd_error, only: fd_error_type => error_type
+   use test_fd_helpers, only: pairs_of
    use fd_model, only: model_type, device_type
    use fd_result, only: result_type
    implicit none
@@ -33,7 +36,8 @@ contains
                   new_unittest("slides alone, or slides between, break the count", test_broken), &
                   new_unittest("steps of two lengths: a line is not counted, +-A is", test_uneven), &
                   new_unittest("below the floor: not counted", test_floor), &
-                  new_unittest("a bearing's observed N: the floor at the smallest", test_observed_floor) &
+                  new_unittest("a bearing's observed N: the floor at the smallest", test_observed_floor), &
+                  new_unittest("band_x at the start, at the end where a range grew", test_band_x) &
                   ]
    end subroutine collect_band_alternation
 
@@ -276,5 +280,44 @@ contains
       end do
       call check(error, abs(a(1) - 0.8_dp*alternation_floor*pmu) <= 1e-12_dp*pmu, "counted at the smaller N")
    end subroutine test_observed_floor
+
+   !> One velocity-law device (P mu = 1000 N, eps = 1e-3 m/s) from a 10 kg mass to the table,
+   !> average acceleration at dt1 = 1e-3 s: band_x = (1 - gamma) dt1 P mu / (eps m) = 50 from
+   !> alternation_init; alternation_finish takes it again only where the N range grew (at its
+   !> largest N: 100 for twice the deck's p), and leaves it otherwise.
+   subroutine test_band_x(error)
+      type(error_type), allocatable, intent(out) :: error
+      type(model_type) :: model
+      type(result_type) :: res
+      type(alternation_type) :: al
+      type(fd_error_type), allocatable :: err
+      real(dp), parameter :: p = 1.0e4_dp, dt1 = 1.0e-3_dp, gamma = 0.5_dp
+
+      model%n_dof = 1
+      model%mass = [10.0_dp]
+      model%n_devices = 1
+      model%dev = [device_type(node_i=1, node_j=0, p=p, mu=pmu/p, eps=1.0e-3_dp)]
+      call pairs_of(model)
+      allocate (res%band_x(1))
+      res%band_x = 0.0_dp
+      call alternation_init(model, dt1, gamma, al, res, err)
+      call check(error, .not. allocated(err), "an error")
+      if (allocated(error)) return
+      call check(error, al%n == 1 .and. res%band_checked .and. .not. al%moved, "the device watched")
+      if (allocated(error)) return
+      call check(error, abs(res%band_x(1) - 50.0_dp) <= 1e-13_dp*50, "band_x at the deck's p")
+      if (allocated(error)) return
+      res%band_x = 0.0_dp
+      call alternation_finish(model, dt1, gamma, al, res, err)
+      call check(error, .not. allocated(err) .and. res%band_x(1) == 0.0_dp, "band_x taken again, no range grew")
+      if (allocated(error)) return
+      al%w(1)%nhi = 2*p
+      al%moved = .true.
+      call alternation_finish(model, dt1, gamma, al, res, err)
+      call check(error, .not. allocated(err) .and. abs(res%band_x(1) - 100.0_dp) <= 1e-13_dp*100, &
+                 "band_x at the largest N of a range that grew")
+      if (allocated(error)) return
+      call check(error, .not. al%moved, "the range's move taken")
+   end subroutine test_band_x
 
 end module test_fd_band_alternation

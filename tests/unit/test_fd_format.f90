@@ -1,9 +1,9 @@
 !> Unit tests of the number formatting used in every message (fd_error): the shortest
-!> text that reads back to the same value.
+!> text that reads back to the same value; and the error of a failed allocation.
 module test_fd_format
    use testdrive, only: new_unittest, unittest_type, error_type, check
    use fd_kinds, only: dp
-   use fd_error, only: fmt_real, fmt_int
+   use fd_error, only: fmt_real, fmt_int, fd_error_type => error_type, allocation_error, stat_no_memory
    implicit none
    private
 
@@ -18,7 +18,8 @@ contains
                   new_unittest("short values", test_short), &
                   new_unittest("round trip", test_round_trip), &
                   new_unittest("exponent form", test_exponent), &
-                  new_unittest("integers", test_int) &
+                  new_unittest("integers", test_int), &
+                  new_unittest("a failed allocation's error", test_allocation_error) &
                   ]
    end subroutine collect_format
 
@@ -94,5 +95,22 @@ contains
          if (p < 9) x = 10*x
       end do
    end subroutine same_as_write
+
+   !> A failed allocation (stat /= 0): "not enough memory for " and what it was for, with
+   !> stat_no_memory (the caller's OutOfMemoryError); stat 0: no error.
+   subroutine test_allocation_error(error)
+      type(error_type), allocatable, intent(out) :: error
+      type(fd_error_type), allocatable :: err
+
+      call allocation_error(err, 0, "the bands of 2 velocity-law devices")
+      call check(error, .not. allocated(err), "an error for stat 0")
+      if (allocated(error)) return
+      call allocation_error(err, 5014, "the bands of 2 velocity-law devices")
+      call check(error, allocated(err), "no error for stat 5014")
+      if (allocated(error)) return
+      call check(error, err%message, "not enough memory for the bands of 2 velocity-law devices")
+      if (allocated(error)) return
+      call check(error, err%stat == stat_no_memory, "the stat of a failed allocation")
+   end subroutine test_allocation_error
 
 end module test_fd_format

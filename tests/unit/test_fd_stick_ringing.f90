@@ -2,14 +2,18 @@
 !> newmark_frequency): the closed forms of the average and linear acceleration rules, the
 !> small-step damping of gamma > 1/2, and the frequency of the recursion itself, run step
 !> by step (an independent computation); a bearing's observed normal force beyond the deck's
-!> moves its sticking spring, its frequency error and its capacities (ringing_normal_force).
+!> moves its sticking spring, its frequency error and its capacities (ringing_normal_force);
+!> the devices watched of a model of node pairs are the same through the general model's
+!> directions (a K_x entry), each mode's damping in closed form (ringing_init).
 module test_fd_stick_ringing
    use testdrive, only: new_unittest, unittest_type, error_type, check
    use fd_kinds, only: dp
-   use fd_stick_ringing, only: newmark_frequency, ringing_type, ringing_normal_force
+   use fd_stick_ringing, only: newmark_frequency, ringing_type, ringing_normal_force, ringing_init
+   use fd_error, only: fd_error_type => error_type
    use fd_model, only: model_type, device_type
-   use fd_names, only: law_hysteretic
+   use fd_names, only: law_hysteretic, law_velocity
    use fd_result, only: result_type
+   use test_fd_helpers, only: pairs_of
    implicit none
    private
 
@@ -27,7 +31,8 @@ contains
                   new_unittest("linear acceleration: its cosine, unstable beyond sqrt(12)", test_linear), &
                   new_unittest("gamma > 1/2: damping (gamma - 1/2) w / 2 at small steps", test_damped), &
                   new_unittest("the frequency of the recursion run step by step", test_recursion), &
-                  new_unittest("a bearing's observed N: spring and error at the largest", test_observed_force) &
+                  new_unittest("a bearing's observed N: spring and error at the largest", test_observed_force), &
+                  new_unittest("node pairs and general directions: the same modes", test_general_modes) &
                   ]
    end subroutine collect_stick_ringing
 
@@ -181,5 +186,85 @@ contains
       if (allocated(error)) return
       call check(error, abs(rg%c_fixed(1)) <= 1e-12_dp, "no damping of average acceleration")
    end subroutine test_observed_force
+
+   !> Two masses (2 and 1 kg) on springs 800 (1 to the table) and 300 N/m (2 to 1), hysteretic
+   !> devices 1 (1 to the table, k = 2000 N/m) and 2 (2 to 1, k = 1000 N/m) and a velocity-law
+   !> device 3 (2 to 1): the devices watched, their modes' masses, frequencies, damping and
+   !> band devices are the same through the node pairs and through the general model's
+   !> directions (a K_x entry of 0 takes that path). The closed forms: device 1's mode is node 1
+   !> alone (m_r = 2, phi' K phi = 800 + 300), device 2's moves node 2 by 2/3 and node 1 by
+   !> -1/3 (m_r = 2/3, phi' K phi = 300 + 800 / 9); device 3 moves with both, (b_3' phi)^2 = 1.
+   subroutine test_general_modes(error)
+      type(error_type), allocatable, intent(out) :: error
+      type(model_type) :: model
+      type(result_type) :: res, res_g
+      type(ringing_type) :: rg, rg_g
+      type(fd_error_type), allocatable :: err
+      real(dp), parameter :: a0 = 0.3_dp, a1 = 2.0e-3_dp, dt1 = 0.01_dp, gamma = 0.6_dp
+      real(dp), parameter :: beta = 0.25_dp*(gamma + 0.5_dp)**2
+      real(dp), parameter :: mr(2) = [2.0_dp, 2.0_dp/3.0_dp], kk(2) = [2000.0_dp, 1000.0_dp]
+      real(dp), parameter :: ek(2) = [1100.0_dp, 300.0_dp + 800.0_dp/9.0_dp]
+      real(dp) :: omega, wt, zn
+      logical :: osc
+      integer :: q
+
+      model%n_dof = 2
+      model%mass = [2.0_dp, 1.0_dp]
+      model%n_springs = 2
+      model%spring_i = [1, 2]
+      model%spring_j = [0, 1]
+      model%spring_k = [800.0_dp, 300.0_dp]
+      model%n_devices = 3
+      model%dev = [device_type(node_i=1, node_j=0, law=law_hysteretic, p=10.0_dp, mu=0.2_dp, f=1.0e-3_dp), &
+                   device_type(node_i=2, node_j=1, law=law_hysteretic, p=5.0_dp, mu=0.2_dp, f=1.0e-3_dp), &
+                   device_type(node_i=2, node_j=1, law=law_velocity, p=5.0_dp, mu=0.2_dp)]
+      call pairs_of(model)
+      allocate (res%stick_freq_error(3), res_g%stick_freq_error(3))
+      res%stick_freq_error = 0.0_dp
+      res_g%stick_freq_error = 0.0_dp
+      call ringing_init(model, dt1, beta, gamma, a0, a1, rg, res, err)
+      call check(error, .not. allocated(err), "node pairs: an error")
+      if (allocated(error)) return
+      model%n_kx = 1
+      model%kx_i = [1]
+      model%kx_j = [1]
+      model%kx_v = [0.0_dp]
+      call ringing_init(model, dt1, beta, gamma, a0, a1, rg_g, res_g, err)
+      call check(error, .not. allocated(err), "general directions: an error")
+      if (allocated(error)) return
+      call check(error, rg%n == 2 .and. rg_g%n == 2 .and. all(rg%dev == [1, 2]) .and. all(rg_g%dev == [1, 2]), &
+                 "the devices with a sticking spring")
+      if (allocated(error)) return
+      call check(error, all(rg%first == [1, 2, 3]) .and. all(rg_g%first == [1, 2, 3]) .and. &
+                 all(rg%band_dev == [3, 3]) .and. all(rg_g%band_dev == [3, 3]), "device 3 moves with both modes")
+      if (allocated(error)) return
+      call check(error, all(abs(rg%band_shape - 1.0_dp) <= 1e-15_dp) .and. &
+                 all(abs(rg_g%band_shape - 1.0_dp) <= 1e-15_dp), "(b_3' phi)^2 = 1")
+      if (allocated(error)) return
+      do q = 1, 2
+         omega = sqrt(kk(q)/mr(q))
+         call newmark_frequency(omega*dt1, beta, gamma, wt, zn, osc)
+         call check(error, abs(rg%mr(q) - mr(q)) <= 1e-15_dp*mr(q) .and. abs(rg_g%mr(q) - mr(q)) <= 1e-15_dp*mr(q), &
+                    "the mode's mass")
+         if (allocated(error)) return
+         call check(error, abs(rg%omega(q) - omega) <= 1e-14_dp*omega .and. &
+                    abs(rg_g%omega(q) - omega) <= 1e-14_dp*omega, "the mode's frequency sqrt(k / m_r)")
+         if (allocated(error)) return
+         call check(error, abs(res%stick_freq_error(q) - (1 - wt/(omega*dt1))) <= 1e-12_dp .and. &
+                    abs(res_g%stick_freq_error(q) - res%stick_freq_error(q)) <= 1e-12_dp, "Newmark's error on it")
+         if (allocated(error)) return
+         call check(error, abs(rg%drift(q) - abs(res%stick_freq_error(q))*omega) <= 1e-12_dp*omega .and. &
+                    abs(rg_g%drift(q) - rg%drift(q)) <= 1e-12_dp*omega, "its drift")
+         if (allocated(error)) return
+         call check(error, abs(rg%c_fixed(q) - (a0*mr(q) + a1*ek(q) + 2*mr(q)*omega*zn)) <= 1e-12_dp*rg%c_fixed(q) &
+                    .and. abs(rg_g%c_fixed(q) - rg%c_fixed(q)) <= 1e-12_dp*rg%c_fixed(q), &
+                    "a0 m_r + a1 phi' K phi + Newmark's own 2 m_r omega zeta")
+         if (allocated(error)) return
+         call check(error, rg%pmu(q) == model%dev(q)%p*model%dev(q)%mu .and. rg_g%pmu(q) == rg%pmu(q) .and. &
+                    rg%pfloor(q) == rg%pmu(q) .and. rg_g%pfloor(q) == rg%pmu(q), "the capacities at the deck's p")
+         if (allocated(error)) return
+      end do
+      call check(error, res%stick_checked .and. res_g%stick_checked, "checked")
+   end subroutine test_general_modes
 
 end module test_fd_stick_ringing

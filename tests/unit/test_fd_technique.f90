@@ -10,7 +10,7 @@ module test_fd_technique
    use fd_model, only: model_type, device_type, integration_type, law_velocity, law_hysteretic, law_coulomb, &
                        technique_newmark, technique_event_driven, technique_moreau_jean, source_brace
    use fd_names, only: techniques, laws, rule_none, rule_newmark, rule_theta
-   use fd_excitation, only: excitation_type, excitation_harmonic
+   use fd_excitation, only: excitation_type, excitation_harmonic, excitation_none
    use fd_result, only: result_type
    use fd_device_state, only: device_state, phase_stick
    use fd_friction, only: friction_init
@@ -39,7 +39,8 @@ contains
                   new_unittest("traits of each technique", test_traits), &
                   new_unittest("the laws each technique integrates", test_integrates), &
                   new_unittest("a brace under an exact Coulomb technique", test_braces), &
-                  new_unittest("newmark: the refinement's limits", test_refinement_limits) &
+                  new_unittest("newmark: the refinement's limits", test_refinement_limits), &
+                  new_unittest("event_driven: a second or vertical component, overturning", test_stepping_only) &
                   ]
    end subroutine collect_technique
 
@@ -366,5 +367,46 @@ contains
       call check_technique(model, exc, opts, err)
       call check(error, .not. allocated(err), "newmark refuses a device of a general direction")
    end subroutine test_general_device
+
+   !> The exact event-driven technique refuses what the time-stepping techniques alone
+   !> integrate: a second horizontal component, a vertical one, the bearings' overturning;
+   !> each message names the group, the variable or component and what the technique does
+   !> instead. An absent or 'none' component is no refusal.
+   subroutine test_stepping_only(error)
+      type(error_type), allocatable, intent(out) :: error
+      type(model_type) :: model
+      type(excitation_type) :: exc, none
+      type(integration_type) :: opts
+      type(result_type) :: res
+      type(fd_error_type), allocatable :: err
+      character(len=*), parameter :: by = " is integrated by technique = 'newmark' or 'moreau_jean'; " // &
+                                           "technique = 'event_driven' "
+
+      call setup(law_coulomb, law_coulomb, model, exc)
+      opts%technique = technique_event_driven
+      none%kind = excitation_none
+      call run_technique(model, exc, opts, res, err, exc2=exc)
+      call check(error, allocated(err), "a second component taken")
+      if (allocated(error)) return
+      call check(error, err%message, "group &excitation2: a second horizontal component"//by// &
+                 "takes one component (&excitation)")
+      if (allocated(error)) return
+      call run_technique(model, exc, opts, res, err, exc2=none, exc3=exc)
+      call check(error, allocated(err), "a vertical component taken")
+      if (allocated(error)) return
+      call check(error, err%message, "group &excitation3: a vertical component (bearings' varying normal force)"// &
+                 by//"holds each bearing's p constant")
+      if (allocated(error)) return
+      model%overturning = .true.
+      call run_technique(model, exc, opts, res, err, exc2=none, exc3=none)
+      call check(error, allocated(err), "overturning taken")
+      if (allocated(error)) return
+      call check(error, err%message, "group &bearings: overturning = .true. (bearings' varying normal force)"// &
+                 by//"holds each bearing's p constant")
+      if (allocated(error)) return
+      model%overturning = .false.
+      call run_technique(model, exc, opts, res, err, exc2=none, exc3=none)
+      call check(error, .not. allocated(err), "components of kind 'none' refused")
+   end subroutine test_stepping_only
 
 end module test_fd_technique

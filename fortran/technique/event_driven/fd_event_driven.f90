@@ -132,9 +132,7 @@ contains
       type(error_type), allocatable, intent(out) :: error  !! a phase decision failed, not finite, stop
       type(run_control), intent(inout), target, optional :: ctl !! the run's control (fd_run_control)
       type(ed_work) :: w
-      real(dp) :: sv
-      integer :: c0, c1, crate, d, stat, nqt, n, nd
-      logical :: changed
+      integer :: c0, c1, crate, stat, nqt, n, nd
 
       call system_clock(c0, crate)
       call event_driven_check(model, exc, error)
@@ -155,7 +153,7 @@ contains
                           trim(fmt_int(nqt))//" output quantities")
          return
       end if
-      associate (st => w%st, t => w%t, h => w%h, t_end => w%t_end)
+      associate (st => w%st, h => w%h, t_end => w%t_end)
          call structure_matrices(model, st%k, st%c, res%exact%setup%period_stuck, res%exact%setup%xi_stuck, error)
          if (allocated(error)) return
          call observer_init(model, exc, opts, res%exact%setup%period_stuck, res, w%obs, error, ctl)
@@ -165,41 +163,7 @@ contains
          t_end = w%obs%nsteps*h
          res%exact%ran = .true.
          res%exact%intervals = w%obs%nsteps
-
-         ! the initial phases: a device moving at t = 0 slides its way, the others are
-         ! candidates for sticking, decided by the complementarity problems
-         st%u = model%u0
-         st%v = model%v0
-         t = 0.0_dp
-         do d = 1, st%nd
-            st%phase(d) = phase_stick
-            st%near(d) = .false.
-            st%crossed(d) = .false.
-            sv = device_relative(model, d, st%v)
-            if (st%active(d) .and. sv /= 0.0_dp) st%phase(d) = int(sign(1.0_dp, sv))
-         end do
-         st%cur = 0
-         call decide_phases(model, exc, t, st, changed, error)
-         if (allocated(error)) then
-            call with_context(w, error)
-            return
-         end if
-         call check_subintervals(w, error)
-         if (allocated(error)) then
-            call with_context(w, error)
-            return
-         end if
-         call observe_start(w%obs, st%mass, st%k, st%u, st%v, 0.0_dp, st%fn)
-         ! the first row: the state at t = 0
-         call ed_polynomials(model, exc, t, 0.0_dp, st)
-         call storey_polynomials(w, res)
-         call values_at(st, 0.0_dp, w%yv)
-         w%env = abs(w%yv)
-         call write_row(w, exc, res, t, 0.0_dp)
-         call update_global(w, res, 0.0_dp, t)
-         w%nrow = 1
-         w%s_row = next_row_time(w, w%nrow)
-         call advance_run(w, model, exc, res, error)
+         call start_and_advance(w, model, exc, res, error)
          if (allocated(error)) then
             call with_context(w, error)
             return
@@ -211,6 +175,59 @@ contains
       res%run_time = real(c1 - c0, dp)/real(max(crate, 1), dp)
    end subroutine run_event_driven
 
+   !> The run from t = 0 to its end: the initial phases decided, the first row (the state at
+   !> t = 0), and the loop over sub-intervals. An error is that of the instant w%t
+   !> (run_event_driven says which).
+   subroutine start_and_advance(w, model, exc, res, err)
+      type(ed_work), intent(inout) :: w
+      type(model_type), intent(in) :: model
+      type(excitation_type), intent(in) :: exc
+      type(result_type), intent(inout) :: res
+      type(error_type), allocatable, intent(out) :: err
+      logical :: changed
+
+      associate (st => w%st, t => w%t)
+         t = 0.0_dp
+         call initial_phases(model, st)
+         call decide_phases(model, exc, t, st, changed, err)
+         if (allocated(err)) return
+         call check_subintervals(w, err)
+         if (allocated(err)) return
+         call observe_start(w%obs, st%mass, st%k, st%u, st%v, 0.0_dp, st%fn)
+         ! the first row: the state at t = 0
+         call ed_polynomials(model, exc, t, 0.0_dp, st)
+         call storey_polynomials(w, res)
+         call values_at(st, 0.0_dp, w%yv)
+         w%env = abs(w%yv)
+         call write_row(w, exc, res, t, 0.0_dp)
+         call update_global(w, res, 0.0_dp, t)
+         w%nrow = 1
+         w%s_row = next_row_time(w, w%nrow)
+         call advance_run(w, model, exc, res, err)
+      end associate
+   end subroutine start_and_advance
+
+   !> The state at t = 0 (u0, v0) and its phases before the decision: a device moving slides
+   !> its way, the others are candidates for sticking (decided by the complementarity
+   !> problems); no pattern yet.
+   pure subroutine initial_phases(model, st)
+      type(model_type), intent(in) :: model         !! the model
+      type(ed_state), intent(inout) :: st           !! u, v, phase, near, crossed, cur set
+      real(dp) :: sv
+      integer :: d
+
+      st%u = model%u0
+      st%v = model%v0
+      do d = 1, st%nd
+         st%phase(d) = phase_stick
+         st%near(d) = .false.
+         st%crossed(d) = .false.
+         sv = device_relative(model, d, st%v)
+         if (st%active(d) .and. sv /= 0.0_dp) st%phase(d) = int(sign(1.0_dp, sv))
+      end do
+      st%cur = 0
+   end subroutine initial_phases
+
    !> Time of history row nrow (dt1 step every*nrow, the last row at nsteps).
    real(dp) function next_row_time(w, k) result(tr)
       type(ed_work), intent(in) :: w
@@ -218,6 +235,8 @@ contains
       tr = min(k*w%obs%every, w%obs%nsteps)*w%h
    end function next_row_time
 
+   !> The context of an error of the run, said once: the technique and the instant w%t (the
+   !> loop's own messages leave it to this); a cancel is left as it is.
    subroutine with_context(w, err)
       type(ed_work), intent(in) :: w
       type(error_type), intent(inout) :: err
@@ -622,8 +641,7 @@ contains
          oldest = mod(w%ring_pos, ring_size) + 1
          if (t - w%ring(oldest) <= accumulation_span*max(1.0_dp, abs(t))) then
             if (t - w%last_accumulation <= accumulation_span*max(1.0_dp, abs(t))) then
-               call fatal_error(err, "event-driven technique at t = "//trim(fmt_real(t))//" s: events "// &
-                                "accumulate again where sticking at the limit of the sequence should have "// &
+               call fatal_error(err, "events accumulate again where sticking at the limit of the sequence should have "// &
                                 "ended them; try technique = 'newmark' with law = 'velocity', or report the deck")
                return
             end if
@@ -654,8 +672,7 @@ contains
          else
             list = ""
          end if
-         call fatal_error(err, "event-driven technique at t = "//trim(fmt_real(t))//" s: "// &
-                          trim(fmt_int(max_burst))//" events within "// &
+         call fatal_error(err, trim(fmt_int(max_burst))//" events within "// &
                           trim(fmt_real(t - w%burst_t0))//" s"//list//", the same instant decided again "// &
                           "and again (the time does not advance); try technique = 'moreau_jean', or "// &
                           "technique = 'newmark' with law = 'velocity', or report the deck")
@@ -702,8 +719,7 @@ contains
          end associate
          if (nbad > 0) then
             call device_list(st%cand, nbad, list)
-            call fatal_error(err, "event-driven technique at t = "//trim(fmt_real(t))//" s: "// &
-                             trim(fmt_int(ring_size))//" phase changes within "// &
+            call fatal_error(err, trim(fmt_int(ring_size))//" phase changes within "// &
                              trim(fmt_real(accumulation_span*max(1.0_dp, abs(t))))//" s, and sticking at their "// &
                              "limit would need forces above P mu in "//list//"; try technique = "// &
                              "'newmark' with law = 'velocity', or report the deck")

@@ -401,8 +401,10 @@ contains
    end subroutine no_memory
 
    !> Enter a pattern at a state (u, v): the reduced state (q: the mass-weighted mean of
-   !> each group), the offsets uc, v projected on the constraints, the constant load b1 and
-   !> the constant term f0 of the force map. Work fn (n) is overwritten.
+   !> each group; a general pattern's q = T'M u, p = T'M v), the offsets uc = u - T q, v
+   !> projected on the constraints (v = T p), the constant load b1 of the reduced system
+   !> (T' fn, over each group's mass for groups) and the constant term f0 = pinv (fn - M T b1)
+   !> of the force map, fn = -K uc - sum_slide b sgn P mu. Work fn (n) is overwritten.
    pure subroutine pattern_entry(pat, model, mass, k, phase, slip, u, v, q, p, uc, b1, f0, fn)
       type(pattern_type), intent(in) :: pat         !! the pattern
       type(model_type), intent(in) :: model         !! the model (device nodes)
@@ -417,60 +419,80 @@ contains
       real(dp), intent(out) :: b1(:)                !! constant load of the reduced system (nq used)
       real(dp), intent(out) :: f0(:)                !! constant term of the force map (ns used)
       real(dp), intent(inout) :: fn(:)              !! work (n)
-      integer :: i, j, g, n, d
+      integer :: i, j, g, n, d, nq
 
       n = size(mass)
-      q(1:pat%nq) = 0.0_dp
-      p(1:pat%nq) = 0.0_dp
+      nq = pat%nq
+      q(1:nq) = 0.0_dp
+      p(1:nq) = 0.0_dp
       if (pat%general) then
-         call general_entry(pat, model, mass, k, phase, slip, u, v, q, p, uc, b1, f0, fn)
-         return
-      end if
-      do i = 1, n
-         g = pat%grp(i)
-         if (g == 0) cycle
-         q(g) = q(g) + mass(i)*u(i)
-         p(g) = p(g) + mass(i)*v(i)
-      end do
-      do g = 1, pat%nq
-         q(g) = q(g)/pat%mq(g)
-         p(g) = p(g)/pat%mq(g)
-      end do
-      do i = 1, n
-         g = pat%grp(i)
-         if (g == 0) then
-            uc(i) = u(i)
-            v(i) = 0.0_dp
-         else
-            uc(i) = u(i) - q(g)
-            v(i) = p(g)
-         end if
-      end do
-      ! fn = -K uc - sum_slide b sgn P mu
-      fn = 0.0_dp
-      do j = 1, n
-         if (uc(j) == 0.0_dp) cycle
-         do i = 1, n
-            fn(i) = fn(i) - k(i, j)*uc(j)
+         do g = 1, nq
+            q(g) = sum(pat%tm(:, g)*mass*u)
+            p(g) = sum(pat%tm(:, g)*mass*v)
          end do
-      end do
+         uc = u
+         v = 0.0_dp
+         do g = 1, nq
+            uc = uc - pat%tm(:, g)*q(g)
+            v = v + pat%tm(:, g)*p(g)
+         end do
+         fn = -matmul(k, uc)
+      else
+         do i = 1, n
+            g = pat%grp(i)
+            if (g == 0) cycle
+            q(g) = q(g) + mass(i)*u(i)
+            p(g) = p(g) + mass(i)*v(i)
+         end do
+         do g = 1, nq
+            q(g) = q(g)/pat%mq(g)
+            p(g) = p(g)/pat%mq(g)
+         end do
+         do i = 1, n
+            g = pat%grp(i)
+            if (g == 0) then
+               uc(i) = u(i)
+               v(i) = 0.0_dp
+            else
+               uc(i) = u(i) - q(g)
+               v(i) = p(g)
+            end if
+         end do
+         ! fn = -K uc
+         fn = 0.0_dp
+         do j = 1, n
+            if (uc(j) == 0.0_dp) cycle
+            do i = 1, n
+               fn(i) = fn(i) - k(i, j)*uc(j)
+            end do
+         end do
+      end if
+      ! the sliding devices' loads
       do d = 1, size(phase)
          if (phase(d) == phase_stick .or. slip(d) <= 0.0_dp) cycle
          call add_device(model, d, -phase(d)*slip(d), fn)
       end do
-      b1(1:pat%nq) = 0.0_dp
-      do i = 1, n
-         g = pat%grp(i)
-         if (g > 0) b1(g) = b1(g) + fn(i)
-      end do
-      do g = 1, pat%nq
-         b1(g) = b1(g)/pat%mq(g)
-      end do
-      ! f0 = pinv (fn - M T b1)
-      do i = 1, n
-         g = pat%grp(i)
-         if (g > 0) fn(i) = fn(i) - mass(i)*b1(g)
-      end do
+      if (pat%general) then
+         do g = 1, nq
+            b1(g) = sum(pat%tm(:, g)*fn)
+         end do
+         do g = 1, nq
+            fn = fn - mass*pat%tm(:, g)*b1(g)
+         end do
+      else
+         b1(1:nq) = 0.0_dp
+         do i = 1, n
+            g = pat%grp(i)
+            if (g > 0) b1(g) = b1(g) + fn(i)
+         end do
+         do g = 1, nq
+            b1(g) = b1(g)/pat%mq(g)
+         end do
+         do i = 1, n
+            g = pat%grp(i)
+            if (g > 0) fn(i) = fn(i) - mass(i)*b1(g)
+         end do
+      end if
       call pinv_times(pat, fn, f0)
    end subroutine pattern_entry
 
@@ -717,49 +739,6 @@ contains
          pat%wf(r) = sum(abs(pat%fq(r, :))*pat%wq) + sum(abs(pat%fp(r, :))*pat%wp)
       end do
    end subroutine general_force_map
-
-   !> pattern_entry of a general pattern: q = T'M u, p = T'M v, uc = u - T q, v = T p,
-   !> b1 = T'(-K uc - sum_slide b sgn P mu), f0 = pinv (fn - M T b1).
-   pure subroutine general_entry(pat, model, mass, k, phase, slip, u, v, q, p, uc, b1, f0, fn)
-      type(pattern_type), intent(in) :: pat         !! the pattern
-      type(model_type), intent(in) :: model         !! the model
-      real(dp), intent(in) :: mass(:), k(:, :)      !! structure
-      integer, intent(in) :: phase(:)               !! the pattern's phases
-      real(dp), intent(in) :: slip(:)               !! P mu
-      real(dp), intent(in) :: u(:)                  !! displacements
-      real(dp), intent(inout) :: v(:)               !! velocities, projected on return
-      real(dp), intent(out) :: q(:), p(:)           !! reduced state (nq used)
-      real(dp), intent(out) :: uc(:)                !! offsets (n)
-      real(dp), intent(out) :: b1(:)                !! constant load (nq used)
-      real(dp), intent(out) :: f0(:)                !! force map's constant (ns used)
-      real(dp), intent(inout) :: fn(:)              !! work (n)
-      integer :: g, n, d, nq
-
-      n = size(mass)
-      nq = pat%nq
-      do g = 1, nq
-         q(g) = sum(pat%tm(:, g)*mass*u)
-         p(g) = sum(pat%tm(:, g)*mass*v)
-      end do
-      uc = u
-      v = 0.0_dp
-      do g = 1, nq
-         uc = uc - pat%tm(:, g)*q(g)
-         v = v + pat%tm(:, g)*p(g)
-      end do
-      fn = -matmul(k, uc)
-      do d = 1, size(phase)
-         if (phase(d) == phase_stick .or. slip(d) <= 0.0_dp) cycle
-         call add_device(model, d, -phase(d)*slip(d), fn)
-      end do
-      do g = 1, nq
-         b1(g) = sum(pat%tm(:, g)*fn)
-      end do
-      do g = 1, nq
-         fn = fn - mass*pat%tm(:, g)*b1(g)
-      end do
-      call pinv_times(pat, fn, f0)
-   end subroutine general_entry
 
    !> f0 = pinv fn: the sticking devices' forces of a net load on the pattern's DOFs.
    pure subroutine pinv_times(pat, fn, f0)

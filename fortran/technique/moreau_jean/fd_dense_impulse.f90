@@ -29,7 +29,7 @@
 !> in the acceleration problem. A model without bearings keeps Lemke's method.
 module fd_dense_impulse
    use fd_kinds, only: dp
-   use fd_error, only: error_type, fatal_error, fmt_int, fmt_real, stat_no_memory
+   use fd_error, only: error_type, fatal_error, fmt_int, fmt_real, allocation_error
    use fd_model, only: model_type
    use fd_kinematics, only: add_device, device_coupling
    use fd_matrices, only: stiffness_matrix
@@ -113,73 +113,24 @@ contains
       type(model_type), intent(in) :: model         !! the model
       type(error_type), allocatable, intent(out) :: error !! not enough memory
       logical, intent(in), optional :: banded       !! the banded form (default: dense)
-      integer :: n, nd, d, e, stat
+      integer :: n, nd, d, stat
 
       if (present(banded)) di%banded = banded
+      n = model%n_dof
+      nd = model%n_devices
+      di%n = n
+      di%nd = nd
+      allocate (di%mass(n), di%a(nd, nd), di%am(nd, nd), di%x(n), di%q(nd), di%lo(nd), di%hi(nd), di%zz(nd), &
+                di%ww(nd), di%sub(nd, nd), di%idx(nd), di%partner(nd), di%psub(nd), di%pos(nd), di%lam0(nd), &
+                di%f0(nd), di%gsub(nd), stat=stat)
+      call allocation_error(error, stat, trim(system_text(di)))
+      if (stat /= 0) return
+      di%mass = model%mass
       if (di%banded) then
-         call banded_setup(di, model, error)
-         return
+         call banded_matrices(di, model, error)
+      else
+         call dense_matrices(di, model, error)
       end if
-      n = model%n_dof
-      nd = model%n_devices
-      di%n = n
-      di%nd = nd
-      allocate (di%mass(n), di%k(n, n), di%b(n, nd), di%wf(n, n), di%z(n, nd), di%a(nd, nd), di%am(nd, nd), &
-                di%x(n), di%q(nd), di%lo(nd), di%hi(nd), di%zz(nd), di%ww(nd), di%sub(nd, nd), di%idx(nd), &
-                di%partner(nd), di%psub(nd), di%pos(nd), di%lam0(nd), di%f0(nd), di%gsub(nd), stat=stat)
-      if (stat /= 0) then
-         call fatal_error(error, "not enough memory for the dense Moreau-Jean system of "//trim(fmt_int(n))// &
-                          " DOFs and "//trim(fmt_int(nd))//" devices", stat_no_memory)
-         return
-      end if
-      di%mass = model%mass
-      call stiffness_matrix(model, di%k)
-      di%b = 0.0_dp
-      do d = 1, nd
-         call add_device(model, d, 1.0_dp, di%b(:, d))
-         di%partner(d) = model%dev(d)%partner
-      end do
-      di%planar = any(di%partner > 0)
-      di%lam0 = 0.0_dp
-      di%f0 = 0.0_dp
-      do e = 1, nd
-         do d = 1, nd
-            di%am(d, e) = sum(di%b(:, d)*di%b(:, e)/di%mass)
-         end do
-      end do
-      if (nd > 0) call lcp_init(di%lcp, nd, nd, error)
-   end subroutine dense_setup
-
-   !> dense_setup's banded form: K (springs and K_x) in fd_banded's band storage, ordered by
-   !> reverse Cuthill-McKee over its own graph (the devices do not enter W), the directions'
-   !> sparse terms, A_M from them.
-   subroutine banded_setup(di, model, error)
-      type(dense_impulse), intent(inout) :: di      !! the solver (banded set)
-      type(model_type), intent(in) :: model         !! the model
-      type(error_type), allocatable, intent(out) :: error !! not enough memory
-      integer, allocatable :: none(:)
-      real(dp), allocatable :: no_coef(:)
-      integer :: n, nd, d, e, stat
-
-      n = model%n_dof
-      nd = model%n_devices
-      di%n = n
-      di%nd = nd
-      allocate (di%mass(n), di%a(nd, nd), di%am(nd, nd), di%x(n), di%y(n), di%q(nd), di%lo(nd), di%hi(nd), &
-                di%zz(nd), di%ww(nd), di%sub(nd, nd), di%idx(nd), di%partner(nd), di%psub(nd), di%pos(nd), &
-                di%lam0(nd), di%f0(nd), di%gsub(nd), di%bptr(nd + 1), di%bdof(model%dev_ptr(nd + 1) - 1), &
-                di%bcoef(model%dev_ptr(nd + 1) - 1), none(0), no_coef(0), stat=stat)
-      if (stat /= 0) then
-         call fatal_error(error, "not enough memory for the banded Moreau-Jean system of "//trim(fmt_int(n))// &
-                          " DOFs and "//trim(fmt_int(nd))//" devices", stat_no_memory)
-         return
-      end if
-      di%mass = model%mass
-      di%bptr = model%dev_ptr(1:nd + 1)
-      di%bdof = model%dev_dof(1:size(di%bdof))
-      di%bcoef = model%dev_coef(1:size(di%bcoef))
-      call spd_setup(di%sys, model%mass, model%spring_i, model%spring_j, model%spring_k, [1], none, no_coef, &
-                     error, path=spd_banded, kx_i=model%kx_i, kx_j=model%kx_j, kx_v=model%kx_v)
       if (allocated(error)) return
       do d = 1, nd
          di%partner(d) = model%dev(d)%partner
@@ -187,13 +138,71 @@ contains
       di%planar = any(di%partner > 0)
       di%lam0 = 0.0_dp
       di%f0 = 0.0_dp
+      if (nd > 0) call lcp_init(di%lcp, nd, nd, error)
+   end subroutine dense_setup
+
+   !> What the solver's system is, in the message of a failed allocation.
+   pure function system_text(di) result(text)
+      type(dense_impulse), intent(in) :: di         !! the solver (n, nd and the form set)
+      character(len=96) :: text
+
+      text = "the "//trim(merge("banded", "dense ", di%banded))//" Moreau-Jean system of "//trim(fmt_int(di%n))// &
+             " DOFs and "//trim(fmt_int(di%nd))//" devices"
+   end function system_text
+
+   !> dense_setup's dense form: K (springs and K_x), the directions B as columns, A_M from
+   !> them over the DOFs.
+   subroutine dense_matrices(di, model, error)
+      type(dense_impulse), intent(inout) :: di      !! the solver (dense, mass set)
+      type(model_type), intent(in) :: model         !! the model
+      type(error_type), allocatable, intent(out) :: error !! not enough memory
+      integer :: n, nd, d, e, stat
+
+      n = di%n
+      nd = di%nd
+      allocate (di%k(n, n), di%b(n, nd), di%wf(n, n), di%z(n, nd), stat=stat)
+      call allocation_error(error, stat, trim(system_text(di)))
+      if (stat /= 0) return
+      call stiffness_matrix(model, di%k)
+      di%b = 0.0_dp
+      do d = 1, nd
+         call add_device(model, d, 1.0_dp, di%b(:, d))
+      end do
+      do e = 1, nd
+         do d = 1, nd
+            di%am(d, e) = sum(di%b(:, d)*di%b(:, e)/di%mass)
+         end do
+      end do
+   end subroutine dense_matrices
+
+   !> dense_setup's banded form: K (springs and K_x) in fd_banded's band storage, ordered by
+   !> reverse Cuthill-McKee over its own graph (the devices do not enter W), the directions'
+   !> sparse terms, A_M from them.
+   subroutine banded_matrices(di, model, error)
+      type(dense_impulse), intent(inout) :: di      !! the solver (banded, mass set)
+      type(model_type), intent(in) :: model         !! the model
+      type(error_type), allocatable, intent(out) :: error !! not enough memory
+      integer, allocatable :: none(:)
+      real(dp), allocatable :: no_coef(:)
+      integer :: nd, d, e, stat
+
+      nd = di%nd
+      allocate (di%y(di%n), di%bptr(nd + 1), di%bdof(model%dev_ptr(nd + 1) - 1), &
+                di%bcoef(model%dev_ptr(nd + 1) - 1), none(0), no_coef(0), stat=stat)
+      call allocation_error(error, stat, trim(system_text(di)))
+      if (stat /= 0) return
+      di%bptr = model%dev_ptr(1:nd + 1)
+      di%bdof = model%dev_dof(1:size(di%bdof))
+      di%bcoef = model%dev_coef(1:size(di%bcoef))
+      call spd_setup(di%sys, model%mass, model%spring_i, model%spring_j, model%spring_k, [1], none, no_coef, &
+                     error, path=spd_banded, kx_i=model%kx_i, kx_j=model%kx_j, kx_v=model%kx_v)
+      if (allocated(error)) return
       do e = 1, nd
          do d = 1, nd
             di%am(d, e) = device_coupling(model, d, e)
          end do
       end do
-      if (nd > 0) call lcp_init(di%lcp, nd, nd, error)
-   end subroutine banded_setup
+   end subroutine banded_matrices
 
    !> b_d' x.
    pure real(dp) function b_dot(di, d, x) result(s)

@@ -45,7 +45,7 @@
 !> band, see fd_group_system; never for a chain).
 module fd_impulse_solver
    use fd_kinds, only: dp
-   use fd_error, only: error_type, fatal_error, fmt_int, stat_no_memory
+   use fd_error, only: error_type, fatal_error, fmt_int, allocation_error
    use fd_rcm, only: rcm_order, graph_bandwidth
    use fd_stick_groups, only: edge_set, edges_setup, groups_build, recover_impulses, expand, restrict, &
                               add_edge, edge_relative
@@ -123,10 +123,8 @@ contains
       p%ne = ne
       ! the nodes in RCM order of the graph of springs and edges: groups numbered in it
       allocate (p%node_order(n), inv(n), stat=stat)
-      if (stat /= 0) then
-         call no_memory(error, n)
-         return
-      end if
+      call allocation_error(error, stat, "the Moreau-Jean solver of n_dof = "//trim(fmt_int(n))//" DOFs")
+      if (stat /= 0) return
       ei = [si, p%es%ei]
       ej = [sj, p%es%ej]
       call rcm_order(n, ei, ej, p%node_order)
@@ -140,10 +138,8 @@ contains
                 p%stuck(ne), p%changed(ne), p%viol(ne), p%doubt(ne), p%dlist(ne), &
                 p%f(n), p%q(n), p%rho(0:n), p%sc(0:n), p%lsc(ne), p%col(n), p%rabs(n), &
                 p%lam_prev(ne), p%w_prev(ne), p%sa(ne), p%fa(ne), p%amax(ne), p%queue(ne), p%wt(ne), stat=stat)
-      if (stat /= 0) then
-         call no_memory(error, n)
-         return
-      end if
+      call allocation_error(error, stat, "the Moreau-Jean solver of n_dof = "//trim(fmt_int(n))//" DOFs")
+      if (stat /= 0) return
       do i = 1, ne
          p%amax(i) = 1.0_dp/mass(p%es%ei(i))
          if (p%es%ej(i) > 0) p%amax(i) = p%amax(i) + 1.0_dp/mass(p%es%ej(i))
@@ -164,16 +160,8 @@ contains
       end if
       allocate (p%amat(p%pmax, p%pmax), p%qv(p%pmax), p%lo(p%pmax), p%hi(p%pmax), p%z(p%pmax), p%wz(p%pmax), &
                 stat=stat)
-      if (stat /= 0) call no_memory(error, n)
+      call allocation_error(error, stat, "the Moreau-Jean solver of n_dof = "//trim(fmt_int(n))//" DOFs")
    end subroutine solver_setup
-
-   !> The error of a failed allocation of the solver's work space.
-   subroutine no_memory(error, n)
-      type(error_type), allocatable, intent(out) :: error !! set: stat_no_memory
-      integer, intent(in) :: n                            !! number of DOFs
-      call fatal_error(error, "not enough memory for the Moreau-Jean solver of n_dof = "//trim(fmt_int(n))// &
-                       " DOFs", stat_no_memory)
-   end subroutine no_memory
 
    !> Solve the one-step problem W v1 = r - B lambda with the complementarity conditions
    !> (module header), from the pattern in p%sigma (the previous solution: warm start). On

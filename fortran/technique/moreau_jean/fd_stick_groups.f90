@@ -27,7 +27,7 @@
 !> Only `edges_setup` allocates.
 module fd_stick_groups
    use fd_kinds, only: dp
-   use fd_error, only: error_type, fatal_error, fmt_int, stat_no_memory
+   use fd_error, only: error_type, fatal_error, fmt_int, allocation_error
    implicit none
    private
 
@@ -72,10 +72,8 @@ contains
       es%n = n
       allocate (es%dev_edge(nd), es%dev_sign(nd), es%dev_share(nd), es%ei(nd), es%ej(nd), es%pmu(nd), &
                 head(0:n), next(nd), stat=stat)
-      if (stat /= 0) then
-         call no_memory(error, n)
-         return
-      end if
+      call allocation_error(error, stat, "the friction edges of n_dof = "//trim(fmt_int(n))//" DOFs")
+      if (stat /= 0) return
       es%dev_edge = 0
       es%dev_sign = 1
       es%dev_share = 0.0_dp
@@ -120,10 +118,8 @@ contains
       es%pmu = es%pmu(1:es%ne)
       ! incidence over nodes 0..n
       allocate (es%start(0:n + 1), fill(0:n), es%inc(2*es%ne), stat=stat)
-      if (stat /= 0) then
-         call no_memory(error, n)
-         return
-      end if
+      call allocation_error(error, stat, "the friction edges of n_dof = "//trim(fmt_int(n))//" DOFs")
+      if (stat /= 0) return
       es%start = 0
       do e = 1, es%ne
          es%start(es%ei(e)) = es%start(es%ei(e)) + 1
@@ -144,24 +140,14 @@ contains
          fill(es%ej(e)) = fill(es%ej(e)) + 1
       end do
       allocate (es%grp(0:n), es%order(n + 1), es%parent(0:n), es%tree(es%ne), es%loops(0:n), stat=stat)
-      if (stat /= 0) then
-         call no_memory(error, n)
-         return
-      end if
+      call allocation_error(error, stat, "the friction edges of n_dof = "//trim(fmt_int(n))//" DOFs")
+      if (stat /= 0) return
       es%grp = 0
       es%order = 0
       es%parent = 0
       es%tree = .false.
       es%loops = .false.
    end subroutine edges_setup
-
-   !> The error of a failed allocation for the edges of n nodes.
-   subroutine no_memory(error, n)
-      type(error_type), allocatable, intent(out) :: error !! set: stat_no_memory
-      integer, intent(in) :: n                            !! number of DOFs
-      call fatal_error(error, "not enough memory for the friction edges of n_dof = "//trim(fmt_int(n))// &
-                       " DOFs", stat_no_memory)
-   end subroutine no_memory
 
    !> Groups of the nodes joined by the sticking edges, numbered 1..nr by their first node
    !> in node_order (0: the table's group), with a spanning forest for recover_impulses.

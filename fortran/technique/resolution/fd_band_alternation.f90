@@ -52,7 +52,7 @@
 !> alternation_finish at the end of the run (band_x at the run's largest N).
 module fd_band_alternation
    use fd_kinds, only: dp
-   use fd_error, only: error_type, fatal_error, fmt_int, stat_no_memory
+   use fd_error, only: error_type, fmt_int, allocation_error
    use fd_model, only: model_type, device_type, sliding_mu
    use fd_kinematics, only: add_device_abs, device_abs_inverse_mass_relative
    use fd_friction, only: holds_when_stuck, law_checks_band_alternation
@@ -93,6 +93,7 @@ module fd_band_alternation
       integer :: n = 0                        !! devices watched: velocity law, P mu(eps) > 0
       type(band_watch), allocatable :: w(:)   !! each of them
       logical :: moved = .false.              !! a range grew beyond the one band_x was taken at
+                                              !! (or band_x not yet taken)
    end type alternation_type
 
 contains
@@ -120,11 +121,8 @@ contains
       res%band_checked = .false.
       al%n = count(watched(model%dev(1:model%n_devices)))
       allocate (al%w(al%n), bof(model%n_devices), stat=stat)
-      if (stat /= 0) then
-         call fatal_error(error, "not enough memory for the bands of "//trim(fmt_int(al%n))// &
-                          " velocity-law devices", stat_no_memory)
-         return
-      end if
+      call allocation_error(error, stat, "the bands of "//trim(fmt_int(al%n))//" velocity-law devices")
+      if (stat /= 0) return
       call device_bearings(res, bof)
       q = 0
       do d = 1, model%n_devices
@@ -140,29 +138,30 @@ contains
             al%w(q)%floor4 = 4.0_dp*alternation_floor*pfloor
          end associate
       end do
-      call band_figures(model, dt1, gamma, al, res, error)
+      al%moved = .true.
+      call alternation_finish(model, dt1, gamma, al, res, error)
       res%band_checked = al%n > 0
    end subroutine alternation_init
 
    !> Every watched device's x at dt1 (res%band_x), each velocity-law device's band coupling
-   !> at the largest N of its range.
-   subroutine band_figures(model, dt1, gamma, al, res, error)
+   !> at the largest N of its range, where the ranges moved since it was last taken (al%moved:
+   !> from alternation_init, and at the end of the run where a bearing's N range grew during it);
+   !> nothing otherwise.
+   subroutine alternation_finish(model, dt1, gamma, al, res, error)
       type(model_type), intent(in) :: model         !! the model
       real(dp), intent(in) :: dt1                   !! main step [s]
       real(dp), intent(in) :: gamma                 !! Newmark's gamma
-      type(alternation_type), intent(in) :: al      !! the devices watched
+      type(alternation_type), intent(inout) :: al   !! the devices watched; moved cleared
       type(result_type), intent(inout) :: res       !! band_x
       type(error_type), allocatable, intent(out) :: error !! not enough memory
       real(dp), allocatable :: c(:)
       integer :: d, q, stat
       real(dp) :: pmu, pfloor, scale
 
+      if (.not. al%moved) return
       allocate (c(model%n_dof), stat=stat)
-      if (stat /= 0) then
-         call fatal_error(error, "not enough memory for the bands of "//trim(fmt_int(al%n))// &
-                          " velocity-law devices", stat_no_memory)
-         return
-      end if
+      call allocation_error(error, stat, "the bands of "//trim(fmt_int(al%n))//" velocity-law devices")
+      if (stat /= 0) return
       c = 0.0_dp
       do q = 1, al%n
          d = al%w(q)%dev
@@ -173,7 +172,8 @@ contains
       do q = 1, al%n
          res%band_x(al%w(q)%dev) = device_abs_inverse_mass_relative(model, al%w(q)%dev, c, scale)
       end do
-   end subroutine band_figures
+      al%moved = .false.
+   end subroutine alternation_finish
 
    !> P mu(eps) of a watched device's band dashpot and of its count's floor at its N range
    !> (the deck's p when the range is one value).
@@ -212,19 +212,6 @@ contains
          al%moved = .true.
       end do
    end subroutine alternation_normal_force
-
-   !> The end of the run: band_x again where a bearing's N range grew during it (at the
-   !> largest N of the run); nothing otherwise.
-   subroutine alternation_finish(model, dt1, gamma, al, res, error)
-      type(model_type), intent(in) :: model         !! the model
-      real(dp), intent(in) :: dt1                   !! main step [s]
-      real(dp), intent(in) :: gamma                 !! Newmark's gamma
-      type(alternation_type), intent(in) :: al      !! the devices watched
-      type(result_type), intent(inout) :: res       !! band_x
-      type(error_type), allocatable, intent(out) :: error !! not enough memory
-
-      if (al%moved) call band_figures(model, dt1, gamma, al, res, error)
-   end subroutine alternation_finish
 
    !> A device whose normal force varies over the run (nlo < nhi): P mu(eps) of its band's
    !> dashpot at the largest N, of the count's floor at the smallest (at the largest when it

@@ -47,7 +47,7 @@
 !> is that of the largest N of the run.
 module fd_stick_ringing
    use fd_kinds, only: dp
-   use fd_error, only: error_type, fatal_error, fmt_int, stat_no_memory
+   use fd_error, only: error_type, fmt_int, allocation_error
    use fd_model, only: model_type, device_type
    use fd_kinematics, only: moved_mass, device_nodes, devices_are_pairs, add_device, device_relative
    use fd_stiffness, only: stiffness_form
@@ -140,19 +140,19 @@ contains
                                                      !! (absent: the deck's p throughout)
       integer, allocatable :: sp_first(:), sp_list(:), vd_first(:), vd_list(:), di(:), dj(:)
       logical, allocatable :: velocity(:)
-      real(dp) :: k, ai, aj, c, x, wt, zn
-      integer :: nd, ns, d, q, i, j, nb, stat, first
-      logical :: osc
+      real(dp) :: ai, aj, c
+      integer :: nd, ns, q, i, j, nb, stat, first
 
+      res%stick_checked = .false.
       if (model%n_kx > 0 .or. .not. devices_are_pairs(model)) then
          call general_ringing_init(model, dt1, beta, gamma, a0, a1, rg, res, error)
-         if (.not. allocated(error)) call watch_normal_force(model, dt1, beta, gamma, rg, res, error, nrange)
+         if (.not. allocated(error)) call watch_normal_force(model, rg, res, nrange)
          return
       end if
+      call watch_springs(model, dt1, beta, gamma, rg, res, error)
+      if (allocated(error)) return
       nd = model%n_devices
       ns = model%n_springs
-      res%stick_checked = .false.
-      rg%n = count(sticking_stiffness(model%dev(1:nd)) > 0.0_dp)
       allocate (di(nd), dj(nd), velocity(nd), stat=stat)
       if (stat == 0) then
          call device_nodes(model, di, dj, first)
@@ -164,50 +164,30 @@ contains
       ! the velocity-law devices that move with each mode: counted, then listed
       nb = 0
       if (stat == 0) then
-         do d = 1, nd
-            if (.not. (sticking_stiffness(model%dev(d)) > 0.0_dp)) cycle
-            call mode_of(d)
+         do q = 1, rg%n
+            call mode_of(rg%dev(q))
             call band_devices(.false.)
          end do
-         allocate (rg%dev(rg%n), rg%k(rg%n), rg%omega(rg%n), rg%pmu(rg%n), rg%drift(rg%n), &
-                   rg%c_fixed(rg%n), rg%mr(rg%n), rg%first(rg%n + 1), rg%band_dev(nb), rg%band_shape(nb), &
-                   rg%c_start(rg%n), rg%stats(4, nd), rg%pfloor(rg%n), stat=stat)
+         allocate (rg%band_dev(nb), rg%band_shape(nb), stat=stat)
       end if
-      call ringing_ready(rg, stat, error)
-      if (allocated(error)) return
+      call springs_memory(rg, stat, error)
+      if (stat /= 0) return
       if (rg%n == 0) return
       res%stick_checked = .true.
-      q = 0
       nb = 0
-      do d = 1, nd
-         k = sticking_stiffness(model%dev(d))
-         if (.not. (k > 0.0_dp)) cycle
-         q = q + 1
-         call mode_of(d)
+      do q = 1, rg%n
+         call mode_of(rg%dev(q))
          rg%first(q) = nb + 1
          call band_devices(.true.)
-         rg%dev(q) = d
-         rg%k(q) = k
-         rg%mr(q) = moved_mass(model, d)
          ! the structure's damping on the mode: a0 M (a0 m_r), and a1 K of the springs at its nodes
          c = a0*rg%mr(q)
          call spring_damping(i)
          call spring_damping(j)
-         rg%omega(q) = sqrt(k/rg%mr(q))
-         rg%pmu(q) = model%dev(d)%p*model%dev(d)%mu
-         rg%pfloor(q) = rg%pmu(q)
-         x = rg%omega(q)*dt1
-         call newmark_frequency(x, beta, gamma, wt, zn, osc)
-         if (osc) then
-            res%stick_freq_error(d) = 1.0_dp - wt/x
-         else
-            res%stick_freq_error(d) = 1.0_dp
-         end if
-         rg%drift(q) = abs(res%stick_freq_error(d))*rg%omega(q)
-         rg%c_fixed(q) = c + 2.0_dp*rg%mr(q)*rg%omega(q)*zn
+         rg%c_fixed(q) = c
+         call spring_mode(q, rg, res)
       end do
       rg%first(rg%n + 1) = nb + 1
-      call watch_normal_force(model, dt1, beta, gamma, rg, res, error, nrange)
+      call watch_normal_force(model, rg, res, nrange)
    contains
       !> The mode of device d: node i moves ai, node j -aj, the centre of mass stays.
       subroutine mode_of(d)
@@ -278,30 +258,24 @@ contains
       type(error_type), allocatable, intent(out) :: error !! not enough memory
       real(dp), allocatable :: phi(:)
       logical, allocatable :: velocity(:)
-      real(dp) :: k, c, x, wt, zn, y, ek
+      real(dp) :: y, ek
       integer :: nd, d, e, q, nb, pass, stat
-      logical :: osc
 
-      nd = model%n_devices
-      res%stick_checked = .false.
-      rg%n = count(sticking_stiffness(model%dev(1:nd)) > 0.0_dp)
-      allocate (phi(model%n_dof), velocity(nd), rg%dev(rg%n), rg%k(rg%n), rg%omega(rg%n), rg%pmu(rg%n), &
-                rg%drift(rg%n), rg%c_fixed(rg%n), rg%mr(rg%n), rg%first(rg%n + 1), rg%c_start(rg%n), &
-                rg%stats(4, nd), rg%pfloor(rg%n), stat=stat)
-      call ringing_ready(rg, stat, error)
+      call watch_springs(model, dt1, beta, gamma, rg, res, error)
       if (allocated(error)) return
+      nd = model%n_devices
+      allocate (phi(model%n_dof), velocity(nd), stat=stat)
+      call springs_memory(rg, stat, error)
+      if (stat /= 0) return
       velocity = law_stuck(model%dev(1:nd)%law) == stuck_dashpot
       ! two passes: count the band devices, then list them
       do pass = 1, 2
-         q = 0
          nb = 0
-         do d = 1, nd
-            k = sticking_stiffness(model%dev(d))
-            if (.not. (k > 0.0_dp)) cycle
-            q = q + 1
+         do q = 1, rg%n
+            d = rg%dev(q)
             phi = 0.0_dp
             call add_device(model, d, 1.0_dp, phi)
-            phi = moved_mass(model, d)*phi/model%mass
+            phi = rg%mr(q)*phi/model%mass
             if (pass == 2) rg%first(q) = nb + 1
             do e = 1, nd
                if (.not. velocity(e)) cycle
@@ -314,61 +288,102 @@ contains
                end if
             end do
             if (pass == 1) cycle
-            rg%dev(q) = d
-            rg%k(q) = k
-            rg%mr(q) = moved_mass(model, d)
             ek = stiffness_form(model, phi, phi)
-            c = a0*rg%mr(q) + a1*ek
-            rg%omega(q) = sqrt(k/rg%mr(q))
-            rg%pmu(q) = model%dev(d)%p*model%dev(d)%mu
-            rg%pfloor(q) = rg%pmu(q)
-            x = rg%omega(q)*dt1
-            call newmark_frequency(x, beta, gamma, wt, zn, osc)
-            res%stick_freq_error(d) = 1.0_dp
-            if (osc) res%stick_freq_error(d) = 1.0_dp - wt/x
-            rg%drift(q) = abs(res%stick_freq_error(d))*rg%omega(q)
-            rg%c_fixed(q) = c + 2.0_dp*rg%mr(q)*rg%omega(q)*zn
+            rg%c_fixed(q) = a0*rg%mr(q) + a1*ek
+            call spring_mode(q, rg, res)
          end do
-         if (pass == 1) then
-            allocate (rg%band_dev(nb), rg%band_shape(nb), stat=stat)
-            if (stat /= 0) then
-               call fatal_error(error, "not enough memory for the sticking springs of "//trim(fmt_int(rg%n))// &
-                                " devices", stat_no_memory)
-               return
-            end if
-         end if
+         if (pass == 2) exit
+         allocate (rg%band_dev(nb), rg%band_shape(nb), stat=stat)
+         call springs_memory(rg, stat, error)
+         if (stat /= 0) return
       end do
       rg%first(rg%n + 1) = nb + 1
       res%stick_checked = rg%n > 0
    end subroutine general_ringing_init
 
-   !> Each watched device's planar bearing (rg%bearing) and the N range its figures are at
-   !> (rg%nrange): the prediction nrange (absent: the deck's p), those that vary moved to it
-   !> (ringing_at).
-   subroutine watch_normal_force(model, dt1, beta, gamma, rg, res, error, nrange)
+   !> The devices with a sticking spring (rg%n, rg%dev), each one's spring, the mass its mode
+   !> moves, its capacities at the deck's p and its planar bearing; the step (rg%dt1, beta,
+   !> gamma); the arrays of the devices watched allocated but for the band devices', and the
+   !> phase statistics zeroed.
+   subroutine watch_springs(model, dt1, beta, gamma, rg, res, error)
       type(model_type), intent(in) :: model         !! the model
       real(dp), intent(in) :: dt1                   !! main step [s]
       real(dp), intent(in) :: beta, gamma           !! Newmark's parameters
       type(ringing_type), intent(inout) :: rg       !! the devices watched
-      type(result_type), intent(inout) :: res       !! stick_freq_error
+      type(result_type), intent(in) :: res          !! the bearings
       type(error_type), allocatable, intent(out) :: error !! not enough memory
-      real(dp), intent(in), optional :: nrange(:, :) !! (2, n_devices) smallest and largest N [N]
       integer, allocatable :: bof(:)
-      integer :: q, d, stat
+      real(dp) :: k
+      integer :: nd, d, q, stat
 
+      nd = model%n_devices
       rg%dt1 = dt1
       rg%beta = beta
       rg%gamma = gamma
-      allocate (rg%bearing(rg%n), rg%nrange(2, rg%n), bof(model%n_devices), stat=stat)
-      if (stat /= 0) then
-         call fatal_error(error, "not enough memory for the sticking springs of "//trim(fmt_int(rg%n))// &
-                          " devices", stat_no_memory)
-         return
-      end if
+      rg%n = count(sticking_stiffness(model%dev(1:nd)) > 0.0_dp)
+      allocate (rg%dev(rg%n), rg%k(rg%n), rg%omega(rg%n), rg%pmu(rg%n), rg%pfloor(rg%n), rg%drift(rg%n), &
+                rg%c_fixed(rg%n), rg%mr(rg%n), rg%first(rg%n + 1), rg%c_start(rg%n), rg%stats(4, nd), &
+                rg%bearing(rg%n), rg%nrange(2, rg%n), bof(nd), stat=stat)
+      call springs_memory(rg, stat, error)
+      if (stat /= 0) return
+      rg%stats = 0.0_dp
+      rg%c_start = 0.0_dp
       call device_bearings(res, bof)
+      q = 0
+      do d = 1, nd
+         k = sticking_stiffness(model%dev(d))
+         if (.not. (k > 0.0_dp)) cycle
+         q = q + 1
+         rg%dev(q) = d
+         rg%k(q) = k
+         rg%mr(q) = moved_mass(model, d)
+         rg%pmu(q) = model%dev(d)%p*model%dev(d)%mu
+         rg%pfloor(q) = rg%pmu(q)
+         rg%bearing(q) = bof(d)
+      end do
+   end subroutine watch_springs
+
+   !> The error of the memory of the devices watched when stat (an allocation's) is not 0.
+   pure subroutine springs_memory(rg, stat, error)
+      type(ringing_type), intent(in) :: rg          !! the devices watched (n set)
+      integer, intent(in) :: stat                   !! the allocation's status
+      type(error_type), allocatable, intent(out) :: error !! not enough memory
+
+      call allocation_error(error, stat, "the sticking springs of "//trim(fmt_int(rg%n))//" devices")
+   end subroutine springs_memory
+
+   !> Watched device q's sticking spring rg%k(q) on the mass its mode moves: the mode's
+   !> frequency, Newmark's error on it at dt1 (res%stick_freq_error), the drift that makes, and
+   !> Newmark's own damping of the mode added to rg%c_fixed(q).
+   pure subroutine spring_mode(q, rg, res)
+      integer, intent(in) :: q                      !! the watched device
+      type(ringing_type), intent(inout) :: rg       !! the devices watched
+      type(result_type), intent(inout) :: res       !! stick_freq_error
+      real(dp) :: x, wt, zn
+      integer :: d
+      logical :: osc
+
+      d = rg%dev(q)
+      rg%omega(q) = sqrt(rg%k(q)/rg%mr(q))
+      x = rg%omega(q)*rg%dt1
+      call newmark_frequency(x, rg%beta, rg%gamma, wt, zn, osc)
+      res%stick_freq_error(d) = 1.0_dp
+      if (osc) res%stick_freq_error(d) = 1.0_dp - wt/x
+      rg%drift(q) = abs(res%stick_freq_error(d))*rg%omega(q)
+      rg%c_fixed(q) = rg%c_fixed(q) + 2.0_dp*rg%mr(q)*rg%omega(q)*zn
+   end subroutine spring_mode
+
+   !> The N range each watched device's figures are at (rg%nrange): the prediction nrange
+   !> (absent: the deck's p), those that vary moved to it (ringing_at).
+   pure subroutine watch_normal_force(model, rg, res, nrange)
+      type(model_type), intent(in) :: model         !! the model
+      type(ringing_type), intent(inout) :: rg       !! the devices watched
+      type(result_type), intent(inout) :: res       !! stick_freq_error
+      real(dp), intent(in), optional :: nrange(:, :) !! (2, n_devices) smallest and largest N [N]
+      integer :: q, d
+
       do q = 1, rg%n
          d = rg%dev(q)
-         rg%bearing(q) = bof(d)
          rg%nrange(:, q) = model%dev(d)%p
          if (.not. present(nrange)) cycle
          rg%nrange(:, q) = nrange(:, d)
@@ -409,7 +424,7 @@ contains
       type(ringing_type), intent(inout) :: rg       !! the devices watched
       type(result_type), intent(inout) :: res       !! stick_freq_error
       type(device_type) :: dv
-      real(dp) :: x, wt, zn, zn0, wt0
+      real(dp) :: zn0, wt0
       integer :: d
       logical :: osc
 
@@ -420,13 +435,7 @@ contains
       call newmark_frequency(rg%omega(q)*rg%dt1, rg%beta, rg%gamma, wt0, zn0, osc)
       rg%c_fixed(q) = rg%c_fixed(q) - 2.0_dp*rg%mr(q)*rg%omega(q)*zn0
       rg%k(q) = sticking_stiffness(dv)
-      rg%omega(q) = sqrt(rg%k(q)/rg%mr(q))
-      x = rg%omega(q)*rg%dt1
-      call newmark_frequency(x, rg%beta, rg%gamma, wt, zn, osc)
-      res%stick_freq_error(d) = 1.0_dp
-      if (osc) res%stick_freq_error(d) = 1.0_dp - wt/x
-      rg%drift(q) = abs(res%stick_freq_error(d))*rg%omega(q)
-      rg%c_fixed(q) = rg%c_fixed(q) + 2.0_dp*rg%mr(q)*rg%omega(q)*zn
+      call spring_mode(q, rg, res)
       rg%pmu(q) = max(rg%nrange(1, q), 0.0_dp)*model%dev(d)%mu
       rg%pfloor(q) = rg%pmu(q)
       if (.not. rg%pfloor(q) > 0.0_dp) rg%pfloor(q) = dv%p*model%dev(d)%mu
@@ -493,22 +502,6 @@ contains
          rg%stats(stat_time:stat_fmax, d) = 0.0_dp
       end do
    end subroutine ringing_changed
-
-   !> The arrays of the devices watched allocated (stat 0: their statistics zeroed), or the
-   !> error of their memory.
-   pure subroutine ringing_ready(rg, stat, error)
-      type(ringing_type), intent(inout) :: rg       !! the devices watched
-      integer, intent(in) :: stat                   !! the allocation's status
-      type(error_type), allocatable, intent(out) :: error !! not enough memory
-
-      if (stat /= 0) then
-         call fatal_error(error, "not enough memory for the sticking springs of "//trim(fmt_int(rg%n))// &
-                          " devices", stat_no_memory)
-         return
-      end if
-      rg%stats = 0.0_dp
-      rg%c_start = 0.0_dp
-   end subroutine ringing_ready
 
    !> The end of the run: the stick phases still open measured (the verdict: fd_warnings).
    subroutine ringing_finish(rg, phase, res)
