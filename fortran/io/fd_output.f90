@@ -20,21 +20,13 @@ module fd_output
    use fd_statistics, only: newmark_stats, event_driven_stats, moreau_jean_stats, summary_counts, &
                             newmark_counts, event_driven_counts, moreau_jean_counts
    use fd_fileops, only: c_lock_acquire, c_lock_release, c_unlink, c_rename, os_error, &
-                         c_file_create, c_file_write, c_file_close, c_mkdir, lock_not_file
+                         c_file_create, c_file_write, c_file_close, c_mkdir, c_rmdir, lock_not_file
    use fd_tempfiles, only: temp_tag, remove_stale_temps
    implicit none
    private
 
    public :: output_type, write_outputs, write_output_files, output_paths, temp_output_paths, summary_json, &
              history_header, make_dir, remove_made_dirs
-
-   interface
-      function c_rmdir(path) bind(c, name='rmdir') result(stat)
-         import :: c_char, c_int
-         character(kind=c_char), intent(in) :: path(*)
-         integer(c_int) :: stat
-      end function c_rmdir
-   end interface
 
    integer(c_int), parameter :: enoent = 2, eexist = 17
    character(len=1), parameter :: nl = achar(10)   !! the summary's line end
