@@ -123,6 +123,13 @@ contains
       type(line_type), allocatable :: w(:)
       character(len=*), parameter :: form = "'%%MatrixMarket matrix coordinate real|integer|pattern " // &
                                             "general|symmetric'"
+      character(len=*), parameter :: part(2) = [character(len=8) :: 'field', 'symmetry']
+      ! the words each part may be (a blank fills the symmetry's column: no token is blank)
+      character(len=*), parameter :: words(3, 2) = reshape([character(len=9) :: 'real', 'integer', 'pattern', &
+                                                            'general', 'symmetric', ''], [3, 2])
+      character(len=*), parameter :: allowed(2) = [character(len=24) :: 'real, integer or pattern', &
+                                                   'general or symmetric']
+      integer :: choice(2), q, k
 
       pattern = .false.
       symmetric = .false.
@@ -143,22 +150,20 @@ contains
          call header_error("the format '"//w(3)%s//"' is not read: only 'coordinate' (sparse)")
          return
       end if
-      select case (w(4)%s)
-      case ('real', 'integer')
-      case ('pattern')
-         pattern = .true.
-      case default
-         call header_error("the field '"//trim(fmt_text(w(4)%s))//"' is not read: real, integer or pattern")
-         return
-      end select
-      select case (w(5)%s)
-      case ('general')
-      case ('symmetric')
-         symmetric = .true.
-      case default
-         call header_error("the symmetry '"//trim(fmt_text(w(5)%s))//"' is not read: general or symmetric")
-         return
-      end select
+      ! the field, then the symmetry: each one of the words of its column
+      do q = 1, 2
+         choice(q) = 0
+         do k = 1, size(words, 1)
+            if (words(k, q) == w(3 + q)%s) choice(q) = k
+         end do
+         if (choice(q) == 0) then
+            call header_error("the "//trim(part(q))//" '"//trim(fmt_text(w(3 + q)%s))//"' is not read: "// &
+                              trim(allowed(q)))
+            return
+         end if
+      end do
+      pattern = choice(1) == 3
+      symmetric = choice(2) == 2
    contains
       subroutine header_error(what)
          character(len=*), intent(in) :: what
