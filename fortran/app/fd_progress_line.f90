@@ -6,6 +6,7 @@ module fd_progress_line
    use, intrinsic :: iso_fortran_env, only: error_unit, int64
    use, intrinsic :: iso_c_binding, only: c_int
    use fd_kinds, only: dp
+   use fd_fileops, only: c_isatty
    implicit none
    private
 
@@ -13,14 +14,6 @@ module fd_progress_line
 
    integer(int64), save :: start = -1   ! clock count at the first report (program state)
    logical, save :: shown = .false.     ! a line is on the screen
-
-   interface
-      function c_isatty(fd) bind(c, name='isatty') result(yes)
-         import :: c_int
-         integer(c_int), value :: fd
-         integer(c_int) :: yes
-      end function c_isatty
-   end interface
 
 contains
 

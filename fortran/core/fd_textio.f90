@@ -35,22 +35,6 @@ module fd_textio
          type(c_ptr), value :: fp
          integer(c_int) :: stat
       end function c_ferror
-      function c_access(path, mode) bind(c, name='access') result(stat)
-         import :: c_char, c_int
-         character(kind=c_char), intent(in) :: path(*)
-         integer(c_int), value :: mode
-         integer(c_int) :: stat
-      end function c_access
-      function c_opendir(path) bind(c, name='opendir') result(dir)
-         import :: c_char, c_ptr
-         character(kind=c_char), intent(in) :: path(*)
-         type(c_ptr) :: dir
-      end function c_opendir
-      function c_closedir(dir) bind(c, name='closedir') result(stat)
-         import :: c_ptr, c_int
-         type(c_ptr), value :: dir
-         integer(c_int) :: stat
-      end function c_closedir
    end interface
 
    !> One line of text.
@@ -86,27 +70,15 @@ contains
       character(len=:), allocatable, intent(out) :: text     !! its bytes
       type(error_type), allocatable, intent(out) :: error    !! set when it cannot be read
       character(len=:), allocatable :: buf, grown
-      type(c_ptr) :: fp, dir
+      character(len=len(path) + 64) :: msg
+      type(c_ptr) :: fp
       integer(c_size_t) :: got, want
       integer :: stat, n, cap, nul
       logical :: failed
 
-      if (index(path, achar(0)) > 0) then
-         call fatal_error(error, "the file name '"//path(1:index(path, achar(0)) - 1)//"...' contains a NUL character")
-         return
-      end if
-      if (c_access(path//c_null_char, 0_c_int) /= 0) then      ! F_OK
-         call fatal_error(error, "file '"//path//"' does not exist")
-         return
-      end if
-      dir = c_opendir(path//c_null_char)
-      if (c_associated(dir)) then
-         stat = c_closedir(dir)
-         call fatal_error(error, "'"//path//"' is a directory, not a file")
-         return
-      end if
-      if (c_access(path//c_null_char, 4_c_int) /= 0) then      ! R_OK
-         call fatal_error(error, "file '"//path//"' is not readable (permission denied)")
+      msg = path_problem(path)
+      if (len_trim(msg) > 0) then
+         call fatal_error(error, trim(msg))
          return
       end if
       fp = c_fopen(path//c_null_char, 'rb'//c_null_char)
@@ -162,6 +134,31 @@ contains
          return
       end if
    end subroutine read_file_text
+
+   !> What keeps a file from being read, checked in this order: a NUL in its name, no such
+   !> file, a directory, no permission to read; blank when none of them. (inquire asks the
+   !> system as access(2) does: F_OK for exist, R_OK for read.)
+   function path_problem(path) result(msg)
+      character(len=*), intent(in) :: path   !! the file's name
+      character(len=len(path) + 64) :: msg   !! the message, trimmed where used
+      character(len=8) :: readable
+      logical :: exists, directory
+
+      msg = ''
+      if (index(path, achar(0)) > 0) then
+         msg = "the file name '"//path(1:index(path, achar(0)) - 1)//"...' contains a NUL character"
+         return
+      end if
+      inquire (file=path, exist=exists, read=readable)
+      inquire (file=path//'/.', exist=directory)
+      if (.not. exists) then
+         msg = "file '"//path//"' does not exist"
+      else if (directory) then
+         msg = "'"//path//"' is a directory, not a file"
+      else if (readable == 'NO') then
+         msg = "file '"//path//"' is not readable (permission denied)"
+      end if
+   end function path_problem
 
    !> Number of the line holding the last character of text (1 + newlines before it).
    pure integer function count_lines(text) result(n)

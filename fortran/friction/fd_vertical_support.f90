@@ -277,8 +277,8 @@ contains
       real(dp), intent(inout) :: z, zd, gap
       logical, intent(inout) :: fly
       real(dp), intent(out) :: w_in, w_damp
-      real(dp) :: tau, left, a_s, a_e, z0, zd0, z2, zd2, lo, hi, mid, ek0, ep0, ek1, ep1, w, mp(8)
-      integer :: e, q
+      real(dp) :: tau, left, a_s, a_e, z0, zd0, z2, zd2, ek0, ep0, ek1, ep1, w, mp(8)
+      integer :: e
       logical :: full
 
       w_in = 0.0_dp
@@ -297,22 +297,9 @@ contains
             if (.not. full) call part_map(vs%wn(i), vs%c(i)/vs%m(i), left, mp)
             call contact_at(mp, z0, zd0, a_s, a_e, z2, zd2)
             tau = left
-            if (e < max_events .and. vs%p(i) + vs%k(i)*z2 + vs%c(i)*zd2 < 0.0_dp) then
-               ! lift-off within: the force's root by bisection
-               lo = 0.0_dp
-               hi = left
-               do q = 1, bisections
-                  mid = 0.5_dp*(lo + hi)
-                  if (.not. (mid > lo .and. mid < hi)) exit
-                  call part_map(vs%wn(i), vs%c(i)/vs%m(i), mid, mp)
-                  call contact_at(mp, z0, zd0, a_s, a_s + (a_e - a_s)*mid/left, z2, zd2)
-                  if (vs%p(i) + vs%k(i)*z2 + vs%c(i)*zd2 < 0.0_dp) then
-                     hi = mid
-                  else
-                     lo = mid
-                  end if
-               end do
-               tau = hi
+            if (e < max_events .and. state_left(vs, i, fly, z2, zd2)) then
+               ! lift-off within: the force's root
+               tau = state_change(vs, i, fly, z0, zd0, a_s, a_e, left)
                a_e = a_s + (ab - a_s)*tau/left
                call part_map(vs%wn(i), vs%c(i)/vs%m(i), tau, mp)
                call contact_at(mp, z0, zd0, a_s, a_e, z2, zd2)
@@ -328,20 +315,9 @@ contains
             ! flight: the free fall z'' = a_z + g
             call flight_at(z0, zd0, a_s, a_e, left, left, z2, zd2)
             tau = left
-            if (e < max_events .and. vs%p(i) + vs%k(i)*z2 + vs%c(i)*min(zd2, 0.0_dp) >= 0.0_dp) then
-               lo = 0.0_dp
-               hi = left
-               do q = 1, bisections
-                  mid = 0.5_dp*(lo + hi)
-                  if (.not. (mid > lo .and. mid < hi)) exit
-                  call flight_at(z0, zd0, a_s, a_e, left, mid, z2, zd2)
-                  if (vs%p(i) + vs%k(i)*z2 + vs%c(i)*min(zd2, 0.0_dp) >= 0.0_dp) then
-                     hi = mid
-                  else
-                     lo = mid
-                  end if
-               end do
-               tau = hi
+            if (e < max_events .and. state_left(vs, i, fly, z2, zd2)) then
+               ! landing within
+               tau = state_change(vs, i, fly, z0, zd0, a_s, a_e, left)
                call flight_at(z0, zd0, a_s, a_e, left, tau, z2, zd2)
                a_e = a_s + (ab - a_s)*tau/left
                fly = .false.
@@ -367,6 +343,51 @@ contains
          if (fly) gap = max(gap, -(z + vs%p(i)/vs%k(i)))
       end do
    end subroutine advance_part
+
+   !> Whether support i at (z, zd) has left the state it was in: lifted off when in contact (fly
+   !> false; P + kv z + c z' < 0), landed when in flight (P + kv z + c min(z', 0) >= 0).
+   pure logical function state_left(vs, i, fly, z, zd) result(left)
+      type(vertical_support), intent(in) :: vs
+      integer, intent(in) :: i
+      logical, intent(in) :: fly                    !! in flight before
+      real(dp), intent(in) :: z, zd                 !! the state [m], [m/s]
+
+      if (fly) then
+         left = vs%p(i) + vs%k(i)*z + vs%c(i)*min(zd, 0.0_dp) >= 0.0_dp
+      else
+         left = vs%p(i) + vs%k(i)*z + vs%c(i)*zd < 0.0_dp
+      end if
+   end function state_left
+
+   !> The time within a piece of length left (a_z from a0 to a1 over it, from (z0, zd0)) at
+   !> which support i changes state: lifts off when in contact (fly false), lands when in
+   !> flight; by bisection to round-off, the state changed at the end of the piece.
+   pure real(dp) function state_change(vs, i, fly, z0, zd0, a0, a1, left) result(hi)
+      type(vertical_support), intent(in) :: vs
+      integer, intent(in) :: i
+      logical, intent(in) :: fly                    !! in flight at the piece's start
+      real(dp), intent(in) :: z0, zd0, a0, a1, left
+      real(dp) :: lo, mid, z, zd, mp(8)
+      integer :: q
+
+      lo = 0.0_dp
+      hi = left
+      do q = 1, bisections
+         mid = 0.5_dp*(lo + hi)
+         if (.not. (mid > lo .and. mid < hi)) exit
+         if (fly) then
+            call flight_at(z0, zd0, a0, a1, left, mid, z, zd)
+         else
+            call part_map(vs%wn(i), vs%c(i)/vs%m(i), mid, mp)
+            call contact_at(mp, z0, zd0, a0, a0 + (a1 - a0)*mid/left, z, zd)
+         end if
+         if (state_left(vs, i, fly, z, zd)) then
+            hi = mid
+         else
+            lo = mid
+         end if
+      end do
+   end function state_change
 
    !> The contact map's end state from (z0, zd0) under a_z from a0 to a1.
    pure subroutine contact_at(mp, z0, zd0, a0, a1, z, zd)

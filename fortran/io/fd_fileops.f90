@@ -1,6 +1,7 @@
-!> The Fortran interfaces of fd_fileops.c, in one place: POSIX file creation, writes,
-!> close, rename, unlink, the output lock, errno texts and the process id (gfortran's own
-!> I/O loses a full disk silently and will not open one file on two units; docs/batch.md).
+!> The Fortran interfaces of fd_fileops.c and of the C library's file calls, in one place: POSIX
+!> file creation, writes, close, rename, unlink, mkdir, rmdir, isatty, the output lock, errno
+!> texts and the process id (gfortran's own I/O loses a full disk silently and will not open
+!> one file on two units; docs/batch.md).
 !> Every function returns 0 or an errno; os_error turns one into an error naming what failed.
 module fd_fileops
    use, intrinsic :: iso_c_binding, only: c_char, c_int, c_long, c_null_char
@@ -9,12 +10,35 @@ module fd_fileops
    private
 
    public :: c_lock_acquire, c_lock_release, c_unlink, c_rename, c_errno_text, c_getpid
-   public :: c_file_create, c_file_write, c_file_close, os_error, c_mkdir
+   public :: c_file_create, c_file_write, c_file_close, os_error, c_mkdir, c_rmdir
+   public :: path_call, c_isatty
 
    !> c_lock_acquire: the lock's path is a symbolic link or not a regular file (never followed).
    integer(c_int), parameter, public :: lock_not_file = -1
 
+   !> A call on a path: 0 or an errno (mkdir, unlink; rmdir: 0 or -1).
+   abstract interface
+      function path_call(path) bind(c) result(err)
+         import :: c_char, c_int
+         character(kind=c_char), intent(in) :: path(*)
+         integer(c_int) :: err
+      end function path_call
+   end interface
+
+   !> Create a directory (mode 0755 less the umask): 0 or errno.
+   procedure(path_call), bind(c, name='fd_mkdir') :: c_mkdir
+   !> Remove a file.
+   procedure(path_call), bind(c, name='fd_unlink') :: c_unlink
+   !> Remove an empty directory (the C library's rmdir: 0, or -1).
+   procedure(path_call), bind(c, name='rmdir') :: c_rmdir
+
    interface
+      !> Whether a file descriptor is a terminal: 1, else 0 (the C library's isatty).
+      function c_isatty(fd) bind(c, name='isatty') result(yes)
+         import :: c_int
+         integer(c_int), value :: fd
+         integer(c_int) :: yes
+      end function c_isatty
       !> Take the lock file `path` (created, held while fd is open).
       function c_lock_acquire(path, fd) bind(c, name='fd_lock_acquire') result(err)
          import :: c_char, c_int
@@ -29,18 +53,6 @@ module fd_fileops
          integer(c_int), value :: fd
          integer(c_int) :: err
       end function c_lock_release
-      !> Create a directory (mode 0755 less the umask): 0 or errno.
-      function c_mkdir(path) bind(c, name='fd_mkdir') result(err)
-         import :: c_char, c_int
-         character(kind=c_char), intent(in) :: path(*)
-         integer(c_int) :: err
-      end function c_mkdir
-      !> Remove a file.
-      function c_unlink(path) bind(c, name='fd_unlink') result(err)
-         import :: c_char, c_int
-         character(kind=c_char), intent(in) :: path(*)
-         integer(c_int) :: err
-      end function c_unlink
       !> Rename a file (atomic within a file system).
       function c_rename(old, new) bind(c, name='fd_rename') result(err)
          import :: c_char, c_int

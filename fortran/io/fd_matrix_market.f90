@@ -14,6 +14,7 @@ module fd_matrix_market
    use fd_error, only: error_type, fatal_error, fmt_int, fmt_text, stat_no_memory
    use fd_textio, only: line_type, read_text_file, lower, split_tokens
    use fd_record, only: parse_real
+   use fd_sort, only: sort_keys, stable_order
    implicit none
    private
 
@@ -29,6 +30,13 @@ module fd_matrix_market
       integer, allocatable :: col(:)        !! column of each entry (1..n_cols)
       real(dp), allocatable :: val(:)       !! value of each entry
    end type sparse_matrix
+
+   !> The positions of a matrix's entries, which check_duplicates sorts them by.
+   type, extends(sort_keys) :: position_keys
+      integer, allocatable :: row(:), col(:)   !! each entry's row and column
+   contains
+      procedure :: before => position_before
+   end type position_keys
 
 contains
 
@@ -123,6 +131,13 @@ contains
       type(line_type), allocatable :: w(:)
       character(len=*), parameter :: form = "'%%MatrixMarket matrix coordinate real|integer|pattern " // &
                                             "general|symmetric'"
+      character(len=*), parameter :: part(2) = [character(len=8) :: 'field', 'symmetry']
+      ! the words each part may be (a blank fills the symmetry's column: no token is blank)
+      character(len=*), parameter :: words(3, 2) = reshape([character(len=9) :: 'real', 'integer', 'pattern', &
+                                                            'general', 'symmetric', ''], [3, 2])
+      character(len=*), parameter :: allowed(2) = [character(len=24) :: 'real, integer or pattern', &
+                                                   'general or symmetric']
+      integer :: choice(2), q, k
 
       pattern = .false.
       symmetric = .false.
@@ -143,22 +158,20 @@ contains
          call header_error("the format '"//w(3)%s//"' is not read: only 'coordinate' (sparse)")
          return
       end if
-      select case (w(4)%s)
-      case ('real', 'integer')
-      case ('pattern')
-         pattern = .true.
-      case default
-         call header_error("the field '"//trim(fmt_text(w(4)%s))//"' is not read: real, integer or pattern")
-         return
-      end select
-      select case (w(5)%s)
-      case ('general')
-      case ('symmetric')
-         symmetric = .true.
-      case default
-         call header_error("the symmetry '"//trim(fmt_text(w(5)%s))//"' is not read: general or symmetric")
-         return
-      end select
+      ! the field, then the symmetry: each one of the words of its column
+      do q = 1, 2
+         choice(q) = 0
+         do k = 1, size(words, 1)
+            if (words(k, q) == w(3 + q)%s) choice(q) = k
+         end do
+         if (choice(q) == 0) then
+            call header_error("the "//trim(part(q))//" '"//trim(fmt_text(w(3 + q)%s))//"' is not read: "// &
+                              trim(allowed(q)))
+            return
+         end if
+      end do
+      pattern = choice(1) == 3
+      symmetric = choice(2) == 2
    contains
       subroutine header_error(what)
          character(len=*), intent(in) :: what
@@ -273,22 +286,27 @@ contains
       end do
    end subroutine parse_count
 
-   !> No position given twice (sorted by row and column, in O(nnz log nnz)).
+   !> No position given twice (sorted by row and column, stable_order: O(nnz log nnz)).
    subroutine check_duplicates(path, mat, error)
       character(len=*), intent(in) :: path
       type(sparse_matrix), intent(in) :: mat
       type(error_type), allocatable, intent(out) :: error
       integer, allocatable :: key_order(:)
+      type(position_keys) :: keys
       integer :: k, a, b, stat
 
-      allocate (key_order(mat%nnz), stat=stat)
+      allocate (key_order(mat%nnz), keys%row(mat%nnz), keys%col(mat%nnz), stat=stat)
+      if (stat == 0) then
+         keys%row = mat%row
+         keys%col = mat%col
+         key_order = [(k, k=1, mat%nnz)]
+         call stable_order(keys, key_order, stat)
+      end if
       if (stat /= 0) then
          call fatal_error(error, path//": not enough memory to check "//trim(fmt_int(mat%nnz))//" entries", &
                           stat_no_memory)
          return
       end if
-      key_order = [(k, k=1, mat%nnz)]
-      call merge_sort(mat%row, mat%col, key_order)
       do k = 2, mat%nnz
          a = key_order(k - 1)
          b = key_order(k)
@@ -302,44 +320,13 @@ contains
       end do
    end subroutine check_duplicates
 
-   !> Order idx by (row, col) of the entries it points to (bottom-up merge sort, stable).
-   pure subroutine merge_sort(row, col, idx)
-      integer, intent(in) :: row(:), col(:)
-      integer, intent(inout) :: idx(:)
-      integer, allocatable :: tmp(:)
-      integer :: width, lo, mid, hi, i, j, k, n
+   !> Whether entry a's position comes before entry b's (by row, then column).
+   pure logical function position_before(keys, a, b) result(before)
+      class(position_keys), intent(in) :: keys   !! the entries' positions
+      integer, intent(in) :: a, b                !! two entries
 
-      n = size(idx)
-      allocate (tmp(n))
-      width = 1
-      do while (width < n)
-         lo = 1
-         do while (lo <= n)
-            mid = min(lo + width - 1, n)
-            hi = min(lo + 2*width - 1, n)
-            i = lo; j = mid + 1; k = lo
-            do while (i <= mid .and. j <= hi)
-               if (before(idx(j), idx(i))) then
-                  tmp(k) = idx(j); j = j + 1
-               else
-                  tmp(k) = idx(i); i = i + 1
-               end if
-               k = k + 1
-            end do
-            tmp(k:k + mid - i) = idx(i:mid)
-            k = k + mid - i + 1
-            tmp(k:k + hi - j) = idx(j:hi)
-            lo = lo + 2*width
-         end do
-         idx = tmp
-         width = 2*width
-      end do
-   contains
-      pure logical function before(a, b)
-         integer, intent(in) :: a, b
-         before = row(a) < row(b) .or. (row(a) == row(b) .and. col(a) < col(b))
-      end function before
-   end subroutine merge_sort
+      before = keys%row(a) < keys%row(b) .or. (keys%row(a) == keys%row(b) .and. keys%col(a) < keys%col(b))
+   end function position_before
 
    !> The entries of the whole matrix: a symmetric file's off-diagonal entries mirrored
    !> (i, j) -> (j, i); a general file's as they are.

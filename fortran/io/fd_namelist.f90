@@ -7,6 +7,7 @@
 module fd_namelist
    use fd_error, only: error_type, fatal_error, fmt_int, fmt_text, stat_no_memory, echo_chars
    use fd_textio, only: line_type, read_text_file, split_lines, lower
+   use fd_sort, only: sort_keys, stable_order
    implicit none
    private
 
@@ -47,6 +48,13 @@ module fd_namelist
       integer :: item = 0
       character(len=:), allocatable :: whole_msg     !! the reader's message on the whole group
    end type group_text
+
+   !> The variables of a group's assignments, which repeated_item sorts them by.
+   type, extends(sort_keys) :: variable_keys
+      character(len=64), allocatable :: bases(:)   !! each assignment's variable, without subscripts
+   contains
+      procedure :: before => variable_before
+   end type variable_keys
 
 contains
 
@@ -464,30 +472,31 @@ contains
    end subroutine find_group
 
    !> The first assignment (i) that sets the same variable or element as an earlier one (j);
-   !> i = 0 if none. Names are sorted (merge sort): linear-logarithmic in the assignments.
+   !> i = 0 if none. Names are sorted (stable_order): linear-logarithmic in the assignments.
    pure subroutine repeated_item(items, i, j, stat)
       type(line_type), intent(in) :: items(:)   !! the assignments of a group
       integer, intent(out) :: i                  !! the repeated one, 0 if none
       integer, intent(out) :: j                  !! the earlier one it repeats
       integer, intent(out) :: stat               !! 0, or not enough memory
       integer, parameter :: pairwise_max = 2000  !! longest run of one variable compared pair by pair
-      character(len=64), allocatable :: names(:), bases(:)
+      character(len=64), allocatable :: names(:)
       character(len=:), allocatable :: var
-      integer, allocatable :: order(:), tmp(:)
-      integer :: k, n, width, lo, mid, hi, a, b, c, r0, r1, p, q, ip, iq
+      type(variable_keys) :: keys
+      integer, allocatable :: order(:)
+      integer :: k, n, c, r0, r1, p, q, ip, iq
 
       i = 0; j = 0
       n = size(items)
-      allocate (names(n), bases(n), order(n), tmp(n), stat=stat)
+      allocate (names(n), keys%bases(n), order(n), stat=stat)
       if (stat /= 0 .or. n < 2) return
       do k = 1, n
          call item_variable(items(k)%s, var)
          names(k) = var
          if (len(var) > len(names)) names(k) = ''   ! not a variable of any group: the reader rejects it
          c = index(names(k), '(')
-         bases(k) = names(k)
+         keys%bases(k) = names(k)
          if (c > 0) then
-            bases(k) = names(k)(1:c - 1)
+            keys%bases(k) = names(k)(1:c - 1)
          else if (len_trim(names(k)) > 0 .and. len_trim(names(k)) < len(names) - 12) then
             ! a whole array given m values sets its elements 1 to m ('mass = 1.0, 2.0' leaves
             ! mass(3) to a later 'mass(3) = ...'): written as that section
@@ -495,31 +504,9 @@ contains
          end if
          order(k) = k
       end do
-      ! bottom-up merge sort of order by (variable, position): stable
-      width = 1
-      do while (width < n)
-         lo = 1
-         do while (lo <= n)
-            mid = min(lo + width, n + 1)
-            hi = min(lo + 2*width, n + 1)
-            a = lo; b = mid; c = lo
-            do while (c < hi)
-               if (b >= hi) then
-                  tmp(c) = order(a); a = a + 1
-               else if (a >= mid) then
-                  tmp(c) = order(b); b = b + 1
-               else if (llt(bases(order(b)), bases(order(a)))) then
-                  tmp(c) = order(b); b = b + 1
-               else
-                  tmp(c) = order(a); a = a + 1
-               end if
-               c = c + 1
-            end do
-            lo = hi
-         end do
-         order = tmp
-         width = 2*width
-      end do
+      ! order by (variable, position): stable_order keeps the deck's order within a variable
+      call stable_order(keys, order, stat)
+      if (stat /= 0) return
       ! the assignments of one variable are adjacent, in deck order: two of them that set the
       ! same element ('mass = ...' and 'mass(2) = ...', 'mass(1:2)' and 'mass(02)') repeat it;
       ! report the repeat that comes first in the deck
@@ -527,10 +514,10 @@ contains
       do while (r0 <= n)
          r1 = r0
          do while (r1 < n)
-            if (bases(order(r1 + 1)) /= bases(order(r0))) exit
+            if (keys%bases(order(r1 + 1)) /= keys%bases(order(r0))) exit
             r1 = r1 + 1
          end do
-         if (r1 > r0 .and. len_trim(bases(order(r0))) > 0) then
+         if (r1 > r0 .and. len_trim(keys%bases(order(r0))) > 0) then
             do q = r0 + 1, r1
                ! each earlier one; in a very long run its neighbour only (deck order)
                do p = merge(q - 1, r0, r1 - r0 >= pairwise_max), q - 1
@@ -546,6 +533,15 @@ contains
          r0 = r1 + 1
       end do
    end subroutine repeated_item
+
+   !> Whether assignment a's variable goes before b's (their names without subscripts, in
+   !> ASCII order): repeated_item's sort.
+   pure logical function variable_before(keys, a, b) result(before)
+      class(variable_keys), intent(in) :: keys   !! the assignments' variables
+      integer, intent(in) :: a, b                !! two assignments
+
+      before = llt(keys%bases(a), keys%bases(b))
+   end function variable_before
 
    !> Whether two assignments of one variable ('mass', 'mass(2)', 'mu_table_v(1:3,2)',
    !> 'label(1)(1:4)', lower case without blanks) set a common element. A whole variable

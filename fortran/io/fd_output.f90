@@ -20,21 +20,13 @@ module fd_output
    use fd_statistics, only: newmark_stats, event_driven_stats, moreau_jean_stats, summary_counts, &
                             newmark_counts, event_driven_counts, moreau_jean_counts
    use fd_fileops, only: c_lock_acquire, c_lock_release, c_unlink, c_rename, os_error, &
-                         c_file_create, c_file_write, c_file_close, c_mkdir, lock_not_file
+                         c_file_create, c_file_write, c_file_close, c_mkdir, c_rmdir, lock_not_file
    use fd_tempfiles, only: temp_tag, remove_stale_temps
    implicit none
    private
 
    public :: output_type, write_outputs, write_output_files, output_paths, temp_output_paths, summary_json, &
              history_header, make_dir, remove_made_dirs
-
-   interface
-      function c_rmdir(path) bind(c, name='rmdir') result(stat)
-         import :: c_char, c_int
-         character(kind=c_char), intent(in) :: path(*)
-         integer(c_int) :: stat
-      end function c_rmdir
-   end interface
 
    integer(c_int), parameter :: enoent = 2, eexist = 17
    character(len=1), parameter :: nl = achar(10)   !! the summary's line end
@@ -388,7 +380,8 @@ contains
       call record_step_part(jt, res, outcome_of(checks, 'record_resolution'))
       call stick_part(jt, res%stick_freq_error, res%stick_ringing_ratio, res%stick_ringing, res%stick_margin, &
                       outcome_of(checks, 'stick_resolution'))
-      call band_part(jt, res, outcome_of(checks, 'band_resolution'))
+      call band_part(jt, res%band_x, res%band_alternation, res%band_alternation_time, &
+                     outcome_of(checks, 'band_resolution'))
       call peaks_part(jt, res)
       if (res%n_bearings > 0) call bearings_part(jt, model, res)
       call statistics_part(jt, res)
@@ -518,15 +511,18 @@ contains
       call kword(jt, 'stick_resolution', verdict)
    end subroutine stick_part
 
-   !> Whether the step damps the velocity-law bands (fd_band_alternation).
-   subroutine band_part(jt, res, verdict)
-      type(json_text), intent(inout) :: jt     !! the summary
-      type(result_type), intent(in) :: res     !! the result
-      character(len=*), intent(in) :: verdict  !! its check's outcome
+   !> Whether the step damps the velocity-law bands (fd_band_alternation): per device x, the
+   !> alternation's amplitude and its time, then the verdict.
+   subroutine band_part(jt, x, alternation, alternation_time, verdict)
+      type(json_text), intent(inout) :: jt        !! the summary
+      real(dp), intent(in) :: x(:)                !! (1 - gamma) dt1 (c_i / m_i + c_j / m_j)
+      real(dp), intent(in) :: alternation(:)      !! largest step-to-step alternation of the band force [N]
+      real(dp), intent(in) :: alternation_time(:) !! its time [s] (null where there is none)
+      character(len=*), intent(in) :: verdict     !! its check's outcome
 
-      call kr(jt, 'band_x', res%band_x)
-      call kr(jt, 'band_alternation_N', res%band_alternation)
-      call kr(jt, 'band_alternation_s', res%band_alternation_time, res%band_alternation /= 0.0_dp)
+      call kr(jt, 'band_x', x)
+      call kr(jt, 'band_alternation_N', alternation)
+      call kr(jt, 'band_alternation_s', alternation_time, alternation /= 0.0_dp)
       call kword(jt, 'band_resolution', verdict)
    end subroutine band_part
 
@@ -643,21 +639,23 @@ contains
       call patterns_part(jt, moreau_jean_counts(st))
    end subroutine moreau_jean_part
 
-   !> The summary's counter keys of every technique, from steps_dt1 to events.
+   !> The summary's counter keys of every technique, from steps_dt1 to events: the counts of
+   !> steps and factorizations (a table of keys), the linear system, its bandwidth, the events.
    subroutine counts_part(jt, c)
       type(json_text), intent(inout) :: jt     !! the summary
       type(summary_counts), intent(in) :: c    !! a technique's counters under these keys
+      character(len=*), parameter :: keys(10) = [character(len=22) :: 'steps_dt1', 'steps_nested', &
+                                                 'steps_implicit', 'implicit_redos', 'implicit_fallbacks', &
+                                                 'steps_dt2', 'steps_finer', 'factorizations', 'factor_updates', &
+                                                 'partial_factorizations']
+      integer :: k
 
-      call kint(jt, 'steps_dt1', c%steps_dt1)
-      call kint(jt, 'steps_nested', c%steps_nested)
-      call kint(jt, 'steps_implicit', c%steps_implicit)
-      call kint(jt, 'implicit_redos', c%implicit_redos)
-      call kint(jt, 'implicit_fallbacks', c%implicit_fallbacks)
-      call kint(jt, 'steps_dt2', c%steps_dt2)
-      call kint(jt, 'steps_finer', c%steps_finer)
-      call kint(jt, 'factorizations', c%factorizations)
-      call kint(jt, 'factor_updates', c%factor_updates)
-      call kint(jt, 'partial_factorizations', c%partial_factorizations)
+      associate (counts => [c%steps_dt1, c%steps_nested, c%steps_implicit, c%implicit_redos, c%implicit_fallbacks, &
+                            c%steps_dt2, c%steps_finer, c%factorizations, c%factor_updates, c%partial_factorizations])
+         do k = 1, size(keys)
+            call kint(jt, trim(keys(k)), counts(k))
+         end do
+      end associate
       call kword(jt, 'linear_system', storage_name(c%storage))
       call kint(jt, 'half_bandwidth', c%bandwidth)
       call kint(jt, 'events', c%events)

@@ -28,6 +28,20 @@ module fd_record
 
    integer, parameter :: num_ok = 0, num_syntax = 1, num_nan = 2, num_infinite = 3
 
+   !> A unit a record's values may be in: its name (lower case), its factor to SI and its kind.
+   type :: unit_type
+      character(len=5) :: name = ''         !! as record_units writes it
+      real(dp) :: factor = 1.0_dp           !! to m/s2 or m
+      logical :: displacement = .false.     !! a displacement's (else an acceleration's)
+   end type unit_type
+
+   !> The units of record_units_list.
+   type(unit_type), parameter :: unit_table(*) = [ &
+      unit_type('g', standard_gravity, .false.), unit_type('m/s2', 1.0_dp, .false.), &
+      unit_type('cm/s2', 1.0e-2_dp, .false.), unit_type('gal', 1.0e-2_dp, .false.), &
+      unit_type('mm/s2', 1.0e-3_dp, .false.), unit_type('m', 1.0_dp, .true.), &
+      unit_type('cm', 1.0e-2_dp, .true.), unit_type('mm', 1.0e-3_dp, .true.)]
+
    !> What was read from a record file (named in the summary).
    type :: record_info
       character(len=:), allocatable :: path    !! the file read
@@ -135,33 +149,15 @@ contains
       logical, intent(in) :: is_displacement     !! displacement (else acceleration) units
       real(dp), intent(out) :: factor            !! multiply a value to get SI
       logical, intent(out) :: ok                 !! the units are known for this kind
-      ok = .true.
+      integer :: k
+
+      ok = .false.
       factor = 1.0_dp
-      if (is_displacement) then
-         select case (units)
-         case ('m')
-            factor = 1.0_dp
-         case ('cm')
-            factor = 1.0e-2_dp
-         case ('mm')
-            factor = 1.0e-3_dp
-         case default
-            ok = .false.
-         end select
-      else
-         select case (units)
-         case ('g')
-            factor = standard_gravity
-         case ('m/s2')
-            factor = 1.0_dp
-         case ('cm/s2', 'gal')
-            factor = 1.0e-2_dp
-         case ('mm/s2')
-            factor = 1.0e-3_dp
-         case default
-            ok = .false.
-         end select
-      end if
+      do k = 1, size(unit_table)
+         if (unit_table(k)%name /= units .or. (unit_table(k)%displacement .neqv. is_displacement)) cycle
+         factor = unit_table(k)%factor
+         ok = .true.
+      end do
    end subroutine units_factor
 
    !> 'auto': an AT2 file has NPTS and DT on its fourth line (or the extension .at2, .dt2);
@@ -224,7 +220,7 @@ contains
       integer :: hlo(4), hhi(4)
       real(dp) :: dt, f_declared, f_given
       character(len=:), allocatable :: h3, declared, where
-      logical :: has_tab, ok, ok_declared
+      logical :: found, ok, ok_declared
 
       next = 1
       do line = 1, 4
@@ -306,17 +302,10 @@ contains
       n = 0
       line = 4
       width = -1   ! the fixed-width fields of the body, from its first line (0: none)
-      do while (next <= len(text))
-         call next_line(text, next, lo, hi)
-         line = line + 1
-         if (is_blank(text(lo:hi), has_tab)) then
-            if (has_tab) then
-               call fatal_error(error, "record file '"//path//"', line "//trim(fmt_int(line))// &
-                                ": no value (only blanks, tabs or commas); expected numbers")
-               return
-            end if
-            cycle
-         end if
+      do
+         call filled_line(path, text, 'numbers', next, line, lo, hi, found, error)
+         if (allocated(error)) return
+         if (.not. found) exit
          call line_values(text(lo:hi), val, n, stat, bad_lo, bad_hi)
          if (stat /= num_ok) then
             call value_error(path, line, text(lo:hi), stat, bad_lo, bad_hi, npts, error)
@@ -641,7 +630,7 @@ contains
       real(dp), allocatable :: buf(:)
       real(dp) :: pair(2), t1
       integer :: next, lo, hi, line, n, nl, k, stat, bad_lo, bad_hi, ncol, m
-      logical :: has_tab
+      logical :: found
       character(len=:), allocatable :: where
 
       ncol = merge(2, 1, two)
@@ -654,17 +643,10 @@ contains
       line = 0
       next = 1
       t1 = 0.0_dp
-      do while (next <= len(text))
-         call next_line(text, next, lo, hi)
-         line = line + 1
-         if (is_blank(text(lo:hi), has_tab)) then
-            if (has_tab) then
-               call fatal_error(error, "record file '"//path//"', line "//trim(fmt_int(line))// &
-                                ": no value (only blanks, tabs or commas); expected "//trim(columns_text(ncol)))
-               return
-            end if
-            cycle
-         end if
+      do
+         call filled_line(path, text, trim(columns_text(ncol)), next, line, lo, hi, found, error)
+         if (allocated(error)) return
+         if (.not. found) exit
          if (is_comment(text(lo:hi))) cycle
          m = 0
          call line_values(text(lo:hi), pair, m, stat, bad_lo, bad_hi)
@@ -940,6 +922,39 @@ contains
    end subroutine next_field
 
    ! ------------------------------------------------------------------ text helpers
+   !> The next line from next that holds more than blanks: text(lo:hi), line its number
+   !> (counted on from the last); a line of blanks is skipped, one of blanks and a tab or a
+   !> comma is an error (no value where `expected` were). found = .false. at the text's end or
+   !> on the error.
+   subroutine filled_line(path, text, expected, next, line, lo, hi, found, error)
+      character(len=*), intent(in) :: path                !! the record file (for the message)
+      character(len=*), intent(in) :: text                !! its text
+      character(len=*), intent(in) :: expected            !! what a line holds, for the message
+      integer, intent(inout) :: next                      !! where the next line starts
+      integer, intent(inout) :: line                      !! the number of the line
+      integer, intent(out) :: lo, hi                      !! the line found
+      logical, intent(out) :: found                       !! a line was found
+      type(error_type), allocatable, intent(out) :: error   !! a line without a value
+      logical :: has_tab
+
+      found = .false.
+      lo = 1
+      hi = 0
+      do while (next <= len(text))
+         call next_line(text, next, lo, hi)
+         line = line + 1
+         if (.not. is_blank(text(lo:hi), has_tab)) then
+            found = .true.
+            return
+         end if
+         if (has_tab) then
+            call fatal_error(error, "record file '"//path//"', line "//trim(fmt_int(line))// &
+                             ": no value (only blanks, tabs or commas); expected "//expected)
+            return
+         end if
+      end do
+   end subroutine filled_line
+
    !> The line starting at next: text(lo:hi), without its newline or carriage return;
    !> next moves past the newline.
    pure subroutine next_line(text, next, lo, hi)

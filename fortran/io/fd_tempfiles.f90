@@ -5,6 +5,7 @@
 !> one of a live process or of another machine.
 module fd_tempfiles
    use, intrinsic :: iso_c_binding, only: c_char, c_int, c_long_long, c_null_char
+   use fd_fileops, only: path_call
    implicit none
    private
 
@@ -17,12 +18,10 @@ module fd_tempfiles
          integer(c_int), value :: len
          integer(c_long_long), value :: salt
       end subroutine c_temp_tag
-      function c_remove_stale_temps(path) bind(c, name='fd_remove_stale_temps') result(n)
-         import :: c_char, c_int
-         character(kind=c_char), intent(in) :: path(*)
-         integer(c_int) :: n
-      end function c_remove_stale_temps
    end interface
+
+   !> Remove the stale temporaries of a path: how many.
+   procedure(path_call), bind(c, name='fd_remove_stale_temps') :: c_remove_stale_temps
 
 contains
 

@@ -26,7 +26,7 @@ module fd_names
    public :: refinements, refinement_step, refinement_nested, refinement_implicit
    public :: mu_laws, mu_constant, mu_exponential, mu_table
    public :: mode_systems, system_stuck, system_free
-   public :: keyword_id, keyword_choices, law_id, law_choices, law_name, technique_name
+   public :: keyword_id, keyword_name, keyword_choices, law_id, law_choices, law_name, technique_name
    public :: default_u0, default_v0, default_xi, default_period, default_rayleigh_a0, default_rayleigh_a1
    public :: default_n_devices, default_eps, default_eps1, default_f
    public :: default_ramp_cycles, default_record_kind, default_record_scale
@@ -217,6 +217,16 @@ contains
       id = 0
    end function keyword_id
 
+   !> The keyword of an id in its table ('unknown' for an id not in it), left-adjusted.
+   pure function keyword_name(table, id) result(name)
+      type(keyword_type), intent(in) :: table(:)  !! the keyword table
+      integer, intent(in) :: id                   !! the id (position in the table)
+      character(len=keyword_len) :: name          !! its keyword
+
+      name = 'unknown'
+      if (id >= 1 .and. id <= size(table)) name = table(id)%name
+   end function keyword_name
+
    !> Id of a friction law from its name; 0 for an unknown name.
    pure integer function law_id(word) result(id)
       character(len=*), intent(in) :: word  !! the word of the deck
@@ -312,8 +322,7 @@ contains
       integer, intent(in) :: technique          !! technique id
       character(len=keyword_len) :: name        !! its name, left-adjusted
 
-      name = 'unknown'
-      if (technique >= 1 .and. technique <= size(techniques)) name = techniques(technique)%name
+      name = keyword_name(techniques, technique)
    end function technique_name
 
 end module fd_names

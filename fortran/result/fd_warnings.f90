@@ -192,8 +192,9 @@ contains
    !> stick ringing, band alternation): its key, its verdict (when `checked`: 'unresolved'
    !> when a value is above `limit`), and (when it applies) the figures `what` (the DOF or
    !> device of the largest value, d; 0 when the check does not apply) and that value under
-   !> the name `name`, then the step dt1 [s] when given (a DOF's step error).
-   pure subroutine largest_check(c, key, checked, limit, values, what, name, d, dt1)
+   !> the name `name`, then the step dt1 [s] when given (a DOF's step error); with `more`, when
+   !> it warns, how many others are above `limit` (the figure more_devices).
+   pure subroutine largest_check(c, key, checked, limit, values, what, name, d, dt1, more)
       type(check_type), intent(out) :: c                 !! the check
       character(len=*), intent(in) :: key                !! its key
       logical, intent(in) :: checked                     !! the check applies
@@ -203,9 +204,11 @@ contains
       character(len=*), intent(in) :: name               !! the values' summary key
       integer, intent(out) :: d                          !! the DOF or device of the largest value
       real(dp), intent(in), optional :: dt1              !! the step judged [s]
+      integer, intent(out), optional :: more             !! the others above limit (0 unless it warns)
       logical :: beyond
 
       d = 0
+      if (present(more)) more = 0
       c%key = key
       beyond = .false.
       if (allocated(values)) beyond = any(values > limit)
@@ -216,6 +219,9 @@ contains
       call add_figure(c, what, real(d, dp))
       call add_figure(c, name, values(d))
       if (present(dt1)) call add_figure(c, 'dt1_s', dt1)
+      if (.not. present(more) .or. c%verdict /= verdict_warns) return
+      more = count(values > limit) - 1
+      call add_figure(c, 'more_devices', real(more, dp))
    end subroutine largest_check
 
    !> Whether dt1 resolves a harmonic table motion's steady state (fd_harmonic_resolution).
@@ -259,12 +265,10 @@ contains
       integer :: d, more
 
       call largest_check(c, 'stick_resolution', res%stick_checked, 1.0_dp, res%stick_ringing_ratio, 'device', &
-                         'stick_ringing_ratio', d)
+                         'stick_ringing_ratio', d, more=more)
       if (c%verdict /= verdict_warns .or. d == 0) return
-      more = count(res%stick_ringing_ratio > 1.0_dp) - 1
       call add_figure(c, 'stick_ringing_N', res%stick_ringing(d))
       call add_figure(c, 'stick_margin_N', res%stick_margin(d))
-      call add_figure(c, 'more_devices', real(more, dp))
       c%warning = 'the sticking spring of device '//trim(fmt_int(d))//' rings with '// &
                   trim(es(res%stick_ringing(d), 3))//' N against a margin of '//trim(es(res%stick_margin(d), 3))// &
                   ' N, dephased by dt1 (stick_ringing_ratio = '//trim(fx(res%stick_ringing_ratio(d), 2))//' > 1'// &
@@ -279,11 +283,9 @@ contains
       integer :: d, more
 
       call largest_check(c, 'band_resolution', res%band_checked, 0.0_dp, res%band_alternation, 'device', &
-                         'band_alternation_N', d)
+                         'band_alternation_N', d, more=more)
       if (c%verdict /= verdict_warns .or. d == 0) return
-      more = count(res%band_alternation > 0.0_dp) - 1
       call add_figure(c, 'band_x', res%band_x(d))
-      call add_figure(c, 'more_devices', real(more, dp))
       if (res%band_x(d) > 1.0_dp) then
          s = 'raise n1 until dt1 < '//trim(es(step_of(res)/res%band_x(d), 3))//' s or widen eps'
       else

@@ -3,7 +3,7 @@
 module test_fd_names
    use testdrive, only: new_unittest, unittest_type, error_type, check
    use fd_names, only: laws, techniques, damping_types, excitation_types, record_kinds, keyword_type, &
-                       keyword_id, keyword_choices, law_id, law_choices, law_name, technique_name, &
+                       keyword_id, keyword_name, keyword_choices, law_id, law_choices, law_name, technique_name, &
                        law_velocity, law_hysteretic, law_coulomb, damping_rayleigh, technique_event_driven
    use fd_textio, only: lower
    implicit none
@@ -91,7 +91,12 @@ contains
             call check(error, keyword_id(table, table(j)%name) == j .and. lower(table(j)%name) == table(j)%name, &
                        what//": "//trim(table(j)%name))
             if (allocated(error)) return
+            call check(error, keyword_id(table, keyword_name(table, j)) == j, what//": the name of id "// &
+                       trim(table(j)%name))
+            if (allocated(error)) return
          end do
+         call check(error, keyword_name(table, 0) == 'unknown' .and. keyword_name(table, size(table) + 1) == 'unknown', &
+                    what//": ids outside the table")
       end subroutine unique
    end subroutine test_tables
 

@@ -83,8 +83,12 @@ contains
 
    subroutine test_units(error)
       type(error_type), allocatable, intent(out) :: error
+      ! the rest of record_units_list: displacements first
+      character(len=5), parameter :: known(6) = [character(len=5) :: 'm', 'mm', 'cm', 'gal', 'mm/s2', 'm/s2']
+      real(dp), parameter :: factor(6) = [1.0_dp, 1.0e-3_dp, 0.01_dp, 0.01_dp, 1.0e-3_dp, 1.0_dp]
       real(dp) :: f
       logical :: ok
+      integer :: k
       call units_factor('g', .false., f, ok)
       call check(error, ok .and. f == standard_gravity .and. f == 9.80665_dp, 'g')
       if (allocated(error)) return
@@ -99,6 +103,17 @@ contains
       if (allocated(error)) return
       call units_factor('m', .false., f, ok)
       call check(error, .not. ok, 'm is not an acceleration unit')
+      if (allocated(error)) return
+      do k = 1, size(known)
+         call units_factor(trim(known(k)), k <= 3, f, ok)
+         call check(error, ok .and. f == factor(k), trim(known(k)))
+         if (allocated(error)) return
+      end do
+      call units_factor('cm/s', .false., f, ok)
+      call check(error, .not. ok, 'cm/s is no unit of a record')
+      if (allocated(error)) return
+      call units_factor('m/s2 per', .false., f, ok)
+      call check(error, .not. ok, 'a unit is the whole word')
    end subroutine test_units
 
    !> Line 4 of an AT2 file: the PEER spellings read, tabs as blanks; a key given twice and

@@ -6,7 +6,8 @@ module test_fd_warnings
    use testdrive, only: new_unittest, unittest_type, error_type, check
    use fd_kinds, only: dp
    use fd_result, only: result_type, record_system_both
-   use fd_warnings, only: warning_text, run_warnings
+   use fd_warnings, only: warning_text, run_warnings, run_checks, n_checks
+   use fd_check, only: check_type, figure_of
    implicit none
    private
 
@@ -62,6 +63,9 @@ contains
       type(error_type), allocatable, intent(out) :: error
       type(result_type) :: res
       type(warning_text), allocatable :: w(:)
+      type(check_type) :: checks(n_checks)
+      real(dp) :: device, more
+      logical :: found
 
       res%band_checked = .true.
       res%newmark%ran = .true.
@@ -75,6 +79,14 @@ contains
       call check(error, w(1)%text, 'the force of device 3 alternates step to step in its band '// &
                  '(band_alternation_N = +-2.500E+00 N, x = 4.000E+00, 1 more device(s)): raise n1 until '// &
                  'dt1 < 2.500E-03 s or widen eps; see docs/warnings.md#band-alternation')
+      if (allocated(error)) return
+      ! the check record carries the device, its figures and the count of the others
+      call run_checks(res, checks)
+      call figure_of(checks(7), 'device', device, found)
+      call check(error, found .and. device == 3.0_dp, "figure 'device' of band_resolution")
+      if (allocated(error)) return
+      call figure_of(checks(7), 'more_devices', more, found)
+      call check(error, found .and. more == 1.0_dp, "figure 'more_devices' of band_resolution")
    end subroutine test_band
 
    !> A ratio of 0.0734 dissipated (7.3 %), or -0.0734 created, against the limit 0.05.

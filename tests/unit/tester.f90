@@ -16,6 +16,7 @@ program tester
    use test_fd_excitation, only: collect_excitation
    use test_fd_lcp, only: collect_lcp
    use test_fd_textio, only: collect_textio
+   use test_fd_sort, only: collect_sort
    use test_fd_names, only: collect_names
    use test_fd_technique, only: collect_technique
    use test_fd_root_finder, only: collect_root_finder
@@ -72,6 +73,7 @@ program tester
    testsuites = [testsuites, new_testsuite("excitation", collect_excitation)]
    testsuites = [testsuites, new_testsuite("lcp", collect_lcp)]
    testsuites = [testsuites, new_testsuite("textio", collect_textio)]
+   testsuites = [testsuites, new_testsuite("sort", collect_sort)]
    testsuites = [testsuites, new_testsuite("names", collect_names)]
    testsuites = [testsuites, new_testsuite("technique", collect_technique)]
    testsuites = [testsuites, new_testsuite("root_finder", collect_root_finder)]
