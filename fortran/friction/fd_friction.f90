@@ -103,33 +103,42 @@ contains
 
    ! ---------------------------------------------------------------- what a device of it is
 
-   !> The sticking spring of a device [N/m]: k = P mu / f of a hysteretic device with P mu > 0
-   !> (eq. 3); 0 for the others (a velocity-law device sticks through a dashpot, a Coulomb one
-   !> rigidly). The stuck system's modes and stiffness, the step limits, the step checks and
-   !> the stick ringing take it from here.
+   !> The sticking spring of a device [N/m]: k = P mu / f of a device whose law sticks through
+   !> a spring (traits stuck_spring: the hysteretic law, eq. 3); 0 for the others (a
+   !> velocity-law device sticks through a dashpot, a Coulomb one rigidly). The stuck system's
+   !> modes and stiffness, the step limits, the step checks and the stick ringing take it from here.
    elemental real(dp) function sticking_stiffness(dev) result(k)
+      type(device_type), intent(in) :: dev   !! the device
+
+      k = 0.0_dp
+      if (law_stuck(dev%law) == stuck_spring) k = sticking_coupling(dev)
+   end function sticking_stiffness
+
+   !> The sticking dashpot of a device [N s/m]: the band coupling P mu(eps) / eps of a device
+   !> whose law sticks through a dashpot (traits stuck_dashpot: the velocity law, eq. 6); 0
+   !> for the others.
+   elemental real(dp) function sticking_damping(dev) result(c)
+      type(device_type), intent(in) :: dev   !! the device
+
+      c = 0.0_dp
+      if (law_stuck(dev%law) == stuck_dashpot) c = sticking_coupling(dev)
+   end function sticking_damping
+
+   !> The coupling through which a sticking device holds, of the kind its law's traits say
+   !> (law_stuck): the hysteretic law's spring [N/m], the velocity law's band dashpot [N s/m];
+   !> 0 for a law that sticks rigidly or has no case.
+   elemental real(dp) function sticking_coupling(dev) result(x)
       type(device_type), intent(in) :: dev   !! the device
 
       select case (dev%law)
       case (law_hysteretic)
-         k = hysteretic_stiffness(dev)
-      case default
-         k = 0.0_dp
-      end select
-   end function sticking_stiffness
-
-   !> The sticking dashpot of a device [N s/m]: the velocity law's band coupling
-   !> P mu(eps) / eps (eq. 6); 0 for the others.
-   elemental real(dp) function sticking_damping(dev) result(c)
-      type(device_type), intent(in) :: dev   !! the device
-
-      select case (dev%law)
+         x = hysteretic_stiffness(dev)
       case (law_velocity)
-         c = velocity_damping(dev)
+         x = velocity_damping(dev)
       case default
-         c = 0.0_dp
+         x = 0.0_dp
       end select
-   end function sticking_damping
+   end function sticking_coupling
 
    !> Whether a device holds its nodes together while it sticks (a link of the stuck system,
    !> or its spring): each law says (a velocity-law device through P mu(eps) > 0, the others

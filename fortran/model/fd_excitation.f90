@@ -7,7 +7,9 @@
 !> or zero (forcing_form, table_sines, ramp_end).
 module fd_excitation
    use fd_kinds, only: dp
+   use fd_error, only: error_type, fatal_error
    use fd_names, only: excitation_none, excitation_harmonic, excitation_record
+   use fd_model, only: model_type
    implicit none
    private
 
@@ -16,6 +18,7 @@ module fd_excitation
    public :: excitation_none, excitation_harmonic, excitation_record
    public :: sine_forcing, max_sines, table_sines, segment_end, table_taylor, forcing_frequency
    public :: forcing_form, forcing_unknown, forcing_zero, forcing_sines, forcing_linear
+   public :: second_table_motion
 
    real(dp), parameter :: pi = acos(-1.0_dp)
 
@@ -171,6 +174,32 @@ contains
       end if
       ag = grid%amp*(grid%sb*grid%cj(j) + grid%cb*grid%sj(j))
    end subroutine grid_acceleration
+
+   !> A time-step loop's second horizontal component exc2 (absent, or of kind none: none): on
+   !> when it moves the table, then the technique's copy of it (exc) and its load mr2 = M r2 of
+   !> a unit of it (r2 the model's influence2). An error when the model gives no direction of
+   !> it, or one the technique cannot take (takes: .false.).
+   subroutine second_table_motion(model, takes, on, exc, mr2, error, exc2)
+      type(model_type), intent(in) :: model         !! the model
+      logical, intent(in) :: takes                  !! the technique takes the model's r2
+      logical, intent(out) :: on                    !! a second component moves the table
+      type(excitation_type), intent(inout) :: exc   !! then exc2
+      real(dp), allocatable, intent(inout) :: mr2(:) !! then M r2
+      type(error_type), allocatable, intent(out) :: error !! no direction of it
+      type(excitation_type), intent(in), optional :: exc2 !! the second component
+
+      on = .false.
+      if (.not. present(exc2)) return
+      if (exc2%kind == excitation_none) return
+      if (.not. (allocated(model%influence2) .and. takes)) then
+         call fatal_error(error, "a second horizontal component needs the model's direction of it "// &
+                          "(a building of rigid floors, &floors, or influence2 of &matrices)")
+         return
+      end if
+      on = .true.
+      exc = exc2
+      mr2 = model%mass*model%influence2
+   end subroutine second_table_motion
 
    !> End of the cosine ramp of harmonic table motion, t_r = ramp_cycles / frequency [s].
    pure real(dp) function ramp_end(exc)

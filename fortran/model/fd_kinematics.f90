@@ -106,29 +106,14 @@ contains
 
    !> s = b' u and s' = b' v of every device, for a time-step loop: explicit shapes (no
    !> array descriptor is made per call, which for a model of one device costs as much as
-   !> the sums), and devices between two nodes by their nodes, as differences.
+   !> the sums). (Newmark's step takes devices that all join two nodes by their nodes.)
    pure subroutine relative_motion(model, n, nd, u, v, s, sd)
       type(model_type), intent(in) :: model   !! the model
       integer, intent(in) :: n, nd            !! DOFs and devices
       real(dp), intent(in) :: u(n), v(n)      !! displacements [m] and velocities [m/s]
       real(dp), intent(out) :: s(nd), sd(nd)  !! relative displacements and velocities
-      integer :: d, i, j
 
-      if (.not. allocated(model%dev_nodes)) then
-         call relative_kernel(nd, model%dev_ptr, model%dev_dof, model%dev_coef, u, v, s, sd)
-         return
-      end if
-      do d = 1, nd
-         i = model%dev_nodes(1, d)
-         j = model%dev_nodes(2, d)
-         if (j > 0) then
-            s(d) = u(i) - u(j)
-            sd(d) = v(i) - v(j)
-         else
-            s(d) = u(i)
-            sd(d) = v(i)
-         end if
-      end do
+      call relative_kernel(nd, model%dev_ptr, model%dev_dof, model%dev_coef, u, v, s, sd)
    end subroutine relative_motion
 
    !> y = y + sum_d f_d b_d, for a time-step loop (as relative_motion).
@@ -137,18 +122,8 @@ contains
       integer, intent(in) :: n, nd            !! DOFs and devices
       real(dp), intent(in) :: f(nd)           !! force of each device [N]
       real(dp), intent(inout) :: y(n)         !! vector over the DOFs
-      integer :: d, i, j
 
-      if (.not. allocated(model%dev_nodes)) then
-         call force_kernel(nd, model%dev_ptr, model%dev_dof, model%dev_coef, f, y)
-         return
-      end if
-      do d = 1, nd
-         i = model%dev_nodes(1, d)
-         j = model%dev_nodes(2, d)
-         y(i) = y(i) + f(d)
-         if (j > 0) y(j) = y(j) - f(d)
-      end do
+      call force_kernel(nd, model%dev_ptr, model%dev_dof, model%dev_coef, f, y)
    end subroutine device_forces
 
    !> device_kinematics' loop on plain arrays; each sum starts from the first term.

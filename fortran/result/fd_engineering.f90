@@ -26,7 +26,7 @@ module fd_engineering
    private
 
    public :: engineering_type, engineering_init, storey_values, observe_engineering, engineering_columns
-   public :: observe_storey_peak, observe_floor_accelerations, observe_floor_peaks
+   public :: observe_storey_peak, observe_floor_accelerations
 
    !> The engineering outputs of a run.
    type :: engineering_type
@@ -55,16 +55,14 @@ module fd_engineering
       integer, allocatable :: dv_first(:)       !! (0:n_storeys+1): devices of cut c
       integer, allocatable :: dv_id(:)          !! device indices
       real(dp), allocatable :: dv_sign(:)       !! +1 or -1 along the cut
-      ! a general model (stiffness K_x, devices of any direction): the base shear along the
-      ! table motion r is r' (K u + a1 K v) + sum_d (b_d' r) F_d, the forces every element
-      ! passes to the table (an element inside the structure passes none: b' r = 0)
-      logical :: general = .false.              !! the base shear from kr and br
-      real(dp), allocatable :: kr(:)            !! (n_dof) K r [N/m]
-      real(dp), allocatable :: br(:)            !! (n_devices) b_d' r [-]
       real(dp), allocatable :: r(:)             !! (n_dof) r, when the model gives one [-]
       real(dp), allocatable :: r2(:)            !! (n_dof) r2 of a second component, if any [-]
-      ! the storey forces that are no element between the storey's two nodes (rigid floors'
-      ! frames and braces), by storey: xs_first(c):xs_first(c+1)-1 and xd_first likewise
+      ! the cut forces that are no element between the cut's two nodes, by cut (0:n_storeys+1):
+      ! xs_first(c):xs_first(c+1)-1 and xd_first likewise. A storey's: rigid floors' frames
+      ! and braces. The base's, of a general model (stiffness K_x, devices of any direction):
+      ! along the table motion r, r' (K u + a1 K v) + sum_d (b_d' r) F_d, the forces every
+      ! element passes to the table (one inside the structure passes none: b' r = 0), as the
+      ! terms (i, (K r)_i) and (d, b_d' r); its springs and devices are then not listed
       integer, allocatable :: xs_first(:), xs_dof(:), xd_first(:), xd_dev(:)
       real(dp), allocatable :: xs_coef(:), xd_coef(:)
       ! a building of rigid floors: the drift of each storey along its axis at the four plan
@@ -124,6 +122,7 @@ contains
       type(error_type), allocatable, intent(out) :: error !! eigenvalue solver failure
       real(dp), allocatable :: k(:, :), c(:, :)
       integer :: n, nd, ns, i, s, stat
+      logical :: general
 
       n = model%n_dof
       nd = model%n_devices
@@ -189,14 +188,9 @@ contains
       end do
       if (allocated(model%influence)) eng%r = model%influence
       if (allocated(model%influence2)) eng%r2 = model%influence2
-      if (model%n_kx > 0 .or. .not. devices_are_pairs(model)) then
-         call general_base(model, eng, stat)
-         if (stat /= 0) then
-            call no_memory('the base shear'); return
-         end if
-      end if
-      call storey_elements(model, eng, stat)
-      if (stat == 0 .and. allocated(model%xs_storey)) call storey_extras(model, eng, stat)
+      general = model%n_kx > 0 .or. .not. devices_are_pairs(model)
+      call storey_elements(model, eng, general, stat)
+      if (stat == 0 .and. (general .or. allocated(model%xs_storey))) call cut_extras(model, eng, general, stat)
       if (stat == 0 .and. model%n_floors > 0) call floor_corners(model, eng, stat)
       if (stat == 0 .and. model%n_floors > 0) call floor_outputs(model, eng, stat)
       if (stat /= 0) then
@@ -220,10 +214,12 @@ contains
    end subroutine engineering_init
 
    !> The springs and devices of every cut (0 = the base, 1..n_storeys the storeys), with
-   !> their sign along the cut, in compressed lists.
-   subroutine storey_elements(model, eng, stat)
+   !> their sign along the cut, in compressed lists (none at the base of a general model,
+   !> whose base is cut_extras').
+   subroutine storey_elements(model, eng, general, stat)
       type(model_type), intent(in) :: model
       type(engineering_type), intent(inout) :: eng
+      logical, intent(in) :: general               !! a general model
       integer, intent(out) :: stat                 !! not 0: not enough memory
       integer :: ns, cut, e, a, b, nsp, ndv
       real(dp) :: sgn
@@ -273,6 +269,7 @@ contains
          integer, intent(in) :: cut, a, b
          sgn = 0.0_dp
          if (cut == 0) then
+            if (general) return
             if (b == 0) sgn = 1.0_dp
             if (a == 0) sgn = -1.0_dp
          else if (a == eng%storey_i(cut) .and. b == eng%storey_j(cut)) then
@@ -282,23 +279,6 @@ contains
          end if
       end function on_cut
    end subroutine storey_elements
-
-   !> The base of a general model: K r and b_d' r (r the table motion's direction).
-   subroutine general_base(model, eng, stat)
-      type(model_type), intent(in) :: model
-      type(engineering_type), intent(inout) :: eng
-      integer, intent(out) :: stat                 !! not 0: not enough memory
-      real(dp), allocatable :: r(:)
-      integer :: i
-
-      allocate (r(model%n_dof), eng%kr(model%n_dof), eng%br(model%n_devices), stat=stat)
-      if (stat /= 0) return
-      do i = 1, model%n_dof
-         r(i) = influence_of(model, i)
-      end do
-      call base_along(model, r, eng%kr, eng%br)
-      eng%general = .true.
-   end subroutine general_base
 
    !> The forces the elements pass to the table along a motion t of the DOFs: K t (the
    !> springs' and K_x's) and b_d' t of every device.
@@ -324,13 +304,20 @@ contains
       real(dp), intent(out) :: drift(:)          !! (n_storeys) drift [m]
       real(dp), intent(out) :: shear(:)          !! (n_storeys) storey shear [N]
       real(dp), intent(out) :: base              !! base shear [N]
+      real(dp) :: f
       integer :: s
 
-      do s = 1, eng%n_storeys
-         drift(s) = storey_drift(eng, s, u)
-         shear(s) = cut_force(eng, s, u, v, force)
+      ! the base (cut 0) and every storey in one loop: one call of cut_force here, which the
+      ! per-step observer's inlining of it asks
+      do s = 0, eng%n_storeys
+         f = cut_force(eng, s, u, v, force)
+         if (s == 0) then
+            base = f
+         else
+            drift(s) = storey_drift(eng, s, u)
+            shear(s) = f
+         end if
       end do
-      base = cut_force(eng, 0, u, v, force)
    end subroutine storey_values
 
    !> Drift of storey s, u(node_i) - u(node_j) (node 0: the table).
@@ -348,28 +335,15 @@ contains
    end function storey_drift
 
    !> The force across cut `cut` (0: the base): the springs' (elastic and stiffness-damping)
-   !> and the devices' crossing it.
+   !> and the devices' crossing it, and the cut's forces beyond its elements (xs_*, xd_*).
    pure real(dp) function cut_force(eng, cut, u, v, force) result(f)
       type(engineering_type), intent(in) :: eng  !! the set-up outputs
       integer, intent(in) :: cut                 !! 0 (base) .. n_storeys
-      real(dp), intent(in) :: u(:)               !! relative displacements [m]
-      real(dp), intent(in) :: v(:)               !! relative velocities [m/s]
-      real(dp), intent(in) :: force(:)           !! device forces [N]
-      if (cut == 0 .and. eng%general) then
-         f = general_base_force(eng, u, v, force)
-      else
-         f = element_cut_force(eng, cut, u, v, force)
-      end if
-   end function cut_force
-
-   !> cut_force by the elements crossing the cut: its springs, its devices and (not the base)
-   !> the storey's forces beyond them; the base of a general model is general_base_force's.
-   pure real(dp) function element_cut_force(eng, cut, u, v, force) result(f)
-      type(engineering_type), intent(in) :: eng  !! the set-up outputs
-      integer, intent(in) :: cut                 !! 0 (base) .. n_storeys
-      real(dp), intent(in) :: u(:)               !! relative displacements [m]
-      real(dp), intent(in) :: v(:)               !! relative velocities [m/s]
-      real(dp), intent(in) :: force(:)           !! device forces [N]
+      ! (assumed sizes: the per-step observer calls it for every cut, and a call that builds
+      ! three array descriptors costs a two-mass model more than its base's two springs)
+      real(dp), intent(in) :: u(*)               !! relative displacements [m]
+      real(dp), intent(in) :: v(*)               !! relative velocities [m/s]
+      real(dp), intent(in) :: force(*)           !! device forces [N]
       real(dp) :: du, dv
       integer :: e, i, j
 
@@ -392,58 +366,71 @@ contains
       do e = eng%dv_first(cut), eng%dv_first(cut + 1) - 1
          f = f + eng%dv_sign(e)*force(eng%dv_id(e))
       end do
-      if (.not. allocated(eng%xs_first) .or. cut == 0) return
+      if (.not. allocated(eng%xs_first)) return
       do e = eng%xs_first(cut), eng%xs_first(cut + 1) - 1
          f = f + eng%xs_coef(e)*(u(eng%xs_dof(e)) + eng%a1*v(eng%xs_dof(e)))
       end do
       do e = eng%xd_first(cut), eng%xd_first(cut + 1) - 1
          f = f + eng%xd_coef(e)*force(eng%xd_dev(e))
       end do
-   end function element_cut_force
+   end function cut_force
 
-   !> The base shear of a general model (kr, br: general_base), apart from cut_force, whose
-   !> springs' and devices' sums run at every accepted step.
-   pure real(dp) function general_base_force(eng, u, v, force) result(f)
-      type(engineering_type), intent(in) :: eng  !! the set-up outputs
-      real(dp), intent(in) :: u(:)               !! relative displacements [m]
-      real(dp), intent(in) :: v(:)               !! relative velocities [m/s]
-      real(dp), intent(in) :: force(:)           !! device forces [N]
-      integer :: i, e
-
-      f = 0.0_dp
-      do i = 1, size(u)
-         f = f + eng%kr(i)*(u(i) + eng%a1*v(i))
-      end do
-      do e = 1, size(force)
-         f = f + eng%br(e)*force(e)
-      end do
-   end function general_base_force
-
-   !> The model's storey forces beyond its storeys' elements (xs_*, xd_*), by storey.
-   subroutine storey_extras(model, eng, stat)
+   !> The cut forces beyond the cuts' elements (xs_*, xd_*), by cut: the base's of a general
+   !> model (general: K r and b_d' r, r the table motion's direction), then the model's storey
+   !> forces beyond its storeys' elements.
+   subroutine cut_extras(model, eng, general, stat)
       type(model_type), intent(in) :: model
       type(engineering_type), intent(inout) :: eng
+      logical, intent(in) :: general               !! a general model
       integer, intent(out) :: stat                 !! not 0: not enough memory
+      real(dp), allocatable :: r(:), kr(:), br(:)
+      integer :: i, n, nd
 
-      call by_storey(eng%n_storeys, model%xs_storey, model%xs_dof, model%xs_coef, eng%xs_first, eng%xs_dof, &
+      n = 0
+      nd = 0
+      if (general) then
+         n = model%n_dof
+         nd = model%n_devices
+      end if
+      allocate (r(model%n_dof), kr(n), br(nd), stat=stat)
+      if (stat /= 0) return
+      if (general) then
+         do i = 1, n
+            r(i) = influence_of(model, i)
+         end do
+         call base_along(model, r, kr, br)
+      end if
+      if (allocated(model%xs_storey)) then
+         call by_cut(eng%n_storeys, model%xs_storey, model%xs_dof, model%xs_coef, kr, eng%xs_first, eng%xs_dof, &
                      eng%xs_coef, stat)
-      if (stat == 0) call by_storey(eng%n_storeys, model%xd_storey, model%xd_dev, model%xd_coef, eng%xd_first, &
+         if (stat == 0) call by_cut(eng%n_storeys, model%xd_storey, model%xd_dev, model%xd_coef, br, eng%xd_first, &
                                     eng%xd_dev, eng%xd_coef, stat)
-   end subroutine storey_extras
+      else
+         call by_cut(eng%n_storeys, [integer ::], [integer ::], [real(dp) ::], kr, eng%xs_first, eng%xs_dof, &
+                     eng%xs_coef, stat)
+         if (stat == 0) call by_cut(eng%n_storeys, [integer ::], [integer ::], [real(dp) ::], br, eng%xd_first, &
+                                    eng%xd_dev, eng%xd_coef, stat)
+      end if
+   end subroutine cut_extras
 
-   !> Entries (storey, index, coefficient) sorted by storey: those of storey c at
-   !> first(c):first(c+1)-1 of idx and coef.
-   pure subroutine by_storey(ns, storey, index, coefficient, first, idx, coef, stat)
+   !> Entries by cut: the base's coefficients base(1:nb) of indices 1..nb at first(0):first(1)-1
+   !> of idx and coef, then the storeys' (storey, index, coefficient) sorted by storey, those
+   !> of storey c at first(c):first(c+1)-1.
+   pure subroutine by_cut(ns, storey, index, coefficient, base, first, idx, coef, stat)
       integer, intent(in) :: ns, storey(:), index(:)
-      real(dp), intent(in) :: coefficient(:)
+      real(dp), intent(in) :: coefficient(:), base(:)
       integer, allocatable, intent(out) :: first(:), idx(:)
       real(dp), allocatable, intent(out) :: coef(:)
       integer, intent(out) :: stat
       integer :: c, e, k
 
-      allocate (first(ns + 1), idx(size(storey)), coef(size(storey)), stat=stat)
+      allocate (first(0:ns + 1), idx(size(base) + size(storey)), coef(size(base) + size(storey)), stat=stat)
       if (stat /= 0) return
-      k = 0
+      first(0) = 1
+      do k = 1, size(base)
+         idx(k) = k; coef(k) = base(k)
+      end do
+      k = size(base)
       do c = 1, ns
          first(c) = k + 1
          do e = 1, size(storey)
@@ -453,13 +440,13 @@ contains
          end do
       end do
       first(ns + 1) = k + 1
-   end subroutine by_storey
+   end subroutine by_cut
 
    !> One accepted state: drifts and shears, their peaks, and the values kept as the
-   !> residual ones (those of the last state observed). Runs at every accepted step: the
-   !> values go straight into the peaks (no array sections passed, no temporaries). A
-   !> building of rigid floors adds observe_floor_peaks (the observer calls it beside this
-   !> one: a call in here cost a two-mass model's every step the registers it saves).
+   !> residual ones (those of the last state observed); a building of rigid floors, its base
+   !> shears along x, y and the base torque (kt, bt), and each storey's largest corner drift.
+   !> Runs at every accepted step: the values go straight into the peaks (no array sections
+   !> passed, no temporaries).
    pure subroutine observe_engineering(eng, t, n, nd, u, v, s, force)
       type(engineering_type), intent(inout) :: eng  !! the outputs
       real(dp), intent(in) :: t                     !! time [s]
@@ -470,69 +457,30 @@ contains
       real(dp), intent(in) :: s(nd)                 !! device relative displacements [m]
       real(dp), intent(in) :: force(nd)             !! device forces [N]
       real(dp) :: x
-      integer :: i, first
+      integer :: i, c, k
 
       if (.not. allocated(eng%drift)) return
       do i = 1, nd
          eng%residual_s(i) = s(i)
       end do
       do i = 1, eng%n_storeys
-         x = storey_drift(eng, i, u)
-         eng%drift(i) = x
-         if (abs(x) > eng%peak_drift(i)) then
-            eng%peak_drift(i) = abs(x); eng%peak_drift_time(i) = t
-         end if
+         call track(storey_drift(eng, i, u), t, eng%drift(i), eng%peak_drift(i), eng%peak_drift_time(i))
       end do
-      ! cut_force's cuts: a general model's base before the loop, every other cut by its
-      ! elements (the test of the base in the loop cost a two-mass model 1 % of its run)
-      first = 0
-      if (eng%general) then
-         x = general_base_force(eng, u, v, force)
-         eng%shear(0) = x
-         if (abs(x) > eng%peak_shear(0)) then
-            eng%peak_shear(0) = abs(x); eng%peak_shear_time(0) = t
-         end if
-         first = 1
-      end if
-      do i = first, eng%n_storeys
-         x = element_cut_force(eng, i, u, v, force)
-         eng%shear(i) = x
-         if (abs(x) > eng%peak_shear(i)) then
-            eng%peak_shear(i) = abs(x); eng%peak_shear_time(i) = t
-         end if
+      do i = 0, eng%n_storeys
+         call track(cut_force(eng, i, u, v, force), t, eng%shear(i), eng%peak_shear(i), eng%peak_shear_time(i))
       end do
-   end subroutine observe_engineering
-
-   !> The peaks of a building of rigid floors at one accepted state: the base shears along
-   !> x, y and the base torque (kt, bt), and each storey's largest corner drift (apart from
-   !> observe_engineering, which runs them only for such a building).
-   pure subroutine observe_floor_peaks(eng, t, n, nd, u, v, force)
-      type(engineering_type), intent(inout) :: eng  !! the outputs
-      real(dp), intent(in) :: t                     !! time [s]
-      integer, intent(in) :: n                      !! DOFs
-      integer, intent(in) :: nd                     !! devices
-      real(dp), intent(in) :: u(n)                  !! relative displacements [m]
-      real(dp), intent(in) :: v(n)                  !! relative velocities [m/s]
-      real(dp), intent(in) :: force(nd)             !! device forces [N]
-      real(dp) :: x
-      integer :: i, c, k
-
-      if (allocated(eng%kt)) then
-         do c = 1, 3
-            x = 0.0_dp
-            do i = 1, n
-               x = x + eng%kt(i, c)*(u(i) + eng%a1*v(i))
-            end do
-            do i = 1, nd
-               x = x + eng%bt(i, c)*force(i)
-            end do
-            eng%base3(c) = x
-            if (abs(x) > eng%peak_base3(c)) then
-               eng%peak_base3(c) = abs(x); eng%peak_base3_time(c) = t
-            end if
+      ! a building of rigid floors (kt, bt and the corners are set up with its floors)
+      if (eng%n_floors == 0) return
+      do c = 1, 3
+         x = 0.0_dp
+         do i = 1, n
+            x = x + eng%kt(i, c)*(u(i) + eng%a1*v(i))
          end do
-      end if
-      if (.not. allocated(eng%peak_corner)) return
+         do i = 1, nd
+            x = x + eng%bt(i, c)*force(i)
+         end do
+         call track(x, t, eng%base3(c), eng%peak_base3(c), eng%peak_base3_time(c))
+      end do
       do i = 1, eng%n_storeys
          if (.not. eng%has_corners(i)) cycle
          do c = 1, 4
@@ -541,13 +489,35 @@ contains
             do k = 1, 4
                x = x + eng%corner_coef(k, c, i)*u(eng%corner_dof(k, c, i))
             end do
-            x = abs(x)
-            if (x > eng%peak_corner(i)) then
-               eng%peak_corner(i) = x; eng%peak_corner_time(i) = t
-            end if
+            call peak_at(abs(x), t, eng%peak_corner(i), eng%peak_corner_time(i))
          end do
       end do
-   end subroutine observe_floor_peaks
+   end subroutine observe_engineering
+
+   !> A quantity's value x at the accepted time t: kept as its last value, and its magnitude
+   !> into its peak (and the peak's time) when it exceeds it.
+   pure subroutine track(x, t, last, peak, peak_time)
+      real(dp), intent(in) :: x                     !! the value
+      real(dp), intent(in) :: t                     !! its time [s]
+      real(dp), intent(out) :: last                 !! the last value
+      real(dp), intent(inout) :: peak               !! the peak |x| so far
+      real(dp), intent(inout) :: peak_time          !! its time [s]
+
+      last = x
+      call peak_at(abs(x), t, peak, peak_time)
+   end subroutine track
+
+   !> A magnitude y >= 0 at time t into a peak (and the peak's time) when it exceeds it.
+   pure subroutine peak_at(y, t, peak, peak_time)
+      real(dp), intent(in) :: y                     !! the magnitude
+      real(dp), intent(in) :: t                     !! its time [s]
+      real(dp), intent(inout) :: peak               !! the peak so far
+      real(dp), intent(inout) :: peak_time          !! its time [s]
+
+      if (y > peak) then
+         peak = y; peak_time = t
+      end if
+   end subroutine peak_at
 
    !> The plan corners of a building of rigid floors: storey q = 2 s - 2 + a (a = 1 along x,
    !> 2 along y) at the corners (x_s +- l_x / 2, y_s +- l_y / 2) of floor s: the motion of
@@ -715,7 +685,7 @@ contains
       real(dp), intent(in) :: acc(n)                !! relative accelerations [m/s2]
       real(dp), intent(in) :: ag                    !! table acceleration [m/s2]
       real(dp), intent(in), optional :: ag2         !! a second component's [m/s2]
-      real(dp) :: a(3), x
+      real(dp) :: a(3)
       integer :: f, c, i
 
       if (.not. allocated(eng%peak_corner_aabs)) return
@@ -728,10 +698,8 @@ contains
          end do
          do c = 1, 2
             if (eng%half_plan(c, f) <= 0.0_dp) cycle
-            x = abs(a(c)) + abs(a(3))*eng%half_plan(c, f)
-            if (x > eng%peak_corner_aabs(c, f)) then
-               eng%peak_corner_aabs(c, f) = x; eng%peak_corner_aabs_time(c, f) = t
-            end if
+            call peak_at(abs(a(c)) + abs(a(3))*eng%half_plan(c, f), t, eng%peak_corner_aabs(c, f), &
+                         eng%peak_corner_aabs_time(c, f))
          end do
       end do
    end subroutine observe_floor_accelerations
@@ -752,15 +720,11 @@ contains
       else
          s = (q + 1)/2
          if (mod(q, 2) == 1) then
-            if (value > eng%peak_drift(s)) then
-               eng%peak_drift(s) = value; eng%peak_drift_time(s) = t
-            end if
+            call peak_at(value, t, eng%peak_drift(s), eng%peak_drift_time(s))
             return
          end if
       end if
-      if (value > eng%peak_shear(s)) then
-         eng%peak_shear(s) = value; eng%peak_shear_time(s) = t
-      end if
+      call peak_at(value, t, eng%peak_shear(s), eng%peak_shear_time(s))
    end subroutine observe_storey_peak
 
    !> Number of history columns the storeys add: drift and shear per storey and the base

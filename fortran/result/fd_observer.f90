@@ -1,14 +1,14 @@
 !> The observer of a run, one for every technique, and the only writer of the result's
 !> histories, peaks and energies: it sets up the result, keeps the peaks over every accepted
 !> state, samples the history, counts phase transitions and correctness violations, and
-!> closes the energy balance. A technique hands it the state (observe_peaks, observe_sample:
-!> time, table acceleration, u, v, relative acceleration, and per device s, s', F and phase),
-!> the work of each step (observe_work) and of each device's force with the device's slip
-!> travel (observe_device_motion, or added into the observer's device_work and slip_travel
-!> in the technique's own loop over the devices), and, when it knows its solution between
-!> steps, the
-!> exact extrema (observe_extrema, observe_extremum); the stuck system's period it computed is
-!> an argument of observer_init. A new output quantity is a change here (and in the writer),
+!> closes the energy balance. A technique hands it the state (observe_peaks: the
+!> observed_state its workspace extends; observe_sample: time, table acceleration, u, v,
+!> relative acceleration, and per device s, s', F and phase), the planar bearings' normal
+!> forces (observe_bearing_forces), the work of each step (observe_work) and of each device's
+!> force with the device's slip travel (observe_device_motion, or added into the observer's
+!> device_work and slip_travel in the technique's own loop over the devices), and, when it
+!> knows its solution between steps, the exact extrema (observe_extrema, observe_extremum);
+!> the stuck system's period it computed is an argument of observer_init. A new output quantity is a change here (and in the writer),
 !> not in the loops.
 !>
 !> A run's control (fd_run_control), when the technique is given one, says which history
@@ -28,19 +28,36 @@ module fd_observer
    use fd_linalg, only: sym_matvec
    use fd_run_control, only: run_control, cancel_requested, stat_cancelled
    use fd_result, only: history_header
+   use fd_friction_planar, only: normal_force
+   use fd_vertical_support, only: vertical_support, supported_normal_forces
    use fd_engineering, only: engineering_init, observe_engineering, storey_values, observe_storey_peak, &
-                             observe_floor_accelerations, observe_floor_peaks
+                             observe_floor_accelerations
    implicit none
    private
 
-   public :: observer_type, observer_init, sample_due, observe_start, observe_peaks, observe_sample
+   public :: observer_type, observed_state, observer_init, sample_due, observe_start, observe_peaks, observe_sample
    public :: observe_transitions, observe_violations, observe_end, strain_energy
    public :: observe_start_energies, observe_end_energies, observe_poll, observe_stop_error
    public :: observe_extrema, observe_extremum, observe_work, observe_device_motion
-   public :: observe_storeys, observe_normal_forces, observe_flights
+   public :: observe_storeys, observe_normal_forces, observe_flights, observe_bearing_forces
 
    !> Wall-clock time aimed at between two polls that look at the clock [s].
    real(dp), parameter :: poll_target = 0.01_dp
+
+   !> The state of the structure a technique hands the observer at an accepted step (observe_peaks):
+   !> its workspace extends this type, so that the observer reads the technique's own arrays
+   !> through one argument (no copy, no array descriptor built a step).
+   type :: observed_state
+      integer :: n = 0                        !! DOFs
+      integer :: nd = 0                       !! devices
+      real(dp) :: ag = 0.0_dp                 !! table acceleration [m/s2]
+      real(dp) :: ag2 = 0.0_dp                !! a second component's table acceleration (0: none) [m/s2]
+      real(dp), allocatable :: u(:)           !! (n) relative displacements [m]
+      real(dp), allocatable :: v(:)           !! (n) relative velocities [m/s]
+      real(dp), allocatable :: a(:)           !! (n) relative accelerations [m/s2]
+      real(dp), allocatable :: s(:)           !! (nd) device relative displacements [m]
+      real(dp), allocatable :: f(:)           !! (nd) device forces [N]
+   end type observed_state
 
    !> What the observer keeps between calls.
    type :: observer_type
@@ -186,70 +203,56 @@ contains
    end subroutine observe_start_energies
 
    !> Peaks over the accepted states: |u| (and its time), |v|, |absolute acceleration| (and
-   !> its time) per DOF, |s| and |F| per device.
-   pure subroutine observe_peaks(res, t, n, nd, u, v, acc, ag, s, force, ag2)
+   !> its time) per DOF, |s| and |F| per device; the planar bearings', the floors' and the
+   !> storeys' (fd_engineering) at the state x at time t.
+   pure subroutine observe_peaks(res, t, x)
       type(result_type), intent(inout) :: res  !! the result
       real(dp), intent(in) :: t                !! time [s]
-      integer, intent(in) :: n                 !! DOFs
-      integer, intent(in) :: nd                !! devices
-      real(dp), intent(in) :: u(n)             !! relative displacements [m]
-      real(dp), intent(in) :: v(n)             !! relative velocities [m/s]
-      real(dp), intent(in) :: acc(n)           !! relative accelerations [m/s2]
-      real(dp), intent(in) :: ag               !! table acceleration [m/s2]
-      real(dp), intent(in), optional :: ag2    !! a second component's table acceleration [m/s2]
-      real(dp), intent(in) :: s(nd)            !! device relative displacements [m]
-      real(dp), intent(in) :: force(nd)        !! device forces [N]
-      real(dp) :: x
+      type(observed_state), intent(in) :: x    !! the state
+      real(dp) :: y, ri
       integer :: i
-      real(dp) :: ri
       logical :: has_r, has_r2
 
-      ! (explicit shapes: this runs at every accepted step, and a call that builds array
-      ! descriptors costs more than a two-mass model's peaks)
       has_r = allocated(res%eng%r)
-      has_r2 = present(ag2)
-      if (has_r2) has_r2 = allocated(res%eng%r2)
+      has_r2 = allocated(res%eng%r2)
       if (.not. (has_r .or. has_r2)) then
          ! every DOF along the table motion (r_i = 1), one component: the loop without the
          ! directions' tests (the paper's models)
-         do i = 1, n
-            if (abs(u(i)) > res%peak_u(i)) then
-               res%peak_u(i) = abs(u(i)); res%peak_u_time(i) = t
+         do i = 1, x%n
+            if (abs(x%u(i)) > res%peak_u(i)) then
+               res%peak_u(i) = abs(x%u(i)); res%peak_u_time(i) = t
             end if
-            res%peak_v(i) = max(res%peak_v(i), abs(v(i)))
-            x = abs(acc(i) + ag)
-            if (x > res%peak_aabs(i)) then
-               res%peak_aabs(i) = x; res%peak_aabs_time(i) = t
+            res%peak_v(i) = max(res%peak_v(i), abs(x%v(i)))
+            y = abs(x%a(i) + x%ag)
+            if (y > res%peak_aabs(i)) then
+               res%peak_aabs(i) = y; res%peak_aabs_time(i) = t
             end if
          end do
       else
-         do i = 1, n
-            if (abs(u(i)) > res%peak_u(i)) then
-               res%peak_u(i) = abs(u(i)); res%peak_u_time(i) = t
+         do i = 1, x%n
+            if (abs(x%u(i)) > res%peak_u(i)) then
+               res%peak_u(i) = abs(x%u(i)); res%peak_u_time(i) = t
             end if
-            res%peak_v(i) = max(res%peak_v(i), abs(v(i)))
+            res%peak_v(i) = max(res%peak_v(i), abs(x%v(i)))
             ! the absolute acceleration: the table's along the DOF's direction r_i added
             ri = 1.0_dp
             if (has_r) ri = res%eng%r(i)
-            x = acc(i) + ri*ag
-            if (has_r2) x = x + res%eng%r2(i)*ag2
-            x = abs(x)
-            if (x > res%peak_aabs(i)) then
-               res%peak_aabs(i) = x; res%peak_aabs_time(i) = t
+            y = x%a(i) + ri*x%ag
+            if (has_r2) y = y + res%eng%r2(i)*x%ag2
+            y = abs(y)
+            if (y > res%peak_aabs(i)) then
+               res%peak_aabs(i) = y; res%peak_aabs_time(i) = t
             end if
          end do
       end if
-      do i = 1, nd
-         res%peak_s(i) = max(res%peak_s(i), abs(s(i)))
-         res%peak_force(i) = max(res%peak_force(i), abs(force(i)))
+      do i = 1, x%nd
+         res%peak_s(i) = max(res%peak_s(i), abs(x%s(i)))
+         res%peak_force(i) = max(res%peak_force(i), abs(x%f(i)))
       end do
-      if (res%n_bearings > 0) call observe_bearings(res, t, nd, s, force)
-      if (res%eng%n_floors > 0) then
-         call observe_floor_accelerations(res%eng, t, n, acc, ag, ag2)
-         call observe_floor_peaks(res%eng, t, n, nd, u, v, force)
-      end if
+      if (res%n_bearings > 0) call observe_bearings(res, t, x%nd, x%s, x%f)
+      if (res%eng%n_floors > 0) call observe_floor_accelerations(res%eng, t, x%n, x%a, x%ag, x%ag2)
       ! last: the compiler makes it a jump (a tail call), no return through this routine
-      call observe_engineering(res%eng, t, n, nd, u, v, s, force)
+      call observe_engineering(res%eng, t, x%n, x%nd, x%u, x%v, x%s, x%f)
    end subroutine observe_peaks
 
    !> The planar bearings' resultant displacement |(s_x, s_y)|: its peak, the peak's direction
@@ -368,6 +371,37 @@ contains
       end do
    end subroutine observe_normal_forces
 
+   !> The planar bearings' normal forces at the accepted time t, into pn and the observer
+   !> (observe_normal_forces: extremes and uplift): N = N0 (1 + az / g) plus the overturning's
+   !> dN of the state (tilt), on an elastic vertical support its oscillator's (vs), with the
+   !> supports' flights (observe_flights); h the step that reached t (0 at the start).
+   subroutine observe_bearing_forces(res, model, t, h, az, tilt, vs, pn, dn)
+      type(result_type), intent(inout) :: res  !! the result
+      type(model_type), intent(in) :: model    !! the model (its bearings' devices)
+      real(dp), intent(in) :: t                !! time [s]
+      real(dp), intent(in) :: h                !! the step that reached t (0: the start) [s]
+      real(dp), intent(in) :: az               !! vertical table acceleration at t [m/s2]
+      logical, intent(in) :: tilt              !! the overturning's dN is added
+      type(vertical_support), intent(in) :: vs !! the elastic vertical supports (none: nb = 0)
+      real(dp), intent(inout) :: pn(:)         !! work: N of each bearing [N]
+      real(dp), intent(in), optional :: dn(:)  !! the overturning's dN of each bearing (tilt) [N]
+      integer :: b
+
+      do b = 1, res%n_bearings
+         if (tilt) then
+            pn(b) = normal_force(model%dev(res%bearing_dev(1, b)), az, dn(b))
+         else
+            pn(b) = normal_force(model%dev(res%bearing_dev(1, b)), az)
+         end if
+      end do
+      ! (the supports' arrays exist only for a model with elastic supports)
+      if (vs%nb > 0) call supported_normal_forces(vs, tilt, pn, dn)
+      call observe_normal_forces(res, t, h, pn)
+      ! the supports' flights, located within the steps (with the overturning, whose dN may
+      ! unload a bearing in contact, its uplift is counted by the steps as on a rigid support)
+      if (vs%nb > 0) call observe_flights(res, vs%bearing, vs%gap, vs%flights, vs%first, vs%air, .not. tilt)
+   end subroutine observe_bearing_forces
+
    !> The bearings on elastic supports: each one's peak uplift so far and, where the supports
    !> locate their flights within the steps (located), its lift-offs, the first one's time and
    !> its time in flight (otherwise, as with the overturning, uplift is counted by the steps).
@@ -475,7 +509,6 @@ contains
       real(dp), intent(in) :: s(:), force(:)   !! device relative displacements [m], forces [N]
 
       call observe_engineering(res%eng, t, size(u), size(s), u, v, s, force)
-      if (res%eng%n_floors > 0) call observe_floor_peaks(res%eng, t, size(u), size(s), u, v, force)
    end subroutine observe_storeys
 
    !> The next row of the history: t, ag, (u, v, aabs) per kept DOF, (s, s', F, phase) per

@@ -2,12 +2,16 @@
 !> form, displacement, velocity and acceleration consistent by central differences with and
 !> without the cosine ramp, the ramp starting from rest and ending continuously, and the
 !> linear interpolation of a record, with the table at rest after its end; the table
-!> acceleration on a time step's grid (grid_motion) against the sine at every point.
+!> acceleration on a time step's grid (grid_motion) against the sine at every point; a second
+!> horizontal component's load M r2 for a time-step loop (second_table_motion), refused
+!> without the model's direction of it.
 module test_fd_excitation
    use testdrive, only: new_unittest, unittest_type, error_type, check
    use fd_kinds, only: dp
    use fd_excitation, only: excitation_type, table_motion, excitation_none, excitation_harmonic, excitation_record, &
-                            table_acceleration, grid_motion, grid_init, grid_acceleration
+                            table_acceleration, grid_motion, grid_init, grid_acceleration, second_table_motion
+   use fd_error, only: fd_error_type => error_type
+   use fd_model, only: model_type
    use test_fd_helpers, only: check_close
    implicit none
    private
@@ -31,7 +35,8 @@ contains
                   new_unittest("record interpolation", test_record), &
                   new_unittest("table at rest", test_none), &
                   new_unittest("grid acceleration against the sine", test_grid), &
-                  new_unittest("grid of other motions", test_grid_other) &
+                  new_unittest("grid of other motions", test_grid_other), &
+                  new_unittest("second component's load", test_second_component) &
                   ]
    end subroutine collect_excitation
 
@@ -251,5 +256,40 @@ contains
          end do
       end do
    end subroutine test_grid_other
+
+   !> A second component moves the table only when given and not of kind none; then its load
+   !> is M r2 (the model's influence2), and a model without influence2, or one the technique
+   !> does not take, is refused with a message naming what gives the direction.
+   subroutine test_second_component(error)
+      type(error_type), allocatable, intent(out) :: error
+      type(model_type) :: model
+      type(excitation_type) :: exc2, copy, rest
+      type(fd_error_type), allocatable :: err
+      real(dp), allocatable :: mr2(:)
+      logical :: on
+
+      model%n_dof = 3
+      model%mass = [2.0_dp, 3.0_dp, 5.0_dp]
+      exc2 = harmonic(0)
+      call second_table_motion(model, .true., on, copy, mr2, err)
+      call check(error, .not. on .and. .not. allocated(err), 'no second component given: none')
+      if (allocated(error)) return
+      call second_table_motion(model, .true., on, copy, mr2, err, rest)
+      call check(error, .not. on .and. .not. allocated(err), 'a second component at rest: none')
+      if (allocated(error)) return
+      call second_table_motion(model, .true., on, copy, mr2, err, exc2)
+      call check(error, .not. on .and. allocated(err), 'no influence2: refused')
+      if (allocated(error)) return
+      call check(error, index(err%message, "&floors, or influence2 of &matrices") > 0, err%message)
+      if (allocated(error)) return
+      model%influence2 = [0.0_dp, 1.0_dp, -0.5_dp]
+      call second_table_motion(model, .false., on, copy, mr2, err, exc2)
+      call check(error, .not. on .and. allocated(err), 'a direction the technique does not take: refused')
+      if (allocated(error)) return
+      call second_table_motion(model, .true., on, copy, mr2, err, exc2)
+      call check(error, on .and. .not. allocated(err) .and. copy%kind == excitation_harmonic, 'taken')
+      if (allocated(error)) return
+      call check(error, all(mr2 == [0.0_dp, 3.0_dp, -2.5_dp]), 'its load M r2')
+   end subroutine test_second_component
 
 end module test_fd_excitation

@@ -13,10 +13,12 @@ module test_fd_observer
    use fd_row_sink, only: row_sink
    use fd_names, only: technique_event_driven
    use, intrinsic :: ieee_arithmetic, only: ieee_value, ieee_quiet_nan, ieee_positive_inf
-   use fd_observer, only: observer_type, observer_init, sample_due, observe_start, observe_peaks, &
+   use fd_observer, only: observer_type, observed_state, observer_init, sample_due, observe_start, observe_peaks, &
                           observe_sample, observe_transitions, observe_violations, observe_end, &
                           observe_extrema, observe_extremum, observe_work, observe_poll, observe_stop_error, &
-                          observe_device_motion, observe_start_energies, observe_end_energies
+                          observe_device_motion, observe_start_energies, observe_end_energies, &
+                          observe_bearing_forces
+   use fd_vertical_support, only: vertical_support
    implicit none
    private
 
@@ -55,7 +57,8 @@ contains
                   new_unittest("the work of the steps into the balance", test_work), &
                   new_unittest("each device's work, dissipation and slip travel", test_device_work), &
                   new_unittest("rows into the control's row sink; its failure stops the run", test_sink), &
-                  new_unittest("a bearing's travel, reversals and the isolation shear", test_bearing_orbit) &
+                  new_unittest("a bearing's travel, reversals and the isolation shear", test_bearing_orbit), &
+                  new_unittest("the bearings' normal forces, extremes and uplift", test_bearing_forces) &
                   ]
    end subroutine collect_observer
 
@@ -124,12 +127,12 @@ contains
 
       call setup(model, res, obs, error)
       if (allocated(error)) return
-      call observe_peaks(res, 0.1_dp, 2, 1, [0.01_dp, 0.0_dp], [0.5_dp, -0.1_dp], [1.0_dp, 0.0_dp], 2.0_dp, &
-                         [0.01_dp], [3.0_dp])
-      call observe_peaks(res, 0.2_dp, 2, 1, [-0.03_dp, 0.02_dp], [-0.7_dp, 0.2_dp], [-1.0_dp, 0.0_dp], -4.0_dp, &
-                         [-0.05_dp], [-1.0_dp])
-      call observe_peaks(res, 0.3_dp, 2, 1, [0.02_dp, 0.01_dp], [0.1_dp, 0.3_dp], [0.0_dp, 5.5_dp], 0.0_dp, &
-                         [0.02_dp], [2.0_dp])
+      call observe_peaks(res, 0.1_dp, observed_state(2, 1, 2.0_dp, 0.0_dp, [0.01_dp, 0.0_dp], [0.5_dp, -0.1_dp], &
+                                                     [1.0_dp, 0.0_dp], [0.01_dp], [3.0_dp]))
+      call observe_peaks(res, 0.2_dp, observed_state(2, 1, -4.0_dp, 0.0_dp, [-0.03_dp, 0.02_dp], [-0.7_dp, 0.2_dp], &
+                                                     [-1.0_dp, 0.0_dp], [-0.05_dp], [-1.0_dp]))
+      call observe_peaks(res, 0.3_dp, observed_state(2, 1, 0.0_dp, 0.0_dp, [0.02_dp, 0.01_dp], [0.1_dp, 0.3_dp], &
+                                                     [0.0_dp, 5.5_dp], [0.02_dp], [2.0_dp]))
       ! |u| and its time; |v|; |a + ag| (absolute acceleration) and its time
       call check(error, all(res%peak_u == [0.03_dp, 0.02_dp]) .and. all(res%peak_u_time == [0.2_dp, 0.2_dp]), &
                  "peak |u| and its time")
@@ -177,13 +180,13 @@ contains
       call check(error, res%n_bearings, 1)
       if (allocated(error)) return
       z = 0.0_dp
-      call observe_peaks(res, 0.0_dp, 2, 2, z, z, z, 0.0_dp, [r, 0.0_dp], z)
+      call observe_peaks(res, 0.0_dp, observed_state(2, 2, 0.0_dp, 0.0_dp, z, z, z, [r, 0.0_dp], z))
       call observe_transitions(res, [0, 0], [1, 1])
       do k = 1, 16
          th = k*pi/4
          s = r*[cos(th), sin(th)]
          f = 2.0_dp*[-sin(th), cos(th)]
-         call observe_peaks(res, 0.01_dp*k, 2, 2, s, z, z, 0.0_dp, s, f)
+         call observe_peaks(res, 0.01_dp*k, observed_state(2, 2, 0.0_dp, 0.0_dp, s, z, z, s, f))
       end do
       call check(error, abs(res%bearing_travel(1) - 16*2*r*sin(pi/8)) <= 1e-14_dp, "travel: the chords")
       if (allocated(error)) return
@@ -197,8 +200,8 @@ contains
       ! it sticks at the end of a step taken sliding (whose chord counts), then moves stuck:
       ! neither travel nor reversals, whatever its force does
       call observe_transitions(res, [1, 1], [0, 0])
-      call observe_peaks(res, 0.17_dp, 2, 2, z, z, z, 0.0_dp, s, [0.0_dp, -2.0_dp])
-      call observe_peaks(res, 0.18_dp, 2, 2, z, z, z, 0.0_dp, [r, 0.01_dp], [0.0_dp, 2.0_dp])
+      call observe_peaks(res, 0.17_dp, observed_state(2, 2, 0.0_dp, 0.0_dp, z, z, z, s, [0.0_dp, -2.0_dp]))
+      call observe_peaks(res, 0.18_dp, observed_state(2, 2, 0.0_dp, 0.0_dp, z, z, z, [r, 0.01_dp], [0.0_dp, 2.0_dp]))
       call check(error, res%bearing_reversals(1) == 3 .and. &
                  abs(res%bearing_travel(1) - 16*2*r*sin(pi/8)) <= 1e-14_dp, "a stuck bearing")
    end subroutine test_bearing_orbit
@@ -603,5 +606,49 @@ contains
       class(memory_sink), intent(inout) :: sink
       sink%rows = 0
    end subroutine memory_discard
+
+   !> A planar bearing of N0 = 10 N (p_static): at a vertical table acceleration az its normal
+   !> force is N0 (1 + az / g), with the overturning's dN added (tilt); the observer keeps its
+   !> extremes and counts an uplift (N <= 0) once, at the state where it starts.
+   subroutine test_bearing_forces(error)
+      type(error_type), allocatable, intent(out) :: error
+      type(model_type) :: model
+      type(result_type) :: res
+      type(observer_type) :: obs
+      type(excitation_type) :: exc
+      type(integration_type) :: opts
+      type(vertical_support) :: rigid
+      type(fd_error_type), allocatable :: err
+      real(dp), parameter :: g = 9.80665_dp
+      real(dp) :: pn(2)
+
+      model%n_dof = 2
+      model%mass = [1.0_dp, 1.0_dp]
+      model%n_devices = 2
+      model%dev = [device_type(node_i=1, node_j=0, law=law_velocity, p=10.0_dp, mu=0.2_dp, partner=2, component=1, &
+                               radius=2.0_dp, p_static=10.0_dp), &
+                   device_type(node_i=2, node_j=0, law=law_velocity, p=10.0_dp, mu=0.2_dp, partner=1, component=2, &
+                               radius=2.0_dp, p_static=10.0_dp)]
+      call pairs_of(model)
+      exc%kind = excitation_none
+      exc%dt_record = 0.01_dp
+      exc%duration = 0.2_dp
+      opts%n1 = 1
+      call observer_init(model, exc, opts, 0.0_dp, res, obs, err)
+      call check(error, .not. allocated(err) .and. res%n_bearings == 1, "observer_init: one bearing")
+      if (allocated(error)) return
+      call observe_bearing_forces(res, model, 0.0_dp, 0.0_dp, -0.5_dp*g, .false., rigid, pn)
+      call check(error, abs(pn(1) - 5.0_dp) <= 1e-14_dp .and. res%bearing_n_min(1) == pn(1) .and. &
+                 res%bearing_n_max(1) == pn(1), "N0 (1 + az / g) at the start")
+      if (allocated(error)) return
+      call observe_bearing_forces(res, model, 0.01_dp, 0.01_dp, 0.0_dp, .true., rigid, pn, [3.0_dp])
+      call check(error, abs(pn(1) - 13.0_dp) <= 1e-14_dp .and. abs(res%bearing_n_max(1) - 13.0_dp) <= 1e-14_dp &
+                 .and. abs(res%bearing_n_min(1) - 5.0_dp) <= 1e-14_dp, "the overturning's dN added, the extremes")
+      if (allocated(error)) return
+      call observe_bearing_forces(res, model, 0.02_dp, 0.01_dp, -2.0_dp*g, .false., rigid, pn)
+      call observe_bearing_forces(res, model, 0.03_dp, 0.01_dp, -3.0_dp*g, .false., rigid, pn)
+      call check(error, res%bearing_uplifts(1) == 1 .and. res%bearing_uplift_first(1) == 0.02_dp .and. &
+                 abs(res%bearing_n_min(1) + 20.0_dp) <= 1e-13_dp, "one uplift, from where N first falls to <= 0")
+   end subroutine test_bearing_forces
 
 end module test_fd_observer

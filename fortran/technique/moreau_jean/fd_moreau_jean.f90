@@ -35,18 +35,19 @@ module fd_moreau_jean
    use fd_names, only: law_coulomb, law_name, excitation_types, technique_name, technique_moreau_jean, &
                        technique_newmark, damping_stiffness, damping_rayleigh, technique_integrates
    use fd_model, only: model_type, integration_type, device_type
-   use fd_excitation, only: excitation_type, table_motion, table_acceleration, excitation_none
-   use fd_friction_planar, only: devices_at_normal_force, normal_force, pendulum_excess, with_normal_force
+   use fd_excitation, only: excitation_type, table_motion, table_acceleration, excitation_none, &
+                            second_table_motion
+   use fd_friction_planar, only: devices_at_normal_force, pendulum_excess, with_normal_force
    use fd_overturning, only: overturning_forces
    use fd_vertical_support, only: vertical_support, support_setup, support_advance, support_accept, support_forces, &
-                                  supported_normal_forces, support_energy
+                                  support_energy
    use fd_kinematics, only: device_kinematics, device_nodes, devices_are_pairs, device_relative
    use fd_stiffness, only: influence_of
    use fd_matrices, only: structure_damping
    use fd_result, only: result_type
-   use fd_observer, only: observer_type, observer_init, sample_due, observe_peaks, observe_sample, &
+   use fd_observer, only: observer_type, observed_state, observer_init, sample_due, observe_peaks, observe_sample, &
                           observe_transitions, observe_start_energies, observe_end_energies, &
-                         observe_poll, observe_stop_error, observe_work, observe_normal_forces, observe_flights
+                         observe_poll, observe_stop_error, observe_work, observe_bearing_forces
    use fd_run_control, only: run_control
    use fd_stick_groups, only: groups_build, edge_relative
    use fd_group_system, only: gs_k_matvec, gs_k_absmatvec, gs_lowest_eigenvalue
@@ -60,8 +61,9 @@ module fd_moreau_jean
 
    real(dp), parameter :: pi = acos(-1.0_dp)
 
-   !> Everything the loop works on, allocated before it starts.
-   type :: mj_work
+   !> Everything the loop works on, allocated before it starts. The accepted state (n, nd, u, v,
+   !> a, s, f, ag, ag2) is the observer's observed_state, which it extends.
+   type, extends(observed_state) :: mj_work
       type(impulse_solver) :: p                           !! the one-step solver (devices between nodes)
       type(dense_impulse) :: di                           !! the dense one-step solver (any device, K_x)
       logical :: general = .false.                        !! the dense form is used
@@ -93,10 +95,10 @@ module fd_moreau_jean
       real(dp), allocatable :: lam(:), wrel(:), fend(:)   !! (nd) dense form: impulses, b'v1, end forces
       integer, allocatable :: sig(:), sa(:)               !! (nd) dense form: statuses of a step, its end
       type(observer_type) :: obs                          !! peaks, history, energy balance
-      integer :: n = 0, nd = 0, ne = 0
+      integer :: ne = 0
       real(dp) :: a0 = 0.0_dp, a1 = 0.0_dp                !! C = a0 M + a1 K
-      real(dp), allocatable :: u(:), v(:), u1(:), v1(:), acc(:), r(:), du(:), kx(:), rabs(:)  !! (n)
-      real(dp), allocatable :: s(:), sd(:), force(:)      !! (nd)
+      real(dp), allocatable :: u1(:), v1(:), r(:), du(:), kx(:), rabs(:)  !! (n)
+      real(dp), allocatable :: sd(:)                      !! (nd)
       integer, allocatable :: phase0(:), phase1(:)        !! (nd) phases before and after a step
       integer, allocatable :: counted(:)                  !! (nd) phase last counted as a transition
       logical, allocatable :: pending(:)                  !! (nd) stopped from a slide at the last step
@@ -206,18 +208,8 @@ contains
       w%linear_system = opts%linear_system
       call setup(model, w, res, error)
       if (allocated(error)) return
-      if (present(exc2)) then
-         if (exc2%kind /= excitation_none) then
-            if (.not. (allocated(model%influence2) .and. w%general)) then
-               call fatal_error(error, "a second horizontal component needs the model's direction of it "// &
-                                "(a building of rigid floors, &floors, or influence2 of &matrices)")
-               return
-            end if
-            w%two = .true.
-            w%exc2 = exc2
-            w%mr2 = model%mass*model%influence2
-         end if
-      end if
+      call second_table_motion(model, w%general, w%two, w%exc2, w%mr2, error, exc2)
+      if (allocated(error)) return
       call observer_init(model, exc, opts, res%moreau_jean%setup%period_stuck, res, w%obs, error, ctl)
       if (allocated(error)) return
       ! a vertical component and the overturning act on planar bearings alone, which take the
@@ -267,7 +259,7 @@ contains
       w%r = w%r - model%mass*(ag0 + w%a0*w%v)
       w%rabs = model%mass*(abs(ag0) + w%a0*abs(w%v))
       call gs_k_absmatvec(w%p%gs, w%kx, w%rabs, 1.0_dp)
-      call solve_impulses(w%p, w%r, w%rabs, 1.0_dp, 0.0_dp, w%g_force, w%acc, error)
+      call solve_impulses(w%p, w%r, w%rabs, 1.0_dp, 0.0_dp, w%g_force, w%a, error)
       if (allocated(error)) return
       w%p%locked = .false.
       call device_state(model, w, w%p%lam, w%phase0)
@@ -301,7 +293,7 @@ contains
          w%kx = w%a1*w%v1 + w%u1
          call gs_k_matvec(w%p%gs, w%kx, w%r, -1.0_dp, 0.0_dp)
          w%r = w%r - model%mass*(ag1 + w%a0*w%v1)
-         call pattern_acceleration(w%p, w%r, w%g_force, w%acc)
+         call pattern_acceleration(w%p, w%r, w%g_force, w%a)
          ! the device forces of that equilibrium (not the step's mean lambda / h): the forces at
          ! t1 the storey shears and hysteresis loops are made of, in equilibrium with acc
          do e = 1, w%ne
@@ -393,8 +385,8 @@ contains
          om = 2.0_dp*pi/period
          res%moreau_jean%setup%xi_stuck = (w%a0 + w%a1*om**2)/(2.0_dp*om)
       end if
-      allocate (w%u(n), w%v(n), w%u1(n), w%v1(n), w%acc(n), w%r(n), w%du(n), w%kx(n), w%rabs(n), &
-                w%s(nd), w%sd(nd), w%force(nd), w%phase0(nd), w%phase1(nd), w%counted(nd), w%pending(nd), &
+      allocate (w%u(n), w%v(n), w%u1(n), w%v1(n), w%a(n), w%r(n), w%du(n), w%kx(n), w%rabs(n), &
+                w%s(nd), w%sd(nd), w%f(nd), w%phase0(nd), w%phase1(nd), w%counted(nd), w%pending(nd), &
                 w%ta(nd), w%tb(nd), w%g_step(w%ne), w%g_force(w%ne), w%f_edge(w%ne), &
                 w%rel_edge(w%ne), stat=stat)
       if (stat /= 0) call no_memory(error, n)
@@ -435,8 +427,8 @@ contains
                              res%moreau_jean%setup%xi_stuck, error)
       if (allocated(error)) return
       w%ne = nd
-      allocate (w%u(n), w%v(n), w%u1(n), w%v1(n), w%acc(n), w%r(n), w%du(n), w%kx(n), w%rabs(n), w%mr(n), &
-                w%s(nd), w%sd(nd), w%force(nd), w%phase0(nd), w%phase1(nd), w%counted(nd), w%pending(nd), &
+      allocate (w%u(n), w%v(n), w%u1(n), w%v1(n), w%a(n), w%r(n), w%du(n), w%kx(n), w%rabs(n), w%mr(n), &
+                w%s(nd), w%sd(nd), w%f(nd), w%phase0(nd), w%phase1(nd), w%counted(nd), w%pending(nd), &
                 w%ta(nd), w%tb(nd), w%g_step(nd), w%g_force(nd), w%f_edge(nd), w%rel_edge(nd), w%lam(nd), &
                 w%wrel(nd), w%fend(nd), w%sig(nd), w%sa(nd), stat=stat)
       if (stat /= 0) then
@@ -481,8 +473,8 @@ contains
       if (w%tilt) then
          ! the overturning at the start: the floors at the table's acceleration (the structure at
          ! rest relative to it: its acceleration is not known before the friction, which takes N)
-         w%acc = 0.0_dp
-         call overturning_forces(model, w%acc, ag0, b0, w%dn)
+         w%a = 0.0_dp
+         call overturning_forces(model, w%a, ag0, b0, w%dn)
       end if
       if (w%varies) call normal_forces(model, az0, 1.0_dp, w, w%g_force)
       ! devices moving at t = 0 slide that way, the others by the acceleration problem
@@ -496,7 +488,7 @@ contains
       call dense_device_state(model, w, w%phase0)
       call dense_energies(w, e_kin, e_str)
       ! the normal forces before the first row, which holds them
-      if (w%varies) call observe_bearing_forces(model, 0.0_dp, 0.0_dp, az0, w, res)
+      if (w%varies) call observe_bearing_forces(res, model, 0.0_dp, 0.0_dp, az0, w%tilt, w%vs, w%pn, w%dn)
       call start_observing(w, res, ag0, e_kin, e_str, b0)
       do k = 1, w%obs%nsteps
          t1 = k*h
@@ -557,8 +549,8 @@ contains
          call dense_device_state(model, w, w%phase1)
          ! the overturning's dN of the accepted state, from its end-of-step accelerations (the
          ! next step's, one step behind)
-         if (w%tilt) call overturning_forces(model, w%acc, ag1, b1, w%dn)
-         if (w%varies) call observe_bearing_forces(model, t1, h, az1, w, res)
+         if (w%tilt) call overturning_forces(model, w%a, ag1, b1, w%dn)
+         if (w%varies) call observe_bearing_forces(res, model, t1, h, az1, w%tilt, w%vs, w%pn, w%dn)
          call end_step(w, res, k, t1, ag1, error, b1)
          if (allocated(error)) return
       end do
@@ -589,7 +581,7 @@ contains
          call normal_forces(model, az, 1.0_dp, w, w%g_force)
          call excess_forces(model, w, u, -1.0_dp, w%r)
       end if
-      call dense_acceleration(w%di, w%r, w%g_force, w%sig, w%acc, w%fend, w%sa, error, w%wrel)
+      call dense_acceleration(w%di, w%r, w%g_force, w%sig, w%a, w%fend, w%sa, error, w%wrel)
       if (allocated(error) .or. .not. w%varies) return
       ! the devices' forces: the friction's and the excess's (both act along b)
       do d = 1, w%nd
@@ -684,34 +676,6 @@ contains
       end do
    end subroutine excess_work
 
-   !> The bearings' normal forces N = N0 (1 + az / g) (+ dN, the overturning's of the state) at
-   !> the accepted time t to the observer: extremes and uplift, as Newmark reports them; h the
-   !> step that reached t (0 at the start).
-   subroutine observe_bearing_forces(model, t, h, az, w, res)
-      type(model_type), intent(in) :: model
-      real(dp), intent(in) :: t, h, az
-      type(mj_work), intent(inout) :: w
-      type(result_type), intent(inout) :: res
-      integer :: b
-
-      if (w%tilt) then
-         do b = 1, res%n_bearings
-            w%pn(b) = normal_force(model%dev(res%bearing_dev(1, b)), az, w%dn(b))
-         end do
-      else
-         do b = 1, res%n_bearings
-            w%pn(b) = normal_force(model%dev(res%bearing_dev(1, b)), az)
-         end do
-      end if
-      ! (the supports' arrays exist only for a model with elastic supports)
-      if (w%vs%nb > 0) call supported_normal_forces(w%vs, w%tilt, w%pn, w%dn)
-      call observe_normal_forces(res, t, h, w%pn)
-      ! the supports' flights, located within the steps (with the overturning, whose dN may
-      ! unload a bearing in contact, its uplift is counted by the steps as on a rigid support)
-      if (w%vs%nb > 0) &
-         call observe_flights(res, w%vs%bearing, w%vs%gap, w%vs%flights, w%vs%first, w%vs%air, .not. w%tilt)
-   end subroutine observe_bearing_forces
-
    !> Device kinematics, forces and phases of the dense form (statuses of the step).
    pure subroutine dense_device_state(model, w, phase)
       type(model_type), intent(in) :: model
@@ -719,7 +683,7 @@ contains
       integer, intent(out) :: phase(:)
 
       call device_kinematics(model, w%u, w%v, w%s, w%sd)
-      w%force = w%fend
+      w%f = w%fend
       phase = w%sig
    end subroutine dense_device_state
 
@@ -750,13 +714,15 @@ contains
       w%counted = w%phase0
       w%pending = .false.
       call observe_start_energies(w%obs, e_kin, e_str, 0.0_dp)
+      w%ag = ag0
+      w%ag2 = 0.0_dp
       if (w%two .and. present(ag2)) then
-         call observe_sample(w%obs, res, 0.0_dp, ag0, w%u, w%v, w%acc, w%s, w%sd, w%force, w%phase0, ag2=ag2)
-         call observe_peaks(res, 0.0_dp, size(w%u), size(w%s), w%u, w%v, w%acc, ag0, w%s, w%force, ag2)
-         return
+         w%ag2 = ag2
+         call observe_sample(w%obs, res, 0.0_dp, ag0, w%u, w%v, w%a, w%s, w%sd, w%f, w%phase0, ag2=ag2)
+      else
+         call observe_sample(w%obs, res, 0.0_dp, ag0, w%u, w%v, w%a, w%s, w%sd, w%f, w%phase0)
       end if
-      call observe_sample(w%obs, res, 0.0_dp, ag0, w%u, w%v, w%acc, w%s, w%sd, w%force, w%phase0)
-      call observe_peaks(res, 0.0_dp, size(w%u), size(w%s), w%u, w%v, w%acc, ag0, w%s, w%force)
+      call observe_peaks(res, 0.0_dp, w%observed_state)
    end subroutine start_observing
 
    !> The end of step k, common to both forms, once the state at t1 and its device phases
@@ -775,21 +741,20 @@ contains
       two = w%two .and. present(ag2)
       call count_transitions(w, res, .false.)
       w%phase0 = w%phase1
-      if (two) then
-         call observe_peaks(res, t1, size(w%u), size(w%s), w%u, w%v, w%acc, ag1, w%s, w%force, ag2)
-      else
-         call observe_peaks(res, t1, size(w%u), size(w%s), w%u, w%v, w%acc, ag1, w%s, w%force)
-      end if
+      w%ag = ag1
+      w%ag2 = 0.0_dp
+      if (two) w%ag2 = ag2
+      call observe_peaks(res, t1, w%observed_state)
       res%moreau_jean%steps = res%moreau_jean%steps + 1
       if (sample_due(w%obs, k)) then
-         if (.not. all(ieee_is_finite(w%u)) .or. .not. all(ieee_is_finite(w%acc))) then
+         if (.not. all(ieee_is_finite(w%u)) .or. .not. all(ieee_is_finite(w%a))) then
             call fatal_error(error, "moreau_jean: the solution is not finite at t = "//trim(fmt_real(t1))//" s")
             return
          end if
          if (two) then
-            call observe_sample(w%obs, res, t1, ag1, w%u, w%v, w%acc, w%s, w%sd, w%force, w%phase1, ag2=ag2)
+            call observe_sample(w%obs, res, t1, ag1, w%u, w%v, w%a, w%s, w%sd, w%f, w%phase1, ag2=ag2)
          else
-            call observe_sample(w%obs, res, t1, ag1, w%u, w%v, w%acc, w%s, w%sd, w%force, w%phase1)
+            call observe_sample(w%obs, res, t1, ag1, w%u, w%v, w%a, w%s, w%sd, w%f, w%phase1)
          end if
       end if
       call observe_poll(w%obs, t1, stopped)
@@ -817,10 +782,10 @@ contains
       do d = 1, w%nd
          e = w%p%es%dev_edge(d)
          if (e == 0) then
-            w%force(d) = 0.0_dp
+            w%f(d) = 0.0_dp
             phase(d) = 0
          else
-            w%force(d) = w%p%es%dev_sign(d)*w%p%es%dev_share(d)*f_edge(e)
+            w%f(d) = w%p%es%dev_sign(d)*w%p%es%dev_share(d)*f_edge(e)
             phase(d) = w%p%es%dev_sign(d)*w%p%sigma(e)
          end if
       end do

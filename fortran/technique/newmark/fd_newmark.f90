@@ -32,13 +32,12 @@ module fd_newmark
    use fd_kinds, only: dp
    use fd_error, only: error_type, fatal_error, fmt_real, fmt_int, stat_no_memory
    use fd_names, only: technique_integrates, law_name, law_choices, excitation_types, technique_name, technique_newmark, &
-                       technique_event_driven, technique_moreau_jean, linear_system_dense, linear_system_banded, &
-                       linear_system_sparse, &
-                       refinement_nested, refinement_implicit
+                       technique_event_driven, technique_moreau_jean, linear_system_auto, linear_system_dense, &
+                       linear_system_banded, linear_system_sparse, refinement_nested, refinement_implicit
    use fd_model, only: model_type, integration_type, device_type
    use fd_names, only: excitation_none
    use fd_excitation, only: excitation_type, table_motion, table_acceleration, grid_motion, grid_init, &
-                            grid_acceleration
+                            grid_acceleration, second_table_motion
    use fd_matrices, only: structure_damping
    use fd_woodbury, only: woodbury_type, woodbury_setup, woodbury_factor, woodbury_correct, lowrank_matvec, &
                           lowrank_form
@@ -51,18 +50,18 @@ module fd_newmark
                         sparse_solve, sparse_k_matvec, sparse_c_matvec, sparse_kc_matvec, sparse_free, sparse_band, &
                         sparse_factor_entries, sparse_nonzeros
    use fd_device_state, only: device_state, device_force, phase_stick
-   use fd_friction_planar, only: pendulum_excess, normal_force, with_normal_force, devices_at_normal_force, &
+   use fd_friction_planar, only: pendulum_excess, with_normal_force, devices_at_normal_force, &
                                  normal_force_range
    use fd_overturning, only: overturning_forces
    use fd_vertical_support, only: vertical_support, support_setup, support_advance, support_accept, support_forces, &
-                                  supported_normal_forces, support_energy
+                                  support_energy
    use fd_friction, only: friction_init, friction_step, friction_settle, follows_velocity, friction_follow, &
                           friction_energy, friction_capacity
    use fd_result, only: result_type
    use fd_run_control, only: run_control
-   use fd_observer, only: observer_type, observer_init, sample_due, observe_start_energies, observe_peaks, &
+   use fd_observer, only: observer_type, observed_state, observer_init, sample_due, observe_start_energies, observe_peaks, &
                           observe_sample, observe_transitions, observe_violations, observe_end_energies, &
-                          observe_poll, observe_stop_error, observe_work, observe_normal_forces, observe_flights
+                          observe_poll, observe_stop_error, observe_work, observe_bearing_forces
    use fd_step_limits, only: halving_levels, unresolved_band, max_nested, nested_splits, max_settle, max_follow, &
                              follow_tol
    use fd_stick_ringing, only: ringing_type, ringing_init, ringing_changed, ringing_finish, stat_time, stat_sd2, &
@@ -84,6 +83,10 @@ module fd_newmark
    !> measured on bench/matrix_scale.py's towers and plans, where they cost about the same
    !> per step at 6 n (kb + 1) = 3 to 4 (2 nnz(L) + 4 nnz(K^)))
    real(dp), parameter :: sparse_weight = 4.0_dp
+   !> The path of each &integration linear_system, indexed by its id (fd_names: auto, dense,
+   !> banded, sparse in that order)
+   integer, parameter :: solver_path(linear_system_auto:linear_system_sparse) = &
+                         [spd_auto, spd_dense, spd_banded, path_sparse]
 
    !> The effective stiffness of one step size.
    type :: level_type
@@ -99,9 +102,9 @@ module fd_newmark
       integer :: version = -1              !! the pattern of device stiffnesses it holds
    end type level_type
 
-   !> Everything the loop works on, allocated once before it starts.
-   type :: workspace
-      integer :: n = 0, nd = 0
+   !> Everything the loop works on, allocated once before it starts. The accepted state (n,
+   !> nd, u, v, a, s, f, ag, ag2) is the observer's observed_state, which it extends.
+   type, extends(observed_state) :: workspace
       integer :: lmax = 0                             !! halvings below dt2
       real(dp) :: a0 = 0.0_dp, a1c = 0.0_dp           !! C = a0 M + a1c K
       real(dp), allocatable :: mass(:)
@@ -111,8 +114,8 @@ module fd_newmark
       integer :: nested = 1                           !! levels of the refinement (the paper's: 1)
       integer :: split(max_nested) = 1                !! ratio of level k - 1 to level k (dt1 / dt2 = product)
       integer :: version = 0                          !! counts the accepted phase changes
-      real(dp), allocatable :: u(:), v(:), a(:), u1(:), v1(:), a1(:), rhs(:), tmp(:)
-      real(dp), allocatable :: s(:), sd(:), s1(:), sd1(:), f(:), kd(:)
+      real(dp), allocatable :: u1(:), v1(:), a1(:), rhs(:), tmp(:)
+      real(dp), allocatable :: sd(:), s1(:), sd1(:), kd(:)
       real(dp), allocatable :: fw(:)                  !! work: the devices' loads of a trial
       ! devices between two nodes: the step's loads and relative motion by their nodes, in this
       ! module (pair_loads, pair_motion: three calls to fd_kinematics' kernels a trial cost a
@@ -131,12 +134,12 @@ module fd_newmark
       logical :: follow_failed = .false.              !! the trial's forces did not converge
       real(dp) :: follow_misfit = 0.0_dp              !! then its last pass's largest |df| / cap
       integer :: follow_passes = 0                    !! solves the fixed point took in all
-      real(dp) :: ag = 0.0_dp, ag1 = 0.0_dp
+      real(dp) :: ag1 = 0.0_dp                        !! the table acceleration at the trial's end
       ! a second horizontal component: its table acceleration now and at the trial state, and
       ! the load M r2 of a unit of it (two = .false.: none)
       logical :: two = .false.
       type(excitation_type) :: exc2
-      real(dp) :: ag2 = 0.0_dp, ag21 = 0.0_dp
+      real(dp) :: ag21 = 0.0_dp
       real(dp), allocatable :: mr2(:)
       ! a vertical component: the bearings' normal forces N = N0 (1 + a_z / g) (three = .false.:
       ! constant); dev holds the devices with p = max(N, 0) at the time normal_forces was
@@ -206,83 +209,79 @@ contains
       type(result_type), intent(out) :: res         !! histories and summary
       type(error_type), allocatable, intent(out) :: error !! singular system, divergence, stop
       type(run_control), intent(inout), target, optional :: ctl !! the run's control
-      type(excitation_type), intent(in), optional :: exc2 !! a second horizontal component
-      type(excitation_type), intent(in), optional :: exc3 !! the vertical component
+      type(excitation_type), intent(in), optional :: exc2 !! a second horizontal component, along
+                                                          !! the model's influence2 (kind none: none)
+      type(excitation_type), intent(in), optional :: exc3 !! the vertical component: the bearings'
+                                                          !! normal forces (kind none: none)
       type(workspace) :: w
-      integer :: l
+      real(dp) :: dt1, dt2
+      integer :: c0, c1, crate, l
 
-      call run_loop(model, exc, opts, res, error, w, ctl, exc2, exc3)
-      ! the sparse factors are CHOLMOD's (C memory): freed on every way out of the loop
+      call system_clock(c0, crate)
+      ! the set-up and the loop in a block left on an error: the sparse factors are CHOLMOD's
+      ! (C memory), freed below on every way out
+      run: block
+         call newmark_check(model, exc, error)
+         if (allocated(error)) exit run
+         dt1 = exc%dt_record/opts%n1
+         dt2 = dt1/opts%n2
+         res%newmark%ran = .true.
+         associate (st => res%newmark%setup)
+            st%dt1 = dt1
+            st%dt2 = dt2
+            st%dt_min = opts%dt_min
+            if (st%dt_min <= 0.0_dp) st%dt_min = dt2/2.0_dp**10
+            ! gamma > 1/2 damps; the average acceleration rule's energy residual is round-off
+            st%damping_method = opts%gamma > 0.5_dp
+            st%exact_accounting = opts%beta == 0.25_dp .and. opts%gamma == 0.5_dp
+         end associate
+         call setup(model, opts, dt1, dt2, halving_levels(dt2, res%newmark%setup%dt_min), w, res, error)
+         if (allocated(error)) exit run
+         call second_table_motion(model, .true., w%two, w%exc2, w%mr2, error, exc2)
+         if (allocated(error)) exit run
+         if (present(exc3)) then
+            w%three = exc3%kind /= excitation_none
+            if (w%three) w%exc3 = exc3
+         end if
+         w%tilt = model%overturning
+         w%varies = w%three .or. w%tilt
+         call observer_init(model, exc, opts, res%newmark%setup%period_stuck, res, w%obs, error, ctl)
+         if (allocated(error)) exit run
+         if (w%three) then
+            call support_setup(w%nd, model%dev, size(w%lev), w%vs, l)
+            if (l /= 0) then
+               call fatal_error(error, "not enough memory for the vertical supports of the bearings", stat_no_memory)
+               exit run
+            end if
+            w%elastic = w%vs%nb > 0
+         end if
+         call grid_init(exc, dt1, w%grid)
+         call time_loop(model, exc, opts, dt1, w, res, error)
+      end block run
       if (allocated(w%lev)) then
          do l = 1, size(w%lev)
             call sparse_free(w%lev(l)%sps)
          end do
       end if
+      if (allocated(error)) return
+      call system_clock(c1)
+      res%run_time = real(c1 - c0, dp)/real(max(crate, 1), dp)
    end subroutine run_newmark
 
-   !> run_newmark's set-up and time-step loop in the workspace w.
-   subroutine run_loop(model, exc, opts, res, error, w, ctl, exc2, exc3)
-      type(model_type), intent(in) :: model         !! validated model
-      type(excitation_type), intent(in) :: exc      !! validated table motion
-      type(integration_type), intent(in) :: opts    !! validated settings
-      type(result_type), intent(out) :: res         !! histories and summary
-      type(error_type), allocatable, intent(out) :: error !! singular system, divergence, stop
-      type(run_control), intent(inout), target, optional :: ctl !! the run's control
-      type(excitation_type), intent(in), optional :: exc2 !! a second horizontal component, along
-                                                          !! the model's influence2 (kind none: none)
-      type(excitation_type), intent(in), optional :: exc3 !! the vertical component: the bearings'
-                                                          !! normal forces (kind none: none)
-      type(workspace), intent(inout) :: w           !! the workspace (set up here)
-      real(dp) :: dt1, dt2, t0, ek_v, ep_v
-      integer :: k, c0, c1, crate, l
+   !> The initial state, run_newmark's time-step loop over the dt1 steps and the run's end
+   !> (the step checks' verdicts, the energy balance, the factors' statistics) in the
+   !> workspace w that run_newmark set up.
+   subroutine time_loop(model, exc, opts, dt1, w, res, error)
+      type(model_type), intent(in) :: model
+      type(excitation_type), intent(in) :: exc
+      type(integration_type), intent(in) :: opts
+      real(dp), intent(in) :: dt1                   !! the step dt1 [s]
+      type(workspace), intent(inout) :: w
+      type(result_type), intent(inout) :: res
+      type(error_type), allocatable, intent(out) :: error
+      real(dp) :: t0, ek_v, ep_v
+      integer :: k, l
       logical :: any_changed, any_bad, stop, settled
-
-      call system_clock(c0, crate)
-      call newmark_check(model, exc, error)
-      if (allocated(error)) return
-      dt1 = exc%dt_record/opts%n1
-      dt2 = dt1/opts%n2
-      res%newmark%ran = .true.
-      associate (st => res%newmark%setup)
-         st%dt1 = dt1
-         st%dt2 = dt2
-         st%dt_min = opts%dt_min
-         if (st%dt_min <= 0.0_dp) st%dt_min = dt2/2.0_dp**10
-         ! gamma > 1/2 damps; the average acceleration rule's energy residual is round-off
-         st%damping_method = opts%gamma > 0.5_dp
-         st%exact_accounting = opts%beta == 0.25_dp .and. opts%gamma == 0.5_dp
-      end associate
-      call setup(model, opts, dt1, dt2, halving_levels(dt2, res%newmark%setup%dt_min), w, res, error)
-      if (allocated(error)) return
-      if (present(exc2)) then
-         if (exc2%kind /= excitation_none) then
-            if (.not. allocated(model%influence2)) then
-               call fatal_error(error, "a second horizontal component needs the model's direction of it "// &
-                                "(a building of rigid floors, &floors)")
-               return
-            end if
-            w%two = .true.
-            w%exc2 = exc2
-            w%mr2 = model%mass*model%influence2
-         end if
-      end if
-      if (present(exc3)) then
-         w%three = exc3%kind /= excitation_none
-         if (w%three) w%exc3 = exc3
-      end if
-      w%tilt = model%overturning
-      w%varies = w%three .or. w%tilt
-      call observer_init(model, exc, opts, res%newmark%setup%period_stuck, res, w%obs, error, ctl)
-      if (allocated(error)) return
-      if (w%three) then
-         call support_setup(w%nd, model%dev, size(w%lev), w%vs, l)
-         if (l /= 0) then
-            call fatal_error(error, "not enough memory for the vertical supports of the bearings", stat_no_memory)
-            return
-         end if
-         w%elastic = w%vs%nb > 0
-      end if
-      call grid_init(exc, dt1, w%grid)
 
       ! initial state: devices from the initial conditions, acceleration from equilibrium
       w%u = model%u0
@@ -290,7 +289,10 @@ contains
       call device_kinematics(model, w%u, w%v, w%s, w%sd)
       if (w%tilt) call start_overturning(model, exc, w)
       call normal_forces(model, 0.0_dp, w, .false.)
-      if (w%varies) call observe_bearing_forces(model, 0.0_dp, 0.0_dp, w, res)
+      if (w%varies) then
+         call observe_bearing_forces(res, model, 0.0_dp, 0.0_dp, w%az, w%tilt, w%vs, w%pn, w%dn)
+         call checks_normal_force(model, w, res)
+      end if
       call friction_init(w%dev, w%s, w%sd, w%st, error)
       if (allocated(error)) return
       ! the devices' forces, kept from here on by device_step
@@ -307,7 +309,7 @@ contains
                                   device_energy(w%dev, w%st, w%s), stored_energies(w%dev, w%st, w%s))
       w%phase0 = w%st%phase
       call observe_sample(w%obs, res, 0.0_dp, w%ag, w%u, w%v, w%a, w%s, w%sd, w%f, w%phase0, ag2=w%ag2)
-      call observe_peaks(res, 0.0_dp, w%n, w%nd, w%u, w%v, w%a, w%ag, w%s, w%f, w%ag2)
+      call observe_peaks(res, 0.0_dp, w%observed_state)
 
       do k = 1, w%obs%nsteps
          t0 = (k - 1)*dt1
@@ -368,9 +370,7 @@ contains
             res%newmark%factor_updates = res%newmark%factor_updates + stats%updates + stats%downdates
          end associate
       end do
-      call system_clock(c1)
-      res%run_time = real(c1 - c0, dp)/real(max(crate, 1), dp)
-   end subroutine run_loop
+   end subroutine time_loop
 
    !> The effective stiffness systems (one set up, copied for every step size; factored when
    !> first used) and the workspace. Memory linear in the number of DOFs and devices.
@@ -406,16 +406,9 @@ contains
       if (allocated(error)) return
       w%a0 = a0
       w%a1c = a1
-      select case (opts%linear_system)
-      case (linear_system_dense)
-         path = spd_dense
-      case (linear_system_banded)
-         path = spd_banded
-      case (linear_system_sparse)
-         path = path_sparse
-      case default
-         path = spd_auto
-      end select
+      path = spd_auto
+      if (opts%linear_system >= lbound(solver_path, 1) .and. opts%linear_system <= ubound(solver_path, 1)) &
+         path = solver_path(opts%linear_system)
       call choose_sparse(model, a0, a1, path, sparse, kb, error)
       if (allocated(error)) return
       if (sparse) then
@@ -480,7 +473,7 @@ contains
       call device_nodes(model, w%di, w%dj, l)
       w%pairs = l == 0
       w%nf = count(follows_velocity(model%dev))
-      allocate (w%fl(w%nf), w%df(w%nf), w%cap(w%nf), stat=stat)
+      allocate (w%fl(w%nf), w%df(w%nf), w%cap(w%nf), w%dev(nd), w%pn(nd), stat=stat)
       if (stat /= 0) then
          call fatal_error(error, "not enough memory for the state of n_devices = "//trim(fmt_int(nd))//" devices", &
                           stat_no_memory)
@@ -488,12 +481,6 @@ contains
       end if
       w%fl = pack([(l, l=1, nd)], follows_velocity(model%dev))
       w%cap = friction_capacity(model%dev(w%fl))
-      allocate (w%dev(nd), w%pn(nd), stat=stat)
-      if (stat /= 0) then
-         call fatal_error(error, "not enough memory for the state of n_devices = "//trim(fmt_int(nd))//" devices", &
-                          stat_no_memory)
-         return
-      end if
       w%dev = model%dev(1:nd)
       if (model%overturning) then
          allocate (w%dn(size(model%ot_dev)), w%dn1(size(model%ot_dev)), stat=stat)
@@ -592,34 +579,6 @@ contains
       end if
       call normal_force_range(w%nd, model%dev, lo, hi, w%nrange)
    end subroutine normal_extremes
-
-   !> The bearings' normal forces at the accepted time t (the one normal_forces was last
-   !> called for) to the observer: extremes and uplift; h the step that reached t (0 at the start).
-   subroutine observe_bearing_forces(model, t, h, w, res)
-      type(model_type), intent(in) :: model
-      real(dp), intent(in) :: t, h
-      type(workspace), intent(inout) :: w
-      type(result_type), intent(inout) :: res
-      integer :: b
-
-      if (w%tilt) then
-         do b = 1, res%n_bearings
-            w%pn(b) = normal_force(model%dev(res%bearing_dev(1, b)), w%az, w%dn(b))
-         end do
-      else
-         do b = 1, res%n_bearings
-            w%pn(b) = normal_force(model%dev(res%bearing_dev(1, b)), w%az)
-         end do
-      end if
-      ! (the supports' arrays exist only for a model with elastic supports)
-      if (w%vs%nb > 0) call supported_normal_forces(w%vs, w%tilt, w%pn, w%dn)
-      call observe_normal_forces(res, t, h, w%pn)
-      ! the supports' flights, located within the steps (with the overturning, whose dN may
-      ! unload a bearing in contact, its uplift is counted by the steps as on a rigid support)
-      if (w%vs%nb > 0) &
-         call observe_flights(res, w%vs%bearing, w%vs%gap, w%vs%flights, w%vs%first, w%vs%air, .not. w%tilt)
-      call checks_normal_force(model, w, res)
-   end subroutine observe_bearing_forces
 
    !> The step checks' N ranges joined with the bearings' N observed so far (the prediction
    !> before the run is a vertical component's alone: the overturning's dN is known as the run
@@ -1285,13 +1244,14 @@ contains
             call support_accept(w%vs)
             call observe_work(res, w%vs%w_in1, w%vs%w_damp1)
          end if
-         call observe_bearing_forces(model, t1, t1 - w%t, w, res)
+         call observe_bearing_forces(res, model, t1, t1 - w%t, w%az, w%tilt, w%vs, w%pn, w%dn)
+         call checks_normal_force(model, w, res)
       end if
       w%t = t1
       if (changed_k) w%version = w%version + 1
       ! (a varying normal force changes a band's dashpot or a sticking spring within a phase)
       if (any_changed .or. any_force .or. (w%varies .and. changed_k)) call consistent_acceleration(model, exc, t1, w)
-      call observe_peaks(res, t1, w%n, w%nd, w%u, w%v, w%a, w%ag, w%s, w%f, w%ag2)
+      call observe_peaks(res, t1, w%observed_state)
    end subroutine accept
 
    !> The state moves to the trial state; du = u1 - u (in du), v + v1 (in vsum) and
