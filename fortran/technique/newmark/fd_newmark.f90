@@ -289,10 +289,7 @@ contains
       call device_kinematics(model, w%u, w%v, w%s, w%sd)
       if (w%tilt) call start_overturning(model, exc, w)
       call normal_forces(model, 0.0_dp, w, .false.)
-      if (w%varies) then
-         call observe_bearing_forces(res, model, 0.0_dp, 0.0_dp, w%az, w%tilt, w%vs, w%pn, w%dn)
-         call checks_normal_force(model, w, res)
-      end if
+      if (w%varies) call observe_bearing_forces(res, model, 0.0_dp, 0.0_dp, w%az, w%tilt, w%vs, w%pn, w%dn)
       call friction_init(w%dev, w%s, w%sd, w%st, error)
       if (allocated(error)) return
       ! the devices' forces, kept from here on by device_step
