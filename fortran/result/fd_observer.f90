@@ -8,8 +8,8 @@
 !> force with the device's slip travel (observe_device_motion, or added into the observer's
 !> device_work and slip_travel in the technique's own loop over the devices), and, when it
 !> knows its solution between steps, the exact extrema (observe_extrema, observe_extremum);
-!> the stuck system's period it computed is an argument of observer_init. A new output quantity is a change here (and in the writer),
-!> not in the loops.
+!> the stuck system's period it computed is an argument of observer_init. A new output
+!> quantity is a change here (and in the writer), not in the loops.
 !>
 !> A run's control (fd_run_control), when the technique is given one, says which history
 !> columns are kept and where their rows go (the result, the caller's buffer, a file written
