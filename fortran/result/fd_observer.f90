@@ -394,8 +394,15 @@ contains
             pn(b) = normal_force(model%dev(res%bearing_dev(1, b)), az)
          end if
       end do
-      ! (the supports' arrays exist only for a model with elastic supports)
-      if (vs%nb > 0) call supported_normal_forces(vs, tilt, pn, dn)
+      ! (the supports' arrays exist only for a model with elastic supports; an absent dn is
+      ! not handed on: gfortran reads the bounds of an absent assumed-shape argument passed on)
+      if (vs%nb > 0) then
+         if (present(dn)) then
+            call supported_normal_forces(vs, tilt, pn, dn)
+         else
+            call supported_normal_forces(vs, tilt, pn)
+         end if
+      end if
       call observe_normal_forces(res, t, h, pn)
       ! the supports' flights, located within the steps (with the overturning, whose dN may
       ! unload a bearing in contact, its uplift is counted by the steps as on a rigid support)
