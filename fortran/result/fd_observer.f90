@@ -216,24 +216,13 @@ contains
       has_r = allocated(res%eng%r)
       has_r2 = allocated(res%eng%r2)
       if (.not. (has_r .or. has_r2)) then
-         ! every DOF along the table motion (r_i = 1), one component: the loop without the
-         ! directions' tests (the paper's models)
-         do i = 1, x%n
-            if (abs(x%u(i)) > res%peak_u(i)) then
-               res%peak_u(i) = abs(x%u(i)); res%peak_u_time(i) = t
-            end if
-            res%peak_v(i) = max(res%peak_v(i), abs(x%v(i)))
-            y = abs(x%a(i) + x%ag)
-            if (y > res%peak_aabs(i)) then
-               res%peak_aabs(i) = y; res%peak_aabs_time(i) = t
-            end if
-         end do
+         ! every DOF along the table motion (r_i = 1), one component (the paper's models): one
+         ! loop over the DOFs
+         call dof_peaks(x%n, t, x%ag, x%u, x%v, x%a, res%peak_u, res%peak_u_time, res%peak_v, res%peak_aabs, &
+                        res%peak_aabs_time)
       else
+         call motion_peaks(x%n, t, x%u, x%v, res%peak_u, res%peak_u_time, res%peak_v)
          do i = 1, x%n
-            if (abs(x%u(i)) > res%peak_u(i)) then
-               res%peak_u(i) = abs(x%u(i)); res%peak_u_time(i) = t
-            end if
-            res%peak_v(i) = max(res%peak_v(i), abs(x%v(i)))
             ! the absolute acceleration: the table's along the DOF's direction r_i added
             ri = 1.0_dp
             if (has_r) ri = res%eng%r(i)
@@ -245,15 +234,76 @@ contains
             end if
          end do
       end if
-      do i = 1, x%nd
-         res%peak_s(i) = max(res%peak_s(i), abs(x%s(i)))
-         res%peak_force(i) = max(res%peak_force(i), abs(x%f(i)))
-      end do
+      call device_peaks(x%nd, x%s, x%f, res%peak_s, res%peak_force)
       if (res%n_bearings > 0) call observe_bearings(res, t, x%nd, x%s, x%f)
       if (res%eng%n_floors > 0) call observe_floor_accelerations(res%eng, t, x%n, x%a, x%ag, x%ag2)
       ! last: the compiler makes it a jump (a tail call), no return through this routine
       call observe_engineering(res%eng, t, x%n, x%nd, x%u, x%v, x%s, x%f)
    end subroutine observe_peaks
+
+   ! The kernels of observe_peaks take their arrays with explicit shapes: the compiler then
+   ! knows that the peaks written alias none of the state's arrays and keeps every address in
+   ! a register (through the result's and the state's components it reloads them after each
+   ! store: observe_peaks cost a third more on the paper's two-mass model, callgrind).
+
+   !> The peaks of |u| (and their times) and of |v| of n DOFs at time t.
+   pure subroutine motion_peaks(n, t, u, v, peak_u, peak_u_time, peak_v)
+      integer, intent(in) :: n                     !! DOFs
+      real(dp), intent(in) :: t                    !! time [s]
+      real(dp), intent(in) :: u(n), v(n)           !! the state [m, m/s]
+      real(dp), intent(inout) :: peak_u(n), peak_u_time(n), peak_v(n) !! [m, s, m/s]
+      integer :: i
+
+      do i = 1, n
+         call motion_peak(t, u(i), v(i), peak_u(i), peak_u_time(i), peak_v(i))
+      end do
+   end subroutine motion_peaks
+
+   !> One DOF's peaks of |u| (and its time) and of |v| at time t.
+   pure subroutine motion_peak(t, u, v, peak_u, peak_u_time, peak_v)
+      real(dp), intent(in) :: t                    !! time [s]
+      real(dp), intent(in) :: u, v                 !! the state [m, m/s]
+      real(dp), intent(inout) :: peak_u, peak_u_time, peak_v !! [m, s, m/s]
+
+      if (abs(u) > peak_u) then
+         peak_u = abs(u); peak_u_time = t
+      end if
+      peak_v = max(peak_v, abs(v))
+   end subroutine motion_peak
+
+   !> motion_peaks, and the peaks of the absolute acceleration |a + ag| (and their times)
+   !> along the one table motion.
+   pure subroutine dof_peaks(n, t, ag, u, v, a, peak_u, peak_u_time, peak_v, peak_aabs, peak_aabs_time)
+      integer, intent(in) :: n                     !! DOFs
+      real(dp), intent(in) :: t                    !! time [s]
+      real(dp), intent(in) :: ag                   !! table acceleration [m/s2]
+      real(dp), intent(in) :: u(n), v(n), a(n)     !! the state [m, m/s, m/s2]
+      real(dp), intent(inout) :: peak_u(n), peak_u_time(n), peak_v(n) !! [m, s, m/s]
+      real(dp), intent(inout) :: peak_aabs(n), peak_aabs_time(n)      !! [m/s2, s]
+      real(dp) :: y
+      integer :: i
+
+      do i = 1, n
+         call motion_peak(t, u(i), v(i), peak_u(i), peak_u_time(i), peak_v(i))
+         y = abs(a(i) + ag)
+         if (y > peak_aabs(i)) then
+            peak_aabs(i) = y; peak_aabs_time(i) = t
+         end if
+      end do
+   end subroutine dof_peaks
+
+   !> The peaks of |s| and |F| of nd devices.
+   pure subroutine device_peaks(nd, s, f, peak_s, peak_f)
+      integer, intent(in) :: nd                    !! devices
+      real(dp), intent(in) :: s(nd), f(nd)         !! relative displacements [m], forces [N]
+      real(dp), intent(inout) :: peak_s(nd), peak_f(nd) !! [m, N]
+      integer :: i
+
+      do i = 1, nd
+         peak_s(i) = max(peak_s(i), abs(s(i)))
+         peak_f(i) = max(peak_f(i), abs(f(i)))
+      end do
+   end subroutine device_peaks
 
    !> The planar bearings' resultant displacement |(s_x, s_y)|: its peak, the peak's direction
    !> and time, and the last value observed (the residual at the run's end); each bearing's
