@@ -52,8 +52,8 @@ module fd_event_driven
    private
 
    public :: run_event_driven, event_driven_check
-   public :: ed_work, next_row_time, with_context, check_subintervals, move_to, values_at, update_global, &
-             absorb_until, energy   ! the loop's steps, for their unit suite
+   public :: ed_work, next_row_time, with_context, check_subintervals, unbounded_series, move_to, values_at, &
+             update_global, absorb_until, energy   ! the loop's steps, for their unit suite
 
    integer, parameter :: ring_size = 64          !! events in the accumulation window
    !> Most sub-intervals a run may need (about an hour of integration): a pattern whose
@@ -236,12 +236,13 @@ contains
    end function next_row_time
 
    !> The context of an error of the run, said once: the technique and the instant w%t (the
-   !> loop's own messages leave it to this); a cancel is left as it is.
+   !> loop's own messages leave it to this; the phase decision's and a row's non-finite
+   !> values start with it, at their own instant); a cancel is left as it is.
    subroutine with_context(w, err)
       type(ed_work), intent(in) :: w
       type(error_type), intent(inout) :: err
       if (err%stat == stat_cancelled) return   ! a cancel says so, as for the other techniques
-      if (index(err%message, "event-driven technique") == 0) &
+      if (index(err%message, "event-driven technique at t = ") /= 1) &
          err%message = "event-driven technique at t = "//trim(fmt_real(w%t))//" s: "//err%message
    end subroutine with_context
 
@@ -262,6 +263,16 @@ contains
          end if
       end associate
    end subroutine check_subintervals
+
+   !> The error of a sub-interval on which the Taylor series' remainder stays above the
+   !> rounding level down to span: no event can be located (the instant is with_context's).
+   subroutine unbounded_series(span, err)
+      real(dp), intent(in) :: span                  !! the shortest sub-interval tried [s]
+      type(error_type), allocatable, intent(out) :: err
+      call fatal_error(err, "the Taylor series' remainder stays above the rounding level on sub-intervals down "// &
+                       "to "//trim(fmt_real(span))//" s, so events cannot be located; use moreau_jean or the "// &
+                       "velocity law")
+   end subroutine unbounded_series
 
    !> The loop over sub-intervals from t = 0 to t_end.
    subroutine advance_run(w, model, exc, res, err)
@@ -289,10 +300,7 @@ contains
                span = 0.5_dp*span
             end do
             if (halvings > 40) then   ! no sub-interval bounds the series: no event is certain
-               call fatal_error(err, "the exact technique at t = "//trim(fmt_real(t))//" s: the Taylor "// &
-                                "series' remainder stays above the rounding level on sub-intervals down to "// &
-                                trim(fmt_real(span))//" s, so events cannot be located; use moreau_jean "// &
-                                "or the velocity law")
+               call unbounded_series(span, err)
                return
             end if
             call storey_polynomials(w, res)
