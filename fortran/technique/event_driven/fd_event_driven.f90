@@ -29,7 +29,7 @@
 module fd_event_driven
    use, intrinsic :: ieee_arithmetic, only: ieee_is_finite
    use fd_kinds, only: dp
-   use fd_error, only: error_type, fatal_error, fmt_real, fmt_int
+   use fd_error, only: error_type, fatal_error, fmt_real, fmt_int, allocation_error
    use fd_names, only: law_coulomb, law_name, excitation_types, technique_name, technique_event_driven, &
                        technique_newmark, technique_integrates
    use fd_model, only: model_type, integration_type
@@ -148,11 +148,9 @@ contains
       allocate (w%env(nqt), w%yv(nqt), w%rts(kmax, nqt), w%nrt(nqt), w%ip(nqt), w%uu(n), w%vv(n), w%aa(n), &
                 w%ss(nd), w%sd(nd), w%ff(nd), w%mp(0:kmax), w%ein(0:2*kmax), w%evi(0:2*kmax), w%cu(n), w%cv(n), &
                 w%cf(nd), stat=stat)
-      if (stat /= 0) then
-         call fatal_error(error, "not enough memory for the exact technique's work arrays of "// &
-                          trim(fmt_int(nqt))//" output quantities")
-         return
-      end if
+      call allocation_error(error, stat, "the exact technique's work arrays of "//trim(fmt_int(nqt))// &
+                            " output quantities")
+      if (allocated(error)) return
       associate (st => w%st, h => w%h, t_end => w%t_end)
          call structure_matrices(model, st%k, st%c, res%exact%setup%period_stuck, res%exact%setup%xi_stuck, error)
          if (allocated(error)) return

@@ -17,7 +17,7 @@
 !> step: not applicable.
 module fd_mode_resolution
    use fd_kinds, only: dp
-   use fd_error, only: error_type, fatal_error, fmt_int, stat_no_memory
+   use fd_error, only: error_type, fmt_int, allocation_error
    use fd_names, only: technique_step_rule, rule_none
    use fd_model, only: model_type
    use fd_friction, only: sticking_stiffness
@@ -70,11 +70,8 @@ contains
       ns = model%n_springs
       nd = model%n_devices
       allocate (ei(ns + nd), ej(ns + nd), ek(ns + nd), stat=stat)
-      if (stat /= 0) then
-         call fatal_error(error, "the highest natural frequency: not enough memory for "// &
-                          trim(fmt_int(ns + nd))//" elements", stat_no_memory)
-         return
-      end if
+      call allocation_error(error, stat, "the highest natural frequency's "//trim(fmt_int(ns + nd))//" elements")
+      if (allocated(error)) return
       ei(1:ns) = model%spring_i(1:ns)
       ej(1:ns) = model%spring_j(1:ns)
       ek(1:ns) = model%spring_k(1:ns)
@@ -136,11 +133,9 @@ contains
       n = model%n_dof
       lam = 0.0_dp
       allocate (k(n, n), m(n, n), w(n), z(n, n), stat=stat)
-      if (stat /= 0) then
-         call fatal_error(error, "the highest natural frequency: not enough memory for "//trim(fmt_int(n))// &
-                          " DOFs (dense matrices)", stat_no_memory)
-         return
-      end if
+      call allocation_error(error, stat, "the highest natural frequency's dense matrices of "//trim(fmt_int(n))// &
+                            " DOFs")
+      if (allocated(error)) return
       call stiffness_matrix(model, k)
       do d = 1, model%n_devices
          kd = sticking_stiffness(model%dev(d))
