@@ -14,7 +14,7 @@ import warnings
 import frictiondyn as fd
 import numpy as np
 import pytest
-from conftest import INPUTS, K1, K2, M1, M2, MU, P, ok
+from conftest import INPUTS, K1, K2, M1, M2, MU, P, deck_text, ok
 from frictiondyn.cli import main as cli
 
 WARNING = "does not resolve the highest modes"
@@ -56,6 +56,49 @@ def test_paper_test4_velocity_springs_only(run):
     omega = max(math.sqrt(K1 / M1), math.sqrt(K2 / M2))
     assert s["omega_max_rad_s"] == pytest.approx(omega, rel=1e-12)
     assert s["mode_resolution"] == "resolved"
+
+
+G = 9.80665
+
+
+@pytest.mark.parametrize("radius", [0.0, 2.0])
+def test_bearing_under_a_vertical_component_at_its_largest_normal_force(tmp_path, radius):
+    """A 1000 kg block on one hysteretic bearing (flat, or a friction pendulum of R = 2 m) to
+    the table, springs 2e4 N/m along x and 1e4 along y, its static normal force p = M g and
+    a constant vertical acceleration a_z = 0.8 g: N = 1.8 p all the run. Newmark integrates
+    x with the sticking spring N mu / f and the pendulum's N / R, so omega_max^2 =
+    (k_x + N (mu / f + 1 / R)) / M (1e-12); at the deck's p it would be 25 % lower, and
+    dt1 = 25 ms resolves that system (omega dt1 = 1.75 flat) but not the one integrated."""
+    m, kx, mu, f, p = 1000.0, 2.0e4, 0.1, 2.0e-4, 1000.0 * G
+    (tmp_path / "az.txt").write_text(f"{0.8 * G:.17e}\n" * 41)
+    bearing = {"n_bearings": 1, "dof_xi": 1, "dof_yi": 2, "dof_xj": 0, "dof_yj": 0, "p": p, "mu": mu,
+               "law": "hysteretic", "f": f, "eps1": 1.0e-3}
+    if radius:
+        bearing["radius"] = radius
+    groups = {
+        "model": {"n_dof": 2, "mass": [m, m]},
+        "springs": {"n_springs": 2, "node_i": [1, 2], "node_j": [0, 0], "k": [kx, 1.0e4]},
+        "damping": {"damping_type": "none"},
+        "bearings": bearing,
+        "excitation": {"excitation_type": "harmonic", "amplitude": 0.08, "frequency": 1.0, "dt_record": 0.025,
+                       "duration": 1.0},
+        "excitation3": {"excitation_type": "record", "record_file": "az.txt", "record_format": "values",
+                        "record_units": "m/s2", "dt_record": 0.025},
+        "integration": {"n1": 1},
+        "output": {"dir": "out"},
+    }
+    with warnings.catch_warnings(record=True) as caught:
+        warnings.simplefilter("always")
+        s = fd.run_text(deck_text(groups), "v.nml", tmp_path).summary
+    n_max = s["bearing_max_normal_force_N"][0]
+    assert n_max == pytest.approx(1.8 * p, rel=1e-14)
+    stiff = 1.0 / radius if radius else 0.0
+    omega = math.sqrt((kx + n_max * (mu / f + stiff)) / m)
+    assert s["omega_max_rad_s"] == pytest.approx(omega, rel=1e-12)
+    assert s["omega_max_dt1"] == pytest.approx(omega * 0.025, rel=1e-12)
+    assert math.sqrt((kx + p * (mu / f + stiff)) / m) * 0.025 < 2.0 < s["omega_max_dt1"]
+    assert s["mode_resolution"] == "unresolved"
+    assert any(WARNING in str(w.message) for w in caught)
 
 
 def building(n: int, law: str, technique: str | None) -> fd.Analysis:

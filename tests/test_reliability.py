@@ -457,6 +457,34 @@ def test_python_out_of_memory_raises_the_packages_exception(tmp_path):
     assert r.stdout.startswith("OutOfMemoryError True big.nml: not enough memory"), r.stdout
 
 
+def test_the_exact_techniques_state_out_of_memory_raises_the_packages_exception(tmp_path):
+    """The exact technique's state of a 4000-DOF chain with one Coulomb device (its K and C
+    dense, 128 MB each) in a Python whose address space is limited to what it uses plus 200
+    MB: OutOfMemoryError (the status of memory that could not be had) naming the state, not
+    a solver error."""
+    deck = big_deck(4000).replace("&integration linear_system = 'dense' /", "&integration technique = 'event_driven' /")
+    deck = deck.replace("&excitation excitation_type = 'none',", "&excitation excitation_type = 'harmonic', "
+                        "amplitude = 0.01, frequency = 1.0,")
+    (tmp_path / "big.nml").write_text(deck + "&friction n_devices = 1, node_i = 1, node_j = 0, law = 'coulomb', "
+                                      "p = 1.0, mu = 0.1 /\n&output n_modes = 0 /\n")
+    script = LIMIT + textwrap.dedent(
+        """
+        import frictiondyn
+        resource.setrlimit(resource.RLIMIT_AS, (vm() + 200 * 2**20, vm() + 200 * 2**20))
+        try:
+            frictiondyn.run('big.nml')
+        except frictiondyn.FrictiondynError as exc:
+            print(type(exc).__name__, isinstance(exc, MemoryError), exc)
+        """
+    )
+    env = dict(os.environ, OPENBLAS_NUM_THREADS="1")
+    r = subprocess.run([sys.executable, "-c", script], cwd=tmp_path, capture_output=True,
+                       text=True, timeout=120, env=env)
+    assert r.returncode == 0, r.stderr
+    assert r.stdout.strip() == ("OutOfMemoryError True big.nml: not enough memory for the exact technique's state "
+                                "of n_dof = 4000 DOFs and n_devices = 1 devices"), r.stdout
+
+
 def test_a_history_numpy_cannot_hold_raises_the_packages_exception(tmp_path, monkeypatch):
     """numpy's MemoryError for the history buffer becomes OutOfMemoryError naming the deck,
     the size and what to change."""

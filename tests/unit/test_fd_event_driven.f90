@@ -16,7 +16,7 @@ module test_fd_event_driven
    use fd_ed_state, only: ed_setup, ed_polynomials, iq_u, iq_v, iq_a
    use fd_phase_decision, only: decide_phases
    use fd_event_driven, only: run_event_driven, ed_work, next_row_time, with_context, check_subintervals, move_to, values_at, &
-                              update_global, absorb_until, energy
+                              update_global, absorb_until, energy, unbounded_series
    use test_fd_helpers, only: check_close, pairs_of
    implicit none
    private
@@ -41,6 +41,7 @@ contains
                   new_unittest("summary peaks from values at a point", test_update_global), &
                   new_unittest("stationary points are taken up to s only", test_absorb_until), &
                   new_unittest("an error says the technique and t once", test_with_context), &
+                  new_unittest("the unbounded series' error in context says t once", test_unbounded_series), &
                   new_unittest("more than 1e9 sub-intervals left is an error", test_subinterval_budget), &
                   new_unittest("a sliding block stops at m v0 / (P mu)", test_event_location) &
                   ]
@@ -248,6 +249,21 @@ contains
       call with_context(w, err)
       call check(error, err%message, "cancelled", "a cancel as it is")
    end subroutine test_with_context
+
+   !> The error of a series no sub-interval bounds, as the run hands it back (with_context):
+   !> the technique and the instant once, then the shortest sub-interval tried.
+   subroutine test_unbounded_series(error)
+      type(error_type), allocatable, intent(out) :: error
+      type(ed_work) :: w
+      type(fd_error_type), allocatable :: err
+
+      w%t = 1.25_dp
+      call unbounded_series(0.5_dp**40, err)
+      call with_context(w, err)
+      call check(error, err%message, "event-driven technique at t = "//trim(fmt_real(1.25_dp))//" s: the Taylor "// &
+                 "series' remainder stays above the rounding level on sub-intervals down to "// &
+                 trim(fmt_real(0.5_dp**40))//" s, so events cannot be located; use moreau_jean or the velocity law")
+   end subroutine test_unbounded_series
 
    !> An error when t_end - t > 1e9 sub-intervals of the current pattern, naming its length;
    !> none at half of that.

@@ -10,7 +10,7 @@
 !> remainder and its rounding level eta.
 module fd_ed_state
    use fd_kinds, only: dp
-   use fd_error, only: error_type, fatal_error, fmt_int
+   use fd_error, only: error_type, fmt_int, allocation_error
    use fd_model, only: model_type
    use fd_kinematics, only: pair_nodes, device_relative
    use fd_stiffness, only: influence_of
@@ -122,11 +122,9 @@ contains
                 st%roots(kmax), st%wm(nd, nd), st%lq(nd), st%lqa(nd), st%lo(nd), st%hi(nd), st%z(nd), st%w(nd), &
                 st%zs(nd), st%cand(nd), st%sig(nd), st%newph(nd), st%oldph(nd), st%crossed(nd), st%near(nd), &
                 st%fn(n), st%pe(n), st%pa(n), st%aab(n), st%qa(n, 0:kmax + 1), st%pq(n, 0:kmax + 1), stat=stat)
-      if (stat /= 0) then
-         call fatal_error(error, "not enough memory for the exact technique's state of n_dof = "// &
-                          trim(fmt_int(n))//" DOFs and n_devices = "//trim(fmt_int(nd))//" devices")
-         return
-      end if
+      call allocation_error(error, stat, "the exact technique's state of n_dof = "//trim(fmt_int(n))// &
+                            " DOFs and n_devices = "//trim(fmt_int(nd))//" devices")
+      if (allocated(error)) return
       st%mass = model%mass
       do d = 1, n
          st%rinf(d) = influence_of(model, d)

@@ -29,7 +29,7 @@
 module fd_event_driven
    use, intrinsic :: ieee_arithmetic, only: ieee_is_finite
    use fd_kinds, only: dp
-   use fd_error, only: error_type, fatal_error, fmt_real, fmt_int
+   use fd_error, only: error_type, fatal_error, fmt_real, fmt_int, allocation_error
    use fd_names, only: law_coulomb, law_name, excitation_types, technique_name, technique_event_driven, &
                        technique_newmark, technique_integrates
    use fd_model, only: model_type, integration_type
@@ -52,8 +52,8 @@ module fd_event_driven
    private
 
    public :: run_event_driven, event_driven_check
-   public :: ed_work, next_row_time, with_context, check_subintervals, move_to, values_at, update_global, &
-             absorb_until, energy   ! the loop's steps, for their unit suite
+   public :: ed_work, next_row_time, with_context, check_subintervals, unbounded_series, move_to, values_at, &
+             update_global, absorb_until, energy   ! the loop's steps, for their unit suite
 
    integer, parameter :: ring_size = 64          !! events in the accumulation window
    !> Most sub-intervals a run may need (about an hour of integration): a pattern whose
@@ -148,11 +148,9 @@ contains
       allocate (w%env(nqt), w%yv(nqt), w%rts(kmax, nqt), w%nrt(nqt), w%ip(nqt), w%uu(n), w%vv(n), w%aa(n), &
                 w%ss(nd), w%sd(nd), w%ff(nd), w%mp(0:kmax), w%ein(0:2*kmax), w%evi(0:2*kmax), w%cu(n), w%cv(n), &
                 w%cf(nd), stat=stat)
-      if (stat /= 0) then
-         call fatal_error(error, "not enough memory for the exact technique's work arrays of "// &
-                          trim(fmt_int(nqt))//" output quantities")
-         return
-      end if
+      call allocation_error(error, stat, "the exact technique's work arrays of "//trim(fmt_int(nqt))// &
+                            " output quantities")
+      if (allocated(error)) return
       associate (st => w%st, h => w%h, t_end => w%t_end)
          call structure_matrices(model, st%k, st%c, res%exact%setup%period_stuck, res%exact%setup%xi_stuck, error)
          if (allocated(error)) return
@@ -236,12 +234,13 @@ contains
    end function next_row_time
 
    !> The context of an error of the run, said once: the technique and the instant w%t (the
-   !> loop's own messages leave it to this); a cancel is left as it is.
+   !> loop's own messages leave it to this; the phase decision's and a row's non-finite
+   !> values start with it, at their own instant); a cancel is left as it is.
    subroutine with_context(w, err)
       type(ed_work), intent(in) :: w
       type(error_type), intent(inout) :: err
       if (err%stat == stat_cancelled) return   ! a cancel says so, as for the other techniques
-      if (index(err%message, "event-driven technique") == 0) &
+      if (index(err%message, "event-driven technique at t = ") /= 1) &
          err%message = "event-driven technique at t = "//trim(fmt_real(w%t))//" s: "//err%message
    end subroutine with_context
 
@@ -262,6 +261,16 @@ contains
          end if
       end associate
    end subroutine check_subintervals
+
+   !> The error of a sub-interval on which the Taylor series' remainder stays above the
+   !> rounding level down to span: no event can be located (the instant is with_context's).
+   subroutine unbounded_series(span, err)
+      real(dp), intent(in) :: span                  !! the shortest sub-interval tried [s]
+      type(error_type), allocatable, intent(out) :: err
+      call fatal_error(err, "the Taylor series' remainder stays above the rounding level on sub-intervals down "// &
+                       "to "//trim(fmt_real(span))//" s, so events cannot be located; use moreau_jean or the "// &
+                       "velocity law")
+   end subroutine unbounded_series
 
    !> The loop over sub-intervals from t = 0 to t_end.
    subroutine advance_run(w, model, exc, res, err)
@@ -289,10 +298,7 @@ contains
                span = 0.5_dp*span
             end do
             if (halvings > 40) then   ! no sub-interval bounds the series: no event is certain
-               call fatal_error(err, "the exact technique at t = "//trim(fmt_real(t))//" s: the Taylor "// &
-                                "series' remainder stays above the rounding level on sub-intervals down to "// &
-                                trim(fmt_real(span))//" s, so events cannot be located; use moreau_jean "// &
-                                "or the velocity law")
+               call unbounded_series(span, err)
                return
             end if
             call storey_polynomials(w, res)

@@ -44,7 +44,7 @@
 !> cache holds at most `nslots` patterns (least recently used replaced).
 module fd_phase_pattern
    use fd_kinds, only: dp
-   use fd_error, only: error_type, fatal_error, fmt_int
+   use fd_error, only: error_type, fatal_error, fmt_int, allocation_error
    use fd_model, only: model_type
    use fd_excitation, only: excitation_type, forcing_frequency
    use fd_matrices, only: link_groups, device_null_space
@@ -119,11 +119,8 @@ contains
          cache%tsize = 2*cache%tsize
       end do
       allocate (cache%slot(cache%nslots), cache%table(0:cache%tsize - 1), stat=stat)
-      if (stat /= 0) then
-         call fatal_error(error, "not enough memory for the cache of "//trim(fmt_int(cache%nslots))// &
-                          " phase patterns")
-         return
-      end if
+      call allocation_error(error, stat, "the cache of "//trim(fmt_int(cache%nslots))//" phase patterns")
+      if (allocated(error)) return
       cache%table = 0
    end subroutine cache_init
 
@@ -239,10 +236,8 @@ contains
       nd = size(phase)
       call free_pattern(pat)
       allocate (pat%key(nd), pat%grp(n), pat%row(nd), stat=stat)
-      if (stat /= 0) then
-         call no_memory(n, nd, error)
-         return
-      end if
+      call allocation_error(error, stat, trim(pattern_text(n, nd)))
+      if (allocated(error)) return
       pat%key = phase
       pat%general = general_pattern(model)
       if (pat%general) then
@@ -258,10 +253,8 @@ contains
       allocate (pat%ids(ns), pat%mq(nq), pat%kt(nq, nq), pat%ct(nq, nq), pat%pinv(ns, n), pat%fq(ns, nq), &
                 pat%fp(ns, nq), pat%fag(ns), pat%wq(nq), pat%wp(nq), pat%wacc(nq), pat%wf(ns), pat%lq(nq), &
                 kq(nq, nq), cq(nq, nq), stat=stat)
-      if (stat /= 0) then
-         call no_memory(n, nd, error)
-         return
-      end if
+      call allocation_error(error, stat, trim(pattern_text(n, nd)))
+      if (allocated(error)) return
       pat%lq = 1.0_dp
       pat%row = 0
       r = 0
@@ -314,10 +307,8 @@ contains
       ! force map F = D (B_S D)^+ r, r = (M T Kt - K T) q + (M T Ct - C T) p - m[grp = 0] ag + ...
       allocate (a(n, ns), b(max(n, ns), n), sv(min(n, ns)), lwk(least_squares_work(n, ns)), mk(n, nq), &
                 mc(n, nq), stat=stat)
-      if (stat /= 0) then
-         call no_memory(n, nd, error)
-         return
-      end if
+      call allocation_error(error, stat, trim(pattern_text(n, nd)))
+      if (allocated(error)) return
       a = 0.0_dp
       do r = 1, ns
          call add_device(model, pat%ids(r), sqrt(slip(pat%ids(r))), a(:, r))
@@ -337,7 +328,7 @@ contains
          pat%pinv(r, :) = sqrt(slip(pat%ids(r)))*b(r, 1:n)
       end do
       if (pat%general) then
-         call general_force_map(model, mass, k, c, pat)
+         call general_force_map(model, mass, k, c, pat, error)
          return
       end if
       do i = 1, n
@@ -393,12 +384,14 @@ contains
       end do
    end subroutine group_reduced
 
-   subroutine no_memory(n, nd, error)
-      integer, intent(in) :: n, nd
-      type(error_type), allocatable, intent(out) :: error
-      call fatal_error(error, "not enough memory for a phase pattern of "//trim(fmt_int(n))//" DOFs and "// &
-                       trim(fmt_int(nd))//" devices")
-   end subroutine no_memory
+   !> What a phase pattern's memory is for, in a message: "a phase pattern of n DOFs and nd
+   !> devices".
+   pure function pattern_text(n, nd) result(text)
+      integer, intent(in) :: n                      !! DOFs
+      integer, intent(in) :: nd                     !! devices
+      character(len=80) :: text
+      text = "a phase pattern of "//trim(fmt_int(n))//" DOFs and "//trim(fmt_int(nd))//" devices"
+   end function pattern_text
 
    !> Enter a pattern at a state (u, v): the reduced state (q: the mass-weighted mean of
    !> each group; a general pattern's q = T'M u, p = T'M v), the offsets uc = u - T q, v
@@ -657,10 +650,8 @@ contains
       call device_null_space(model, linked, z, nq, error)
       if (allocated(error)) return
       allocate (tm(n, nq), mz(nq, nq), eye(nq, nq), y(nq, nq), lam(nq), stat=stat)
-      if (stat /= 0) then
-         call no_memory(n, size(linked), error)
-         return
-      end if
+      call allocation_error(error, stat, trim(pattern_text(n, size(linked))))
+      if (allocated(error)) return
       if (nq == 0) return
       ! Z'MZ = Y diag(lam) Y': T = Z Y diag(lam)^-1/2
       eye = 0.0_dp
@@ -694,10 +685,8 @@ contains
       nq = pat%nq
       nd = model%n_devices
       allocate (pat%tb(nq, nd), mr(n), col(n), stat=stat)
-      if (stat /= 0) then
-         call no_memory(n, nd, error)
-         return
-      end if
+      call allocation_error(error, stat, trim(pattern_text(n, nd)))
+      if (allocated(error)) return
       pat%mq = 1.0_dp
       kq = matmul(transpose(pat%tm), matmul(k, pat%tm))
       cq = matmul(transpose(pat%tm), matmul(c, pat%tm))
@@ -716,15 +705,18 @@ contains
 
    !> A general pattern's force map (pinv set): F = fq q + fp p + fag ag + f0 with
    !> fq = pinv (M T Kt - K T), fp = pinv (M T Ct - C T), fag = -pinv (M r - M T lq).
-   subroutine general_force_map(model, mass, k, c, pat)
+   subroutine general_force_map(model, mass, k, c, pat, error)
       type(model_type), intent(in) :: model         !! the model
       real(dp), intent(in) :: mass(:), k(:, :), c(:, :) !! structure
       type(pattern_type), intent(inout) :: pat      !! the pattern
+      type(error_type), allocatable, intent(out) :: error !! no memory
       real(dp), allocatable :: mt(:, :), rr(:)
-      integer :: n, i, r
+      integer :: n, i, r, stat
 
       n = size(mass)
-      allocate (mt(n, pat%nq), rr(n))
+      allocate (mt(n, pat%nq), rr(n), stat=stat)
+      call allocation_error(error, stat, trim(pattern_text(n, model%n_devices)))
+      if (allocated(error)) return
       do i = 1, n
          mt(i, :) = mass(i)*pat%tm(i, :)
       end do

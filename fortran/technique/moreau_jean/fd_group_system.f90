@@ -13,7 +13,7 @@
 module fd_group_system
    use fd_kinds, only: dp
    use fd_lapack, only: dpbtrf, dpbtrs, dpttrf, dpttrs, dsbgvx
-   use fd_error, only: error_type, fatal_error, fmt_int, fmt_real, stat_no_memory
+   use fd_error, only: error_type, fatal_error, fmt_int, fmt_real, allocation_error
    implicit none
    private
 
@@ -58,10 +58,8 @@ contains
       gs%sk = sk
       gs%capacity = max(1, min(capacity, max(gs%n - 1, 1)))
       allocate (gs%ab((gs%capacity + 1)*gs%n), gs%dd(gs%n), gs%de(gs%n), stat=stat)
-      if (stat /= 0) then
-         call no_memory(error, gs%n, gs%capacity)
-         return
-      end if
+      call allocation_error(error, stat, trim(band_text(gs%n, gs%capacity)))
+      if (allocated(error)) return
       gs%ab = 0.0_dp
       gs%dd = 0.0_dp
       gs%de = 0.0_dp
@@ -110,10 +108,8 @@ contains
             end do
             deallocate (gs%ab)
             allocate (gs%ab((gs%capacity + 1)*gs%n), stat=stat)
-            if (stat /= 0) then
-               call no_memory(error, gs%n, gs%capacity)
-               return
-            end if
+            call allocation_error(error, stat, trim(band_text(gs%n, gs%capacity)))
+            if (allocated(error)) return
             gs%growths = gs%growths + 1
          end if
          ld = kb + 1
@@ -224,10 +220,8 @@ contains
       kb = reduced_bandwidth(gs, grp)
       allocate (ab(kb + 1, nr), bb(1, nr), w(nr), work(7*nr), iwork(5*nr), ifail(nr), q(1, 1), z(1, 1), &
                 stat=stat)
-      if (stat /= 0) then
-         call no_memory(error, gs%n, kb)
-         return
-      end if
+      call allocation_error(error, stat, trim(band_text(gs%n, kb)))
+      if (allocated(error)) return
       ab = 0.0_dp
       bb = 0.0_dp
       do i = 1, gs%n
@@ -269,13 +263,13 @@ contains
       end do
    end function reduced_bandwidth
 
-   !> The error of a failed allocation for a band of n rows and half-bandwidth kb.
-   subroutine no_memory(error, n, kb)
-      type(error_type), allocatable, intent(out) :: error !! set: stat_no_memory
-      integer, intent(in) :: n                            !! rows
-      integer, intent(in) :: kb                           !! half-bandwidth
-      call fatal_error(error, "not enough memory for the reduced band system of "//trim(fmt_int(n))// &
-                       " DOFs (half-bandwidth "//trim(fmt_int(kb))//")", stat_no_memory)
-   end subroutine no_memory
+   !> What a band's memory is for, in a message: "the reduced band system of n DOFs
+   !> (half-bandwidth kb)".
+   pure function band_text(n, kb) result(text)
+      integer, intent(in) :: n                      !! rows
+      integer, intent(in) :: kb                     !! half-bandwidth
+      character(len=80) :: text
+      text = "the reduced band system of "//trim(fmt_int(n))//" DOFs (half-bandwidth "//trim(fmt_int(kb))//")"
+   end function band_text
 
 end module fd_group_system

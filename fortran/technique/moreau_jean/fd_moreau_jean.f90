@@ -31,7 +31,7 @@
 module fd_moreau_jean
    use, intrinsic :: ieee_arithmetic, only: ieee_is_finite
    use fd_kinds, only: dp
-   use fd_error, only: error_type, fatal_error, fmt_real, fmt_int, stat_no_memory
+   use fd_error, only: error_type, fatal_error, fmt_real, fmt_int, allocation_error
    use fd_names, only: law_coulomb, law_name, excitation_types, technique_name, technique_moreau_jean, &
                        technique_newmark, damping_stiffness, damping_rayleigh, technique_integrates
    use fd_model, only: model_type, integration_type, device_type
@@ -163,11 +163,8 @@ contains
 
       period = 0.0_dp
       allocate (all_stuck(p%ne), stat=stat)
-      if (stat /= 0) then
-         call fatal_error(error, "not enough memory for the stuck system's "//trim(fmt_int(p%ne))//" edges", &
-                          stat_no_memory)
-         return
-      end if
+      call allocation_error(error, stat, "the stuck system's "//trim(fmt_int(p%ne))//" edges")
+      if (allocated(error)) return
       all_stuck = .true.
       call groups_build(p%es, all_stuck, p%node_order)
       p%fvalid = .false.
@@ -344,10 +341,8 @@ contains
       ! the devices' nodes and forces as arrays of their own (a component of an array of
       ! derived type passed as an argument is copied to a temporary at the call)
       allocate (dev_i(nd), dev_j(nd), pmu(nd), stat=stat)
-      if (stat /= 0) then
-         call no_memory(error, n)
-         return
-      end if
+      call allocation_error(error, stat, trim(state_text(n)))
+      if (allocated(error)) return
       call device_nodes(model, dev_i, dev_j, first)
       if (first /= 0) then
          call fatal_error(error, "the Moreau-Jean technique integrates devices between two nodes; device "// &
@@ -389,7 +384,7 @@ contains
                 w%s(nd), w%sd(nd), w%f(nd), w%phase0(nd), w%phase1(nd), w%counted(nd), w%pending(nd), &
                 w%ta(nd), w%tb(nd), w%g_step(w%ne), w%g_force(w%ne), w%f_edge(w%ne), &
                 w%rel_edge(w%ne), stat=stat)
-      if (stat /= 0) call no_memory(error, n)
+      call allocation_error(error, stat, trim(state_text(n)))
    end subroutine setup
 
    !> Whether the model takes the dense form of the one-step problem (fd_dense_impulse): a
@@ -431,10 +426,8 @@ contains
                 w%s(nd), w%sd(nd), w%f(nd), w%phase0(nd), w%phase1(nd), w%counted(nd), w%pending(nd), &
                 w%ta(nd), w%tb(nd), w%g_step(nd), w%g_force(nd), w%f_edge(nd), w%rel_edge(nd), w%lam(nd), &
                 w%wrel(nd), w%fend(nd), w%sig(nd), w%sa(nd), stat=stat)
-      if (stat /= 0) then
-         call no_memory(error, n)
-         return
-      end if
+      call allocation_error(error, stat, trim(state_text(n)))
+      if (allocated(error)) return
       do i = 1, n
          w%mr(i) = model%mass(i)*influence_of(model, i)
       end do
@@ -600,10 +593,8 @@ contains
 
       allocate (w%dev(w%nd), w%kp(w%nd), w%fx(w%nd), w%pn(nb), w%dn(nb), stat=stat)
       if (stat == 0 .and. w%three) call support_setup(w%nd, model%dev, 1, w%vs, stat)
-      if (stat /= 0) then
-         call no_memory(error, w%n)
-         return
-      end if
+      call allocation_error(error, stat, trim(state_text(w%n)))
+      if (allocated(error)) return
       w%elastic = w%vs%nb > 0
       w%dn = 0.0_dp
       w%dev = model%dev(1:w%nd)
@@ -761,13 +752,12 @@ contains
       if (stopped) call observe_stop_error(w%obs, error)
    end subroutine end_step
 
-   !> The error of an allocation sized by the deck that failed.
-   subroutine no_memory(error, n)
-      type(error_type), allocatable, intent(out) :: error !! set: stat_no_memory
-      integer, intent(in) :: n                            !! the deck's n_dof
-      call fatal_error(error, "not enough memory for the state of n_dof = "//trim(fmt_int(n))//" DOFs", &
-                       stat_no_memory)
-   end subroutine no_memory
+   !> What the state's memory is for, in a message: "the state of n_dof = n DOFs".
+   pure function state_text(n) result(text)
+      integer, intent(in) :: n                      !! the deck's n_dof
+      character(len=48) :: text
+      text = "the state of n_dof = "//trim(fmt_int(n))//" DOFs"
+   end function state_text
 
    !> Device kinematics, forces (shared out of the edge forces f_edge) and phases (the
    !> statuses of the step's one-step problem) from the solver's edges.

@@ -21,7 +21,7 @@
 module fd_harmonic_resolution
    use, intrinsic :: ieee_arithmetic, only: ieee_is_finite
    use fd_kinds, only: dp
-   use fd_error, only: error_type, fatal_error, fmt_int, stat_no_memory
+   use fd_error, only: error_type, fmt_int, allocation_error
    use fd_names, only: technique_step_rule, rule_none, rule_theta, excitation_harmonic
    use fd_matrices, only: modes_type, modes_kept, mode_damping, mode_participation
    use fd_model, only: model_type
@@ -112,11 +112,8 @@ contains
       if (res%eng%excitation /= excitation_harmonic) return
       if (dt1 <= 0.0_dp .or. .not. (res%eng%frequency > 0.0_dp)) return
       allocate (ue(n), ud(n), stat=stat)
-      if (stat /= 0) then
-         call fatal_error(error, "the step against the table's frequency: not enough memory for "// &
-                          trim(fmt_int(n))//" DOFs", stat_no_memory)
-         return
-      end if
+      call allocation_error(error, stat, "the step check against the table's frequency ("//trim(fmt_int(n))//" DOFs)")
+      if (allocated(error)) return
       any_system = .false.
       call one_system(res%eng%stuck)
       call one_system(res%eng%free)

@@ -36,7 +36,7 @@
 module fd_record_resolution
    use, intrinsic :: ieee_arithmetic, only: ieee_is_finite
    use fd_kinds, only: dp
-   use fd_error, only: error_type, fatal_error, fmt_int, stat_no_memory
+   use fd_error, only: error_type, fmt_int, allocation_error
    use fd_names, only: technique_step_rule, rule_none, rule_newmark, rule_theta, excitation_record
    use fd_stiffness, only: stiffness_times
    use fd_matrices, only: modes_type, modes_kept, mode_damping, mode_participation
@@ -148,11 +148,8 @@ contains
       ! largest and smallest q, exact and by Newmark; kept: the mode is estimated
       allocate (ps%off(n), ps%ku0(n), ps%ex(nm, 8), ps%nx(nm, 12), ps%z(nm, 5), ps%q0(nm), ps%ext(nm, 4), &
                 ps%kept(nm), stat=stat)
-      if (stat /= 0) then
-         call fatal_error(error, "the step against the record: not enough memory for "// &
-                          trim(fmt_int(n))//" DOFs", stat_no_memory)
-         return
-      end if
+      call allocation_error(error, stat, "the step check against the record ("//trim(fmt_int(n))//" DOFs)")
+      if (allocated(error)) return
       ps%h = setup%dt1
       ! the largest wn dt1 the check integrates: mode_resolution's limit 2, and Newmark's
       ! stability limit 1 / sqrt(gamma / 2 - beta) when it is conditionally stable
