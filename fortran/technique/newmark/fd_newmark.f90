@@ -151,6 +151,9 @@ module fd_newmark
       ! forces at the accepted state (dn) and at the trial's end (dn1); N varies (varies) with
       ! a vertical component or the overturning
       logical :: tilt = .false., varies = .false.
+      ! the devices' ks, cs and f0 change only with their phase (N constant, no mu(v), no planar
+      ! bearing): a step without a phase change leaves them as they were (device_step)
+      logical :: phase_coefficients = .false.
       real(dp), allocatable :: dn(:), dn1(:)          !! per bearing [N]
       ! the bearings on elastic vertical supports under a vertical component (elastic): their
       ! oscillators, advanced over each trial step (fd_vertical_support)
@@ -245,6 +248,7 @@ contains
          end if
          w%tilt = model%overturning
          w%varies = w%three .or. w%tilt
+         w%phase_coefficients = .not. (w%varies .or. w%nf > 0 .or. any(w%dev%partner > 0))
          call observer_init(model, exc, opts, res%newmark%setup%period_stuck, res, w%obs, error, ctl)
          if (allocated(error)) exit run
          if (w%three) then
@@ -1223,7 +1227,7 @@ contains
       ! and damping (whatever changed them); after a phase change, or a sliding force that
       ! follows the velocity (mu(v)), the next step starts in equilibrium with the new forces
       call device_step(w%nd, w%st, w%st1, w%s, w%sd, w%s1, w%sd1, w%f, w%w_device, w%obs%device_work, &
-                       w%obs%slip_travel, changed_k, any_force)
+                       w%obs%slip_travel, any_changed .or. .not. w%phase_coefficients, changed_k, any_force)
       ! the sticking springs' ringing: the step joins its phases' statistics (fd_stick_ringing)
       if (w%ring%n > 0) then
          call phase_statistics(w%nd, t1 - w%t, w%st, w%sd, w%f, w%ring%stats)
@@ -1317,8 +1321,9 @@ contains
    !> observer's totals here, in the loop over the devices (a call a step would cost more
    !> than the sums); the devices move
    !> on to the trial state (s, s', state) and their force in it; whether a stiffness or
-   !> damping changed, and whether a constant force f0 changed.
-   pure subroutine device_step(nd, st, st1, s, sd, s1, sd1, f, w, work, travel, changed_k, changed_f0)
+   !> damping changed, and whether a constant force f0 changed (compared only when they may
+   !> have: compare).
+   pure subroutine device_step(nd, st, st1, s, sd, s1, sd1, f, w, work, travel, compare, changed_k, changed_f0)
       integer, intent(in) :: nd
       type(device_state), intent(inout) :: st(nd)
       type(device_state), intent(in) :: st1(nd)
@@ -1329,6 +1334,7 @@ contains
                                                !! at the end, in the phases for the next step
       real(dp), intent(inout) :: w
       real(dp), intent(inout) :: work(nd), travel(nd) !! per device: work [J], slip travel [m]
+      logical, intent(in) :: compare           !! a phase changed, or coefficients change within one
       logical, intent(out) :: changed_k, changed_f0
       real(dp) :: f0, f1, dw
       integer :: d
@@ -1344,8 +1350,10 @@ contains
          if (st(d)%phase /= phase_stick) travel(d) = travel(d) + abs(s1(d) - s(d))
          s(d) = s1(d)
          sd(d) = sd1(d)
-         changed_k = changed_k .or. st1(d)%ks /= st(d)%ks .or. st1(d)%cs /= st(d)%cs
-         changed_f0 = changed_f0 .or. st1(d)%f0 /= st(d)%f0
+         if (compare) then
+            changed_k = changed_k .or. st1(d)%ks /= st(d)%ks .or. st1(d)%cs /= st(d)%cs
+            changed_f0 = changed_f0 .or. st1(d)%f0 /= st(d)%f0
+         end if
          st(d) = st1(d)
          f(d) = st(d)%ks*s(d) + st(d)%cs*sd(d) + st(d)%f0
       end do
