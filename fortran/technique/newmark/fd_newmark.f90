@@ -154,6 +154,10 @@ module fd_newmark
       ! the devices' ks, cs and f0 change only with their phase (N constant, no mu(v), no planar
       ! bearing): a step without a phase change leaves them as they were (device_step)
       logical :: phase_coefficients = .false.
+      ! the plan of a trial step, decided at set-up: K^ banded or dense and no low-rank term
+      ! (lean: try_step's own calls, else general_product, general_solve); a varying N, mu(v)
+      ! or a second component (extras: trial_start, trial_end)
+      logical :: lean = .false., extras = .false.
       real(dp), allocatable :: dn(:), dn1(:)          !! per bearing [N]
       ! the bearings on elastic vertical supports under a vertical component (elastic): their
       ! oscillators, advanced over each trial step (fd_vertical_support)
@@ -249,6 +253,7 @@ contains
          w%tilt = model%overturning
          w%varies = w%three .or. w%tilt
          w%phase_coefficients = .not. (w%varies .or. w%nf > 0 .or. any(w%dev%partner > 0))
+         w%extras = w%varies .or. w%nf > 0 .or. w%two
          call observer_init(model, exc, opts, res%newmark%setup%period_stuck, res, w%obs, error, ctl)
          if (allocated(error)) exit run
          if (w%three) then
@@ -473,6 +478,7 @@ contains
       end if
       call device_nodes(model, w%di, w%dj, l)
       w%pairs = l == 0
+      w%lean = .not. (sparse .or. allocated(model%modal_d))
       w%nf = count(follows_velocity(model%dev))
       allocate (w%fl(w%nf), w%df(w%nf), w%cap(w%nf), w%dev(nd), w%pn(nd), stat=stat)
       if (stat /= 0) then
@@ -640,7 +646,8 @@ contains
       type(error_type), allocatable, intent(out) :: error
       real(dp) :: h, ag1
 
-      if (.not. (w%lev(lv)%factored .and. w%lev(lv)%version == w%version)) then
+      ! (a level's version is the loop's only once it is factored)
+      if (w%lev(lv)%version /= w%version) then
          call factor_for(model, lv, w, error)
          if (allocated(error)) return
       end if
@@ -654,34 +661,24 @@ contains
             ag1 = table_acceleration(exc, t + h)
          end if
          w%ag1 = ag1
-         ! the normal forces of the step's start (the follow's), then of its end (the laws' update)
-         if (w%varies) call normal_forces(model, t, w, .false.)
-         ! a speed-dependent mu's sliding forces start from the velocity at the step's start,
-         ! whatever an earlier trial of the step left in them (follow_forces takes them on)
-         if (w%nf > 0) call start_forces(w%dev, w)
          call predict(w%n, h, lev%g1h, lev%b2h2, ag1, w%mr, w%u, w%v, w%a, w%tmp, w%u1, w%rhs)
-         if (w%two) then
-            w%ag21 = table_acceleration(w%exc2, t + h)
-            w%rhs = w%rhs - w%mr2*w%ag21
-         end if
-         if (lev%sparse) then
-            call sparse_kc_matvec(lev%sps, w%u1, w%tmp, w%rhs, -1.0_dp)
-         else
+         if (w%extras) call trial_start(model, t, h, w)
+         if (w%lean) then
             call spd_kc_matvec(lev%sys, w%u1, w%tmp, w%rhs, -1.0_dp)
+         else
+            call general_product(model, lv, w)
          end if
-         if (lev%wb%r > 0) call lowrank_matvec(model%modal_u, model%modal_d, w%tmp, w%rhs, -1.0_dp)
          if (w%pairs) then
             call pair_loads(w%n, w%nd, w%di, w%dj, w%st, w%u1, w%tmp, lev%c0, w%rhs)
          else
             call device_loads(model, w%n, w%nd, w%st, w%u1, w%tmp, lev%c0, w%rhs, w%s1, w%sd1, w%fw)
          end if
-         if (lev%sparse) then
-            call sparse_solve(lev%sps, w%rhs, error)
-         else
+         if (w%lean) then
             call spd_solve(lev%sys, w%rhs, error)
+         else
+            call general_solve(model, lv, w, error)
          end if
          if (allocated(error)) return
-         if (lev%wb%r > 0) call woodbury_correct(lev%wb, model%modal_u, w%rhs)
          call correct(w%n, lev%bh2, lev%gh, w%rhs, w%tmp, w%a1, w%u1, w%v1)
          if (w%pairs) then
             call pair_motion(w%n, w%nd, w%di, w%dj, w%u1, w%v1, w%s1, w%sd1)
@@ -689,11 +686,76 @@ contains
             call relative_motion(model, w%n, w%nd, w%u1, w%v1, w%s1, w%sd1)
          end if
       end associate
+      if (w%extras) call trial_end(model, t, h, lv, w, error)
+   end subroutine try_step
+
+   !> A trial's start beyond the lean step (w%extras), after the predictors: the normal forces
+   !> of the step's start (the follow's; of its end for the laws' update: trial_end), a
+   !> speed-dependent mu's sliding forces from the velocity at the step's start (whatever an
+   !> earlier trial of the step left in them: follow_forces takes them on), and the second
+   !> component's load at the step's end t + h.
+   subroutine trial_start(model, t, h, w)
+      type(model_type), intent(in) :: model
+      real(dp), intent(in) :: t, h
+      type(workspace), intent(inout) :: w
+
+      if (w%varies) call normal_forces(model, t, w, .false.)
+      if (w%nf > 0) call start_forces(w%dev, w)
+      if (w%two) then
+         w%ag21 = table_acceleration(w%exc2, t + h)
+         w%rhs = w%rhs - w%mr2*w%ag21
+      end if
+   end subroutine trial_start
+
+   !> A trial's product K u~ + C v~ off the lean path: K^ sparse (CHOLMOD) or banded, 'modal'
+   !> damping's low-rank term.
+   subroutine general_product(model, lv, w)
+      type(model_type), intent(in) :: model
+      integer, intent(in) :: lv
+      type(workspace), intent(inout) :: w
+
+      associate (lev => w%lev(lv))
+         if (lev%sparse) then
+            call sparse_kc_matvec(lev%sps, w%u1, w%tmp, w%rhs, -1.0_dp)
+         else
+            call spd_kc_matvec(lev%sys, w%u1, w%tmp, w%rhs, -1.0_dp)
+         end if
+         if (lev%wb%r > 0) call lowrank_matvec(model%modal_u, model%modal_d, w%tmp, w%rhs, -1.0_dp)
+      end associate
+   end subroutine general_product
+
+   !> A trial's solve off the lean path (general_product's): the solution a1 in w%rhs.
+   subroutine general_solve(model, lv, w, error)
+      type(model_type), intent(in) :: model
+      integer, intent(in) :: lv
+      type(workspace), intent(inout) :: w
+      type(error_type), allocatable, intent(out) :: error
+
+      associate (lev => w%lev(lv))
+         if (lev%sparse) then
+            call sparse_solve(lev%sps, w%rhs, error)
+         else
+            call spd_solve(lev%sys, w%rhs, error)
+         end if
+         if (allocated(error)) return
+         if (lev%wb%r > 0) call woodbury_correct(lev%wb, model%modal_u, w%rhs)
+      end associate
+   end subroutine general_solve
+
+   !> A trial's end beyond the lean step (w%extras): a speed-dependent mu's forces iterated to
+   !> the step's end, the vertical supports' trial from the accepted state at t (a_z linear in
+   !> the step), the normal forces at the step's end t + h.
+   subroutine trial_end(model, t, h, lv, w, error)
+      type(model_type), intent(in) :: model
+      real(dp), intent(in) :: t, h
+      integer, intent(in) :: lv
+      type(workspace), intent(inout) :: w
+      type(error_type), allocatable, intent(out) :: error
+
       if (w%nf > 0) call follow_forces(model, lv, w, error)
-      ! the vertical supports' trial from the accepted state at t (a_z linear in the step)
       if (w%elastic) call support_advance(w%vs, lv, t + h, table_acceleration(w%exc3, t), table_acceleration(w%exc3, t + h))
       if (w%varies) call normal_forces(model, t + h, w, .true.)
-   end subroutine try_step
+   end subroutine trial_end
 
    !> A speed-dependent mu at the velocity at the step's end (implicit, as a Newton-Raphson
    !> code's trial takes it): the sliding forces f0 of the devices that follow the velocity are
