@@ -117,6 +117,9 @@ module fd_newmark
       real(dp), allocatable :: u1(:), v1(:), a1(:), rhs(:), tmp(:)
       real(dp), allocatable :: sd(:), s1(:), sd1(:), kd(:)
       real(dp), allocatable :: fw(:)                  !! work: the devices' loads of a trial
+      ! an accepted step's u1 - u and v + v1 (0:n), 0 at the table's index 0: a spring's ends
+      ! without a test for the table (viscous_work)
+      real(dp), allocatable :: du(:), vsum(:)
       ! devices between two nodes: the step's loads and relative motion by their nodes, in this
       ! module (pair_loads, pair_motion: three calls to fd_kinematics' kernels a trial cost a
       ! one-device model about 6 % of its instructions); other directions through fd_kinematics
@@ -470,12 +473,15 @@ contains
       end do
       allocate (w%u(n), w%v(n), w%a(n), w%u1(n), w%v1(n), w%a1(n), w%rhs(n), w%tmp(n), &
                 w%s(nd), w%sd(nd), w%s1(nd), w%sd1(nd), w%f(nd), w%fw(nd), w%kd(nd), w%st(nd), w%st1(nd), w%st0(nd), &
-                w%phase0(nd), w%phase1(nd), w%phase_end(nd), w%changed(nd), w%ok(nd), w%di(nd), w%dj(nd), stat=stat)
+                w%phase0(nd), w%phase1(nd), w%phase_end(nd), w%changed(nd), w%ok(nd), w%di(nd), w%dj(nd), &
+                w%du(0:n), w%vsum(0:n), stat=stat)
       if (stat /= 0) then
          call fatal_error(error, "not enough memory for the state of n_dof = "//trim(fmt_int(n))//" DOFs", &
                           stat_no_memory)
          return
       end if
+      w%du(0) = 0.0_dp
+      w%vsum(0) = 0.0_dp
       call device_nodes(model, w%di, w%dj, l)
       w%pairs = l == 0
       w%lean = .not. (sparse .or. allocated(model%modal_d))
@@ -1264,13 +1270,13 @@ contains
       logical :: changed_k, any_force
 
       ! energy of the step, forces at both ends in the step's phases; the state moves on
-      call step_energy(w%n, w%mr, w%u, w%v, w%a, w%u1, w%v1, w%a1, w%tmp, w%rhs, ein)
+      call step_energy(w%n, w%mr, w%u, w%v, w%a, w%u1, w%v1, w%a1, w%du, w%vsum, ein)
       ein = 0.5_dp*(w%ag + w%ag1)*ein
       if (w%two) then
-         ein = ein + 0.5_dp*(w%ag2 + w%ag21)*dot_product(w%mr2, w%tmp)
+         ein = ein + 0.5_dp*(w%ag2 + w%ag21)*dot_product(w%mr2, w%du(1:))
          w%ag2 = w%ag21
       end if
-      call observe_work(res, -ein, 0.5_dp*viscous_work(model, w%a0, w%a1c, w%n, w%mass, w%tmp, w%rhs))
+      call observe_work(res, -ein, 0.5_dp*viscous_work(model, w%a0, w%a1c, w%n, w%mass, w%du, w%vsum))
       w%ag = w%ag1
       ! violations of the correctness condition left in an accepted step
       if (any_bad) call observe_violations(res, t1, w%ok)
@@ -1317,14 +1323,15 @@ contains
       call observe_peaks(res, t1, w%observed_state)
    end subroutine accept
 
-   !> The state moves to the trial state; du = u1 - u (in du), v + v1 (in vsum) and
+   !> The state moves to the trial state; du = u1 - u (in du(1:n)), v + v1 (in vsum(1:n)) and
    !> sum_i m_i r_i du_i (the input work's factor) of the step.
    pure subroutine step_energy(n, mass, u, v, a, u1, v1, a1, du, vsum, ein)
       integer, intent(in) :: n
       real(dp), intent(in) :: mass(n)   !! M r
       real(dp), intent(in) :: u1(n), v1(n), a1(n)
       real(dp), intent(inout) :: u(n), v(n), a(n)
-      real(dp), intent(out) :: du(n), vsum(n), ein
+      real(dp), intent(inout) :: du(0:n), vsum(0:n)   !! index 0 (the table) left as it is
+      real(dp), intent(out) :: ein
       integer :: i
 
       ein = 0.0_dp
@@ -1346,8 +1353,9 @@ contains
       type(model_type), intent(in) :: model
       real(dp), intent(in) :: a0, a1
       integer, intent(in) :: n
-      real(dp), intent(in) :: mass(n), du(n), vsum(n)
-      real(dp) :: ek, x, y
+      real(dp), intent(in) :: mass(n)
+      real(dp), intent(in) :: du(0:n), vsum(0:n)   !! 0 at index 0: a spring's end at the table
+      real(dp) :: ek
       integer :: i, s
 
       e = 0.0_dp
@@ -1359,23 +1367,16 @@ contains
       end if
       if (a1 /= 0.0_dp) then
          ek = 0.0_dp
+         ! (an end at the table, index 0, subtracts 0 or is subtracted from 0: the values of
+         ! a spring's (u_i - u_j) alone)
          do s = 1, model%n_springs
-            x = 0.0_dp
-            y = 0.0_dp
-            if (model%spring_i(s) > 0) then
-               x = du(model%spring_i(s))
-               y = vsum(model%spring_i(s))
-            end if
-            if (model%spring_j(s) > 0) then
-               x = x - du(model%spring_j(s))
-               y = y - vsum(model%spring_j(s))
-            end if
-            ek = ek + model%spring_k(s)*x*y
+            ek = ek + model%spring_k(s)*(du(model%spring_i(s)) - du(model%spring_j(s)))* &
+                 (vsum(model%spring_i(s)) - vsum(model%spring_j(s)))
          end do
-         if (model%n_kx > 0) ek = ek + general_form(model, du, vsum)
+         if (model%n_kx > 0) ek = ek + general_form(model, du(1:n), vsum(1:n))
          e = e + a1*ek
       end if
-      if (allocated(model%modal_d)) e = e + lowrank_form(model%modal_u, model%modal_d, vsum, du)
+      if (allocated(model%modal_d)) e = e + lowrank_form(model%modal_u, model%modal_d, vsum(1:n), du(1:n))
    end function viscous_work
 
    !> Work of the device forces over the step (trapezoid, the step's phases), in all and per
