@@ -1280,12 +1280,6 @@ contains
       w%ag = w%ag1
       ! violations of the correctness condition left in an accepted step
       if (any_bad) call observe_violations(res, t1, w%ok)
-      ! a speed-dependent mu's forces that did not converge, left in an accepted step
-      if (w%follow_failed) then
-         res%mu_unconverged = res%mu_unconverged + 1
-         if (res%mu_unconverged == 1) res%mu_unconverged_time = t1
-         res%mu_misfit = max(res%mu_misfit, w%follow_misfit)
-      end if
       if (any_changed) then
          w%phase0 = w%st%phase
          w%phase1 = w%st1%phase
@@ -1304,24 +1298,39 @@ contains
       ! the velocity-law bands' forces: an alternation from step to step (fd_band_alternation)
       if (w%alt%n > 0) call alternation_step(w%alt, w%nd, t1 - w%t, w%st, w%f, res%band_alternation, &
                                              res%band_alternation_time)
-      if (w%varies) then
-         ! (a vertical component or the overturning, tilt, makes N vary: one test for the models
-         ! without bearings; an elastic support comes with a vertical component)
-         if (w%tilt) w%dn = w%dn1
-         if (w%elastic) then
-            ! the vertical supports move on: the ground's work on them and their dashpots'
-            call support_accept(w%vs)
-            call observe_work(res, w%vs%w_in1, w%vs%w_damp1)
-         end if
-         call observe_bearing_forces(res, model, t1, t1 - w%t, w%az, w%tilt, w%vs, w%pn, w%dn)
-         call checks_normal_force(model, w, res)
-      end if
+      if (w%extras) call accept_extras(model, t1, w, res)
       w%t = t1
       if (changed_k) w%version = w%version + 1
       ! (a varying normal force changes a band's dashpot or a sticking spring within a phase)
       if (any_changed .or. any_force .or. (w%varies .and. changed_k)) call consistent_acceleration(model, exc, t1, w)
       call observe_peaks(res, t1, w%observed_state)
    end subroutine accept
+
+   !> An accepted step's part beyond the lean step (w%extras), before the state's time moves to
+   !> t1: a speed-dependent mu's forces that did not converge in it, counted; a varying N (a
+   !> vertical component or the overturning, tilt; an elastic support comes with a vertical
+   !> component): the vertical supports move on, the bearings' forces, the step checks' N ranges.
+   subroutine accept_extras(model, t1, w, res)
+      type(model_type), intent(in) :: model
+      real(dp), intent(in) :: t1
+      type(workspace), intent(inout) :: w
+      type(result_type), intent(inout) :: res
+
+      if (w%follow_failed) then
+         res%mu_unconverged = res%mu_unconverged + 1
+         if (res%mu_unconverged == 1) res%mu_unconverged_time = t1
+         res%mu_misfit = max(res%mu_misfit, w%follow_misfit)
+      end if
+      if (.not. w%varies) return
+      if (w%tilt) w%dn = w%dn1
+      if (w%elastic) then
+         ! the ground's work on the vertical supports and their dashpots'
+         call support_accept(w%vs)
+         call observe_work(res, w%vs%w_in1, w%vs%w_damp1)
+      end if
+      call observe_bearing_forces(res, model, t1, t1 - w%t, w%az, w%tilt, w%vs, w%pn, w%dn)
+      call checks_normal_force(model, w, res)
+   end subroutine accept_extras
 
    !> The state moves to the trial state; du = u1 - u (in du(1:n)), v + v1 (in vsum(1:n)) and
    !> sum_i m_i r_i du_i (the input work's factor) of the step.
