@@ -211,16 +211,17 @@ contains
       logical, intent(out) :: any_changed       !! some phase changed
       logical, intent(out) :: any_bad           !! some device violates the condition
       integer :: d
+      logical :: some_changed, some_bad          ! locals: the dummies would be stored at every device
 
-      any_changed = .false.
-      any_bad = .false.
+      some_changed = .false.
+      some_bad = .false.
       do d = 1, nd
          if (dev(d)%partner > 0) then
             ! a planar bearing: its two components together, once
             if (dev(d)%partner < d) cycle
             call planar_step(dev(d), n, [d, dev(d)%partner], s1, sd1, sd, st, st1, changed, ok)
-            any_changed = any_changed .or. changed(d) .or. changed(dev(d)%partner)
-            any_bad = any_bad .or. .not. ok(d)
+            some_changed = some_changed .or. changed(d) .or. changed(dev(d)%partner)
+            some_bad = some_bad .or. .not. ok(d)
             cycle
          end if
          st1(d) = st(d)
@@ -235,9 +236,11 @@ contains
             changed(d) = .false.
             ok(d) = .true.
          end select
-         any_changed = any_changed .or. changed(d)
-         any_bad = any_bad .or. .not. ok(d)
+         some_changed = some_changed .or. changed(d)
+         some_bad = some_bad .or. .not. ok(d)
       end do
+      any_changed = some_changed
+      any_bad = some_bad
    end subroutine friction_step
 
    !> friction_step for a planar bearing, the devices pq = (x, y) components: the phases for the

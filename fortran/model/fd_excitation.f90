@@ -36,7 +36,8 @@ module fd_excitation
       real(dp) :: amp(max_sines) = 0.0_dp      !! amplitudes [m/s2]
    end type sine_forcing
 
-   integer, parameter :: grid_block = 64      !! grid points per block of grid_motion
+   integer, parameter :: grid_shift = 6       !! log2 of grid_block: a point's block by a shift
+   integer, parameter :: grid_block = 2**grid_shift !! grid points per block of grid_motion
 
    !> The table acceleration at the points t = k h of a grid (the ends of a run's dt1 steps)
    !> of harmonic motion without a ramp, without a sine per point: with k = b + j, b a multiple
@@ -164,8 +165,8 @@ contains
          ag = table_acceleration(exc, t)
          return
       end if
-      b = k/grid_block
-      j = k - b*grid_block
+      b = shiftr(k, grid_shift)                  ! k / grid_block and its remainder, k >= 0
+      j = iand(k, grid_block - 1)
       if (b /= grid%block) then
          x = grid%w*(real(b, dp)*grid_block*grid%h)
          grid%sb = sin(x)

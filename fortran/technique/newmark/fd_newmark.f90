@@ -117,6 +117,9 @@ module fd_newmark
       real(dp), allocatable :: u1(:), v1(:), a1(:), rhs(:), tmp(:)
       real(dp), allocatable :: sd(:), s1(:), sd1(:), kd(:)
       real(dp), allocatable :: fw(:)                  !! work: the devices' loads of a trial
+      ! an accepted step's u1 - u and v + v1 (0:n), 0 at the table's index 0: a spring's ends
+      ! without a test for the table (viscous_work)
+      real(dp), allocatable :: du(:), vsum(:)
       ! devices between two nodes: the step's loads and relative motion by their nodes, in this
       ! module (pair_loads, pair_motion: three calls to fd_kinematics' kernels a trial cost a
       ! one-device model about 6 % of its instructions); other directions through fd_kinematics
@@ -151,6 +154,13 @@ module fd_newmark
       ! forces at the accepted state (dn) and at the trial's end (dn1); N varies (varies) with
       ! a vertical component or the overturning
       logical :: tilt = .false., varies = .false.
+      ! the devices' ks, cs and f0 change only with their phase (N constant, no mu(v), no planar
+      ! bearing): a step without a phase change leaves them as they were (device_step)
+      logical :: phase_coefficients = .false.
+      ! the plan of a trial step, decided at set-up: K^ banded or dense and no low-rank term
+      ! (lean: try_step's own calls, else general_product, general_solve); a varying N, mu(v)
+      ! or a second component (extras: trial_start, trial_end)
+      logical :: lean = .false., extras = .false.
       real(dp), allocatable :: dn(:), dn1(:)          !! per bearing [N]
       ! the bearings on elastic vertical supports under a vertical component (elastic): their
       ! oscillators, advanced over each trial step (fd_vertical_support)
@@ -245,6 +255,8 @@ contains
          end if
          w%tilt = model%overturning
          w%varies = w%three .or. w%tilt
+         w%phase_coefficients = .not. (w%varies .or. w%nf > 0 .or. any(w%dev%partner > 0))
+         w%extras = w%varies .or. w%nf > 0 .or. w%two
          call observer_init(model, exc, opts, res%newmark%setup%period_stuck, res, w%obs, error, ctl)
          if (allocated(error)) exit run
          if (w%three) then
@@ -461,14 +473,18 @@ contains
       end do
       allocate (w%u(n), w%v(n), w%a(n), w%u1(n), w%v1(n), w%a1(n), w%rhs(n), w%tmp(n), &
                 w%s(nd), w%sd(nd), w%s1(nd), w%sd1(nd), w%f(nd), w%fw(nd), w%kd(nd), w%st(nd), w%st1(nd), w%st0(nd), &
-                w%phase0(nd), w%phase1(nd), w%phase_end(nd), w%changed(nd), w%ok(nd), w%di(nd), w%dj(nd), stat=stat)
+                w%phase0(nd), w%phase1(nd), w%phase_end(nd), w%changed(nd), w%ok(nd), w%di(nd), w%dj(nd), &
+                w%du(0:n), w%vsum(0:n), stat=stat)
       if (stat /= 0) then
          call fatal_error(error, "not enough memory for the state of n_dof = "//trim(fmt_int(n))//" DOFs", &
                           stat_no_memory)
          return
       end if
+      w%du(0) = 0.0_dp
+      w%vsum(0) = 0.0_dp
       call device_nodes(model, w%di, w%dj, l)
       w%pairs = l == 0
+      w%lean = .not. (sparse .or. allocated(model%modal_d))
       w%nf = count(follows_velocity(model%dev))
       allocate (w%fl(w%nf), w%df(w%nf), w%cap(w%nf), w%dev(nd), w%pn(nd), stat=stat)
       if (stat /= 0) then
@@ -636,7 +652,8 @@ contains
       type(error_type), allocatable, intent(out) :: error
       real(dp) :: h, ag1
 
-      if (.not. (w%lev(lv)%factored .and. w%lev(lv)%version == w%version)) then
+      ! (a level's version is the loop's only once it is factored)
+      if (w%lev(lv)%version /= w%version) then
          call factor_for(model, lv, w, error)
          if (allocated(error)) return
       end if
@@ -650,34 +667,24 @@ contains
             ag1 = table_acceleration(exc, t + h)
          end if
          w%ag1 = ag1
-         ! the normal forces of the step's start (the follow's), then of its end (the laws' update)
-         if (w%varies) call normal_forces(model, t, w, .false.)
-         ! a speed-dependent mu's sliding forces start from the velocity at the step's start,
-         ! whatever an earlier trial of the step left in them (follow_forces takes them on)
-         if (w%nf > 0) call start_forces(w%dev, w)
          call predict(w%n, h, lev%g1h, lev%b2h2, ag1, w%mr, w%u, w%v, w%a, w%tmp, w%u1, w%rhs)
-         if (w%two) then
-            w%ag21 = table_acceleration(w%exc2, t + h)
-            w%rhs = w%rhs - w%mr2*w%ag21
-         end if
-         if (lev%sparse) then
-            call sparse_kc_matvec(lev%sps, w%u1, w%tmp, w%rhs, -1.0_dp)
-         else
+         if (w%extras) call trial_start(model, t, h, w)
+         if (w%lean) then
             call spd_kc_matvec(lev%sys, w%u1, w%tmp, w%rhs, -1.0_dp)
+         else
+            call general_product(model, lv, w)
          end if
-         if (lev%wb%r > 0) call lowrank_matvec(model%modal_u, model%modal_d, w%tmp, w%rhs, -1.0_dp)
          if (w%pairs) then
             call pair_loads(w%n, w%nd, w%di, w%dj, w%st, w%u1, w%tmp, lev%c0, w%rhs)
          else
             call device_loads(model, w%n, w%nd, w%st, w%u1, w%tmp, lev%c0, w%rhs, w%s1, w%sd1, w%fw)
          end if
-         if (lev%sparse) then
-            call sparse_solve(lev%sps, w%rhs, error)
-         else
+         if (w%lean) then
             call spd_solve(lev%sys, w%rhs, error)
+         else
+            call general_solve(model, lv, w, error)
          end if
          if (allocated(error)) return
-         if (lev%wb%r > 0) call woodbury_correct(lev%wb, model%modal_u, w%rhs)
          call correct(w%n, lev%bh2, lev%gh, w%rhs, w%tmp, w%a1, w%u1, w%v1)
          if (w%pairs) then
             call pair_motion(w%n, w%nd, w%di, w%dj, w%u1, w%v1, w%s1, w%sd1)
@@ -685,11 +692,76 @@ contains
             call relative_motion(model, w%n, w%nd, w%u1, w%v1, w%s1, w%sd1)
          end if
       end associate
+      if (w%extras) call trial_end(model, t, h, lv, w, error)
+   end subroutine try_step
+
+   !> A trial's start beyond the lean step (w%extras), after the predictors: the normal forces
+   !> of the step's start (the follow's; of its end for the laws' update: trial_end), a
+   !> speed-dependent mu's sliding forces from the velocity at the step's start (whatever an
+   !> earlier trial of the step left in them: follow_forces takes them on), and the second
+   !> component's load at the step's end t + h.
+   subroutine trial_start(model, t, h, w)
+      type(model_type), intent(in) :: model
+      real(dp), intent(in) :: t, h
+      type(workspace), intent(inout) :: w
+
+      if (w%varies) call normal_forces(model, t, w, .false.)
+      if (w%nf > 0) call start_forces(w%dev, w)
+      if (w%two) then
+         w%ag21 = table_acceleration(w%exc2, t + h)
+         w%rhs = w%rhs - w%mr2*w%ag21
+      end if
+   end subroutine trial_start
+
+   !> A trial's product K u~ + C v~ off the lean path: K^ sparse (CHOLMOD) or banded, 'modal'
+   !> damping's low-rank term.
+   subroutine general_product(model, lv, w)
+      type(model_type), intent(in) :: model
+      integer, intent(in) :: lv
+      type(workspace), intent(inout) :: w
+
+      associate (lev => w%lev(lv))
+         if (lev%sparse) then
+            call sparse_kc_matvec(lev%sps, w%u1, w%tmp, w%rhs, -1.0_dp)
+         else
+            call spd_kc_matvec(lev%sys, w%u1, w%tmp, w%rhs, -1.0_dp)
+         end if
+         if (lev%wb%r > 0) call lowrank_matvec(model%modal_u, model%modal_d, w%tmp, w%rhs, -1.0_dp)
+      end associate
+   end subroutine general_product
+
+   !> A trial's solve off the lean path (general_product's): the solution a1 in w%rhs.
+   subroutine general_solve(model, lv, w, error)
+      type(model_type), intent(in) :: model
+      integer, intent(in) :: lv
+      type(workspace), intent(inout) :: w
+      type(error_type), allocatable, intent(out) :: error
+
+      associate (lev => w%lev(lv))
+         if (lev%sparse) then
+            call sparse_solve(lev%sps, w%rhs, error)
+         else
+            call spd_solve(lev%sys, w%rhs, error)
+         end if
+         if (allocated(error)) return
+         if (lev%wb%r > 0) call woodbury_correct(lev%wb, model%modal_u, w%rhs)
+      end associate
+   end subroutine general_solve
+
+   !> A trial's end beyond the lean step (w%extras): a speed-dependent mu's forces iterated to
+   !> the step's end, the vertical supports' trial from the accepted state at t (a_z linear in
+   !> the step), the normal forces at the step's end t + h.
+   subroutine trial_end(model, t, h, lv, w, error)
+      type(model_type), intent(in) :: model
+      real(dp), intent(in) :: t, h
+      integer, intent(in) :: lv
+      type(workspace), intent(inout) :: w
+      type(error_type), allocatable, intent(out) :: error
+
       if (w%nf > 0) call follow_forces(model, lv, w, error)
-      ! the vertical supports' trial from the accepted state at t (a_z linear in the step)
       if (w%elastic) call support_advance(w%vs, lv, t + h, table_acceleration(w%exc3, t), table_acceleration(w%exc3, t + h))
       if (w%varies) call normal_forces(model, t + h, w, .true.)
-   end subroutine try_step
+   end subroutine trial_end
 
    !> A speed-dependent mu at the velocity at the step's end (implicit, as a Newton-Raphson
    !> code's trial takes it): the sliding forces f0 of the devices that follow the velocity are
@@ -1198,22 +1270,16 @@ contains
       logical :: changed_k, any_force
 
       ! energy of the step, forces at both ends in the step's phases; the state moves on
-      call step_energy(w%n, w%mr, w%u, w%v, w%a, w%u1, w%v1, w%a1, w%tmp, w%rhs, ein)
+      call step_energy(w%n, w%mr, w%u, w%v, w%a, w%u1, w%v1, w%a1, w%du, w%vsum, ein)
       ein = 0.5_dp*(w%ag + w%ag1)*ein
       if (w%two) then
-         ein = ein + 0.5_dp*(w%ag2 + w%ag21)*dot_product(w%mr2, w%tmp)
+         ein = ein + 0.5_dp*(w%ag2 + w%ag21)*dot_product(w%mr2, w%du(1:))
          w%ag2 = w%ag21
       end if
-      call observe_work(res, -ein, 0.5_dp*viscous_work(model, w%a0, w%a1c, w%n, w%mass, w%tmp, w%rhs))
+      call observe_work(res, -ein, 0.5_dp*viscous_work(model, w%a0, w%a1c, w%n, w%mass, w%du, w%vsum))
       w%ag = w%ag1
       ! violations of the correctness condition left in an accepted step
       if (any_bad) call observe_violations(res, t1, w%ok)
-      ! a speed-dependent mu's forces that did not converge, left in an accepted step
-      if (w%follow_failed) then
-         res%mu_unconverged = res%mu_unconverged + 1
-         if (res%mu_unconverged == 1) res%mu_unconverged_time = t1
-         res%mu_misfit = max(res%mu_misfit, w%follow_misfit)
-      end if
       if (any_changed) then
          w%phase0 = w%st%phase
          w%phase1 = w%st1%phase
@@ -1223,7 +1289,7 @@ contains
       ! and damping (whatever changed them); after a phase change, or a sliding force that
       ! follows the velocity (mu(v)), the next step starts in equilibrium with the new forces
       call device_step(w%nd, w%st, w%st1, w%s, w%sd, w%s1, w%sd1, w%f, w%w_device, w%obs%device_work, &
-                       w%obs%slip_travel, changed_k, any_force)
+                       w%obs%slip_travel, any_changed .or. .not. w%phase_coefficients, changed_k, any_force)
       ! the sticking springs' ringing: the step joins its phases' statistics (fd_stick_ringing)
       if (w%ring%n > 0) then
          call phase_statistics(w%nd, t1 - w%t, w%st, w%sd, w%f, w%ring%stats)
@@ -1232,18 +1298,7 @@ contains
       ! the velocity-law bands' forces: an alternation from step to step (fd_band_alternation)
       if (w%alt%n > 0) call alternation_step(w%alt, w%nd, t1 - w%t, w%st, w%f, res%band_alternation, &
                                              res%band_alternation_time)
-      if (w%varies) then
-         ! (a vertical component or the overturning, tilt, makes N vary: one test for the models
-         ! without bearings; an elastic support comes with a vertical component)
-         if (w%tilt) w%dn = w%dn1
-         if (w%elastic) then
-            ! the vertical supports move on: the ground's work on them and their dashpots'
-            call support_accept(w%vs)
-            call observe_work(res, w%vs%w_in1, w%vs%w_damp1)
-         end if
-         call observe_bearing_forces(res, model, t1, t1 - w%t, w%az, w%tilt, w%vs, w%pn, w%dn)
-         call checks_normal_force(model, w, res)
-      end if
+      if (w%extras) call accept_extras(model, t1, w, res)
       w%t = t1
       if (changed_k) w%version = w%version + 1
       ! (a varying normal force changes a band's dashpot or a sticking spring within a phase)
@@ -1251,14 +1306,41 @@ contains
       call observe_peaks(res, t1, w%observed_state)
    end subroutine accept
 
-   !> The state moves to the trial state; du = u1 - u (in du), v + v1 (in vsum) and
+   !> An accepted step's part beyond the lean step (w%extras), before the state's time moves to
+   !> t1: a speed-dependent mu's forces that did not converge in it, counted; a varying N (a
+   !> vertical component or the overturning, tilt; an elastic support comes with a vertical
+   !> component): the vertical supports move on, the bearings' forces, the step checks' N ranges.
+   subroutine accept_extras(model, t1, w, res)
+      type(model_type), intent(in) :: model
+      real(dp), intent(in) :: t1
+      type(workspace), intent(inout) :: w
+      type(result_type), intent(inout) :: res
+
+      if (w%follow_failed) then
+         res%mu_unconverged = res%mu_unconverged + 1
+         if (res%mu_unconverged == 1) res%mu_unconverged_time = t1
+         res%mu_misfit = max(res%mu_misfit, w%follow_misfit)
+      end if
+      if (.not. w%varies) return
+      if (w%tilt) w%dn = w%dn1
+      if (w%elastic) then
+         ! the ground's work on the vertical supports and their dashpots'
+         call support_accept(w%vs)
+         call observe_work(res, w%vs%w_in1, w%vs%w_damp1)
+      end if
+      call observe_bearing_forces(res, model, t1, t1 - w%t, w%az, w%tilt, w%vs, w%pn, w%dn)
+      call checks_normal_force(model, w, res)
+   end subroutine accept_extras
+
+   !> The state moves to the trial state; du = u1 - u (in du(1:n)), v + v1 (in vsum(1:n)) and
    !> sum_i m_i r_i du_i (the input work's factor) of the step.
    pure subroutine step_energy(n, mass, u, v, a, u1, v1, a1, du, vsum, ein)
       integer, intent(in) :: n
       real(dp), intent(in) :: mass(n)   !! M r
       real(dp), intent(in) :: u1(n), v1(n), a1(n)
       real(dp), intent(inout) :: u(n), v(n), a(n)
-      real(dp), intent(out) :: du(n), vsum(n), ein
+      real(dp), intent(inout) :: du(0:n), vsum(0:n)   !! index 0 (the table) left as it is
+      real(dp), intent(out) :: ein
       integer :: i
 
       ein = 0.0_dp
@@ -1280,8 +1362,9 @@ contains
       type(model_type), intent(in) :: model
       real(dp), intent(in) :: a0, a1
       integer, intent(in) :: n
-      real(dp), intent(in) :: mass(n), du(n), vsum(n)
-      real(dp) :: ek, x, y
+      real(dp), intent(in) :: mass(n)
+      real(dp), intent(in) :: du(0:n), vsum(0:n)   !! 0 at index 0: a spring's end at the table
+      real(dp) :: ek
       integer :: i, s
 
       e = 0.0_dp
@@ -1293,23 +1376,16 @@ contains
       end if
       if (a1 /= 0.0_dp) then
          ek = 0.0_dp
+         ! (an end at the table, index 0, subtracts 0 or is subtracted from 0: the values of
+         ! a spring's (u_i - u_j) alone)
          do s = 1, model%n_springs
-            x = 0.0_dp
-            y = 0.0_dp
-            if (model%spring_i(s) > 0) then
-               x = du(model%spring_i(s))
-               y = vsum(model%spring_i(s))
-            end if
-            if (model%spring_j(s) > 0) then
-               x = x - du(model%spring_j(s))
-               y = y - vsum(model%spring_j(s))
-            end if
-            ek = ek + model%spring_k(s)*x*y
+            ek = ek + model%spring_k(s)*(du(model%spring_i(s)) - du(model%spring_j(s)))* &
+                 (vsum(model%spring_i(s)) - vsum(model%spring_j(s)))
          end do
-         if (model%n_kx > 0) ek = ek + general_form(model, du, vsum)
+         if (model%n_kx > 0) ek = ek + general_form(model, du(1:n), vsum(1:n))
          e = e + a1*ek
       end if
-      if (allocated(model%modal_d)) e = e + lowrank_form(model%modal_u, model%modal_d, vsum, du)
+      if (allocated(model%modal_d)) e = e + lowrank_form(model%modal_u, model%modal_d, vsum(1:n), du(1:n))
    end function viscous_work
 
    !> Work of the device forces over the step (trapezoid, the step's phases), in all and per
@@ -1317,8 +1393,9 @@ contains
    !> observer's totals here, in the loop over the devices (a call a step would cost more
    !> than the sums); the devices move
    !> on to the trial state (s, s', state) and their force in it; whether a stiffness or
-   !> damping changed, and whether a constant force f0 changed.
-   pure subroutine device_step(nd, st, st1, s, sd, s1, sd1, f, w, work, travel, changed_k, changed_f0)
+   !> damping changed, and whether a constant force f0 changed (compared only when they may
+   !> have: compare).
+   pure subroutine device_step(nd, st, st1, s, sd, s1, sd1, f, w, work, travel, compare, changed_k, changed_f0)
       integer, intent(in) :: nd
       type(device_state), intent(inout) :: st(nd)
       type(device_state), intent(in) :: st1(nd)
@@ -1329,6 +1406,7 @@ contains
                                                !! at the end, in the phases for the next step
       real(dp), intent(inout) :: w
       real(dp), intent(inout) :: work(nd), travel(nd) !! per device: work [J], slip travel [m]
+      logical, intent(in) :: compare           !! a phase changed, or coefficients change within one
       logical, intent(out) :: changed_k, changed_f0
       real(dp) :: f0, f1, dw
       integer :: d
@@ -1344,8 +1422,10 @@ contains
          if (st(d)%phase /= phase_stick) travel(d) = travel(d) + abs(s1(d) - s(d))
          s(d) = s1(d)
          sd(d) = sd1(d)
-         changed_k = changed_k .or. st1(d)%ks /= st(d)%ks .or. st1(d)%cs /= st(d)%cs
-         changed_f0 = changed_f0 .or. st1(d)%f0 /= st(d)%f0
+         if (compare) then
+            changed_k = changed_k .or. st1(d)%ks /= st(d)%ks .or. st1(d)%cs /= st(d)%cs
+            changed_f0 = changed_f0 .or. st1(d)%f0 /= st(d)%f0
+         end if
          st(d) = st1(d)
          f(d) = st(d)%ks*s(d) + st(d)%cs*sd(d) + st(d)%f0
       end do
