@@ -49,22 +49,22 @@ module fd_engineering
       integer, allocatable :: storey_i(:)       !! upper node
       integer, allocatable :: storey_j(:)       !! lower node (0 = table)
       real(dp), allocatable :: height(:)        !! storey height [m] (0: not given)
-      integer, allocatable :: sp_first(:)       !! (0:n_storeys+1): springs of cut c at sp_first(c):sp_first(c+1)-1
-      integer, allocatable :: sp_i(:), sp_j(:)  !! their nodes
-      real(dp), allocatable :: sp_k(:)          !! their stiffness, signed along the cut [N/m]
-      integer, allocatable :: dv_first(:)       !! (0:n_storeys+1): devices of cut c
-      integer, allocatable :: dv_id(:)          !! device indices
-      real(dp), allocatable :: dv_sign(:)       !! +1 or -1 along the cut
       real(dp), allocatable :: r(:)             !! (n_dof) r, when the model gives one [-]
       real(dp), allocatable :: r2(:)            !! (n_dof) r2 of a second component, if any [-]
-      ! the cut forces that are no element between the cut's two nodes, by cut (0:n_storeys+1):
-      ! xs_first(c):xs_first(c+1)-1 and xd_first likewise. A storey's: rigid floors' frames
-      ! and braces. The base's, of a general model (stiffness K_x, devices of any direction):
-      ! along the table motion r, r' (K u + a1 K v) + sum_d (b_d' r) F_d, the forces every
-      ! element passes to the table (one inside the structure passes none: b' r = 0), as the
-      ! terms (i, (K r)_i) and (d, b_d' r); its springs and devices are then not listed
-      integer, allocatable :: xs_first(:), xs_dof(:), xd_first(:), xd_dev(:)
-      real(dp), allocatable :: xs_coef(:), xd_coef(:)
+      ! the force across each cut c (0 = the base, 1..n_storeys) as a sum of terms, those of
+      ! cut c at term_first(c):term_first(c+1)-1: the springs joining the cut's two nodes,
+      ! then its devices, then its forces beyond those elements. A spring term (term_i,
+      ! term_j >= 0: its nodes, 0 the table) adds term_c (du + a1 dv), term_c the stiffness
+      ! signed along the cut; a device term (term_i = -d) adds term_c F_d, term_c its sign.
+      ! The forces beyond the elements: a storey's rigid floors' frames and braces; the base of
+      ! a general model (stiffness K_x, devices of any direction), along the table motion r,
+      ! r' (K u + a1 K v) + sum_d (b_d' r) F_d, the forces every element passes to the table
+      ! (one inside the structure passes none: b' r = 0), as springs from DOF i to the table
+      ! of stiffness (K r)_i and devices of sign b_d' r; its springs and devices are then not
+      ! listed
+      integer, allocatable :: term_first(:)     !! (0:n_storeys+1)
+      integer, allocatable :: term_i(:), term_j(:) !! nodes of a spring; -d for device d
+      real(dp), allocatable :: term_c(:)        !! [N/m] (spring) or [-] (device)
       ! a building of rigid floors: the drift of each storey along its axis at the four plan
       ! corners of its floor (a rectangle about the floor's centre of mass), as functionals
       ! corner_coef(t, c, q) u(corner_dof(t, c, q)), t = 1..4; its peak over the corners
@@ -107,6 +107,19 @@ module fd_engineering
       real(dp), allocatable :: peak_shear_time(:)  !! (0:n_storeys) its time [s]
    end type engineering_type
 
+   !> The elements of every cut, while they are set up (cut c's at first(c):first(c+1)-1 of
+   !> each list); join_terms makes them eng's terms.
+   type :: cut_lists
+      integer, allocatable :: sp_first(:), sp_i(:), sp_j(:) !! springs: their nodes
+      real(dp), allocatable :: sp_k(:)                      !! their stiffness, signed along the cut [N/m]
+      integer, allocatable :: dv_first(:), dv_id(:)         !! devices
+      real(dp), allocatable :: dv_sign(:)                   !! +1 or -1 along the cut
+      integer, allocatable :: xs_first(:), xs_dof(:)        !! forces beyond the elements: DOF terms
+      real(dp), allocatable :: xs_coef(:)                   !! [N/m]
+      integer, allocatable :: xd_first(:), xd_dev(:)        !! and device terms
+      real(dp), allocatable :: xd_coef(:)                   !! [-]
+   end type cut_lists
+
 contains
 
    !> Set up the engineering outputs of a run: names (defaults 'DOF i', 'device d', 'storey
@@ -121,6 +134,7 @@ contains
       type(engineering_type), intent(out) :: eng    !! the outputs, set up
       type(error_type), allocatable, intent(out) :: error !! eigenvalue solver failure
       real(dp), allocatable :: k(:, :), c(:, :)
+      type(cut_lists) :: cuts
       integer :: n, nd, ns, i, s, stat
       logical :: general
 
@@ -189,8 +203,9 @@ contains
       if (allocated(model%influence)) eng%r = model%influence
       if (allocated(model%influence2)) eng%r2 = model%influence2
       general = model%n_kx > 0 .or. .not. devices_are_pairs(model)
-      call storey_elements(model, eng, general, stat)
-      if (stat == 0 .and. (general .or. allocated(model%xs_storey))) call cut_extras(model, eng, general, stat)
+      call storey_elements(model, eng, general, cuts, stat)
+      if (stat == 0 .and. (general .or. allocated(model%xs_storey))) call cut_extras(model, ns, general, cuts, stat)
+      if (stat == 0) call join_terms(cuts, ns, eng, stat)
       if (stat == 0 .and. model%n_floors > 0) call floor_corners(model, eng, stat)
       if (stat == 0 .and. model%n_floors > 0) call floor_outputs(model, eng, stat)
       if (stat /= 0) then
@@ -216,16 +231,17 @@ contains
    !> The springs and devices of every cut (0 = the base, 1..n_storeys the storeys), with
    !> their sign along the cut, in compressed lists (none at the base of a general model,
    !> whose base is cut_extras').
-   subroutine storey_elements(model, eng, general, stat)
+   subroutine storey_elements(model, eng, general, cuts, stat)
       type(model_type), intent(in) :: model
-      type(engineering_type), intent(inout) :: eng
+      type(engineering_type), intent(in) :: eng    !! its storeys
       logical, intent(in) :: general               !! a general model
+      type(cut_lists), intent(inout) :: cuts       !! the cuts' springs and devices, set
       integer, intent(out) :: stat                 !! not 0: not enough memory
       integer :: ns, cut, e, a, b, nsp, ndv
       real(dp) :: sgn
 
       ns = eng%n_storeys
-      allocate (eng%sp_first(0:ns + 1), eng%dv_first(0:ns + 1), stat=stat)
+      allocate (cuts%sp_first(0:ns + 1), cuts%dv_first(0:ns + 1), stat=stat)
       if (stat /= 0) return
       ! count, then fill
       nsp = 0; ndv = 0
@@ -239,18 +255,18 @@ contains
             if (on_cut(cut, a, b) /= 0.0_dp) ndv = ndv + 1
          end do
       end do
-      allocate (eng%sp_i(nsp), eng%sp_j(nsp), eng%sp_k(nsp), eng%dv_id(ndv), eng%dv_sign(ndv), stat=stat)
+      allocate (cuts%sp_i(nsp), cuts%sp_j(nsp), cuts%sp_k(nsp), cuts%dv_id(ndv), cuts%dv_sign(ndv), stat=stat)
       if (stat /= 0) return
       nsp = 0; ndv = 0
       do cut = 0, ns
-         eng%sp_first(cut) = nsp + 1
-         eng%dv_first(cut) = ndv + 1
+         cuts%sp_first(cut) = nsp + 1
+         cuts%dv_first(cut) = ndv + 1
          do e = 1, model%n_springs
             a = model%spring_i(e); b = model%spring_j(e)
             sgn = on_cut(cut, a, b)
             if (sgn == 0.0_dp) cycle
             nsp = nsp + 1
-            eng%sp_i(nsp) = a; eng%sp_j(nsp) = b; eng%sp_k(nsp) = sgn*model%spring_k(e)
+            cuts%sp_i(nsp) = a; cuts%sp_j(nsp) = b; cuts%sp_k(nsp) = sgn*model%spring_k(e)
          end do
          do e = 1, model%n_devices
             call pair_nodes(model, e, a, b)
@@ -258,11 +274,11 @@ contains
             sgn = on_cut(cut, a, b)
             if (sgn == 0.0_dp) cycle
             ndv = ndv + 1
-            eng%dv_id(ndv) = e; eng%dv_sign(ndv) = sgn
+            cuts%dv_id(ndv) = e; cuts%dv_sign(ndv) = sgn
          end do
       end do
-      eng%sp_first(ns + 1) = nsp + 1
-      eng%dv_first(ns + 1) = ndv + 1
+      cuts%sp_first(ns + 1) = nsp + 1
+      cuts%dv_first(ns + 1) = ndv + 1
    contains
       !> +1 if the element (a, b) lies on the cut in its direction, -1 reversed, 0 not on it.
       real(dp) function on_cut(cut, a, b) result(sgn)
@@ -334,13 +350,14 @@ contains
       if (j > 0) du = du - u(j)
    end function storey_drift
 
-   !> The force across cut `cut` (0: the base): the springs' (elastic and stiffness-damping)
-   !> and the devices' crossing it, and the cut's forces beyond its elements (xs_*, xd_*).
+   !> The force across cut `cut` (0: the base): the sum of its terms (the springs' elastic
+   !> and stiffness-damping forces, the devices', the forces beyond its elements), in one loop
+   !> over one list: the per-step observer runs it for every cut.
    pure real(dp) function cut_force(eng, cut, u, v, force) result(f)
       type(engineering_type), intent(in) :: eng  !! the set-up outputs
       integer, intent(in) :: cut                 !! 0 (base) .. n_storeys
-      ! (assumed sizes: the per-step observer calls it for every cut, and a call that builds
-      ! three array descriptors costs a two-mass model more than its base's two springs)
+      ! (assumed sizes: a call that builds three array descriptors costs a two-mass model more
+      ! than its base's two springs)
       real(dp), intent(in) :: u(*)               !! relative displacements [m]
       real(dp), intent(in) :: v(*)               !! relative velocities [m/s]
       real(dp), intent(in) :: force(*)           !! device forces [N]
@@ -348,40 +365,77 @@ contains
       integer :: e, i, j
 
       f = 0.0_dp
-      do e = eng%sp_first(cut), eng%sp_first(cut + 1) - 1
-         i = eng%sp_i(e)
-         j = eng%sp_j(e)
-         du = 0.0_dp
-         dv = 0.0_dp
-         if (i > 0) then
-            du = u(i)
-            dv = v(i)
+      do e = eng%term_first(cut), eng%term_first(cut + 1) - 1
+         i = eng%term_i(e)
+         if (i < 0) then
+            f = f + eng%term_c(e)*force(-i)
+         else
+            j = eng%term_j(e)
+            du = 0.0_dp
+            dv = 0.0_dp
+            if (i > 0) then
+               du = u(i)
+               dv = v(i)
+            end if
+            if (j > 0) then
+               du = du - u(j)
+               dv = dv - v(j)
+            end if
+            f = f + eng%term_c(e)*(du + eng%a1*dv)
          end if
-         if (j > 0) then
-            du = du - u(j)
-            dv = dv - v(j)
-         end if
-         f = f + eng%sp_k(e)*(du + eng%a1*dv)
-      end do
-      do e = eng%dv_first(cut), eng%dv_first(cut + 1) - 1
-         f = f + eng%dv_sign(e)*force(eng%dv_id(e))
-      end do
-      if (.not. allocated(eng%xs_first)) return
-      do e = eng%xs_first(cut), eng%xs_first(cut + 1) - 1
-         f = f + eng%xs_coef(e)*(u(eng%xs_dof(e)) + eng%a1*v(eng%xs_dof(e)))
-      end do
-      do e = eng%xd_first(cut), eng%xd_first(cut + 1) - 1
-         f = f + eng%xd_coef(e)*force(eng%xd_dev(e))
       end do
    end function cut_force
+
+   !> eng's terms of every cut from the cuts' lists: springs, devices, then the forces beyond
+   !> the elements (a DOF term as a spring from the DOF to the table, a device term as a device).
+   subroutine join_terms(cuts, ns, eng, stat)
+      type(cut_lists), intent(in) :: cuts
+      integer, intent(in) :: ns                    !! storeys
+      type(engineering_type), intent(inout) :: eng
+      integer, intent(out) :: stat                 !! not 0: not enough memory
+      integer :: c, e, m
+      logical :: extra
+
+      extra = allocated(cuts%xs_first)
+      m = size(cuts%sp_i) + size(cuts%dv_id)
+      if (extra) m = m + size(cuts%xs_dof) + size(cuts%xd_dev)
+      allocate (eng%term_first(0:ns + 1), eng%term_i(m), eng%term_j(m), eng%term_c(m), stat=stat)
+      if (stat /= 0) return
+      m = 0
+      do c = 0, ns
+         eng%term_first(c) = m + 1
+         do e = cuts%sp_first(c), cuts%sp_first(c + 1) - 1
+            call add(cuts%sp_i(e), cuts%sp_j(e), cuts%sp_k(e))
+         end do
+         do e = cuts%dv_first(c), cuts%dv_first(c + 1) - 1
+            call add(-cuts%dv_id(e), 0, cuts%dv_sign(e))
+         end do
+         if (.not. extra) cycle
+         do e = cuts%xs_first(c), cuts%xs_first(c + 1) - 1
+            call add(cuts%xs_dof(e), 0, cuts%xs_coef(e))
+         end do
+         do e = cuts%xd_first(c), cuts%xd_first(c + 1) - 1
+            call add(-cuts%xd_dev(e), 0, cuts%xd_coef(e))
+         end do
+      end do
+      eng%term_first(ns + 1) = m + 1
+   contains
+      subroutine add(i, j, coef)
+         integer, intent(in) :: i, j
+         real(dp), intent(in) :: coef
+         m = m + 1
+         eng%term_i(m) = i; eng%term_j(m) = j; eng%term_c(m) = coef
+      end subroutine add
+   end subroutine join_terms
 
    !> The cut forces beyond the cuts' elements (xs_*, xd_*), by cut: the base's of a general
    !> model (general: K r and b_d' r, r the table motion's direction), then the model's storey
    !> forces beyond its storeys' elements.
-   subroutine cut_extras(model, eng, general, stat)
+   subroutine cut_extras(model, ns, general, cuts, stat)
       type(model_type), intent(in) :: model
-      type(engineering_type), intent(inout) :: eng
+      integer, intent(in) :: ns                    !! storeys
       logical, intent(in) :: general               !! a general model
+      type(cut_lists), intent(inout) :: cuts       !! the cuts' forces beyond their elements, set
       integer, intent(out) :: stat                 !! not 0: not enough memory
       real(dp), allocatable :: r(:), kr(:), br(:)
       integer :: i, n, nd
@@ -401,15 +455,15 @@ contains
          call base_along(model, r, kr, br)
       end if
       if (allocated(model%xs_storey)) then
-         call by_cut(eng%n_storeys, model%xs_storey, model%xs_dof, model%xs_coef, kr, eng%xs_first, eng%xs_dof, &
-                     eng%xs_coef, stat)
-         if (stat == 0) call by_cut(eng%n_storeys, model%xd_storey, model%xd_dev, model%xd_coef, br, eng%xd_first, &
-                                    eng%xd_dev, eng%xd_coef, stat)
+         call by_cut(ns, model%xs_storey, model%xs_dof, model%xs_coef, kr, cuts%xs_first, cuts%xs_dof, &
+                     cuts%xs_coef, stat)
+         if (stat == 0) call by_cut(ns, model%xd_storey, model%xd_dev, model%xd_coef, br, cuts%xd_first, &
+                                    cuts%xd_dev, cuts%xd_coef, stat)
       else
-         call by_cut(eng%n_storeys, [integer ::], [integer ::], [real(dp) ::], kr, eng%xs_first, eng%xs_dof, &
-                     eng%xs_coef, stat)
-         if (stat == 0) call by_cut(eng%n_storeys, [integer ::], [integer ::], [real(dp) ::], br, eng%xd_first, &
-                                    eng%xd_dev, eng%xd_coef, stat)
+         call by_cut(ns, [integer ::], [integer ::], [real(dp) ::], kr, cuts%xs_first, cuts%xs_dof, &
+                     cuts%xs_coef, stat)
+         if (stat == 0) call by_cut(ns, [integer ::], [integer ::], [real(dp) ::], br, cuts%xd_first, &
+                                    cuts%xd_dev, cuts%xd_coef, stat)
       end if
    end subroutine cut_extras
 
