@@ -497,26 +497,23 @@ contains
    end subroutine by_cut
 
    !> One accepted state: drifts and shears, their peaks, and the values kept as the
-   !> residual ones (those of the last state observed); a building of rigid floors, its base
-   !> shears along x, y and the base torque (kt, bt), and each storey's largest corner drift.
-   !> Runs at every accepted step: the values go straight into the peaks (no array sections
-   !> passed, no temporaries).
-   pure subroutine observe_engineering(eng, t, n, nd, u, v, s, force)
+   !> residual ones (those of the last state observed; the devices' residual displacements
+   !> are the observer's, kept with their peaks); a building of rigid floors, its base shears
+   !> along x, y and the base torque (kt, bt), and each storey's largest corner drift. Runs at
+   !> every accepted step: the values go straight into the peaks (no array sections passed,
+   !> no temporaries).
+   pure subroutine observe_engineering(eng, t, n, nd, u, v, force)
       type(engineering_type), intent(inout) :: eng  !! the outputs
       real(dp), intent(in) :: t                     !! time [s]
       integer, intent(in) :: n                      !! DOFs
       integer, intent(in) :: nd                     !! devices
       real(dp), intent(in) :: u(n)                  !! relative displacements [m]
       real(dp), intent(in) :: v(n)                  !! relative velocities [m/s]
-      real(dp), intent(in) :: s(nd)                 !! device relative displacements [m]
       real(dp), intent(in) :: force(nd)             !! device forces [N]
       real(dp) :: x
       integer :: i, c, k
 
       if (.not. allocated(eng%drift)) return
-      do i = 1, nd
-         eng%residual_s(i) = s(i)
-      end do
       do i = 1, eng%n_storeys
          call track(storey_drift(eng, i, u), t, eng%drift(i), eng%peak_drift(i), eng%peak_drift_time(i))
       end do

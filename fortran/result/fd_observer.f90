@@ -203,8 +203,8 @@ contains
    end subroutine observe_start_energies
 
    !> Peaks over the accepted states: |u| (and its time), |v|, |absolute acceleration| (and
-   !> its time) per DOF, |s| and |F| per device; the planar bearings', the floors' and the
-   !> storeys' (fd_engineering) at the state x at time t.
+   !> its time) per DOF, |s| and |F| per device (and s as its residual displacement); the
+   !> planar bearings', the floors' and the storeys' (fd_engineering) at the state x at time t.
    pure subroutine observe_peaks(res, t, x)
       type(result_type), intent(inout) :: res  !! the result
       real(dp), intent(in) :: t                !! time [s]
@@ -234,11 +234,11 @@ contains
             end if
          end do
       end if
-      call device_peaks(x%nd, x%s, x%f, res%peak_s, res%peak_force)
+      call device_peaks(x%nd, x%s, x%f, res%peak_s, res%peak_force, res%eng%residual_s)
       if (res%n_bearings > 0) call observe_bearings(res, t, x%nd, x%s, x%f)
       if (res%eng%n_floors > 0) call observe_floor_accelerations(res%eng, t, x%n, x%a, x%ag, x%ag2)
       ! last: the compiler makes it a jump (a tail call), no return through this routine
-      call observe_engineering(res%eng, t, x%n, x%nd, x%u, x%v, x%s, x%f)
+      call observe_engineering(res%eng, t, x%n, x%nd, x%u, x%v, x%f)
    end subroutine observe_peaks
 
    ! The kernels of observe_peaks take their arrays with explicit shapes: the compiler then
@@ -292,16 +292,19 @@ contains
       end do
    end subroutine dof_peaks
 
-   !> The peaks of |s| and |F| of nd devices.
-   pure subroutine device_peaks(nd, s, f, peak_s, peak_f)
+   !> The peaks of |s| and |F| of nd devices, and s as the residual displacement (that of
+   !> the last state observed).
+   pure subroutine device_peaks(nd, s, f, peak_s, peak_f, residual_s)
       integer, intent(in) :: nd                    !! devices
       real(dp), intent(in) :: s(nd), f(nd)         !! relative displacements [m], forces [N]
       real(dp), intent(inout) :: peak_s(nd), peak_f(nd) !! [m, N]
+      real(dp), intent(out) :: residual_s(nd)      !! [m]
       integer :: i
 
       do i = 1, nd
          peak_s(i) = max(peak_s(i), abs(s(i)))
          peak_f(i) = max(peak_f(i), abs(f(i)))
+         residual_s(i) = s(i)
       end do
    end subroutine device_peaks
 
@@ -565,7 +568,8 @@ contains
       real(dp), intent(in) :: u(:), v(:)       !! relative displacements [m], velocities [m/s]
       real(dp), intent(in) :: s(:), force(:)   !! device relative displacements [m], forces [N]
 
-      call observe_engineering(res%eng, t, size(u), size(s), u, v, s, force)
+      res%eng%residual_s = s
+      call observe_engineering(res%eng, t, size(u), size(s), u, v, force)
    end subroutine observe_storeys
 
    !> The next row of the history: t, ag, (u, v, aabs) per kept DOF, (s, s', F, phase) per

@@ -143,6 +143,9 @@ contains
                  all(res%peak_aabs_time == [0.2_dp, 0.3_dp]), "peak |aabs| and its time")
       if (allocated(error)) return
       call check(error, res%peak_s(1) == 0.05_dp .and. res%peak_force(1) == 3.0_dp, "peak |s| and |F|")
+      if (allocated(error)) return
+      ! the residual displacement: the last state's s, not its peak
+      call check(error, res%eng%residual_s(1) == 0.02_dp, "residual s: the last state's")
    end subroutine test_peaks
 
    !> A friction pendulum bearing (p = 10 N, mu = 0.2, R = 2 m: restoring stiffness 5 N/m) on a
