@@ -221,8 +221,8 @@ contains
          call dof_peaks(x%n, t, x%ag, x%u, x%v, x%a, res%peak_u, res%peak_u_time, res%peak_v, res%peak_aabs, &
                         res%peak_aabs_time)
       else
-         call motion_peaks(x%n, t, x%u, x%v, res%peak_u, res%peak_u_time, res%peak_v)
          do i = 1, x%n
+            call motion_peak(t, x%u(i), x%v(i), res%peak_u(i), res%peak_u_time(i), res%peak_v(i))
             ! the absolute acceleration: the table's along the DOF's direction r_i added
             ri = 1.0_dp
             if (has_r) ri = res%eng%r(i)
@@ -246,19 +246,6 @@ contains
    ! a register (through the result's and the state's components it reloads them after each
    ! store: observe_peaks cost a third more on the paper's two-mass model, callgrind).
 
-   !> The peaks of |u| (and their times) and of |v| of n DOFs at time t.
-   pure subroutine motion_peaks(n, t, u, v, peak_u, peak_u_time, peak_v)
-      integer, intent(in) :: n                     !! DOFs
-      real(dp), intent(in) :: t                    !! time [s]
-      real(dp), intent(in) :: u(n), v(n)           !! the state [m, m/s]
-      real(dp), intent(inout) :: peak_u(n), peak_u_time(n), peak_v(n) !! [m, s, m/s]
-      integer :: i
-
-      do i = 1, n
-         call motion_peak(t, u(i), v(i), peak_u(i), peak_u_time(i), peak_v(i))
-      end do
-   end subroutine motion_peaks
-
    !> One DOF's peaks of |u| (and its time) and of |v| at time t.
    pure subroutine motion_peak(t, u, v, peak_u, peak_u_time, peak_v)
       real(dp), intent(in) :: t                    !! time [s]
@@ -271,8 +258,8 @@ contains
       peak_v = max(peak_v, abs(v))
    end subroutine motion_peak
 
-   !> motion_peaks, and the peaks of the absolute acceleration |a + ag| (and their times)
-   !> along the one table motion.
+   !> The peaks of |u| (and their times) and of |v| of n DOFs (motion_peak), and of the absolute
+   !> acceleration |a + ag| (and their times) along the one table motion, at time t.
    pure subroutine dof_peaks(n, t, ag, u, v, a, peak_u, peak_u_time, peak_v, peak_aabs, peak_aabs_time)
       integer, intent(in) :: n                     !! DOFs
       real(dp), intent(in) :: t                    !! time [s]
