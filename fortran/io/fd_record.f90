@@ -631,9 +631,10 @@ contains
       real(dp) :: pair(2), t1
       integer :: next, lo, hi, line, n, nl, k, stat, bad_lo, bad_hi, ncol, m
       logical :: found
-      character(len=:), allocatable :: where
+      character(len=:), allocatable :: where, expected
 
       ncol = merge(2, 1, two)
+      expected = trim(columns_text(ncol))   ! once: only a message uses it
       nl = 1
       do k = 1, len(text)
          if (text(k:k) == achar(10)) nl = nl + 1
@@ -644,7 +645,7 @@ contains
       next = 1
       t1 = 0.0_dp
       do
-         call filled_line(path, text, trim(columns_text(ncol)), next, line, lo, hi, found, error)
+         call filled_line(path, text, expected, next, line, lo, hi, found, error)
          if (allocated(error)) return
          if (.not. found) exit
          if (is_comment(text(lo:hi))) cycle
@@ -652,7 +653,7 @@ contains
          call line_values(text(lo:hi), pair, m, stat, bad_lo, bad_hi)
          if (stat == 4 .or. (stat == num_ok .and. m /= ncol)) then
             call fatal_error(error, "record file '"//path//"', line "//trim(fmt_int(line))//": expected "// &
-                             trim(columns_text(ncol))//", found "//trim(fmt_int(count_fields(text(lo:hi))))//" values")
+                             expected//", found "//trim(fmt_int(count_fields(text(lo:hi))))//" values")
             return
          end if
          if (stat /= num_ok) then
