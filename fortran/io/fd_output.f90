@@ -3,7 +3,7 @@
 !> name unique to the writer and the pair is committed under a lock (write_outputs); on
 !> any error no output file is left behind and earlier outputs of the name stay.
 module fd_output
-   use, intrinsic :: iso_c_binding, only: c_char, c_int, c_long, c_long_long, c_null_char
+   use, intrinsic :: iso_c_binding, only: c_int, c_long, c_long_long, c_null_char
    use fd_kinds, only: dp
    use fd_error, only: error_type, fatal_error, fmt_int, fmt_real
    use fd_model, only: model_type, output_type, law_name, technique_name

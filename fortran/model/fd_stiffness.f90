@@ -10,17 +10,10 @@ module fd_stiffness
    implicit none
    private
 
-   public :: has_general_stiffness, add_general_times, general_form, add_general_dense
+   public :: general_form, add_general_dense
    public :: influence_of, add_general_entry, stiffness_times, stiffness_form
 
 contains
-
-   !> Whether the model has stiffness beyond its springs.
-   pure logical function has_general_stiffness(model) result(has)
-      type(model_type), intent(in) :: model  !! the model
-
-      has = model%n_kx > 0
-   end function has_general_stiffness
 
    !> ku = ku + K_x u.
    pure subroutine add_general_times(model, u, ku)
