@@ -308,9 +308,15 @@ contains
       w%f = device_force(w%st, w%s, w%sd)
       if (w%three) call normal_extremes(model, dt1, w, error)
       if (allocated(error)) return
-      call ringing_init(model, dt1, opts%beta, opts%gamma, w%a0, w%a1c, w%ring, res, error, w%nrange)
-      if (allocated(error)) return
-      call alternation_init(model, dt1, opts%gamma, w%alt, res, error, w%nrange)
+      ! the step checks, with the N ranges when N varies (nrange is allocated only then: an
+      ! unallocated one is not handed on, gfortran would pass its stale bounds)
+      if (allocated(w%nrange)) then
+         call ringing_init(model, dt1, opts%beta, opts%gamma, w%a0, w%a1c, w%ring, res, error, w%nrange)
+         if (.not. allocated(error)) call alternation_init(model, dt1, opts%gamma, w%alt, res, error, w%nrange)
+      else
+         call ringing_init(model, dt1, opts%beta, opts%gamma, w%a0, w%a1c, w%ring, res, error)
+         if (.not. allocated(error)) call alternation_init(model, dt1, opts%gamma, w%alt, res, error)
+      end if
       if (allocated(error)) return
       if (w%varies) call checks_normal_force(model, w, res)
       call consistent_acceleration(model, exc, 0.0_dp, w)
@@ -1014,7 +1020,8 @@ contains
    !> The factored effective stiffness of level lv for the current phases: factored the
    !> first time the level is used, updated (never refactored from scratch) when the
    !> devices' stiffnesses have changed since it was last used; with 'modal' damping, the
-   !> Woodbury factors of its low-rank term follow the factor.
+   !> Woodbury factors of its low-rank term follow the factor. try_step calls it when the
+   !> level's version is not the loop's.
    subroutine factor_for(model, lv, w, error)
       type(model_type), intent(in) :: model
       integer, intent(in) :: lv
@@ -1023,7 +1030,6 @@ contains
       integer :: d
 
       associate (lev => w%lev(lv))
-         if (lev%factored .and. lev%version == w%version) return
          do d = 1, w%nd
             w%kd(d) = w%st(d)%ks + lev%c1*w%st(d)%cs
          end do
