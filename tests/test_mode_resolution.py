@@ -65,10 +65,11 @@ G = 9.80665
 def test_bearing_under_a_vertical_component_at_its_largest_normal_force(tmp_path, radius):
     """A 1000 kg block on one hysteretic bearing (flat, or a friction pendulum of R = 2 m) to
     the table, springs 2e4 N/m along x and 1e4 along y, its static normal force p = M g and
-    a constant vertical acceleration a_z = 0.8 g: N = 1.8 p all the run. Newmark integrates
-    x with the sticking spring N mu / f and the pendulum's N / R, so omega_max^2 =
-    (k_x + N (mu / f + 1 / R)) / M (1e-12); at the deck's p it would be 25 % lower, and
-    dt1 = 25 ms resolves that system (omega dt1 = 1.75 flat) but not the one integrated."""
+    a constant vertical acceleration a_z = 0.8 g: N = 1.8 p all the run. The structure's
+    stiffness along x is then k_x, the sticking spring N mu / f and the pendulum's N / R (a
+    force lagged one step in Newmark's step), so omega_max^2 = (k_x + N (mu / f + 1 / R)) / M
+    (1e-12); at the deck's p it would be 25 % lower, and dt1 = 25 ms resolves that system
+    (omega dt1 = 1.75 flat) but not the structure's."""
     m, kx, mu, f, p = 1000.0, 2.0e4, 0.1, 2.0e-4, 1000.0 * G
     (tmp_path / "az.txt").write_text(f"{0.8 * G:.17e}\n" * 41)
     bearing = {"n_bearings": 1, "dof_xi": 1, "dof_yi": 2, "dof_xj": 0, "dof_yj": 0, "p": p, "mu": mu,

@@ -1,8 +1,9 @@
-!> The Fortran interfaces of fd_fileops.c and of the C library's file calls, in one place: POSIX
-!> file creation, writes, close, rename, unlink, mkdir, rmdir, isatty, the output lock, errno
-!> texts and the process id (gfortran's own I/O loses a full disk silently and will not open
-!> one file on two units; docs/batch.md).
-!> Every function returns 0 or an errno; os_error turns one into an error naming what failed.
+!> The Fortran interfaces of fd_fileops.c and of the C library's calls on files the outputs
+!> use: POSIX file creation, writes, close, rename, unlink, mkdir, rmdir, isatty, the output
+!> lock, errno texts and the process id (gfortran's own I/O loses a full disk silently and
+!> will not open one file on two units; docs/batch.md). Reading decks and records goes
+!> through fd_textio. The file calls return 0 or an errno; os_error turns one into an error
+!> naming what failed.
 module fd_fileops
    use, intrinsic :: iso_c_binding, only: c_char, c_int, c_long, c_null_char
    use fd_error, only: error_type, fatal_error, stat_output
@@ -16,7 +17,8 @@ module fd_fileops
    !> c_lock_acquire: the lock's path is a symbolic link or not a regular file (never followed).
    integer(c_int), parameter, public :: lock_not_file = -1
 
-   !> A call on a path: 0 or an errno (mkdir, unlink; rmdir: 0 or -1).
+   !> A C function of a NUL-terminated path returning an int (mkdir, unlink: 0 or an errno;
+   !> rmdir: 0 or -1; fd_tempfiles' removal of stale files: a count).
    abstract interface
       function path_call(path) bind(c) result(err)
          import :: c_char, c_int

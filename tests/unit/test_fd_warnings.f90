@@ -82,6 +82,8 @@ contains
       if (allocated(error)) return
       ! the check record carries the device, its figures and the count of the others
       call run_checks(res, checks)
+      call check(error, checks(7)%key, 'band_resolution')
+      if (allocated(error)) return
       call figure_of(checks(7), 'device', device, found)
       call check(error, found .and. device == 3.0_dp, "figure 'device' of band_resolution")
       if (allocated(error)) return

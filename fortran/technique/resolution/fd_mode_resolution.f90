@@ -16,8 +16,10 @@
 !> cannot raise the largest eigenvalue), so neither enters. A bearing whose normal force N
 !> varies (a vertical component, the overturning) enters at the largest N of the run (the
 !> summary's bearing N_max, every accepted state): its sticking spring N_max mu / f and a
-!> friction pendulum's stiffness beyond K's, (N_max - p_static) / R. The event-driven
-!> technique has no step: not applicable.
+!> friction pendulum's stiffness beyond K's, (N_max - p_static) / R. (The techniques apply
+!> that last stiffness as a force lagged one step, not in their system matrix; it is in the
+!> structure's motion all the same, and counting it errs on the safe side.) The
+!> event-driven technique has no step: not applicable.
 module fd_mode_resolution
    use fd_kinds, only: dp
    use fd_error, only: error_type, fmt_int, allocation_error
