@@ -308,15 +308,9 @@ contains
       w%f = device_force(w%st, w%s, w%sd)
       if (w%three) call normal_extremes(model, dt1, w, error)
       if (allocated(error)) return
-      ! the step checks, with the N ranges when N varies (nrange is allocated only then: an
-      ! unallocated one is not handed on, gfortran would pass its stale bounds)
-      if (allocated(w%nrange)) then
-         call ringing_init(model, dt1, opts%beta, opts%gamma, w%a0, w%a1c, w%ring, res, error, w%nrange)
-         if (.not. allocated(error)) call alternation_init(model, dt1, opts%gamma, w%alt, res, error, w%nrange)
-      else
-         call ringing_init(model, dt1, opts%beta, opts%gamma, w%a0, w%a1c, w%ring, res, error)
-         if (.not. allocated(error)) call alternation_init(model, dt1, opts%gamma, w%alt, res, error)
-      end if
+      call ringing_init(model, dt1, opts%beta, opts%gamma, w%a0, w%a1c, w%ring, res, error, w%nrange)
+      if (allocated(error)) return
+      call alternation_init(model, dt1, opts%gamma, w%alt, res, error, w%nrange)
       if (allocated(error)) return
       if (w%varies) call checks_normal_force(model, w, res)
       call consistent_acceleration(model, exc, 0.0_dp, w)

@@ -146,7 +146,7 @@ contains
       res%stick_checked = .false.
       if (model%n_kx > 0 .or. .not. devices_are_pairs(model)) then
          call general_ringing_init(model, dt1, beta, gamma, a0, a1, rg, res, error)
-         if (.not. allocated(error)) call watch_normal_force(model, rg, res, nrange)
+         if (.not. allocated(error)) call watch_ranges()
          return
       end if
       call watch_springs(model, dt1, beta, gamma, rg, res, error)
@@ -187,8 +187,19 @@ contains
          call spring_mode(q, rg, res)
       end do
       rg%first(rg%n + 1) = nb + 1
-      call watch_normal_force(model, rg, res, nrange)
+      call watch_ranges()
    contains
+      !> The N ranges watched: an absent nrange is not handed on (gfortran 12 reads the bounds
+      !> of an absent assumed-shape argument passed on to this pure routine, whether the
+      !> caller's actual was absent or an unallocated array: the checked build's UBSan
+      !> reports an overflow in either case)
+      subroutine watch_ranges()
+         if (present(nrange)) then
+            call watch_normal_force(model, rg, res, nrange)
+         else
+            call watch_normal_force(model, rg, res)
+         end if
+      end subroutine watch_ranges
       !> The mode of device d: node i moves ai, node j -aj, the centre of mass stays.
       subroutine mode_of(d)
          integer, intent(in) :: d
